@@ -1,0 +1,105 @@
+//! The node graph: operations with parameters and inputs, built once from a preset and
+//! evaluated on demand.
+//!
+//! Design rule (resvg's filter graph): a node is data — an `Op` and the ids of its inputs —
+//! and evaluation dispatches with one `match` in `op.rs`. Builders in `maps` add nodes
+//! through `GraphBuilder`, which returns ids, so a graph cannot hold a dangling reference:
+//! an input id always names an earlier node, which also makes the node order topological.
+
+mod dot;
+mod eval;
+mod op;
+
+pub use dot::to_dot;
+pub use eval::{EvalStats, Evaluation, NodeStats, evaluate};
+pub use op::Op;
+
+use std::collections::BTreeMap;
+
+use crate::maps::MapKind;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId(pub usize);
+
+#[derive(Debug, Clone)]
+pub struct Node {
+    /// Unique, human-readable name, grouped by a dotted prefix (`pattern0.mask`).
+    pub name: String,
+    pub op: Op,
+    pub inputs: Vec<NodeId>,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct Graph {
+    nodes: Vec<Node>,
+    outputs: BTreeMap<MapKind, NodeId>,
+}
+
+impl Graph {
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    pub fn node(&self, id: NodeId) -> &Node {
+        &self.nodes[id.0]
+    }
+
+    pub fn output(&self, map: MapKind) -> Option<NodeId> {
+        self.outputs.get(&map).copied()
+    }
+
+    pub fn outputs(&self) -> &BTreeMap<MapKind, NodeId> {
+        &self.outputs
+    }
+
+    /// Every node that the given maps depend on, in topological (id) order.
+    pub fn reachable(&self, maps: &[MapKind]) -> Vec<NodeId> {
+        let mut needed = vec![false; self.nodes.len()];
+        let mut stack: Vec<NodeId> = maps.iter().filter_map(|m| self.output(*m)).collect();
+        while let Some(id) = stack.pop() {
+            if !std::mem::replace(&mut needed[id.0], true) {
+                stack.extend(&self.nodes[id.0].inputs);
+            }
+        }
+        (0..self.nodes.len())
+            .filter(|&i| needed[i])
+            .map(NodeId)
+            .collect()
+    }
+}
+
+/// Adds nodes in topological order; the only way to make a `Graph`.
+#[derive(Debug, Default)]
+pub struct GraphBuilder {
+    graph: Graph,
+}
+
+impl GraphBuilder {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a node. Names must be unique: they key stats and DOT output.
+    pub fn add(&mut self, name: impl Into<String>, op: Op, inputs: &[NodeId]) -> NodeId {
+        let name = name.into();
+        debug_assert!(
+            self.graph.nodes.iter().all(|n| n.name != name),
+            "duplicate node name {name}"
+        );
+        debug_assert!(inputs.iter().all(|i| i.0 < self.graph.nodes.len()));
+        self.graph.nodes.push(Node {
+            name,
+            op,
+            inputs: inputs.to_vec(),
+        });
+        NodeId(self.graph.nodes.len() - 1)
+    }
+
+    pub fn set_output(&mut self, map: MapKind, id: NodeId) {
+        self.graph.outputs.insert(map, id);
+    }
+
+    pub fn finish(self) -> Graph {
+        self.graph
+    }
+}

@@ -1,0 +1,135 @@
+//! The operations a node can perform, and the one `match` that dispatches them to the pixel
+//! kernels in `ops`.
+
+use crate::ops::Image;
+use crate::ops::filters::{self, BlendMode, NormalConvention};
+use crate::ops::noise::{FractalNoise, NoiseKind, NoiseSampler};
+use crate::ops::scales::ScaleField;
+use crate::ops::shapes::{self, SpotGrid};
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Op {
+    /// Tileable fractal noise in [0, 1]. No inputs.
+    Noise(FractalNoise),
+    /// The multi-channel scale field (`ops::scales::channel`). No inputs.
+    Scales(ScaleField),
+    /// One channel of the input.
+    Channel { index: usize },
+    /// Smooth bands of constant u (stripes along the body, the belly). No inputs.
+    Bands {
+        centres: Vec<f32>,
+        half_width: f32,
+        softness: f32,
+    },
+    /// A jittered grid of round spots (tiny-skia coverage). No inputs.
+    Spots(SpotGrid),
+    /// Linear remap of the input range to the output range.
+    Levels {
+        in_low: f32,
+        in_high: f32,
+        out_low: f32,
+        out_high: f32,
+    },
+    /// Soft binarisation of the input.
+    Threshold { level: f32, softness: f32 },
+    /// Wrap-around Gaussian blur, sigma in texture widths.
+    Blur { sigma: f32 },
+    /// Sobel edge magnitude, normalised for edges blurred by `edge_sigma`.
+    Sobel { edge_sigma: f32 },
+    /// Inputs: base, layer and an optional mask.
+    Blend { mode: BlendMode, opacity: f32 },
+    /// Gray input to linear RGB between two colours.
+    Colorize { low: [f32; 3], high: [f32; 3] },
+    /// Inputs: RGB base and a mask; mixes a constant colour in where the mask is set.
+    Tint { color: [f32; 3], opacity: f32 },
+    /// Height to a tangent-space normal.
+    HeightToNormal {
+        slope: f32,
+        convention: NormalConvention,
+    },
+}
+
+impl Op {
+    /// Evaluates the operation; `inputs` are in the node's input order.
+    pub fn eval(&self, inputs: &[&Image], width: usize, height: usize) -> Image {
+        match self {
+            Op::Noise(noise) => {
+                let sampler = NoiseSampler::new(noise);
+                Image::from_fn(width, height, 1, |u, v, out| out[0] = sampler.sample(u, v))
+            }
+            Op::Scales(field) => field.render(width, height),
+            Op::Channel { index } => filters::extract_channel(inputs[0], *index),
+            Op::Bands {
+                centres,
+                half_width,
+                softness,
+            } => shapes::bands_u(width, height, centres, *half_width, *softness),
+            Op::Spots(grid) => shapes::spots(width, height, grid),
+            Op::Levels {
+                in_low,
+                in_high,
+                out_low,
+                out_high,
+            } => filters::levels(inputs[0], *in_low, *in_high, *out_low, *out_high),
+            Op::Threshold { level, softness } => filters::threshold(inputs[0], *level, *softness),
+            Op::Blur { sigma } => filters::blur(inputs[0], *sigma),
+            Op::Sobel { edge_sigma } => filters::sobel(inputs[0], *edge_sigma),
+            Op::Blend { mode, opacity } => filters::blend(
+                inputs[0],
+                inputs[1],
+                inputs.get(2).copied(),
+                *mode,
+                *opacity,
+            ),
+            Op::Colorize { low, high } => filters::colorize(inputs[0], *low, *high),
+            Op::Tint { color, opacity } => tint(inputs[0], inputs[1], *color, *opacity),
+            Op::HeightToNormal { slope, convention } => {
+                filters::height_to_normal(inputs[0], *slope, *convention)
+            }
+        }
+    }
+
+    /// A short description for stats and DOT labels.
+    pub fn label(&self) -> String {
+        match self {
+            Op::Noise(n) => {
+                let kind = match n.kind {
+                    NoiseKind::Perlin => "perlin",
+                    NoiseKind::Cellular => "cellular",
+                };
+                format!(
+                    "noise {kind} {}x{} octaves={}",
+                    n.cells_u, n.cells_v, n.octaves
+                )
+            }
+            Op::Scales(s) => format!("scales {:?} rows={}", s.shape, s.rows).to_lowercase(),
+            Op::Channel { index } => format!("channel {index}"),
+            Op::Bands { centres, .. } => format!("bands n={}", centres.len()),
+            Op::Spots(g) => format!("spots {}x{}", g.across, g.along),
+            Op::Levels { .. } => "levels".into(),
+            Op::Threshold { level, .. } => format!("threshold {level:.2}"),
+            Op::Blur { sigma } => format!("blur sigma={sigma:.4}"),
+            Op::Sobel { .. } => "sobel".into(),
+            Op::Blend { mode, .. } => format!("blend {mode:?}").to_lowercase(),
+            Op::Colorize { .. } => "colorize".into(),
+            Op::Tint { .. } => "tint".into(),
+            Op::HeightToNormal { .. } => "height to normal".into(),
+        }
+    }
+}
+
+fn tint(base: &Image, mask: &Image, color: [f32; 3], opacity: f32) -> Image {
+    let mut out = base.clone();
+    let ch = out.channels;
+    for (px, m) in out
+        .data
+        .chunks_exact_mut(ch)
+        .zip(mask.data.chunks_exact(mask.channels))
+    {
+        let w = m[0] * opacity;
+        for c in 0..ch.min(3) {
+            px[c] += (color[c] - px[c]) * w;
+        }
+    }
+    out
+}

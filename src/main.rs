@@ -1,0 +1,174 @@
+//! The `snakeskin` binary: parse the command line, call the library, map errors to exit codes
+//! (2 for invalid input, 1 for anything else).
+
+mod cli;
+
+use std::io::IsTerminal;
+use std::process::ExitCode;
+
+use anyhow::Result;
+use clap::Parser;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use cli::{Cli, Command, Convention, PresetsCommand};
+use snakeskin::graph::{EvalStats, to_dot};
+use snakeskin::maps::{BuildOptions, build_graph};
+use snakeskin::ops::filters::NormalConvention;
+use snakeskin::preset::library;
+use snakeskin::{Error, GenerateRequest, generate, parse_map_list};
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            let invalid = err
+                .downcast_ref::<Error>()
+                .is_some_and(Error::is_invalid_input);
+            ExitCode::from(if invalid { 2 } else { 1 })
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Generate(args) => {
+            let convention = match args.normal_convention {
+                Convention::Opengl => NormalConvention::OpenGl,
+                Convention::Directx => NormalConvention::DirectX,
+            };
+            let request = GenerateRequest {
+                preset: args.preset.preset.clone(),
+                overrides: args.preset.overrides.clone(),
+                seed: args.preset.seed,
+                size: args.size,
+                maps: parse_map_list(&args.preset.maps)?,
+                out_dir: args.out.clone(),
+                options: BuildOptions {
+                    normal_convention: convention,
+                },
+            };
+            let bar = progress_bar();
+            let report = generate(&request, &|done, total| {
+                if let Some(bar) = &bar {
+                    bar.set_length(total as u64);
+                    bar.set_position(done as u64);
+                }
+            })?;
+            if let Some(bar) = bar {
+                bar.finish_and_clear();
+            }
+            for file in &report.files {
+                println!("{}", file.display());
+            }
+            if args.stats {
+                print_stats(&report.stats);
+                eprintln!(
+                    "encode + write: {:.1} ms, total: {:.1} ms",
+                    report.encode_time.as_secs_f64() * 1e3,
+                    report.total_time.as_secs_f64() * 1e3
+                );
+            }
+            Ok(())
+        }
+        Command::Graph(args) => {
+            let maps = parse_map_list(&args.preset.maps)?;
+            let loaded = snakeskin::generate::load(
+                &args.preset.preset,
+                &args.preset.overrides,
+                args.preset.seed,
+            )?;
+            let graph = build_graph(&loaded.preset, BuildOptions::default());
+            if args.dot {
+                print!("{}", to_dot(&graph, &maps));
+            } else {
+                for id in graph.reachable(&maps) {
+                    let node = graph.node(id);
+                    let inputs: Vec<&str> = node
+                        .inputs
+                        .iter()
+                        .map(|i| graph.node(*i).name.as_str())
+                        .collect();
+                    println!(
+                        "{:<28} {:<36} <- {}",
+                        node.name,
+                        node.op.label(),
+                        inputs.join(", ")
+                    );
+                }
+            }
+            Ok(())
+        }
+        Command::Presets {
+            command: PresetsCommand::List,
+        } => {
+            for (name, text) in library::all() {
+                let preset: snakeskin::preset::Preset = toml::from_str(text)?;
+                let category = preset
+                    .category
+                    .map(|c| format!("{c:?}"))
+                    .unwrap_or_default();
+                println!(
+                    "{name:<28} {:<32} {}",
+                    preset.common_name.unwrap_or_default(),
+                    category.to_lowercase()
+                );
+            }
+            Ok(())
+        }
+        Command::Presets {
+            command: PresetsCommand::Show { name },
+        } => match library::get(&name) {
+            Some(text) => {
+                print!("{text}");
+                Ok(())
+            }
+            None => Err(
+                Error::Preset(snakeskin::preset::PresetError::UnknownPreset {
+                    available: library::names().join(", "),
+                    name,
+                })
+                .into(),
+            ),
+        },
+    }
+}
+
+/// A progress bar on a terminal; nothing when stderr is redirected.
+fn progress_bar() -> Option<ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = ProgressBar::new(1);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} generating [{bar:30}] {pos}/{len} nodes {elapsed}")
+            .ok()?,
+    );
+    Some(bar)
+}
+
+fn print_stats(stats: &EvalStats) {
+    eprintln!(
+        "{:<28} {:<36} {:>5} {:>10} {:>10}",
+        "node", "operation", "evals", "ms", "MiB"
+    );
+    let mut nodes = stats.nodes.clone();
+    nodes.sort_by(|a, b| b.time.cmp(&a.time));
+    for n in &nodes {
+        eprintln!(
+            "{:<28} {:<36} {:>5} {:>10.2} {:>10.1}",
+            n.name,
+            n.label,
+            n.evaluations,
+            n.time.as_secs_f64() * 1e3,
+            n.bytes as f64 / (1 << 20) as f64
+        );
+    }
+    eprintln!(
+        "{} nodes evaluated, graph wall {:.1} ms, peak buffers {:.1} MiB",
+        stats.nodes.len(),
+        stats.wall.as_secs_f64() * 1e3,
+        stats.peak_bytes as f64 / (1 << 20) as f64
+    );
+}

@@ -1,0 +1,342 @@
+//! Graph builders: a validated preset becomes one node graph with a named output per map.
+//!
+//! Node names are grouped by a dotted prefix: `scales*` and `noise.grain` are shared by
+//! several maps; `color.*`, `pattern<i>.*` and `belly.*` feed only the colour map; `height.*`,
+//! `normal.*`, `roughness.*` and `iridescence.*` their own map. Which maps share which nodes is
+//! what makes `--maps roughness` cheap: it never reaches a colour or pattern node.
+
+mod color;
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::graph::{Graph, GraphBuilder, NodeId, Op};
+use crate::ops::filters::{BlendMode, NormalConvention};
+use crate::ops::hash::derive_seed;
+use crate::ops::noise::{FractalNoise, NoiseKind};
+use crate::ops::scales::{ScaleField, ScaleShape, channel};
+use crate::preset::Preset;
+use crate::preset::schema::{self, IridescenceGradient};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum MapKind {
+    Color,
+    Height,
+    Normal,
+    Roughness,
+    Iridescence,
+}
+
+impl MapKind {
+    pub const ALL: [MapKind; 5] = [
+        MapKind::Color,
+        MapKind::Height,
+        MapKind::Normal,
+        MapKind::Roughness,
+        MapKind::Iridescence,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MapKind::Color => "color",
+            MapKind::Height => "height",
+            MapKind::Normal => "normal",
+            MapKind::Roughness => "roughness",
+            MapKind::Iridescence => "iridescence",
+        }
+    }
+}
+
+impl fmt::Display for MapKind {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for MapKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        MapKind::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "unknown map {s:?}; accepted: color, height, normal, roughness, iridescence"
+                )
+            })
+    }
+}
+
+/// Choices that are not part of the preset (they do not change the skin, only its encoding).
+#[derive(Debug, Clone, Copy)]
+pub struct BuildOptions {
+    pub normal_convention: NormalConvention,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            normal_convention: NormalConvention::OpenGl,
+        }
+    }
+}
+
+/// The film thickness range the iridescence map spans, from the preset.
+pub fn thickness_range_nm(preset: &Preset) -> (f64, f64) {
+    let min = (preset.optics.film_thickness_nm - preset.iridescence.spread_nm * 0.5).max(0.0);
+    (min, min + preset.iridescence.spread_nm)
+}
+
+pub fn scale_field(preset: &Preset) -> ScaleField {
+    let s = &preset.scales;
+    ScaleField {
+        shape: match s.shape {
+            schema::ScaleShape::Leaf => ScaleShape::Leaf,
+            schema::ScaleShape::Diamond => ScaleShape::Diamond,
+            schema::ScaleShape::Hexagon => ScaleShape::Hexagon,
+        },
+        rows: s.rows,
+        aspect: s.aspect as f32,
+        size: s.size as f32,
+        keel_height: if s.keeled { s.keel_height as f32 } else { 0.0 },
+        keel_width: s.keel_width as f32,
+        jitter: s.jitter as f32,
+        imbrication: s.imbrication as f32,
+        edge_softness: s.edge_softness as f32,
+        belly_width: if preset.belly.plates {
+            preset.belly.width as f32
+        } else {
+            0.0
+        },
+        seed: derive_seed(preset.seed, "scales"),
+    }
+}
+
+/// Nodes that several maps read.
+pub(crate) struct Shared {
+    pub scales: NodeId,
+    pub crevice: NodeId,
+    pub scale_height: NodeId,
+    pub grain: NodeId,
+}
+
+/// Builds the whole graph for a preset; evaluation later picks the part it needs.
+pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
+    let mut g = GraphBuilder::new();
+    let field = scale_field(preset);
+    let lattice = field.lattice();
+    let scales = g.add("scales", Op::Scales(field), &[]);
+    let crevice = g.add(
+        "scales.crevice",
+        Op::Channel {
+            index: channel::CREVICE,
+        },
+        &[scales],
+    );
+    let scale_height = g.add(
+        "scales.height",
+        Op::Channel {
+            index: channel::HEIGHT,
+        },
+        &[scales],
+    );
+    // Fine grain, a few features per scale, shared by height and roughness.
+    let grain = g.add(
+        "noise.grain",
+        Op::Noise(FractalNoise {
+            kind: NoiseKind::Perlin,
+            cells_u: lattice.cols as u32 * 3,
+            cells_v: lattice.rows_v as u32 * 3,
+            octaves: 3,
+            gain: 0.5,
+            seed: derive_seed(preset.seed, "grain"),
+        }),
+        &[],
+    );
+    let shared = Shared {
+        scales,
+        crevice,
+        scale_height,
+        grain,
+    };
+
+    let color = color::build(&mut g, preset, &shared);
+    g.set_output(MapKind::Color, color);
+
+    let height = build_height(&mut g, preset, &shared);
+    g.set_output(MapKind::Height, height);
+
+    let slope = preset.height.normal_strength as f32 / lattice.cols as f32;
+    let normal = g.add(
+        "normal.out",
+        Op::HeightToNormal {
+            slope,
+            convention: options.normal_convention,
+        },
+        &[height],
+    );
+    g.set_output(MapKind::Normal, normal);
+
+    let roughness = build_roughness(&mut g, preset, &shared);
+    g.set_output(MapKind::Roughness, roughness);
+
+    let iridescence = build_iridescence(&mut g, preset, &shared, lattice.cols as u32);
+    g.set_output(MapKind::Iridescence, iridescence);
+    g.finish()
+}
+
+fn build_height(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
+    let amp = preset.height.grain as f32;
+    let grain = g.add(
+        "height.grain",
+        Op::Levels {
+            in_low: 0.0,
+            in_high: 1.0,
+            out_low: -amp,
+            out_high: amp,
+        },
+        &[s.grain],
+    );
+    let sum = g.add(
+        "height.sum",
+        Op::Blend {
+            mode: BlendMode::Add,
+            opacity: 1.0,
+        },
+        &[s.scale_height, grain],
+    );
+    g.add(
+        "height.out",
+        Op::Levels {
+            in_low: 0.0,
+            in_high: 1.0,
+            out_low: 0.0,
+            out_high: 1.0,
+        },
+        &[sum],
+    )
+}
+
+fn build_roughness(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
+    let r = &preset.roughness;
+    let (lo, hi) = ((r.base - r.variation) as f32, (r.base + r.variation) as f32);
+    let base = g.add(
+        "roughness.noise",
+        Op::Levels {
+            in_low: 0.0,
+            in_high: 1.0,
+            out_low: lo,
+            out_high: hi,
+        },
+        &[s.grain],
+    );
+    let gaps = g.add(
+        "roughness.between_scales",
+        Op::Blend {
+            mode: BlendMode::Add,
+            opacity: r.between_scales as f32,
+        },
+        &[base, s.crevice],
+    );
+    let last = if preset.scales.keeled && r.keel > 0.0 {
+        let keel = g.add(
+            "roughness.keel_mask",
+            Op::Channel {
+                index: channel::KEEL,
+            },
+            &[s.scales],
+        );
+        g.add(
+            "roughness.keel",
+            Op::Blend {
+                mode: BlendMode::Add,
+                opacity: r.keel as f32,
+            },
+            &[gaps, keel],
+        )
+    } else {
+        gaps
+    };
+    g.add(
+        "roughness.out",
+        Op::Levels {
+            in_low: 0.0,
+            in_high: 1.0,
+            out_low: 0.0,
+            out_high: 1.0,
+        },
+        &[last],
+    )
+}
+
+fn build_iridescence(g: &mut GraphBuilder, preset: &Preset, s: &Shared, cols: u32) -> NodeId {
+    let p = &preset.iridescence;
+    let gradient = match p.gradient {
+        IridescenceGradient::Vertical => g.add(
+            "iridescence.gradient",
+            Op::Channel {
+                index: channel::ALONG,
+            },
+            &[s.scales],
+        ),
+        IridescenceGradient::Radial => {
+            let radial = g.add(
+                "iridescence.radial",
+                Op::Channel {
+                    index: channel::RADIAL,
+                },
+                &[s.scales],
+            );
+            // Thickest at the scale's centre (thesis Fig. 4.14a).
+            g.add(
+                "iridescence.gradient",
+                Op::Levels {
+                    in_low: 0.0,
+                    in_high: 1.0,
+                    out_low: 1.0,
+                    out_high: 0.0,
+                },
+                &[radial],
+            )
+        }
+    };
+    // Blend with the scale shape so the film thins into the crevices (thesis §4.2.5).
+    let shaped = g.add(
+        "iridescence.shaped",
+        Op::Blend {
+            mode: BlendMode::Multiply,
+            opacity: 0.5,
+        },
+        &[gradient, s.scale_height],
+    );
+    let noise = g.add(
+        "iridescence.noise",
+        Op::Noise(FractalNoise {
+            kind: NoiseKind::Perlin,
+            cells_u: (cols / 2).max(1),
+            cells_v: (cols / 2).max(1),
+            octaves: 4,
+            gain: 0.55,
+            seed: derive_seed(preset.seed, "iridescence"),
+        }),
+        &[],
+    );
+    let mixed = g.add(
+        "iridescence.mixed",
+        Op::Blend {
+            mode: BlendMode::Mix,
+            opacity: p.noise as f32,
+        },
+        &[shaped, noise],
+    );
+    g.add(
+        "iridescence.out",
+        Op::Levels {
+            in_low: 0.0,
+            in_high: 1.0,
+            out_low: 0.0,
+            out_high: 1.0,
+        },
+        &[mixed],
+    )
+}

@@ -1,0 +1,273 @@
+//! Per-pixel and neighbourhood filters: levels, threshold, blend, colourise, wrap-around
+//! Gaussian blur, Sobel edges and height → normal.
+//!
+//! All neighbourhood filters address pixels modulo the image size, so a tileable input stays
+//! tileable. Radii are given in normalised texture units and converted to pixels here, which
+//! keeps `--size 512` and `--size 4096` of one preset the same picture at different detail.
+
+use rayon::prelude::*;
+
+use super::image::Image;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BlendMode {
+    /// `base + (layer - base) * opacity * mask`
+    Mix,
+    Multiply,
+    Add,
+    Screen,
+    Max,
+    Min,
+}
+
+/// Blends `layer` over `base`. A single-channel layer or mask broadcasts over the base's
+/// channels; the result has the base's channel count.
+pub fn blend(
+    base: &Image,
+    layer: &Image,
+    mask: Option<&Image>,
+    mode: BlendMode,
+    opacity: f32,
+) -> Image {
+    let channels = base.channels;
+    let mut out = base.clone();
+    out.data
+        .par_chunks_mut(channels * base.width)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let layer_row = layer.row(y);
+            let mask_row = mask.map(|m| (m.row(y), m.channels));
+            for x in 0..base.width {
+                let weight = opacity * mask_row.map_or(1.0, |(m, mc)| m[x * mc]);
+                for c in 0..channels {
+                    let b = row[x * channels + c];
+                    let l = layer_row[x * layer.channels + c.min(layer.channels - 1)];
+                    let mixed = match mode {
+                        BlendMode::Mix => l,
+                        BlendMode::Multiply => b * l,
+                        BlendMode::Add => b + l,
+                        BlendMode::Screen => 1.0 - (1.0 - b) * (1.0 - l),
+                        BlendMode::Max => b.max(l),
+                        BlendMode::Min => b.min(l),
+                    };
+                    row[x * channels + c] = b + (mixed - b) * weight;
+                }
+            }
+        });
+    out
+}
+
+/// Linear remap of `[in_low, in_high]` to `[out_low, out_high]`, clamped to the output range.
+pub fn levels(input: &Image, in_low: f32, in_high: f32, out_low: f32, out_high: f32) -> Image {
+    let scale = (out_high - out_low) / (in_high - in_low).max(1e-6);
+    let (lo, hi) = (out_low.min(out_high), out_low.max(out_high));
+    input.clone().map_pixels(|p| {
+        for value in p {
+            *value = (out_low + (*value - in_low) * scale).clamp(lo, hi);
+        }
+    })
+}
+
+/// Soft binarisation: 0 below `level - softness`, 1 above `level + softness`, smooth between.
+pub fn threshold(input: &Image, level: f32, softness: f32) -> Image {
+    let s = softness.max(1e-5);
+    input.clone().map_pixels(|p| {
+        for value in p {
+            let t = ((*value - (level - s)) / (2.0 * s)).clamp(0.0, 1.0);
+            *value = t * t * (3.0 - 2.0 * t);
+        }
+    })
+}
+
+/// Maps a single-channel image to colour: `low` at 0, `high` at 1 (linear RGB).
+pub fn colorize(input: &Image, low: [f32; 3], high: [f32; 3]) -> Image {
+    let mut out = Image::new(input.width, input.height, 3);
+    out.data
+        .par_chunks_mut(3 * input.width)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let src = input.row(y);
+            for (x, px) in row.chunks_exact_mut(3).enumerate() {
+                let t = src[x * input.channels];
+                for c in 0..3 {
+                    px[c] = (low[c] + (high[c] - low[c]) * t).max(0.0);
+                }
+            }
+        });
+    out
+}
+
+/// Copies one channel out of a multi-channel image.
+pub fn extract_channel(input: &Image, channel: usize) -> Image {
+    let mut out = Image::new(input.width, input.height, 1);
+    out.data
+        .par_chunks_mut(input.width)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let src = input.row(y);
+            for (x, value) in row.iter_mut().enumerate() {
+                *value = src[x * input.channels + channel];
+            }
+        });
+    out
+}
+
+fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
+    let radius = (sigma_px * 3.0).ceil().max(1.0) as isize;
+    let mut kernel: Vec<f32> = (-radius..=radius)
+        .map(|i| (-(i * i) as f32 / (2.0 * sigma_px * sigma_px)).exp())
+        .collect();
+    let sum: f32 = kernel.iter().sum();
+    kernel.iter_mut().for_each(|k| *k /= sum);
+    kernel
+}
+
+/// Separable Gaussian blur with wrap-around edges. `sigma` is in normalised units (fraction of
+/// the image width); below a third of a pixel it is the identity.
+pub fn blur(input: &Image, sigma: f32) -> Image {
+    let sigma_px = sigma * input.width as f32;
+    if sigma_px < 0.33 {
+        return input.clone();
+    }
+    let kernel = gaussian_kernel(sigma_px);
+    let radius = (kernel.len() / 2) as isize;
+    let (w, h, ch) = (input.width, input.height, input.channels);
+    // Horizontal pass.
+    let mut tmp = Image::new(w, h, ch);
+    tmp.data
+        .par_chunks_mut(w * ch)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let src = input.row(y);
+            for x in 0..w {
+                for c in 0..ch {
+                    let mut acc = 0.0;
+                    for (k, weight) in kernel.iter().enumerate() {
+                        let sx = (x as isize + k as isize - radius).rem_euclid(w as isize) as usize;
+                        acc += weight * src[sx * ch + c];
+                    }
+                    row[x * ch + c] = acc;
+                }
+            }
+        });
+    // Vertical pass: accumulate whole rows so memory is read sequentially.
+    let mut out = Image::new(w, h, ch);
+    out.data
+        .par_chunks_mut(w * ch)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (k, weight) in kernel.iter().enumerate() {
+                let sy = (y as isize + k as isize - radius).rem_euclid(h as isize) as usize;
+                for (o, s) in row.iter_mut().zip(tmp.row(sy)) {
+                    *o += weight * s;
+                }
+            }
+        });
+    out
+}
+
+/// Sobel gradient magnitude of channel 0, wrap-around. The result is normalised so that a
+/// step edge blurred by a Gaussian of `edge_sigma` (normalised units) peaks at 1: the peak
+/// slope of such an edge is 1 / (sqrt(2π) σ) per pixel and Sobel's x kernel weighs the
+/// central difference by 4 (so 8 × slope per pixel).
+pub fn sobel(input: &Image, edge_sigma: f32) -> Image {
+    let sigma_px = (edge_sigma * input.width as f32).max(0.5);
+    let norm = (2.0 * std::f32::consts::PI).sqrt() * sigma_px / 8.0;
+    Image::from_fn(input.width, input.height, 1, |u, v, out| {
+        let x = (u * input.width as f32) as isize;
+        let y = (v * input.height as f32) as isize;
+        let p = |dx: isize, dy: isize| input.at_wrapped(x + dx, y + dy, 0);
+        let gx = (p(1, -1) + 2.0 * p(1, 0) + p(1, 1)) - (p(-1, -1) + 2.0 * p(-1, 0) + p(-1, 1));
+        let gy = (p(-1, 1) + 2.0 * p(0, 1) + p(1, 1)) - (p(-1, -1) + 2.0 * p(0, -1) + p(1, -1));
+        out[0] = ((gx * gx + gy * gy).sqrt() * norm).min(1.0);
+    })
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum NormalConvention {
+    /// +Y up (green = up), glTF and Blender.
+    OpenGl,
+    /// +Y down (green flipped), DirectX and Unreal.
+    DirectX,
+}
+
+/// Tangent-space normal (unit XYZ in [-1, 1]) from a height map by central differences.
+/// `slope_per_unit_height` is the surface rise, in texture widths, of the full height range
+/// (so the result does not change with resolution).
+pub fn height_to_normal(
+    height: &Image,
+    slope_per_unit_height: f32,
+    convention: NormalConvention,
+) -> Image {
+    let (w, h) = (height.width as isize, height.height as isize);
+    Image::from_fn(height.width, height.height, 3, |u, v, out| {
+        let x = (u * w as f32) as isize;
+        let y = (v * h as f32) as isize;
+        // dh/du with u in texture widths: (h[x+1] - h[x-1]) / (2 / w).
+        let dhdx =
+            (height.at_wrapped(x + 1, y, 0) - height.at_wrapped(x - 1, y, 0)) * 0.5 * w as f32;
+        let dhdy =
+            (height.at_wrapped(x, y + 1, 0) - height.at_wrapped(x, y - 1, 0)) * 0.5 * h as f32;
+        let sx = -dhdx * slope_per_unit_height;
+        // Image y runs down; OpenGL's +Y (bitangent) points up the image.
+        let sy = match convention {
+            NormalConvention::OpenGl => dhdy * slope_per_unit_height,
+            NormalConvention::DirectX => -dhdy * slope_per_unit_height,
+        };
+        let len = (sx * sx + sy * sy + 1.0).sqrt();
+        out[0] = sx / len;
+        out[1] = sy / len;
+        out[2] = 1.0 / len;
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blur_preserves_mean_and_wraps() {
+        let img = Image::from_fn(64, 32, 1, |u, _| if u < 0.1 { 1.0 } else { 0.0 });
+        let mean = |i: &Image| i.data.iter().sum::<f32>() / i.data.len() as f32;
+        let blurred = blur(&img, 0.05);
+        assert!((mean(&img) - mean(&blurred)).abs() < 1e-4);
+        // The bright band at the left edge bleeds across the seam to the right edge.
+        assert!(blurred.data[63] > 0.05);
+    }
+
+    #[test]
+    fn sobel_of_blurred_step_peaks_near_one() {
+        let step = Image::from_fn(
+            256,
+            8,
+            1,
+            |u, _| if (0.25..0.75).contains(&u) { 1.0 } else { 0.0 },
+        );
+        let sigma = 0.02;
+        let edges = sobel(&blur(&step, sigma), sigma);
+        let peak = edges.data.iter().cloned().fold(0.0, f32::max);
+        assert!((peak - 1.0).abs() < 0.1, "peak {peak}");
+    }
+
+    #[test]
+    fn normals_are_unit_and_flat_height_points_up() {
+        let flat = Image::new(16, 16, 1);
+        let n = height_to_normal(&flat, 1.0, NormalConvention::OpenGl);
+        assert!(n.data.chunks(3).all(|p| p == [0.0, 0.0, 1.0]));
+        let ramp = Image::from_fn(32, 32, 1, |u, v| (u * 6.28).sin() * 0.1 + v * 0.0);
+        let n = height_to_normal(&ramp, 1.0, NormalConvention::OpenGl);
+        for p in n.data.chunks(3) {
+            assert!(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn opengl_green_points_up_the_image_on_a_slope_rising_down() {
+        // Height grows with image y (downwards): the surface faces up the image, +Y in OpenGL.
+        let ramp = Image::from_fn(16, 16, 1, |_, v| (v * std::f32::consts::TAU).sin());
+        let gl = height_to_normal(&ramp, 0.1, NormalConvention::OpenGl);
+        let dx = height_to_normal(&ramp, 0.1, NormalConvention::DirectX);
+        let i = (1 * 16 + 3) * 3; // near v = 0 the slope is positive
+        assert!(gl.data[i + 1] > 0.0 && dx.data[i + 1] < 0.0);
+    }
+}

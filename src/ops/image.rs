@@ -1,0 +1,84 @@
+//! The one pixel buffer every node produces: a square-or-rectangular grid of f32 channels.
+//!
+//! Channels are interleaved (`data[(y * width + x) * channels + c]`) so a pixel's channels sit
+//! in one cache line; rows are the unit of parallel work. Everything is f32 in linear units:
+//! quantisation happens only in `export`, so no intermediate step loses precision.
+
+use rayon::prelude::*;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    pub width: usize,
+    pub height: usize,
+    pub channels: usize,
+    pub data: Vec<f32>,
+}
+
+impl Image {
+    pub fn new(width: usize, height: usize, channels: usize) -> Self {
+        Image {
+            width,
+            height,
+            channels,
+            data: vec![0.0; width * height * channels],
+        }
+    }
+
+    /// Fills a new image row by row in parallel; `pixel(u, v, out)` receives the pixel centre
+    /// in normalised texture coordinates (u, v in [0, 1)) and writes `channels` values.
+    pub fn from_fn<F>(width: usize, height: usize, channels: usize, pixel: F) -> Self
+    where
+        F: Fn(f32, f32, &mut [f32]) + Sync,
+    {
+        let mut image = Image::new(width, height, channels);
+        let (inv_w, inv_h) = (1.0 / width as f32, 1.0 / height as f32);
+        image
+            .data
+            .par_chunks_mut(width * channels)
+            .enumerate()
+            .for_each(|(y, row)| {
+                let v = (y as f32 + 0.5) * inv_h;
+                for (x, out) in row.chunks_exact_mut(channels).enumerate() {
+                    pixel((x as f32 + 0.5) * inv_w, v, out);
+                }
+            });
+        image
+    }
+
+    /// Applies `f` to every pixel of `self` in place (parallel over rows).
+    pub fn map_pixels<F>(mut self, f: F) -> Self
+    where
+        F: Fn(&mut [f32]) + Sync,
+    {
+        let channels = self.channels;
+        self.data
+            .par_chunks_mut(channels * self.width)
+            .for_each(|row| {
+                row.chunks_exact_mut(channels).for_each(&f);
+            });
+        self
+    }
+
+    pub fn pixel_count(&self) -> usize {
+        self.width * self.height
+    }
+
+    pub fn bytes(&self) -> usize {
+        self.data.len() * std::mem::size_of::<f32>()
+    }
+
+    /// Value at (x, y, c) with wrap-around addressing: the texture is a torus.
+    #[inline]
+    pub fn at_wrapped(&self, x: isize, y: isize, c: usize) -> f32 {
+        let xw = x.rem_euclid(self.width as isize) as usize;
+        let yw = y.rem_euclid(self.height as isize) as usize;
+        self.data[(yw * self.width + xw) * self.channels + c]
+    }
+
+    /// One row of pixels (all channels).
+    #[inline]
+    pub fn row(&self, y: usize) -> &[f32] {
+        let stride = self.width * self.channels;
+        &self.data[y * stride..(y + 1) * stride]
+    }
+}

@@ -1,0 +1,12 @@
+//! Pure pixel kernels, kept apart from graph bookkeeping (as noise-rs keeps `noise_fns/` and
+//! resvg keeps `filter/`): each function takes images and parameters and returns an image.
+//! Everything is defined in normalised coordinates and wraps around, so outputs tile.
+
+pub mod filters;
+pub mod hash;
+pub mod image;
+pub mod noise;
+pub mod scales;
+pub mod shapes;
+
+pub use image::Image;

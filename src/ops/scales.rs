@@ -1,0 +1,418 @@
+//! The scale field: one pass over a periodic, staggered lattice of scales that yields every
+//! per-pixel quantity the maps need (height, crevice, position on the scale, keel, identity).
+//!
+//! Why one multi-channel node instead of one per map? Finding the visible scale costs nine
+//! candidate evaluations per pixel; height, roughness, iridescence and colour all need the
+//! answer, so the graph computes it once and the maps read channels of it.
+//!
+//! Geometry (texture space per DESIGN.md: u around the body, v head to tail):
+//! - `rows` columns of scales around the body (the dorsal scale rows), `cells_v` along it.
+//!   Column c is shifted along v by `c * k / rows` cells with `k ≈ rows / 2`, which staggers
+//!   neighbouring columns by about half a scale (interleaved rows, thesis §4.2.2 "Tiling")
+//!   while keeping the lattice exactly periodic for odd row counts too.
+//! - Leaf (two intersecting circles, thesis Fig. 4.8) and diamond scales overlap like roof
+//!   tiles: each scale's height rises towards its free posterior edge, and the visible surface
+//!   is the highest candidate, so a scale's posterior edge lies over the anterior part of the
+//!   scale behind it. Hexagons tile without overlap (the Voronoi cells of the lattice).
+//! - In the belly band (centred on u = 0 ≡ 1) one wide ventral plate spans each row.
+//!
+//! Per-cell jitter (position, size, rotation) is drawn once per cell into a table, so the
+//! per-pixel loop does lookups, not hashing.
+
+use super::hash;
+use super::image::Image;
+
+/// Channel layout of the scale field.
+pub mod channel {
+    /// Surface height in [0, 1], 0 the skin between scales.
+    pub const HEIGHT: usize = 0;
+    /// 1 in the crevices between scales, 0 on a scale's body.
+    pub const CREVICE: usize = 1;
+    /// Position along the visible scale, 0 at its anterior tip, 1 at its posterior edge.
+    pub const ALONG: usize = 2;
+    /// Normalised distance from the visible scale's centre, 0 centre .. 1 rim.
+    pub const RADIAL: usize = 3;
+    /// Keel ridge strength in [0, 1].
+    pub const KEEL: usize = 4;
+    /// A uniform random number per scale (the same over the whole scale).
+    pub const CELL_RANDOM: usize = 5;
+    pub const COUNT: usize = 6;
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ScaleShape {
+    Leaf,
+    Diamond,
+    Hexagon,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScaleField {
+    pub shape: ScaleShape,
+    /// Scale columns around the body (dorsal scale rows).
+    pub rows: u32,
+    /// Cell length along the body over cell width around it.
+    pub aspect: f32,
+    /// Scale size relative to its cell; above 1 neighbours overlap.
+    pub size: f32,
+    pub keel_height: f32,
+    /// Keel half-width as a fraction of the scale width.
+    pub keel_width: f32,
+    /// Random offset, size and rotation per scale, 0..0.5.
+    pub jitter: f32,
+    /// How far the posterior edge is raised over the anterior tip, 0..1.
+    pub imbrication: f32,
+    /// Width of the rounded rim of each scale, in scale widths.
+    pub edge_softness: f32,
+    /// Width of the ventral band as a fraction of the circumference; 0 disables plates.
+    pub belly_width: f32,
+    pub seed: u32,
+}
+
+/// The lattice's integer layout derived from the parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct Lattice {
+    pub cols: i32,
+    pub rows_v: i32,
+    /// Column c is shifted by c * stagger / cols cells along v.
+    pub stagger: i32,
+    /// Actual cell length / width after rounding `rows_v` to an integer.
+    pub aspect: f32,
+}
+
+impl ScaleField {
+    pub fn lattice(&self) -> Lattice {
+        let cols = self.rows.max(1) as i32;
+        let rows_v = ((cols as f32 / self.aspect).round() as i32).max(1);
+        let stagger = cols / 2;
+        Lattice {
+            cols,
+            rows_v,
+            stagger,
+            aspect: cols as f32 / rows_v as f32,
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct CellJitter {
+    dx: f32,
+    dy: f32,
+    cos: f32,
+    sin: f32,
+    inv_size: f32,
+    random: f32,
+}
+
+struct CellTable {
+    cells: Vec<CellJitter>,
+    cols: i32,
+    rows_v: i32,
+}
+
+impl CellTable {
+    fn new(field: &ScaleField, lattice: &Lattice) -> Self {
+        let j = field.jitter.clamp(0.0, 0.5);
+        let mut cells = Vec::with_capacity((lattice.cols * lattice.rows_v) as usize);
+        for r in 0..lattice.rows_v {
+            for c in 0..lattice.cols {
+                let s = field.seed;
+                let angle = hash::signed(c, r, 2, s) * j * 0.6;
+                let size = field.size * (1.0 + hash::signed(c, r, 3, s) * j * 0.4);
+                cells.push(CellJitter {
+                    dx: hash::signed(c, r, 0, s) * j * 0.5,
+                    dy: hash::signed(c, r, 1, s) * j * 0.5,
+                    cos: angle.cos(),
+                    sin: angle.sin(),
+                    inv_size: 1.0 / size.max(0.05),
+                    random: hash::unit(c, r, 4, s),
+                });
+            }
+        }
+        CellTable {
+            cells,
+            cols: lattice.cols,
+            rows_v: lattice.rows_v,
+        }
+    }
+
+    #[inline]
+    fn get(&self, c: i32, r: i32) -> &CellJitter {
+        &self.cells[(r.rem_euclid(self.rows_v) * self.cols + c.rem_euclid(self.cols)) as usize]
+    }
+}
+
+#[inline]
+fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// One candidate scale evaluated at a pixel, in the scale's own frame (units: scale widths).
+struct Candidate {
+    /// Distance inside the outline (negative outside).
+    inside: f32,
+    /// Local position: across (x) and along the body (y, towards the tail), unit = size.
+    x: f32,
+    y: f32,
+    half_len: f32,
+    random: f32,
+}
+
+/// Signed distance inside a shape with half-width 0.5 and half-length `b` (positive inside).
+#[inline]
+fn inside_distance(shape: ScaleShape, x: f32, y: f32, b: f32) -> f32 {
+    let a = 0.5;
+    match shape {
+        ScaleShape::Leaf => {
+            // Lens from two circles (thesis Fig. 4.8): radius R centred at (±d, 0) gives
+            // half-width R - d = a and tips at y = ±sqrt(R² - d²) = ±b.
+            let (a, b, x, y) = if b >= a { (a, b, x, y) } else { (b, a, y, x) };
+            let r = 0.5 * (a + b * b / a);
+            let d = r - a;
+            let d1 = ((x - d) * (x - d) + y * y).sqrt() - r;
+            let d2 = ((x + d) * (x + d) + y * y).sqrt() - r;
+            -d1.max(d2)
+        }
+        ScaleShape::Diamond => {
+            // Rhombus with half-diagonals a, b; exact distance to the nearer edge line.
+            let k = a * b / (a * a + b * b).sqrt();
+            -(x.abs() / a + y.abs() / b - 1.0) * k
+        }
+        ScaleShape::Hexagon => unreachable!("hexagons are Voronoi cells, see hexagon_pixel"),
+    }
+}
+
+impl ScaleField {
+    /// Evaluates the scale field at every pixel: a `channel::COUNT`-channel image.
+    pub fn render(&self, width: usize, height: usize) -> Image {
+        let lattice = self.lattice();
+        let table = CellTable::new(self, &lattice);
+        Image::from_fn(width, height, channel::COUNT, |u, v, out| {
+            let dist_belly = u.min(1.0 - u);
+            if self.belly_width > 0.0 && dist_belly < self.belly_width * 0.5 {
+                self.ventral_pixel(&lattice, dist_belly, v, out);
+            } else if self.shape == ScaleShape::Hexagon {
+                self.hexagon_pixel(&lattice, &table, u, v, out);
+            } else {
+                self.imbricate_pixel(&lattice, &table, u, v, out);
+            }
+        })
+    }
+
+    /// Lattice position of the jittered centre of cell (c, r), c unwrapped.
+    #[inline]
+    fn centre<'t>(
+        &self,
+        lattice: &Lattice,
+        table: &'t CellTable,
+        c: i32,
+        r: i32,
+    ) -> (f32, f32, &'t CellJitter) {
+        let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
+        // Row index of the same physical cell in the wrapped column.
+        let wrapped_row = r + lattice.stagger * c.div_euclid(lattice.cols);
+        let cell = table.get(c, wrapped_row);
+        (
+            c as f32 + 0.5 + cell.dx,
+            r as f32 + 0.5 + shift + cell.dy,
+            cell,
+        )
+    }
+
+    fn candidates(
+        &self,
+        lattice: &Lattice,
+        table: &CellTable,
+        u: f32,
+        v: f32,
+    ) -> impl Iterator<Item = Candidate> {
+        let x = u * lattice.cols as f32;
+        let y = v * lattice.rows_v as f32;
+        let c0 = x.floor() as i32;
+        let b = 0.5 * lattice.aspect;
+        let shape = self.shape;
+        (-1..=1).flat_map(move |dc| {
+            let c = c0 + dc;
+            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
+            let r0 = (y - shift).floor() as i32;
+            (-1..=1).map(move |dr| {
+                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
+                // To isotropic units (scale widths), rotate by the jitter angle, scale by size.
+                let px = x - cx;
+                let py = (y - cy) * lattice.aspect;
+                let lx = (px * cell.cos + py * cell.sin) * cell.inv_size;
+                let ly = (-px * cell.sin + py * cell.cos) * cell.inv_size;
+                let inside = inside_distance(shape, lx, ly, b) / cell.inv_size;
+                Candidate {
+                    inside,
+                    x: lx,
+                    y: ly,
+                    half_len: b,
+                    random: cell.random,
+                }
+            })
+        })
+    }
+
+    fn imbricate_pixel(
+        &self,
+        lattice: &Lattice,
+        table: &CellTable,
+        u: f32,
+        v: f32,
+        out: &mut [f32],
+    ) {
+        let soft = self.edge_softness.max(1e-4);
+        let mut best_height = 0.0f32;
+        let mut best: Option<Candidate> = None;
+        for cand in self.candidates(lattice, table, u, v) {
+            if cand.inside <= 0.0 {
+                continue;
+            }
+            let along = (cand.y / cand.half_len * 0.5 + 0.5).clamp(0.0, 1.0);
+            let rim = smoothstep(0.0, soft, cand.inside);
+            let dome = smoothstep(0.0, 0.35, cand.inside);
+            let h = rim * (0.45 + 0.15 * dome + 0.3 * self.imbrication * along);
+            if h > best_height || best.is_none() {
+                best_height = h;
+                best = Some(cand);
+            }
+        }
+        self.write_scale(best, best_height, self.keel_height, out);
+    }
+
+    fn hexagon_pixel(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32, out: &mut [f32]) {
+        // Voronoi cell of the jittered lattice: nearest centre, then the distance to the
+        // nearest bisector with any other centre is the distance to the cell's edge.
+        let x = u * lattice.cols as f32;
+        let y = v * lattice.rows_v as f32;
+        let c0 = x.floor() as i32;
+        let mut centres = [(0.0f32, 0.0f32, 0.0f32, 1.0f32, 0.0f32); 9];
+        let mut n = 0;
+        for dc in -1..=1 {
+            let c = c0 + dc;
+            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
+            let r0 = (y - shift).floor() as i32;
+            for dr in -1..=1 {
+                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
+                // Isotropic coordinates: along-body distances scaled by the cell aspect.
+                centres[n] = (
+                    cx,
+                    cy * lattice.aspect,
+                    cell.random,
+                    cell.inv_size,
+                    cell.cos,
+                );
+                n += 1;
+            }
+        }
+        let p = (x, y * lattice.aspect);
+        let d2 = |c: &(f32, f32, f32, f32, f32)| (c.0 - p.0).powi(2) + (c.1 - p.1).powi(2);
+        let nearest = (0..9)
+            .min_by(|&i, &j| d2(&centres[i]).total_cmp(&d2(&centres[j])))
+            .unwrap_or(0);
+        let c1 = centres[nearest];
+        let mut edge = f32::MAX;
+        for (i, c2) in centres.iter().enumerate() {
+            if i == nearest {
+                continue;
+            }
+            let (dx, dy) = (c2.0 - c1.0, c2.1 - c1.1);
+            let len = (dx * dx + dy * dy).sqrt().max(1e-6);
+            let mid = ((c1.0 + c2.0) * 0.5, (c1.1 + c2.1) * 0.5);
+            edge = edge.min(((mid.0 - p.0) * dx + (mid.1 - p.1) * dy) / len);
+        }
+        // `size` below 1 opens a gap of skin between the plates.
+        let inside = edge - (1.0 - self.size.min(1.0)) * 0.5;
+        let half_len = 0.5 * lattice.aspect;
+        let cand = Candidate {
+            inside,
+            x: p.0 - c1.0,
+            y: p.1 - c1.1,
+            half_len,
+            random: c1.2,
+        };
+        let soft = self.edge_softness.max(1e-4);
+        let along = (cand.y / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
+        let rim = smoothstep(0.0, soft, inside);
+        let dome = smoothstep(0.0, 0.35, inside);
+        let h = rim * (0.5 + 0.2 * dome + 0.15 * self.imbrication * along);
+        let visible = if inside > 0.0 { Some(cand) } else { None };
+        self.write_scale(visible, h, self.keel_height, out);
+    }
+
+    fn write_scale(&self, best: Option<Candidate>, height: f32, keel_height: f32, out: &mut [f32]) {
+        let soft = self.edge_softness.max(1e-4);
+        match best {
+            None => {
+                out[channel::HEIGHT] = 0.0;
+                out[channel::CREVICE] = 1.0;
+                out[channel::ALONG] = 0.0;
+                out[channel::RADIAL] = 1.0;
+                out[channel::KEEL] = 0.0;
+                out[channel::CELL_RANDOM] = 0.0;
+            }
+            Some(c) => {
+                let along = (c.y / c.half_len * 0.5 + 0.5).clamp(0.0, 1.0);
+                let radial = ((c.x / 0.5).powi(2) + (c.y / c.half_len).powi(2))
+                    .sqrt()
+                    .min(1.0);
+                let keel = if keel_height > 0.0 {
+                    // A ridge along the long axis, fading out towards the anterior tip.
+                    (1.0 - smoothstep(0.0, self.keel_width.max(1e-3), c.x.abs()))
+                        * smoothstep(0.0, 0.6, along)
+                        * smoothstep(0.0, soft, c.inside)
+                } else {
+                    0.0
+                };
+                out[channel::HEIGHT] = (height + 0.2 * keel_height * keel).clamp(0.0, 1.0);
+                out[channel::CREVICE] = 1.0 - smoothstep(0.0, soft * 1.5, c.inside);
+                out[channel::ALONG] = along;
+                out[channel::RADIAL] = radial;
+                out[channel::KEEL] = keel;
+                out[channel::CELL_RANDOM] = c.random;
+            }
+        }
+    }
+
+    /// Ventral plates: one wide plate per row across the belly band, overlapping like the
+    /// dorsal scales (the thesis stretches normal scales "from the middle", §4.2.2).
+    fn ventral_pixel(&self, lattice: &Lattice, dist_belly: f32, v: f32, out: &mut [f32]) {
+        let soft = self.edge_softness.max(1e-4);
+        let half_band = self.belly_width * 0.5;
+        // Distances in dorsal scale widths, the unit of `edge_softness`.
+        let to_side = (half_band - dist_belly) * lattice.cols as f32;
+        let y = v * lattice.rows_v as f32;
+        let r0 = y.floor() as i32;
+        let half_len = 0.5 * self.size.max(0.5);
+        let mut best: Option<(f32, Candidate)> = None;
+        for r in r0 - 1..=r0 + 1 {
+            let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * lattice.aspect;
+            let to_end = (half_len - (y - (r as f32 + 0.5)).abs()) * lattice.aspect;
+            let inside = to_side.min(to_end);
+            if inside <= 0.0 {
+                continue;
+            }
+            let along = ((y - (r as f32 + 0.5)) / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
+            let h = smoothstep(0.0, soft, inside) * (0.45 + 0.1 + 0.3 * self.imbrication * along);
+            if best.as_ref().is_none_or(|(bh, _)| h > *bh) {
+                let random = hash::unit(-1, r.rem_euclid(lattice.rows_v), 4, self.seed);
+                let x = dist_belly / half_band * 0.5;
+                let cand = Candidate {
+                    inside,
+                    x,
+                    y: ly,
+                    half_len: 0.5 * lattice.aspect,
+                    random,
+                };
+                best = Some((h, cand));
+            }
+        }
+        match best {
+            // Ventral plates carry no keel.
+            Some((h, cand)) => self.write_scale(Some(cand), h, 0.0, out),
+            None => self.write_scale(None, 0.0, 0.0, out),
+        }
+    }
+}

@@ -1,0 +1,70 @@
+//! Errors a user can cause with a preset or an override. Each names where (file, line,
+//! column or the `--set` argument), what (the key) and what would be accepted.
+
+use std::fmt;
+use std::path::PathBuf;
+
+#[derive(Debug, thiserror::Error)]
+pub enum PresetError {
+    #[error("cannot read preset {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+
+    #[error(
+        "unknown preset {name:?}: not a .toml file and not a built-in preset (built-in: {available})"
+    )]
+    UnknownPreset { name: String, available: String },
+
+    /// TOML syntax, a wrong type, an unknown key or a bad enum value.
+    #[error("{location}: {message}")]
+    Parse { location: Location, message: String },
+
+    /// Values out of range, one line each.
+    #[error("{}", format_problems(.file, .problems))]
+    Invalid {
+        file: String,
+        problems: Vec<LocatedProblem>,
+    },
+
+    #[error("invalid --set {argument:?}: {message}")]
+    Override { argument: String, message: String },
+}
+
+/// Where in a preset something is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Location {
+    pub file: String,
+    pub line: Option<usize>,
+    pub column: Option<usize>,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match (self.line, self.column) {
+            (Some(l), Some(c)) => write!(f, "{}:{l}:{c}", self.file),
+            (Some(l), None) => write!(f, "{}:{l}", self.file),
+            _ => write!(f, "{}", self.file),
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocatedProblem {
+    pub key: String,
+    /// Line in the file, or None when the value came from `--set`.
+    pub line: Option<usize>,
+    pub message: String,
+}
+
+fn format_problems(file: &str, problems: &[LocatedProblem]) -> String {
+    problems
+        .iter()
+        .map(|p| match p.line {
+            Some(line) => format!("{file}:{line}: key `{}` {}", p.key, p.message),
+            None => format!("{file} (with --set): key `{}` {}", p.key, p.message),
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}

@@ -1,0 +1,346 @@
+//! From a preset argument (a path or a built-in name) and `--set` overrides to a validated
+//! `Preset`, with errors that point at the file, line and key.
+//!
+//! Order: read → parse the file alone (so syntax, type and unknown-key errors carry the
+//! file's line and column) → apply overrides to the TOML tree and parse again (errors name
+//! the `--set` argument) → range-check (errors name the key, with its line when it came
+//! from the file).
+
+use std::ops::Range;
+use std::path::Path;
+
+use serde::Deserialize;
+use toml::de::{DeTable, DeValue};
+
+use super::error::{LocatedProblem, Location, PresetError};
+use super::library;
+use super::schema::Preset;
+use super::validate::validate;
+
+/// Preset text and where it came from.
+#[derive(Debug, Clone)]
+pub struct PresetSource {
+    /// Output file stem: the file stem or the built-in name.
+    pub name: String,
+    /// What error messages call the file.
+    pub display: String,
+    pub text: String,
+}
+
+/// A validated preset with its provenance.
+#[derive(Debug, Clone)]
+pub struct LoadedPreset {
+    pub name: String,
+    pub preset: Preset,
+    /// FNV-1a 64 of the resolved preset (after overrides), as 16 hex digits.
+    pub content_hash: String,
+}
+
+/// Resolves a PRESET argument: an existing path or anything ending in `.toml` is a file,
+/// anything else a built-in preset name.
+pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
+    let path = Path::new(spec);
+    if spec.ends_with(".toml") || path.exists() {
+        let text = std::fs::read_to_string(path).map_err(|source| PresetError::Read {
+            path: path.into(),
+            source,
+        })?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "preset".into());
+        return Ok(PresetSource {
+            name,
+            display: spec.to_string(),
+            text,
+        });
+    }
+    match library::get(spec) {
+        Some(text) => Ok(PresetSource {
+            name: spec.into(),
+            display: format!("built-in preset {spec}"),
+            text: text.into(),
+        }),
+        None => Err(PresetError::UnknownPreset {
+            name: spec.into(),
+            available: library::names().join(", "),
+        }),
+    }
+}
+
+/// Parses and validates; `overrides` are `(dotted.key, toml value text)` pairs.
+pub fn parse(
+    source: &PresetSource,
+    overrides: &[(String, String)],
+) -> Result<LoadedPreset, PresetError> {
+    let file_preset: Preset = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
+    let preset = if overrides.is_empty() {
+        file_preset
+    } else {
+        let mut table: toml::Table =
+            toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
+        for (key, value) in overrides {
+            apply_override(&mut table, key, value)?;
+        }
+        Preset::deserialize(toml::Value::Table(table)).map_err(|e| PresetError::Override {
+            argument: overrides
+                .iter()
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect::<Vec<_>>()
+                .join(" "),
+            message: with_suggestion(e.message()),
+        })?
+    };
+
+    let problems = validate(&preset);
+    if !problems.is_empty() {
+        let overridden = |key: &str| {
+            overrides
+                .iter()
+                .any(|(k, _)| key == k || key.starts_with(&format!("{k}.")))
+        };
+        let located = problems
+            .into_iter()
+            .map(|p| {
+                let line = if overridden(&p.key) {
+                    None
+                } else {
+                    key_line(&source.text, &p.key)
+                };
+                LocatedProblem {
+                    line,
+                    key: p.key,
+                    message: p.message,
+                }
+            })
+            .collect();
+        return Err(PresetError::Invalid {
+            file: source.display.clone(),
+            problems: located,
+        });
+    }
+    let canonical = toml::to_string(&preset).unwrap_or_default();
+    Ok(LoadedPreset {
+        name: source.name.clone(),
+        preset,
+        content_hash: format!("{:016x}", fnv1a64(canonical.as_bytes())),
+    })
+}
+
+fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
+    let (line, column) = match error.span() {
+        Some(span) => {
+            let (l, c) = line_column(&source.text, span.start);
+            (Some(l), Some(c))
+        }
+        None => (None, None),
+    };
+    let message = error.message().trim_end().to_string();
+    PresetError::Parse {
+        location: Location {
+            file: source.display.clone(),
+            line,
+            column,
+        },
+        message: with_suggestion(&message),
+    }
+}
+
+/// 1-based line and column of a byte offset.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |s| s.chars().count()) + 1;
+    (line, column)
+}
+
+/// Rewrites serde's "unknown field `x`, expected one of `a`, `b`" into a message that names
+/// the key, suggests the nearest accepted one, and lists them all.
+fn with_suggestion(message: &str) -> String {
+    let Some(rest) = message.strip_prefix("unknown field `") else {
+        return message.to_string();
+    };
+    let Some((unknown, expected)) = rest.split_once('`') else {
+        return message.to_string();
+    };
+    let accepted: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
+    let nearest = accepted
+        .iter()
+        .map(|a| (edit_distance(unknown, a), *a))
+        .filter(|(d, a)| *d <= 2.max(a.len() / 3))
+        .min();
+    let hint = nearest
+        .map(|(_, a)| format!("; did you mean `{a}`?"))
+        .unwrap_or_default();
+    format!(
+        "unknown key `{unknown}`{hint} (accepted keys here: {})",
+        accepted.join(", ")
+    )
+}
+
+/// Levenshtein distance, for "did you mean".
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// Line of a dotted key (`pattern.1.size`) in the preset text, if it is written there.
+fn key_line(text: &str, dotted: &str) -> Option<usize> {
+    let root = DeTable::parse(text).ok()?;
+    let mut span: Option<Range<usize>> = None;
+    let mut table = Some(root.get_ref());
+    let mut value: Option<&DeValue> = None;
+    for segment in dotted.split('.') {
+        if let Some(current) = value {
+            match current {
+                DeValue::Table(t) => table = Some(t),
+                DeValue::Array(items) => {
+                    let item = items.get(segment.parse::<usize>().ok()?)?;
+                    span = Some(item.span());
+                    value = Some(item.get_ref());
+                    continue;
+                }
+                _ => return span.map(|s| line_column(text, s.start).0),
+            }
+        } else if segment.parse::<usize>().is_ok() {
+            // `pattern.0` when `pattern` is a single table.
+            continue;
+        }
+        let (key, item) = table?
+            .iter()
+            .find(|(k, _)| k.get_ref().as_ref() == segment)?;
+        span = Some(key.span());
+        value = Some(item.get_ref());
+        table = None;
+    }
+    span.map(|s| line_column(text, s.start).0)
+}
+
+/// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).
+fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), PresetError> {
+    let parsed: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(value.into())),
+        Err(_) => toml::Value::String(value.into()),
+    };
+    let segments: Vec<&str> = key.split('.').collect();
+    let result = if segments.iter().any(|s| s.is_empty()) {
+        Err("the key must be a dotted path like scales.rows or pattern.0.kind".to_string())
+    } else {
+        let mut tree = toml::Value::Table(std::mem::take(root));
+        let result = set_path(&mut tree, &segments, parsed);
+        if let toml::Value::Table(t) = tree {
+            *root = t;
+        }
+        result
+    };
+    result.map_err(|message| PresetError::Override {
+        argument: format!("{key}={value}"),
+        message,
+    })
+}
+
+fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> Result<(), String> {
+    let Some((first, rest)) = segments.split_first() else {
+        *target = value;
+        return Ok(());
+    };
+    match target {
+        // `pattern.0` addresses a single `[pattern]` table as layer 0.
+        toml::Value::Table(t) if *first == "0" && !t.contains_key("0") => {
+            set_path(target, rest, value)
+        }
+        toml::Value::Table(t) => {
+            if rest.is_empty() {
+                t.insert(first.to_string(), value);
+                return Ok(());
+            }
+            let child = t
+                .entry(first.to_string())
+                .or_insert_with(|| toml::Value::Table(Default::default()));
+            set_path(child, rest, value)
+        }
+        toml::Value::Array(items) => {
+            let len = items.len();
+            let index: usize = first
+                .parse()
+                .map_err(|_| format!("`{first}` must be an array index"))?;
+            let item = items
+                .get_mut(index)
+                .ok_or_else(|| format!("index {index} is out of range: there are {len} entries"))?;
+            set_path(item, rest, value)
+        }
+        _ => Err(format!("`{first}` is inside a value that is not a table")),
+    }
+}
+
+fn fnv1a64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ *b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn source(text: &str) -> PresetSource {
+        PresetSource {
+            name: "t".into(),
+            display: "t.toml".into(),
+            text: text.into(),
+        }
+    }
+
+    #[test]
+    fn suggestion_names_the_nearest_key() {
+        let err = parse(&source("[scales]\nrwos = 3\n"), &[])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("t.toml:2:1"), "{err}");
+        assert!(err.contains("did you mean `rows`"), "{err}");
+    }
+
+    #[test]
+    fn range_error_has_line_and_key() {
+        let err = parse(&source("seed = 1\n\n[optics]\nfilm_ior = 9.0\n"), &[])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("t.toml:4: key `optics.film_ior`"), "{err}");
+        assert!(err.contains("[1, 3]"), "{err}");
+    }
+
+    #[test]
+    fn overrides_set_nested_keys_and_strings() {
+        let overrides = vec![
+            ("scales.rows".to_string(), "25".to_string()),
+            ("scales.shape".to_string(), "diamond".to_string()),
+            ("pattern.0.kind".to_string(), "spots".to_string()),
+            ("pattern.0.color".to_string(), "#102030".to_string()),
+        ];
+        let loaded = parse(&source("seed = 1\n"), &overrides).unwrap();
+        assert_eq!(loaded.preset.scales.rows, 25);
+        assert_eq!(
+            loaded.preset.scales.shape,
+            super::super::schema::ScaleShape::Diamond
+        );
+        assert_eq!(loaded.preset.pattern.len(), 1);
+    }
+
+    #[test]
+    fn non_finite_values_are_refused() {
+        let err = parse(&source("[optics]\nfilm_thickness_nm = nan\n"), &[])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("optics.film_thickness_nm"), "{err}");
+    }
+}

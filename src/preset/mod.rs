@@ -1,0 +1,12 @@
+//! Snake presets: the TOML schema, loading with helpful errors, validation, and the built-in
+//! species library.
+
+mod error;
+pub mod library;
+mod load;
+pub mod schema;
+pub mod validate;
+
+pub use error::{LocatedProblem, Location, PresetError};
+pub use load::{LoadedPreset, PresetSource, edit_distance, parse, read_source};
+pub use schema::Preset;

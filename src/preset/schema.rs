@@ -1,0 +1,436 @@
+//! The preset schema: what a snake preset file may say, with defaults.
+//!
+//! Every struct rejects unknown keys. Names follow the thesis' generator and shading
+//! parameters (Bie & Jiang 2024, Tables 5.1 and 5.2); the thesis symbol is noted on each
+//! field. Ranges live in `validate.rs`; docs/presets.md documents every key.
+
+use serde::{Deserialize, Deserializer, Serialize, de};
+
+/// A colour written as `"#rrggbb"` (sRGB, 8 bits per channel).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Srgb8(pub [u8; 3]);
+
+impl Srgb8 {
+    /// Linear RGB by the sRGB transfer function (IEC 61966-2-1).
+    pub fn to_linear(self) -> [f32; 3] {
+        self.0.map(|c| {
+            let c = c as f32 / 255.0;
+            if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        })
+    }
+
+    pub fn parse(text: &str) -> Option<Self> {
+        let hex = text.strip_prefix('#')?;
+        if hex.len() != 6 || !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
+            return None;
+        }
+        let byte = |i: usize| u8::from_str_radix(&hex[i..i + 2], 16).ok();
+        Some(Srgb8([byte(0)?, byte(2)?, byte(4)?]))
+    }
+}
+
+impl<'de> Deserialize<'de> for Srgb8 {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let text = String::deserialize(deserializer)?;
+        Srgb8::parse(&text).ok_or_else(|| {
+            de::Error::custom(format!(
+                "invalid colour {text:?}: expected \"#rrggbb\" (sRGB hex)"
+            ))
+        })
+    }
+}
+
+impl Serialize for Srgb8 {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let [r, g, b] = self.0;
+        serializer.serialize_str(&format!("#{r:02x}{g:02x}{b:02x}"))
+    }
+}
+
+/// Pinheiro & Walter's pattern categories, used to group the species library.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Category {
+    Solid,
+    VerticalStripe,
+    HorizontalStripe,
+    Spot,
+    Simple,
+    Complex,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Preset {
+    /// Scientific name.
+    #[serde(default)]
+    pub species: Option<String>,
+    #[serde(default)]
+    pub common_name: Option<String>,
+    #[serde(default)]
+    pub category: Option<Category>,
+    /// Where the facts in this preset come from.
+    #[serde(default)]
+    pub sources: Vec<String>,
+    /// Thesis "Seed": fixes every random choice.
+    #[serde(default)]
+    pub seed: u64,
+    #[serde(default)]
+    pub scales: Scales,
+    /// A `[pattern]` table or `[[pattern]]` layers, composed in order.
+    #[serde(default, deserialize_with = "one_or_many")]
+    pub pattern: Vec<PatternLayer>,
+    #[serde(default)]
+    pub belly: Belly,
+    #[serde(default)]
+    pub color: ColorParams,
+    #[serde(default)]
+    pub height: HeightParams,
+    #[serde(default)]
+    pub roughness: RoughnessParams,
+    #[serde(default)]
+    pub iridescence: IridescenceParams,
+    #[serde(default)]
+    pub optics: Optics,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ScaleShape {
+    Leaf,
+    Diamond,
+    Hexagon,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Scales {
+    /// Thesis "ScaleType".
+    pub shape: ScaleShape,
+    /// Thesis "ScaleAmount": dorsal scale rows around the body.
+    pub rows: u32,
+    /// Thesis "ScaleSize": scale size relative to its lattice cell (above 1 they overlap).
+    pub size: f64,
+    /// Scale length along the body over its width around it.
+    pub aspect: f64,
+    /// Thesis "ScaleKeeled".
+    pub keeled: bool,
+    pub keel_height: f64,
+    /// Keel half-width as a fraction of the scale width.
+    pub keel_width: f64,
+    /// Random offset, size and rotation per scale.
+    pub jitter: f64,
+    /// How far the free posterior edge is raised over the tucked anterior edge.
+    pub imbrication: f64,
+    /// Width of a scale's rounded rim, in scale widths.
+    pub edge_softness: f64,
+}
+
+impl Default for Scales {
+    fn default() -> Self {
+        Scales {
+            shape: ScaleShape::Leaf,
+            rows: 19,
+            size: 1.2,
+            aspect: 1.3,
+            keeled: false,
+            keel_height: 0.5,
+            keel_width: 0.08,
+            jitter: 0.1,
+            imbrication: 0.6,
+            edge_softness: 0.06,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PatternKind {
+    /// A uniform colour over the whole body, with fractal variation.
+    Solid,
+    /// Stripes along the body.
+    Stripes,
+    /// Round spots on a jittered grid.
+    Spots,
+    /// Thresholded noise blobs.
+    Irregular,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseChoice {
+    Perlin,
+    Cellular,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PatternLayer {
+    /// Thesis "PatternType".
+    pub kind: PatternKind,
+    pub color: Srgb8,
+    /// Thesis "PatternAmount": stripes per side, spots around the body, or blob coverage.
+    #[serde(default = "PatternLayer::default_amount")]
+    pub amount: f64,
+    /// Thesis "PatternSize": stripe width or spot radius (fraction of the circumference),
+    /// or blob feature size.
+    #[serde(default = "PatternLayer::default_size")]
+    pub size: f64,
+    /// Stripes: distance of the innermost stripe from the dorsal midline (fraction of the
+    /// circumference); 0 puts a stripe on the spine.
+    #[serde(default)]
+    pub offset: f64,
+    /// Thesis "PatternOutlineSize" (fraction of the circumference; 0 = no outline).
+    #[serde(default)]
+    pub outline_size: f64,
+    #[serde(default = "PatternLayer::default_outline_color")]
+    pub outline_color: Srgb8,
+    /// Thesis "EdgeDistortion": noise displacement of the pattern's edges.
+    #[serde(default = "PatternLayer::default_edge_distortion")]
+    pub edge_distortion: f64,
+    #[serde(default = "PatternLayer::default_opacity")]
+    pub opacity: f64,
+    /// Irregular: the noise that shapes the blobs.
+    #[serde(default = "PatternLayer::default_noise")]
+    pub noise: NoiseChoice,
+}
+
+impl PatternLayer {
+    fn default_amount() -> f64 {
+        1.0
+    }
+    fn default_size() -> f64 {
+        0.05
+    }
+    fn default_outline_color() -> Srgb8 {
+        Srgb8([0x14, 0x12, 0x10])
+    }
+    fn default_edge_distortion() -> f64 {
+        0.2
+    }
+    fn default_opacity() -> f64 {
+        1.0
+    }
+    fn default_noise() -> NoiseChoice {
+        NoiseChoice::Perlin
+    }
+}
+
+/// Accepts `[pattern]` (one table) or `[[pattern]]` (an array of tables).
+fn one_or_many<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<PatternLayer>, D::Error> {
+    struct Visitor;
+    impl<'de> de::Visitor<'de> for Visitor {
+        type Value = Vec<PatternLayer>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a [pattern] table or [[pattern]] layers")
+        }
+        fn visit_map<A: de::MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+            Ok(vec![PatternLayer::deserialize(
+                de::value::MapAccessDeserializer::new(map),
+            )?])
+        }
+        fn visit_seq<A: de::SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+            Vec::deserialize(de::value::SeqAccessDeserializer::new(seq))
+        }
+    }
+    deserializer.deserialize_any(Visitor)
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Belly {
+    /// Thesis "BellySize": width of the ventral band, fraction of the circumference.
+    pub width: f64,
+    pub color: Srgb8,
+    /// Draw ventral plates (one wide plate per row) in the band.
+    pub plates: bool,
+    /// Softness of the colour boundary between back and belly (fraction of circumference).
+    pub blend: f64,
+}
+
+impl Default for Belly {
+    fn default() -> Self {
+        Belly {
+            width: 0.22,
+            color: Srgb8([0xe6, 0xdc, 0xc0]),
+            plates: true,
+            blend: 0.03,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ColorParams {
+    /// Base colour of the back (thesis §4.2.1.1).
+    pub base: Srgb8,
+    /// Strength of the fractal colour variation, 0..1.
+    pub variation: f64,
+    /// Darkening of the skin between scales, 0..1.
+    pub between_scales: f64,
+}
+
+impl Default for ColorParams {
+    fn default() -> Self {
+        ColorParams {
+            base: Srgb8([0x5a, 0x6b, 0x3c]),
+            variation: 0.15,
+            between_scales: 0.35,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HeightParams {
+    /// Slope of the normal map: surface rise of the full height range, in scale widths.
+    pub normal_strength: f64,
+    /// Amplitude of fine surface grain added to the height, 0..0.2.
+    pub grain: f64,
+}
+
+impl Default for HeightParams {
+    fn default() -> Self {
+        HeightParams {
+            normal_strength: 0.25,
+            grain: 0.02,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RoughnessParams {
+    /// Perceptual roughness of a scale's surface (alpha = roughness², as glTF).
+    pub base: f64,
+    /// Amplitude of fine noise (thesis §4.2.4).
+    pub variation: f64,
+    /// Extra roughness of the skin between scales.
+    pub between_scales: f64,
+    /// Extra roughness on keels.
+    pub keel: f64,
+}
+
+impl Default for RoughnessParams {
+    fn default() -> Self {
+        RoughnessParams {
+            base: 0.35,
+            variation: 0.08,
+            between_scales: 0.35,
+            keel: 0.15,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IridescenceGradient {
+    /// Thicker towards each scale's posterior edge (thesis Fig. 5.4a).
+    Vertical,
+    /// Thicker towards each scale's centre (thesis Fig. 4.14a, 5.4b).
+    Radial,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct IridescenceParams {
+    pub gradient: IridescenceGradient,
+    /// Width of the thickness range around `optics.film_thickness_nm`, in nm.
+    pub spread_nm: f64,
+    /// Strength of the fractal noise (thesis Fig. 5.4c), 0..1.
+    pub noise: f64,
+}
+
+impl Default for IridescenceParams {
+    fn default() -> Self {
+        IridescenceParams {
+            gradient: IridescenceGradient::Radial,
+            spread_nm: 200.0,
+            noise: 0.25,
+        }
+    }
+}
+
+/// Layer optics (thesis Table 5.2 defaults).
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Optics {
+    /// n0: refractive index of the environment.
+    pub ambient_ior: f64,
+    /// n1: refractive index of the iridescent film.
+    pub film_ior: f64,
+    /// n2: refractive index of the pigment (absorption) layer.
+    pub pigment_ior: f64,
+    /// δ0: film thickness in nm.
+    pub film_thickness_nm: f64,
+    /// δ1: pigment layer thickness (relative units; optical depth = σ0 δ1).
+    pub pigment_thickness: f64,
+    /// σ0: absorption coefficient of the pigment layer, one value or linear [r, g, b].
+    pub absorption: Absorption,
+}
+
+impl Default for Optics {
+    fn default() -> Self {
+        Optics {
+            ambient_ior: 1.0,
+            film_ior: 1.55,
+            pigment_ior: 2.0,
+            film_thickness_nm: 400.0,
+            pigment_thickness: 1.0,
+            absorption: Absorption([0.6; 3]),
+        }
+    }
+}
+
+/// σ0, written as one number or `[r, g, b]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Absorption(pub [f64; 3]);
+
+impl<'de> Deserialize<'de> for Absorption {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> de::Visitor<'de> for Visitor {
+            type Value = Absorption;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or [r, g, b]")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Absorption, E> {
+                Ok(Absorption([v; 3]))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Absorption, E> {
+                Ok(Absorption([v as f64; 3]))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Absorption, E> {
+                Ok(Absorption([v as f64; 3]))
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, mut seq: A) -> Result<Absorption, A::Error> {
+                let mut rgb = [0.0; 3];
+                for (i, slot) in rgb.iter_mut().enumerate() {
+                    *slot = seq
+                        .next_element()?
+                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                if seq.next_element::<f64>()?.is_some() {
+                    return Err(de::Error::invalid_length(4, &self));
+                }
+                Ok(Absorption(rgb))
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
+}
+
+impl Serialize for Absorption {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let [r, g, b] = self.0;
+        if r == g && g == b {
+            serializer.serialize_f64(r)
+        } else {
+            self.0.serialize(serializer)
+        }
+    }
+}

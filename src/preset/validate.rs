@@ -1,0 +1,141 @@
+//! Range checks on a parsed preset, all before any pixel is computed ("parse first, then
+//! run"). Each problem names the dotted key and the accepted range; `load` adds the line.
+
+use super::schema::{PatternKind, Preset};
+
+/// One value outside what the generator accepts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    /// Dotted key path, e.g. `optics.film_ior` or `pattern.1.size`.
+    pub key: String,
+    pub message: String,
+}
+
+/// The accepted ranges, one place, so docs/presets.md and the checks agree.
+pub mod ranges {
+    pub const ROWS: (u32, u32) = (4, 128);
+    pub const SCALE_SIZE: (f64, f64) = (0.5, 2.0);
+    pub const SCALE_ASPECT: (f64, f64) = (0.3, 4.0);
+    pub const UNIT: (f64, f64) = (0.0, 1.0);
+    pub const KEEL_WIDTH: (f64, f64) = (0.01, 0.5);
+    pub const JITTER: (f64, f64) = (0.0, 0.5);
+    pub const EDGE_SOFTNESS: (f64, f64) = (0.005, 0.5);
+    pub const STRIPES_PER_SIDE: (f64, f64) = (1.0, 16.0);
+    pub const SPOTS_AROUND: (f64, f64) = (1.0, 64.0);
+    pub const PATTERN_SIZE: (f64, f64) = (0.001, 0.5);
+    pub const PATTERN_OFFSET: (f64, f64) = (0.0, 0.5);
+    pub const OUTLINE_SIZE: (f64, f64) = (0.0, 0.1);
+    pub const BELLY_WIDTH: (f64, f64) = (0.0, 0.6);
+    pub const BELLY_BLEND: (f64, f64) = (0.0, 0.2);
+    pub const NORMAL_STRENGTH: (f64, f64) = (0.0, 10.0);
+    pub const GRAIN: (f64, f64) = (0.0, 0.2);
+    pub const ROUGHNESS_VARIATION: (f64, f64) = (0.0, 0.5);
+    pub const SPREAD_NM: (f64, f64) = (0.0, 2000.0);
+    /// Refractive indices of real dielectrics; 1 is vacuum.
+    pub const IOR: (f64, f64) = (1.0, 3.0);
+    /// Up to 10 mm, the stress-test bound of PHYSICS.md.
+    pub const FILM_THICKNESS_NM: (f64, f64) = (0.0, 1.0e7);
+    pub const PIGMENT_THICKNESS: (f64, f64) = (0.0, 100.0);
+    pub const ABSORPTION: (f64, f64) = (0.0, 100.0);
+}
+
+#[derive(Default)]
+struct Checker {
+    problems: Vec<Problem>,
+}
+
+impl Checker {
+    fn range(&mut self, key: impl Into<String>, value: f64, (lo, hi): (f64, f64)) {
+        if !(value.is_finite() && (lo..=hi).contains(&value)) {
+            self.problems.push(Problem {
+                key: key.into(),
+                message: format!("must be a finite number in [{lo}, {hi}], got {value}"),
+            });
+        }
+    }
+
+    fn int_range(&mut self, key: &str, value: u32, (lo, hi): (u32, u32)) {
+        if !(lo..=hi).contains(&value) {
+            self.problems.push(Problem {
+                key: key.into(),
+                message: format!("must be an integer in [{lo}, {hi}], got {value}"),
+            });
+        }
+    }
+}
+
+/// Every out-of-range value in the preset (empty when it is valid).
+pub fn validate(preset: &Preset) -> Vec<Problem> {
+    use ranges::*;
+    let mut c = Checker::default();
+    let s = &preset.scales;
+    c.int_range("scales.rows", s.rows, ROWS);
+    c.range("scales.size", s.size, SCALE_SIZE);
+    c.range("scales.aspect", s.aspect, SCALE_ASPECT);
+    c.range("scales.keel_height", s.keel_height, UNIT);
+    c.range("scales.keel_width", s.keel_width, KEEL_WIDTH);
+    c.range("scales.jitter", s.jitter, JITTER);
+    c.range("scales.imbrication", s.imbrication, UNIT);
+    c.range("scales.edge_softness", s.edge_softness, EDGE_SOFTNESS);
+
+    for (i, p) in preset.pattern.iter().enumerate() {
+        let key = |field: &str| format!("pattern.{i}.{field}");
+        match p.kind {
+            PatternKind::Stripes => c.range(key("amount"), p.amount, STRIPES_PER_SIDE),
+            PatternKind::Spots => c.range(key("amount"), p.amount, SPOTS_AROUND),
+            PatternKind::Irregular | PatternKind::Solid => c.range(key("amount"), p.amount, UNIT),
+        }
+        c.range(key("size"), p.size, PATTERN_SIZE);
+        c.range(key("offset"), p.offset, PATTERN_OFFSET);
+        c.range(key("outline_size"), p.outline_size, OUTLINE_SIZE);
+        c.range(key("edge_distortion"), p.edge_distortion, UNIT);
+        c.range(key("opacity"), p.opacity, UNIT);
+    }
+
+    c.range("belly.width", preset.belly.width, BELLY_WIDTH);
+    c.range("belly.blend", preset.belly.blend, BELLY_BLEND);
+    c.range("color.variation", preset.color.variation, UNIT);
+    c.range("color.between_scales", preset.color.between_scales, UNIT);
+    c.range(
+        "height.normal_strength",
+        preset.height.normal_strength,
+        NORMAL_STRENGTH,
+    );
+    c.range("height.grain", preset.height.grain, GRAIN);
+    let r = &preset.roughness;
+    c.range("roughness.base", r.base, UNIT);
+    c.range("roughness.variation", r.variation, ROUGHNESS_VARIATION);
+    c.range("roughness.between_scales", r.between_scales, UNIT);
+    c.range("roughness.keel", r.keel, UNIT);
+    c.range(
+        "iridescence.spread_nm",
+        preset.iridescence.spread_nm,
+        SPREAD_NM,
+    );
+    c.range("iridescence.noise", preset.iridescence.noise, UNIT);
+
+    let o = &preset.optics;
+    c.range("optics.ambient_ior", o.ambient_ior, IOR);
+    c.range("optics.film_ior", o.film_ior, IOR);
+    c.range("optics.pigment_ior", o.pigment_ior, IOR);
+    c.range(
+        "optics.film_thickness_nm",
+        o.film_thickness_nm,
+        FILM_THICKNESS_NM,
+    );
+    c.range(
+        "optics.pigment_thickness",
+        o.pigment_thickness,
+        PIGMENT_THICKNESS,
+    );
+    for (i, a) in o.absorption.0.iter().enumerate() {
+        let key = if o.absorption.0.iter().all(|x| x == a) {
+            "optics.absorption".to_string()
+        } else {
+            format!("optics.absorption.{i}")
+        };
+        c.range(key, *a, ABSORPTION);
+    }
+    c.problems.dedup();
+    c.problems
+}
