@@ -154,7 +154,7 @@ fn print_stats(stats: &EvalStats) {
         "node", "operation", "evals", "ms", "MiB"
     );
     let mut nodes = stats.nodes.clone();
-    nodes.sort_by(|a, b| b.time.cmp(&a.time));
+    nodes.sort_by_key(|n| std::cmp::Reverse(n.time));
     for n in &nodes {
         eprintln!(
             "{:<28} {:<36} {:>5} {:>10.2} {:>10.1}",

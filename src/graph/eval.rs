@@ -117,16 +117,16 @@ pub fn evaluate(
         for (id, image, time) in results {
             let node = graph.node(id);
             live_bytes += image.bytes();
-            stats.insert(
-                id.0,
-                NodeStats {
-                    name: node.name.clone(),
-                    label: node.op.label(),
-                    evaluations: 1,
-                    time,
-                    bytes: image.bytes(),
-                },
-            );
+            let entry = stats.entry(id.0).or_insert_with(|| NodeStats {
+                name: node.name.clone(),
+                label: node.op.label(),
+                evaluations: 0,
+                time: Duration::ZERO,
+                bytes: 0,
+            });
+            entry.evaluations += 1;
+            entry.time += time;
+            entry.bytes = image.bytes();
             store[id.0] = Some(Arc::new(image));
             done += 1;
             progress(done, total);
@@ -136,10 +136,10 @@ pub fn evaluate(
         for id in &batch {
             for input in &graph.node(*id).inputs {
                 consumers[input.0] -= 1;
-                if consumers[input.0] == 0 {
-                    if let Some(buf) = store[input.0].take() {
-                        live_bytes -= buf.bytes();
-                    }
+                if consumers[input.0] == 0
+                    && let Some(buf) = store[input.0].take()
+                {
+                    live_bytes -= buf.bytes();
                 }
             }
         }

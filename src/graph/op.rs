@@ -55,7 +55,7 @@ impl Op {
         match self {
             Op::Noise(noise) => {
                 let sampler = NoiseSampler::new(noise);
-                Image::from_fn(width, height, 1, |u, v, out| out[0] = sampler.sample(u, v))
+                Image::gray_from_fn(width, height, |u, v| sampler.sample(u, v))
             }
             Op::Scales(field) => field.render(width, height),
             Op::Channel { index } => filters::extract_channel(inputs[0], *index),

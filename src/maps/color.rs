@@ -172,8 +172,16 @@ fn pattern_layer(
     };
 
     let mask = if layer.edge_distortion > 0.0 {
-        // Thesis §4.2.1.2: blend with noise, then threshold, for ragged edges.
-        let d = layer.edge_distortion as f32 * 0.6;
+        // Thesis §4.2.1.2: blend with noise, then threshold, for ragged edges. The shape is
+        // softened first so that adding noise moves its edges instead of leaving them.
+        let d = layer.edge_distortion as f32;
+        let soft = g.add(
+            name("soften"),
+            Op::Blur {
+                sigma: 0.002 + 0.01 * d,
+            },
+            &[shape],
+        );
         let n = g.add(
             name("distortion_noise"),
             perlin(24, 24, 3, 0.5, seed ^ 0x5eed),
@@ -186,13 +194,13 @@ fn pattern_layer(
                 mode: BlendMode::Add,
                 opacity: 1.0,
             },
-            &[shape, offset],
+            &[soft, offset],
         );
         g.add(
             name("mask"),
             Op::Threshold {
                 level: 0.5,
-                softness: 0.06,
+                softness: 0.04,
             },
             &[moved],
         )

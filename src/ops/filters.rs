@@ -227,7 +227,7 @@ mod tests {
 
     #[test]
     fn blur_preserves_mean_and_wraps() {
-        let img = Image::from_fn(64, 32, 1, |u, _| if u < 0.1 { 1.0 } else { 0.0 });
+        let img = Image::gray_from_fn(64, 32, |u, _| if u < 0.1 { 1.0 } else { 0.0 });
         let mean = |i: &Image| i.data.iter().sum::<f32>() / i.data.len() as f32;
         let blurred = blur(&img, 0.05);
         assert!((mean(&img) - mean(&blurred)).abs() < 1e-4);
@@ -237,10 +237,9 @@ mod tests {
 
     #[test]
     fn sobel_of_blurred_step_peaks_near_one() {
-        let step = Image::from_fn(
+        let step = Image::gray_from_fn(
             256,
             8,
-            1,
             |u, _| if (0.25..0.75).contains(&u) { 1.0 } else { 0.0 },
         );
         let sigma = 0.02;
@@ -254,7 +253,9 @@ mod tests {
         let flat = Image::new(16, 16, 1);
         let n = height_to_normal(&flat, 1.0, NormalConvention::OpenGl);
         assert!(n.data.chunks(3).all(|p| p == [0.0, 0.0, 1.0]));
-        let ramp = Image::from_fn(32, 32, 1, |u, v| (u * 6.28).sin() * 0.1 + v * 0.0);
+        let ramp = Image::gray_from_fn(32, 32, |u, v| {
+            (u * std::f32::consts::TAU).sin() * 0.1 + v * 0.0
+        });
         let n = height_to_normal(&ramp, 1.0, NormalConvention::OpenGl);
         for p in n.data.chunks(3) {
             assert!(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs() < 1e-5);
@@ -264,10 +265,10 @@ mod tests {
     #[test]
     fn opengl_green_points_up_the_image_on_a_slope_rising_down() {
         // Height grows with image y (downwards): the surface faces up the image, +Y in OpenGL.
-        let ramp = Image::from_fn(16, 16, 1, |_, v| (v * std::f32::consts::TAU).sin());
+        let ramp = Image::gray_from_fn(16, 16, |_, v| (v * std::f32::consts::TAU).sin());
         let gl = height_to_normal(&ramp, 0.1, NormalConvention::OpenGl);
         let dx = height_to_normal(&ramp, 0.1, NormalConvention::DirectX);
-        let i = (1 * 16 + 3) * 3; // near v = 0 the slope is positive
+        let i = (16 + 3) * 3; // pixel (3, 1): near v = 0 the slope is positive
         assert!(gl.data[i + 1] > 0.0 && dx.data[i + 1] < 0.0);
     }
 }

@@ -45,6 +45,14 @@ impl Image {
         image
     }
 
+    /// A single-channel image from `value(u, v)` at pixel centres.
+    pub fn gray_from_fn<F>(width: usize, height: usize, value: F) -> Self
+    where
+        F: Fn(f32, f32) -> f32 + Sync,
+    {
+        Image::from_fn(width, height, 1, |u, v, out| out[0] = value(u, v))
+    }
+
     /// Applies `f` to every pixel of `self` in place (parallel over rows).
     pub fn map_pixels<F>(mut self, f: F) -> Self
     where

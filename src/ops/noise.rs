@@ -10,6 +10,8 @@
 //!
 //! Every octave has integer periods in u and v, so each octave — and so the sum — tiles.
 
+use std::f32::consts::FRAC_1_SQRT_2;
+
 use noise::permutationtable::{NoiseHasher, PermutationTable};
 
 use super::hash;
@@ -42,19 +44,19 @@ const GRADIENTS: [[f32; 2]; 16] = {
     let c = [
         1.0,
         0.923_879_5,
-        0.707_106_8,
+        FRAC_1_SQRT_2,
         0.382_683_4,
         0.0,
         -0.382_683_4,
-        -0.707_106_8,
+        -FRAC_1_SQRT_2,
         -0.923_879_5,
         -1.0,
         -0.923_879_5,
-        -0.707_106_8,
+        -FRAC_1_SQRT_2,
         -0.382_683_4,
         0.0,
         0.382_683_4,
-        0.707_106_8,
+        FRAC_1_SQRT_2,
         0.923_879_5,
     ];
     let mut k = 0;

@@ -1,0 +1,137 @@
+//! Bad input: a clear message (file, line, key, what is accepted), exit code 2, and no change
+//! on disk — no new file, and an earlier output of the same name untouched.
+
+mod common;
+
+use common::*;
+
+/// Runs `generate` with `preset` into a folder that already holds an earlier output named
+/// like the preset's; asserts exit 2 and an unchanged folder; returns stderr.
+fn refused(preset_name: &str, preset_text: &str, extra: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let presets = tempfile::tempdir().unwrap();
+    let path = write_preset(presets.path(), preset_name, preset_text);
+    let stem = preset_name.trim_end_matches(".toml");
+    std::fs::write(
+        dir.path().join(format!("{stem}_color.png")),
+        b"earlier output",
+    )
+    .unwrap();
+    let before = snapshot(dir.path());
+    let out_dir = dir.path().to_str().unwrap();
+    let mut args = vec!["generate", path.as_str(), "-o", out_dir];
+    if !extra.contains(&"--size") {
+        args.extend(["--size", "64"]);
+    }
+    args.extend_from_slice(extra);
+    let out = snakeskin(&args);
+    assert_eq!(out.status.code(), Some(2), "stderr: {}", stderr(&out));
+    assert_eq!(snapshot(dir.path()), before, "the output folder changed");
+    stderr(&out)
+}
+
+#[test]
+fn toml_syntax_error_names_file_and_line() {
+    let err = refused("broken.toml", "seed = 1\n\n[scales]\nrows = = 3\n", &[]);
+    assert!(err.contains("broken.toml:4:"), "{err}");
+}
+
+#[test]
+fn type_error_names_line() {
+    let err = refused("typed.toml", "seed = 1\n[scales]\nrows = \"many\"\n", &[]);
+    assert!(err.contains("typed.toml:3:"), "{err}");
+    assert!(err.contains("integer") || err.contains("u32"), "{err}");
+}
+
+#[test]
+fn unknown_key_is_named_with_a_suggestion() {
+    let err = refused("typo.toml", "seed = 1\n[optics]\nfilm_iro = 1.4\n", &[]);
+    assert!(err.contains("typo.toml:3:"), "{err}");
+    assert!(err.contains("`film_iro`"), "{err}");
+    assert!(err.contains("did you mean `film_ior`"), "{err}");
+}
+
+#[test]
+fn unknown_enum_value_lists_what_is_accepted() {
+    let err = refused("shape.toml", "[scales]\nshape = \"round\"\n", &[]);
+    assert!(err.contains("shape.toml:2:"), "{err}");
+    assert!(
+        err.contains("leaf") && err.contains("diamond") && err.contains("hexagon"),
+        "{err}"
+    );
+}
+
+#[test]
+fn out_of_range_value_names_key_and_range() {
+    let err = refused("range.toml", "seed = 1\n[optics]\nfilm_ior = 7.5\n", &[]);
+    assert!(err.contains("range.toml:3"), "{err}");
+    assert!(err.contains("optics.film_ior"), "{err}");
+    assert!(err.contains("[1, 3]"), "{err}");
+}
+
+#[test]
+fn non_finite_value_is_refused() {
+    let err = refused("nan.toml", "[scales]\nsize = nan\n", &[]);
+    assert!(
+        err.contains("scales.size") && err.contains("finite"),
+        "{err}"
+    );
+}
+
+#[test]
+fn out_of_range_override_names_the_set_argument() {
+    let err = refused("ok.toml", "seed = 1\n", &["--set", "scales.rows=1000"]);
+    assert!(
+        err.contains("scales.rows") && err.contains("--set"),
+        "{err}"
+    );
+    let err = refused("ok.toml", "seed = 1\n", &["--set", "scales.rwos=20"]);
+    assert!(err.contains("did you mean `rows`"), "{err}");
+}
+
+#[test]
+fn sizes_outside_the_range_are_refused_before_anything_runs() {
+    for size in ["0", "15", "1000000", "16385"] {
+        let err = refused("fine.toml", "seed = 1\n", &["--size", size]);
+        assert!(
+            err.contains("16..=16384") || err.contains("16 to 16384"),
+            "{size}: {err}"
+        );
+    }
+}
+
+#[test]
+fn unknown_map_and_preset_are_refused() {
+    let err = refused("fine.toml", "seed = 1\n", &["--maps", "colour"]);
+    assert!(err.contains("colour") && err.contains("roughness"), "{err}");
+    let out = snakeskin(&[
+        "generate",
+        "no-such-snake",
+        "-o",
+        "/nonexistent-dir-never-created",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("erythrolamprus-miliaris"),
+        "lists the built-in presets"
+    );
+    assert!(!std::path::Path::new("/nonexistent-dir-never-created").exists());
+}
+
+#[test]
+fn unwritable_output_leaves_no_partial_files() {
+    // The output "folder" is a file: creating it fails, nothing else is written.
+    let dir = tempfile::tempdir().unwrap();
+    let blocker = dir.path().join("blocked");
+    std::fs::write(&blocker, b"a file").unwrap();
+    let out = snakeskin(&[
+        "generate",
+        PATTERNED,
+        "-o",
+        blocker.join("sub").to_str().unwrap(),
+        "--size",
+        "32",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert_eq!(snapshot(dir.path()).len(), 1);
+}

@@ -1,0 +1,277 @@
+//! End-to-end tests of the texture pipeline: the files and formats `generate` writes, what
+//! the graph evaluates, and that bad input changes nothing on disk.
+
+mod common;
+
+use std::collections::BTreeSet;
+
+use common::*;
+use image::{ColorType, ImageReader};
+use snakeskin::graph::evaluate;
+use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+use snakeskin::preset::{parse, read_source};
+
+fn patterned_graph() -> snakeskin::graph::Graph {
+    let loaded = parse(&read_source(PATTERNED).unwrap(), &[]).unwrap();
+    build_graph(&loaded.preset, BuildOptions::default())
+}
+
+fn is_color_only(name: &str) -> bool {
+    name.starts_with("color.") || name.starts_with("pattern") || name.starts_with("belly.")
+}
+
+#[test]
+fn generate_writes_five_maps_in_their_formats_and_a_manifest() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let run = snakeskin(&[
+        "generate",
+        "erythrolamprus-miliaris",
+        "-o",
+        out,
+        "--size",
+        "256",
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+
+    let expected = [
+        ("color", ColorType::Rgb8),
+        ("height", ColorType::L16),
+        ("normal", ColorType::Rgb8),
+        ("roughness", ColorType::L8),
+        ("iridescence", ColorType::L16),
+    ];
+    for (map, color_type) in expected {
+        let path = dir
+            .path()
+            .join(format!("erythrolamprus-miliaris_{map}.png"));
+        let image = ImageReader::open(&path).unwrap().decode().unwrap();
+        assert_eq!(image.color(), color_type, "{map}");
+        assert_eq!((image.width(), image.height()), (256, 256), "{map}");
+    }
+    let files = snapshot(dir.path());
+    assert_eq!(
+        files.len(),
+        6,
+        "five maps and a manifest: {:?}",
+        files.keys()
+    );
+
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&files[&dir.path().join("erythrolamprus-miliaris.material.json")])
+            .unwrap();
+    assert_eq!(manifest["preset"], "erythrolamprus-miliaris");
+    assert_eq!(manifest["width"], 256);
+    assert_eq!(manifest["seed"], 1);
+    assert_eq!(manifest["preset_hash"].as_str().unwrap().len(), 16);
+    assert_eq!(manifest["maps"].as_array().unwrap().len(), 5);
+    let depth = |m: &str| {
+        manifest["maps"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["map"] == m)
+            .unwrap()["bit_depth"]
+            .as_u64()
+            .unwrap()
+    };
+    assert_eq!(
+        (depth("color"), depth("height"), depth("iridescence")),
+        (8, 16, 16)
+    );
+    let (min_nm, max_nm) = (
+        manifest["iridescence"]["min_nm"].as_f64().unwrap(),
+        manifest["iridescence"]["max_nm"].as_f64().unwrap(),
+    );
+    assert!(
+        min_nm < 400.0 && max_nm > 400.0 && min_nm >= 0.0,
+        "{min_nm}..{max_nm}"
+    );
+    assert_eq!(manifest["optics"]["film_ior"], 1.55);
+}
+
+#[test]
+fn normal_map_decodes_to_unit_vectors_facing_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let run = snakeskin(&[
+        "generate", PATTERNED, "-o", out, "--size", "128", "--maps", "normal",
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let normal = ImageReader::open(dir.path().join("patterned_normal.png"))
+        .unwrap()
+        .decode()
+        .unwrap()
+        .to_rgb8();
+    for p in normal.pixels() {
+        let v = p.0.map(|c| c as f32 / 255.0 * 2.0 - 1.0);
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        // 8-bit quantisation moves each component by at most 1/255.
+        assert!((len - 1.0).abs() < 0.02, "length {len}");
+        assert!(v[2] > 0.0);
+    }
+}
+
+#[test]
+fn roughness_alone_writes_one_map_and_runs_no_colour_node() {
+    let graph = patterned_graph();
+    let only = evaluate(&graph, &[MapKind::Roughness], 64, 64, &|_, _| {});
+    assert!(!only.stats.nodes.is_empty());
+    let colour_nodes: Vec<&str> = only
+        .stats
+        .nodes
+        .iter()
+        .map(|n| n.name.as_str())
+        .filter(|n| is_color_only(n))
+        .collect();
+    assert!(
+        colour_nodes.is_empty(),
+        "roughness ran colour nodes: {colour_nodes:?}"
+    );
+    // The full set does run them, so the check above can fail.
+    let full = evaluate(&graph, &MapKind::ALL, 64, 64, &|_, _| {});
+    assert!(
+        full.stats
+            .nodes
+            .iter()
+            .any(|n| n.name.starts_with("pattern"))
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let run = snakeskin(&[
+        "generate",
+        PATTERNED,
+        "-o",
+        dir.path().to_str().unwrap(),
+        "--size",
+        "64",
+        "--maps",
+        "roughness",
+        "--stats",
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let files: Vec<String> = snapshot(dir.path())
+        .keys()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        files,
+        ["patterned.material.json", "patterned_roughness.png"]
+    );
+    let stats = stderr(&run);
+    assert!(stats.contains("roughness.out"), "{stats}");
+    assert!(
+        !stats
+            .lines()
+            .any(|l| is_color_only(l.split_whitespace().next().unwrap_or(""))),
+        "{stats}"
+    );
+}
+
+#[test]
+fn a_node_shared_by_two_maps_runs_once() {
+    let graph = patterned_graph();
+    let both = evaluate(
+        &graph,
+        &[MapKind::Height, MapKind::Roughness],
+        64,
+        64,
+        &|_, _| {},
+    );
+    // `scales` feeds height (through scales.height) and roughness (through scales.crevice).
+    assert_eq!(both.stats.get("scales").unwrap().evaluations, 1);
+    assert_eq!(both.stats.get("noise.grain").unwrap().evaluations, 1);
+    let all = evaluate(&graph, &MapKind::ALL, 64, 64, &|_, _| {});
+    assert!(all.stats.nodes.iter().all(|n| n.evaluations == 1));
+    // Each evaluated node appears once: as many entries as distinct names.
+    let names: BTreeSet<&str> = all.stats.nodes.iter().map(|n| n.name.as_str()).collect();
+    assert_eq!(names.len(), all.stats.nodes.len());
+    assert_eq!(all.stats.nodes.len(), graph.reachable(&MapKind::ALL).len());
+}
+
+/// Node names declared in a DOT digraph (lines of the form `"name" [label=...]`).
+fn dot_nodes(dot: &str) -> BTreeSet<String> {
+    dot.lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with('"') && l.contains("[label="))
+        .map(|l| l[1..].split('"').next().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn graph_dot_lists_exactly_the_evaluated_nodes() {
+    let graph = patterned_graph();
+    for maps in ["roughness", "color", "height,normal", "iridescence", "all"] {
+        let run = snakeskin(&["graph", PATTERNED, "--maps", maps, "--dot"]);
+        assert!(run.status.success(), "{}", stderr(&run));
+        let dot = stdout(&run);
+        assert!(dot.starts_with("digraph"), "{dot}");
+        let requested = snakeskin::parse_map_list(maps).unwrap();
+        let evaluated: BTreeSet<String> = evaluate(&graph, &requested, 32, 32, &|_, _| {})
+            .stats
+            .nodes
+            .into_iter()
+            .map(|n| n.name)
+            .collect();
+        assert_eq!(dot_nodes(&dot), evaluated, "maps {maps}");
+        // Every edge joins two declared nodes.
+        for line in dot.lines().filter(|l| l.contains("->")) {
+            let ends: Vec<&str> = line
+                .split('"')
+                .filter(|s| !s.trim().is_empty() && !s.contains("->") && !s.contains(';'))
+                .collect();
+            assert!(ends.iter().all(|e| evaluated.contains(*e)), "{line}");
+        }
+    }
+}
+
+#[test]
+fn same_bytes_for_any_thread_count_and_across_runs() {
+    let run = |threads: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let out = snakeskin_env(
+            &[
+                "generate",
+                PATTERNED,
+                "-o",
+                dir.path().to_str().unwrap(),
+                "--size",
+                "192",
+            ],
+            &[("RAYON_NUM_THREADS", threads)],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        snapshot(dir.path())
+            .into_iter()
+            .map(|(p, b)| (p.file_name().unwrap().to_owned(), b))
+            .collect::<Vec<_>>()
+    };
+    let one = run("1");
+    assert_eq!(one.len(), 6);
+    assert_eq!(one, run("2"));
+    assert_eq!(one, run("2"));
+}
+
+#[test]
+fn seed_changes_the_skin() {
+    let a = tempfile::tempdir().unwrap();
+    let b = tempfile::tempdir().unwrap();
+    for (dir, seed) in [(&a, "1"), (&b, "2")] {
+        let out = snakeskin(&[
+            "generate",
+            PATTERNED,
+            "-o",
+            dir.path().to_str().unwrap(),
+            "--size",
+            "64",
+            "--maps",
+            "height",
+            "--seed",
+            seed,
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let read =
+        |d: &tempfile::TempDir| std::fs::read(d.path().join("patterned_height.png")).unwrap();
+    assert_ne!(read(&a), read(&b));
+}
