@@ -1,1 +1,81 @@
-fn main() {}
+//! Criterion benchmarks of the texture pipeline: whole sets (generation + PNG encoding, no
+//! disk), a single map (to show demand-driven evaluation pays), and the heavy operations.
+//!
+//! Run: `cargo bench --bench pipeline` (add `-- full_set` etc. to pick groups).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use snakeskin::export::encode_all;
+use snakeskin::graph::{Op, evaluate};
+use snakeskin::maps::{BuildOptions, MapKind, build_graph, scale_field};
+use snakeskin::ops::filters;
+use snakeskin::ops::noise::{FractalNoise, NoiseKind};
+use snakeskin::preset::{LoadedPreset, parse, read_source};
+
+const PATTERNED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/patterned.toml");
+
+fn load() -> LoadedPreset {
+    parse(&read_source(PATTERNED).unwrap(), &[]).unwrap()
+}
+
+fn set(loaded: &LoadedPreset, maps: &[MapKind], size: usize) -> usize {
+    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    let eval = evaluate(&graph, maps, size, size, &|_, _| {});
+    encode_all(&loaded.name, &eval.maps)
+        .unwrap()
+        .iter()
+        .map(|(_, b)| b.len())
+        .sum()
+}
+
+fn sets(c: &mut Criterion) {
+    let loaded = load();
+    let mut group = c.benchmark_group("set_1024");
+    group.sample_size(10);
+    group.bench_function("all_maps", |b| b.iter(|| set(&loaded, &MapKind::ALL, 1024)));
+    group.bench_function("roughness_only", |b| {
+        b.iter(|| set(&loaded, &[MapKind::Roughness], 1024))
+    });
+    group.finish();
+}
+
+fn operations(c: &mut Criterion) {
+    let loaded = load();
+    let size = 1024;
+    let mut group = c.benchmark_group("ops_1024");
+    group.sample_size(10);
+    let field = scale_field(&loaded.preset);
+    group.bench_function("scales", |b| b.iter(|| field.render(size, size)));
+    for (name, kind) in [
+        ("perlin_4oct", NoiseKind::Perlin),
+        ("cellular_4oct", NoiseKind::Cellular),
+    ] {
+        let op = Op::Noise(FractalNoise {
+            kind,
+            cells_u: 8,
+            cells_v: 8,
+            octaves: 4,
+            gain: 0.5,
+            seed: 1,
+        });
+        group.bench_function(name, |b| b.iter(|| op.eval(&[], size, size)));
+    }
+    let noise = Op::Noise(FractalNoise {
+        kind: NoiseKind::Perlin,
+        cells_u: 8,
+        cells_v: 8,
+        octaves: 1,
+        gain: 0.5,
+        seed: 1,
+    })
+    .eval(&[], size, size);
+    group.bench_function("blur_sigma_0.005", |b| {
+        b.iter(|| filters::blur(&noise, 0.005))
+    });
+    group.bench_function("height_to_normal", |b| {
+        b.iter(|| filters::height_to_normal(&noise, 0.05, filters::NormalConvention::OpenGl))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, sets, operations);
+criterion_main!(benches);

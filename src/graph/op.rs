@@ -3,7 +3,7 @@
 
 use crate::ops::Image;
 use crate::ops::filters::{self, BlendMode, NormalConvention};
-use crate::ops::noise::{FractalNoise, NoiseKind, NoiseSampler};
+use crate::ops::noise::{FractalNoise, NoiseKind};
 use crate::ops::scales::ScaleField;
 use crate::ops::shapes::{self, SpotGrid};
 
@@ -53,10 +53,7 @@ impl Op {
     /// Evaluates the operation; `inputs` are in the node's input order.
     pub fn eval(&self, inputs: &[&Image], width: usize, height: usize) -> Image {
         match self {
-            Op::Noise(noise) => {
-                let sampler = NoiseSampler::new(noise);
-                Image::gray_from_fn(width, height, |u, v| sampler.sample(u, v))
-            }
+            Op::Noise(noise) => crate::ops::noise::render(noise, width, height),
             Op::Scales(field) => field.render(width, height),
             Op::Channel { index } => filters::extract_channel(inputs[0], *index),
             Op::Bands {

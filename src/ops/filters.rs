@@ -132,24 +132,24 @@ pub fn blur(input: &Image, sigma: f32) -> Image {
     let kernel = gaussian_kernel(sigma_px);
     let radius = (kernel.len() / 2) as isize;
     let (w, h, ch) = (input.width, input.height, input.channels);
-    // Horizontal pass.
+    // Horizontal pass over a row padded with its own wrap-around, so the inner loop is a
+    // plain dot product over contiguous memory.
     let mut tmp = Image::new(w, h, ch);
-    tmp.data
-        .par_chunks_mut(w * ch)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let src = input.row(y);
-            for x in 0..w {
-                for c in 0..ch {
-                    let mut acc = 0.0;
-                    for (k, weight) in kernel.iter().enumerate() {
-                        let sx = (x as isize + k as isize - radius).rem_euclid(w as isize) as usize;
-                        acc += weight * src[sx * ch + c];
-                    }
-                    row[x * ch + c] = acc;
+    tmp.data.par_chunks_mut(w * ch).enumerate().for_each(|(y, row)| {
+        let src = input.row(y);
+        let r = radius as usize;
+        let padded: Vec<f32> =
+            (0..(w + 2 * r) * ch).map(|i| src[((i / ch) as isize - radius).rem_euclid(w as isize) as usize * ch + i % ch]).collect();
+        for x in 0..w {
+            for c in 0..ch {
+                let mut acc = 0.0;
+                for (k, weight) in kernel.iter().enumerate() {
+                    acc += weight * padded[(x + k) * ch + c];
                 }
+                row[x * ch + c] = acc;
             }
-        });
+        }
+    });
     // Vertical pass: accumulate whole rows so memory is read sequentially.
     let mut out = Image::new(w, h, ch);
     out.data
@@ -164,6 +164,22 @@ pub fn blur(input: &Image, sigma: f32) -> Image {
             }
         });
     out
+}
+
+/// Bilinear resampling of a periodic image whose sample (i, j) sits at (i / w, j / h).
+pub fn resample_bilinear_wrapped(src: &Image, width: usize, height: usize) -> Image {
+    let (sw, sh) = (src.width as f32, src.height as f32);
+    Image::from_fn(width, height, src.channels, |u, v, out| {
+        let (x, y) = (u * sw, v * sh);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as isize, y0 as isize);
+        for (c, o) in out.iter_mut().enumerate() {
+            let a = src.at_wrapped(x0, y0, c) + (src.at_wrapped(x0 + 1, y0, c) - src.at_wrapped(x0, y0, c)) * fx;
+            let b = src.at_wrapped(x0, y0 + 1, c) + (src.at_wrapped(x0 + 1, y0 + 1, c) - src.at_wrapped(x0, y0 + 1, c)) * fx;
+            *o = a + (b - a) * fy;
+        }
+    })
 }
 
 /// Sobel gradient magnitude of channel 0, wrap-around. The result is normalised so that a

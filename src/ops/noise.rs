@@ -15,6 +15,7 @@ use std::f32::consts::FRAC_1_SQRT_2;
 use noise::permutationtable::{NoiseHasher, PermutationTable};
 
 use super::hash;
+use super::image::Image;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum NoiseKind {
@@ -72,105 +73,133 @@ fn quintic(t: f32) -> f32 {
     t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
 }
 
-/// Periodic 2D gradient noise in about [-1, 1]; (x, y) in lattice units, periods in cells.
-#[inline]
-pub fn perlin_periodic(
-    table: &PermutationTable,
-    x: f32,
-    y: f32,
+/// One octave's lattice: a gradient (Perlin) or feature point (cellular) per cell, drawn once
+/// so the per-pixel loop does table lookups instead of hashing.
+struct Octave {
     period_x: i32,
     period_y: i32,
-) -> f32 {
-    let (xf, yf) = (x.floor(), y.floor());
-    let (ix, iy) = (xf as i32, yf as i32);
-    let (fx, fy) = (x - xf, y - yf);
-    let x0 = ix.rem_euclid(period_x) as isize;
-    let y0 = iy.rem_euclid(period_y) as isize;
-    let x1 = (ix + 1).rem_euclid(period_x) as isize;
-    let y1 = (iy + 1).rem_euclid(period_y) as isize;
-    let dot = |cx: isize, cy: isize, dx: f32, dy: f32| {
-        let g = GRADIENTS[table.hash(&[cx, cy]) & 15];
-        g[0] * dx + g[1] * dy
-    };
-    let n00 = dot(x0, y0, fx, fy);
-    let n10 = dot(x1, y0, fx - 1.0, fy);
-    let n01 = dot(x0, y1, fx, fy - 1.0);
-    let n11 = dot(x1, y1, fx - 1.0, fy - 1.0);
-    let (sx, sy) = (quintic(fx), quintic(fy));
-    let nx0 = n00 + sx * (n10 - n00);
-    let nx1 = n01 + sx * (n11 - n01);
-    // 2D gradient noise with unit gradients peaks at sqrt(2)/2; scale to about [-1, 1].
-    (nx0 + sy * (nx1 - nx0)) * std::f32::consts::SQRT_2
+    /// Per cell, row-major: a unit gradient, or a feature point's offset in [0, 1)².
+    cells: Vec<[f32; 2]>,
 }
 
-/// Periodic Worley F1 distance in lattice units (0 at a feature point, about 0..1).
-#[inline]
-pub fn cellular_periodic(seed: u32, x: f32, y: f32, period_x: i32, period_y: i32) -> f32 {
-    let (ix, iy) = (x.floor() as i32, y.floor() as i32);
-    let mut best = f32::MAX;
-    for dy in -1..=1 {
-        for dx in -1..=1 {
-            let (cx, cy) = (ix + dx, iy + dy);
-            let (wx, wy) = (cx.rem_euclid(period_x), cy.rem_euclid(period_y));
-            let px = cx as f32 + hash::unit(wx, wy, 0, seed);
-            let py = cy as f32 + hash::unit(wx, wy, 1, seed);
-            let d2 = (px - x) * (px - x) + (py - y) * (py - y);
-            best = best.min(d2);
+impl Octave {
+    fn new(kind: NoiseKind, period_x: i32, period_y: i32, seed: u32) -> Self {
+        let table = PermutationTable::new(seed);
+        let mut cells = Vec::with_capacity((period_x * period_y) as usize);
+        for y in 0..period_y {
+            for x in 0..period_x {
+                cells.push(match kind {
+                    // The `noise` crate's seeded permutation picks the gradient, as in its Perlin.
+                    NoiseKind::Perlin => GRADIENTS[table.hash(&[x as isize, y as isize]) & 15],
+                    NoiseKind::Cellular => [hash::unit(x, y, 0, seed), hash::unit(x, y, 1, seed)],
+                });
+            }
         }
+        Octave { period_x, period_y, cells }
     }
-    best.sqrt()
+
+    #[inline]
+    fn cell(&self, x: i32, y: i32) -> [f32; 2] {
+        self.cells[(y.rem_euclid(self.period_y) * self.period_x + x.rem_euclid(self.period_x)) as usize]
+    }
+
+    /// Periodic 2D gradient noise in about [-1, 1]; (x, y) in lattice units.
+    #[inline]
+    fn perlin(&self, x: f32, y: f32) -> f32 {
+        let (xf, yf) = (x.floor(), y.floor());
+        let (ix, iy) = (xf as i32, yf as i32);
+        let (fx, fy) = (x - xf, y - yf);
+        let dot = |cx: i32, cy: i32, dx: f32, dy: f32| {
+            let g = self.cell(cx, cy);
+            g[0] * dx + g[1] * dy
+        };
+        let n00 = dot(ix, iy, fx, fy);
+        let n10 = dot(ix + 1, iy, fx - 1.0, fy);
+        let n01 = dot(ix, iy + 1, fx, fy - 1.0);
+        let n11 = dot(ix + 1, iy + 1, fx - 1.0, fy - 1.0);
+        let (sx, sy) = (quintic(fx), quintic(fy));
+        let nx0 = n00 + sx * (n10 - n00);
+        let nx1 = n01 + sx * (n11 - n01);
+        // 2D gradient noise with unit gradients peaks at sqrt(2)/2; scale to about [-1, 1].
+        (nx0 + sy * (nx1 - nx0)) * std::f32::consts::SQRT_2
+    }
+
+    /// Periodic Worley F1 distance in lattice units (0 at a feature point, about 0..1).
+    #[inline]
+    fn cellular(&self, x: f32, y: f32) -> f32 {
+        let (ix, iy) = (x.floor() as i32, y.floor() as i32);
+        let mut best = f32::MAX;
+        for cy in iy - 1..=iy + 1 {
+            for cx in ix - 1..=ix + 1 {
+                let p = self.cell(cx, cy);
+                let (dx, dy) = (cx as f32 + p[0] - x, cy as f32 + p[1] - y);
+                best = best.min(dx * dx + dy * dy);
+            }
+        }
+        best.sqrt()
+    }
 }
 
-/// Precomputed per-octave state; build once per node evaluation.
+/// Precomputed per-octave lattices; build once per node evaluation.
 pub struct NoiseSampler {
-    noise: FractalNoise,
-    tables: Vec<PermutationTable>,
+    kind: NoiseKind,
+    octaves: Vec<Octave>,
+    amplitudes: Vec<f32>,
     norm: f32,
 }
 
 impl NoiseSampler {
     pub fn new(noise: &FractalNoise) -> Self {
-        let octaves = noise.octaves.max(1);
-        let tables = (0..octaves)
-            .map(|o| PermutationTable::new(noise.seed.wrapping_add(o * 0x9e37)))
+        let count = noise.octaves.max(1);
+        let octaves = (0..count)
+            .map(|o| {
+                let (pu, pv) = ((noise.cells_u.max(1) << o) as i32, (noise.cells_v.max(1) << o) as i32);
+                Octave::new(noise.kind, pu, pv, noise.seed.wrapping_add(o.wrapping_mul(0x9e37)))
+            })
             .collect();
-        let norm = (0..octaves)
-            .map(|o| noise.gain.powi(o as i32))
-            .sum::<f32>()
-            .max(1e-6);
-        NoiseSampler {
-            noise: noise.clone(),
-            tables,
-            norm,
-        }
+        let amplitudes: Vec<f32> = (0..count).map(|o| noise.gain.powi(o as i32)).collect();
+        let norm = amplitudes.iter().sum::<f32>().max(1e-6);
+        NoiseSampler { kind: noise.kind, octaves, amplitudes, norm }
     }
 
     /// Fractal noise at texture coordinate (u, v), in [0, 1].
     #[inline]
     pub fn sample(&self, u: f32, v: f32) -> f32 {
-        let n = &self.noise;
         let mut total = 0.0;
-        let mut amplitude = 1.0;
-        for (o, table) in self.tables.iter().enumerate() {
-            let (pu, pv) = (
-                (n.cells_u.max(1) << o) as i32,
-                (n.cells_v.max(1) << o) as i32,
-            );
-            let value = match n.kind {
-                NoiseKind::Perlin => {
-                    perlin_periodic(table, u * pu as f32, v * pv as f32, pu, pv) * 0.5 + 0.5
-                }
-                NoiseKind::Cellular => cellular_periodic(
-                    n.seed.wrapping_add(o as u32),
-                    u * pu as f32,
-                    v * pv as f32,
-                    pu,
-                    pv,
-                ),
+        for (octave, amplitude) in self.octaves.iter().zip(&self.amplitudes) {
+            let (x, y) = (u * octave.period_x as f32, v * octave.period_y as f32);
+            let value = match self.kind {
+                NoiseKind::Perlin => octave.perlin(x, y) * 0.5 + 0.5,
+                NoiseKind::Cellular => octave.cellular(x, y),
             };
             total += value * amplitude;
-            amplitude *= n.gain;
         }
         (total / self.norm).clamp(0.0, 1.0)
     }
+
+    /// Lattice cells per tile of the finest octave, around and along.
+    pub fn finest_periods(&self) -> (u32, u32) {
+        self.octaves.last().map_or((1, 1), |o| (o.period_x as u32, o.period_y as u32))
+    }
+}
+
+/// Pixels per lattice cell of the finest octave at which a noise is sampled before it is
+/// upsampled. The quintic-interpolated lattice is smooth within a cell, so bilinear
+/// interpolation from 8 samples per cell changes values by well under one 8-bit step for
+/// the (already weakest) finest octave; coarse noise then costs a fraction of full
+/// resolution, and every output size sees the same samples (resolution independence).
+pub const SAMPLES_PER_CELL: u32 = 8;
+
+/// Renders fractal noise at `width` × `height`, sampling at most `SAMPLES_PER_CELL` per
+/// finest-octave cell and upsampling bilinearly (wrap-around) when that is coarser.
+pub fn render(noise: &FractalNoise, width: usize, height: usize) -> Image {
+    let sampler = NoiseSampler::new(noise);
+    let (pu, pv) = sampler.finest_periods();
+    let (cw, ch) = ((pu * SAMPLES_PER_CELL) as usize, (pv * SAMPLES_PER_CELL) as usize);
+    if cw >= width || ch >= height {
+        return Image::gray_from_fn(width, height, |u, v| sampler.sample(u, v));
+    }
+    // Sample on a coarse grid whose points are at i / cw (not pixel centres), then interpolate.
+    let coarse = Image::gray_from_fn(cw, ch, |u, v| sampler.sample(u - 0.5 / cw as f32, v - 0.5 / ch as f32));
+    super::filters::resample_bilinear_wrapped(&coarse, width, height)
 }

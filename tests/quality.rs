@@ -1,0 +1,93 @@
+//! Quality properties of the maps themselves: seamless tiling and value ranges.
+
+mod common;
+
+use common::PATTERNED;
+use snakeskin::graph::evaluate;
+use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+use snakeskin::ops::Image;
+use snakeskin::preset::{library, parse, read_source};
+
+/// Mean absolute difference between rows `a` and `b` (all channels).
+fn row_jump(img: &Image, a: usize, b: usize) -> f64 {
+    let (ra, rb) = (img.row(a), img.row(b));
+    ra.iter()
+        .zip(rb)
+        .map(|(x, y)| (x - y).abs() as f64)
+        .sum::<f64>()
+        / ra.len() as f64
+}
+
+fn transpose(img: &Image) -> Image {
+    let mut t = Image::new(img.height, img.width, img.channels);
+    for y in 0..img.height {
+        for x in 0..img.width {
+            for c in 0..img.channels {
+                t.data[(x * img.height + y) * img.channels + c] =
+                    img.data[(y * img.width + x) * img.channels + c];
+            }
+        }
+    }
+    t
+}
+
+/// Asserts the seam (last row → first row) jumps no more than 1.5× the larger of the jumps
+/// just beside it and the mean jump between neighbouring rows.
+fn assert_rows_seamless(img: &Image, what: &str) {
+    let n = img.height;
+    let seam = row_jump(img, n - 1, 0);
+    let beside = row_jump(img, 0, 1).max(row_jump(img, n - 2, n - 1));
+    let mean = (0..n - 1).map(|y| row_jump(img, y, y + 1)).sum::<f64>() / (n - 1) as f64;
+    let limit = 1.5 * beside.max(mean);
+    assert!(
+        seam <= limit,
+        "{what}: seam jump {seam:.5} > 1.5 × max(beside {beside:.5}, mean {mean:.5})"
+    );
+}
+
+#[test]
+fn every_preset_and_map_tiles_seamlessly() {
+    let mut specs: Vec<String> = library::names().iter().map(|s| s.to_string()).collect();
+    specs.push(PATTERNED.to_string());
+    for spec in specs {
+        let loaded = parse(&read_source(&spec).unwrap(), &[]).unwrap();
+        let graph = build_graph(&loaded.preset, BuildOptions::default());
+        let eval = evaluate(&graph, &MapKind::ALL, 256, 256, &|_, _| {});
+        for (map, img) in &eval.maps {
+            assert_rows_seamless(img, &format!("{spec} {map} rows"));
+            assert_rows_seamless(&transpose(img), &format!("{spec} {map} columns"));
+        }
+    }
+}
+
+#[test]
+fn a_shifted_copy_shows_the_seam_check_would_fail() {
+    // A texture cut out of a larger non-periodic pattern has a visible seam.
+    let img = Image::gray_from_fn(64, 64, |u, v| (u * 3.3).sin() * 0.5 + v * 0.9);
+    let result = std::panic::catch_unwind(|| assert_rows_seamless(&img, "gradient"));
+    assert!(result.is_err(), "a v-gradient must fail the seam check");
+}
+
+#[test]
+fn map_values_stay_in_range() {
+    let loaded = parse(&read_source(PATTERNED).unwrap(), &[]).unwrap();
+    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    let eval = evaluate(&graph, &MapKind::ALL, 128, 128, &|_, _| {});
+    for (map, img) in &eval.maps {
+        let (lo, hi) = if *map == MapKind::Normal {
+            (-1.0, 1.0)
+        } else {
+            (0.0, 1.0)
+        };
+        assert!(
+            img.data
+                .iter()
+                .all(|v| v.is_finite() && (lo..=hi).contains(v)),
+            "{map} out of [{lo}, {hi}]"
+        );
+    }
+    let height = &eval.maps[&MapKind::Height];
+    let spread = height.data.iter().cloned().fold(f32::MIN, f32::max)
+        - height.data.iter().cloned().fold(f32::MAX, f32::min);
+    assert!(spread > 0.5, "height uses its range: {spread}");
+}
