@@ -85,8 +85,10 @@ fn set_overrides_change_the_output_like_editing_the_file() {
 #[test]
 fn docs_presets_md_documents_every_key() {
     // Every key of a fully populated preset must appear in the docs, as `key`.
-    let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/presets.md")).unwrap();
-    let preset: snakeskin::preset::Preset = toml::from_str(&std::fs::read_to_string(PATTERNED).unwrap()).unwrap();
+    let docs =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/presets.md")).unwrap();
+    let preset: snakeskin::preset::Preset =
+        toml::from_str(&std::fs::read_to_string(PATTERNED).unwrap()).unwrap();
     let mut full = toml::Table::try_from(&preset).unwrap();
     full.insert("species".into(), "x".into());
     full.insert("common_name".into(), "x".into());
@@ -96,7 +98,10 @@ fn docs_presets_md_documents_every_key() {
             out.push(k.clone());
             match v {
                 toml::Value::Table(t) => keys(t, out),
-                toml::Value::Array(items) => items.iter().filter_map(|i| i.as_table()).for_each(|t| keys(t, out)),
+                toml::Value::Array(items) => items
+                    .iter()
+                    .filter_map(|i| i.as_table())
+                    .for_each(|t| keys(t, out)),
                 _ => {}
             }
         }
@@ -105,6 +110,11 @@ fn docs_presets_md_documents_every_key() {
     keys(&full, &mut all);
     assert!(all.len() > 40, "walked the schema: {all:?}");
     for key in all {
-        assert!(docs.contains(&format!("`{key}`")) || docs.contains(&format!("[{key}]")) || docs.contains(&format!("[[{key}]]")), "docs/presets.md lacks `{key}`");
+        assert!(
+            docs.contains(&format!("`{key}`"))
+                || docs.contains(&format!("[{key}]"))
+                || docs.contains(&format!("[[{key}]]")),
+            "docs/presets.md lacks `{key}`"
+        );
     }
 }

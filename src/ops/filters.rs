@@ -135,21 +135,27 @@ pub fn blur(input: &Image, sigma: f32) -> Image {
     // Horizontal pass over a row padded with its own wrap-around, so the inner loop is a
     // plain dot product over contiguous memory.
     let mut tmp = Image::new(w, h, ch);
-    tmp.data.par_chunks_mut(w * ch).enumerate().for_each(|(y, row)| {
-        let src = input.row(y);
-        let r = radius as usize;
-        let padded: Vec<f32> =
-            (0..(w + 2 * r) * ch).map(|i| src[((i / ch) as isize - radius).rem_euclid(w as isize) as usize * ch + i % ch]).collect();
-        for x in 0..w {
-            for c in 0..ch {
-                let mut acc = 0.0;
-                for (k, weight) in kernel.iter().enumerate() {
-                    acc += weight * padded[(x + k) * ch + c];
+    tmp.data
+        .par_chunks_mut(w * ch)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let src = input.row(y);
+            let r = radius as usize;
+            let padded: Vec<f32> = (0..(w + 2 * r) * ch)
+                .map(|i| {
+                    src[((i / ch) as isize - radius).rem_euclid(w as isize) as usize * ch + i % ch]
+                })
+                .collect();
+            for x in 0..w {
+                for c in 0..ch {
+                    let mut acc = 0.0;
+                    for (k, weight) in kernel.iter().enumerate() {
+                        acc += weight * padded[(x + k) * ch + c];
+                    }
+                    row[x * ch + c] = acc;
                 }
-                row[x * ch + c] = acc;
             }
-        }
-    });
+        });
     // Vertical pass: accumulate whole rows so memory is read sequentially.
     let mut out = Image::new(w, h, ch);
     out.data
@@ -175,8 +181,10 @@ pub fn resample_bilinear_wrapped(src: &Image, width: usize, height: usize) -> Im
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as isize, y0 as isize);
         for (c, o) in out.iter_mut().enumerate() {
-            let a = src.at_wrapped(x0, y0, c) + (src.at_wrapped(x0 + 1, y0, c) - src.at_wrapped(x0, y0, c)) * fx;
-            let b = src.at_wrapped(x0, y0 + 1, c) + (src.at_wrapped(x0 + 1, y0 + 1, c) - src.at_wrapped(x0, y0 + 1, c)) * fx;
+            let a = src.at_wrapped(x0, y0, c)
+                + (src.at_wrapped(x0 + 1, y0, c) - src.at_wrapped(x0, y0, c)) * fx;
+            let b = src.at_wrapped(x0, y0 + 1, c)
+                + (src.at_wrapped(x0 + 1, y0 + 1, c) - src.at_wrapped(x0, y0 + 1, c)) * fx;
             *o = a + (b - a) * fy;
         }
     })

@@ -90,3 +90,12 @@ impl Image {
         &self.data[y * stride..(y + 1) * stride]
     }
 }
+
+/// `x.floor() as i32` without a libm call: x86-64's baseline has no SSE4.1 `roundss`, so
+/// `f32::floor` is a function call, and the lattice kernels floor several times per pixel.
+/// Exact for |x| < 2³¹.
+#[inline(always)]
+pub fn floor_i32(x: f32) -> i32 {
+    let i = x as i32;
+    if (i as f32) > x { i - 1 } else { i }
+}

@@ -15,7 +15,7 @@ use std::f32::consts::FRAC_1_SQRT_2;
 use noise::permutationtable::{NoiseHasher, PermutationTable};
 
 use super::hash;
-use super::image::Image;
+use super::image::{Image, floor_i32};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum NoiseKind {
@@ -95,28 +95,40 @@ impl Octave {
                 });
             }
         }
-        Octave { period_x, period_y, cells }
+        Octave {
+            period_x,
+            period_y,
+            cells,
+        }
     }
 
     #[inline]
-    fn cell(&self, x: i32, y: i32) -> [f32; 2] {
-        self.cells[(y.rem_euclid(self.period_y) * self.period_x + x.rem_euclid(self.period_x)) as usize]
+    fn cell(&self, wrapped_x: i32, wrapped_y: i32) -> [f32; 2] {
+        self.cells[(wrapped_y * self.period_x + wrapped_x) as usize]
+    }
+
+    /// Wraps a lattice coordinate and its successor into [0, period) with one division.
+    #[inline]
+    fn wrap_pair(i: i32, period: i32) -> (i32, i32) {
+        let w = i.rem_euclid(period);
+        (w, if w + 1 == period { 0 } else { w + 1 })
     }
 
     /// Periodic 2D gradient noise in about [-1, 1]; (x, y) in lattice units.
     #[inline]
     fn perlin(&self, x: f32, y: f32) -> f32 {
-        let (xf, yf) = (x.floor(), y.floor());
-        let (ix, iy) = (xf as i32, yf as i32);
-        let (fx, fy) = (x - xf, y - yf);
+        let (ix, iy) = (floor_i32(x), floor_i32(y));
+        let (fx, fy) = (x - ix as f32, y - iy as f32);
+        let (x0, x1) = Self::wrap_pair(ix, self.period_x);
+        let (y0, y1) = Self::wrap_pair(iy, self.period_y);
         let dot = |cx: i32, cy: i32, dx: f32, dy: f32| {
             let g = self.cell(cx, cy);
             g[0] * dx + g[1] * dy
         };
-        let n00 = dot(ix, iy, fx, fy);
-        let n10 = dot(ix + 1, iy, fx - 1.0, fy);
-        let n01 = dot(ix, iy + 1, fx, fy - 1.0);
-        let n11 = dot(ix + 1, iy + 1, fx - 1.0, fy - 1.0);
+        let n00 = dot(x0, y0, fx, fy);
+        let n10 = dot(x1, y0, fx - 1.0, fy);
+        let n01 = dot(x0, y1, fx, fy - 1.0);
+        let n11 = dot(x1, y1, fx - 1.0, fy - 1.0);
         let (sx, sy) = (quintic(fx), quintic(fy));
         let nx0 = n00 + sx * (n10 - n00);
         let nx1 = n01 + sx * (n11 - n01);
@@ -127,13 +139,25 @@ impl Octave {
     /// Periodic Worley F1 distance in lattice units (0 at a feature point, about 0..1).
     #[inline]
     fn cellular(&self, x: f32, y: f32) -> f32 {
-        let (ix, iy) = (x.floor() as i32, y.floor() as i32);
+        let (ix, iy) = (floor_i32(x), floor_i32(y));
+        let (px, py) = (self.period_x, self.period_y);
+        let wrap = |i: i32, p: i32| {
+            if i < 0 {
+                i + p
+            } else if i >= p {
+                i - p
+            } else {
+                i
+            }
+        };
+        let (wx, wy) = (ix.rem_euclid(px), iy.rem_euclid(py));
         let mut best = f32::MAX;
-        for cy in iy - 1..=iy + 1 {
-            for cx in ix - 1..=ix + 1 {
-                let p = self.cell(cx, cy);
-                let (dx, dy) = (cx as f32 + p[0] - x, cy as f32 + p[1] - y);
-                best = best.min(dx * dx + dy * dy);
+        for dy in -1..=1 {
+            let cy = wrap(wy + dy, py);
+            for dx in -1..=1 {
+                let p = self.cell(wrap(wx + dx, px), cy);
+                let (ddx, ddy) = ((ix + dx) as f32 + p[0] - x, (iy + dy) as f32 + p[1] - y);
+                best = best.min(ddx * ddx + ddy * ddy);
             }
         }
         best.sqrt()
@@ -153,13 +177,26 @@ impl NoiseSampler {
         let count = noise.octaves.max(1);
         let octaves = (0..count)
             .map(|o| {
-                let (pu, pv) = ((noise.cells_u.max(1) << o) as i32, (noise.cells_v.max(1) << o) as i32);
-                Octave::new(noise.kind, pu, pv, noise.seed.wrapping_add(o.wrapping_mul(0x9e37)))
+                let (pu, pv) = (
+                    (noise.cells_u.max(1) << o) as i32,
+                    (noise.cells_v.max(1) << o) as i32,
+                );
+                Octave::new(
+                    noise.kind,
+                    pu,
+                    pv,
+                    noise.seed.wrapping_add(o.wrapping_mul(0x9e37)),
+                )
             })
             .collect();
         let amplitudes: Vec<f32> = (0..count).map(|o| noise.gain.powi(o as i32)).collect();
         let norm = amplitudes.iter().sum::<f32>().max(1e-6);
-        NoiseSampler { kind: noise.kind, octaves, amplitudes, norm }
+        NoiseSampler {
+            kind: noise.kind,
+            octaves,
+            amplitudes,
+            norm,
+        }
     }
 
     /// Fractal noise at texture coordinate (u, v), in [0, 1].
@@ -179,7 +216,9 @@ impl NoiseSampler {
 
     /// Lattice cells per tile of the finest octave, around and along.
     pub fn finest_periods(&self) -> (u32, u32) {
-        self.octaves.last().map_or((1, 1), |o| (o.period_x as u32, o.period_y as u32))
+        self.octaves
+            .last()
+            .map_or((1, 1), |o| (o.period_x as u32, o.period_y as u32))
     }
 }
 
@@ -195,11 +234,16 @@ pub const SAMPLES_PER_CELL: u32 = 8;
 pub fn render(noise: &FractalNoise, width: usize, height: usize) -> Image {
     let sampler = NoiseSampler::new(noise);
     let (pu, pv) = sampler.finest_periods();
-    let (cw, ch) = ((pu * SAMPLES_PER_CELL) as usize, (pv * SAMPLES_PER_CELL) as usize);
+    let (cw, ch) = (
+        (pu * SAMPLES_PER_CELL) as usize,
+        (pv * SAMPLES_PER_CELL) as usize,
+    );
     if cw >= width || ch >= height {
         return Image::gray_from_fn(width, height, |u, v| sampler.sample(u, v));
     }
     // Sample on a coarse grid whose points are at i / cw (not pixel centres), then interpolate.
-    let coarse = Image::gray_from_fn(cw, ch, |u, v| sampler.sample(u - 0.5 / cw as f32, v - 0.5 / ch as f32));
+    let coarse = Image::gray_from_fn(cw, ch, |u, v| {
+        sampler.sample(u - 0.5 / cw as f32, v - 0.5 / ch as f32)
+    });
     super::filters::resample_bilinear_wrapped(&coarse, width, height)
 }

@@ -20,7 +20,7 @@
 //! per-pixel loop does lookups, not hashing.
 
 use super::hash;
-use super::image::Image;
+use super::image::{Image, floor_i32};
 
 /// Channel layout of the scale field.
 pub mod channel {
@@ -107,7 +107,6 @@ struct CellJitter {
 struct CellTable {
     cells: Vec<CellJitter>,
     cols: i32,
-    rows_v: i32,
 }
 
 impl CellTable {
@@ -132,13 +131,7 @@ impl CellTable {
         CellTable {
             cells,
             cols: lattice.cols,
-            rows_v: lattice.rows_v,
         }
-    }
-
-    #[inline]
-    fn get(&self, c: i32, r: i32) -> &CellJitter {
-        &self.cells[(r.rem_euclid(self.rows_v) * self.cols + c.rem_euclid(self.cols)) as usize]
     }
 }
 
@@ -200,7 +193,8 @@ impl ScaleField {
         })
     }
 
-    /// Lattice position of the jittered centre of cell (c, r), c unwrapped.
+    /// Lattice position of the jittered centre of cell (c, r), c unwrapped by at most one
+    /// period (the callers look one column either side of a pixel's column).
     #[inline]
     fn centre<'t>(
         &self,
@@ -210,9 +204,24 @@ impl ScaleField {
         r: i32,
     ) -> (f32, f32, &'t CellJitter) {
         let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
-        // Row index of the same physical cell in the wrapped column.
-        let wrapped_row = r + lattice.stagger * c.div_euclid(lattice.cols);
-        let cell = table.get(c, wrapped_row);
+        // The same physical cell in the wrapped column: column -1 is column cols - 1 shifted
+        // by one stagger, column cols is column 0 shifted back (no integer division: this
+        // runs nine times per pixel).
+        let (wc, wr) = if c < 0 {
+            (c + lattice.cols, r - lattice.stagger)
+        } else if c >= lattice.cols {
+            (c - lattice.cols, r + lattice.stagger)
+        } else {
+            (c, r)
+        };
+        let mut wr = wr;
+        while wr < 0 {
+            wr += lattice.rows_v;
+        }
+        while wr >= lattice.rows_v {
+            wr -= lattice.rows_v;
+        }
+        let cell = &table.cells[(wr * table.cols + wc) as usize];
         (
             c as f32 + 0.5 + cell.dx,
             r as f32 + 0.5 + shift + cell.dy,
@@ -229,28 +238,32 @@ impl ScaleField {
     ) -> impl Iterator<Item = Candidate> {
         let x = u * lattice.cols as f32;
         let y = v * lattice.rows_v as f32;
-        let c0 = x.floor() as i32;
+        let c0 = floor_i32(x);
         let b = 0.5 * lattice.aspect;
         let shape = self.shape;
         (-1..=1).flat_map(move |dc| {
             let c = c0 + dc;
             let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
-            let r0 = (y - shift).floor() as i32;
-            (-1..=1).map(move |dr| {
+            let r0 = floor_i32(y - shift);
+            (-1..=1).filter_map(move |dr| {
                 let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
                 // To isotropic units (scale widths), rotate by the jitter angle, scale by size.
                 let px = x - cx;
                 let py = (y - cy) * lattice.aspect;
                 let lx = (px * cell.cos + py * cell.sin) * cell.inv_size;
                 let ly = (-px * cell.sin + py * cell.cos) * cell.inv_size;
+                // Every shape lies inside its |x| < 0.5, |y| < b box: skip the distance there.
+                if lx.abs() >= 0.5 || ly.abs() >= b {
+                    return None;
+                }
                 let inside = inside_distance(shape, lx, ly, b) / cell.inv_size;
-                Candidate {
+                Some(Candidate {
                     inside,
                     x: lx,
                     y: ly,
                     half_len: b,
                     random: cell.random,
-                }
+                })
             })
         })
     }
@@ -287,13 +300,13 @@ impl ScaleField {
         // nearest bisector with any other centre is the distance to the cell's edge.
         let x = u * lattice.cols as f32;
         let y = v * lattice.rows_v as f32;
-        let c0 = x.floor() as i32;
+        let c0 = floor_i32(x);
         let mut centres = [(0.0f32, 0.0f32, 0.0f32, 1.0f32, 0.0f32); 9];
         let mut n = 0;
         for dc in -1..=1 {
             let c = c0 + dc;
             let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
-            let r0 = (y - shift).floor() as i32;
+            let r0 = floor_i32(y - shift);
             for dr in -1..=1 {
                 let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
                 // Isotropic coordinates: along-body distances scaled by the cell aspect.
@@ -384,7 +397,7 @@ impl ScaleField {
         // Distances in dorsal scale widths, the unit of `edge_softness`.
         let to_side = (half_band - dist_belly) * lattice.cols as f32;
         let y = v * lattice.rows_v as f32;
-        let r0 = y.floor() as i32;
+        let r0 = floor_i32(y);
         let half_len = 0.5 * self.size.max(0.5);
         let mut best: Option<(f32, Candidate)> = None;
         for r in r0 - 1..=r0 + 1 {
