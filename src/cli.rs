@@ -24,6 +24,11 @@ pub enum Command {
     Generate(GenerateArgs),
     /// Print the node graph the requested maps need.
     Graph(GraphArgs),
+    /// Query the optics: exact thin-film reflectance and film colour (JSON output).
+    Brdf {
+        #[command(subcommand)]
+        command: BrdfCommand,
+    },
     /// List or show the built-in species presets.
     Presets {
         #[command(subcommand)]
@@ -96,4 +101,54 @@ fn parse_key_value(arg: &str) -> Result<(String, String), String> {
         return Err(format!("empty key in {arg:?}"));
     }
     Ok((key.trim().to_string(), value.trim().to_string()))
+}
+
+#[derive(Debug, Args)]
+pub struct StackArgs {
+    /// Refractive index of the ambient medium (thesis n0).
+    #[arg(long, default_value_t = 1.0)]
+    pub n0: f64,
+    /// Refractive index of the iridescent film (thesis n1).
+    #[arg(long, default_value_t = 1.55)]
+    pub n1: f64,
+    /// Refractive index of the pigment layer under the film (thesis n2).
+    #[arg(long, default_value_t = 2.0)]
+    pub n2: f64,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum BrdfCommand {
+    /// The exact coherent film at one wavelength: {"rs","rp","r","ts","tp","t"}.
+    Film {
+        #[command(flatten)]
+        stack: StackArgs,
+        /// Film thickness in nm (thesis δ0).
+        #[arg(long, required_unless_present = "batch")]
+        thickness_nm: Option<f64>,
+        /// Vacuum wavelength in nm.
+        #[arg(long, required_unless_present = "batch")]
+        wavelength_nm: Option<f64>,
+        /// Incidence angle in the ambient medium, degrees (0 = normal).
+        #[arg(long, required_unless_present = "batch")]
+        angle_deg: Option<f64>,
+        /// Read JSON lines {n0, n1, n2, thickness_nm, wavelength_nm, angle_deg} from FILE
+        /// (or - for stdin); print one JSON line per query, in order.
+        #[arg(long, value_name = "FILE")]
+        batch: Option<String>,
+    },
+    /// The film's reflectance colour in linear sRGB under D65: {"rgb":[r,g,b]}.
+    Color {
+        #[command(flatten)]
+        stack: StackArgs,
+        #[arg(long, required_unless_present = "batch")]
+        thickness_nm: Option<f64>,
+        #[arg(long, required_unless_present = "batch")]
+        angle_deg: Option<f64>,
+        /// Colour method; `spectral` is the 1 nm reference of PHYSICS.md.
+        #[arg(long, default_value = "spectral")]
+        method: String,
+        /// JSON lines {n0, n1, n2, thickness_nm, angle_deg, method}.
+        #[arg(long, value_name = "FILE")]
+        batch: Option<String>,
+    },
 }

@@ -10,6 +10,7 @@ pub mod generate;
 pub mod graph;
 pub mod maps;
 pub mod ops;
+pub mod optics;
 pub mod preset;
 
 pub use generate::{GenerateReport, GenerateRequest, generate};
@@ -28,6 +29,9 @@ pub enum Error {
     Size { size: u64 },
     #[error("invalid --maps: {0}")]
     Maps(String),
+    /// An optics query outside what the physics covers (`snakeskin brdf`).
+    #[error("invalid query: {0}")]
+    Query(String),
 }
 
 impl Error {

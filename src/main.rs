@@ -1,6 +1,7 @@
 //! The `snakeskin` binary: parse the command line, call the library, map errors to exit codes
 //! (2 for invalid input, 1 for anything else).
 
+mod brdf;
 mod cli;
 
 use std::io::IsTerminal;
@@ -100,6 +101,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
+        Command::Brdf { command } => brdf::run(command),
         Command::Presets {
             command: PresetsCommand::List,
         } => {

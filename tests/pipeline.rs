@@ -282,7 +282,12 @@ fn buffers_are_freed_after_their_last_consumer() {
     let eval = evaluate(&graph, &MapKind::ALL, 64, 64, &|_, _| {});
     let total: usize = eval.stats.nodes.iter().map(|n| n.bytes).sum();
     // Holding every buffer to the end would need `total`; the graph is far narrower.
-    assert!(eval.stats.peak_bytes * 2 < total, "peak {} of total {}", eval.stats.peak_bytes, total);
+    assert!(
+        eval.stats.peak_bytes * 2 < total,
+        "peak {} of total {}",
+        eval.stats.peak_bytes,
+        total
+    );
     // The five outputs are alive at the end, so the peak is at least their size.
     let outputs: usize = eval.maps.values().map(|m| m.bytes()).sum();
     assert!(eval.stats.peak_bytes >= outputs);

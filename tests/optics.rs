@@ -1,0 +1,321 @@
+//! The exact thin film against PHYSICS.md's identities and an independent formulation (the
+//! 2×2 characteristic-matrix method, written here with `num-complex`), and the colour
+//! reference against its defining property.
+
+use num_complex::Complex64 as C;
+use snakeskin::optics::film::{Stack, airy, fresnel, incoherent};
+use snakeskin::optics::film_rgb_reference;
+
+/// A small deterministic generator (SplitMix64) so failures reproduce.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+}
+
+/// Characteristic-matrix (Abelès / Macleod) reflectance and transmittance of one layer, per
+/// polarisation, with tilted admittances η = n cos θ (s) and η = n / cos θ (p).
+fn transfer_matrix(stack: Stack, d_nm: f64, lambda_nm: f64, cos0: f64) -> (f64, f64, f64, f64) {
+    let sin2 = 1.0 - cos0 * cos0;
+    let cos_in = |n: f64| {
+        let z = C::new(1.0 - (stack.n0 / n).powi(2) * sin2, 0.0).sqrt();
+        if z.im < 0.0 { -z } else { z }
+    };
+    let (c0, c1, c2) = (C::new(cos0, 0.0), cos_in(stack.n1), cos_in(stack.n2));
+    let delta = c1 * (2.0 * std::f64::consts::PI * stack.n1 * d_nm / lambda_nm);
+    let i = C::new(0.0, 1.0);
+    let solve = |eta0: C, eta1: C, eta2: C| {
+        let (m11, m12, m21, m22) = (
+            delta.cos(),
+            i * delta.sin() / eta1,
+            i * eta1 * delta.sin(),
+            delta.cos(),
+        );
+        let b = m11 + m12 * eta2;
+        let c = m21 + m22 * eta2;
+        let r = (eta0 * b - c) / (eta0 * b + c);
+        let t = 4.0 * eta0.re * eta2.re / (eta0 * b + c).norm_sqr();
+        (r.norm_sqr(), t)
+    };
+    let (rs, ts) = solve(c0 * stack.n0, c1 * stack.n1, c2 * stack.n2);
+    let (rp, tp) = solve(stack.n0 / c0, stack.n1 / c1, stack.n2 / c2);
+    (rs, rp, ts, tp)
+}
+
+#[test]
+fn airy_matches_the_transfer_matrix_on_random_inputs_including_tir() {
+    let mut rng = Rng(7);
+    let mut tir_cases = 0;
+    for _ in 0..20_000 {
+        let stack = Stack {
+            n0: rng.range(1.0, 1.6),
+            n1: rng.range(1.0, 2.5),
+            n2: rng.range(1.0, 2.5),
+        };
+        let cos0 = rng.range(1e-4, 1.0);
+        let d = if rng.next() < 0.1 {
+            0.0
+        } else {
+            rng.range(0.0, 3000.0)
+        };
+        let lambda = rng.range(360.0, 780.0);
+        let sin0 = (1.0 - cos0 * cos0).sqrt();
+        if stack.n0 * sin0 > stack.n1.min(stack.n2) {
+            tir_cases += 1;
+        }
+        let a = airy(stack, d, lambda, cos0);
+        let (rs, rp, ts, tp) = transfer_matrix(stack, d, lambda, cos0);
+        for (x, y, what) in [
+            (a.rs, rs, "rs"),
+            (a.rp, rp, "rp"),
+            (a.ts, ts, "ts"),
+            (a.tp, tp, "tp"),
+        ] {
+            assert!(
+                (x - y).abs() <= 1e-9,
+                "{what}: airy {x} vs matrix {y} for {stack:?} d={d} λ={lambda} cos={cos0}"
+            );
+        }
+    }
+    assert!(
+        tir_cases > 1000,
+        "the sample must include total internal reflection: {tir_cases}"
+    );
+}
+
+#[test]
+fn zero_thickness_and_matched_film_give_plain_fresnel() {
+    let mut rng = Rng(11);
+    for _ in 0..2000 {
+        let (n0, n1, n2) = (
+            rng.range(1.0, 1.5),
+            rng.range(1.0, 2.5),
+            rng.range(1.0, 2.5),
+        );
+        let cos0 = rng.range(1e-3, 1.0);
+        let lambda = rng.range(360.0, 780.0);
+        let fresnel_r = |a: f64, b: f64| {
+            let (s, p) = fresnel(a, b, cos0);
+            0.5 * (s + p)
+        };
+        // d = 0: the film vanishes.
+        let r = airy(Stack { n0, n1, n2 }, 0.0, lambda, cos0).r;
+        assert!((r - fresnel_r(n0, n2)).abs() < 1e-12, "d = 0");
+        // n1 = n0: the film is the ambient medium.
+        let r = airy(
+            Stack { n0, n1: n0, n2 },
+            rng.range(0.0, 5000.0),
+            lambda,
+            cos0,
+        )
+        .r;
+        assert!((r - fresnel_r(n0, n2)).abs() < 1e-12, "n1 = n0");
+        // n1 = n2: the film is the substrate.
+        let r = airy(
+            Stack { n0, n1, n2: n1 },
+            rng.range(0.0, 5000.0),
+            lambda,
+            cos0,
+        )
+        .r;
+        assert!((r - fresnel_r(n0, n1)).abs() < 1e-12, "n1 = n2");
+    }
+}
+
+#[test]
+fn normal_incidence_fresnel_is_the_textbook_value() {
+    // ((n0 - n2) / (n0 + n2))² at normal incidence: 1.0 | 1.5 reflects 4 %.
+    let (s, p) = fresnel(1.0, 1.5, 1.0);
+    assert!((s - 0.04).abs() < 1e-12 && (p - 0.04).abs() < 1e-12);
+    // Brewster's angle, tan θB = n2 / n0: p reflectance vanishes.
+    let theta_b = (1.5f64).atan();
+    let (_, p) = fresnel(1.0, 1.5, theta_b.cos());
+    assert!(p < 1e-20, "{p}");
+}
+
+#[test]
+fn energy_is_conserved_and_bounded() {
+    let mut rng = Rng(3);
+    for _ in 0..20_000 {
+        let stack = Stack {
+            n0: rng.range(1.0, 2.0),
+            n1: rng.range(1.0, 3.0),
+            n2: rng.range(1.0, 3.0),
+        };
+        let f = airy(
+            stack,
+            rng.range(0.0, 1e5),
+            rng.range(360.0, 780.0),
+            rng.range(0.0, 1.0),
+        );
+        for v in [f.rs, f.rp, f.r, f.ts, f.tp, f.t] {
+            assert!(v.is_finite() && (0.0..=1.0).contains(&v));
+        }
+        assert!(
+            (f.r + f.t - 1.0).abs() < 1e-9,
+            "R + T = {} for {stack:?}",
+            f.r + f.t
+        );
+        let inc = incoherent(stack, rng.range(0.0, 1.0));
+        assert!((inc.r + inc.t - 1.0).abs() < 1e-12 && (0.0..=1.0).contains(&inc.r));
+    }
+}
+
+#[test]
+fn total_internal_reflection_reflects_everything() {
+    // n0 sin θ0 > n2: no wave propagates in the substrate, whatever the film does.
+    let stack = Stack {
+        n0: 1.5,
+        n1: 1.55,
+        n2: 1.0,
+    };
+    for angle_deg in [45.0f64, 60.0, 80.0, 89.0] {
+        let cos0 = angle_deg.to_radians().cos();
+        for d in [0.0, 100.0, 400.0, 2400.0, 1e7] {
+            for lambda in [380.0, 550.0, 700.0] {
+                let f = airy(stack, d, lambda, cos0);
+                assert!(
+                    (f.r - 1.0).abs() < 1e-12 && f.t.abs() < 1e-12,
+                    "{angle_deg}° d={d}: {f:?}"
+                );
+            }
+        }
+        assert!((incoherent(stack, cos0).r - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn film_colour_of_the_bare_substrate_is_gray_fresnel() {
+    // With d = 0 the reflectance is flat over wavelength, so its colour is gray with the
+    // Fresnel value in every channel (the perfect reflector gives (1, 1, 1)).
+    let stack = Stack::THESIS;
+    let rgb = film_rgb_reference(stack, 0.0, 1.0);
+    let (s, p) = fresnel(1.0, 2.0, 1.0);
+    for c in rgb {
+        assert!((c - 0.5 * (s + p)).abs() < 1e-3, "{rgb:?}");
+    }
+    // A 400 nm film (the thesis default) is coloured: its channels differ.
+    let film = film_rgb_reference(stack, 400.0, 1.0);
+    let spread = film.iter().cloned().fold(f64::MIN, f64::max)
+        - film.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(spread > 0.02, "{film:?}");
+}
+
+mod cli {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+
+    fn snakeskin(args: &[&str], stdin: &str) -> (i32, String, String) {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(args)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(stdin.as_bytes())
+            .unwrap();
+        let out = child.wait_with_output().unwrap();
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stdout).into(),
+            String::from_utf8_lossy(&out.stderr).into(),
+        )
+    }
+
+    #[test]
+    fn brdf_film_prints_the_fresnel_value_for_a_bare_interface() {
+        let (code, out, err) = snakeskin(
+            &[
+                "brdf",
+                "film",
+                "--n2",
+                "1.5",
+                "--thickness-nm",
+                "0",
+                "--wavelength-nm",
+                "550",
+                "--angle-deg",
+                "0",
+            ],
+            "",
+        );
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        for key in ["rs", "rp", "r"] {
+            assert!((v[key].as_f64().unwrap() - 0.04).abs() < 1e-12, "{out}");
+        }
+        for key in ["ts", "tp", "t"] {
+            assert!((v[key].as_f64().unwrap() - 0.96).abs() < 1e-12, "{out}");
+        }
+    }
+
+    #[test]
+    fn batch_answers_one_line_per_query_in_order() {
+        let queries = "{\"n0\":1,\"n1\":1.55,\"n2\":1.5,\"thickness_nm\":0,\"wavelength_nm\":500,\"angle_deg\":0}\n\
+                       {\"n0\":1,\"n1\":1.55,\"n2\":2.25,\"thickness_nm\":0,\"wavelength_nm\":500,\"angle_deg\":0}\n";
+        let (code, out, err) = snakeskin(&["brdf", "film", "--batch", "-"], queries);
+        assert_eq!(code, 0, "{err}");
+        let r: Vec<f64> = out
+            .lines()
+            .map(|l| {
+                serde_json::from_str::<serde_json::Value>(l).unwrap()["r"]
+                    .as_f64()
+                    .unwrap()
+            })
+            .collect();
+        // ((1 - n) / (1 + n))²: 0.04 for n = 1.5, (1.25 / 3.25)² for n = 2.25.
+        assert_eq!(r.len(), 2);
+        assert!(
+            (r[0] - 0.04).abs() < 1e-12 && (r[1] - (1.25f64 / 3.25).powi(2)).abs() < 1e-12,
+            "{r:?}"
+        );
+    }
+
+    #[test]
+    fn brdf_color_and_bad_queries() {
+        let (code, out, _) = snakeskin(
+            &["brdf", "color", "--thickness-nm", "400", "--angle-deg", "0"],
+            "",
+        );
+        assert_eq!(code, 0);
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["rgb"].as_array().unwrap().len(), 3);
+        let (code, _, err) = snakeskin(
+            &[
+                "brdf",
+                "film",
+                "--thickness-nm",
+                "10",
+                "--wavelength-nm",
+                "500",
+                "--angle-deg",
+                "95",
+            ],
+            "",
+        );
+        assert_eq!(code, 2);
+        assert!(
+            err.contains("angle_deg") && err.contains("[0, 90]"),
+            "{err}"
+        );
+        let (code, _, err) = snakeskin(&["brdf", "film", "--batch", "-"], "{\"thickness_nm\":1}\n");
+        assert_eq!(code, 2);
+        assert!(
+            err.contains("-:1") && err.contains("wavelength_nm"),
+            "{err}"
+        );
+    }
+}
