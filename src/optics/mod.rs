@@ -5,6 +5,7 @@
 pub mod complex;
 pub mod film;
 pub mod lab;
+pub mod series;
 pub mod spectrum;
 
 use film::{Stack, airy, incoherent};
