@@ -330,7 +330,11 @@ mod series {
         let mut rng = Rng(19);
         let mut used = 0;
         for _ in 0..5000 {
-            let stack = Stack { n0: rng.range(1.0, 1.4), n1: rng.range(1.0, 2.5), n2: rng.range(1.0, 2.5) };
+            let stack = Stack {
+                n0: rng.range(1.0, 1.4),
+                n1: rng.range(1.0, 2.5),
+                n2: rng.range(1.0, 2.5),
+            };
             let cos0 = rng.range(0.05, 1.0);
             let series = FilmSeries::new(stack, cos0);
             if !series.usable() {
@@ -340,11 +344,23 @@ mod series {
             let (d, lambda) = (rng.range(0.0, 3000.0), rng.range(360.0, 780.0));
             let phase = series.phase(stack.n1, d, lambda);
             let exact = airy(stack, d, lambda, cos0).r;
-            assert!((series.reflectance(phase, 0.0) - exact).abs() < 1e-9, "closed form");
-            assert!((series.reflectance(phase, 1e-9) - exact).abs() < 1e-7, "summed series");
-            assert!((series.incoherent() - incoherent(stack, cos0).r).abs() < 1e-9, "c0 is the incoherent sum");
+            assert!(
+                (series.reflectance(phase, 0.0) - exact).abs() < 1e-9,
+                "closed form"
+            );
+            assert!(
+                (series.reflectance(phase, 1e-9) - exact).abs() < 1e-7,
+                "summed series"
+            );
+            assert!(
+                (series.incoherent() - incoherent(stack, cos0).r).abs() < 1e-9,
+                "c0 is the incoherent sum"
+            );
             // The box average over one full period of phase is the incoherent value.
-            assert!((series.reflectance(phase, 2.0 * std::f64::consts::PI) - series.incoherent()).abs() < 1e-9);
+            assert!(
+                (series.reflectance(phase, 2.0 * std::f64::consts::PI) - series.incoherent()).abs()
+                    < 1e-9
+            );
         }
         assert!(used > 4000);
     }
@@ -356,10 +372,18 @@ mod series {
         for (phase, width) in [(3.0, 0.5), (10.0, 2.0), (1.0, 5.0)] {
             let n = 20_000;
             let numeric: f64 = (0..n)
-                .map(|i| series.reflectance(phase - width / 2.0 + width * (i as f64 + 0.5) / n as f64, 0.0))
+                .map(|i| {
+                    series.reflectance(
+                        phase - width / 2.0 + width * (i as f64 + 0.5) / n as f64,
+                        0.0,
+                    )
+                })
                 .sum::<f64>()
                 / n as f64;
-            assert!((series.reflectance(phase, width) - numeric).abs() < 1e-7, "{phase} {width}");
+            assert!(
+                (series.reflectance(phase, width) - numeric).abs() < 1e-7,
+                "{phase} {width}"
+            );
         }
     }
 }

@@ -2,9 +2,14 @@
 //! CIELAB and CIEDE2000. This is the f64 reference every faster method is measured against
 //! (PHYSICS.md).
 
+pub mod accuracy;
+pub mod brdf;
 pub mod complex;
+pub mod fast;
 pub mod film;
 pub mod lab;
+pub mod lut;
+pub mod methods;
 pub mod series;
 pub mod spectrum;
 

@@ -1,0 +1,287 @@
+//! The multi-layer snake-skin BRDF of PHYSICS.md (Weidlich & Wilkie 2007 single-scatter
+//! layering, as the thesis' eq. 4.21), in f64 (reference) and f32 (fast path, film colour
+//! from the LUT):
+//!
+//! ```text
+//! f = D(h) G2(wi, wo) F(|wo·h|, d) / (4 |n·wi| |n·wo|)
+//!   + (1 − F(n·wi)) (1 − F(n·wo)) exp(−τ (1/cos_t(wi) + 1/cos_t(wo))) k_d / π
+//! ```
+//!
+//! D: GGX; G2: Smith height-correlated (Heitz 2014, eq. 99); F: the film's RGB reflectance,
+//! clamped to [0, 1] per channel (a saturated film colour can fall outside the sRGB gamut,
+//! and 1 − F must stay a valid transmittance); cos_t: the refracted cosine in the pigment
+//! layer, from Snell's law n0 sin θ = n2 sin θ_t (the thesis mixes θ2 and θ3, mistake 5).
+//!
+//! Stability rules (PHYSICS.md): GGX α = max(roughness², ALPHA_MIN) so roughness 0 stays
+//! finite; a zero-length or non-finite normal falls back to the tangent-space up vector;
+//! directions below the shading horizon give 0; cosines are floored at COS_MIN after that
+//! test so grazing angles give finite values.
+
+/// Smallest GGX α: roughness 0 would make D a Dirac delta. 1e-3 keeps D's peak
+/// 1 / (π α²) ≈ 3.2e5, finite in f32, and is a mirror to the eye.
+pub const ALPHA_MIN: f64 = 1e-3;
+/// Floor on cosines after the hemisphere test.
+pub const COS_MIN: f64 = 1e-6;
+
+/// Per-pixel layer parameters (linear RGB where RGB).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layers {
+    pub n0: f64,
+    pub n2: f64,
+    /// Perceptual roughness r (α = r²).
+    pub roughness: f64,
+    /// Optical depth τ = σ0 δ1 of the pigment layer, per channel.
+    pub optical_depth: [f64; 3],
+    /// Albedo k_d of the Lambertian base.
+    pub albedo: [f64; 3],
+}
+
+/// The BRDF split into its two lobes (each RGB, per steradian).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct BrdfValue {
+    pub specular: [f64; 3],
+    pub diffuse: [f64; 3],
+}
+
+impl BrdfValue {
+    pub fn total(&self) -> [f64; 3] {
+        [0, 1, 2].map(|c| self.specular[c] + self.diffuse[c])
+    }
+    const ZERO: BrdfValue = BrdfValue {
+        specular: [0.0; 3],
+        diffuse: [0.0; 3],
+    };
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalize(v: [f64; 3]) -> Option<[f64; 3]> {
+    let len = dot(v, v).sqrt();
+    (len.is_finite() && len > 1e-12).then(|| v.map(|c| c / len))
+}
+
+/// GGX normal distribution D(h) for cos θ_h and α.
+pub fn ggx_d(cos_h: f64, alpha: f64) -> f64 {
+    let a2 = alpha * alpha;
+    let t = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    a2 / (std::f64::consts::PI * t * t)
+}
+
+/// Smith Λ for GGX (Heitz 2014, eq. 72).
+pub fn smith_lambda(cos: f64, alpha: f64) -> f64 {
+    let c2 = cos * cos;
+    let tan2 = (1.0 - c2).max(0.0) / c2;
+    0.5 * ((1.0 + alpha * alpha * tan2).sqrt() - 1.0)
+}
+
+/// Height-correlated masking-shadowing G2 = 1 / (1 + Λ(wi) + Λ(wo)) (Heitz 2014, eq. 99).
+pub fn smith_g2(cos_i: f64, cos_o: f64, alpha: f64) -> f64 {
+    1.0 / (1.0 + smith_lambda(cos_i, alpha) + smith_lambda(cos_o, alpha))
+}
+
+/// Cosine of the refracted direction in the pigment layer; None under total internal
+/// reflection (no light enters).
+pub fn cos_transmitted(n0: f64, n2: f64, cos: f64) -> Option<f64> {
+    let k = 1.0 - (n0 / n2) * (n0 / n2) * (1.0 - cos * cos);
+    (k > 0.0).then(|| k.sqrt())
+}
+
+/// Evaluates the BRDF. `film(cos)` returns the film's RGB reflectance at incidence cosine
+/// `cos` (the caller binds the material, thickness and method).
+pub fn eval(
+    layers: &Layers,
+    normal: [f64; 3],
+    wi: [f64; 3],
+    wo: [f64; 3],
+    film: &dyn Fn(f64) -> [f64; 3],
+) -> BrdfValue {
+    let n = normalize(normal).unwrap_or([0.0, 0.0, 1.0]);
+    let (Some(wi), Some(wo)) = (normalize(wi), normalize(wo)) else {
+        return BrdfValue::ZERO;
+    };
+    let (cos_i, cos_o) = (dot(n, wi), dot(n, wo));
+    if !(cos_i > 0.0 && cos_o > 0.0) {
+        return BrdfValue::ZERO;
+    }
+    let (cos_i, cos_o) = (cos_i.max(COS_MIN), cos_o.max(COS_MIN));
+    let Some(h) = normalize([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]) else {
+        return BrdfValue::ZERO;
+    };
+    let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
+    let film_clamped = |c: f64| {
+        film(c.clamp(0.0, 1.0)).map(|v| {
+            if v.is_finite() {
+                v.clamp(0.0, 1.0)
+            } else {
+                1.0
+            }
+        })
+    };
+
+    let d = ggx_d(dot(n, h).clamp(0.0, 1.0), alpha);
+    let g2 = smith_g2(cos_i, cos_o, alpha);
+    let f_h = film_clamped(dot(wo, h).abs());
+    let spec_scale = d * g2 / (4.0 * cos_i * cos_o);
+    let specular = f_h.map(|f| f * spec_scale);
+
+    let diffuse = match (
+        cos_transmitted(layers.n0, layers.n2, cos_i),
+        cos_transmitted(layers.n0, layers.n2, cos_o),
+    ) {
+        (Some(ti), Some(to)) => {
+            let (f_i, f_o) = (film_clamped(cos_i), film_clamped(cos_o));
+            let path = 1.0 / ti.max(COS_MIN) + 1.0 / to.max(COS_MIN);
+            [0, 1, 2].map(|c| {
+                let attenuation = (-layers.optical_depth[c].max(0.0) * path).exp();
+                (1.0 - f_i[c]) * (1.0 - f_o[c]) * attenuation * layers.albedo[c].max(0.0)
+                    / std::f64::consts::PI
+            })
+        }
+        _ => [0.0; 3],
+    };
+    BrdfValue { specular, diffuse }
+}
+
+/// White-furnace albedo ∫ f(wi, wo) cos θi dωi for view cosine `cos_o`, with k_d = 1 and
+/// τ = 0 passed in `layers`. The specular lobe is integrated in half-vector space with
+/// stratified GGX sampling (exact for any α, however peaked); the diffuse lobe, which
+/// depends on θi only, by the midpoint rule in cos θi. `n` strata per axis.
+pub fn furnace_albedo(
+    layers: &Layers,
+    cos_o: f64,
+    film: &dyn Fn(f64) -> [f64; 3],
+    n: usize,
+) -> [f64; 3] {
+    let cos_o = cos_o.clamp(COS_MIN, 1.0);
+    let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
+    let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
+    let mut spec = [0.0; 3];
+    for a in 0..n {
+        for b in 0..n {
+            let (u1, u2) = ((a as f64 + 0.5) / n as f64, (b as f64 + 0.5) / n as f64);
+            // GGX sampling of h with pdf D(h) cos θh: tan² θh = α² u1 / (1 − u1).
+            let cos_h = (1.0 / (1.0 + alpha * alpha * u1 / (1.0 - u1))).sqrt();
+            let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
+            let phi = 2.0 * std::f64::consts::PI * u2;
+            let h = [sin_h * phi.cos(), sin_h * phi.sin(), cos_h];
+            let wo_h = dot(wo, h);
+            if wo_h <= 0.0 {
+                continue;
+            }
+            let wi = [0, 1, 2].map(|k| 2.0 * wo_h * h[k] - wo[k]);
+            if wi[2] <= 0.0 {
+                continue;
+            }
+            // f cos θi / pdf(wi) with pdf(wi) = D cos θh / (4 |wo·h|).
+            let value = eval(
+                &Layers {
+                    albedo: [0.0; 3],
+                    ..*layers
+                },
+                [0.0, 0.0, 1.0],
+                wi,
+                wo,
+                film,
+            );
+            let pdf = ggx_d(cos_h, alpha) * cos_h / (4.0 * wo_h);
+            for c in 0..3 {
+                spec[c] += value.specular[c] * wi[2] / pdf;
+            }
+        }
+    }
+    let spec = spec.map(|s| s / (n * n) as f64);
+    let mut diffuse = [0.0; 3];
+    for a in 0..n * n {
+        // ∫ over the hemisphere of g(θi) cos θi dω = 2π ∫ g(μ) μ dμ.
+        let mu = (a as f64 + 0.5) / (n * n) as f64;
+        let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+        let value = eval(layers, [0.0, 0.0, 1.0], wi, wo, film);
+        for c in 0..3 {
+            diffuse[c] += value.diffuse[c] * mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
+        }
+    }
+    [0, 1, 2].map(|c| spec[c] + diffuse[c])
+}
+
+/// f32 layer parameters for the fast path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layers32 {
+    pub n0: f32,
+    pub n2: f32,
+    pub roughness: f32,
+    pub optical_depth: [f32; 3],
+    pub albedo: [f32; 3],
+    pub thickness_nm: f32,
+}
+
+fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalize32(v: [f32; 3]) -> Option<[f32; 3]> {
+    let len = dot32(v, v).sqrt();
+    (len.is_finite() && len > 1e-12).then(|| v.map(|c| c / len))
+}
+
+/// The f32 fast path, film colour from the material's LUT: the CPU twin of the shader.
+pub fn eval_f32(
+    layers: &Layers32,
+    normal: [f32; 3],
+    wi: [f32; 3],
+    wo: [f32; 3],
+    lut: &super::lut::Lut,
+) -> [f32; 3] {
+    let n = normalize32(normal).unwrap_or([0.0, 0.0, 1.0]);
+    let (Some(wi), Some(wo)) = (normalize32(wi), normalize32(wo)) else {
+        return [0.0; 3];
+    };
+    let (cos_i, cos_o) = (dot32(n, wi), dot32(n, wo));
+    if !(cos_i > 0.0 && cos_o > 0.0) {
+        return [0.0; 3];
+    }
+    let cos_min = COS_MIN as f32;
+    let (cos_i, cos_o) = (cos_i.max(cos_min), cos_o.max(cos_min));
+    let Some(h) = normalize32([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]) else {
+        return [0.0; 3];
+    };
+    let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN as f32, 1.0);
+    let a2 = alpha * alpha;
+    let film = |c: f32| {
+        lut.lookup_f32(layers.thickness_nm, c.clamp(0.0, 1.0))
+            .map(|v| v.clamp(0.0, 1.0))
+    };
+
+    let cos_h = dot32(n, h).clamp(0.0, 1.0);
+    let t = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    let d = a2 / (std::f32::consts::PI * t * t);
+    let lambda = |c: f32| 0.5 * ((1.0 + a2 * (1.0 - c * c).max(0.0) / (c * c)).sqrt() - 1.0);
+    let g2 = 1.0 / (1.0 + lambda(cos_i) + lambda(cos_o));
+    let f_h = film(dot32(wo, h).abs());
+    let spec = d * g2 / (4.0 * cos_i * cos_o);
+
+    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    let (ki, ko) = (
+        1.0 - eta2 * (1.0 - cos_i * cos_i),
+        1.0 - eta2 * (1.0 - cos_o * cos_o),
+    );
+    let (f_i, f_o) = (film(cos_i), film(cos_o));
+    let path = if ki > 0.0 && ko > 0.0 {
+        1.0 / ki.sqrt().max(cos_min) + 1.0 / ko.sqrt().max(cos_min)
+    } else {
+        -1.0
+    };
+    [0, 1, 2].map(|c| {
+        let diffuse = if path > 0.0 {
+            (1.0 - f_i[c])
+                * (1.0 - f_o[c])
+                * (-layers.optical_depth[c].max(0.0) * path).exp()
+                * layers.albedo[c].max(0.0)
+                / std::f32::consts::PI
+        } else {
+            0.0
+        };
+        f_h[c] * spec + diffuse
+    })
+}

@@ -1,0 +1,287 @@
+//! Real-time film colour methods, each an f32 function shaped for a direct WGSL twin, with
+//! an f64 form of the same method for the agreement test, all compared against the f64
+//! spectral reference (PHYSICS.md, "Real-time methods").
+//!
+//! - `rgb3`: the film at three wavelengths taken as R, G, B (what many engines and the thesis
+//!   do), each prefiltered over a 100 nm band so thick films fade instead of aliasing.
+//! - `spectral-N`: N box bands over 360–780 nm with CMF·D65 weights converted to linear sRGB,
+//!   each band's reflectance prefiltered over the band (exact for the Fourier series).
+//! - `gaussian-fit`: Belcour & Barla (2017): the Airy sum as a Fourier series whose spectral
+//!   integral is taken analytically with Gaussian fits of the XYZ sensitivities (their
+//!   published fit, normalised to illuminant E; here scaled to D65 white by a von Kries
+//!   scaling in XYZ), three harmonics.
+//! - `lut`: a per-material table over (cos θ, thickness) baked from the spectral sum, each
+//!   texel box-averaged over its thickness cell, so bilinear lookups never alias; see `lut.rs`.
+
+use std::sync::OnceLock;
+
+use super::fast::{film_f32, phase_f32, reflectance_f32};
+use super::film::Stack;
+use super::series::FilmSeries;
+use super::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, Observer, XYZ_TO_SRGB, mat3_mul};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// The 1 nm spectral reference (f64 only).
+    Spectral,
+    Rgb3,
+    SpectralN(usize),
+    GaussianFit,
+    Lut,
+}
+
+impl Method {
+    pub fn parse(name: &str) -> Option<Method> {
+        Some(match name {
+            "spectral" => Method::Spectral,
+            "rgb3" => Method::Rgb3,
+            "gaussian-fit" => Method::GaussianFit,
+            "lut" => Method::Lut,
+            other => Method::SpectralN(
+                other
+                    .strip_prefix("spectral-")?
+                    .parse()
+                    .ok()
+                    .filter(|n| (1..=421).contains(n))?,
+            ),
+        })
+    }
+
+    pub fn name(&self) -> String {
+        match self {
+            Method::Spectral => "spectral".into(),
+            Method::Rgb3 => "rgb3".into(),
+            Method::SpectralN(n) => format!("spectral-{n}"),
+            Method::GaussianFit => "gaussian-fit".into(),
+            Method::Lut => "lut".into(),
+        }
+    }
+
+    /// The methods the benchmark compares, cheapest idea first.
+    pub fn all_realtime() -> Vec<Method> {
+        vec![
+            Method::Rgb3,
+            Method::SpectralN(4),
+            Method::SpectralN(8),
+            Method::SpectralN(16),
+            Method::SpectralN(32),
+            Method::GaussianFit,
+            Method::Lut,
+        ]
+    }
+
+    pub const ACCEPTED: &'static str =
+        "spectral, rgb3, spectral-N (N = 1..421, e.g. spectral-8), gaussian-fit, lut";
+}
+
+/// rgb3 wavelengths in nm for R, G, B (the usual 650 / 550 / 450 choice) and the band each
+/// stands for when prefiltering.
+pub const RGB3_NM: [f32; 3] = [650.0, 550.0, 450.0];
+pub const RGB3_BAND_NM: f32 = 100.0;
+
+/// Band centres, widths and linear-sRGB weights of `spectral-N`.
+#[derive(Debug, Clone)]
+pub struct Bands {
+    pub centres_nm: Vec<f64>,
+    pub width_nm: f64,
+    pub rgb_weights: Vec<[f64; 3]>,
+}
+
+impl Bands {
+    pub fn new(n: usize) -> Bands {
+        let obs = Observer::get();
+        let span = (LAMBDA_MAX_NM - LAMBDA_MIN_NM + 1) as f64;
+        let width = span / n as f64;
+        let mut xyz = vec![[0.0f64; 3]; n];
+        for (i, w) in obs.weights.iter().enumerate() {
+            // 1 nm sample i covers [λ - 0.5, λ + 0.5]; assign it to the band of its centre.
+            let band = (((i as f64 + 0.5) / width) as usize).min(n - 1);
+            for c in 0..3 {
+                xyz[band][c] += w[c];
+            }
+        }
+        Bands {
+            centres_nm: (0..n)
+                .map(|i| LAMBDA_MIN_NM as f64 - 0.5 + (i as f64 + 0.5) * width)
+                .collect(),
+            width_nm: width,
+            rgb_weights: xyz.into_iter().map(|v| mat3_mul(&XYZ_TO_SRGB, v)).collect(),
+        }
+    }
+
+    /// Shared band tables for the common N.
+    pub fn cached(n: usize) -> &'static Bands {
+        static CACHE: OnceLock<Vec<Bands>> = OnceLock::new();
+        let all = CACHE.get_or_init(|| (1..=64).map(Bands::new).collect());
+        if n <= 64 {
+            &all[n - 1]
+        } else {
+            Box::leak(Box::new(Bands::new(n)))
+        }
+    }
+}
+
+/// f64 form: spectral-N with band prefiltering.
+pub fn spectral_n_f64(stack: Stack, thickness_nm: f64, cos0: f64, n: usize) -> [f64; 3] {
+    let bands = Bands::cached(n);
+    let film = FilmSeries::new(stack, cos0);
+    let mut rgb = [0.0; 3];
+    for (lambda, w) in bands.centres_nm.iter().zip(&bands.rgb_weights) {
+        let r = band_reflectance_f64(&film, stack, thickness_nm, *lambda, bands.width_nm, cos0);
+        for c in 0..3 {
+            rgb[c] += r * w[c];
+        }
+    }
+    rgb
+}
+
+fn band_reflectance_f64(
+    film: &FilmSeries,
+    stack: Stack,
+    d: f64,
+    lambda: f64,
+    band_nm: f64,
+    cos0: f64,
+) -> f64 {
+    if !film.usable() {
+        return super::film::airy(stack, d, lambda, cos0).r;
+    }
+    let phase = film.phase(stack.n1, d, lambda);
+    film.reflectance(phase, phase * band_nm / lambda)
+}
+
+/// f32 form: spectral-N with band prefiltering.
+pub fn spectral_n_f32(
+    n0: f32,
+    n1: f32,
+    n2: f32,
+    thickness_nm: f32,
+    cos0: f32,
+    n: usize,
+) -> [f32; 3] {
+    let bands = Bands::cached(n);
+    let film = film_f32(n0, n1, n2, cos0);
+    let width = bands.width_nm as f32;
+    let mut rgb = [0.0f32; 3];
+    for (lambda, w) in bands.centres_nm.iter().zip(&bands.rgb_weights) {
+        let lambda = *lambda as f32;
+        let phase = phase_f32(&film, n1, thickness_nm, lambda);
+        let r = reflectance_f32(&film, phase, phase * width / lambda);
+        for c in 0..3 {
+            rgb[c] += r * w[c] as f32;
+        }
+    }
+    rgb
+}
+
+pub fn rgb3_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
+    let film = FilmSeries::new(stack, cos0);
+    RGB3_NM.map(|l| {
+        band_reflectance_f64(
+            &film,
+            stack,
+            thickness_nm,
+            l as f64,
+            RGB3_BAND_NM as f64,
+            cos0,
+        )
+    })
+}
+
+pub fn rgb3_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32; 3] {
+    let film = film_f32(n0, n1, n2, cos0);
+    RGB3_NM.map(|lambda| {
+        let phase = phase_f32(&film, n1, thickness_nm, lambda);
+        reflectance_f32(&film, phase, phase * RGB3_BAND_NM / lambda)
+    })
+}
+
+/// Belcour & Barla (2017) Gaussian fits of the XYZ sensitivity in Fourier space
+/// (supplemental material; the same constants as the glTF KHR_materials_iridescence sample
+/// code): per channel amplitude, centre and variance, plus a second lobe for X, normalised
+/// by 1.0685e-7 so that S(0) is illuminant E's white, XYZ = (1, 1, 1).
+const BB_VAL: [f64; 3] = [5.4856e-13, 4.4201e-13, 5.2481e-13];
+const BB_POS: [f64; 3] = [1.6810e+06, 1.7953e+06, 2.2084e+06];
+const BB_VAR: [f64; 3] = [4.3278e+09, 9.3046e+09, 6.6121e+09];
+const BB_X2: (f64, f64, f64) = (9.7470e-14, 2.2399e+06, 4.5282e+09);
+const BB_NORM: f64 = 1.0685e-7;
+/// Harmonics Belcour & Barla's method sums (they use 2; 3 costs little more).
+pub const GAUSSIAN_FIT_HARMONICS: usize = 3;
+
+/// Re(C · S(opd)) per XYZ channel, C a harmonic coefficient, `opd_nm` the path difference.
+fn bb_sensitivity(c_re: f64, c_im: f64, opd_nm: f64) -> [f64; 3] {
+    let phase = 2.0 * std::f64::consts::PI * opd_nm * 1e-9;
+    let (mag, arg) = ((c_re * c_re + c_im * c_im).sqrt(), c_im.atan2(c_re));
+    let lobe = |val: f64, pos: f64, var: f64| {
+        val * (2.0 * std::f64::consts::PI * var).sqrt()
+            * (pos * phase + arg).cos()
+            * (-var * phase * phase).exp()
+    };
+    let mut xyz = [0, 1, 2].map(|i| lobe(BB_VAL[i], BB_POS[i], BB_VAR[i]));
+    xyz[0] += lobe(BB_X2.0, BB_X2.1, BB_X2.2);
+    xyz.map(|v| mag * v / BB_NORM)
+}
+
+/// D65 white XYZ relative to illuminant E's (1, 1, 1), for the von Kries scaling.
+fn d65_white() -> [f64; 3] {
+    static WHITE: OnceLock<[f64; 3]> = OnceLock::new();
+    *WHITE.get_or_init(|| Observer::get().white_xyz())
+}
+
+pub fn gaussian_fit_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
+    let film = FilmSeries::new(stack, cos0);
+    let Some(cos1) = film.cos1 else {
+        let r = super::film::airy(stack, thickness_nm, 550.0, cos0).r;
+        return [r; 3];
+    };
+    let opd = 2.0 * stack.n1 * thickness_nm * cos1;
+    let mut xyz = [film.incoherent(); 3];
+    for h in [&film.s, &film.p] {
+        let mut c = h.d;
+        for m in 1..=GAUSSIAN_FIT_HARMONICS {
+            let s = bb_sensitivity(c.re, c.im, m as f64 * opd);
+            for k in 0..3 {
+                // 2 Re(...) per polarisation, averaged over s and p.
+                xyz[k] += s[k];
+            }
+            c = c * h.q;
+        }
+    }
+    let white = d65_white();
+    mat3_mul(
+        &XYZ_TO_SRGB,
+        [xyz[0] * white[0], xyz[1] * white[1], xyz[2] * white[2]],
+    )
+}
+
+pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32; 3] {
+    use super::fast::C32;
+    let film = film_f32(n0, n1, n2, cos0);
+    let opd = 2.0 * n1 * thickness_nm * film.cos1;
+    let mut xyz = [0.5 * (film.s.c0 + film.p.c0); 3];
+    let mul = |a: C32, b: C32| [a[0] * b[0] - a[1] * b[1], a[0] * b[1] + a[1] * b[0]];
+    for h in [&film.s, &film.p] {
+        let mut c = h.d;
+        for m in 1..=GAUSSIAN_FIT_HARMONICS {
+            let phase = 2.0 * std::f32::consts::PI * (m as f32 * opd) * 1e-9;
+            let (mag, arg) = ((c[0] * c[0] + c[1] * c[1]).sqrt(), c[1].atan2(c[0]));
+            let lobe = |val: f64, pos: f64, var: f64| {
+                (val * (2.0 * std::f64::consts::PI * var).sqrt() / BB_NORM) as f32
+                    * (pos as f32 * phase + arg).cos()
+                    * (-(var as f32) * phase * phase).exp()
+            };
+            xyz[0] +=
+                mag * (lobe(BB_VAL[0], BB_POS[0], BB_VAR[0]) + lobe(BB_X2.0, BB_X2.1, BB_X2.2));
+            xyz[1] += mag * lobe(BB_VAL[1], BB_POS[1], BB_VAR[1]);
+            xyz[2] += mag * lobe(BB_VAL[2], BB_POS[2], BB_VAR[2]);
+            c = mul(c, h.q);
+        }
+    }
+    let white = d65_white();
+    let v = [
+        xyz[0] as f64 * white[0],
+        xyz[1] as f64 * white[1],
+        xyz[2] as f64 * white[2],
+    ];
+    mat3_mul(&XYZ_TO_SRGB, v).map(|x| x as f32)
+}
