@@ -6,9 +6,15 @@ use std::io::{BufRead, BufReader, Write};
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 
-use crate::cli::{BrdfCommand, StackArgs};
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use crate::cli::{BenchCommand, BrdfCommand, EvalArgs, StackArgs};
+use snakeskin::optics::brdf::{Layers, eval};
 use snakeskin::optics::film::{Stack, airy};
 use snakeskin::optics::film_rgb_reference;
+use snakeskin::optics::lut::Lut;
+use snakeskin::optics::methods::{Method, gaussian_fit_f64, rgb3_f64, spectral_n_f64};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -109,13 +115,74 @@ fn color_json(q: &ColorQuery) -> Result<String> {
         n2: q.n2,
     };
     check(stack, q.thickness_nm, q.angle_deg, None)?;
-    let rgb = match q.method.as_str() {
-        "spectral" => film_rgb_reference(stack, q.thickness_nm, q.angle_deg.to_radians().cos()),
-        other => bail!(snakeskin::Error::Query(format!(
-            "unknown method {other:?}; accepted: spectral"
-        ))),
-    };
+    let method = parse_method(&q.method)?;
+    let rgb = film_colour(
+        method,
+        stack,
+        q.thickness_nm,
+        q.angle_deg.to_radians().cos(),
+    );
     Ok(serde_json::json!({ "rgb": rgb }).to_string())
+}
+
+fn parse_method(name: &str) -> Result<Method> {
+    Method::parse(name).ok_or_else(|| {
+        snakeskin::Error::Query(format!(
+            "unknown method {name:?}; accepted: {}",
+            Method::ACCEPTED
+        ))
+        .into()
+    })
+}
+
+/// LUTs baked so far, per material (a batch of queries on one material bakes once).
+fn lut_for(stack: Stack) -> std::sync::Arc<Lut> {
+    static CACHE: Mutex<Option<HashMap<[u64; 3], std::sync::Arc<Lut>>>> = Mutex::new(None);
+    let key = [stack.n0.to_bits(), stack.n1.to_bits(), stack.n2.to_bits()];
+    let mut cache = CACHE.lock().expect("lut cache");
+    cache
+        .get_or_insert_with(HashMap::new)
+        .entry(key)
+        .or_insert_with(|| std::sync::Arc::new(Lut::bake_default(stack)))
+        .clone()
+}
+
+/// A method's film colour in f64 (the LUT read in f64 arithmetic).
+fn film_colour(method: Method, stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
+    match method {
+        Method::Spectral => film_rgb_reference(stack, thickness_nm, cos0),
+        Method::Rgb3 => rgb3_f64(stack, thickness_nm, cos0),
+        Method::SpectralN(n) => spectral_n_f64(stack, thickness_nm, cos0, n),
+        Method::GaussianFit => gaussian_fit_f64(stack, thickness_nm, cos0),
+        Method::Lut => lut_for(stack).lookup_f64(thickness_nm, cos0),
+    }
+}
+
+fn eval_json(args: &EvalArgs) -> Result<String> {
+    let stack = Stack {
+        n0: args.stack.n0,
+        n1: args.stack.n1,
+        n2: args.stack.n2,
+    };
+    check(stack, args.thickness_nm, 0.0, None)?;
+    if !(args.roughness.is_finite() && (0.0..=1.0).contains(&args.roughness)) {
+        bail!(snakeskin::Error::Query(format!(
+            "roughness must be in [0, 1], got {}",
+            args.roughness
+        )));
+    }
+    let method = parse_method(&args.method)?;
+    let layers = Layers {
+        n0: stack.n0,
+        n2: stack.n2,
+        roughness: args.roughness,
+        optical_depth: args.absorption.map(|a| a * args.pigment_thickness),
+        albedo: args.albedo,
+    };
+    let value = eval(&layers, args.normal, args.wi, args.wo, &|c| {
+        film_colour(method, stack, args.thickness_nm, c)
+    });
+    Ok(serde_json::json!({ "f": value.total(), "specular": value.specular, "diffuse": value.diffuse }).to_string())
 }
 
 fn batch_lines(path: &str) -> Result<Box<dyn BufRead>> {
@@ -175,6 +242,49 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             println!("{}", film_json(&query)?);
             Ok(())
         }
+        BrdfCommand::Chart {
+            stack,
+            out,
+            method,
+            width,
+            height,
+        } => {
+            let stack = Stack {
+                n0: stack.n0,
+                n1: stack.n1,
+                n2: stack.n2,
+            };
+            check(stack, 0.0, 0.0, None)?;
+            let method = parse_method(&method)?;
+            if !(2..=4096).contains(&width) || !(2..=4096).contains(&height) {
+                bail!(snakeskin::Error::Query(
+                    "chart width and height must be 2..=4096 pixels".into()
+                ));
+            }
+            let exposure = chart(stack, method, width as usize, height as usize, &out)?;
+            eprintln!(
+                "wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)",
+                out.display()
+            );
+            Ok(())
+        }
+        BrdfCommand::Eval(args) => {
+            println!("{}", eval_json(&args)?);
+            Ok(())
+        }
+        BrdfCommand::Stress {
+            samples,
+            seed,
+            json,
+        } => {
+            let report = snakeskin::optics::stress::run(samples, seed);
+            if json {
+                println!("{}", serde_json::to_string(&report)?);
+            } else {
+                println!("{report:#?}");
+            }
+            Ok(())
+        }
         BrdfCommand::Color {
             batch: Some(path), ..
         } => run_batch(&path, color_json),
@@ -198,4 +308,140 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             Ok(())
         }
     }
+}
+
+pub fn bench(command: BenchCommand) -> Result<()> {
+    match command {
+        BenchCommand::Irid {
+            json,
+            plot,
+            d_step_nm,
+            angle_step_deg,
+            lut_sweep,
+        } => {
+            use snakeskin::optics::accuracy::{Prepared, grid, measure, reference_colours};
+            use snakeskin::optics::lab::linear_srgb_to_lab;
+            if !(d_step_nm > 0.0 && angle_step_deg > 0.0) {
+                bail!(snakeskin::Error::Query(
+                    "grid steps must be positive".into()
+                ));
+            }
+            let samples = grid(d_step_nm, angle_step_deg);
+            eprintln!(
+                "reference: {} grid points, 1 nm spectral sum",
+                samples.len()
+            );
+            let reference_lab: Vec<[f64; 3]> = reference_colours(&samples)
+                .into_iter()
+                .map(linear_srgb_to_lab)
+                .collect();
+            let mut reports = Vec::new();
+            for method in Method::all_realtime() {
+                eprintln!("measuring {}", method.name());
+                reports.push(measure(&Prepared::new(method), &samples, &reference_lab));
+            }
+            if lut_sweep {
+                for size in [(16, 64, 16), (32, 128, 32), (128, 512, 128)] {
+                    let mut report = measure(
+                        &Prepared::with_lut_size(Method::Lut, size),
+                        &samples,
+                        &reference_lab,
+                    );
+                    report.name = format!("lut-{}x{}+{}", size.0, size.1, size.2);
+                    reports.push(report);
+                }
+            }
+            let default = Method::Lut.name();
+            if json {
+                println!(
+                    "{}",
+                    serde_json::json!({ "default": default, "methods": reports })
+                );
+            } else {
+                println!(
+                    "{:<18} {:>9} {:>9} {:>9} {:>12}",
+                    "method", "mean ΔE", "p95 ΔE", "max ΔE", "ns/eval"
+                );
+                for r in &reports {
+                    let mark = if r.name == default { " (default)" } else { "" };
+                    println!(
+                        "{:<18} {:>9.3} {:>9.3} {:>9.3} {:>12.1}{mark}",
+                        r.name, r.mean_de, r.p95_de, r.max_de, r.ns_per_eval
+                    );
+                }
+            }
+            if let Some(path) = plot {
+                let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default);
+                snakeskin::export::write_all_atomically(
+                    path.parent()
+                        .filter(|p| !p.as_os_str().is_empty())
+                        .unwrap_or(std::path::Path::new(".")),
+                    &[(
+                        path.file_name()
+                            .context("plot path names a file")?
+                            .to_string_lossy()
+                            .into_owned(),
+                        svg.into_bytes(),
+                    )],
+                )?;
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Renders the chart; returns the exposure (1 / brightest channel) applied so the colours
+/// use the whole range (film reflectances are a few percent to a few tens of percent).
+fn chart(
+    stack: Stack,
+    method: Method,
+    width: usize,
+    height: usize,
+    out: &std::path::Path,
+) -> Result<f64> {
+    use rayon::prelude::*;
+    let rows: Vec<Vec<[f64; 3]>> = (0..height)
+        .into_par_iter()
+        .map(|y| {
+            let angle_deg = 89.0 * y as f64 / (height - 1) as f64;
+            (0..width)
+                .map(|x| {
+                    film_colour(
+                        method,
+                        stack,
+                        2000.0 * x as f64 / (width - 1) as f64,
+                        angle_deg.to_radians().cos(),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    let brightest = rows
+        .iter()
+        .flatten()
+        .flat_map(|p| p.iter().copied())
+        .fold(1e-6, f64::max);
+    let exposure = 1.0 / brightest;
+    let image = snakeskin::ops::Image {
+        width,
+        height,
+        channels: 3,
+        data: rows
+            .into_iter()
+            .flatten()
+            .flat_map(|p| p.map(|c| (c * exposure) as f32))
+            .collect(),
+    };
+    let png = snakeskin::export::encode_png(snakeskin::maps::MapKind::Color, &image)?;
+    let dir = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = out
+        .file_name()
+        .context("the output path names a file")?
+        .to_string_lossy()
+        .into_owned();
+    snakeskin::export::write_all_atomically(dir, &[(name, png)])?;
+    Ok(exposure)
 }

@@ -29,6 +29,11 @@ pub enum Command {
         #[command(subcommand)]
         command: BrdfCommand,
     },
+    /// Benchmarks: `bench irid` measures every film colour method's error against cost.
+    Bench {
+        #[command(subcommand)]
+        command: BenchCommand,
+    },
     /// List or show the built-in species presets.
     Presets {
         #[command(subcommand)]
@@ -144,11 +149,120 @@ pub enum BrdfCommand {
         thickness_nm: Option<f64>,
         #[arg(long, required_unless_present = "batch")]
         angle_deg: Option<f64>,
-        /// Colour method; `spectral` is the 1 nm reference of PHYSICS.md.
+        /// Colour method: spectral (the 1 nm reference of PHYSICS.md), rgb3, spectral-N
+        /// (e.g. spectral-16), gaussian-fit, lut.
         #[arg(long, default_value = "spectral")]
         method: String,
         /// JSON lines {n0, n1, n2, thickness_nm, angle_deg, method}.
         #[arg(long, value_name = "FILE")]
         batch: Option<String>,
     },
+    /// The full multi-layer BRDF for given directions and layer parameters (JSON).
+    Eval(EvalArgs),
+    /// A thin-film colour chart PNG: thickness 0..2000 nm across, angle 0..89° down.
+    Chart {
+        #[command(flatten)]
+        stack: StackArgs,
+        /// Output PNG file.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Colour method (spectral = the 1 nm reference).
+        #[arg(long, default_value = "spectral")]
+        method: String,
+        /// Chart width (thickness samples) and height (angle samples) in pixels.
+        #[arg(long, default_value_t = 800)]
+        width: u32,
+        #[arg(long, default_value_t = 300)]
+        height: u32,
+    },
+    /// Random and adversarial inputs: counts NaN and Inf, the range of R and T, the worst
+    /// white-furnace albedo and the f32 path's worst deviation from f64 (JSON with --json).
+    Stress {
+        /// Number of random samples.
+        #[arg(long, default_value_t = 100_000)]
+        samples: u64,
+        /// Seed of the sample generator.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Debug, Args)]
+pub struct EvalArgs {
+    #[command(flatten)]
+    pub stack: StackArgs,
+    /// Direction towards the light, x,y,z (need not be normalised).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub wi: [f64; 3],
+    /// Direction towards the viewer, x,y,z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub wo: [f64; 3],
+    /// Shading normal, x,y,z (a zero vector falls back to 0,0,1).
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,1", allow_hyphen_values = true)]
+    pub normal: [f64; 3],
+    /// Film thickness in nm (thesis δ0).
+    #[arg(long, default_value_t = 400.0)]
+    pub thickness_nm: f64,
+    /// Perceptual roughness (GGX α = roughness²).
+    #[arg(long, default_value_t = 0.35)]
+    pub roughness: f64,
+    /// Absorption coefficient σ0 (one value, or r,g,b).
+    #[arg(long, value_parser = parse_vec3_or_scalar, default_value = "0.6")]
+    pub absorption: [f64; 3],
+    /// Pigment layer thickness δ1 (optical depth τ = σ0 δ1).
+    #[arg(long, default_value_t = 1.0)]
+    pub pigment_thickness: f64,
+    /// Base albedo k_d, linear r,g,b (or one value).
+    #[arg(long, value_parser = parse_vec3_or_scalar, default_value = "1")]
+    pub albedo: [f64; 3],
+    /// Film colour method (as for `brdf color`).
+    #[arg(long, default_value = "spectral")]
+    pub method: String,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// Time against error of every film colour method on PHYSICS.md's grid.
+    Irid {
+        /// Print JSON {"default", "methods": [{"name","mean_de","p95_de","max_de","ns_per_eval"}]}.
+        #[arg(long)]
+        json: bool,
+        /// Write an SVG plot of error against cost, one point per method.
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
+        /// Thickness step of the grid in nm (PHYSICS.md grid: 0..2000 nm).
+        #[arg(long, default_value_t = 10.0)]
+        d_step_nm: f64,
+        /// Angle step of the grid in degrees (0..89°).
+        #[arg(long, default_value_t = 1.0)]
+        angle_step_deg: f64,
+        /// Also measure other LUT sizes (the table-size trade-off).
+        #[arg(long)]
+        lut_sweep: bool,
+    },
+}
+
+fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<f64> = text
+        .split(',')
+        .map(|p| {
+            p.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("expected x,y,z numbers, got {text:?}"))
+        })
+        .collect::<Result<_, _>>()?;
+    match parts.as_slice() {
+        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!("expected three finite numbers x,y,z, got {text:?}")),
+    }
+}
+
+fn parse_vec3_or_scalar(text: &str) -> Result<[f64; 3], String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok([v; 3]),
+        _ => parse_vec3(text),
+    }
 }

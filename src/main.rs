@@ -102,6 +102,7 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Brdf { command } => brdf::run(command),
+        Command::Bench { command } => brdf::bench(command),
         Command::Presets {
             command: PresetsCommand::List,
         } => {

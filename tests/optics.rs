@@ -387,3 +387,158 @@ mod series {
         }
     }
 }
+
+mod commands {
+    use std::process::Command;
+
+    fn run(args: &[&str]) -> (i32, String, String) {
+        let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stdout).into(),
+            String::from_utf8_lossy(&out.stderr).into(),
+        )
+    }
+
+    #[test]
+    fn brdf_eval_matches_the_library_and_is_symmetric() {
+        let (code, out, err) = run(&[
+            "brdf",
+            "eval",
+            "--wi",
+            "0.3,0,1",
+            "--wo",
+            "-0.2,0.1,1",
+            "--roughness",
+            "0.4",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let (code, swapped, _) = run(&[
+            "brdf",
+            "eval",
+            "--wi",
+            "-0.2,0.1,1",
+            "--wo",
+            "0.3,0,1",
+            "--roughness",
+            "0.4",
+        ]);
+        assert_eq!(code, 0);
+        let w: serde_json::Value = serde_json::from_str(&swapped).unwrap();
+        for c in 0..3 {
+            let (a, b) = (v["f"][c].as_f64().unwrap(), w["f"][c].as_f64().unwrap());
+            // Helmholtz reciprocity: every term of the BRDF is symmetric in wi and wo.
+            assert!((a - b).abs() <= 1e-12 * a.abs().max(1.0), "{a} vs {b}");
+            let sum = v["specular"][c].as_f64().unwrap() + v["diffuse"][c].as_f64().unwrap();
+            assert!((sum - a).abs() < 1e-12);
+        }
+        // Light from below the surface gives nothing.
+        let (_, below, _) = run(&["brdf", "eval", "--wi", "0,0,-1", "--wo", "0,0,1"]);
+        let b: serde_json::Value = serde_json::from_str(&below).unwrap();
+        assert!(
+            b["f"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|x| x.as_f64() == Some(0.0))
+        );
+    }
+
+    #[test]
+    fn brdf_stress_reports_every_key_and_no_nan() {
+        let (code, out, err) = run(&["brdf", "stress", "--samples", "4000", "--json"]);
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["samples"], 4000);
+        assert_eq!(v["nan"], 0);
+        assert_eq!(v["inf"], 0);
+        assert!(v["min_r"].as_f64().unwrap() >= 0.0 && v["max_r"].as_f64().unwrap() <= 1.0);
+        assert!(v["max_albedo"].as_f64().unwrap() <= 1.0 + 2e-3);
+        assert!(v["max_f32_dev"].as_f64().unwrap() < 1e-2);
+    }
+
+    #[test]
+    fn bench_irid_json_lists_every_method_and_the_default_meets_its_target() {
+        let (code, out, err) = run(&[
+            "bench",
+            "irid",
+            "--json",
+            "--d-step-nm",
+            "50",
+            "--angle-step-deg",
+            "11",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["default"], "lut");
+        let methods = v["methods"].as_array().unwrap();
+        let names: Vec<&str> = methods
+            .iter()
+            .map(|m| m["name"].as_str().unwrap())
+            .collect();
+        for expected in [
+            "rgb3",
+            "spectral-4",
+            "spectral-8",
+            "spectral-16",
+            "spectral-32",
+            "gaussian-fit",
+            "lut",
+        ] {
+            assert!(names.contains(&expected), "{names:?}");
+        }
+        let lut = methods.iter().find(|m| m["name"] == "lut").unwrap();
+        assert!(
+            lut["mean_de"].as_f64().unwrap() <= 0.5 && lut["max_de"].as_f64().unwrap() <= 2.0,
+            "{lut}"
+        );
+        for m in methods {
+            for key in ["mean_de", "p95_de", "max_de", "ns_per_eval"] {
+                assert!(m[key].as_f64().unwrap().is_finite(), "{m}");
+            }
+        }
+        // Error falls as spectral-N gets more samples.
+        let mean = |n: &str| {
+            methods.iter().find(|m| m["name"] == n).unwrap()["mean_de"]
+                .as_f64()
+                .unwrap()
+        };
+        assert!(
+            mean("spectral-32") < mean("spectral-8") && mean("spectral-8") < mean("spectral-4")
+        );
+    }
+
+    #[test]
+    fn every_method_is_accepted_by_brdf_color() {
+        for method in ["spectral", "rgb3", "spectral-16", "gaussian-fit", "lut"] {
+            let (code, out, err) = run(&[
+                "brdf",
+                "color",
+                "--thickness-nm",
+                "300",
+                "--angle-deg",
+                "20",
+                "--method",
+                method,
+            ]);
+            assert_eq!(code, 0, "{method}: {err}");
+            assert!(out.contains("\"rgb\""));
+        }
+        let (code, _, err) = run(&[
+            "brdf",
+            "color",
+            "--thickness-nm",
+            "300",
+            "--angle-deg",
+            "20",
+            "--method",
+            "rgb4",
+        ]);
+        assert_eq!(code, 2);
+        assert!(err.contains("gaussian-fit") && err.contains("lut"), "{err}");
+    }
+}

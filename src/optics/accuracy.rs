@@ -68,7 +68,7 @@ pub fn grid(d_step_nm: f64, angle_step_deg: f64) -> Vec<Sample> {
                 samples.push(Sample {
                     material,
                     thickness_nm: d,
-                    cos0: (angle as f64).to_radians().cos(),
+                    cos0: f64::to_radians(angle).cos(),
                 });
                 d += d_step_nm;
             }

@@ -64,9 +64,23 @@ fn normalize(v: [f64; 3]) -> Option<[f64; 3]> {
 
 /// GGX normal distribution D(h) for cos θ_h and α.
 pub fn ggx_d(cos_h: f64, alpha: f64) -> f64 {
+    ggx_d_sin(cos_h, (1.0 - cos_h * cos_h).max(0.0), alpha)
+}
+
+/// GGX D from cos² and sin² of θ_h computed separately: the usual cos²(α² − 1) + 1 cancels
+/// catastrophically near the peak when α is small (1 − 1e-6 in f32 keeps one digit).
+pub fn ggx_d_sin(cos_h: f64, sin2_h: f64, alpha: f64) -> f64 {
     let a2 = alpha * alpha;
-    let t = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    let t = sin2_h + cos_h * cos_h * a2;
     a2 / (std::f64::consts::PI * t * t)
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// Smith Λ for GGX (Heitz 2014, eq. 72).
@@ -84,7 +98,8 @@ pub fn smith_g2(cos_i: f64, cos_o: f64, alpha: f64) -> f64 {
 /// Cosine of the refracted direction in the pigment layer; None under total internal
 /// reflection (no light enters).
 pub fn cos_transmitted(n0: f64, n2: f64, cos: f64) -> Option<f64> {
-    let k = 1.0 - (n0 / n2) * (n0 / n2) * (1.0 - cos * cos);
+    let eta2 = (n0 / n2) * (n0 / n2);
+    let k = (1.0 - eta2) + eta2 * cos * cos;
     (k > 0.0).then(|| k.sqrt())
 }
 
@@ -120,7 +135,8 @@ pub fn eval(
         })
     };
 
-    let d = ggx_d(dot(n, h).clamp(0.0, 1.0), alpha);
+    let nxh = cross(n, h);
+    let d = ggx_d_sin(dot(n, h).clamp(0.0, 1.0), dot(nxh, nxh), alpha);
     let g2 = smith_g2(cos_i, cos_o, alpha);
     let f_h = film_clamped(dot(wo, h).abs());
     let spec_scale = d * g2 / (4.0 * cos_i * cos_o);
@@ -185,9 +201,9 @@ pub fn furnace_albedo(
                 wo,
                 film,
             );
-            let pdf = ggx_d(cos_h, alpha) * cos_h / (4.0 * wo_h);
-            for c in 0..3 {
-                spec[c] += value.specular[c] * wi[2] / pdf;
+            let pdf = ggx_d_sin(cos_h, sin_h * sin_h, alpha) * cos_h / (4.0 * wo_h);
+            for (s, v) in spec.iter_mut().zip(value.specular) {
+                *s += v * wi[2] / pdf;
             }
         }
     }
@@ -198,8 +214,8 @@ pub fn furnace_albedo(
         let mu = (a as f64 + 0.5) / (n * n) as f64;
         let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
         let value = eval(layers, [0.0, 0.0, 1.0], wi, wo, film);
-        for c in 0..3 {
-            diffuse[c] += value.diffuse[c] * mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
+        for (d, v) in diffuse.iter_mut().zip(value.diffuse) {
+            *d += v * mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
         }
     }
     [0, 1, 2].map(|c| spec[c] + diffuse[c])
@@ -254,7 +270,12 @@ pub fn eval_f32(
     };
 
     let cos_h = dot32(n, h).clamp(0.0, 1.0);
-    let t = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    let nxh = [
+        n[1] * h[2] - n[2] * h[1],
+        n[2] * h[0] - n[0] * h[2],
+        n[0] * h[1] - n[1] * h[0],
+    ];
+    let t = dot32(nxh, nxh) + cos_h * cos_h * a2;
     let d = a2 / (std::f32::consts::PI * t * t);
     let lambda = |c: f32| 0.5 * ((1.0 + a2 * (1.0 - c * c).max(0.0) / (c * c)).sqrt() - 1.0);
     let g2 = 1.0 / (1.0 + lambda(cos_i) + lambda(cos_o));

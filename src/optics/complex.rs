@@ -40,6 +40,11 @@ impl C64 {
         C64::cis(z.re) * (-z.im).exp()
     }
 
+    /// Principal natural logarithm: ln|z| + i arg z.
+    pub fn ln(self) -> Self {
+        C64::new(0.5 * self.norm_sqr().ln(), self.im.atan2(self.re))
+    }
+
     /// The square root with a non-negative imaginary part (for a real negative argument,
     /// +i sqrt|x|): the branch that makes an evanescent wave decay into the medium.
     pub fn sqrt_upper(self) -> Self {

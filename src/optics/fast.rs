@@ -81,10 +81,11 @@ fn harmonics(a: C32, b: C32) -> Harmonics32 {
 #[inline]
 pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
     let cos0 = cos0.clamp(0.0, 1.0);
-    let sin2 = 1.0 - cos0 * cos0;
     let c0: C32 = [cos0, 0.0];
-    let c1 = sqrt_real(1.0 - (n0 / n1) * (n0 / n1) * sin2);
-    let c2 = sqrt_real(1.0 - (n0 / n2) * (n0 / n2) * sin2);
+    // (1 − η²) + η² cos²θ0: exact for η = 1 at grazing (see film::cos_in).
+    let cos_sq = |eta: f32| sqrt_real((1.0 - eta * eta) + eta * eta * cos0 * cos0);
+    let c1 = cos_sq(n0 / n1);
+    let c2 = cos_sq(n0 / n2);
     let r = |ni: f32, ci: C32, nj: f32, cj: C32| {
         let (a, b) = (scale(ci, ni), scale(cj, nj));
         let rs = div(sub(a, b), add(a, b));
@@ -106,21 +107,39 @@ fn sinc(x: f32) -> f32 {
     if x.abs() < 1e-4 { 1.0 } else { x.sin() / x }
 }
 
-/// Harmonics summed in the box-prefiltered series; enough for |q| ≤ 0.6 to 1e-4.
-pub const HARMONICS: u32 = 12;
+#[inline]
+fn ln(a: C32) -> C32 {
+    [0.5 * norm_sqr(a).ln(), a[1].atan2(a[0])]
+}
 
+/// Box-prefiltered series in closed form (see `series.rs`): the mean of D z / (1 − q z)
+/// over φ ± Δ/2 is (i D / q) [ln(1 − q z₊) − ln(1 − q z₋)] / Δ. Below a box of 1e-3 rad the
+/// log difference cancels in f32 and the unfiltered closed form is used (its error there is
+/// O(Δ²) < 1e-6).
 #[inline]
 fn series(h: &Harmonics32, phase: f32, box_width: f32) -> f32 {
-    let mut total = h.c0;
-    let mut coeff = h.d;
-    let step = [phase.cos(), phase.sin()];
-    let mut z = step;
-    for m in 1..=HARMONICS {
-        total += 2.0 * mul(coeff, z)[0] * sinc(0.5 * m as f32 * box_width);
-        coeff = mul(coeff, h.q);
-        z = mul(z, step);
-    }
-    total.clamp(0.0, 1.0)
+    let z = [phase.cos(), phase.sin()];
+    let one: C32 = [1.0, 0.0];
+    let mean = if box_width < 1e-3 {
+        div(mul(h.d, z), sub(one, mul(h.q, z)))
+    } else if norm_sqr(h.q) < 1e-12 {
+        scale(mul(h.d, z), sinc(0.5 * box_width))
+    } else {
+        let half = 0.5 * box_width;
+        let upper = ln(sub(
+            one,
+            mul(h.q, [(phase + half).cos(), (phase + half).sin()]),
+        ));
+        let lower = ln(sub(
+            one,
+            mul(h.q, [(phase - half).cos(), (phase - half).sin()]),
+        ));
+        scale(
+            mul([0.0, 1.0], div(mul(h.d, sub(upper, lower)), h.q)),
+            1.0 / box_width,
+        )
+    };
+    (h.c0 + 2.0 * mean[0]).clamp(0.0, 1.0)
 }
 
 /// Unpolarised reflectance at phase φ, averaged over a box of phase width `box_width`.

@@ -56,8 +56,10 @@ impl FilmRT {
 /// Complex cosine of the angle in a medium of index `n` for incidence `cos0` in `n0`:
 /// sqrt(1 − (n0/n)² sin²θ0), imaginary (evanescent) beyond total internal reflection.
 pub fn cos_in(n0: f64, n: f64, cos0: f64) -> C64 {
-    let sin2 = (1.0 - cos0 * cos0).max(0.0);
-    C64::real(1.0 - (n0 / n) * (n0 / n) * sin2).sqrt_upper()
+    // Written as (1 − η²) + η² cos²θ0 rather than 1 − η² sin²θ0: at grazing incidence with
+    // η = 1 the latter cancels to 0 and the film equations divide 0 by 0.
+    let eta2 = (n0 / n) * (n0 / n);
+    C64::real((1.0 - eta2) + eta2 * cos0 * cos0).sqrt_upper()
 }
 
 /// Fresnel amplitude coefficients (r_s, r_p, t_s, t_p) from medium i into medium j.
@@ -114,6 +116,10 @@ pub fn airy(stack: Stack, thickness_nm: f64, wavelength_nm: f64, cos0: f64) -> F
         (0.0, 0.0)
     };
     let (rs, rp) = if cos0 > 0.0 { (rs, rp) } else { (1.0, 1.0) };
+    if ![rs, rp, ts, tp].iter().all(|v| v.is_finite()) {
+        // Only |r01 r12| = 1 makes the Airy denominator vanish: the grazing limit, R = 1.
+        return FilmRT::from_sp(1.0, 1.0, 0.0, 0.0);
+    }
     FilmRT::from_sp(
         rs.clamp(0.0, 1.0),
         rp.clamp(0.0, 1.0),

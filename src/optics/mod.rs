@@ -10,8 +10,10 @@ pub mod film;
 pub mod lab;
 pub mod lut;
 pub mod methods;
+pub mod plot;
 pub mod series;
 pub mod spectrum;
+pub mod stress;
 
 use film::{Stack, airy, incoherent};
 use spectrum::{Observer, xyz_to_linear_srgb};

@@ -1,0 +1,260 @@
+//! `snakeskin brdf stress`: random and adversarial inputs through the film and the BRDF,
+//! f64 and f32, counting anything non-finite and the worst of every bound PHYSICS.md sets.
+//!
+//! Adversarial on purpose: grazing (cos = 0 and 1e-9) and back-facing directions, d = 0 and
+//! 10 mm, n1 = n0, n2 < n1, n0 > n2 (total internal reflection), roughness 0 and 1, τ = 0 and
+//! 50, zero-length and back-facing normals. Samples are generated from (seed, index) alone,
+//! so a report is reproducible at any thread count.
+
+use rayon::prelude::*;
+
+use super::brdf::{Layers, Layers32, eval, eval_f32, furnace_albedo};
+use super::film::{Stack, airy, incoherent};
+use super::lut::Lut;
+use crate::ops::hash;
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StressReport {
+    pub samples: u64,
+    pub nan: u64,
+    pub inf: u64,
+    /// Smallest and largest of R_s, R_p, R, T_s, T_p, T seen (must stay in [0, 1]).
+    pub min_r: f64,
+    pub max_r: f64,
+    /// Largest white-furnace albedo (k_d = 1, τ = 0) over the furnace subset.
+    pub max_albedo: f64,
+    /// Largest |f32 − f64| / (1 + |f64|) of the BRDF.
+    pub max_f32_dev: f64,
+    pub furnace_evaluations: u64,
+}
+
+/// The materials the stress draws from: the thesis default and its edge cases.
+pub const STRESS_MATERIALS: [Stack; 7] = [
+    Stack {
+        n0: 1.0,
+        n1: 1.55,
+        n2: 2.0,
+    },
+    Stack {
+        n0: 1.0,
+        n1: 1.0,
+        n2: 2.0,
+    },
+    Stack {
+        n0: 1.0,
+        n1: 1.56,
+        n2: 1.33,
+    },
+    Stack {
+        n0: 1.5,
+        n1: 1.55,
+        n2: 1.0,
+    },
+    Stack {
+        n0: 1.33,
+        n1: 1.55,
+        n2: 2.0,
+    },
+    Stack {
+        n0: 1.0,
+        n1: 3.0,
+        n2: 1.0,
+    },
+    Stack {
+        n0: 1.0,
+        n1: 2.0,
+        n2: 2.0,
+    },
+];
+
+/// One furnace integration per this many samples (it costs ~2000 BRDF evaluations).
+const FURNACE_EVERY: u64 = 2000;
+
+struct Draw {
+    seed: u32,
+    index: u64,
+    stream: u32,
+}
+
+impl Draw {
+    fn unit(&mut self) -> f64 {
+        self.stream += 1;
+        let lo = hash::unit(
+            self.index as i32,
+            (self.index >> 31) as i32,
+            self.stream,
+            self.seed,
+        ) as f64;
+        let hi = hash::unit(
+            self.index as i32,
+            (self.index >> 31) as i32,
+            self.stream + 1000,
+            self.seed,
+        ) as f64;
+        (lo + hi / (1u64 << 24) as f64).min(1.0 - 1e-15)
+    }
+    fn pick<T: Copy>(&mut self, options: &[T]) -> T {
+        options[((self.unit() * options.len() as f64) as usize).min(options.len() - 1)]
+    }
+    fn direction(&mut self) -> [f64; 3] {
+        let kind = self.pick(&[0, 0, 0, 1, 2, 3]);
+        let phi = self.unit() * std::f64::consts::TAU;
+        let cos = match kind {
+            0 => self.unit() * 2.0 - 1.0, // anywhere on the sphere, back-facing included
+            1 => 0.0,                     // exactly grazing
+            2 => 1e-9,                    // almost grazing
+            _ => 1.0,
+        };
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        [sin * phi.cos(), sin * phi.sin(), cos]
+    }
+}
+
+pub fn run(samples: u64, seed: u64) -> StressReport {
+    let luts: Vec<Lut> = STRESS_MATERIALS
+        .iter()
+        .map(|s| Lut::bake_default(*s))
+        .collect();
+    let seed32 = (seed ^ (seed >> 32)) as u32;
+    let partials: Vec<StressReport> = (0..samples)
+        .into_par_iter()
+        .fold(empty, |mut acc, index| {
+            sample(
+                &mut acc,
+                &luts,
+                Draw {
+                    seed: seed32,
+                    index,
+                    stream: 0,
+                },
+            );
+            acc
+        })
+        .collect();
+    let mut total = empty();
+    for p in partials {
+        total.samples += p.samples;
+        total.nan += p.nan;
+        total.inf += p.inf;
+        total.min_r = total.min_r.min(p.min_r);
+        total.max_r = total.max_r.max(p.max_r);
+        total.max_albedo = total.max_albedo.max(p.max_albedo);
+        total.max_f32_dev = total.max_f32_dev.max(p.max_f32_dev);
+        total.furnace_evaluations += p.furnace_evaluations;
+    }
+    total
+}
+
+fn empty() -> StressReport {
+    StressReport {
+        samples: 0,
+        nan: 0,
+        inf: 0,
+        min_r: f64::INFINITY,
+        max_r: f64::NEG_INFINITY,
+        max_albedo: 0.0,
+        max_f32_dev: 0.0,
+        furnace_evaluations: 0,
+    }
+}
+
+fn count(acc: &mut StressReport, values: &[f64]) {
+    for v in values {
+        if v.is_nan() {
+            acc.nan += 1;
+        } else if v.is_infinite() {
+            acc.inf += 1;
+        }
+    }
+}
+
+fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
+    acc.samples += 1;
+    let material = draw.pick(&[0, 1, 2, 3, 4, 5, 6]);
+    let stack = STRESS_MATERIALS[material];
+    let thickness = match draw.pick(&[0, 1, 2, 3]) {
+        0 => 0.0,
+        1 => 1.0e7,
+        2 => 10f64.powf(draw.unit() * 7.0),
+        _ => draw.unit() * 2000.0,
+    };
+    let roughness = draw.pick(&[0.0, 1.0, -1.0]);
+    let roughness = if roughness < 0.0 {
+        draw.unit()
+    } else {
+        roughness
+    };
+    let tau = draw.pick(&[0.0, 50.0, -1.0]);
+    let tau = if tau < 0.0 { draw.unit() * 5.0 } else { tau };
+    let normal = match draw.pick(&[0, 1, 2, 2, 2]) {
+        0 => [0.0; 3],
+        1 => [0.0, 0.0, -1.0],
+        _ => draw.direction(),
+    };
+    let (wi, wo) = (draw.direction(), draw.direction());
+
+    // Film R and T at a random wavelength and angle.
+    let cos0 = draw.pick(&[0.0, 1e-9, 1.0, -1.0]);
+    let cos0 = if cos0 < 0.0 { draw.unit() } else { cos0 };
+    let film = airy(stack, thickness, 360.0 + draw.unit() * 420.0, cos0);
+    let inc = incoherent(stack, cos0);
+    let rt = [
+        film.rs, film.rp, film.r, film.ts, film.tp, film.t, inc.r, inc.t,
+    ];
+    count(acc, &rt);
+    for v in rt {
+        acc.min_r = acc.min_r.min(v);
+        acc.max_r = acc.max_r.max(v);
+    }
+
+    let lut = &luts[material];
+    let layers = Layers {
+        n0: stack.n0,
+        n2: stack.n2,
+        roughness,
+        optical_depth: [tau; 3],
+        albedo: [1.0, 0.5, 0.0],
+    };
+    let value = eval(&layers, normal, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
+    let layers32 = Layers32 {
+        n0: stack.n0 as f32,
+        n2: stack.n2 as f32,
+        roughness: roughness as f32,
+        optical_depth: [tau as f32; 3],
+        albedo: [1.0, 0.5, 0.0],
+        thickness_nm: thickness as f32,
+    };
+    let value32 = eval_f32(
+        &layers32,
+        normal.map(|x| x as f32),
+        wi.map(|x| x as f32),
+        wo.map(|x| x as f32),
+        lut,
+    );
+    count(acc, &value);
+    count(acc, &value32.map(|v| v as f64));
+    for c in 0..3 {
+        if value[c] < 0.0 || value32[c] < 0.0 {
+            // Negative radiance is as wrong as NaN; report it there.
+            acc.nan += 1;
+        }
+        let dev = (value32[c] as f64 - value[c]).abs() / (1.0 + value[c].abs());
+        if dev.is_finite() {
+            acc.max_f32_dev = acc.max_f32_dev.max(dev);
+        }
+    }
+
+    if draw.index.is_multiple_of(FURNACE_EVERY) {
+        let white = Layers {
+            optical_depth: [0.0; 3],
+            albedo: [1.0; 3],
+            ..layers
+        };
+        let cos_o = draw.pick(&[1.0, 1e-3, -1.0]);
+        let cos_o = if cos_o < 0.0 { draw.unit() } else { cos_o };
+        let albedo = furnace_albedo(&white, cos_o, &|c| lut.lookup_f64(thickness, c), 32);
+        count(acc, &albedo);
+        acc.furnace_evaluations += 1;
+        acc.max_albedo = albedo.iter().cloned().fold(acc.max_albedo, f64::max);
+    }
+}
