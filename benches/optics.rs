@@ -14,9 +14,7 @@ fn methods(c: &mut Criterion) {
     let lut = Lut::bake_default(Stack::THESIS);
     let mut group = c.benchmark_group("film_colour_f32");
     let (n0, n1, n2, d, cos0) = (1.0f32, 1.55f32, 2.0f32, 437.0f32, 0.81f32);
-    group.bench_function("rgb3", |b| {
-        b.iter(|| rgb3_f32(black_box(n0), n1, n2, black_box(d), black_box(cos0)))
-    });
+    group.bench_function("rgb3", |b| b.iter(|| rgb3_f32(black_box(n0), n1, n2, black_box(d), black_box(cos0))));
     for n in [4usize, 8, 16, 32] {
         group.bench_function(format!("spectral-{n}"), |b| {
             b.iter(|| spectral_n_f32(black_box(n0), n1, n2, black_box(d), black_box(cos0), n))
@@ -25,9 +23,7 @@ fn methods(c: &mut Criterion) {
     group.bench_function("gaussian-fit", |b| {
         b.iter(|| gaussian_fit_f32(black_box(n0), n1, n2, black_box(d), black_box(cos0)))
     });
-    group.bench_function("lut", |b| {
-        b.iter(|| lut.lookup_f32(black_box(d), black_box(cos0)))
-    });
+    group.bench_function("lut", |b| b.iter(|| lut.lookup_f32(black_box(d), black_box(cos0))));
     group.finish();
 
     let layers = Layers32 {
@@ -40,18 +36,10 @@ fn methods(c: &mut Criterion) {
     };
     c.bench_function("brdf_f32_lut", |b| {
         b.iter(|| {
-            eval_f32(
-                &layers,
-                black_box([0.1, 0.0, 1.0]),
-                black_box([0.3, 0.1, 0.9]),
-                black_box([-0.2, 0.0, 1.0]),
-                &lut,
-            )
+            eval_f32(&layers, black_box([0.1, 0.0, 1.0]), black_box([0.3, 0.1, 0.9]), black_box([-0.2, 0.0, 1.0]), &lut)
         })
     });
-    c.bench_function("lut_bake_default", |b| {
-        b.iter(|| Lut::bake_default(black_box(Stack::THESIS)))
-    });
+    c.bench_function("lut_bake_default", |b| b.iter(|| Lut::bake_default(black_box(Stack::THESIS))));
 }
 
 criterion_group! {

@@ -20,11 +20,7 @@ fn load() -> LoadedPreset {
 fn set(loaded: &LoadedPreset, maps: &[MapKind], size: usize) -> usize {
     let graph = build_graph(&loaded.preset, BuildOptions::default());
     let eval = evaluate(&graph, maps, size, size, &|_, _| {});
-    encode_all(&loaded.name, &eval.maps)
-        .unwrap()
-        .iter()
-        .map(|(_, b)| b.len())
-        .sum()
+    encode_all(&loaded.name, &eval.maps).unwrap().iter().map(|(_, b)| b.len()).sum()
 }
 
 fn sets(c: &mut Criterion) {
@@ -32,9 +28,7 @@ fn sets(c: &mut Criterion) {
     let mut group = c.benchmark_group("set_1024");
     group.sample_size(10);
     group.bench_function("all_maps", |b| b.iter(|| set(&loaded, &MapKind::ALL, 1024)));
-    group.bench_function("roughness_only", |b| {
-        b.iter(|| set(&loaded, &[MapKind::Roughness], 1024))
-    });
+    group.bench_function("roughness_only", |b| b.iter(|| set(&loaded, &[MapKind::Roughness], 1024)));
     group.finish();
 }
 
@@ -45,32 +39,14 @@ fn operations(c: &mut Criterion) {
     group.sample_size(10);
     let field = scale_field(&loaded.preset);
     group.bench_function("scales", |b| b.iter(|| field.render(size, size)));
-    for (name, kind) in [
-        ("perlin_4oct", NoiseKind::Perlin),
-        ("cellular_4oct", NoiseKind::Cellular),
-    ] {
-        let op = Op::Noise(FractalNoise {
-            kind,
-            cells_u: 8,
-            cells_v: 8,
-            octaves: 4,
-            gain: 0.5,
-            seed: 1,
-        });
+    for (name, kind) in [("perlin_4oct", NoiseKind::Perlin), ("cellular_4oct", NoiseKind::Cellular)] {
+        let op = Op::Noise(FractalNoise { kind, cells_u: 8, cells_v: 8, octaves: 4, gain: 0.5, seed: 1 });
         group.bench_function(name, |b| b.iter(|| op.eval(&[], size, size)));
     }
-    let noise = Op::Noise(FractalNoise {
-        kind: NoiseKind::Perlin,
-        cells_u: 8,
-        cells_v: 8,
-        octaves: 1,
-        gain: 0.5,
-        seed: 1,
-    })
-    .eval(&[], size, size);
-    group.bench_function("blur_sigma_0.005", |b| {
-        b.iter(|| filters::blur(&noise, 0.005))
-    });
+    let noise =
+        Op::Noise(FractalNoise { kind: NoiseKind::Perlin, cells_u: 8, cells_v: 8, octaves: 1, gain: 0.5, seed: 1 })
+            .eval(&[], size, size);
+    group.bench_function("blur_sigma_0.005", |b| b.iter(|| filters::blur(&noise, 0.005)));
     group.bench_function("height_to_normal", |b| {
         b.iter(|| filters::height_to_normal(&noise, 0.05, filters::NormalConvention::OpenGl))
     });

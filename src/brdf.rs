@@ -59,79 +59,44 @@ fn spectral() -> String {
 }
 
 /// Refuses what the physics does not cover, naming the parameter and the accepted range.
-fn check(
-    stack: Stack,
-    thickness_nm: f64,
-    angle_deg: f64,
-    wavelength_nm: Option<f64>,
-) -> Result<()> {
+fn check(stack: Stack, thickness_nm: f64, angle_deg: f64, wavelength_nm: Option<f64>) -> Result<()> {
     for (name, n) in [("n0", stack.n0), ("n1", stack.n1), ("n2", stack.n2)] {
         if !(n.is_finite() && n >= 1.0) {
-            bail!(snakeskin::Error::Query(format!(
-                "{name} must be a finite refractive index >= 1, got {n}"
-            )));
+            bail!(snakeskin::Error::Query(format!("{name} must be a finite refractive index >= 1, got {n}")));
         }
     }
     if !(thickness_nm.is_finite() && thickness_nm >= 0.0) {
-        bail!(snakeskin::Error::Query(format!(
-            "thickness_nm must be finite and >= 0, got {thickness_nm}"
-        )));
+        bail!(snakeskin::Error::Query(format!("thickness_nm must be finite and >= 0, got {thickness_nm}")));
     }
     if !(angle_deg.is_finite() && (0.0..=90.0).contains(&angle_deg)) {
-        bail!(snakeskin::Error::Query(format!(
-            "angle_deg must be in [0, 90], got {angle_deg}"
-        )));
+        bail!(snakeskin::Error::Query(format!("angle_deg must be in [0, 90], got {angle_deg}")));
     }
     if let Some(l) = wavelength_nm
         && !(l.is_finite() && l > 0.0)
     {
-        bail!(snakeskin::Error::Query(format!(
-            "wavelength_nm must be finite and > 0, got {l}"
-        )));
+        bail!(snakeskin::Error::Query(format!("wavelength_nm must be finite and > 0, got {l}")));
     }
     Ok(())
 }
 
 fn film_json(q: &FilmQuery) -> Result<String> {
-    let stack = Stack {
-        n0: q.n0,
-        n1: q.n1,
-        n2: q.n2,
-    };
+    let stack = Stack { n0: q.n0, n1: q.n1, n2: q.n2 };
     check(stack, q.thickness_nm, q.angle_deg, Some(q.wavelength_nm))?;
-    let rt = airy(
-        stack,
-        q.thickness_nm,
-        q.wavelength_nm,
-        q.angle_deg.to_radians().cos(),
-    );
+    let rt = airy(stack, q.thickness_nm, q.wavelength_nm, q.angle_deg.to_radians().cos());
     Ok(serde_json::to_string(&rt)?)
 }
 
 fn color_json(q: &ColorQuery) -> Result<String> {
-    let stack = Stack {
-        n0: q.n0,
-        n1: q.n1,
-        n2: q.n2,
-    };
+    let stack = Stack { n0: q.n0, n1: q.n1, n2: q.n2 };
     check(stack, q.thickness_nm, q.angle_deg, None)?;
     let method = parse_method(&q.method)?;
-    let rgb = film_colour(
-        method,
-        stack,
-        q.thickness_nm,
-        q.angle_deg.to_radians().cos(),
-    );
+    let rgb = film_colour(method, stack, q.thickness_nm, q.angle_deg.to_radians().cos());
     Ok(serde_json::json!({ "rgb": rgb }).to_string())
 }
 
 fn parse_method(name: &str) -> Result<Method> {
     Method::parse(name).ok_or_else(|| {
-        snakeskin::Error::Query(format!(
-            "unknown method {name:?}; accepted: {}",
-            Method::ACCEPTED
-        ))
-        .into()
+        snakeskin::Error::Query(format!("unknown method {name:?}; accepted: {}", Method::ACCEPTED)).into()
     })
 }
 
@@ -159,17 +124,10 @@ fn film_colour(method: Method, stack: Stack, thickness_nm: f64, cos0: f64) -> [f
 }
 
 fn eval_json(args: &EvalArgs) -> Result<String> {
-    let stack = Stack {
-        n0: args.stack.n0,
-        n1: args.stack.n1,
-        n2: args.stack.n2,
-    };
+    let stack = Stack { n0: args.stack.n0, n1: args.stack.n1, n2: args.stack.n2 };
     check(stack, args.thickness_nm, 0.0, None)?;
     if !(args.roughness.is_finite() && (0.0..=1.0).contains(&args.roughness)) {
-        bail!(snakeskin::Error::Query(format!(
-            "roughness must be in [0, 1], got {}",
-            args.roughness
-        )));
+        bail!(snakeskin::Error::Query(format!("roughness must be in [0, 1], got {}", args.roughness)));
     }
     let method = parse_method(&args.method)?;
     let layers = Layers {
@@ -179,9 +137,7 @@ fn eval_json(args: &EvalArgs) -> Result<String> {
         optical_depth: args.absorption.map(|a| a * args.pigment_thickness),
         albedo: args.albedo,
     };
-    let value = eval(&layers, args.normal, args.wi, args.wo, &|c| {
-        film_colour(method, stack, args.thickness_nm, c)
-    });
+    let value = eval(&layers, args.normal, args.wi, args.wo, &|c| film_colour(method, stack, args.thickness_nm, c));
     Ok(serde_json::json!({ "f": value.total(), "specular": value.specular, "diffuse": value.diffuse }).to_string())
 }
 
@@ -189,25 +145,20 @@ fn batch_lines(path: &str) -> Result<Box<dyn BufRead>> {
     Ok(if path == "-" {
         Box::new(BufReader::new(std::io::stdin()))
     } else {
-        Box::new(BufReader::new(
-            std::fs::File::open(path).with_context(|| format!("cannot read {path}"))?,
-        ))
+        Box::new(BufReader::new(std::fs::File::open(path).with_context(|| format!("cannot read {path}"))?))
     })
 }
 
 /// Runs `per_line` on every non-empty JSON line; errors name the line number.
-fn run_batch<Q: for<'de> Deserialize<'de>>(
-    path: &str,
-    per_line: impl Fn(&Q) -> Result<String>,
-) -> Result<()> {
+fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> Result<String>) -> Result<()> {
     let mut out = std::io::stdout().lock();
     for (i, line) in batch_lines(path)?.lines().enumerate() {
         let line = line?;
         if line.trim().is_empty() {
             continue;
         }
-        let query: Q = serde_json::from_str(&line)
-            .map_err(|e| snakeskin::Error::Query(format!("{path}:{}: {e}", i + 1)))?;
+        let query: Q =
+            serde_json::from_str(&line).map_err(|e| snakeskin::Error::Query(format!("{path}:{}: {e}", i + 1)))?;
         let json = per_line(&query).with_context(|| format!("{path}:{}", i + 1))?;
         writeln!(out, "{json}")?;
     }
@@ -220,16 +171,8 @@ fn stack_of(s: &StackArgs) -> (f64, f64, f64) {
 
 pub fn run(command: BrdfCommand) -> Result<()> {
     match command {
-        BrdfCommand::Film {
-            batch: Some(path), ..
-        } => run_batch(&path, film_json),
-        BrdfCommand::Film {
-            stack,
-            thickness_nm,
-            wavelength_nm,
-            angle_deg,
-            batch: None,
-        } => {
+        BrdfCommand::Film { batch: Some(path), .. } => run_batch(&path, film_json),
+        BrdfCommand::Film { stack, thickness_nm, wavelength_nm, angle_deg, batch: None } => {
             let (n0, n1, n2) = stack_of(&stack);
             let query = FilmQuery {
                 n0,
@@ -242,41 +185,22 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             println!("{}", film_json(&query)?);
             Ok(())
         }
-        BrdfCommand::Chart {
-            stack,
-            out,
-            method,
-            width,
-            height,
-        } => {
-            let stack = Stack {
-                n0: stack.n0,
-                n1: stack.n1,
-                n2: stack.n2,
-            };
+        BrdfCommand::Chart { stack, out, method, width, height } => {
+            let stack = Stack { n0: stack.n0, n1: stack.n1, n2: stack.n2 };
             check(stack, 0.0, 0.0, None)?;
             let method = parse_method(&method)?;
             if !(2..=4096).contains(&width) || !(2..=4096).contains(&height) {
-                bail!(snakeskin::Error::Query(
-                    "chart width and height must be 2..=4096 pixels".into()
-                ));
+                bail!(snakeskin::Error::Query("chart width and height must be 2..=4096 pixels".into()));
             }
             let exposure = chart(stack, method, width as usize, height as usize, &out)?;
-            eprintln!(
-                "wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)",
-                out.display()
-            );
+            eprintln!("wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)", out.display());
             Ok(())
         }
         BrdfCommand::Eval(args) => {
             println!("{}", eval_json(&args)?);
             Ok(())
         }
-        BrdfCommand::Stress {
-            samples,
-            seed,
-            json,
-        } => {
+        BrdfCommand::Stress { samples, seed, json } => {
             let report = snakeskin::optics::stress::run(samples, seed);
             if json {
                 println!("{}", serde_json::to_string(&report)?);
@@ -285,16 +209,8 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             }
             Ok(())
         }
-        BrdfCommand::Color {
-            batch: Some(path), ..
-        } => run_batch(&path, color_json),
-        BrdfCommand::Color {
-            stack,
-            thickness_nm,
-            angle_deg,
-            method,
-            batch: None,
-        } => {
+        BrdfCommand::Color { batch: Some(path), .. } => run_batch(&path, color_json),
+        BrdfCommand::Color { stack, thickness_nm, angle_deg, method, batch: None } => {
             let (n0, n1, n2) = stack_of(&stack);
             let query = ColorQuery {
                 n0,
@@ -312,29 +228,16 @@ pub fn run(command: BrdfCommand) -> Result<()> {
 
 pub fn bench(command: BenchCommand) -> Result<()> {
     match command {
-        BenchCommand::Irid {
-            json,
-            plot,
-            d_step_nm,
-            angle_step_deg,
-            lut_sweep,
-        } => {
+        BenchCommand::Irid { json, plot, d_step_nm, angle_step_deg, lut_sweep } => {
             use snakeskin::optics::accuracy::{Prepared, grid, measure, reference_colours};
             use snakeskin::optics::lab::linear_srgb_to_lab;
             if !(d_step_nm > 0.0 && angle_step_deg > 0.0) {
-                bail!(snakeskin::Error::Query(
-                    "grid steps must be positive".into()
-                ));
+                bail!(snakeskin::Error::Query("grid steps must be positive".into()));
             }
             let samples = grid(d_step_nm, angle_step_deg);
-            eprintln!(
-                "reference: {} grid points, 1 nm spectral sum",
-                samples.len()
-            );
-            let reference_lab: Vec<[f64; 3]> = reference_colours(&samples)
-                .into_iter()
-                .map(linear_srgb_to_lab)
-                .collect();
+            eprintln!("reference: {} grid points, 1 nm spectral sum", samples.len());
+            let reference_lab: Vec<[f64; 3]> =
+                reference_colours(&samples).into_iter().map(linear_srgb_to_lab).collect();
             let mut reports = Vec::new();
             for method in Method::all_realtime() {
                 eprintln!("measuring {}", method.name());
@@ -342,26 +245,16 @@ pub fn bench(command: BenchCommand) -> Result<()> {
             }
             if lut_sweep {
                 for size in [(16, 64, 16), (32, 128, 32), (128, 512, 128)] {
-                    let mut report = measure(
-                        &Prepared::with_lut_size(Method::Lut, size),
-                        &samples,
-                        &reference_lab,
-                    );
+                    let mut report = measure(&Prepared::with_lut_size(Method::Lut, size), &samples, &reference_lab);
                     report.name = format!("lut-{}x{}+{}", size.0, size.1, size.2);
                     reports.push(report);
                 }
             }
             let default = Method::Lut.name();
             if json {
-                println!(
-                    "{}",
-                    serde_json::json!({ "default": default, "methods": reports })
-                );
+                println!("{}", serde_json::json!({ "default": default, "methods": reports }));
             } else {
-                println!(
-                    "{:<18} {:>9} {:>9} {:>9} {:>12}",
-                    "method", "mean ΔE", "p95 ΔE", "max ΔE", "ns/eval"
-                );
+                println!("{:<18} {:>9} {:>9} {:>9} {:>12}", "method", "mean ΔE", "p95 ΔE", "max ΔE", "ns/eval");
                 for r in &reports {
                     let mark = if r.name == default { " (default)" } else { "" };
                     println!(
@@ -373,14 +266,9 @@ pub fn bench(command: BenchCommand) -> Result<()> {
             if let Some(path) = plot {
                 let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default);
                 snakeskin::export::write_all_atomically(
-                    path.parent()
-                        .filter(|p| !p.as_os_str().is_empty())
-                        .unwrap_or(std::path::Path::new(".")),
+                    path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new(".")),
                     &[(
-                        path.file_name()
-                            .context("plot path names a file")?
-                            .to_string_lossy()
-                            .into_owned(),
+                        path.file_name().context("plot path names a file")?.to_string_lossy().into_owned(),
                         svg.into_bytes(),
                     )],
                 )?;
@@ -392,13 +280,7 @@ pub fn bench(command: BenchCommand) -> Result<()> {
 
 /// Renders the chart; returns the exposure (1 / brightest channel) applied so the colours
 /// use the whole range (film reflectances are a few percent to a few tens of percent).
-fn chart(
-    stack: Stack,
-    method: Method,
-    width: usize,
-    height: usize,
-    out: &std::path::Path,
-) -> Result<f64> {
+fn chart(stack: Stack, method: Method, width: usize, height: usize, out: &std::path::Path) -> Result<f64> {
     use rayon::prelude::*;
     let rows: Vec<Vec<[f64; 3]>> = (0..height)
         .into_par_iter()
@@ -406,42 +288,22 @@ fn chart(
             let angle_deg = 89.0 * y as f64 / (height - 1) as f64;
             (0..width)
                 .map(|x| {
-                    film_colour(
-                        method,
-                        stack,
-                        2000.0 * x as f64 / (width - 1) as f64,
-                        angle_deg.to_radians().cos(),
-                    )
+                    film_colour(method, stack, 2000.0 * x as f64 / (width - 1) as f64, angle_deg.to_radians().cos())
                 })
                 .collect()
         })
         .collect();
-    let brightest = rows
-        .iter()
-        .flatten()
-        .flat_map(|p| p.iter().copied())
-        .fold(1e-6, f64::max);
+    let brightest = rows.iter().flatten().flat_map(|p| p.iter().copied()).fold(1e-6, f64::max);
     let exposure = 1.0 / brightest;
     let image = snakeskin::ops::Image {
         width,
         height,
         channels: 3,
-        data: rows
-            .into_iter()
-            .flatten()
-            .flat_map(|p| p.map(|c| (c * exposure) as f32))
-            .collect(),
+        data: rows.into_iter().flatten().flat_map(|p| p.map(|c| (c * exposure) as f32)).collect(),
     };
     let png = snakeskin::export::encode_png(snakeskin::maps::MapKind::Color, &image)?;
-    let dir = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let name = out
-        .file_name()
-        .context("the output path names a file")?
-        .to_string_lossy()
-        .into_owned();
+    let dir = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    let name = out.file_name().context("the output path names a file")?.to_string_lossy().into_owned();
     snakeskin::export::write_all_atomically(dir, &[(name, png)])?;
     Ok(exposure)
 }

@@ -34,6 +34,18 @@ pub enum Command {
         #[command(subcommand)]
         command: BenchCommand,
     },
+    /// A gallery PNG of every scale shape and pattern kind (tile order: see README).
+    Gallery {
+        /// Output PNG file.
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Tile size in pixels.
+        #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(16..=2048))]
+        tile: u64,
+        /// Tiles per row.
+        #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u64).range(1..=64))]
+        columns: u64,
+    },
     /// List or show the built-in species presets.
     Presets {
         #[command(subcommand)]
@@ -99,9 +111,7 @@ pub enum PresetsCommand {
 }
 
 fn parse_key_value(arg: &str) -> Result<(String, String), String> {
-    let (key, value) = arg
-        .split_once('=')
-        .ok_or_else(|| format!("expected KEY=VALUE, got {arg:?}"))?;
+    let (key, value) = arg.split_once('=').ok_or_else(|| format!("expected KEY=VALUE, got {arg:?}"))?;
     if key.trim().is_empty() {
         return Err(format!("empty key in {arg:?}"));
     }
@@ -248,11 +258,7 @@ pub enum BenchCommand {
 fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
     let parts: Vec<f64> = text
         .split(',')
-        .map(|p| {
-            p.trim()
-                .parse::<f64>()
-                .map_err(|_| format!("expected x,y,z numbers, got {text:?}"))
-        })
+        .map(|p| p.trim().parse::<f64>().map_err(|_| format!("expected x,y,z numbers, got {text:?}")))
         .collect::<Result<_, _>>()?;
     match parts.as_slice() {
         [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok([*x, *y, *z]),

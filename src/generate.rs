@@ -33,11 +33,7 @@ pub struct GenerateReport {
 }
 
 /// Loads and validates a preset with overrides and an optional seed.
-pub fn load(
-    spec: &str,
-    overrides: &[(String, String)],
-    seed: Option<u64>,
-) -> Result<LoadedPreset, Error> {
+pub fn load(spec: &str, overrides: &[(String, String)], seed: Option<u64>) -> Result<LoadedPreset, Error> {
     let source = preset::read_source(spec)?;
     let mut all = overrides.to_vec();
     if let Some(seed) = seed {
@@ -54,10 +50,7 @@ pub fn check_size(size: u64) -> Result<usize, Error> {
 }
 
 /// Runs a whole generation. `progress(done, total)` reports node evaluations.
-pub fn generate(
-    request: &GenerateRequest,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<GenerateReport, Error> {
+pub fn generate(request: &GenerateRequest, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
     let start = Instant::now();
     let size = check_size(request.size)?;
     let loaded = load(&request.preset, &request.overrides, request.seed)?;
@@ -66,21 +59,13 @@ pub fn generate(
 
     let encode_start = Instant::now();
     let mut files = export::encode_all(&loaded.name, &evaluation.maps)?;
-    let names: Vec<(MapKind, String)> = evaluation
-        .maps
-        .keys()
-        .map(|m| (*m, export::map_file_name(&loaded.name, *m)))
-        .collect();
+    let names: Vec<(MapKind, String)> =
+        evaluation.maps.keys().map(|m| (*m, export::map_file_name(&loaded.name, *m))).collect();
     let manifest = export::manifest(&loaded, size, &names, request.options.normal_convention);
     let json = serde_json::to_vec_pretty(&manifest).expect("manifest serialises");
     files.push((format!("{}.material.json", loaded.name), json));
     let encode_time = encode_start.elapsed();
 
     let written = write_all_atomically(&request.out_dir, &files)?;
-    Ok(GenerateReport {
-        files: written,
-        stats: evaluation.stats,
-        encode_time,
-        total_time: start.elapsed(),
-    })
+    Ok(GenerateReport { files: written, stats: evaluation.stats, encode_time, total_time: start.elapsed() })
 }

@@ -6,6 +6,7 @@
 //! for tests.
 
 pub mod export;
+pub mod gallery;
 pub mod generate;
 pub mod graph;
 pub mod maps;

@@ -24,9 +24,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {err:#}");
-            let invalid = err
-                .downcast_ref::<Error>()
-                .is_some_and(Error::is_invalid_input);
+            let invalid = err.downcast_ref::<Error>().is_some_and(Error::is_invalid_input);
             ExitCode::from(if invalid { 2 } else { 1 })
         }
     }
@@ -46,9 +44,7 @@ fn run(cli: Cli) -> Result<()> {
                 size: args.size,
                 maps: parse_map_list(&args.preset.maps)?,
                 out_dir: args.out.clone(),
-                options: BuildOptions {
-                    normal_convention: convention,
-                },
+                options: BuildOptions { normal_convention: convention },
             };
             let bar = progress_bar();
             let report = generate(&request, &|done, total| {
@@ -75,65 +71,44 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Graph(args) => {
             let maps = parse_map_list(&args.preset.maps)?;
-            let loaded = snakeskin::generate::load(
-                &args.preset.preset,
-                &args.preset.overrides,
-                args.preset.seed,
-            )?;
+            let loaded = snakeskin::generate::load(&args.preset.preset, &args.preset.overrides, args.preset.seed)?;
             let graph = build_graph(&loaded.preset, BuildOptions::default());
             if args.dot {
                 print!("{}", to_dot(&graph, &maps));
             } else {
                 for id in graph.reachable(&maps) {
                     let node = graph.node(id);
-                    let inputs: Vec<&str> = node
-                        .inputs
-                        .iter()
-                        .map(|i| graph.node(*i).name.as_str())
-                        .collect();
-                    println!(
-                        "{:<28} {:<36} <- {}",
-                        node.name,
-                        node.op.label(),
-                        inputs.join(", ")
-                    );
+                    let inputs: Vec<&str> = node.inputs.iter().map(|i| graph.node(*i).name.as_str()).collect();
+                    println!("{:<28} {:<36} <- {}", node.name, node.op.label(), inputs.join(", "));
                 }
             }
             Ok(())
         }
         Command::Brdf { command } => brdf::run(command),
         Command::Bench { command } => brdf::bench(command),
-        Command::Presets {
-            command: PresetsCommand::List,
-        } => {
+        Command::Gallery { out, tile, columns } => {
+            snakeskin::gallery::write(&out, tile as usize, columns as usize)?;
+            println!("{}", out.display());
+            Ok(())
+        }
+        Command::Presets { command: PresetsCommand::List } => {
             for (name, text) in library::all() {
                 let preset: snakeskin::preset::Preset = toml::from_str(text)?;
-                let category = preset
-                    .category
-                    .map(|c| format!("{c:?}"))
-                    .unwrap_or_default();
-                println!(
-                    "{name:<28} {:<32} {}",
-                    preset.common_name.unwrap_or_default(),
-                    category.to_lowercase()
-                );
+                let category = preset.category.map(|c| format!("{c:?}")).unwrap_or_default();
+                println!("{name:<28} {:<32} {}", preset.common_name.unwrap_or_default(), category.to_lowercase());
             }
             Ok(())
         }
-        Command::Presets {
-            command: PresetsCommand::Show { name },
-        } => match library::get(&name) {
+        Command::Presets { command: PresetsCommand::Show { name } } => match library::get(&name) {
             Some(text) => {
                 print!("{text}");
                 Ok(())
             }
-            None => Err(
-                Error::Preset(snakeskin::preset::PresetError::UnknownPreset {
-                    available: library::names().join(", "),
-                    name,
-                })
-                .into(),
-            ),
+            None => Err(Error::Preset(snakeskin::preset::PresetError::UnknownPreset {
+                available: library::names().join(", "),
+                name,
+            })
+            .into()),
         },
     }
 }
@@ -144,18 +119,12 @@ fn progress_bar() -> Option<ProgressBar> {
         return None;
     }
     let bar = ProgressBar::new(1);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} generating [{bar:30}] {pos}/{len} nodes {elapsed}")
-            .ok()?,
-    );
+    bar.set_style(ProgressStyle::with_template("{spinner} generating [{bar:30}] {pos}/{len} nodes {elapsed}").ok()?);
     Some(bar)
 }
 
 fn print_stats(stats: &EvalStats) {
-    eprintln!(
-        "{:<28} {:<36} {:>5} {:>10} {:>10}",
-        "node", "operation", "evals", "ms", "MiB"
-    );
+    eprintln!("{:<28} {:<36} {:>5} {:>10} {:>10}", "node", "operation", "evals", "ms", "MiB");
     let mut nodes = stats.nodes.clone();
     nodes.sort_by_key(|n| std::cmp::Reverse(n.time));
     for n in &nodes {

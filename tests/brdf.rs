@@ -12,13 +12,7 @@ use snakeskin::optics::methods::{
 };
 
 fn white_layers(stack: Stack, roughness: f64) -> Layers {
-    Layers {
-        n0: stack.n0,
-        n2: stack.n2,
-        roughness,
-        optical_depth: [0.0; 3],
-        albedo: [1.0; 3],
-    }
+    Layers { n0: stack.n0, n2: stack.n2, roughness, optical_depth: [0.0; 3], albedo: [1.0; 3] }
 }
 
 #[test]
@@ -36,22 +30,9 @@ fn furnace_machinery_integrates_known_cases() {
 #[test]
 fn white_furnace_never_exceeds_one() {
     let mut worst: f64 = 0.0;
-    let stacks = [
-        GRID_MATERIALS.to_vec(),
-        vec![
-            Stack {
-                n0: 1.0,
-                n1: 1.0,
-                n2: 1.5,
-            },
-            Stack {
-                n0: 1.0,
-                n1: 2.5,
-                n2: 1.2,
-            },
-        ],
-    ]
-    .concat();
+    let stacks =
+        [GRID_MATERIALS.to_vec(), vec![Stack { n0: 1.0, n1: 1.0, n2: 1.5 }, Stack { n0: 1.0, n1: 2.5, n2: 1.2 }]]
+            .concat();
     for stack in stacks {
         let lut = Lut::bake(stack, 16, 64, 8);
         for thickness in [0.0, 250.0, 400.0, 900.0, 2400.0, 1e7] {
@@ -83,11 +64,7 @@ fn furnace_with_the_exact_spectral_film() {
 }
 
 fn unit(theta: f64, phi: f64) -> [f64; 3] {
-    [
-        theta.sin() * phi.cos(),
-        theta.sin() * phi.sin(),
-        theta.cos(),
-    ]
+    [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
 }
 
 proptest! {
@@ -132,13 +109,8 @@ fn f32_brdf_follows_the_f64_brdf() {
     for (i, roughness) in [0.05, 0.3, 0.9].into_iter().enumerate() {
         for t in 0..20 {
             let thickness = 100.0 * t as f64;
-            let layers = Layers {
-                n0: 1.0,
-                n2: 2.0,
-                roughness,
-                optical_depth: [0.6, 0.3, 0.1],
-                albedo: [0.5, 0.4, 0.2],
-            };
+            let layers =
+                Layers { n0: 1.0, n2: 2.0, roughness, optical_depth: [0.6, 0.3, 0.1], albedo: [0.5, 0.4, 0.2] };
             let layers32 = Layers32 {
                 n0: 1.0,
                 n2: 2.0,
@@ -147,19 +119,10 @@ fn f32_brdf_follows_the_f64_brdf() {
                 albedo: [0.5, 0.4, 0.2],
                 thickness_nm: thickness as f32,
             };
-            let (wi, wo) = (
-                unit(0.3 + 0.1 * i as f64, 0.5),
-                unit(0.2 + 0.07 * t as f64, 2.0),
-            );
+            let (wi, wo) = (unit(0.3 + 0.1 * i as f64, 0.5), unit(0.2 + 0.07 * t as f64, 2.0));
             let n = [0.1, -0.05, 1.0];
             let f64v = eval(&layers, n, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
-            let f32v = eval_f32(
-                &layers32,
-                n.map(|x| x as f32),
-                wi.map(|x| x as f32),
-                wo.map(|x| x as f32),
-                &lut,
-            );
+            let f32v = eval_f32(&layers32, n.map(|x| x as f32), wi.map(|x| x as f32), wo.map(|x| x as f32), &lut);
             for c in 0..3 {
                 // Relative to 1 + f: f32 carries ~7 digits, the peak of D amplifies rounding.
                 let dev = (f32v[c] as f64 - f64v[c]).abs() / (1.0 + f64v[c]);
@@ -175,55 +138,25 @@ fn each_method_f32_agrees_with_its_f64_form() {
     let samples: Vec<Sample> = grid(50.0, 7.0);
     for s in &samples {
         let stack = GRID_MATERIALS[s.material];
-        let (n0, n1, n2, d, c) = (
-            stack.n0 as f32,
-            stack.n1 as f32,
-            stack.n2 as f32,
-            s.thickness_nm as f32,
-            s.cos0 as f32,
-        );
+        let (n0, n1, n2, d, c) =
+            (stack.n0 as f32, stack.n1 as f32, stack.n2 as f32, s.thickness_nm as f32, s.cos0 as f32);
         let pairs: [(&str, [f32; 3], [f64; 3]); 4] = [
-            (
-                "rgb3",
-                rgb3_f32(n0, n1, n2, d, c),
-                rgb3_f64(stack, s.thickness_nm, s.cos0),
-            ),
-            (
-                "spectral-8",
-                spectral_n_f32(n0, n1, n2, d, c, 8),
-                spectral_n_f64(stack, s.thickness_nm, s.cos0, 8),
-            ),
-            (
-                "spectral-32",
-                spectral_n_f32(n0, n1, n2, d, c, 32),
-                spectral_n_f64(stack, s.thickness_nm, s.cos0, 32),
-            ),
-            (
-                "gaussian-fit",
-                gaussian_fit_f32(n0, n1, n2, d, c),
-                gaussian_fit_f64(stack, s.thickness_nm, s.cos0),
-            ),
+            ("rgb3", rgb3_f32(n0, n1, n2, d, c), rgb3_f64(stack, s.thickness_nm, s.cos0)),
+            ("spectral-8", spectral_n_f32(n0, n1, n2, d, c, 8), spectral_n_f64(stack, s.thickness_nm, s.cos0, 8)),
+            ("spectral-32", spectral_n_f32(n0, n1, n2, d, c, 32), spectral_n_f64(stack, s.thickness_nm, s.cos0, 32)),
+            ("gaussian-fit", gaussian_fit_f32(n0, n1, n2, d, c), gaussian_fit_f64(stack, s.thickness_nm, s.cos0)),
         ];
         for (name, a, b) in pairs {
-            let de = ciede2000(
-                linear_srgb_to_lab(a.map(|v| v as f64)),
-                linear_srgb_to_lab(b),
-            );
+            let de = ciede2000(linear_srgb_to_lab(a.map(|v| v as f64)), linear_srgb_to_lab(b));
             // 0.05 ΔE00 is a twentieth of a just-noticeable difference.
-            assert!(
-                de < 0.05,
-                "{name} at {s:?}: f32 {a:?} vs f64 {b:?} (ΔE {de})"
-            );
+            assert!(de < 0.05, "{name} at {s:?}: f32 {a:?} vs f64 {b:?} (ΔE {de})");
         }
     }
     let lut = Lut::bake(Stack::THESIS, 16, 64, 8);
     for s in samples.iter().filter(|s| s.material == 0) {
         let a = lut.lookup_f32(s.thickness_nm as f32, s.cos0 as f32);
         let b = lut.lookup_f64(s.thickness_nm, s.cos0);
-        assert!(
-            (0..3).all(|k| (a[k] as f64 - b[k]).abs() < 1e-5),
-            "lut {a:?} {b:?}"
-        );
+        assert!((0..3).all(|k| (a[k] as f64 - b[k]).abs() < 1e-5), "lut {a:?} {b:?}");
     }
 }
 
@@ -239,14 +172,8 @@ fn thick_films_converge_to_the_incoherent_limit() {
             for d in [2.0e4, 3.3e4, 5.0e4, 1.0e5, 2.4e6, 1.0e7] {
                 let (n0, n1, n2) = (stack.n0 as f32, stack.n1 as f32, stack.n2 as f32);
                 let colours: [(&str, [f64; 3]); 5] = [
-                    (
-                        "rgb3",
-                        rgb3_f32(n0, n1, n2, d as f32, cos0 as f32).map(|v| v as f64),
-                    ),
-                    (
-                        "spectral-8",
-                        spectral_n_f32(n0, n1, n2, d as f32, cos0 as f32, 8).map(|v| v as f64),
-                    ),
+                    ("rgb3", rgb3_f32(n0, n1, n2, d as f32, cos0 as f32).map(|v| v as f64)),
+                    ("spectral-8", spectral_n_f32(n0, n1, n2, d as f32, cos0 as f32, 8).map(|v| v as f64)),
                     ("spectral-32", spectral_n_f64(stack, d, cos0, 32)),
                     ("gaussian-fit", gaussian_fit_f64(stack, d, cos0)),
                     ("lut", lut.lookup_f64(d, cos0)),
@@ -262,20 +189,8 @@ fn thick_films_converge_to_the_incoherent_limit() {
 
 #[test]
 fn roughness_zero_uses_the_documented_floor() {
-    let layers = Layers {
-        n0: 1.0,
-        n2: 2.0,
-        roughness: 0.0,
-        optical_depth: [0.0; 3],
-        albedo: [0.0; 3],
-    };
-    let v = eval(
-        &layers,
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, 1.0],
-        &|_| [1.0; 3],
-    );
+    let layers = Layers { n0: 1.0, n2: 2.0, roughness: 0.0, optical_depth: [0.0; 3], albedo: [0.0; 3] };
+    let v = eval(&layers, [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], &|_| [1.0; 3]);
     // At the mirror direction D = 1 / (π α²) with α = ALPHA_MIN and G2 = 1: f = D / 4.
     let expected = 1.0 / (std::f64::consts::PI * ALPHA_MIN * ALPHA_MIN) / 4.0;
     assert!((v.specular[0] - expected).abs() / expected < 1e-9, "{v:?}");

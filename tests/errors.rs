@@ -12,11 +12,7 @@ fn refused(preset_name: &str, preset_text: &str, extra: &[&str]) -> String {
     let presets = tempfile::tempdir().unwrap();
     let path = write_preset(presets.path(), preset_name, preset_text);
     let stem = preset_name.trim_end_matches(".toml");
-    std::fs::write(
-        dir.path().join(format!("{stem}_color.png")),
-        b"earlier output",
-    )
-    .unwrap();
+    std::fs::write(dir.path().join(format!("{stem}_color.png")), b"earlier output").unwrap();
     let before = snapshot(dir.path());
     let out_dir = dir.path().to_str().unwrap();
     let mut args = vec!["generate", path.as_str(), "-o", out_dir];
@@ -55,10 +51,7 @@ fn unknown_key_is_named_with_a_suggestion() {
 fn unknown_enum_value_lists_what_is_accepted() {
     let err = refused("shape.toml", "[scales]\nshape = \"round\"\n", &[]);
     assert!(err.contains("shape.toml:2:"), "{err}");
-    assert!(
-        err.contains("leaf") && err.contains("diamond") && err.contains("hexagon"),
-        "{err}"
-    );
+    assert!(err.contains("leaf") && err.contains("diamond") && err.contains("hexagon"), "{err}");
 }
 
 #[test]
@@ -72,19 +65,13 @@ fn out_of_range_value_names_key_and_range() {
 #[test]
 fn non_finite_value_is_refused() {
     let err = refused("nan.toml", "[scales]\nsize = nan\n", &[]);
-    assert!(
-        err.contains("scales.size") && err.contains("finite"),
-        "{err}"
-    );
+    assert!(err.contains("scales.size") && err.contains("finite"), "{err}");
 }
 
 #[test]
 fn out_of_range_override_names_the_set_argument() {
     let err = refused("ok.toml", "seed = 1\n", &["--set", "scales.rows=1000"]);
-    assert!(
-        err.contains("scales.rows") && err.contains("--set"),
-        "{err}"
-    );
+    assert!(err.contains("scales.rows") && err.contains("--set"), "{err}");
     let err = refused("ok.toml", "seed = 1\n", &["--set", "scales.rwos=20"]);
     assert!(err.contains("did you mean `rows`"), "{err}");
 }
@@ -93,10 +80,7 @@ fn out_of_range_override_names_the_set_argument() {
 fn sizes_outside_the_range_are_refused_before_anything_runs() {
     for size in ["0", "15", "1000000", "16385"] {
         let err = refused("fine.toml", "seed = 1\n", &["--size", size]);
-        assert!(
-            err.contains("16..=16384") || err.contains("16 to 16384"),
-            "{size}: {err}"
-        );
+        assert!(err.contains("16..=16384") || err.contains("16 to 16384"), "{size}: {err}");
     }
 }
 
@@ -104,17 +88,9 @@ fn sizes_outside_the_range_are_refused_before_anything_runs() {
 fn unknown_map_and_preset_are_refused() {
     let err = refused("fine.toml", "seed = 1\n", &["--maps", "colour"]);
     assert!(err.contains("colour") && err.contains("roughness"), "{err}");
-    let out = snakeskin(&[
-        "generate",
-        "no-such-snake",
-        "-o",
-        "/nonexistent-dir-never-created",
-    ]);
+    let out = snakeskin(&["generate", "no-such-snake", "-o", "/nonexistent-dir-never-created"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(
-        stderr(&out).contains("erythrolamprus-miliaris"),
-        "lists the built-in presets"
-    );
+    assert!(stderr(&out).contains("erythrolamprus-miliaris"), "lists the built-in presets");
     assert!(!std::path::Path::new("/nonexistent-dir-never-created").exists());
 }
 
@@ -124,14 +100,7 @@ fn unwritable_output_leaves_no_partial_files() {
     let dir = tempfile::tempdir().unwrap();
     let blocker = dir.path().join("blocked");
     std::fs::write(&blocker, b"a file").unwrap();
-    let out = snakeskin(&[
-        "generate",
-        PATTERNED,
-        "-o",
-        blocker.join("sub").to_str().unwrap(),
-        "--size",
-        "32",
-    ]);
+    let out = snakeskin(&["generate", PATTERNED, "-o", blocker.join("sub").to_str().unwrap(), "--size", "32"]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert_eq!(snapshot(dir.path()).len(), 1);
 }

@@ -33,12 +33,7 @@ fn transfer_matrix(stack: Stack, d_nm: f64, lambda_nm: f64, cos0: f64) -> (f64, 
     let delta = c1 * (2.0 * std::f64::consts::PI * stack.n1 * d_nm / lambda_nm);
     let i = C::new(0.0, 1.0);
     let solve = |eta0: C, eta1: C, eta2: C| {
-        let (m11, m12, m21, m22) = (
-            delta.cos(),
-            i * delta.sin() / eta1,
-            i * eta1 * delta.sin(),
-            delta.cos(),
-        );
+        let (m11, m12, m21, m22) = (delta.cos(), i * delta.sin() / eta1, i * eta1 * delta.sin(), delta.cos());
         let b = m11 + m12 * eta2;
         let c = m21 + m22 * eta2;
         let r = (eta0 * b - c) / (eta0 * b + c);
@@ -55,17 +50,9 @@ fn airy_matches_the_transfer_matrix_on_random_inputs_including_tir() {
     let mut rng = Rng(7);
     let mut tir_cases = 0;
     for _ in 0..20_000 {
-        let stack = Stack {
-            n0: rng.range(1.0, 1.6),
-            n1: rng.range(1.0, 2.5),
-            n2: rng.range(1.0, 2.5),
-        };
+        let stack = Stack { n0: rng.range(1.0, 1.6), n1: rng.range(1.0, 2.5), n2: rng.range(1.0, 2.5) };
         let cos0 = rng.range(1e-4, 1.0);
-        let d = if rng.next() < 0.1 {
-            0.0
-        } else {
-            rng.range(0.0, 3000.0)
-        };
+        let d = if rng.next() < 0.1 { 0.0 } else { rng.range(0.0, 3000.0) };
         let lambda = rng.range(360.0, 780.0);
         let sin0 = (1.0 - cos0 * cos0).sqrt();
         if stack.n0 * sin0 > stack.n1.min(stack.n2) {
@@ -73,33 +60,18 @@ fn airy_matches_the_transfer_matrix_on_random_inputs_including_tir() {
         }
         let a = airy(stack, d, lambda, cos0);
         let (rs, rp, ts, tp) = transfer_matrix(stack, d, lambda, cos0);
-        for (x, y, what) in [
-            (a.rs, rs, "rs"),
-            (a.rp, rp, "rp"),
-            (a.ts, ts, "ts"),
-            (a.tp, tp, "tp"),
-        ] {
-            assert!(
-                (x - y).abs() <= 1e-9,
-                "{what}: airy {x} vs matrix {y} for {stack:?} d={d} λ={lambda} cos={cos0}"
-            );
+        for (x, y, what) in [(a.rs, rs, "rs"), (a.rp, rp, "rp"), (a.ts, ts, "ts"), (a.tp, tp, "tp")] {
+            assert!((x - y).abs() <= 1e-9, "{what}: airy {x} vs matrix {y} for {stack:?} d={d} λ={lambda} cos={cos0}");
         }
     }
-    assert!(
-        tir_cases > 1000,
-        "the sample must include total internal reflection: {tir_cases}"
-    );
+    assert!(tir_cases > 1000, "the sample must include total internal reflection: {tir_cases}");
 }
 
 #[test]
 fn zero_thickness_and_matched_film_give_plain_fresnel() {
     let mut rng = Rng(11);
     for _ in 0..2000 {
-        let (n0, n1, n2) = (
-            rng.range(1.0, 1.5),
-            rng.range(1.0, 2.5),
-            rng.range(1.0, 2.5),
-        );
+        let (n0, n1, n2) = (rng.range(1.0, 1.5), rng.range(1.0, 2.5), rng.range(1.0, 2.5));
         let cos0 = rng.range(1e-3, 1.0);
         let lambda = rng.range(360.0, 780.0);
         let fresnel_r = |a: f64, b: f64| {
@@ -110,22 +82,10 @@ fn zero_thickness_and_matched_film_give_plain_fresnel() {
         let r = airy(Stack { n0, n1, n2 }, 0.0, lambda, cos0).r;
         assert!((r - fresnel_r(n0, n2)).abs() < 1e-12, "d = 0");
         // n1 = n0: the film is the ambient medium.
-        let r = airy(
-            Stack { n0, n1: n0, n2 },
-            rng.range(0.0, 5000.0),
-            lambda,
-            cos0,
-        )
-        .r;
+        let r = airy(Stack { n0, n1: n0, n2 }, rng.range(0.0, 5000.0), lambda, cos0).r;
         assert!((r - fresnel_r(n0, n2)).abs() < 1e-12, "n1 = n0");
         // n1 = n2: the film is the substrate.
-        let r = airy(
-            Stack { n0, n1, n2: n1 },
-            rng.range(0.0, 5000.0),
-            lambda,
-            cos0,
-        )
-        .r;
+        let r = airy(Stack { n0, n1, n2: n1 }, rng.range(0.0, 5000.0), lambda, cos0).r;
         assert!((r - fresnel_r(n0, n1)).abs() < 1e-12, "n1 = n2");
     }
 }
@@ -145,25 +105,12 @@ fn normal_incidence_fresnel_is_the_textbook_value() {
 fn energy_is_conserved_and_bounded() {
     let mut rng = Rng(3);
     for _ in 0..20_000 {
-        let stack = Stack {
-            n0: rng.range(1.0, 2.0),
-            n1: rng.range(1.0, 3.0),
-            n2: rng.range(1.0, 3.0),
-        };
-        let f = airy(
-            stack,
-            rng.range(0.0, 1e5),
-            rng.range(360.0, 780.0),
-            rng.range(0.0, 1.0),
-        );
+        let stack = Stack { n0: rng.range(1.0, 2.0), n1: rng.range(1.0, 3.0), n2: rng.range(1.0, 3.0) };
+        let f = airy(stack, rng.range(0.0, 1e5), rng.range(360.0, 780.0), rng.range(0.0, 1.0));
         for v in [f.rs, f.rp, f.r, f.ts, f.tp, f.t] {
             assert!(v.is_finite() && (0.0..=1.0).contains(&v));
         }
-        assert!(
-            (f.r + f.t - 1.0).abs() < 1e-9,
-            "R + T = {} for {stack:?}",
-            f.r + f.t
-        );
+        assert!((f.r + f.t - 1.0).abs() < 1e-9, "R + T = {} for {stack:?}", f.r + f.t);
         let inc = incoherent(stack, rng.range(0.0, 1.0));
         assert!((inc.r + inc.t - 1.0).abs() < 1e-12 && (0.0..=1.0).contains(&inc.r));
     }
@@ -172,20 +119,13 @@ fn energy_is_conserved_and_bounded() {
 #[test]
 fn total_internal_reflection_reflects_everything() {
     // n0 sin θ0 > n2: no wave propagates in the substrate, whatever the film does.
-    let stack = Stack {
-        n0: 1.5,
-        n1: 1.55,
-        n2: 1.0,
-    };
+    let stack = Stack { n0: 1.5, n1: 1.55, n2: 1.0 };
     for angle_deg in [45.0f64, 60.0, 80.0, 89.0] {
         let cos0 = angle_deg.to_radians().cos();
         for d in [0.0, 100.0, 400.0, 2400.0, 1e7] {
             for lambda in [380.0, 550.0, 700.0] {
                 let f = airy(stack, d, lambda, cos0);
-                assert!(
-                    (f.r - 1.0).abs() < 1e-12 && f.t.abs() < 1e-12,
-                    "{angle_deg}° d={d}: {f:?}"
-                );
+                assert!((f.r - 1.0).abs() < 1e-12 && f.t.abs() < 1e-12, "{angle_deg}° d={d}: {f:?}");
             }
         }
         assert!((incoherent(stack, cos0).r - 1.0).abs() < 1e-12);
@@ -204,8 +144,7 @@ fn film_colour_of_the_bare_substrate_is_gray_fresnel() {
     }
     // A 400 nm film (the thesis default) is coloured: its channels differ.
     let film = film_rgb_reference(stack, 400.0, 1.0);
-    let spread = film.iter().cloned().fold(f64::MIN, f64::max)
-        - film.iter().cloned().fold(f64::MAX, f64::min);
+    let spread = film.iter().cloned().fold(f64::MIN, f64::max) - film.iter().cloned().fold(f64::MAX, f64::min);
     assert!(spread > 0.02, "{film:?}");
 }
 
@@ -221,12 +160,7 @@ mod cli {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        child
-            .stdin
-            .take()
-            .unwrap()
-            .write_all(stdin.as_bytes())
-            .unwrap();
+        child.stdin.take().unwrap().write_all(stdin.as_bytes()).unwrap();
         let out = child.wait_with_output().unwrap();
         (
             out.status.code().unwrap_or(-1),
@@ -238,18 +172,7 @@ mod cli {
     #[test]
     fn brdf_film_prints_the_fresnel_value_for_a_bare_interface() {
         let (code, out, err) = snakeskin(
-            &[
-                "brdf",
-                "film",
-                "--n2",
-                "1.5",
-                "--thickness-nm",
-                "0",
-                "--wavelength-nm",
-                "550",
-                "--angle-deg",
-                "0",
-            ],
+            &["brdf", "film", "--n2", "1.5", "--thickness-nm", "0", "--wavelength-nm", "550", "--angle-deg", "0"],
             "",
         );
         assert_eq!(code, 0, "{err}");
@@ -268,55 +191,26 @@ mod cli {
                        {\"n0\":1,\"n1\":1.55,\"n2\":2.25,\"thickness_nm\":0,\"wavelength_nm\":500,\"angle_deg\":0}\n";
         let (code, out, err) = snakeskin(&["brdf", "film", "--batch", "-"], queries);
         assert_eq!(code, 0, "{err}");
-        let r: Vec<f64> = out
-            .lines()
-            .map(|l| {
-                serde_json::from_str::<serde_json::Value>(l).unwrap()["r"]
-                    .as_f64()
-                    .unwrap()
-            })
-            .collect();
+        let r: Vec<f64> =
+            out.lines().map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["r"].as_f64().unwrap()).collect();
         // ((1 - n) / (1 + n))²: 0.04 for n = 1.5, (1.25 / 3.25)² for n = 2.25.
         assert_eq!(r.len(), 2);
-        assert!(
-            (r[0] - 0.04).abs() < 1e-12 && (r[1] - (1.25f64 / 3.25).powi(2)).abs() < 1e-12,
-            "{r:?}"
-        );
+        assert!((r[0] - 0.04).abs() < 1e-12 && (r[1] - (1.25f64 / 3.25).powi(2)).abs() < 1e-12, "{r:?}");
     }
 
     #[test]
     fn brdf_color_and_bad_queries() {
-        let (code, out, _) = snakeskin(
-            &["brdf", "color", "--thickness-nm", "400", "--angle-deg", "0"],
-            "",
-        );
+        let (code, out, _) = snakeskin(&["brdf", "color", "--thickness-nm", "400", "--angle-deg", "0"], "");
         assert_eq!(code, 0);
         let v: serde_json::Value = serde_json::from_str(&out).unwrap();
         assert_eq!(v["rgb"].as_array().unwrap().len(), 3);
-        let (code, _, err) = snakeskin(
-            &[
-                "brdf",
-                "film",
-                "--thickness-nm",
-                "10",
-                "--wavelength-nm",
-                "500",
-                "--angle-deg",
-                "95",
-            ],
-            "",
-        );
+        let (code, _, err) =
+            snakeskin(&["brdf", "film", "--thickness-nm", "10", "--wavelength-nm", "500", "--angle-deg", "95"], "");
         assert_eq!(code, 2);
-        assert!(
-            err.contains("angle_deg") && err.contains("[0, 90]"),
-            "{err}"
-        );
+        assert!(err.contains("angle_deg") && err.contains("[0, 90]"), "{err}");
         let (code, _, err) = snakeskin(&["brdf", "film", "--batch", "-"], "{\"thickness_nm\":1}\n");
         assert_eq!(code, 2);
-        assert!(
-            err.contains("-:1") && err.contains("wavelength_nm"),
-            "{err}"
-        );
+        assert!(err.contains("-:1") && err.contains("wavelength_nm"), "{err}");
     }
 }
 
@@ -330,11 +224,7 @@ mod series {
         let mut rng = Rng(19);
         let mut used = 0;
         for _ in 0..5000 {
-            let stack = Stack {
-                n0: rng.range(1.0, 1.4),
-                n1: rng.range(1.0, 2.5),
-                n2: rng.range(1.0, 2.5),
-            };
+            let stack = Stack { n0: rng.range(1.0, 1.4), n1: rng.range(1.0, 2.5), n2: rng.range(1.0, 2.5) };
             let cos0 = rng.range(0.05, 1.0);
             let series = FilmSeries::new(stack, cos0);
             if !series.usable() {
@@ -344,23 +234,11 @@ mod series {
             let (d, lambda) = (rng.range(0.0, 3000.0), rng.range(360.0, 780.0));
             let phase = series.phase(stack.n1, d, lambda);
             let exact = airy(stack, d, lambda, cos0).r;
-            assert!(
-                (series.reflectance(phase, 0.0) - exact).abs() < 1e-9,
-                "closed form"
-            );
-            assert!(
-                (series.reflectance(phase, 1e-9) - exact).abs() < 1e-7,
-                "summed series"
-            );
-            assert!(
-                (series.incoherent() - incoherent(stack, cos0).r).abs() < 1e-9,
-                "c0 is the incoherent sum"
-            );
+            assert!((series.reflectance(phase, 0.0) - exact).abs() < 1e-9, "closed form");
+            assert!((series.reflectance(phase, 1e-9) - exact).abs() < 1e-7, "summed series");
+            assert!((series.incoherent() - incoherent(stack, cos0).r).abs() < 1e-9, "c0 is the incoherent sum");
             // The box average over one full period of phase is the incoherent value.
-            assert!(
-                (series.reflectance(phase, 2.0 * std::f64::consts::PI) - series.incoherent()).abs()
-                    < 1e-9
-            );
+            assert!((series.reflectance(phase, 2.0 * std::f64::consts::PI) - series.incoherent()).abs() < 1e-9);
         }
         assert!(used > 4000);
     }
@@ -372,18 +250,10 @@ mod series {
         for (phase, width) in [(3.0, 0.5), (10.0, 2.0), (1.0, 5.0)] {
             let n = 20_000;
             let numeric: f64 = (0..n)
-                .map(|i| {
-                    series.reflectance(
-                        phase - width / 2.0 + width * (i as f64 + 0.5) / n as f64,
-                        0.0,
-                    )
-                })
+                .map(|i| series.reflectance(phase - width / 2.0 + width * (i as f64 + 0.5) / n as f64, 0.0))
                 .sum::<f64>()
                 / n as f64;
-            assert!(
-                (series.reflectance(phase, width) - numeric).abs() < 1e-7,
-                "{phase} {width}"
-            );
+            assert!((series.reflectance(phase, width) - numeric).abs() < 1e-7, "{phase} {width}");
         }
     }
 }
@@ -392,10 +262,7 @@ mod commands {
     use std::process::Command;
 
     fn run(args: &[&str]) -> (i32, String, String) {
-        let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-            .args(args)
-            .output()
-            .unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_snakeskin")).args(args).output().unwrap();
         (
             out.status.code().unwrap_or(-1),
             String::from_utf8_lossy(&out.stdout).into(),
@@ -405,28 +272,10 @@ mod commands {
 
     #[test]
     fn brdf_eval_matches_the_library_and_is_symmetric() {
-        let (code, out, err) = run(&[
-            "brdf",
-            "eval",
-            "--wi",
-            "0.3,0,1",
-            "--wo",
-            "-0.2,0.1,1",
-            "--roughness",
-            "0.4",
-        ]);
+        let (code, out, err) = run(&["brdf", "eval", "--wi", "0.3,0,1", "--wo", "-0.2,0.1,1", "--roughness", "0.4"]);
         assert_eq!(code, 0, "{err}");
         let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-        let (code, swapped, _) = run(&[
-            "brdf",
-            "eval",
-            "--wi",
-            "-0.2,0.1,1",
-            "--wo",
-            "0.3,0,1",
-            "--roughness",
-            "0.4",
-        ]);
+        let (code, swapped, _) = run(&["brdf", "eval", "--wi", "-0.2,0.1,1", "--wo", "0.3,0,1", "--roughness", "0.4"]);
         assert_eq!(code, 0);
         let w: serde_json::Value = serde_json::from_str(&swapped).unwrap();
         for c in 0..3 {
@@ -439,13 +288,7 @@ mod commands {
         // Light from below the surface gives nothing.
         let (_, below, _) = run(&["brdf", "eval", "--wi", "0,0,-1", "--wo", "0,0,1"]);
         let b: serde_json::Value = serde_json::from_str(&below).unwrap();
-        assert!(
-            b["f"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .all(|x| x.as_f64() == Some(0.0))
-        );
+        assert!(b["f"].as_array().unwrap().iter().all(|x| x.as_f64() == Some(0.0)));
     }
 
     #[test]
@@ -463,81 +306,36 @@ mod commands {
 
     #[test]
     fn bench_irid_json_lists_every_method_and_the_default_meets_its_target() {
-        let (code, out, err) = run(&[
-            "bench",
-            "irid",
-            "--json",
-            "--d-step-nm",
-            "50",
-            "--angle-step-deg",
-            "11",
-        ]);
+        let (code, out, err) = run(&["bench", "irid", "--json", "--d-step-nm", "50", "--angle-step-deg", "11"]);
         assert_eq!(code, 0, "{err}");
         let v: serde_json::Value = serde_json::from_str(&out).unwrap();
         assert_eq!(v["default"], "lut");
         let methods = v["methods"].as_array().unwrap();
-        let names: Vec<&str> = methods
-            .iter()
-            .map(|m| m["name"].as_str().unwrap())
-            .collect();
-        for expected in [
-            "rgb3",
-            "spectral-4",
-            "spectral-8",
-            "spectral-16",
-            "spectral-32",
-            "gaussian-fit",
-            "lut",
-        ] {
+        let names: Vec<&str> = methods.iter().map(|m| m["name"].as_str().unwrap()).collect();
+        for expected in ["rgb3", "spectral-4", "spectral-8", "spectral-16", "spectral-32", "gaussian-fit", "lut"] {
             assert!(names.contains(&expected), "{names:?}");
         }
         let lut = methods.iter().find(|m| m["name"] == "lut").unwrap();
-        assert!(
-            lut["mean_de"].as_f64().unwrap() <= 0.5 && lut["max_de"].as_f64().unwrap() <= 2.0,
-            "{lut}"
-        );
+        assert!(lut["mean_de"].as_f64().unwrap() <= 0.5 && lut["max_de"].as_f64().unwrap() <= 2.0, "{lut}");
         for m in methods {
             for key in ["mean_de", "p95_de", "max_de", "ns_per_eval"] {
                 assert!(m[key].as_f64().unwrap().is_finite(), "{m}");
             }
         }
         // Error falls as spectral-N gets more samples.
-        let mean = |n: &str| {
-            methods.iter().find(|m| m["name"] == n).unwrap()["mean_de"]
-                .as_f64()
-                .unwrap()
-        };
-        assert!(
-            mean("spectral-32") < mean("spectral-8") && mean("spectral-8") < mean("spectral-4")
-        );
+        let mean = |n: &str| methods.iter().find(|m| m["name"] == n).unwrap()["mean_de"].as_f64().unwrap();
+        assert!(mean("spectral-32") < mean("spectral-8") && mean("spectral-8") < mean("spectral-4"));
     }
 
     #[test]
     fn every_method_is_accepted_by_brdf_color() {
         for method in ["spectral", "rgb3", "spectral-16", "gaussian-fit", "lut"] {
-            let (code, out, err) = run(&[
-                "brdf",
-                "color",
-                "--thickness-nm",
-                "300",
-                "--angle-deg",
-                "20",
-                "--method",
-                method,
-            ]);
+            let (code, out, err) =
+                run(&["brdf", "color", "--thickness-nm", "300", "--angle-deg", "20", "--method", method]);
             assert_eq!(code, 0, "{method}: {err}");
             assert!(out.contains("\"rgb\""));
         }
-        let (code, _, err) = run(&[
-            "brdf",
-            "color",
-            "--thickness-nm",
-            "300",
-            "--angle-deg",
-            "20",
-            "--method",
-            "rgb4",
-        ]);
+        let (code, _, err) = run(&["brdf", "color", "--thickness-nm", "300", "--angle-deg", "20", "--method", "rgb4"]);
         assert_eq!(code, 2);
         assert!(err.contains("gaussian-fit") && err.contains("lut"), "{err}");
     }

@@ -24,14 +24,7 @@ fn is_color_only(name: &str) -> bool {
 fn generate_writes_five_maps_in_their_formats_and_a_manifest() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let run = snakeskin(&[
-        "generate",
-        "erythrolamprus-miliaris",
-        "-o",
-        out,
-        "--size",
-        "256",
-    ]);
+    let run = snakeskin(&["generate", "erythrolamprus-miliaris", "-o", out, "--size", "256"]);
     assert!(run.status.success(), "{}", stderr(&run));
 
     let expected = [
@@ -42,51 +35,28 @@ fn generate_writes_five_maps_in_their_formats_and_a_manifest() {
         ("iridescence", ColorType::L16),
     ];
     for (map, color_type) in expected {
-        let path = dir
-            .path()
-            .join(format!("erythrolamprus-miliaris_{map}.png"));
+        let path = dir.path().join(format!("erythrolamprus-miliaris_{map}.png"));
         let image = ImageReader::open(&path).unwrap().decode().unwrap();
         assert_eq!(image.color(), color_type, "{map}");
         assert_eq!((image.width(), image.height()), (256, 256), "{map}");
     }
     let files = snapshot(dir.path());
-    assert_eq!(
-        files.len(),
-        6,
-        "five maps and a manifest: {:?}",
-        files.keys()
-    );
+    assert_eq!(files.len(), 6, "five maps and a manifest: {:?}", files.keys());
 
     let manifest: serde_json::Value =
-        serde_json::from_slice(&files[&dir.path().join("erythrolamprus-miliaris.material.json")])
-            .unwrap();
+        serde_json::from_slice(&files[&dir.path().join("erythrolamprus-miliaris.material.json")]).unwrap();
     assert_eq!(manifest["preset"], "erythrolamprus-miliaris");
     assert_eq!(manifest["width"], 256);
     assert_eq!(manifest["seed"], 1);
     assert_eq!(manifest["preset_hash"].as_str().unwrap().len(), 16);
     assert_eq!(manifest["maps"].as_array().unwrap().len(), 5);
     let depth = |m: &str| {
-        manifest["maps"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|e| e["map"] == m)
-            .unwrap()["bit_depth"]
-            .as_u64()
-            .unwrap()
+        manifest["maps"].as_array().unwrap().iter().find(|e| e["map"] == m).unwrap()["bit_depth"].as_u64().unwrap()
     };
-    assert_eq!(
-        (depth("color"), depth("height"), depth("iridescence")),
-        (8, 16, 16)
-    );
-    let (min_nm, max_nm) = (
-        manifest["iridescence"]["min_nm"].as_f64().unwrap(),
-        manifest["iridescence"]["max_nm"].as_f64().unwrap(),
-    );
-    assert!(
-        min_nm < 400.0 && max_nm > 400.0 && min_nm >= 0.0,
-        "{min_nm}..{max_nm}"
-    );
+    assert_eq!((depth("color"), depth("height"), depth("iridescence")), (8, 16, 16));
+    let (min_nm, max_nm) =
+        (manifest["iridescence"]["min_nm"].as_f64().unwrap(), manifest["iridescence"]["max_nm"].as_f64().unwrap());
+    assert!(min_nm < 400.0 && max_nm > 400.0 && min_nm >= 0.0, "{min_nm}..{max_nm}");
     assert_eq!(manifest["optics"]["film_ior"], 1.55);
 }
 
@@ -94,15 +64,9 @@ fn generate_writes_five_maps_in_their_formats_and_a_manifest() {
 fn normal_map_decodes_to_unit_vectors_facing_out() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let run = snakeskin(&[
-        "generate", PATTERNED, "-o", out, "--size", "128", "--maps", "normal",
-    ]);
+    let run = snakeskin(&["generate", PATTERNED, "-o", out, "--size", "128", "--maps", "normal"]);
     assert!(run.status.success(), "{}", stderr(&run));
-    let normal = ImageReader::open(dir.path().join("patterned_normal.png"))
-        .unwrap()
-        .decode()
-        .unwrap()
-        .to_rgb8();
+    let normal = ImageReader::open(dir.path().join("patterned_normal.png")).unwrap().decode().unwrap().to_rgb8();
     for p in normal.pixels() {
         let v = p.0.map(|c| c as f32 / 255.0 * 2.0 - 1.0);
         let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -117,25 +81,12 @@ fn roughness_alone_writes_one_map_and_runs_no_colour_node() {
     let graph = patterned_graph();
     let only = evaluate(&graph, &[MapKind::Roughness], 64, 64, &|_, _| {});
     assert!(!only.stats.nodes.is_empty());
-    let colour_nodes: Vec<&str> = only
-        .stats
-        .nodes
-        .iter()
-        .map(|n| n.name.as_str())
-        .filter(|n| is_color_only(n))
-        .collect();
-    assert!(
-        colour_nodes.is_empty(),
-        "roughness ran colour nodes: {colour_nodes:?}"
-    );
+    let colour_nodes: Vec<&str> =
+        only.stats.nodes.iter().map(|n| n.name.as_str()).filter(|n| is_color_only(n)).collect();
+    assert!(colour_nodes.is_empty(), "roughness ran colour nodes: {colour_nodes:?}");
     // The full set does run them, so the check above can fail.
     let full = evaluate(&graph, &MapKind::ALL, 64, 64, &|_, _| {});
-    assert!(
-        full.stats
-            .nodes
-            .iter()
-            .any(|n| n.name.starts_with("pattern"))
-    );
+    assert!(full.stats.nodes.iter().any(|n| n.name.starts_with("pattern")));
 
     let dir = tempfile::tempdir().unwrap();
     let run = snakeskin(&[
@@ -150,34 +101,18 @@ fn roughness_alone_writes_one_map_and_runs_no_colour_node() {
         "--stats",
     ]);
     assert!(run.status.success(), "{}", stderr(&run));
-    let files: Vec<String> = snapshot(dir.path())
-        .keys()
-        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
-        .collect();
-    assert_eq!(
-        files,
-        ["patterned.material.json", "patterned_roughness.png"]
-    );
+    let files: Vec<String> =
+        snapshot(dir.path()).keys().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    assert_eq!(files, ["patterned.material.json", "patterned_roughness.png"]);
     let stats = stderr(&run);
     assert!(stats.contains("roughness.out"), "{stats}");
-    assert!(
-        !stats
-            .lines()
-            .any(|l| is_color_only(l.split_whitespace().next().unwrap_or(""))),
-        "{stats}"
-    );
+    assert!(!stats.lines().any(|l| is_color_only(l.split_whitespace().next().unwrap_or(""))), "{stats}");
 }
 
 #[test]
 fn a_node_shared_by_two_maps_runs_once() {
     let graph = patterned_graph();
-    let both = evaluate(
-        &graph,
-        &[MapKind::Height, MapKind::Roughness],
-        64,
-        64,
-        &|_, _| {},
-    );
+    let both = evaluate(&graph, &[MapKind::Height, MapKind::Roughness], 64, 64, &|_, _| {});
     // `scales` feeds height (through scales.height) and roughness (through scales.crevice).
     assert_eq!(both.stats.get("scales").unwrap().evaluations, 1);
     assert_eq!(both.stats.get("noise.grain").unwrap().evaluations, 1);
@@ -207,19 +142,13 @@ fn graph_dot_lists_exactly_the_evaluated_nodes() {
         let dot = stdout(&run);
         assert!(dot.starts_with("digraph"), "{dot}");
         let requested = snakeskin::parse_map_list(maps).unwrap();
-        let evaluated: BTreeSet<String> = evaluate(&graph, &requested, 32, 32, &|_, _| {})
-            .stats
-            .nodes
-            .into_iter()
-            .map(|n| n.name)
-            .collect();
+        let evaluated: BTreeSet<String> =
+            evaluate(&graph, &requested, 32, 32, &|_, _| {}).stats.nodes.into_iter().map(|n| n.name).collect();
         assert_eq!(dot_nodes(&dot), evaluated, "maps {maps}");
         // Every edge joins two declared nodes.
         for line in dot.lines().filter(|l| l.contains("->")) {
-            let ends: Vec<&str> = line
-                .split('"')
-                .filter(|s| !s.trim().is_empty() && !s.contains("->") && !s.contains(';'))
-                .collect();
+            let ends: Vec<&str> =
+                line.split('"').filter(|s| !s.trim().is_empty() && !s.contains("->") && !s.contains(';')).collect();
             assert!(ends.iter().all(|e| evaluated.contains(*e)), "{line}");
         }
     }
@@ -230,21 +159,11 @@ fn same_bytes_for_any_thread_count_and_across_runs() {
     let run = |threads: &str| {
         let dir = tempfile::tempdir().unwrap();
         let out = snakeskin_env(
-            &[
-                "generate",
-                PATTERNED,
-                "-o",
-                dir.path().to_str().unwrap(),
-                "--size",
-                "192",
-            ],
+            &["generate", PATTERNED, "-o", dir.path().to_str().unwrap(), "--size", "192"],
             &[("RAYON_NUM_THREADS", threads)],
         );
         assert!(out.status.success(), "{}", stderr(&out));
-        snapshot(dir.path())
-            .into_iter()
-            .map(|(p, b)| (p.file_name().unwrap().to_owned(), b))
-            .collect::<Vec<_>>()
+        snapshot(dir.path()).into_iter().map(|(p, b)| (p.file_name().unwrap().to_owned(), b)).collect::<Vec<_>>()
     };
     let one = run("1");
     assert_eq!(one.len(), 6);
@@ -271,8 +190,7 @@ fn seed_changes_the_skin() {
         ]);
         assert!(out.status.success(), "{}", stderr(&out));
     }
-    let read =
-        |d: &tempfile::TempDir| std::fs::read(d.path().join("patterned_height.png")).unwrap();
+    let read = |d: &tempfile::TempDir| std::fs::read(d.path().join("patterned_height.png")).unwrap();
     assert_ne!(read(&a), read(&b));
 }
 
@@ -282,12 +200,7 @@ fn buffers_are_freed_after_their_last_consumer() {
     let eval = evaluate(&graph, &MapKind::ALL, 64, 64, &|_, _| {});
     let total: usize = eval.stats.nodes.iter().map(|n| n.bytes).sum();
     // Holding every buffer to the end would need `total`; the graph is far narrower.
-    assert!(
-        eval.stats.peak_bytes * 2 < total,
-        "peak {} of total {}",
-        eval.stats.peak_bytes,
-        total
-    );
+    assert!(eval.stats.peak_bytes * 2 < total, "peak {} of total {}", eval.stats.peak_bytes, total);
     // The five outputs are alive at the end, so the peak is at least their size.
     let outputs: usize = eval.maps.values().map(|m| m.bytes()).sum();
     assert!(eval.stats.peak_bytes >= outputs);

@@ -11,11 +11,7 @@ use snakeskin::preset::{library, parse, read_source};
 /// Mean absolute difference between rows `a` and `b` (all channels).
 fn row_jump(img: &Image, a: usize, b: usize) -> f64 {
     let (ra, rb) = (img.row(a), img.row(b));
-    ra.iter()
-        .zip(rb)
-        .map(|(x, y)| (x - y).abs() as f64)
-        .sum::<f64>()
-        / ra.len() as f64
+    ra.iter().zip(rb).map(|(x, y)| (x - y).abs() as f64).sum::<f64>() / ra.len() as f64
 }
 
 fn transpose(img: &Image) -> Image {
@@ -23,8 +19,7 @@ fn transpose(img: &Image) -> Image {
     for y in 0..img.height {
         for x in 0..img.width {
             for c in 0..img.channels {
-                t.data[(x * img.height + y) * img.channels + c] =
-                    img.data[(y * img.width + x) * img.channels + c];
+                t.data[(x * img.height + y) * img.channels + c] = img.data[(y * img.width + x) * img.channels + c];
             }
         }
     }
@@ -39,10 +34,7 @@ fn assert_rows_seamless(img: &Image, what: &str) {
     let beside = row_jump(img, 0, 1).max(row_jump(img, n - 2, n - 1));
     let mean = (0..n - 1).map(|y| row_jump(img, y, y + 1)).sum::<f64>() / (n - 1) as f64;
     let limit = 1.5 * beside.max(mean);
-    assert!(
-        seam <= limit,
-        "{what}: seam jump {seam:.5} > 1.5 × max(beside {beside:.5}, mean {mean:.5})"
-    );
+    assert!(seam <= limit, "{what}: seam jump {seam:.5} > 1.5 × max(beside {beside:.5}, mean {mean:.5})");
 }
 
 #[test]
@@ -74,20 +66,11 @@ fn map_values_stay_in_range() {
     let graph = build_graph(&loaded.preset, BuildOptions::default());
     let eval = evaluate(&graph, &MapKind::ALL, 128, 128, &|_, _| {});
     for (map, img) in &eval.maps {
-        let (lo, hi) = if *map == MapKind::Normal {
-            (-1.0, 1.0)
-        } else {
-            (0.0, 1.0)
-        };
-        assert!(
-            img.data
-                .iter()
-                .all(|v| v.is_finite() && (lo..=hi).contains(v)),
-            "{map} out of [{lo}, {hi}]"
-        );
+        let (lo, hi) = if *map == MapKind::Normal { (-1.0, 1.0) } else { (0.0, 1.0) };
+        assert!(img.data.iter().all(|v| v.is_finite() && (lo..=hi).contains(v)), "{map} out of [{lo}, {hi}]");
     }
     let height = &eval.maps[&MapKind::Height];
-    let spread = height.data.iter().cloned().fold(f32::MIN, f32::max)
-        - height.data.iter().cloned().fold(f32::MAX, f32::min);
+    let spread =
+        height.data.iter().cloned().fold(f32::MIN, f32::max) - height.data.iter().cloned().fold(f32::MAX, f32::min);
     assert!(spread > 0.5, "height uses its range: {spread}");
 }

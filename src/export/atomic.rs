@@ -9,14 +9,8 @@ use std::path::{Path, PathBuf};
 use super::ExportError;
 
 /// Writes `files` (name, bytes) into `dir`, creating it if needed.
-pub fn write_all_atomically(
-    dir: &Path,
-    files: &[(String, Vec<u8>)],
-) -> Result<Vec<PathBuf>, ExportError> {
-    fs::create_dir_all(dir).map_err(|source| ExportError::Io {
-        path: dir.into(),
-        source,
-    })?;
+pub fn write_all_atomically(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBuf>, ExportError> {
+    fs::create_dir_all(dir).map_err(|source| ExportError::Io { path: dir.into(), source })?;
     let mut staged: Vec<(PathBuf, PathBuf)> = Vec::new();
     let cleanup = |staged: &[(PathBuf, PathBuf)]| {
         for (tmp, _) in staged {
@@ -40,10 +34,7 @@ pub fn write_all_atomically(
     for (tmp, target) in &staged {
         if let Err(source) = fs::rename(tmp, target) {
             cleanup(&staged);
-            return Err(ExportError::Io {
-                path: target.clone(),
-                source,
-            });
+            return Err(ExportError::Io { path: target.clone(), source });
         }
     }
     Ok(staged.into_iter().map(|(_, target)| target).collect())

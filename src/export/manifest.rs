@@ -52,51 +52,21 @@ pub struct OpticsEntry {
 
 fn entry(map: MapKind, file: String, convention: NormalConvention) -> MapEntry {
     let (color_space, channels, bit_depth, meaning) = match map {
-        MapKind::Color => (
-            "srgb",
-            3,
-            8,
-            "base colour (albedo k_d of the Lambertian base layer)".to_string(),
-        ),
-        MapKind::Height => (
-            "linear",
-            1,
-            16,
-            "relative surface height, 0 = lowest".to_string(),
-        ),
+        MapKind::Color => ("srgb", 3, 8, "base colour (albedo k_d of the Lambertian base layer)".to_string()),
+        MapKind::Height => ("linear", 1, 16, "relative surface height, 0 = lowest".to_string()),
         MapKind::Normal => {
             let y = match convention {
                 NormalConvention::OpenGl => "OpenGL convention, +Y up",
                 NormalConvention::DirectX => "DirectX convention, +Y down",
             };
-            (
-                "linear",
-                3,
-                8,
-                format!("tangent-space normal, rgb = xyz * 0.5 + 0.5, {y}"),
-            )
+            ("linear", 3, 8, format!("tangent-space normal, rgb = xyz * 0.5 + 0.5, {y}"))
         }
-        MapKind::Roughness => (
-            "linear",
-            1,
-            8,
-            "perceptual roughness r; GGX alpha = r^2 (glTF)".to_string(),
-        ),
-        MapKind::Iridescence => (
-            "linear",
-            1,
-            16,
-            "film thickness: min_nm + value / 65535 * (max_nm - min_nm)".to_string(),
-        ),
+        MapKind::Roughness => ("linear", 1, 8, "perceptual roughness r; GGX alpha = r^2 (glTF)".to_string()),
+        MapKind::Iridescence => {
+            ("linear", 1, 16, "film thickness: min_nm + value / 65535 * (max_nm - min_nm)".to_string())
+        }
     };
-    MapEntry {
-        map: map.name().into(),
-        file,
-        color_space: color_space.into(),
-        channels,
-        bit_depth,
-        meaning,
-    }
+    MapEntry { map: map.name().into(), file, color_space: color_space.into(), channels, bit_depth, meaning }
 }
 
 pub fn manifest(
@@ -116,10 +86,7 @@ pub fn manifest(
         seed: p.seed,
         width: size,
         height: size,
-        maps: files
-            .iter()
-            .map(|(m, f)| entry(*m, f.clone(), convention))
-            .collect(),
+        maps: files.iter().map(|(m, f)| entry(*m, f.clone(), convention)).collect(),
         iridescence: IridescenceRange { min_nm, max_nm },
         optics: OpticsEntry {
             ambient_ior: p.optics.ambient_ior,

@@ -80,13 +80,7 @@ pub fn evaluate(
 
     let mut level = vec![0usize; graph.nodes().len()];
     for id in &needed {
-        level[id.0] = graph
-            .node(*id)
-            .inputs
-            .iter()
-            .map(|i| level[i.0] + 1)
-            .max()
-            .unwrap_or(0);
+        level[id.0] = graph.node(*id).inputs.iter().map(|i| level[i.0] + 1).max().unwrap_or(0);
     }
     let max_level = needed.iter().map(|id| level[id.0]).max().unwrap_or(0);
 
@@ -95,20 +89,13 @@ pub fn evaluate(
     let (mut live_bytes, mut peak_bytes, mut done) = (0usize, 0usize, 0usize);
 
     for lv in 0..=max_level {
-        let batch: Vec<NodeId> = needed
-            .iter()
-            .copied()
-            .filter(|id| level[id.0] == lv)
-            .collect();
+        let batch: Vec<NodeId> = needed.iter().copied().filter(|id| level[id.0] == lv).collect();
         let results: Vec<(NodeId, Image, Duration)> = batch
             .par_iter()
             .map(|&id| {
                 let node = graph.node(id);
-                let inputs: Vec<&Image> = node
-                    .inputs
-                    .iter()
-                    .map(|i| store[i.0].as_deref().expect("input evaluated"))
-                    .collect();
+                let inputs: Vec<&Image> =
+                    node.inputs.iter().map(|i| store[i.0].as_deref().expect("input evaluated")).collect();
                 let t = Instant::now();
                 let image = node.op.eval(&inputs, width, height);
                 (id, image, t.elapsed())
@@ -156,10 +143,6 @@ pub fn evaluate(
     drop(store);
     Evaluation {
         maps: result,
-        stats: EvalStats {
-            nodes: stats.into_values().collect(),
-            peak_bytes,
-            wall: start.elapsed(),
-        },
+        stats: EvalStats { nodes: stats.into_values().collect(), peak_bytes, wall: start.elapsed() },
     }
 }

@@ -61,10 +61,7 @@ impl Graph {
                 stack.extend(&self.nodes[id.0].inputs);
             }
         }
-        (0..self.nodes.len())
-            .filter(|&i| needed[i])
-            .map(NodeId)
-            .collect()
+        (0..self.nodes.len()).filter(|&i| needed[i]).map(NodeId).collect()
     }
 }
 
@@ -82,16 +79,9 @@ impl GraphBuilder {
     /// Adds a node. Names must be unique: they key stats and DOT output.
     pub fn add(&mut self, name: impl Into<String>, op: Op, inputs: &[NodeId]) -> NodeId {
         let name = name.into();
-        debug_assert!(
-            self.graph.nodes.iter().all(|n| n.name != name),
-            "duplicate node name {name}"
-        );
+        debug_assert!(self.graph.nodes.iter().all(|n| n.name != name), "duplicate node name {name}");
         debug_assert!(inputs.iter().all(|i| i.0 < self.graph.nodes.len()));
-        self.graph.nodes.push(Node {
-            name,
-            op,
-            inputs: inputs.to_vec(),
-        });
+        self.graph.nodes.push(Node { name, op, inputs: inputs.to_vec() });
         NodeId(self.graph.nodes.len() - 1)
     }
 

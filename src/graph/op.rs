@@ -5,7 +5,7 @@ use crate::ops::Image;
 use crate::ops::filters::{self, BlendMode, NormalConvention};
 use crate::ops::noise::{FractalNoise, NoiseKind};
 use crate::ops::scales::ScaleField;
-use crate::ops::shapes::{self, SpotGrid};
+use crate::ops::shapes::{self, Axis, Blotches, SpotGrid};
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Op {
@@ -15,21 +15,19 @@ pub enum Op {
     Scales(ScaleField),
     /// One channel of the input.
     Channel { index: usize },
-    /// Smooth bands of constant u (stripes along the body, the belly). No inputs.
-    Bands {
-        centres: Vec<f32>,
-        half_width: f32,
-        softness: f32,
-    },
+    /// Smooth bands along one axis (stripes, rings, the belly). No inputs.
+    Bands { axis: Axis, centres: Vec<f32>, half_width: f32, softness: f32 },
+    /// A dorsal series of blotches (tiny-skia coverage). No inputs.
+    Blotches(Blotches),
+    /// Checkered ventral plates. No inputs.
+    BellyChecker { rows_v: u32, belly_width: f32, softness: f32 },
+    /// Inputs: a mask and the scale field; replaces each pixel's mask value by the value at
+    /// its scale's centre, by `amount` (colour that follows scale boundaries).
+    SnapToScales { amount: f32, centre_u: usize, centre_v: usize },
     /// A jittered grid of round spots (tiny-skia coverage). No inputs.
     Spots(SpotGrid),
     /// Linear remap of the input range to the output range.
-    Levels {
-        in_low: f32,
-        in_high: f32,
-        out_low: f32,
-        out_high: f32,
-    },
+    Levels { in_low: f32, in_high: f32, out_low: f32, out_high: f32 },
     /// Soft binarisation of the input.
     Threshold { level: f32, softness: f32 },
     /// Wrap-around Gaussian blur, sigma in texture widths.
@@ -43,10 +41,7 @@ pub enum Op {
     /// Inputs: RGB base and a mask; mixes a constant colour in where the mask is set.
     Tint { color: [f32; 3], opacity: f32 },
     /// Height to a tangent-space normal.
-    HeightToNormal {
-        slope: f32,
-        convention: NormalConvention,
-    },
+    HeightToNormal { slope: f32, convention: NormalConvention },
 }
 
 impl Op {
@@ -56,33 +51,29 @@ impl Op {
             Op::Noise(noise) => crate::ops::noise::render(noise, width, height),
             Op::Scales(field) => field.render(width, height),
             Op::Channel { index } => filters::extract_channel(inputs[0], *index),
-            Op::Bands {
-                centres,
-                half_width,
-                softness,
-            } => shapes::bands_u(width, height, centres, *half_width, *softness),
+            Op::Bands { axis, centres, half_width, softness } => {
+                shapes::bands(width, height, *axis, centres, *half_width, *softness)
+            }
+            Op::Blotches(b) => shapes::blotches(width, height, b),
+            Op::BellyChecker { rows_v, belly_width, softness } => {
+                shapes::belly_checker(width, height, *rows_v, *belly_width, *softness)
+            }
+            Op::SnapToScales { amount, centre_u, centre_v } => {
+                filters::snap_to_scales(inputs[0], inputs[1], *amount, *centre_u, *centre_v)
+            }
             Op::Spots(grid) => shapes::spots(width, height, grid),
-            Op::Levels {
-                in_low,
-                in_high,
-                out_low,
-                out_high,
-            } => filters::levels(inputs[0], *in_low, *in_high, *out_low, *out_high),
+            Op::Levels { in_low, in_high, out_low, out_high } => {
+                filters::levels(inputs[0], *in_low, *in_high, *out_low, *out_high)
+            }
             Op::Threshold { level, softness } => filters::threshold(inputs[0], *level, *softness),
             Op::Blur { sigma } => filters::blur(inputs[0], *sigma),
             Op::Sobel { edge_sigma } => filters::sobel(inputs[0], *edge_sigma),
-            Op::Blend { mode, opacity } => filters::blend(
-                inputs[0],
-                inputs[1],
-                inputs.get(2).copied(),
-                *mode,
-                *opacity,
-            ),
+            Op::Blend { mode, opacity } => {
+                filters::blend(inputs[0], inputs[1], inputs.get(2).copied(), *mode, *opacity)
+            }
             Op::Colorize { low, high } => filters::colorize(inputs[0], *low, *high),
             Op::Tint { color, opacity } => tint(inputs[0], inputs[1], *color, *opacity),
-            Op::HeightToNormal { slope, convention } => {
-                filters::height_to_normal(inputs[0], *slope, *convention)
-            }
+            Op::HeightToNormal { slope, convention } => filters::height_to_normal(inputs[0], *slope, *convention),
         }
     }
 
@@ -94,14 +85,14 @@ impl Op {
                     NoiseKind::Perlin => "perlin",
                     NoiseKind::Cellular => "cellular",
                 };
-                format!(
-                    "noise {kind} {}x{} octaves={}",
-                    n.cells_u, n.cells_v, n.octaves
-                )
+                format!("noise {kind} {}x{} octaves={}", n.cells_u, n.cells_v, n.octaves)
             }
             Op::Scales(s) => format!("scales {:?} rows={}", s.shape, s.rows).to_lowercase(),
             Op::Channel { index } => format!("channel {index}"),
-            Op::Bands { centres, .. } => format!("bands n={}", centres.len()),
+            Op::Bands { axis, centres, .. } => format!("bands {axis:?} n={}", centres.len()).to_lowercase(),
+            Op::Blotches(b) => format!("blotches {:?} n={}", b.shape, b.count).to_lowercase(),
+            Op::BellyChecker { .. } => "belly checker".into(),
+            Op::SnapToScales { amount, .. } => format!("snap to scales {amount:.2}"),
             Op::Spots(g) => format!("spots {}x{}", g.across, g.along),
             Op::Levels { .. } => "levels".into(),
             Op::Threshold { level, .. } => format!("threshold {level:.2}"),
@@ -118,11 +109,7 @@ impl Op {
 fn tint(base: &Image, mask: &Image, color: [f32; 3], opacity: f32) -> Image {
     let mut out = base.clone();
     let ch = out.channels;
-    for (px, m) in out
-        .data
-        .chunks_exact_mut(ch)
-        .zip(mask.data.chunks_exact(mask.channels))
-    {
+    for (px, m) in out.data.chunks_exact_mut(ch).zip(mask.data.chunks_exact(mask.channels)) {
         let w = m[0] * opacity;
         for c in 0..ch.min(3) {
             px[c] += (color[c] - px[c]) * w;

@@ -1,131 +1,126 @@
-//! The colour map's graph (thesis §4.2.1): a base colour with fractal variation, pattern
-//! layers composed in order (each a coverage mask, optionally edge-distorted and outlined),
-//! the belly, and darker skin between the scales.
+//! The colour map's graph (thesis §4.2.1): a base colour with fractal variation, the belly
+//! (its colour and an optional checkered plate pattern), pattern layers composed in order —
+//! each one or more coverage masks, optionally edge-distorted, snapped to whole scales and
+//! outlined — and darker skin between the scales.
 
 use super::Shared;
 use crate::graph::{GraphBuilder, NodeId, Op};
 use crate::ops::filters::BlendMode;
 use crate::ops::hash::derive_seed;
 use crate::ops::noise::{FractalNoise, NoiseKind};
-use crate::ops::shapes::SpotGrid;
+use crate::ops::scales::channel;
+use crate::ops::shapes::{Axis, BlotchShape, Blotches, SpotGrid};
 use crate::preset::Preset;
-use crate::preset::schema::{NoiseChoice, PatternKind, PatternLayer};
+use crate::preset::schema::{Arrangement, BellyPattern, NoiseChoice, PatternKind, PatternLayer, PatternShape, Srgb8};
 
 pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
     let base = preset.color.base.to_linear();
     let var = preset.color.variation as f32;
-    let noise = g.add(
-        "color.variation_noise",
-        perlin(4, 4, 5, 0.55, derive_seed(preset.seed, "color")),
-        &[],
-    );
+    let noise = g.add("color.variation_noise", perlin(4, 4, 5, 0.55, derive_seed(preset.seed, "color")), &[]);
     let mut color = g.add(
         "color.base",
-        Op::Colorize {
-            low: base.map(|c| c * (1.0 - var)),
-            high: base.map(|c| c * (1.0 + var)),
-        },
+        Op::Colorize { low: base.map(|c| c * (1.0 - var)), high: base.map(|c| c * (1.0 + var)) },
         &[noise],
     );
 
-    for (i, layer) in preset.pattern.iter().enumerate() {
-        color = pattern_layer(g, preset, i, layer, color);
-    }
-
-    if preset.belly.width > 0.0 {
-        let b = &preset.belly;
+    let b = &preset.belly;
+    let mut outside_belly = None;
+    if b.width > 0.0 {
         let mask = g.add(
             "belly.mask",
-            Op::Bands {
-                centres: vec![0.0],
-                half_width: b.width as f32 * 0.5,
-                softness: b.blend as f32,
-            },
+            Op::Bands { axis: Axis::U, centres: vec![0.0], half_width: b.width as f32 * 0.5, softness: b.blend as f32 },
             &[],
         );
-        color = g.add(
-            "belly.tint",
-            Op::Tint {
-                color: b.color.to_linear(),
-                opacity: 1.0,
-            },
-            &[color, mask],
-        );
+        color = g.add("belly.tint", Op::Tint { color: b.color.to_linear(), opacity: 1.0 }, &[color, mask]);
+        if b.pattern == BellyPattern::Checkered {
+            let rows_v = s.field.lattice().rows_v as u32;
+            let checker =
+                g.add("belly.checker", Op::BellyChecker { rows_v, belly_width: b.width as f32, softness: 0.004 }, &[]);
+            color = g.add(
+                "belly.checker_tint",
+                Op::Tint { color: b.pattern_color.to_linear(), opacity: 1.0 },
+                &[color, checker],
+            );
+        }
+        outside_belly = Some(g.add(
+            "belly.outside",
+            Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 1.0, out_high: 0.0 },
+            &[mask],
+        ));
+    }
+
+    for (i, layer) in preset.pattern.iter().enumerate() {
+        color = pattern_layer(g, preset, s, i, layer, color, outside_belly);
     }
 
     let k = preset.color.between_scales as f32;
     let shade = g.add(
         "color.scale_shade",
-        Op::Levels {
-            in_low: 0.0,
-            in_high: 1.0,
-            out_low: 1.0,
-            out_high: 1.0 - k,
-        },
+        Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 1.0, out_high: 1.0 - k },
         &[s.crevice],
     );
-    g.add(
-        "color.out",
-        Op::Blend {
-            mode: BlendMode::Multiply,
-            opacity: 1.0,
-        },
-        &[color, shade],
-    )
+    g.add("color.out", Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[color, shade])
 }
 
 fn perlin(cells_u: u32, cells_v: u32, octaves: u32, gain: f32, seed: u32) -> Op {
-    Op::Noise(FractalNoise {
-        kind: NoiseKind::Perlin,
-        cells_u,
-        cells_v,
-        octaves,
-        gain,
-        seed,
-    })
+    Op::Noise(FractalNoise { kind: NoiseKind::Perlin, cells_u, cells_v, octaves, gain, seed })
 }
 
-/// Adds one pattern layer over `below`; returns the new colour node.
-fn pattern_layer(
-    g: &mut GraphBuilder,
-    preset: &Preset,
-    i: usize,
-    layer: &PatternLayer,
-    below: NodeId,
-) -> NodeId {
-    let name = |part: &str| format!("pattern{i}.{part}");
-    let seed = derive_seed(preset.seed, &name("seed"));
-    let size = layer.size as f32;
+fn levels(g: &mut GraphBuilder, name: &str, input: NodeId, lo: f32, hi: f32) -> NodeId {
+    g.add(name, Op::Levels { in_low: 0.0, in_high: 1.0, out_low: lo, out_high: hi }, &[input])
+}
 
-    let shape = match layer.kind {
+/// The raw coverage shapes of a layer, each with its colour.
+fn shapes(
+    g: &mut GraphBuilder,
+    layer: &PatternLayer,
+    name: &dyn Fn(&str) -> String,
+    seed: u32,
+) -> Vec<(NodeId, Srgb8)> {
+    let size = layer.size as f32;
+    match layer.kind {
         PatternKind::Solid => {
             // Full coverage, modulated by broad noise so the tint is not flat.
             let n = g.add(name("noise"), perlin(3, 3, 4, 0.5, seed), &[]);
             let amount = layer.amount as f32;
-            let mask = g_levels(g, &name("mask"), n, amount * 0.6, amount);
-            return tint(g, &name("tint"), layer, below, mask);
+            vec![(levels(g, &name("shape"), n, amount * 0.6, amount), layer.color)]
         }
         PatternKind::Stripes => {
             // `amount` stripes each side of the dorsal midline (u = 0.5), centre to centre
-            // three stripe widths apart; offset 0 puts the first on the spine.
-            let half_width = size * 0.5;
+            // three stripe widths apart; the innermost at `offset` (or a named position).
+            let offset = layer.position.map_or(layer.offset, |p| p.offset()) as f32;
             let mut centres = Vec::new();
             for k in 0..layer.amount.round() as usize {
-                let d = layer.offset as f32 + k as f32 * size * 3.0;
+                let d = offset + k as f32 * size * 3.0;
                 centres.push(0.5 + d);
                 if d > 0.0 {
                     centres.push(0.5 - d);
                 }
             }
-            g.add(
-                name("shape"),
-                Op::Bands {
-                    centres,
-                    half_width,
-                    softness: 0.002,
-                },
-                &[],
-            )
+            let op = Op::Bands { axis: Axis::U, centres, half_width: size * 0.5, softness: 0.002 };
+            vec![(g.add(name("shape"), op, &[]), layer.color)]
+        }
+        PatternKind::Rings => {
+            // A colour sequence repeated `amount` times along the body; widths are
+            // fractions of one repeat (default: one ring of `size`, or equal parts).
+            let repeats = layer.amount.round().max(1.0) as f32;
+            let (colors, widths): (Vec<Srgb8>, Vec<f32>) = if layer.colors.is_empty() {
+                (vec![layer.color], vec![size.min(1.0)])
+            } else if layer.widths.is_empty() {
+                let n = layer.colors.len();
+                (layer.colors.clone(), vec![1.0 / n as f32; n])
+            } else {
+                (layer.colors.clone(), layer.widths.iter().map(|w| *w as f32).collect())
+            };
+            let mut start = 0.0f32;
+            let mut out = Vec::new();
+            for (k, (color, width)) in colors.into_iter().zip(widths).enumerate() {
+                let centres = (0..repeats as usize).map(|r| (r as f32 + start + width * 0.5) / repeats).collect();
+                let op = Op::Bands { axis: Axis::V, centres, half_width: width * 0.5 / repeats, softness: 0.002 };
+                out.push((g.add(name(&format!("ring{k}")), op, &[]), color));
+                start += width;
+            }
+            out
         }
         PatternKind::Spots => {
             let across = layer.amount.round().max(1.0) as u32;
@@ -134,10 +129,28 @@ fn pattern_layer(
                 along: across,
                 radius: size,
                 jitter: 0.35,
-                alternate: true,
+                alternate: layer.arrangement == Arrangement::Alternating,
+                checkered: layer.arrangement == Arrangement::Checkered,
+                hole: if layer.shape == PatternShape::Ring { 0.55 } else { 0.0 },
                 seed,
             };
-            g.add(name("shape"), Op::Spots(grid), &[])
+            vec![(g.add(name("shape"), Op::Spots(grid), &[]), layer.color)]
+        }
+        PatternKind::Blotches => {
+            let shape = match layer.shape {
+                PatternShape::Diamond => BlotchShape::Diamond,
+                PatternShape::Saddle => BlotchShape::Saddle,
+                _ => BlotchShape::Round,
+            };
+            let blotches = Blotches {
+                shape,
+                count: layer.amount.round().max(1.0) as u32,
+                half_width: size,
+                length: layer.length as f32,
+                jitter: 0.3,
+                seed,
+            };
+            vec![(g.add(name("shape"), Op::Blotches(blotches), &[]), layer.color)]
         }
         PatternKind::Irregular => {
             let kind = match layer.noise {
@@ -145,125 +158,69 @@ fn pattern_layer(
                 NoiseChoice::Cellular => NoiseKind::Cellular,
             };
             let cells = (1.0 / size).round().clamp(1.0, 256.0) as u32;
-            let n = g.add(
-                name("noise"),
-                Op::Noise(FractalNoise {
-                    kind,
-                    cells_u: cells,
-                    cells_v: cells,
-                    octaves: 3,
-                    gain: 0.45,
-                    seed,
-                }),
-                &[],
-            );
+            let noise = FractalNoise { kind, cells_u: cells, cells_v: cells, octaves: 3, gain: 0.45, seed };
+            let n = g.add(name("noise"), Op::Noise(noise), &[]);
             // Higher amount, lower threshold, more coverage; fBm sits mostly in [0.3, 0.7].
             let level = 0.7 - 0.4 * layer.amount as f32;
-            let binary = g.add(
-                name("threshold"),
-                Op::Threshold {
-                    level,
-                    softness: 0.01,
-                },
-                &[n],
-            );
-            g.add(name("shape"), Op::Blur { sigma: size * 0.04 }, &[binary])
+            let binary = g.add(name("threshold"), Op::Threshold { level, softness: 0.01 }, &[n]);
+            vec![(g.add(name("shape"), Op::Blur { sigma: size * 0.04 }, &[binary]), layer.color)]
         }
-    };
-
-    let mask = if layer.edge_distortion > 0.0 {
-        // Thesis §4.2.1.2: blend with noise, then threshold, for ragged edges. The shape is
-        // softened first so that adding noise moves its edges instead of leaving them.
-        let d = layer.edge_distortion as f32;
-        let soft = g.add(
-            name("soften"),
-            Op::Blur {
-                sigma: 0.002 + 0.01 * d,
-            },
-            &[shape],
-        );
-        let n = g.add(
-            name("distortion_noise"),
-            perlin(24, 24, 3, 0.5, seed ^ 0x5eed),
-            &[],
-        );
-        let offset = g_levels(g, &name("distortion"), n, -d * 0.5, d * 0.5);
-        let moved = g.add(
-            name("distorted"),
-            Op::Blend {
-                mode: BlendMode::Add,
-                opacity: 1.0,
-            },
-            &[soft, offset],
-        );
-        g.add(
-            name("mask"),
-            Op::Threshold {
-                level: 0.5,
-                softness: 0.04,
-            },
-            &[moved],
-        )
-    } else {
-        shape
-    };
-
-    let color = tint(g, &name("tint"), layer, below, mask);
-    if layer.outline_size <= 0.0 {
-        return color;
     }
-    // Thesis §4.2.1.6: edge detection, blur and binarise, then colour the outline.
-    let sigma = layer.outline_size as f32 * 0.5;
-    let soft = g.add(name("outline_blur"), Op::Blur { sigma }, &[mask]);
-    let edges = g.add(
-        name("outline_edges"),
-        Op::Sobel { edge_sigma: sigma },
-        &[soft],
-    );
-    let outline = g.add(
-        name("outline"),
-        Op::Threshold {
-            level: 0.35,
-            softness: 0.1,
-        },
-        &[edges],
-    );
-    g.add(
-        name("outline_tint"),
-        Op::Tint {
-            color: layer.outline_color.to_linear(),
-            opacity: layer.opacity as f32,
-        },
-        &[color, outline],
-    )
 }
 
-fn g_levels(g: &mut GraphBuilder, name: &str, input: NodeId, lo: f32, hi: f32) -> NodeId {
-    g.add(
-        name,
-        Op::Levels {
-            in_low: 0.0,
-            in_high: 1.0,
-            out_low: lo,
-            out_high: hi,
-        },
-        &[input],
-    )
-}
-
-fn tint(
+/// Adds one pattern layer over `below`; returns the new colour node.
+fn pattern_layer(
     g: &mut GraphBuilder,
-    name: &str,
+    preset: &Preset,
+    s: &Shared,
+    i: usize,
     layer: &PatternLayer,
     below: NodeId,
-    mask: NodeId,
+    outside_belly: Option<NodeId>,
 ) -> NodeId {
-    g.add(
-        name,
-        Op::Tint {
-            color: layer.color.to_linear(),
-            opacity: layer.opacity as f32,
-        },
-        &[below, mask],
-    )
+    let prefix = format!("pattern{i}");
+    let seed = derive_seed(preset.seed, &prefix);
+    let mut color = below;
+    let parts = shapes(g, layer, &|part: &str| format!("{prefix}.{part}"), seed);
+    let many = parts.len() > 1;
+    for (k, (shape, tint)) in parts.into_iter().enumerate() {
+        let name = |part: &str| if many { format!("{prefix}.{k}.{part}") } else { format!("{prefix}.{part}") };
+        let mut mask = shape;
+        if layer.edge_distortion > 0.0 && layer.kind != PatternKind::Solid {
+            // Thesis §4.2.1.2: blend with noise, then threshold, for ragged edges. The shape is
+            // softened first so that adding noise moves its edges instead of leaving them.
+            let d = layer.edge_distortion as f32;
+            let soft = g.add(name("soften"), Op::Blur { sigma: 0.002 + 0.01 * d }, &[mask]);
+            let n = g.add(name("distortion_noise"), perlin(24, 24, 3, 0.5, seed ^ 0x5eed ^ k as u32), &[]);
+            let offset = levels(g, &name("distortion"), n, -d * 0.5, d * 0.5);
+            let moved = g.add(name("distorted"), Op::Blend { mode: BlendMode::Add, opacity: 1.0 }, &[soft, offset]);
+            mask = g.add(name("mask"), Op::Threshold { level: 0.5, softness: 0.04 }, &[moved]);
+        }
+        if layer.scale_aligned > 0.0 {
+            let op = Op::SnapToScales {
+                amount: layer.scale_aligned as f32,
+                centre_u: s.channel_index(channel::CENTRE_U),
+                centre_v: s.channel_index(channel::CENTRE_V),
+            };
+            mask = g.add(name("scale_aligned"), op, &[mask, s.scales]);
+        }
+        if let (Some(outside), false) = (outside_belly, layer.over_belly) {
+            mask = g.add(name("off_belly"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, outside]);
+        }
+        color =
+            g.add(name("tint"), Op::Tint { color: tint.to_linear(), opacity: layer.opacity as f32 }, &[color, mask]);
+        if layer.outline_size > 0.0 {
+            // Thesis §4.2.1.6: edge detection, blur and binarise, then colour the outline.
+            let sigma = layer.outline_size as f32 * 0.5;
+            let soft = g.add(name("outline_blur"), Op::Blur { sigma }, &[mask]);
+            let edges = g.add(name("outline_edges"), Op::Sobel { edge_sigma: sigma }, &[soft]);
+            let outline = g.add(name("outline"), Op::Threshold { level: 0.35, softness: 0.1 }, &[edges]);
+            color = g.add(
+                name("outline_tint"),
+                Op::Tint { color: layer.outline_color.to_linear(), opacity: layer.opacity as f32 },
+                &[color, outline],
+            );
+        }
+    }
+    color
 }

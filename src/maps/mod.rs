@@ -28,13 +28,8 @@ pub enum MapKind {
 }
 
 impl MapKind {
-    pub const ALL: [MapKind; 5] = [
-        MapKind::Color,
-        MapKind::Height,
-        MapKind::Normal,
-        MapKind::Roughness,
-        MapKind::Iridescence,
-    ];
+    pub const ALL: [MapKind; 5] =
+        [MapKind::Color, MapKind::Height, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -59,11 +54,7 @@ impl FromStr for MapKind {
         MapKind::ALL
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                format!(
-                    "unknown map {s:?}; accepted: color, height, normal, roughness, iridescence"
-                )
-            })
+            .ok_or_else(|| format!("unknown map {s:?}; accepted: color, height, normal, roughness, iridescence"))
     }
 }
 
@@ -75,9 +66,7 @@ pub struct BuildOptions {
 
 impl Default for BuildOptions {
     fn default() -> Self {
-        BuildOptions {
-            normal_convention: NormalConvention::OpenGl,
-        }
+        BuildOptions { normal_convention: NormalConvention::OpenGl }
     }
 }
 
@@ -103,21 +92,50 @@ pub fn scale_field(preset: &Preset) -> ScaleField {
         jitter: s.jitter as f32,
         imbrication: s.imbrication as f32,
         edge_softness: s.edge_softness as f32,
-        belly_width: if preset.belly.plates {
-            preset.belly.width as f32
-        } else {
-            0.0
-        },
+        belly_width: if preset.belly.plates { preset.belly.width as f32 } else { 0.0 },
         seed: derive_seed(preset.seed, "scales"),
+        outputs: scale_outputs(preset),
     }
+}
+
+/// The scale-field channels this preset's maps read (each costs 4 bytes per pixel).
+fn scale_outputs(preset: &Preset) -> Vec<usize> {
+    let mut outputs = vec![channel::HEIGHT, channel::CREVICE];
+    outputs.push(match preset.iridescence.gradient {
+        IridescenceGradient::Vertical => channel::ALONG,
+        IridescenceGradient::Radial => channel::RADIAL,
+    });
+    if preset.scales.keeled && preset.roughness.keel > 0.0 {
+        outputs.push(channel::KEEL);
+    }
+    if preset.roughness.per_scale > 0.0 {
+        outputs.push(channel::CELL_RANDOM);
+    }
+    if preset.pattern.iter().any(|p| p.scale_aligned > 0.0) {
+        outputs.extend([channel::CENTRE_U, channel::CENTRE_V]);
+    }
+    outputs
 }
 
 /// Nodes that several maps read.
 pub(crate) struct Shared {
     pub scales: NodeId,
+    pub field: ScaleField,
     pub crevice: NodeId,
     pub scale_height: NodeId,
     pub grain: NodeId,
+}
+
+impl Shared {
+    /// Index of a scale-field channel in the `scales` node's output.
+    pub fn channel_index(&self, channel: usize) -> usize {
+        self.field.output_index(channel).expect("scale_outputs requests every channel the maps read")
+    }
+
+    /// Adds a node extracting one scale-field channel.
+    pub fn channel(&self, g: &mut GraphBuilder, name: &str, channel: usize) -> NodeId {
+        g.add(name, Op::Channel { index: self.channel_index(channel) }, &[self.scales])
+    }
 }
 
 /// Builds the whole graph for a preset; evaluation later picks the part it needs.
@@ -125,21 +143,10 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     let mut g = GraphBuilder::new();
     let field = scale_field(preset);
     let lattice = field.lattice();
-    let scales = g.add("scales", Op::Scales(field), &[]);
-    let crevice = g.add(
-        "scales.crevice",
-        Op::Channel {
-            index: channel::CREVICE,
-        },
-        &[scales],
-    );
-    let scale_height = g.add(
-        "scales.height",
-        Op::Channel {
-            index: channel::HEIGHT,
-        },
-        &[scales],
-    );
+    let scales = g.add("scales", Op::Scales(field.clone()), &[]);
+    let index = |channel: usize| field.output_index(channel).expect("height and crevice are always output");
+    let crevice = g.add("scales.crevice", Op::Channel { index: index(channel::CREVICE) }, &[scales]);
+    let scale_height = g.add("scales.height", Op::Channel { index: index(channel::HEIGHT) }, &[scales]);
     // Fine grain, a few features per scale, shared by height and roughness.
     let grain = g.add(
         "noise.grain",
@@ -153,12 +160,7 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
         }),
         &[],
     );
-    let shared = Shared {
-        scales,
-        crevice,
-        scale_height,
-        grain,
-    };
+    let shared = Shared { scales, field, crevice, scale_height, grain };
 
     let color = color::build(&mut g, preset, &shared);
     g.set_output(MapKind::Color, color);
@@ -167,14 +169,7 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     g.set_output(MapKind::Height, height);
 
     let slope = preset.height.normal_strength as f32 / lattice.cols as f32;
-    let normal = g.add(
-        "normal.out",
-        Op::HeightToNormal {
-            slope,
-            convention: options.normal_convention,
-        },
-        &[height],
-    );
+    let normal = g.add("normal.out", Op::HeightToNormal { slope, convention: options.normal_convention }, &[height]);
     g.set_output(MapKind::Normal, normal);
 
     let roughness = build_roughness(&mut g, preset, &shared);
@@ -187,128 +182,58 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
 
 fn build_height(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
     let amp = preset.height.grain as f32;
-    let grain = g.add(
-        "height.grain",
-        Op::Levels {
-            in_low: 0.0,
-            in_high: 1.0,
-            out_low: -amp,
-            out_high: amp,
-        },
-        &[s.grain],
-    );
-    let sum = g.add(
-        "height.sum",
-        Op::Blend {
-            mode: BlendMode::Add,
-            opacity: 1.0,
-        },
-        &[s.scale_height, grain],
-    );
-    g.add(
-        "height.out",
-        Op::Levels {
-            in_low: 0.0,
-            in_high: 1.0,
-            out_low: 0.0,
-            out_high: 1.0,
-        },
-        &[sum],
-    )
+    let grain =
+        g.add("height.grain", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: -amp, out_high: amp }, &[s.grain]);
+    let sum = g.add("height.sum", Op::Blend { mode: BlendMode::Add, opacity: 1.0 }, &[s.scale_height, grain]);
+    g.add("height.out", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 0.0, out_high: 1.0 }, &[sum])
 }
 
 fn build_roughness(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
     let r = &preset.roughness;
     let (lo, hi) = ((r.base - r.variation) as f32, (r.base + r.variation) as f32);
-    let base = g.add(
-        "roughness.noise",
-        Op::Levels {
-            in_low: 0.0,
-            in_high: 1.0,
-            out_low: lo,
-            out_high: hi,
-        },
-        &[s.grain],
-    );
+    let base =
+        g.add("roughness.noise", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: lo, out_high: hi }, &[s.grain]);
     let gaps = g.add(
         "roughness.between_scales",
-        Op::Blend {
-            mode: BlendMode::Add,
-            opacity: r.between_scales as f32,
-        },
+        Op::Blend { mode: BlendMode::Add, opacity: r.between_scales as f32 },
         &[base, s.crevice],
     );
-    let last = if preset.scales.keeled && r.keel > 0.0 {
-        let keel = g.add(
-            "roughness.keel_mask",
-            Op::Channel {
-                index: channel::KEEL,
-            },
-            &[s.scales],
-        );
-        g.add(
-            "roughness.keel",
-            Op::Blend {
-                mode: BlendMode::Add,
-                opacity: r.keel as f32,
-            },
-            &[gaps, keel],
-        )
+    let keeled = if preset.scales.keeled && r.keel > 0.0 {
+        let keel = s.channel(g, "roughness.keel_mask", channel::KEEL);
+        g.add("roughness.keel", Op::Blend { mode: BlendMode::Add, opacity: r.keel as f32 }, &[gaps, keel])
     } else {
         gaps
     };
-    g.add(
-        "roughness.out",
-        Op::Levels {
-            in_low: 0.0,
-            in_high: 1.0,
-            out_low: 0.0,
-            out_high: 1.0,
-        },
-        &[last],
-    )
+    let last = if r.per_scale > 0.0 {
+        // Each scale a little smoother or rougher than its neighbours.
+        let random = s.channel(g, "roughness.scale_random", channel::CELL_RANDOM);
+        let k = r.per_scale as f32;
+        let offset =
+            g.add("roughness.per_scale", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: -k, out_high: k }, &[random]);
+        g.add("roughness.varied", Op::Blend { mode: BlendMode::Add, opacity: 1.0 }, &[keeled, offset])
+    } else {
+        keeled
+    };
+    g.add("roughness.out", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 0.0, out_high: 1.0 }, &[last])
 }
 
 fn build_iridescence(g: &mut GraphBuilder, preset: &Preset, s: &Shared, cols: u32) -> NodeId {
     let p = &preset.iridescence;
     let gradient = match p.gradient {
-        IridescenceGradient::Vertical => g.add(
-            "iridescence.gradient",
-            Op::Channel {
-                index: channel::ALONG,
-            },
-            &[s.scales],
-        ),
+        IridescenceGradient::Vertical => s.channel(g, "iridescence.gradient", channel::ALONG),
         IridescenceGradient::Radial => {
-            let radial = g.add(
-                "iridescence.radial",
-                Op::Channel {
-                    index: channel::RADIAL,
-                },
-                &[s.scales],
-            );
+            let radial = s.channel(g, "iridescence.radial", channel::RADIAL);
             // Thickest at the scale's centre (thesis Fig. 4.14a).
             g.add(
                 "iridescence.gradient",
-                Op::Levels {
-                    in_low: 0.0,
-                    in_high: 1.0,
-                    out_low: 1.0,
-                    out_high: 0.0,
-                },
+                Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 1.0, out_high: 0.0 },
                 &[radial],
             )
         }
     };
     // Blend with the scale shape so the film thins into the crevices (thesis §4.2.5).
-    let shaped = g.add(
-        "iridescence.shaped",
-        Op::Blend {
-            mode: BlendMode::Multiply,
-            opacity: 0.5,
-        },
-        &[gradient, s.scale_height],
-    );
+    let shaped =
+        g.add("iridescence.shaped", Op::Blend { mode: BlendMode::Multiply, opacity: 0.5 }, &[gradient, s.scale_height]);
     let noise = g.add(
         "iridescence.noise",
         Op::Noise(FractalNoise {
@@ -321,22 +246,7 @@ fn build_iridescence(g: &mut GraphBuilder, preset: &Preset, s: &Shared, cols: u3
         }),
         &[],
     );
-    let mixed = g.add(
-        "iridescence.mixed",
-        Op::Blend {
-            mode: BlendMode::Mix,
-            opacity: p.noise as f32,
-        },
-        &[shaped, noise],
-    );
-    g.add(
-        "iridescence.out",
-        Op::Levels {
-            in_low: 0.0,
-            in_high: 1.0,
-            out_low: 0.0,
-            out_high: 1.0,
-        },
-        &[mixed],
-    )
+    let mixed =
+        g.add("iridescence.mixed", Op::Blend { mode: BlendMode::Mix, opacity: p.noise as f32 }, &[shaped, noise]);
+    g.add("iridescence.out", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 0.0, out_high: 1.0 }, &[mixed])
 }

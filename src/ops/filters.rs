@@ -22,38 +22,29 @@ pub enum BlendMode {
 
 /// Blends `layer` over `base`. A single-channel layer or mask broadcasts over the base's
 /// channels; the result has the base's channel count.
-pub fn blend(
-    base: &Image,
-    layer: &Image,
-    mask: Option<&Image>,
-    mode: BlendMode,
-    opacity: f32,
-) -> Image {
+pub fn blend(base: &Image, layer: &Image, mask: Option<&Image>, mode: BlendMode, opacity: f32) -> Image {
     let channels = base.channels;
     let mut out = base.clone();
-    out.data
-        .par_chunks_mut(channels * base.width)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let layer_row = layer.row(y);
-            let mask_row = mask.map(|m| (m.row(y), m.channels));
-            for x in 0..base.width {
-                let weight = opacity * mask_row.map_or(1.0, |(m, mc)| m[x * mc]);
-                for c in 0..channels {
-                    let b = row[x * channels + c];
-                    let l = layer_row[x * layer.channels + c.min(layer.channels - 1)];
-                    let mixed = match mode {
-                        BlendMode::Mix => l,
-                        BlendMode::Multiply => b * l,
-                        BlendMode::Add => b + l,
-                        BlendMode::Screen => 1.0 - (1.0 - b) * (1.0 - l),
-                        BlendMode::Max => b.max(l),
-                        BlendMode::Min => b.min(l),
-                    };
-                    row[x * channels + c] = b + (mixed - b) * weight;
-                }
+    out.data.par_chunks_mut(channels * base.width).enumerate().for_each(|(y, row)| {
+        let layer_row = layer.row(y);
+        let mask_row = mask.map(|m| (m.row(y), m.channels));
+        for x in 0..base.width {
+            let weight = opacity * mask_row.map_or(1.0, |(m, mc)| m[x * mc]);
+            for c in 0..channels {
+                let b = row[x * channels + c];
+                let l = layer_row[x * layer.channels + c.min(layer.channels - 1)];
+                let mixed = match mode {
+                    BlendMode::Mix => l,
+                    BlendMode::Multiply => b * l,
+                    BlendMode::Add => b + l,
+                    BlendMode::Screen => 1.0 - (1.0 - b) * (1.0 - l),
+                    BlendMode::Max => b.max(l),
+                    BlendMode::Min => b.min(l),
+                };
+                row[x * channels + c] = b + (mixed - b) * weight;
             }
-        });
+        }
+    });
     out
 }
 
@@ -82,41 +73,34 @@ pub fn threshold(input: &Image, level: f32, softness: f32) -> Image {
 /// Maps a single-channel image to colour: `low` at 0, `high` at 1 (linear RGB).
 pub fn colorize(input: &Image, low: [f32; 3], high: [f32; 3]) -> Image {
     let mut out = Image::new(input.width, input.height, 3);
-    out.data
-        .par_chunks_mut(3 * input.width)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let src = input.row(y);
-            for (x, px) in row.chunks_exact_mut(3).enumerate() {
-                let t = src[x * input.channels];
-                for c in 0..3 {
-                    px[c] = (low[c] + (high[c] - low[c]) * t).max(0.0);
-                }
+    out.data.par_chunks_mut(3 * input.width).enumerate().for_each(|(y, row)| {
+        let src = input.row(y);
+        for (x, px) in row.chunks_exact_mut(3).enumerate() {
+            let t = src[x * input.channels];
+            for c in 0..3 {
+                px[c] = (low[c] + (high[c] - low[c]) * t).max(0.0);
             }
-        });
+        }
+    });
     out
 }
 
 /// Copies one channel out of a multi-channel image.
 pub fn extract_channel(input: &Image, channel: usize) -> Image {
     let mut out = Image::new(input.width, input.height, 1);
-    out.data
-        .par_chunks_mut(input.width)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let src = input.row(y);
-            for (x, value) in row.iter_mut().enumerate() {
-                *value = src[x * input.channels + channel];
-            }
-        });
+    out.data.par_chunks_mut(input.width).enumerate().for_each(|(y, row)| {
+        let src = input.row(y);
+        for (x, value) in row.iter_mut().enumerate() {
+            *value = src[x * input.channels + channel];
+        }
+    });
     out
 }
 
 fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
     let radius = (sigma_px * 3.0).ceil().max(1.0) as isize;
-    let mut kernel: Vec<f32> = (-radius..=radius)
-        .map(|i| (-(i * i) as f32 / (2.0 * sigma_px * sigma_px)).exp())
-        .collect();
+    let mut kernel: Vec<f32> =
+        (-radius..=radius).map(|i| (-(i * i) as f32 / (2.0 * sigma_px * sigma_px)).exp()).collect();
     let sum: f32 = kernel.iter().sum();
     kernel.iter_mut().for_each(|k| *k /= sum);
     kernel
@@ -135,41 +119,53 @@ pub fn blur(input: &Image, sigma: f32) -> Image {
     // Horizontal pass over a row padded with its own wrap-around, so the inner loop is a
     // plain dot product over contiguous memory.
     let mut tmp = Image::new(w, h, ch);
-    tmp.data
-        .par_chunks_mut(w * ch)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let src = input.row(y);
-            let r = radius as usize;
-            let padded: Vec<f32> = (0..(w + 2 * r) * ch)
-                .map(|i| {
-                    src[((i / ch) as isize - radius).rem_euclid(w as isize) as usize * ch + i % ch]
-                })
-                .collect();
-            for x in 0..w {
-                for c in 0..ch {
-                    let mut acc = 0.0;
-                    for (k, weight) in kernel.iter().enumerate() {
-                        acc += weight * padded[(x + k) * ch + c];
-                    }
-                    row[x * ch + c] = acc;
+    tmp.data.par_chunks_mut(w * ch).enumerate().for_each(|(y, row)| {
+        let src = input.row(y);
+        let r = radius as usize;
+        let padded: Vec<f32> = (0..(w + 2 * r) * ch)
+            .map(|i| src[((i / ch) as isize - radius).rem_euclid(w as isize) as usize * ch + i % ch])
+            .collect();
+        for x in 0..w {
+            for c in 0..ch {
+                let mut acc = 0.0;
+                for (k, weight) in kernel.iter().enumerate() {
+                    acc += weight * padded[(x + k) * ch + c];
                 }
+                row[x * ch + c] = acc;
             }
-        });
+        }
+    });
     // Vertical pass: accumulate whole rows so memory is read sequentially.
     let mut out = Image::new(w, h, ch);
-    out.data
-        .par_chunks_mut(w * ch)
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (k, weight) in kernel.iter().enumerate() {
-                let sy = (y as isize + k as isize - radius).rem_euclid(h as isize) as usize;
-                for (o, s) in row.iter_mut().zip(tmp.row(sy)) {
-                    *o += weight * s;
-                }
+    out.data.par_chunks_mut(w * ch).enumerate().for_each(|(y, row)| {
+        for (k, weight) in kernel.iter().enumerate() {
+            let sy = (y as isize + k as isize - radius).rem_euclid(h as isize) as usize;
+            for (o, s) in row.iter_mut().zip(tmp.row(sy)) {
+                *o += weight * s;
             }
-        });
+        }
+    });
     out
+}
+
+/// Moves a mask towards its value at each pixel's scale centre (channels `centre_u`,
+/// `centre_v` of the scale field; negative where no scale covers the pixel).
+pub fn snap_to_scales(mask: &Image, scales: &Image, amount: f32, centre_u: usize, centre_v: usize) -> Image {
+    Image::from_fn(mask.width, mask.height, 1, |u, v, out| {
+        let x = (u * mask.width as f32) as usize;
+        let y = (v * mask.height as f32) as usize;
+        let i = y * mask.width + x;
+        let own = mask.data[i * mask.channels];
+        let (cu, cv) = (scales.data[i * scales.channels + centre_u], scales.data[i * scales.channels + centre_v]);
+        out[0] = if cu < 0.0 {
+            own
+        } else {
+            let cx = ((cu * mask.width as f32) as isize).min(mask.width as isize - 1);
+            let cy = ((cv * mask.height as f32) as isize).min(mask.height as isize - 1);
+            let centre = mask.at_wrapped(cx, cy, 0);
+            own + (centre - own) * amount
+        };
+    })
 }
 
 /// Bilinear resampling of a periodic image whose sample (i, j) sits at (i / w, j / h).
@@ -181,8 +177,7 @@ pub fn resample_bilinear_wrapped(src: &Image, width: usize, height: usize) -> Im
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as isize, y0 as isize);
         for (c, o) in out.iter_mut().enumerate() {
-            let a = src.at_wrapped(x0, y0, c)
-                + (src.at_wrapped(x0 + 1, y0, c) - src.at_wrapped(x0, y0, c)) * fx;
+            let a = src.at_wrapped(x0, y0, c) + (src.at_wrapped(x0 + 1, y0, c) - src.at_wrapped(x0, y0, c)) * fx;
             let b = src.at_wrapped(x0, y0 + 1, c)
                 + (src.at_wrapped(x0 + 1, y0 + 1, c) - src.at_wrapped(x0, y0 + 1, c)) * fx;
             *o = a + (b - a) * fy;
@@ -218,20 +213,14 @@ pub enum NormalConvention {
 /// Tangent-space normal (unit XYZ in [-1, 1]) from a height map by central differences.
 /// `slope_per_unit_height` is the surface rise, in texture widths, of the full height range
 /// (so the result does not change with resolution).
-pub fn height_to_normal(
-    height: &Image,
-    slope_per_unit_height: f32,
-    convention: NormalConvention,
-) -> Image {
+pub fn height_to_normal(height: &Image, slope_per_unit_height: f32, convention: NormalConvention) -> Image {
     let (w, h) = (height.width as isize, height.height as isize);
     Image::from_fn(height.width, height.height, 3, |u, v, out| {
         let x = (u * w as f32) as isize;
         let y = (v * h as f32) as isize;
         // dh/du with u in texture widths: (h[x+1] - h[x-1]) / (2 / w).
-        let dhdx =
-            (height.at_wrapped(x + 1, y, 0) - height.at_wrapped(x - 1, y, 0)) * 0.5 * w as f32;
-        let dhdy =
-            (height.at_wrapped(x, y + 1, 0) - height.at_wrapped(x, y - 1, 0)) * 0.5 * h as f32;
+        let dhdx = (height.at_wrapped(x + 1, y, 0) - height.at_wrapped(x - 1, y, 0)) * 0.5 * w as f32;
+        let dhdy = (height.at_wrapped(x, y + 1, 0) - height.at_wrapped(x, y - 1, 0)) * 0.5 * h as f32;
         let sx = -dhdx * slope_per_unit_height;
         // Image y runs down; OpenGL's +Y (bitangent) points up the image.
         let sy = match convention {
@@ -261,11 +250,7 @@ mod tests {
 
     #[test]
     fn sobel_of_blurred_step_peaks_near_one() {
-        let step = Image::gray_from_fn(
-            256,
-            8,
-            |u, _| if (0.25..0.75).contains(&u) { 1.0 } else { 0.0 },
-        );
+        let step = Image::gray_from_fn(256, 8, |u, _| if (0.25..0.75).contains(&u) { 1.0 } else { 0.0 });
         let sigma = 0.02;
         let edges = sobel(&blur(&step, sigma), sigma);
         let peak = edges.data.iter().cloned().fold(0.0, f32::max);
@@ -277,9 +262,7 @@ mod tests {
         let flat = Image::new(16, 16, 1);
         let n = height_to_normal(&flat, 1.0, NormalConvention::OpenGl);
         assert!(n.data.chunks(3).all(|p| p == [0.0, 0.0, 1.0]));
-        let ramp = Image::gray_from_fn(32, 32, |u, v| {
-            (u * std::f32::consts::TAU).sin() * 0.1 + v * 0.0
-        });
+        let ramp = Image::gray_from_fn(32, 32, |u, v| (u * std::f32::consts::TAU).sin() * 0.1 + v * 0.0);
         let n = height_to_normal(&ramp, 1.0, NormalConvention::OpenGl);
         for p in n.data.chunks(3) {
             assert!(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs() < 1e-5);

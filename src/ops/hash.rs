@@ -40,9 +40,7 @@ pub fn signed(a: i32, b: i32, stream: u32, seed: u32) -> f32 {
 /// (SplitMix64's output function, so nearby seeds give unrelated streams).
 pub fn derive_seed(seed: u64, purpose: &str) -> u32 {
     let mut z = seed
-        ^ purpose.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-            (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-        });
+        ^ purpose.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3));
     z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);

@@ -16,12 +16,7 @@ pub struct Image {
 
 impl Image {
     pub fn new(width: usize, height: usize, channels: usize) -> Self {
-        Image {
-            width,
-            height,
-            channels,
-            data: vec![0.0; width * height * channels],
-        }
+        Image { width, height, channels, data: vec![0.0; width * height * channels] }
     }
 
     /// Fills a new image row by row in parallel; `pixel(u, v, out)` receives the pixel centre
@@ -32,16 +27,12 @@ impl Image {
     {
         let mut image = Image::new(width, height, channels);
         let (inv_w, inv_h) = (1.0 / width as f32, 1.0 / height as f32);
-        image
-            .data
-            .par_chunks_mut(width * channels)
-            .enumerate()
-            .for_each(|(y, row)| {
-                let v = (y as f32 + 0.5) * inv_h;
-                for (x, out) in row.chunks_exact_mut(channels).enumerate() {
-                    pixel((x as f32 + 0.5) * inv_w, v, out);
-                }
-            });
+        image.data.par_chunks_mut(width * channels).enumerate().for_each(|(y, row)| {
+            let v = (y as f32 + 0.5) * inv_h;
+            for (x, out) in row.chunks_exact_mut(channels).enumerate() {
+                pixel((x as f32 + 0.5) * inv_w, v, out);
+            }
+        });
         image
     }
 
@@ -59,11 +50,9 @@ impl Image {
         F: Fn(&mut [f32]) + Sync,
     {
         let channels = self.channels;
-        self.data
-            .par_chunks_mut(channels * self.width)
-            .for_each(|row| {
-                row.chunks_exact_mut(channels).for_each(&f);
-            });
+        self.data.par_chunks_mut(channels * self.width).for_each(|row| {
+            row.chunks_exact_mut(channels).for_each(&f);
+        });
         self
     }
 

@@ -95,11 +95,7 @@ impl Octave {
                 });
             }
         }
-        Octave {
-            period_x,
-            period_y,
-            cells,
-        }
+        Octave { period_x, period_y, cells }
     }
 
     #[inline]
@@ -177,26 +173,13 @@ impl NoiseSampler {
         let count = noise.octaves.max(1);
         let octaves = (0..count)
             .map(|o| {
-                let (pu, pv) = (
-                    (noise.cells_u.max(1) << o) as i32,
-                    (noise.cells_v.max(1) << o) as i32,
-                );
-                Octave::new(
-                    noise.kind,
-                    pu,
-                    pv,
-                    noise.seed.wrapping_add(o.wrapping_mul(0x9e37)),
-                )
+                let (pu, pv) = ((noise.cells_u.max(1) << o) as i32, (noise.cells_v.max(1) << o) as i32);
+                Octave::new(noise.kind, pu, pv, noise.seed.wrapping_add(o.wrapping_mul(0x9e37)))
             })
             .collect();
         let amplitudes: Vec<f32> = (0..count).map(|o| noise.gain.powi(o as i32)).collect();
         let norm = amplitudes.iter().sum::<f32>().max(1e-6);
-        NoiseSampler {
-            kind: noise.kind,
-            octaves,
-            amplitudes,
-            norm,
-        }
+        NoiseSampler { kind: noise.kind, octaves, amplitudes, norm }
     }
 
     /// Fractal noise at texture coordinate (u, v), in [0, 1].
@@ -216,9 +199,7 @@ impl NoiseSampler {
 
     /// Lattice cells per tile of the finest octave, around and along.
     pub fn finest_periods(&self) -> (u32, u32) {
-        self.octaves
-            .last()
-            .map_or((1, 1), |o| (o.period_x as u32, o.period_y as u32))
+        self.octaves.last().map_or((1, 1), |o| (o.period_x as u32, o.period_y as u32))
     }
 }
 
@@ -234,16 +215,11 @@ pub const SAMPLES_PER_CELL: u32 = 8;
 pub fn render(noise: &FractalNoise, width: usize, height: usize) -> Image {
     let sampler = NoiseSampler::new(noise);
     let (pu, pv) = sampler.finest_periods();
-    let (cw, ch) = (
-        (pu * SAMPLES_PER_CELL) as usize,
-        (pv * SAMPLES_PER_CELL) as usize,
-    );
+    let (cw, ch) = ((pu * SAMPLES_PER_CELL) as usize, (pv * SAMPLES_PER_CELL) as usize);
     if cw >= width || ch >= height {
         return Image::gray_from_fn(width, height, |u, v| sampler.sample(u, v));
     }
     // Sample on a coarse grid whose points are at i / cw (not pixel centres), then interpolate.
-    let coarse = Image::gray_from_fn(cw, ch, |u, v| {
-        sampler.sample(u - 0.5 / cw as f32, v - 0.5 / ch as f32)
-    });
+    let coarse = Image::gray_from_fn(cw, ch, |u, v| sampler.sample(u - 0.5 / cw as f32, v - 0.5 / ch as f32));
     super::filters::resample_bilinear_wrapped(&coarse, width, height)
 }

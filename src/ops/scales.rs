@@ -36,7 +36,10 @@ pub mod channel {
     pub const KEEL: usize = 4;
     /// A uniform random number per scale (the same over the whole scale).
     pub const CELL_RANDOM: usize = 5;
-    pub const COUNT: usize = 6;
+    /// Texture coordinates of the visible scale's centre (for colour that follows scales).
+    pub const CENTRE_U: usize = 6;
+    pub const CENTRE_V: usize = 7;
+    pub const COUNT: usize = 8;
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -67,6 +70,9 @@ pub struct ScaleField {
     /// Width of the ventral band as a fraction of the circumference; 0 disables plates.
     pub belly_width: f32,
     pub seed: u32,
+    /// Which `channel`s the node outputs, in order (memory: 4 bytes per pixel each, so the
+    /// graph asks only for those its maps read).
+    pub outputs: Vec<usize>,
 }
 
 /// The lattice's integer layout derived from the parameters.
@@ -85,12 +91,7 @@ impl ScaleField {
         let cols = self.rows.max(1) as i32;
         let rows_v = ((cols as f32 / self.aspect).round() as i32).max(1);
         let stagger = cols / 2;
-        Lattice {
-            cols,
-            rows_v,
-            stagger,
-            aspect: cols as f32 / rows_v as f32,
-        }
+        Lattice { cols, rows_v, stagger, aspect: cols as f32 / rows_v as f32 }
     }
 }
 
@@ -128,10 +129,7 @@ impl CellTable {
                 });
             }
         }
-        CellTable {
-            cells,
-            cols: lattice.cols,
-        }
+        CellTable { cells, cols: lattice.cols }
     }
 }
 
@@ -150,12 +148,39 @@ struct Candidate {
     y: f32,
     half_len: f32,
     random: f32,
+    /// Texture coordinates of the scale's centre, wrapped into [0, 1).
+    centre_u: f32,
+    centre_v: f32,
+    /// Stacking order: the centre's unwrapped lattice row; smaller lies on top.
+    order: f32,
 }
 
-/// Signed distance inside a shape with half-width 0.5 and half-length `b` (positive inside).
+/// Where a scale's rim meets the scale underneath, the surface falls to this fraction of the
+/// lower scale's height: a groove, not a hole.
+const CREVICE_FLOOR: f32 = 0.8;
+
+/// Half-width of a diamond in cell widths (see `inside_distance`).
+const DIAMOND_HALF_WIDTH: f32 = 1.0;
+
+/// Half-width of a leaf in cell widths: wider than half a cell, so that with the staggered
+/// columns neighbouring leaves overlap sideways as well as lengthwise and no skin shows
+/// between them at the default size.
+const LEAF_HALF_WIDTH: f32 = 0.7;
+
+/// Half-width of a shape's bounding box in cell widths.
+fn half_width(shape: ScaleShape) -> f32 {
+    match shape {
+        ScaleShape::Diamond => DIAMOND_HALF_WIDTH,
+        ScaleShape::Leaf => LEAF_HALF_WIDTH,
+        ScaleShape::Hexagon => 0.5,
+    }
+}
+
+/// Signed distance inside a shape with half-width `half_width(shape)` and
+/// half-length `b` (positive inside).
 #[inline]
 fn inside_distance(shape: ScaleShape, x: f32, y: f32, b: f32) -> f32 {
-    let a = 0.5;
+    let a = LEAF_HALF_WIDTH;
     match shape {
         ScaleShape::Leaf => {
             // Lens from two circles (thesis Fig. 4.8): radius R centred at (±d, 0) gives
@@ -168,7 +193,10 @@ fn inside_distance(shape: ScaleShape, x: f32, y: f32, b: f32) -> f32 {
             -d1.max(d2)
         }
         ScaleShape::Diamond => {
-            // Rhombus with half-diagonals a, b; exact distance to the nearer edge line.
+            // Rhombus with half-diagonals a = 1 cell width and b = half a cell length: with
+            // columns staggered by half a row, neighbouring rhombi share edges at size 1
+            // (and overlap, imbricated, above). Exact distance to the nearer edge line.
+            let a = DIAMOND_HALF_WIDTH;
             let k = a * b / (a * a + b * b).sqrt();
             -(x.abs() / a + y.abs() / b - 1.0) * k
         }
@@ -177,18 +205,27 @@ fn inside_distance(shape: ScaleShape, x: f32, y: f32, b: f32) -> f32 {
 }
 
 impl ScaleField {
-    /// Evaluates the scale field at every pixel: a `channel::COUNT`-channel image.
+    /// Position of `channel` among the outputs.
+    pub fn output_index(&self, channel: usize) -> Option<usize> {
+        self.outputs.iter().position(|c| *c == channel)
+    }
+
+    /// Evaluates the scale field at every pixel: one image channel per entry of `outputs`.
     pub fn render(&self, width: usize, height: usize) -> Image {
         let lattice = self.lattice();
         let table = CellTable::new(self, &lattice);
-        Image::from_fn(width, height, channel::COUNT, |u, v, out| {
+        Image::from_fn(width, height, self.outputs.len(), |u, v, out| {
+            let mut all = [0.0f32; channel::COUNT];
             let dist_belly = u.min(1.0 - u);
             if self.belly_width > 0.0 && dist_belly < self.belly_width * 0.5 {
-                self.ventral_pixel(&lattice, dist_belly, v, out);
+                self.ventral_pixel(&lattice, dist_belly, v, &mut all);
             } else if self.shape == ScaleShape::Hexagon {
-                self.hexagon_pixel(&lattice, &table, u, v, out);
+                self.hexagon_pixel(&lattice, &table, u, v, &mut all);
             } else {
-                self.imbricate_pixel(&lattice, &table, u, v, out);
+                self.imbricate_pixel(&lattice, &table, u, v, &mut all);
+            }
+            for (o, c) in out.iter_mut().zip(&self.outputs) {
+                *o = all[*c];
             }
         })
     }
@@ -196,13 +233,7 @@ impl ScaleField {
     /// Lattice position of the jittered centre of cell (c, r), c unwrapped by at most one
     /// period (the callers look one column either side of a pixel's column).
     #[inline]
-    fn centre<'t>(
-        &self,
-        lattice: &Lattice,
-        table: &'t CellTable,
-        c: i32,
-        r: i32,
-    ) -> (f32, f32, &'t CellJitter) {
+    fn centre<'t>(&self, lattice: &Lattice, table: &'t CellTable, c: i32, r: i32) -> (f32, f32, &'t CellJitter) {
         let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
         // The same physical cell in the wrapped column: column -1 is column cols - 1 shifted
         // by one stagger, column cols is column 0 shifted back (no integer division: this
@@ -222,20 +253,10 @@ impl ScaleField {
             wr -= lattice.rows_v;
         }
         let cell = &table.cells[(wr * table.cols + wc) as usize];
-        (
-            c as f32 + 0.5 + cell.dx,
-            r as f32 + 0.5 + shift + cell.dy,
-            cell,
-        )
+        (c as f32 + 0.5 + cell.dx, r as f32 + 0.5 + shift + cell.dy, cell)
     }
 
-    fn candidates(
-        &self,
-        lattice: &Lattice,
-        table: &CellTable,
-        u: f32,
-        v: f32,
-    ) -> impl Iterator<Item = Candidate> {
+    fn candidates(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32) -> impl Iterator<Item = Candidate> {
         let x = u * lattice.cols as f32;
         let y = v * lattice.rows_v as f32;
         let c0 = floor_i32(x);
@@ -252,8 +273,8 @@ impl ScaleField {
                 let py = (y - cy) * lattice.aspect;
                 let lx = (px * cell.cos + py * cell.sin) * cell.inv_size;
                 let ly = (-px * cell.sin + py * cell.cos) * cell.inv_size;
-                // Every shape lies inside its |x| < 0.5, |y| < b box: skip the distance there.
-                if lx.abs() >= 0.5 || ly.abs() >= b {
+                // Every shape lies inside its |x| < half-width, |y| < b box: skip the rest.
+                if lx.abs() >= half_width(shape) || ly.abs() >= b {
                     return None;
                 }
                 let inside = inside_distance(shape, lx, ly, b) / cell.inv_size;
@@ -263,36 +284,47 @@ impl ScaleField {
                     y: ly,
                     half_len: b,
                     random: cell.random,
+                    centre_u: (cx / lattice.cols as f32).rem_euclid(1.0),
+                    centre_v: (cy / lattice.rows_v as f32).rem_euclid(1.0),
+                    order: cy,
                 })
             })
         })
     }
 
-    fn imbricate_pixel(
-        &self,
-        lattice: &Lattice,
-        table: &CellTable,
-        u: f32,
-        v: f32,
-        out: &mut [f32],
-    ) {
+    fn imbricate_pixel(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32, out: &mut [f32]) {
+        // Roof tiles: of the scales covering a pixel, the most anterior (smallest centre v)
+        // lies on top, its free posterior edge over the scale behind. Its rim falls towards
+        // the scale underneath, which leaves a groove along every free edge: the visible
+        // crevice between scales.
         let soft = self.edge_softness.max(1e-4);
-        let mut best_height = 0.0f32;
-        let mut best: Option<Candidate> = None;
+        let profile = |c: &Candidate| {
+            let along = (c.y / c.half_len * 0.5 + 0.5).clamp(0.0, 1.0);
+            let dome = smoothstep(0.0, 0.35, c.inside);
+            0.45 + 0.15 * dome + 0.3 * self.imbrication * along
+        };
+        let mut top: Option<Candidate> = None;
+        let mut under_height = 0.0f32;
         for cand in self.candidates(lattice, table, u, v) {
             if cand.inside <= 0.0 {
                 continue;
             }
-            let along = (cand.y / cand.half_len * 0.5 + 0.5).clamp(0.0, 1.0);
-            let rim = smoothstep(0.0, soft, cand.inside);
-            let dome = smoothstep(0.0, 0.35, cand.inside);
-            let h = rim * (0.45 + 0.15 * dome + 0.3 * self.imbrication * along);
-            if h > best_height || best.is_none() {
-                best_height = h;
-                best = Some(cand);
+            match &top {
+                Some(t) if cand.order >= t.order => under_height = under_height.max(profile(&cand)),
+                _ => {
+                    if let Some(t) = top.take() {
+                        under_height = under_height.max(profile(&t));
+                    }
+                    top = Some(cand);
+                }
             }
         }
-        self.write_scale(best, best_height, self.keel_height, out);
+        let height = top.as_ref().map_or(0.0, |t| {
+            let rim = smoothstep(0.0, soft, t.inside);
+            // Groove depth: the rim falls to 80 % of the surface underneath, not below it.
+            (rim * profile(t)).max(CREVICE_FLOOR * under_height)
+        });
+        self.write_scale(top, height, self.keel_height, out);
     }
 
     fn hexagon_pixel(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32, out: &mut [f32]) {
@@ -310,21 +342,13 @@ impl ScaleField {
             for dr in -1..=1 {
                 let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
                 // Isotropic coordinates: along-body distances scaled by the cell aspect.
-                centres[n] = (
-                    cx,
-                    cy * lattice.aspect,
-                    cell.random,
-                    cell.inv_size,
-                    cell.cos,
-                );
+                centres[n] = (cx, cy * lattice.aspect, cell.random, cell.inv_size, cell.cos);
                 n += 1;
             }
         }
         let p = (x, y * lattice.aspect);
         let d2 = |c: &(f32, f32, f32, f32, f32)| (c.0 - p.0).powi(2) + (c.1 - p.1).powi(2);
-        let nearest = (0..9)
-            .min_by(|&i, &j| d2(&centres[i]).total_cmp(&d2(&centres[j])))
-            .unwrap_or(0);
+        let nearest = (0..9).min_by(|&i, &j| d2(&centres[i]).total_cmp(&d2(&centres[j]))).unwrap_or(0);
         let c1 = centres[nearest];
         let mut edge = f32::MAX;
         for (i, c2) in centres.iter().enumerate() {
@@ -345,6 +369,9 @@ impl ScaleField {
             y: p.1 - c1.1,
             half_len,
             random: c1.2,
+            centre_u: (c1.0 / lattice.cols as f32).rem_euclid(1.0),
+            centre_v: (c1.1 / lattice.aspect / lattice.rows_v as f32).rem_euclid(1.0),
+            order: 0.0,
         };
         let soft = self.edge_softness.max(1e-4);
         let along = (cand.y / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
@@ -365,12 +392,13 @@ impl ScaleField {
                 out[channel::RADIAL] = 1.0;
                 out[channel::KEEL] = 0.0;
                 out[channel::CELL_RANDOM] = 0.0;
+                out[channel::CENTRE_U] = -1.0;
+                out[channel::CENTRE_V] = -1.0;
             }
             Some(c) => {
                 let along = (c.y / c.half_len * 0.5 + 0.5).clamp(0.0, 1.0);
-                let radial = ((c.x / 0.5).powi(2) + (c.y / c.half_len).powi(2))
-                    .sqrt()
-                    .min(1.0);
+                let hw = half_width(self.shape);
+                let radial = ((c.x / hw).powi(2) + (c.y / c.half_len).powi(2)).sqrt().min(1.0);
                 let keel = if keel_height > 0.0 {
                     // A ridge along the long axis, fading out towards the anterior tip.
                     (1.0 - smoothstep(0.0, self.keel_width.max(1e-3), c.x.abs()))
@@ -385,6 +413,8 @@ impl ScaleField {
                 out[channel::RADIAL] = radial;
                 out[channel::KEEL] = keel;
                 out[channel::CELL_RANDOM] = c.random;
+                out[channel::CENTRE_U] = c.centre_u;
+                out[channel::CENTRE_V] = c.centre_v;
             }
         }
     }
@@ -418,6 +448,9 @@ impl ScaleField {
                     y: ly,
                     half_len: 0.5 * lattice.aspect,
                     random,
+                    centre_u: 0.0,
+                    centre_v: ((r as f32 + 0.5) / lattice.rows_v as f32).rem_euclid(1.0),
+                    order: r as f32,
                 };
                 best = Some((h, cand));
             }

@@ -11,30 +11,48 @@ use tiny_skia::{FillRule, Mask, PathBuilder, Transform};
 use super::hash;
 use super::image::Image;
 
-/// Coverage of bands of constant u (running along the body) with smooth edges.
-/// `centres` and `half_width` are fractions of the circumference; `softness` likewise.
-pub fn bands_u(
-    width: usize,
-    height: usize,
-    centres: &[f32],
-    half_width: f32,
-    softness: f32,
-) -> Image {
-    let soft = softness.max(0.5 / width as f32);
-    let mut profile = vec![0.0f32; width];
-    for (x, value) in profile.iter_mut().enumerate() {
-        let u = (x as f32 + 0.5) / width as f32;
-        for &c in centres {
-            let d = (u - c).rem_euclid(1.0);
-            let d = d.min(1.0 - d);
-            let t = ((half_width + soft * 0.5 - d) / soft).clamp(0.0, 1.0);
-            *value = value.max(t * t * (3.0 - 2.0 * t));
-        }
-    }
-    // Constant along v: every row is the same profile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Axis {
+    /// Bands of constant u: stripes running along the body.
+    U,
+    /// Bands of constant v: rings around the body.
+    V,
+}
+
+/// A smooth periodic band profile over `n` samples: coverage of bands centred on `centres`
+/// (fractions of the period) with half-width `half_width` and edge width `softness`.
+fn band_profile(n: usize, centres: &[f32], half_width: f32, softness: f32) -> Vec<f32> {
+    let soft = softness.max(0.5 / n as f32);
+    (0..n)
+        .map(|i| {
+            let t = (i as f32 + 0.5) / n as f32;
+            centres.iter().fold(0.0f32, |acc, &c| {
+                let d = (t - c).rem_euclid(1.0);
+                let d = d.min(1.0 - d);
+                let k = ((half_width + soft * 0.5 - d) / soft).clamp(0.0, 1.0);
+                acc.max(k * k * (3.0 - 2.0 * k))
+            })
+        })
+        .collect()
+}
+
+/// Coverage of bands along one axis with smooth edges; `centres`, `half_width` and
+/// `softness` are fractions of the image along that axis.
+pub fn bands(width: usize, height: usize, axis: Axis, centres: &[f32], half_width: f32, softness: f32) -> Image {
     let mut image = Image::new(width, height, 1);
-    for row in image.data.chunks_exact_mut(width) {
-        row.copy_from_slice(&profile);
+    match axis {
+        Axis::U => {
+            let profile = band_profile(width, centres, half_width, softness);
+            for row in image.data.chunks_exact_mut(width) {
+                row.copy_from_slice(&profile);
+            }
+        }
+        Axis::V => {
+            let profile = band_profile(height, centres, half_width, softness);
+            for (row, value) in image.data.chunks_exact_mut(width).zip(profile) {
+                row.fill(value);
+            }
+        }
     }
     image
 }
@@ -52,6 +70,10 @@ pub struct SpotGrid {
     pub jitter: f32,
     /// Shift every other row by half a spacing (alternating rather than aligned spots).
     pub alternate: bool,
+    /// Draw only every other cell (a checkerboard).
+    pub checkered: bool,
+    /// Ring spots: the hole's radius as a fraction of the spot's (0 = solid spots).
+    pub hole: f32,
     pub seed: u32,
 }
 
@@ -66,11 +88,10 @@ pub fn spots(width: usize, height: usize, grid: &SpotGrid) -> Image {
     let (across, along) = (grid.across.max(1), grid.along.max(1));
     for row in 0..along as i32 {
         for col in 0..across as i32 {
-            let shift = if grid.alternate && row % 2 == 1 {
-                0.5
-            } else {
-                0.0
-            };
+            if grid.checkered && (row + col) % 2 == 1 {
+                continue;
+            }
+            let shift = if grid.alternate && row % 2 == 1 { 0.5 } else { 0.0 };
             let jx = hash::signed(col, row, 0, grid.seed) * grid.jitter * 0.5;
             let jy = hash::signed(col, row, 1, grid.seed) * grid.jitter * 0.5;
             let jr = 1.0 + hash::signed(col, row, 2, grid.seed) * grid.jitter * 0.5;
@@ -83,7 +104,96 @@ pub fn spots(width: usize, height: usize, grid: &SpotGrid) -> Image {
                     let (x, y) = ((cu + ox) * w, (cv + oy) * h);
                     if x + r_px >= 0.0 && x - r_px <= w && y + r_px >= 0.0 && y - r_px <= h {
                         pb.push_circle(x, y, r_px.max(0.1));
+                        if grid.hole > 0.0 {
+                            // Even-odd filling turns the inner circle into a hole.
+                            pb.push_circle(x, y, (r_px * grid.hole).max(0.05));
+                        }
                     }
+                }
+            }
+        }
+    }
+    if let Some(path) = pb.finish() {
+        mask.fill_path(&path, FillRule::EvenOdd, true, Transform::identity());
+    }
+    for (o, &m) in out.data.iter_mut().zip(mask.data()) {
+        *o = m as f32 / 255.0;
+    }
+    out
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BlotchShape {
+    Round,
+    Diamond,
+    /// A band over the back reaching down the flanks, with rounded corners.
+    Saddle,
+}
+
+/// A dorsal series of blotches centred on the spine (u = 0.5), repeated along the body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Blotches {
+    pub shape: BlotchShape,
+    /// Blotches per tile along the body.
+    pub count: u32,
+    /// Half-width around the body, fraction of the circumference.
+    pub half_width: f32,
+    /// Length along the body as a fraction of the spacing between blotches.
+    pub length: f32,
+    /// Random offset and size change, 0..1.
+    pub jitter: f32,
+    pub seed: u32,
+}
+
+/// Rasterises blotches into an anti-aliased coverage mask (tiny-skia), wrapping along v.
+pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
+    let mut out = Image::new(width, height, 1);
+    let Some(mut mask) = Mask::new(width as u32, height as u32) else {
+        return out;
+    };
+    let (w, h) = (width as f32, height as f32);
+    let count = b.count.max(1);
+    let spacing = h / count as f32;
+    let mut pb = PathBuilder::new();
+    for i in 0..count as i32 {
+        let jx = hash::signed(i, 0, 0, b.seed) * b.jitter * 0.05;
+        let jy = hash::signed(i, 0, 1, b.seed) * b.jitter * 0.2;
+        let js = 1.0 + hash::signed(i, 0, 2, b.seed) * b.jitter * 0.3;
+        let cx = (0.5 + jx) * w;
+        let hw = b.half_width * js * w;
+        let hl = 0.5 * b.length * js * spacing;
+        for copy in [-1.0f32, 0.0, 1.0] {
+            let cy = (i as f32 + 0.5 + jy) * spacing + copy * h;
+            if cy + hl < 0.0 || cy - hl > h {
+                continue;
+            }
+            match b.shape {
+                BlotchShape::Round => {
+                    if let Some(rect) = tiny_skia::Rect::from_xywh(cx - hw, cy - hl, 2.0 * hw, 2.0 * hl) {
+                        pb.push_oval(rect);
+                    }
+                }
+                BlotchShape::Diamond => {
+                    pb.move_to(cx, cy - hl);
+                    pb.line_to(cx + hw, cy);
+                    pb.line_to(cx, cy + hl);
+                    pb.line_to(cx - hw, cy);
+                    pb.close();
+                }
+                BlotchShape::Saddle => {
+                    // A rounded rectangle: corners of radius min(hw, hl) / 2 as quadratics.
+                    let r = 0.5 * hw.min(hl);
+                    let (x0, x1, y0, y1) = (cx - hw, cx + hw, cy - hl, cy + hl);
+                    pb.move_to(x0 + r, y0);
+                    pb.line_to(x1 - r, y0);
+                    pb.quad_to(x1, y0, x1, y0 + r);
+                    pb.line_to(x1, y1 - r);
+                    pb.quad_to(x1, y1, x1 - r, y1);
+                    pb.line_to(x0 + r, y1);
+                    pb.quad_to(x0, y1, x0, y1 - r);
+                    pb.line_to(x0, y0 + r);
+                    pb.quad_to(x0, y0, x0 + r, y0);
+                    pb.close();
                 }
             }
         }
@@ -95,4 +205,23 @@ pub fn spots(width: usize, height: usize, grid: &SpotGrid) -> Image {
         *o = m as f32 / 255.0;
     }
     out
+}
+
+/// Checkered ventral plates: in the belly band (centred on u = 0), the left half of every
+/// other plate row and the right half of the rows between, inset from the plate edges.
+pub fn belly_checker(width: usize, height: usize, rows_v: u32, belly_width: f32, softness: f32) -> Image {
+    let half = belly_width * 0.5;
+    let rows = rows_v.max(1) as f32;
+    let soft = softness.max(0.5 / width as f32);
+    Image::gray_from_fn(width, height, |u, v| {
+        let (side, d) = if u < 0.5 { (0, u) } else { (1, 1.0 - u) };
+        let r = (v * rows) as i32;
+        if (r + side) % 2 == 1 || d > half {
+            return 0.0;
+        }
+        // Inset: fade out near the plate's ends and its lateral edge.
+        let along = (v * rows).fract();
+        let edge = (along.min(1.0 - along) / rows).min(half - d);
+        ((edge - 0.3 * soft) / soft).clamp(0.0, 1.0)
+    })
 }

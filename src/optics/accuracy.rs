@@ -18,26 +18,10 @@ use super::methods::{Method, gaussian_fit_f32, rgb3_f32, spectral_n_f32};
 /// (n0, n1, n2) of PHYSICS.md's error grid: the thesis' default, a water-like film on a
 /// keratin-like base, the same inverted, and the default under water.
 pub const GRID_MATERIALS: [Stack; 4] = [
-    Stack {
-        n0: 1.00,
-        n1: 1.55,
-        n2: 2.00,
-    },
-    Stack {
-        n0: 1.00,
-        n1: 1.33,
-        n2: 1.56,
-    },
-    Stack {
-        n0: 1.00,
-        n1: 1.56,
-        n2: 1.33,
-    },
-    Stack {
-        n0: 1.33,
-        n1: 1.55,
-        n2: 2.00,
-    },
+    Stack { n0: 1.00, n1: 1.55, n2: 2.00 },
+    Stack { n0: 1.00, n1: 1.33, n2: 1.56 },
+    Stack { n0: 1.00, n1: 1.56, n2: 1.33 },
+    Stack { n0: 1.33, n1: 1.55, n2: 2.00 },
 ];
 
 #[derive(Debug, Clone, serde::Serialize)]
@@ -65,11 +49,7 @@ pub fn grid(d_step_nm: f64, angle_step_deg: f64) -> Vec<Sample> {
         while angle <= 89.0 + 1e-9 {
             let mut d = 0.0;
             while d <= 2000.0 + 1e-9 {
-                samples.push(Sample {
-                    material,
-                    thickness_nm: d,
-                    cos0: f64::to_radians(angle).cos(),
-                });
+                samples.push(Sample { material, thickness_nm: d, cos0: f64::to_radians(angle).cos() });
                 d += d_step_nm;
             }
             angle += angle_step_deg;
@@ -91,10 +71,7 @@ impl Prepared {
 
     pub fn with_lut_size(method: Method, size: (usize, usize, usize)) -> Self {
         let luts = if method == Method::Lut {
-            GRID_MATERIALS
-                .iter()
-                .map(|s| Lut::bake(*s, size.0, size.1, size.2))
-                .collect()
+            GRID_MATERIALS.iter().map(|s| Lut::bake(*s, size.0, size.1, size.2)).collect()
         } else {
             Vec::new()
         };
@@ -105,13 +82,7 @@ impl Prepared {
     #[inline]
     pub fn eval_f32(&self, s: &Sample) -> [f32; 3] {
         let m = &GRID_MATERIALS[s.material];
-        let (n0, n1, n2, d, c) = (
-            m.n0 as f32,
-            m.n1 as f32,
-            m.n2 as f32,
-            s.thickness_nm as f32,
-            s.cos0 as f32,
-        );
+        let (n0, n1, n2, d, c) = (m.n0 as f32, m.n1 as f32, m.n2 as f32, s.thickness_nm as f32, s.cos0 as f32);
         match self.method {
             Method::Rgb3 => rgb3_f32(n0, n1, n2, d, c),
             Method::SpectralN(n) => spectral_n_f32(n0, n1, n2, d, c, n),
@@ -123,18 +94,11 @@ impl Prepared {
 }
 
 pub fn reference_colours(samples: &[Sample]) -> Vec<[f64; 3]> {
-    samples
-        .par_iter()
-        .map(|s| film_rgb_reference(GRID_MATERIALS[s.material], s.thickness_nm, s.cos0))
-        .collect()
+    samples.par_iter().map(|s| film_rgb_reference(GRID_MATERIALS[s.material], s.thickness_nm, s.cos0)).collect()
 }
 
 /// ΔE2000 statistics and cost of one method.
-pub fn measure(
-    prepared: &Prepared,
-    samples: &[Sample],
-    reference_lab: &[[f64; 3]],
-) -> MethodReport {
+pub fn measure(prepared: &Prepared, samples: &[Sample], reference_lab: &[[f64; 3]]) -> MethodReport {
     let mut errors: Vec<f64> = samples
         .par_iter()
         .zip(reference_lab)
@@ -162,24 +126,12 @@ pub fn measure(
         })
         .collect();
     per_eval.sort_by(f64::total_cmp);
-    MethodReport {
-        name: prepared.method.name(),
-        mean_de: mean,
-        p95_de: p95,
-        max_de: max,
-        ns_per_eval: per_eval[2],
-    }
+    MethodReport { name: prepared.method.name(), mean_de: mean, p95_de: p95, max_de: max, ns_per_eval: per_eval[2] }
 }
 
 /// The whole table: every real-time method on the grid.
 pub fn bench_irid(d_step_nm: f64, angle_step_deg: f64, methods: &[Method]) -> Vec<MethodReport> {
     let samples = grid(d_step_nm, angle_step_deg);
-    let reference_lab: Vec<[f64; 3]> = reference_colours(&samples)
-        .into_iter()
-        .map(linear_srgb_to_lab)
-        .collect();
-    methods
-        .iter()
-        .map(|m| measure(&Prepared::new(*m), &samples, &reference_lab))
-        .collect()
+    let reference_lab: Vec<[f64; 3]> = reference_colours(&samples).into_iter().map(linear_srgb_to_lab).collect();
+    methods.iter().map(|m| measure(&Prepared::new(*m), &samples, &reference_lab)).collect()
 }

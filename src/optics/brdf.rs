@@ -47,10 +47,7 @@ impl BrdfValue {
     pub fn total(&self) -> [f64; 3] {
         [0, 1, 2].map(|c| self.specular[c] + self.diffuse[c])
     }
-    const ZERO: BrdfValue = BrdfValue {
-        specular: [0.0; 3],
-        diffuse: [0.0; 3],
-    };
+    const ZERO: BrdfValue = BrdfValue { specular: [0.0; 3], diffuse: [0.0; 3] };
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -76,11 +73,7 @@ pub fn ggx_d_sin(cos_h: f64, sin2_h: f64, alpha: f64) -> f64 {
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// Smith Λ for GGX (Heitz 2014, eq. 72).
@@ -125,15 +118,7 @@ pub fn eval(
         return BrdfValue::ZERO;
     };
     let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
-    let film_clamped = |c: f64| {
-        film(c.clamp(0.0, 1.0)).map(|v| {
-            if v.is_finite() {
-                v.clamp(0.0, 1.0)
-            } else {
-                1.0
-            }
-        })
-    };
+    let film_clamped = |c: f64| film(c.clamp(0.0, 1.0)).map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 1.0 });
 
     let nxh = cross(n, h);
     let d = ggx_d_sin(dot(n, h).clamp(0.0, 1.0), dot(nxh, nxh), alpha);
@@ -142,17 +127,13 @@ pub fn eval(
     let spec_scale = d * g2 / (4.0 * cos_i * cos_o);
     let specular = f_h.map(|f| f * spec_scale);
 
-    let diffuse = match (
-        cos_transmitted(layers.n0, layers.n2, cos_i),
-        cos_transmitted(layers.n0, layers.n2, cos_o),
-    ) {
+    let diffuse = match (cos_transmitted(layers.n0, layers.n2, cos_i), cos_transmitted(layers.n0, layers.n2, cos_o)) {
         (Some(ti), Some(to)) => {
             let (f_i, f_o) = (film_clamped(cos_i), film_clamped(cos_o));
             let path = 1.0 / ti.max(COS_MIN) + 1.0 / to.max(COS_MIN);
             [0, 1, 2].map(|c| {
                 let attenuation = (-layers.optical_depth[c].max(0.0) * path).exp();
-                (1.0 - f_i[c]) * (1.0 - f_o[c]) * attenuation * layers.albedo[c].max(0.0)
-                    / std::f64::consts::PI
+                (1.0 - f_i[c]) * (1.0 - f_o[c]) * attenuation * layers.albedo[c].max(0.0) / std::f64::consts::PI
             })
         }
         _ => [0.0; 3],
@@ -164,12 +145,7 @@ pub fn eval(
 /// τ = 0 passed in `layers`. The specular lobe is integrated in half-vector space with
 /// stratified GGX sampling (exact for any α, however peaked); the diffuse lobe, which
 /// depends on θi only, by the midpoint rule in cos θi. `n` strata per axis.
-pub fn furnace_albedo(
-    layers: &Layers,
-    cos_o: f64,
-    film: &dyn Fn(f64) -> [f64; 3],
-    n: usize,
-) -> [f64; 3] {
+pub fn furnace_albedo(layers: &Layers, cos_o: f64, film: &dyn Fn(f64) -> [f64; 3], n: usize) -> [f64; 3] {
     let cos_o = cos_o.clamp(COS_MIN, 1.0);
     let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
     let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
@@ -191,16 +167,7 @@ pub fn furnace_albedo(
                 continue;
             }
             // f cos θi / pdf(wi) with pdf(wi) = D cos θh / (4 |wo·h|).
-            let value = eval(
-                &Layers {
-                    albedo: [0.0; 3],
-                    ..*layers
-                },
-                [0.0, 0.0, 1.0],
-                wi,
-                wo,
-                film,
-            );
+            let value = eval(&Layers { albedo: [0.0; 3], ..*layers }, [0.0, 0.0, 1.0], wi, wo, film);
             let pdf = ggx_d_sin(cos_h, sin_h * sin_h, alpha) * cos_h / (4.0 * wo_h);
             for (s, v) in spec.iter_mut().zip(value.specular) {
                 *s += v * wi[2] / pdf;
@@ -242,13 +209,7 @@ fn normalize32(v: [f32; 3]) -> Option<[f32; 3]> {
 }
 
 /// The f32 fast path, film colour from the material's LUT: the CPU twin of the shader.
-pub fn eval_f32(
-    layers: &Layers32,
-    normal: [f32; 3],
-    wi: [f32; 3],
-    wo: [f32; 3],
-    lut: &super::lut::Lut,
-) -> [f32; 3] {
+pub fn eval_f32(layers: &Layers32, normal: [f32; 3], wi: [f32; 3], wo: [f32; 3], lut: &super::lut::Lut) -> [f32; 3] {
     let n = normalize32(normal).unwrap_or([0.0, 0.0, 1.0]);
     let (Some(wi), Some(wo)) = (normalize32(wi), normalize32(wo)) else {
         return [0.0; 3];
@@ -264,17 +225,10 @@ pub fn eval_f32(
     };
     let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN as f32, 1.0);
     let a2 = alpha * alpha;
-    let film = |c: f32| {
-        lut.lookup_f32(layers.thickness_nm, c.clamp(0.0, 1.0))
-            .map(|v| v.clamp(0.0, 1.0))
-    };
+    let film = |c: f32| lut.lookup_f32(layers.thickness_nm, c.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
 
     let cos_h = dot32(n, h).clamp(0.0, 1.0);
-    let nxh = [
-        n[1] * h[2] - n[2] * h[1],
-        n[2] * h[0] - n[0] * h[2],
-        n[0] * h[1] - n[1] * h[0],
-    ];
+    let nxh = [n[1] * h[2] - n[2] * h[1], n[2] * h[0] - n[0] * h[2], n[0] * h[1] - n[1] * h[0]];
     let t = dot32(nxh, nxh) + cos_h * cos_h * a2;
     let d = a2 / (std::f32::consts::PI * t * t);
     let lambda = |c: f32| 0.5 * ((1.0 + a2 * (1.0 - c * c).max(0.0) / (c * c)).sqrt() - 1.0);
@@ -283,16 +237,9 @@ pub fn eval_f32(
     let spec = d * g2 / (4.0 * cos_i * cos_o);
 
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
-    let (ki, ko) = (
-        1.0 - eta2 * (1.0 - cos_i * cos_i),
-        1.0 - eta2 * (1.0 - cos_o * cos_o),
-    );
+    let (ki, ko) = (1.0 - eta2 * (1.0 - cos_i * cos_i), 1.0 - eta2 * (1.0 - cos_o * cos_o));
     let (f_i, f_o) = (film(cos_i), film(cos_o));
-    let path = if ki > 0.0 && ko > 0.0 {
-        1.0 / ki.sqrt().max(cos_min) + 1.0 / ko.sqrt().max(cos_min)
-    } else {
-        -1.0
-    };
+    let path = if ki > 0.0 && ko > 0.0 { 1.0 / ki.sqrt().max(cos_min) + 1.0 / ko.sqrt().max(cos_min) } else { -1.0 };
     [0, 1, 2].map(|c| {
         let diffuse = if path > 0.0 {
             (1.0 - f_i[c])

@@ -52,11 +52,7 @@ impl C64 {
         let re = ((r + self.re) * 0.5).max(0.0).sqrt();
         let im = ((r - self.re) * 0.5).max(0.0).sqrt();
         // sign(im of result) follows sign(self.im); then flip into the upper half-plane.
-        let root = if self.im < 0.0 {
-            C64::new(re, -im)
-        } else {
-            C64::new(re, im)
-        };
+        let root = if self.im < 0.0 { C64::new(re, -im) } else { C64::new(re, im) };
         if root.im < 0.0 { -root } else { root }
     }
 }
@@ -78,10 +74,7 @@ impl Sub for C64 {
 impl Mul for C64 {
     type Output = C64;
     fn mul(self, o: C64) -> C64 {
-        C64::new(
-            self.re * o.re - self.im * o.im,
-            self.re * o.im + self.im * o.re,
-        )
+        C64::new(self.re * o.re - self.im * o.im, self.re * o.im + self.im * o.re)
     }
 }
 
@@ -96,10 +89,7 @@ impl Div for C64 {
     type Output = C64;
     fn div(self, o: C64) -> C64 {
         let d = o.norm_sqr();
-        C64::new(
-            (self.re * o.re + self.im * o.im) / d,
-            (self.im * o.re - self.re * o.im) / d,
-        )
+        C64::new((self.re * o.re + self.im * o.im) / d, (self.im * o.re - self.re * o.im) / d)
     }
 }
 
@@ -116,22 +106,12 @@ mod tests {
 
     #[test]
     fn sqrt_upper_squares_back_and_stays_in_the_upper_half_plane() {
-        for &(re, im) in &[
-            (4.0, 0.0),
-            (-4.0, 0.0),
-            (-4.0, -0.0),
-            (3.0, -4.0),
-            (-3.0, 4.0),
-            (0.0, 0.0),
-        ] {
+        for &(re, im) in &[(4.0, 0.0), (-4.0, 0.0), (-4.0, -0.0), (3.0, -4.0), (-3.0, 4.0), (0.0, 0.0)] {
             let z = C64::new(re, im);
             let s = z.sqrt_upper();
             assert!(s.im >= 0.0, "{z:?} -> {s:?}");
             let back = s * s;
-            assert!(
-                (back.re - re).abs() < 1e-12 && (back.im - im).abs() < 1e-12,
-                "{z:?}"
-            );
+            assert!((back.re - re).abs() < 1e-12 && (back.im - im).abs() < 1e-12, "{z:?}");
         }
         assert_eq!(C64::new(-4.0, -0.0).sqrt_upper(), C64::new(0.0, 2.0));
     }

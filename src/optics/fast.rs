@@ -25,10 +25,7 @@ fn scale(a: C32, k: f32) -> C32 {
 #[inline]
 fn div(a: C32, b: C32) -> C32 {
     let d = b[0] * b[0] + b[1] * b[1];
-    [
-        (a[0] * b[0] + a[1] * b[1]) / d,
-        (a[1] * b[0] - a[0] * b[1]) / d,
-    ]
+    [(a[0] * b[0] + a[1] * b[1]) / d, (a[1] * b[0] - a[0] * b[1]) / d]
 }
 #[inline]
 fn conj(a: C32) -> C32 {
@@ -41,11 +38,7 @@ fn norm_sqr(a: C32) -> f32 {
 /// sqrt(x) for real x, as a complex number in the upper half-plane.
 #[inline]
 fn sqrt_real(x: f32) -> C32 {
-    if x >= 0.0 {
-        [x.sqrt(), 0.0]
-    } else {
-        [0.0, (-x).sqrt()]
-    }
+    if x >= 0.0 { [x.sqrt(), 0.0] } else { [0.0, (-x).sqrt()] }
 }
 
 /// Fourier coefficients (c0, D, q) of one polarisation, f32.
@@ -70,11 +63,7 @@ fn harmonics(a: C32, b: C32) -> Harmonics32 {
     let k = mul(b, sub([1.0, 0.0], mul(a, a)));
     let k2 = norm_sqr(k);
     let inv = 1.0 / (1.0 - norm_sqr(q)).max(1e-6);
-    Harmonics32 {
-        c0: norm_sqr(a) + k2 * inv,
-        d: add(mul(k, conj(a)), scale(q, k2 * inv)),
-        q,
-    }
+    Harmonics32 { c0: norm_sqr(a) + k2 * inv, d: add(mul(k, conj(a)), scale(q, k2 * inv)), q }
 }
 
 /// Film coefficients for indices (n0, n1, n2) and the incidence cosine in the ambient medium.
@@ -95,11 +84,7 @@ pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
     };
     let (a_s, a_p) = r(n0, c0, n1, c1);
     let (b_s, b_p) = r(n1, c1, n2, c2);
-    Film32 {
-        s: harmonics(a_s, b_s),
-        p: harmonics(a_p, b_p),
-        cos1: if c1[1] == 0.0 { c1[0] } else { 0.0 },
-    }
+    Film32 { s: harmonics(a_s, b_s), p: harmonics(a_p, b_p), cos1: if c1[1] == 0.0 { c1[0] } else { 0.0 } }
 }
 
 #[inline]
@@ -126,18 +111,9 @@ fn series(h: &Harmonics32, phase: f32, box_width: f32) -> f32 {
         scale(mul(h.d, z), sinc(0.5 * box_width))
     } else {
         let half = 0.5 * box_width;
-        let upper = ln(sub(
-            one,
-            mul(h.q, [(phase + half).cos(), (phase + half).sin()]),
-        ));
-        let lower = ln(sub(
-            one,
-            mul(h.q, [(phase - half).cos(), (phase - half).sin()]),
-        ));
-        scale(
-            mul([0.0, 1.0], div(mul(h.d, sub(upper, lower)), h.q)),
-            1.0 / box_width,
-        )
+        let upper = ln(sub(one, mul(h.q, [(phase + half).cos(), (phase + half).sin()])));
+        let lower = ln(sub(one, mul(h.q, [(phase - half).cos(), (phase - half).sin()])));
+        scale(mul([0.0, 1.0], div(mul(h.d, sub(upper, lower)), h.q)), 1.0 / box_width)
     };
     (h.c0 + 2.0 * mean[0]).clamp(0.0, 1.0)
 }

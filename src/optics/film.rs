@@ -22,11 +22,7 @@ pub struct Stack {
 
 impl Stack {
     /// The thesis' defaults (Table 5.2): air, film 1.55, pigment 2.00.
-    pub const THESIS: Stack = Stack {
-        n0: 1.0,
-        n1: 1.55,
-        n2: 2.0,
-    };
+    pub const THESIS: Stack = Stack { n0: 1.0, n1: 1.55, n2: 2.0 };
 }
 
 /// Reflectance and transmittance per polarisation and unpolarised (the mean of s and p).
@@ -42,14 +38,7 @@ pub struct FilmRT {
 
 impl FilmRT {
     fn from_sp(rs: f64, rp: f64, ts: f64, tp: f64) -> Self {
-        FilmRT {
-            rs,
-            rp,
-            r: 0.5 * (rs + rp),
-            ts,
-            tp,
-            t: 0.5 * (ts + tp),
-        }
+        FilmRT { rs, rp, r: 0.5 * (rs + rp), ts, tp, t: 0.5 * (ts + tp) }
     }
 }
 
@@ -97,8 +86,7 @@ pub fn airy(stack: Stack, thickness_nm: f64, wavelength_nm: f64, cos0: f64) -> F
     let e1 = C64::exp_i(beta);
     let e2 = C64::exp_i(beta * 2.0);
     let airy_r = |r01: C64, r12: C64| (r01 + r12 * e2) / (C64::ONE + r01 * r12 * e2);
-    let airy_t =
-        |r01: C64, r12: C64, t01: C64, t12: C64| (t01 * t12 * e1) / (C64::ONE + r01 * r12 * e2);
+    let airy_t = |r01: C64, r12: C64, t01: C64, t12: C64| (t01 * t12 * e1) / (C64::ONE + r01 * r12 * e2);
 
     let rs = airy_r(r01s, r12s).norm_sqr();
     let rp = airy_r(r01p, r12p).norm_sqr();
@@ -107,10 +95,7 @@ pub fn airy(stack: Stack, thickness_nm: f64, wavelength_nm: f64, cos0: f64) -> F
     let flux_s = (c2 * n2).re / (c0 * n0).re;
     let flux_p = (c2.conj() * n2).re / (c0.conj() * n0).re;
     let (ts, tp) = if cos0 > 0.0 {
-        (
-            flux_s * airy_t(r01s, r12s, t01s, t12s).norm_sqr(),
-            flux_p * airy_t(r01p, r12p, t01p, t12p).norm_sqr(),
-        )
+        (flux_s * airy_t(r01s, r12s, t01s, t12s).norm_sqr(), flux_p * airy_t(r01p, r12p, t01p, t12p).norm_sqr())
     } else {
         // Exactly grazing incidence carries no flux: everything is reflected.
         (0.0, 0.0)
@@ -120,12 +105,7 @@ pub fn airy(stack: Stack, thickness_nm: f64, wavelength_nm: f64, cos0: f64) -> F
         // Only |r01 r12| = 1 makes the Airy denominator vanish: the grazing limit, R = 1.
         return FilmRT::from_sp(1.0, 1.0, 0.0, 0.0);
     }
-    FilmRT::from_sp(
-        rs.clamp(0.0, 1.0),
-        rp.clamp(0.0, 1.0),
-        ts.clamp(0.0, 1.0),
-        tp.clamp(0.0, 1.0),
-    )
+    FilmRT::from_sp(rs.clamp(0.0, 1.0), rp.clamp(0.0, 1.0), ts.clamp(0.0, 1.0), tp.clamp(0.0, 1.0))
 }
 
 /// The incoherent (thick-film) limit: intensities add, phases average out.
@@ -139,19 +119,11 @@ pub fn incoherent(stack: Stack, cos0: f64) -> FilmRT {
     let (r01s, r01p) = fresnel(n0, n1, cos0);
     let c1 = cos_in(n0, n1, cos0);
     // Internal incidence on the 1|2 interface: cos θ1 real unless TIR at 0|1 (then R01 = 1).
-    let (r12s, r12p) = if c1.im == 0.0 && c1.re > 0.0 {
-        fresnel(n1, n2, c1.re)
-    } else {
-        (1.0, 1.0)
-    };
+    let (r12s, r12p) = if c1.im == 0.0 && c1.re > 0.0 { fresnel(n1, n2, c1.re) } else { (1.0, 1.0) };
     let sum = |r01: f64, r12: f64| {
         let t01 = 1.0 - r01;
         let denom = 1.0 - r01 * r12;
-        if denom <= 1e-300 {
-            1.0
-        } else {
-            (r01 + t01 * t01 * r12 / denom).clamp(0.0, 1.0)
-        }
+        if denom <= 1e-300 { 1.0 } else { (r01 + t01 * t01 * r12 / denom).clamp(0.0, 1.0) }
     };
     let (rs, rp) = (sum(r01s, r12s), sum(r01p, r12p));
     FilmRT::from_sp(rs, rp, 1.0 - rs, 1.0 - rp)

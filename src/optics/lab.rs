@@ -12,11 +12,7 @@ use super::spectrum::linear_srgb_to_xyz;
 fn lab_f(t: f64) -> f64 {
     // CIE 015: cube root above (6/29)³, linear below.
     const DELTA: f64 = 6.0 / 29.0;
-    if t > DELTA * DELTA * DELTA {
-        t.cbrt()
-    } else {
-        t / (3.0 * DELTA * DELTA) + 4.0 / 29.0
-    }
+    if t > DELTA * DELTA * DELTA { t.cbrt() } else { t / (3.0 * DELTA * DELTA) + 4.0 / 29.0 }
 }
 
 pub fn xyz_to_lab(xyz: [f64; 3], white: [f64; 3]) -> [f64; 3] {
@@ -43,11 +39,7 @@ pub fn ciede2000(lab1: [f64; 3], lab2: [f64; 3]) -> f64 {
     let (a1p, a2p) = ((1.0 + g) * a1, (1.0 + g) * a2);
     let (c1p, c2p) = ((a1p * a1p + b1 * b1).sqrt(), (a2p * a2p + b2 * b2).sqrt());
     let hue = |b: f64, a: f64| {
-        if a == 0.0 && b == 0.0 {
-            0.0
-        } else {
-            b.atan2(a).rem_euclid(2.0 * PI)
-        }
+        if a == 0.0 && b == 0.0 { 0.0 } else { b.atan2(a).rem_euclid(2.0 * PI) }
     };
     let (h1p, h2p) = (hue(b1, a1p), hue(b2, a2p));
 
@@ -114,41 +106,17 @@ mod tests {
         ([50.0, 2.5, 0.0], [61.0, -5.0, 29.0], 22.8977),
         ([50.0, 2.5, 0.0], [56.0, -27.0, -3.0], 31.9030),
         ([50.0, 2.5, 0.0], [58.0, 24.0, 15.0], 19.4535),
-        (
-            [60.2574, -34.0099, 36.2677],
-            [60.4626, -34.1751, 39.4387],
-            1.2644,
-        ),
-        (
-            [63.0109, -31.0961, -5.8663],
-            [62.8187, -29.7946, -4.0864],
-            1.2630,
-        ),
-        (
-            [22.7233, 20.0904, -46.6940],
-            [23.0331, 14.9730, -42.5619],
-            2.0373,
-        ),
-        (
-            [90.8027, -2.0831, 1.4410],
-            [91.1528, -1.6435, 0.0447],
-            1.4441,
-        ),
-        (
-            [2.0776, 0.0795, -1.1350],
-            [0.9033, -0.0636, -0.5514],
-            0.9082,
-        ),
+        ([60.2574, -34.0099, 36.2677], [60.4626, -34.1751, 39.4387], 1.2644),
+        ([63.0109, -31.0961, -5.8663], [62.8187, -29.7946, -4.0864], 1.2630),
+        ([22.7233, 20.0904, -46.6940], [23.0331, 14.9730, -42.5619], 2.0373),
+        ([90.8027, -2.0831, 1.4410], [91.1528, -1.6435, 0.0447], 1.4441),
+        ([2.0776, 0.0795, -1.1350], [0.9033, -0.0636, -0.5514], 0.9082),
     ];
 
     #[test]
     fn matches_sharma_wu_dalal_pairs_both_ways() {
         for (a, b, expected) in PAIRS {
-            assert!(
-                (ciede2000(a, b) - expected).abs() < 5e-5,
-                "{a:?} {b:?}: {}",
-                ciede2000(a, b)
-            );
+            assert!((ciede2000(a, b) - expected).abs() < 5e-5, "{a:?} {b:?}: {}", ciede2000(a, b));
             assert!((ciede2000(b, a) - expected).abs() < 5e-5);
         }
     }
@@ -156,10 +124,7 @@ mod tests {
     #[test]
     fn white_is_l100_and_black_is_l0() {
         let white = linear_srgb_to_lab([1.0; 3]);
-        assert!(
-            (white[0] - 100.0).abs() < 1e-9 && white[1].abs() < 1e-9 && white[2].abs() < 1e-9,
-            "{white:?}"
-        );
+        assert!((white[0] - 100.0).abs() < 1e-9 && white[1].abs() < 1e-9 && white[2].abs() < 1e-9, "{white:?}");
         assert!(linear_srgb_to_lab([0.0; 3])[0].abs() < 1e-12);
     }
 }

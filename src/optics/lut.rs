@@ -47,26 +47,15 @@ impl Lut {
     /// Thickness at texel column j and the width of the cell it stands for.
     pub fn texel_thickness(&self, j: usize) -> (f64, f64) {
         if j < self.n_fine {
-            (
-                j as f64 * self.fine_step(),
-                if j == 0 { 0.0 } else { self.fine_step() },
-            )
+            (j as f64 * self.fine_step(), if j == 0 { 0.0 } else { self.fine_step() })
         } else {
-            (
-                FINE_MAX_NM + (j + 1 - self.n_fine) as f64 * self.coarse_step(),
-                self.coarse_step(),
-            )
+            (FINE_MAX_NM + (j + 1 - self.n_fine) as f64 * self.coarse_step(), self.coarse_step())
         }
     }
 
     /// Bakes the table for one material (parallel over angles).
     pub fn bake(stack: Stack, n_cos: usize, n_fine: usize, n_coarse: usize) -> Lut {
-        let mut lut = Lut {
-            n_cos: n_cos.max(2),
-            n_fine: n_fine.max(2),
-            n_coarse: n_coarse.max(1),
-            texels: Vec::new(),
-        };
+        let mut lut = Lut { n_cos: n_cos.max(2), n_fine: n_fine.max(2), n_coarse: n_coarse.max(1), texels: Vec::new() };
         let width = lut.width();
         let rows: Vec<Vec<[f32; 3]>> = (0..lut.n_cos)
             .into_par_iter()

@@ -37,13 +37,9 @@ impl Method {
             "rgb3" => Method::Rgb3,
             "gaussian-fit" => Method::GaussianFit,
             "lut" => Method::Lut,
-            other => Method::SpectralN(
-                other
-                    .strip_prefix("spectral-")?
-                    .parse()
-                    .ok()
-                    .filter(|n| (1..=421).contains(n))?,
-            ),
+            other => {
+                Method::SpectralN(other.strip_prefix("spectral-")?.parse().ok().filter(|n| (1..=421).contains(n))?)
+            }
         })
     }
 
@@ -70,8 +66,7 @@ impl Method {
         ]
     }
 
-    pub const ACCEPTED: &'static str =
-        "spectral, rgb3, spectral-N (N = 1..421, e.g. spectral-8), gaussian-fit, lut";
+    pub const ACCEPTED: &'static str = "spectral, rgb3, spectral-N (N = 1..421, e.g. spectral-8), gaussian-fit, lut";
 }
 
 /// rgb3 wavelengths in nm for R, G, B (the usual 650 / 550 / 450 choice) and the band each
@@ -101,9 +96,7 @@ impl Bands {
             }
         }
         Bands {
-            centres_nm: (0..n)
-                .map(|i| LAMBDA_MIN_NM as f64 - 0.5 + (i as f64 + 0.5) * width)
-                .collect(),
+            centres_nm: (0..n).map(|i| LAMBDA_MIN_NM as f64 - 0.5 + (i as f64 + 0.5) * width).collect(),
             width_nm: width,
             rgb_weights: xyz.into_iter().map(|v| mat3_mul(&XYZ_TO_SRGB, v)).collect(),
         }
@@ -113,11 +106,7 @@ impl Bands {
     pub fn cached(n: usize) -> &'static Bands {
         static CACHE: OnceLock<Vec<Bands>> = OnceLock::new();
         let all = CACHE.get_or_init(|| (1..=64).map(Bands::new).collect());
-        if n <= 64 {
-            &all[n - 1]
-        } else {
-            Box::leak(Box::new(Bands::new(n)))
-        }
+        if n <= 64 { &all[n - 1] } else { Box::leak(Box::new(Bands::new(n))) }
     }
 }
 
@@ -135,14 +124,7 @@ pub fn spectral_n_f64(stack: Stack, thickness_nm: f64, cos0: f64, n: usize) -> [
     rgb
 }
 
-fn band_reflectance_f64(
-    film: &FilmSeries,
-    stack: Stack,
-    d: f64,
-    lambda: f64,
-    band_nm: f64,
-    cos0: f64,
-) -> f64 {
+fn band_reflectance_f64(film: &FilmSeries, stack: Stack, d: f64, lambda: f64, band_nm: f64, cos0: f64) -> f64 {
     if !film.usable() {
         return super::film::airy(stack, d, lambda, cos0).r;
     }
@@ -151,14 +133,7 @@ fn band_reflectance_f64(
 }
 
 /// f32 form: spectral-N with band prefiltering.
-pub fn spectral_n_f32(
-    n0: f32,
-    n1: f32,
-    n2: f32,
-    thickness_nm: f32,
-    cos0: f32,
-    n: usize,
-) -> [f32; 3] {
+pub fn spectral_n_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32, n: usize) -> [f32; 3] {
     let bands = Bands::cached(n);
     let film = film_f32(n0, n1, n2, cos0);
     let width = bands.width_nm as f32;
@@ -176,16 +151,7 @@ pub fn spectral_n_f32(
 
 pub fn rgb3_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
     let film = FilmSeries::new(stack, cos0);
-    RGB3_NM.map(|l| {
-        band_reflectance_f64(
-            &film,
-            stack,
-            thickness_nm,
-            l as f64,
-            RGB3_BAND_NM as f64,
-            cos0,
-        )
-    })
+    RGB3_NM.map(|l| band_reflectance_f64(&film, stack, thickness_nm, l as f64, RGB3_BAND_NM as f64, cos0))
 }
 
 pub fn rgb3_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32; 3] {
@@ -213,9 +179,7 @@ fn bb_sensitivity(c_re: f64, c_im: f64, opd_nm: f64) -> [f64; 3] {
     let phase = 2.0 * std::f64::consts::PI * opd_nm * 1e-9;
     let (mag, arg) = ((c_re * c_re + c_im * c_im).sqrt(), c_im.atan2(c_re));
     let lobe = |val: f64, pos: f64, var: f64| {
-        val * (2.0 * std::f64::consts::PI * var).sqrt()
-            * (pos * phase + arg).cos()
-            * (-var * phase * phase).exp()
+        val * (2.0 * std::f64::consts::PI * var).sqrt() * (pos * phase + arg).cos() * (-var * phase * phase).exp()
     };
     let mut xyz = [0, 1, 2].map(|i| lobe(BB_VAL[i], BB_POS[i], BB_VAR[i]));
     xyz[0] += lobe(BB_X2.0, BB_X2.1, BB_X2.2);
@@ -248,10 +212,7 @@ pub fn gaussian_fit_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] 
         }
     }
     let white = d65_white();
-    mat3_mul(
-        &XYZ_TO_SRGB,
-        [xyz[0] * white[0], xyz[1] * white[1], xyz[2] * white[2]],
-    )
+    mat3_mul(&XYZ_TO_SRGB, [xyz[0] * white[0], xyz[1] * white[1], xyz[2] * white[2]])
 }
 
 pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32; 3] {
@@ -270,18 +231,13 @@ pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32)
                     * (pos as f32 * phase + arg).cos()
                     * (-(var as f32) * phase * phase).exp()
             };
-            xyz[0] +=
-                mag * (lobe(BB_VAL[0], BB_POS[0], BB_VAR[0]) + lobe(BB_X2.0, BB_X2.1, BB_X2.2));
+            xyz[0] += mag * (lobe(BB_VAL[0], BB_POS[0], BB_VAR[0]) + lobe(BB_X2.0, BB_X2.1, BB_X2.2));
             xyz[1] += mag * lobe(BB_VAL[1], BB_POS[1], BB_VAR[1]);
             xyz[2] += mag * lobe(BB_VAL[2], BB_POS[2], BB_VAR[2]);
             c = mul(c, h.q);
         }
     }
     let white = d65_white();
-    let v = [
-        xyz[0] as f64 * white[0],
-        xyz[1] as f64 * white[1],
-        xyz[2] as f64 * white[2],
-    ];
+    let v = [xyz[0] as f64 * white[0], xyz[1] as f64 * white[1], xyz[2] as f64 * white[2]];
     mat3_mul(&XYZ_TO_SRGB, v).map(|x| x as f32)
 }

@@ -53,11 +53,7 @@ pub fn error_vs_cost_svg(reports: &[MethodReport], default: &str) -> String {
     );
     for r in reports {
         let (x, y) = (px(r.ns_per_eval), py(r.mean_de));
-        let colour = if r.name == default {
-            "#c0392b"
-        } else {
-            "#2c3e50"
-        };
+        let colour = if r.name == default { "#c0392b" } else { "#2c3e50" };
         let _ = writeln!(
             svg,
             r#"<circle cx="{x:.1}" cy="{y:.1}" r="5" fill="{colour}"/><text x="{:.1}" y="{:.1}">{}</text>"#,

@@ -40,11 +40,7 @@ fn harmonics(a: C64, b: C64) -> Harmonics {
     let k = b * (C64::ONE - a * a);
     let denom = (1.0 - q.norm_sqr()).max(1e-300);
     let k2 = k.norm_sqr();
-    Harmonics {
-        c0: a.norm_sqr() + k2 / denom,
-        d: k * a.conj() + q * (k2 / denom),
-        q,
-    }
+    Harmonics { c0: a.norm_sqr() + k2 / denom, d: k * a.conj() + q * (k2 / denom), q }
 }
 
 /// `|q|` at or above this makes the series converge too slowly; callers use Airy directly.
@@ -63,18 +59,12 @@ impl FilmSeries {
         let (a_s, a_p) = r(n0, c0, n1, c1);
         let (b_s, b_p) = r(n1, c1, n2, c2);
         let cos1 = if c1.im == 0.0 { Some(c1.re) } else { None };
-        FilmSeries {
-            s: harmonics(a_s, b_s),
-            p: harmonics(a_p, b_p),
-            cos1,
-        }
+        FilmSeries { s: harmonics(a_s, b_s), p: harmonics(a_p, b_p), cos1 }
     }
 
     /// True when the series is usable (real film angle, |q| < MAX_Q, not grazing).
     pub fn usable(&self) -> bool {
-        self.cos1.is_some()
-            && self.s.q.norm_sqr() < MAX_Q * MAX_Q
-            && self.p.q.norm_sqr() < MAX_Q * MAX_Q
+        self.cos1.is_some() && self.s.q.norm_sqr() < MAX_Q * MAX_Q && self.p.q.norm_sqr() < MAX_Q * MAX_Q
     }
 
     /// The round-trip phase φ = 4π n1 d cos θ1 / λ.

@@ -16,11 +16,8 @@ pub const LAMBDA_MAX_NM: u32 = 780;
 pub const SAMPLES: usize = (LAMBDA_MAX_NM - LAMBDA_MIN_NM + 1) as usize;
 
 /// XYZ → linear sRGB (IEC 61966-2-1), the matrix PHYSICS.md fixes.
-pub const XYZ_TO_SRGB: [[f64; 3]; 3] = [
-    [3.2404542, -1.5371385, -0.4985314],
-    [-0.9692660, 1.8760108, 0.0415560],
-    [0.0556434, -0.2040259, 1.0572252],
-];
+pub const XYZ_TO_SRGB: [[f64; 3]; 3] =
+    [[3.2404542, -1.5371385, -0.4985314], [-0.9692660, 1.8760108, 0.0415560], [0.0556434, -0.2040259, 1.0572252]];
 
 /// Per-wavelength weights k S(λ) (x̄, ȳ, z̄)(λ) for λ = 360..=780 nm.
 pub struct Observer {
@@ -31,11 +28,7 @@ fn parse_csv(text: &str) -> Vec<Vec<f64>> {
     text.lines()
         .skip(1)
         .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.trim().parse::<f64>().expect("numeric CIE table"))
-                .collect()
-        })
+        .map(|l| l.split(',').map(|v| v.trim().parse::<f64>().expect("numeric CIE table")).collect())
         .collect()
 }
 
@@ -44,31 +37,19 @@ impl Observer {
         let cmf = parse_csv(include_str!("../../data/cie1931_2deg_cmf_1nm.csv"));
         let d65 = parse_csv(include_str!("../../data/cie_d65_spd_5nm.csv"));
         let d65_at = |lambda: f64| {
-            let i = d65
-                .iter()
-                .rposition(|row| row[0] <= lambda)
-                .expect("D65 covers 300-780 nm");
+            let i = d65.iter().rposition(|row| row[0] <= lambda).expect("D65 covers 300-780 nm");
             let (a, b) = (&d65[i], d65.get(i + 1).unwrap_or(&d65[i]));
-            if b[0] == a[0] {
-                a[1]
-            } else {
-                a[1] + (b[1] - a[1]) * (lambda - a[0]) / (b[0] - a[0])
-            }
+            if b[0] == a[0] { a[1] } else { a[1] + (b[1] - a[1]) * (lambda - a[0]) / (b[0] - a[0]) }
         };
         let mut weights: Vec<[f64; 3]> = (LAMBDA_MIN_NM..=LAMBDA_MAX_NM)
             .map(|l| {
-                let row = cmf
-                    .iter()
-                    .find(|r| r[0] == l as f64)
-                    .expect("CMF covers 360-830 nm");
+                let row = cmf.iter().find(|r| r[0] == l as f64).expect("CMF covers 360-830 nm");
                 let s = d65_at(l as f64);
                 [s * row[1], s * row[2], s * row[3]]
             })
             .collect();
         let k = 1.0 / weights.iter().map(|w| w[1]).sum::<f64>();
-        weights
-            .iter_mut()
-            .for_each(|w| w.iter_mut().for_each(|c| *c *= k));
+        weights.iter_mut().for_each(|w| w.iter_mut().for_each(|c| *c *= k));
         Observer { weights }
     }
 
@@ -107,8 +88,7 @@ pub fn xyz_to_linear_srgb(xyz: [f64; 3]) -> [f64; 3] {
 /// Inverse of a 3×3 matrix (cofactors), for linear sRGB → XYZ with exactly the inverse of
 /// the matrix above, so the two conversions round-trip.
 pub fn mat3_inverse(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let c =
-        |r0: usize, c0: usize, r1: usize, c1: usize| m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0];
+    let c = |r0: usize, c0: usize, r1: usize, c1: usize| m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0];
     let cof = [
         [c(1, 1, 2, 2), -c(1, 0, 2, 2), c(1, 0, 2, 1)],
         [-c(0, 1, 2, 2), c(0, 0, 2, 2), -c(0, 0, 2, 1)],
@@ -138,10 +118,7 @@ mod tests {
         }
         // The D65 chromaticity (CIE 015: x = 0.31272, y = 0.32903 for the 2° observer).
         let sum = white.iter().sum::<f64>();
-        assert!(
-            (white[0] / sum - 0.31272).abs() < 2e-4 && (white[1] / sum - 0.32903).abs() < 2e-4,
-            "{white:?}"
-        );
+        assert!((white[0] / sum - 0.31272).abs() < 2e-4 && (white[1] / sum - 0.32903).abs() < 2e-4, "{white:?}");
     }
 
     #[test]

@@ -30,41 +30,13 @@ pub struct StressReport {
 
 /// The materials the stress draws from: the thesis default and its edge cases.
 pub const STRESS_MATERIALS: [Stack; 7] = [
-    Stack {
-        n0: 1.0,
-        n1: 1.55,
-        n2: 2.0,
-    },
-    Stack {
-        n0: 1.0,
-        n1: 1.0,
-        n2: 2.0,
-    },
-    Stack {
-        n0: 1.0,
-        n1: 1.56,
-        n2: 1.33,
-    },
-    Stack {
-        n0: 1.5,
-        n1: 1.55,
-        n2: 1.0,
-    },
-    Stack {
-        n0: 1.33,
-        n1: 1.55,
-        n2: 2.0,
-    },
-    Stack {
-        n0: 1.0,
-        n1: 3.0,
-        n2: 1.0,
-    },
-    Stack {
-        n0: 1.0,
-        n1: 2.0,
-        n2: 2.0,
-    },
+    Stack { n0: 1.0, n1: 1.55, n2: 2.0 },
+    Stack { n0: 1.0, n1: 1.0, n2: 2.0 },
+    Stack { n0: 1.0, n1: 1.56, n2: 1.33 },
+    Stack { n0: 1.5, n1: 1.55, n2: 1.0 },
+    Stack { n0: 1.33, n1: 1.55, n2: 2.0 },
+    Stack { n0: 1.0, n1: 3.0, n2: 1.0 },
+    Stack { n0: 1.0, n1: 2.0, n2: 2.0 },
 ];
 
 /// One furnace integration per this many samples (it costs ~2000 BRDF evaluations).
@@ -79,18 +51,8 @@ struct Draw {
 impl Draw {
     fn unit(&mut self) -> f64 {
         self.stream += 1;
-        let lo = hash::unit(
-            self.index as i32,
-            (self.index >> 31) as i32,
-            self.stream,
-            self.seed,
-        ) as f64;
-        let hi = hash::unit(
-            self.index as i32,
-            (self.index >> 31) as i32,
-            self.stream + 1000,
-            self.seed,
-        ) as f64;
+        let lo = hash::unit(self.index as i32, (self.index >> 31) as i32, self.stream, self.seed) as f64;
+        let hi = hash::unit(self.index as i32, (self.index >> 31) as i32, self.stream + 1000, self.seed) as f64;
         (lo + hi / (1u64 << 24) as f64).min(1.0 - 1e-15)
     }
     fn pick<T: Copy>(&mut self, options: &[T]) -> T {
@@ -111,23 +73,12 @@ impl Draw {
 }
 
 pub fn run(samples: u64, seed: u64) -> StressReport {
-    let luts: Vec<Lut> = STRESS_MATERIALS
-        .iter()
-        .map(|s| Lut::bake_default(*s))
-        .collect();
+    let luts: Vec<Lut> = STRESS_MATERIALS.iter().map(|s| Lut::bake_default(*s)).collect();
     let seed32 = (seed ^ (seed >> 32)) as u32;
     let partials: Vec<StressReport> = (0..samples)
         .into_par_iter()
         .fold(empty, |mut acc, index| {
-            sample(
-                &mut acc,
-                &luts,
-                Draw {
-                    seed: seed32,
-                    index,
-                    stream: 0,
-                },
-            );
+            sample(&mut acc, &luts, Draw { seed: seed32, index, stream: 0 });
             acc
         })
         .collect();
@@ -179,11 +130,7 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
         _ => draw.unit() * 2000.0,
     };
     let roughness = draw.pick(&[0.0, 1.0, -1.0]);
-    let roughness = if roughness < 0.0 {
-        draw.unit()
-    } else {
-        roughness
-    };
+    let roughness = if roughness < 0.0 { draw.unit() } else { roughness };
     let tau = draw.pick(&[0.0, 50.0, -1.0]);
     let tau = if tau < 0.0 { draw.unit() * 5.0 } else { tau };
     let normal = match draw.pick(&[0, 1, 2, 2, 2]) {
@@ -198,9 +145,7 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
     let cos0 = if cos0 < 0.0 { draw.unit() } else { cos0 };
     let film = airy(stack, thickness, 360.0 + draw.unit() * 420.0, cos0);
     let inc = incoherent(stack, cos0);
-    let rt = [
-        film.rs, film.rp, film.r, film.ts, film.tp, film.t, inc.r, inc.t,
-    ];
+    let rt = [film.rs, film.rp, film.r, film.ts, film.tp, film.t, inc.r, inc.t];
     count(acc, &rt);
     for v in rt {
         acc.min_r = acc.min_r.min(v);
@@ -208,13 +153,7 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
     }
 
     let lut = &luts[material];
-    let layers = Layers {
-        n0: stack.n0,
-        n2: stack.n2,
-        roughness,
-        optical_depth: [tau; 3],
-        albedo: [1.0, 0.5, 0.0],
-    };
+    let layers = Layers { n0: stack.n0, n2: stack.n2, roughness, optical_depth: [tau; 3], albedo: [1.0, 0.5, 0.0] };
     let value = eval(&layers, normal, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
     let layers32 = Layers32 {
         n0: stack.n0 as f32,
@@ -224,13 +163,7 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
         albedo: [1.0, 0.5, 0.0],
         thickness_nm: thickness as f32,
     };
-    let value32 = eval_f32(
-        &layers32,
-        normal.map(|x| x as f32),
-        wi.map(|x| x as f32),
-        wo.map(|x| x as f32),
-        lut,
-    );
+    let value32 = eval_f32(&layers32, normal.map(|x| x as f32), wi.map(|x| x as f32), wo.map(|x| x as f32), lut);
     count(acc, &value);
     count(acc, &value32.map(|v| v as f64));
     for c in 0..3 {
@@ -245,11 +178,7 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
     }
 
     if draw.index.is_multiple_of(FURNACE_EVERY) {
-        let white = Layers {
-            optical_depth: [0.0; 3],
-            albedo: [1.0; 3],
-            ..layers
-        };
+        let white = Layers { optical_depth: [0.0; 3], albedo: [1.0; 3], ..layers };
         let cos_o = draw.pick(&[1.0, 1e-3, -1.0]);
         let cos_o = if cos_o < 0.0 { draw.unit() } else { cos_o };
         let albedo = furnace_albedo(&white, cos_o, &|c| lut.lookup_f64(thickness, c), 32);

@@ -7,14 +7,9 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
     #[error("cannot read preset {path}: {source}")]
-    Read {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Read { path: PathBuf, source: std::io::Error },
 
-    #[error(
-        "unknown preset {name:?}: not a .toml file and not a built-in preset (built-in: {available})"
-    )]
+    #[error("unknown preset {name:?}: not a .toml file and not a built-in preset (built-in: {available})")]
     UnknownPreset { name: String, available: String },
 
     /// TOML syntax, a wrong type, an unknown key or a bad enum value.
@@ -23,10 +18,7 @@ pub enum PresetError {
 
     /// Values out of range, one line each.
     #[error("{}", format_problems(.file, .problems))]
-    Invalid {
-        file: String,
-        problems: Vec<LocatedProblem>,
-    },
+    Invalid { file: String, problems: Vec<LocatedProblem> },
 
     #[error("invalid --set {argument:?}: {message}")]
     Override { argument: String, message: String },

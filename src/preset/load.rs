@@ -41,83 +41,45 @@ pub struct LoadedPreset {
 pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
     if spec.ends_with(".toml") || path.exists() {
-        let text = std::fs::read_to_string(path).map_err(|source| PresetError::Read {
-            path: path.into(),
-            source,
-        })?;
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "preset".into());
-        return Ok(PresetSource {
-            name,
-            display: spec.to_string(),
-            text,
-        });
+        let text = std::fs::read_to_string(path).map_err(|source| PresetError::Read { path: path.into(), source })?;
+        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "preset".into());
+        return Ok(PresetSource { name, display: spec.to_string(), text });
     }
     match library::get(spec) {
-        Some(text) => Ok(PresetSource {
-            name: spec.into(),
-            display: format!("built-in preset {spec}"),
-            text: text.into(),
-        }),
-        None => Err(PresetError::UnknownPreset {
-            name: spec.into(),
-            available: library::names().join(", "),
-        }),
+        Some(text) => {
+            Ok(PresetSource { name: spec.into(), display: format!("built-in preset {spec}"), text: text.into() })
+        }
+        None => Err(PresetError::UnknownPreset { name: spec.into(), available: library::names().join(", ") }),
     }
 }
 
 /// Parses and validates; `overrides` are `(dotted.key, toml value text)` pairs.
-pub fn parse(
-    source: &PresetSource,
-    overrides: &[(String, String)],
-) -> Result<LoadedPreset, PresetError> {
+pub fn parse(source: &PresetSource, overrides: &[(String, String)]) -> Result<LoadedPreset, PresetError> {
     let file_preset: Preset = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
     let preset = if overrides.is_empty() {
         file_preset
     } else {
-        let mut table: toml::Table =
-            toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
+        let mut table: toml::Table = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
         for (key, value) in overrides {
             apply_override(&mut table, key, value)?;
         }
         Preset::deserialize(toml::Value::Table(table)).map_err(|e| PresetError::Override {
-            argument: overrides
-                .iter()
-                .map(|(k, v)| format!("{k}={v}"))
-                .collect::<Vec<_>>()
-                .join(" "),
+            argument: overrides.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" "),
             message: with_suggestion(e.message()),
         })?
     };
 
     let problems = validate(&preset);
     if !problems.is_empty() {
-        let overridden = |key: &str| {
-            overrides
-                .iter()
-                .any(|(k, _)| key == k || key.starts_with(&format!("{k}.")))
-        };
+        let overridden = |key: &str| overrides.iter().any(|(k, _)| key == k || key.starts_with(&format!("{k}.")));
         let located = problems
             .into_iter()
             .map(|p| {
-                let line = if overridden(&p.key) {
-                    None
-                } else {
-                    key_line(&source.text, &p.key)
-                };
-                LocatedProblem {
-                    line,
-                    key: p.key,
-                    message: p.message,
-                }
+                let line = if overridden(&p.key) { None } else { key_line(&source.text, &p.key) };
+                LocatedProblem { line, key: p.key, message: p.message }
             })
             .collect();
-        return Err(PresetError::Invalid {
-            file: source.display.clone(),
-            problems: located,
-        });
+        return Err(PresetError::Invalid { file: source.display.clone(), problems: located });
     }
     let canonical = toml::to_string(&preset).unwrap_or_default();
     Ok(LoadedPreset {
@@ -137,11 +99,7 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
     };
     let message = error.message().trim_end().to_string();
     PresetError::Parse {
-        location: Location {
-            file: source.display.clone(),
-            line,
-            column,
-        },
+        location: Location { file: source.display.clone(), line, column },
         message: with_suggestion(&message),
     }
 }
@@ -164,18 +122,10 @@ fn with_suggestion(message: &str) -> String {
         return message.to_string();
     };
     let accepted: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
-    let nearest = accepted
-        .iter()
-        .map(|a| (edit_distance(unknown, a), *a))
-        .filter(|(d, a)| *d <= 2.max(a.len() / 3))
-        .min();
-    let hint = nearest
-        .map(|(_, a)| format!("; did you mean `{a}`?"))
-        .unwrap_or_default();
-    format!(
-        "unknown key `{unknown}`{hint} (accepted keys here: {})",
-        accepted.join(", ")
-    )
+    let nearest =
+        accepted.iter().map(|a| (edit_distance(unknown, a), *a)).filter(|(d, a)| *d <= 2.max(a.len() / 3)).min();
+    let hint = nearest.map(|(_, a)| format!("; did you mean `{a}`?")).unwrap_or_default();
+    format!("unknown key `{unknown}`{hint} (accepted keys here: {})", accepted.join(", "))
 }
 
 /// Levenshtein distance, for "did you mean".
@@ -185,9 +135,7 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
     for (i, ca) in a.chars().enumerate() {
         let mut cur = vec![i + 1; b.len() + 1];
         for (j, cb) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
-                .min(prev[j + 1] + 1)
-                .min(cur[j] + 1);
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
         }
         prev = cur;
     }
@@ -216,9 +164,7 @@ fn key_line(text: &str, dotted: &str) -> Option<usize> {
             // `pattern.0` when `pattern` is a single table.
             continue;
         }
-        let (key, item) = table?
-            .iter()
-            .find(|(k, _)| k.get_ref().as_ref() == segment)?;
+        let (key, item) = table?.iter().find(|(k, _)| k.get_ref().as_ref() == segment)?;
         span = Some(key.span());
         value = Some(item.get_ref());
         table = None;
@@ -243,10 +189,7 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
         }
         result
     };
-    result.map_err(|message| PresetError::Override {
-        argument: format!("{key}={value}"),
-        message,
-    })
+    result.map_err(|message| PresetError::Override { argument: format!("{key}={value}"), message })
 }
 
 fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> Result<(), String> {
@@ -256,24 +199,18 @@ fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> 
     };
     match target {
         // `pattern.0` addresses a single `[pattern]` table as layer 0.
-        toml::Value::Table(t) if *first == "0" && !t.contains_key("0") => {
-            set_path(target, rest, value)
-        }
+        toml::Value::Table(t) if *first == "0" && !t.contains_key("0") => set_path(target, rest, value),
         toml::Value::Table(t) => {
             if rest.is_empty() {
                 t.insert(first.to_string(), value);
                 return Ok(());
             }
-            let child = t
-                .entry(first.to_string())
-                .or_insert_with(|| toml::Value::Table(Default::default()));
+            let child = t.entry(first.to_string()).or_insert_with(|| toml::Value::Table(Default::default()));
             set_path(child, rest, value)
         }
         toml::Value::Array(items) => {
             let len = items.len();
-            let index: usize = first
-                .parse()
-                .map_err(|_| format!("`{first}` must be an array index"))?;
+            let index: usize = first.parse().map_err(|_| format!("`{first}` must be an array index"))?;
             let item = items
                 .get_mut(index)
                 .ok_or_else(|| format!("index {index} is out of range: there are {len} entries"))?;
@@ -284,9 +221,7 @@ fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> 
 }
 
 fn fnv1a64(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ *b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ *b as u64).wrapping_mul(0x0000_0100_0000_01b3))
 }
 
 #[cfg(test)]
@@ -294,27 +229,19 @@ mod tests {
     use super::*;
 
     fn source(text: &str) -> PresetSource {
-        PresetSource {
-            name: "t".into(),
-            display: "t.toml".into(),
-            text: text.into(),
-        }
+        PresetSource { name: "t".into(), display: "t.toml".into(), text: text.into() }
     }
 
     #[test]
     fn suggestion_names_the_nearest_key() {
-        let err = parse(&source("[scales]\nrwos = 3\n"), &[])
-            .unwrap_err()
-            .to_string();
+        let err = parse(&source("[scales]\nrwos = 3\n"), &[]).unwrap_err().to_string();
         assert!(err.contains("t.toml:2:1"), "{err}");
         assert!(err.contains("did you mean `rows`"), "{err}");
     }
 
     #[test]
     fn range_error_has_line_and_key() {
-        let err = parse(&source("seed = 1\n\n[optics]\nfilm_ior = 9.0\n"), &[])
-            .unwrap_err()
-            .to_string();
+        let err = parse(&source("seed = 1\n\n[optics]\nfilm_ior = 9.0\n"), &[]).unwrap_err().to_string();
         assert!(err.contains("t.toml:4: key `optics.film_ior`"), "{err}");
         assert!(err.contains("[1, 3]"), "{err}");
     }
@@ -329,18 +256,13 @@ mod tests {
         ];
         let loaded = parse(&source("seed = 1\n"), &overrides).unwrap();
         assert_eq!(loaded.preset.scales.rows, 25);
-        assert_eq!(
-            loaded.preset.scales.shape,
-            super::super::schema::ScaleShape::Diamond
-        );
+        assert_eq!(loaded.preset.scales.shape, super::super::schema::ScaleShape::Diamond);
         assert_eq!(loaded.preset.pattern.len(), 1);
     }
 
     #[test]
     fn non_finite_values_are_refused() {
-        let err = parse(&source("[optics]\nfilm_thickness_nm = nan\n"), &[])
-            .unwrap_err()
-            .to_string();
+        let err = parse(&source("[optics]\nfilm_thickness_nm = nan\n"), &[]).unwrap_err().to_string();
         assert!(err.contains("optics.film_thickness_nm"), "{err}");
     }
 }

@@ -15,11 +15,7 @@ impl Srgb8 {
     pub fn to_linear(self) -> [f32; 3] {
         self.0.map(|c| {
             let c = c as f32 / 255.0;
-            if c <= 0.04045 {
-                c / 12.92
-            } else {
-                ((c + 0.055) / 1.055).powf(2.4)
-            }
+            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
         })
     }
 
@@ -36,11 +32,8 @@ impl Srgb8 {
 impl<'de> Deserialize<'de> for Srgb8 {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         let text = String::deserialize(deserializer)?;
-        Srgb8::parse(&text).ok_or_else(|| {
-            de::Error::custom(format!(
-                "invalid colour {text:?}: expected \"#rrggbb\" (sRGB hex)"
-            ))
-        })
+        Srgb8::parse(&text)
+            .ok_or_else(|| de::Error::custom(format!("invalid colour {text:?}: expected \"#rrggbb\" (sRGB hex)")))
     }
 }
 
@@ -150,14 +143,63 @@ impl Default for Scales {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PatternKind {
-    /// A uniform colour over the whole body, with fractal variation.
+    /// A uniform colour over the whole body, with fractal variation (P&W "solid").
     Solid,
-    /// Stripes along the body.
+    /// Stripes along the body (P&W "vertical stripe").
     Stripes,
-    /// Round spots on a jittered grid.
+    /// Rings across the body, optionally a colour sequence (P&W "horizontal stripe").
+    Rings,
+    /// Round or ring spots on a jittered grid (P&W "spot").
     Spots,
-    /// Thresholded noise blobs.
+    /// A dorsal series of saddles, diamonds or rounded blotches (P&W "other simple").
+    Blotches,
+    /// Thresholded noise blobs (P&W "complex").
     Irregular,
+}
+
+/// Named stripe positions, measured from the dorsal midline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StripePosition {
+    /// On the spine.
+    Vertebral,
+    /// Between the spine and the flank.
+    Dorsolateral,
+    /// On the flanks.
+    Lateral,
+}
+
+impl StripePosition {
+    /// Distance of the stripe centre from the dorsal midline, fraction of the circumference.
+    pub fn offset(self) -> f64 {
+        match self {
+            StripePosition::Vertebral => 0.0,
+            StripePosition::Dorsolateral => 0.12,
+            StripePosition::Lateral => 0.24,
+        }
+    }
+}
+
+/// Shape of spots (`round`, `ring`) or blotches (`round`, `diamond`, `saddle`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PatternShape {
+    Round,
+    Ring,
+    Diamond,
+    Saddle,
+}
+
+/// How spots are laid out in rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Arrangement {
+    /// Rows one above the other.
+    Aligned,
+    /// Every other row shifted by half a spacing.
+    Alternating,
+    /// Only every other cell of an aligned grid (a checkerboard).
+    Checkered,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
@@ -197,6 +239,33 @@ pub struct PatternLayer {
     /// Irregular: the noise that shapes the blobs.
     #[serde(default = "PatternLayer::default_noise")]
     pub noise: NoiseChoice,
+    /// Stripes: a named position (overrides `offset`).
+    #[serde(default)]
+    pub position: Option<StripePosition>,
+    /// Spots: `round` or `ring`; blotches: `round`, `diamond` or `saddle`.
+    #[serde(default = "PatternLayer::default_shape")]
+    pub shape: PatternShape,
+    /// Spots: `aligned`, `alternating` or `checkered`.
+    #[serde(default = "PatternLayer::default_arrangement")]
+    pub arrangement: Arrangement,
+    /// Rings: a colour sequence repeated `amount` times along the body (e.g. a coral
+    /// snake's red, yellow, black, yellow); empty means one ring of `color`.
+    #[serde(default)]
+    pub colors: Vec<Srgb8>,
+    /// Rings: the width of each colour of `colors` as a fraction of one repeat (default:
+    /// equal widths filling the repeat).
+    #[serde(default)]
+    pub widths: Vec<f64>,
+    /// Blotches: length along the body as a fraction of the spacing between blotches.
+    #[serde(default = "PatternLayer::default_length")]
+    pub length: f64,
+    /// Paint over the belly band too (by default the belly keeps its own colour).
+    #[serde(default)]
+    pub over_belly: bool,
+    /// 0..1: snap the pattern to whole scales (in real snakes colour follows scale
+    /// boundaries); 0 leaves it free, 1 colours each scale by the pattern at its centre.
+    #[serde(default)]
+    pub scale_aligned: f64,
 }
 
 impl PatternLayer {
@@ -218,6 +287,15 @@ impl PatternLayer {
     fn default_noise() -> NoiseChoice {
         NoiseChoice::Perlin
     }
+    fn default_length() -> f64 {
+        0.6
+    }
+    fn default_shape() -> PatternShape {
+        PatternShape::Round
+    }
+    fn default_arrangement() -> Arrangement {
+        Arrangement::Alternating
+    }
 }
 
 /// Accepts `[pattern]` (one table) or `[[pattern]]` (an array of tables).
@@ -229,9 +307,7 @@ fn one_or_many<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<Pattern
             f.write_str("a [pattern] table or [[pattern]] layers")
         }
         fn visit_map<A: de::MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
-            Ok(vec![PatternLayer::deserialize(
-                de::value::MapAccessDeserializer::new(map),
-            )?])
+            Ok(vec![PatternLayer::deserialize(de::value::MapAccessDeserializer::new(map))?])
         }
         fn visit_seq<A: de::SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
             Vec::deserialize(de::value::SeqAccessDeserializer::new(seq))
@@ -250,6 +326,17 @@ pub struct Belly {
     pub plates: bool,
     /// Softness of the colour boundary between back and belly (fraction of circumference).
     pub blend: f64,
+    /// A pattern on the ventral plates: `none` or `checkered` (alternate halves of each
+    /// plate in `pattern_color`, as in corn snakes).
+    pub pattern: BellyPattern,
+    pub pattern_color: Srgb8,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BellyPattern {
+    None,
+    Checkered,
 }
 
 impl Default for Belly {
@@ -259,6 +346,8 @@ impl Default for Belly {
             color: Srgb8([0xe6, 0xdc, 0xc0]),
             plates: true,
             blend: 0.03,
+            pattern: BellyPattern::None,
+            pattern_color: Srgb8([0x18, 0x16, 0x14]),
         }
     }
 }
@@ -276,11 +365,7 @@ pub struct ColorParams {
 
 impl Default for ColorParams {
     fn default() -> Self {
-        ColorParams {
-            base: Srgb8([0x5a, 0x6b, 0x3c]),
-            variation: 0.15,
-            between_scales: 0.35,
-        }
+        ColorParams { base: Srgb8([0x5a, 0x6b, 0x3c]), variation: 0.15, between_scales: 0.35 }
     }
 }
 
@@ -295,10 +380,7 @@ pub struct HeightParams {
 
 impl Default for HeightParams {
     fn default() -> Self {
-        HeightParams {
-            normal_strength: 0.25,
-            grain: 0.02,
-        }
+        HeightParams { normal_strength: 0.25, grain: 0.02 }
     }
 }
 
@@ -313,16 +395,13 @@ pub struct RoughnessParams {
     pub between_scales: f64,
     /// Extra roughness on keels.
     pub keel: f64,
+    /// Random roughness offset per scale (± this much).
+    pub per_scale: f64,
 }
 
 impl Default for RoughnessParams {
     fn default() -> Self {
-        RoughnessParams {
-            base: 0.35,
-            variation: 0.08,
-            between_scales: 0.35,
-            keel: 0.15,
-        }
+        RoughnessParams { base: 0.35, variation: 0.08, between_scales: 0.35, keel: 0.15, per_scale: 0.05 }
     }
 }
 
@@ -347,11 +426,7 @@ pub struct IridescenceParams {
 
 impl Default for IridescenceParams {
     fn default() -> Self {
-        IridescenceParams {
-            gradient: IridescenceGradient::Radial,
-            spread_nm: 200.0,
-            noise: 0.25,
-        }
+        IridescenceParams { gradient: IridescenceGradient::Radial, spread_nm: 200.0, noise: 0.25 }
     }
 }
 
@@ -410,9 +485,7 @@ impl<'de> Deserialize<'de> for Absorption {
             fn visit_seq<A: de::SeqAccess<'de>>(self, mut seq: A) -> Result<Absorption, A::Error> {
                 let mut rgb = [0.0; 3];
                 for (i, slot) in rgb.iter_mut().enumerate() {
-                    *slot = seq
-                        .next_element()?
-                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                    *slot = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
                 }
                 if seq.next_element::<f64>()?.is_some() {
                     return Err(de::Error::invalid_length(4, &self));
@@ -427,10 +500,6 @@ impl<'de> Deserialize<'de> for Absorption {
 impl Serialize for Absorption {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let [r, g, b] = self.0;
-        if r == g && g == b {
-            serializer.serialize_f64(r)
-        } else {
-            self.0.serialize(serializer)
-        }
+        if r == g && g == b { serializer.serialize_f64(r) } else { self.0.serialize(serializer) }
     }
 }

@@ -1,7 +1,7 @@
 //! Range checks on a parsed preset, all before any pixel is computed ("parse first, then
 //! run"). Each problem names the dotted key and the accepted range; `load` adds the line.
 
-use super::schema::{PatternKind, Preset};
+use super::schema::{PatternKind, PatternShape, Preset};
 
 /// One value outside what the generator accepts.
 #[derive(Debug, Clone, PartialEq)]
@@ -22,6 +22,10 @@ pub mod ranges {
     pub const EDGE_SOFTNESS: (f64, f64) = (0.005, 0.5);
     pub const STRIPES_PER_SIDE: (f64, f64) = (1.0, 16.0);
     pub const SPOTS_AROUND: (f64, f64) = (1.0, 64.0);
+    pub const RINGS_PER_TILE: (f64, f64) = (1.0, 32.0);
+    pub const BLOTCHES_PER_TILE: (f64, f64) = (1.0, 32.0);
+    pub const RING_WIDTH: (f64, f64) = (0.0, 1.0);
+    pub const BLOTCH_LENGTH: (f64, f64) = (0.05, 1.0);
     pub const PATTERN_SIZE: (f64, f64) = (0.001, 0.5);
     pub const PATTERN_OFFSET: (f64, f64) = (0.0, 0.5);
     pub const OUTLINE_SIZE: (f64, f64) = (0.0, 0.1);
@@ -56,10 +60,8 @@ impl Checker {
 
     fn int_range(&mut self, key: &str, value: u32, (lo, hi): (u32, u32)) {
         if !(lo..=hi).contains(&value) {
-            self.problems.push(Problem {
-                key: key.into(),
-                message: format!("must be an integer in [{lo}, {hi}], got {value}"),
-            });
+            self.problems
+                .push(Problem { key: key.into(), message: format!("must be an integer in [{lo}, {hi}], got {value}") });
         }
     }
 }
@@ -83,8 +85,44 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
         match p.kind {
             PatternKind::Stripes => c.range(key("amount"), p.amount, STRIPES_PER_SIDE),
             PatternKind::Spots => c.range(key("amount"), p.amount, SPOTS_AROUND),
+            PatternKind::Rings => c.range(key("amount"), p.amount, RINGS_PER_TILE),
+            PatternKind::Blotches => c.range(key("amount"), p.amount, BLOTCHES_PER_TILE),
             PatternKind::Irregular | PatternKind::Solid => c.range(key("amount"), p.amount, UNIT),
         }
+        let shapes: &[PatternShape] = match p.kind {
+            PatternKind::Spots => &[PatternShape::Round, PatternShape::Ring],
+            PatternKind::Blotches => &[PatternShape::Round, PatternShape::Diamond, PatternShape::Saddle],
+            _ => &[PatternShape::Round],
+        };
+        if !shapes.contains(&p.shape) {
+            let names: Vec<String> = shapes.iter().map(|s| format!("{s:?}").to_lowercase()).collect();
+            c.problems.push(Problem {
+                key: key("shape"),
+                message: format!(
+                    "must be one of {} for kind {:?}",
+                    names.join(", "),
+                    format!("{:?}", p.kind).to_lowercase()
+                ),
+            });
+        }
+        for (j, w) in p.widths.iter().enumerate() {
+            c.range(format!("pattern.{i}.widths.{j}"), *w, RING_WIDTH);
+        }
+        if !p.widths.is_empty() && p.widths.len() != p.colors.len() {
+            c.problems.push(Problem {
+                key: key("widths"),
+                message: format!(
+                    "must list one width per colour of `colors` ({} colours, {} widths)",
+                    p.colors.len(),
+                    p.widths.len()
+                ),
+            });
+        }
+        if p.widths.iter().sum::<f64>() > 1.0 + 1e-9 {
+            c.problems.push(Problem { key: key("widths"), message: "must sum to at most 1 (one repeat)".into() });
+        }
+        c.range(key("scale_aligned"), p.scale_aligned, UNIT);
+        c.range(key("length"), p.length, BLOTCH_LENGTH);
         c.range(key("size"), p.size, PATTERN_SIZE);
         c.range(key("offset"), p.offset, PATTERN_OFFSET);
         c.range(key("outline_size"), p.outline_size, OUTLINE_SIZE);
@@ -96,38 +134,23 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
     c.range("belly.blend", preset.belly.blend, BELLY_BLEND);
     c.range("color.variation", preset.color.variation, UNIT);
     c.range("color.between_scales", preset.color.between_scales, UNIT);
-    c.range(
-        "height.normal_strength",
-        preset.height.normal_strength,
-        NORMAL_STRENGTH,
-    );
+    c.range("height.normal_strength", preset.height.normal_strength, NORMAL_STRENGTH);
     c.range("height.grain", preset.height.grain, GRAIN);
     let r = &preset.roughness;
     c.range("roughness.base", r.base, UNIT);
     c.range("roughness.variation", r.variation, ROUGHNESS_VARIATION);
     c.range("roughness.between_scales", r.between_scales, UNIT);
     c.range("roughness.keel", r.keel, UNIT);
-    c.range(
-        "iridescence.spread_nm",
-        preset.iridescence.spread_nm,
-        SPREAD_NM,
-    );
+    c.range("roughness.per_scale", r.per_scale, ROUGHNESS_VARIATION);
+    c.range("iridescence.spread_nm", preset.iridescence.spread_nm, SPREAD_NM);
     c.range("iridescence.noise", preset.iridescence.noise, UNIT);
 
     let o = &preset.optics;
     c.range("optics.ambient_ior", o.ambient_ior, IOR);
     c.range("optics.film_ior", o.film_ior, IOR);
     c.range("optics.pigment_ior", o.pigment_ior, IOR);
-    c.range(
-        "optics.film_thickness_nm",
-        o.film_thickness_nm,
-        FILM_THICKNESS_NM,
-    );
-    c.range(
-        "optics.pigment_thickness",
-        o.pigment_thickness,
-        PIGMENT_THICKNESS,
-    );
+    c.range("optics.film_thickness_nm", o.film_thickness_nm, FILM_THICKNESS_NM);
+    c.range("optics.pigment_thickness", o.pigment_thickness, PIGMENT_THICKNESS);
     for (i, a) in o.absorption.0.iter().enumerate() {
         let key = if o.absorption.0.iter().all(|x| x == a) {
             "optics.absorption".to_string()

@@ -9,10 +9,7 @@ pub const PATTERNED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/pat
 
 /// Runs the `snakeskin` binary with `args`, stderr not a terminal (so no progress bar).
 pub fn snakeskin(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(args)
-        .output()
-        .expect("run snakeskin")
+    Command::new(env!("CARGO_BIN_EXE_snakeskin")).args(args).output().expect("run snakeskin")
 }
 
 pub fn snakeskin_env(args: &[&str], env: &[(&str, &str)]) -> Output {

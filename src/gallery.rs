@@ -1,0 +1,139 @@
+//! A gallery of the generator's vocabulary: every scale shape (height maps) and every
+//! pattern kind (colour maps), each a small variation of one base preset, tiled into one PNG.
+//! `snakeskin gallery -o docs/gallery.png` makes the README's figure; the tile order is
+//! `VARIANTS`.
+
+use rayon::prelude::*;
+
+use crate::Error;
+use crate::export::{encode_png, write_all_atomically};
+use crate::graph::evaluate;
+use crate::maps::{BuildOptions, MapKind, build_graph};
+use crate::ops::Image;
+use crate::preset::{PresetSource, parse};
+
+/// The base every variant edits: a plain olive snake with a pale belly.
+const BASE: &str = "seed = 5\n";
+/// Tables the base adds when a variant does not write its own.
+const BASE_COLOR: &str = "[color]\nbase = \"#6b7a3a\"\n";
+const BASE_BELLY: &str = "[belly]\nwidth = 0.2\ncolor = \"#e8dcb8\"\n";
+
+/// (label, map shown, overrides as TOML appended to `BASE`).
+pub const VARIANTS: &[(&str, MapKind, &str)] = &[
+    ("leaf scales", MapKind::Height, "[scales]\nshape = \"leaf\"\n"),
+    ("diamond scales", MapKind::Height, "[scales]\nshape = \"diamond\"\n"),
+    ("hexagon scales", MapKind::Height, "[scales]\nshape = \"hexagon\"\nsize = 0.95\n"),
+    ("keeled leaf scales", MapKind::Height, "[scales]\nshape = \"leaf\"\nkeeled = true\n"),
+    ("keeled diamond scales", MapKind::Height, "[scales]\nshape = \"diamond\"\nkeeled = true\n"),
+    ("solid", MapKind::Color, "[[pattern]]\nkind = \"solid\"\ncolor = \"#3f6a2a\"\namount = 0.8\n"),
+    (
+        "stripes: vertebral + lateral",
+        MapKind::Color,
+        "[[pattern]]\nkind = \"stripes\"\ncolor = \"#e8d060\"\nposition = \"vertebral\"\nsize = 0.03\n\
+         [[pattern]]\nkind = \"stripes\"\ncolor = \"#202018\"\nposition = \"lateral\"\nsize = 0.05\n",
+    ),
+    (
+        "rings: coral triads",
+        MapKind::Color,
+        "[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\namount = 3\nover_belly = true\n\
+         colors = [\"#c8201a\", \"#f0d020\", \"#101010\", \"#f0d020\"]\nwidths = [0.4, 0.1, 0.4, 0.1]\n",
+    ),
+    (
+        "spots: round, alternating",
+        MapKind::Color,
+        "[[pattern]]\nkind = \"spots\"\ncolor = \"#3a2a18\"\namount = 6\nsize = 0.04\noutline_size = 0.006\n\
+         outline_color = \"#f0e8c0\"\n",
+    ),
+    (
+        "spots: rings, checkered",
+        MapKind::Color,
+        "[[pattern]]\nkind = \"spots\"\ncolor = \"#2a1a10\"\namount = 6\nsize = 0.05\nshape = \"ring\"\n\
+         arrangement = \"checkered\"\n",
+    ),
+    (
+        "blotches: diamonds",
+        MapKind::Color,
+        "[color]\nbase = \"#a08a68\"\n[[pattern]]\nkind = \"blotches\"\nshape = \"diamond\"\ncolor = \"#5a4430\"\n\
+         amount = 3\nsize = 0.2\nlength = 1.0\noutline_size = 0.01\noutline_color = \"#f0e8d8\"\n",
+    ),
+    (
+        "blotches: saddles",
+        MapKind::Color,
+        "[color]\nbase = \"#c87838\"\n[[pattern]]\nkind = \"blotches\"\nshape = \"saddle\"\ncolor = \"#a02818\"\n\
+         amount = 4\nsize = 0.28\nlength = 0.5\noutline_size = 0.008\n",
+    ),
+    (
+        "blotches: rounded",
+        MapKind::Color,
+        "[color]\nbase = \"#d0b890\"\n[[pattern]]\nkind = \"blotches\"\nshape = \"round\"\ncolor = \"#403020\"\n\
+         amount = 4\nsize = 0.14\nlength = 0.7\n",
+    ),
+    (
+        "irregular: perlin",
+        MapKind::Color,
+        "[[pattern]]\nkind = \"irregular\"\ncolor = \"#2a3018\"\namount = 0.4\nsize = 0.12\n",
+    ),
+    (
+        "irregular: cellular",
+        MapKind::Color,
+        "[[pattern]]\nkind = \"irregular\"\nnoise = \"cellular\"\ncolor = \"#403018\"\namount = 0.5\nsize = 0.15\n",
+    ),
+    (
+        "scale-aligned spots",
+        MapKind::Color,
+        "[[pattern]]\nkind = \"spots\"\ncolor = \"#201810\"\namount = 8\nsize = 0.03\nscale_aligned = 1.0\n",
+    ),
+    ("checkered belly", MapKind::Color, "[belly]\nwidth = 0.3\ncolor = \"#e8dcb8\"\npattern = \"checkered\"\n"),
+];
+
+/// Renders every variant at `tile` pixels and tiles them `columns` wide into one PNG.
+pub fn render(tile: usize, columns: usize) -> Result<Image, Error> {
+    let tiles: Vec<Image> = VARIANTS
+        .par_iter()
+        .map(|(label, map, overrides)| {
+            let source = PresetSource {
+                name: label.replace([' ', ':', ',', '+'], "_"),
+                display: format!("gallery variant {label:?}"),
+                text: format!(
+                    "{BASE}{}{}{overrides}",
+                    if overrides.contains("[color]") { "" } else { BASE_COLOR },
+                    if overrides.contains("[belly]") { "" } else { BASE_BELLY },
+                ),
+            };
+            let loaded = parse(&source, &[])?;
+            let graph = build_graph(&loaded.preset, BuildOptions::default());
+            let mut maps = evaluate(&graph, &[*map], tile, tile, &|_, _| {}).maps;
+            let image = maps.remove(map).expect("requested map");
+            Ok(if image.channels == 1 { gray_to_display(&image) } else { image })
+        })
+        .collect::<Result<_, Error>>()?;
+    let gap = 4;
+    let rows = tiles.len().div_ceil(columns);
+    let (w, h) = (columns * tile + (columns + 1) * gap, rows * tile + (rows + 1) * gap);
+    // White background; colour tiles are linear, so white is 1.0.
+    let mut sheet = Image { width: w, height: h, channels: 3, data: vec![1.0; w * h * 3] };
+    for (i, t) in tiles.iter().enumerate() {
+        let (x0, y0) = (gap + (i % columns) * (tile + gap), gap + (i / columns) * (tile + gap));
+        for y in 0..tile {
+            let dst = ((y0 + y) * w + x0) * 3;
+            sheet.data[dst..dst + tile * 3].copy_from_slice(&t.data[y * tile * 3..(y + 1) * tile * 3]);
+        }
+    }
+    Ok(sheet)
+}
+
+/// A height map shown as linear gray, gamma-adjusted so sRGB encoding shows it as stored.
+fn gray_to_display(image: &Image) -> Image {
+    let data = image.data.iter().flat_map(|v| [v.clamp(0.0, 1.0).powf(2.2); 3]).collect();
+    Image { width: image.width, height: image.height, channels: 3, data }
+}
+
+/// Renders and writes the gallery PNG atomically.
+pub fn write(path: &std::path::Path, tile: usize, columns: usize) -> Result<(), Error> {
+    let sheet = render(tile, columns)?;
+    let png = encode_png(MapKind::Color, &sheet)?;
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "gallery.png".into());
+    write_all_atomically(dir, &[(name, png)])?;
+    Ok(())
+}
