@@ -40,9 +40,20 @@ fn assert_rows_seamless(img: &Image, what: &str) {
 #[test]
 fn every_preset_and_map_tiles_seamlessly() {
     let mut specs: Vec<String> = library::names().iter().map(|s| s.to_string()).collect();
+    // The gallery variants cover every scale shape and pattern kind.
+    let variants: Vec<String> = snakeskin::gallery::VARIANTS.iter().map(|(_, _, o)| format!("seed = 5\n{o}")).collect();
     specs.push(PATTERNED.to_string());
-    for spec in specs {
-        let loaded = parse(&read_source(&spec).unwrap(), &[]).unwrap();
+    let sources =
+        specs.iter().map(|spec| read_source(spec).unwrap()).chain(variants.into_iter().enumerate().map(|(i, text)| {
+            snakeskin::preset::PresetSource {
+                name: format!("variant{i}"),
+                display: format!("gallery variant {i}"),
+                text,
+            }
+        }));
+    for source in sources {
+        let spec = source.display.clone();
+        let loaded = parse(&source, &[]).unwrap();
         let graph = build_graph(&loaded.preset, BuildOptions::default());
         let eval = evaluate(&graph, &MapKind::ALL, 256, 256, &|_, _| {});
         for (map, img) in &eval.maps {

@@ -112,7 +112,9 @@ fn shapes(
             } else {
                 (layer.colors.clone(), layer.widths.iter().map(|w| *w as f32).collect())
             };
-            let mut start = 0.0f32;
+            // Start half way into the first colour, so the texture's v seam falls inside a
+            // ring rather than on the boundary between two.
+            let mut start = -0.5 * widths.first().copied().unwrap_or(0.0);
             let mut out = Vec::new();
             for (k, (color, width)) in colors.into_iter().zip(widths).enumerate() {
                 let centres = (0..repeats as usize).map(|r| (r as f32 + start + width * 0.5) / repeats).collect();

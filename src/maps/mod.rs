@@ -168,7 +168,9 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     let height = build_height(&mut g, preset, &shared);
     g.set_output(MapKind::Height, height);
 
-    let slope = preset.height.normal_strength as f32 / lattice.cols as f32;
+    // The normal follows the physical surface: undo the height map's stretch.
+    let (low, high) = height_range(preset);
+    let slope = preset.height.normal_strength as f32 / lattice.cols as f32 * (high - low);
     let normal = g.add("normal.out", Op::HeightToNormal { slope, convention: options.normal_convention }, &[height]);
     g.set_output(MapKind::Normal, normal);
 
@@ -185,7 +187,19 @@ fn build_height(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
     let grain =
         g.add("height.grain", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: -amp, out_high: amp }, &[s.grain]);
     let sum = g.add("height.sum", Op::Blend { mode: BlendMode::Add, opacity: 1.0 }, &[s.scale_height, grain]);
-    g.add("height.out", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 0.0, out_high: 1.0 }, &[sum])
+    let (low, high) = height_range(preset);
+    g.add("height.out", Op::Levels { in_low: low, in_high: high, out_low: 0.0, out_high: 1.0 }, &[sum])
+}
+
+/// The scale-field heights the height map stretches over [0, 1] to use its 16 bits. Low:
+/// below the deepest groove between overlapping scales (0.8 × the lowest scale profile,
+/// 0.45, is 0.36); skin showing between scales that do not overlap clamps to 0. High: the
+/// tallest profile (`ScaleField` tops out at 0.6 + 0.3 imbrication, plus 0.2 × keel height)
+/// plus the grain.
+pub fn height_range(preset: &Preset) -> (f32, f32) {
+    let s = &preset.scales;
+    let keel = if s.keeled { 0.2 * s.keel_height } else { 0.0 };
+    (0.3, (0.6 + 0.3 * s.imbrication + keel + preset.height.grain) as f32)
 }
 
 fn build_roughness(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {

@@ -155,6 +155,10 @@ struct Candidate {
     order: f32,
 }
 
+/// The lattice is shifted by a quarter row along v so that no row of scale edges lies
+/// exactly on the texture's v seam (a crevice there would be real but would read as a seam).
+const ROW_PHASE: f32 = 0.25;
+
 /// Where a scale's rim meets the scale underneath, the surface falls to this fraction of the
 /// lower scale's height: a groove, not a hole.
 const CREVICE_FLOOR: f32 = 0.8;
@@ -258,7 +262,7 @@ impl ScaleField {
 
     fn candidates(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32) -> impl Iterator<Item = Candidate> {
         let x = u * lattice.cols as f32;
-        let y = v * lattice.rows_v as f32;
+        let y = v * lattice.rows_v as f32 - ROW_PHASE;
         let c0 = floor_i32(x);
         let b = 0.5 * lattice.aspect;
         let shape = self.shape;
@@ -285,7 +289,7 @@ impl ScaleField {
                     half_len: b,
                     random: cell.random,
                     centre_u: (cx / lattice.cols as f32).rem_euclid(1.0),
-                    centre_v: (cy / lattice.rows_v as f32).rem_euclid(1.0),
+                    centre_v: ((cy + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
                     order: cy,
                 })
             })
@@ -331,7 +335,7 @@ impl ScaleField {
         // Voronoi cell of the jittered lattice: nearest centre, then the distance to the
         // nearest bisector with any other centre is the distance to the cell's edge.
         let x = u * lattice.cols as f32;
-        let y = v * lattice.rows_v as f32;
+        let y = v * lattice.rows_v as f32 - ROW_PHASE;
         let c0 = floor_i32(x);
         let mut centres = [(0.0f32, 0.0f32, 0.0f32, 1.0f32, 0.0f32); 9];
         let mut n = 0;
@@ -370,7 +374,7 @@ impl ScaleField {
             half_len,
             random: c1.2,
             centre_u: (c1.0 / lattice.cols as f32).rem_euclid(1.0),
-            centre_v: (c1.1 / lattice.aspect / lattice.rows_v as f32).rem_euclid(1.0),
+            centre_v: ((c1.1 / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
             order: 0.0,
         };
         let soft = self.edge_softness.max(1e-4);
@@ -426,7 +430,7 @@ impl ScaleField {
         let half_band = self.belly_width * 0.5;
         // Distances in dorsal scale widths, the unit of `edge_softness`.
         let to_side = (half_band - dist_belly) * lattice.cols as f32;
-        let y = v * lattice.rows_v as f32;
+        let y = v * lattice.rows_v as f32 - ROW_PHASE;
         let r0 = floor_i32(y);
         let half_len = 0.5 * self.size.max(0.5);
         let mut best: Option<(f32, Candidate)> = None;
@@ -449,7 +453,7 @@ impl ScaleField {
                     half_len: 0.5 * lattice.aspect,
                     random,
                     centre_u: 0.0,
-                    centre_v: ((r as f32 + 0.5) / lattice.rows_v as f32).rem_euclid(1.0),
+                    centre_v: ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
                     order: r as f32,
                 };
                 best = Some((h, cand));

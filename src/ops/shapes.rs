@@ -207,8 +207,9 @@ pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
     out
 }
 
-/// Checkered ventral plates: in the belly band (centred on u = 0), the left half of every
-/// other plate row and the right half of the rows between, inset from the plate edges.
+/// Checkered ventral plates: in the belly band (centred on u = 0), a square on the left
+/// outer third of every other plate row and on the right outer third of the rows between,
+/// inset from the plate edges; the middle third stays plain (so nothing meets the seam).
 pub fn belly_checker(width: usize, height: usize, rows_v: u32, belly_width: f32, softness: f32) -> Image {
     let half = belly_width * 0.5;
     let rows = rows_v.max(1) as f32;
@@ -216,12 +217,12 @@ pub fn belly_checker(width: usize, height: usize, rows_v: u32, belly_width: f32,
     Image::gray_from_fn(width, height, |u, v| {
         let (side, d) = if u < 0.5 { (0, u) } else { (1, 1.0 - u) };
         let r = (v * rows) as i32;
-        if (r + side) % 2 == 1 || d > half {
+        if (r + side) % 2 == 1 || d > half || d < half / 3.0 {
             return 0.0;
         }
-        // Inset: fade out near the plate's ends and its lateral edge.
+        // Inset: fade out near the plate's ends and the square's sides.
         let along = (v * rows).fract();
-        let edge = (along.min(1.0 - along) / rows).min(half - d);
+        let edge = (along.min(1.0 - along) / rows).min(half - d).min(d - half / 3.0);
         ((edge - 0.3 * soft) / soft).clamp(0.0, 1.0)
     })
 }
