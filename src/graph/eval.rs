@@ -9,6 +9,7 @@
 //!
 //! Results do not depend on scheduling: every node is a pure function of its inputs.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -90,14 +91,36 @@ pub fn evaluate(
 
     for lv in 0..=max_level {
         let batch: Vec<NodeId> = needed.iter().copied().filter(|id| level[id.0] == lv).collect();
-        let results: Vec<(NodeId, Image, Duration)> = batch
-            .par_iter()
+        // A node that is the last consumer of its first input may reuse that buffer: take it
+        // out of the store now (no other node can still need it), so the kernel runs in
+        // place instead of allocating, and page-faulting, a new image.
+        let owned: Vec<Option<Image>> = batch
+            .iter()
             .map(|&id| {
                 let node = graph.node(id);
-                let inputs: Vec<&Image> =
-                    node.inputs.iter().map(|i| store[i.0].as_deref().expect("input evaluated")).collect();
+                let first = *node.inputs.first()?;
+                let used_once = node.inputs.iter().filter(|i| **i == first).count() == 1;
+                if !(node.op.in_place() && used_once && consumers[first.0] == 1) {
+                    return None;
+                }
+                let image = Arc::try_unwrap(store[first.0].take()?).ok()?;
+                live_bytes -= image.bytes();
+                Some(image)
+            })
+            .collect();
+        let results: Vec<(NodeId, Image, Duration)> = batch
+            .par_iter()
+            .zip(owned)
+            .map(|(&id, owned)| {
+                let node = graph.node(id);
+                let first = match owned {
+                    Some(image) => node.inputs.first().map(|_| Cow::Owned(image)),
+                    None => node.inputs.first().map(|i| Cow::Borrowed(store[i.0].as_deref().expect("input evaluated"))),
+                };
+                let rest: Vec<&Image> =
+                    node.inputs.iter().skip(1).map(|i| store[i.0].as_deref().expect("input evaluated")).collect();
                 let t = Instant::now();
-                let image = node.op.eval(&inputs, width, height);
+                let image = node.op.eval(first, &rest, width, height);
                 (id, image, t.elapsed())
             })
             .collect();

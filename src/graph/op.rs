@@ -2,6 +2,8 @@
 //! kernels in `ops`.
 
 use crate::ops::Image;
+use std::borrow::Cow;
+
 use crate::ops::filters::{self, BlendMode, NormalConvention};
 use crate::ops::noise::{FractalNoise, NoiseKind};
 use crate::ops::scales::ScaleField;
@@ -45,12 +47,19 @@ pub enum Op {
 }
 
 impl Op {
-    /// Evaluates the operation; `inputs` are in the node's input order.
-    pub fn eval(&self, inputs: &[&Image], width: usize, height: usize) -> Image {
+    /// True for operations that can write their result into their first input's buffer.
+    pub fn in_place(&self) -> bool {
+        matches!(self, Op::Levels { .. } | Op::Threshold { .. } | Op::Blend { .. } | Op::Tint { .. })
+    }
+
+    /// Evaluates the operation. `first` is the first input (owned when the evaluator could
+    /// hand its buffer over, see `in_place`), `rest` the others in input order.
+    pub fn eval(&self, first: Option<Cow<'_, Image>>, rest: &[&Image], width: usize, height: usize) -> Image {
+        let input = || first.as_deref().expect("operation has an input");
         match self {
             Op::Noise(noise) => crate::ops::noise::render(noise, width, height),
             Op::Scales(field) => field.render(width, height),
-            Op::Channel { index } => filters::extract_channel(inputs[0], *index),
+            Op::Channel { index } => filters::extract_channel(input(), *index),
             Op::Bands { axis, centres, half_width, softness } => {
                 shapes::bands(width, height, *axis, centres, *half_width, *softness)
             }
@@ -59,21 +68,19 @@ impl Op {
                 shapes::belly_checker(width, height, *rows_v, *belly_width, *softness)
             }
             Op::SnapToScales { amount, centre_u, centre_v } => {
-                filters::snap_to_scales(inputs[0], inputs[1], *amount, *centre_u, *centre_v)
+                filters::snap_to_scales(input(), rest[0], *amount, *centre_u, *centre_v)
             }
             Op::Spots(grid) => shapes::spots(width, height, grid),
+            Op::Blur { sigma } => filters::blur(input(), *sigma),
+            Op::Sobel { edge_sigma } => filters::sobel(input(), *edge_sigma),
+            Op::Colorize { low, high } => filters::colorize(input(), *low, *high),
+            Op::HeightToNormal { slope, convention } => filters::height_to_normal(input(), *slope, *convention),
             Op::Levels { in_low, in_high, out_low, out_high } => {
-                filters::levels(inputs[0], *in_low, *in_high, *out_low, *out_high)
+                filters::levels(owned(first), *in_low, *in_high, *out_low, *out_high)
             }
-            Op::Threshold { level, softness } => filters::threshold(inputs[0], *level, *softness),
-            Op::Blur { sigma } => filters::blur(inputs[0], *sigma),
-            Op::Sobel { edge_sigma } => filters::sobel(inputs[0], *edge_sigma),
-            Op::Blend { mode, opacity } => {
-                filters::blend(inputs[0], inputs[1], inputs.get(2).copied(), *mode, *opacity)
-            }
-            Op::Colorize { low, high } => filters::colorize(inputs[0], *low, *high),
-            Op::Tint { color, opacity } => tint(inputs[0], inputs[1], *color, *opacity),
-            Op::HeightToNormal { slope, convention } => filters::height_to_normal(inputs[0], *slope, *convention),
+            Op::Threshold { level, softness } => filters::threshold(owned(first), *level, *softness),
+            Op::Blend { mode, opacity } => filters::blend(owned(first), rest[0], rest.get(1).copied(), *mode, *opacity),
+            Op::Tint { color, opacity } => tint(owned(first), rest[0], *color, *opacity),
         }
     }
 
@@ -106,8 +113,13 @@ impl Op {
     }
 }
 
-fn tint(base: &Image, mask: &Image, color: [f32; 3], opacity: f32) -> Image {
-    let mut out = base.clone();
+/// The first input as an owned buffer (a copy only when the evaluator could not hand it over).
+fn owned(first: Option<Cow<'_, Image>>) -> Image {
+    first.expect("operation has an input").into_owned()
+}
+
+fn tint(base: Image, mask: &Image, color: [f32; 3], opacity: f32) -> Image {
+    let mut out = base;
     let ch = out.channels;
     for (px, m) in out.data.chunks_exact_mut(ch).zip(mask.data.chunks_exact(mask.channels)) {
         let w = m[0] * opacity;

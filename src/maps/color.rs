@@ -49,8 +49,14 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
         ));
     }
 
+    // One distortion noise for every layer (shared, so it is evaluated once).
+    let distorted = preset.pattern.iter().any(|l| l.edge_distortion > 0.0 && l.kind != PatternKind::Solid);
+    let distortion_noise = distorted.then(|| {
+        g.add("pattern.distortion_noise", perlin(24, 24, 3, 0.5, derive_seed(preset.seed, "distortion")), &[])
+    });
+    let context = LayerContext { seed: preset.seed, outside_belly, distortion_noise };
     for (i, layer) in preset.pattern.iter().enumerate() {
-        color = pattern_layer(g, preset, s, i, layer, color, outside_belly);
+        color = pattern_layer(g, s, &context, i, layer, color);
     }
 
     let k = preset.color.between_scales as f32;
@@ -170,30 +176,40 @@ fn shapes(
     }
 }
 
+/// What every pattern layer shares.
+#[derive(Clone, Copy)]
+struct LayerContext {
+    /// The preset's seed.
+    seed: u64,
+    /// 1 off the belly band (None without a belly).
+    outside_belly: Option<NodeId>,
+    /// The shared edge-distortion noise (None when no layer distorts).
+    distortion_noise: Option<NodeId>,
+}
+
 /// Adds one pattern layer over `below`; returns the new colour node.
 fn pattern_layer(
     g: &mut GraphBuilder,
-    preset: &Preset,
     s: &Shared,
+    context: &LayerContext,
     i: usize,
     layer: &PatternLayer,
     below: NodeId,
-    outside_belly: Option<NodeId>,
 ) -> NodeId {
+    let LayerContext { outside_belly, distortion_noise, .. } = *context;
     let prefix = format!("pattern{i}");
-    let seed = derive_seed(preset.seed, &prefix);
+    let seed = derive_seed(context.seed, &prefix);
     let mut color = below;
     let parts = shapes(g, layer, &|part: &str| format!("{prefix}.{part}"), seed);
     let many = parts.len() > 1;
     for (k, (shape, tint)) in parts.into_iter().enumerate() {
         let name = |part: &str| if many { format!("{prefix}.{k}.{part}") } else { format!("{prefix}.{part}") };
         let mut mask = shape;
-        if layer.edge_distortion > 0.0 && layer.kind != PatternKind::Solid {
+        if let (true, Some(n)) = (layer.edge_distortion > 0.0 && layer.kind != PatternKind::Solid, distortion_noise) {
             // Thesis §4.2.1.2: blend with noise, then threshold, for ragged edges. The shape is
             // softened first so that adding noise moves its edges instead of leaving them.
             let d = layer.edge_distortion as f32;
             let soft = g.add(name("soften"), Op::Blur { sigma: 0.002 + 0.01 * d }, &[mask]);
-            let n = g.add(name("distortion_noise"), perlin(24, 24, 3, 0.5, seed ^ 0x5eed ^ k as u32), &[]);
             let offset = levels(g, &name("distortion"), n, -d * 0.5, d * 0.5);
             let moved = g.add(name("distorted"), Op::Blend { mode: BlendMode::Add, opacity: 1.0 }, &[soft, offset]);
             mask = g.add(name("mask"), Op::Threshold { level: 0.5, softness: 0.04 }, &[moved]);

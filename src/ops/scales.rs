@@ -151,8 +151,6 @@ struct Candidate {
     /// Texture coordinates of the scale's centre, wrapped into [0, 1).
     centre_u: f32,
     centre_v: f32,
-    /// Stacking order: the centre's unwrapped lattice row; smaller lies on top.
-    order: f32,
 }
 
 /// The lattice is shifted by a quarter row along v so that no row of scale edges lies
@@ -180,31 +178,58 @@ fn half_width(shape: ScaleShape) -> f32 {
     }
 }
 
-/// Signed distance inside a shape with half-width `half_width(shape)` and
-/// half-length `b` (positive inside).
-#[inline]
-fn inside_distance(shape: ScaleShape, x: f32, y: f32, b: f32) -> f32 {
-    let a = LEAF_HALF_WIDTH;
-    match shape {
-        ScaleShape::Leaf => {
-            // Lens from two circles (thesis Fig. 4.8): radius R centred at (±d, 0) gives
-            // half-width R - d = a and tips at y = ±sqrt(R² - d²) = ±b.
-            let (a, b, x, y) = if b >= a { (a, b, x, y) } else { (b, a, y, x) };
-            let r = 0.5 * (a + b * b / a);
-            let d = r - a;
-            let d1 = ((x - d) * (x - d) + y * y).sqrt() - r;
-            let d2 = ((x + d) * (x + d) + y * y).sqrt() - r;
-            -d1.max(d2)
+/// Shape constants that depend only on the field, computed once per render.
+#[derive(Clone, Copy)]
+struct Geometry {
+    shape: ScaleShape,
+    /// Half-length of the shape (isotropic units, cell widths).
+    b: f32,
+    half_width: f32,
+    /// Leaf: circle radius and centre offset, and whether the lens lies across (b < a).
+    leaf_r: f32,
+    leaf_d: f32,
+    leaf_across: bool,
+    /// Diamond: distance scale of the edge-line equation.
+    diamond_k: f32,
+}
+
+impl Geometry {
+    fn new(shape: ScaleShape, b: f32) -> Self {
+        let a = LEAF_HALF_WIDTH;
+        let (la, lb) = if b >= a { (a, b) } else { (b, a) };
+        let leaf_r = 0.5 * (la + lb * lb / la);
+        let da = DIAMOND_HALF_WIDTH;
+        Geometry {
+            shape,
+            b,
+            half_width: half_width(shape),
+            leaf_r,
+            leaf_d: leaf_r - la,
+            leaf_across: b < a,
+            diamond_k: da * b / (da * da + b * b).sqrt(),
         }
-        ScaleShape::Diamond => {
+    }
+
+    /// Distance inside the outline (negative outside), for local (x, y) in cell widths.
+    #[inline]
+    fn inside(&self, x: f32, y: f32) -> f32 {
+        match self.shape {
+            ScaleShape::Leaf => {
+                // Lens from two circles (thesis Fig. 4.8): radius R centred at (±d, 0) gives
+                // half-width R − d = a and tips at y = ±sqrt(R² − d²) = ±b.
+                let (x, y) = if self.leaf_across { (y, x) } else { (x, y) };
+                let (d, r) = (self.leaf_d, self.leaf_r);
+                let y2 = y * y;
+                let d1 = ((x - d) * (x - d) + y2).sqrt() - r;
+                let d2 = ((x + d) * (x + d) + y2).sqrt() - r;
+                -d1.max(d2)
+            }
             // Rhombus with half-diagonals a = 1 cell width and b = half a cell length: with
             // columns staggered by half a row, neighbouring rhombi share edges at size 1
             // (and overlap, imbricated, above). Exact distance to the nearer edge line.
-            let a = DIAMOND_HALF_WIDTH;
-            let k = a * b / (a * a + b * b).sqrt();
-            -(x.abs() / a + y.abs() / b - 1.0) * k
+            ScaleShape::Diamond => -(x.abs() / DIAMOND_HALF_WIDTH + y.abs() / self.b - 1.0) * self.diamond_k,
+            ScaleShape::Hexagon => unreachable!("hexagons are Voronoi cells, see hexagon_pixel"),
         }
-        ScaleShape::Hexagon => unreachable!("hexagons are Voronoi cells, see hexagon_pixel"),
     }
 }
 
@@ -218,6 +243,7 @@ impl ScaleField {
     pub fn render(&self, width: usize, height: usize) -> Image {
         let lattice = self.lattice();
         let table = CellTable::new(self, &lattice);
+        let geo = Geometry::new(self.shape, 0.5 * lattice.aspect);
         Image::from_fn(width, height, self.outputs.len(), |u, v, out| {
             let mut all = [0.0f32; channel::COUNT];
             let dist_belly = u.min(1.0 - u);
@@ -226,7 +252,7 @@ impl ScaleField {
             } else if self.shape == ScaleShape::Hexagon {
                 self.hexagon_pixel(&lattice, &table, u, v, &mut all);
             } else {
-                self.imbricate_pixel(&lattice, &table, u, v, &mut all);
+                self.imbricate_pixel(&lattice, &table, &geo, u, v, &mut all);
             }
             for (o, c) in out.iter_mut().zip(&self.outputs) {
                 *o = all[*c];
@@ -260,75 +286,69 @@ impl ScaleField {
         (c as f32 + 0.5 + cell.dx, r as f32 + 0.5 + shift + cell.dy, cell)
     }
 
-    fn candidates(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32) -> impl Iterator<Item = Candidate> {
-        let x = u * lattice.cols as f32;
-        let y = v * lattice.rows_v as f32 - ROW_PHASE;
-        let c0 = floor_i32(x);
-        let b = 0.5 * lattice.aspect;
-        let shape = self.shape;
-        (-1..=1).flat_map(move |dc| {
-            let c = c0 + dc;
-            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
-            let r0 = floor_i32(y - shift);
-            (-1..=1).filter_map(move |dr| {
-                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
-                // To isotropic units (scale widths), rotate by the jitter angle, scale by size.
-                let px = x - cx;
-                let py = (y - cy) * lattice.aspect;
-                let lx = (px * cell.cos + py * cell.sin) * cell.inv_size;
-                let ly = (-px * cell.sin + py * cell.cos) * cell.inv_size;
-                // Every shape lies inside its |x| < half-width, |y| < b box: skip the rest.
-                if lx.abs() >= half_width(shape) || ly.abs() >= b {
-                    return None;
-                }
-                let inside = inside_distance(shape, lx, ly, b) / cell.inv_size;
-                Some(Candidate {
-                    inside,
-                    x: lx,
-                    y: ly,
-                    half_len: b,
-                    random: cell.random,
-                    centre_u: (cx / lattice.cols as f32).rem_euclid(1.0),
-                    centre_v: ((cy + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
-                    order: cy,
-                })
-            })
-        })
-    }
-
-    fn imbricate_pixel(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32, out: &mut [f32]) {
+    fn imbricate_pixel(&self, lattice: &Lattice, table: &CellTable, geo: &Geometry, u: f32, v: f32, out: &mut [f32]) {
         // Roof tiles: of the scales covering a pixel, the most anterior (smallest centre v)
         // lies on top, its free posterior edge over the scale behind. Its rim falls towards
         // the scale underneath, which leaves a groove along every free edge: the visible
         // crevice between scales.
         let soft = self.edge_softness.max(1e-4);
-        let profile = |c: &Candidate| {
-            let along = (c.y / c.half_len * 0.5 + 0.5).clamp(0.0, 1.0);
-            let dome = smoothstep(0.0, 0.35, c.inside);
+        let profile = |inside: f32, y: f32| {
+            let along = (y / geo.b * 0.5 + 0.5).clamp(0.0, 1.0);
+            let dome = smoothstep(0.0, 0.35, inside);
             0.45 + 0.15 * dome + 0.3 * self.imbrication * along
         };
-        let mut top: Option<Candidate> = None;
+        let x = u * lattice.cols as f32;
+        let y = v * lattice.rows_v as f32 - ROW_PHASE;
+        let c0 = floor_i32(x);
+        // (inside, lx, ly, random, cx, cy) of the top scale so far.
+        let mut top: Option<(f32, f32, f32, f32, f32, f32)> = None;
         let mut under_height = 0.0f32;
-        for cand in self.candidates(lattice, table, u, v) {
-            if cand.inside <= 0.0 {
-                continue;
-            }
-            match &top {
-                Some(t) if cand.order >= t.order => under_height = under_height.max(profile(&cand)),
-                _ => {
-                    if let Some(t) = top.take() {
-                        under_height = under_height.max(profile(&t));
+        for dc in -1..=1 {
+            let c = c0 + dc;
+            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
+            let r0 = floor_i32(y - shift);
+            for dr in -1..=1 {
+                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
+                // To isotropic units (cell widths), rotate by the jitter angle, scale by size.
+                let px = x - cx;
+                let py = (y - cy) * lattice.aspect;
+                let lx = (px * cell.cos + py * cell.sin) * cell.inv_size;
+                let ly = (-px * cell.sin + py * cell.cos) * cell.inv_size;
+                // Every shape lies inside its |x| < half-width, |y| < b box: skip the rest.
+                if lx.abs() >= geo.half_width || ly.abs() >= geo.b {
+                    continue;
+                }
+                let inside = geo.inside(lx, ly) / cell.inv_size;
+                if inside <= 0.0 {
+                    continue;
+                }
+                match top {
+                    Some(t) if cy >= t.5 => under_height = under_height.max(profile(inside, ly)),
+                    _ => {
+                        if let Some(t) = top {
+                            under_height = under_height.max(profile(t.0, t.2));
+                        }
+                        top = Some((inside, lx, ly, cell.random, cx, cy));
                     }
-                    top = Some(cand);
                 }
             }
         }
-        let height = top.as_ref().map_or(0.0, |t| {
-            let rim = smoothstep(0.0, soft, t.inside);
-            // Groove depth: the rim falls to 80 % of the surface underneath, not below it.
-            (rim * profile(t)).max(CREVICE_FLOOR * under_height)
-        });
-        self.write_scale(top, height, self.keel_height, out);
+        let Some((inside, lx, ly, random, cx, cy)) = top else {
+            return self.write_scale(None, 0.0, self.keel_height, out);
+        };
+        let rim = smoothstep(0.0, soft, inside);
+        // Groove depth: the rim falls to a fraction of the surface underneath, not below it.
+        let height = (rim * profile(inside, ly)).max(CREVICE_FLOOR * under_height);
+        let top = Candidate {
+            inside,
+            x: lx,
+            y: ly,
+            half_len: geo.b,
+            random,
+            centre_u: (cx / lattice.cols as f32).rem_euclid(1.0),
+            centre_v: ((cy + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+        };
+        self.write_scale(Some(top), height, self.keel_height, out);
     }
 
     fn hexagon_pixel(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32, out: &mut [f32]) {
@@ -375,7 +395,6 @@ impl ScaleField {
             random: c1.2,
             centre_u: (c1.0 / lattice.cols as f32).rem_euclid(1.0),
             centre_v: ((c1.1 / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
-            order: 0.0,
         };
         let soft = self.edge_softness.max(1e-4);
         let along = (cand.y / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
@@ -454,7 +473,6 @@ impl ScaleField {
                     random,
                     centre_u: 0.0,
                     centre_v: ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
-                    order: r as f32,
                 };
                 best = Some((h, cand));
             }
