@@ -4,8 +4,8 @@
 //! Run: `cargo bench --bench pipeline` (add `-- full_set` etc. to pick groups).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use snakeskin::export::encode_all;
-use snakeskin::graph::{Op, evaluate};
+use snakeskin::export::{encode_all, quantize};
+use snakeskin::graph::{Op, evaluate_into};
 use snakeskin::maps::{BuildOptions, MapKind, build_graph, scale_field};
 use snakeskin::ops::filters;
 use snakeskin::ops::noise::{FractalNoise, NoiseKind};
@@ -17,10 +17,12 @@ fn load() -> LoadedPreset {
     parse(&read_source(PATTERNED).unwrap(), &[]).unwrap()
 }
 
+/// Evaluation, quantisation and PNG encoding, as `generate` does them (no disk).
 fn set(loaded: &LoadedPreset, maps: &[MapKind], size: usize) -> usize {
     let graph = build_graph(&loaded.preset, BuildOptions::default());
-    let eval = evaluate(&graph, maps, size, size, &|_, _| {});
-    encode_all(&loaded.name, &eval.maps).unwrap().iter().map(|(_, b)| b.len()).sum()
+    let mut quantized = Vec::new();
+    evaluate_into(&graph, maps, size, size, &|_, _| {}, &mut |map, image| quantized.push(quantize(map, &image)));
+    encode_all(&loaded.name, &quantized).unwrap().iter().map(|(_, b)| b.len()).sum()
 }
 
 fn sets(c: &mut Criterion) {

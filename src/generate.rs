@@ -5,8 +5,9 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use crate::export::Quantized;
 use crate::export::{self, write_all_atomically};
-use crate::graph::{EvalStats, evaluate};
+use crate::graph::{EvalStats, evaluate_into};
 use crate::maps::{BuildOptions, MapKind, build_graph};
 use crate::preset::{self, LoadedPreset};
 use crate::{Error, SIZE_RANGE};
@@ -55,17 +56,24 @@ pub fn generate(request: &GenerateRequest, progress: &(dyn Fn(usize, usize) + Sy
     let size = check_size(request.size)?;
     let loaded = load(&request.preset, &request.overrides, request.seed)?;
     let graph = build_graph(&loaded.preset, request.options);
-    let evaluation = evaluate(&graph, &request.maps, size, size, progress);
+    // Each map is quantised to its file format the moment it is finished, freeing its f32
+    // buffer; PNG compression then runs for all maps in parallel.
+    let mut quantized: Vec<Quantized> = Vec::new();
+    let stats = evaluate_into(&graph, &request.maps, size, size, progress, &mut |map, image| {
+        quantized.push(export::quantize(map, &image));
+    });
+    quantized.sort_by_key(|q| q.map);
 
     let encode_start = Instant::now();
-    let mut files = export::encode_all(&loaded.name, &evaluation.maps)?;
+    let mut files = export::encode_all(&loaded.name, &quantized)?;
+    drop(quantized);
     let names: Vec<(MapKind, String)> =
-        evaluation.maps.keys().map(|m| (*m, export::map_file_name(&loaded.name, *m))).collect();
+        request.maps.iter().map(|m| (*m, export::map_file_name(&loaded.name, *m))).collect();
     let manifest = export::manifest(&loaded, size, &names, request.options.normal_convention);
     let json = serde_json::to_vec_pretty(&manifest).expect("manifest serialises");
     files.push((format!("{}.material.json", loaded.name), json));
     let encode_time = encode_start.elapsed();
 
     let written = write_all_atomically(&request.out_dir, &files)?;
-    Ok(GenerateReport { files: written, stats: evaluation.stats, encode_time, total_time: start.elapsed() })
+    Ok(GenerateReport { files: written, stats, encode_time, total_time: start.elapsed() })
 }

@@ -10,7 +10,6 @@ mod manifest;
 pub use atomic::write_all_atomically;
 pub use manifest::{Manifest, manifest};
 
-use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::PathBuf;
 
@@ -49,33 +48,49 @@ fn unit_to_u16(x: f32) -> u16 {
     (x.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16
 }
 
-/// Raw samples and PNG colour type of a map, per DESIGN.md's formats.
-fn samples(map: MapKind, image: &Image) -> (Vec<u8>, ExtendedColorType) {
-    match map {
+/// A map quantised to its file format (DESIGN.md's formats), ready to encode; a quarter
+/// to an eighth of the f32 image's memory, so maps are quantised as soon as they are done.
+#[derive(Debug, Clone)]
+pub struct Quantized {
+    pub map: MapKind,
+    pub width: usize,
+    pub height: usize,
+    pub samples: Vec<u8>,
+    pub color: ExtendedColorType,
+}
+
+/// Quantises a map: sRGB 8-bit colour, 8-bit normal and roughness, 16-bit height and
+/// iridescence (samples in native byte order, as `ImageEncoder::write_image` takes them).
+pub fn quantize(map: MapKind, image: &Image) -> Quantized {
+    let (samples, color) = match map {
         MapKind::Color => (image.data.par_iter().map(|&c| linear_to_srgb8(c)).collect(), ExtendedColorType::Rgb8),
         MapKind::Normal => {
             (image.data.par_iter().map(|&n| unit_to_u8(n * 0.5 + 0.5)).collect(), ExtendedColorType::Rgb8)
         }
         MapKind::Roughness => (image.data.par_iter().map(|&r| unit_to_u8(r)).collect(), ExtendedColorType::L8),
-        // `ImageEncoder::write_image` takes 16-bit samples in native byte order.
         MapKind::Height | MapKind::Iridescence => {
             (image.data.par_iter().flat_map_iter(|&h| unit_to_u16(h).to_ne_bytes()).collect(), ExtendedColorType::L16)
         }
-    }
+    };
+    Quantized { map, width: image.width, height: image.height, samples, color }
+}
+
+/// Encodes a quantised map as PNG bytes.
+pub fn encode_quantized(q: &Quantized) -> Result<Vec<u8>, ExportError> {
+    let mut out = Cursor::new(Vec::new());
+    let encoder = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
+    encoder
+        .write_image(&q.samples, q.width as u32, q.height as u32, q.color)
+        .map_err(|e| ExportError::Encode { map: q.map, message: e.to_string() })?;
+    Ok(out.into_inner())
 }
 
 /// Encodes one map as PNG bytes.
 pub fn encode_png(map: MapKind, image: &Image) -> Result<Vec<u8>, ExportError> {
-    let (data, color) = samples(map, image);
-    let mut out = Cursor::new(Vec::new());
-    let encoder = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
-    encoder
-        .write_image(&data, image.width as u32, image.height as u32, color)
-        .map_err(|e| ExportError::Encode { map, message: e.to_string() })?;
-    Ok(out.into_inner())
+    encode_quantized(&quantize(map, image))
 }
 
-/// Encodes every map in parallel; returns (file name, bytes) in map order.
-pub fn encode_all(preset_name: &str, maps: &BTreeMap<MapKind, Image>) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
-    maps.par_iter().map(|(map, image)| Ok((map_file_name(preset_name, *map), encode_png(*map, image)?))).collect()
+/// Encodes quantised maps in parallel; returns (file name, bytes) in the given order.
+pub fn encode_all(preset_name: &str, maps: &[Quantized]) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
+    maps.par_iter().map(|q| Ok((map_file_name(preset_name, q.map), encode_quantized(q)?))).collect()
 }

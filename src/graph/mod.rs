@@ -11,7 +11,7 @@ mod eval;
 mod op;
 
 pub use dot::to_dot;
-pub use eval::{EvalStats, Evaluation, NodeStats, evaluate};
+pub use eval::{EvalStats, Evaluation, NodeStats, evaluate, evaluate_into};
 pub use op::Op;
 
 use std::collections::BTreeMap;

@@ -150,12 +150,16 @@ fn box_pass_horizontal(input: &Image, r: usize) -> Image {
     let norm = 1.0 / (2 * r + 1) as f64;
     out.data.par_chunks_mut(w * ch).enumerate().for_each(|(y, row)| {
         let src = input.row(y);
-        let at = |x: isize, c: usize| src[x.rem_euclid(w as isize) as usize * ch + c] as f64;
+        // The row's channel padded with its own wrap-around: no modulo in the sweep.
+        let mut padded = vec![0.0f64; w + 2 * r + 1];
         for c in 0..ch {
-            let mut sum: f64 = (-(r as isize)..=r as isize).map(|x| at(x, c)).sum();
+            for (i, p) in padded.iter_mut().enumerate() {
+                *p = src[(i as isize - r as isize).rem_euclid(w as isize) as usize * ch + c] as f64;
+            }
+            let mut sum: f64 = padded[..2 * r + 1].iter().sum();
             for x in 0..w {
                 row[x * ch + c] = (sum * norm) as f32;
-                sum += at(x as isize + r as isize + 1, c) - at(x as isize - r as isize, c);
+                sum += padded[x + 2 * r + 1] - padded[x];
             }
         }
     });
