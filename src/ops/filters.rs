@@ -294,6 +294,27 @@ pub fn resample_bilinear_wrapped(src: &Image, width: usize, height: usize) -> Im
     out
 }
 
+/// Calls `f(centre, left, right, up, here, down, out)` for every pixel: sample offsets of the
+/// pixel and its wrapped left and right neighbours within a row (channel 0), the wrapped
+/// rows above, at and below it, and the pixel's output (no modulo per sample).
+fn neighbourhood<F>(input: &Image, channels_out: usize, f: F) -> Image
+where
+    F: Fn(usize, usize, usize, &[f32], &[f32], &[f32], &mut [f32]) + Sync,
+{
+    let (w, h, ch) = (input.width, input.height, input.channels);
+    let mut out = Image::new(w, h, channels_out);
+    out.data.par_chunks_mut(w * channels_out).enumerate().for_each(|(y, row)| {
+        let up = input.row((y + h - 1) % h);
+        let here = input.row(y);
+        let down = input.row((y + 1) % h);
+        for (x, px) in row.chunks_exact_mut(channels_out).enumerate() {
+            let (l, r) = (((x + w - 1) % w) * ch, ((x + 1) % w) * ch);
+            f(x * ch, l, r, up, here, down, px);
+        }
+    });
+    out
+}
+
 /// Sobel gradient magnitude of channel 0, wrap-around. The result is normalised so that a
 /// step edge blurred by a Gaussian of `edge_sigma` (normalised units) peaks at 1: the peak
 /// slope of such an edge is 1 / (sqrt(2π) σ) per pixel and Sobel's x kernel weighs the
@@ -301,12 +322,9 @@ pub fn resample_bilinear_wrapped(src: &Image, width: usize, height: usize) -> Im
 pub fn sobel(input: &Image, edge_sigma: f32) -> Image {
     let sigma_px = (edge_sigma * input.width as f32).max(0.5);
     let norm = (2.0 * std::f32::consts::PI).sqrt() * sigma_px / 8.0;
-    Image::from_fn(input.width, input.height, 1, |u, v, out| {
-        let x = (u * input.width as f32) as isize;
-        let y = (v * input.height as f32) as isize;
-        let p = |dx: isize, dy: isize| input.at_wrapped(x + dx, y + dy, 0);
-        let gx = (p(1, -1) + 2.0 * p(1, 0) + p(1, 1)) - (p(-1, -1) + 2.0 * p(-1, 0) + p(-1, 1));
-        let gy = (p(-1, 1) + 2.0 * p(0, 1) + p(1, 1)) - (p(-1, -1) + 2.0 * p(0, -1) + p(1, -1));
+    neighbourhood(input, 1, |c, l, r, up, here, down, out| {
+        let gx = (up[r] + 2.0 * here[r] + down[r]) - (up[l] + 2.0 * here[l] + down[l]);
+        let gy = (down[l] + 2.0 * down[c] + down[r]) - (up[l] + 2.0 * up[c] + up[r]);
         out[0] = ((gx * gx + gy * gy).sqrt() * norm).min(1.0);
     })
 }
@@ -323,13 +341,11 @@ pub enum NormalConvention {
 /// `slope_per_unit_height` is the surface rise, in texture widths, of the full height range
 /// (so the result does not change with resolution).
 pub fn height_to_normal(height: &Image, slope_per_unit_height: f32, convention: NormalConvention) -> Image {
-    let (w, h) = (height.width as isize, height.height as isize);
-    Image::from_fn(height.width, height.height, 3, |u, v, out| {
-        let x = (u * w as f32) as isize;
-        let y = (v * h as f32) as isize;
+    let (w, h) = (height.width as f32, height.height as f32);
+    neighbourhood(height, 3, |c, l, r, up, here, down, out| {
         // dh/du with u in texture widths: (h[x+1] - h[x-1]) / (2 / w).
-        let dhdx = (height.at_wrapped(x + 1, y, 0) - height.at_wrapped(x - 1, y, 0)) * 0.5 * w as f32;
-        let dhdy = (height.at_wrapped(x, y + 1, 0) - height.at_wrapped(x, y - 1, 0)) * 0.5 * h as f32;
+        let dhdx = (here[r] - here[l]) * 0.5 * w;
+        let dhdy = (down[c] - up[c]) * 0.5 * h;
         let sx = -dhdx * slope_per_unit_height;
         // Image y runs down; OpenGL's +Y (bitangent) points up the image.
         let sy = match convention {

@@ -1,0 +1,24 @@
+// Compute entry point that evaluates skin_brdf (brdf.wgsl, prepended) on a buffer of
+// samples: the GPU side of the CPU/GPU comparison in tests/gpu.rs.
+
+struct Sample {
+    normal_roughness: vec4<f32>,
+    wi_thickness: vec4<f32>,
+    wo_n0: vec4<f32>,
+    tau_n2: vec4<f32>,
+    albedo: vec4<f32>,
+}
+
+@group(1) @binding(0) var<storage, read> samples: array<Sample>;
+@group(1) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn eval_samples(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= arrayLength(&samples)) {
+        return;
+    }
+    let s = samples[i];
+    let layers = Layers(s.wo_n0.w, s.tau_n2.w, s.normal_roughness.w, s.wi_thickness.w, s.tau_n2.xyz, s.albedo.xyz);
+    results[i] = vec4<f32>(skin_brdf(layers, s.normal_roughness.xyz, s.wi_thickness.xyz, s.wo_n0.xyz), 1.0);
+}

@@ -1,0 +1,134 @@
+//! Evaluates the WGSL BRDF on the GPU for a batch of inputs (one compute invocation per
+//! sample) and reads the results back: the GPU half of the CPU/GPU twin test, and the way to
+//! measure the shader's cost per million evaluations.
+
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+use super::{Gpu, GpuError, shader_programs};
+use crate::optics::brdf::Layers32;
+use crate::optics::lut::Lut;
+
+/// One BRDF query, laid out as the shader's `Sample` (five vec4s).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct GpuSample {
+    pub normal_roughness: [f32; 4],
+    pub wi_thickness: [f32; 4],
+    pub wo_n0: [f32; 4],
+    pub tau_n2: [f32; 4],
+    pub albedo: [f32; 4],
+}
+
+impl GpuSample {
+    pub fn new(layers: &Layers32, normal: [f32; 3], wi: [f32; 3], wo: [f32; 3]) -> Self {
+        let [a, b, c] = layers.optical_depth;
+        let [r, g, bl] = layers.albedo;
+        GpuSample {
+            normal_roughness: [normal[0], normal[1], normal[2], layers.roughness],
+            wi_thickness: [wi[0], wi[1], wi[2], layers.thickness_nm],
+            wo_n0: [wo[0], wo[1], wo[2], layers.n0],
+            tau_n2: [a, b, c, layers.n2],
+            albedo: [r, g, bl, 0.0],
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct LutInfo {
+    n_cos: u32,
+    n_fine: u32,
+    n_coarse: u32,
+    pad: u32,
+}
+
+/// Evaluates the BRDF for every sample with film colours from `lut`; returns linear RGB.
+pub fn eval_on_gpu(gpu: &Gpu, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f32; 3]>, GpuError> {
+    let device = &gpu.device;
+    let (_, source, _) = shader_programs().into_iter().find(|(name, _, _)| *name == "brdf_eval").expect("program");
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("brdf_eval"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("brdf_eval"),
+        layout: None,
+        module: &module,
+        entry_point: Some("eval_samples"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+
+    let info = LutInfo { n_cos: lut.n_cos as u32, n_fine: lut.n_fine as u32, n_coarse: lut.n_coarse as u32, pad: 0 };
+    let texels: Vec<[f32; 4]> = lut.texels.iter().map(|t| [t[0], t[1], t[2], 0.0]).collect();
+    let info_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("lut info"),
+        contents: bytemuck::bytes_of(&info),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let texel_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("lut texels"),
+        contents: bytemuck::cast_slice(&texels),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let sample_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("samples"),
+        contents: bytemuck::cast_slice(samples),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let size = (samples.len() * 16) as u64;
+    let result_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("results"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let lut_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("lut"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: info_buffer.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: texel_buffer.as_entire_binding() },
+        ],
+    });
+    let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("samples"),
+        layout: &pipeline.get_bind_group_layout(1),
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: sample_buffer.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: result_buffer.as_entire_binding() },
+        ],
+    });
+
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("brdf_eval") });
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("brdf_eval"), timestamp_writes: None });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &lut_group, &[]);
+        pass.set_bind_group(1, &io_group, &[]);
+        pass.dispatch_workgroups((samples.len() as u32).div_ceil(64), 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(&result_buffer, 0, &readback, 0, size);
+    gpu.queue.submit([encoder.finish()]);
+
+    let slice = readback.slice(..);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
+    receiver
+        .recv()
+        .map_err(|e| GpuError::Readback(e.to_string()))?
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
+    let values: &[[f32; 4]] = bytemuck::cast_slice(&data);
+    Ok(values.iter().map(|v| [v[0], v[1], v[2]]).collect())
+}

@@ -1,0 +1,54 @@
+//! Finding and opening a GPU. On machines without one (CI, the development machines) wgpu
+//! finds Mesa's software Vulkan (lavapipe, `apt-get install mesa-vulkan-drivers`).
+
+use std::fmt;
+
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error("no GPU adapter found ({0}); install a Vulkan driver, e.g. `apt-get install mesa-vulkan-drivers libvulkan1`")]
+    NoAdapter(String),
+    #[error("the GPU adapter refused a device: {0}")]
+    Device(String),
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+}
+
+/// An open device and its queue.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+}
+
+impl fmt::Debug for Gpu {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "Gpu({} / {:?} / {:?})", self.info.name, self.info.backend, self.info.device_type)
+    }
+}
+
+impl Gpu {
+    /// Opens the default adapter without a window (a software adapter if that is all there is).
+    pub fn headless() -> Result<Gpu, GpuError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+        }))
+        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("snakeskin"),
+            required_features: wgpu::Features::empty(),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+        Ok(Gpu { device, queue, info })
+    }
+
+    /// A short description of the adapter, for reports.
+    pub fn describe(&self) -> String {
+        format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
+    }
+}

@@ -1,0 +1,124 @@
+//! GPU tests: every shader validates (naga), and the WGSL BRDF matches its Rust f32 twin.
+//! They run for real on Mesa's software Vulkan (lavapipe) in CI. Without an adapter they
+//! skip with a printed reason, unless SNAKESKIN_REQUIRE_GPU=1 (set in .ci/run), which makes
+//! a missing adapter a failure.
+
+use snakeskin::optics::brdf::{Layers32, eval_f32};
+use snakeskin::optics::film::Stack;
+use snakeskin::optics::lut::Lut;
+use snakeskin::render::brdf_eval::{GpuSample, eval_on_gpu};
+use snakeskin::render::{Gpu, shader_programs};
+
+/// The GPU, or None (after printing why) when the test may skip.
+fn gpu_or_skip(test: &str) -> Option<Gpu> {
+    match Gpu::headless() {
+        Ok(gpu) => {
+            eprintln!("{test}: running on {}", gpu.describe());
+            Some(gpu)
+        }
+        Err(e) if std::env::var("SNAKESKIN_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
+            panic!("{test}: SNAKESKIN_REQUIRE_GPU=1 but {e}")
+        }
+        Err(e) => {
+            eprintln!("{test}: SKIPPED: {e}");
+            None
+        }
+    }
+}
+
+#[test]
+fn every_wgsl_file_parses_and_validates() {
+    let programs = shader_programs();
+    for (name, source, _) in &programs {
+        let module =
+            naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    }
+    // Every file in shaders/ is part of some program (so none escapes validation).
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/shaders");
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let file = entry.unwrap().file_name().to_string_lossy().into_owned();
+        if file.ends_with(".wgsl") {
+            assert!(programs.iter().any(|(_, _, files)| files.contains(&file.as_str())), "{file} is in no program");
+        }
+    }
+}
+
+/// SplitMix64, so the inputs are the same on every run.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn direction(&mut self, upper: bool) -> [f32; 3] {
+        let cos = if upper { self.next() } else { self.next() * 2.0 - 1.0 };
+        let phi = self.next() * std::f32::consts::TAU;
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        [sin * phi.cos(), sin * phi.sin(), cos]
+    }
+}
+
+#[test]
+fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
+    let Some(gpu) = gpu_or_skip("wgsl_brdf_matches_the_rust_twin") else { return };
+    let stack = Stack::THESIS;
+    let lut = Lut::bake(stack, 32, 128, 32);
+    let mut rng = Rng(42);
+    let mut layers = Vec::new();
+    let mut samples = Vec::new();
+    for i in 0..10_000 {
+        let l = Layers32 {
+            n0: 1.0,
+            n2: 2.0,
+            // Every 10th sample is a mirror (roughness 0) or fully rough, the extremes.
+            roughness: match i % 10 {
+                0 => 0.0,
+                1 => 1.0,
+                _ => 0.02 + 0.98 * rng.next(),
+            },
+            optical_depth: [rng.next() * 3.0, rng.next() * 3.0, rng.next() * 3.0],
+            albedo: [rng.next(), rng.next(), rng.next()],
+            thickness_nm: match i % 7 {
+                0 => 0.0,
+                1 => 1.0e7,
+                _ => rng.next() * 3000.0,
+            },
+        };
+        // Mostly upper hemisphere (where the BRDF is non-zero), some anywhere.
+        let upper = i % 5 != 0;
+        let normal = if i % 50 == 0 {
+            [0.0, 0.0, 0.0]
+        } else {
+            let d = rng.direction(true);
+            [d[0] * 0.3, d[1] * 0.3, 1.0]
+        };
+        let (wi, wo) = (rng.direction(upper), rng.direction(upper));
+        samples.push(GpuSample::new(&l, normal, wi, wo));
+        layers.push((l, normal, wi, wo));
+    }
+    let gpu_values = eval_on_gpu(&gpu, &lut, &samples).expect("gpu evaluation");
+    assert_eq!(gpu_values.len(), samples.len());
+    let mut worst: f32 = 0.0;
+    let mut non_zero = 0;
+    for ((l, n, wi, wo), g) in layers.iter().zip(&gpu_values) {
+        let cpu = eval_f32(l, *n, *wi, *wo, &lut);
+        if cpu.iter().any(|v| *v > 0.0) {
+            non_zero += 1;
+        }
+        for c in 0..3 {
+            assert!(g[c].is_finite(), "GPU value not finite for {l:?}");
+            // Relative to 1 + f: the GPU's sqrt, exp and division may round differently
+            // from the CPU's, and GGX's peak (up to ~3e5 at roughness 0) amplifies that.
+            worst = worst.max((g[c] - cpu[c]).abs() / (1.0 + cpu[c].abs()));
+        }
+    }
+    eprintln!("max |gpu - cpu| / (1 + cpu) = {worst:e} over {} samples ({non_zero} non-zero)", samples.len());
+    assert!(non_zero > 5000, "the inputs exercise the BRDF: {non_zero}");
+    assert!(worst < 1e-3, "GPU and CPU BRDF differ by {worst}");
+}
