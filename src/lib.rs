@@ -13,6 +13,7 @@ pub mod maps;
 pub mod ops;
 pub mod optics;
 pub mod preset;
+pub mod render;
 
 pub use generate::{GenerateReport, GenerateRequest, generate};
 

@@ -120,5 +120,7 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
     }
     eprintln!("max |gpu - cpu| / (1 + cpu) = {worst:e} over {} samples ({non_zero} non-zero)", samples.len());
     assert!(non_zero > 5000, "the inputs exercise the BRDF: {non_zero}");
-    assert!(worst < 1e-3, "GPU and CPU BRDF differ by {worst}");
+    // Measured 1.1e-7 on lavapipe (llvmpipe, Vulkan); 1e-4 leaves room for GPUs with
+    // faster, less exact sqrt and exp.
+    assert!(worst < 1e-4, "GPU and CPU BRDF differ by {worst}");
 }

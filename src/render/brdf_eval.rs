@@ -109,7 +109,8 @@ pub fn eval_on_gpu(gpu: &Gpu, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f
 
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("brdf_eval") });
     {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("brdf_eval"), timestamp_writes: None });
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("brdf_eval"), timestamp_writes: None });
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &lut_group, &[]);
         pass.set_bind_group(1, &io_group, &[]);
@@ -124,10 +125,7 @@ pub fn eval_on_gpu(gpu: &Gpu, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f
         let _ = sender.send(result);
     });
     device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
-    receiver
-        .recv()
-        .map_err(|e| GpuError::Readback(e.to_string()))?
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    receiver.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
     let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
     let values: &[[f32; 4]] = bytemuck::cast_slice(&data);
     Ok(values.iter().map(|v| [v[0], v[1], v[2]]).collect())
