@@ -228,6 +228,7 @@ pub fn run(command: BrdfCommand) -> Result<()> {
 
 pub fn bench(command: BenchCommand) -> Result<()> {
     match command {
+        BenchCommand::Gpu { samples, json } => bench_gpu(samples as usize, json),
         BenchCommand::Irid { json, plot, d_step_nm, angle_step_deg, lut_sweep } => {
             use snakeskin::optics::accuracy::{Prepared, grid, measure, reference_colours};
             use snakeskin::optics::lab::linear_srgb_to_lab;
@@ -306,4 +307,78 @@ fn chart(stack: Stack, method: Method, width: usize, height: usize, out: &std::p
     let name = out.file_name().context("the output path names a file")?.to_string_lossy().into_owned();
     snakeskin::export::write_all_atomically(dir, &[(name, png)])?;
     Ok(exposure)
+}
+
+/// GPU compute against the CPU twin, per million BRDF evaluations, on the same inputs.
+fn bench_gpu(count: usize, json: bool) -> Result<()> {
+    use snakeskin::optics::brdf::{Layers32, eval_f32};
+    use snakeskin::render::Gpu;
+    use snakeskin::render::brdf_eval::{GpuSample, eval_timed};
+    use std::hint::black_box;
+
+    let gpu = Gpu::headless()?;
+    let lut = Lut::bake_default(Stack::THESIS);
+    // Deterministic inputs over the upper hemisphere, a spread of roughness and thickness.
+    let unit = |i: usize, k: u32| snakeskin::ops::hash::unit(i as i32, (i >> 31) as i32, k, 7);
+    let inputs: Vec<(Layers32, [f32; 3], [f32; 3])> = (0..count)
+        .map(|i| {
+            let layers = Layers32 {
+                n0: 1.0,
+                n2: 2.0,
+                roughness: 0.05 + 0.9 * unit(i, 0),
+                optical_depth: [0.6, 0.4, 0.2],
+                albedo: [0.5, 0.4, 0.3],
+                thickness_nm: 2000.0 * unit(i, 1),
+            };
+            let dir = |a: f32, b: f32| {
+                let phi = b * std::f32::consts::TAU;
+                let sin = (1.0 - a * a).sqrt();
+                [sin * phi.cos(), sin * phi.sin(), a]
+            };
+            (layers, dir(unit(i, 2), unit(i, 3)), dir(unit(i, 4), unit(i, 5)))
+        })
+        .collect();
+    let samples: Vec<GpuSample> =
+        inputs.iter().map(|(l, wi, wo)| GpuSample::new(l, [0.0, 0.0, 1.0], *wi, *wo)).collect();
+
+    // Fixed costs (submit, readback) cancel in the difference of 11 and 1 dispatches; the
+    // median of five such pairs.
+    let mut per_million: Vec<f64> = (0..5)
+        .map(|_| -> Result<f64> {
+            let (_, one) = eval_timed(&gpu, &lut, &samples, 1)?;
+            let (_, eleven) = eval_timed(&gpu, &lut, &samples, 11)?;
+            Ok((eleven.as_secs_f64() - one.as_secs_f64()).max(0.0) / 10.0 * 1e3 * 1e6 / count as f64)
+        })
+        .collect::<Result<_>>()?;
+    per_million.sort_by(f64::total_cmp);
+    let gpu_ms = per_million[2];
+
+    let mut cpu: Vec<f64> = (0..5)
+        .map(|_| {
+            let start = std::time::Instant::now();
+            let mut acc = 0.0f32;
+            for (l, wi, wo) in &inputs {
+                acc += eval_f32(black_box(l), [0.0, 0.0, 1.0], *wi, *wo, &lut)[1];
+            }
+            black_box(acc);
+            start.elapsed().as_secs_f64() * 1e3 * 1e6 / count as f64
+        })
+        .collect();
+    cpu.sort_by(f64::total_cmp);
+    let cpu_ms = cpu[2];
+    let report = serde_json::json!({
+        "adapter": gpu.describe(),
+        "samples": count,
+        "gpu_ms_per_million": gpu_ms,
+        "cpu_f32_ms_per_million": cpu_ms,
+        "cpu_threads": 1,
+    });
+    if json {
+        println!("{report}");
+    } else {
+        println!("adapter: {}", gpu.describe());
+        println!("WGSL BRDF (compute):  {gpu_ms:.3} ms per million evaluations");
+        println!("Rust f32 twin (1 core): {cpu_ms:.3} ms per million evaluations");
+    }
+    Ok(())
 }

@@ -235,6 +235,16 @@ pub struct EvalArgs {
 
 #[derive(Debug, Subcommand)]
 pub enum BenchCommand {
+    /// The BRDF (LUT film) per million evaluations: WGSL compute shader on the GPU and the
+    /// Rust f32 twin on one CPU core, side by side in one run.
+    Gpu {
+        /// Evaluations per dispatch.
+        #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1000..=16_000_000))]
+        samples: u64,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
     /// Time against error of every film colour method on PHYSICS.md's grid.
     Irid {
         /// Print JSON {"default", "methods": [{"name","mean_de","p95_de","max_de","ns_per_eval"}]}.

@@ -124,3 +124,21 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
     // faster, less exact sqrt and exp.
     assert!(worst < 1e-4, "GPU and CPU BRDF differ by {worst}");
 }
+
+#[test]
+fn bench_gpu_reports_both_costs() {
+    let Some(_gpu) = gpu_or_skip("bench_gpu_reports_both_costs") else { return };
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["bench", "gpu", "--samples", "20000", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["samples"], 20000);
+    assert!(v["adapter"].as_str().is_some_and(|a| !a.is_empty()));
+    for key in ["gpu_ms_per_million", "cpu_f32_ms_per_million"] {
+        let ms = v[key].as_f64().unwrap();
+        assert!(ms.is_finite() && ms >= 0.0, "{key} = {ms}");
+    }
+    assert!(v["cpu_f32_ms_per_million"].as_f64().unwrap() > 0.0);
+}

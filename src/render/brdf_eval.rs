@@ -45,6 +45,19 @@ struct LutInfo {
 
 /// Evaluates the BRDF for every sample with film colours from `lut`; returns linear RGB.
 pub fn eval_on_gpu(gpu: &Gpu, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f32; 3]>, GpuError> {
+    Ok(eval_timed(gpu, lut, samples, 1)?.0)
+}
+
+/// Like `eval_on_gpu`, dispatching the evaluation `repeats` times in one submission (same
+/// inputs and outputs); also returns the wall time from submit to results on the CPU.
+/// Two calls with different `repeats` isolate the cost of the evaluations from the fixed
+/// costs of submission and readback.
+pub fn eval_timed(
+    gpu: &Gpu,
+    lut: &Lut,
+    samples: &[GpuSample],
+    repeats: u32,
+) -> Result<(Vec<[f32; 3]>, std::time::Duration), GpuError> {
     let device = &gpu.device;
     let (_, source, _) = shader_programs().into_iter().find(|(name, _, _)| *name == "brdf_eval").expect("program");
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -114,9 +127,12 @@ pub fn eval_on_gpu(gpu: &Gpu, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &lut_group, &[]);
         pass.set_bind_group(1, &io_group, &[]);
-        pass.dispatch_workgroups((samples.len() as u32).div_ceil(64), 1, 1);
+        for _ in 0..repeats.max(1) {
+            pass.dispatch_workgroups((samples.len() as u32).div_ceil(64), 1, 1);
+        }
     }
     encoder.copy_buffer_to_buffer(&result_buffer, 0, &readback, 0, size);
+    let start = std::time::Instant::now();
     gpu.queue.submit([encoder.finish()]);
 
     let slice = readback.slice(..);
@@ -126,7 +142,8 @@ pub fn eval_on_gpu(gpu: &Gpu, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f
     });
     device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
     receiver.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+    let elapsed = start.elapsed();
     let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
     let values: &[[f32; 4]] = bytemuck::cast_slice(&data);
-    Ok(values.iter().map(|v| [v[0], v[1], v[2]]).collect())
+    Ok((values.iter().map(|v| [v[0], v[1], v[2]]).collect(), elapsed))
 }
