@@ -266,13 +266,7 @@ pub fn bench(command: BenchCommand) -> Result<()> {
             }
             if let Some(path) = plot {
                 let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default);
-                snakeskin::export::write_all_atomically(
-                    path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new(".")),
-                    &[(
-                        path.file_name().context("plot path names a file")?.to_string_lossy().into_owned(),
-                        svg.into_bytes(),
-                    )],
-                )?;
+                snakeskin::export::write_file_atomically(&path, svg.into_bytes())?;
             }
             Ok(())
         }
@@ -303,9 +297,7 @@ fn chart(stack: Stack, method: Method, width: usize, height: usize, out: &std::p
         data: rows.into_iter().flatten().flat_map(|p| p.map(|c| (c * exposure) as f32)).collect(),
     };
     let png = snakeskin::export::encode_png(snakeskin::maps::MapKind::Color, &image)?;
-    let dir = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    let name = out.file_name().context("the output path names a file")?.to_string_lossy().into_owned();
-    snakeskin::export::write_all_atomically(dir, &[(name, png)])?;
+    snakeskin::export::write_file_atomically(out, png)?;
     Ok(exposure)
 }
 

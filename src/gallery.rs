@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use crate::Error;
-use crate::export::{encode_png, write_all_atomically};
+use crate::export::{encode_png, write_file_atomically};
 use crate::graph::evaluate;
 use crate::maps::{BuildOptions, MapKind, build_graph};
 use crate::ops::Image;
@@ -132,8 +132,6 @@ fn gray_to_display(image: &Image) -> Image {
 pub fn write(path: &std::path::Path, tile: usize, columns: usize) -> Result<(), Error> {
     let sheet = render(tile, columns)?;
     let png = encode_png(MapKind::Color, &sheet)?;
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "gallery.png".into());
-    write_all_atomically(dir, &[(name, png)])?;
+    write_file_atomically(path, png)?;
     Ok(())
 }

@@ -39,3 +39,14 @@ pub fn write_all_atomically(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<V
     }
     Ok(staged.into_iter().map(|(_, target)| target).collect())
 }
+
+/// Writes one file atomically (temporary name, then rename) to `path`.
+pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, ExportError> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().ok_or_else(|| ExportError::Io {
+        path: path.into(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path does not name a file"),
+    })?;
+    let written = write_all_atomically(dir, &[(name.to_string_lossy().into_owned(), bytes)])?;
+    Ok(written.into_iter().next().unwrap_or_else(|| path.into()))
+}

@@ -7,7 +7,7 @@
 mod atomic;
 mod manifest;
 
-pub use atomic::write_all_atomically;
+pub use atomic::{write_all_atomically, write_file_atomically};
 pub use manifest::{Manifest, manifest};
 
 use std::io::Cursor;

@@ -102,11 +102,13 @@ impl Bands {
         }
     }
 
-    /// Shared band tables for the common N.
+    /// The band table for N (1..=421), built once on first use.
     pub fn cached(n: usize) -> &'static Bands {
-        static CACHE: OnceLock<Vec<Bands>> = OnceLock::new();
-        let all = CACHE.get_or_init(|| (1..=64).map(Bands::new).collect());
-        if n <= 64 { &all[n - 1] } else { Box::leak(Box::new(Bands::new(n))) }
+        const MAX_BANDS: usize = (LAMBDA_MAX_NM - LAMBDA_MIN_NM + 1) as usize;
+        static CACHE: OnceLock<Vec<OnceLock<Bands>>> = OnceLock::new();
+        let n = n.clamp(1, MAX_BANDS);
+        let all = CACHE.get_or_init(|| (0..MAX_BANDS).map(|_| OnceLock::new()).collect());
+        all[n - 1].get_or_init(|| Bands::new(n))
     }
 }
 

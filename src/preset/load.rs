@@ -146,28 +146,25 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 fn key_line(text: &str, dotted: &str) -> Option<usize> {
     let root = DeTable::parse(text).ok()?;
     let mut span: Option<Range<usize>> = None;
-    let mut table = Some(root.get_ref());
     let mut value: Option<&DeValue> = None;
     for segment in dotted.split('.') {
-        if let Some(current) = value {
-            match current {
-                DeValue::Table(t) => table = Some(t),
-                DeValue::Array(items) => {
-                    let item = items.get(segment.parse::<usize>().ok()?)?;
-                    span = Some(item.span());
-                    value = Some(item.get_ref());
-                    continue;
-                }
-                _ => return span.map(|s| line_column(text, s.start).0),
+        let (key_span, item) = match value {
+            None => root.get_ref().iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?,
+            Some(DeValue::Table(t)) if segment == "0" && !t.iter().any(|(k, _)| k.get_ref().as_ref() == "0") => {
+                // `pattern.0` when `pattern` is a single table: the table is layer 0.
+                continue;
             }
-        } else if segment.parse::<usize>().is_ok() {
-            // `pattern.0` when `pattern` is a single table.
-            continue;
-        }
-        let (key, item) = table?.iter().find(|(k, _)| k.get_ref().as_ref() == segment)?;
-        span = Some(key.span());
+            Some(DeValue::Table(t)) => {
+                t.iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?
+            }
+            Some(DeValue::Array(items)) => {
+                let item = items.get(segment.parse::<usize>().ok()?)?;
+                (item.span(), item)
+            }
+            Some(_) => break,
+        };
+        span = Some(key_span);
         value = Some(item.get_ref());
-        table = None;
     }
     span.map(|s| line_column(text, s.start).0)
 }
@@ -258,6 +255,16 @@ mod tests {
         assert_eq!(loaded.preset.scales.rows, 25);
         assert_eq!(loaded.preset.scales.shape, super::super::schema::ScaleShape::Diamond);
         assert_eq!(loaded.preset.pattern.len(), 1);
+    }
+
+    #[test]
+    fn range_errors_in_a_single_pattern_table_have_their_line() {
+        let text = "seed = 1\n[pattern]\nkind = \"spots\"\ncolor = \"#102030\"\nsize = 9.0\n";
+        let err = parse(&source(text), &[]).unwrap_err().to_string();
+        assert!(err.contains("t.toml:5: key `pattern.0.size`"), "{err}");
+        let layers = "[[pattern]]\nkind = \"solid\"\ncolor = \"#000000\"\n[[pattern]]\nkind = \"spots\"\ncolor = \"#102030\"\nsize = 9.0\n";
+        let err = parse(&source(layers), &[]).unwrap_err().to_string();
+        assert!(err.contains("t.toml:7: key `pattern.1.size`"), "{err}");
     }
 
     #[test]
