@@ -4,53 +4,13 @@
 //   f = D G2 F(|wo.h|) / (4 |n.wi| |n.wo|)
 //     + (1 - F(n.wi)) (1 - F(n.wo)) exp(-tau (1/cos_t(wi) + 1/cos_t(wo))) k_d / pi
 
-const PI: f32 = 3.14159265358979;
+// Film colour comes from film_rgb (film.wgsl, prepended before this file).
 // GGX alpha floor and cosine floor, as optics::brdf::ALPHA_MIN and COS_MIN.
 const ALPHA_MIN: f32 = 0.001;
 const COS_MIN: f32 = 0.000001;
-// Thickness axis of the LUT, as optics::lut::FINE_MAX_NM and COARSE_MAX_NM.
-const FINE_MAX_NM: f32 = 2000.0;
-const COARSE_MAX_NM: f32 = 20000.0;
-
-struct LutInfo {
-    n_cos: u32,
-    n_fine: u32,
-    n_coarse: u32,
-    _pad: u32,
-}
-
-// The per-material film colour table, row-major [cos][thickness], RGB in xyz.
-@group(0) @binding(0) var<uniform> lut_info: LutInfo;
-@group(0) @binding(1) var<storage, read> lut_texels: array<vec4<f32>>;
-
-fn lut_texel(i: u32, j: u32) -> vec3<f32> {
-    return lut_texels[i * (lut_info.n_fine + lut_info.n_coarse) + j].xyz;
-}
-
-// Film colour at thickness d (nm) and incidence cosine c: bilinear in the table.
-fn film_lut(thickness_nm: f32, cos0: f32) -> vec3<f32> {
-    let d = max(thickness_nm, 0.0);
-    let fine_step = FINE_MAX_NM / f32(lut_info.n_fine - 1u);
-    let coarse_step = (COARSE_MAX_NM - FINE_MAX_NM) / f32(lut_info.n_coarse);
-    var x: f32;
-    if (d <= FINE_MAX_NM) {
-        x = d / fine_step;
-    } else {
-        x = f32(lut_info.n_fine - 1u) + (d - FINE_MAX_NM) / coarse_step;
-    }
-    let w = lut_info.n_fine + lut_info.n_coarse;
-    x = min(x, f32(w - 1u));
-    let y = clamp(cos0, 0.0, 1.0) * f32(lut_info.n_cos - 1u);
-    let x0 = u32(x);
-    let y0 = u32(y);
-    let x1 = min(x0 + 1u, w - 1u);
-    let y1 = min(y0 + 1u, lut_info.n_cos - 1u);
-    let fx = x - f32(x0);
-    let fy = y - f32(y0);
-    let top = mix(lut_texel(y0, x0), lut_texel(y0, x1), fx);
-    let bottom = mix(lut_texel(y1, x0), lut_texel(y1, x1), fx);
-    return mix(top, bottom, fy);
-}
+// False for a pipeline specialised to a material with no absorption (tau = 0): the
+// attenuation and the refracted path length are skipped.
+override HAS_ABSORPTION: bool = true;
 
 struct Layers {
     n0: f32,
@@ -70,7 +30,7 @@ fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
 }
 
 fn film_clamped(layers: Layers, c: f32) -> vec3<f32> {
-    return clamp(film_lut(layers.thickness_nm, clamp(c, 0.0, 1.0)), vec3<f32>(0.0), vec3<f32>(1.0));
+    return clamp(film_rgb(layers.thickness_nm, clamp(c, 0.0, 1.0)), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
 fn skin_brdf(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
@@ -106,12 +66,20 @@ fn skin_brdf(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f3
     let ko = (1.0 - eta2) + eta2 * cos_o * cos_o;
     var diffuse = vec3<f32>(0.0);
     if (ki > 0.0 && ko > 0.0) {
-        let path = 1.0 / max(sqrt(ki), COS_MIN) + 1.0 / max(sqrt(ko), COS_MIN);
         let f_i = film_clamped(layers, cos_i);
         let f_o = film_clamped(layers, cos_o);
-        diffuse = (vec3<f32>(1.0) - f_i) * (vec3<f32>(1.0) - f_o)
-            * exp(-max(layers.optical_depth, vec3<f32>(0.0)) * path)
-            * max(layers.albedo, vec3<f32>(0.0)) / PI;
+        diffuse = (vec3<f32>(1.0) - f_i) * (vec3<f32>(1.0) - f_o) * max(layers.albedo, vec3<f32>(0.0)) / PI;
+        if (HAS_ABSORPTION) {
+            let path = 1.0 / max(sqrt(ki), COS_MIN) + 1.0 / max(sqrt(ko), COS_MIN);
+            diffuse *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) * path);
+        }
     }
     return f_h * spec + diffuse;
+}
+
+// The specular lobe alone: stage (c) of the thesis' Fig. 5.12, the isolated film.
+fn skin_specular(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
+    var no_base = layers;
+    no_base.albedo = vec3<f32>(0.0);
+    return skin_brdf(no_base, normal, wi_in, wo_in);
 }

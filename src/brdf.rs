@@ -229,6 +229,9 @@ pub fn run(command: BrdfCommand) -> Result<()> {
 pub fn bench(command: BenchCommand) -> Result<()> {
     match command {
         BenchCommand::Gpu { samples, json } => bench_gpu(samples as usize, json),
+        BenchCommand::Render { preset, size, frames, map_size, reference_size, json } => {
+            crate::render_cmd::bench(&preset, &size, frames, map_size, &reference_size, json)
+        }
         BenchCommand::Irid { json, plot, d_step_nm, angle_step_deg, lut_sweep } => {
             use snakeskin::optics::accuracy::{Prepared, grid, measure, reference_colours};
             use snakeskin::optics::lab::linear_srgb_to_lab;
@@ -306,6 +309,7 @@ fn bench_gpu(count: usize, json: bool) -> Result<()> {
     use snakeskin::optics::brdf::{Layers32, eval_f32};
     use snakeskin::render::Gpu;
     use snakeskin::render::brdf_eval::{GpuSample, eval_timed};
+    use snakeskin::render::film::GpuFilmMethod;
     use std::hint::black_box;
 
     let gpu = Gpu::headless()?;
@@ -337,8 +341,8 @@ fn bench_gpu(count: usize, json: bool) -> Result<()> {
     // median of five such pairs.
     let mut per_million: Vec<f64> = (0..5)
         .map(|_| -> Result<f64> {
-            let (_, one) = eval_timed(&gpu, &lut, &samples, 1)?;
-            let (_, eleven) = eval_timed(&gpu, &lut, &samples, 11)?;
+            let (_, one) = eval_timed(&gpu, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 1)?;
+            let (_, eleven) = eval_timed(&gpu, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 11)?;
             Ok((eleven.as_secs_f64() - one.as_secs_f64()).max(0.0) / 10.0 * 1e3 * 1e6 / count as f64)
         })
         .collect::<Result<_>>()?;

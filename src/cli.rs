@@ -46,6 +46,26 @@ pub enum Command {
         #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u64).range(1..=64))]
         columns: u64,
     },
+    /// Render a preset on a snake body with the multi-layer BRDF: headless to a PNG (--out)
+    /// or in a window with sliders and live reload (--window).
+    Preview(PreviewArgs),
+    /// Render the documentation figures: layer stages (thesis Fig. 5.12), film thickness
+    /// δ0 = 0, 200, 400, 600 nm and 2.4 mm (Figs. 5.5-5.9), absorption σ0 = 0.1 and 0.7
+    /// (Figs. 5.10-5.11).
+    Figures {
+        /// Preset to render (file or built-in name).
+        #[arg(default_value = "erythrolamprus-miliaris")]
+        preset: String,
+        /// Output folder.
+        #[arg(short, long, default_value = "docs/figures", value_name = "DIR")]
+        out: PathBuf,
+        /// Image size WIDTHxHEIGHT.
+        #[arg(long, default_value = "640x400")]
+        size: String,
+        /// Map resolution for the preview (pixels per side).
+        #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
+        map_size: u64,
+    },
     /// List or show the built-in species presets.
     Presets {
         #[command(subcommand)]
@@ -85,6 +105,57 @@ pub struct GenerateArgs {
     /// Print per-node evaluations, time and buffer size after the run.
     #[arg(long)]
     pub stats: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct PreviewArgs {
+    /// A preset: a path to a .toml file, or a built-in name (see `snakeskin presets list`).
+    pub preset: String,
+    /// Override a preset key by dotted path, e.g. `--set optics.film_thickness_nm=600`.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_key_value)]
+    pub overrides: Vec<(String, String)>,
+    /// Override the preset's seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Write the rendered image to this PNG file (headless; no window needed).
+    #[arg(short, long, value_name = "FILE.png")]
+    pub out: Option<PathBuf>,
+    /// Open a window: drag to orbit, wheel to zoom, sliders for the optics; the preset file
+    /// is watched and reloaded on save.
+    #[arg(long)]
+    pub window: bool,
+    /// Image or window size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720")]
+    pub size: String,
+    /// What to show: a layer stage (diffuse, normal, film, all; thesis Fig. 5.12) or one map
+    /// unlit on the body (map:color, map:height, map:normal, map:roughness, map:iridescence).
+    #[arg(long, default_value = "all", value_name = "STAGE")]
+    pub layers: String,
+    /// Film colour method: lut (default), rgb3, spectral-N (e.g. spectral-16), gaussian-fit.
+    #[arg(long, default_value = "lut", value_name = "M")]
+    pub method: String,
+    /// Map resolution for the preview (pixels per side).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
+    pub map_size: u64,
+    /// With --window: render N frames, print the mean frame time and exit.
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// Exposure multiplier before tone mapping (Khronos PBR Neutral).
+    #[arg(long, default_value_t = 1.0)]
+    pub exposure: f32,
+    /// Number of snakes (instanced in a grid).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=400))]
+    pub snakes: u32,
+    /// Hide the ground plane.
+    #[arg(long)]
+    pub no_ground: bool,
+    /// Frame the mid-body closely instead of the whole snake.
+    #[arg(long)]
+    pub close_up: bool,
+    /// Also shade the frame on the CPU with the f64 spectral reference, print mean and p99
+    /// CIEDE2000 against the GPU image, and write the error heat map to this PNG.
+    #[arg(long, value_name = "HEATMAP.png")]
+    pub reference: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -235,6 +306,29 @@ pub struct EvalArgs {
 
 #[derive(Debug, Subcommand)]
 pub enum BenchCommand {
+    /// Frame time of the skin shader against a plain PBR shader on the same scene (GPU
+    /// timestamps where available), the specialised variants, 20 snakes, and the CPU
+    /// reference comparison (mean and p99 CIEDE2000).
+    Render {
+        /// Preset to render.
+        #[arg(default_value = "erythrolamprus-miliaris")]
+        preset: String,
+        /// Frame size WIDTHxHEIGHT (use 1920x1080 on a real GPU).
+        #[arg(long, default_value = "1280x720")]
+        size: String,
+        /// Timed frames per variant (after 3 warm-up frames); the median is reported.
+        #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(3..=10_000))]
+        frames: u64,
+        /// Map resolution (pixels per side).
+        #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
+        map_size: u64,
+        /// Frame size of the CPU reference comparison (the CPU shades each pixel spectrally).
+        #[arg(long, default_value = "480x300")]
+        reference_size: String,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
     /// The BRDF (LUT film) per million evaluations: WGSL compute shader on the GPU and the
     /// Rust f32 twin on one CPU core, side by side in one run.
     Gpu {

@@ -34,12 +34,17 @@ pub enum Error {
     /// An optics query outside what the physics covers (`snakeskin brdf`).
     #[error("invalid query: {0}")]
     Query(String),
+    #[error(transparent)]
+    Gpu(#[from] render::GpuError),
+    /// A preview option outside what the renderer accepts (`snakeskin preview`).
+    #[error("invalid preview option: {0}")]
+    Preview(String),
 }
 
 impl Error {
     /// True when the user's input is at fault (exit code 2), false for I/O trouble.
     pub fn is_invalid_input(&self) -> bool {
-        !matches!(self, Error::Export(_))
+        !matches!(self, Error::Export(_) | Error::Gpu(_))
     }
 }
 

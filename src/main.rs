@@ -3,6 +3,7 @@
 
 mod brdf;
 mod cli;
+mod render_cmd;
 
 use std::io::IsTerminal;
 use std::process::ExitCode;
@@ -86,6 +87,8 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Brdf { command } => brdf::run(command),
         Command::Bench { command } => brdf::bench(command),
+        Command::Preview(args) => render_cmd::preview(args),
+        Command::Figures { preset, out, size, map_size } => render_cmd::figures(&preset, &out, &size, map_size),
         Command::Gallery { out, tile, columns } => {
             snakeskin::gallery::write(&out, tile as usize, columns as usize)?;
             println!("{}", out.display());

@@ -6,10 +6,12 @@
 //! through `GraphBuilder`, which returns ids, so a graph cannot hold a dangling reference:
 //! an input id always names an earlier node, which also makes the node order topological.
 
+mod cache;
 mod dot;
 mod eval;
 mod op;
 
+pub use cache::{CacheStats, NodeCache};
 pub use dot::to_dot;
 pub use eval::{EvalStats, Evaluation, NodeStats, evaluate, evaluate_into};
 pub use op::Op;

@@ -189,7 +189,7 @@ fn bb_sensitivity(c_re: f64, c_im: f64, opd_nm: f64) -> [f64; 3] {
 }
 
 /// D65 white XYZ relative to illuminant E's (1, 1, 1), for the von Kries scaling.
-fn d65_white() -> [f64; 3] {
+pub fn d65_white() -> [f64; 3] {
     static WHITE: OnceLock<[f64; 3]> = OnceLock::new();
     *WHITE.get_or_init(|| Observer::get().white_xyz())
 }

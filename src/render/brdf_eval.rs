@@ -5,7 +5,9 @@
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
+use super::film::{self, FilmBinding, GpuFilmMethod};
 use super::{Gpu, GpuError, shader_programs};
+use crate::optics::film::Stack;
 use crate::optics::brdf::Layers32;
 use crate::optics::lut::Lut;
 
@@ -34,27 +36,21 @@ impl GpuSample {
     }
 }
 
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct LutInfo {
-    n_cos: u32,
-    n_fine: u32,
-    n_coarse: u32,
-    pad: u32,
-}
-
 /// Evaluates the BRDF for every sample with film colours from `lut`; returns linear RGB.
 pub fn eval_on_gpu(gpu: &Gpu, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f32; 3]>, GpuError> {
-    Ok(eval_timed(gpu, lut, samples, 1)?.0)
+    Ok(eval_timed(gpu, Stack::THESIS, lut, GpuFilmMethod::Lut, samples, 1)?.0)
 }
 
-/// Like `eval_on_gpu`, dispatching the evaluation `repeats` times in one submission (same
-/// inputs and outputs); also returns the wall time from submit to results on the CPU.
-/// Two calls with different `repeats` isolate the cost of the evaluations from the fixed
-/// costs of submission and readback.
+/// Evaluates the BRDF for every sample, dispatching the evaluation `repeats` times in one
+/// submission (same inputs and outputs), with film colour by `method` for the material
+/// `stack` (whose LUT is `lut`); also returns the wall time from submit to results on the
+/// CPU. Two calls with different `repeats` isolate the cost of the evaluations from the
+/// fixed costs of submission and readback.
 pub fn eval_timed(
     gpu: &Gpu,
+    stack: Stack,
     lut: &Lut,
+    method: GpuFilmMethod,
     samples: &[GpuSample],
     repeats: u32,
 ) -> Result<(Vec<[f32; 3]>, std::time::Duration), GpuError> {
@@ -64,27 +60,40 @@ pub fn eval_timed(
         label: Some("brdf_eval"),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
+    let film_layout = film::bind_group_layout(device);
+    let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("samples"),
+        entries: &[storage(0, true), storage(1, false)],
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("brdf_eval"),
+        bind_group_layouts: &[Some(&film_layout), Some(&io_layout)],
+        immediate_size: 0,
+    });
+    let constants = [("FILM_METHOD", method.constant())];
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("brdf_eval"),
-        layout: None,
+        layout: Some(&layout),
         module: &module,
         entry_point: Some("eval_samples"),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
         cache: None,
     });
-
-    let info = LutInfo { n_cos: lut.n_cos as u32, n_fine: lut.n_fine as u32, n_coarse: lut.n_coarse as u32, pad: 0 };
-    let texels: Vec<[f32; 4]> = lut.texels.iter().map(|t| [t[0], t[1], t[2], 0.0]).collect();
-    let info_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("lut info"),
-        contents: bytemuck::bytes_of(&info),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let texel_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("lut texels"),
-        contents: bytemuck::cast_slice(&texels),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
+    let n_bands = match method {
+        GpuFilmMethod::SpectralN(n) => n,
+        _ => 1,
+    };
+    let film = FilmBinding::new(device, &film_layout, stack, lut, n_bands);
     let sample_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("samples"),
         contents: bytemuck::cast_slice(samples),
@@ -103,17 +112,9 @@ pub fn eval_timed(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let lut_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("lut"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: info_buffer.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: texel_buffer.as_entire_binding() },
-        ],
-    });
     let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("samples"),
-        layout: &pipeline.get_bind_group_layout(1),
+        layout: &io_layout,
         entries: &[
             wgpu::BindGroupEntry { binding: 0, resource: sample_buffer.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: result_buffer.as_entire_binding() },
@@ -125,7 +126,7 @@ pub fn eval_timed(
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("brdf_eval"), timestamp_writes: None });
         pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &lut_group, &[]);
+        pass.set_bind_group(0, &film.bind_group, &[]);
         pass.set_bind_group(1, &io_group, &[]);
         for _ in 0..repeats.max(1) {
             pass.dispatch_workgroups((samples.len() as u32).div_ceil(64), 1, 1);

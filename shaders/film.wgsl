@@ -1,0 +1,241 @@
+// Film colour F_film(d, cos θ0) as linear sRGB, by the method chosen with the FILM_METHOD
+// override constant: the WGSL twins of optics::lut (0), optics::methods rgb3 (1),
+// spectral-N (2) and gaussian-fit (3), and the plain Fresnel reflectance of n0|n2 for a
+// material without a film (4). A pipeline specialised for one method carries only its code
+// (the constant is resolved before the driver compiles the shader).
+
+override FILM_METHOD: u32 = 0u;
+
+// Thickness axis of the LUT, as optics::lut::FINE_MAX_NM and COARSE_MAX_NM.
+const FINE_MAX_NM: f32 = 2000.0;
+const COARSE_MAX_NM: f32 = 20000.0;
+
+struct FilmInfo {
+    n_cos: u32,
+    n_fine: u32,
+    n_coarse: u32,
+    n_bands: u32,
+    // n0, n1, n2 and the spectral-N band width in nm.
+    iors_band: vec4<f32>,
+    // XYZ (relative to illuminant E) to linear sRGB under D65, rows; for gaussian-fit.
+    xyz_to_rgb: array<vec4<f32>, 3>,
+}
+
+// The per-material film colour table, row-major [cos][thickness], RGB in xyz.
+@group(0) @binding(0) var<uniform> film_info: FilmInfo;
+@group(0) @binding(1) var<storage, read> lut_texels: array<vec4<f32>>;
+// spectral-N: per band (centre nm, then linear-sRGB weights).
+@group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
+
+fn lut_texel(i: u32, j: u32) -> vec3<f32> {
+    return lut_texels[i * (film_info.n_fine + film_info.n_coarse) + j].xyz;
+}
+
+// Film colour at thickness d (nm) and incidence cosine c: bilinear in the table.
+fn film_lut(thickness_nm: f32, cos0: f32) -> vec3<f32> {
+    let d = max(thickness_nm, 0.0);
+    let fine_step = FINE_MAX_NM / f32(film_info.n_fine - 1u);
+    let coarse_step = (COARSE_MAX_NM - FINE_MAX_NM) / f32(film_info.n_coarse);
+    var x: f32;
+    if (d <= FINE_MAX_NM) {
+        x = d / fine_step;
+    } else {
+        x = f32(film_info.n_fine - 1u) + (d - FINE_MAX_NM) / coarse_step;
+    }
+    let w = film_info.n_fine + film_info.n_coarse;
+    x = min(x, f32(w - 1u));
+    let y = clamp(cos0, 0.0, 1.0) * f32(film_info.n_cos - 1u);
+    let x0 = u32(x);
+    let y0 = u32(y);
+    let x1 = min(x0 + 1u, w - 1u);
+    let y1 = min(y0 + 1u, film_info.n_cos - 1u);
+    let fx = x - f32(x0);
+    let fy = y - f32(y0);
+    let top = mix(lut_texel(y0, x0), lut_texel(y0, x1), fx);
+    let bottom = mix(lut_texel(y1, x0), lut_texel(y1, x1), fx);
+    return mix(top, bottom, fy);
+}
+
+// ---- Complex arithmetic on vec2 (re, im), as optics::fast. ----
+
+fn cmul(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
+}
+
+fn cdiv(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    let d = dot(b, b);
+    return vec2<f32>((a.x * b.x + a.y * b.y) / d, (a.y * b.x - a.x * b.y) / d);
+}
+
+fn csqrt_real(x: f32) -> vec2<f32> {
+    if (x >= 0.0) {
+        return vec2<f32>(sqrt(x), 0.0);
+    }
+    return vec2<f32>(0.0, sqrt(-x));
+}
+
+fn cln(a: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(0.5 * log(dot(a, a)), atan2(a.y, a.x));
+}
+
+// Fourier coefficients of one polarisation (optics::fast::Harmonics32).
+struct Harmonics {
+    c0: f32,
+    d: vec2<f32>,
+    q: vec2<f32>,
+}
+
+struct Film {
+    s: Harmonics,
+    p: Harmonics,
+    cos1: f32,
+}
+
+fn harmonics(a: vec2<f32>, b: vec2<f32>) -> Harmonics {
+    let q = -cmul(a, b);
+    let k = cmul(b, vec2<f32>(1.0, 0.0) - cmul(a, a));
+    let k2 = dot(k, k);
+    let inv = 1.0 / max(1.0 - dot(q, q), 1e-6);
+    return Harmonics(dot(a, a) + k2 * inv, cmul(k, vec2<f32>(a.x, -a.y)) + q * (k2 * inv), q);
+}
+
+fn cos_in(eta: f32, cos0: f32) -> vec2<f32> {
+    return csqrt_real((1.0 - eta * eta) + eta * eta * cos0 * cos0);
+}
+
+fn r_s(ni: f32, ci: vec2<f32>, nj: f32, cj: vec2<f32>) -> vec2<f32> {
+    return cdiv(ci * ni - cj * nj, ci * ni + cj * nj);
+}
+
+fn r_p(ni: f32, ci: vec2<f32>, nj: f32, cj: vec2<f32>) -> vec2<f32> {
+    return cdiv(ci * nj - cj * ni, ci * nj + cj * ni);
+}
+
+fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
+    let cos0 = clamp(cos0_in, 0.0, 1.0);
+    let c0 = vec2<f32>(cos0, 0.0);
+    let c1 = cos_in(n0 / n1, cos0);
+    let c2 = cos_in(n0 / n2, cos0);
+    let s = harmonics(r_s(n0, c0, n1, c1), r_s(n1, c1, n2, c2));
+    let p = harmonics(r_p(n0, c0, n1, c1), r_p(n1, c1, n2, c2));
+    var cos1 = 0.0;
+    if (c1.y == 0.0) {
+        cos1 = c1.x;
+    }
+    return Film(s, p, cos1);
+}
+
+fn sinc(x: f32) -> f32 {
+    if (abs(x) < 1e-4) {
+        return 1.0;
+    }
+    return sin(x) / x;
+}
+
+// The box-prefiltered series in closed form (optics::fast::series).
+fn series(h: Harmonics, phase: f32, box_width: f32) -> f32 {
+    let z = vec2<f32>(cos(phase), sin(phase));
+    let one = vec2<f32>(1.0, 0.0);
+    var mean: vec2<f32>;
+    if (box_width < 1e-3) {
+        mean = cdiv(cmul(h.d, z), one - cmul(h.q, z));
+    } else if (dot(h.q, h.q) < 1e-12) {
+        mean = cmul(h.d, z) * sinc(0.5 * box_width);
+    } else {
+        let half = 0.5 * box_width;
+        let upper = cln(one - cmul(h.q, vec2<f32>(cos(phase + half), sin(phase + half))));
+        let lower = cln(one - cmul(h.q, vec2<f32>(cos(phase - half), sin(phase - half))));
+        mean = cmul(vec2<f32>(0.0, 1.0), cdiv(cmul(h.d, upper - lower), h.q)) * (1.0 / box_width);
+    }
+    return clamp(h.c0 + 2.0 * mean.x, 0.0, 1.0);
+}
+
+fn band_reflectance(f: Film, n1: f32, thickness_nm: f32, wavelength_nm: f32, band_nm: f32) -> f32 {
+    let phase = 4.0 * PI * n1 * thickness_nm * f.cos1 / wavelength_nm;
+    let box_width = phase * band_nm / wavelength_nm;
+    return 0.5 * (series(f.s, phase, box_width) + series(f.p, phase, box_width));
+}
+
+// rgb3: 650 / 550 / 450 nm, each prefiltered over 100 nm (optics::methods::RGB3_NM).
+fn film_rgb3(thickness_nm: f32, cos0: f32) -> vec3<f32> {
+    let n = film_info.iors_band;
+    let f = film_coefficients(n.x, n.y, n.z, cos0);
+    return vec3<f32>(
+        band_reflectance(f, n.y, thickness_nm, 650.0, 100.0),
+        band_reflectance(f, n.y, thickness_nm, 550.0, 100.0),
+        band_reflectance(f, n.y, thickness_nm, 450.0, 100.0),
+    );
+}
+
+fn film_spectral_n(thickness_nm: f32, cos0: f32) -> vec3<f32> {
+    let n = film_info.iors_band;
+    let f = film_coefficients(n.x, n.y, n.z, cos0);
+    var rgb = vec3<f32>(0.0);
+    for (var i = 0u; i < film_info.n_bands; i++) {
+        let band = bands[i];
+        rgb += band_reflectance(f, n.y, thickness_nm, band.x, n.w) * band.yzw;
+    }
+    return rgb;
+}
+
+// Belcour & Barla (2017) Gaussian fits, as optics::methods (BB_VAL, BB_POS, BB_VAR, BB_X2,
+// BB_NORM; three harmonics).
+fn bb_lobe(val: f32, pos: f32, var_: f32, phase: f32, arg: f32) -> f32 {
+    return val * sqrt(2.0 * PI * var_) / 1.0685e-7 * cos(pos * phase + arg) * exp(-var_ * phase * phase);
+}
+
+fn film_gaussian_fit(thickness_nm: f32, cos0: f32) -> vec3<f32> {
+    let n = film_info.iors_band;
+    let f = film_coefficients(n.x, n.y, n.z, cos0);
+    let opd = 2.0 * n.y * thickness_nm * f.cos1;
+    var xyz = vec3<f32>(0.5 * (f.s.c0 + f.p.c0));
+    for (var pol = 0u; pol < 2u; pol++) {
+        var h = f.s;
+        if (pol == 1u) {
+            h = f.p;
+        }
+        var c = h.d;
+        for (var m = 1u; m <= 3u; m++) {
+            let phase = 2.0 * PI * (f32(m) * opd) * 1e-9;
+            let mag = length(c);
+            let arg = atan2(c.y, c.x);
+            xyz.x += mag * (bb_lobe(5.4856e-13, 1.6810e+06, 4.3278e+09, phase, arg)
+                + bb_lobe(9.7470e-14, 2.2399e+06, 4.5282e+09, phase, arg));
+            xyz.y += mag * bb_lobe(4.4201e-13, 1.7953e+06, 9.3046e+09, phase, arg);
+            xyz.z += mag * bb_lobe(5.2481e-13, 2.2084e+06, 6.6121e+09, phase, arg);
+            c = cmul(c, h.q);
+        }
+    }
+    let m = film_info.xyz_to_rgb;
+    return vec3<f32>(dot(m[0].xyz, xyz), dot(m[1].xyz, xyz), dot(m[2].xyz, xyz));
+}
+
+// Unpolarised Fresnel reflectance of the n0|n2 interface (no film), grey.
+fn film_none(cos0: f32) -> vec3<f32> {
+    let n = film_info.iors_band;
+    let c0 = vec2<f32>(clamp(cos0, 0.0, 1.0), 0.0);
+    let c2 = cos_in(n.x / n.z, c0.x);
+    let rs = r_s(n.x, c0, n.z, c2);
+    let rp = r_p(n.x, c0, n.z, c2);
+    return vec3<f32>(0.5 * (dot(rs, rs) + dot(rp, rp)));
+}
+
+fn film_rgb(thickness_nm: f32, cos0: f32) -> vec3<f32> {
+    switch FILM_METHOD {
+        case 1u: {
+            return film_rgb3(thickness_nm, cos0);
+        }
+        case 2u: {
+            return film_spectral_n(thickness_nm, cos0);
+        }
+        case 3u: {
+            return film_gaussian_fit(thickness_nm, cos0);
+        }
+        case 4u: {
+            return film_none(cos0);
+        }
+        default: {
+            return film_lut(thickness_nm, cos0);
+        }
+    }
+}

@@ -1,0 +1,131 @@
+// The skin pass: the multi-layer BRDF (brdf.wgsl) under the scene's lights, a layer stage or
+// a single map on the body, and the G-buffer the CPU reference shades
+// (src/render/reference.rs is this file's CPU twin: keep the two in step).
+
+// Layer stages of the thesis' Fig. 5.12: 0 = diffuse only, 1 = diffuse + normal map,
+// 2 = the thin film alone, 3 = all layers.
+override STAGE: u32 = 3u;
+// 0 = shade; 1..5 = show the color, height, normal, roughness or iridescence map unlit.
+override VIEW_MAP: u32 = 0u;
+// Which half of the G-buffer fs_gbuffer writes (two passes keep each under 32 bytes/pixel).
+override GBUFFER_PART: u32 = 0u;
+
+fn layers_of(m: Material) -> Layers {
+    return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, scene.optical_depth.rgb, m.albedo);
+}
+
+// Ambient light from the sky gradient, the same formula as reference::ambient: the sky
+// seen along the normal enters the pigment layer through the film (1 - F at the view angle)
+// and is attenuated along the view path plus one layer thickness; the sky seen along the
+// mirror direction is reflected by the film.
+fn ambient(m: Material, n: vec3<f32>, wo: vec3<f32>, with_diffuse: bool, with_film: bool) -> vec3<f32> {
+    let cos_o = max(dot(n, wo), COS_MIN);
+    let f_o = clamp(film_rgb(m.thickness_nm, cos_o), vec3<f32>(0.0), vec3<f32>(1.0));
+    var result = vec3<f32>(0.0);
+    if (with_film) {
+        result += sky(reflect(-wo, n)) * f_o;
+    }
+    if (with_diffuse) {
+        var base = sky(n) * (vec3<f32>(1.0) - f_o) * m.albedo;
+        if (HAS_ABSORPTION) {
+            let eta = scene.film.z / scene.film.w;
+            let k = (1.0 - eta * eta) + eta * eta * cos_o * cos_o;
+            let path = 1.0 / max(sqrt(max(k, 0.0)), COS_MIN) + 1.0;
+            base *= exp(-max(scene.optical_depth.rgb, vec3<f32>(0.0)) * path);
+        }
+        result += base;
+    }
+    return result;
+}
+
+fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
+    let wo = normalize(scene.camera.xyz - world);
+    var radiance = vec3<f32>(0.0);
+    if (STAGE <= 1u) {
+        var n = m.normal;
+        if (STAGE == 0u) {
+            n = m.geometric;
+        }
+        for (var i = 0u; i < 2u; i++) {
+            let wi = scene.light_dir[i].xyz;
+            radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * m.albedo / PI * max(dot(n, wi), 0.0);
+        }
+        return radiance + sky(n) * m.albedo;
+    }
+    let layers = layers_of(m);
+    for (var i = 0u; i < 2u; i++) {
+        let wi = scene.light_dir[i].xyz;
+        let cos_i = max(dot(m.normal, wi), 0.0);
+        var f: vec3<f32>;
+        if (STAGE == 2u) {
+            f = skin_specular(layers, m.normal, wi, wo);
+        } else {
+            f = skin_brdf(layers, m.normal, wi, wo);
+        }
+        radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * f * cos_i;
+    }
+    return radiance + ambient(m, m.normal, wo, STAGE == 3u, true);
+}
+
+fn map_view(m: Material) -> vec3<f32> {
+    switch VIEW_MAP {
+        case 1u: {
+            return m.albedo;
+        }
+        case 2u: {
+            return vec3<f32>(m.height);
+        }
+        case 3u: {
+            return m.map_normal * 0.5 + vec3<f32>(0.5);
+        }
+        case 4u: {
+            return vec3<f32>(m.roughness);
+        }
+        default: {
+            return vec3<f32>(m.map_value);
+        }
+    }
+}
+
+@fragment
+fn fs_skin(in: VertexOut) -> @location(0) vec4<f32> {
+    let m = sample_material(in);
+    if (VIEW_MAP != 0u) {
+        return vec4<f32>(map_view(m), 1.0);
+    }
+    return vec4<f32>(shade(m, in.world), 1.0);
+}
+
+struct GBuffer {
+    @location(0) first: vec4<f32>,
+    @location(1) second: vec4<f32>,
+}
+
+// Part 0: (world position, thickness nm), (shading normal, roughness).
+// Part 1: (albedo, 1 = covered), (geometric normal, 0).
+@fragment
+fn fs_gbuffer(in: VertexOut) -> GBuffer {
+    let m = sample_material(in);
+    var out: GBuffer;
+    if (GBUFFER_PART == 0u) {
+        out.first = vec4<f32>(in.world, m.thickness_nm);
+        out.second = vec4<f32>(m.normal, m.roughness);
+    } else {
+        out.first = vec4<f32>(m.albedo, 1.0);
+        out.second = vec4<f32>(m.geometric, 0.0);
+    }
+    return out;
+}
+
+// The ground: a grey Lambertian floor under the same lights and sky.
+@fragment
+fn fs_ground(in: VertexOut) -> @location(0) vec4<f32> {
+    let n = vec3<f32>(0.0, 1.0, 0.0);
+    let checker = select(0.07, 0.09, (i32(floor(in.uv.x * 2.0)) + i32(floor(in.uv.y * 2.0))) % 2 == 0);
+    var radiance = sky(n) * checker;
+    for (var i = 0u; i < 2u; i++) {
+        let wi = scene.light_dir[i].xyz;
+        radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * checker / PI * max(dot(n, wi), 0.0);
+    }
+    return vec4<f32>(radiance, 1.0);
+}

@@ -1,0 +1,197 @@
+//! `snakeskin bench render`: GPU time of the skin shader against a plain metal-roughness PBR
+//! shader on the same mesh, maps and view, in one run, plus the specialised variants (no
+//! film, no absorption), the other film methods, twenty snakes, and the CPU reference check.
+//!
+//! Timing: GPU timestamps around the scene pass where the adapter offers them (lavapipe does),
+//! otherwise wall time around submit + wait; the median over many frames after warm-up, since
+//! shared machines are noisy. The tone-mapping pass is the same for every variant and is not
+//! in the scene-pass time.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::film::GpuFilmMethod;
+use super::preview::{bands_for, material_maps, reference_check};
+use super::renderer::{FrameSettings, Material, OUTPUT_FORMAT, Renderer};
+use super::scene::LayerOptics;
+use crate::Error;
+use crate::optics::lut::Lut;
+use crate::preset::LoadedPreset;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct VariantTiming {
+    pub name: String,
+    pub snakes: u32,
+    pub median_ms: f64,
+    pub p10_ms: f64,
+    pub p90_ms: f64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct RenderBench {
+    pub adapter: String,
+    pub timing: &'static str,
+    pub width: u32,
+    pub height: u32,
+    pub frames: usize,
+    pub skin_ms: f64,
+    pub plain_ms: f64,
+    pub ratio: f64,
+    pub skin_20_ms: f64,
+    pub plain_20_ms: f64,
+    pub variants: Vec<VariantTiming>,
+    pub reference_width: u32,
+    pub reference_height: u32,
+    pub reference_mean_de: f64,
+    pub reference_p99_de: f64,
+    pub reference_max_de: f64,
+    pub reference_pixels: usize,
+}
+
+pub struct BenchOptions {
+    pub width: u32,
+    pub height: u32,
+    pub frames: usize,
+    pub map_size: usize,
+    pub reference_size: (u32, u32),
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
+}
+
+/// Median scene-pass time of `frames` frames (after 3 warm-up frames).
+fn time_frames(
+    renderer: &Renderer,
+    settings: &FrameSettings,
+    material: &Material,
+    options: &BenchOptions,
+) -> Result<(f64, f64, f64, &'static str), Error> {
+    let device = &renderer.gpu.device;
+    let queue = &renderer.gpu.queue;
+    let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+    let targets = renderer.targets(options.width, options.height, settings.samples);
+    let output = renderer.output_texture(options.width, options.height);
+    let view = output.create_view(&wgpu::TextureViewDescriptor::default());
+    let query_set = timestamps.then(|| {
+        device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("frame"),
+            ty: wgpu::QueryType::Timestamp,
+            count: 2,
+        })
+    });
+    let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("timestamps"),
+        size: 16,
+        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("timestamps readback"),
+        size: 16,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let period_ns = queue.get_timestamp_period() as f64;
+    let mut samples = Vec::with_capacity(options.frames);
+    for frame in 0..options.frames + 3 {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        renderer.encode_frame(
+            &mut encoder,
+            &targets,
+            settings,
+            material,
+            &view,
+            OUTPUT_FORMAT,
+            query_set.as_ref().map(|q| (q, 0)),
+        );
+        if let Some(q) = &query_set {
+            encoder.resolve_query_set(q, 0..2, &resolve, 0);
+            encoder.copy_buffer_to_buffer(&resolve, 0, &readback, 0, 16);
+        }
+        let start = Instant::now();
+        queue.submit([encoder.finish()]);
+        let ms = if query_set.is_some() {
+            let data = super::renderer::map_read(device, &readback)?;
+            let ticks: &[u64] = bytemuck::cast_slice(&data);
+            ticks[1].saturating_sub(ticks[0]) as f64 * period_ns * 1e-6
+        } else {
+            device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| Error::Gpu(super::GpuError::Readback(e.to_string())))?;
+            start.elapsed().as_secs_f64() * 1e3
+        };
+        if frame >= 3 {
+            samples.push(ms);
+        }
+    }
+    samples.sort_by(f64::total_cmp);
+    let timing = if timestamps { "gpu-timestamp" } else { "wall" };
+    Ok((percentile(&samples, 0.5), percentile(&samples, 0.1), percentile(&samples, 0.9), timing))
+}
+
+/// Runs the whole benchmark for one preset.
+pub fn bench_render(
+    renderer: &Renderer,
+    loaded: &LoadedPreset,
+    options: &BenchOptions,
+    progress: &dyn Fn(&str),
+) -> Result<RenderBench, Error> {
+    let maps = material_maps(loaded, options.map_size)?;
+    let optics = LayerOptics::from_preset(&loaded.preset);
+    let lut = Lut::bake_default(optics.stack);
+    let base = FrameSettings { ground: false, ..FrameSettings::default() };
+    let no_film = LayerOptics { thickness_range_nm: (0.0, 0.0), ..optics };
+    let no_absorption = LayerOptics { optical_depth: [0.0; 3], ..optics };
+    let variants: Vec<(String, LayerOptics, GpuFilmMethod, bool)> = vec![
+        ("plain-pbr".into(), optics, GpuFilmMethod::Lut, true),
+        ("skin-lut".into(), optics, GpuFilmMethod::Lut, false),
+        ("skin-no-film".into(), no_film, GpuFilmMethod::Lut, false),
+        ("skin-no-absorption".into(), no_absorption, GpuFilmMethod::Lut, false),
+        ("skin-rgb3".into(), optics, GpuFilmMethod::Rgb3, false),
+        ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false),
+        ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false),
+    ];
+    let mut timings = Vec::new();
+    let mut timing_kind = "wall";
+    for snakes in [1u32, 20] {
+        for (name, variant_optics, method, plain) in &variants {
+            if snakes == 20 && !matches!(name.as_str(), "plain-pbr" | "skin-lut") {
+                continue;
+            }
+            progress(&format!("{name}, {snakes} snake(s)"));
+            let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method));
+            let settings = FrameSettings { method: *method, plain: *plain, snakes, ..base };
+            let (median, p10, p90, kind) = time_frames(renderer, &settings, &material, options)?;
+            timing_kind = kind;
+            timings.push(VariantTiming { name: name.clone(), snakes, median_ms: median, p10_ms: p10, p90_ms: p90 });
+        }
+    }
+    let find = |name: &str, snakes: u32| {
+        timings.iter().find(|t| t.name == name && t.snakes == snakes).map(|t| t.median_ms).unwrap_or(f64::NAN)
+    };
+    progress("reference comparison");
+    let material = renderer.material(&maps, optics, &lut, 1);
+    let (w, h) = options.reference_size;
+    let (report, _) = reference_check(renderer, &material, &base, w, h)?;
+    Ok(RenderBench {
+        adapter: renderer.gpu.describe(),
+        timing: timing_kind,
+        width: options.width,
+        height: options.height,
+        frames: options.frames,
+        skin_ms: find("skin-lut", 1),
+        plain_ms: find("plain-pbr", 1),
+        ratio: find("skin-lut", 1) / find("plain-pbr", 1),
+        skin_20_ms: find("skin-lut", 20),
+        plain_20_ms: find("plain-pbr", 20),
+        variants: timings,
+        reference_width: w,
+        reference_height: h,
+        reference_mean_de: report.mean_de,
+        reference_p99_de: report.p99_de,
+        reference_max_de: report.max_de,
+        reference_pixels: report.pixels,
+    })
+}

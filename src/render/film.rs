@@ -1,0 +1,155 @@
+//! The film's GPU resources: one bind group (group 0 of every shading program) holding the
+//! material's indices, its baked colour LUT and the spectral-N band table, so that every film
+//! method in `shaders/film.wgsl` reads the same inputs and a method switch is only a pipeline
+//! switch. The LUT is a storage buffer read with a manual bilinear lookup (not a filtered
+//! texture) because its thickness axis is piecewise (fine, then coarse) and because RGBA32F
+//! textures are not filterable everywhere; the lookup is the exact twin of `Lut::lookup_f32`.
+
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+use crate::optics::film::Stack;
+use crate::optics::lut::Lut;
+use crate::optics::methods::{Bands, Method, d65_white};
+use crate::optics::spectrum::XYZ_TO_SRGB;
+
+/// How `film.wgsl` computes the film colour (its `FILM_METHOD` override constant).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum GpuFilmMethod {
+    Lut,
+    Rgb3,
+    SpectralN(usize),
+    GaussianFit,
+    /// No film: the Fresnel reflectance of the n0|n2 interface.
+    None,
+}
+
+impl GpuFilmMethod {
+    /// The GPU form of an optics method; the 1 nm reference becomes 421 one-nanometre bands.
+    pub fn from_method(method: Method) -> GpuFilmMethod {
+        match method {
+            Method::Lut => GpuFilmMethod::Lut,
+            Method::Rgb3 => GpuFilmMethod::Rgb3,
+            Method::SpectralN(n) => GpuFilmMethod::SpectralN(n),
+            Method::Spectral => GpuFilmMethod::SpectralN(421),
+            Method::GaussianFit => GpuFilmMethod::GaussianFit,
+        }
+    }
+
+    pub fn constant(self) -> f64 {
+        match self {
+            GpuFilmMethod::Lut => 0.0,
+            GpuFilmMethod::Rgb3 => 1.0,
+            GpuFilmMethod::SpectralN(_) => 2.0,
+            GpuFilmMethod::GaussianFit => 3.0,
+            GpuFilmMethod::None => 4.0,
+        }
+    }
+
+    pub fn name(self) -> String {
+        match self {
+            GpuFilmMethod::Lut => "lut".into(),
+            GpuFilmMethod::Rgb3 => "rgb3".into(),
+            GpuFilmMethod::SpectralN(n) => format!("spectral-{n}"),
+            GpuFilmMethod::GaussianFit => "gaussian-fit".into(),
+            GpuFilmMethod::None => "none".into(),
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct FilmInfo {
+    n_cos: u32,
+    n_fine: u32,
+    n_coarse: u32,
+    n_bands: u32,
+    iors_band: [f32; 4],
+    xyz_to_rgb: [[f32; 4]; 3],
+}
+
+/// The bind group layout of `film.wgsl`'s group 0.
+pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+    let storage = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("film"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            storage(1),
+            storage(2),
+        ],
+    })
+}
+
+/// A material's film on the GPU: its bind group and what it was made from.
+pub struct FilmBinding {
+    pub stack: Stack,
+    pub n_bands: usize,
+    pub bind_group: wgpu::BindGroup,
+}
+
+impl FilmBinding {
+    /// Uploads `lut` (baked for `stack`) and the band table for `n_bands` (1 if unused).
+    pub fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        stack: Stack,
+        lut: &Lut,
+        n_bands: usize,
+    ) -> FilmBinding {
+        let bands = Bands::cached(n_bands.max(1));
+        let white = d65_white();
+        let xyz_to_rgb =
+            XYZ_TO_SRGB.map(|row| [row[0] * white[0], row[1] * white[1], row[2] * white[2], 0.0].map(|v| v as f32));
+        let info = FilmInfo {
+            n_cos: lut.n_cos as u32,
+            n_fine: lut.n_fine as u32,
+            n_coarse: lut.n_coarse as u32,
+            n_bands: bands.centres_nm.len() as u32,
+            iors_band: [stack.n0 as f32, stack.n1 as f32, stack.n2 as f32, bands.width_nm as f32],
+            xyz_to_rgb,
+        };
+        let texels: Vec<[f32; 4]> = lut.texels.iter().map(|t| [t[0], t[1], t[2], 0.0]).collect();
+        let band_table: Vec<[f32; 4]> = bands
+            .centres_nm
+            .iter()
+            .zip(&bands.rgb_weights)
+            .map(|(c, w)| [*c as f32, w[0] as f32, w[1] as f32, w[2] as f32])
+            .collect();
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let info_buffer = buffer("film info", bytemuck::bytes_of(&info), wgpu::BufferUsages::UNIFORM);
+        let lut_buffer = buffer("film lut", bytemuck::cast_slice(&texels), wgpu::BufferUsages::STORAGE);
+        let band_buffer = buffer("film bands", bytemuck::cast_slice(&band_table), wgpu::BufferUsages::STORAGE);
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("film"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: info_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: lut_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: band_buffer.as_entire_binding() },
+            ],
+        });
+        FilmBinding { stack, n_bands: bands.centres_nm.len(), bind_group }
+    }
+}

@@ -1,0 +1,262 @@
+//! The five maps as GPU textures. The renderer takes the generator's f32 maps directly (no PNG
+//! round trip) and packs them into three filterable half-float textures with a full mip
+//! chain built on the CPU (2×2 box, colour averaged in linear light), so distant scales
+//! average instead of shimmering:
+//! `albedo_roughness` (linear colour, perceptual roughness), `normal_height` (tangent-space
+//! normal in [-1, 1], height), `thickness` (iridescence map value in [0, 1]).
+
+use std::collections::BTreeMap;
+
+use crate::maps::MapKind;
+use crate::ops::Image;
+
+/// The maps a preview needs, as packed RGBA f32 levels (level 0 first).
+#[derive(Debug, Clone)]
+pub struct MaterialMaps {
+    pub width: usize,
+    pub height: usize,
+    pub albedo_roughness: Vec<Vec<[f32; 4]>>,
+    pub normal_height: Vec<Vec<[f32; 4]>>,
+    pub thickness: Vec<Vec<f32>>,
+}
+
+#[derive(Debug, thiserror::Error)]
+#[error("the preview needs the {0} map")]
+pub struct MissingMap(pub MapKind);
+
+impl MaterialMaps {
+    /// Packs generator output (all five maps, the same size).
+    pub fn from_maps(maps: &BTreeMap<MapKind, Image>) -> Result<MaterialMaps, MissingMap> {
+        let get = |kind| maps.get(&kind).ok_or(MissingMap(kind));
+        let (color, height, normal, rough, irid) = (
+            get(MapKind::Color)?,
+            get(MapKind::Height)?,
+            get(MapKind::Normal)?,
+            get(MapKind::Roughness)?,
+            get(MapKind::Iridescence)?,
+        );
+        let (w, h) = (color.width, color.height);
+        let px = |img: &Image, i: usize, c: usize| img.data[i * img.channels + c];
+        let ar: Vec<[f32; 4]> =
+            (0..w * h).map(|i| [px(color, i, 0), px(color, i, 1), px(color, i, 2), px(rough, i, 0)]).collect();
+        let nh: Vec<[f32; 4]> =
+            (0..w * h).map(|i| [px(normal, i, 0), px(normal, i, 1), px(normal, i, 2), px(height, i, 0)]).collect();
+        let t: Vec<f32> = (0..w * h).map(|i| px(irid, i, 0)).collect();
+        Ok(MaterialMaps {
+            width: w,
+            height: h,
+            albedo_roughness: mip_chain(ar, w, h),
+            normal_height: mip_chain(nh, w, h),
+            thickness: mip_chain(t, w, h),
+        })
+    }
+
+    pub fn levels(&self) -> usize {
+        self.thickness.len()
+    }
+}
+
+/// Anything a 2×2 box filter can average.
+pub trait Texel: Copy + Default {
+    fn average(a: Self, b: Self, c: Self, d: Self) -> Self;
+}
+
+impl Texel for f32 {
+    fn average(a: f32, b: f32, c: f32, d: f32) -> f32 {
+        0.25 * (a + b + c + d)
+    }
+}
+
+impl Texel for [f32; 4] {
+    fn average(a: Self, b: Self, c: Self, d: Self) -> Self {
+        [0, 1, 2, 3].map(|k| 0.25 * (a[k] + b[k] + c[k] + d[k]))
+    }
+}
+
+/// Level 0 and every halving down to 1×1; odd sizes drop their last row or column.
+pub fn mip_chain<T: Texel>(level0: Vec<T>, width: usize, height: usize) -> Vec<Vec<T>> {
+    let mut levels = vec![level0];
+    let (mut w, mut h) = (width, height);
+    while w > 1 || h > 1 {
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let src = levels.last().expect("level 0");
+        let at = |x: usize, y: usize| src[y.min(h - 1) * w + x.min(w - 1)];
+        let mut next = Vec::with_capacity(nw * nh);
+        for y in 0..nh {
+            for x in 0..nw {
+                next.push(T::average(at(2 * x, 2 * y), at(2 * x + 1, 2 * y), at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)));
+            }
+        }
+        levels.push(next);
+        (w, h) = (nw, nh);
+    }
+    levels
+}
+
+fn half(v: f32) -> u16 {
+    f32_to_f16(v)
+}
+
+/// IEEE 754 binary16 from f32, round to nearest even; overflow to infinity (maps never get
+/// near 65504).
+pub fn f32_to_f16(value: f32) -> u16 {
+    let bits = value.to_bits();
+    let sign = ((bits >> 16) & 0x8000) as u16;
+    let exp = ((bits >> 23) & 0xff) as i32;
+    let mantissa = bits & 0x7f_ffff;
+    if exp == 0xff {
+        return sign | 0x7c00 | if mantissa != 0 { 0x200 } else { 0 };
+    }
+    let e = exp - 127 + 15;
+    if e >= 0x1f {
+        return sign | 0x7c00;
+    }
+    if e <= 0 {
+        if e < -10 {
+            return sign;
+        }
+        let m = (mantissa | 0x80_0000) >> (1 - e);
+        let round = ((m & 0x1fff) > 0x1000 || ((m & 0x1fff) == 0x1000 && (m & 0x2000) != 0)) as u32;
+        return sign | ((m >> 13) + round) as u16;
+    }
+    let round = ((mantissa & 0x1fff) > 0x1000 || ((mantissa & 0x1fff) == 0x1000 && (mantissa & 0x2000) != 0)) as u32;
+    let out = ((e as u32) << 10 | (mantissa >> 13)) + round;
+    sign | out as u16
+}
+
+/// The material's textures and the bind group (group 2 of the scene programs).
+pub struct MaterialTextures {
+    pub bind_group: wgpu::BindGroup,
+    _textures: [wgpu::Texture; 3],
+}
+
+pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let texture = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("material"),
+        entries: &[
+            texture(0),
+            texture(1),
+            texture(2),
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ],
+    })
+}
+
+impl MaterialTextures {
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        layout: &wgpu::BindGroupLayout,
+        maps: &MaterialMaps,
+    ) -> MaterialTextures {
+        let levels = maps.levels() as u32;
+        let make = |label, format| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: maps.width as u32, height: maps.height as u32, depth_or_array_layers: 1 },
+                mip_level_count: levels,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            })
+        };
+        let ar = make("albedo_roughness", wgpu::TextureFormat::Rgba16Float);
+        let nh = make("normal_height", wgpu::TextureFormat::Rgba16Float);
+        let th = make("thickness", wgpu::TextureFormat::R16Float);
+        let (mut w, mut h) = (maps.width, maps.height);
+        for level in 0..levels as usize {
+            let upload = |texture: &wgpu::Texture, data: Vec<u16>, texel_bytes: usize| {
+                queue.write_texture(
+                    wgpu::TexelCopyTextureInfo {
+                        texture,
+                        mip_level: level as u32,
+                        origin: wgpu::Origin3d::ZERO,
+                        aspect: wgpu::TextureAspect::All,
+                    },
+                    bytemuck::cast_slice(&data),
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some((w * texel_bytes) as u32),
+                        rows_per_image: Some(h as u32),
+                    },
+                    wgpu::Extent3d { width: w as u32, height: h as u32, depth_or_array_layers: 1 },
+                );
+            };
+            upload(&ar, maps.albedo_roughness[level].iter().flat_map(|t| t.map(half)).collect(), 8);
+            upload(&nh, maps.normal_height[level].iter().flat_map(|t| t.map(half)).collect(), 8);
+            upload(&th, maps.thickness[level].iter().map(|t| half(*t)).collect(), 2);
+            (w, h) = ((w / 2).max(1), (h / 2).max(1));
+        }
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("maps"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            address_mode_w: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            anisotropy_clamp: 8,
+            ..Default::default()
+        });
+        let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+        let (v0, v1, v2) = (view(&ar), view(&nh), view(&th));
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("material"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&v0) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&v1) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&v2) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&sampler) },
+            ],
+        });
+        MaterialTextures { bind_group, _textures: [ar, nh, th] }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_floats_round_trip_known_values() {
+        // Reference bit patterns from IEEE 754 binary16.
+        assert_eq!(f32_to_f16(0.0), 0x0000);
+        assert_eq!(f32_to_f16(1.0), 0x3c00);
+        assert_eq!(f32_to_f16(-2.0), 0xc000);
+        assert_eq!(f32_to_f16(0.5), 0x3800);
+        assert_eq!(f32_to_f16(65504.0), 0x7bff);
+        assert_eq!(f32_to_f16(1e6), 0x7c00);
+        // Smallest subnormal 2^-24.
+        assert_eq!(f32_to_f16(5.960_464_5e-8), 0x0001);
+        // 1/3 rounds to 0x3555.
+        assert_eq!(f32_to_f16(1.0 / 3.0), 0x3555);
+    }
+
+    #[test]
+    fn mip_chain_preserves_the_mean() {
+        let level0: Vec<f32> = (0..64 * 32).map(|i| (i % 7) as f32).collect();
+        let mean0 = level0.iter().sum::<f32>() / level0.len() as f32;
+        let chain = mip_chain(level0, 64, 32);
+        assert_eq!(chain.len(), 7);
+        assert_eq!(chain.last().unwrap().len(), 1);
+        assert!((chain.last().unwrap()[0] - mean0).abs() < 1e-4);
+    }
+}

@@ -1,0 +1,270 @@
+//! The procedural snake body: a tube swept along a smooth S-curve on the ground, tapering to
+//! a rounded head and a pointed tail, closed at both ends, with UVs in the texture-space
+//! convention of DESIGN.md (u around the body, seam on the belly; v along it, head to tail).
+//!
+//! Design rule: the texture repeats along the body at the aspect it was generated for: one
+//! texture width is one circumference at the thickest point, and one texture height is the same
+//! length along the body, so scales stay as round as the generator drew them. Near the
+//! tail the circumference shrinks and so do the scales, as on a real snake. Normals and
+//! tangents come from the same parametric surface (finite differences of the grid), so normal
+//! mapping follows `∂P/∂u` and `-∂P/∂v` (OpenGL's +Y points up the image).
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    /// Unit ∂P/∂u, and in `w` the sign that makes `w · cross(normal, tangent)` point up the
+    /// image (towards −v).
+    pub tangent: [f32; 4],
+    pub uv: [f32; 2],
+}
+
+#[derive(Debug, Clone)]
+pub struct Mesh {
+    pub vertices: Vec<Vertex>,
+    pub indices: Vec<u32>,
+}
+
+/// The body's shape in world units (metres, but only ratios matter for a preview).
+#[derive(Debug, Clone, Copy)]
+pub struct BodyShape {
+    pub length: f32,
+    /// Radius at the thickest point.
+    pub radius: f32,
+    /// Sideways amplitude and number of half-waves of the S-curve.
+    pub wave_amplitude: f32,
+    pub half_waves: f32,
+    /// Height over width of the cross-section (snakes are flatter below).
+    pub flatten: f32,
+    /// Rings along the body and vertices around it.
+    pub rings: usize,
+    pub segments: usize,
+}
+
+impl Default for BodyShape {
+    fn default() -> Self {
+        BodyShape {
+            length: 3.0,
+            radius: 0.09,
+            wave_amplitude: 0.35,
+            half_waves: 2.5,
+            flatten: 0.85,
+            rings: 480,
+            segments: 64,
+        }
+    }
+}
+
+impl BodyShape {
+    /// Centre line at s ∈ [0, 1] (0 = snout), lying on the ground plane y = radius.
+    pub fn centre(&self, s: f32) -> Vec3 {
+        let x = (s - 0.5) * self.length * 0.8;
+        let z = self.wave_amplitude * (std::f32::consts::PI * self.half_waves * s).sin();
+        Vec3::new(x, 0.0, z)
+    }
+
+    /// Body radius at s: an elliptical head cap, a slight neck, full body, and a long taper
+    /// over the last 30 % to a point.
+    pub fn radius_at(&self, s: f32) -> f32 {
+        const HEAD: f32 = 0.035;
+        const TAIL_START: f32 = 0.7;
+        let s = s.clamp(0.0, 1.0);
+        let profile = if s < HEAD {
+            let x = 1.0 - s / HEAD;
+            (1.0 - x * x).max(0.0).sqrt() * 0.9
+        } else if s < 0.08 {
+            // Head (0.9) narrowing to the neck (0.75), then widening to the body.
+            let t = (s - HEAD) / (0.08 - HEAD);
+            0.9 - 0.15 * (std::f32::consts::PI * t).sin()
+        } else if s < TAIL_START {
+            let t = ((s - 0.08) / 0.2).min(1.0);
+            0.9 + 0.1 * (t * std::f32::consts::FRAC_PI_2).sin()
+        } else {
+            let t = (s - TAIL_START) / (1.0 - TAIL_START);
+            (1.0 - t).powf(1.3)
+        };
+        self.radius * profile
+    }
+
+    /// World-space length of one texture repeat along the body (one circumference).
+    pub fn texture_length(&self) -> f32 {
+        2.0 * std::f32::consts::PI * self.radius
+    }
+
+    /// A point on the surface at body parameter s and around-angle u (0 = belly, 0.5 = back).
+    fn surface(&self, s: f32, u: f32) -> (Vec3, Vec3) {
+        let c = self.centre(s);
+        let ahead = (self.centre((s + 1e-3).min(1.0)) - self.centre((s - 1e-3).max(0.0))).normalize();
+        let right = ahead.cross(Vec3::Y).normalize();
+        let up = right.cross(ahead);
+        let r = self.radius_at(s);
+        let phi = 2.0 * std::f32::consts::PI * u;
+        let lift = Vec3::Y * self.radius * self.flatten;
+        let offset = up * (-phi.cos() * r * self.flatten) + right * (phi.sin() * r);
+        (c + lift + offset, c + lift)
+    }
+
+    /// The closed tube with UVs and tangents.
+    pub fn mesh(&self) -> Mesh {
+        let (rings, segments) = (self.rings.max(4), self.segments.max(3));
+        // Arc length along the centre line at each ring gives v.
+        let mut arc = vec![0.0f32; rings + 1];
+        for i in 1..=rings {
+            let (a, b) = (i as f32 - 1.0, i as f32);
+            arc[i] = arc[i - 1] + (self.centre(b / rings as f32) - self.centre(a / rings as f32)).length();
+        }
+        let repeat = self.texture_length();
+        let mut vertices = Vec::with_capacity((rings + 1) * (segments + 1));
+        let (du, ds) = (1e-3f32, 1e-3f32);
+        for (i, arc_i) in arc.iter().enumerate() {
+            let s = i as f32 / rings as f32;
+            for j in 0..=segments {
+                let u = j as f32 / segments as f32;
+                let (p, centre) = self.surface(s, u);
+                let dpdu = self.surface(s, u + du).0 - self.surface(s, u - du).0;
+                let (s0, s1) = ((s - ds).max(0.0), (s + ds).min(1.0));
+                let dpds = self.surface(s1, u).0 - self.surface(s0, u).0;
+                let outward = p - centre;
+                let mut normal = dpdu.cross(dpds).normalize_or_zero();
+                if normal == Vec3::ZERO {
+                    // The closed ends: the ring has collapsed to a point on the centre line.
+                    let ahead = (self.centre(s1) - self.centre(s0)).normalize();
+                    normal = if s < 0.5 { -ahead } else { ahead };
+                } else if normal.dot(outward) < 0.0 {
+                    normal = -normal;
+                }
+                let tangent = dpdu.normalize_or(normal.any_orthonormal_vector());
+                // "Up the image" is −v, i.e. towards the head.
+                let up_image = -dpds;
+                let sign = if normal.cross(tangent).dot(up_image) >= 0.0 { 1.0 } else { -1.0 };
+                vertices.push(Vertex {
+                    position: p.to_array(),
+                    normal: normal.to_array(),
+                    tangent: [tangent.x, tangent.y, tangent.z, sign],
+                    uv: [u, arc_i / repeat],
+                });
+            }
+        }
+        let stride = (segments + 1) as u32;
+        let mut indices = Vec::with_capacity(rings * segments * 6);
+        for i in 0..rings as u32 {
+            for j in 0..segments as u32 {
+                let a = i * stride + j;
+                let b = a + stride;
+                // Counter-clockwise seen from outside (checked by the winding test).
+                indices.extend_from_slice(&[a, a + 1, b, b, a + 1, b + 1]);
+            }
+        }
+        let mut mesh = Mesh { vertices, indices };
+        mesh.orient_outward();
+        mesh
+    }
+}
+
+impl Mesh {
+    /// Flips every triangle whose geometric normal disagrees with its vertex normals, so that
+    /// front faces are counter-clockwise from outside whatever the parametrisation's handedness.
+    fn orient_outward(&mut self) {
+        for tri in self.indices.chunks_exact_mut(3) {
+            let p = |k: usize| Vec3::from(self.vertices[tri[k] as usize].position);
+            let n = |k: usize| Vec3::from(self.vertices[tri[k] as usize].normal);
+            let face = (p(1) - p(0)).cross(p(2) - p(0));
+            if face.dot(n(0) + n(1) + n(2)) < 0.0 {
+                tri.swap(1, 2);
+            }
+        }
+    }
+
+    /// A square ground plane at y = 0, `half_size` from the origin, UVs in world units.
+    pub fn ground(half_size: f32) -> Mesh {
+        let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+        let vertices = corners
+            .iter()
+            .map(|[x, z]| Vertex {
+                position: [x * half_size, 0.0, z * half_size],
+                normal: [0.0, 1.0, 0.0],
+                tangent: [1.0, 0.0, 0.0, 1.0],
+                uv: [x * half_size, z * half_size],
+            })
+            .collect();
+        // Counter-clockwise seen from above (+y).
+        Mesh { vertices, indices: vec![0, 2, 1, 0, 3, 2] }
+    }
+
+    /// Axis-aligned bounds (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.vertices.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), v| {
+            let p = Vec3::from(v.position);
+            (lo.min(p), hi.max(p))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn small() -> Mesh {
+        BodyShape { rings: 120, segments: 24, ..BodyShape::default() }.mesh()
+    }
+
+    #[test]
+    fn normals_and_tangents_are_unit_and_orthogonal() {
+        for v in &small().vertices {
+            let n = Vec3::from(v.normal);
+            let t = Vec3::new(v.tangent[0], v.tangent[1], v.tangent[2]);
+            assert!((n.length() - 1.0).abs() < 1e-4, "{v:?}");
+            assert!((t.length() - 1.0).abs() < 1e-4, "{v:?}");
+            assert!(v.tangent[3].abs() == 1.0);
+            assert!(n.dot(t).abs() < 0.05, "{v:?}");
+        }
+    }
+
+    #[test]
+    fn belly_at_u_zero_back_at_u_half() {
+        let shape = BodyShape { rings: 100, segments: 20, ..BodyShape::default() };
+        let mesh = shape.mesh();
+        let ring = 50 * 21;
+        let belly = Vec3::from(mesh.vertices[ring].position);
+        let back = Vec3::from(mesh.vertices[ring + 10].position);
+        assert!(back.y > belly.y + shape.radius, "back {back} belly {belly}");
+        assert_eq!(mesh.vertices[ring].uv[0], 0.0);
+        assert_eq!(mesh.vertices[ring + 20].uv[0], 1.0);
+        // The belly rests on the ground.
+        assert!(belly.y >= -1e-4 && belly.y < 0.2 * shape.radius, "{belly}");
+    }
+
+    #[test]
+    fn triangles_face_outward_and_the_tube_is_closed() {
+        let mesh = small();
+        // A closed, outward-oriented surface encloses a positive volume (divergence theorem).
+        let volume: f32 = mesh
+            .indices
+            .chunks_exact(3)
+            .map(|t| {
+                let p = |k: usize| Vec3::from(mesh.vertices[t[k] as usize].position);
+                p(0).dot(p(1).cross(p(2))) / 6.0
+            })
+            .sum();
+        let shape = BodyShape::default();
+        let tube = std::f32::consts::PI * shape.radius.powi(2) * shape.flatten * shape.length * 0.8;
+        assert!(volume > 0.3 * tube && volume < 1.2 * tube, "volume {volume} vs tube {tube}");
+        // Closed ends: the first and last rings collapse to points.
+        let first = &mesh.vertices[0..25];
+        assert!(first.iter().all(|v| (Vec3::from(v.position) - Vec3::from(first[0].position)).length() < 1e-5));
+    }
+
+    #[test]
+    fn v_advances_one_texture_per_circumference() {
+        let shape = BodyShape { rings: 200, segments: 16, ..BodyShape::default() };
+        let mesh = shape.mesh();
+        let last = mesh.vertices.last().unwrap();
+        // The S-curve is longer than its chord; the texture repeats several times.
+        let chord_repeats = shape.length * 0.8 / shape.texture_length();
+        assert!(last.uv[1] > chord_repeats && last.uv[1] < 2.0 * chord_repeats, "{}", last.uv[1]);
+    }
+}

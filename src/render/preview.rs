@@ -1,0 +1,187 @@
+//! From a preset to pictures: generate the maps at preview resolution, bake the film LUT,
+//! render headless, check against the CPU reference, and write the documentation figures.
+//! The window (`window.rs`) and `snakeskin sheet` use the same steps.
+
+use std::path::{Path, PathBuf};
+
+use super::material::MaterialMaps;
+use super::reference::{ReferenceReport, compare};
+use super::renderer::{FrameSettings, Material, Renderer};
+use super::scene::{Camera, LayerOptics, Stage, View};
+use super::film::GpuFilmMethod;
+use crate::Error;
+use crate::export::write_file_atomically;
+use crate::graph::{NodeCache, evaluate};
+use crate::maps::{BuildOptions, MapKind, build_graph};
+use crate::optics::lut::Lut;
+use crate::optics::methods::Method;
+use crate::preset::LoadedPreset;
+
+/// Preview image size limits (pixels per side): lavapipe handles 8K, a window rarely more.
+pub const IMAGE_RANGE: std::ops::RangeInclusive<u32> = 16..=8192;
+
+/// Generates the five maps of `preset` at `map_size`² for rendering.
+pub fn material_maps(loaded: &LoadedPreset, map_size: usize) -> Result<MaterialMaps, Error> {
+    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    let evaluation = evaluate(&graph, &MapKind::ALL, map_size, map_size, &|_, _| {});
+    MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))
+}
+
+/// The same through a node cache: after an edit only changed nodes run (live reload).
+pub fn material_maps_cached(
+    loaded: &LoadedPreset,
+    map_size: usize,
+    cache: &mut NodeCache,
+) -> Result<(MaterialMaps, crate::graph::CacheStats), Error> {
+    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    let (maps, stats) = cache.evaluate(&graph, &MapKind::ALL, map_size, map_size);
+    Ok((MaterialMaps::from_maps(&maps).map_err(|e| Error::Preview(e.to_string()))?, stats))
+}
+
+/// Parses `--method` for the GPU.
+pub fn parse_method(name: &str) -> Result<GpuFilmMethod, Error> {
+    Method::parse(name)
+        .map(GpuFilmMethod::from_method)
+        .ok_or_else(|| Error::Preview(format!("unknown --method {name:?}; accepted: {}", Method::ACCEPTED)))
+}
+
+/// Parses `--size WxH` (or a single number for a square).
+pub fn parse_image_size(text: &str) -> Result<(u32, u32), Error> {
+    let bad = || {
+        Error::Preview(format!(
+            "invalid --size {text:?}: expected WIDTHxHEIGHT (e.g. 1280x720), each {} to {} pixels",
+            IMAGE_RANGE.start(),
+            IMAGE_RANGE.end()
+        ))
+    };
+    let (w, h) = match text.split_once(['x', 'X']) {
+        Some((w, h)) => (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?),
+        None => {
+            let s: u32 = text.trim().parse().map_err(|_| bad())?;
+            (s, s)
+        }
+    };
+    if !IMAGE_RANGE.contains(&w) || !IMAGE_RANGE.contains(&h) {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+/// A material ready to draw: maps, optics and film tables for `method`.
+pub fn upload_material(
+    renderer: &Renderer,
+    loaded: &LoadedPreset,
+    map_size: usize,
+    method: GpuFilmMethod,
+) -> Result<Material, Error> {
+    let maps = material_maps(loaded, map_size)?;
+    let optics = LayerOptics::from_preset(&loaded.preset);
+    let lut = Lut::bake_default(optics.stack);
+    Ok(renderer.material(&maps, optics, &lut, bands_for(method)))
+}
+
+pub fn bands_for(method: GpuFilmMethod) -> usize {
+    match method {
+        GpuFilmMethod::SpectralN(n) => n,
+        _ => 1,
+    }
+}
+
+/// Encodes and writes a rendered image (atomically).
+pub fn write_png(path: &Path, image: &image::RgbaImage) -> Result<PathBuf, Error> {
+    let rgb = image::DynamicImage::ImageRgba8(image.clone()).into_rgb8();
+    let mut bytes = Vec::new();
+    rgb.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| Error::Preview(format!("PNG encoding failed: {e}")))?;
+    Ok(write_file_atomically(path, bytes)?)
+}
+
+/// The GPU frame at one sample per pixel against the CPU reference (stage "all").
+pub fn reference_check(
+    renderer: &Renderer,
+    material: &Material,
+    settings: &FrameSettings,
+    width: u32,
+    height: u32,
+) -> Result<(ReferenceReport, image::RgbaImage), Error> {
+    let settings = FrameSettings { samples: 1, ground: false, view: View::Shaded(Stage::All), ..*settings };
+    let image = renderer.render_image(&settings, material, width, height)?;
+    let gbuffer = renderer.render_gbuffer(&settings, material, width, height)?;
+    Ok((compare(&image, &gbuffer, &settings, &material.optics), image))
+}
+
+/// One documentation figure: its file name, what it shows, and the overrides it needs.
+pub struct Figure {
+    pub file: &'static str,
+    pub caption: &'static str,
+    pub overrides: Vec<(&'static str, &'static str)>,
+    pub view: View,
+}
+
+/// The thesis' Figs. 5.5–5.12, redone: layer stages, film thickness δ0 and absorption σ0.
+pub fn figure_list() -> Vec<Figure> {
+    // Fig. 5.12's material: film IOR 1.56, δ0 = 900 nm, absorption 0.4 (thesis, caption).
+    let fig_5_12 = vec![("optics.film_ior", "1.56"), ("optics.film_thickness_nm", "900"), ("optics.absorption", "0.4")];
+    let mut figures: Vec<Figure> = Stage::ALL
+        .iter()
+        .zip(["stage_a_diffuse.png", "stage_b_normal.png", "stage_c_film.png", "stage_d_all.png"])
+        .zip([
+            "(a) diffuse base only",
+            "(b) diffuse + normal map",
+            "(c) thin film alone",
+            "(d) all layers (film, pigment, base)",
+        ])
+        .map(|((stage, file), caption)| Figure { file, caption, overrides: fig_5_12.clone(), view: View::Shaded(*stage) })
+        .collect();
+    for (file, caption, d) in [
+        ("thickness_0nm.png", "δ0 = 0 nm: plain Fresnel, no interference (Fig. 5.8)", "0"),
+        ("thickness_200nm.png", "δ0 = 200 nm (Fig. 5.5)", "200"),
+        ("thickness_400nm.png", "δ0 = 400 nm (Fig. 5.6)", "400"),
+        ("thickness_600nm.png", "δ0 = 600 nm (Fig. 5.7)", "600"),
+        ("thickness_2.4mm.png", "δ0 = 2.4 mm: the incoherent limit, no moiré (Fig. 5.9)", "2400000"),
+    ] {
+        figures.push(Figure {
+            file,
+            caption,
+            overrides: vec![("optics.film_thickness_nm", d), ("optics.absorption", "0.6")],
+            view: View::Shaded(Stage::All),
+        });
+    }
+    for (file, caption, s) in [
+        ("absorption_0.1.png", "σ0 = 0.1 (Fig. 5.10)", "0.1"),
+        ("absorption_0.7.png", "σ0 = 0.7 (Fig. 5.11)", "0.7"),
+    ] {
+        figures.push(Figure {
+            file,
+            caption,
+            overrides: vec![("optics.absorption", s), ("optics.film_thickness_nm", "400")],
+            view: View::Shaded(Stage::All),
+        });
+    }
+    figures
+}
+
+/// Renders every figure of `figure_list` for `preset` into `out_dir`; returns the files.
+pub fn write_figures(
+    renderer: &Renderer,
+    preset: &str,
+    out_dir: &Path,
+    size: (u32, u32),
+    map_size: usize,
+    progress: &dyn Fn(usize, usize),
+) -> Result<Vec<PathBuf>, Error> {
+    let figures = figure_list();
+    let mut written = Vec::new();
+    for (i, figure) in figures.iter().enumerate() {
+        progress(i, figures.len());
+        let overrides: Vec<(String, String)> =
+            figure.overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+        let loaded = crate::generate::load(preset, &overrides, None)?;
+        let material = upload_material(renderer, &loaded, map_size, GpuFilmMethod::Lut)?;
+        let settings = FrameSettings { view: figure.view, camera: Camera::close_up(), ..FrameSettings::default() };
+        let image = renderer.render_image(&settings, &material, size.0, size.1)?;
+        written.push(write_png(&out_dir.join(figure.file), &image)?);
+    }
+    progress(figures.len(), figures.len());
+    Ok(written)
+}

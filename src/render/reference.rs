@@ -1,0 +1,197 @@
+//! The CPU reference for a rendered frame: shade every pixel the snake covers from the GPU's
+//! own G-buffer (the sampled material: position, shading normal, albedo, roughness, film
+//! thickness) with the f64 BRDF and the 1 nm spectral film colour, under the same lights,
+//! ambient term, exposure and tone mapping, and compare with the GPU image in CIEDE2000.
+//!
+//! Because both sides start from the same material samples, the difference isolates shading:
+//! the film method (LUT or another), f32 arithmetic, and the 8-bit output. This file is the
+//! CPU twin of `shaders/skin.wgsl`'s `shade` (stage "all") and `shaders/tonemap.wgsl`.
+
+use rayon::prelude::*;
+
+use super::renderer::{FrameSettings, GBuffer};
+use super::scene::{LayerOptics, Lighting};
+use crate::optics::brdf::{COS_MIN, Layers, eval};
+use crate::optics::film_rgb_reference;
+use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
+
+/// Mean, 99th percentile and max CIEDE2000 over covered pixels, and the heat map.
+#[derive(Debug, Clone)]
+pub struct ReferenceReport {
+    pub mean_de: f64,
+    pub p99_de: f64,
+    pub max_de: f64,
+    pub pixels: usize,
+    /// ΔE per pixel (`None` where the snake does not cover it).
+    pub de: Vec<Option<f64>>,
+    pub width: u32,
+    pub height: u32,
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalize(v: [f64; 3]) -> [f64; 3] {
+    let len = dot(v, v).sqrt();
+    v.map(|c| c / len)
+}
+
+fn sky(lighting: &Lighting, d: [f64; 3]) -> [f64; 3] {
+    let t = (0.5 + 0.5 * d[1]).clamp(0.0, 1.0);
+    [0, 1, 2].map(|c| lighting.sky_bottom[c] as f64 + (lighting.sky_top[c] as f64 - lighting.sky_bottom[c] as f64) * t)
+}
+
+/// Khronos PBR Neutral tone mapping (the twin of `tonemap.wgsl`'s `pbr_neutral`).
+pub fn pbr_neutral(color: [f64; 3]) -> [f64; 3] {
+    const START_COMPRESSION: f64 = 0.8 - 0.04;
+    const DESATURATION: f64 = 0.15;
+    let x = color[0].min(color[1]).min(color[2]);
+    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+    let mut c = color.map(|v| v - offset);
+    let peak = c[0].max(c[1]).max(c[2]);
+    if peak < START_COMPRESSION {
+        return c;
+    }
+    let d = 1.0 - START_COMPRESSION;
+    let new_peak = 1.0 - d * d / (peak + d - START_COMPRESSION);
+    c = c.map(|v| v * new_peak / peak);
+    let g = 1.0 - 1.0 / (DESATURATION * (peak - new_peak) + 1.0);
+    c.map(|v| v + (new_peak - v) * g)
+}
+
+pub fn srgb_encode(linear: f64) -> f64 {
+    let l = linear.clamp(0.0, 1.0);
+    if l <= 0.003_130_8 { 12.92 * l } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 }
+}
+
+pub fn srgb_decode(encoded: f64) -> f64 {
+    if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Linear radiance of one covered pixel (stage "all"), the twin of `skin.wgsl`'s `shade`.
+pub fn shade_pixel(gbuffer: &GBuffer, i: usize, settings: &FrameSettings, optics: &LayerOptics) -> [f64; 3] {
+    let pt = gbuffer.position_thickness[i].map(|v| v as f64);
+    let nr = gbuffer.normal_roughness[i].map(|v| v as f64);
+    let albedo = gbuffer.albedo_coverage[i].map(|v| v as f64);
+    let camera = settings.camera.position().to_array().map(|v| v as f64);
+    let n = normalize([nr[0], nr[1], nr[2]]);
+    let wo = normalize([camera[0] - pt[0], camera[1] - pt[1], camera[2] - pt[2]]);
+    let thickness = pt[3];
+    let film = |cos: f64| film_rgb_reference(optics.stack, thickness, cos);
+    let layers = Layers {
+        n0: optics.stack.n0,
+        n2: optics.stack.n2,
+        roughness: nr[3],
+        optical_depth: optics.optical_depth,
+        albedo: [albedo[0], albedo[1], albedo[2]],
+    };
+    let lighting = &settings.lighting;
+    let mut radiance = [0.0; 3];
+    for light in [&lighting.key, &lighting.fill] {
+        if !light.enabled {
+            continue;
+        }
+        let wi = light.direction.normalize().to_array().map(|v| v as f64);
+        let cos_i = dot(n, wi).max(0.0);
+        let f = eval(&layers, n, wi, wo, &film).total();
+        for c in 0..3 {
+            radiance[c] += light.irradiance[c] as f64 * f[c] * cos_i;
+        }
+    }
+    // Ambient, as skin.wgsl's `ambient`.
+    let cos_o = dot(n, wo).max(COS_MIN);
+    let f_o = film(cos_o).map(|v| v.clamp(0.0, 1.0));
+    let mirror = [0, 1, 2].map(|c| -wo[c] + 2.0 * dot(n, wo) * n[c]);
+    let sky_mirror = sky(lighting, mirror);
+    let sky_normal = sky(lighting, n);
+    let eta = optics.stack.n0 / optics.stack.n2;
+    let k = (1.0 - eta * eta) + eta * eta * cos_o * cos_o;
+    let path = 1.0 / k.max(0.0).sqrt().max(COS_MIN) + 1.0;
+    for c in 0..3 {
+        let attenuation = if optics.has_absorption() { (-optics.optical_depth[c].max(0.0) * path).exp() } else { 1.0 };
+        radiance[c] += sky_mirror[c] * f_o[c] + sky_normal[c] * (1.0 - f_o[c]) * albedo[c] * attenuation;
+    }
+    radiance
+}
+
+/// Display value in [0, 1] (sRGB-encoded) after exposure and tone mapping.
+pub fn display(radiance: [f64; 3], exposure: f64) -> [f64; 3] {
+    pbr_neutral(radiance.map(|v| v.max(0.0) * exposure)).map(srgb_encode)
+}
+
+/// Shades every covered pixel on the CPU and compares with the GPU's 8-bit image.
+pub fn compare(
+    gpu_image: &image::RgbaImage,
+    gbuffer: &GBuffer,
+    settings: &FrameSettings,
+    optics: &LayerOptics,
+) -> ReferenceReport {
+    let exposure = settings.exposure as f64;
+    let de: Vec<Option<f64>> = (0..(gbuffer.width * gbuffer.height) as usize)
+        .into_par_iter()
+        .map(|i| {
+            if !gbuffer.covered(i) {
+                return None;
+            }
+            let cpu = display(shade_pixel(gbuffer, i, settings, optics), exposure).map(srgb_decode);
+            let px = gpu_image.as_raw()[4 * i..4 * i + 3].iter().map(|v| srgb_decode(*v as f64 / 255.0));
+            let gpu: Vec<f64> = px.collect();
+            Some(ciede2000(linear_srgb_to_lab(cpu), linear_srgb_to_lab([gpu[0], gpu[1], gpu[2]])))
+        })
+        .collect();
+    let mut values: Vec<f64> = de.iter().flatten().copied().collect();
+    values.sort_by(f64::total_cmp);
+    let pixels = values.len();
+    let mean_de = if pixels == 0 { f64::NAN } else { values.iter().sum::<f64>() / pixels as f64 };
+    let p99_de = values.get(((pixels as f64 * 0.99) as usize).min(pixels.saturating_sub(1))).copied().unwrap_or(f64::NAN);
+    ReferenceReport {
+        mean_de,
+        p99_de,
+        max_de: values.last().copied().unwrap_or(f64::NAN),
+        pixels,
+        de,
+        width: gbuffer.width,
+        height: gbuffer.height,
+    }
+}
+
+impl ReferenceReport {
+    /// ΔE as a heat map: black 0, through purple and orange, to yellow at `full_scale` and
+    /// above; pixels outside the snake dark grey.
+    pub fn heat_map(&self, full_scale: f64) -> image::RgbImage {
+        const STOPS: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [0.45, 0.1, 0.55], [0.95, 0.45, 0.1], [1.0, 1.0, 0.3]];
+        image::RgbImage::from_fn(self.width, self.height, |x, y| match self.de[(y * self.width + x) as usize] {
+            None => image::Rgb([40, 40, 40]),
+            Some(de) => {
+                let t = (de / full_scale).clamp(0.0, 1.0) * 3.0;
+                let k = (t as usize).min(2);
+                let f = t - k as f64;
+                let c = [0, 1, 2].map(|c| STOPS[k][c] + (STOPS[k + 1][c] - STOPS[k][c]) * f);
+                image::Rgb(c.map(|v| (v * 255.0).round() as u8))
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pbr_neutral_leaves_dark_colours_and_compresses_bright_ones() {
+        // Below the compression start only the small toe offset applies.
+        let c = pbr_neutral([0.5, 0.3, 0.2]);
+        assert!((c[0] - 0.46).abs() < 1e-9 && (c[2] - 0.16).abs() < 1e-9, "{c:?}");
+        // Bright white approaches but never reaches 1.
+        let w = pbr_neutral([100.0; 3]);
+        assert!(w[0] < 1.0 && w[0] > 0.99, "{w:?}");
+    }
+
+    #[test]
+    fn srgb_round_trips() {
+        for v in [0.0, 0.001, 0.2, 0.5, 1.0] {
+            assert!((srgb_decode(srgb_encode(v)) - v).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,739 @@
+//! The frame: the snake (instanced), optionally the ground, shaded into a 4× MSAA HDR target,
+//! resolved, tone mapped into any 8-bit sRGB view (an offscreen texture or the window's
+//! surface). Pipelines are specialised with WGSL override constants — layer stage, map view,
+//! film method (or none for an inert film), absorption on/off — and built once per
+//! combination on first use, so a material pays only for the layers it has.
+
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use wgpu::util::DeviceExt;
+
+use super::film::{self, FilmBinding, GpuFilmMethod};
+use super::material::{self, MaterialMaps, MaterialTextures};
+use super::mesh::{BodyShape, Mesh, Vertex};
+use super::scene::{Camera, LayerOptics, Lighting, SceneUniform, Stage, View};
+use super::{Gpu, GpuError, program};
+use crate::maps::MapKind;
+use crate::optics::lut::Lut;
+
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+pub const MSAA_SAMPLES: u32 = 4;
+
+/// Everything about a frame that is not the material.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameSettings {
+    pub view: View,
+    pub method: GpuFilmMethod,
+    pub camera: Camera,
+    pub lighting: Lighting,
+    pub exposure: f32,
+    pub ground: bool,
+    /// Number of snakes (instanced, in a grid).
+    pub snakes: u32,
+    /// 4 for the preview (MSAA), 1 where pixels must match the G-buffer exactly.
+    pub samples: u32,
+    /// The plain PBR shader instead of the skin (the benchmark's baseline).
+    pub plain: bool,
+    pub background: [f64; 3],
+}
+
+impl Default for FrameSettings {
+    fn default() -> Self {
+        FrameSettings {
+            view: View::Shaded(Stage::All),
+            method: GpuFilmMethod::Lut,
+            camera: Camera::default(),
+            lighting: Lighting::default(),
+            exposure: 1.0,
+            ground: true,
+            snakes: 1,
+            samples: MSAA_SAMPLES,
+            plain: false,
+            background: [0.05, 0.055, 0.06],
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Program {
+    Skin,
+    Plain,
+    Ground,
+    GBuffer(u32),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct PipelineKey {
+    program: Program,
+    stage: u32,
+    view_map: u32,
+    method: u32,
+    absorption: bool,
+    samples: u32,
+}
+
+/// The material currently shown: optics, film tables and map textures.
+pub struct Material {
+    pub optics: LayerOptics,
+    film: FilmBinding,
+    textures: MaterialTextures,
+}
+
+/// Render targets for one size and sample count.
+pub struct Targets {
+    pub width: u32,
+    pub height: u32,
+    samples: u32,
+    msaa: Option<wgpu::TextureView>,
+    depth: wgpu::TextureView,
+    resolve: wgpu::TextureView,
+    tonemap_group: wgpu::BindGroup,
+    tonemap_uniform: wgpu::Buffer,
+}
+
+pub struct Renderer {
+    pub gpu: Gpu,
+    film_layout: wgpu::BindGroupLayout,
+    material_layout: wgpu::BindGroupLayout,
+    tonemap_layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    skin_module: wgpu::ShaderModule,
+    plain_module: wgpu::ShaderModule,
+    tonemap_module: wgpu::ShaderModule,
+    pipelines: Mutex<HashMap<PipelineKey, wgpu::RenderPipeline>>,
+    tonemap_pipelines: Mutex<HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>>,
+    scene_buffer: wgpu::Buffer,
+    scene_group: wgpu::BindGroup,
+    body: GpuMesh,
+    ground: GpuMesh,
+    instances: Mutex<(u32, wgpu::Buffer)>,
+    single_instance: wgpu::Buffer,
+}
+
+struct GpuMesh {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    count: u32,
+}
+
+impl GpuMesh {
+    fn new(device: &wgpu::Device, mesh: &Mesh) -> GpuMesh {
+        GpuMesh {
+            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("vertices"),
+                contents: bytemuck::cast_slice(&mesh.vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            }),
+            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("indices"),
+                contents: bytemuck::cast_slice(&mesh.indices),
+                usage: wgpu::BufferUsages::INDEX,
+            }),
+            count: mesh.indices.len() as u32,
+        }
+    }
+}
+
+/// Placements (x, z, yaw) of `n` snakes in a grid, the first at the origin.
+pub fn snake_grid(n: u32) -> Vec<[f32; 4]> {
+    let columns = (n as f32).sqrt().ceil().max(1.0) as u32;
+    (0..n)
+        .map(|i| {
+            let (col, row) = ((i % columns) as f32, (i / columns) as f32);
+            [col * 2.8, -row * 1.1, 0.0, 0.0]
+        })
+        .collect()
+}
+
+impl Renderer {
+    pub fn new(gpu: Gpu) -> Renderer {
+        let device = &gpu.device;
+        let film_layout = film::bind_group_layout(device);
+        let material_layout = material::bind_group_layout(device);
+        let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene"),
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
+        });
+        let tonemap_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tonemap"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene"),
+            bind_group_layouts: &[Some(&film_layout), Some(&scene_layout), Some(&material_layout)],
+            immediate_size: 0,
+        });
+        let module = |name: &str| {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(program(name).into()),
+            })
+        };
+        let scene_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("scene"),
+            size: std::mem::size_of::<SceneUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &scene_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: scene_buffer.as_entire_binding() }],
+        });
+        let body = GpuMesh::new(device, &BodyShape::default().mesh());
+        let ground = GpuMesh::new(device, &Mesh::ground(30.0));
+        let instance_buffer = |placements: &[[f32; 4]]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("instances"),
+                contents: bytemuck::cast_slice(placements),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        };
+        let single_instance = instance_buffer(&[[0.0; 4]]);
+        let instances = Mutex::new((1, instance_buffer(&snake_grid(1))));
+        Renderer {
+            skin_module: module("skin"),
+            plain_module: module("plain"),
+            tonemap_module: module("tonemap"),
+            film_layout,
+
+            material_layout,
+            tonemap_layout,
+            pipeline_layout,
+            pipelines: Mutex::new(HashMap::new()),
+            tonemap_pipelines: Mutex::new(HashMap::new()),
+            scene_buffer,
+            scene_group,
+            body,
+            ground,
+            instances,
+            single_instance,
+            gpu,
+        }
+    }
+
+    pub fn headless() -> Result<Renderer, GpuError> {
+        Ok(Renderer::new(Gpu::headless()?))
+    }
+
+    /// Uploads a material: maps, optics and the film LUT baked for its indices.
+    pub fn material(&self, maps: &MaterialMaps, optics: LayerOptics, lut: &Lut, n_bands: usize) -> Material {
+        let device = &self.gpu.device;
+        Material {
+            optics,
+            film: FilmBinding::new(device, &self.film_layout, optics.stack, lut, n_bands),
+            textures: MaterialTextures::new(device, &self.gpu.queue, &self.material_layout, maps),
+        }
+    }
+
+    /// Replaces the film tables of a material (after its indices or band count changed).
+    pub fn refilm(&self, material: &mut Material, optics: LayerOptics, lut: &Lut, n_bands: usize) {
+        material.film = FilmBinding::new(&self.gpu.device, &self.film_layout, optics.stack, lut, n_bands);
+        material.optics = optics;
+    }
+
+    /// Replaces the maps of a material (live reload).
+    pub fn retexture(&self, material: &mut Material, maps: &MaterialMaps) {
+        material.textures = MaterialTextures::new(&self.gpu.device, &self.gpu.queue, &self.material_layout, maps);
+    }
+
+    pub fn targets(&self, width: u32, height: u32, samples: u32) -> Targets {
+        let device = &self.gpu.device;
+        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+        let texture = |label, format, samples, usage| {
+            device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size,
+                    mip_level_count: 1,
+                    sample_count: samples,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+                .create_view(&wgpu::TextureViewDescriptor::default())
+        };
+        let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let msaa = (samples > 1).then(|| texture("hdr msaa", HDR_FORMAT, samples, attach));
+        let depth = texture("depth", DEPTH_FORMAT, samples, attach);
+        let resolve = texture("hdr", HDR_FORMAT, 1, attach | wgpu::TextureUsages::TEXTURE_BINDING);
+        let tonemap_uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tonemap"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let tonemap_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tonemap"),
+            layout: &self.tonemap_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&resolve) },
+                wgpu::BindGroupEntry { binding: 1, resource: tonemap_uniform.as_entire_binding() },
+            ],
+        });
+        Targets { width, height, samples, msaa, depth, resolve, tonemap_group, tonemap_uniform }
+    }
+
+    fn pipeline(&self, key: PipelineKey) -> wgpu::RenderPipeline {
+        let mut cache = self.pipelines.lock().expect("pipeline cache");
+        cache.entry(key).or_insert_with(|| self.build_pipeline(key)).clone()
+    }
+
+    fn build_pipeline(&self, key: PipelineKey) -> wgpu::RenderPipeline {
+        let (module, entry) = match key.program {
+            Program::Skin => (&self.skin_module, "fs_skin"),
+            Program::GBuffer(_) => (&self.skin_module, "fs_gbuffer"),
+            Program::Ground => (&self.skin_module, "fs_ground"),
+            Program::Plain => (&self.plain_module, "fs_plain"),
+        };
+        let mut constants: Vec<(&str, f64)> = Vec::new();
+        if module_is_skin(key.program) {
+            constants.extend([
+                ("STAGE", key.stage as f64),
+                ("VIEW_MAP", key.view_map as f64),
+                ("FILM_METHOD", key.method as f64),
+                ("HAS_ABSORPTION", if key.absorption { 1.0 } else { 0.0 }),
+            ]);
+            if let Program::GBuffer(part) = key.program {
+                constants.push(("GBUFFER_PART", part as f64));
+            }
+        }
+        let hdr_target = Some(wgpu::ColorTargetState {
+            format: HDR_FORMAT,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        });
+        let gbuffer_target =
+            Some(wgpu::ColorTargetState { format: GBUFFER_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
+        let targets: Vec<Option<wgpu::ColorTargetState>> = match key.program {
+            Program::GBuffer(_) => vec![gbuffer_target.clone(), gbuffer_target],
+            _ => vec![hdr_target],
+        };
+        let vertex_layouts = [
+            Some(wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<Vertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2],
+            }),
+            Some(wgpu::VertexBufferLayout {
+                array_stride: 16,
+                step_mode: wgpu::VertexStepMode::Instance,
+                attributes: &wgpu::vertex_attr_array![4 => Float32x4],
+            }),
+        ];
+        let vertex_module = &self.skin_module;
+        let vertex_constants: Vec<(&str, f64)> = constants.clone();
+        let vertex_module = if key.program == Program::Plain { &self.plain_module } else { vertex_module };
+        self.gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(&format!("{key:?}")),
+            layout: Some(&self.pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: vertex_module,
+                entry_point: Some("vs_main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &vertex_constants,
+                    ..Default::default()
+                },
+                buffers: &vertex_layouts,
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: wgpu::MultisampleState { count: key.samples, ..Default::default() },
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    fn tonemap_pipeline(&self, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
+        let mut cache = self.tonemap_pipelines.lock().expect("tonemap cache");
+        cache
+            .entry(format)
+            .or_insert_with(|| {
+                let layout = self.gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("tonemap"),
+                    bind_group_layouts: &[Some(&self.tonemap_layout)],
+                    immediate_size: 0,
+                });
+                self.gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("tonemap"),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &self.tonemap_module,
+                        entry_point: Some("vs_fullscreen"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: Default::default(),
+                    depth_stencil: None,
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &self.tonemap_module,
+                        entry_point: Some("fs_tonemap"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(wgpu::ColorTargetState {
+                            format,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        })],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            })
+            .clone()
+    }
+
+    fn key(&self, program: Program, settings: &FrameSettings, material: &Material, samples: u32) -> PipelineKey {
+        let (stage, view_map) = match settings.view {
+            View::Shaded(stage) => (stage.constant() as u32, 0),
+            View::Map(map) => (3, map_index(map)),
+        };
+        // Specialisation: an inert film needs no film code, no absorption no exponential.
+        let method = material.optics.specialised_method(settings.method).constant() as u32;
+        PipelineKey { program, stage, view_map, method, absorption: material.optics.has_absorption(), samples }
+    }
+
+    fn write_scene(&self, settings: &FrameSettings, material: &Material, aspect: f32) {
+        let uniform = SceneUniform::new(&settings.camera, aspect, &settings.lighting, &material.optics);
+        self.gpu.queue.write_buffer(&self.scene_buffer, 0, bytemuck::bytes_of(&uniform));
+    }
+
+    fn instance_buffer(&self, snakes: u32) -> wgpu::Buffer {
+        let mut current = self.instances.lock().expect("instances");
+        if current.0 != snakes {
+            let buffer = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("instances"),
+                contents: bytemuck::cast_slice(&snake_grid(snakes.max(1))),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            *current = (snakes, buffer);
+        }
+        current.1.clone()
+    }
+
+    /// Records a whole frame: the scene pass (timestamps around it if given) and the tone
+    /// mapping pass into `output` (any 8-bit sRGB format).
+    pub fn encode_frame(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+        settings: &FrameSettings,
+        material: &Material,
+        output: &wgpu::TextureView,
+        output_format: wgpu::TextureFormat,
+        timestamps: Option<(&wgpu::QuerySet, u32)>,
+    ) {
+        self.write_scene(settings, material, targets.width as f32 / targets.height as f32);
+        let mode: u32 = if matches!(settings.view, View::Map(_)) { 1 } else { 0 };
+        let tone: [u32; 4] = [settings.exposure.to_bits(), mode, 0, 0];
+        self.gpu.queue.write_buffer(&targets.tonemap_uniform, 0, bytemuck::cast_slice(&tone));
+        let program = if settings.plain { Program::Plain } else { Program::Skin };
+        let body = self.pipeline(self.key(program, settings, material, targets.samples));
+        let ground = settings.ground.then(|| self.pipeline(self.key(Program::Ground, settings, material, targets.samples)));
+        let instances = self.instance_buffer(settings.snakes);
+        let [r, g, b] = settings.background;
+        {
+            let (view, resolve) = match &targets.msaa {
+                Some(msaa) => (msaa, Some(&targets.resolve)),
+                None => (&targets.resolve, None),
+            };
+            let timestamp_writes = timestamps.map(|(query_set, first)| wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(first),
+                end_of_pass_write_index: Some(first + 1),
+            });
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("scene"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: resolve,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(depth_attachment(&targets.depth)),
+                timestamp_writes,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, &material.film.bind_group, &[]);
+            pass.set_bind_group(1, &self.scene_group, &[]);
+            pass.set_bind_group(2, &material.textures.bind_group, &[]);
+            pass.set_pipeline(&body);
+            pass.set_vertex_buffer(0, self.body.vertices.slice(..));
+            pass.set_vertex_buffer(1, instances.slice(..));
+            pass.set_index_buffer(self.body.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..self.body.count, 0, 0..settings.snakes.max(1));
+            if let Some(ground) = ground {
+                pass.set_pipeline(&ground);
+                pass.set_vertex_buffer(0, self.ground.vertices.slice(..));
+                pass.set_vertex_buffer(1, self.single_instance.slice(..));
+                pass.set_index_buffer(self.ground.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..self.ground.count, 0, 0..1);
+            }
+        }
+        let tonemap = self.tonemap_pipeline(output_format);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("tonemap"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: output,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&tonemap);
+        pass.set_bind_group(0, &targets.tonemap_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// Renders one frame offscreen and reads it back as 8-bit sRGB RGBA.
+    pub fn render_image(
+        &self,
+        settings: &FrameSettings,
+        material: &Material,
+        width: u32,
+        height: u32,
+    ) -> Result<image::RgbaImage, GpuError> {
+        let targets = self.targets(width, height, settings.samples);
+        let output = self.output_texture(width, height);
+        let view = output.create_view(&wgpu::TextureViewDescriptor::default());
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        self.encode_frame(&mut encoder, &targets, settings, material, &view, OUTPUT_FORMAT, None);
+        let bytes = self.read_texture(encoder, &output, width, height, 4)?;
+        image::RgbaImage::from_raw(width, height, bytes).ok_or_else(|| GpuError::Readback("image size".into()))
+    }
+
+    pub fn output_texture(&self, width: u32, height: u32) -> wgpu::Texture {
+        self.gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("output"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: OUTPUT_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    }
+
+    /// The G-buffer of the snake (no ground) at one sample per pixel: per pixel the world
+    /// position, film thickness, shading and geometric normals, roughness and albedo, and
+    /// whether the snake covers it.
+    pub fn render_gbuffer(
+        &self,
+        settings: &FrameSettings,
+        material: &Material,
+        width: u32,
+        height: u32,
+    ) -> Result<GBuffer, GpuError> {
+        let device = &self.gpu.device;
+        self.write_scene(settings, material, width as f32 / height as f32);
+        let instances = self.instance_buffer(settings.snakes);
+        let mut parts = Vec::new();
+        for part in 0..2 {
+            let make = || {
+                device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("gbuffer"),
+                    size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: GBUFFER_FORMAT,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                })
+            };
+            let (first, second) = (make(), make());
+            let depth = self.targets(width, height, 1).depth;
+            let pipeline = self.pipeline(self.key(Program::GBuffer(part), settings, material, 1));
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let views = [&first, &second].map(|t| t.create_view(&wgpu::TextureViewDescriptor::default()));
+                let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
+                    .iter()
+                    .map(|view| {
+                        Some(wgpu::RenderPassColorAttachment {
+                            view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations {
+                                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                                store: wgpu::StoreOp::Store,
+                            },
+                        })
+                    })
+                    .collect();
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("gbuffer"),
+                    color_attachments: &attachments,
+                    depth_stencil_attachment: Some(depth_attachment(&depth)),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_bind_group(0, &material.film.bind_group, &[]);
+                pass.set_bind_group(1, &self.scene_group, &[]);
+                pass.set_bind_group(2, &material.textures.bind_group, &[]);
+                pass.set_pipeline(&pipeline);
+                pass.set_vertex_buffer(0, self.body.vertices.slice(..));
+                pass.set_vertex_buffer(1, instances.slice(..));
+                pass.set_index_buffer(self.body.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..self.body.count, 0, 0..settings.snakes.max(1));
+            }
+            let a = self.read_texture(encoder, &first, width, height, 16)?;
+            let b = self.read_texture(device.create_command_encoder(&Default::default()), &second, width, height, 16)?;
+            parts.push((bytemuck::cast_slice::<u8, [f32; 4]>(&a).to_vec(), bytemuck::cast_slice::<u8, [f32; 4]>(&b).to_vec()));
+        }
+        let (position_thickness, normal_roughness) = parts.remove(0);
+        let (albedo_coverage, geometric) = parts.remove(0);
+        Ok(GBuffer { width, height, position_thickness, normal_roughness, albedo_coverage, geometric })
+    }
+
+    /// Submits `encoder` with a copy of `texture` and returns its rows, tightly packed.
+    pub fn read_texture(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        width: u32,
+        height: u32,
+        texel_bytes: u32,
+    ) -> Result<Vec<u8>, GpuError> {
+        let device = &self.gpu.device;
+        let row = width * texel_bytes;
+        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: (padded * height) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        let data = map_read(device, &buffer)?;
+        let mut out = Vec::with_capacity((row * height) as usize);
+        for y in 0..height as usize {
+            let start = y * padded as usize;
+            out.extend_from_slice(&data[start..start + row as usize]);
+        }
+        Ok(out)
+    }
+}
+
+fn module_is_skin(program: Program) -> bool {
+    !matches!(program, Program::Plain)
+}
+
+fn map_index(map: MapKind) -> u32 {
+    match map {
+        MapKind::Color => 1,
+        MapKind::Height => 2,
+        MapKind::Normal => 3,
+        MapKind::Roughness => 4,
+        MapKind::Iridescence => 5,
+    }
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn depth_attachment(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+        stencil_ops: None,
+    }
+}
+
+/// Maps a buffer for reading and waits for it.
+pub fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let slice = buffer.slice(..);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
+    receiver.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?.to_vec();
+    buffer.unmap();
+    Ok(data)
+}
+
+/// The G-buffer read back from the GPU (row-major, `width × height`).
+#[derive(Debug, Clone)]
+pub struct GBuffer {
+    pub width: u32,
+    pub height: u32,
+    pub position_thickness: Vec<[f32; 4]>,
+    pub normal_roughness: Vec<[f32; 4]>,
+    /// Albedo and, in `w`, 1 where the snake covers the pixel.
+    pub albedo_coverage: Vec<[f32; 4]>,
+    pub geometric: Vec<[f32; 4]>,
+}
+
+impl GBuffer {
+    pub fn covered(&self, i: usize) -> bool {
+        self.albedo_coverage[i][3] > 0.5
+    }
+}

@@ -1,0 +1,214 @@
+//! What a frame shows besides the maps: the orbit camera, the lights and sky, the layer stage
+//! or map being viewed, the film method, and the uniform block `shaders/scene.wgsl` reads.
+//! The CPU reference reads the same structs, so GPU and CPU shade under identical light.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+
+use crate::optics::film::Stack;
+use crate::preset::Preset;
+use crate::render::film::GpuFilmMethod;
+
+/// An orbit camera around a target: drag changes yaw and pitch, the wheel the distance.
+#[derive(Debug, Clone, Copy)]
+pub struct Camera {
+    pub target: Vec3,
+    pub yaw_deg: f32,
+    pub pitch_deg: f32,
+    pub distance: f32,
+    pub fov_y_deg: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera { target: Vec3::new(0.0, 0.05, 0.0), yaw_deg: 20.0, pitch_deg: 38.0, distance: 2.9, fov_y_deg: 35.0 }
+    }
+}
+
+impl Camera {
+    pub fn position(&self) -> Vec3 {
+        let (yaw, pitch) = (self.yaw_deg.to_radians(), self.pitch_deg.clamp(-89.0, 89.0).to_radians());
+        self.target + self.distance * Vec3::new(pitch.cos() * yaw.sin(), pitch.sin(), pitch.cos() * yaw.cos())
+    }
+
+    pub fn view_proj(&self, aspect: f32) -> Mat4 {
+        let view = Mat4::look_at_rh(self.position(), self.target, Vec3::Y);
+        let near = (self.distance * 0.02).max(1e-3);
+        let proj = Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, near, self.distance * 20.0 + 10.0);
+        proj * view
+    }
+
+    /// A close-up of the mid-body (for figures where the scales must be visible).
+    pub fn close_up() -> Camera {
+        Camera { target: Vec3::new(-0.24, 0.08, 0.0), yaw_deg: 0.0, pitch_deg: 40.0, distance: 0.62, fov_y_deg: 35.0 }
+    }
+}
+
+/// A directional light: unit direction towards the light and irradiance (linear RGB).
+#[derive(Debug, Clone, Copy)]
+pub struct Light {
+    pub direction: Vec3,
+    pub irradiance: [f32; 3],
+    pub enabled: bool,
+}
+
+impl Light {
+    pub fn from_angles(azimuth_deg: f32, elevation_deg: f32, irradiance: [f32; 3]) -> Light {
+        let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
+        Light { direction: Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos()), irradiance, enabled: true }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Lighting {
+    pub key: Light,
+    pub fill: Light,
+    pub sky_top: [f32; 3],
+    pub sky_bottom: [f32; 3],
+}
+
+impl Default for Lighting {
+    fn default() -> Self {
+        Lighting {
+            // A warm key light from the upper front-left and a weak cool fill from the right.
+            key: Light::from_angles(-35.0, 50.0, [3.0, 2.85, 2.6]),
+            fill: Light::from_angles(110.0, 25.0, [0.35, 0.4, 0.5]),
+            sky_top: [0.30, 0.36, 0.45],
+            sky_bottom: [0.08, 0.07, 0.06],
+        }
+    }
+}
+
+/// Layer stages of the thesis' Fig. 5.12.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Stage {
+    Diffuse,
+    DiffuseNormal,
+    Film,
+    All,
+}
+
+impl Stage {
+    pub const ALL: [Stage; 4] = [Stage::Diffuse, Stage::DiffuseNormal, Stage::Film, Stage::All];
+    pub const ACCEPTED: &'static str = "diffuse, normal, film, all";
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Diffuse => "diffuse",
+            Stage::DiffuseNormal => "normal",
+            Stage::Film => "film",
+            Stage::All => "all",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Stage> {
+        Stage::ALL.into_iter().find(|s| s.name() == name)
+    }
+
+    pub fn constant(self) -> f64 {
+        match self {
+            Stage::Diffuse => 0.0,
+            Stage::DiffuseNormal => 1.0,
+            Stage::Film => 2.0,
+            Stage::All => 3.0,
+        }
+    }
+}
+
+/// What the skin pass outputs: a shaded stage or one map shown unlit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum View {
+    Shaded(Stage),
+    Map(crate::maps::MapKind),
+}
+
+impl View {
+    /// Parses `--layers`: a stage name or `map:NAME`.
+    pub fn parse(name: &str) -> Option<View> {
+        if let Some(map) = name.strip_prefix("map:") {
+            return map.parse().ok().map(View::Map);
+        }
+        Stage::parse(name).map(View::Shaded)
+    }
+
+    pub const ACCEPTED: &'static str =
+        "diffuse, normal, film, all, or map:color|map:height|map:normal|map:roughness|map:iridescence";
+}
+
+/// The material's layer optics as the shader needs them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LayerOptics {
+    pub stack: Stack,
+    /// Film thickness at iridescence-map values 0 and 1.
+    pub thickness_range_nm: (f64, f64),
+    pub optical_depth: [f64; 3],
+}
+
+impl LayerOptics {
+    pub fn from_preset(preset: &Preset) -> LayerOptics {
+        let o = &preset.optics;
+        LayerOptics {
+            stack: Stack { n0: o.ambient_ior, n1: o.film_ior, n2: o.pigment_ior },
+            thickness_range_nm: crate::maps::thickness_range_nm(preset),
+            optical_depth: o.absorption.0.map(|s| s * o.pigment_thickness),
+        }
+    }
+
+    /// True when the film changes nothing: zero thickness everywhere or n1 equal to n0.
+    pub fn film_is_inert(&self) -> bool {
+        self.thickness_range_nm.1 <= 0.0 || self.stack.n1 == self.stack.n0
+    }
+
+    pub fn has_absorption(&self) -> bool {
+        self.optical_depth.iter().any(|t| *t > 0.0)
+    }
+
+    /// The film method a pipeline needs: `chosen`, or none when the film is inert. (With no
+    /// film the reflectance is the n0|n2 Fresnel term; n1 = n0 makes the film vanish, so the
+    /// same holds.)
+    pub fn specialised_method(&self, chosen: GpuFilmMethod) -> GpuFilmMethod {
+        if self.film_is_inert() { GpuFilmMethod::None } else { chosen }
+    }
+}
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct SceneUniform {
+    pub view_proj: [[f32; 4]; 4],
+    pub camera: [f32; 4],
+    pub light_dir: [[f32; 4]; 2],
+    pub light_rgb: [[f32; 4]; 2],
+    pub sky_top: [f32; 4],
+    pub sky_bottom: [f32; 4],
+    pub film: [f32; 4],
+    pub optical_depth: [f32; 4],
+}
+
+impl SceneUniform {
+    pub fn new(camera: &Camera, aspect: f32, lighting: &Lighting, optics: &LayerOptics) -> SceneUniform {
+        let light = |l: &Light| {
+            let d = l.direction.normalize();
+            ([d.x, d.y, d.z, if l.enabled { 1.0 } else { 0.0 }], [l.irradiance[0], l.irradiance[1], l.irradiance[2], 0.0])
+        };
+        let (key_dir, key_rgb) = light(&lighting.key);
+        let (fill_dir, fill_rgb) = light(&lighting.fill);
+        let p = camera.position();
+        let rgb4 = |c: [f32; 3]| [c[0], c[1], c[2], 0.0];
+        let tau = optics.optical_depth.map(|t| t as f32);
+        SceneUniform {
+            view_proj: camera.view_proj(aspect).to_cols_array_2d(),
+            camera: [p.x, p.y, p.z, 0.0],
+            light_dir: [key_dir, fill_dir],
+            light_rgb: [key_rgb, fill_rgb],
+            sky_top: rgb4(lighting.sky_top),
+            sky_bottom: rgb4(lighting.sky_bottom),
+            film: [
+                optics.thickness_range_nm.0 as f32,
+                optics.thickness_range_nm.1 as f32,
+                optics.stack.n0 as f32,
+                optics.stack.n2 as f32,
+            ],
+            optical_depth: [tau[0], tau[1], tau[2], 0.0],
+        }
+    }
+}

@@ -1,0 +1,166 @@
+//! The binary's rendering commands: `preview`, `figures` and `bench render`.
+
+use std::io::IsTerminal;
+
+use anyhow::Result;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::cli::PreviewArgs;
+use snakeskin::Error;
+use snakeskin::render::Renderer;
+use snakeskin::render::bench::{BenchOptions, bench_render};
+use snakeskin::render::preview::{
+    parse_image_size, parse_method, reference_check, upload_material, write_figures, write_png,
+};
+use snakeskin::render::renderer::FrameSettings;
+use snakeskin::render::scene::{Camera, View};
+
+fn parse_view(text: &str) -> Result<View, Error> {
+    View::parse(text).ok_or_else(|| Error::Preview(format!("unknown --layers {text:?}; accepted: {}", View::ACCEPTED)))
+}
+
+fn spinner(message: &str) -> Option<ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(ProgressStyle::with_template("{spinner} {msg} {elapsed}").ok()?);
+    bar.set_message(message.to_string());
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    Some(bar)
+}
+
+pub fn preview(args: PreviewArgs) -> Result<()> {
+    // Validate everything before touching the GPU or any file.
+    let size = parse_image_size(&args.size)?;
+    let view = parse_view(&args.layers)?;
+    let method = parse_method(&args.method)?;
+    let loaded = snakeskin::generate::load(&args.preset, &args.overrides, args.seed)?;
+    if !(args.exposure.is_finite() && args.exposure > 0.0) {
+        return Err(Error::Preview(format!("--exposure must be a positive number, got {}", args.exposure)).into());
+    }
+    if args.out.is_none() && !args.window {
+        return Err(Error::Preview("nothing to do: give --out FILE.png (headless) or --window".into()).into());
+    }
+    let settings = FrameSettings {
+        view,
+        method,
+        exposure: args.exposure,
+        ground: !args.no_ground,
+        snakes: args.snakes,
+        camera: if args.close_up { Camera::close_up() } else { Camera::default() },
+        ..FrameSettings::default()
+    };
+    if args.window {
+        let options = snakeskin::render::window::WindowOptions {
+            preset: args.preset.clone(),
+            overrides: args.overrides.clone(),
+            seed: args.seed,
+            map_size: args.map_size as usize,
+            size,
+            frames: args.frames,
+            settings,
+        };
+        let report = snakeskin::render::window::run(options)?;
+        if let Some(frames) = args.frames {
+            println!(
+                "{frames} frames, mean frame time {:.2} ms ({:.1} fps), adapter {}",
+                report.mean_frame_ms,
+                1000.0 / report.mean_frame_ms,
+                report.adapter
+            );
+        }
+        return Ok(());
+    }
+    let bar = spinner("generating maps and baking the film LUT");
+    let renderer = Renderer::headless()?;
+    let material = upload_material(&renderer, &loaded, args.map_size as usize, method)?;
+    if let Some(bar) = &bar {
+        bar.set_message("rendering");
+    }
+    let image = renderer.render_image(&settings, &material, size.0, size.1)?;
+    let out = args.out.expect("checked above");
+    let written = write_png(&out, &image)?;
+    if let Some(heat_path) = &args.reference {
+        if let Some(bar) = &bar {
+            bar.set_message("shading the CPU reference");
+        }
+        let (report, _) = reference_check(&renderer, &material, &settings, size.0, size.1)?;
+        let bytes = {
+            let mut b = Vec::new();
+            report
+                .heat_map(5.0)
+                .write_to(&mut std::io::Cursor::new(&mut b), image::ImageFormat::Png)
+                .map_err(|e| Error::Preview(e.to_string()))?;
+            b
+        };
+        snakeskin::export::write_file_atomically(heat_path, bytes)?;
+        eprintln!(
+            "reference: {} pixels, CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3} (heat map: black 0 .. yellow >= 5)",
+            report.pixels, report.mean_de, report.p99_de, report.max_de
+        );
+    }
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    println!("{}", written.display());
+    Ok(())
+}
+
+pub fn figures(preset: &str, out: &std::path::Path, size: &str, map_size: u64) -> Result<()> {
+    let size = parse_image_size(size)?;
+    snakeskin::generate::load(preset, &[], None)?;
+    let renderer = Renderer::headless()?;
+    let bar = if std::io::stderr().is_terminal() { Some(ProgressBar::new(1)) } else { None };
+    let files = write_figures(&renderer, preset, out, size, map_size as usize, &|done, total| {
+        if let Some(bar) = &bar {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        }
+    })?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    for f in files {
+        println!("{}", f.display());
+    }
+    Ok(())
+}
+
+pub fn bench(preset: &str, size: &str, frames: u64, map_size: u64, reference_size: &str, json: bool) -> Result<()> {
+    let (width, height) = parse_image_size(size)?;
+    let reference_size = parse_image_size(reference_size)?;
+    let loaded = snakeskin::generate::load(preset, &[], None)?;
+    let renderer = Renderer::headless()?;
+    let options = BenchOptions { width, height, frames: frames as usize, map_size: map_size as usize, reference_size };
+    let bar = spinner("bench render");
+    let result = bench_render(&renderer, &loaded, &options, &|what| {
+        if let Some(bar) = &bar {
+            bar.set_message(what.to_string());
+        }
+    })?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+        return Ok(());
+    }
+    println!("adapter: {} (timing: {})", result.adapter, result.timing);
+    println!("frame {}x{}, median of {} frames, scene pass only", result.width, result.height, result.frames);
+    println!("{:<22} {:>7} {:>10} {:>10} {:>10}", "variant", "snakes", "median ms", "p10 ms", "p90 ms");
+    for v in &result.variants {
+        println!("{:<22} {:>7} {:>10.3} {:>10.3} {:>10.3}", v.name, v.snakes, v.median_ms, v.p10_ms, v.p90_ms);
+    }
+    println!("skin / plain: {:.3}", result.ratio);
+    println!(
+        "reference ({}x{}, {} px): CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3}",
+        result.reference_width,
+        result.reference_height,
+        result.reference_pixels,
+        result.reference_mean_de,
+        result.reference_p99_de,
+        result.reference_max_de
+    );
+    Ok(())
+}
