@@ -102,7 +102,7 @@ struct GBuffer {
 }
 
 // Part 0: (world position, thickness nm), (shading normal, roughness).
-// Part 1: (albedo, 1 = covered), (geometric normal, 0).
+// Part 1: (albedo, 1 = covered), (geometric normal, height map value).
 @fragment
 fn fs_gbuffer(in: VertexOut) -> GBuffer {
     let m = sample_material(in);
@@ -112,7 +112,7 @@ fn fs_gbuffer(in: VertexOut) -> GBuffer {
         out.second = vec4<f32>(m.normal, m.roughness);
     } else {
         out.first = vec4<f32>(m.albedo, 1.0);
-        out.second = vec4<f32>(m.geometric, 0.0);
+        out.second = vec4<f32>(m.geometric, m.height);
     }
     return out;
 }

@@ -68,10 +68,8 @@ impl NodeCache {
             fresh.insert(key, Arc::new(image));
             stats.evaluated += 1;
         }
-        let outputs = maps
-            .iter()
-            .filter_map(|m| graph.output(*m).map(|id| (*m, (*fresh[&keys[&id.0]]).clone())))
-            .collect();
+        let outputs =
+            maps.iter().filter_map(|m| graph.output(*m).map(|id| (*m, (*fresh[&keys[&id.0]]).clone()))).collect();
         self.entries = fresh;
         (outputs, stats)
     }

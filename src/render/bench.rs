@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use super::film::GpuFilmMethod;
 use super::preview::{bands_for, material_maps, reference_check};
-use super::renderer::{FrameSettings, Material, OUTPUT_FORMAT, Renderer};
+use super::renderer::{FrameOutput, FrameSettings, Material, OUTPUT_FORMAT, Renderer};
 use super::scene::LayerOptics;
 use crate::Error;
 use crate::optics::lut::Lut;
@@ -102,8 +102,7 @@ fn time_frames(
             &targets,
             settings,
             material,
-            &view,
-            OUTPUT_FORMAT,
+            FrameOutput { view: &view, format: OUTPUT_FORMAT },
             query_set.as_ref().map(|q| (q, 0)),
         );
         if let Some(q) = &query_set {

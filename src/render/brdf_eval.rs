@@ -7,8 +7,8 @@ use wgpu::util::DeviceExt;
 
 use super::film::{self, FilmBinding, GpuFilmMethod};
 use super::{Gpu, GpuError, shader_programs};
-use crate::optics::film::Stack;
 use crate::optics::brdf::Layers32;
+use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
 
 /// One BRDF query, laid out as the shader's `Sample` (five vec4s).

@@ -84,7 +84,12 @@ pub fn mip_chain<T: Texel>(level0: Vec<T>, width: usize, height: usize) -> Vec<V
         let mut next = Vec::with_capacity(nw * nh);
         for y in 0..nh {
             for x in 0..nw {
-                next.push(T::average(at(2 * x, 2 * y), at(2 * x + 1, 2 * y), at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)));
+                next.push(T::average(
+                    at(2 * x, 2 * y),
+                    at(2 * x + 1, 2 * y),
+                    at(2 * x, 2 * y + 1),
+                    at(2 * x + 1, 2 * y + 1),
+                ));
             }
         }
         levels.push(next);

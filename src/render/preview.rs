@@ -4,11 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
+use super::film::GpuFilmMethod;
 use super::material::MaterialMaps;
 use super::reference::{ReferenceReport, compare};
 use super::renderer::{FrameSettings, Material, Renderer};
 use super::scene::{Camera, LayerOptics, Stage, View};
-use super::film::GpuFilmMethod;
 use crate::Error;
 use crate::export::write_file_atomically;
 use crate::graph::{NodeCache, evaluate};
@@ -131,7 +131,12 @@ pub fn figure_list() -> Vec<Figure> {
             "(c) thin film alone",
             "(d) all layers (film, pigment, base)",
         ])
-        .map(|((stage, file), caption)| Figure { file, caption, overrides: fig_5_12.clone(), view: View::Shaded(*stage) })
+        .map(|((stage, file), caption)| Figure {
+            file,
+            caption,
+            overrides: fig_5_12.clone(),
+            view: View::Shaded(*stage),
+        })
         .collect();
     for (file, caption, d) in [
         ("thickness_0nm.png", "δ0 = 0 nm: plain Fresnel, no interference (Fig. 5.8)", "0"),
@@ -147,10 +152,9 @@ pub fn figure_list() -> Vec<Figure> {
             view: View::Shaded(Stage::All),
         });
     }
-    for (file, caption, s) in [
-        ("absorption_0.1.png", "σ0 = 0.1 (Fig. 5.10)", "0.1"),
-        ("absorption_0.7.png", "σ0 = 0.7 (Fig. 5.11)", "0.7"),
-    ] {
+    for (file, caption, s) in
+        [("absorption_0.1.png", "σ0 = 0.1 (Fig. 5.10)", "0.1"), ("absorption_0.7.png", "σ0 = 0.7 (Fig. 5.11)", "0.7")]
+    {
         figures.push(Figure {
             file,
             caption,

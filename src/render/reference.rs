@@ -144,7 +144,8 @@ pub fn compare(
     values.sort_by(f64::total_cmp);
     let pixels = values.len();
     let mean_de = if pixels == 0 { f64::NAN } else { values.iter().sum::<f64>() / pixels as f64 };
-    let p99_de = values.get(((pixels as f64 * 0.99) as usize).min(pixels.saturating_sub(1))).copied().unwrap_or(f64::NAN);
+    let p99_de =
+        values.get(((pixels as f64 * 0.99) as usize).min(pixels.saturating_sub(1))).copied().unwrap_or(f64::NAN);
     ReferenceReport {
         mean_de,
         p99_de,

@@ -23,6 +23,13 @@ const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const MSAA_SAMPLES: u32 = 4;
 
+/// Where a frame's tone-mapped result goes: any 8-bit sRGB view.
+#[derive(Clone, Copy)]
+pub struct FrameOutput<'a> {
+    pub view: &'a wgpu::TextureView,
+    pub format: wgpu::TextureFormat,
+}
+
 /// Everything about a frame that is not the material.
 #[derive(Debug, Clone, Copy)]
 pub struct FrameSettings {
@@ -315,11 +322,8 @@ impl Renderer {
                 constants.push(("GBUFFER_PART", part as f64));
             }
         }
-        let hdr_target = Some(wgpu::ColorTargetState {
-            format: HDR_FORMAT,
-            blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
-        });
+        let hdr_target =
+            Some(wgpu::ColorTargetState { format: HDR_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let gbuffer_target =
             Some(wgpu::ColorTargetState { format: GBUFFER_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let targets: Vec<Option<wgpu::ColorTargetState>> = match key.program {
@@ -448,8 +452,7 @@ impl Renderer {
         targets: &Targets,
         settings: &FrameSettings,
         material: &Material,
-        output: &wgpu::TextureView,
-        output_format: wgpu::TextureFormat,
+        output: FrameOutput<'_>,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) {
         self.write_scene(settings, material, targets.width as f32 / targets.height as f32);
@@ -458,7 +461,8 @@ impl Renderer {
         self.gpu.queue.write_buffer(&targets.tonemap_uniform, 0, bytemuck::cast_slice(&tone));
         let program = if settings.plain { Program::Plain } else { Program::Skin };
         let body = self.pipeline(self.key(program, settings, material, targets.samples));
-        let ground = settings.ground.then(|| self.pipeline(self.key(Program::Ground, settings, material, targets.samples)));
+        let ground =
+            settings.ground.then(|| self.pipeline(self.key(Program::Ground, settings, material, targets.samples)));
         let instances = self.instance_buffer(settings.snakes);
         let [r, g, b] = settings.background;
         {
@@ -503,11 +507,11 @@ impl Renderer {
                 pass.draw_indexed(0..self.ground.count, 0, 0..1);
             }
         }
-        let tonemap = self.tonemap_pipeline(output_format);
+        let tonemap = self.tonemap_pipeline(output.format);
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("tonemap"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: output,
+                view: output.view,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
@@ -534,7 +538,14 @@ impl Renderer {
         let output = self.output_texture(width, height);
         let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        self.encode_frame(&mut encoder, &targets, settings, material, &view, OUTPUT_FORMAT, None);
+        self.encode_frame(
+            &mut encoder,
+            &targets,
+            settings,
+            material,
+            FrameOutput { view: &view, format: OUTPUT_FORMAT },
+            None,
+        );
         let bytes = self.read_texture(encoder, &output, width, height, 4)?;
         image::RgbaImage::from_raw(width, height, bytes).ok_or_else(|| GpuError::Readback("image size".into()))
     }
@@ -617,8 +628,12 @@ impl Renderer {
                 pass.draw_indexed(0..self.body.count, 0, 0..settings.snakes.max(1));
             }
             let a = self.read_texture(encoder, &first, width, height, 16)?;
-            let b = self.read_texture(device.create_command_encoder(&Default::default()), &second, width, height, 16)?;
-            parts.push((bytemuck::cast_slice::<u8, [f32; 4]>(&a).to_vec(), bytemuck::cast_slice::<u8, [f32; 4]>(&b).to_vec()));
+            let b =
+                self.read_texture(device.create_command_encoder(&Default::default()), &second, width, height, 16)?;
+            parts.push((
+                bytemuck::cast_slice::<u8, [f32; 4]>(&a).to_vec(),
+                bytemuck::cast_slice::<u8, [f32; 4]>(&b).to_vec(),
+            ));
         }
         let (position_thickness, normal_roughness) = parts.remove(0);
         let (albedo_coverage, geometric) = parts.remove(0);
@@ -729,6 +744,7 @@ pub struct GBuffer {
     pub normal_roughness: Vec<[f32; 4]>,
     /// Albedo and, in `w`, 1 where the snake covers the pixel.
     pub albedo_coverage: Vec<[f32; 4]>,
+    /// Interpolated geometric normal and, in `w`, the height map value.
     pub geometric: Vec<[f32; 4]>,
 }
 

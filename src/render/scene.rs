@@ -71,7 +71,7 @@ impl Default for Lighting {
     fn default() -> Self {
         Lighting {
             // A warm key light from the upper front-left and a weak cool fill from the right.
-            key: Light::from_angles(-35.0, 50.0, [3.0, 2.85, 2.6]),
+            key: Light::from_angles(-35.0, 40.0, [3.0, 2.85, 2.6]),
             fill: Light::from_angles(110.0, 25.0, [0.35, 0.4, 0.5]),
             sky_top: [0.30, 0.36, 0.45],
             sky_bottom: [0.08, 0.07, 0.06],
@@ -188,7 +188,10 @@ impl SceneUniform {
     pub fn new(camera: &Camera, aspect: f32, lighting: &Lighting, optics: &LayerOptics) -> SceneUniform {
         let light = |l: &Light| {
             let d = l.direction.normalize();
-            ([d.x, d.y, d.z, if l.enabled { 1.0 } else { 0.0 }], [l.irradiance[0], l.irradiance[1], l.irradiance[2], 0.0])
+            (
+                [d.x, d.y, d.z, if l.enabled { 1.0 } else { 0.0 }],
+                [l.irradiance[0], l.irradiance[1], l.irradiance[2], 0.0],
+            )
         };
         let (key_dir, key_rgb) = light(&lighting.key);
         let (fill_dir, fill_rgb) = light(&lighting.fill);

@@ -21,7 +21,7 @@ use winit::window::{Window, WindowId};
 use super::film::GpuFilmMethod;
 use super::material::MaterialMaps;
 use super::preview::{bands_for, material_maps_cached};
-use super::renderer::{FrameSettings, Material, Renderer, Targets};
+use super::renderer::{FrameOutput, FrameSettings, Material, Renderer, Targets};
 use super::scene::{LayerOptics, Stage, View};
 use super::{Gpu, GpuError};
 use crate::Error;
@@ -347,22 +347,38 @@ impl App {
         let jobs = self.egui.tessellate(full.shapes, full.pixels_per_point);
         let device = &gfx.renderer.gpu.device;
         let queue = &gfx.renderer.gpu.queue;
-        for (id, deltas) in &full.textures_delta.set {
+        let mut textures = full.textures_delta;
+        for (id, deltas) in &textures.set {
             for delta in deltas {
                 gfx.egui_renderer.update_texture(device, queue, *id, delta);
             }
         }
+        // Freed textures are released after this frame's painting; on an early return they
+        // are released now (egui never paints them again).
+        let freed = std::mem::take(&mut textures.free);
+        textures.clear();
         let frame = match gfx.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => return,
-            _ => {
-                gfx.surface.configure(device, &gfx.config);
+            other => {
+                for id in &freed {
+                    gfx.egui_renderer.free_texture(id);
+                }
+                if !matches!(other, wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded) {
+                    gfx.surface.configure(device, &gfx.config);
+                }
                 return;
             }
         };
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let mut encoder = device.create_command_encoder(&Default::default());
-        gfx.renderer.encode_frame(&mut encoder, &gfx.targets, &self.settings, &gfx.material, &view, gfx.config.format, None);
+        gfx.renderer.encode_frame(
+            &mut encoder,
+            &gfx.targets,
+            &self.settings,
+            &gfx.material,
+            FrameOutput { view: &view, format: gfx.config.format },
+            None,
+        );
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [gfx.config.width, gfx.config.height],
             pixels_per_point: full.pixels_per_point,
@@ -387,7 +403,7 @@ impl App {
         queue.submit(extra.into_iter().chain([encoder.finish()]));
         gfx.window.pre_present_notify();
         queue.present(frame);
-        for id in &full.textures_delta.free {
+        for id in &freed {
             gfx.egui_renderer.free_texture(id);
         }
         self.frames_done += 1;

@@ -46,3 +46,23 @@ pub fn write_preset(dir: &Path, name: &str, text: &str) -> String {
     std::fs::write(&path, text).unwrap();
     path.to_string_lossy().into_owned()
 }
+
+/// The GPU, or None (after printing why) when the test may skip. With
+/// SNAKESKIN_REQUIRE_GPU=1 (set in .ci/run) a missing adapter fails the test instead.
+pub fn gpu_or_skip(test: &str) -> Option<snakeskin::render::Gpu> {
+    match snakeskin::render::Gpu::headless() {
+        Ok(gpu) => {
+            eprintln!("{test}: running on {}", gpu.describe());
+            Some(gpu)
+        }
+        Err(e) if gpu_required() => panic!("{test}: SNAKESKIN_REQUIRE_GPU=1 but {e}"),
+        Err(e) => {
+            eprintln!("{test}: SKIPPED: {e}");
+            None
+        }
+    }
+}
+
+pub fn gpu_required() -> bool {
+    std::env::var("SNAKESKIN_REQUIRE_GPU").is_ok_and(|v| v == "1")
+}

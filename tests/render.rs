@@ -1,0 +1,325 @@
+//! Renderer tests: headless frames are not blank, match the CPU spectral reference, show no
+//! moiré for thick films, the specialised pipelines agree with the general one, the map
+//! viewer shows the maps, the window runs under Xvfb, and live reload re-evaluates only what
+//! changed. GPU tests run for real on lavapipe in CI (SNAKESKIN_REQUIRE_GPU=1); without an
+//! adapter they skip with a printed reason.
+
+mod common;
+
+use common::{gpu_or_skip, gpu_required, snakeskin};
+use snakeskin::graph::{NodeCache, evaluate};
+use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+use snakeskin::render::Renderer;
+use snakeskin::render::film::GpuFilmMethod;
+use snakeskin::render::preview::{material_maps, reference_check};
+use snakeskin::render::reference::srgb_encode;
+use snakeskin::render::renderer::{FrameSettings, Material};
+use snakeskin::render::scene::{Camera, LayerOptics, Stage, View};
+
+const PRESET: &str = "erythrolamprus-miliaris";
+const MAP_SIZE: usize = 256;
+
+fn load(overrides: &[(&str, &str)]) -> snakeskin::preset::LoadedPreset {
+    let overrides: Vec<(String, String)> = overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    snakeskin::generate::load(PRESET, &overrides, None).unwrap()
+}
+
+fn material(renderer: &Renderer, overrides: &[(&str, &str)], method: GpuFilmMethod) -> Material {
+    let loaded = load(overrides);
+    let maps = material_maps(&loaded, MAP_SIZE).unwrap();
+    let optics = LayerOptics::from_preset(&loaded.preset);
+    let lut = snakeskin::optics::lut::Lut::bake(optics.stack, 32, 128, 32);
+    let bands = if let GpuFilmMethod::SpectralN(n) = method { n } else { 1 };
+    renderer.material(&maps, optics, &lut, bands)
+}
+
+fn close_up() -> FrameSettings {
+    FrameSettings { camera: Camera::close_up(), ground: false, ..FrameSettings::default() }
+}
+
+/// Pixels that differ from the background (the most common colour), as a fraction.
+fn coverage(image: &image::RgbaImage) -> f64 {
+    let mut counts = std::collections::HashMap::new();
+    for p in image.pixels() {
+        *counts.entry([p[0], p[1], p[2]]).or_insert(0usize) += 1;
+    }
+    let background = counts.into_iter().max_by_key(|(_, n)| *n).unwrap().0;
+    let covered = image.pixels().filter(|p| (0..3).any(|c| p[c].abs_diff(background[c]) > 2)).count();
+    covered as f64 / (image.width() * image.height()) as f64
+}
+
+#[test]
+fn a_headless_render_shows_the_snake() {
+    let Some(gpu) = gpu_or_skip("a_headless_render_shows_the_snake") else { return };
+    let renderer = Renderer::new(gpu);
+    let material = material(&renderer, &[], GpuFilmMethod::Lut);
+    let settings = FrameSettings { ground: false, ..FrameSettings::default() };
+    let image = renderer.render_image(&settings, &material, 320, 200).unwrap();
+    let fraction = coverage(&image);
+    // The whole body in the default view covers roughly a tenth of the frame.
+    assert!((0.04..0.4).contains(&fraction), "snake covers {fraction}");
+    // Shaded, not flat: the covered pixels span a range of brightness.
+    let lum: Vec<u32> = image.pixels().map(|p| p[0] as u32 + p[1] as u32 + p[2] as u32).collect();
+    let (lo, hi) = (lum.iter().min().unwrap(), lum.iter().max().unwrap());
+    assert!(hi - lo > 150, "brightness range {lo}..{hi}");
+    // The close-up is mostly snake.
+    let near = renderer.render_image(&close_up(), &material, 320, 200).unwrap();
+    assert!(coverage(&near) > 0.3, "close-up covers {}", coverage(&near));
+}
+
+#[test]
+fn gpu_render_matches_the_cpu_spectral_reference() {
+    let Some(gpu) = gpu_or_skip("gpu_render_matches_the_cpu_spectral_reference") else { return };
+    let renderer = Renderer::new(gpu);
+    let material = material(&renderer, &[], GpuFilmMethod::Lut);
+    let (report, _) = reference_check(&renderer, &material, &close_up(), 200, 125).unwrap();
+    eprintln!(
+        "reference: {} px, mean {:.3}, p99 {:.3}, max {:.3}",
+        report.pixels, report.mean_de, report.p99_de, report.max_de
+    );
+    assert!(report.pixels > 5000, "{} pixels", report.pixels);
+    assert!(report.mean_de <= 1.0, "mean CIEDE2000 {}", report.mean_de);
+}
+
+#[test]
+fn the_reference_check_catches_a_wrong_film() {
+    // Negative control: the same comparison against a GPU frame with the wrong film
+    // thickness (the maps and G-buffer of one material, the image of another) must fail.
+    let Some(gpu) = gpu_or_skip("the_reference_check_catches_a_wrong_film") else { return };
+    let renderer = Renderer::new(gpu);
+    let right = material(&renderer, &[], GpuFilmMethod::Lut);
+    let wrong = material(&renderer, &[("optics.film_thickness_nm", "250")], GpuFilmMethod::Lut);
+    let settings = FrameSettings { samples: 1, ..close_up() };
+    let image = renderer.render_image(&settings, &wrong, 160, 100).unwrap();
+    let gbuffer = renderer.render_gbuffer(&settings, &right, 160, 100).unwrap();
+    let report = snakeskin::render::reference::compare(&image, &gbuffer, &settings, &right.optics);
+    assert!(report.mean_de > 2.0, "a 150 nm thinner film went unnoticed: mean {}", report.mean_de);
+}
+
+/// Mean squared Laplacian of luminance over pixels whose 3×3 neighbourhood is all snake.
+fn high_frequency_energy(image: &image::RgbaImage, mask: &[bool]) -> f64 {
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    let lum = |x: usize, y: usize| {
+        let p = image.get_pixel(x as u32, y as u32);
+        0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64
+    };
+    let (mut sum, mut n) = (0.0, 0);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            if !(y - 1..=y + 1).all(|yy| (x - 1..=x + 1).all(|xx| mask[yy * w + xx])) {
+                continue;
+            }
+            let l = 4.0 * lum(x, y) - lum(x - 1, y) - lum(x + 1, y) - lum(x, y - 1) - lum(x, y + 1);
+            sum += l * l;
+            n += 1;
+        }
+    }
+    sum / n as f64
+}
+
+#[test]
+fn no_moire_at_a_thickness_of_2_4_mm() {
+    // The thesis' Fig. 5.9 shows moiré at δ0 = 2.4 mm: the film was point-sampled where its
+    // colour oscillates far faster than pixels and wavelengths. Every method here prefilters,
+    // so the render's high-frequency energy stays near that of the film-free δ0 = 0 render.
+    let Some(gpu) = gpu_or_skip("no_moire_at_a_thickness_of_2_4_mm") else { return };
+    let renderer = Renderer::new(gpu);
+    let settings = FrameSettings { camera: Camera { distance: 1.4, ..Camera::close_up() }, ..close_up() };
+    let (w, h) = (320, 200);
+    let flat =
+        material(&renderer, &[("optics.film_thickness_nm", "0"), ("iridescence.spread_nm", "0")], GpuFilmMethod::Lut);
+    let gbuffer = renderer.render_gbuffer(&settings, &flat, w, h).unwrap();
+    let mask: Vec<bool> = (0..(w * h) as usize).map(|i| gbuffer.covered(i)).collect();
+    let base = high_frequency_energy(&renderer.render_image(&settings, &flat, w, h).unwrap(), &mask);
+    for method in [GpuFilmMethod::Lut, GpuFilmMethod::Rgb3, GpuFilmMethod::SpectralN(8), GpuFilmMethod::GaussianFit] {
+        let thick = material(&renderer, &[("optics.film_thickness_nm", "2400000")], method);
+        let settings = FrameSettings { method, ..settings };
+        let energy = high_frequency_energy(&renderer.render_image(&settings, &thick, w, h).unwrap(), &mask);
+        eprintln!("{}: high-frequency energy {energy:.2} vs {base:.2} at δ0 = 0", method.name());
+        assert!(energy < 1.3 * base, "{}: {energy} vs {base}", method.name());
+    }
+}
+
+fn max_channel_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
+    a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap()).max().unwrap()
+}
+
+#[test]
+fn specialised_pipelines_agree_with_the_general_one() {
+    let Some(gpu) = gpu_or_skip("specialised_pipelines_agree_with_the_general_one") else { return };
+    let renderer = Renderer::new(gpu);
+    let settings = close_up();
+    let (w, h) = (200, 125);
+    // No film: δ0 = 0 everywhere. The specialised pipeline uses the closed-form Fresnel term;
+    // the general one reads the LUT's d = 0 column.
+    let mut no_film =
+        material(&renderer, &[("optics.film_thickness_nm", "0"), ("iridescence.spread_nm", "0")], GpuFilmMethod::Lut);
+    assert!(no_film.optics.film_is_inert());
+    let specialised = renderer.render_image(&settings, &no_film, w, h).unwrap();
+    // The same material, but declared with a tiny non-zero film range so that the general
+    // pipeline runs (a film of 1e-6 nm changes nothing visible).
+    no_film.optics.thickness_range_nm = (0.0, 1e-6);
+    assert!(!no_film.optics.film_is_inert());
+    let general = renderer.render_image(&settings, &no_film, w, h).unwrap();
+    let diff = max_channel_difference(&specialised, &general);
+    assert!(diff <= 2, "no-film pipeline differs by {diff}/255");
+
+    // No absorption: τ = 0 skips the attenuation; τ = 1e-9 takes the general path.
+    let mut clear = material(&renderer, &[("optics.absorption", "0")], GpuFilmMethod::Lut);
+    assert!(!clear.optics.has_absorption());
+    let specialised = renderer.render_image(&settings, &clear, w, h).unwrap();
+    clear.optics.optical_depth = [1e-9; 3];
+    let general = renderer.render_image(&settings, &clear, w, h).unwrap();
+    let diff = max_channel_difference(&specialised, &general);
+    assert!(diff <= 1, "no-absorption pipeline differs by {diff}/255");
+}
+
+#[test]
+fn the_map_viewer_shows_the_color_map_and_stages_differ() {
+    let Some(gpu) = gpu_or_skip("the_map_viewer_shows_the_color_map_and_stages_differ") else { return };
+    let renderer = Renderer::new(gpu);
+    let material = material(&renderer, &[], GpuFilmMethod::Lut);
+    let settings = FrameSettings { samples: 1, view: View::Map(MapKind::Color), ..close_up() };
+    let (w, h) = (200, 125);
+    let image = renderer.render_image(&settings, &material, w, h).unwrap();
+    let gbuffer = renderer.render_gbuffer(&settings, &material, w, h).unwrap();
+    let mut worst = 0.0f64;
+    for i in (0..(w * h) as usize).filter(|i| gbuffer.covered(*i)) {
+        for c in 0..3 {
+            let expected = srgb_encode(gbuffer.albedo_coverage[i][c] as f64) * 255.0;
+            worst = worst.max((image.as_raw()[4 * i + c] as f64 - expected).abs());
+        }
+    }
+    assert!(worst <= 1.5, "map view differs from the sampled colour map by {worst}/255");
+
+    // Each layer stage adds something visible.
+    let render = |stage| {
+        renderer.render_image(&FrameSettings { view: View::Shaded(stage), ..close_up() }, &material, w, h).unwrap()
+    };
+    let images: Vec<_> = Stage::ALL.iter().map(|s| render(*s)).collect();
+    let mean_difference = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        let total: u64 =
+            a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c]) as u64).sum::<u64>()).sum();
+        total as f64 / (3 * a.width() * a.height()) as f64
+    };
+    for i in 0..images.len() {
+        for j in i + 1..images.len() {
+            if (i, j) == (0, 1) {
+                continue; // the normal map's effect is subtle in Lambert light; checked below
+            }
+            let d = mean_difference(&images[i], &images[j]);
+            eprintln!("stages {i} and {j}: mean difference {d:.2}/255");
+            assert!(d > 1.0, "stages {i} and {j} look the same ({d})");
+        }
+    }
+    // The normal map adds relief: more high-frequency energy than the smooth body.
+    let mask: Vec<bool> = (0..(w * h) as usize).map(|i| gbuffer.covered(i)).collect();
+    let (flat, relief) = (high_frequency_energy(&images[0], &mask), high_frequency_energy(&images[1], &mask));
+    assert!(relief > flat, "normal mapping added no relief: {relief} vs {flat}");
+}
+
+#[test]
+fn preview_writes_a_png_and_rejects_bad_options() {
+    let Some(_gpu) = gpu_or_skip("preview_writes_a_png_and_rejects_bad_options") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("snake.png");
+    let o = out.to_str().unwrap();
+    let run = snakeskin(&["preview", PRESET, "--out", o, "--size", "160x100", "--map-size", "128", "--layers", "film"]);
+    assert!(run.status.success(), "{}", common::stderr(&run));
+    let image = image::open(&out).unwrap();
+    assert_eq!((image.width(), image.height()), (160, 100));
+
+    let before = std::fs::read(&out).unwrap();
+    for (args, needle) in [
+        (vec!["--layers", "shiny"], "accepted: diffuse, normal, film, all"),
+        (vec!["--method", "rgb4"], "accepted: spectral, rgb3"),
+        (vec!["--size", "100x"], "expected WIDTHxHEIGHT"),
+        (vec!["--set", "optics.film_ior=-1"], "optics.film_ior"),
+    ] {
+        let mut full = vec!["preview", PRESET, "--out", o, "--map-size", "128"];
+        full.extend(args);
+        let run = snakeskin(&full);
+        assert_eq!(run.status.code(), Some(2), "{full:?}");
+        assert!(common::stderr(&run).contains(needle), "{full:?}: {}", common::stderr(&run));
+    }
+    assert_eq!(std::fs::read(&out).unwrap(), before, "a failed run touched the earlier output");
+}
+
+#[test]
+fn the_window_runs_frames_under_xvfb() {
+    if gpu_or_skip("the_window_runs_frames_under_xvfb").is_none() {
+        return;
+    }
+    let has_xvfb = std::process::Command::new("xvfb-run").arg("--help").output().is_ok();
+    if !has_xvfb {
+        assert!(!gpu_required(), "SNAKESKIN_REQUIRE_GPU=1 but xvfb-run is missing (apt-get install xvfb)");
+        eprintln!("the_window_runs_frames_under_xvfb: SKIPPED: xvfb-run not installed");
+        return;
+    }
+    let out = std::process::Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
+        .args(["preview", PRESET, "--window", "--frames", "12", "--size", "480x300", "--map-size", "128"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}\n{}", stdout, String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("12 frames, mean frame time"), "{stdout}");
+}
+
+#[test]
+fn live_reload_re_evaluates_only_the_changed_nodes() {
+    let before = load(&[]);
+    let after = load(&[("belly.color", "\"#203040\"")]);
+    let mut cache = NodeCache::new();
+    let size = 64;
+    let (_, first) = cache.evaluate(&build_graph(&before.preset, BuildOptions::default()), &MapKind::ALL, size, size);
+    assert_eq!(first.reused, 0);
+    let graph = build_graph(&after.preset, BuildOptions::default());
+    let (maps, second) = cache.evaluate(&graph, &MapKind::ALL, size, size);
+    eprintln!("after a belly colour edit: {} nodes evaluated, {} reused", second.evaluated, second.reused);
+    assert!(second.evaluated >= 1, "the edit changed something");
+    assert!(second.reused > second.evaluated, "{second:?}");
+    // The incremental result is exactly the from-scratch result.
+    let fresh = evaluate(&graph, &MapKind::ALL, size, size, &|_, _| {});
+    for map in MapKind::ALL {
+        assert_eq!(maps[&map], fresh.maps[&map], "{map} differs from a fresh evaluation");
+    }
+    // Only colour nodes ran: the height map's nodes were all reused.
+    let (_, third) = cache.evaluate(&graph, &MapKind::ALL, size, size);
+    assert_eq!(third.evaluated, 0);
+}
+
+#[test]
+fn normal_mapping_tilts_the_normal_away_from_higher_ground() {
+    // An independent check of the tangent frame (u around the body, +Y up the image): across
+    // neighbouring pixels, the shading normal's tilt away from the geometric normal must
+    // point down the height map's slope. A flipped tangent or bitangent breaks the correlation.
+    let Some(gpu) = gpu_or_skip("normal_mapping_tilts_the_normal_away_from_higher_ground") else { return };
+    let renderer = Renderer::new(gpu);
+    let material = material(&renderer, &[], GpuFilmMethod::Lut);
+    let settings = FrameSettings { camera: Camera { distance: 0.35, ..Camera::close_up() }, ..close_up() };
+    let (w, h) = (240, 160);
+    let g = renderer.render_gbuffer(&settings, &material, w, h).unwrap();
+    let v3 = |a: [f32; 4]| glam::Vec3::new(a[0], a[1], a[2]);
+    let (mut xy, mut xx, mut yy) = (0.0f64, 0.0f64, 0.0f64);
+    for y in 0..h as usize - 1 {
+        for x in 0..w as usize - 1 {
+            let i = y * w as usize + x;
+            let tilt = v3(g.normal_roughness[i]) - v3(g.geometric[i]);
+            for j in [i + 1, i + w as usize] {
+                if !(g.covered(i) && g.covered(j)) {
+                    continue;
+                }
+                let step = v3(g.position_thickness[j]) - v3(g.position_thickness[i]);
+                let rise = (g.geometric[j][3] - g.geometric[i][3]) as f64;
+                let along = tilt.dot(step) as f64;
+                xy += along * rise;
+                xx += along * along;
+                yy += rise * rise;
+            }
+        }
+    }
+    let correlation = xy / (xx * yy).sqrt();
+    eprintln!("correlation of normal tilt with the height rise: {correlation:.3}");
+    assert!(correlation < -0.5, "normal tilt and height slope correlate at {correlation}");
+}
