@@ -35,6 +35,22 @@ fn film_clamped(layers: Layers, c: f32) -> vec3<f32> {
 
 fn skin_brdf(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
     let n = safe_normalize(normal, vec3<f32>(0.0, 0.0, 1.0));
+    let f_o = film_clamped(layers, max(dot(n, safe_normalize(wo_in, vec3<f32>(0.0))), COS_MIN));
+    return skin_brdf_seen(layers, normal, wi_in, wo_in, f_o, true);
+}
+
+// The BRDF with the film's reflectance towards the viewer, f_o = F(max(n.wo, COS_MIN)),
+// computed by the caller: a pixel lit by several lights (and the ambient term) looks it up
+// once instead of once per light. `with_diffuse` = false gives the specular lobe alone.
+fn skin_brdf_seen(
+    layers: Layers,
+    normal: vec3<f32>,
+    wi_in: vec3<f32>,
+    wo_in: vec3<f32>,
+    f_o: vec3<f32>,
+    with_diffuse: bool,
+) -> vec3<f32> {
+    let n = safe_normalize(normal, vec3<f32>(0.0, 0.0, 1.0));
     let wi = safe_normalize(wi_in, vec3<f32>(0.0));
     let wo = safe_normalize(wo_in, vec3<f32>(0.0));
     let raw_i = dot(n, wi);
@@ -65,9 +81,8 @@ fn skin_brdf(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f3
     let ki = (1.0 - eta2) + eta2 * cos_i * cos_i;
     let ko = (1.0 - eta2) + eta2 * cos_o * cos_o;
     var diffuse = vec3<f32>(0.0);
-    if (ki > 0.0 && ko > 0.0) {
+    if (with_diffuse && ki > 0.0 && ko > 0.0) {
         let f_i = film_clamped(layers, cos_i);
-        let f_o = film_clamped(layers, cos_o);
         diffuse = (vec3<f32>(1.0) - f_i) * (vec3<f32>(1.0) - f_o) * max(layers.albedo, vec3<f32>(0.0)) / PI;
         if (HAS_ABSORPTION) {
             let path = 1.0 / max(sqrt(ki), COS_MIN) + 1.0 / max(sqrt(ko), COS_MIN);
@@ -77,9 +92,3 @@ fn skin_brdf(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f3
     return f_h * spec + diffuse;
 }
 
-// The specular lobe alone: stage (c) of the thesis' Fig. 5.12, the isolated film.
-fn skin_specular(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
-    var no_base = layers;
-    no_base.albedo = vec3<f32>(0.0);
-    return skin_brdf(no_base, normal, wi_in, wo_in);
-}

@@ -18,13 +18,9 @@ fn layers_of(m: Material) -> Layers {
 // seen along the normal enters the pigment layer through the film (1 - F at the view angle)
 // and is attenuated along the view path plus one layer thickness; the sky seen along the
 // mirror direction is reflected by the film.
-fn ambient(m: Material, n: vec3<f32>, wo: vec3<f32>, with_diffuse: bool, with_film: bool) -> vec3<f32> {
+fn ambient(m: Material, n: vec3<f32>, wo: vec3<f32>, f_o: vec3<f32>, with_diffuse: bool) -> vec3<f32> {
     let cos_o = max(dot(n, wo), COS_MIN);
-    let f_o = clamp(film_rgb(m.thickness_nm, cos_o), vec3<f32>(0.0), vec3<f32>(1.0));
-    var result = vec3<f32>(0.0);
-    if (with_film) {
-        result += sky(reflect(-wo, n)) * f_o;
-    }
+    var result = sky(reflect(-wo, n)) * f_o;
     if (with_diffuse) {
         var base = sky(n) * (vec3<f32>(1.0) - f_o) * m.albedo;
         if (HAS_ABSORPTION) {
@@ -53,18 +49,17 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
         return radiance + sky(n) * m.albedo;
     }
     let layers = layers_of(m);
+    // The film towards the viewer, shared by both lights and the ambient term.
+    let f_o = clamp(film_rgb(m.thickness_nm, max(dot(m.normal, wo), COS_MIN)), vec3<f32>(0.0), vec3<f32>(1.0));
     for (var i = 0u; i < 2u; i++) {
         let wi = scene.light_dir[i].xyz;
         let cos_i = max(dot(m.normal, wi), 0.0);
-        var f: vec3<f32>;
-        if (STAGE == 2u) {
-            f = skin_specular(layers, m.normal, wi, wo);
-        } else {
-            f = skin_brdf(layers, m.normal, wi, wo);
+        if (scene.light_dir[i].w > 0.0 && cos_i > 0.0) {
+            let f = skin_brdf_seen(layers, m.normal, wi, wo, f_o, STAGE == 3u);
+            radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * f * cos_i;
         }
-        radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * f * cos_i;
     }
-    return radiance + ambient(m, m.normal, wo, STAGE == 3u, true);
+    return radiance + ambient(m, m.normal, wo, f_o, STAGE == 3u);
 }
 
 fn map_view(m: Material) -> vec3<f32> {
