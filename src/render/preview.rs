@@ -148,7 +148,12 @@ pub fn figure_list() -> Vec<Figure> {
         figures.push(Figure {
             file,
             caption,
-            overrides: vec![("optics.film_thickness_nm", d), ("optics.absorption", "0.6")],
+            // δ0 = 0 means no film anywhere: the thickness map's spread goes too.
+            overrides: if d == "0" {
+                vec![("optics.film_thickness_nm", d), ("iridescence.spread_nm", "0"), ("optics.absorption", "0.6")]
+            } else {
+                vec![("optics.film_thickness_nm", d), ("optics.absorption", "0.6")]
+            },
             view: View::Shaded(Stage::All),
         });
     }
