@@ -66,6 +66,22 @@ pub enum Command {
         #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
         map_size: u64,
     },
+    /// A contact sheet of the species library: per species its colour map and a preview
+    /// render, labelled with scientific name, common name and pattern category.
+    Sheet {
+        /// Output PNG file.
+        #[arg(short, long, value_name = "FILE.png")]
+        out: PathBuf,
+        /// Tile size in pixels (colour map tile × tile, render 2·tile × tile).
+        #[arg(long, default_value_t = 224, value_parser = clap::value_parser!(u32).range(64..=1024))]
+        tile: u32,
+        /// Cells per row.
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
+        columns: u32,
+        /// Map resolution per species (pixels per side).
+        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u64).range(64..=4096))]
+        map_size: u64,
+    },
     /// List or show the built-in species presets.
     Presets {
         #[command(subcommand)]

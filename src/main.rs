@@ -95,13 +95,19 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Presets { command: PresetsCommand::List } => {
+            println!("{:<26} {:<26} {:<32} category", "name", "species", "common name");
             for (name, text) in library::all() {
                 let preset: snakeskin::preset::Preset = toml::from_str(text)?;
-                let category = preset.category.map(|c| format!("{c:?}")).unwrap_or_default();
-                println!("{name:<28} {:<32} {}", preset.common_name.unwrap_or_default(), category.to_lowercase());
+                println!(
+                    "{name:<26} {:<26} {:<32} {}",
+                    preset.species.unwrap_or_default(),
+                    preset.common_name.unwrap_or_default(),
+                    preset.category.map(|c| c.name()).unwrap_or("-")
+                );
             }
             Ok(())
         }
+        Command::Sheet { out, tile, columns, map_size } => render_cmd::sheet(&out, tile, columns, map_size as usize),
         Command::Presets { command: PresetsCommand::Show { name } } => match library::get(&name) {
             Some(text) => {
                 print!("{text}");

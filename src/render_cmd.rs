@@ -164,3 +164,28 @@ pub fn bench(preset: &str, size: &str, frames: u64, map_size: u64, reference_siz
     );
     Ok(())
 }
+
+pub fn sheet(out: &std::path::Path, tile: u32, columns: u32, map_size: usize) -> Result<()> {
+    use snakeskin::render::sheet::{SheetOptions, write_sheet};
+    let renderer = Renderer::headless()?;
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new(1);
+        if let Ok(style) = ProgressStyle::with_template("{spinner} sheet [{bar:30}] {pos}/{len} species {elapsed}") {
+            bar.set_style(style);
+        }
+        Some(bar)
+    } else {
+        None
+    };
+    let written = write_sheet(&renderer, out, SheetOptions { tile, columns, map_size }, &|done, total| {
+        if let Some(bar) = &bar {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        }
+    })?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    println!("{}", written.display());
+    Ok(())
+}

@@ -9,17 +9,132 @@ use snakeskin::preset::{library, parse, read_source};
 fn every_builtin_preset_parses_and_validates() {
     for name in library::names() {
         let loaded = parse(&read_source(name).unwrap(), &[]).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(loaded.preset.species.is_some(), "{name} names its species");
-        assert!(!loaded.preset.sources.is_empty(), "{name} cites a source");
+        let preset = &loaded.preset;
+        let species = preset.species.as_deref().unwrap_or_else(|| panic!("{name} names its species"));
+        assert_eq!(species.to_lowercase().replace(' ', "-"), name, "file name follows the species");
+        assert!(preset.common_name.is_some(), "{name} has a common name");
+        assert!(preset.category.is_some(), "{name} has a category");
+        assert!(!preset.sources.is_empty(), "{name} cites a source");
+        // A citation says where: a URL, or a publication with its year.
+        for source in &preset.sources {
+            let has_year = source.chars().collect::<Vec<_>>().windows(4).any(|w| w.iter().all(|c| c.is_ascii_digit()));
+            assert!(source.contains("http") || has_year, "{name}: vague source {source:?}");
+        }
     }
+}
+
+#[test]
+fn every_file_in_presets_is_built_in() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/presets");
+    let mut files: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|f| f.ends_with(".toml"))
+        .map(|f| f.trim_end_matches(".toml").to_string())
+        .collect();
+    files.sort();
+    assert_eq!(files, library::names());
+    for name in library::names() {
+        let on_disk = std::fs::read_to_string(format!("{dir}/{name}.toml")).unwrap();
+        assert_eq!(library::get(name), Some(on_disk.as_str()), "{name}: the embedded copy is current");
+    }
+}
+
+#[test]
+fn the_library_covers_the_thesis_species_every_category_and_scale_type() {
+    use snakeskin::preset::schema::{Category, ScaleShape};
+    let required = [
+        "Erythrolamprus miliaris",
+        "Lampropeltis triangulum",
+        "Philodryas olfersii",
+        "Philodryas aestiva",
+        "Phalotris lemniscatus",
+        "Micrurus diastema",
+        "Ptychophis flavovirgatus",
+        "Bothrops alternatus",
+        "Python regius",
+        "Leiopython albertisii",
+        "Xenopeltis unicolor",
+        "Epicrates cenchria",
+    ];
+    let presets: Vec<_> =
+        library::names().into_iter().map(|n| parse(&read_source(n).unwrap(), &[]).unwrap().preset).collect();
+    assert!(presets.len() >= 20, "{} presets", presets.len());
+    for species in required {
+        assert!(presets.iter().any(|p| p.species.as_deref() == Some(species)), "{species} is missing");
+    }
+    for category in [
+        Category::Solid,
+        Category::VerticalStripe,
+        Category::HorizontalStripe,
+        Category::Spot,
+        Category::Simple,
+        Category::Complex,
+    ] {
+        assert!(presets.iter().any(|p| p.category == Some(category)), "no {category:?} preset");
+    }
+    for shape in [ScaleShape::Leaf, ScaleShape::Diamond, ScaleShape::Hexagon] {
+        assert!(presets.iter().any(|p| p.scales.shape == shape), "no {shape:?} preset");
+    }
+    assert!(presets.iter().any(|p| p.scales.keeled) && presets.iter().any(|p| !p.scales.keeled));
+    // The iridescent species have a film; most others do not.
+    for species in ["Xenopeltis unicolor", "Epicrates cenchria", "Leiopython albertisii"] {
+        let p = presets.iter().find(|p| p.species.as_deref() == Some(species)).unwrap();
+        assert!(p.optics.film_thickness_nm > 0.0 && p.iridescence.spread_nm > 0.0, "{species} has no film");
+    }
+}
+
+#[test]
+fn every_preset_generates_and_no_two_look_alike() {
+    use snakeskin::graph::evaluate;
+    use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+    use snakeskin::optics::lab::linear_srgb_to_lab;
+    let size = 48;
+    let mut labs: Vec<(&str, Vec<[f64; 3]>)> = Vec::new();
+    for name in library::names() {
+        let preset = parse(&read_source(name).unwrap(), &[]).unwrap().preset;
+        let maps = evaluate(&build_graph(&preset, BuildOptions::default()), &MapKind::ALL, size, size, &|_, _| {}).maps;
+        assert_eq!(maps.len(), 5, "{name}");
+        for image in maps.values() {
+            assert!(image.data.iter().all(|v| v.is_finite()), "{name}: non-finite map value");
+        }
+        let color = &maps[&MapKind::Color];
+        let lab =
+            color.data.chunks_exact(3).map(|c| linear_srgb_to_lab([c[0] as f64, c[1] as f64, c[2] as f64])).collect();
+        labs.push((name, lab));
+    }
+    // Mean per-pixel CIE76 difference of the colour maps: near-identical presets would be
+    // close to 0; distinct species differ by tens of units.
+    let mut closest = (f64::MAX, "", "");
+    for (i, (a, la)) in labs.iter().enumerate() {
+        for (b, lb) in &labs[i + 1..] {
+            let d = la
+                .iter()
+                .zip(lb)
+                .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt())
+                .sum::<f64>()
+                / la.len() as f64;
+            if d < closest.0 {
+                closest = (d, a, b);
+            }
+        }
+    }
+    eprintln!("closest pair: {} and {}, mean ΔE76 {:.1}", closest.1, closest.2, closest.0);
+    assert!(closest.0 > 10.0, "{} and {} look alike (mean ΔE76 {:.1})", closest.1, closest.2, closest.0);
 }
 
 #[test]
 fn presets_list_prints_names_first_and_show_prints_toml() {
     let out = snakeskin(&["presets", "list"]);
     assert!(out.status.success());
-    let listed: Vec<String> = stdout(&out).lines().map(|l| l.split_whitespace().next().unwrap().to_string()).collect();
+    let text = stdout(&out);
+    let listed: Vec<String> = text.lines().skip(1).map(|l| l.split_whitespace().next().unwrap().to_string()).collect();
     assert_eq!(listed, library::names());
+    // Each line shows the common name and the category.
+    let line = text.lines().find(|l| l.starts_with("crotalus-atrox")).unwrap();
+    assert!(line.contains("Crotalus atrox") && line.contains("Western diamondback rattlesnake"), "{line}");
+    assert!(line.trim_end().ends_with("simple"), "{line}");
+    assert!(text.lines().any(|l| l.starts_with("micrurus-diastema") && l.trim_end().ends_with("horizontal_stripe")));
     let shown = snakeskin(&["presets", "show", "erythrolamprus-miliaris"]);
     assert!(shown.status.success());
     let text = stdout(&shown);

@@ -323,3 +323,49 @@ fn normal_mapping_tilts_the_normal_away_from_higher_ground() {
     eprintln!("correlation of normal tilt with the height rise: {correlation:.3}");
     assert!(correlation < -0.5, "normal tilt and height slope correlate at {correlation}");
 }
+
+#[test]
+fn the_contact_sheet_renders_every_preset() {
+    use snakeskin::preset::library;
+    use snakeskin::render::sheet::{SheetOptions, render_sheet};
+    let Some(gpu) = gpu_or_skip("the_contact_sheet_renders_every_preset") else { return };
+    let renderer = Renderer::new(gpu);
+    let tile = 64;
+    let options = SheetOptions { tile, columns: 4, map_size: 64 };
+    let calls = std::sync::atomic::AtomicUsize::new(0);
+    let sheet = render_sheet(&renderer, options, &|_, _| {
+        calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    })
+    .unwrap();
+    let n = library::names().len() as u32;
+    let rows = n.div_ceil(4);
+    let cell_h = sheet.height() / rows;
+    assert_eq!(sheet.width(), 4 * 3 * tile);
+    assert!(calls.load(std::sync::atomic::Ordering::Relaxed) > n as usize, "progress is reported");
+    for i in 0..n {
+        let (x0, y0) = ((i % 4) * 3 * tile, (i / 4) * cell_h);
+        let label_y = y0 + 4;
+        // The label is drawn, the render shows a shaded snake (a range of brightness).
+        let inked =
+            (x0..x0 + 3 * tile).filter(|x| (label_y..label_y + 16).any(|y| sheet.get_pixel(*x, y)[0] > 150)).count();
+        assert!(inked > 20, "cell {i}: no label");
+        let render_top = y0 + cell_h - tile;
+        let lum: Vec<u32> = (x0 + tile..x0 + 3 * tile)
+            .flat_map(|x| (render_top..render_top + tile).map(move |y| (x, y)))
+            .map(|(x, y)| sheet.get_pixel(x, y).0.iter().map(|v| *v as u32).sum())
+            .collect();
+        let (lo, hi) = (lum.iter().min().unwrap(), lum.iter().max().unwrap());
+        assert!(hi - lo > 60, "cell {i} ({}): render looks blank ({lo}..{hi})", library::names()[i as usize]);
+    }
+}
+
+#[test]
+fn sheet_command_writes_a_png() {
+    let Some(_gpu) = gpu_or_skip("sheet_command_writes_a_png") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sheet.png");
+    let run = snakeskin(&["sheet", "-o", out.to_str().unwrap(), "--tile", "64", "--map-size", "64", "--columns", "5"]);
+    assert!(run.status.success(), "{}", common::stderr(&run));
+    let image = image::open(&out).unwrap();
+    assert_eq!(image.width(), 5 * 3 * 64);
+}

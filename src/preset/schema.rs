@@ -56,6 +56,20 @@ pub enum Category {
     Complex,
 }
 
+impl Category {
+    /// The name as written in presets.
+    pub fn name(self) -> &'static str {
+        match self {
+            Category::Solid => "solid",
+            Category::VerticalStripe => "vertical_stripe",
+            Category::HorizontalStripe => "horizontal_stripe",
+            Category::Spot => "spot",
+            Category::Simple => "simple",
+            Category::Complex => "complex",
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Preset {

@@ -18,6 +18,7 @@ pub mod preview;
 pub mod reference;
 pub mod renderer;
 pub mod scene;
+pub mod sheet;
 pub mod window;
 
 pub use gpu::{Gpu, GpuError};

@@ -1,0 +1,165 @@
+//! `snakeskin sheet`: the species library at a glance. One cell per built-in preset: its
+//! colour map beside a preview render, under a label with the scientific name, common name
+//! and pattern category. Labels use the public-domain 8×8 bitmap font of the `font8x8` crate,
+//! drawn at 2×, so the sheet needs no system fonts.
+
+use std::path::{Path, PathBuf};
+
+use font8x8::UnicodeFonts;
+use image::{Rgb, RgbImage, imageops};
+
+use super::film::GpuFilmMethod;
+use super::material::MaterialMaps;
+use super::renderer::{FrameSettings, Renderer};
+use super::scene::{Camera, LayerOptics};
+use crate::Error;
+use crate::export::write_file_atomically;
+use crate::graph::evaluate;
+use crate::maps::{BuildOptions, MapKind, build_graph};
+use crate::optics::lut::Lut;
+use crate::preset::library;
+
+const LABEL_SCALE: u32 = 2;
+/// Two lines of text: the scientific name, then common name and category.
+const LABEL_HEIGHT: u32 = 2 * 8 * LABEL_SCALE + 14;
+const BACKGROUND: Rgb<u8> = Rgb([24, 24, 26]);
+const INK: Rgb<u8> = Rgb([235, 235, 230]);
+const MUTED: Rgb<u8> = Rgb([170, 170, 160]);
+
+/// Sheet layout: tile size (the colour map is tile × tile, the render 2·tile × tile),
+/// cells per row, and the resolution the maps are generated at.
+#[derive(Debug, Clone, Copy)]
+pub struct SheetOptions {
+    pub tile: u32,
+    pub columns: u32,
+    pub map_size: usize,
+}
+
+/// The camera for sheet renders: the mid-body, close enough to read the pattern.
+pub fn sheet_camera() -> Camera {
+    Camera { target: glam::Vec3::new(-0.3, 0.08, 0.15), yaw_deg: 5.0, pitch_deg: 38.0, distance: 1.25, fov_y_deg: 35.0 }
+}
+
+/// Draws `text` with its top-left corner at (x, y); characters outside the font are skipped.
+pub fn draw_text(image: &mut RgbImage, x: u32, y: u32, text: &str, color: Rgb<u8>) {
+    let mut pen = x;
+    for ch in text.chars() {
+        let glyph = font8x8::BASIC_FONTS.get(ch).or_else(|| font8x8::LATIN_FONTS.get(ch));
+        if let Some(rows) = glyph {
+            for (row, bits) in rows.iter().enumerate() {
+                for col in 0..8 {
+                    if bits & (1 << col) == 0 {
+                        continue;
+                    }
+                    for dy in 0..LABEL_SCALE {
+                        for dx in 0..LABEL_SCALE {
+                            let (px, py) = (pen + col * LABEL_SCALE + dx, y + row as u32 * LABEL_SCALE + dy);
+                            if px < image.width() && py < image.height() {
+                                image.put_pixel(px, py, color);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        pen += 8 * LABEL_SCALE;
+    }
+}
+
+/// The linear colour map as an sRGB image, box-filtered down to `tile` × `tile`.
+fn colour_tile(maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>, tile: u32) -> RgbImage {
+    let color = &maps[&MapKind::Color];
+    let full = RgbImage::from_fn(color.width as u32, color.height as u32, |x, y| {
+        let i = (y as usize * color.width + x as usize) * color.channels;
+        Rgb([0, 1, 2].map(|c| crate::export::linear_to_srgb8(color.data[i + c])))
+    });
+    imageops::resize(&full, tile, tile, imageops::FilterType::Triangle)
+}
+
+/// Renders the contact sheet; `progress(done, total)` after each species.
+pub fn render_sheet(
+    renderer: &Renderer,
+    options: SheetOptions,
+    progress: &dyn Fn(usize, usize),
+) -> Result<RgbImage, Error> {
+    let presets = library::all();
+    let (tile, columns) = (options.tile, options.columns.max(1));
+    let (cell_w, cell_h) = (3 * tile, tile + LABEL_HEIGHT);
+    let rows = (presets.len() as u32).div_ceil(columns);
+    let mut sheet = RgbImage::from_pixel(cell_w * columns, cell_h * rows, BACKGROUND);
+    let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
+    for (i, (name, _)) in presets.iter().enumerate() {
+        progress(i, presets.len());
+        let loaded = crate::generate::load(name, &[], None)?;
+        let graph = build_graph(&loaded.preset, BuildOptions::default());
+        let evaluation = evaluate(&graph, &MapKind::ALL, options.map_size, options.map_size, &|_, _| {});
+        let maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
+        let optics = LayerOptics::from_preset(&loaded.preset);
+        // Most species share the thesis' indices: bake each distinct stack once.
+        let lut_index = match luts.iter().position(|(s, _)| *s == optics.stack) {
+            Some(k) => k,
+            None => {
+                luts.push((optics.stack, Lut::bake_default(optics.stack)));
+                luts.len() - 1
+            }
+        };
+        let material = renderer.material(&maps, optics, &luts[lut_index].1, 1);
+        let settings = FrameSettings {
+            camera: sheet_camera(),
+            method: GpuFilmMethod::Lut,
+            ground: false,
+            ..FrameSettings::default()
+        };
+        let render = renderer.render_image(&settings, &material, 2 * tile, tile)?;
+        let render = image::DynamicImage::ImageRgba8(render).into_rgb8();
+
+        let (x0, y0) = ((i as u32 % columns) * cell_w, (i as u32 / columns) * cell_h);
+        let preset = &loaded.preset;
+        let category = preset.category.map(|c| format!(" ({})", c.name())).unwrap_or_default();
+        let fits = (cell_w as usize - 12) / (8 * LABEL_SCALE as usize);
+        let clip = |text: String| text.chars().take(fits).collect::<String>();
+        let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
+        let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
+        draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
+        draw_text(&mut sheet, x0 + 6, y0 + 8 + 8 * LABEL_SCALE, &second, MUTED);
+        imageops::replace(&mut sheet, &colour_tile(&evaluation.maps, tile), (x0) as i64, (y0 + LABEL_HEIGHT) as i64);
+        imageops::replace(&mut sheet, &render, (x0 + tile) as i64, (y0 + LABEL_HEIGHT) as i64);
+    }
+    progress(presets.len(), presets.len());
+    Ok(sheet)
+}
+
+/// Renders the sheet and writes it as a PNG (atomically).
+pub fn write_sheet(
+    renderer: &Renderer,
+    path: &Path,
+    options: SheetOptions,
+    progress: &dyn Fn(usize, usize),
+) -> Result<PathBuf, Error> {
+    let sheet = render_sheet(renderer, options, progress)?;
+    let mut bytes = Vec::new();
+    sheet
+        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| Error::Preview(format!("PNG encoding failed: {e}")))?;
+    Ok(write_file_atomically(path, bytes)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_is_drawn_where_asked_and_clipped_at_the_edge() {
+        let mut image = RgbImage::from_pixel(40, 20, BACKGROUND);
+        draw_text(&mut image, 2, 2, "Ab", INK);
+        let inked = image.pixels().filter(|p| **p == INK).count();
+        assert!(inked > 20, "{inked} pixels inked");
+        // Nothing left of x = 2 or above y = 2.
+        for y in 0..20 {
+            assert_ne!(*image.get_pixel(0, y), INK);
+            assert_ne!(*image.get_pixel(1, y), INK);
+        }
+        // A label longer than the image is clipped, not a panic.
+        draw_text(&mut image, 30, 10, "overflowing", INK);
+    }
+}
