@@ -369,3 +369,72 @@ fn sheet_command_writes_a_png() {
     let image = image::open(&out).unwrap();
     assert_eq!(image.width(), 5 * 3 * 64);
 }
+
+#[test]
+fn the_window_reloads_the_preset_file_on_save() {
+    use std::io::{BufRead, BufReader};
+    use std::os::unix::process::CommandExt;
+    use std::process::{Command, Stdio};
+    use std::sync::mpsc;
+    use std::time::{Duration, Instant};
+    if gpu_or_skip("the_window_reloads_the_preset_file_on_save").is_none() {
+        return;
+    }
+    if std::process::Command::new("xvfb-run").arg("--help").output().is_err() {
+        assert!(!gpu_required(), "SNAKESKIN_REQUIRE_GPU=1 but xvfb-run is missing (apt-get install xvfb)");
+        eprintln!("the_window_reloads_the_preset_file_on_save: SKIPPED: xvfb-run not installed");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let preset = dir.path().join("snake.toml");
+    let original = snakeskin::preset::library::get(PRESET).unwrap();
+    std::fs::write(&preset, original).unwrap();
+    let mut child = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
+        .args(["preview", preset.to_str().unwrap(), "--window", "--frames", "1000000", "--size", "320x200"])
+        .args(["--map-size", "128"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        // Its own process group, so that stopping it also stops Xvfb and the preview.
+        .process_group(0)
+        .spawn()
+        .unwrap();
+    let (lines_tx, lines) = mpsc::channel();
+    let stderr = child.stderr.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = lines_tx.send(line);
+        }
+    });
+    let wait_for = |needle: &str| -> Option<String> {
+        let deadline = Instant::now() + Duration::from_secs(120);
+        while Instant::now() < deadline {
+            if let Ok(line) = lines.recv_timeout(Duration::from_millis(200))
+                && line.contains(needle)
+            {
+                return Some(line);
+            }
+        }
+        None
+    };
+    let first = wait_for("first frame presented");
+    // A colour edit: only colour nodes re-run.
+    let edited = original.replace("color = \"#d8c248\"", "color = \"#304080\"");
+    assert_ne!(edited, original, "the edit applies");
+    std::fs::write(&preset, &edited).unwrap();
+    let reloaded = wait_for("reloaded in");
+    // A broken edit keeps the window running with the last good maps.
+    std::fs::write(&preset, "[scales]\nrwos = 3\n").unwrap();
+    let failed = wait_for("reload failed");
+    let group = format!("-{}", child.id());
+    let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
+    let _ = child.wait();
+    assert!(first.is_some(), "the window never presented a frame");
+    let reloaded = reloaded.expect("no reload after saving the preset");
+    eprintln!("{reloaded}");
+    let numbers: Vec<usize> = reloaded.split(|c: char| !c.is_ascii_digit()).filter_map(|t| t.parse().ok()).collect();
+    // "reloaded in T ms: E nodes re-evaluated, R reused": fewer re-evaluated than reused.
+    assert!(numbers.len() >= 3 && numbers[1] < numbers[2], "{reloaded}");
+    let failed = failed.expect("a broken preset was not reported");
+    assert!(failed.contains("rwos"), "{failed}");
+}

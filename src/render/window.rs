@@ -309,6 +309,8 @@ impl App {
                 }
                 Err(error) => self.status = format!("reload failed, keeping the last good maps: {error}"),
             }
+            // Also on stderr: the window may be behind others, and tests read it.
+            eprintln!("preview: {}", self.status);
         }
         while let Ok((stack, bands, lut)) = self.lut_results.try_recv() {
             let optics = LayerOptics { stack, ..gfx.material.optics };
@@ -407,6 +409,9 @@ impl App {
             gfx.egui_renderer.free_texture(id);
         }
         self.frames_done += 1;
+        if self.frames_done == 1 {
+            eprintln!("preview: first frame presented");
+        }
         if self.options.frames.is_some_and(|n| self.frames_done >= n) {
             // Wait for the last frame so the reported times cover finished work.
             let _ = device.poll(wgpu::PollType::wait_indefinitely());
