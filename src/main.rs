@@ -3,14 +3,13 @@
 
 mod brdf;
 mod cli;
+mod progress;
 mod render_cmd;
 
-use std::io::IsTerminal;
 use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::Parser;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use cli::{Cli, Command, Convention, PresetsCommand};
 use snakeskin::graph::{EvalStats, to_dot};
@@ -47,16 +46,9 @@ fn run(cli: Cli) -> Result<()> {
                 out_dir: args.out.clone(),
                 options: BuildOptions { normal_convention: convention },
             };
-            let bar = progress_bar();
-            let report = generate(&request, &|done, total| {
-                if let Some(bar) = &bar {
-                    bar.set_length(total as u64);
-                    bar.set_position(done as u64);
-                }
-            })?;
-            if let Some(bar) = bar {
-                bar.finish_and_clear();
-            }
+            let bar = progress::Progress::counting("{spinner} generating [{bar:30}] {pos}/{len} nodes {elapsed}");
+            let report = generate(&request, &|done, total| bar.update(done, total))?;
+            bar.finish();
             for file in &report.files {
                 println!("{}", file.display());
             }
@@ -120,16 +112,6 @@ fn run(cli: Cli) -> Result<()> {
             .into()),
         },
     }
-}
-
-/// A progress bar on a terminal; nothing when stderr is redirected.
-fn progress_bar() -> Option<ProgressBar> {
-    if !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = ProgressBar::new(1);
-    bar.set_style(ProgressStyle::with_template("{spinner} generating [{bar:30}] {pos}/{len} nodes {elapsed}").ok()?);
-    Some(bar)
 }
 
 fn print_stats(stats: &EvalStats) {

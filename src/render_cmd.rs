@@ -1,11 +1,9 @@
 //! The binary's rendering commands: `preview`, `figures` and `bench render`.
 
-use std::io::IsTerminal;
-
 use anyhow::Result;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::cli::PreviewArgs;
+use crate::progress::Progress;
 use snakeskin::Error;
 use snakeskin::render::Renderer;
 use snakeskin::render::bench::{BenchOptions, bench_render};
@@ -17,17 +15,6 @@ use snakeskin::render::scene::{Camera, View};
 
 fn parse_view(text: &str) -> Result<View, Error> {
     View::parse(text).ok_or_else(|| Error::Preview(format!("unknown --layers {text:?}; accepted: {}", View::ACCEPTED)))
-}
-
-fn spinner(message: &str) -> Option<ProgressBar> {
-    if !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = ProgressBar::new_spinner();
-    bar.set_style(ProgressStyle::with_template("{spinner} {msg} {elapsed}").ok()?);
-    bar.set_message(message.to_string());
-    bar.enable_steady_tick(std::time::Duration::from_millis(120));
-    Some(bar)
 }
 
 pub fn preview(args: PreviewArgs) -> Result<()> {
@@ -72,19 +59,15 @@ pub fn preview(args: PreviewArgs) -> Result<()> {
         }
         return Ok(());
     }
-    let bar = spinner("generating maps and baking the film LUT");
+    let bar = Progress::spinner("generating maps and baking the film LUT");
     let renderer = Renderer::headless()?;
     let material = upload_material(&renderer, &loaded, args.map_size as usize, method)?;
-    if let Some(bar) = &bar {
-        bar.set_message("rendering");
-    }
+    bar.message("rendering");
     let image = renderer.render_image(&settings, &material, size.0, size.1)?;
     let out = args.out.expect("checked above");
     let written = write_png(&out, &image)?;
     if let Some(heat_path) = &args.reference {
-        if let Some(bar) = &bar {
-            bar.set_message("shading the CPU reference");
-        }
+        bar.message("shading the CPU reference");
         let (report, _) = reference_check(&renderer, &material, &settings, size.0, size.1)?;
         let bytes = {
             let mut b = Vec::new();
@@ -100,9 +83,7 @@ pub fn preview(args: PreviewArgs) -> Result<()> {
             report.pixels, report.mean_de, report.p99_de, report.max_de
         );
     }
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+    bar.finish();
     println!("{}", written.display());
     Ok(())
 }
@@ -111,16 +92,9 @@ pub fn figures(preset: &str, out: &std::path::Path, size: &str, map_size: u64) -
     let size = parse_image_size(size)?;
     snakeskin::generate::load(preset, &[], None)?;
     let renderer = Renderer::headless()?;
-    let bar = if std::io::stderr().is_terminal() { Some(ProgressBar::new(1)) } else { None };
-    let files = write_figures(&renderer, preset, out, size, map_size as usize, &|done, total| {
-        if let Some(bar) = &bar {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-        }
-    })?;
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+    let bar = Progress::counting("{spinner} figures [{bar:30}] {pos}/{len} {elapsed}");
+    let files = write_figures(&renderer, preset, out, size, map_size as usize, &|done, total| bar.update(done, total))?;
+    bar.finish();
     for f in files {
         println!("{}", f.display());
     }
@@ -133,15 +107,9 @@ pub fn bench(preset: &str, size: &str, frames: u64, map_size: u64, reference_siz
     let loaded = snakeskin::generate::load(preset, &[], None)?;
     let renderer = Renderer::headless()?;
     let options = BenchOptions { width, height, frames: frames as usize, map_size: map_size as usize, reference_size };
-    let bar = spinner("bench render");
-    let result = bench_render(&renderer, &loaded, &options, &|what| {
-        if let Some(bar) = &bar {
-            bar.set_message(what.to_string());
-        }
-    })?;
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+    let bar = Progress::spinner("bench render");
+    let result = bench_render(&renderer, &loaded, &options, &|what| bar.message(what))?;
+    bar.finish();
     if json {
         println!("{}", serde_json::to_string_pretty(&result)?);
         return Ok(());
@@ -168,24 +136,10 @@ pub fn bench(preset: &str, size: &str, frames: u64, map_size: u64, reference_siz
 pub fn sheet(out: &std::path::Path, tile: u32, columns: u32, map_size: usize) -> Result<()> {
     use snakeskin::render::sheet::{SheetOptions, write_sheet};
     let renderer = Renderer::headless()?;
-    let bar = if std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(1);
-        if let Ok(style) = ProgressStyle::with_template("{spinner} sheet [{bar:30}] {pos}/{len} species {elapsed}") {
-            bar.set_style(style);
-        }
-        Some(bar)
-    } else {
-        None
-    };
-    let written = write_sheet(&renderer, out, SheetOptions { tile, columns, map_size }, &|done, total| {
-        if let Some(bar) = &bar {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-        }
-    })?;
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+    let bar = Progress::counting("{spinner} sheet [{bar:30}] {pos}/{len} species {elapsed}");
+    let written =
+        write_sheet(&renderer, out, SheetOptions { tile, columns, map_size }, &|done, total| bar.update(done, total))?;
+    bar.finish();
     println!("{}", written.display());
     Ok(())
 }

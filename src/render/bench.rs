@@ -112,7 +112,7 @@ fn time_frames(
         let start = Instant::now();
         queue.submit([encoder.finish()]);
         let ms = if query_set.is_some() {
-            let data = super::renderer::map_read(device, &readback)?;
+            let data = super::gpu::map_read(device, &readback)?;
             let ticks: &[u64] = bytemuck::cast_slice(&data);
             ticks[1].saturating_sub(ticks[0]) as f64 * period_ns * 1e-6
         } else {

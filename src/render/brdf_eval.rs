@@ -6,6 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use super::film::{self, FilmBinding, GpuFilmMethod};
+use super::gpu::{map_read, storage_entry};
 use super::{Gpu, GpuError, shader_programs};
 use crate::optics::brdf::Layers32;
 use crate::optics::film::Stack;
@@ -61,19 +62,12 @@ pub fn eval_timed(
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
     let film_layout = film::bind_group_layout(device);
-    let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
     let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("samples"),
-        entries: &[storage(0, true), storage(1, false)],
+        entries: &[
+            storage_entry(0, wgpu::ShaderStages::COMPUTE, true),
+            storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
+        ],
     });
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("brdf_eval"),
@@ -136,15 +130,8 @@ pub fn eval_timed(
     let start = std::time::Instant::now();
     gpu.queue.submit([encoder.finish()]);
 
-    let slice = readback.slice(..);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |result| {
-        let _ = sender.send(result);
-    });
-    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
-    receiver.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+    let data = map_read(device, &readback)?;
     let elapsed = start.elapsed();
-    let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
     let values: &[[f32; 4]] = bytemuck::cast_slice(&data);
     Ok((values.iter().map(|v| [v[0], v[1], v[2]]).collect(), elapsed))
 }

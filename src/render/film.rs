@@ -8,6 +8,7 @@
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
+use super::gpu::{storage_entry, uniform_entry};
 use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
 use crate::optics::methods::{Bands, Method, d65_white};
@@ -71,31 +72,12 @@ struct FilmInfo {
 /// The bind group layout of `film.wgsl`'s group 0.
 pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-    let storage = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("film"),
         entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            storage(1),
-            storage(2),
+            uniform_entry(0, visibility),
+            storage_entry(1, visibility, true),
+            storage_entry(2, visibility, true),
         ],
     })
 }
