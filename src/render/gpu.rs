@@ -13,6 +13,9 @@ pub enum GpuError {
     Device(String),
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    /// No window could be opened or drawn into (no display, no compatible surface).
+    #[error("{0}")]
+    Window(String),
 }
 
 /// An open device and its queue.

@@ -175,7 +175,9 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     }
 
     let event_loop = EventLoop::new().map_err(|e| {
-        Error::Preview(format!("cannot open a window: {e} (no display? run under `xvfb-run -a`, or use --out)"))
+        Error::Gpu(GpuError::Window(format!(
+            "cannot open a window: {e} (no display? run under `xvfb-run -a`, or use --out)"
+        )))
     })?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
@@ -200,7 +202,7 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
         _watcher: watcher,
         options,
     };
-    event_loop.run_app(&mut app).map_err(|e| Error::Preview(format!("window event loop failed: {e}")))?;
+    event_loop.run_app(&mut app).map_err(|e| Error::Gpu(GpuError::Window(format!("window event loop failed: {e}"))))?;
     if let Some(error) = app.error {
         return Err(error);
     }
@@ -241,14 +243,16 @@ impl App {
             .with_title(format!("snakeskin — {}", self.options.preset))
             .with_inner_size(winit::dpi::PhysicalSize::new(w, h));
         let window = Arc::new(
-            event_loop.create_window(attributes).map_err(|e| Error::Preview(format!("cannot open a window: {e}")))?,
+            event_loop
+                .create_window(attributes)
+                .map_err(|e| Error::Gpu(GpuError::Window(format!("cannot open a window: {e}"))))?,
         );
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
             event_loop.owned_display_handle(),
         )));
         let surface = instance
             .create_surface(window.clone())
-            .map_err(|e| Error::Preview(format!("cannot draw into the window: {e}")))?;
+            .map_err(|e| Error::Gpu(GpuError::Window(format!("cannot draw into the window: {e}"))))?;
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             compatible_surface: Some(&surface),
