@@ -116,7 +116,12 @@ fn fs_gbuffer(in: VertexOut) -> GBuffer {
 @fragment
 fn fs_ground(in: VertexOut) -> @location(0) vec4<f32> {
     let n = vec3<f32>(0.0, 1.0, 0.0);
-    let checker = select(0.07, 0.09, (i32(floor(in.uv.x * 2.0)) + i32(floor(in.uv.y * 2.0))) % 2 == 0);
+    // A box-filtered checker (the analytic integral over the pixel footprint), so the far
+    // ground fades to grey instead of aliasing.
+    let p = in.uv * 2.0;
+    let w = fwidth(p) + vec2<f32>(1e-4);
+    let i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
+    let checker = mix(0.07, 0.09, 0.5 - 0.5 * i.x * i.y);
     var radiance = sky(n) * checker;
     for (var i = 0u; i < 2u; i++) {
         let wi = scene.light_dir[i].xyz;

@@ -35,7 +35,7 @@ pub fn preview(args: PreviewArgs) -> Result<()> {
         exposure: args.exposure,
         ground: !args.no_ground,
         snakes: args.snakes,
-        camera: if args.close_up { Camera::close_up() } else { Camera::default() },
+        camera: if args.close_up { Camera::close_up() } else { Camera::framing(args.snakes) },
         ..FrameSettings::default()
     };
     if args.window {

@@ -438,3 +438,22 @@ fn the_window_reloads_the_preset_file_on_save() {
     let failed = failed.expect("a broken preset was not reported");
     assert!(failed.contains("rwos"), "{failed}");
 }
+
+#[test]
+fn twenty_instanced_snakes_are_all_in_view() {
+    use snakeskin::render::renderer::snake_grid;
+    let Some(gpu) = gpu_or_skip("twenty_instanced_snakes_are_all_in_view") else { return };
+    let renderer = Renderer::new(gpu);
+    let material = material(&renderer, &[], GpuFilmMethod::Lut);
+    let settings = FrameSettings { snakes: 20, camera: Camera::framing(20), ground: false, ..FrameSettings::default() };
+    let (w, h) = (480, 270);
+    let g = renderer.render_gbuffer(&settings, &material, w, h).unwrap();
+    // Every snake's placement has covered pixels whose world position lies on its body.
+    for (k, p) in snake_grid(20).iter().enumerate() {
+        let on_body = (0..(w * h) as usize).filter(|i| g.covered(*i)).any(|i| {
+            let q = g.position_thickness[i];
+            (q[0] - p[0]).abs() < 1.3 && (q[2] - p[1]).abs() < 0.5
+        });
+        assert!(on_body, "snake {k} at {p:?} is not in view");
+    }
+}

@@ -161,7 +161,8 @@ pub fn bench_render(
             }
             progress(&format!("{name}, {snakes} snake(s)"));
             let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method));
-            let settings = FrameSettings { method: *method, plain: *plain, snakes, ..base };
+            let camera = super::scene::Camera::framing(snakes);
+            let settings = FrameSettings { method: *method, plain: *plain, snakes, camera, ..base };
             let (median, p10, p90, kind) = time_frames(renderer, &settings, &material, options)?;
             timing_kind = kind;
             timings.push(VariantTiming { name: name.clone(), snakes, median_ms: median, p10_ms: p10, p90_ms: p90 });

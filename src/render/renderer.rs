@@ -148,13 +148,19 @@ impl GpuMesh {
 
 /// Placements (x, z, yaw) of `n` snakes in a grid, the first at the origin.
 pub fn snake_grid(n: u32) -> Vec<[f32; 4]> {
-    let columns = (n as f32).sqrt().ceil().max(1.0) as u32;
+    let (columns, spacing_x, spacing_z) = grid_layout(n);
     (0..n)
         .map(|i| {
             let (col, row) = ((i % columns) as f32, (i / columns) as f32);
-            [col * 2.8, -row * 1.1, 0.0, 0.0]
+            [col * spacing_x, -row * spacing_z, 0.0, 0.0]
         })
         .collect()
+}
+
+/// Columns of the snake grid and the spacing along x and z (a body is 2.4 long and
+/// ±0.35 wide, see `BodyShape`).
+pub fn grid_layout(n: u32) -> (u32, f32, f32) {
+    ((n as f32).sqrt().ceil().max(1.0) as u32, 2.8, 1.1)
 }
 
 impl Renderer {

@@ -38,6 +38,24 @@ impl Camera {
         proj * view
     }
 
+    /// The default view for one snake; for several, a view of the whole grid
+    /// (`renderer::snake_grid`), so that a many-snake frame really draws every snake.
+    pub fn framing(snakes: u32) -> Camera {
+        if snakes <= 1 {
+            return Camera::default();
+        }
+        let (columns, spacing_x, spacing_z) = crate::render::renderer::grid_layout(snakes);
+        let rows = snakes.div_ceil(columns);
+        let width = (columns - 1) as f32 * spacing_x + 2.6;
+        let depth = (rows - 1) as f32 * spacing_z + 1.0;
+        let target = Vec3::new((columns - 1) as f32 * spacing_x * 0.5, 0.05, -((rows - 1) as f32) * spacing_z * 0.5);
+        // Fit the grid's width into the horizontal field of view of a 16:9 frame, and its
+        // depth (foreshortened by the 40° pitch, about ×1.8 on screen) into the vertical one.
+        let tan_v = (35.0f32.to_radians() * 0.5).tan();
+        let distance = 1.15 * (width / (2.0 * tan_v * 16.0 / 9.0)).max(depth * 1.8 / (2.0 * tan_v));
+        Camera { target, yaw_deg: 0.0, pitch_deg: 40.0, distance, fov_y_deg: 35.0 }
+    }
+
     /// A close-up of the mid-body (for figures where the scales must be visible).
     pub fn close_up() -> Camera {
         Camera { target: Vec3::new(-0.24, 0.08, 0.0), yaw_deg: 0.0, pitch_deg: 40.0, distance: 0.62, fov_y_deg: 35.0 }
