@@ -1,6 +1,6 @@
-// The snake-skin multi-layer BRDF in WGSL: the twin of `optics::brdf::eval_f32` and
-// `optics::lut::Lut::lookup_f32` (keep the two in step; tests/gpu.rs compares them on
-// 10,000 random inputs). See PHYSICS.md and src/optics/brdf.rs for the model:
+// The snake-skin multi-layer BRDF in WGSL: the twin of `optics::brdf::eval_f32` (keep the
+// two in step; tests/gpu.rs compares them on 10,000 random inputs, with the CPU reading the
+// LUT at the half precision the GPU texture holds). See PHYSICS.md and src/optics/brdf.rs for the model:
 //   f = D G2 F(|wo.h|) / (4 |n.wi| |n.wo|)
 //     + (1 - F(n.wi)) (1 - F(n.wo)) exp(-tau (1/cos_t(wi) + 1/cos_t(wo))) k_d / pi
 

@@ -21,39 +21,30 @@ struct FilmInfo {
     xyz_to_rgb: array<vec4<f32>, 3>,
 }
 
-// The per-material film colour table, row-major [cos][thickness], RGB in xyz.
+// The per-material film colour table: x = thickness texel, y = cos texel, RGB, half floats,
+// read with the sampler's bilinear filter (clamped to the edge texels).
 @group(0) @binding(0) var<uniform> film_info: FilmInfo;
-@group(0) @binding(1) var<storage, read> lut_texels: array<vec4<f32>>;
+@group(0) @binding(1) var lut_texture: texture_2d<f32>;
+@group(0) @binding(3) var lut_sampler: sampler;
 // spectral-N: per band (centre nm, then linear-sRGB weights).
 @group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
 
-fn lut_texel(i: u32, j: u32) -> vec3<f32> {
-    return lut_texels[i * (film_info.n_fine + film_info.n_coarse) + j].xyz;
-}
-
-// Film colour at thickness d (nm) and incidence cosine c: bilinear in the table.
+// Film colour at thickness d (nm) and incidence cosine c: the table's texel coordinates
+// as in optics::lut::Lut::lookup_f32, then one filtered fetch at those coordinates.
 fn film_lut(thickness_nm: f32, cos0: f32) -> vec3<f32> {
     let d = max(thickness_nm, 0.0);
-    let fine_step = FINE_MAX_NM / f32(film_info.n_fine - 1u);
-    let coarse_step = (COARSE_MAX_NM - FINE_MAX_NM) / f32(film_info.n_coarse);
+    let n_fine = f32(film_info.n_fine);
+    let w = n_fine + f32(film_info.n_coarse);
     var x: f32;
     if (d <= FINE_MAX_NM) {
-        x = d / fine_step;
+        x = d * ((n_fine - 1.0) / FINE_MAX_NM);
     } else {
-        x = f32(film_info.n_fine - 1u) + (d - FINE_MAX_NM) / coarse_step;
+        x = (n_fine - 1.0) + (d - FINE_MAX_NM) * (f32(film_info.n_coarse) / (COARSE_MAX_NM - FINE_MAX_NM));
     }
-    let w = film_info.n_fine + film_info.n_coarse;
-    x = min(x, f32(w - 1u));
-    let y = clamp(cos0, 0.0, 1.0) * f32(film_info.n_cos - 1u);
-    let x0 = u32(x);
-    let y0 = u32(y);
-    let x1 = min(x0 + 1u, w - 1u);
-    let y1 = min(y0 + 1u, film_info.n_cos - 1u);
-    let fx = x - f32(x0);
-    let fy = y - f32(y0);
-    let top = mix(lut_texel(y0, x0), lut_texel(y0, x1), fx);
-    let bottom = mix(lut_texel(y1, x0), lut_texel(y1, x1), fx);
-    return mix(top, bottom, fy);
+    x = min(x, w - 1.0);
+    let h = f32(film_info.n_cos);
+    let y = clamp(cos0, 0.0, 1.0) * (h - 1.0);
+    return textureSampleLevel(lut_texture, lut_sampler, vec2<f32>((x + 0.5) / w, (y + 0.5) / h), 0.0).rgb;
 }
 
 // ---- Complex arithmetic on vec2 (re, im), as optics::fast. ----

@@ -3,9 +3,10 @@
 //! film, no absorption), the other film methods, twenty snakes, and the CPU reference check.
 //!
 //! Timing: GPU timestamps around the scene pass where the adapter offers them (lavapipe does),
-//! otherwise wall time around submit + wait; the median over many frames after warm-up, since
-//! shared machines are noisy. The tone-mapping pass is the same for every variant and is not
-//! in the scene-pass time.
+//! otherwise wall time around submit + wait. Variants are interleaved frame by frame and each
+//! reports the median over many frames after warm-up: shared machines drift by tens of percent
+//! between minutes, and interleaving keeps that drift out of the ratios. The tone-mapping pass
+//! is the same for every variant and is not in the scene-pass time.
 
 use std::time::Instant;
 
@@ -61,73 +62,79 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
 
-/// Median scene-pass time of `frames` frames (after 3 warm-up frames).
-fn time_frames(
-    renderer: &Renderer,
-    settings: &FrameSettings,
-    material: &Material,
-    options: &BenchOptions,
-) -> Result<(f64, f64, f64, &'static str), Error> {
-    let device = &renderer.gpu.device;
-    let queue = &renderer.gpu.queue;
-    let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-    let targets = renderer.targets(options.width, options.height, settings.samples);
-    let output = renderer.output_texture(options.width, options.height);
-    let view = output.create_view(&wgpu::TextureViewDescriptor::default());
-    let query_set = timestamps.then(|| {
-        device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("frame"),
-            ty: wgpu::QueryType::Timestamp,
-            count: 2,
-        })
-    });
-    let resolve = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("timestamps"),
-        size: 16,
-        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("timestamps readback"),
-        size: 16,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let period_ns = queue.get_timestamp_period() as f64;
-    let mut samples = Vec::with_capacity(options.frames);
-    for frame in 0..options.frames + 3 {
-        let mut encoder = device.create_command_encoder(&Default::default());
-        renderer.encode_frame(
-            &mut encoder,
-            &targets,
-            settings,
-            material,
-            FrameOutput { view: &view, format: OUTPUT_FORMAT },
-            query_set.as_ref().map(|q| (q, 0)),
-        );
-        if let Some(q) = &query_set {
-            encoder.resolve_query_set(q, 0..2, &resolve, 0);
-            encoder.copy_buffer_to_buffer(&resolve, 0, &readback, 0, 16);
-        }
-        let start = Instant::now();
-        queue.submit([encoder.finish()]);
-        let ms = if query_set.is_some() {
-            let data = super::gpu::map_read(device, &readback)?;
-            let ticks: &[u64] = bytemuck::cast_slice(&data);
-            ticks[1].saturating_sub(ticks[0]) as f64 * period_ns * 1e-6
-        } else {
-            device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| Error::Gpu(super::GpuError::Readback(e.to_string())))?;
-            start.elapsed().as_secs_f64() * 1e3
+/// Times one frame's scene pass at a time, for any variant, with shared targets.
+struct FrameTimer<'a> {
+    renderer: &'a Renderer,
+    targets: super::renderer::Targets,
+    view: wgpu::TextureView,
+    query_set: Option<wgpu::QuerySet>,
+    resolve: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    period_ns: f64,
+}
+
+impl<'a> FrameTimer<'a> {
+    fn new(renderer: &'a Renderer, options: &BenchOptions, samples: u32) -> FrameTimer<'a> {
+        let device = &renderer.gpu.device;
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let output = renderer.output_texture(options.width, options.height);
+        let buffer = |label, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 16,
+                usage,
+                mapped_at_creation: false,
+            })
         };
-        if frame >= 3 {
-            samples.push(ms);
+        FrameTimer {
+            renderer,
+            targets: renderer.targets(options.width, options.height, samples),
+            view: output.create_view(&wgpu::TextureViewDescriptor::default()),
+            query_set: timestamps.then(|| {
+                device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("frame"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2,
+                })
+            }),
+            resolve: buffer("timestamps", wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
+            readback: buffer("timestamps readback", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
+            period_ns: renderer.gpu.queue.get_timestamp_period() as f64,
         }
     }
-    samples.sort_by(f64::total_cmp);
-    let timing = if timestamps { "gpu-timestamp" } else { "wall" };
-    Ok((percentile(&samples, 0.5), percentile(&samples, 0.1), percentile(&samples, 0.9), timing))
+
+    fn kind(&self) -> &'static str {
+        if self.query_set.is_some() { "gpu-timestamp" } else { "wall" }
+    }
+
+    /// Renders one frame and returns its scene-pass time in ms.
+    fn frame(&self, settings: &FrameSettings, material: &Material) -> Result<f64, Error> {
+        let device = &self.renderer.gpu.device;
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.renderer.encode_frame(
+            &mut encoder,
+            &self.targets,
+            settings,
+            material,
+            FrameOutput { view: &self.view, format: OUTPUT_FORMAT },
+            self.query_set.as_ref().map(|q| (q, 0)),
+        );
+        if let Some(q) = &self.query_set {
+            encoder.resolve_query_set(q, 0..2, &self.resolve, 0);
+            encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, 16);
+        }
+        let start = Instant::now();
+        self.renderer.gpu.queue.submit([encoder.finish()]);
+        if self.query_set.is_some() {
+            let data = super::gpu::map_read(device, &self.readback)?;
+            let ticks: &[u64] = bytemuck::cast_slice(&data);
+            return Ok(ticks[1].saturating_sub(ticks[0]) as f64 * self.period_ns * 1e-6);
+        }
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu(super::GpuError::Readback(e.to_string())))?;
+        Ok(start.elapsed().as_secs_f64() * 1e3)
+    }
 }
 
 /// Runs the whole benchmark for one preset.
@@ -152,22 +159,45 @@ pub fn bench_render(
         ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false),
         ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false),
     ];
-    let mut timings = Vec::new();
-    let mut timing_kind = "wall";
+    // All variants are timed round-robin, one frame each per round, so that a shared
+    // machine's drift (other jobs, clock changes) affects every variant alike; the first
+    // three rounds are warm-up (pipeline compilation, caches).
+    let mut runs = Vec::new();
     for snakes in [1u32, 20] {
         for (name, variant_optics, method, plain) in &variants {
             if snakes == 20 && !matches!(name.as_str(), "plain-pbr" | "skin-lut") {
                 continue;
             }
-            progress(&format!("{name}, {snakes} snake(s)"));
             let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method));
             let camera = super::scene::Camera::framing(snakes);
             let settings = FrameSettings { method: *method, plain: *plain, snakes, camera, ..base };
-            let (median, p10, p90, kind) = time_frames(renderer, &settings, &material, options)?;
-            timing_kind = kind;
-            timings.push(VariantTiming { name: name.clone(), snakes, median_ms: median, p10_ms: p10, p90_ms: p90 });
+            runs.push((name.clone(), snakes, material, settings, Vec::with_capacity(options.frames)));
         }
     }
+    let timer = FrameTimer::new(renderer, options, base.samples);
+    for round in 0..options.frames + 3 {
+        progress(&format!("round {} of {}", round + 1, options.frames + 3));
+        for (_, _, material, settings, samples) in runs.iter_mut() {
+            let ms = timer.frame(settings, material)?;
+            if round >= 3 {
+                samples.push(ms);
+            }
+        }
+    }
+    let timing_kind = timer.kind();
+    let timings: Vec<VariantTiming> = runs
+        .into_iter()
+        .map(|(name, snakes, _, _, mut samples)| {
+            samples.sort_by(f64::total_cmp);
+            VariantTiming {
+                name,
+                snakes,
+                median_ms: percentile(&samples, 0.5),
+                p10_ms: percentile(&samples, 0.1),
+                p90_ms: percentile(&samples, 0.9),
+            }
+        })
+        .collect();
     let find = |name: &str, snakes: u32| {
         timings.iter().find(|t| t.name == name && t.snakes == snakes).map(|t| t.median_ms).unwrap_or(f64::NAN)
     };

@@ -87,7 +87,7 @@ pub fn eval_timed(
         GpuFilmMethod::SpectralN(n) => n,
         _ => 1,
     };
-    let film = FilmBinding::new(device, &film_layout, stack, lut, n_bands);
+    let film = FilmBinding::new(device, &gpu.queue, &film_layout, stack, lut, n_bands);
     let sample_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("samples"),
         contents: bytemuck::cast_slice(samples),

@@ -129,6 +129,24 @@ pub fn f32_to_f16(value: f32) -> u16 {
     sign | out as u16
 }
 
+/// f32 from IEEE 754 binary16 (exact: every half is an f32).
+pub fn f16_to_f32(half: u16) -> f32 {
+    let sign = if half & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exp = ((half >> 10) & 0x1f) as i32;
+    let mantissa = (half & 0x3ff) as f32;
+    match exp {
+        0 => sign * mantissa * 2f32.powi(-24),
+        0x1f if mantissa == 0.0 => sign * f32::INFINITY,
+        0x1f => f32::NAN,
+        _ => sign * (1.0 + mantissa / 1024.0) * 2f32.powi(exp - 15),
+    }
+}
+
+/// The value a half-float texture stores for `value`.
+pub fn round_to_f16(value: f32) -> f32 {
+    f16_to_f32(f32_to_f16(value))
+}
+
 /// The material's textures and the bind group (group 2 of the scene programs).
 pub struct MaterialTextures {
     pub bind_group: wgpu::BindGroup,
@@ -253,6 +271,13 @@ mod tests {
         assert_eq!(f32_to_f16(5.960_464_5e-8), 0x0001);
         // 1/3 rounds to 0x3555.
         assert_eq!(f32_to_f16(1.0 / 3.0), 0x3555);
+        // And back: 0x3555 is 0.333251953125, the nearest half to 1/3.
+        assert_eq!(f16_to_f32(0x3555), 0.333_251_95);
+        for v in [0.0f32, 1.0, -2.0, 0.5, 65504.0, 5.960_464_5e-8, 0.1] {
+            let r = round_to_f16(v);
+            assert!((r - v).abs() <= v.abs() * 4.9e-4 + 6e-8, "{v} -> {r}");
+            assert_eq!(round_to_f16(r), r, "rounding is idempotent");
+        }
     }
 
     #[test]

@@ -251,14 +251,15 @@ impl Renderer {
         let device = &self.gpu.device;
         Material {
             optics,
-            film: FilmBinding::new(device, &self.film_layout, optics.stack, lut, n_bands),
+            film: FilmBinding::new(device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands),
             textures: MaterialTextures::new(device, &self.gpu.queue, &self.material_layout, maps),
         }
     }
 
     /// Replaces the film tables of a material (after its indices or band count changed).
     pub fn refilm(&self, material: &mut Material, optics: LayerOptics, lut: &Lut, n_bands: usize) {
-        material.film = FilmBinding::new(&self.gpu.device, &self.film_layout, optics.stack, lut, n_bands);
+        material.film =
+            FilmBinding::new(&self.gpu.device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands);
         material.optics = optics;
     }
 
