@@ -89,8 +89,9 @@ pub enum Command {
     },
 }
 
+/// Which preset, with which edits: shared by every command that reads one.
 #[derive(Debug, Args)]
-pub struct PresetArgs {
+pub struct PresetSource {
     /// A preset: a path to a .toml file, or a built-in name (see `snakeskin presets list`).
     pub preset: String,
     /// Override a preset key by dotted path, e.g. `--set scales.rows=23 --set pattern.0.kind=spots`.
@@ -100,6 +101,12 @@ pub struct PresetArgs {
     /// Override the preset's seed.
     #[arg(long)]
     pub seed: Option<u64>,
+}
+
+#[derive(Debug, Args)]
+pub struct PresetArgs {
+    #[command(flatten)]
+    pub source: PresetSource,
     /// Maps to produce, comma-separated: color, height, normal, roughness, iridescence (default: all).
     #[arg(long, default_value = "all", value_name = "LIST")]
     pub maps: String,
@@ -125,14 +132,8 @@ pub struct GenerateArgs {
 
 #[derive(Debug, Args)]
 pub struct PreviewArgs {
-    /// A preset: a path to a .toml file, or a built-in name (see `snakeskin presets list`).
-    pub preset: String,
-    /// Override a preset key by dotted path, e.g. `--set optics.film_thickness_nm=600`.
-    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_key_value)]
-    pub overrides: Vec<(String, String)>,
-    /// Override the preset's seed.
-    #[arg(long)]
-    pub seed: Option<u64>,
+    #[command(flatten)]
+    pub source: PresetSource,
     /// Write the rendered image to this PNG file (headless; no window needed).
     #[arg(short, long, value_name = "FILE.png")]
     pub out: Option<PathBuf>,

@@ -38,9 +38,9 @@ fn run(cli: Cli) -> Result<()> {
                 Convention::Directx => NormalConvention::DirectX,
             };
             let request = GenerateRequest {
-                preset: args.preset.preset.clone(),
-                overrides: args.preset.overrides.clone(),
-                seed: args.preset.seed,
+                preset: args.preset.source.preset.clone(),
+                overrides: args.preset.source.overrides.clone(),
+                seed: args.preset.source.seed,
                 size: args.size,
                 maps: parse_map_list(&args.preset.maps)?,
                 out_dir: args.out.clone(),
@@ -64,7 +64,11 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Graph(args) => {
             let maps = parse_map_list(&args.preset.maps)?;
-            let loaded = snakeskin::generate::load(&args.preset.preset, &args.preset.overrides, args.preset.seed)?;
+            let loaded = snakeskin::generate::load(
+                &args.preset.source.preset,
+                &args.preset.source.overrides,
+                args.preset.source.seed,
+            )?;
             let graph = build_graph(&loaded.preset, BuildOptions::default());
             if args.dot {
                 print!("{}", to_dot(&graph, &maps));

@@ -22,7 +22,7 @@ pub fn preview(args: PreviewArgs) -> Result<()> {
     let size = parse_image_size(&args.size)?;
     let view = parse_view(&args.layers)?;
     let method = parse_method(&args.method)?;
-    let loaded = snakeskin::generate::load(&args.preset, &args.overrides, args.seed)?;
+    let loaded = snakeskin::generate::load(&args.source.preset, &args.source.overrides, args.source.seed)?;
     if !(args.exposure.is_finite() && args.exposure > 0.0) {
         return Err(Error::Preview(format!("--exposure must be a positive number, got {}", args.exposure)).into());
     }
@@ -40,9 +40,9 @@ pub fn preview(args: PreviewArgs) -> Result<()> {
     };
     if args.window {
         let options = snakeskin::render::window::WindowOptions {
-            preset: args.preset.clone(),
-            overrides: args.overrides.clone(),
-            seed: args.seed,
+            preset: args.source.preset.clone(),
+            overrides: args.source.overrides.clone(),
+            seed: args.source.seed,
             map_size: args.map_size as usize,
             size,
             frames: args.frames,

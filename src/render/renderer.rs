@@ -452,6 +452,25 @@ impl Renderer {
         current.1.clone()
     }
 
+    /// Binds the material and scene and draws `snakes` instances of the body with `pipeline`.
+    fn draw_snakes(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        pipeline: &wgpu::RenderPipeline,
+        material: &Material,
+        instances: &wgpu::Buffer,
+        snakes: u32,
+    ) {
+        pass.set_bind_group(0, &material.film.bind_group, &[]);
+        pass.set_bind_group(1, &self.scene_group, &[]);
+        pass.set_bind_group(2, &material.textures.bind_group, &[]);
+        pass.set_pipeline(pipeline);
+        pass.set_vertex_buffer(0, self.body.vertices.slice(..));
+        pass.set_vertex_buffer(1, instances.slice(..));
+        pass.set_index_buffer(self.body.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.body.count, 0, 0..snakes.max(1));
+    }
+
     /// Records a whole frame: the scene pass (timestamps around it if given) and the tone
     /// mapping pass into `output` (any 8-bit sRGB format).
     pub fn encode_frame(
@@ -499,14 +518,7 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_bind_group(0, &material.film.bind_group, &[]);
-            pass.set_bind_group(1, &self.scene_group, &[]);
-            pass.set_bind_group(2, &material.textures.bind_group, &[]);
-            pass.set_pipeline(&body);
-            pass.set_vertex_buffer(0, self.body.vertices.slice(..));
-            pass.set_vertex_buffer(1, instances.slice(..));
-            pass.set_index_buffer(self.body.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..self.body.count, 0, 0..settings.snakes.max(1));
+            self.draw_snakes(&mut pass, &body, material, &instances, settings.snakes);
             if let Some(ground) = ground {
                 pass.set_pipeline(&ground);
                 pass.set_vertex_buffer(0, self.ground.vertices.slice(..));
@@ -626,14 +638,7 @@ impl Renderer {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_bind_group(0, &material.film.bind_group, &[]);
-                pass.set_bind_group(1, &self.scene_group, &[]);
-                pass.set_bind_group(2, &material.textures.bind_group, &[]);
-                pass.set_pipeline(&pipeline);
-                pass.set_vertex_buffer(0, self.body.vertices.slice(..));
-                pass.set_vertex_buffer(1, instances.slice(..));
-                pass.set_index_buffer(self.body.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..self.body.count, 0, 0..settings.snakes.max(1));
+                self.draw_snakes(&mut pass, &pipeline, material, &instances, settings.snakes);
             }
             let a = self.read_texture(encoder, &first, width, height, 16)?;
             let b =
