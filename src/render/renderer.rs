@@ -570,14 +570,20 @@ impl Renderer {
         image::RgbaImage::from_raw(width, height, bytes).ok_or_else(|| GpuError::Readback("image size".into()))
     }
 
+    /// An 8-bit sRGB texture frames can be drawn into and read back from.
     pub fn output_texture(&self, width: u32, height: u32) -> wgpu::Texture {
+        self.readable_target("output", OUTPUT_FORMAT, width, height)
+    }
+
+    /// A single-sample render target that can be copied to a buffer.
+    fn readable_target(&self, label: &str, format: wgpu::TextureFormat, width: u32, height: u32) -> wgpu::Texture {
         self.gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("output"),
+            label: Some(label),
             size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: OUTPUT_FORMAT,
+            format,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         })
@@ -598,18 +604,7 @@ impl Renderer {
         let instances = self.instance_buffer(settings.snakes);
         let mut parts = Vec::new();
         for part in 0..2 {
-            let make = || {
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("gbuffer"),
-                    size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: GBUFFER_FORMAT,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                    view_formats: &[],
-                })
-            };
+            let make = || self.readable_target("gbuffer", GBUFFER_FORMAT, width, height);
             let (first, second) = (make(), make());
             let depth = self.targets(width, height, 1).depth;
             let pipeline = self.pipeline(self.key(Program::GBuffer(part), settings, material, 1));
