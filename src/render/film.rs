@@ -9,7 +9,7 @@
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-use super::gpu::{storage_entry, uniform_entry};
+use super::gpu::{sampler_entry, storage_entry, texture_entry, uniform_entry};
 use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
 use crate::optics::methods::{Bands, Method, d65_white};
@@ -77,23 +77,9 @@ pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         label: Some("film"),
         entries: &[
             uniform_entry(0, visibility),
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            },
+            texture_entry(1, visibility, true),
             storage_entry(2, visibility, true),
-            wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            },
+            sampler_entry(3, visibility),
         ],
     })
 }

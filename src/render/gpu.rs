@@ -92,6 +92,30 @@ pub fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bo
     buffer_entry(binding, visibility, wgpu::BufferBindingType::Storage { read_only })
 }
 
+/// A 2D float texture entry of a bind group layout.
+pub fn texture_entry(binding: u32, visibility: wgpu::ShaderStages, filterable: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A filtering sampler entry of a bind group layout.
+pub fn sampler_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }
+}
+
 fn buffer_entry(
     binding: u32,
     visibility: wgpu::ShaderStages,

@@ -7,6 +7,7 @@
 
 use std::collections::BTreeMap;
 
+use super::gpu::{sampler_entry, texture_entry};
 use crate::maps::MapKind;
 use crate::ops::Image;
 
@@ -98,10 +99,6 @@ pub fn mip_chain<T: Texel>(level0: Vec<T>, width: usize, height: usize) -> Vec<V
     levels
 }
 
-fn half(v: f32) -> u16 {
-    f32_to_f16(v)
-}
-
 /// IEEE 754 binary16 from f32, round to nearest even; overflow to infinity (maps never get
 /// near 65504).
 pub fn f32_to_f16(value: f32) -> u16 {
@@ -154,28 +151,14 @@ pub struct MaterialTextures {
 }
 
 pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let texture = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    };
+    let fragment = wgpu::ShaderStages::FRAGMENT;
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("material"),
         entries: &[
-            texture(0),
-            texture(1),
-            texture(2),
-            wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            },
+            texture_entry(0, fragment, true),
+            texture_entry(1, fragment, true),
+            texture_entry(2, fragment, true),
+            sampler_entry(3, fragment),
         ],
     })
 }
@@ -222,9 +205,9 @@ impl MaterialTextures {
                     wgpu::Extent3d { width: w as u32, height: h as u32, depth_or_array_layers: 1 },
                 );
             };
-            upload(&ar, maps.albedo_roughness[level].iter().flat_map(|t| t.map(half)).collect(), 8);
-            upload(&nh, maps.normal_height[level].iter().flat_map(|t| t.map(half)).collect(), 8);
-            upload(&th, maps.thickness[level].iter().map(|t| half(*t)).collect(), 2);
+            upload(&ar, maps.albedo_roughness[level].iter().flat_map(|t| t.map(f32_to_f16)).collect(), 8);
+            upload(&nh, maps.normal_height[level].iter().flat_map(|t| t.map(f32_to_f16)).collect(), 8);
+            upload(&th, maps.thickness[level].iter().map(|t| f32_to_f16(*t)).collect(), 2);
             (w, h) = ((w / 2).max(1), (h / 2).max(1));
         }
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {

@@ -78,7 +78,17 @@ pub fn shade_pixel(gbuffer: &GBuffer, i: usize, settings: &FrameSettings, optics
     let n = normalize([nr[0], nr[1], nr[2]]);
     let wo = normalize([camera[0] - pt[0], camera[1] - pt[1], camera[2] - pt[2]]);
     let thickness = pt[3];
-    let film = |cos: f64| film_rgb_reference(optics.stack, thickness, cos);
+    // Each light asks for the film at the same view cosine (421 Airy evaluations each): keep
+    // every colour computed for this pixel, keyed by the exact cosine.
+    let computed: std::cell::RefCell<Vec<(u64, [f64; 3])>> = Default::default();
+    let film = |cos: f64| {
+        if let Some((_, rgb)) = computed.borrow().iter().find(|(bits, _)| *bits == cos.to_bits()) {
+            return *rgb;
+        }
+        let rgb = film_rgb_reference(optics.stack, thickness, cos);
+        computed.borrow_mut().push((cos.to_bits(), rgb));
+        rgb
+    };
     let layers = Layers {
         n0: optics.stack.n0,
         n2: optics.stack.n2,

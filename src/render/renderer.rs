@@ -10,7 +10,7 @@ use std::sync::Mutex;
 use wgpu::util::DeviceExt;
 
 use super::film::{self, FilmBinding, GpuFilmMethod};
-use super::gpu::{map_read, uniform_entry};
+use super::gpu::{map_read, texture_entry, uniform_entry};
 use super::material::{self, MaterialMaps, MaterialTextures};
 use super::mesh::{BodyShape, Mesh, Vertex};
 use super::scene::{Camera, LayerOptics, Lighting, SceneUniform, Stage, View};
@@ -175,16 +175,7 @@ impl Renderer {
         let tonemap_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                texture_entry(0, wgpu::ShaderStages::FRAGMENT, false),
                 uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
             ],
         });
@@ -350,19 +341,13 @@ impl Renderer {
                 attributes: &wgpu::vertex_attr_array![4 => Float32x4],
             }),
         ];
-        let vertex_module = &self.skin_module;
-        let vertex_constants: Vec<(&str, f64)> = constants.clone();
-        let vertex_module = if key.program == Program::Plain { &self.plain_module } else { vertex_module };
         self.gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(&format!("{key:?}")),
             layout: Some(&self.pipeline_layout),
             vertex: wgpu::VertexState {
-                module: vertex_module,
+                module,
                 entry_point: Some("vs_main"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &vertex_constants,
-                    ..Default::default()
-                },
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
                 buffers: &vertex_layouts,
             },
             primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
@@ -602,11 +587,12 @@ impl Renderer {
         let device = &self.gpu.device;
         self.write_scene(settings, material, width as f32 / height as f32);
         let instances = self.instance_buffer(settings.snakes);
+        // Depth only: the colour targets of `Targets` are not used here.
+        let depth = self.targets(width, height, 1).depth;
         let mut parts = Vec::new();
         for part in 0..2 {
             let make = || self.readable_target("gbuffer", GBUFFER_FORMAT, width, height);
             let (first, second) = (make(), make());
-            let depth = self.targets(width, height, 1).depth;
             let pipeline = self.pipeline(self.key(Program::GBuffer(part), settings, material, 1));
             let mut encoder = device.create_command_encoder(&Default::default());
             {
