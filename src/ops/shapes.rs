@@ -79,10 +79,6 @@ pub struct SpotGrid {
 
 /// Rasterises the spot grid into an anti-aliased coverage mask in [0, 1].
 pub fn spots(width: usize, height: usize, grid: &SpotGrid) -> Image {
-    let mut out = Image::new(width, height, 1);
-    let Some(mut mask) = Mask::new(width as u32, height as u32) else {
-        return out;
-    };
     let (w, h) = (width as f32, height as f32);
     let mut pb = PathBuilder::new();
     let (across, along) = (grid.across.max(1), grid.along.max(1));
@@ -113,9 +109,18 @@ pub fn spots(width: usize, height: usize, grid: &SpotGrid) -> Image {
             }
         }
     }
-    if let Some(path) = pb.finish() {
-        mask.fill_path(&path, FillRule::EvenOdd, true, Transform::identity());
-    }
+    // Even-odd: ring spots are a circle with its inner circle as a hole.
+    rasterise(width, height, pb, FillRule::EvenOdd)
+}
+
+/// Fills the path into an anti-aliased coverage mask in [0, 1] (all zero if there is
+/// nothing to fill or the size is unusable).
+fn rasterise(width: usize, height: usize, pb: PathBuilder, rule: FillRule) -> Image {
+    let mut out = Image::new(width, height, 1);
+    let (Some(mut mask), Some(path)) = (Mask::new(width as u32, height as u32), pb.finish()) else {
+        return out;
+    };
+    mask.fill_path(&path, rule, true, Transform::identity());
     for (o, &m) in out.data.iter_mut().zip(mask.data()) {
         *o = m as f32 / 255.0;
     }
@@ -147,10 +152,6 @@ pub struct Blotches {
 
 /// Rasterises blotches into an anti-aliased coverage mask (tiny-skia), wrapping along v.
 pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
-    let mut out = Image::new(width, height, 1);
-    let Some(mut mask) = Mask::new(width as u32, height as u32) else {
-        return out;
-    };
     let (w, h) = (width as f32, height as f32);
     let count = b.count.max(1);
     let spacing = h / count as f32;
@@ -198,13 +199,7 @@ pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
             }
         }
     }
-    if let Some(path) = pb.finish() {
-        mask.fill_path(&path, FillRule::Winding, true, Transform::identity());
-    }
-    for (o, &m) in out.data.iter_mut().zip(mask.data()) {
-        *o = m as f32 / 255.0;
-    }
-    out
+    rasterise(width, height, pb, FillRule::Winding)
 }
 
 /// Checkered ventral plates: in the belly band (centred on u = 0), a square on the left
