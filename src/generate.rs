@@ -1,14 +1,17 @@
-//! One texture-set generation: load and validate, build the graph, evaluate the requested
-//! maps, encode and write them with the manifest. Nothing touches the output folder until
-//! every input has been validated and every map encoded.
+//! One texture-set generation, planned before it runs: `Plan::new` loads and validates the
+//! preset, builds the graph and estimates the peak memory from it (refusing a set that
+//! cannot fit); `Plan::run` locks the output set, evaluates the requested maps, encodes them
+//! and writes them with the manifest as one set (`export::SetLock`). Nothing touches the
+//! output folder until every input has been validated.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::export::Quantized;
-use crate::export::{self, write_all_atomically};
-use crate::graph::{EvalStats, evaluate_into};
-use crate::maps::{BuildOptions, MapKind, build_graph};
+use crate::export::{self, Quantized, SetLock, sha256_hex};
+use crate::graph::{EvalStats, Graph, evaluate_into};
+use crate::maps::{BuildOptions, build_graph};
+use crate::material::MapKind;
+use crate::memory::MemoryCheck;
 use crate::preset::{self, LoadedPreset};
 use crate::{Error, SIZE_RANGE};
 
@@ -31,16 +34,8 @@ pub struct GenerateReport {
     pub stats: EvalStats,
     pub encode_time: Duration,
     pub total_time: Duration,
-}
-
-/// Loads and validates a preset with overrides and an optional seed.
-pub fn load(spec: &str, overrides: &[(String, String)], seed: Option<u64>) -> Result<LoadedPreset, Error> {
-    let source = preset::read_source(spec)?;
-    let mut all = overrides.to_vec();
-    if let Some(seed) = seed {
-        all.push(("seed".into(), seed.to_string()));
-    }
-    Ok(preset::parse(&source, &all)?)
+    /// True when the output folder did not exist and was created.
+    pub created_folder: bool,
 }
 
 pub fn check_size(size: u64) -> Result<usize, Error> {
@@ -50,30 +45,73 @@ pub fn check_size(size: u64) -> Result<usize, Error> {
     Ok(size as usize)
 }
 
-/// Runs a whole generation. `progress(done, total)` reports node evaluations.
+/// A validated generation whose memory has been checked; nothing computed or written yet.
+#[derive(Debug)]
+pub struct Plan {
+    request: GenerateRequest,
+    size: usize,
+    loaded: LoadedPreset,
+    graph: Graph,
+    memory: MemoryCheck,
+    start: Instant,
+}
+
+impl Plan {
+    /// Validates the request and estimates its peak memory; refuses a set whose estimate
+    /// exceeds the memory available (`Error::Memory`, before any allocation).
+    pub fn new(request: &GenerateRequest) -> Result<Plan, Error> {
+        let start = Instant::now();
+        let size = check_size(request.size)?;
+        let loaded = preset::load(&request.preset, &request.overrides, request.seed)?;
+        let graph = build_graph(&loaded.preset, request.options);
+        let estimate = crate::memory::estimate_generate_bytes(&graph, &request.maps, size);
+        let memory = MemoryCheck::against_available(estimate);
+        memory.refuse_if_over(&format!("--size {size}"))?;
+        Ok(Plan { request: request.clone(), size, loaded, graph, memory, start })
+    }
+
+    pub fn memory(&self) -> MemoryCheck {
+        self.memory
+    }
+
+    pub fn loaded(&self) -> &LoadedPreset {
+        &self.loaded
+    }
+
+    /// Runs the plan. `progress(done, total)` reports node evaluations.
+    pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
+        let Plan { request, size, loaded, graph, start, .. } = self;
+        let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
+        // Each map is quantised to its file format the moment it is finished, freeing its f32
+        // buffer; PNG compression then runs for all maps in parallel.
+        let mut quantized: Vec<Quantized> = Vec::new();
+        let stats = evaluate_into(&graph, &request.maps, size, size, progress, &mut |map, image| {
+            quantized.push(export::quantize(map, &image));
+        });
+        quantized.sort_by_key(|q| q.map);
+
+        let encode_start = Instant::now();
+        let files = export::encode_all(&loaded.name, &quantized)?;
+        drop(quantized);
+        let entries: Vec<(MapKind, String, String)> =
+            request.maps.iter().zip(&files).map(|(m, (name, bytes))| (*m, name.clone(), sha256_hex(bytes))).collect();
+        let manifest = export::manifest(&loaded, size, &entries, request.options.normal_convention);
+        let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
+        let manifest_name = export::manifest_file_name(&loaded.name);
+        let encode_time = encode_start.elapsed();
+
+        let written = lock.write(&files, (&manifest_name, &json))?;
+        Ok(GenerateReport {
+            files: written,
+            stats,
+            encode_time,
+            total_time: start.elapsed(),
+            created_folder: lock.created_folder,
+        })
+    }
+}
+
+/// Plans and runs a whole generation.
 pub fn generate(request: &GenerateRequest, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
-    let start = Instant::now();
-    let size = check_size(request.size)?;
-    let loaded = load(&request.preset, &request.overrides, request.seed)?;
-    let graph = build_graph(&loaded.preset, request.options);
-    // Each map is quantised to its file format the moment it is finished, freeing its f32
-    // buffer; PNG compression then runs for all maps in parallel.
-    let mut quantized: Vec<Quantized> = Vec::new();
-    let stats = evaluate_into(&graph, &request.maps, size, size, progress, &mut |map, image| {
-        quantized.push(export::quantize(map, &image));
-    });
-    quantized.sort_by_key(|q| q.map);
-
-    let encode_start = Instant::now();
-    let mut files = export::encode_all(&loaded.name, &quantized)?;
-    drop(quantized);
-    let names: Vec<(MapKind, String)> =
-        request.maps.iter().map(|m| (*m, export::map_file_name(&loaded.name, *m))).collect();
-    let manifest = export::manifest(&loaded, size, &names, request.options.normal_convention);
-    let json = serde_json::to_vec_pretty(&manifest).expect("manifest serialises");
-    files.push((format!("{}.material.json", loaded.name), json));
-    let encode_time = encode_start.elapsed();
-
-    let written = write_all_atomically(&request.out_dir, &files)?;
-    Ok(GenerateReport { files: written, stats, encode_time, total_time: start.elapsed() })
+    Plan::new(request)?.run(progress)
 }

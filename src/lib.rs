@@ -2,23 +2,27 @@
 //!
 //! The pipeline is "parse first, then run": a preset is read and validated (`preset`), turned
 //! into a node graph (`maps`), evaluated on demand (`graph`) with pure pixel kernels (`ops`),
-//! and written atomically (`export`). `generate` ties the steps together for the CLI and
-//! for tests.
+//! and written atomically (`export`). `material` is the one home of what a set means (map
+//! formats, layer optics, thesis defaults); `generate` plans and runs one set; `render` is
+//! the wgpu preview. The library neither parses command lines nor prints: the `snakeskin`
+//! binary (`src/bin/snakeskin/`) does both.
 
 pub mod export;
-pub mod gallery;
 pub mod generate;
 pub mod graph;
 pub mod maps;
+pub mod material;
+pub mod memory;
 pub mod ops;
 pub mod optics;
 pub mod preset;
 pub mod render;
 
-pub use generate::{GenerateReport, GenerateRequest, generate};
+pub use generate::{GenerateReport, GenerateRequest, Plan, generate};
+pub use material::parse_map_list;
 
-/// Smallest and largest accepted `--size` (pixels per side). 16384² RGB f32 is 3 GiB per
-/// colour buffer, the most a 24 GiB machine can evaluate with the graph's peak widths.
+/// Smallest and largest accepted `--size` (pixels per side). Whether a size fits is decided
+/// by the memory estimate (`memory`), not by this bound: 16384² needs about 17 GiB.
 pub const SIZE_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
 
 #[derive(Debug, thiserror::Error)]
@@ -39,27 +43,28 @@ pub enum Error {
     /// A preview option outside what the renderer accepts (`snakeskin preview`).
     #[error("invalid preview option: {0}")]
     Preview(String),
+    /// The work would need more memory than the machine has available.
+    #[error(
+        "{what} needs about {needed_mib} MiB at its peak, but only {available_mib} MiB are available; use a \
+         smaller size (or raise SNAKESKIN_MEMORY_LIMIT_MIB if it is set)"
+    )]
+    Memory { what: String, needed_mib: u64, available_mib: u64 },
+    /// An output path that cannot be used as given.
+    #[error("invalid output path: {0}")]
+    OutputPath(String),
+    /// A failure that is not the user's: a bug or a library refusing valid data.
+    #[error("internal error: {0}")]
+    Internal(String),
 }
 
 impl Error {
-    /// True when the user's input is at fault (exit code 2), false for I/O trouble.
+    /// True when the user's input is at fault (exit code 2), false for the environment
+    /// (I/O, GPU, a concurrent run) and internal failures (exit code 1).
     pub fn is_invalid_input(&self) -> bool {
-        !matches!(self, Error::Export(_) | Error::Gpu(_))
-    }
-}
-
-/// Parses a comma-separated map list ("color,height"); "all" or empty means all five.
-pub fn parse_map_list(list: &str) -> Result<Vec<maps::MapKind>, Error> {
-    if list.trim().is_empty() || list.trim() == "all" {
-        return Ok(maps::MapKind::ALL.to_vec());
-    }
-    let mut out = Vec::new();
-    for item in list.split(',').map(str::trim) {
-        let map: maps::MapKind = item.parse().map_err(Error::Maps)?;
-        if !out.contains(&map) {
-            out.push(map);
+        match self {
+            Error::Export(e) => matches!(e, export::ExportError::NotAFolder { .. }),
+            Error::Gpu(_) | Error::Internal(_) => false,
+            _ => true,
         }
     }
-    out.sort();
-    Ok(out)
 }

@@ -21,7 +21,7 @@ const MAP_SIZE: usize = 256;
 
 fn load(overrides: &[(&str, &str)]) -> snakeskin::preset::LoadedPreset {
     let overrides: Vec<(String, String)> = overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-    snakeskin::generate::load(PRESET, &overrides, None).unwrap()
+    snakeskin::preset::load(PRESET, &overrides, None).unwrap()
 }
 
 fn material(renderer: &Renderer, overrides: &[(&str, &str)], method: GpuFilmMethod) -> Material {

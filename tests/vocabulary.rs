@@ -4,7 +4,7 @@
 mod common;
 
 use common::PATTERNED;
-use snakeskin::gallery::VARIANTS;
+use snakeskin::render::gallery::VARIANTS;
 use snakeskin::graph::evaluate;
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::ops::{Image, filters};

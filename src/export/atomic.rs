@@ -1,52 +1,235 @@
-//! All-or-nothing output: every file of a set is written to a temporary name in the target
-//! folder first, and only when all of them are complete are they renamed into place. A
-//! failed or interrupted run leaves no truncated file and never damages an earlier output.
+//! Output that is never half-written, never mixed, and never follows a planted link.
+//!
+//! **Single files** (`write_file_atomically`: charts, plots, previews, sheets) are written
+//! to a fresh temporary in the target folder — created exclusively (`O_EXCL`), with an
+//! unpredictable name, so a symlink planted at a guessable name cannot redirect the write —
+//! then renamed over the target. A reader sees the old file or the new one, never a part.
+//!
+//! **Texture sets** (`SetLock`, `SetLock::write`) are several files, and a rename is atomic
+//! only per file, so the set's manifest is its commit record:
+//!
+//! 1. `SetLock::acquire` takes an exclusive advisory lock (`flock`) on `DIR/.NAME.lock`
+//!    before any pixel is computed; a second run on the same set fails at once with a
+//!    clear error instead of interleaving its files with ours. The kernel releases the
+//!    lock when a process dies, so a killed run never blocks the next one. The lock file is
+//!    removed when the run ends (a killed run leaves an empty one, reused by the next);
+//!    whoever locks checks that the path still names the file it locked, so removal never
+//!    lets two runs hold the set at once.
+//! 2. Under the lock, temporaries of this set left by a killed run are removed (their
+//!    names end in `.snakeskin-tmp`), then every file is written to a new temporary.
+//! 3. Before any rename, every target is checked: a folder where a file must go is an
+//!    error, and nothing has changed yet.
+//! 4. The old manifest is removed, the maps are renamed into place, and the new manifest,
+//!    which records the SHA-256 of every map, is renamed in last.
+//!
+//! The guarantee: **whenever `NAME.material.json` exists, the maps it names are exactly the
+//! ones it was written with** — `verify_set` checks the hashes. A failure or a kill during
+//! step 4 leaves maps without a manifest (an incomplete set that no reader accepts), never
+//! new maps under an old manifest. An earlier set survives every failure before step 4.
 
-use std::fs;
+use std::fs::{self, File};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use sha2::{Digest, Sha256};
+
 use super::ExportError;
 
-/// Writes `files` (name, bytes) into `dir`, creating it if needed.
-pub fn write_all_atomically(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBuf>, ExportError> {
-    fs::create_dir_all(dir).map_err(|source| ExportError::Io { path: dir.into(), source })?;
-    let mut staged: Vec<(PathBuf, PathBuf)> = Vec::new();
-    let cleanup = |staged: &[(PathBuf, PathBuf)]| {
-        for (tmp, _) in staged {
-            let _ = fs::remove_file(tmp);
-        }
-    };
-    for (name, bytes) in files {
-        let target = dir.join(name);
-        let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-        let written = fs::File::create(&tmp).and_then(|mut f| {
-            f.write_all(bytes)?;
-            f.sync_all()
-        });
-        if let Err(source) = written {
-            let _ = fs::remove_file(&tmp);
-            cleanup(&staged);
-            return Err(ExportError::Io { path: tmp, source });
-        }
-        staged.push((tmp, target));
-    }
-    for (tmp, target) in &staged {
-        if let Err(source) = fs::rename(tmp, target) {
-            cleanup(&staged);
-            return Err(ExportError::Io { path: target.clone(), source });
-        }
-    }
-    Ok(staged.into_iter().map(|(_, target)| target).collect())
+/// The suffix of every temporary this module creates.
+const TMP_SUFFIX: &str = ".snakeskin-tmp";
+
+fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
+    move |source| ExportError::Io { path: path.into(), source }
 }
 
-/// Writes one file atomically (temporary name, then rename) to `path`.
+/// SHA-256 of `bytes` as 64 hex digits (the manifest's `sha256` per map).
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Removes temporaries that a killed run left for `file_names` in `dir`
+/// (`.FILE.*.snakeskin-tmp`) and that are at least `min_age` old.
+fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time::Duration) {
+    let Ok(entries) = fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        let ours = name.ends_with(TMP_SUFFIX)
+            && file_names.iter().any(|f| name.strip_prefix('.').is_some_and(|rest| rest.starts_with(&format!("{f}."))));
+        let old_enough = || {
+            entry.metadata().and_then(|m| m.modified()).is_ok_and(|t| t.elapsed().is_ok_and(|age| age >= min_age))
+        };
+        if ours && entry.file_type().is_ok_and(|t| t.is_file()) && old_enough() {
+            let _ = fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Writes `bytes` to a new exclusive temporary beside `target` and returns it (deleted on
+/// drop unless persisted).
+fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedTempFile, ExportError> {
+    let mut tmp = tempfile::Builder::new()
+        .prefix(&format!(".{target_name}."))
+        .suffix(TMP_SUFFIX)
+        .tempfile_in(dir)
+        .map_err(io_error(dir))?;
+    tmp.write_all(bytes).and_then(|_| tmp.as_file().sync_all()).map_err(io_error(tmp.path()))?;
+    Ok(tmp)
+}
+
+/// Refuses a target that is a folder (a rename over it would fail half-way through a set).
+fn check_target(target: &Path) -> Result<(), ExportError> {
+    match fs::symlink_metadata(target) {
+        Ok(meta) if meta.is_dir() => Err(ExportError::Io {
+            path: target.into(),
+            source: std::io::Error::new(std::io::ErrorKind::IsADirectory, "a folder is in the way of this output file"),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Creates `dir` if needed; true when it was created.
+fn create_folder(dir: &Path) -> Result<bool, ExportError> {
+    match fs::metadata(dir) {
+        Ok(meta) if meta.is_dir() => Ok(false),
+        Ok(_) => Err(ExportError::NotAFolder { path: dir.into() }),
+        Err(_) => fs::create_dir_all(dir).map(|_| true).map_err(io_error(dir)),
+    }
+}
+
+/// An exclusive lock on one output set (`DIR/.NAME.lock`), held until dropped.
+#[derive(Debug)]
+pub struct SetLock {
+    dir: PathBuf,
+    name: String,
+    path: PathBuf,
+    /// The locked file; the lock goes with it.
+    _file: File,
+    /// Whether acquiring created the output folder.
+    pub created_folder: bool,
+}
+
+impl SetLock {
+    /// Locks the set `name` in `dir`, creating the folder if it is missing.
+    pub fn acquire(dir: &Path, name: &str) -> Result<SetLock, ExportError> {
+        let created_folder = create_folder(dir)?;
+        let path = dir.join(format!(".{name}.lock"));
+        let mut options = fs::OpenOptions::new();
+        options.create(true).truncate(false).write(true);
+        #[cfg(unix)]
+        std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW);
+        // A run that ends removes the lock file; if that happened between our open and our
+        // lock, we hold a lock on a file nobody else will open: open again.
+        for _ in 0..8 {
+            let file = options.open(&path).map_err(io_error(&path))?;
+            match file.try_lock() {
+                Ok(()) if same_file(&file, &path) => {
+                    return Ok(SetLock { dir: dir.into(), name: name.into(), path, _file: file, created_folder });
+                }
+                Ok(()) => continue,
+                Err(fs::TryLockError::WouldBlock) => {
+                    return Err(ExportError::Busy { dir: dir.into(), name: name.into() });
+                }
+                Err(fs::TryLockError::Error(source)) => return Err(ExportError::Io { path, source }),
+            }
+        }
+        Err(ExportError::Busy { dir: dir.into(), name: name.into() })
+    }
+
+    /// Writes the set: `maps` (file name, bytes) first, then `manifest` (file name, bytes)
+    /// as the commit record. See the module documentation for the guarantee.
+    pub fn write(&self, maps: &[(String, Vec<u8>)], manifest: (&str, &[u8])) -> Result<Vec<PathBuf>, ExportError> {
+        let dir = &self.dir;
+        let names: Vec<&str> = maps.iter().map(|(n, _)| n.as_str()).chain([manifest.0]).collect();
+        // Under the lock no other run can be writing this set: every temporary of it is stale.
+        remove_stale_temporaries(dir, &names, std::time::Duration::ZERO);
+        let mut staged = Vec::new();
+        for (name, bytes) in maps.iter().map(|(n, b)| (n.as_str(), b.as_slice())).chain([manifest]) {
+            staged.push((stage(dir, name, bytes)?, dir.join(name)));
+        }
+        for (_, target) in &staged {
+            check_target(target)?;
+        }
+        let manifest_target = dir.join(manifest.0);
+        match fs::remove_file(&manifest_target) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io_error(&manifest_target)(e)),
+            _ => {}
+        }
+        let mut written = Vec::new();
+        for (renamed, (tmp, target)) in staged.into_iter().enumerate() {
+            fault_point(renamed);
+            tmp.persist(&target).map_err(|e| ExportError::Io { path: target.clone(), source: e.error })?;
+            written.push(target);
+        }
+        sync_folder(dir);
+        Ok(written)
+    }
+
+    /// The set's name (file stem of its manifest).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+impl Drop for SetLock {
+    /// Removes the lock file while still holding the lock (see `acquire`).
+    fn drop(&mut self) {
+        let _ = fs::remove_file(&self.path);
+    }
+}
+
+/// True when `path` still names the open `file` (same device and inode).
+fn same_file(file: &File, path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (file.metadata(), fs::symlink_metadata(path)) {
+            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (file, path);
+        true
+    }
+}
+
+/// Makes the renames durable where the platform allows (a folder fsync on Unix).
+fn sync_folder(dir: &Path) {
+    #[cfg(unix)]
+    if let Ok(folder) = File::open(dir) {
+        let _ = folder.sync_all();
+    }
+}
+
+/// Test hook (debug builds only): `SNAKESKIN_TEST_ABORT_AFTER_RENAMES=N` aborts the process
+/// after N renames of a set, as a SIGKILL would, so the kill-during-rename test can stop a
+/// run at an exact point. Release builds ignore it.
+fn fault_point(renamed: usize) {
+    #[cfg(debug_assertions)]
+    if std::env::var("SNAKESKIN_TEST_ABORT_AFTER_RENAMES").ok().and_then(|v| v.parse::<usize>().ok())
+        == Some(renamed)
+    {
+        std::process::abort();
+    }
+    #[cfg(not(debug_assertions))]
+    let _ = renamed;
+}
+
+/// Writes one file atomically (exclusive temporary, then rename) to `path`. The folder must
+/// exist (the binary creates missing folders and says so).
 pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, ExportError> {
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| ExportError::Io {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).ok_or_else(|| ExportError::Io {
         path: path.into(),
         source: std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path does not name a file"),
     })?;
-    let written = write_all_atomically(dir, &[(name.to_string_lossy().into_owned(), bytes)])?;
-    Ok(written.into_iter().next().unwrap_or_else(|| path.into()))
+    create_folder(dir)?;
+    check_target(path)?;
+    // Without a lock, a temporary is only taken as stale once it is older than any write.
+    remove_stale_temporaries(dir, &[&name], std::time::Duration::from_secs(600));
+    let tmp = stage(dir, &name, &bytes)?;
+    tmp.persist(path).map_err(|e| ExportError::Io { path: path.into(), source: e.error })?;
+    Ok(path.into())
 }

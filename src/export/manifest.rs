@@ -1,11 +1,17 @@
 //! `<name>.material.json`: what each file is, so a renderer or pipeline can use the set
-//! without guessing (colour space, bit depth, meaning, and the film thickness range the
-//! iridescence map spans, as glTF's KHR_materials_iridescence does).
+//! without guessing (colour space, bit depth, meaning, the film thickness range the
+//! iridescence map spans as glTF's KHR_materials_iridescence does, the layer optics), and
+//! the SHA-256 of every map: the manifest is the set's commit record (`atomic.rs`), and
+//! `verify_set` is how a reader checks that the files are the ones it describes.
+
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::maps::{MapKind, thickness_range_nm};
-use crate::ops::filters::NormalConvention;
+use super::ExportError;
+use super::atomic::sha256_hex;
+use crate::maps::thickness_range_nm;
+use crate::material::{MapKind, NormalConvention, Optics};
 use crate::preset::LoadedPreset;
 
 #[derive(Debug, Serialize)]
@@ -20,7 +26,7 @@ pub struct Manifest {
     pub height: usize,
     pub maps: Vec<MapEntry>,
     pub iridescence: IridescenceRange,
-    pub optics: OpticsEntry,
+    pub optics: Optics,
 }
 
 #[derive(Debug, Serialize)]
@@ -31,6 +37,8 @@ pub struct MapEntry {
     pub channels: u32,
     pub bit_depth: u32,
     pub meaning: String,
+    /// SHA-256 of the file's bytes, 64 hex digits.
+    pub sha256: String,
 }
 
 #[derive(Debug, Serialize)]
@@ -40,43 +48,32 @@ pub struct IridescenceRange {
     pub max_nm: f64,
 }
 
-#[derive(Debug, Serialize)]
-pub struct OpticsEntry {
-    pub ambient_ior: f64,
-    pub film_ior: f64,
-    pub pigment_ior: f64,
-    pub film_thickness_nm: f64,
-    pub pigment_thickness: f64,
-    pub absorption: [f64; 3],
+/// The manifest's file name for a set name.
+pub fn manifest_file_name(set_name: &str) -> String {
+    format!("{set_name}.material.json")
 }
 
-fn entry(map: MapKind, file: String, convention: NormalConvention) -> MapEntry {
-    let (color_space, channels, bit_depth, meaning) = match map {
-        MapKind::Color => ("srgb", 3, 8, "base colour (albedo k_d of the Lambertian base layer)".to_string()),
-        MapKind::Height => ("linear", 1, 16, "relative surface height, 0 = lowest".to_string()),
-        MapKind::Normal => {
-            let y = match convention {
-                NormalConvention::OpenGl => "OpenGL convention, +Y up",
-                NormalConvention::DirectX => "DirectX convention, +Y down",
-            };
-            ("linear", 3, 8, format!("tangent-space normal, rgb = xyz * 0.5 + 0.5, {y}"))
-        }
-        MapKind::Roughness => ("linear", 1, 8, "perceptual roughness r; GGX alpha = r^2 (glTF)".to_string()),
-        MapKind::Iridescence => {
-            ("linear", 1, 16, "film thickness: min_nm + value / 65535 * (max_nm - min_nm)".to_string())
-        }
-    };
-    MapEntry { map: map.name().into(), file, color_space: color_space.into(), channels, bit_depth, meaning }
-}
-
+/// The manifest of a set; `files` are (map, file name, SHA-256 of the file).
 pub fn manifest(
     loaded: &LoadedPreset,
     size: usize,
-    files: &[(MapKind, String)],
+    files: &[(MapKind, String, String)],
     convention: NormalConvention,
 ) -> Manifest {
     let p = &loaded.preset;
     let (min_nm, max_nm) = thickness_range_nm(p);
+    let entry = |(map, file, sha256): &(MapKind, String, String)| {
+        let format = map.format();
+        MapEntry {
+            map: map.name().into(),
+            file: file.clone(),
+            color_space: format.color_space().into(),
+            channels: format.channels,
+            bit_depth: format.bit_depth,
+            meaning: map.meaning(convention),
+            sha256: sha256.clone(),
+        }
+    };
     Manifest {
         generator: "snakeskin".into(),
         generator_version: env!("CARGO_PKG_VERSION").into(),
@@ -86,15 +83,56 @@ pub fn manifest(
         seed: p.seed,
         width: size,
         height: size,
-        maps: files.iter().map(|(m, f)| entry(*m, f.clone(), convention)).collect(),
+        maps: files.iter().map(entry).collect(),
         iridescence: IridescenceRange { min_nm, max_nm },
-        optics: OpticsEntry {
-            ambient_ior: p.optics.ambient_ior,
-            film_ior: p.optics.film_ior,
-            pigment_ior: p.optics.pigment_ior,
-            film_thickness_nm: p.optics.film_thickness_nm,
-            pigment_thickness: p.optics.pigment_thickness,
-            absorption: p.optics.absorption.0,
-        },
+        optics: p.optics.clone(),
     }
+}
+
+/// A set whose files match its manifest.
+#[derive(Debug, Clone)]
+pub struct VerifiedSet {
+    pub manifest: PathBuf,
+    /// (map name, file path) in manifest order.
+    pub files: Vec<(String, PathBuf)>,
+}
+
+/// Checks a set through its manifest: every map it lists exists beside it with the SHA-256
+/// it records. A set whose manifest is missing is incomplete (a run failed or was killed
+/// while renaming); one whose hashes differ is mixed or altered.
+pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
+    let problem = |problem: String| ExportError::Verify { manifest: manifest_path.into(), problem };
+    let text = std::fs::read(manifest_path).map_err(|e| {
+        problem(if e.kind() == std::io::ErrorKind::NotFound {
+            "no manifest: the set is incomplete (a run failed or was killed while writing it)".into()
+        } else {
+            format!("cannot read the manifest: {e}")
+        })
+    })?;
+    let json: serde_json::Value =
+        serde_json::from_slice(&text).map_err(|e| problem(format!("the manifest is not valid JSON: {e}")))?;
+    let dir = manifest_path.parent().unwrap_or(Path::new("."));
+    let maps = json["maps"].as_array().ok_or_else(|| problem("the manifest lists no maps".into()))?;
+    let mut files = Vec::new();
+    for entry in maps {
+        let (Some(map), Some(file), Some(expected)) =
+            (entry["map"].as_str(), entry["file"].as_str(), entry["sha256"].as_str())
+        else {
+            return Err(problem("a map entry lacks map, file or sha256".into()));
+        };
+        if file.contains(['/', '\\']) || file.starts_with('.') {
+            return Err(problem(format!("map file {file:?} is not a plain file name")));
+        }
+        let path = dir.join(file);
+        let bytes = std::fs::read(&path).map_err(|e| problem(format!("{map} map {}: {e}", path.display())))?;
+        let actual = sha256_hex(&bytes);
+        if actual != expected {
+            return Err(problem(format!(
+                "{map} map {} has SHA-256 {actual}, the manifest records {expected}: the set is mixed or altered",
+                path.display()
+            )));
+        }
+        files.push((map.to_string(), path));
+    }
+    Ok(VerifiedSet { manifest: manifest_path.into(), files })
 }

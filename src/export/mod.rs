@@ -1,5 +1,5 @@
-//! Map encoding (PNG in the formats DESIGN.md fixes), the material manifest, and atomic
-//! output.
+//! Map encoding (PNG in the formats `material` fixes), the material manifest, and atomic
+//! output (single files and whole sets, see `atomic.rs`).
 //!
 //! Encoding runs in parallel, one map per task: PNG compression of a 2K set is ~0.2 s on
 //! one core, the largest single cost after generation.
@@ -7,8 +7,8 @@
 mod atomic;
 mod manifest;
 
-pub use atomic::{write_all_atomically, write_file_atomically};
-pub use manifest::{Manifest, manifest};
+pub use atomic::{SetLock, sha256_hex, write_file_atomically};
+pub use manifest::{Manifest, VerifiedSet, manifest, manifest_file_name, verify_set};
 
 use std::io::Cursor;
 use std::path::PathBuf;
@@ -17,7 +17,7 @@ use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::{ExtendedColorType, ImageEncoder};
 use rayon::prelude::*;
 
-use crate::maps::MapKind;
+use crate::material::{Encoding, MapKind};
 use crate::ops::Image;
 
 #[derive(Debug, thiserror::Error)]
@@ -26,6 +26,15 @@ pub enum ExportError {
     Io { path: PathBuf, source: std::io::Error },
     #[error("cannot encode the {map} map: {message}")]
     Encode { map: MapKind, message: String },
+    #[error(
+        "another snakeskin run is writing the set {name} in {dir} (it holds {dir}/.{name}.lock); run again when it has \
+         finished, or write to another folder"
+    )]
+    Busy { dir: PathBuf, name: String },
+    #[error("{path} exists and is not a folder; the output option takes the folder to write into")]
+    NotAFolder { path: PathBuf },
+    #[error("set {manifest}: {problem}")]
+    Verify { manifest: PathBuf, problem: String },
 }
 
 /// File name of a map for a preset name.
@@ -59,18 +68,23 @@ pub struct Quantized {
     pub color: ExtendedColorType,
 }
 
-/// Quantises a map: sRGB 8-bit colour, 8-bit normal and roughness, 16-bit height and
-/// iridescence (samples in native byte order, as `ImageEncoder::write_image` takes them).
+/// Quantises a map to its file format (`MapKind::format`: encoding, channels, bit depth);
+/// 16-bit samples in native byte order, as `ImageEncoder::write_image` takes them.
 pub fn quantize(map: MapKind, image: &Image) -> Quantized {
-    let (samples, color) = match map {
-        MapKind::Color => (image.data.par_iter().map(|&c| linear_to_srgb8(c)).collect(), ExtendedColorType::Rgb8),
-        MapKind::Normal => {
-            (image.data.par_iter().map(|&n| unit_to_u8(n * 0.5 + 0.5)).collect(), ExtendedColorType::Rgb8)
-        }
-        MapKind::Roughness => (image.data.par_iter().map(|&r| unit_to_u8(r)).collect(), ExtendedColorType::L8),
-        MapKind::Height | MapKind::Iridescence => {
-            (image.data.par_iter().flat_map_iter(|&h| unit_to_u16(h).to_ne_bytes()).collect(), ExtendedColorType::L16)
-        }
+    let format = map.format();
+    let encode = |x: f32| match format.encoding {
+        Encoding::Srgb => linear_to_srgb8(x) as f32 / 255.0,
+        Encoding::Linear => x,
+        Encoding::SignedUnit => x * 0.5 + 0.5,
+    };
+    let (samples, color) = match (format.channels, format.bit_depth) {
+        (3, 8) => (image.data.par_iter().map(|&x| unit_to_u8(encode(x))).collect(), ExtendedColorType::Rgb8),
+        (1, 8) => (image.data.par_iter().map(|&x| unit_to_u8(encode(x))).collect(), ExtendedColorType::L8),
+        (1, 16) => (
+            image.data.par_iter().flat_map_iter(|&x| unit_to_u16(encode(x)).to_ne_bytes()).collect(),
+            ExtendedColorType::L16,
+        ),
+        other => unreachable!("MapKind::format has no {other:?} layout"),
     };
     Quantized { map, width: image.width, height: image.height, samples, color }
 }

@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 use super::{Graph, NodeId};
-use crate::maps::MapKind;
+use crate::material::MapKind;
 use crate::ops::Image;
 
 /// How many nodes past the next one in builder order the scheduler may start early.
@@ -110,15 +110,7 @@ pub fn evaluate_into(
     while !remaining.is_empty() {
         // The first ready node in builder order, plus ready nodes a short way ahead, at most
         // one per thread: branch parallelism without running far ahead (memory).
-        let mut batch = Vec::new();
-        for id in remaining.iter().take(LOOKAHEAD) {
-            if batch.len() == threads {
-                break;
-            }
-            if graph.node(*id).inputs.iter().all(|i| computed[i.0]) {
-                batch.push(*id);
-            }
-        }
+        let batch = next_batch(graph, &remaining, &computed, threads);
         remaining.retain(|id| !batch.contains(id));
 
         // A node that is the last consumer of its first input may reuse that buffer: take it
@@ -127,13 +119,7 @@ pub fn evaluate_into(
         let owned: Vec<Option<Image>> = batch
             .iter()
             .map(|&id| {
-                let node = graph.node(id);
-                let first = *node.inputs.first()?;
-                let used_once = node.inputs.iter().filter(|i| **i == first).count() == 1;
-                let needed_later = consumers[first.0] != 1 || produces.contains_key(&first.0);
-                if !node.op.in_place() || !used_once || needed_later {
-                    return None;
-                }
+                let first = reusable_input(graph, id, &consumers, &produces)?;
                 let image = Arc::try_unwrap(store[first.0].take()?).ok()?;
                 live_bytes -= image.bytes();
                 Some(image)
@@ -199,4 +185,93 @@ pub fn evaluate_into(
     }
 
     EvalStats { nodes: stats.into_values().collect(), peak_bytes, wall: start.elapsed() }
+}
+
+/// The first ready node in builder order, plus ready nodes a short way ahead, at most one
+/// per thread: branch parallelism without running far ahead (memory).
+fn next_batch(graph: &Graph, remaining: &[NodeId], computed: &[bool], threads: usize) -> Vec<NodeId> {
+    let mut batch = Vec::new();
+    for id in remaining.iter().take(LOOKAHEAD) {
+        if batch.len() == threads {
+            break;
+        }
+        if graph.node(*id).inputs.iter().all(|i| computed[i.0]) {
+            batch.push(*id);
+        }
+    }
+    batch
+}
+
+/// The input whose buffer node `id` may overwrite: its first input, when it is an in-place
+/// operation and the last consumer of that buffer, and the buffer is no requested map.
+fn reusable_input(
+    graph: &Graph,
+    id: NodeId,
+    consumers: &[usize],
+    produces: &BTreeMap<usize, Vec<MapKind>>,
+) -> Option<NodeId> {
+    let node = graph.node(id);
+    let first = *node.inputs.first()?;
+    let used_once = node.inputs.iter().filter(|i| **i == first).count() == 1;
+    let needed_later = consumers[first.0] != 1 || produces.contains_key(&first.0);
+    (node.op.in_place() && used_once && !needed_later).then_some(first)
+}
+
+/// The most bytes of node buffers alive at once when `maps` are evaluated at `width` ×
+/// `height`, found by running the evaluator's schedule on buffer sizes instead of buffers
+/// (same batches, same in-place reuse, same releases), plus the scratch buffers of the
+/// kernels running together. Maps are counted until they are handed over.
+pub fn estimate_peak_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> u64 {
+    let needed = graph.reachable(maps);
+    let pixels = (width as u64) * (height as u64);
+    let mut consumers = vec![0usize; graph.nodes().len()];
+    for id in &needed {
+        for input in &graph.node(*id).inputs {
+            consumers[input.0] += 1;
+        }
+    }
+    let mut produces: BTreeMap<usize, Vec<MapKind>> = BTreeMap::new();
+    for map in maps {
+        if let Some(id) = graph.output(*map) {
+            produces.entry(id.0).or_default().push(*map);
+        }
+    }
+    let mut channels = vec![0usize; graph.nodes().len()];
+    let mut live = vec![0u64; graph.nodes().len()];
+    let mut computed = vec![false; graph.nodes().len()];
+    let (mut live_bytes, mut peak_bytes) = (0u64, 0u64);
+    let threads = rayon::current_num_threads().max(1);
+    let mut remaining = needed;
+    while !remaining.is_empty() {
+        let batch = next_batch(graph, &remaining, &computed, threads);
+        remaining.retain(|id| !batch.contains(id));
+        let mut scratch = 0;
+        for &id in &batch {
+            let node = graph.node(id);
+            if let Some(first) = reusable_input(graph, id, &consumers, &produces) {
+                live_bytes -= std::mem::take(&mut live[first.0]);
+            }
+            let inputs: Vec<usize> = node.inputs.iter().map(|i| channels[i.0]).collect();
+            channels[id.0] = node.op.output_channels(&inputs);
+            let bytes = channels[id.0] as u64 * pixels * 4;
+            scratch += node.op.scratch_images() as u64 * bytes;
+            live[id.0] = bytes;
+            live_bytes += bytes;
+            computed[id.0] = true;
+        }
+        peak_bytes = peak_bytes.max(live_bytes + scratch);
+        let mut finished: Vec<usize> = batch.iter().map(|id| id.0).filter(|i| consumers[*i] == 0).collect();
+        for id in &batch {
+            for input in &graph.node(*id).inputs {
+                consumers[input.0] -= 1;
+                if consumers[input.0] == 0 {
+                    finished.push(input.0);
+                }
+            }
+        }
+        for index in finished {
+            live_bytes -= std::mem::take(&mut live[index]);
+        }
+    }
+    peak_bytes
 }

@@ -13,12 +13,12 @@ mod op;
 
 pub use cache::{CacheStats, NodeCache};
 pub use dot::to_dot;
-pub use eval::{EvalStats, Evaluation, NodeStats, evaluate, evaluate_into};
+pub use eval::{EvalStats, Evaluation, NodeStats, estimate_peak_bytes, evaluate, evaluate_into};
 pub use op::Op;
 
 use std::collections::BTreeMap;
 
-use crate::maps::MapKind;
+use crate::material::MapKind;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct NodeId(pub usize);
@@ -78,9 +78,11 @@ impl GraphBuilder {
         Self::default()
     }
 
-    /// Adds a node. Names must be unique: they key stats and DOT output.
+    /// Adds a node. Names must be unique: they key stats and DOT output. A wrong number of
+    /// inputs is a bug in a graph builder, caught here rather than during evaluation.
     pub fn add(&mut self, name: impl Into<String>, op: Op, inputs: &[NodeId]) -> NodeId {
         let name = name.into();
+        assert!(op.arity().contains(&inputs.len()), "node {name}: {} takes {:?} inputs, got {}", op.label(), op.arity(), inputs.len());
         debug_assert!(self.graph.nodes.iter().all(|n| n.name != name), "duplicate node name {name}");
         debug_assert!(inputs.iter().all(|i| i.0 < self.graph.nodes.len()));
         self.graph.nodes.push(Node { name, op, inputs: inputs.to_vec() });

@@ -47,6 +47,55 @@ pub enum Op {
 }
 
 impl Op {
+    /// How many inputs the operation takes (checked when a node is added).
+    pub fn arity(&self) -> std::ops::RangeInclusive<usize> {
+        match self {
+            Op::Noise(_) | Op::Scales(_) | Op::Bands { .. } | Op::Blotches(_) | Op::BellyChecker { .. } | Op::Spots(_) => {
+                0..=0
+            }
+            Op::Channel { .. }
+            | Op::Levels { .. }
+            | Op::Threshold { .. }
+            | Op::Blur { .. }
+            | Op::Sobel { .. }
+            | Op::Colorize { .. }
+            | Op::HeightToNormal { .. } => 1..=1,
+            Op::SnapToScales { .. } | Op::Tint { .. } => 2..=2,
+            Op::Blend { .. } => 2..=3,
+        }
+    }
+
+    /// Channels of the output, from the channels of the inputs (the memory estimate walks
+    /// the graph with these instead of images; a test holds them to what `eval` returns).
+    pub fn output_channels(&self, inputs: &[usize]) -> usize {
+        match self {
+            Op::Scales(field) => field.outputs.len(),
+            Op::Colorize { .. } | Op::HeightToNormal { .. } => 3,
+            Op::Levels { .. } | Op::Threshold { .. } | Op::Blur { .. } | Op::Blend { .. } | Op::Tint { .. } => {
+                inputs.first().copied().unwrap_or(1)
+            }
+            Op::Noise(_)
+            | Op::Channel { .. }
+            | Op::Bands { .. }
+            | Op::Blotches(_)
+            | Op::BellyChecker { .. }
+            | Op::SnapToScales { .. }
+            | Op::Spots(_)
+            | Op::Sobel { .. } => 1,
+        }
+    }
+
+    /// Temporary buffers a kernel allocates besides its output, in output-sized images:
+    /// the blur's transposed copy and its running sums; the coverage pixmap of tiny-skia
+    /// shapes (RGBA8, the size of one f32 channel).
+    pub fn scratch_images(&self) -> usize {
+        match self {
+            Op::Blur { .. } => 2,
+            Op::Blotches(_) | Op::Spots(_) => 1,
+            _ => 0,
+        }
+    }
+
     /// True for operations that can write their result into their first input's buffer.
     pub fn in_place(&self) -> bool {
         matches!(self, Op::Levels { .. } | Op::Threshold { .. } | Op::Blend { .. } | Op::Tint { .. })

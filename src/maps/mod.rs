@@ -7,9 +7,6 @@
 
 mod color;
 
-use std::fmt;
-use std::str::FromStr;
-
 use crate::graph::{Graph, GraphBuilder, NodeId, Op};
 use crate::ops::filters::{BlendMode, NormalConvention};
 use crate::ops::hash::derive_seed;
@@ -18,45 +15,7 @@ use crate::ops::scales::{ScaleField, ScaleShape, channel};
 use crate::preset::Preset;
 use crate::preset::schema::{self, IridescenceGradient};
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum MapKind {
-    Color,
-    Height,
-    Normal,
-    Roughness,
-    Iridescence,
-}
-
-impl MapKind {
-    pub const ALL: [MapKind; 5] =
-        [MapKind::Color, MapKind::Height, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            MapKind::Color => "color",
-            MapKind::Height => "height",
-            MapKind::Normal => "normal",
-            MapKind::Roughness => "roughness",
-            MapKind::Iridescence => "iridescence",
-        }
-    }
-}
-
-impl fmt::Display for MapKind {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for MapKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        MapKind::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown map {s:?}; accepted: color, height, normal, roughness, iridescence"))
-    }
-}
+pub use crate::material::MapKind;
 
 /// Choices that are not part of the preset (they do not change the skin, only its encoding).
 #[derive(Debug, Clone, Copy)]
@@ -72,8 +31,7 @@ impl Default for BuildOptions {
 
 /// The film thickness range the iridescence map spans, from the preset.
 pub fn thickness_range_nm(preset: &Preset) -> (f64, f64) {
-    let min = (preset.optics.film_thickness_nm - preset.iridescence.spread_nm * 0.5).max(0.0);
-    (min, min + preset.iridescence.spread_nm)
+    crate::material::thickness_range_nm(preset.optics.film_thickness_nm, preset.iridescence.spread_nm)
 }
 
 pub fn scale_field(preset: &Preset) -> ScaleField {

@@ -329,13 +329,7 @@ pub fn sobel(input: &Image, edge_sigma: f32) -> Image {
     })
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum NormalConvention {
-    /// +Y up (green = up), glTF and Blender.
-    OpenGl,
-    /// +Y down (green flipped), DirectX and Unreal.
-    DirectX,
-}
+pub use crate::material::NormalConvention;
 
 /// Tangent-space normal (unit XYZ in [-1, 1]) from a height map by central differences.
 /// `slope_per_unit_height` is the surface rise, in texture widths, of the full height range

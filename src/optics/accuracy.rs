@@ -41,6 +41,16 @@ pub struct Sample {
     pub cos0: f64,
 }
 
+/// The most grid points `bench irid` accepts: each needs a 421-wavelength reference sum
+/// (the default 10 nm × 1° grid has 72,360; 400,000 take a few minutes on two cores).
+pub const MAX_GRID_POINTS: usize = 400_000;
+
+/// How many points `grid` makes for these steps, computed without building it.
+pub fn grid_points(d_step_nm: f64, angle_step_deg: f64) -> usize {
+    let count = |span: f64, step: f64| (span / step + 1e-9).floor() as usize + 1;
+    GRID_MATERIALS.len() * count(89.0, angle_step_deg) * count(2000.0, d_step_nm)
+}
+
 /// The grid with `d_step_nm` and `angle_step_deg` spacing.
 pub fn grid(d_step_nm: f64, angle_step_deg: f64) -> Vec<Sample> {
     let mut samples = Vec::new();

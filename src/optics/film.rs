@@ -22,7 +22,11 @@ pub struct Stack {
 
 impl Stack {
     /// The thesis' defaults (Table 5.2): air, film 1.55, pigment 2.00.
-    pub const THESIS: Stack = Stack { n0: 1.0, n1: 1.55, n2: 2.0 };
+    pub const THESIS: Stack = Stack {
+        n0: crate::material::thesis::AMBIENT_IOR,
+        n1: crate::material::thesis::FILM_IOR,
+        n2: crate::material::thesis::PIGMENT_IOR,
+    };
 }
 
 /// Reflectance and transmittance per polarisation and unpolarised (the mean of s and p).

@@ -11,6 +11,7 @@ pub mod lab;
 pub mod lut;
 pub mod methods;
 pub mod plot;
+pub mod query;
 pub mod series;
 pub mod spectrum;
 pub mod stress;

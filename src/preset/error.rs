@@ -9,6 +9,12 @@ pub enum PresetError {
     #[error("cannot read preset {path}: {source}")]
     Read { path: PathBuf, source: std::io::Error },
 
+    #[error("cannot read preset {path}: it is {kind}; a preset must be a regular file")]
+    NotAFile { path: PathBuf, kind: &'static str },
+
+    #[error("cannot read preset {path}: it is {bytes} bytes; presets are limited to {limit} bytes")]
+    TooLarge { path: PathBuf, bytes: u64, limit: u64 },
+
     #[error("unknown preset {name:?}: not a .toml file and not a built-in preset (built-in: {available})")]
     UnknownPreset { name: String, available: String },
 

@@ -36,12 +36,16 @@ pub struct LoadedPreset {
     pub content_hash: String,
 }
 
+/// The largest preset file accepted, in bytes. Built-in presets are 1–8 KiB; a megabyte is
+/// far beyond any real preset and bounds what `generate /dev/zero`-like input can cost.
+pub const MAX_PRESET_BYTES: u64 = 1 << 20;
+
 /// Resolves a PRESET argument: an existing path or anything ending in `.toml` is a file,
 /// anything else a built-in preset name.
 pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
     if spec.ends_with(".toml") || path.exists() {
-        let text = std::fs::read_to_string(path).map_err(|source| PresetError::Read { path: path.into(), source })?;
+        let text = read_bounded(path)?;
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "preset".into());
         return Ok(PresetSource { name, display: spec.to_string(), text });
     }
@@ -53,8 +57,71 @@ pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     }
 }
 
+/// Reads a preset file: a regular file of at most `MAX_PRESET_BYTES`, in UTF-8. It is
+/// opened without blocking (a FIFO would otherwise wait forever for a writer) and checked
+/// through the open handle, then read with a bound, so neither a device like /dev/zero nor a
+/// file that grows while it is read can exhaust memory.
+fn read_bounded(path: &Path) -> Result<String, PresetError> {
+    use std::io::Read;
+    let read_error = |source| PresetError::Read { path: path.into(), source };
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
+    let file = options.open(path).map_err(read_error)?;
+    let meta = file.metadata().map_err(read_error)?;
+    if !meta.is_file() {
+        return Err(PresetError::NotAFile { path: path.into(), kind: file_kind(&meta) });
+    }
+    if meta.len() > MAX_PRESET_BYTES {
+        return Err(PresetError::TooLarge { path: path.into(), bytes: meta.len(), limit: MAX_PRESET_BYTES });
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_PRESET_BYTES + 1).read_to_end(&mut bytes).map_err(read_error)?;
+    if bytes.len() as u64 > MAX_PRESET_BYTES {
+        return Err(PresetError::TooLarge { path: path.into(), bytes: bytes.len() as u64, limit: MAX_PRESET_BYTES });
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 text ({e})")))
+    })
+}
+
+fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_char_device() || t.is_block_device() {
+            return "a device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if meta.is_dir() { "a folder" } else { "not a regular file" }
+}
+
+/// Loads a preset argument (a path or a built-in name) with `--set` overrides and an optional
+/// seed: read, parse, validate.
+pub fn load(spec: &str, overrides: &[(String, String)], seed: Option<u64>) -> Result<LoadedPreset, PresetError> {
+    parse_with_seed(&read_source(spec)?, overrides, seed)
+}
+
 /// Parses and validates; `overrides` are `(dotted.key, toml value text)` pairs.
 pub fn parse(source: &PresetSource, overrides: &[(String, String)]) -> Result<LoadedPreset, PresetError> {
+    parse_with_seed(source, overrides, None)
+}
+
+/// `parse`, then the seed replaced by `seed` when given. The seed is set on the parsed
+/// preset, not written into the TOML: TOML integers stop at 2^63 - 1, seeds at 2^64 - 1.
+pub fn parse_with_seed(
+    source: &PresetSource,
+    overrides: &[(String, String)],
+    seed: Option<u64>,
+) -> Result<LoadedPreset, PresetError> {
     let file_preset: Preset = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
     let preset = if overrides.is_empty() {
         file_preset
@@ -69,6 +136,10 @@ pub fn parse(source: &PresetSource, overrides: &[(String, String)]) -> Result<Lo
         })?
     };
 
+    let mut preset = preset;
+    if let Some(seed) = seed {
+        preset.seed = seed;
+    }
     let problems = validate(&preset);
     if !problems.is_empty() {
         let overridden = |key: &str| overrides.iter().any(|(k, _)| key == k || key.starts_with(&format!("{k}.")));
@@ -81,11 +152,20 @@ pub fn parse(source: &PresetSource, overrides: &[(String, String)]) -> Result<Lo
             .collect();
         return Err(PresetError::Invalid { file: source.display.clone(), problems: located });
     }
-    let canonical = toml::to_string(&preset).unwrap_or_default();
+    let canonical = canonical_text(&preset);
     Ok(LoadedPreset {
         name: source.name.clone(),
         preset,
         content_hash: format!("{:016x}", fnv1a64(canonical.as_bytes())),
+    })
+}
+
+/// The resolved preset as TOML, what `content_hash` hashes. A seed above TOML's integer
+/// range is written as a decimal string after the rest.
+fn canonical_text(preset: &Preset) -> String {
+    toml::to_string(preset).unwrap_or_else(|_| {
+        let rest = Preset { seed: 0, ..preset.clone() };
+        format!("{}\nseed = \"{}\"\n", toml::to_string(&rest).unwrap_or_default(), preset.seed)
     })
 }
 
@@ -97,7 +177,13 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
         }
         None => (None, None),
     };
-    let message = error.message().trim_end().to_string();
+    let mut message = error.message().trim_end().to_string();
+    if message.contains("duplicate key") && !message.contains('`') {
+        // Name the key: the span of a duplicate-key error covers it.
+        if let Some(key) = error.span().and_then(|s| source.text.get(s)).map(str::trim).filter(|k| !k.is_empty()) {
+            message = format!("duplicate key `{key}`: each key may appear once per table");
+        }
+    }
     PresetError::Parse {
         location: Location { file: source.display.clone(), line, column },
         message: with_suggestion(&message),
@@ -171,13 +257,21 @@ fn key_line(text: &str, dotted: &str) -> Option<usize> {
 
 /// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).
 fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), PresetError> {
+    let refuse = |message: String| PresetError::Override { argument: format!("{key}={value}"), message };
+    if key.chars().chain(value.chars()).any(char::is_control) {
+        return Err(refuse("the key and value must be one line without control characters".into()));
+    }
+    // One TOML value, nothing else: the table must hold exactly the key `v`.
     let parsed: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
-        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(value.into())),
+        Ok(mut t) if t.len() == 1 => t.remove("v").unwrap_or(toml::Value::String(value.into())),
+        Ok(_) => return Err(refuse("the value must be a single TOML value".into())),
         Err(_) => toml::Value::String(value.into()),
     };
     let segments: Vec<&str> = key.split('.').collect();
     let result = if segments.iter().any(|s| s.is_empty()) {
         Err("the key must be a dotted path like scales.rows or pattern.0.kind".to_string())
+    } else if let Err(message) = check_layer_index(root, &segments) {
+        Err(message)
     } else {
         let mut tree = toml::Value::Table(std::mem::take(root));
         let result = set_path(&mut tree, &segments, parsed);
@@ -187,6 +281,30 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
         result
     };
     result.map_err(|message| PresetError::Override { argument: format!("{key}={value}"), message })
+}
+
+/// `pattern.N...` must name an existing layer (or layer 0 of a preset without layers, which
+/// `--set` creates); otherwise the message says how many layers there are.
+fn check_layer_index(root: &toml::Table, segments: &[&str]) -> Result<(), String> {
+    let [first, index, ..] = segments else { return Ok(()) };
+    let Ok(index) = index.parse::<usize>() else { return Ok(()) };
+    if *first != "pattern" {
+        return Ok(());
+    }
+    let layers = match root.get("pattern") {
+        None => 0,
+        Some(toml::Value::Array(items)) => items.len(),
+        Some(_) => 1,
+    };
+    if index < layers || (layers == 0 && index == 0) {
+        return Ok(());
+    }
+    let have = match layers {
+        0 => "the preset has no pattern layers: `pattern.0.KEY` starts one".to_string(),
+        1 => "the preset has 1 pattern layer: pattern.0".to_string(),
+        n => format!("the preset has {n} pattern layers: pattern.0 to pattern.{}", n - 1),
+    };
+    Err(format!("there is no pattern layer {index}; {have} (add layers in the preset file)"))
 }
 
 fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> Result<(), String> {

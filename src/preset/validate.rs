@@ -41,6 +41,11 @@ pub mod ranges {
     pub const FILM_THICKNESS_NM: (f64, f64) = (0.0, 1.0e7);
     pub const PIGMENT_THICKNESS: (f64, f64) = (0.0, 100.0);
     pub const ABSORPTION: (f64, f64) = (0.0, 100.0);
+    /// Pattern layers per preset: every built-in species needs at most 3; each layer adds
+    /// a few full-size buffers and their time.
+    pub const MAX_PATTERN_LAYERS: usize = 16;
+    /// Colours (and widths) of one layer's ring sequence: a coral-snake triad needs 4.
+    pub const MAX_LAYER_COLORS: usize = 32;
 }
 
 #[derive(Default)]
@@ -80,8 +85,27 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
     c.range("scales.imbrication", s.imbrication, UNIT);
     c.range("scales.edge_softness", s.edge_softness, EDGE_SOFTNESS);
 
+    if preset.pattern.len() > MAX_PATTERN_LAYERS {
+        c.problems.push(Problem {
+            key: "pattern".into(),
+            message: format!("has {} layers; at most {MAX_PATTERN_LAYERS} are accepted", preset.pattern.len()),
+        });
+        // Checking ten thousand layers one by one only buries this message.
+        return c.problems;
+    }
     for (i, p) in preset.pattern.iter().enumerate() {
         let key = |field: &str| format!("pattern.{i}.{field}");
+        for (field, count) in [("colors", p.colors.len()), ("widths", p.widths.len())] {
+            if count > MAX_LAYER_COLORS {
+                c.problems.push(Problem {
+                    key: key(field),
+                    message: format!("has {count} entries; at most {MAX_LAYER_COLORS} are accepted"),
+                });
+            }
+        }
+        if p.colors.len() > MAX_LAYER_COLORS || p.widths.len() > MAX_LAYER_COLORS {
+            continue;
+        }
         match p.kind {
             PatternKind::Stripes => c.range(key("amount"), p.amount, STRIPES_PER_SIDE),
             PatternKind::Spots => c.range(key("amount"), p.amount, SPOTS_AROUND),

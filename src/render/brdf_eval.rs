@@ -135,3 +135,81 @@ pub fn eval_timed(
     let values: &[[f32; 4]] = bytemuck::cast_slice(&data);
     Ok((values.iter().map(|v| [v[0], v[1], v[2]]).collect(), elapsed))
 }
+
+/// `snakeskin bench gpu`: the WGSL BRDF (LUT film) per million evaluations on the GPU and
+/// the Rust f32 twin on one CPU core, on the same inputs, in one run.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct GpuBench {
+    pub adapter: String,
+    pub samples: usize,
+    pub gpu_ms_per_million: f64,
+    pub cpu_f32_ms_per_million: f64,
+    pub cpu_threads: usize,
+}
+
+/// Measures `GpuBench` over `count` deterministic inputs (upper hemisphere, a spread of
+/// roughness and thickness). GPU: fixed costs (submit, readback) cancel in the difference of
+/// 11 and 1 dispatches, median of five pairs; a difference that is not positive means the
+/// timing is meaningless and is an error, not a zero. CPU: median of five passes.
+pub fn bench_per_million(gpu: &Gpu, count: usize) -> Result<GpuBench, GpuError> {
+    use crate::optics::brdf::eval_f32;
+    use std::hint::black_box;
+
+    let lut = Lut::bake_default(Stack::THESIS);
+    let unit = |i: usize, k: u32| crate::ops::hash::unit(i as i32, (i >> 31) as i32, k, 7);
+    let inputs: Vec<(Layers32, [f32; 3], [f32; 3])> = (0..count)
+        .map(|i| {
+            let layers = Layers32 {
+                n0: 1.0,
+                n2: 2.0,
+                roughness: 0.05 + 0.9 * unit(i, 0),
+                optical_depth: [0.6, 0.4, 0.2],
+                albedo: [0.5, 0.4, 0.3],
+                thickness_nm: 2000.0 * unit(i, 1),
+            };
+            let dir = |a: f32, b: f32| {
+                let phi = b * std::f32::consts::TAU;
+                let sin = (1.0 - a * a).sqrt();
+                [sin * phi.cos(), sin * phi.sin(), a]
+            };
+            (layers, dir(unit(i, 2), unit(i, 3)), dir(unit(i, 4), unit(i, 5)))
+        })
+        .collect();
+    let samples: Vec<GpuSample> =
+        inputs.iter().map(|(l, wi, wo)| GpuSample::new(l, [0.0, 0.0, 1.0], *wi, *wo)).collect();
+
+    let mut per_million = Vec::new();
+    for _ in 0..5 {
+        let (_, one) = eval_timed(gpu, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 1)?;
+        let (_, eleven) = eval_timed(gpu, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 11)?;
+        per_million.push((eleven.as_secs_f64() - one.as_secs_f64()) / 10.0 * 1e3 * 1e6 / count as f64);
+    }
+    per_million.sort_by(f64::total_cmp);
+    let gpu_ms = per_million[2];
+    if !(gpu_ms.is_finite() && gpu_ms > 0.0) {
+        return Err(GpuError::Timing(format!(
+            "10 extra dispatches took {gpu_ms:.4} ms per million evaluations (median of 5): the timing is \
+             dominated by noise; use more --samples"
+        )));
+    }
+
+    let mut cpu: Vec<f64> = (0..5)
+        .map(|_| {
+            let start = std::time::Instant::now();
+            let mut acc = 0.0f32;
+            for (l, wi, wo) in &inputs {
+                acc += eval_f32(black_box(l), [0.0, 0.0, 1.0], *wi, *wo, &lut)[1];
+            }
+            black_box(acc);
+            start.elapsed().as_secs_f64() * 1e3 * 1e6 / count as f64
+        })
+        .collect();
+    cpu.sort_by(f64::total_cmp);
+    Ok(GpuBench {
+        adapter: gpu.describe(),
+        samples: count,
+        gpu_ms_per_million: gpu_ms,
+        cpu_f32_ms_per_million: cpu[2],
+        cpu_threads: 1,
+    })
+}

@@ -13,6 +13,9 @@ pub enum GpuError {
     Device(String),
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    /// A GPU timing that came out meaningless (not positive): noise swamped the work.
+    #[error("GPU timing failed: {0}")]
+    Timing(String),
     /// No window could be opened or drawn into (no display, no compatible surface).
     #[error("{0}")]
     Window(String),

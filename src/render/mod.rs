@@ -11,6 +11,7 @@
 pub mod bench;
 pub mod brdf_eval;
 pub mod film;
+pub mod gallery;
 pub mod gpu;
 pub mod material;
 pub mod mesh;
@@ -19,6 +20,7 @@ pub mod reference;
 pub mod renderer;
 pub mod scene;
 pub mod sheet;
+#[cfg(feature = "window")]
 pub mod window;
 
 pub use gpu::{Gpu, GpuError};

@@ -89,10 +89,15 @@ pub fn bands_for(method: GpuFilmMethod) -> usize {
 
 /// Encodes and writes a rendered image (atomically).
 pub fn write_png(path: &Path, image: &image::RgbaImage) -> Result<PathBuf, Error> {
-    let rgb = image::DynamicImage::ImageRgba8(image.clone()).into_rgb8();
+    write_rgb_png(path, &image::DynamicImage::ImageRgba8(image.clone()).into_rgb8())
+}
+
+/// Encodes and writes an RGB image (atomically). An encoder failure is ours, not the user's.
+pub fn write_rgb_png(path: &Path, image: &image::RgbImage) -> Result<PathBuf, Error> {
     let mut bytes = Vec::new();
-    rgb.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| Error::Preview(format!("PNG encoding failed: {e}")))?;
+    image
+        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
     Ok(write_file_atomically(path, bytes)?)
 }
 
@@ -185,7 +190,7 @@ pub fn write_figures(
         progress(i, figures.len());
         let overrides: Vec<(String, String)> =
             figure.overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-        let loaded = crate::generate::load(preset, &overrides, None)?;
+        let loaded = crate::preset::load(preset, &overrides, None)?;
         let material = upload_material(renderer, &loaded, map_size, GpuFilmMethod::Lut)?;
         let settings = FrameSettings { view: figure.view, camera: Camera::close_up(), ..FrameSettings::default() };
         let image = renderer.render_image(&settings, &material, size.0, size.1)?;

@@ -90,7 +90,7 @@ pub fn render_sheet(
     let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
     for (i, (name, _)) in presets.iter().enumerate() {
         progress(i, presets.len());
-        let loaded = crate::generate::load(name, &[], None)?;
+        let loaded = crate::preset::load(name, &[], None)?;
         let graph = build_graph(&loaded.preset, BuildOptions::default());
         let evaluation = evaluate(&graph, &MapKind::ALL, options.map_size, options.map_size, &|_, _| {});
         let maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;

@@ -83,10 +83,9 @@ impl Sliders {
     }
 
     fn optics(&self) -> LayerOptics {
-        let min = (self.thickness_nm - self.spread_nm * 0.5).max(0.0);
         LayerOptics {
             stack: Stack { n0: self.n0, n1: self.n1, n2: self.n2 },
-            thickness_range_nm: (min, min + self.spread_nm),
+            thickness_range_nm: crate::material::thickness_range_nm(self.thickness_nm, self.spread_nm),
             optical_depth: [self.absorption * self.pigment_thickness; 3],
         }
     }
@@ -128,7 +127,7 @@ struct App {
 
 /// Opens the window and runs until it is closed (or `frames` frames were drawn).
 pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
-    let loaded = crate::generate::load(&options.preset, &options.overrides, options.seed)?;
+    let loaded = crate::preset::load(&options.preset, &options.overrides, options.seed)?;
     let sliders = Sliders::from_preset(&loaded.preset);
     let mut cache = NodeCache::new();
     let (maps, _) = material_maps_cached(&loaded, options.map_size, &mut cache)?;
@@ -163,7 +162,7 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
                 std::thread::sleep(Duration::from_millis(150));
                 while changed_rx.try_recv().is_ok() {}
                 let start = Instant::now();
-                let result = crate::generate::load(&spec, &overrides, seed).and_then(|loaded| {
+                let result = crate::preset::load(&spec, &overrides, seed).map_err(Error::from).and_then(|loaded| {
                     let (maps, stats) = material_maps_cached(&loaded, map_size, &mut cache)?;
                     Ok(Reloaded { maps, sliders: Sliders::from_preset(&loaded.preset), stats, took: start.elapsed() })
                 });

@@ -1,8 +1,17 @@
-//! Command-line definitions only (clap derive); `main.rs` turns them into library calls.
+//! Command-line definitions (clap derive). Every value is parsed into its type here, once —
+//! map lists, image sizes, views, film methods, vectors and bounded numbers — so a command
+//! in `cmd/` receives checked values and a bad argument is a clap error naming the flag
+//! (exit 2) before anything runs.
 
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use snakeskin::material::MapKind;
+use snakeskin::optics::methods::Method;
+use snakeskin::preset::validate::ranges;
+use snakeskin::render::film::GpuFilmMethod;
+use snakeskin::render::scene::View;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -60,8 +69,8 @@ pub enum Command {
         #[arg(short, long, default_value = "docs/figures", value_name = "DIR")]
         out: PathBuf,
         /// Image size WIDTHxHEIGHT.
-        #[arg(long, default_value = "640x400")]
-        size: String,
+        #[arg(long, default_value = "640x400", value_parser = parse_image_size)]
+        size: ImageSize,
         /// Map resolution for the preview (pixels per side).
         #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
         map_size: u64,
@@ -98,7 +107,7 @@ pub struct PresetSource {
     /// VALUE is parsed as TOML; a bare word that is not valid TOML is taken as a string.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_key_value)]
     pub overrides: Vec<(String, String)>,
-    /// Override the preset's seed.
+    /// Override the preset's seed (any 64-bit unsigned integer).
     #[arg(long)]
     pub seed: Option<u64>,
 }
@@ -108,8 +117,8 @@ pub struct PresetArgs {
     #[command(flatten)]
     pub source: PresetSource,
     /// Maps to produce, comma-separated: color, height, normal, roughness, iridescence (default: all).
-    #[arg(long, default_value = "all", value_name = "LIST")]
-    pub maps: String,
+    #[arg(long, default_value = "all", value_name = "LIST", value_parser = parse_maps)]
+    pub maps: MapList,
 }
 
 #[derive(Debug, Args)]
@@ -142,23 +151,23 @@ pub struct PreviewArgs {
     #[arg(long)]
     pub window: bool,
     /// Image or window size WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720")]
-    pub size: String,
+    #[arg(long, default_value = "1280x720", value_parser = parse_image_size)]
+    pub size: ImageSize,
     /// What to show: a layer stage (diffuse, normal, film, all; thesis Fig. 5.12) or one map
     /// unlit on the body (map:color, map:height, map:normal, map:roughness, map:iridescence).
-    #[arg(long, default_value = "all", value_name = "STAGE")]
-    pub layers: String,
+    #[arg(long, default_value = "all", value_name = "STAGE", value_parser = parse_view)]
+    pub layers: View,
     /// Film colour method: lut (default), rgb3, spectral-N (e.g. spectral-16), gaussian-fit.
-    #[arg(long, default_value = "lut", value_name = "M")]
-    pub method: String,
+    #[arg(long, default_value = "lut", value_name = "M", value_parser = parse_gpu_method)]
+    pub method: GpuFilmMethod,
     /// Map resolution for the preview (pixels per side).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
     pub map_size: u64,
     /// With --window: render N frames, print the mean frame time and exit.
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
-    /// Exposure multiplier before tone mapping (Khronos PBR Neutral).
-    #[arg(long, default_value_t = 1.0)]
+    /// Exposure multiplier before tone mapping (Khronos PBR Neutral), > 0 and at most 1000.
+    #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     pub exposure: f32,
     /// Number of snakes (instanced in a grid).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=400))]
@@ -199,6 +208,9 @@ pub enum PresetsCommand {
 }
 
 fn parse_key_value(arg: &str) -> Result<(String, String), String> {
+    if arg.chars().any(char::is_control) {
+        return Err("KEY=VALUE must be one line without control characters (a newline would add TOML of its own)".into());
+    }
     let (key, value) = arg.split_once('=').ok_or_else(|| format!("expected KEY=VALUE, got {arg:?}"))?;
     if key.trim().is_empty() {
         return Err(format!("empty key in {arg:?}"));
@@ -249,8 +261,8 @@ pub enum BrdfCommand {
         angle_deg: Option<f64>,
         /// Colour method: spectral (the 1 nm reference of PHYSICS.md), rgb3, spectral-N
         /// (e.g. spectral-16), gaussian-fit, lut.
-        #[arg(long, default_value = "spectral")]
-        method: String,
+        #[arg(long, default_value = "spectral", value_parser = parse_method)]
+        method: Method,
         /// JSON lines {n0, n1, n2, thickness_nm, angle_deg, method}.
         #[arg(long, value_name = "FILE")]
         batch: Option<String>,
@@ -265,12 +277,12 @@ pub enum BrdfCommand {
         #[arg(short, long)]
         out: PathBuf,
         /// Colour method (spectral = the 1 nm reference).
-        #[arg(long, default_value = "spectral")]
-        method: String,
-        /// Chart width (thickness samples) and height (angle samples) in pixels.
-        #[arg(long, default_value_t = 800)]
+        #[arg(long, default_value = "spectral", value_parser = parse_method)]
+        method: Method,
+        /// Chart width (thickness samples) and height (angle samples) in pixels, 2 to 4096.
+        #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(2..=4096))]
         width: u32,
-        #[arg(long, default_value_t = 300)]
+        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(2..=4096))]
         height: u32,
     },
     /// Random and adversarial inputs: counts NaN and Inf, the range of R and T, the worst
@@ -292,33 +304,33 @@ pub enum BrdfCommand {
 pub struct EvalArgs {
     #[command(flatten)]
     pub stack: StackArgs,
-    /// Direction towards the light, x,y,z (need not be normalised).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    /// Direction towards the light, x,y,z (need not be normalised; not zero).
+    #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     pub wi: [f64; 3],
-    /// Direction towards the viewer, x,y,z.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    /// Direction towards the viewer, x,y,z (not zero).
+    #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     pub wo: [f64; 3],
-    /// Shading normal, x,y,z (a zero vector falls back to 0,0,1).
+    /// Shading normal, x,y,z (a zero vector falls back to 0,0,1, as a blank normal map does).
     #[arg(long, value_parser = parse_vec3, default_value = "0,0,1", allow_hyphen_values = true)]
     pub normal: [f64; 3],
-    /// Film thickness in nm (thesis δ0).
-    #[arg(long, default_value_t = 400.0)]
+    /// Film thickness in nm (thesis δ0), 0 to 10^7 (10 mm).
+    #[arg(long, default_value_t = 400.0, value_parser = parse_thickness_nm)]
     pub thickness_nm: f64,
-    /// Perceptual roughness (GGX α = roughness²).
-    #[arg(long, default_value_t = 0.35)]
+    /// Perceptual roughness (GGX α = roughness²), 0 to 1.
+    #[arg(long, default_value_t = 0.35, value_parser = parse_unit)]
     pub roughness: f64,
-    /// Absorption coefficient σ0 (one value, or r,g,b).
-    #[arg(long, value_parser = parse_vec3_or_scalar, default_value = "0.6")]
+    /// Absorption coefficient σ0 (one value, or r,g,b), each 0 to 100.
+    #[arg(long, value_parser = parse_absorption, default_value = "0.6")]
     pub absorption: [f64; 3],
-    /// Pigment layer thickness δ1 (optical depth τ = σ0 δ1).
-    #[arg(long, default_value_t = 1.0)]
+    /// Pigment layer thickness δ1 (optical depth τ = σ0 δ1), 0 to 100.
+    #[arg(long, default_value_t = 1.0, value_parser = parse_pigment_thickness)]
     pub pigment_thickness: f64,
-    /// Base albedo k_d, linear r,g,b (or one value).
-    #[arg(long, value_parser = parse_vec3_or_scalar, default_value = "1")]
+    /// Base albedo k_d, linear r,g,b (or one value), each 0 to 1.
+    #[arg(long, value_parser = parse_albedo, default_value = "1")]
     pub albedo: [f64; 3],
     /// Film colour method (as for `brdf color`).
-    #[arg(long, default_value = "spectral")]
-    pub method: String,
+    #[arg(long, default_value = "spectral", value_parser = parse_method)]
+    pub method: Method,
 }
 
 #[derive(Debug, Subcommand)]
@@ -331,8 +343,8 @@ pub enum BenchCommand {
         #[arg(default_value = "erythrolamprus-miliaris")]
         preset: String,
         /// Frame size WIDTHxHEIGHT (use 1920x1080 on a real GPU).
-        #[arg(long, default_value = "1280x720")]
-        size: String,
+        #[arg(long, default_value = "1280x720", value_parser = parse_image_size)]
+        size: ImageSize,
         /// Timed frames per variant (after 3 warm-up frames); the median is reported.
         #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(3..=10_000))]
         frames: u64,
@@ -340,8 +352,8 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
         map_size: u64,
         /// Frame size of the CPU reference comparison (the CPU shades each pixel spectrally).
-        #[arg(long, default_value = "480x300")]
-        reference_size: String,
+        #[arg(long, default_value = "480x300", value_parser = parse_image_size)]
+        reference_size: ImageSize,
         /// Print one JSON object.
         #[arg(long)]
         json: bool,
@@ -364,16 +376,117 @@ pub enum BenchCommand {
         /// Write an SVG plot of error against cost, one point per method.
         #[arg(long, value_name = "FILE")]
         plot: Option<PathBuf>,
-        /// Thickness step of the grid in nm (PHYSICS.md grid: 0..2000 nm).
-        #[arg(long, default_value_t = 10.0)]
+        /// Thickness step of the grid in nm (PHYSICS.md grid: 0..2000 nm), 0.1 to 2000.
+        #[arg(long, default_value_t = 10.0, value_parser = parse_d_step_nm)]
         d_step_nm: f64,
-        /// Angle step of the grid in degrees (0..89°).
-        #[arg(long, default_value_t = 1.0)]
+        /// Angle step of the grid in degrees (0..89°), 0.1 to 89.
+        #[arg(long, default_value_t = 1.0, value_parser = parse_angle_step_deg)]
         angle_step_deg: f64,
         /// Also measure other LUT sizes (the table-size trade-off).
         #[arg(long)]
         lut_sweep: bool,
     },
+}
+
+/// `--maps`: the maps to produce, in `MapKind` order, each once.
+#[derive(Debug, Clone)]
+pub struct MapList(pub Vec<MapKind>);
+
+fn parse_maps(list: &str) -> Result<MapList, String> {
+    snakeskin::material::parse_map_list(list).map(MapList)
+}
+
+/// An image size in pixels, WIDTHxHEIGHT (or one number for a square).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ImageSize {
+    pub width: u32,
+    pub height: u32,
+}
+
+fn parse_image_size(text: &str) -> Result<ImageSize, String> {
+    let range = snakeskin::render::preview::IMAGE_RANGE;
+    let bad = || format!("expected WIDTHxHEIGHT (e.g. 1280x720), each {} to {} pixels", range.start(), range.end());
+    let (w, h) = match text.split_once(['x', 'X']) {
+        Some((w, h)) => (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?),
+        None => {
+            let s: u32 = text.trim().parse().map_err(|_| bad())?;
+            (s, s)
+        }
+    };
+    if !range.contains(&w) || !range.contains(&h) {
+        return Err(bad());
+    }
+    Ok(ImageSize { width: w, height: h })
+}
+
+fn parse_view(text: &str) -> Result<View, String> {
+    View::parse(text).ok_or_else(|| format!("accepted: {}", View::ACCEPTED))
+}
+
+fn parse_method(text: &str) -> Result<Method, String> {
+    Method::parse(text).ok_or_else(|| format!("accepted: {}", Method::ACCEPTED))
+}
+
+fn parse_gpu_method(text: &str) -> Result<GpuFilmMethod, String> {
+    parse_method(text).map(GpuFilmMethod::from_method)
+}
+
+/// A finite number inside `lo..=hi`, for the flags that take one.
+fn bounded(text: &str, (lo, hi): (f64, f64)) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && (lo..=hi).contains(&v) => Ok(v),
+        _ => Err(format!("must be a finite number in [{lo}, {hi}]")),
+    }
+}
+
+fn parse_thickness_nm(text: &str) -> Result<f64, String> {
+    bounded(text, ranges::FILM_THICKNESS_NM)
+}
+
+fn parse_unit(text: &str) -> Result<f64, String> {
+    bounded(text, ranges::UNIT)
+}
+
+fn parse_pigment_thickness(text: &str) -> Result<f64, String> {
+    bounded(text, ranges::PIGMENT_THICKNESS)
+}
+
+fn parse_exposure(text: &str) -> Result<f32, String> {
+    match bounded(text, (0.0, 1000.0)) {
+        Ok(v) if v > 0.0 => Ok(v as f32),
+        _ => Err("must be a finite number above 0 and at most 1000".into()),
+    }
+}
+
+fn parse_d_step_nm(text: &str) -> Result<f64, String> {
+    // 0.1 nm over 0..2000 nm and 1° steps is 1.8 million reference colours (minutes, ~100
+    // MB); finer steps only repeat the 1 nm spectral reference's own resolution.
+    bounded(text, (0.1, 2000.0))
+}
+
+fn parse_angle_step_deg(text: &str) -> Result<f64, String> {
+    bounded(text, (0.1, 89.0))
+}
+
+/// One value for all three channels, or r,g,b; each inside `range`.
+fn vec3_or_scalar(text: &str, range: (f64, f64)) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let values: Vec<f64> = parts.iter().map(|p| bounded(p, range)).collect::<Result<_, _>>().map_err(|_| {
+        format!("expected one number or r,g,b, each a finite number in [{}, {}]", range.0, range.1)
+    })?;
+    match values.as_slice() {
+        [v] => Ok([*v; 3]),
+        [r, g, b] => Ok([*r, *g, *b]),
+        _ => Err(format!("expected one number or r,g,b, each a finite number in [{}, {}]", range.0, range.1)),
+    }
+}
+
+fn parse_absorption(text: &str) -> Result<[f64; 3], String> {
+    vec3_or_scalar(text, ranges::ABSORPTION)
+}
+
+fn parse_albedo(text: &str) -> Result<[f64; 3], String> {
+    vec3_or_scalar(text, ranges::UNIT)
 }
 
 fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
@@ -382,14 +495,16 @@ fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
         .map(|p| p.trim().parse::<f64>().map_err(|_| format!("expected x,y,z numbers, got {text:?}")))
         .collect::<Result<_, _>>()?;
     match parts.as_slice() {
-        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok([*x, *y, *z]),
-        _ => Err(format!("expected three finite numbers x,y,z, got {text:?}")),
+        [x, y, z] if parts.iter().all(|v| v.is_finite() && v.abs() <= 1e6) => Ok([*x, *y, *z]),
+        _ => Err("expected three finite numbers x,y,z (each at most 1e6 in size)".into()),
     }
 }
 
-fn parse_vec3_or_scalar(text: &str) -> Result<[f64; 3], String> {
-    match text.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok([v; 3]),
-        _ => parse_vec3(text),
+/// A direction: three finite numbers, not all zero (it is normalised before use).
+fn parse_direction(text: &str) -> Result<[f64; 3], String> {
+    let v = parse_vec3(text)?;
+    if v.iter().map(|c| c * c).sum::<f64>() < 1e-12 {
+        return Err("a direction must not be the zero vector".into());
     }
+    Ok(v)
 }

@@ -1,0 +1,123 @@
+//! `snakeskin bench ...`: film-method error against cost, the WGSL BRDF against its CPU
+//! twin, and the renderer's frame time against a plain PBR shader.
+
+use anyhow::Result;
+
+use crate::cli::{BenchCommand, ImageSize};
+use crate::output::ensure_parent_folder;
+use crate::progress::Progress;
+use snakeskin::Error;
+use snakeskin::optics::accuracy::{MAX_GRID_POINTS, Prepared, grid, grid_points, measure, reference_colours};
+use snakeskin::optics::lab::linear_srgb_to_lab;
+use snakeskin::optics::methods::Method;
+use snakeskin::render::Renderer;
+use snakeskin::render::bench::{BenchOptions, bench_render};
+
+pub fn run(command: BenchCommand) -> Result<()> {
+    match command {
+        BenchCommand::Gpu { samples, json } => gpu(samples as usize, json),
+        BenchCommand::Render { preset, size, frames, map_size, reference_size, json } => {
+            render(&preset, size, frames, map_size, reference_size, json)
+        }
+        BenchCommand::Irid { json, plot, d_step_nm, angle_step_deg, lut_sweep } => {
+            irid(json, plot.as_deref(), d_step_nm, angle_step_deg, lut_sweep)
+        }
+    }
+}
+
+fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_deg: f64, sweep: bool) -> Result<()> {
+    let points = grid_points(d_step_nm, angle_step_deg);
+    if points > MAX_GRID_POINTS {
+        return Err(Error::Query(format!(
+            "--d-step-nm {d_step_nm} with --angle-step-deg {angle_step_deg} makes {points} grid points; at most \
+             {MAX_GRID_POINTS} are accepted (each needs a 421-wavelength reference sum): use larger steps"
+        ))
+        .into());
+    }
+    if let Some(path) = plot {
+        ensure_parent_folder(path)?;
+    }
+    let samples = grid(d_step_nm, angle_step_deg);
+    eprintln!("reference: {} grid points, 1 nm spectral sum", samples.len());
+    let reference_lab: Vec<[f64; 3]> = reference_colours(&samples).into_iter().map(linear_srgb_to_lab).collect();
+    let mut reports = Vec::new();
+    for method in Method::all_realtime() {
+        eprintln!("measuring {}", method.name());
+        reports.push(measure(&Prepared::new(method), &samples, &reference_lab));
+    }
+    if sweep {
+        for size in [(16, 64, 16), (32, 128, 32), (128, 512, 128)] {
+            let mut report = measure(&Prepared::with_lut_size(Method::Lut, size), &samples, &reference_lab);
+            report.name = format!("lut-{}x{}+{}", size.0, size.1, size.2);
+            reports.push(report);
+        }
+    }
+    let default = Method::Lut.name();
+    if json {
+        println!("{}", serde_json::json!({ "default": default, "methods": reports }));
+    } else {
+        println!("{:<18} {:>9} {:>9} {:>9} {:>12}", "method", "mean ΔE", "p95 ΔE", "max ΔE", "ns/eval");
+        for r in &reports {
+            let mark = if r.name == default { " (default)" } else { "" };
+            println!(
+                "{:<18} {:>9.3} {:>9.3} {:>9.3} {:>12.1}{mark}",
+                r.name, r.mean_de, r.p95_de, r.max_de, r.ns_per_eval
+            );
+        }
+    }
+    if let Some(path) = plot {
+        let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default);
+        snakeskin::export::write_file_atomically(path, svg.into_bytes())?;
+    }
+    Ok(())
+}
+
+/// GPU compute against the CPU twin, per million BRDF evaluations, on the same inputs.
+fn gpu(count: usize, json: bool) -> Result<()> {
+    let gpu = snakeskin::render::Gpu::headless()?;
+    let result = snakeskin::render::brdf_eval::bench_per_million(&gpu, count)?;
+    if json {
+        println!("{}", serde_json::to_string(&result)?);
+    } else {
+        println!("adapter: {}", result.adapter);
+        println!("WGSL BRDF (compute):  {:.3} ms per million evaluations", result.gpu_ms_per_million);
+        println!("Rust f32 twin (1 core): {:.3} ms per million evaluations", result.cpu_f32_ms_per_million);
+    }
+    Ok(())
+}
+
+fn render(preset: &str, size: ImageSize, frames: u64, map_size: u64, reference: ImageSize, json: bool) -> Result<()> {
+    let loaded = snakeskin::preset::load(preset, &[], None)?;
+    let renderer = Renderer::headless()?;
+    let options = BenchOptions {
+        width: size.width,
+        height: size.height,
+        frames: frames as usize,
+        map_size: map_size as usize,
+        reference_size: (reference.width, reference.height),
+    };
+    let bar = Progress::spinner("bench render");
+    let result = bench_render(&renderer, &loaded, &options, &|what| bar.message(what))?;
+    bar.finish();
+    if json {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+        return Ok(());
+    }
+    println!("adapter: {} (timing: {})", result.adapter, result.timing);
+    println!("frame {}x{}, median of {} frames, scene pass only", result.width, result.height, result.frames);
+    println!("{:<22} {:>7} {:>10} {:>10} {:>10}", "variant", "snakes", "median ms", "p10 ms", "p90 ms");
+    for v in &result.variants {
+        println!("{:<22} {:>7} {:>10.3} {:>10.3} {:>10.3}", v.name, v.snakes, v.median_ms, v.p10_ms, v.p90_ms);
+    }
+    println!("skin / plain: {:.3}", result.ratio);
+    println!(
+        "reference ({}x{}, {} px): CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3}",
+        result.reference_width,
+        result.reference_height,
+        result.reference_pixels,
+        result.reference_mean_de,
+        result.reference_p99_de,
+        result.reference_max_de
+    );
+    Ok(())
+}

@@ -1,0 +1,176 @@
+//! `snakeskin brdf ...`: machine-readable optics queries, so anyone can check the physics
+//! against their own implementation. One JSON object per query; `--batch` reads JSON lines.
+
+use std::io::{BufRead, BufReader, Write};
+
+use anyhow::Result;
+use serde::Deserialize;
+
+use crate::cli::{BrdfCommand, EvalArgs, StackArgs};
+use crate::output::{ensure_parent_folder, printable};
+use snakeskin::Error;
+use snakeskin::optics::brdf::{Layers, eval};
+use snakeskin::optics::film::{Stack, airy};
+use snakeskin::optics::methods::Method;
+use snakeskin::optics::query::{chart, check, film_colour};
+
+/// The thesis' layer indices (Table 5.2), the defaults of a query that leaves them out.
+const THESIS: Stack = Stack::THESIS;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FilmQuery {
+    #[serde(default = "n0_default")]
+    n0: f64,
+    #[serde(default = "n1_default")]
+    n1: f64,
+    #[serde(default = "n2_default")]
+    n2: f64,
+    thickness_nm: f64,
+    wavelength_nm: f64,
+    angle_deg: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ColorQuery {
+    #[serde(default = "n0_default")]
+    n0: f64,
+    #[serde(default = "n1_default")]
+    n1: f64,
+    #[serde(default = "n2_default")]
+    n2: f64,
+    thickness_nm: f64,
+    angle_deg: f64,
+    #[serde(default = "spectral")]
+    method: String,
+}
+
+fn n0_default() -> f64 {
+    THESIS.n0
+}
+fn n1_default() -> f64 {
+    THESIS.n1
+}
+fn n2_default() -> f64 {
+    THESIS.n2
+}
+fn spectral() -> String {
+    "spectral".into()
+}
+
+fn stack_of(s: &StackArgs) -> Stack {
+    Stack { n0: s.n0, n1: s.n1, n2: s.n2 }
+}
+
+fn film_json(q: &FilmQuery) -> Result<String> {
+    let stack = Stack { n0: q.n0, n1: q.n1, n2: q.n2 };
+    check(stack, q.thickness_nm, q.angle_deg, Some(q.wavelength_nm))?;
+    let rt = airy(stack, q.thickness_nm, q.wavelength_nm, q.angle_deg.to_radians().cos());
+    Ok(serde_json::to_string(&rt)?)
+}
+
+fn color_json(q: &ColorQuery) -> Result<String> {
+    let method = Method::parse(&q.method)
+        .ok_or_else(|| Error::Query(format!("unknown method {:?}; accepted: {}", q.method, Method::ACCEPTED)))?;
+    color_json_with(Stack { n0: q.n0, n1: q.n1, n2: q.n2 }, q.thickness_nm, q.angle_deg, method)
+}
+
+fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Method) -> Result<String> {
+    check(stack, thickness_nm, angle_deg, None)?;
+    let rgb = film_colour(method, stack, thickness_nm, angle_deg.to_radians().cos());
+    Ok(serde_json::json!({ "rgb": rgb }).to_string())
+}
+
+fn eval_json(args: &EvalArgs) -> Result<String> {
+    let stack = stack_of(&args.stack);
+    check(stack, args.thickness_nm, 0.0, None)?;
+    let layers = Layers {
+        n0: stack.n0,
+        n2: stack.n2,
+        roughness: args.roughness,
+        optical_depth: args.absorption.map(|a| a * args.pigment_thickness),
+        albedo: args.albedo,
+    };
+    let film = |c: f64| film_colour(args.method, stack, args.thickness_nm, c);
+    let value = eval(&layers, args.normal, args.wi, args.wo, &film);
+    Ok(serde_json::json!({ "f": value.total(), "specular": value.specular, "diffuse": value.diffuse }).to_string())
+}
+
+/// Runs `per_line` on every non-empty JSON line; errors name the file and the line.
+fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> Result<String>) -> Result<()> {
+    let shown = printable(path);
+    let reader: Box<dyn BufRead> = if path == "-" {
+        Box::new(BufReader::new(std::io::stdin()))
+    } else {
+        let file = std::fs::File::open(path).map_err(|e| Error::Query(format!("cannot read --batch {shown}: {e}")))?;
+        Box::new(BufReader::new(file))
+    };
+    let mut out = std::io::stdout().lock();
+    for (i, line) in reader.lines().enumerate() {
+        let line = line.map_err(|e| Error::Query(format!("cannot read --batch {shown}: {e}")))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let query: Q = serde_json::from_str(&line).map_err(|e| Error::Query(format!("{shown}:{}: {e}", i + 1)))?;
+        let json = per_line(&query).map_err(|e| Error::Query(format!("{shown}:{}: {e}", i + 1)))?;
+        writeln!(out, "{json}")?;
+    }
+    Ok(())
+}
+
+pub fn run(command: BrdfCommand) -> Result<()> {
+    match command {
+        BrdfCommand::Film { batch: Some(path), .. } => run_batch(&path, film_json),
+        BrdfCommand::Film { stack, thickness_nm, wavelength_nm, angle_deg, batch: None } => {
+            let Stack { n0, n1, n2 } = stack_of(&stack);
+            let query = FilmQuery {
+                n0,
+                n1,
+                n2,
+                thickness_nm: thickness_nm.unwrap_or_default(),
+                wavelength_nm: wavelength_nm.unwrap_or_default(),
+                angle_deg: angle_deg.unwrap_or_default(),
+            };
+            println!("{}", film_json(&query)?);
+            Ok(())
+        }
+        BrdfCommand::Color { batch: Some(path), .. } => run_batch(&path, color_json),
+        BrdfCommand::Color { stack, thickness_nm, angle_deg, method, batch: None } => {
+            let json = color_json_with(
+                stack_of(&stack),
+                thickness_nm.unwrap_or_default(),
+                angle_deg.unwrap_or_default(),
+                method,
+            )?;
+            println!("{json}");
+            Ok(())
+        }
+        BrdfCommand::Chart { stack, out, method, width, height } => {
+            let stack = stack_of(&stack);
+            check(stack, 0.0, 0.0, None)?;
+            ensure_parent_folder(&out)?;
+            let (image, exposure) = chart(stack, method, width as usize, height as usize);
+            let png = snakeskin::export::encode_png(snakeskin::material::MapKind::Color, &image)?;
+            snakeskin::export::write_file_atomically(&out, png)?;
+            eprintln!(
+                "wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)",
+                printable(&out.display().to_string())
+            );
+            Ok(())
+        }
+        BrdfCommand::Eval(args) => {
+            println!("{}", eval_json(&args)?);
+            Ok(())
+        }
+        BrdfCommand::Stress { samples, seed, json } => {
+            let report = snakeskin::optics::stress::run(samples, seed);
+            if json {
+                println!("{}", serde_json::to_string(&report)?);
+            } else {
+                println!("{report:#?}");
+            }
+            Ok(())
+        }
+    }
+}

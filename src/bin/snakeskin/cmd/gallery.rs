@@ -1,0 +1,14 @@
+//! `snakeskin gallery`: every scale shape and pattern kind on one sheet.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+use crate::output::{ensure_parent_folder, printable};
+
+pub fn run(out: &Path, tile: usize, columns: usize) -> Result<()> {
+    ensure_parent_folder(out)?;
+    snakeskin::render::gallery::write(out, tile, columns)?;
+    println!("{}", printable(&out.display().to_string()));
+    Ok(())
+}

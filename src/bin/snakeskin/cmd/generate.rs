@@ -1,0 +1,85 @@
+//! `snakeskin generate`: one texture set, planned (validated, memory estimated) before any
+//! pixel is computed, then evaluated and written as a whole.
+
+use anyhow::Result;
+
+use crate::cli::{Convention, GenerateArgs};
+use crate::output::printable;
+use crate::progress::Progress;
+use snakeskin::generate::{GenerateRequest, Plan};
+use snakeskin::graph::EvalStats;
+use snakeskin::maps::BuildOptions;
+use snakeskin::ops::filters::NormalConvention;
+
+const MIB: f64 = (1u64 << 20) as f64;
+
+pub fn run(args: GenerateArgs) -> Result<()> {
+    let convention = match args.normal_convention {
+        Convention::Opengl => NormalConvention::OpenGl,
+        Convention::Directx => NormalConvention::DirectX,
+    };
+    let source = &args.preset.source;
+    let request = GenerateRequest {
+        preset: source.preset.clone(),
+        overrides: source.overrides.clone(),
+        seed: source.seed,
+        size: args.size,
+        maps: args.preset.maps.0.clone(),
+        out_dir: args.out.clone(),
+        options: BuildOptions { normal_convention: convention },
+    };
+    let plan = Plan::new(&request)?;
+    let memory = plan.memory();
+    if memory.is_tight() {
+        eprintln!(
+            "warning: this set needs about {:.0} MiB at its peak; {:.0} MiB are available",
+            memory.estimate_bytes as f64 / MIB,
+            memory.available_bytes as f64 / MIB
+        );
+    }
+    let bar = Progress::counting("{spinner} generating [{bar:30}] {pos}/{len} nodes {elapsed}");
+    let report = plan.run(&|done, total| bar.update(done, total))?;
+    bar.finish();
+    if report.created_folder {
+        eprintln!("note: created folder {}", printable(&args.out.display().to_string()));
+    }
+    for file in &report.files {
+        println!("{}", printable(&file.display().to_string()));
+    }
+    if args.stats {
+        print_stats(&report.stats);
+        eprintln!(
+            "memory estimate before the run: {:.1} MiB (available: {:.0} MiB)",
+            memory.estimate_bytes as f64 / MIB,
+            memory.available_bytes as f64 / MIB
+        );
+        eprintln!(
+            "encode + write: {:.1} ms, total: {:.1} ms",
+            report.encode_time.as_secs_f64() * 1e3,
+            report.total_time.as_secs_f64() * 1e3
+        );
+    }
+    Ok(())
+}
+
+fn print_stats(stats: &EvalStats) {
+    eprintln!("{:<28} {:<36} {:>5} {:>10} {:>10}", "node", "operation", "evals", "ms", "MiB");
+    let mut nodes = stats.nodes.clone();
+    nodes.sort_by_key(|n| std::cmp::Reverse(n.time));
+    for n in &nodes {
+        eprintln!(
+            "{:<28} {:<36} {:>5} {:>10.2} {:>10.1}",
+            n.name,
+            n.label,
+            n.evaluations,
+            n.time.as_secs_f64() * 1e3,
+            n.bytes as f64 / MIB
+        );
+    }
+    eprintln!(
+        "{} nodes evaluated, graph wall {:.1} ms, peak buffers {:.1} MiB",
+        stats.nodes.len(),
+        stats.wall.as_secs_f64() * 1e3,
+        stats.peak_bytes as f64 / MIB
+    );
+}

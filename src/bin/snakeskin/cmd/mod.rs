@@ -1,0 +1,30 @@
+//! One file per command: each turns its typed arguments into library calls and prints the
+//! result. Nothing here computes anything the library could not do without it.
+
+mod bench;
+mod brdf;
+mod figures;
+mod gallery;
+mod generate;
+mod graph;
+mod presets;
+mod preview;
+mod sheet;
+
+use anyhow::Result;
+
+use crate::cli::{Cli, Command};
+
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Generate(args) => generate::run(args),
+        Command::Graph(args) => graph::run(args),
+        Command::Brdf { command } => brdf::run(command),
+        Command::Bench { command } => bench::run(command),
+        Command::Preview(args) => preview::run(args),
+        Command::Figures { preset, out, size, map_size } => figures::run(&preset, &out, size, map_size),
+        Command::Gallery { out, tile, columns } => gallery::run(&out, tile as usize, columns as usize),
+        Command::Sheet { out, tile, columns, map_size } => sheet::run(&out, tile, columns, map_size as usize),
+        Command::Presets { command } => presets::run(command),
+    }
+}

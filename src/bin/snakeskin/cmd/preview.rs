@@ -1,0 +1,86 @@
+//! `snakeskin preview`: a preset on a snake body, headless to a PNG or in a window.
+
+use anyhow::Result;
+
+use crate::cli::PreviewArgs;
+use crate::output::{ensure_parent_folder, printable};
+use crate::progress::Progress;
+use snakeskin::Error;
+use snakeskin::render::Renderer;
+use snakeskin::render::preview::{reference_check, upload_material, write_png};
+use snakeskin::render::renderer::FrameSettings;
+use snakeskin::render::scene::Camera;
+
+pub fn run(args: PreviewArgs) -> Result<()> {
+    // Validate everything before touching the GPU or any file.
+    let source = &args.source;
+    let loaded = snakeskin::preset::load(&source.preset, &source.overrides, source.seed)?;
+    if args.out.is_none() && !args.window {
+        return Err(Error::Preview("nothing to do: give --out FILE.png (headless) or --window".into()).into());
+    }
+    let settings = FrameSettings {
+        view: args.layers,
+        method: args.method,
+        exposure: args.exposure,
+        ground: !args.no_ground,
+        snakes: args.snakes,
+        camera: if args.close_up { Camera::close_up() } else { Camera::framing(args.snakes) },
+        ..FrameSettings::default()
+    };
+    if args.window {
+        return window(&args, settings);
+    }
+    let out = args.out.as_deref().expect("checked above");
+    ensure_parent_folder(out)?;
+    if let Some(heat_path) = &args.reference {
+        ensure_parent_folder(heat_path)?;
+    }
+    let bar = Progress::spinner("generating maps and baking the film LUT");
+    let renderer = Renderer::headless()?;
+    let material = upload_material(&renderer, &loaded, args.map_size as usize, args.method)?;
+    bar.message("rendering");
+    let (width, height) = (args.size.width, args.size.height);
+    let image = renderer.render_image(&settings, &material, width, height)?;
+    let written = write_png(out, &image)?;
+    if let Some(heat_path) = &args.reference {
+        bar.message("shading the CPU reference");
+        let (report, _) = reference_check(&renderer, &material, &settings, width, height)?;
+        snakeskin::render::preview::write_rgb_png(heat_path, &report.heat_map(5.0))?;
+        eprintln!(
+            "reference: {} pixels, CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3} (heat map: black 0 .. yellow >= 5)",
+            report.pixels, report.mean_de, report.p99_de, report.max_de
+        );
+    }
+    bar.finish();
+    println!("{}", printable(&written.display().to_string()));
+    Ok(())
+}
+
+#[cfg(feature = "window")]
+fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
+    let options = snakeskin::render::window::WindowOptions {
+        preset: args.source.preset.clone(),
+        overrides: args.source.overrides.clone(),
+        seed: args.source.seed,
+        map_size: args.map_size as usize,
+        size: (args.size.width, args.size.height),
+        frames: args.frames,
+        settings,
+    };
+    let report = snakeskin::render::window::run(options)?;
+    if let Some(frames) = args.frames {
+        println!(
+            "{frames} frames, mean frame time {:.2} ms ({:.1} fps), adapter {}",
+            report.mean_frame_ms,
+            1000.0 / report.mean_frame_ms,
+            report.adapter
+        );
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "window"))]
+fn window(_: &PreviewArgs, _: FrameSettings) -> Result<()> {
+    Err(Error::Preview("this build has no window (built without the `window` feature); use --out FILE.png".into())
+        .into())
+}

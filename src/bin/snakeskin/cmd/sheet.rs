@@ -1,0 +1,21 @@
+//! `snakeskin sheet`: the species library's contact sheet.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+use crate::output::{ensure_parent_folder, printable};
+use crate::progress::Progress;
+use snakeskin::render::Renderer;
+use snakeskin::render::sheet::{SheetOptions, write_sheet};
+
+pub fn run(out: &Path, tile: u32, columns: u32, map_size: usize) -> Result<()> {
+    ensure_parent_folder(out)?;
+    let renderer = Renderer::headless()?;
+    let bar = Progress::counting("{spinner} sheet [{bar:30}] {pos}/{len} species {elapsed}");
+    let written =
+        write_sheet(&renderer, out, SheetOptions { tile, columns, map_size }, &|done, total| bar.update(done, total))?;
+    bar.finish();
+    println!("{}", printable(&written.display().to_string()));
+    Ok(())
+}

@@ -1,0 +1,26 @@
+//! The `snakeskin` binary: parse the command line into typed values (`cli`), call the
+//! library (`cmd/`, one file per command), print, and map errors to exit codes — 2 when the
+//! user's input is at fault, 1 for anything else. The library neither parses arguments nor
+//! prints; everything a user sees on a terminal is written from here.
+
+mod cli;
+mod cmd;
+mod output;
+mod progress;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    output::restore_default_sigpipe();
+    output::quiet_vulkan_device_select();
+    let cli = cli::Cli::parse();
+    match cmd::run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {}", output::error_message(&err));
+            ExitCode::from(output::exit_code(&err))
+        }
+    }
+}

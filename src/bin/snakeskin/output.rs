@@ -1,0 +1,105 @@
+//! What the binary prints, and how: errors once each and free of terminal control codes,
+//! notes about what a command did on the user's behalf, and the usual behaviour of a Unix
+//! tool whose reader goes away (`snakeskin presets list | head -1` ends quietly).
+
+use std::path::Path;
+
+/// A closed pipe ends the process quietly by SIGPIPE (exit status 141 in a shell), as `cat`
+/// or `ls` do. Rust ignores SIGPIPE by default, which turns every `println!` into a panic
+/// ("failed printing to stdout: Broken pipe", exit 101) once the reader has gone.
+pub fn restore_default_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in `main`, before any other thread exists; SIG_DFL is a
+    // valid disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+/// Mesa's Vulkan `device_select` layer (an implicit layer, loaded into every Vulkan program)
+/// connects to the Wayland display to order the GPUs; without `XDG_RUNTIME_DIR` libwayland
+/// prints "error: XDG_RUNTIME_DIR is invalid or not set in the environment." twice per run
+/// (found with a breakpoint on `wl_display_connect`). The layer's ordering is not needed —
+/// wgpu picks the adapter itself — so where that message would appear the layer is switched
+/// off with Mesa's own `NODEVICE_SELECT`, unless the user has set it.
+pub fn quiet_vulkan_device_select() {
+    let runtime_dir_usable = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir());
+    if !runtime_dir_usable && std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: called first thing in `main`, before any other thread exists.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
+}
+
+/// The error and its causes, each said once: a cause whose text its parent already
+/// includes (thiserror's "cannot write X: {source}" wrapping an OS error) is not repeated.
+/// Control characters (e.g. ANSI escapes copied from a preset) are shown escaped, never
+/// sent raw to the terminal.
+pub fn error_message(err: &anyhow::Error) -> String {
+    let mut message = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if message.contains(&text) {
+            continue;
+        }
+        if !message.is_empty() {
+            message.push_str(": ");
+        }
+        message.push_str(&text);
+    }
+    printable(&message)
+}
+
+/// 2 when the user's input is at fault, 1 for the environment and internal failures: the
+/// first typed library error in the chain decides.
+pub fn exit_code(err: &anyhow::Error) -> u8 {
+    use snakeskin::export::ExportError;
+    for cause in err.chain() {
+        if let Some(e) = cause.downcast_ref::<snakeskin::Error>() {
+            return if e.is_invalid_input() { 2 } else { 1 };
+        }
+        if cause.is::<snakeskin::preset::PresetError>() {
+            return 2;
+        }
+        if let Some(e) = cause.downcast_ref::<ExportError>() {
+            return if matches!(e, ExportError::NotAFolder { .. }) { 2 } else { 1 };
+        }
+    }
+    1
+}
+
+/// `text` with every control character but newline and tab written as `\u{..}`.
+pub fn printable(text: &str) -> String {
+    text.chars()
+        .map(|c| if c.is_control() && c != '\n' && c != '\t' { c.escape_unicode().to_string() } else { c.to_string() })
+        .collect()
+}
+
+/// Creates the folder a single output file goes into when it is missing, and says so on
+/// stderr. Every command treats output paths alike: `generate -o DIR`, `preview --out`,
+/// `preview --reference`, `sheet -o` and the rest create missing folders with this note.
+pub fn ensure_parent_folder(file: &Path) -> anyhow::Result<()> {
+    match file.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(folder) => ensure_folder(folder),
+        None => Ok(()),
+    }
+}
+
+/// Creates an output folder when it is missing (with a note on stderr); refuses a path
+/// that exists but is not a folder, naming it.
+pub fn ensure_folder(folder: &Path) -> anyhow::Result<()> {
+    match std::fs::metadata(folder) {
+        Ok(meta) if meta.is_dir() => Ok(()),
+        Ok(_) => Err(snakeskin::Error::OutputPath(format!(
+            "{} exists and is not a folder (an output folder is needed here)",
+            folder.display()
+        ))
+        .into()),
+        Err(_) => {
+            std::fs::create_dir_all(folder).map_err(|source| {
+                snakeskin::Error::Export(snakeskin::export::ExportError::Io { path: folder.into(), source })
+            })?;
+            eprintln!("note: created folder {}", printable(&folder.display().to_string()));
+            Ok(())
+        }
+    }
+}

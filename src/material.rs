@@ -1,0 +1,239 @@
+//! The material model, one home for what a texture set *means*: the map kinds and their
+//! file formats (colour space, channels, bit depth, meaning), the layer optics with the
+//! thesis defaults, and the film thickness range the iridescence map spans.
+//!
+//! Every part that reads or writes a set — the graph builders, PNG export, the manifest,
+//! the renderer, the window, the CLI — takes these facts from here, so a format or a
+//! default cannot drift between the file and its description. It depends on nothing else
+//! in the crate.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Deserializer, Serialize, de};
+
+/// The thesis' layer defaults (Bie & Jiang 2024, Table 5.2): air, a film of index 1.55,
+/// a pigment layer of index 2.00, a 400 nm film, σ0 = 0.6 over δ1 = 1.
+pub mod thesis {
+    pub const AMBIENT_IOR: f64 = 1.0;
+    pub const FILM_IOR: f64 = 1.55;
+    pub const PIGMENT_IOR: f64 = 2.0;
+    pub const FILM_THICKNESS_NM: f64 = 400.0;
+    pub const PIGMENT_THICKNESS: f64 = 1.0;
+    pub const ABSORPTION: f64 = 0.6;
+}
+
+/// The five maps of a set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum MapKind {
+    Color,
+    Height,
+    Normal,
+    Roughness,
+    Iridescence,
+}
+
+impl MapKind {
+    pub const ALL: [MapKind; 5] =
+        [MapKind::Color, MapKind::Height, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MapKind::Color => "color",
+            MapKind::Height => "height",
+            MapKind::Normal => "normal",
+            MapKind::Roughness => "roughness",
+            MapKind::Iridescence => "iridescence",
+        }
+    }
+
+    /// The map's file format (DESIGN.md, "Maps").
+    pub fn format(self) -> MapFormat {
+        match self {
+            MapKind::Color => MapFormat { encoding: Encoding::Srgb, channels: 3, bit_depth: 8 },
+            MapKind::Height => MapFormat { encoding: Encoding::Linear, channels: 1, bit_depth: 16 },
+            MapKind::Normal => MapFormat { encoding: Encoding::SignedUnit, channels: 3, bit_depth: 8 },
+            MapKind::Roughness => MapFormat { encoding: Encoding::Linear, channels: 1, bit_depth: 8 },
+            MapKind::Iridescence => MapFormat { encoding: Encoding::Linear, channels: 1, bit_depth: 16 },
+        }
+    }
+
+    /// What a sample of the map means, for the manifest.
+    pub fn meaning(self, convention: NormalConvention) -> String {
+        match self {
+            MapKind::Color => "base colour (albedo k_d of the Lambertian base layer)".into(),
+            MapKind::Height => "relative surface height, 0 = lowest".into(),
+            MapKind::Normal => {
+                let y = match convention {
+                    NormalConvention::OpenGl => "OpenGL convention, +Y up",
+                    NormalConvention::DirectX => "DirectX convention, +Y down",
+                };
+                format!("tangent-space normal, rgb = xyz * 0.5 + 0.5, {y}")
+            }
+            MapKind::Roughness => "perceptual roughness r; GGX alpha = r^2 (glTF)".into(),
+            MapKind::Iridescence => "film thickness: min_nm + value / 65535 * (max_nm - min_nm)".into(),
+        }
+    }
+}
+
+impl fmt::Display for MapKind {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for MapKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        MapKind::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown map {s:?}; accepted: color, height, normal, roughness, iridescence"))
+    }
+}
+
+/// Parses a comma-separated map list ("color,height"); "all" or empty means all five. The
+/// result is in `MapKind` order, each map once.
+pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
+    if list.trim().is_empty() || list.trim() == "all" {
+        return Ok(MapKind::ALL.to_vec());
+    }
+    let mut out = Vec::new();
+    for item in list.split(',').map(str::trim) {
+        let map: MapKind = item.parse()?;
+        if !out.contains(&map) {
+            out.push(map);
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// How a map's linear f32 samples become file samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Encoding {
+    /// sRGB transfer function (IEC 61966-2-1) on [0, 1].
+    Srgb,
+    /// Linear on [0, 1].
+    Linear,
+    /// Linear on [-1, 1] stored as x * 0.5 + 0.5 (normals).
+    SignedUnit,
+}
+
+/// A map's file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MapFormat {
+    pub encoding: Encoding,
+    pub channels: u32,
+    pub bit_depth: u32,
+}
+
+impl MapFormat {
+    /// The colour space as the manifest names it.
+    pub fn color_space(self) -> &'static str {
+        match self.encoding {
+            Encoding::Srgb => "srgb",
+            Encoding::Linear | Encoding::SignedUnit => "linear",
+        }
+    }
+
+    /// Bytes per pixel in the file's sample layout.
+    pub fn bytes_per_pixel(self) -> usize {
+        (self.channels * self.bit_depth / 8) as usize
+    }
+}
+
+/// Normal map convention: OpenGL (+Y up, glTF, Blender) or DirectX (+Y down, Unreal).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum NormalConvention {
+    OpenGl,
+    DirectX,
+}
+
+/// The layer stack's optics (thesis Table 5.2 names in comments; defaults in `thesis`).
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Optics {
+    /// n0: refractive index of the environment.
+    pub ambient_ior: f64,
+    /// n1: refractive index of the iridescent film.
+    pub film_ior: f64,
+    /// n2: refractive index of the pigment (absorption) layer.
+    pub pigment_ior: f64,
+    /// δ0: film thickness in nm.
+    pub film_thickness_nm: f64,
+    /// δ1: pigment layer thickness (relative units; optical depth = σ0 δ1).
+    pub pigment_thickness: f64,
+    /// σ0: absorption coefficient of the pigment layer, one value or linear [r, g, b].
+    pub absorption: Absorption,
+}
+
+impl Default for Optics {
+    fn default() -> Self {
+        Optics {
+            ambient_ior: thesis::AMBIENT_IOR,
+            film_ior: thesis::FILM_IOR,
+            pigment_ior: thesis::PIGMENT_IOR,
+            film_thickness_nm: thesis::FILM_THICKNESS_NM,
+            pigment_thickness: thesis::PIGMENT_THICKNESS,
+            absorption: Absorption([thesis::ABSORPTION; 3]),
+        }
+    }
+}
+
+impl Optics {
+    /// Optical depth τ = σ0 δ1 per channel.
+    pub fn optical_depth(&self) -> [f64; 3] {
+        self.absorption.0.map(|a| a * self.pigment_thickness)
+    }
+}
+
+/// The film thickness range the iridescence map spans: `spread_nm` wide, centred on the
+/// film thickness δ0, never below 0 (values 0 and 1 of the map are its ends).
+pub fn thickness_range_nm(film_thickness_nm: f64, spread_nm: f64) -> (f64, f64) {
+    let min = (film_thickness_nm - spread_nm * 0.5).max(0.0);
+    (min, min + spread_nm)
+}
+
+/// σ0, written as one number or `[r, g, b]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Absorption(pub [f64; 3]);
+
+impl<'de> Deserialize<'de> for Absorption {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> de::Visitor<'de> for Visitor {
+            type Value = Absorption;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or [r, g, b]")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Absorption, E> {
+                Ok(Absorption([v; 3]))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Absorption, E> {
+                Ok(Absorption([v as f64; 3]))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Absorption, E> {
+                Ok(Absorption([v as f64; 3]))
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, mut seq: A) -> Result<Absorption, A::Error> {
+                let mut rgb = [0.0; 3];
+                for (i, slot) in rgb.iter_mut().enumerate() {
+                    *slot = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                if seq.next_element::<f64>()?.is_some() {
+                    return Err(de::Error::invalid_length(4, &self));
+                }
+                Ok(Absorption(rgb))
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
+}
+
+impl Serialize for Absorption {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let [r, g, b] = self.0;
+        if r == g && g == b { serializer.serialize_f64(r) } else { self.0.serialize(serializer) }
+    }
+}

@@ -1,0 +1,86 @@
+//! Peak memory, estimated before anything is allocated, and the memory the machine has.
+//!
+//! A texture set at 16384² needs tens of GiB; allocating blindly ends in an abort after
+//! tens of seconds. `estimate_generate_bytes` walks the graph's schedule with buffer sizes
+//! instead of buffers (`graph::estimate_peak_bytes`) and adds what export holds; `Plan`
+//! refuses a set whose estimate exceeds the available memory, and the binary warns when it
+//! takes more than half of it.
+//!
+//! Available memory is the smallest of: `MemAvailable` in /proc/meminfo, the cgroup's
+//! `memory.max` less its `memory.current` (containers), and `SNAKESKIN_MEMORY_LIMIT_MIB`
+//! when set (a cap the user chooses, also how the tests pretend to be a small machine).
+
+use crate::Error;
+use crate::graph::{Graph, estimate_peak_bytes};
+use crate::material::MapKind;
+
+const MIB: u64 = 1 << 20;
+
+/// Allocator slack, thread stacks, the binary and its tables: measured resident size of a
+/// 16² run is about 20 MiB; 64 MiB leaves room.
+const FIXED_OVERHEAD_BYTES: u64 = 64 * MIB;
+
+/// Estimated peak bytes of `generate` for `maps` at `size`²: the graph's live buffers at
+/// their worst point, plus every quantised map (held until encoding) and its PNG (at most
+/// the quantised size with the fast filter; held until written), plus a fixed overhead.
+pub fn estimate_generate_bytes(graph: &Graph, maps: &[MapKind], size: usize) -> u64 {
+    let pixels = (size * size) as u64;
+    let quantized: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * pixels).sum();
+    estimate_peak_bytes(graph, maps, size, size) + 2 * quantized + FIXED_OVERHEAD_BYTES
+}
+
+/// An estimate next to the memory available for it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MemoryCheck {
+    pub estimate_bytes: u64,
+    pub available_bytes: u64,
+}
+
+impl MemoryCheck {
+    pub fn against_available(estimate_bytes: u64) -> MemoryCheck {
+        MemoryCheck { estimate_bytes, available_bytes: available_bytes() }
+    }
+
+    /// More than half of the available memory: worth a warning.
+    pub fn is_tight(&self) -> bool {
+        self.estimate_bytes > self.available_bytes / 2
+    }
+
+    /// `Error::Memory` when the estimate exceeds what is available.
+    pub fn refuse_if_over(&self, what: &str) -> Result<(), Error> {
+        if self.estimate_bytes > self.available_bytes {
+            return Err(Error::Memory {
+                what: what.into(),
+                needed_mib: self.estimate_bytes.div_ceil(MIB),
+                available_mib: self.available_bytes / MIB,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Memory available to this process now, in bytes (see the module documentation).
+pub fn available_bytes() -> u64 {
+    let mut available = meminfo_available().unwrap_or(u64::MAX);
+    if let Some(cgroup) = cgroup_headroom() {
+        available = available.min(cgroup);
+    }
+    if let Some(limit) = std::env::var("SNAKESKIN_MEMORY_LIMIT_MIB").ok().and_then(|v| v.trim().parse::<u64>().ok()) {
+        available = available.min(limit.saturating_mul(MIB));
+    }
+    available
+}
+
+fn meminfo_available() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+fn cgroup_headroom() -> Option<u64> {
+    let max: u64 = std::fs::read_to_string("/sys/fs/cgroup/memory.max").ok()?.trim().parse().ok()?;
+    let current: u64 =
+        std::fs::read_to_string("/sys/fs/cgroup/memory.current").ok().and_then(|t| t.trim().parse().ok()).unwrap_or(0);
+    Some(max.saturating_sub(current))
+}

@@ -1,0 +1,87 @@
+//! Optics queries by method: the film colour of any method in f64 (the 1 nm reference, the
+//! real-time methods, the LUT read in f64 arithmetic), the range checks a query must pass,
+//! and the thickness × angle colour chart. `snakeskin brdf` and its batch mode call these;
+//! the checks name the parameter and what is accepted, so a bad query is an error, never a
+//! silently clamped answer.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use rayon::prelude::*;
+
+use super::film::Stack;
+use super::film_rgb_reference;
+use super::lut::Lut;
+use super::methods::{Method, gaussian_fit_f64, rgb3_f64, spectral_n_f64};
+use crate::Error;
+use crate::ops::Image;
+use crate::preset::validate::ranges;
+
+/// Refuses what the physics does not cover, naming the parameter and the accepted range
+/// (the preset's range table: indices, film thickness).
+pub fn check(stack: Stack, thickness_nm: f64, angle_deg: f64, wavelength_nm: Option<f64>) -> Result<(), Error> {
+    let (lo, hi) = ranges::IOR;
+    for (name, n) in [("n0", stack.n0), ("n1", stack.n1), ("n2", stack.n2)] {
+        if !(n.is_finite() && (lo..=hi).contains(&n)) {
+            return Err(Error::Query(format!("{name} must be a refractive index in [{lo}, {hi}], got {n}")));
+        }
+    }
+    let (lo, hi) = ranges::FILM_THICKNESS_NM;
+    if !(thickness_nm.is_finite() && (lo..=hi).contains(&thickness_nm)) {
+        return Err(Error::Query(format!("thickness_nm must be a finite number in [{lo}, {hi}], got {thickness_nm}")));
+    }
+    if !(angle_deg.is_finite() && (0.0..=90.0).contains(&angle_deg)) {
+        return Err(Error::Query(format!("angle_deg must be in [0, 90], got {angle_deg}")));
+    }
+    if let Some(l) = wavelength_nm
+        && !(l.is_finite() && (1.0..=1.0e6).contains(&l))
+    {
+        return Err(Error::Query(format!("wavelength_nm must be a finite number in [1, 1000000], got {l}")));
+    }
+    Ok(())
+}
+
+/// LUTs baked so far, per material (a batch of queries on one material bakes once).
+fn lut_for(stack: Stack) -> Arc<Lut> {
+    static CACHE: Mutex<Option<HashMap<[u64; 3], Arc<Lut>>>> = Mutex::new(None);
+    let key = [stack.n0.to_bits(), stack.n1.to_bits(), stack.n2.to_bits()];
+    let mut cache = CACHE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    cache.get_or_insert_with(HashMap::new).entry(key).or_insert_with(|| Arc::new(Lut::bake_default(stack))).clone()
+}
+
+/// A method's film colour in f64 (the LUT read in f64 arithmetic): linear sRGB under D65.
+pub fn film_colour(method: Method, stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
+    match method {
+        Method::Spectral => film_rgb_reference(stack, thickness_nm, cos0),
+        Method::Rgb3 => rgb3_f64(stack, thickness_nm, cos0),
+        Method::SpectralN(n) => spectral_n_f64(stack, thickness_nm, cos0, n),
+        Method::GaussianFit => gaussian_fit_f64(stack, thickness_nm, cos0),
+        Method::Lut => lut_for(stack).lookup_f64(thickness_nm, cos0),
+    }
+}
+
+/// The film colour chart: thickness 0..2000 nm across, angle 0..89° down, scaled so the
+/// brightest channel is 1. Returns the linear image and the exposure applied (film
+/// reflectances are a few percent to a few tens of percent).
+pub fn chart(stack: Stack, method: Method, width: usize, height: usize) -> (Image, f64) {
+    let rows: Vec<Vec<[f64; 3]>> = (0..height)
+        .into_par_iter()
+        .map(|y| {
+            let angle_deg = 89.0 * y as f64 / (height - 1) as f64;
+            (0..width)
+                .map(|x| {
+                    film_colour(method, stack, 2000.0 * x as f64 / (width - 1) as f64, angle_deg.to_radians().cos())
+                })
+                .collect()
+        })
+        .collect();
+    let brightest = rows.iter().flatten().flat_map(|p| p.iter().copied()).fold(1e-6, f64::max);
+    let exposure = 1.0 / brightest;
+    let image = Image {
+        width,
+        height,
+        channels: 3,
+        data: rows.into_iter().flatten().flat_map(|p| p.map(|c| (c * exposure) as f32)).collect(),
+    };
+    (image, exposure)
+}
