@@ -1,0 +1,406 @@
+//! Hostile input: every failure found by the hostile-input review (issue "House in order",
+//! part 2), each as a test that failed before the fix. Closed pipes, memory, unbounded
+//! input, all-or-nothing sets (a folder in the way, a kill during the renames, concurrent
+//! writers), temporary files, wrong or silent acceptance, unclear messages, missing folders.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use common::*;
+
+const PRESET: &str = "erythrolamprus-miliaris";
+const BIN: &str = env!("CARGO_BIN_EXE_snakeskin");
+
+/// Runs the binary with its stdout on a pipe whose reader is already closed.
+fn with_closed_stdout(args: &[&str]) -> std::process::Output {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let child = Command::new(BIN).args(args).stdout(writer).stderr(Stdio::piped()).spawn().unwrap();
+    child.wait_with_output().unwrap()
+}
+
+fn ended_quietly(out: &std::process::Output) -> bool {
+    use std::os::unix::process::ExitStatusExt;
+    let quiet_status = out.status.code() == Some(0) || out.status.signal() == Some(libc::SIGPIPE);
+    quiet_status && !stderr(out).contains("panicked")
+}
+
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    for args in [vec!["presets", "list"], vec!["presets", "show", PRESET]] {
+        let out = with_closed_stdout(&args);
+        assert!(ended_quietly(&out), "{args:?}: {:?} {}", out.status, stderr(&out));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = with_closed_stdout(&["generate", PRESET, "-o", dir.path().to_str().unwrap(), "--size", "32"]);
+    assert!(ended_quietly(&out), "generate: {:?} {}", out.status, stderr(&out));
+}
+
+#[test]
+fn a_set_larger_than_memory_is_refused_before_it_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("out");
+    let out = snakeskin_env(
+        &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "8192"],
+        &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1024")],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("--size 8192 needs about") && err.contains("1024 MiB are available"), "{err}");
+    assert!(!o.exists(), "nothing may be written");
+
+    // The same set fits without the cap, and --stats reports the estimate.
+    let out = snakeskin(&["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "64", "--stats"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("memory estimate before the run:"), "{}", stderr(&out));
+}
+
+#[test]
+fn the_memory_estimate_bounds_the_evaluator_and_knows_every_channel_count() {
+    use snakeskin::graph::{estimate_peak_bytes, evaluate};
+    use snakeskin::maps::{BuildOptions, build_graph};
+    use snakeskin::material::MapKind;
+    for (name, _) in snakeskin::preset::library::all() {
+        let loaded = snakeskin::preset::load(name, &[], None).unwrap();
+        let graph = build_graph(&loaded.preset, BuildOptions::default());
+        let evaluation = evaluate(&graph, &MapKind::ALL, 48, 48, &|_, _| {});
+        // Every node's output has the channels the estimate assumes.
+        for node_stats in &evaluation.stats.nodes {
+            let node = graph.nodes().iter().find(|n| n.name == node_stats.name).unwrap();
+            let inputs: Vec<usize> = node
+                .inputs
+                .iter()
+                .map(|i| evaluation.stats.get(&graph.node(*i).name).unwrap().bytes / (48 * 48 * 4))
+                .collect();
+            assert_eq!(node.op.output_channels(&inputs) * 48 * 48 * 4, node_stats.bytes, "{name}: {}", node.name);
+        }
+        let estimate = estimate_peak_bytes(&graph, &MapKind::ALL, 48, 48);
+        assert!(estimate >= evaluation.stats.peak_bytes as u64, "{name}: {estimate} < {}", evaluation.stats.peak_bytes);
+    }
+}
+
+#[test]
+fn an_oversized_benchmark_grid_is_refused() {
+    let out = snakeskin(&["bench", "irid", "--d-step-nm", "1e-9"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--d-step-nm"), "{}", stderr(&out));
+    let out = snakeskin(&["bench", "irid", "--d-step-nm", "0.5", "--angle-step-deg", "0.5"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("grid points"), "{}", stderr(&out));
+}
+
+#[test]
+fn devices_fifos_and_huge_files_are_not_read() {
+    let out = snakeskin(&["generate", "/dev/zero", "-o", "/tmp/never"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("it is a device"), "{}", stderr(&out));
+
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("preset.toml");
+    let c_path = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c_path.as_ptr(), 0o600) }, 0);
+    // Without the fix this blocks forever waiting for a writer.
+    let out = snakeskin(&["generate", fifo.to_str().unwrap(), "-o", dir.path().to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("it is a FIFO"), "{}", stderr(&out));
+
+    let huge = dir.path().join("huge.toml");
+    let mut text = String::from("seed = 1\n");
+    text.push_str(&"# padding padding padding padding padding padding padding padding\n".repeat(20_000));
+    std::fs::write(&huge, text).unwrap();
+    let out = snakeskin(&["generate", huge.to_str().unwrap(), "-o", dir.path().to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("presets are limited to 1048576 bytes"), "{}", stderr(&out));
+}
+
+#[test]
+fn counts_are_capped_with_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let layers = "[[pattern]]\nkind = \"spots\"\ncolor = \"#102030\"\n".repeat(10_000);
+    let path = write_preset(dir.path(), "layers.toml", &layers);
+    let out = snakeskin(&["generate", &path, "-o", dir.path().to_str().unwrap(), "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("key `pattern` has 10000 layers; at most 16"), "{}", stderr(&out));
+
+    let colours = vec!["\"#102030\""; 60_000].join(", ");
+    let path = write_preset(dir.path(), "rings.toml", &format!("[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\ncolors = [{colours}]\n"));
+    let out = snakeskin(&["generate", &path, "-o", dir.path().to_str().unwrap(), "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("pattern.0.colors` has 60000 entries; at most 32"), "{}", stderr(&out));
+}
+
+fn generate_into(dir: &Path, seed: &str, env: &[(&str, &str)]) -> std::process::Output {
+    snakeskin_env(&["generate", PRESET, "-o", dir.to_str().unwrap(), "--size", "48", "--seed", seed], env)
+}
+
+fn manifest_of(dir: &Path) -> std::path::PathBuf {
+    dir.join(format!("{PRESET}.material.json"))
+}
+
+#[test]
+fn a_folder_in_the_way_of_the_manifest_leaves_the_earlier_set_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let before = snapshot(dir.path());
+    std::fs::remove_file(manifest_of(dir.path())).unwrap();
+    std::fs::create_dir(manifest_of(dir.path())).unwrap();
+    let out = generate_into(dir.path(), "2", &[]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("a folder is in the way"), "{err}");
+    // No map was replaced: the maps of seed 1 are still there, byte for byte.
+    for (path, bytes) in &before {
+        if path.extension().is_some_and(|e| e == "png") {
+            assert_eq!(&std::fs::read(path).unwrap(), bytes, "{} changed", path.display());
+        }
+    }
+    // No temporary is left behind.
+    let names: Vec<String> =
+        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(names.iter().all(|n| !n.contains("tmp")), "{names:?}");
+}
+
+#[test]
+fn a_kill_during_the_renames_never_leaves_a_manifest_over_mixed_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
+    for renames_before_kill in [0, 2, 5] {
+        let n = renames_before_kill.to_string();
+        let out = generate_into(dir.path(), "7", &[("SNAKESKIN_TEST_ABORT_AFTER_RENAMES", &n)]);
+        assert!(!out.status.success(), "the fault hook did not fire");
+        // Either no manifest (an incomplete set, refused by readers) or a manifest whose
+        // maps verify — never an old manifest over new maps.
+        match snakeskin::export::verify_set(&manifest_of(dir.path())) {
+            Ok(set) => panic!("after {n} renames a manifest claims a complete set: {set:?}"),
+            Err(e) => assert!(e.to_string().contains("incomplete"), "{e}"),
+        }
+    }
+    // The next run cleans up the killed runs' temporaries and writes a whole set.
+    assert!(generate_into(dir.path(), "7", &[]).status.success());
+    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
+    let leftovers: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn a_concurrent_writer_gets_a_clear_error_not_a_mix() {
+    let dir = tempfile::tempdir().unwrap();
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let before = snapshot(dir.path());
+    // Another run holds the set.
+    let lock = std::fs::File::create(dir.path().join(format!(".{PRESET}.lock"))).unwrap();
+    lock.try_lock().unwrap();
+    let out = generate_into(dir.path(), "2", &[]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("another snakeskin run is writing the set"), "{}", stderr(&out));
+    let after: Vec<_> = snapshot(dir.path()).into_iter().filter(|(p, _)| !p.ends_with(format!(".{PRESET}.lock"))).collect();
+    assert_eq!(after, before.into_iter().collect::<Vec<_>>());
+    drop(lock);
+
+    // Four runs at once, four seeds: whatever interleaving, the set on disk verifies, and
+    // its manifest's seed is the seed its maps were made with.
+    let children: Vec<_> = (10..14)
+        .map(|seed| {
+            Command::new(BIN)
+                .args(["generate", PRESET, "-o", dir.path().to_str().unwrap(), "--size", "96"])
+                .args(["--seed", &seed.to_string()])
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    let mut succeeded = 0;
+    for child in children {
+        let out = child.wait_with_output().unwrap();
+        if out.status.success() {
+            succeeded += 1;
+        } else {
+            assert!(stderr(&out).contains("another snakeskin run"), "{}", stderr(&out));
+        }
+    }
+    assert!(succeeded >= 1);
+    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
+    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(manifest_of(dir.path())).unwrap()).unwrap();
+    let seed = manifest["seed"].as_u64().unwrap().to_string();
+    let solo = tempfile::tempdir().unwrap();
+    assert!(
+        snakeskin(&["generate", PRESET, "-o", solo.path().to_str().unwrap(), "--size", "96", "--seed", &seed])
+            .status
+            .success()
+    );
+    let color = format!("{PRESET}_color.png");
+    assert_eq!(std::fs::read(dir.path().join(&color)).unwrap(), std::fs::read(solo.path().join(&color)).unwrap());
+}
+
+#[test]
+fn a_planted_symlink_at_a_temporary_name_is_not_followed() {
+    let dir = tempfile::tempdir().unwrap();
+    let victim = dir.path().join("victim.txt");
+    std::fs::write(&victim, b"precious").unwrap();
+    // The old scheme's predictable name: `.NAME.tmp-PID`.
+    let target = dir.path().join("chart.png");
+    std::os::unix::fs::symlink(&victim, dir.path().join(format!(".chart.png.tmp-{}", std::process::id()))).unwrap();
+    snakeskin::export::write_file_atomically(&target, b"new chart".to_vec()).unwrap();
+    assert_eq!(std::fs::read(&victim).unwrap(), b"precious");
+    assert_eq!(std::fs::read(&target).unwrap(), b"new chart");
+    // A symlink planted at the set's lock file is refused, not followed.
+    let sets = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink(&victim, sets.path().join(format!(".{PRESET}.lock"))).unwrap();
+    let out = generate_into(sets.path(), "1", &[]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert_eq!(std::fs::read(&victim).unwrap(), b"precious");
+}
+
+#[test]
+fn stale_temporaries_of_the_set_are_removed_and_others_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let stale = dir.path().join(format!(".{PRESET}_color.png.Xy12Ab.snakeskin-tmp"));
+    let other = dir.path().join(".another-snake_color.png.Zz99Qq.snakeskin-tmp");
+    std::fs::write(&stale, vec![0u8; 4096]).unwrap();
+    std::fs::write(&other, b"not ours").unwrap();
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    assert!(!stale.exists(), "a stale temporary of this set survived");
+    assert!(other.exists(), "another set's temporary was removed");
+}
+
+#[test]
+fn seeds_use_the_whole_u64_range() {
+    let dir = tempfile::tempdir().unwrap();
+    for seed in [(1u64 << 63).to_string(), u64::MAX.to_string()] {
+        let out = generate_into(dir.path(), &seed, &[]);
+        assert!(out.status.success(), "--seed {seed}: {}", stderr(&out));
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(manifest_of(dir.path())).unwrap()).unwrap();
+        assert_eq!(manifest["seed"].as_u64().unwrap().to_string(), seed);
+        assert_eq!(manifest["preset_hash"].as_str().unwrap().len(), 16);
+    }
+}
+
+#[test]
+fn a_set_value_cannot_smuggle_in_more_toml() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().to_str().unwrap();
+    for value in ["scales.rows=20\nseed = 5", "scales.rows=20\r"] {
+        let out = snakeskin(&["generate", PRESET, "-o", o, "--size", "16", "--set", value]);
+        assert_eq!(out.status.code(), Some(2), "{value:?}");
+        assert!(stderr(&out).contains("one line"), "{}", stderr(&out));
+    }
+    // Through the library (the window's live reload passes overrides too).
+    let source = snakeskin::preset::read_source(PRESET).unwrap();
+    let err = snakeskin::preset::parse(&source, &[("scales.rows".into(), "20\nseed = 5".into())]).unwrap_err();
+    assert!(err.to_string().contains("one line"), "{err}");
+}
+
+#[test]
+fn brdf_eval_refuses_what_it_used_to_clamp() {
+    let base = ["brdf", "eval", "--wi", "0,0.3,1", "--wo", "0.2,0,1"];
+    for (flag, value) in [
+        ("--thickness-nm", "NaN"),
+        ("--thickness-nm", "-5"),
+        ("--absorption", "-1"),
+        ("--absorption", "nan,0,0"),
+        ("--albedo", "1e308"),
+        ("--albedo", "0.5,2,0.5"),
+        ("--roughness", "inf"),
+        ("--wi", "0,0,0"),
+        ("--wo", "0,0,0"),
+    ] {
+        let pair = format!("{flag}={value}");
+        let mut args: Vec<&str> = base.to_vec();
+        if let Some(i) = args.iter().position(|a| *a == flag) {
+            args.drain(i..i + 2);
+        }
+        args.push(&pair);
+        let out = snakeskin(&args);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}");
+        assert!(stderr(&out).contains(flag), "{flag} {value}: {}", stderr(&out));
+    }
+    assert!(snakeskin(&base).status.success());
+}
+
+#[test]
+fn messages_say_each_thing_once_and_name_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().to_str().unwrap();
+
+    // An OS error once, not twice (the error and its source used to be printed both).
+    let missing = dir.path().join("missing.toml");
+    let out = snakeskin(&["generate", missing.to_str().unwrap(), "-o", o, "--size", "16"]);
+    let err = stderr(&out);
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+
+    // -o naming a file.
+    let file = dir.path().join("file.txt");
+    std::fs::write(&file, b"x").unwrap();
+    let out = snakeskin(&["generate", PRESET, "-o", file.to_str().unwrap(), "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("exists and is not a folder"), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("File exists"), "{}", stderr(&out));
+
+    // Duplicate keys are named.
+    let path = write_preset(dir.path(), "dup.toml", "[optics]\nfilm_ior = 1.5\nfilm_ior = 1.6\n");
+    let out = snakeskin(&["generate", &path, "-o", o, "--size", "16"]);
+    assert!(stderr(&out).contains("dup.toml:3:1: duplicate key `film_ior`"), "{}", stderr(&out));
+
+    // A layer that does not exist.
+    let out = snakeskin(&["generate", PRESET, "-o", o, "--size", "16", "--set", "pattern.999.kind=spots"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("there is no pattern layer 999"), "{}", stderr(&out));
+
+    // --batch naming a folder says which.
+    let out = snakeskin(&["brdf", "color", "--batch", o]);
+    assert_ne!(out.status.code(), Some(0));
+    assert!(stderr(&out).contains(&format!("--batch {o}")), "{}", stderr(&out));
+
+    // Terminal escapes from a preset are shown escaped.
+    // TOML's \u001b escape puts a real ESC into the key, which the unknown-key error echoes.
+    let path = write_preset(dir.path(), "ansi.toml", "[scales]\n\"\\u001b[31mrows\" = 3\n");
+    let out = snakeskin(&["generate", &path, "-o", o, "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!stderr(&out).contains('\u{1b}'), "raw escape in {:?}", stderr(&out));
+    assert!(stderr(&out).contains("\\u{1b}"), "{}", stderr(&out));
+}
+
+#[test]
+fn missing_output_folders_are_created_with_a_note() {
+    let dir = tempfile::tempdir().unwrap();
+    let nested = dir.path().join("a/b");
+    let out = snakeskin(&["generate", PRESET, "-o", nested.to_str().unwrap(), "--size", "16"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains(&format!("note: created folder {}", nested.display())), "{}", stderr(&out));
+    let chart = dir.path().join("c/d/chart.png");
+    let out = snakeskin(&["brdf", "chart", "-o", chart.to_str().unwrap(), "--width", "8", "--height", "4"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("note: created folder"), "{}", stderr(&out));
+    assert!(chart.exists());
+}
+
+#[test]
+fn preview_reference_into_a_missing_folder_and_no_loader_noise() {
+    if gpu_or_skip("preview_reference_into_a_missing_folder_and_no_loader_noise").is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("img/snake.png");
+    let heat = dir.path().join("heat/maps/heat.png");
+    let out = Command::new(BIN)
+        .args(["preview", PRESET, "--out", image.to_str().unwrap(), "--reference", heat.to_str().unwrap()])
+        .args(["--size", "48x32", "--map-size", "64"])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(image.exists() && heat.exists());
+    assert!(err.contains(&format!("note: created folder {}", heat.parent().unwrap().display())), "{err}");
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+}
