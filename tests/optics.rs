@@ -329,12 +329,29 @@ mod commands {
 
     #[test]
     fn every_method_is_accepted_by_brdf_color() {
+        // Each method's answer is that method's colour (a dispatch that ignored --method
+        // would give the spectral answer for all five), and the methods do differ.
+        use snakeskin::optics::methods::Method;
+        let mut answers: Vec<[f64; 3]> = Vec::new();
         for method in ["spectral", "rgb3", "spectral-16", "gaussian-fit", "lut"] {
             let (code, out, err) =
                 run(&["brdf", "color", "--thickness-nm", "300", "--angle-deg", "20", "--method", method]);
             assert_eq!(code, 0, "{method}: {err}");
-            assert!(out.contains("\"rgb\""));
+            let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+            let rgb: Vec<f64> = v["rgb"].as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect();
+            let expected = snakeskin::optics::query::film_colour(
+                Method::parse(method).unwrap(),
+                snakeskin::optics::film::Stack::THESIS,
+                300.0,
+                20f64.to_radians().cos(),
+            );
+            for c in 0..3 {
+                assert!((rgb[c] - expected[c]).abs() < 1e-12, "{method}: {rgb:?} vs {expected:?}");
+            }
+            answers.push([rgb[0], rgb[1], rgb[2]]);
         }
+        let spread = |a: [f64; 3], b: [f64; 3]| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f64::max);
+        assert!(spread(answers[0], answers[1]) > 1e-3, "rgb3 answered like the reference: {answers:?}");
         let (code, _, err) = run(&["brdf", "color", "--thickness-nm", "300", "--angle-deg", "20", "--method", "rgb4"]);
         assert_eq!(code, 2);
         assert!(err.contains("gaussian-fit") && err.contains("lut"), "{err}");

@@ -284,9 +284,23 @@ fn live_reload_re_evaluates_only_the_changed_nodes() {
     for map in MapKind::ALL {
         assert_eq!(maps[&map], fresh.maps[&map], "{map} differs from a fresh evaluation");
     }
-    // Only colour nodes ran: the height map's nodes were all reused.
-    let (_, third) = cache.evaluate(&graph, &MapKind::ALL, size, size);
-    assert_eq!(third.evaluated, 0);
+}
+
+#[test]
+fn a_colour_edit_re_evaluates_only_colour_nodes() {
+    // After a belly colour edit, the other four maps come entirely from the cache of the
+    // unedited preset: not one of their nodes runs. Negative control: a scale edit does run
+    // nodes of those maps.
+    let others = [MapKind::Height, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence];
+    let size = 64;
+    let ran_for_others = |edit: (&str, &str)| {
+        let mut cache = NodeCache::new();
+        cache.evaluate(&build_graph(&load(&[]).preset, BuildOptions::default()), &MapKind::ALL, size, size);
+        let edited = build_graph(&load(&[edit]).preset, BuildOptions::default());
+        cache.evaluate(&edited, &others, size, size).1.evaluated
+    };
+    assert_eq!(ran_for_others(("belly.color", "\"#203040\"")), 0, "a colour edit re-ran non-colour nodes");
+    assert!(ran_for_others(("scales.rows", "23")) > 0, "negative control: a scale edit must re-run them");
 }
 
 #[test]
