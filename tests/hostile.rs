@@ -125,7 +125,11 @@ fn counts_are_capped_with_a_clear_error() {
     assert!(stderr(&out).contains("key `pattern` has 10000 layers; at most 16"), "{}", stderr(&out));
 
     let colours = vec!["\"#102030\""; 60_000].join(", ");
-    let path = write_preset(dir.path(), "rings.toml", &format!("[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\ncolors = [{colours}]\n"));
+    let path = write_preset(
+        dir.path(),
+        "rings.toml",
+        &format!("[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\ncolors = [{colours}]\n"),
+    );
     let out = snakeskin(&["generate", &path, "-o", dir.path().to_str().unwrap(), "--size", "16"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("pattern.0.colors` has 60000 entries; at most 32"), "{}", stderr(&out));
@@ -200,7 +204,8 @@ fn a_concurrent_writer_gets_a_clear_error_not_a_mix() {
     let out = generate_into(dir.path(), "2", &[]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("another snakeskin run is writing the set"), "{}", stderr(&out));
-    let after: Vec<_> = snapshot(dir.path()).into_iter().filter(|(p, _)| !p.ends_with(format!(".{PRESET}.lock"))).collect();
+    let after: Vec<_> =
+        snapshot(dir.path()).into_iter().filter(|(p, _)| !p.ends_with(format!(".{PRESET}.lock"))).collect();
     assert_eq!(after, before.into_iter().collect::<Vec<_>>());
     drop(lock);
 

@@ -56,9 +56,8 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
         let name = name.to_string_lossy();
         let ours = name.ends_with(TMP_SUFFIX)
             && file_names.iter().any(|f| name.strip_prefix('.').is_some_and(|rest| rest.starts_with(&format!("{f}."))));
-        let old_enough = || {
-            entry.metadata().and_then(|m| m.modified()).is_ok_and(|t| t.elapsed().is_ok_and(|age| age >= min_age))
-        };
+        let old_enough =
+            || entry.metadata().and_then(|m| m.modified()).is_ok_and(|t| t.elapsed().is_ok_and(|age| age >= min_age));
         if ours && entry.file_type().is_ok_and(|t| t.is_file()) && old_enough() {
             let _ = fs::remove_file(entry.path());
         }
@@ -208,9 +207,7 @@ fn sync_folder(dir: &Path) {
 /// run at an exact point. Release builds ignore it.
 fn fault_point(renamed: usize) {
     #[cfg(debug_assertions)]
-    if std::env::var("SNAKESKIN_TEST_ABORT_AFTER_RENAMES").ok().and_then(|v| v.parse::<usize>().ok())
-        == Some(renamed)
-    {
+    if std::env::var("SNAKESKIN_TEST_ABORT_AFTER_RENAMES").ok().and_then(|v| v.parse::<usize>().ok()) == Some(renamed) {
         std::process::abort();
     }
     #[cfg(not(debug_assertions))]

@@ -82,7 +82,13 @@ impl GraphBuilder {
     /// inputs is a bug in a graph builder, caught here rather than during evaluation.
     pub fn add(&mut self, name: impl Into<String>, op: Op, inputs: &[NodeId]) -> NodeId {
         let name = name.into();
-        assert!(op.arity().contains(&inputs.len()), "node {name}: {} takes {:?} inputs, got {}", op.label(), op.arity(), inputs.len());
+        assert!(
+            op.arity().contains(&inputs.len()),
+            "node {name}: {} takes {:?} inputs, got {}",
+            op.label(),
+            op.arity(),
+            inputs.len()
+        );
         debug_assert!(self.graph.nodes.iter().all(|n| n.name != name), "duplicate node name {name}");
         debug_assert!(inputs.iter().all(|i| i.0 < self.graph.nodes.len()));
         self.graph.nodes.push(Node { name, op, inputs: inputs.to_vec() });

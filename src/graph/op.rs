@@ -50,9 +50,12 @@ impl Op {
     /// How many inputs the operation takes (checked when a node is added).
     pub fn arity(&self) -> std::ops::RangeInclusive<usize> {
         match self {
-            Op::Noise(_) | Op::Scales(_) | Op::Bands { .. } | Op::Blotches(_) | Op::BellyChecker { .. } | Op::Spots(_) => {
-                0..=0
-            }
+            Op::Noise(_)
+            | Op::Scales(_)
+            | Op::Bands { .. }
+            | Op::Blotches(_)
+            | Op::BellyChecker { .. }
+            | Op::Spots(_) => 0..=0,
             Op::Channel { .. }
             | Op::Levels { .. }
             | Op::Threshold { .. }

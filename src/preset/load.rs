@@ -81,9 +81,8 @@ fn read_bounded(path: &Path) -> Result<String, PresetError> {
     if bytes.len() as u64 > MAX_PRESET_BYTES {
         return Err(PresetError::TooLarge { path: path.into(), bytes: bytes.len() as u64, limit: MAX_PRESET_BYTES });
     }
-    String::from_utf8(bytes).map_err(|e| {
-        read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 text ({e})")))
-    })
+    String::from_utf8(bytes)
+        .map_err(|e| read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 text ({e})"))))
 }
 
 fn file_kind(meta: &std::fs::Metadata) -> &'static str {

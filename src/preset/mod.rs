@@ -8,5 +8,7 @@ pub mod schema;
 pub mod validate;
 
 pub use error::{LocatedProblem, Location, PresetError};
-pub use load::{LoadedPreset, MAX_PRESET_BYTES, PresetSource, edit_distance, load, parse, parse_with_seed, read_source};
+pub use load::{
+    LoadedPreset, MAX_PRESET_BYTES, PresetSource, edit_distance, load, parse, parse_with_seed, read_source,
+};
 pub use schema::Preset;

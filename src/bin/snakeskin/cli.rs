@@ -209,7 +209,9 @@ pub enum PresetsCommand {
 
 fn parse_key_value(arg: &str) -> Result<(String, String), String> {
     if arg.chars().any(char::is_control) {
-        return Err("KEY=VALUE must be one line without control characters (a newline would add TOML of its own)".into());
+        return Err(
+            "KEY=VALUE must be one line without control characters (a newline would add TOML of its own)".into()
+        );
     }
     let (key, value) = arg.split_once('=').ok_or_else(|| format!("expected KEY=VALUE, got {arg:?}"))?;
     if key.trim().is_empty() {
@@ -471,9 +473,11 @@ fn parse_angle_step_deg(text: &str) -> Result<f64, String> {
 /// One value for all three channels, or r,g,b; each inside `range`.
 fn vec3_or_scalar(text: &str, range: (f64, f64)) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = text.split(',').collect();
-    let values: Vec<f64> = parts.iter().map(|p| bounded(p, range)).collect::<Result<_, _>>().map_err(|_| {
-        format!("expected one number or r,g,b, each a finite number in [{}, {}]", range.0, range.1)
-    })?;
+    let values: Vec<f64> = parts
+        .iter()
+        .map(|p| bounded(p, range))
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected one number or r,g,b, each a finite number in [{}, {}]", range.0, range.1))?;
     match values.as_slice() {
         [v] => Ok([*v; 3]),
         [r, g, b] => Ok([*r, *g, *b]),
