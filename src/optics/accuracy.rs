@@ -145,3 +145,15 @@ pub fn bench_irid(d_step_nm: f64, angle_step_deg: f64, methods: &[Method]) -> Ve
     let reference_lab: Vec<[f64; 3]> = reference_colours(&samples).into_iter().map(linear_srgb_to_lab).collect();
     methods.iter().map(|m| measure(&Prepared::new(*m), &samples, &reference_lab)).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_points_counts_the_grid_without_building_it() {
+        for (d, a) in [(10.0, 1.0), (50.0, 11.0), (7.0, 3.0), (0.5, 89.0), (2000.0, 0.7), (3.3, 2.9)] {
+            assert_eq!(grid_points(d, a), grid(d, a).len(), "steps {d} nm, {a}°");
+        }
+    }
+}
