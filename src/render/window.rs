@@ -39,6 +39,9 @@ pub struct WindowOptions {
     /// Render this many frames, then exit (tests, benchmarks).
     pub frames: Option<u32>,
     pub settings: FrameSettings,
+    /// Receives status lines (first frame, each reload or failed reload) for the user: the
+    /// window may be behind others, and tests read them. The library itself prints nothing.
+    pub report: Box<dyn Fn(&str)>,
 }
 
 #[derive(Debug, Clone)]
@@ -312,8 +315,8 @@ impl App {
                 }
                 Err(error) => self.status = format!("reload failed, keeping the last good maps: {error}"),
             }
-            // Also on stderr: the window may be behind others, and tests read it.
-            eprintln!("preview: {}", self.status);
+            // Also to the caller: the window may be behind others, and tests read it.
+            (self.options.report)(&self.status);
         }
         while let Ok((stack, bands, lut)) = self.lut_results.try_recv() {
             let optics = LayerOptics { stack, ..gfx.material.optics };
@@ -413,7 +416,7 @@ impl App {
         }
         self.frames_done += 1;
         if self.frames_done == 1 {
-            eprintln!("preview: first frame presented");
+            (self.options.report)("first frame presented");
         }
         if self.options.frames.is_some_and(|n| self.frames_done >= n) {
             // Wait for the last frame so the reported times cover finished work.

@@ -66,6 +66,7 @@ fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
         size: (args.size.width, args.size.height),
         frames: args.frames,
         settings,
+        report: Box::new(|status| eprintln!("preview: {}", printable(status))),
     };
     let report = snakeskin::render::window::run(options)?;
     if let Some(frames) = args.frames {
