@@ -89,12 +89,13 @@ impl Plan {
             quantized.push(export::quantize(map, &image));
         });
         quantized.sort_by_key(|q| q.map);
+        let kinds: Vec<MapKind> = quantized.iter().map(|q| q.map).collect();
 
         let encode_start = Instant::now();
         let files = export::encode_all(&loaded.name, &quantized)?;
         drop(quantized);
         let entries: Vec<(MapKind, String, String)> =
-            request.maps.iter().zip(&files).map(|(m, (name, bytes))| (*m, name.clone(), sha256_hex(bytes))).collect();
+            kinds.iter().zip(&files).map(|(m, (name, bytes))| (*m, name.clone(), sha256_hex(bytes))).collect();
         let manifest = export::manifest(&loaded, size, &entries, request.options.normal_convention);
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
         let manifest_name = export::manifest_file_name(&loaded.name);

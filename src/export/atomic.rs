@@ -38,6 +38,9 @@ use super::ExportError;
 /// The suffix of every temporary this module creates.
 const TMP_SUFFIX: &str = ".snakeskin-tmp";
 
+/// Random characters in a temporary's name (between `.FILE.` and the suffix).
+const RANDOM_CHARS: usize = 6;
+
 fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
     move |source| ExportError::Io { path: path.into(), source }
 }
@@ -54,10 +57,22 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
     for entry in entries.flatten() {
         let name = entry.file_name();
         let name = name.to_string_lossy();
-        let ours = name.ends_with(TMP_SUFFIX)
-            && file_names.iter().any(|f| name.strip_prefix('.').is_some_and(|rest| rest.starts_with(&format!("{f}."))));
-        let old_enough =
-            || entry.metadata().and_then(|m| m.modified()).is_ok_and(|t| t.elapsed().is_ok_and(|age| age >= min_age));
+        // Exactly `.FILE.` + tempfile's random part + the suffix.
+        let ours = file_names.iter().any(|f| {
+            let random = name
+                .strip_prefix('.')
+                .and_then(|r| r.strip_prefix(*f))
+                .and_then(|r| r.strip_prefix('.'))
+                .and_then(|r| r.strip_suffix(TMP_SUFFIX));
+            random.is_some_and(|r| r.len() == RANDOM_CHARS && r.chars().all(|c| c.is_ascii_alphanumeric()))
+        });
+        let old_enough = || {
+            min_age.is_zero()
+                || entry
+                    .metadata()
+                    .and_then(|m| m.modified())
+                    .is_ok_and(|t| t.elapsed().is_ok_and(|age| age >= min_age))
+        };
         if ours && entry.file_type().is_ok_and(|t| t.is_file()) && old_enough() {
             let _ = fs::remove_file(entry.path());
         }
@@ -67,11 +82,14 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
 /// Writes `bytes` to a new exclusive temporary beside `target` and returns it (deleted on
 /// drop unless persisted).
 fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedTempFile, ExportError> {
-    let mut tmp = tempfile::Builder::new()
-        .prefix(&format!(".{target_name}."))
-        .suffix(TMP_SUFFIX)
-        .tempfile_in(dir)
-        .map_err(io_error(dir))?;
+    let prefix = format!(".{target_name}.");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(TMP_SUFFIX).rand_bytes(RANDOM_CHARS);
+    // tempfile creates 0600 files; outputs are ordinary files (0666 less the umask, as
+    // `File::create` makes them), readable by whoever reads the user's other files.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder.tempfile_in(dir).map_err(io_error(dir))?;
     tmp.write_all(bytes).and_then(|_| tmp.as_file().sync_all()).map_err(io_error(tmp.path()))?;
     Ok(tmp)
 }
@@ -202,15 +220,17 @@ fn sync_folder(dir: &Path) {
     }
 }
 
-/// Test hook (debug builds only): `SNAKESKIN_TEST_ABORT_AFTER_RENAMES=N` aborts the process
-/// after N renames of a set, as a SIGKILL would, so the kill-during-rename test can stop a
-/// run at an exact point. Release builds ignore it.
+/// Test hook (debug builds only): `SNAKESKIN_TEST_ABORT_AFTER_RENAMES=N` ends the process
+/// after N renames of a set with no cleanup at all (`_exit`, as a SIGKILL would: no
+/// destructor runs, temporaries and the lock file stay), so the kill-during-rename test can
+/// stop a run at an exact point. Release builds ignore it.
 fn fault_point(renamed: usize) {
-    #[cfg(debug_assertions)]
+    #[cfg(all(debug_assertions, unix))]
     if std::env::var("SNAKESKIN_TEST_ABORT_AFTER_RENAMES").ok().and_then(|v| v.parse::<usize>().ok()) == Some(renamed) {
-        std::process::abort();
+        // SAFETY: `_exit` ends the process at once; nothing after it runs.
+        unsafe { libc::_exit(137) };
     }
-    #[cfg(not(debug_assertions))]
+    #[cfg(not(all(debug_assertions, unix)))]
     let _ = renamed;
 }
 

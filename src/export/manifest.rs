@@ -112,7 +112,10 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
     let json: serde_json::Value =
         serde_json::from_slice(&text).map_err(|e| problem(format!("the manifest is not valid JSON: {e}")))?;
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
-    let maps = json["maps"].as_array().ok_or_else(|| problem("the manifest lists no maps".into()))?;
+    let maps = json["maps"]
+        .as_array()
+        .filter(|m| !m.is_empty())
+        .ok_or_else(|| problem("the manifest lists no maps".into()))?;
     let mut files = Vec::new();
     for entry in maps {
         let (Some(map), Some(file), Some(expected)) =
@@ -122,6 +125,9 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
         };
         if file.contains(['/', '\\']) || file.starts_with('.') {
             return Err(problem(format!("map file {file:?} is not a plain file name")));
+        }
+        if files.iter().any(|(m, p): &(String, PathBuf)| m == map || p.ends_with(file)) {
+            return Err(problem(format!("the {map} map or its file {file:?} is listed twice")));
         }
         let path = dir.join(file);
         let bytes = std::fs::read(&path).map_err(|e| problem(format!("{map} map {}: {e}", path.display())))?;

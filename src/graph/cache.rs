@@ -1,17 +1,16 @@
-//! Incremental re-evaluation for live reload: each node's output is cached under a key that
-//! hashes its operation (with every parameter), its inputs' keys and the size, so after a
-//! preset edit only the nodes whose parameters changed — and the nodes downstream of them —
-//! run again. A one-shot `generate` does not need this and uses the frugal scheduler in
-//! `eval.rs`, which frees buffers early; the cache keeps every node of the current graph alive
-//! instead (fine at preview resolution: a 512² preview holds a few tens of MiB).
+//! The node cache for live reload: node outputs kept under a key that hashes the operation
+//! (with every parameter, `op::hash_op`), its inputs' keys and the size, so after a preset
+//! edit only the nodes whose parameters changed — and the nodes downstream of them — run
+//! again. Evaluation itself is the one evaluator in `eval.rs` with `CachePolicy::Keep`; a
+//! one-shot `generate` uses `CachePolicy::None`, which frees buffers early, where the cache
+//! keeps every node alive (fine at preview resolution: a 512² preview holds tens of MiB).
 
-use std::collections::hash_map::DefaultHasher;
 use std::collections::{BTreeMap, HashMap};
-use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
 use super::Graph;
-use crate::maps::MapKind;
+use super::eval::{CachePolicy, evaluate_with};
+use crate::material::MapKind;
 use crate::ops::Image;
 
 #[derive(Debug, Default)]
@@ -22,7 +21,10 @@ pub struct NodeCache {
 /// How much of the graph an evaluation had to run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct CacheStats {
+    /// Nodes that ran.
     pub evaluated: usize,
+    /// Nodes the maps reach whose results were not recomputed (cached, or needed only by
+    /// cached nodes).
     pub reused: usize,
 }
 
@@ -31,8 +33,16 @@ impl NodeCache {
         NodeCache::default()
     }
 
+    pub(crate) fn get(&self, key: u64) -> Option<Arc<Image>> {
+        self.entries.get(&key).cloned()
+    }
+
+    pub(crate) fn replace(&mut self, entries: Vec<(u64, Arc<Image>)>) {
+        self.entries = entries.into_iter().collect();
+    }
+
     /// Evaluates `maps`, reusing every node whose key is cached; afterwards the cache holds
-    /// exactly the nodes of this evaluation.
+    /// the nodes this evaluation ran or used.
     pub fn evaluate(
         &mut self,
         graph: &Graph,
@@ -40,37 +50,18 @@ impl NodeCache {
         width: usize,
         height: usize,
     ) -> (BTreeMap<MapKind, Image>, CacheStats) {
-        let mut keys: HashMap<usize, u64> = HashMap::new();
-        let mut fresh: HashMap<u64, Arc<Image>> = HashMap::new();
-        let mut stats = CacheStats::default();
-        for id in graph.reachable(maps) {
-            let node = graph.node(id);
-            let mut hasher = DefaultHasher::new();
-            format!("{:?}", node.op).hash(&mut hasher);
-            (width, height).hash(&mut hasher);
-            for input in &node.inputs {
-                keys[&input.0].hash(&mut hasher);
-            }
-            let key = hasher.finish();
-            keys.insert(id.0, key);
-            if fresh.contains_key(&key) {
-                continue;
-            }
-            if let Some(image) = self.entries.get(&key) {
-                fresh.insert(key, image.clone());
-                stats.reused += 1;
-                continue;
-            }
-            let inputs: Vec<Arc<Image>> = node.inputs.iter().map(|i| fresh[&keys[&i.0]].clone()).collect();
-            let rest: Vec<&Image> = inputs.iter().skip(1).map(|i| i.as_ref()).collect();
-            let first = inputs.first().map(|i| std::borrow::Cow::Borrowed(i.as_ref()));
-            let image = node.op.eval(first, &rest, width, height);
-            fresh.insert(key, Arc::new(image));
-            stats.evaluated += 1;
-        }
-        let outputs =
-            maps.iter().filter_map(|m| graph.output(*m).map(|id| (*m, (*fresh[&keys[&id.0]]).clone()))).collect();
-        self.entries = fresh;
+        let mut outputs = BTreeMap::new();
+        let (_, stats) = evaluate_with(
+            graph,
+            maps,
+            width,
+            height,
+            &|_, _| {},
+            &mut |map, image| {
+                outputs.insert(map, image);
+            },
+            CachePolicy::Keep(self),
+        );
         (outputs, stats)
     }
 }

@@ -20,6 +20,8 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
+use super::cache::{CacheStats, NodeCache};
+use super::op::hash_op;
 use super::{Graph, NodeId};
 use crate::material::MapKind;
 use crate::ops::Image;
@@ -82,11 +84,64 @@ pub fn evaluate_into(
     progress: &(dyn Fn(usize, usize) + Sync),
     sink: &mut dyn FnMut(MapKind, Image),
 ) -> EvalStats {
-    let start = Instant::now();
-    let needed = graph.reachable(maps);
-    let total = needed.len();
+    evaluate_with(graph, maps, width, height, progress, sink, CachePolicy::None).0
+}
 
-    // Remaining consumers of each needed node, and the maps each node produces.
+/// What the evaluator keeps between evaluations: the one difference between a one-shot
+/// `generate` and live reload.
+pub enum CachePolicy<'a> {
+    /// Nothing: every buffer is freed after its last consumer, or overwritten in place by it.
+    None,
+    /// Nodes whose key (operation, parameters, input keys, size) is in the cache are not run,
+    /// nor anything only they need; afterwards the cache holds every node this evaluation
+    /// ran or used. Buffers are kept, so nothing is overwritten in place.
+    Keep(&'a mut NodeCache),
+}
+
+/// The one evaluator: `evaluate_into` with a cache policy. Returns the stats and, for
+/// `CachePolicy::Keep`, how many nodes ran and how many reachable nodes did not have to.
+pub fn evaluate_with(
+    graph: &Graph,
+    maps: &[MapKind],
+    width: usize,
+    height: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    sink: &mut dyn FnMut(MapKind, Image),
+    mut policy: CachePolicy,
+) -> (EvalStats, CacheStats) {
+    let start = Instant::now();
+    let reachable = graph.reachable(maps);
+    let keys: Vec<u64> = match policy {
+        CachePolicy::None => Vec::new(),
+        CachePolicy::Keep(_) => node_keys(graph, &reachable, width, height),
+    };
+    let cached = |id: NodeId| match &policy {
+        CachePolicy::None => None,
+        CachePolicy::Keep(cache) => cache.get(keys[id.0]),
+    };
+
+    // Nodes to run: those the maps reach without passing through a cached node.
+    let mut run = vec![false; graph.nodes().len()];
+    let mut store: Vec<Option<Arc<Image>>> = vec![None; graph.nodes().len()];
+    let mut computed = vec![false; graph.nodes().len()];
+    let mut stack: Vec<NodeId> = maps.iter().filter_map(|m| graph.output(*m)).collect();
+    while let Some(id) = stack.pop() {
+        if run[id.0] || computed[id.0] {
+            continue;
+        }
+        if let Some(image) = cached(id) {
+            store[id.0] = Some(image);
+            computed[id.0] = true;
+        } else {
+            run[id.0] = true;
+            stack.extend(&graph.node(id).inputs);
+        }
+    }
+    let needed: Vec<NodeId> = (0..graph.nodes().len()).filter(|&i| run[i]).map(NodeId).collect();
+    let total = needed.len();
+    let in_place = matches!(policy, CachePolicy::None);
+
+    // Remaining consumers of each buffer, and the maps each node produces.
     let mut consumers = vec![0usize; graph.nodes().len()];
     for id in &needed {
         for input in &graph.node(*id).inputs {
@@ -100,16 +155,34 @@ pub fn evaluate_into(
         }
     }
 
-    let mut store: Vec<Option<Arc<Image>>> = vec![None; graph.nodes().len()];
+    let mut kept: Vec<(u64, Arc<Image>)> = Vec::new();
     let mut stats: BTreeMap<usize, NodeStats> = BTreeMap::new();
     let (mut live_bytes, mut peak_bytes, mut done) = (0usize, 0usize, 0usize);
     let threads = rayon::current_num_threads().max(1);
 
-    let mut computed = vec![false; graph.nodes().len()];
-    let mut remaining: Vec<NodeId> = needed.clone();
-    while !remaining.is_empty() {
-        // The first ready node in builder order, plus ready nodes a short way ahead, at most
-        // one per thread: branch parallelism without running far ahead (memory).
+    // Cached nodes nothing here consumes are finished already (a cached map).
+    let mut finished: Vec<usize> = (0..graph.nodes().len()).filter(|&i| computed[i] && consumers[i] == 0).collect();
+    let mut remaining: Vec<NodeId> = needed;
+    loop {
+        // Release every buffer whose last consumer has run; hand finished maps over.
+        for index in finished.drain(..) {
+            let Some(buffer) = store[index].take() else { continue };
+            if run[index] {
+                live_bytes -= buffer.bytes();
+            }
+            if !keys.is_empty() {
+                kept.push((keys[index], buffer.clone()));
+            }
+            if let Some((last, others)) = produces.get(&index).and_then(|kinds| kinds.split_last()) {
+                for map in others {
+                    sink(*map, (*buffer).clone());
+                }
+                sink(*last, Arc::try_unwrap(buffer).unwrap_or_else(|shared| (*shared).clone()));
+            }
+        }
+        if remaining.is_empty() {
+            break;
+        }
         let batch = next_batch(graph, &remaining, &computed, threads);
         remaining.retain(|id| !batch.contains(id));
 
@@ -119,7 +192,7 @@ pub fn evaluate_into(
         let owned: Vec<Option<Image>> = batch
             .iter()
             .map(|&id| {
-                let first = reusable_input(graph, id, &consumers, &produces)?;
+                let first = reusable_input(graph, id, &consumers, &produces).filter(|_| in_place)?;
                 let image = Arc::try_unwrap(store[first.0].take()?).ok()?;
                 live_bytes -= image.bytes();
                 Some(image)
@@ -130,12 +203,12 @@ pub fn evaluate_into(
             .zip(owned)
             .map(|(&id, owned)| {
                 let node = graph.node(id);
+                let input = |i: &NodeId| store[i.0].as_deref().expect("inputs are computed before their consumers");
                 let first = match owned {
                     Some(image) => Some(Cow::Owned(image)),
-                    None => node.inputs.first().map(|i| Cow::Borrowed(store[i.0].as_deref().expect("input evaluated"))),
+                    None => node.inputs.first().map(|i| Cow::Borrowed(input(i))),
                 };
-                let rest: Vec<&Image> =
-                    node.inputs.iter().skip(1).map(|i| store[i.0].as_deref().expect("input evaluated")).collect();
+                let rest: Vec<&Image> = node.inputs.iter().skip(1).map(input).collect();
                 let t = Instant::now();
                 let image = node.op.eval(first, &rest, width, height);
                 (id, image, t.elapsed())
@@ -162,8 +235,7 @@ pub fn evaluate_into(
         }
         peak_bytes = peak_bytes.max(live_bytes);
 
-        // Release every buffer whose last consumer has now run; hand finished maps over.
-        let mut finished: Vec<usize> = batch.iter().map(|id| id.0).filter(|i| consumers[*i] == 0).collect();
+        finished.extend(batch.iter().map(|id| id.0).filter(|i| consumers[*i] == 0));
         for id in &batch {
             for input in &graph.node(*id).inputs {
                 consumers[input.0] -= 1;
@@ -172,19 +244,31 @@ pub fn evaluate_into(
                 }
             }
         }
-        for index in finished {
-            let Some(buffer) = store[index].take() else { continue };
-            live_bytes -= buffer.bytes();
-            if let Some((last, others)) = produces.get(&index).and_then(|kinds| kinds.split_last()) {
-                for map in others {
-                    sink(*map, (*buffer).clone());
-                }
-                sink(*last, Arc::try_unwrap(buffer).unwrap_or_else(|shared| (*shared).clone()));
-            }
-        }
     }
 
-    EvalStats { nodes: stats.into_values().collect(), peak_bytes, wall: start.elapsed() }
+    if let CachePolicy::Keep(cache) = &mut policy {
+        cache.replace(kept);
+    }
+    let cache_stats = CacheStats { evaluated: total, reused: reachable.len() - total };
+    (EvalStats { nodes: stats.into_values().collect(), peak_bytes, wall: start.elapsed() }, cache_stats)
+}
+
+/// Cache keys of the reachable nodes (in topological order, so inputs come first): the
+/// operation with every parameter (`hash_op`), the size and the inputs' keys.
+fn node_keys(graph: &Graph, reachable: &[NodeId], width: usize, height: usize) -> Vec<u64> {
+    use std::hash::{Hash, Hasher};
+    let mut keys = vec![0u64; graph.nodes().len()];
+    for &id in reachable {
+        let node = graph.node(id);
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        hash_op(&node.op, &mut hasher);
+        (width, height).hash(&mut hasher);
+        for input in &node.inputs {
+            keys[input.0].hash(&mut hasher);
+        }
+        keys[id.0] = hasher.finish();
+    }
+    keys
 }
 
 /// The first ready node in builder order, plus ready nodes a short way ahead, at most one

@@ -181,3 +181,96 @@ fn tint(base: Image, mask: &Image, color: [f32; 3], opacity: f32) -> Image {
     }
     out
 }
+
+/// Feeds an operation and every parameter into a hasher: the node cache's key. Each struct
+/// is destructured in full, so a parameter added later fails to compile here instead of
+/// silently sharing a cache entry with different output; floats hash by their bits (so
+/// 0.0 and -0.0 differ, which can only cost a needless re-evaluation, never a wrong reuse).
+pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
+    use std::hash::Hash;
+    let float = |h: &mut H, x: f32| x.to_bits().hash(h);
+    std::mem::discriminant(op).hash(h);
+    match op {
+        Op::Noise(FractalNoise { kind, cells_u, cells_v, octaves, gain, seed }) => {
+            (kind, cells_u, cells_v, octaves, seed).hash(h);
+            float(h, *gain);
+        }
+        Op::Scales(ScaleField {
+            shape,
+            rows,
+            aspect,
+            size,
+            keel_height,
+            keel_width,
+            jitter,
+            imbrication,
+            edge_softness,
+            belly_width,
+            seed,
+            outputs,
+        }) => {
+            (shape, rows, seed, outputs).hash(h);
+            for x in [aspect, size, keel_height, keel_width, jitter, imbrication, edge_softness, belly_width] {
+                float(h, *x);
+            }
+        }
+        Op::Channel { index } => index.hash(h),
+        Op::Bands { axis, centres, half_width, softness } => {
+            axis.hash(h);
+            centres.len().hash(h);
+            for x in centres.iter().chain([half_width, softness]) {
+                float(h, *x);
+            }
+        }
+        Op::Blotches(Blotches { shape, count, half_width, length, jitter, seed }) => {
+            (shape, count, seed).hash(h);
+            for x in [half_width, length, jitter] {
+                float(h, *x);
+            }
+        }
+        Op::BellyChecker { rows_v, belly_width, softness } => {
+            rows_v.hash(h);
+            float(h, *belly_width);
+            float(h, *softness);
+        }
+        Op::SnapToScales { amount, centre_u, centre_v } => {
+            (centre_u, centre_v).hash(h);
+            float(h, *amount);
+        }
+        Op::Spots(SpotGrid { across, along, radius, jitter, alternate, checkered, hole, seed }) => {
+            (across, along, alternate, checkered, seed).hash(h);
+            for x in [radius, jitter, hole] {
+                float(h, *x);
+            }
+        }
+        Op::Levels { in_low, in_high, out_low, out_high } => {
+            for x in [in_low, in_high, out_low, out_high] {
+                float(h, *x);
+            }
+        }
+        Op::Threshold { level, softness } => {
+            float(h, *level);
+            float(h, *softness);
+        }
+        Op::Blur { sigma } => float(h, *sigma),
+        Op::Sobel { edge_sigma } => float(h, *edge_sigma),
+        Op::Blend { mode, opacity } => {
+            mode.hash(h);
+            float(h, *opacity);
+        }
+        Op::Colorize { low, high } => {
+            for x in low.iter().chain(high) {
+                float(h, *x);
+            }
+        }
+        Op::Tint { color, opacity } => {
+            for x in color.iter().chain([opacity]) {
+                float(h, *x);
+            }
+        }
+        Op::HeightToNormal { slope, convention } => {
+            convention.hash(h);
+            float(h, *slope);
+        }
+    }
+}

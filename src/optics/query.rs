@@ -41,11 +41,18 @@ pub fn check(stack: Stack, thickness_nm: f64, angle_deg: f64, wavelength_nm: Opt
     Ok(())
 }
 
+/// Baked tables kept at once by `film_colour`'s LUT cache.
+const MAX_CACHED_LUTS: usize = 8;
+
 /// LUTs baked so far, per material (a batch of queries on one material bakes once).
 fn lut_for(stack: Stack) -> Arc<Lut> {
     static CACHE: Mutex<Option<HashMap<[u64; 3], Arc<Lut>>>> = Mutex::new(None);
     let key = [stack.n0.to_bits(), stack.n1.to_bits(), stack.n2.to_bits()];
     let mut cache = CACHE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    // A table is about 12 MiB; a batch over many materials keeps the last few, not all.
+    if cache.as_ref().is_some_and(|c| c.len() >= MAX_CACHED_LUTS && !c.contains_key(&key)) {
+        cache.take();
+    }
     cache.get_or_insert_with(HashMap::new).entry(key).or_insert_with(|| Arc::new(Lut::bake_default(stack))).clone()
 }
 

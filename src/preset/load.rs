@@ -46,7 +46,12 @@ pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
     if spec.ends_with(".toml") || path.exists() {
         let text = read_bounded(path)?;
-        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "preset".into());
+        // The set's files are named after it: a hidden name (`.toml`) would hide them.
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| !s.is_empty() && !s.starts_with('.'))
+            .unwrap_or_else(|| "preset".into());
         return Ok(PresetSource { name, display: spec.to_string(), text });
     }
     match library::get(spec) {

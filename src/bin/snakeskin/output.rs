@@ -24,7 +24,9 @@ pub fn restore_default_sigpipe() {
 /// off with Mesa's own `NODEVICE_SELECT`, unless the user has set it.
 pub fn quiet_vulkan_device_select() {
     let runtime_dir_usable = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir());
-    if !runtime_dir_usable && std::env::var_os("NODEVICE_SELECT").is_none() {
+    let user_chose =
+        std::env::var_os("NODEVICE_SELECT").is_some() || std::env::var_os("MESA_VK_DEVICE_SELECT").is_some();
+    if !runtime_dir_usable && !user_chose {
         // SAFETY: called first thing in `main`, before any other thread exists.
         unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
     }
@@ -36,11 +38,13 @@ pub fn quiet_vulkan_device_select() {
 /// sent raw to the terminal.
 pub fn error_message(err: &anyhow::Error) -> String {
     let mut message = String::new();
+    let mut parent = String::new();
     for cause in err.chain() {
         let text = cause.to_string();
-        if message.contains(&text) {
+        if parent.contains(&text) {
             continue;
         }
+        parent = text.clone();
         if !message.is_empty() {
             message.push_str(": ");
         }
@@ -74,6 +78,11 @@ pub fn printable(text: &str) -> String {
         .collect()
 }
 
+/// A path for a line of its own (stdout lists one file per line): newlines escaped too.
+pub fn path_line(path: &Path) -> String {
+    printable(&path.display().to_string()).replace('\n', "\\n")
+}
+
 /// Creates the folder a single output file goes into when it is missing, and says so on
 /// stderr. Every command treats output paths alike: `generate -o DIR`, `preview --out`,
 /// `preview --reference`, `sheet -o` and the rest create missing folders with this note.
@@ -98,7 +107,7 @@ pub fn ensure_folder(folder: &Path) -> anyhow::Result<()> {
             std::fs::create_dir_all(folder).map_err(|source| {
                 snakeskin::Error::Export(snakeskin::export::ExportError::Io { path: folder.into(), source })
             })?;
-            eprintln!("note: created folder {}", printable(&folder.display().to_string()));
+            eprintln!("note: created folder {}", path_line(folder));
             Ok(())
         }
     }

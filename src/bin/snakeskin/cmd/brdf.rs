@@ -1,13 +1,13 @@
 //! `snakeskin brdf ...`: machine-readable optics queries, so anyone can check the physics
 //! against their own implementation. One JSON object per query; `--batch` reads JSON lines.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 
 use anyhow::Result;
 use serde::Deserialize;
 
 use crate::cli::{BrdfCommand, EvalArgs, StackArgs};
-use crate::output::{ensure_parent_folder, printable};
+use crate::output::{ensure_parent_folder, path_line, printable};
 use snakeskin::Error;
 use snakeskin::optics::brdf::{Layers, eval};
 use snakeskin::optics::film::{Stack, airy};
@@ -97,6 +97,9 @@ fn eval_json(args: &EvalArgs) -> Result<String> {
     Ok(serde_json::json!({ "f": value.total(), "specular": value.specular, "diffuse": value.diffuse }).to_string())
 }
 
+/// The longest `--batch` line accepted (a query is under 200 bytes).
+const MAX_LINE_BYTES: u64 = 64 * 1024;
+
 /// Runs `per_line` on every non-empty JSON line; errors name the file and the line.
 fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> Result<String>) -> Result<()> {
     let shown = printable(path);
@@ -106,9 +109,23 @@ fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> 
         let file = std::fs::File::open(path).map_err(|e| Error::Query(format!("cannot read --batch {shown}: {e}")))?;
         Box::new(BufReader::new(file))
     };
+    let mut reader = reader;
     let mut out = std::io::stdout().lock();
-    for (i, line) in reader.lines().enumerate() {
-        let line = line.map_err(|e| Error::Query(format!("cannot read --batch {shown}: {e}")))?;
+    for i in 0.. {
+        // One query is a short JSON object: a line is read with a bound (--batch /dev/zero
+        // must not grow a line until memory runs out).
+        let mut bytes = Vec::new();
+        (&mut reader)
+            .take(MAX_LINE_BYTES + 1)
+            .read_until(b'\n', &mut bytes)
+            .map_err(|e| Error::Query(format!("cannot read --batch {shown}: {e}")))?;
+        if bytes.is_empty() {
+            break;
+        }
+        if bytes.len() as u64 > MAX_LINE_BYTES {
+            return Err(Error::Query(format!("{shown}:{}: line longer than {MAX_LINE_BYTES} bytes", i + 1)).into());
+        }
+        let line = String::from_utf8(bytes).map_err(|_| Error::Query(format!("{shown}:{}: not UTF-8", i + 1)))?;
         if line.trim().is_empty() {
             continue;
         }
@@ -153,10 +170,7 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             let (image, exposure) = chart(stack, method, width as usize, height as usize);
             let png = snakeskin::export::encode_png(snakeskin::material::MapKind::Color, &image)?;
             snakeskin::export::write_file_atomically(&out, png)?;
-            eprintln!(
-                "wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)",
-                printable(&out.display().to_string())
-            );
+            eprintln!("wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)", path_line(&out));
             Ok(())
         }
         BrdfCommand::Eval(args) => {

@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::Result;
 
 use crate::cli::ImageSize;
-use crate::output::{ensure_folder, printable};
+use crate::output::{ensure_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::render::Renderer;
 use snakeskin::render::preview::write_figures;
@@ -20,7 +20,7 @@ pub fn run(preset: &str, out: &Path, size: ImageSize, map_size: u64) -> Result<(
     })?;
     bar.finish();
     for f in files {
-        println!("{}", printable(&f.display().to_string()));
+        println!("{}", path_line(&f));
     }
     Ok(())
 }

@@ -4,11 +4,11 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use crate::output::{ensure_parent_folder, printable};
+use crate::output::{ensure_parent_folder, path_line};
 
 pub fn run(out: &Path, tile: usize, columns: usize) -> Result<()> {
     ensure_parent_folder(out)?;
     snakeskin::render::gallery::write(out, tile, columns)?;
-    println!("{}", printable(&out.display().to_string()));
+    println!("{}", path_line(out));
     Ok(())
 }

@@ -4,7 +4,7 @@
 use anyhow::Result;
 
 use crate::cli::{Convention, GenerateArgs};
-use crate::output::printable;
+use crate::output::path_line;
 use crate::progress::Progress;
 use snakeskin::generate::{GenerateRequest, Plan};
 use snakeskin::graph::EvalStats;
@@ -41,10 +41,10 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     let report = plan.run(&|done, total| bar.update(done, total))?;
     bar.finish();
     if report.created_folder {
-        eprintln!("note: created folder {}", printable(&args.out.display().to_string()));
+        eprintln!("note: created folder {}", path_line(&args.out));
     }
     for file in &report.files {
-        println!("{}", printable(&file.display().to_string()));
+        println!("{}", path_line(file));
     }
     if args.stats {
         print_stats(&report.stats);

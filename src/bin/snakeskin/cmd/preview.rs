@@ -3,7 +3,7 @@
 use anyhow::Result;
 
 use crate::cli::PreviewArgs;
-use crate::output::{ensure_parent_folder, printable};
+use crate::output::{ensure_parent_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::Error;
 use snakeskin::render::Renderer;
@@ -52,7 +52,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         );
     }
     bar.finish();
-    println!("{}", printable(&written.display().to_string()));
+    println!("{}", path_line(&written));
     Ok(())
 }
 
@@ -66,7 +66,7 @@ fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
         size: (args.size.width, args.size.height),
         frames: args.frames,
         settings,
-        report: Box::new(|status| eprintln!("preview: {}", printable(status))),
+        report: Box::new(|status| eprintln!("preview: {}", crate::output::printable(status))),
     };
     let report = snakeskin::render::window::run(options)?;
     if let Some(frames) = args.frames {

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use crate::output::{ensure_parent_folder, printable};
+use crate::output::{ensure_parent_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::render::Renderer;
 use snakeskin::render::sheet::{SheetOptions, write_sheet};
@@ -16,6 +16,6 @@ pub fn run(out: &Path, tile: u32, columns: u32, map_size: usize) -> Result<()> {
     let written =
         write_sheet(&renderer, out, SheetOptions { tile, columns, map_size }, &|done, total| bar.update(done, total))?;
     bar.finish();
-    println!("{}", printable(&written.display().to_string()));
+    println!("{}", path_line(&written));
     Ok(())
 }
