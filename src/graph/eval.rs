@@ -141,19 +141,7 @@ pub fn evaluate_with(
     let total = needed.len();
     let in_place = matches!(policy, CachePolicy::None);
 
-    // Remaining consumers of each buffer, and the maps each node produces.
-    let mut consumers = vec![0usize; graph.nodes().len()];
-    for id in &needed {
-        for input in &graph.node(*id).inputs {
-            consumers[input.0] += 1;
-        }
-    }
-    let mut produces: BTreeMap<usize, Vec<MapKind>> = BTreeMap::new();
-    for map in maps {
-        if let Some(id) = graph.output(*map) {
-            produces.entry(id.0).or_default().push(*map);
-        }
-    }
+    let (mut consumers, produces) = consumers_and_products(graph, &needed, maps);
 
     let mut kept: Vec<(u64, Arc<Image>)> = Vec::new();
     let mut stats: BTreeMap<usize, NodeStats> = BTreeMap::new();
@@ -271,6 +259,28 @@ fn node_keys(graph: &Graph, reachable: &[NodeId], width: usize, height: usize) -
     keys
 }
 
+/// Remaining consumers of each buffer among the `needed` nodes, and the maps each node
+/// produces.
+fn consumers_and_products(
+    graph: &Graph,
+    needed: &[NodeId],
+    maps: &[MapKind],
+) -> (Vec<usize>, BTreeMap<usize, Vec<MapKind>>) {
+    let mut consumers = vec![0usize; graph.nodes().len()];
+    for id in needed {
+        for input in &graph.node(*id).inputs {
+            consumers[input.0] += 1;
+        }
+    }
+    let mut produces: BTreeMap<usize, Vec<MapKind>> = BTreeMap::new();
+    for map in maps {
+        if let Some(id) = graph.output(*map) {
+            produces.entry(id.0).or_default().push(*map);
+        }
+    }
+    (consumers, produces)
+}
+
 /// The first ready node in builder order, plus ready nodes a short way ahead, at most one
 /// per thread: branch parallelism without running far ahead (memory).
 fn next_batch(graph: &Graph, remaining: &[NodeId], computed: &[bool], threads: usize) -> Vec<NodeId> {
@@ -308,18 +318,7 @@ fn reusable_input(
 pub fn estimate_peak_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> u64 {
     let needed = graph.reachable(maps);
     let pixels = (width as u64) * (height as u64);
-    let mut consumers = vec![0usize; graph.nodes().len()];
-    for id in &needed {
-        for input in &graph.node(*id).inputs {
-            consumers[input.0] += 1;
-        }
-    }
-    let mut produces: BTreeMap<usize, Vec<MapKind>> = BTreeMap::new();
-    for map in maps {
-        if let Some(id) = graph.output(*map) {
-            produces.entry(id.0).or_default().push(*map);
-        }
-    }
+    let (mut consumers, produces) = consumers_and_products(graph, &needed, maps);
     let mut channels = vec![0usize; graph.nodes().len()];
     let mut live = vec![0u64; graph.nodes().len()];
     let mut computed = vec![false; graph.nodes().len()];

@@ -14,7 +14,6 @@ use crate::export::write_file_atomically;
 use crate::graph::{NodeCache, evaluate};
 use crate::maps::{BuildOptions, MapKind, build_graph};
 use crate::optics::lut::Lut;
-use crate::optics::methods::Method;
 use crate::preset::LoadedPreset;
 
 /// Preview image size limits (pixels per side): lavapipe handles 8K, a window rarely more.
@@ -36,35 +35,6 @@ pub fn material_maps_cached(
     let graph = build_graph(&loaded.preset, BuildOptions::default());
     let (maps, stats) = cache.evaluate(&graph, &MapKind::ALL, map_size, map_size);
     Ok((MaterialMaps::from_maps(&maps).map_err(|e| Error::Preview(e.to_string()))?, stats))
-}
-
-/// Parses `--method` for the GPU.
-pub fn parse_method(name: &str) -> Result<GpuFilmMethod, Error> {
-    Method::parse(name)
-        .map(GpuFilmMethod::from_method)
-        .ok_or_else(|| Error::Preview(format!("unknown --method {name:?}; accepted: {}", Method::ACCEPTED)))
-}
-
-/// Parses `--size WxH` (or a single number for a square).
-pub fn parse_image_size(text: &str) -> Result<(u32, u32), Error> {
-    let bad = || {
-        Error::Preview(format!(
-            "invalid --size {text:?}: expected WIDTHxHEIGHT (e.g. 1280x720), each {} to {} pixels",
-            IMAGE_RANGE.start(),
-            IMAGE_RANGE.end()
-        ))
-    };
-    let (w, h) = match text.split_once(['x', 'X']) {
-        Some((w, h)) => (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?),
-        None => {
-            let s: u32 = text.trim().parse().map_err(|_| bad())?;
-            (s, s)
-        }
-    };
-    if !IMAGE_RANGE.contains(&w) || !IMAGE_RANGE.contains(&h) {
-        return Err(bad());
-    }
-    Ok((w, h))
 }
 
 /// A material ready to draw: maps, optics and film tables for `method`.
