@@ -458,13 +458,16 @@ fn controls(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Sliders, st
         settings.method = method;
         ui.separator();
         ui.label("Layer optics (thesis Table 5.2)");
-        ui.add(egui::Slider::new(&mut s.n0, 1.0..=2.0).text("n0 ambient"));
-        ui.add(egui::Slider::new(&mut s.n1, 1.0..=2.5).text("n1 film"));
-        ui.add(egui::Slider::new(&mut s.n2, 1.0..=2.5).text("n2 pigment"));
-        ui.add(egui::Slider::new(&mut s.thickness_nm, 0.0..=2000.0).text("δ0 film nm"));
-        ui.add(egui::Slider::new(&mut s.spread_nm, 0.0..=1000.0).text("δ spread nm"));
-        ui.add(egui::Slider::new(&mut s.pigment_thickness, 0.0..=4.0).text("δ1 pigment"));
-        ui.add(egui::Slider::new(&mut s.absorption, 0.0..=4.0).text("σ0 absorption"));
+        // The preset's own ranges (one table for files, --set and the window); the wide ones
+        // (10 mm of film, σ0 and δ1 up to 100) are logarithmic so the usual values stay fine.
+        use crate::preset::validate::ranges;
+        ui.add(slider(&mut s.n0, ranges::IOR, false, "n0 ambient"));
+        ui.add(slider(&mut s.n1, ranges::IOR, false, "n1 film"));
+        ui.add(slider(&mut s.n2, ranges::IOR, false, "n2 pigment"));
+        ui.add(slider(&mut s.thickness_nm, ranges::FILM_THICKNESS_NM, true, "δ0 film nm"));
+        ui.add(slider(&mut s.spread_nm, ranges::SPREAD_NM, false, "δ spread nm"));
+        ui.add(slider(&mut s.pigment_thickness, ranges::PIGMENT_THICKNESS, true, "δ1 pigment"));
+        ui.add(slider(&mut s.absorption, ranges::ABSORPTION, true, "σ0 absorption"));
         ui.separator();
         ui.label("Scene");
         ui.add(egui::Slider::new(&mut settings.exposure, 0.1..=4.0).logarithmic(true).text("exposure"));
@@ -495,6 +498,11 @@ fn view_name(view: View) -> String {
         View::Shaded(Stage::All) => "(d) all layers".into(),
         View::Map(map) => format!("map: {map}"),
     }
+}
+
+/// A slider over one of the preset's ranges.
+fn slider<'a>(value: &'a mut f64, (lo, hi): (f64, f64), logarithmic: bool, text: &str) -> egui::Slider<'a> {
+    egui::Slider::new(value, lo..=hi).logarithmic(logarithmic).text(text)
 }
 
 impl ApplicationHandler for App {
