@@ -74,10 +74,6 @@ impl Plan {
         self.memory
     }
 
-    pub fn loaded(&self) -> &LoadedPreset {
-        &self.loaded
-    }
-
     /// Runs the plan. `progress(done, total)` reports node evaluations.
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
         let Plan { request, size, loaded, graph, start, .. } = self;

@@ -33,8 +33,6 @@ pub enum Error {
     Export(#[from] export::ExportError),
     #[error("invalid --size {size}: accepted sizes are {lo} to {hi} pixels", lo = SIZE_RANGE.start(), hi = SIZE_RANGE.end())]
     Size { size: u64 },
-    #[error("invalid --maps: {0}")]
-    Maps(String),
     /// An optics query outside what the physics covers (`snakeskin brdf`).
     #[error("invalid query: {0}")]
     Query(String),
@@ -49,9 +47,6 @@ pub enum Error {
          smaller size (or raise SNAKESKIN_MEMORY_LIMIT_MIB if it is set)"
     )]
     Memory { what: String, needed_mib: u64, available_mib: u64 },
-    /// An output path that cannot be used as given.
-    #[error("invalid output path: {0}")]
-    OutputPath(String),
     /// A failure that is not the user's: a bug or a library refusing valid data.
     #[error("internal error: {0}")]
     Internal(String),
@@ -62,7 +57,7 @@ impl Error {
     /// (I/O, GPU, a concurrent run) and internal failures (exit code 1).
     pub fn is_invalid_input(&self) -> bool {
         match self {
-            Error::Export(e) => matches!(e, export::ExportError::NotAFolder { .. }),
+            Error::Export(e) => e.is_invalid_input(),
             Error::Gpu(_) | Error::Internal(_) => false,
             _ => true,
         }

@@ -105,8 +105,9 @@ fn check_target(target: &Path) -> Result<(), ExportError> {
     }
 }
 
-/// Creates `dir` if needed; true when it was created.
-fn create_folder(dir: &Path) -> Result<bool, ExportError> {
+/// Creates an output folder if needed (true when it was created); a path that exists and is
+/// not a folder is `ExportError::NotAFolder`. Every output path goes through here.
+pub fn create_folder(dir: &Path) -> Result<bool, ExportError> {
     match fs::metadata(dir) {
         Ok(meta) if meta.is_dir() => Ok(false),
         Ok(_) => Err(ExportError::NotAFolder { path: dir.into() }),
@@ -118,7 +119,6 @@ fn create_folder(dir: &Path) -> Result<bool, ExportError> {
 #[derive(Debug)]
 pub struct SetLock {
     dir: PathBuf,
-    name: String,
     path: PathBuf,
     /// The locked file; the lock goes with it.
     _file: File,
@@ -141,7 +141,7 @@ impl SetLock {
             let file = options.open(&path).map_err(io_error(&path))?;
             match file.try_lock() {
                 Ok(()) if same_file(&file, &path) => {
-                    return Ok(SetLock { dir: dir.into(), name: name.into(), path, _file: file, created_folder });
+                    return Ok(SetLock { dir: dir.into(), path, _file: file, created_folder });
                 }
                 Ok(()) => continue,
                 Err(fs::TryLockError::WouldBlock) => {
@@ -180,11 +180,6 @@ impl SetLock {
         }
         sync_folder(dir);
         Ok(written)
-    }
-
-    /// The set's name (file stem of its manifest).
-    pub fn name(&self) -> &str {
-        &self.name
     }
 }
 

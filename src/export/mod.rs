@@ -7,7 +7,7 @@
 mod atomic;
 mod manifest;
 
-pub use atomic::{SetLock, sha256_hex, write_file_atomically};
+pub use atomic::{SetLock, create_folder, sha256_hex, write_file_atomically};
 pub use manifest::{Manifest, VerifiedSet, manifest, manifest_file_name, verify_set};
 
 use std::io::Cursor;
@@ -35,6 +35,13 @@ pub enum ExportError {
     NotAFolder { path: PathBuf },
     #[error("set {manifest}: {problem}")]
     Verify { manifest: PathBuf, problem: String },
+}
+
+impl ExportError {
+    /// True when the user's input is at fault: an output path that is not a folder.
+    pub fn is_invalid_input(&self) -> bool {
+        matches!(self, ExportError::NotAFolder { .. })
+    }
 }
 
 /// File name of a map for a preset name.

@@ -120,24 +120,20 @@ pub fn evaluate_with(
         CachePolicy::Keep(cache) => cache.get(keys[id.0]),
     };
 
-    // Nodes to run: those the maps reach without passing through a cached node.
-    let mut run = vec![false; graph.nodes().len()];
+    // Nodes to run: those the maps reach without passing through a cached node; the cached
+    // nodes where the walk stops go straight into the store.
     let mut store: Vec<Option<Arc<Image>>> = vec![None; graph.nodes().len()];
     let mut computed = vec![false; graph.nodes().len()];
-    let mut stack: Vec<NodeId> = maps.iter().filter_map(|m| graph.output(*m)).collect();
-    while let Some(id) = stack.pop() {
-        if run[id.0] || computed[id.0] {
-            continue;
-        }
-        if let Some(image) = cached(id) {
-            store[id.0] = Some(image);
-            computed[id.0] = true;
-        } else {
-            run[id.0] = true;
-            stack.extend(&graph.node(id).inputs);
-        }
+    let needed = graph.reachable_until(maps, |id| {
+        let image = cached(id);
+        computed[id.0] = image.is_some();
+        store[id.0] = image;
+        computed[id.0]
+    });
+    let mut run = vec![false; graph.nodes().len()];
+    for id in &needed {
+        run[id.0] = true;
     }
-    let needed: Vec<NodeId> = (0..graph.nodes().len()).filter(|&i| run[i]).map(NodeId).collect();
     let total = needed.len();
     let in_place = matches!(policy, CachePolicy::None);
 

@@ -56,10 +56,19 @@ impl Graph {
 
     /// Every node that the given maps depend on, in topological (id) order.
     pub fn reachable(&self, maps: &[MapKind]) -> Vec<NodeId> {
+        self.reachable_until(maps, |_| false)
+    }
+
+    /// The nodes the maps reach without passing through a node for which `stop` is true
+    /// (asked once per such node; it is left out, and so is what only it needs), in
+    /// topological order. The cached evaluator stops at nodes it already has.
+    pub fn reachable_until(&self, maps: &[MapKind], mut stop: impl FnMut(NodeId) -> bool) -> Vec<NodeId> {
+        let mut seen = vec![false; self.nodes.len()];
         let mut needed = vec![false; self.nodes.len()];
         let mut stack: Vec<NodeId> = maps.iter().filter_map(|m| self.output(*m)).collect();
         while let Some(id) = stack.pop() {
-            if !std::mem::replace(&mut needed[id.0], true) {
+            if !std::mem::replace(&mut seen[id.0], true) && !stop(id) {
+                needed[id.0] = true;
                 stack.extend(&self.nodes[id.0].inputs);
             }
         }

@@ -65,7 +65,7 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
             return 2;
         }
         if let Some(e) = cause.downcast_ref::<ExportError>() {
-            return if matches!(e, ExportError::NotAFolder { .. }) { 2 } else { 1 };
+            return if e.is_invalid_input() { 2 } else { 1 };
         }
     }
     1
@@ -93,22 +93,11 @@ pub fn ensure_parent_folder(file: &Path) -> anyhow::Result<()> {
     }
 }
 
-/// Creates an output folder when it is missing (with a note on stderr); refuses a path
-/// that exists but is not a folder, naming it.
+/// Creates an output folder when it is missing (`export::create_folder`), with a note on
+/// stderr; a path that exists but is not a folder is refused, naming it.
 pub fn ensure_folder(folder: &Path) -> anyhow::Result<()> {
-    match std::fs::metadata(folder) {
-        Ok(meta) if meta.is_dir() => Ok(()),
-        Ok(_) => Err(snakeskin::Error::OutputPath(format!(
-            "{} exists and is not a folder (an output folder is needed here)",
-            folder.display()
-        ))
-        .into()),
-        Err(_) => {
-            std::fs::create_dir_all(folder).map_err(|source| {
-                snakeskin::Error::Export(snakeskin::export::ExportError::Io { path: folder.into(), source })
-            })?;
-            eprintln!("note: created folder {}", path_line(folder));
-            Ok(())
-        }
+    if snakeskin::export::create_folder(folder)? {
+        eprintln!("note: created folder {}", path_line(folder));
     }
+    Ok(())
 }
