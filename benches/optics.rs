@@ -5,7 +5,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use snakeskin::optics::brdf::{Layers32, eval_f32};
+use snakeskin::optics::brdf::{Layers32, Model};
 use snakeskin::optics::film::Stack;
 use snakeskin::optics::lut::Lut;
 use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
@@ -34,11 +34,14 @@ fn methods(c: &mut Criterion) {
         albedo: [0.4, 0.3, 0.2],
         thickness_nm: 400.0,
     };
-    c.bench_function("brdf_f32_lut", |b| {
-        b.iter(|| {
-            eval_f32(&layers, black_box([0.1, 0.0, 1.0]), black_box([0.3, 0.1, 0.9]), black_box([-0.2, 0.0, 1.0]), &lut)
-        })
-    });
+    for model in Model::ALL {
+        c.bench_function(&format!("brdf_f32_lut_{}", model.name()), |b| {
+            b.iter(|| {
+                let (n, wi, wo) = (black_box([0.1, 0.0, 1.0]), black_box([0.3, 0.1, 0.9]), black_box([-0.2, 0.0, 1.0]));
+                model.eval_f32(&layers, n, wi, wo, &lut)
+            })
+        });
+    }
     c.bench_function("lut_bake_default", |b| b.iter(|| Lut::bake_default(black_box(Stack::THESIS))));
 }
 

@@ -1,13 +1,13 @@
-// The snake-skin multi-layer BRDF in WGSL: the twin of `optics::brdf::eval_f32` (keep the
-// two in step; tests/gpu.rs compares them on 10,000 random inputs, with the CPU reading the
-// LUT at the half precision the GPU texture holds). See PHYSICS.md and src/optics/brdf.rs for the model:
-//   f = D G2 F(|wo.h|) / (4 |n.wi| |n.wo|)
-//     + (1 - F(n.wi)) (1 - F(n.wo)) exp(-tau (1/cos_t(wi) + 1/cos_t(wo))) k_d / pi
+// The snake-skin BRDF in WGSL: the twin of optics::brdf (Model::eval_f32; keep the two in
+// step: tests/gpu.rs compares them on 10,000 random inputs per model, with the CPU reading
+// the LUT at the half precision the GPU texture holds). One GGX top interface over the layer
+// model chosen by the BRDF_MODEL override constant (codes MODEL_* from the generated
+// prelude, as optics::brdf::Model::code):
+//   f = D G2 F(|wo.h|) / (4 |n.wi| |n.wo|) + f_diff(model)
+// ALPHA_MIN and COS_MIN (the GGX alpha floor and the cosine floor) come from the prelude.
 
 // Film colour comes from film_rgb (film.wgsl, prepended before this file).
-// GGX alpha floor and cosine floor, as optics::brdf::ALPHA_MIN and COS_MIN.
-const ALPHA_MIN: f32 = 0.001;
-const COS_MIN: f32 = 0.000001;
+override BRDF_MODEL: u32 = MODEL_THESIS;
 // False for a pipeline specialised to a material with no absorption (tau = 0): the
 // attenuation and the refracted path length are skipped.
 override HAS_ABSORPTION: bool = true;
@@ -23,7 +23,7 @@ struct Layers {
 
 fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
     let len = length(v);
-    if (len > 1e-12 && len < 3.0e38) {
+    if (len > LENGTH_MIN && len < 3.0e38) {
         return v / len;
     }
     return fallback;
@@ -31,6 +31,67 @@ fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
 
 fn film_clamped(layers: Layers, c: f32) -> vec3<f32> {
     return clamp(film_rgb(layers.thickness_nm, clamp(c, 0.0, 1.0)), vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// D G2 / (4 cos_i cos_o) for GGX with Smith height-correlated G2 (optics::brdf::ggx).
+fn specular_scale(cos_h: f32, sin2_h: f32, cos_i: f32, cos_o: f32, a2: f32) -> f32 {
+    let t = sin2_h + cos_h * cos_h * a2;
+    let d = a2 / (PI * t * t);
+    let lambda_i = 0.5 * (sqrt(1.0 + a2 * max(1.0 - cos_i * cos_i, 0.0) / (cos_i * cos_i)) - 1.0);
+    let lambda_o = 0.5 * (sqrt(1.0 + a2 * max(1.0 - cos_o * cos_o, 0.0) / (cos_o * cos_o)) - 1.0);
+    let g2 = 1.0 / (1.0 + lambda_i + lambda_o);
+    return d * g2 / (4.0 * cos_i * cos_o);
+}
+
+// ---- The thesis model (optics::brdf::thesis). ----
+
+// (1 - F(n.wi)) (1 - F(n.wo)) exp(-tau (1/cos_t(wi) + 1/cos_t(wo))) k_d / pi.
+fn thesis_diffuse(layers: Layers, cos_i: f32, cos_o: f32, f_i: vec3<f32>, f_o: vec3<f32>) -> vec3<f32> {
+    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    let ki = (1.0 - eta2) + eta2 * cos_i * cos_i;
+    let ko = (1.0 - eta2) + eta2 * cos_o * cos_o;
+    if (!(ki > 0.0 && ko > 0.0)) {
+        return vec3<f32>(0.0);
+    }
+    var diffuse = (vec3<f32>(1.0) - f_i) * (vec3<f32>(1.0) - f_o) * max(layers.albedo, vec3<f32>(0.0)) / PI;
+    if (HAS_ABSORPTION) {
+        let path = 1.0 / max(sqrt(ki), COS_MIN) + 1.0 / max(sqrt(ko), COS_MIN);
+        diffuse *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) * path);
+    }
+    return diffuse;
+}
+
+// The sky along the normal enters through the film (1 - F at the view cosine) and is
+// attenuated along the view path plus one layer thickness.
+fn thesis_ambient_diffuse(layers: Layers, cos_o: f32, f_o: vec3<f32>) -> vec3<f32> {
+    var base = (vec3<f32>(1.0) - f_o) * layers.albedo;
+    if (HAS_ABSORPTION) {
+        let eta = layers.n0 / layers.n2;
+        let k = (1.0 - eta * eta) + eta * eta * cos_o * cos_o;
+        let path = 1.0 / max(sqrt(max(k, 0.0)), COS_MIN) + 1.0;
+        base *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) * path);
+    }
+    return base;
+}
+
+// ---- The model seam (optics::brdf::Model). ----
+
+fn diffuse_lobe(layers: Layers, cos_i: f32, cos_o: f32, f_i: vec3<f32>, f_o: vec3<f32>) -> vec3<f32> {
+    switch BRDF_MODEL {
+        default: {
+            return thesis_diffuse(layers, cos_i, cos_o, f_i, f_o);
+        }
+    }
+}
+
+// The ambient term's diffuse part towards a view at cosine cos_o (Model::ambient_diffuse):
+// multiplies the sky radiance along the normal.
+fn ambient_diffuse(layers: Layers, cos_o: f32, f_o: vec3<f32>) -> vec3<f32> {
+    switch BRDF_MODEL {
+        default: {
+            return thesis_ambient_diffuse(layers, cos_o, f_o);
+        }
+    }
 }
 
 fn skin_brdf(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
@@ -65,30 +126,14 @@ fn skin_brdf_seen(
         return vec3<f32>(0.0);
     }
     let alpha = clamp(layers.roughness * layers.roughness, ALPHA_MIN, 1.0);
-    let a2 = alpha * alpha;
     let cos_h = clamp(dot(n, h), 0.0, 1.0);
     // sin^2 from the cross product: cos^2 (a^2 - 1) + 1 cancels near the peak in f32.
     let nxh = cross(n, h);
-    let t = dot(nxh, nxh) + cos_h * cos_h * a2;
-    let d = a2 / (PI * t * t);
-    let lambda_i = 0.5 * (sqrt(1.0 + a2 * max(1.0 - cos_i * cos_i, 0.0) / (cos_i * cos_i)) - 1.0);
-    let lambda_o = 0.5 * (sqrt(1.0 + a2 * max(1.0 - cos_o * cos_o, 0.0) / (cos_o * cos_o)) - 1.0);
-    let g2 = 1.0 / (1.0 + lambda_i + lambda_o);
+    let spec = specular_scale(cos_h, dot(nxh, nxh), cos_i, cos_o, alpha * alpha);
     let f_h = film_clamped(layers, abs(dot(wo, h)));
-    let spec = d * g2 / (4.0 * cos_i * cos_o);
-
-    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
-    let ki = (1.0 - eta2) + eta2 * cos_i * cos_i;
-    let ko = (1.0 - eta2) + eta2 * cos_o * cos_o;
     var diffuse = vec3<f32>(0.0);
-    if (with_diffuse && ki > 0.0 && ko > 0.0) {
-        let f_i = film_clamped(layers, cos_i);
-        diffuse = (vec3<f32>(1.0) - f_i) * (vec3<f32>(1.0) - f_o) * max(layers.albedo, vec3<f32>(0.0)) / PI;
-        if (HAS_ABSORPTION) {
-            let path = 1.0 / max(sqrt(ki), COS_MIN) + 1.0 / max(sqrt(ko), COS_MIN);
-            diffuse *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) * path);
-        }
+    if (with_diffuse) {
+        diffuse = diffuse_lobe(layers, cos_i, cos_o, film_clamped(layers, cos_i), f_o);
     }
     return f_h * spec + diffuse;
 }
-

@@ -1,14 +1,13 @@
 // Film colour F_film(d, cos θ0) as linear sRGB, by the method chosen with the FILM_METHOD
-// override constant: the WGSL twins of optics::lut (0), optics::methods rgb3 (1),
-// spectral-N (2) and gaussian-fit (3), and the plain Fresnel reflectance of n0|n2 for a
-// material without a film (4). A pipeline specialised for one method carries only its code
-// (the constant is resolved before the driver compiles the shader).
+// override constant: the WGSL twins of optics::lut (FILM_LUT), optics::methods rgb3
+// (FILM_RGB3), spectral-N (FILM_SPECTRAL_N) and gaussian-fit (FILM_GAUSSIAN_FIT), and the
+// plain Fresnel reflectance of n0|n2 for a material without a film (FILM_NONE). A pipeline
+// specialised for one method carries only its code (the constant is resolved before the
+// driver compiles the shader). The codes, the LUT's thickness axis (FINE_MAX_NM,
+// COARSE_MAX_NM), the rgb3 wavelengths and the Belcour–Barla fits come from the generated
+// prelude (render::shaders).
 
-override FILM_METHOD: u32 = 0u;
-
-// Thickness axis of the LUT, as optics::lut::FINE_MAX_NM and COARSE_MAX_NM.
-const FINE_MAX_NM: f32 = 2000.0;
-const COARSE_MAX_NM: f32 = 20000.0;
+override FILM_METHOD: u32 = FILM_LUT;
 
 struct FilmInfo {
     n_cos: u32,
@@ -86,7 +85,7 @@ fn harmonics(a: vec2<f32>, b: vec2<f32>) -> Harmonics {
     let q = -cmul(a, b);
     let k = cmul(b, vec2<f32>(1.0, 0.0) - cmul(a, a));
     let k2 = dot(k, k);
-    let inv = 1.0 / max(1.0 - dot(q, q), 1e-6);
+    let inv = 1.0 / max(1.0 - dot(q, q), HARMONICS_DENOM_MIN);
     return Harmonics(dot(a, a) + k2 * inv, cmul(k, vec2<f32>(a.x, -a.y)) + q * (k2 * inv), q);
 }
 
@@ -117,7 +116,7 @@ fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
 }
 
 fn sinc(x: f32) -> f32 {
-    if (abs(x) < 1e-4) {
+    if (abs(x) < SINC_SMALL) {
         return 1.0;
     }
     return sin(x) / x;
@@ -128,9 +127,9 @@ fn series(h: Harmonics, phase: f32, box_width: f32) -> f32 {
     let z = vec2<f32>(cos(phase), sin(phase));
     let one = vec2<f32>(1.0, 0.0);
     var mean: vec2<f32>;
-    if (box_width < 1e-3) {
+    if (box_width < BOX_NARROW_RAD) {
         mean = cdiv(cmul(h.d, z), one - cmul(h.q, z));
-    } else if (dot(h.q, h.q) < 1e-12) {
+    } else if (dot(h.q, h.q) < Q_NEGLIGIBLE) {
         mean = cmul(h.d, z) * sinc(0.5 * box_width);
     } else {
         let half = 0.5 * box_width;
@@ -147,14 +146,14 @@ fn band_reflectance(f: Film, n1: f32, thickness_nm: f32, wavelength_nm: f32, ban
     return 0.5 * (series(f.s, phase, box_width) + series(f.p, phase, box_width));
 }
 
-// rgb3: 650 / 550 / 450 nm, each prefiltered over 100 nm (optics::methods::RGB3_NM).
+// rgb3: three wavelengths (RGB3_NM), each prefiltered over RGB3_BAND_NM.
 fn film_rgb3(thickness_nm: f32, cos0: f32) -> vec3<f32> {
     let n = film_info.iors_band;
     let f = film_coefficients(n.x, n.y, n.z, cos0);
     return vec3<f32>(
-        band_reflectance(f, n.y, thickness_nm, 650.0, 100.0),
-        band_reflectance(f, n.y, thickness_nm, 550.0, 100.0),
-        band_reflectance(f, n.y, thickness_nm, 450.0, 100.0),
+        band_reflectance(f, n.y, thickness_nm, RGB3_NM.x, RGB3_BAND_NM),
+        band_reflectance(f, n.y, thickness_nm, RGB3_NM.y, RGB3_BAND_NM),
+        band_reflectance(f, n.y, thickness_nm, RGB3_NM.z, RGB3_BAND_NM),
     );
 }
 
@@ -169,10 +168,10 @@ fn film_spectral_n(thickness_nm: f32, cos0: f32) -> vec3<f32> {
     return rgb;
 }
 
-// Belcour & Barla (2017) Gaussian fits, as optics::methods (BB_VAL, BB_POS, BB_VAR, BB_X2,
-// BB_NORM; three harmonics).
-fn bb_lobe(val: f32, pos: f32, var_: f32, phase: f32, arg: f32) -> f32 {
-    return val * sqrt(2.0 * PI * var_) / 1.0685e-7 * cos(pos * phase + arg) * exp(-var_ * phase * phase);
+// Belcour & Barla (2017) Gaussian fits, optics::methods::BB_LOBES as (X, Y, Z, X's second
+// lobe): amplitude with its normalisation folded in (BB_AMP), centre, variance.
+fn bb_lobes(phase: f32, arg: f32) -> vec4<f32> {
+    return BB_AMP * cos(BB_POS * phase + vec4<f32>(arg)) * exp(-BB_VAR * phase * phase);
 }
 
 fn film_gaussian_fit(thickness_nm: f32, cos0: f32) -> vec3<f32> {
@@ -186,14 +185,12 @@ fn film_gaussian_fit(thickness_nm: f32, cos0: f32) -> vec3<f32> {
             h = f.p;
         }
         var c = h.d;
-        for (var m = 1u; m <= 3u; m++) {
+        for (var m = 1u; m <= GAUSSIAN_FIT_HARMONICS; m++) {
             let phase = 2.0 * PI * (f32(m) * opd) * 1e-9;
             let mag = length(c);
             let arg = atan2(c.y, c.x);
-            xyz.x += mag * (bb_lobe(5.4856e-13, 1.6810e+06, 4.3278e+09, phase, arg)
-                + bb_lobe(9.7470e-14, 2.2399e+06, 4.5282e+09, phase, arg));
-            xyz.y += mag * bb_lobe(4.4201e-13, 1.7953e+06, 9.3046e+09, phase, arg);
-            xyz.z += mag * bb_lobe(5.2481e-13, 2.2084e+06, 6.6121e+09, phase, arg);
+            let lobes = bb_lobes(phase, arg);
+            xyz += mag * vec3<f32>(lobes.x + lobes.w, lobes.y, lobes.z);
             c = cmul(c, h.q);
         }
     }
@@ -213,16 +210,16 @@ fn film_none(cos0: f32) -> vec3<f32> {
 
 fn film_rgb(thickness_nm: f32, cos0: f32) -> vec3<f32> {
     switch FILM_METHOD {
-        case 1u: {
+        case FILM_RGB3: {
             return film_rgb3(thickness_nm, cos0);
         }
-        case 2u: {
+        case FILM_SPECTRAL_N: {
             return film_spectral_n(thickness_nm, cos0);
         }
-        case 3u: {
+        case FILM_GAUSSIAN_FIT: {
             return film_gaussian_fit(thickness_nm, cos0);
         }
-        case 4u: {
+        case FILM_NONE: {
             return film_none(cos0);
         }
         default: {

@@ -9,7 +9,7 @@ fn plain_brdf(albedo: vec3<f32>, roughness: f32, n: vec3<f32>, wi: vec3<f32>, wo
         return vec3<f32>(0.0);
     }
     let h = normalize(wi + wo);
-    let alpha = max(roughness * roughness, 0.001);
+    let alpha = max(roughness * roughness, ALPHA_MIN);
     let a2 = alpha * alpha;
     let cos_h = max(dot(n, h), 0.0);
     let t = cos_h * cos_h * (a2 - 1.0) + 1.0;

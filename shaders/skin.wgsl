@@ -2,11 +2,11 @@
 // a single map on the body, and the G-buffer the CPU reference shades
 // (src/render/reference.rs is this file's CPU twin: keep the two in step).
 
-// Layer stages of the thesis' Fig. 5.12: 0 = diffuse only, 1 = diffuse + normal map,
-// 2 = the thin film alone, 3 = all layers.
-override STAGE: u32 = 3u;
-// 0 = shade; 1..5 = show the color, height, normal, roughness or iridescence map unlit.
-override VIEW_MAP: u32 = 0u;
+// Layer stages of the thesis' Fig. 5.12: STAGE_DIFFUSE, STAGE_DIFFUSE_NORMAL (+ normal
+// map), STAGE_FILM (the thin film alone), STAGE_ALL (codes from the generated prelude).
+override STAGE: u32 = STAGE_ALL;
+// VIEW_SHADED = shade; VIEW_COLOR ... VIEW_IRIDESCENCE = show that map unlit.
+override VIEW_MAP: u32 = VIEW_SHADED;
 // Which half of the G-buffer fs_gbuffer writes (two passes keep each under 32 bytes/pixel).
 override GBUFFER_PART: u32 = 0u;
 
@@ -14,22 +14,13 @@ fn layers_of(m: Material) -> Layers {
     return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, scene.optical_depth.rgb, m.albedo);
 }
 
-// Ambient light from the sky gradient, the same formula as reference::ambient: the sky
-// seen along the normal enters the pigment layer through the film (1 - F at the view angle)
-// and is attenuated along the view path plus one layer thickness; the sky seen along the
-// mirror direction is reflected by the film.
+// Ambient light from the sky gradient, as reference::shade_pixel: the sky seen along the
+// mirror direction is reflected by the film; the sky seen along the normal goes through
+// the layer model (brdf.wgsl's ambient_diffuse).
 fn ambient(m: Material, n: vec3<f32>, wo: vec3<f32>, f_o: vec3<f32>, with_diffuse: bool) -> vec3<f32> {
-    let cos_o = max(dot(n, wo), COS_MIN);
     var result = sky(reflect(-wo, n)) * f_o;
     if (with_diffuse) {
-        var base = sky(n) * (vec3<f32>(1.0) - f_o) * m.albedo;
-        if (HAS_ABSORPTION) {
-            let eta = scene.film.z / scene.film.w;
-            let k = (1.0 - eta * eta) + eta * eta * cos_o * cos_o;
-            let path = 1.0 / max(sqrt(max(k, 0.0)), COS_MIN) + 1.0;
-            base *= exp(-max(scene.optical_depth.rgb, vec3<f32>(0.0)) * path);
-        }
-        result += base;
+        result += sky(n) * ambient_diffuse(layers_of(m), max(dot(n, wo), COS_MIN), f_o);
     }
     return result;
 }
@@ -37,9 +28,9 @@ fn ambient(m: Material, n: vec3<f32>, wo: vec3<f32>, f_o: vec3<f32>, with_diffus
 fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
     let wo = normalize(scene.camera.xyz - world);
     var radiance = vec3<f32>(0.0);
-    if (STAGE <= 1u) {
+    if (STAGE == STAGE_DIFFUSE || STAGE == STAGE_DIFFUSE_NORMAL) {
         var n = m.normal;
-        if (STAGE == 0u) {
+        if (STAGE == STAGE_DIFFUSE) {
             n = m.geometric;
         }
         for (var i = 0u; i < 2u; i++) {
@@ -55,25 +46,25 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
         let wi = scene.light_dir[i].xyz;
         let cos_i = max(dot(m.normal, wi), 0.0);
         if (scene.light_dir[i].w > 0.0 && cos_i > 0.0) {
-            let f = skin_brdf_seen(layers, m.normal, wi, wo, f_o, STAGE == 3u);
+            let f = skin_brdf_seen(layers, m.normal, wi, wo, f_o, STAGE == STAGE_ALL);
             radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * f * cos_i;
         }
     }
-    return radiance + ambient(m, m.normal, wo, f_o, STAGE == 3u);
+    return radiance + ambient(m, m.normal, wo, f_o, STAGE == STAGE_ALL);
 }
 
 fn map_view(m: Material) -> vec3<f32> {
     switch VIEW_MAP {
-        case 1u: {
+        case VIEW_COLOR: {
             return m.albedo;
         }
-        case 2u: {
+        case VIEW_HEIGHT: {
             return vec3<f32>(m.height);
         }
-        case 3u: {
+        case VIEW_NORMAL: {
             return m.map_normal * 0.5 + vec3<f32>(0.5);
         }
-        case 4u: {
+        case VIEW_ROUGHNESS: {
             return vec3<f32>(m.roughness);
         }
         default: {
@@ -85,7 +76,7 @@ fn map_view(m: Material) -> vec3<f32> {
 @fragment
 fn fs_skin(in: VertexOut) -> @location(0) vec4<f32> {
     let m = sample_material(in);
-    if (VIEW_MAP != 0u) {
+    if (VIEW_MAP != VIEW_SHADED) {
         return vec4<f32>(map_view(m), 1.0);
     }
     return vec4<f32>(shade(m, in.world), 1.0);
@@ -119,7 +110,7 @@ fn fs_ground(in: VertexOut) -> @location(0) vec4<f32> {
     // A box-filtered checker (the analytic integral over the pixel footprint), so the far
     // ground fades to grey instead of aliasing.
     let p = in.uv * 2.0;
-    let w = fwidth(p) + vec2<f32>(1e-4);
+    let w = fwidth(p) + vec2<f32>(1e-4); // not a shared constant: keeps w > 0 on flat ground
     let i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
     let checker = mix(0.07, 0.09, 0.5 - 0.5 * i.x * i.y);
     var radiance = sky(n) * checker;

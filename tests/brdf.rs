@@ -1,9 +1,10 @@
 //! The multi-layer BRDF: energy (white furnace), the whole input domain (proptest), the f32
 //! path against f64, and each real-time method's f32 function against its own f64 form.
+//! Every test that evaluates the BRDF runs over every layer model (`Model::ALL`).
 
 use proptest::prelude::*;
 use snakeskin::optics::accuracy::{GRID_MATERIALS, Sample, grid};
-use snakeskin::optics::brdf::{ALPHA_MIN, Layers, Layers32, eval, eval_f32, furnace_albedo};
+use snakeskin::optics::brdf::{ALPHA_MIN, Layers, Layers32, Model};
 use snakeskin::optics::film::{Stack, airy, incoherent};
 use snakeskin::optics::lab::{ciede2000, linear_srgb_to_lab};
 use snakeskin::optics::lut::Lut;
@@ -18,13 +19,17 @@ fn white_layers(stack: Stack, roughness: f64) -> Layers {
 #[test]
 fn furnace_machinery_integrates_known_cases() {
     // No film reflection: all light reaches the white Lambertian base, albedo exactly 1.
+    // (The thesis model has no (n0/n2)² factor: with no film at all its diffuse lobe is the
+    // bare Lambertian base, which the integrator must return as 1.)
     let layers = white_layers(Stack::THESIS, 0.5);
-    let a = furnace_albedo(&layers, 0.7, &|_| [0.0; 3], 64);
+    let a = Model::Thesis.furnace_albedo(&layers, 0.7, &|_| [0.0; 3], 64);
     assert!(a.iter().all(|v| (v - 1.0).abs() < 2e-3), "{a:?}");
     // A perfect mirror film on a smooth surface at normal view reflects everything.
     let mirror = white_layers(Stack::THESIS, 0.0);
-    let a = furnace_albedo(&mirror, 1.0, &|_| [1.0; 3], 64);
-    assert!(a.iter().all(|v| (v - 1.0).abs() < 2e-3), "{a:?}");
+    for model in Model::ALL {
+        let a = model.furnace_albedo(&mirror, 1.0, &|_| [1.0; 3], 64);
+        assert!(a.iter().all(|v| (v - 1.0).abs() < 2e-3), "{model:?} {a:?}");
+    }
 }
 
 #[test]
@@ -33,18 +38,18 @@ fn white_furnace_never_exceeds_one() {
     let stacks =
         [GRID_MATERIALS.to_vec(), vec![Stack { n0: 1.0, n1: 1.0, n2: 1.5 }, Stack { n0: 1.0, n1: 2.5, n2: 1.2 }]]
             .concat();
-    for stack in stacks {
+    for (stack, model) in stacks.into_iter().flat_map(|s| Model::ALL.map(|m| (s, m))) {
         let lut = Lut::bake(stack, 16, 64, 8);
         for thickness in [0.0, 250.0, 400.0, 900.0, 2400.0, 1e7] {
             let film = |c: f64| lut.lookup_f64(thickness, c);
             for roughness in [0.0, 0.05, 0.2, 0.5, 1.0] {
                 for cos_o in [1.0, 0.7, 0.3, 0.1, 0.02] {
-                    let a = furnace_albedo(&white_layers(stack, roughness), cos_o, &film, 48);
+                    let a = model.furnace_albedo(&white_layers(stack, roughness), cos_o, &film, 48);
                     worst = a.iter().cloned().fold(worst, f64::max);
                     // 2e-3: the stratified quadrature's error, measured on the known cases above.
                     assert!(
                         a.iter().all(|v| *v <= 1.0 + 2e-3),
-                        "{stack:?} d={thickness} r={roughness} cos={cos_o}: {a:?}"
+                        "{model:?} {stack:?} d={thickness} r={roughness} cos={cos_o}: {a:?}"
                     );
                 }
             }
@@ -57,9 +62,11 @@ fn white_furnace_never_exceeds_one() {
 fn furnace_with_the_exact_spectral_film() {
     let stack = Stack::THESIS;
     let film = |c: f64| snakeskin::optics::film_rgb_reference(stack, 400.0, c);
-    for (roughness, cos_o) in [(0.3, 0.9), (0.8, 0.2)] {
-        let a = furnace_albedo(&white_layers(stack, roughness), cos_o, &film, 16);
-        assert!(a.iter().all(|v| *v <= 1.0 + 5e-3 && *v > 0.3), "{a:?}");
+    for model in Model::ALL {
+        for (roughness, cos_o) in [(0.3, 0.9), (0.8, 0.2)] {
+            let a = model.furnace_albedo(&white_layers(stack, roughness), cos_o, &film, 16);
+            assert!(a.iter().all(|v| *v <= 1.0 + 5e-3 && *v > 0.3), "{model:?} {a:?}");
+        }
     }
 }
 
@@ -78,10 +85,11 @@ proptest! {
         n0 in 1.0f64..2.0, n2 in 1.0f64..3.0, roughness in 0.0f64..1.0,
         tau in prop_oneof![Just(0.0), 0.0f64..60.0], albedo in 0.0f64..1.0,
         film_r in prop_oneof![Just(0.0), Just(1.0), -0.1f64..1.1],
+        model in proptest::sample::select(Model::ALL.to_vec()),
     ) {
         let layers = Layers { n0, n2, roughness, optical_depth: [tau; 3], albedo: [albedo; 3] };
         let normal = if zero_normal { [0.0; 3] } else { [nx, ny, nz] };
-        let value = eval(&layers, normal, unit(ti, pi), unit(to, po), &|_| [film_r; 3]);
+        let value = model.eval(&layers, normal, unit(ti, pi), unit(to, po), &|_| [film_r; 3]);
         for v in value.total() {
             prop_assert!(v.is_finite() && v >= 0.0, "{value:?}");
         }
@@ -106,7 +114,9 @@ fn f32_brdf_follows_the_f64_brdf() {
     let stack = Stack::THESIS;
     let lut = Lut::bake(stack, 32, 128, 16);
     let mut worst: f64 = 0.0;
-    for (i, roughness) in [0.05, 0.3, 0.9].into_iter().enumerate() {
+    for (i, roughness, model) in
+        [0.05, 0.3, 0.9].into_iter().enumerate().flat_map(|(i, r)| Model::ALL.map(|m| (i, r, m)))
+    {
         for t in 0..20 {
             let thickness = 100.0 * t as f64;
             let layers =
@@ -121,8 +131,8 @@ fn f32_brdf_follows_the_f64_brdf() {
             };
             let (wi, wo) = (unit(0.3 + 0.1 * i as f64, 0.5), unit(0.2 + 0.07 * t as f64, 2.0));
             let n = [0.1, -0.05, 1.0];
-            let f64v = eval(&layers, n, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
-            let f32v = eval_f32(&layers32, n.map(|x| x as f32), wi.map(|x| x as f32), wo.map(|x| x as f32), &lut);
+            let f64v = model.eval(&layers, n, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
+            let f32v = model.eval_f32(&layers32, n.map(|x| x as f32), wi.map(|x| x as f32), wo.map(|x| x as f32), &lut);
             for c in 0..3 {
                 // Relative to 1 + f: f32 carries ~7 digits, the peak of D amplifies rounding.
                 let dev = (f32v[c] as f64 - f64v[c]).abs() / (1.0 + f64v[c]);
@@ -190,8 +200,10 @@ fn thick_films_converge_to_the_incoherent_limit() {
 #[test]
 fn roughness_zero_uses_the_documented_floor() {
     let layers = Layers { n0: 1.0, n2: 2.0, roughness: 0.0, optical_depth: [0.0; 3], albedo: [0.0; 3] };
-    let v = eval(&layers, [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], &|_| [1.0; 3]);
     // At the mirror direction D = 1 / (π α²) with α = ALPHA_MIN and G2 = 1: f = D / 4.
     let expected = 1.0 / (std::f64::consts::PI * ALPHA_MIN * ALPHA_MIN) / 4.0;
-    assert!((v.specular[0] - expected).abs() / expected < 1e-9, "{v:?}");
+    for model in Model::ALL {
+        let v = model.eval(&layers, [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], &|_| [1.0; 3]);
+        assert!((v.specular[0] - expected).abs() / expected < 1e-9, "{model:?} {v:?}");
+    }
 }

@@ -3,7 +3,7 @@
 //! skip with a printed reason, unless SNAKESKIN_REQUIRE_GPU=1 (set in .ci/run), which makes
 //! a missing adapter a failure.
 
-use snakeskin::optics::brdf::{Layers32, eval_f32};
+use snakeskin::optics::brdf::{Layers32, Model};
 use snakeskin::optics::film::Stack;
 use snakeskin::optics::lut::Lut;
 use snakeskin::render::brdf_eval::{GpuSample, eval_on_gpu};
@@ -89,30 +89,35 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
         samples.push(GpuSample::new(&l, normal, wi, wo));
         layers.push((l, normal, wi, wo));
     }
-    let gpu_values = eval_on_gpu(&gpu, &lut, &samples).expect("gpu evaluation");
     // The GPU holds the table as a half-float texture: its CPU twin reads the same values.
-    let lut = Lut { texels: lut.texels.iter().map(|t| t.map(round_to_f16)).collect(), ..lut };
-    assert_eq!(gpu_values.len(), samples.len());
-    let mut worst: f32 = 0.0;
-    let mut non_zero = 0;
-    for ((l, n, wi, wo), g) in layers.iter().zip(&gpu_values) {
-        let cpu = eval_f32(l, *n, *wi, *wo, &lut);
-        if cpu.iter().any(|v| *v > 0.0) {
-            non_zero += 1;
+    let lut_f16 = Lut { texels: lut.texels.iter().map(|t| t.map(round_to_f16)).collect(), ..lut.clone() };
+    for model in Model::ALL {
+        let gpu_values = eval_on_gpu(&gpu, model, &lut, &samples).expect("gpu evaluation");
+        assert_eq!(gpu_values.len(), samples.len());
+        let mut worst: f32 = 0.0;
+        let mut non_zero = 0;
+        for ((l, n, wi, wo), g) in layers.iter().zip(&gpu_values) {
+            let cpu = model.eval_f32(l, *n, *wi, *wo, &lut_f16);
+            if cpu.iter().any(|v| *v > 0.0) {
+                non_zero += 1;
+            }
+            for c in 0..3 {
+                assert!(g[c].is_finite(), "{model:?}: GPU value not finite for {l:?}");
+                // Relative to 1 + f: the GPU's sqrt, exp and division may round differently
+                // from the CPU's, and GGX's peak (up to ~3e5 at roughness 0) amplifies that.
+                worst = worst.max((g[c] - cpu[c]).abs() / (1.0 + cpu[c].abs()));
+            }
         }
-        for c in 0..3 {
-            assert!(g[c].is_finite(), "GPU value not finite for {l:?}");
-            // Relative to 1 + f: the GPU's sqrt, exp and division may round differently
-            // from the CPU's, and GGX's peak (up to ~3e5 at roughness 0) amplifies that.
-            worst = worst.max((g[c] - cpu[c]).abs() / (1.0 + cpu[c].abs()));
-        }
+        eprintln!(
+            "{model:?}: max |gpu - cpu| / (1 + cpu) = {worst:e} over {} samples ({non_zero} non-zero)",
+            samples.len()
+        );
+        assert!(non_zero > 5000, "the inputs exercise the BRDF: {non_zero}");
+        // Measured 4.2e-7 on lavapipe (llvmpipe, Vulkan), whose texture filter interpolates in
+        // f32; 1e-4 leaves room for GPUs with faster, less exact sqrt and exp. (GPUs that
+        // quantise bilinear weights to 8 bits may need more: up to 1/512 of a texel step.)
+        assert!(worst < 1e-4, "{model:?}: GPU and CPU BRDF differ by {worst}");
     }
-    eprintln!("max |gpu - cpu| / (1 + cpu) = {worst:e} over {} samples ({non_zero} non-zero)", samples.len());
-    assert!(non_zero > 5000, "the inputs exercise the BRDF: {non_zero}");
-    // Measured 4.2e-7 on lavapipe (llvmpipe, Vulkan), whose texture filter interpolates in
-    // f32; 1e-4 leaves room for GPUs with faster, less exact sqrt and exp. (GPUs that
-    // quantise bilinear weights to 8 bits may need more: up to 1/512 of a texel step.)
-    assert!(worst < 1e-4, "GPU and CPU BRDF differ by {worst}");
 }
 
 #[test]
@@ -136,7 +141,7 @@ fn bench_gpu_reports_both_costs() {
 
 #[test]
 fn every_gpu_film_method_matches_its_cpu_f32_twin() {
-    use snakeskin::optics::brdf::{Layers, eval};
+    use snakeskin::optics::brdf::Layers;
     use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
     use snakeskin::render::brdf_eval::eval_timed;
     use snakeskin::render::film::GpuFilmMethod;
@@ -167,7 +172,8 @@ fn every_gpu_film_method_matches_its_cpu_f32_twin() {
         (GpuFilmMethod::GaussianFit, |d, c| gaussian_fit_f32(1.0, 1.55, 2.0, d, c)),
     ];
     for (method, film) in methods {
-        let (gpu_values, _) = eval_timed(&gpu, stack, &lut, method, &samples, 1).expect("gpu evaluation");
+        let (gpu_values, _) =
+            eval_timed(&gpu, Model::Thesis, stack, &lut, method, &samples, 1).expect("gpu evaluation");
         let mut worst = 0.0f64;
         for ((l, wi, wo), g) in inputs.iter().zip(&gpu_values) {
             let layers = Layers {
@@ -178,10 +184,11 @@ fn every_gpu_film_method_matches_its_cpu_f32_twin() {
                 albedo: l.albedo.map(|v| v as f64),
             };
             let d = l.thickness_nm;
-            let cpu = eval(&layers, [0.0, 0.0, 1.0], wi.map(|v| v as f64), wo.map(|v| v as f64), &|c| {
-                film(d, c as f32).map(|v| v as f64)
-            })
-            .total();
+            let cpu = Model::Thesis
+                .eval(&layers, [0.0, 0.0, 1.0], wi.map(|v| v as f64), wo.map(|v| v as f64), &|c| {
+                    film(d, c as f32).map(|v| v as f64)
+                })
+                .total();
             for c in 0..3 {
                 assert!(g[c].is_finite(), "{}: not finite", method.name());
                 worst = worst.max((g[c] as f64 - cpu[c]).abs() / (1.0 + cpu[c].abs()));

@@ -57,12 +57,24 @@ pub struct Film32 {
     pub cos1: f32,
 }
 
+/// Floor on 1 − |q|² in the harmonics' normalisation: |q| < 1 for any physical interface
+/// pair, and 1e-6 keeps f32 finite as |q| → 1 at grazing. (`film.wgsl` reads it, and the
+/// three thresholds below, from the generated prelude.)
+pub const HARMONICS_DENOM_MIN: f32 = 1e-6;
+/// Below this |x|, sinc(x) = 1 in f32 (the next term, x²/6, is under 2e-9).
+pub const SINC_SMALL: f32 = 1e-4;
+/// Below this box width (rad) the prefiltered series' log difference cancels in f32 and the
+/// unfiltered closed form is used (its error there is O(Δ²) < 1e-6).
+pub const BOX_NARROW_RAD: f32 = 1e-3;
+/// |q|² below this: the series is a single term (no multiple reflections to sum).
+pub const Q_NEGLIGIBLE: f32 = 1e-12;
+
 #[inline]
 fn harmonics(a: C32, b: C32) -> Harmonics32 {
     let q = scale(mul(a, b), -1.0);
     let k = mul(b, sub([1.0, 0.0], mul(a, a)));
     let k2 = norm_sqr(k);
-    let inv = 1.0 / (1.0 - norm_sqr(q)).max(1e-6);
+    let inv = 1.0 / (1.0 - norm_sqr(q)).max(HARMONICS_DENOM_MIN);
     Harmonics32 { c0: norm_sqr(a) + k2 * inv, d: add(mul(k, conj(a)), scale(q, k2 * inv)), q }
 }
 
@@ -89,7 +101,7 @@ pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
 
 #[inline]
 fn sinc(x: f32) -> f32 {
-    if x.abs() < 1e-4 { 1.0 } else { x.sin() / x }
+    if x.abs() < SINC_SMALL { 1.0 } else { x.sin() / x }
 }
 
 #[inline]
@@ -98,16 +110,15 @@ fn ln(a: C32) -> C32 {
 }
 
 /// Box-prefiltered series in closed form (see `series.rs`): the mean of D z / (1 − q z)
-/// over φ ± Δ/2 is (i D / q) [ln(1 − q z₊) − ln(1 − q z₋)] / Δ. Below a box of 1e-3 rad the
-/// log difference cancels in f32 and the unfiltered closed form is used (its error there is
-/// O(Δ²) < 1e-6).
+/// over φ ± Δ/2 is (i D / q) [ln(1 − q z₊) − ln(1 − q z₋)] / Δ. Below BOX_NARROW_RAD the
+/// unfiltered closed form is used.
 #[inline]
 fn series(h: &Harmonics32, phase: f32, box_width: f32) -> f32 {
     let z = [phase.cos(), phase.sin()];
     let one: C32 = [1.0, 0.0];
-    let mean = if box_width < 1e-3 {
+    let mean = if box_width < BOX_NARROW_RAD {
         div(mul(h.d, z), sub(one, mul(h.q, z)))
-    } else if norm_sqr(h.q) < 1e-12 {
+    } else if norm_sqr(h.q) < Q_NEGLIGIBLE {
         scale(mul(h.d, z), sinc(0.5 * box_width))
     } else {
         let half = 0.5 * box_width;

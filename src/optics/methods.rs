@@ -168,11 +168,21 @@ pub fn rgb3_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32
 /// (supplemental material; the same constants as the glTF KHR_materials_iridescence sample
 /// code): per channel amplitude, centre and variance, plus a second lobe for X, normalised
 /// by 1.0685e-7 so that S(0) is illuminant E's white, XYZ = (1, 1, 1).
-const BB_VAL: [f64; 3] = [5.4856e-13, 4.4201e-13, 5.2481e-13];
-const BB_POS: [f64; 3] = [1.6810e+06, 1.7953e+06, 2.2084e+06];
-const BB_VAR: [f64; 3] = [4.3278e+09, 9.3046e+09, 6.6121e+09];
-const BB_X2: (f64, f64, f64) = (9.7470e-14, 2.2399e+06, 4.5282e+09);
-const BB_NORM: f64 = 1.0685e-7;
+/// (amplitude, centre, variance) per lobe: X, Y, Z, then X's second lobe. `film.wgsl` reads
+/// them from `render::shaders::generated_constants` (as `BB_AMP`, `BB_POS`, `BB_VAR`).
+pub const BB_LOBES: [(f64, f64, f64); 4] = [
+    (5.4856e-13, 1.6810e+06, 4.3278e+09),
+    (4.4201e-13, 1.7953e+06, 9.3046e+09),
+    (5.2481e-13, 2.2084e+06, 6.6121e+09),
+    (9.7470e-14, 2.2399e+06, 4.5282e+09),
+];
+pub const BB_NORM: f64 = 1.0685e-7;
+
+/// A lobe's amplitude with its normalisation folded in, val √(2π var) / BB_NORM: what the
+/// f32 paths (Rust and WGSL) multiply by.
+pub fn bb_amplitude((val, _, var): (f64, f64, f64)) -> f64 {
+    val * (2.0 * std::f64::consts::PI * var).sqrt() / BB_NORM
+}
 /// Harmonics Belcour & Barla's method sums (they use 2; 3 costs little more).
 pub const GAUSSIAN_FIT_HARMONICS: usize = 3;
 
@@ -180,11 +190,11 @@ pub const GAUSSIAN_FIT_HARMONICS: usize = 3;
 fn bb_sensitivity(c_re: f64, c_im: f64, opd_nm: f64) -> [f64; 3] {
     let phase = 2.0 * std::f64::consts::PI * opd_nm * 1e-9;
     let (mag, arg) = ((c_re * c_re + c_im * c_im).sqrt(), c_im.atan2(c_re));
-    let lobe = |val: f64, pos: f64, var: f64| {
+    let lobe = |(val, pos, var): (f64, f64, f64)| {
         val * (2.0 * std::f64::consts::PI * var).sqrt() * (pos * phase + arg).cos() * (-var * phase * phase).exp()
     };
-    let mut xyz = [0, 1, 2].map(|i| lobe(BB_VAL[i], BB_POS[i], BB_VAR[i]));
-    xyz[0] += lobe(BB_X2.0, BB_X2.1, BB_X2.2);
+    let mut xyz = [0, 1, 2].map(|i| lobe(BB_LOBES[i]));
+    xyz[0] += lobe(BB_LOBES[3]);
     xyz.map(|v| mag * v / BB_NORM)
 }
 
@@ -228,14 +238,12 @@ pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32)
         for m in 1..=GAUSSIAN_FIT_HARMONICS {
             let phase = 2.0 * std::f32::consts::PI * (m as f32 * opd) * 1e-9;
             let (mag, arg) = ((c[0] * c[0] + c[1] * c[1]).sqrt(), c[1].atan2(c[0]));
-            let lobe = |val: f64, pos: f64, var: f64| {
-                (val * (2.0 * std::f64::consts::PI * var).sqrt() / BB_NORM) as f32
-                    * (pos as f32 * phase + arg).cos()
-                    * (-(var as f32) * phase * phase).exp()
+            let lobe = |l: (f64, f64, f64)| {
+                bb_amplitude(l) as f32 * (l.1 as f32 * phase + arg).cos() * (-(l.2 as f32) * phase * phase).exp()
             };
-            xyz[0] += mag * (lobe(BB_VAL[0], BB_POS[0], BB_VAR[0]) + lobe(BB_X2.0, BB_X2.1, BB_X2.2));
-            xyz[1] += mag * lobe(BB_VAL[1], BB_POS[1], BB_VAR[1]);
-            xyz[2] += mag * lobe(BB_VAL[2], BB_POS[2], BB_VAR[2]);
+            xyz[0] += mag * (lobe(BB_LOBES[0]) + lobe(BB_LOBES[3]));
+            xyz[1] += mag * lobe(BB_LOBES[1]);
+            xyz[2] += mag * lobe(BB_LOBES[2]);
             c = mul(c, h.q);
         }
     }

@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use super::brdf::{Layers, Layers32, eval, eval_f32, furnace_albedo};
+use super::brdf::{Layers, Layers32, Model};
 use super::film::{Stack, airy, incoherent};
 use super::lut::Lut;
 use crate::ops::hash;
@@ -26,6 +26,8 @@ pub struct StressReport {
     /// Largest |f32 − f64| / (1 + |f64|) of the BRDF.
     pub max_f32_dev: f64,
     pub furnace_evaluations: u64,
+    /// The layer models every sample went through (the bounds above are over all of them).
+    pub models: Vec<&'static str>,
 }
 
 /// The materials the stress draws from: the thesis default and its edge cases.
@@ -106,6 +108,7 @@ fn empty() -> StressReport {
         max_albedo: 0.0,
         max_f32_dev: 0.0,
         furnace_evaluations: 0,
+        models: Model::ALL.iter().map(|m| m.name()).collect(),
     }
 }
 
@@ -154,7 +157,6 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
 
     let lut = &luts[material];
     let layers = Layers { n0: stack.n0, n2: stack.n2, roughness, optical_depth: [tau; 3], albedo: [1.0, 0.5, 0.0] };
-    let value = eval(&layers, normal, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
     let layers32 = Layers32 {
         n0: stack.n0 as f32,
         n2: stack.n2 as f32,
@@ -163,17 +165,21 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
         albedo: [1.0, 0.5, 0.0],
         thickness_nm: thickness as f32,
     };
-    let value32 = eval_f32(&layers32, normal.map(|x| x as f32), wi.map(|x| x as f32), wo.map(|x| x as f32), lut);
-    count(acc, &value);
-    count(acc, &value32.map(|v| v as f64));
-    for c in 0..3 {
-        if value[c] < 0.0 || value32[c] < 0.0 {
-            // Negative radiance is as wrong as NaN; report it there.
-            acc.nan += 1;
-        }
-        let dev = (value32[c] as f64 - value[c]).abs() / (1.0 + value[c].abs());
-        if dev.is_finite() {
-            acc.max_f32_dev = acc.max_f32_dev.max(dev);
+    for model in Model::ALL {
+        let value = model.eval(&layers, normal, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
+        let value32 =
+            model.eval_f32(&layers32, normal.map(|x| x as f32), wi.map(|x| x as f32), wo.map(|x| x as f32), lut);
+        count(acc, &value);
+        count(acc, &value32.map(|v| v as f64));
+        for c in 0..3 {
+            if value[c] < 0.0 || value32[c] < 0.0 {
+                // Negative radiance is as wrong as NaN; report it there.
+                acc.nan += 1;
+            }
+            let dev = (value32[c] as f64 - value[c]).abs() / (1.0 + value[c].abs());
+            if dev.is_finite() {
+                acc.max_f32_dev = acc.max_f32_dev.max(dev);
+            }
         }
     }
 
@@ -181,9 +187,11 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
         let white = Layers { optical_depth: [0.0; 3], albedo: [1.0; 3], ..layers };
         let cos_o = draw.pick(&[1.0, 1e-3, -1.0]);
         let cos_o = if cos_o < 0.0 { draw.unit() } else { cos_o };
-        let albedo = furnace_albedo(&white, cos_o, &|c| lut.lookup_f64(thickness, c), 32);
-        count(acc, &albedo);
-        acc.furnace_evaluations += 1;
-        acc.max_albedo = albedo.iter().cloned().fold(acc.max_albedo, f64::max);
+        for model in Model::ALL {
+            let albedo = model.furnace_albedo(&white, cos_o, &|c| lut.lookup_f64(thickness, c), 32);
+            count(acc, &albedo);
+            acc.furnace_evaluations += 1;
+            acc.max_albedo = albedo.iter().cloned().fold(acc.max_albedo, f64::max);
+        }
     }
 }

@@ -8,7 +8,7 @@ use wgpu::util::DeviceExt;
 use super::film::{self, FilmBinding, GpuFilmMethod};
 use super::gpu::{map_read, storage_entry};
 use super::{Gpu, GpuError, shader_programs};
-use crate::optics::brdf::Layers32;
+use crate::optics::brdf::{Layers32, Model};
 use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
 
@@ -37,18 +37,20 @@ impl GpuSample {
     }
 }
 
-/// Evaluates the BRDF for every sample with film colours from `lut`; returns linear RGB.
-pub fn eval_on_gpu(gpu: &Gpu, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f32; 3]>, GpuError> {
-    Ok(eval_timed(gpu, Stack::THESIS, lut, GpuFilmMethod::Lut, samples, 1)?.0)
+/// Evaluates the BRDF of `model` for every sample with film colours from `lut`; returns
+/// linear RGB.
+pub fn eval_on_gpu(gpu: &Gpu, model: Model, lut: &Lut, samples: &[GpuSample]) -> Result<Vec<[f32; 3]>, GpuError> {
+    Ok(eval_timed(gpu, model, Stack::THESIS, lut, GpuFilmMethod::Lut, samples, 1)?.0)
 }
 
-/// Evaluates the BRDF for every sample, dispatching the evaluation `repeats` times in one
+/// Evaluates the BRDF of `model` for every sample, dispatching the evaluation `repeats` times in one
 /// submission (same inputs and outputs), with film colour by `method` for the material
 /// `stack` (whose LUT is `lut`); also returns the wall time from submit to results on the
 /// CPU. Two calls with different `repeats` isolate the cost of the evaluations from the
 /// fixed costs of submission and readback.
 pub fn eval_timed(
     gpu: &Gpu,
+    model: Model,
     stack: Stack,
     lut: &Lut,
     method: GpuFilmMethod,
@@ -74,7 +76,7 @@ pub fn eval_timed(
         bind_group_layouts: &[Some(&film_layout), Some(&io_layout)],
         immediate_size: 0,
     });
-    let constants = [("FILM_METHOD", method.constant())];
+    let constants = [("FILM_METHOD", method.code() as f64), ("BRDF_MODEL", model.code() as f64)];
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("brdf_eval"),
         layout: Some(&layout),
@@ -141,6 +143,7 @@ pub fn eval_timed(
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct GpuBench {
     pub adapter: String,
+    pub model: &'static str,
     pub samples: usize,
     pub gpu_ms_per_million: f64,
     pub cpu_f32_ms_per_million: f64,
@@ -151,8 +154,7 @@ pub struct GpuBench {
 /// roughness and thickness). GPU: fixed costs (submit, readback) cancel in the difference of
 /// 11 and 1 dispatches, median of five pairs; a difference that is not positive means the
 /// timing is meaningless and is an error, not a zero. CPU: median of five passes.
-pub fn bench_per_million(gpu: &Gpu, count: usize) -> Result<GpuBench, GpuError> {
-    use crate::optics::brdf::eval_f32;
+pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBench, GpuError> {
     use std::hint::black_box;
 
     let lut = Lut::bake_default(Stack::THESIS);
@@ -180,8 +182,8 @@ pub fn bench_per_million(gpu: &Gpu, count: usize) -> Result<GpuBench, GpuError> 
 
     let mut per_million = Vec::new();
     for _ in 0..5 {
-        let (_, one) = eval_timed(gpu, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 1)?;
-        let (_, eleven) = eval_timed(gpu, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 11)?;
+        let (_, one) = eval_timed(gpu, model, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 1)?;
+        let (_, eleven) = eval_timed(gpu, model, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 11)?;
         per_million.push((eleven.as_secs_f64() - one.as_secs_f64()) / 10.0 * 1e3 * 1e6 / count as f64);
     }
     per_million.sort_by(f64::total_cmp);
@@ -198,7 +200,7 @@ pub fn bench_per_million(gpu: &Gpu, count: usize) -> Result<GpuBench, GpuError> 
             let start = std::time::Instant::now();
             let mut acc = 0.0f32;
             for (l, wi, wo) in &inputs {
-                acc += eval_f32(black_box(l), [0.0, 0.0, 1.0], *wi, *wo, &lut)[1];
+                acc += model.eval_f32(black_box(l), [0.0, 0.0, 1.0], *wi, *wo, &lut)[1];
             }
             black_box(acc);
             start.elapsed().as_secs_f64() * 1e3 * 1e6 / count as f64
@@ -207,6 +209,7 @@ pub fn bench_per_million(gpu: &Gpu, count: usize) -> Result<GpuBench, GpuError> 
     cpu.sort_by(f64::total_cmp);
     Ok(GpuBench {
         adapter: gpu.describe(),
+        model: model.name(),
         samples: count,
         gpu_ms_per_million: gpu_ms,
         cpu_f32_ms_per_million: cpu[2],

@@ -38,13 +38,14 @@ impl GpuFilmMethod {
         }
     }
 
-    pub fn constant(self) -> f64 {
+    /// The value of `film.wgsl`'s `FILM_METHOD` (`FILM_LUT`, ... in the generated prelude).
+    pub fn code(self) -> u32 {
         match self {
-            GpuFilmMethod::Lut => 0.0,
-            GpuFilmMethod::Rgb3 => 1.0,
-            GpuFilmMethod::SpectralN(_) => 2.0,
-            GpuFilmMethod::GaussianFit => 3.0,
-            GpuFilmMethod::None => 4.0,
+            GpuFilmMethod::Lut => 0,
+            GpuFilmMethod::Rgb3 => 1,
+            GpuFilmMethod::SpectralN(_) => 2,
+            GpuFilmMethod::GaussianFit => 3,
+            GpuFilmMethod::None => 4,
         }
     }
 

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use super::renderer::{FrameSettings, GBuffer};
 use super::scene::{LayerOptics, Lighting};
-use crate::optics::brdf::{COS_MIN, Layers, eval};
+use crate::optics::brdf::{COS_MIN, Layers};
 use crate::optics::film_rgb_reference;
 use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
 
@@ -104,23 +104,21 @@ pub fn shade_pixel(gbuffer: &GBuffer, i: usize, settings: &FrameSettings, optics
         }
         let wi = light.direction.normalize().to_array().map(|v| v as f64);
         let cos_i = dot(n, wi).max(0.0);
-        let f = eval(&layers, n, wi, wo, &film).total();
+        let f = settings.model.eval(&layers, n, wi, wo, &film).total();
         for c in 0..3 {
             radiance[c] += light.irradiance[c] as f64 * f[c] * cos_i;
         }
     }
-    // Ambient, as skin.wgsl's `ambient`.
+    // Ambient, as skin.wgsl's `ambient`: the sky along the mirror direction reflected by the
+    // film, the sky along the normal through the layer model.
     let cos_o = dot(n, wo).max(COS_MIN);
     let f_o = film(cos_o).map(|v| v.clamp(0.0, 1.0));
     let mirror = [0, 1, 2].map(|c| -wo[c] + 2.0 * dot(n, wo) * n[c]);
     let sky_mirror = sky(lighting, mirror);
     let sky_normal = sky(lighting, n);
-    let eta = optics.stack.n0 / optics.stack.n2;
-    let k = (1.0 - eta * eta) + eta * eta * cos_o * cos_o;
-    let path = 1.0 / k.max(0.0).sqrt().max(COS_MIN) + 1.0;
+    let diffuse = settings.model.ambient_diffuse(&layers, cos_o, f_o);
     for c in 0..3 {
-        let attenuation = if optics.has_absorption() { (-optics.optical_depth[c].max(0.0) * path).exp() } else { 1.0 };
-        radiance[c] += sky_mirror[c] * f_o[c] + sky_normal[c] * (1.0 - f_o[c]) * albedo[c] * attenuation;
+        radiance[c] += sky_mirror[c] * f_o[c] + sky_normal[c] * diffuse[c];
     }
     radiance
 }

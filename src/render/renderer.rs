@@ -15,7 +15,7 @@ use super::material::{self, MaterialMaps, MaterialTextures};
 use super::mesh::{BodyShape, Mesh, Vertex};
 use super::scene::{Camera, LayerOptics, Lighting, SceneUniform, Stage, View};
 use super::{Gpu, GpuError, program};
-use crate::maps::MapKind;
+use crate::optics::brdf::Model;
 use crate::optics::lut::Lut;
 
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -36,6 +36,8 @@ pub struct FrameOutput<'a> {
 pub struct FrameSettings {
     pub view: View,
     pub method: GpuFilmMethod,
+    /// The layer model the skin is shaded with (`brdf.wgsl`'s `BRDF_MODEL`).
+    pub model: Model,
     pub camera: Camera,
     pub lighting: Lighting,
     pub exposure: f32,
@@ -54,6 +56,7 @@ impl Default for FrameSettings {
         FrameSettings {
             view: View::Shaded(Stage::All),
             method: GpuFilmMethod::Lut,
+            model: Model::default(),
             camera: Camera::default(),
             lighting: Lighting::default(),
             exposure: 1.0,
@@ -80,6 +83,7 @@ struct PipelineKey {
     stage: u32,
     view_map: u32,
     method: u32,
+    model: u32,
     absorption: bool,
     samples: u32,
 }
@@ -315,6 +319,7 @@ impl Renderer {
                 ("STAGE", key.stage as f64),
                 ("VIEW_MAP", key.view_map as f64),
                 ("FILM_METHOD", key.method as f64),
+                ("BRDF_MODEL", key.model as f64),
                 ("HAS_ABSORPTION", if key.absorption { 1.0 } else { 0.0 }),
             ]);
             if let Program::GBuffer(part) = key.program {
@@ -410,13 +415,11 @@ impl Renderer {
     }
 
     fn key(&self, program: Program, settings: &FrameSettings, material: &Material, samples: u32) -> PipelineKey {
-        let (stage, view_map) = match settings.view {
-            View::Shaded(stage) => (stage.constant() as u32, 0),
-            View::Map(map) => (3, map_index(map)),
-        };
+        let (stage, view_map) = settings.view.codes();
         // Specialisation: an inert film needs no film code, no absorption no exponential.
-        let method = material.optics.specialised_method(settings.method).constant() as u32;
-        PipelineKey { program, stage, view_map, method, absorption: material.optics.has_absorption(), samples }
+        let method = material.optics.specialised_method(settings.method).code();
+        let model = settings.model.code();
+        PipelineKey { program, stage, view_map, method, model, absorption: material.optics.has_absorption(), samples }
     }
 
     fn write_scene(&self, settings: &FrameSettings, material: &Material, aspect: f32) {
@@ -682,16 +685,6 @@ impl Renderer {
 
 fn module_is_skin(program: Program) -> bool {
     !matches!(program, Program::Plain)
-}
-
-fn map_index(map: MapKind) -> u32 {
-    match map {
-        MapKind::Color => 1,
-        MapKind::Height => 2,
-        MapKind::Normal => 3,
-        MapKind::Roughness => 4,
-        MapKind::Iridescence => 5,
-    }
 }
 
 fn depth_attachment(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {

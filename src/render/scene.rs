@@ -123,12 +123,13 @@ impl Stage {
         Stage::ALL.into_iter().find(|s| s.name() == name)
     }
 
-    pub fn constant(self) -> f64 {
+    /// The value of `skin.wgsl`'s `STAGE` (`STAGE_DIFFUSE`, ... in the generated prelude).
+    pub fn code(self) -> u32 {
         match self {
-            Stage::Diffuse => 0.0,
-            Stage::DiffuseNormal => 1.0,
-            Stage::Film => 2.0,
-            Stage::All => 3.0,
+            Stage::Diffuse => 0,
+            Stage::DiffuseNormal => 1,
+            Stage::Film => 2,
+            Stage::All => 3,
         }
     }
 }
@@ -151,6 +152,28 @@ impl View {
 
     pub const ACCEPTED: &'static str =
         "diffuse, normal, film, all, or map:color|map:height|map:normal|map:roughness|map:iridescence";
+
+    /// The pipeline's (`STAGE`, `VIEW_MAP`) pair: a map view is drawn by the full-stage
+    /// pipeline with the map shown unlit.
+    pub fn codes(self) -> (u32, u32) {
+        match self {
+            View::Shaded(stage) => (stage.code(), self.map_code()),
+            View::Map(_) => (Stage::All.code(), self.map_code()),
+        }
+    }
+
+    /// The value of `skin.wgsl`'s `VIEW_MAP`: 0 to shade, else the map shown unlit
+    /// (`VIEW_COLOR`, ... in the generated prelude).
+    pub fn map_code(self) -> u32 {
+        match self {
+            View::Shaded(_) => 0,
+            View::Map(crate::maps::MapKind::Color) => 1,
+            View::Map(crate::maps::MapKind::Height) => 2,
+            View::Map(crate::maps::MapKind::Normal) => 3,
+            View::Map(crate::maps::MapKind::Roughness) => 4,
+            View::Map(crate::maps::MapKind::Iridescence) => 5,
+        }
+    }
 }
 
 /// The material's layer optics as the shader needs them.

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use snakeskin::material::MapKind;
+use snakeskin::optics::brdf::Model;
 use snakeskin::optics::methods::Method;
 use snakeskin::preset::validate::ranges;
 use snakeskin::render::film::GpuFilmMethod;
@@ -333,6 +334,9 @@ pub struct EvalArgs {
     /// Film colour method (as for `brdf color`).
     #[arg(long, default_value = "spectral", value_parser = parse_method)]
     pub method: Method,
+    /// Layer model under the top interface (thesis: PHYSICS.md's eq. 4.21 diffuse lobe).
+    #[arg(long, default_value = "thesis", value_parser = parse_model)]
+    pub model: Model,
 }
 
 #[derive(Debug, Subcommand)]
@@ -366,6 +370,9 @@ pub enum BenchCommand {
         /// Evaluations per dispatch.
         #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1000..=16_000_000))]
         samples: u64,
+        /// Layer model to evaluate.
+        #[arg(long, default_value = "thesis", value_parser = parse_model)]
+        model: Model,
         /// Print one JSON object.
         #[arg(long)]
         json: bool,
@@ -427,6 +434,10 @@ fn parse_view(text: &str) -> Result<View, String> {
 
 fn parse_method(text: &str) -> Result<Method, String> {
     Method::parse(text).ok_or_else(|| format!("accepted: {}", Method::ACCEPTED))
+}
+
+fn parse_model(text: &str) -> Result<Model, String> {
+    Model::parse(text).ok_or_else(|| format!("accepted: {}", Model::ACCEPTED))
 }
 
 fn parse_gpu_method(text: &str) -> Result<GpuFilmMethod, String> {

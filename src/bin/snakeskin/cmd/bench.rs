@@ -15,7 +15,7 @@ use snakeskin::render::bench::{BenchOptions, bench_render};
 
 pub fn run(command: BenchCommand) -> Result<()> {
     match command {
-        BenchCommand::Gpu { samples, json } => gpu(samples as usize, json),
+        BenchCommand::Gpu { samples, model, json } => gpu(samples as usize, model, json),
         BenchCommand::Render { preset, size, frames, map_size, reference_size, json } => {
             render(&preset, size, frames, map_size, reference_size, json)
         }
@@ -73,13 +73,13 @@ fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_d
 }
 
 /// GPU compute against the CPU twin, per million BRDF evaluations, on the same inputs.
-fn gpu(count: usize, json: bool) -> Result<()> {
+fn gpu(count: usize, model: snakeskin::optics::brdf::Model, json: bool) -> Result<()> {
     let gpu = snakeskin::render::Gpu::headless()?;
-    let result = snakeskin::render::brdf_eval::bench_per_million(&gpu, count)?;
+    let result = snakeskin::render::brdf_eval::bench_per_million(&gpu, model, count)?;
     if json {
         println!("{}", serde_json::to_string(&result)?);
     } else {
-        println!("adapter: {}", result.adapter);
+        println!("adapter: {}, model: {}", result.adapter, result.model);
         println!("WGSL BRDF (compute):  {:.3} ms per million evaluations", result.gpu_ms_per_million);
         println!("Rust f32 twin (1 core): {:.3} ms per million evaluations", result.cpu_f32_ms_per_million);
     }

@@ -9,7 +9,7 @@ use serde::Deserialize;
 use crate::cli::{BrdfCommand, EvalArgs, StackArgs};
 use crate::output::{ensure_parent_folder, path_line, printable};
 use snakeskin::Error;
-use snakeskin::optics::brdf::{Layers, eval};
+use snakeskin::optics::brdf::Layers;
 use snakeskin::optics::film::{Stack, airy};
 use snakeskin::optics::methods::Method;
 use snakeskin::optics::query::{chart, check, film_colour};
@@ -93,8 +93,14 @@ fn eval_json(args: &EvalArgs) -> Result<String> {
         albedo: args.albedo,
     };
     let film = |c: f64| film_colour(args.method, stack, args.thickness_nm, c);
-    let value = eval(&layers, args.normal, args.wi, args.wo, &film);
-    Ok(serde_json::json!({ "f": value.total(), "specular": value.specular, "diffuse": value.diffuse }).to_string())
+    let value = args.model.eval(&layers, args.normal, args.wi, args.wo, &film);
+    let json = serde_json::json!({
+        "model": args.model.name(),
+        "f": value.total(),
+        "specular": value.specular,
+        "diffuse": value.diffuse,
+    });
+    Ok(json.to_string())
 }
 
 /// The longest `--batch` line accepted (a query is under 200 bytes).

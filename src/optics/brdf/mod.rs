@@ -1,0 +1,270 @@
+//! The snake-skin BRDF: one rough top interface (GGX, `ggx`) over a layer model that says
+//! what happens beneath it. Every model is reached through [`Model`] — f64 (the reference
+//! side), f32 (the CPU twin of the shader, film colour from the LUT), the ambient term of the
+//! reference renderer — and `shaders/brdf.wgsl` selects the same model by its `BRDF_MODEL`
+//! override constant, whose values come from [`Model::code`]. The references, the stress
+//! and furnace tests and `snakeskin brdf eval` all take a `Model`, so a new model is added
+//! in one place (a file beside `thesis.rs`, one arm per match here and in the WGSL).
+//!
+//! ```text
+//! f = D(h) G2(wi, wo) F(|wo·h|, d) / (4 |n·wi| |n·wo|) + f_diff(model)
+//! ```
+//!
+//! D: GGX; G2: Smith height-correlated (Heitz 2014, eq. 99); F: the film's RGB reflectance,
+//! clamped to [0, 1] per channel (a saturated film colour can fall outside the sRGB gamut,
+//! and 1 − F must stay a valid transmittance).
+//!
+//! Stability rules (PHYSICS.md): GGX α = max(roughness², ALPHA_MIN) so roughness 0 stays
+//! finite; a zero-length or non-finite normal falls back to the tangent-space up vector;
+//! directions below the shading horizon give 0; cosines are floored at COS_MIN after that
+//! test so grazing angles give finite values. These numbers reach the WGSL from here
+//! (`render::shaders::generated_constants`), never by copy.
+
+pub mod ggx;
+pub mod thesis;
+
+pub use ggx::{ggx_d, ggx_d_sin, smith_g2, smith_lambda};
+pub use thesis::cos_transmitted;
+
+/// Smallest GGX α: roughness 0 would make D a Dirac delta. 1e-3 keeps D's peak
+/// 1 / (π α²) ≈ 3.2e5, finite in f32, and is a mirror to the eye.
+pub const ALPHA_MIN: f64 = 1e-3;
+/// Floor on cosines after the hemisphere test.
+pub const COS_MIN: f64 = 1e-6;
+/// A direction shorter than this is treated as no direction (zero normal, zero wi or wo).
+pub const LENGTH_MIN: f64 = 1e-12;
+
+/// A layer model: what the light that crosses the top interface does beneath it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Model {
+    /// The thesis' eq. 4.21 (Weidlich & Wilkie 2007 single scatter): kept for comparison.
+    #[default]
+    Thesis,
+}
+
+impl Model {
+    pub const ALL: [Model; 1] = [Model::Thesis];
+    pub const ACCEPTED: &'static str = "thesis";
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Thesis => "thesis",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Model> {
+        Model::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// The value of `brdf.wgsl`'s `BRDF_MODEL` override constant (`MODEL_THESIS`, ...).
+    pub fn code(self) -> u32 {
+        match self {
+            Model::Thesis => 0,
+        }
+    }
+
+    /// The diffuse lobe (f64) at floored cosines with the film's clamped reflectance there.
+    fn diffuse(self, layers: &Layers, cos_i: f64, cos_o: f64, f_i: [f64; 3], f_o: [f64; 3]) -> [f64; 3] {
+        match self {
+            Model::Thesis => thesis::diffuse(layers, cos_i, cos_o, f_i, f_o),
+        }
+    }
+
+    fn diffuse_f32(self, layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o: [f32; 3]) -> [f32; 3] {
+        match self {
+            Model::Thesis => thesis::diffuse_f32(layers, cos_i, cos_o, f_i, f_o),
+        }
+    }
+
+    /// The ambient term's diffuse part towards a view at cosine `cos_o` with the film's
+    /// reflectance `f_o` there: multiplies the sky radiance along the normal (the reference
+    /// renderer's twin of `brdf.wgsl`'s `ambient_diffuse`).
+    pub fn ambient_diffuse(self, layers: &Layers, cos_o: f64, f_o: [f64; 3]) -> [f64; 3] {
+        match self {
+            Model::Thesis => thesis::ambient_diffuse(layers, cos_o, f_o),
+        }
+    }
+}
+
+/// Per-pixel layer parameters (linear RGB where RGB).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layers {
+    pub n0: f64,
+    pub n2: f64,
+    /// Perceptual roughness r (α = r²).
+    pub roughness: f64,
+    /// Optical depth τ = σ0 δ1 of the pigment layer, per channel.
+    pub optical_depth: [f64; 3],
+    /// Albedo k_d of the Lambertian base.
+    pub albedo: [f64; 3],
+}
+
+/// The BRDF split into its two lobes (each RGB, per steradian).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct BrdfValue {
+    pub specular: [f64; 3],
+    pub diffuse: [f64; 3],
+}
+
+impl BrdfValue {
+    pub fn total(&self) -> [f64; 3] {
+        [0, 1, 2].map(|c| self.specular[c] + self.diffuse[c])
+    }
+    const ZERO: BrdfValue = BrdfValue { specular: [0.0; 3], diffuse: [0.0; 3] };
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalize(v: [f64; 3]) -> Option<[f64; 3]> {
+    let len = dot(v, v).sqrt();
+    (len.is_finite() && len > LENGTH_MIN).then(|| v.map(|c| c / len))
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+impl Model {
+    /// Evaluates the BRDF. `film(cos)` returns the film's RGB reflectance at incidence cosine
+    /// `cos` (the caller binds the material, thickness and method).
+    pub fn eval(
+        self,
+        layers: &Layers,
+        normal: [f64; 3],
+        wi: [f64; 3],
+        wo: [f64; 3],
+        film: &dyn Fn(f64) -> [f64; 3],
+    ) -> BrdfValue {
+        let n = normalize(normal).unwrap_or([0.0, 0.0, 1.0]);
+        let (Some(wi), Some(wo)) = (normalize(wi), normalize(wo)) else {
+            return BrdfValue::ZERO;
+        };
+        let (cos_i, cos_o) = (dot(n, wi), dot(n, wo));
+        if !(cos_i > 0.0 && cos_o > 0.0) {
+            return BrdfValue::ZERO;
+        }
+        let (cos_i, cos_o) = (cos_i.max(COS_MIN), cos_o.max(COS_MIN));
+        let Some(h) = normalize([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]) else {
+            return BrdfValue::ZERO;
+        };
+        let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
+        let film_clamped = |c: f64| film_clamped(film(c.clamp(0.0, 1.0)));
+
+        let nxh = cross(n, h);
+        let d = ggx_d_sin(dot(n, h).clamp(0.0, 1.0), dot(nxh, nxh), alpha);
+        let g2 = smith_g2(cos_i, cos_o, alpha);
+        let f_h = film_clamped(dot(wo, h).abs());
+        let spec_scale = d * g2 / (4.0 * cos_i * cos_o);
+        let specular = f_h.map(|f| f * spec_scale);
+        let diffuse = self.diffuse(layers, cos_i, cos_o, film_clamped(cos_i), film_clamped(cos_o));
+        BrdfValue { specular, diffuse }
+    }
+
+    /// The f32 fast path, film colour from the material's LUT: the CPU twin of the shader.
+    pub fn eval_f32(
+        self,
+        layers: &Layers32,
+        normal: [f32; 3],
+        wi: [f32; 3],
+        wo: [f32; 3],
+        lut: &super::lut::Lut,
+    ) -> [f32; 3] {
+        let n = normalize32(normal).unwrap_or([0.0, 0.0, 1.0]);
+        let (Some(wi), Some(wo)) = (normalize32(wi), normalize32(wo)) else {
+            return [0.0; 3];
+        };
+        let (cos_i, cos_o) = (dot32(n, wi), dot32(n, wo));
+        if !(cos_i > 0.0 && cos_o > 0.0) {
+            return [0.0; 3];
+        }
+        let cos_min = COS_MIN as f32;
+        let (cos_i, cos_o) = (cos_i.max(cos_min), cos_o.max(cos_min));
+        let Some(h) = normalize32([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]) else {
+            return [0.0; 3];
+        };
+        let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN as f32, 1.0);
+        let film = |c: f32| lut.lookup_f32(layers.thickness_nm, c.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
+
+        let cos_h = dot32(n, h).clamp(0.0, 1.0);
+        let nxh = [n[1] * h[2] - n[2] * h[1], n[2] * h[0] - n[0] * h[2], n[0] * h[1] - n[1] * h[0]];
+        let spec = ggx::specular_scale_f32(cos_h, dot32(nxh, nxh), cos_i, cos_o, alpha * alpha);
+        let f_h = film(dot32(wo, h).abs());
+        let diffuse = self.diffuse_f32(layers, cos_i, cos_o, film(cos_i), film(cos_o));
+        [0, 1, 2].map(|c| f_h[c] * spec + diffuse[c])
+    }
+
+    /// White-furnace albedo ∫ f(wi, wo) cos θi dωi for view cosine `cos_o`, with k_d = 1 and
+    /// τ = 0 passed in `layers`. The specular lobe is integrated in half-vector space with
+    /// stratified GGX sampling (exact for any α, however peaked); the diffuse lobe, which
+    /// depends on θi only, by the midpoint rule in cos θi. `n` strata per axis.
+    pub fn furnace_albedo(self, layers: &Layers, cos_o: f64, film: &dyn Fn(f64) -> [f64; 3], n: usize) -> [f64; 3] {
+        let cos_o = cos_o.clamp(COS_MIN, 1.0);
+        let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
+        let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
+        let mut spec = [0.0; 3];
+        for a in 0..n {
+            for b in 0..n {
+                let (u1, u2) = ((a as f64 + 0.5) / n as f64, (b as f64 + 0.5) / n as f64);
+                // GGX sampling of h with pdf D(h) cos θh: tan² θh = α² u1 / (1 − u1).
+                let cos_h = (1.0 / (1.0 + alpha * alpha * u1 / (1.0 - u1))).sqrt();
+                let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
+                let phi = 2.0 * std::f64::consts::PI * u2;
+                let h = [sin_h * phi.cos(), sin_h * phi.sin(), cos_h];
+                let wo_h = dot(wo, h);
+                if wo_h <= 0.0 {
+                    continue;
+                }
+                let wi = [0, 1, 2].map(|k| 2.0 * wo_h * h[k] - wo[k]);
+                if wi[2] <= 0.0 {
+                    continue;
+                }
+                // f cos θi / pdf(wi) with pdf(wi) = D cos θh / (4 |wo·h|).
+                let value = self.eval(&Layers { albedo: [0.0; 3], ..*layers }, [0.0, 0.0, 1.0], wi, wo, film);
+                let pdf = ggx_d_sin(cos_h, sin_h * sin_h, alpha) * cos_h / (4.0 * wo_h);
+                for (s, v) in spec.iter_mut().zip(value.specular) {
+                    *s += v * wi[2] / pdf;
+                }
+            }
+        }
+        let spec = spec.map(|s| s / (n * n) as f64);
+        let mut diffuse = [0.0; 3];
+        for a in 0..n * n {
+            // ∫ over the hemisphere of g(θi) cos θi dω = 2π ∫ g(μ) μ dμ.
+            let mu = (a as f64 + 0.5) / (n * n) as f64;
+            let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+            let value = self.eval(layers, [0.0, 0.0, 1.0], wi, wo, film);
+            for (d, v) in diffuse.iter_mut().zip(value.diffuse) {
+                *d += v * mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
+            }
+        }
+        [0, 1, 2].map(|c| spec[c] + diffuse[c])
+    }
+}
+
+/// f32 layer parameters for the fast path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layers32 {
+    pub n0: f32,
+    pub n2: f32,
+    pub roughness: f32,
+    pub optical_depth: [f32; 3],
+    pub albedo: [f32; 3],
+    pub thickness_nm: f32,
+}
+
+fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalize32(v: [f32; 3]) -> Option<[f32; 3]> {
+    let len = dot32(v, v).sqrt();
+    (len.is_finite() && len > LENGTH_MIN as f32).then(|| v.map(|c| c / len))
+}
+
+/// The film's reflectance made a valid reflectance: clamped to [0, 1] per channel, 1 where
+/// not finite (so 1 − F is a valid transmittance).
+fn film_clamped(rgb: [f64; 3]) -> [f64; 3] {
+    rgb.map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 1.0 })
+}
