@@ -1,6 +1,6 @@
 // The skin pass: the multi-layer BRDF (brdf.wgsl) under the scene's lights, a layer stage or
 // a single map on the body, and the G-buffer the CPU reference shades
-// (src/render/reference.rs is this file's CPU twin: keep the two in step).
+// (src/render/reference/frame.rs is this file's CPU twin: keep the two in step).
 
 // Layer stages of the thesis' Fig. 5.12: STAGE_DIFFUSE, STAGE_DIFFUSE_NORMAL (+ normal
 // map), STAGE_FILM (the thin film alone), STAGE_ALL (codes from the generated prelude).

@@ -6,8 +6,8 @@
 use snakeskin::optics::brdf::{Layers32, Model};
 use snakeskin::optics::film::Stack;
 use snakeskin::optics::lut::Lut;
-use snakeskin::render::brdf_eval::{GpuSample, eval_on_gpu};
-use snakeskin::render::material::round_to_f16;
+use snakeskin::render::engine::material::round_to_f16;
+use snakeskin::render::reference::brdf_eval::{GpuSample, eval_on_gpu};
 use snakeskin::render::shader_programs;
 
 mod common;
@@ -143,8 +143,8 @@ fn bench_gpu_reports_both_costs() {
 fn every_gpu_film_method_matches_its_cpu_f32_twin() {
     use snakeskin::optics::brdf::Layers;
     use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
-    use snakeskin::render::brdf_eval::eval_timed;
-    use snakeskin::render::film::GpuFilmMethod;
+    use snakeskin::render::engine::film::GpuFilmMethod;
+    use snakeskin::render::reference::brdf_eval::eval_timed;
     let Some(gpu) = gpu_or_skip("every_gpu_film_method_matches_its_cpu_f32_twin") else { return };
     let stack = Stack::THESIS;
     let lut = Lut::bake(stack, 16, 32, 8);

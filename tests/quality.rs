@@ -42,7 +42,7 @@ fn every_preset_and_map_tiles_seamlessly() {
     let mut specs: Vec<String> = library::names().iter().map(|s| s.to_string()).collect();
     // The gallery variants cover every scale shape and pattern kind.
     let variants: Vec<String> =
-        snakeskin::render::gallery::VARIANTS.iter().map(|(_, _, o)| format!("seed = 5\n{o}")).collect();
+        snakeskin::render::figures::gallery::VARIANTS.iter().map(|(_, _, o)| format!("seed = 5\n{o}")).collect();
     specs.push(PATTERNED.to_string());
     let sources =
         specs.iter().map(|spec| read_source(spec).unwrap()).chain(variants.into_iter().enumerate().map(|(i, text)| {

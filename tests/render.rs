@@ -10,11 +10,12 @@ use common::{gpu_or_skip, gpu_required, snakeskin};
 use snakeskin::graph::{NodeCache, evaluate};
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::render::Renderer;
-use snakeskin::render::film::GpuFilmMethod;
-use snakeskin::render::preview::{material_maps, reference_check};
-use snakeskin::render::reference::srgb_encode;
-use snakeskin::render::renderer::{FrameSettings, Material};
-use snakeskin::render::scene::{Camera, LayerOptics, Stage, View};
+use snakeskin::render::engine::film::GpuFilmMethod;
+use snakeskin::render::engine::prepare::material_maps;
+use snakeskin::render::engine::renderer::{FrameSettings, Material};
+use snakeskin::render::engine::scene::{Camera, LayerOptics, Stage, View};
+use snakeskin::render::reference::frame::reference_check;
+use snakeskin::render::reference::frame::srgb_encode;
 
 const PRESET: &str = "erythrolamprus-miliaris";
 const MAP_SIZE: usize = 256;
@@ -92,7 +93,7 @@ fn the_reference_check_catches_a_wrong_film() {
     let settings = FrameSettings { samples: 1, ..close_up() };
     let image = renderer.render_image(&settings, &wrong, 160, 100).unwrap();
     let gbuffer = renderer.render_gbuffer(&settings, &right, 160, 100).unwrap();
-    let report = snakeskin::render::reference::compare(&image, &gbuffer, &settings, &right.optics);
+    let report = snakeskin::render::reference::frame::compare(&image, &gbuffer, &settings, &right.optics);
     assert!(report.mean_de > 2.0, "a 150 nm thinner film went unnoticed: mean {}", report.mean_de);
 }
 
@@ -341,7 +342,7 @@ fn normal_mapping_tilts_the_normal_away_from_higher_ground() {
 #[test]
 fn the_contact_sheet_renders_every_preset() {
     use snakeskin::preset::library;
-    use snakeskin::render::sheet::{SheetOptions, render_sheet};
+    use snakeskin::render::figures::sheet::{SheetOptions, render_sheet};
     let Some(gpu) = gpu_or_skip("the_contact_sheet_renders_every_preset") else { return };
     let renderer = Renderer::new(gpu);
     let tile = 64;
@@ -455,7 +456,7 @@ fn the_window_reloads_the_preset_file_on_save() {
 
 #[test]
 fn twenty_instanced_snakes_are_all_in_view() {
-    use snakeskin::render::renderer::snake_grid;
+    use snakeskin::render::engine::renderer::snake_grid;
     let Some(gpu) = gpu_or_skip("twenty_instanced_snakes_are_all_in_view") else { return };
     let renderer = Renderer::new(gpu);
     let material = material(&renderer, &[], GpuFilmMethod::Lut);

@@ -8,7 +8,7 @@ use snakeskin::graph::evaluate;
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::ops::{Image, filters};
 use snakeskin::preset::{PresetSource, parse, read_source};
-use snakeskin::render::gallery::VARIANTS;
+use snakeskin::render::figures::gallery::VARIANTS;
 
 fn maps_of(text: &str, maps: &[MapKind], size: usize) -> std::collections::BTreeMap<MapKind, Image> {
     let source = PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };

@@ -11,8 +11,8 @@ use snakeskin::material::MapKind;
 use snakeskin::optics::brdf::Model;
 use snakeskin::optics::methods::Method;
 use snakeskin::preset::validate::ranges;
-use snakeskin::render::film::GpuFilmMethod;
-use snakeskin::render::scene::View;
+use snakeskin::render::engine::film::GpuFilmMethod;
+use snakeskin::render::engine::scene::View;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -413,7 +413,7 @@ pub struct ImageSize {
 }
 
 fn parse_image_size(text: &str) -> Result<ImageSize, String> {
-    let range = snakeskin::render::preview::IMAGE_RANGE;
+    let range = snakeskin::render::engine::prepare::IMAGE_RANGE;
     let bad = || format!("expected WIDTHxHEIGHT (e.g. 1280x720), each {} to {} pixels", range.start(), range.end());
     let (w, h) = match text.split_once(['x', 'X']) {
         Some((w, h)) => (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?),

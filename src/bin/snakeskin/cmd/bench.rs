@@ -11,7 +11,7 @@ use snakeskin::optics::accuracy::{MAX_GRID_POINTS, Prepared, grid, grid_points, 
 use snakeskin::optics::lab::linear_srgb_to_lab;
 use snakeskin::optics::methods::Method;
 use snakeskin::render::Renderer;
-use snakeskin::render::bench::{BenchOptions, bench_render};
+use snakeskin::render::reference::bench::{BenchOptions, bench_render};
 
 pub fn run(command: BenchCommand) -> Result<()> {
     match command {
@@ -75,7 +75,7 @@ fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_d
 /// GPU compute against the CPU twin, per million BRDF evaluations, on the same inputs.
 fn gpu(count: usize, model: snakeskin::optics::brdf::Model, json: bool) -> Result<()> {
     let gpu = snakeskin::render::Gpu::headless()?;
-    let result = snakeskin::render::brdf_eval::bench_per_million(&gpu, model, count)?;
+    let result = snakeskin::render::reference::brdf_eval::bench_per_million(&gpu, model, count)?;
     if json {
         println!("{}", serde_json::to_string(&result)?);
     } else {

@@ -8,7 +8,7 @@ use crate::cli::ImageSize;
 use crate::output::{ensure_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::render::Renderer;
-use snakeskin::render::preview::write_figures;
+use snakeskin::render::figures::write_figures;
 
 pub fn run(preset: &str, out: &Path, size: ImageSize, map_size: u64) -> Result<()> {
     snakeskin::preset::load(preset, &[], None)?;

@@ -8,7 +8,7 @@ use crate::output::{ensure_parent_folder, path_line};
 
 pub fn run(out: &Path, tile: usize, columns: usize) -> Result<()> {
     ensure_parent_folder(out)?;
-    snakeskin::render::gallery::write(out, tile, columns)?;
+    snakeskin::render::figures::gallery::write(out, tile, columns)?;
     println!("{}", path_line(out));
     Ok(())
 }

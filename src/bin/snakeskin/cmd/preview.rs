@@ -7,9 +7,11 @@ use crate::output::{ensure_parent_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::Error;
 use snakeskin::render::Renderer;
-use snakeskin::render::preview::{reference_check, upload_material, write_png};
-use snakeskin::render::renderer::FrameSettings;
-use snakeskin::render::scene::Camera;
+use snakeskin::render::engine::prepare::upload_material;
+use snakeskin::render::engine::renderer::FrameSettings;
+use snakeskin::render::engine::scene::Camera;
+use snakeskin::render::figures::write_png;
+use snakeskin::render::reference::frame::reference_check;
 
 pub fn run(args: PreviewArgs) -> Result<()> {
     // Validate everything before touching the GPU or any file.
@@ -45,7 +47,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     if let Some(heat_path) = &args.reference {
         bar.message("shading the CPU reference");
         let (report, _) = reference_check(&renderer, &material, &settings, width, height)?;
-        snakeskin::render::preview::write_rgb_png(heat_path, &report.heat_map(5.0))?;
+        snakeskin::render::figures::write_rgb_png(heat_path, &report.heat_map(5.0))?;
         eprintln!(
             "reference: {} pixels, CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3} (heat map: black 0 .. yellow >= 5)",
             report.pixels, report.mean_de, report.p99_de, report.max_de

@@ -7,7 +7,7 @@ use anyhow::Result;
 use crate::output::{ensure_parent_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::render::Renderer;
-use snakeskin::render::sheet::{SheetOptions, write_sheet};
+use snakeskin::render::figures::sheet::{SheetOptions, write_sheet};
 
 pub fn run(out: &Path, tile: u32, columns: u32, map_size: usize) -> Result<()> {
     ensure_parent_folder(out)?;

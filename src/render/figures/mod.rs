@@ -1,61 +1,18 @@
-//! From a preset to pictures: generate the maps at preview resolution, bake the film LUT,
-//! render headless, check against the CPU reference, and write the documentation figures.
-//! The window (`window.rs`) and `snakeskin sheet` use the same steps.
+//! Pictures for people: the documentation figures (the thesis' Figs. 5.5–5.12 redone), the
+//! species contact sheet and the pattern gallery, and the PNG writing they share. Each
+//! renders through the engine (`render::engine`) exactly as the window does.
+
+pub mod gallery;
+pub mod sheet;
 
 use std::path::{Path, PathBuf};
 
-use super::film::GpuFilmMethod;
-use super::material::MaterialMaps;
-use super::reference::{ReferenceReport, compare};
-use super::renderer::{FrameSettings, Material, Renderer};
-use super::scene::{Camera, LayerOptics, Stage, View};
+use super::engine::film::GpuFilmMethod;
+use super::engine::prepare::upload_material;
+use super::engine::renderer::{FrameSettings, Renderer};
+use super::engine::scene::{Camera, Stage, View};
 use crate::Error;
 use crate::export::write_file_atomically;
-use crate::graph::{NodeCache, evaluate};
-use crate::maps::{BuildOptions, MapKind, build_graph};
-use crate::optics::lut::Lut;
-use crate::preset::LoadedPreset;
-
-/// Preview image size limits (pixels per side): lavapipe handles 8K, a window rarely more.
-pub const IMAGE_RANGE: std::ops::RangeInclusive<u32> = 16..=8192;
-
-/// Generates the five maps of `preset` at `map_size`² for rendering.
-pub fn material_maps(loaded: &LoadedPreset, map_size: usize) -> Result<MaterialMaps, Error> {
-    let graph = build_graph(&loaded.preset, BuildOptions::default());
-    let evaluation = evaluate(&graph, &MapKind::ALL, map_size, map_size, &|_, _| {});
-    MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))
-}
-
-/// The same through a node cache: after an edit only changed nodes run (live reload).
-pub fn material_maps_cached(
-    loaded: &LoadedPreset,
-    map_size: usize,
-    cache: &mut NodeCache,
-) -> Result<(MaterialMaps, crate::graph::CacheStats), Error> {
-    let graph = build_graph(&loaded.preset, BuildOptions::default());
-    let (maps, stats) = cache.evaluate(&graph, &MapKind::ALL, map_size, map_size);
-    Ok((MaterialMaps::from_maps(&maps).map_err(|e| Error::Preview(e.to_string()))?, stats))
-}
-
-/// A material ready to draw: maps, optics and film tables for `method`.
-pub fn upload_material(
-    renderer: &Renderer,
-    loaded: &LoadedPreset,
-    map_size: usize,
-    method: GpuFilmMethod,
-) -> Result<Material, Error> {
-    let maps = material_maps(loaded, map_size)?;
-    let optics = LayerOptics::from_preset(&loaded.preset);
-    let lut = Lut::bake_default(optics.stack);
-    Ok(renderer.material(&maps, optics, &lut, bands_for(method)))
-}
-
-pub fn bands_for(method: GpuFilmMethod) -> usize {
-    match method {
-        GpuFilmMethod::SpectralN(n) => n,
-        _ => 1,
-    }
-}
 
 /// Encodes and writes a rendered image (atomically).
 pub fn write_png(path: &Path, image: &image::RgbaImage) -> Result<PathBuf, Error> {
@@ -69,20 +26,6 @@ pub fn write_rgb_png(path: &Path, image: &image::RgbImage) -> Result<PathBuf, Er
         .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
         .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
     Ok(write_file_atomically(path, bytes)?)
-}
-
-/// The GPU frame at one sample per pixel against the CPU reference (stage "all").
-pub fn reference_check(
-    renderer: &Renderer,
-    material: &Material,
-    settings: &FrameSettings,
-    width: u32,
-    height: u32,
-) -> Result<(ReferenceReport, image::RgbaImage), Error> {
-    let settings = FrameSettings { samples: 1, ground: false, view: View::Shaded(Stage::All), ..*settings };
-    let image = renderer.render_image(&settings, material, width, height)?;
-    let gbuffer = renderer.render_gbuffer(&settings, material, width, height)?;
-    Ok((compare(&image, &gbuffer, &settings, &material.optics), image))
 }
 
 /// One documentation figure: its file name, what it shows, and the overrides it needs.

@@ -10,11 +10,12 @@ use std::sync::Mutex;
 use wgpu::util::DeviceExt;
 
 use super::film::{self, FilmBinding, GpuFilmMethod};
+use super::gpu::{Gpu, GpuError};
 use super::gpu::{map_read, texture_entry, uniform_entry};
 use super::material::{self, MaterialMaps, MaterialTextures};
 use super::mesh::{BodyShape, Mesh, Vertex};
 use super::scene::{Camera, LayerOptics, Lighting, SceneUniform, Stage, View};
-use super::{Gpu, GpuError, program};
+use super::shaders::program;
 use crate::optics::brdf::Model;
 use crate::optics::lut::Lut;
 

@@ -9,11 +9,26 @@
 
 use rayon::prelude::*;
 
-use super::renderer::{FrameSettings, GBuffer};
-use super::scene::{LayerOptics, Lighting};
+use crate::Error;
 use crate::optics::brdf::{COS_MIN, Layers};
 use crate::optics::film_rgb_reference;
 use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
+use crate::render::engine::renderer::{FrameSettings, GBuffer, Material, Renderer};
+use crate::render::engine::scene::{LayerOptics, Lighting, Stage, View};
+
+/// The GPU frame at one sample per pixel against the CPU reference (stage "all").
+pub fn reference_check(
+    renderer: &Renderer,
+    material: &Material,
+    settings: &FrameSettings,
+    width: u32,
+    height: u32,
+) -> Result<(ReferenceReport, image::RgbaImage), Error> {
+    let settings = FrameSettings { samples: 1, ground: false, view: View::Shaded(Stage::All), ..*settings };
+    let image = renderer.render_image(&settings, material, width, height)?;
+    let gbuffer = renderer.render_gbuffer(&settings, material, width, height)?;
+    Ok((compare(&image, &gbuffer, &settings, &material.optics), image))
+}
 
 /// Mean, 99th percentile and max CIEDE2000 over covered pixels, and the heat map.
 #[derive(Debug, Clone)]

@@ -18,15 +18,15 @@ use super::film::GpuFilmMethod;
 use super::scene::{Stage, View};
 
 /// Film colour by method (LUT lookup and the analytic methods).
-pub const FILM_WGSL: &str = include_str!("../../shaders/film.wgsl");
+pub const FILM_WGSL: &str = include_str!("../../../shaders/film.wgsl");
 /// The WGSL of the BRDF.
-pub const BRDF_WGSL: &str = include_str!("../../shaders/brdf.wgsl");
+pub const BRDF_WGSL: &str = include_str!("../../../shaders/brdf.wgsl");
 /// Compute entry point evaluating the BRDF on a buffer of samples.
-pub const BRDF_EVAL_WGSL: &str = include_str!("../../shaders/brdf_eval.wgsl");
-pub const SCENE_WGSL: &str = include_str!("../../shaders/scene.wgsl");
-pub const SKIN_WGSL: &str = include_str!("../../shaders/skin.wgsl");
-pub const PLAIN_WGSL: &str = include_str!("../../shaders/plain.wgsl");
-pub const TONEMAP_WGSL: &str = include_str!("../../shaders/tonemap.wgsl");
+pub const BRDF_EVAL_WGSL: &str = include_str!("../../../shaders/brdf_eval.wgsl");
+pub const SCENE_WGSL: &str = include_str!("../../../shaders/scene.wgsl");
+pub const SKIN_WGSL: &str = include_str!("../../../shaders/skin.wgsl");
+pub const PLAIN_WGSL: &str = include_str!("../../../shaders/plain.wgsl");
+pub const TONEMAP_WGSL: &str = include_str!("../../../shaders/tonemap.wgsl");
 
 /// The name the generated prelude goes by in a program's file list.
 pub const GENERATED: &str = "generated constants";

@@ -7,7 +7,7 @@ use glam::{Mat4, Vec3};
 
 use crate::optics::film::Stack;
 use crate::preset::Preset;
-use crate::render::film::GpuFilmMethod;
+use crate::render::engine::film::GpuFilmMethod;
 
 /// An orbit camera around a target: drag changes yaw and pitch, the wheel the distance.
 #[derive(Debug, Clone, Copy)]
@@ -44,7 +44,7 @@ impl Camera {
         if snakes <= 1 {
             return Camera::default();
         }
-        let (columns, spacing_x, spacing_z) = crate::render::renderer::grid_layout(snakes);
+        let (columns, spacing_x, spacing_z) = crate::render::engine::renderer::grid_layout(snakes);
         let rows = snakes.div_ceil(columns);
         let width = (columns - 1) as f32 * spacing_x + 2.6;
         let depth = (rows - 1) as f32 * spacing_z + 1.0;

@@ -12,13 +12,14 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::film::GpuFilmMethod;
-use super::preview::{bands_for, material_maps, reference_check};
-use super::renderer::{FrameOutput, FrameSettings, Material, OUTPUT_FORMAT, Renderer};
-use super::scene::LayerOptics;
+use super::frame::reference_check;
 use crate::Error;
 use crate::optics::lut::Lut;
 use crate::preset::LoadedPreset;
+use crate::render::engine::film::GpuFilmMethod;
+use crate::render::engine::prepare::{bands_for, material_maps};
+use crate::render::engine::renderer::{FrameOutput, FrameSettings, Material, OUTPUT_FORMAT, Renderer};
+use crate::render::engine::scene::LayerOptics;
 
 #[derive(Debug, Clone, Serialize)]
 pub struct VariantTiming {
@@ -65,7 +66,7 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 /// Times one frame's scene pass at a time, for any variant, with shared targets.
 struct FrameTimer<'a> {
     renderer: &'a Renderer,
-    targets: super::renderer::Targets,
+    targets: crate::render::engine::renderer::Targets,
     view: wgpu::TextureView,
     query_set: Option<wgpu::QuerySet>,
     resolve: wgpu::Buffer,
@@ -126,13 +127,13 @@ impl<'a> FrameTimer<'a> {
         let start = Instant::now();
         self.renderer.gpu.queue.submit([encoder.finish()]);
         if self.query_set.is_some() {
-            let data = super::gpu::map_read(device, &self.readback)?;
+            let data = crate::render::engine::gpu::map_read(device, &self.readback)?;
             let ticks: &[u64] = bytemuck::cast_slice(&data);
             return Ok(ticks[1].saturating_sub(ticks[0]) as f64 * self.period_ns * 1e-6);
         }
         device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| Error::Gpu(super::GpuError::Readback(e.to_string())))?;
+            .map_err(|e| Error::Gpu(crate::render::GpuError::Readback(e.to_string())))?;
         Ok(start.elapsed().as_secs_f64() * 1e3)
     }
 }
@@ -169,7 +170,7 @@ pub fn bench_render(
                 continue;
             }
             let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method));
-            let camera = super::scene::Camera::framing(snakes);
+            let camera = crate::render::engine::scene::Camera::framing(snakes);
             let settings = FrameSettings { method: *method, plain: *plain, snakes, camera, ..base };
             runs.push((name.clone(), snakes, material, settings, Vec::with_capacity(options.frames)));
         }

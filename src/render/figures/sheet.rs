@@ -8,16 +8,16 @@ use std::path::{Path, PathBuf};
 use font8x8::UnicodeFonts;
 use image::{Rgb, RgbImage, imageops};
 
-use super::film::GpuFilmMethod;
-use super::material::MaterialMaps;
-use super::renderer::{FrameSettings, Renderer};
-use super::scene::{Camera, LayerOptics};
 use crate::Error;
 use crate::export::write_file_atomically;
 use crate::graph::evaluate;
 use crate::maps::{BuildOptions, MapKind, build_graph};
 use crate::optics::lut::Lut;
 use crate::preset::library;
+use crate::render::engine::film::GpuFilmMethod;
+use crate::render::engine::material::MaterialMaps;
+use crate::render::engine::renderer::{FrameSettings, Renderer};
+use crate::render::engine::scene::{Camera, LayerOptics};
 
 const LABEL_SCALE: u32 = 2;
 /// Two lines of text: the scientific name, then common name and category.

@@ -5,12 +5,13 @@
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-use super::film::{self, FilmBinding, GpuFilmMethod};
-use super::gpu::{map_read, storage_entry};
-use super::{Gpu, GpuError, shader_programs};
 use crate::optics::brdf::{Layers32, Model};
 use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
+use crate::render::engine::film::{self, FilmBinding, GpuFilmMethod};
+use crate::render::engine::gpu::{map_read, storage_entry};
+use crate::render::engine::shaders::shader_programs;
+use crate::render::{Gpu, GpuError};
 
 /// One BRDF query, laid out as the shader's `Sample` (five vec4s).
 #[repr(C)]

@@ -1,0 +1,123 @@
+//! The window's side panel: the optics sliders (over the preset's own range table, the wide
+//! ones logarithmic, like the thesis' Unity inspector, Fig. 5.1), the stage, map and film
+//! method pickers, the scene controls and the status line.
+
+use crate::maps::MapKind;
+use crate::optics::film::Stack;
+use crate::render::engine::film::GpuFilmMethod;
+use crate::render::engine::renderer::FrameSettings;
+use crate::render::engine::scene::{LayerOptics, Light, Stage, View};
+
+/// Optics as the sliders edit them (σ0 as one number; an RGB σ0 shows its mean).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sliders {
+    pub n0: f64,
+    pub n1: f64,
+    pub n2: f64,
+    pub thickness_nm: f64,
+    spread_nm: f64,
+    pigment_thickness: f64,
+    absorption: f64,
+}
+
+impl Sliders {
+    pub fn from_preset(preset: &crate::preset::Preset) -> Sliders {
+        let o = &preset.optics;
+        Sliders {
+            n0: o.ambient_ior,
+            n1: o.film_ior,
+            n2: o.pigment_ior,
+            thickness_nm: o.film_thickness_nm,
+            spread_nm: preset.iridescence.spread_nm,
+            pigment_thickness: o.pigment_thickness,
+            absorption: o.absorption.0.iter().sum::<f64>() / 3.0,
+        }
+    }
+
+    pub fn optics(&self) -> LayerOptics {
+        LayerOptics {
+            stack: Stack { n0: self.n0, n1: self.n1, n2: self.n2 },
+            thickness_range_nm: crate::material::thickness_range_nm(self.thickness_nm, self.spread_nm),
+            optical_depth: [self.absorption * self.pigment_thickness; 3],
+        }
+    }
+}
+
+/// The side panel.
+pub fn controls(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Sliders, status: &str, frame_ms: f64) {
+    egui::Panel::left("controls").default_size(260.0).show(ui, |ui| {
+        ui.heading("snakeskin");
+        ui.label(format!("frame {frame_ms:.2} ms ({:.0} fps)", if frame_ms > 0.0 { 1000.0 / frame_ms } else { 0.0 }));
+        ui.separator();
+        ui.label("View");
+        let mut view = settings.view;
+        egui::ComboBox::from_label("stage / map").selected_text(view_name(view)).show_ui(ui, |ui| {
+            for stage in Stage::ALL {
+                ui.selectable_value(&mut view, View::Shaded(stage), view_name(View::Shaded(stage)));
+            }
+            for map in MapKind::ALL {
+                ui.selectable_value(&mut view, View::Map(map), view_name(View::Map(map)));
+            }
+        });
+        settings.view = view;
+        let mut method = settings.method;
+        egui::ComboBox::from_label("film method").selected_text(method.name()).show_ui(ui, |ui| {
+            for m in [
+                GpuFilmMethod::Lut,
+                GpuFilmMethod::Rgb3,
+                GpuFilmMethod::SpectralN(8),
+                GpuFilmMethod::SpectralN(32),
+                GpuFilmMethod::GaussianFit,
+            ] {
+                ui.selectable_value(&mut method, m, m.name());
+            }
+        });
+        settings.method = method;
+        ui.separator();
+        ui.label("Layer optics (thesis Table 5.2)");
+        // The preset's own ranges (one table for files, --set and the window); the wide ones
+        // (10 mm of film, σ0 and δ1 up to 100) are logarithmic so the usual values stay fine.
+        use crate::preset::validate::ranges;
+        ui.add(slider(&mut s.n0, ranges::IOR, false, "n0 ambient"));
+        ui.add(slider(&mut s.n1, ranges::IOR, false, "n1 film"));
+        ui.add(slider(&mut s.n2, ranges::IOR, false, "n2 pigment"));
+        ui.add(slider(&mut s.thickness_nm, ranges::FILM_THICKNESS_NM, true, "δ0 film nm"));
+        ui.add(slider(&mut s.spread_nm, ranges::SPREAD_NM, false, "δ spread nm"));
+        ui.add(slider(&mut s.pigment_thickness, ranges::PIGMENT_THICKNESS, true, "δ1 pigment"));
+        ui.add(slider(&mut s.absorption, ranges::ABSORPTION, true, "σ0 absorption"));
+        ui.separator();
+        ui.label("Scene");
+        ui.add(egui::Slider::new(&mut settings.exposure, 0.1..=4.0).logarithmic(true).text("exposure"));
+        let mut azimuth = settings.lighting.key.direction.x.atan2(settings.lighting.key.direction.z).to_degrees();
+        let mut elevation = settings.lighting.key.direction.y.clamp(-1.0, 1.0).asin().to_degrees();
+        let a = ui.add(egui::Slider::new(&mut azimuth, -180.0..=180.0).text("light azimuth"));
+        let e = ui.add(egui::Slider::new(&mut elevation, 1.0..=89.0).text("light elevation"));
+        if a.changed() || e.changed() {
+            let irradiance = settings.lighting.key.irradiance;
+            settings.lighting.key = Light::from_angles(azimuth, elevation, irradiance);
+        }
+        ui.checkbox(&mut settings.lighting.fill.enabled, "fill light");
+        ui.checkbox(&mut settings.ground, "ground");
+        ui.add(egui::Slider::new(&mut settings.snakes, 1..=20).text("snakes"));
+        ui.separator();
+        ui.label("drag: orbit · wheel: zoom");
+        if !status.is_empty() {
+            ui.label(status);
+        }
+    });
+}
+
+fn view_name(view: View) -> String {
+    match view {
+        View::Shaded(Stage::Diffuse) => "(a) diffuse".into(),
+        View::Shaded(Stage::DiffuseNormal) => "(b) + normal map".into(),
+        View::Shaded(Stage::Film) => "(c) thin film".into(),
+        View::Shaded(Stage::All) => "(d) all layers".into(),
+        View::Map(map) => format!("map: {map}"),
+    }
+}
+
+/// A slider over one of the preset's ranges.
+fn slider<'a>(value: &'a mut f64, (lo, hi): (f64, f64), logarithmic: bool, text: &str) -> egui::Slider<'a> {
+    egui::Slider::new(value, lo..=hi).logarithmic(logarithmic).text(text)
+}
