@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use snakeskin::material::MapKind;
+use snakeskin::material::{MapKind, thesis};
 use snakeskin::optics::brdf::Model;
 use snakeskin::optics::methods::Method;
 use snakeskin::preset::validate::ranges;
@@ -224,13 +224,13 @@ fn parse_key_value(arg: &str) -> Result<(String, String), String> {
 #[derive(Debug, Args)]
 pub struct StackArgs {
     /// Refractive index of the ambient medium (thesis n0).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = thesis::AMBIENT_IOR)]
     pub n0: f64,
     /// Refractive index of the iridescent film (thesis n1).
-    #[arg(long, default_value_t = 1.55)]
+    #[arg(long, default_value_t = thesis::FILM_IOR)]
     pub n1: f64,
     /// Refractive index of the pigment layer under the film (thesis n2).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = thesis::PIGMENT_IOR)]
     pub n2: f64,
 }
 
@@ -317,16 +317,18 @@ pub struct EvalArgs {
     #[arg(long, value_parser = parse_vec3, default_value = "0,0,1", allow_hyphen_values = true)]
     pub normal: [f64; 3],
     /// Film thickness in nm (thesis δ0), 0 to 10^7 (10 mm).
-    #[arg(long, default_value_t = 400.0, value_parser = parse_thickness_nm)]
+    #[arg(long, default_value_t = thesis::FILM_THICKNESS_NM, value_parser = parse_thickness_nm)]
     pub thickness_nm: f64,
     /// Perceptual roughness (GGX α = roughness²), 0 to 1.
     #[arg(long, default_value_t = 0.35, value_parser = parse_unit)]
     pub roughness: f64,
     /// Absorption coefficient σ0 (one value, or r,g,b), each 0 to 100.
+    // The default is thesis::ABSORPTION written out (clap needs text for an array); the
+    // test `brdf_eval_defaults_are_the_thesis_values` ties the two.
     #[arg(long, value_parser = parse_absorption, default_value = "0.6")]
     pub absorption: [f64; 3],
     /// Pigment layer thickness δ1 (optical depth τ = σ0 δ1), 0 to 100.
-    #[arg(long, default_value_t = 1.0, value_parser = parse_pigment_thickness)]
+    #[arg(long, default_value_t = thesis::PIGMENT_THICKNESS, value_parser = parse_pigment_thickness)]
     pub pigment_thickness: f64,
     /// Base albedo k_d, linear r,g,b (or one value), each 0 to 1.
     #[arg(long, value_parser = parse_albedo, default_value = "1")]
@@ -522,4 +524,26 @@ fn parse_direction(text: &str) -> Result<[f64; 3], String> {
         return Err("a direction must not be the zero vector".into());
     }
     Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[test]
+    fn brdf_eval_defaults_are_the_thesis_values() {
+        let cli = Cli::try_parse_from(["snakeskin", "brdf", "eval", "--wi", "0,0,1", "--wo", "0,0,1"]).unwrap();
+        let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.command else { panic!("parsed as brdf eval") };
+        let stack = (args.stack.n0, args.stack.n1, args.stack.n2);
+        assert_eq!(stack, (thesis::AMBIENT_IOR, thesis::FILM_IOR, thesis::PIGMENT_IOR));
+        assert_eq!(args.absorption, [thesis::ABSORPTION; 3]);
+        assert_eq!(args.pigment_thickness, thesis::PIGMENT_THICKNESS);
+        assert_eq!(args.thickness_nm, thesis::FILM_THICKNESS_NM);
+        // Negative control: a value given on the command line is not the default.
+        let cli =
+            Cli::try_parse_from(["snakeskin", "brdf", "eval", "--wi", "0,0,1", "--wo", "0,0,1", "--absorption", "0.5"]);
+        let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.unwrap().command else { panic!() };
+        assert_ne!(args.absorption, [thesis::ABSORPTION; 3]);
+    }
 }
