@@ -20,8 +20,10 @@
 //! test so grazing angles give finite values. These numbers reach the WGSL from here
 //! (`render::shaders::generated_constants`), never by copy.
 
+pub mod exact;
 pub mod ggx;
 pub mod thesis;
+pub mod walk;
 
 pub use ggx::{ggx_d, ggx_d_sin, smith_g2, smith_lambda};
 pub use thesis::cos_transmitted;

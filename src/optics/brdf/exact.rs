@@ -1,0 +1,215 @@
+//! The layer stack's transport, exactly, for a smooth top interface (PHYSICS.md, "Layered
+//! transport, exactly"): the reference the real-time models are measured against.
+//!
+//! Light that crosses the film into the pigment layer (index n2) reaches the Lambertian
+//! base, and every diffuse bounce meets the film from below: directions outside the escape
+//! cone are totally reflected, the rest are reflected or transmitted by the film seen from
+//! below (the Airy stack n2 | n1 | n0). Summing the bounces is a geometric series:
+//!
+//! ```text
+//! K = ∫0^1 2μ R_b(μ) exp(−2τ/μ) dμ      sent back to the base per bounce
+//! E = ∫0^1 2μ T_b(μ) exp(−τ/μ) dμ       escapes per bounce
+//! f_diff = T(μi) T(μo) exp(−τ (1/cos_t(wi) + 1/cos_t(wo))) (n0/n2)² k_d / (π (1 − k_d K))
+//! R_d(μi) = T(μi) exp(−τ / cos_t(wi)) k_d E / (1 − k_d K)
+//! ```
+//!
+//! Colour: every spectral quantity enters as its linear sRGB colour under D65, as the film
+//! colour does (`film_rgb_reference`): the colour map is linear, so ∫ w(μ) R(λ, μ) dμ has
+//! the colour ∫ w(μ) colour(R(·, μ)) dμ, and channel c of K is taken with channel c's τ.
+//! The integrals are Gauss–Legendre, split at the critical cosines where R_b has a kink.
+
+use std::f64::consts::PI;
+
+use super::thesis::cos_transmitted;
+use super::{BrdfValue, Layers};
+use crate::optics::film::Stack;
+use crate::optics::film_rgb_reference;
+use crate::optics::spectrum::{Observer, xyz_to_linear_srgb};
+
+/// Gauss–Legendre nodes per segment of [0, 1]: with the segments split at the kinks the
+/// integrands are smooth, and 24 nodes integrate them to ~1e-10 (checked against 48).
+const NODES_PER_SEGMENT: usize = 24;
+
+/// The stack seen from below: light in the pigment layer (n2) meets the film (n1), then
+/// the ambient medium (n0).
+pub fn reversed(stack: Stack) -> Stack {
+    Stack { n0: stack.n2, n1: stack.n1, n2: stack.n0 }
+}
+
+/// The linear sRGB colour of the perfect reflector (R = 1 at every wavelength): (1, 1, 1)
+/// within 1e-3 (PHYSICS.md).
+fn white() -> [f64; 3] {
+    xyz_to_linear_srgb(Observer::get().white_xyz())
+}
+
+/// The film's reflectance colour for light arriving in `stack.n0` at cosine `cos0`: the
+/// 1 nm spectral sum (or the incoherent limit beyond `COHERENT_LIMIT_NM`) relative to the
+/// perfect reflector's colour, so that R = 1 is exactly (1, 1, 1) and the transmittance
+/// colour is exactly 1 − R (R + T = 1 at every wavelength for the lossless film): energy
+/// balances hold to rounding, not to the 1e-3 of the white point. Total internal reflection
+/// (no propagating wave in n2) gives R = 1.
+pub fn reflectance(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
+    let white = white();
+    let r = film_rgb_reference(stack, thickness_nm, cos0);
+    [0, 1, 2].map(|c| r[c] / white[c])
+}
+
+/// Gauss–Legendre nodes and weights on [a, b] (Newton's iteration on P_n).
+pub fn gauss_legendre(n: usize, a: f64, b: f64) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let step = p1 / dp;
+                x -= step;
+                if step.abs() < 1e-15 {
+                    break;
+                }
+            }
+            let w = 2.0 / ((1.0 - x * x) * dp * dp);
+            (0.5 * (a + b) + 0.5 * (b - a) * x, 0.5 * (b - a) * w)
+        })
+        .collect()
+}
+
+/// Cosines in the pigment layer where the film seen from below changes regime: the critical
+/// angles of n2 against n1 and against n0 (when those are lower).
+fn kinks(stack: Stack) -> Vec<f64> {
+    let mut cuts: Vec<f64> = [stack.n1, stack.n0]
+        .into_iter()
+        .filter(|n| *n < stack.n2)
+        .map(|n| (1.0 - (n / stack.n2) * (n / stack.n2)).sqrt())
+        .collect();
+    cuts.push(0.0);
+    cuts.push(1.0);
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    cuts
+}
+
+/// The smooth-top stack of one material and film thickness: the film from below tabulated
+/// at the quadrature nodes, from which K and E follow for any τ.
+#[derive(Debug, Clone)]
+pub struct SmoothTop {
+    pub stack: Stack,
+    pub thickness_nm: f64,
+    /// (μ in the pigment layer, quadrature weight, colour of R_b(μ)).
+    below: Vec<(f64, f64, [f64; 3])>,
+}
+
+impl SmoothTop {
+    pub fn new(stack: Stack, thickness_nm: f64) -> SmoothTop {
+        let cuts = kinks(stack);
+        let below = cuts
+            .windows(2)
+            .flat_map(|w| gauss_legendre(NODES_PER_SEGMENT, w[0], w[1]))
+            .map(|(mu, weight)| (mu, weight, reflectance(reversed(stack), thickness_nm, mu)))
+            .collect();
+        SmoothTop { stack, thickness_nm, below }
+    }
+
+    /// K (sent back to the base per bounce) and E (escaping per bounce) per channel for
+    /// optical depth τ per channel.
+    pub fn k_e(&self, tau: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let (mut k, mut e) = ([0.0; 3], [0.0; 3]);
+        for &(mu, weight, rb) in &self.below {
+            for c in 0..3 {
+                let tau = tau[c].max(0.0);
+                k[c] += weight * 2.0 * mu * rb[c] * (-2.0 * tau / mu).exp();
+                e[c] += weight * 2.0 * mu * (1.0 - rb[c]) * (-tau / mu).exp();
+            }
+        }
+        (k, e)
+    }
+
+    /// The film's transmittance colour from above at cosine `cos0`.
+    pub fn transmittance(&self, cos0: f64) -> [f64; 3] {
+        let r = reflectance(self.stack, self.thickness_nm, cos0);
+        r.map(|v| 1.0 - v)
+    }
+
+    /// Light entering the pigment layer from a direction at cosine `cos` and reaching the
+    /// base: T(μ) exp(−τ / cos_t), per channel (zero under total internal reflection).
+    pub fn entering(&self, layers: &Layers, cos: f64) -> [f64; 3] {
+        let Some(cos_t) = cos_transmitted(self.stack.n0, self.stack.n2, cos) else {
+            return [0.0; 3];
+        };
+        let t = self.transmittance(cos);
+        [0, 1, 2].map(|c| t[c] * (-layers.optical_depth[c].max(0.0) / cos_t).exp())
+    }
+
+    /// The diffuse lobe f_diff(wi, wo) at cosines `cos_i`, `cos_o` about the normal (the
+    /// specular part of a smooth top is a mirror: see `albedo`).
+    pub fn diffuse(&self, layers: &Layers, cos_i: f64, cos_o: f64) -> [f64; 3] {
+        let (k, _) = self.k_e(layers.optical_depth);
+        let (a_i, a_o) = (self.entering(layers, cos_i), self.entering(layers, cos_o));
+        let eta2 = (self.stack.n0 / self.stack.n2).powi(2);
+        [0, 1, 2].map(|c| {
+            let kd = layers.albedo[c].max(0.0);
+            a_i[c] * a_o[c] * eta2 * kd / (PI * (1.0 - kd * k[c]))
+        })
+    }
+
+    /// The directional albedo for light from a direction at cosine `cos_i`: the mirror
+    /// reflection F(μi) and the diffuse reflectance R_d(μi), as a `BrdfValue` of
+    /// reflectances (not per steradian).
+    pub fn albedo(&self, layers: &Layers, cos_i: f64) -> BrdfValue {
+        let (k, e) = self.k_e(layers.optical_depth);
+        let a_i = self.entering(layers, cos_i);
+        let diffuse = [0, 1, 2].map(|c| {
+            let kd = layers.albedo[c].max(0.0);
+            a_i[c] * kd * e[c] / (1.0 - kd * k[c])
+        });
+        BrdfValue { specular: reflectance(self.stack, self.thickness_nm, cos_i), diffuse }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        let nodes = gauss_legendre(NODES_PER_SEGMENT, 0.2, 0.9);
+        // Degree 2n − 1 is exact; x^7 on [0.2, 0.9].
+        let sum: f64 = nodes.iter().map(|(x, w)| w * x.powi(7)).sum();
+        let exact = (0.9f64.powi(8) - 0.2f64.powi(8)) / 8.0;
+        assert!((sum - exact).abs() < 1e-14, "{sum} {exact}");
+    }
+
+    #[test]
+    fn lossless_stack_reflects_everything_and_k_plus_e_is_one() {
+        // τ = 0: every photon that leaves the base either escapes or comes back (K + E = 1);
+        // with k_d = 1 the albedo is F + T = 1 at every angle.
+        for stack in [Stack::THESIS, Stack { n0: 1.0, n1: 1.56, n2: 1.33 }, Stack { n0: 1.33, n1: 1.55, n2: 2.0 }] {
+            let top = SmoothTop::new(stack, 420.0);
+            let (k, e) = top.k_e([0.0; 3]);
+            for c in 0..3 {
+                assert!((k[c] + e[c] - 1.0).abs() < 1e-9, "{stack:?} K {k:?} E {e:?}");
+            }
+            let layers =
+                Layers { n0: stack.n0, n2: stack.n2, roughness: 0.0, optical_depth: [0.0; 3], albedo: [1.0; 3] };
+            for cos_i in [1.0, 0.7, 0.3, 0.05] {
+                let a = top.albedo(&layers, cos_i).total();
+                assert!(a.iter().all(|v| (v - 1.0).abs() < 1e-9), "{stack:?} cos {cos_i}: {a:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn total_internal_reflection_keeps_three_quarters_for_n2_2() {
+        // With no film (n1 = n0) and n2 = 2, directions outside the escape cone are the
+        // fraction 1 − (n0/n2)² = 3/4 of a Lambertian distribution (PHYSICS.md): K ≥ 0.75.
+        let top = SmoothTop::new(Stack { n0: 1.0, n1: 1.0, n2: 2.0 }, 0.0);
+        let (k, _) = top.k_e([0.0; 3]);
+        assert!(k.iter().all(|v| *v > 0.75 && *v < 0.85), "{k:?}");
+    }
+}

@@ -1,0 +1,261 @@
+//! The stochastic reference: photons followed one by one through the stack, with a rough
+//! (GGX) or smooth top, in the manner of Guo, Hašan & Zhao 2018 (position-free layered
+//! transport) and pbrt-v4's `LayeredBxDF`. It shares no formula with `exact.rs` beyond the
+//! film's reflectance, so the closed form's geometric series, its escape cone, its (n0/n2)²
+//! and its K and E are checked against a simulation of the physics they describe.
+//!
+//! A photon from direction wi meets the top: a microfacet normal m is drawn from GGX's
+//! distribution of visible normals (Heitz 2018; m = n for a smooth top), the film reflects
+//! with probability R(wi·m) (from above, or from below with total internal reflection) or
+//! the photon refracts through m by Snell's law. A reflection that points back into the
+//! surface meets another microfacet (so the rough interface conserves energy, as a real one
+//! does, instead of losing GGX's single-scatter deficit). In the pigment layer the photon
+//! survives a path at cosine μ with probability exp(−τ/|μ|), at the base with probability
+//! k_d, leaving in a cosine-distributed direction; it is followed until it escapes or is
+//! absorbed. Analog (0/1) tallies make the noise binomial: σ = √(p(1 − p)/N).
+//!
+//! Film colours come from tables over the cosine (2049 entries from above and from below,
+//! linear interpolation: bias below 1e-5 next to the square-root kink at a critical angle),
+//! each channel walked separately with its own R, τ and k_d.
+
+use super::Layers;
+use super::exact::{reflectance, reversed};
+use crate::optics::film::Stack;
+
+/// Entries of the film tables over cos ∈ [0, 1].
+const TABLE_SIZE: usize = 2049;
+/// Interface events after which a photon is counted as absorbed (never reached in practice:
+/// with K ≤ 0.9 the chance of 10,000 bounces is below 1e-400).
+const MAX_EVENTS: usize = 10_000;
+
+/// The film's reflectance colour from above and from below, tabulated over the cosine.
+#[derive(Debug, Clone)]
+pub struct FilmTables {
+    pub stack: Stack,
+    above: Vec<[f64; 3]>,
+    below: Vec<[f64; 3]>,
+}
+
+impl FilmTables {
+    pub fn new(stack: Stack, thickness_nm: f64) -> FilmTables {
+        let cos = |i: usize| i as f64 / (TABLE_SIZE - 1) as f64;
+        // Colours relative to the white point (`exact::reflectance`): R is a probability.
+        let normalise = |rgb: [f64; 3]| rgb.map(|v| v.clamp(0.0, 1.0));
+        FilmTables {
+            stack,
+            above: (0..TABLE_SIZE).map(|i| normalise(reflectance(stack, thickness_nm, cos(i)))).collect(),
+            below: (0..TABLE_SIZE).map(|i| normalise(reflectance(reversed(stack), thickness_nm, cos(i)))).collect(),
+        }
+    }
+
+    fn lookup(table: &[[f64; 3]], cos: f64, channel: usize) -> f64 {
+        let x = cos.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f64;
+        let i = (x as usize).min(TABLE_SIZE - 2);
+        let f = x - i as f64;
+        table[i][channel] * (1.0 - f) + table[i + 1][channel] * f
+    }
+}
+
+/// What the photons did: the fractions reflected by the top alone (specular) and after
+/// entering the stack (diffuse), per channel, with their standard errors; and the diffuse
+/// photons' outgoing cosines in `bins` equal bins of cos θo.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct WalkResult {
+    pub photons: u64,
+    pub specular: [f64; 3],
+    pub diffuse: [f64; 3],
+    pub specular_sigma: [f64; 3],
+    pub diffuse_sigma: [f64; 3],
+    /// Per channel, per bin of cos θo (bin b covers [b/n, (b+1)/n)): fraction of photons.
+    pub diffuse_bins: Vec<[f64; 3]>,
+}
+
+impl WalkResult {
+    pub fn total(&self) -> [f64; 3] {
+        [0, 1, 2].map(|c| self.specular[c] + self.diffuse[c])
+    }
+    /// σ of the total: the two tallies are exclusive outcomes of one trial.
+    pub fn total_sigma(&self) -> [f64; 3] {
+        let n = self.photons as f64;
+        self.total().map(|p| (p * (1.0 - p) / n).max(0.0).sqrt())
+    }
+}
+
+/// SplitMix64: a small, fast generator whose streams are fixed by the seed.
+struct Rng(u64);
+
+impl Rng {
+    fn unit(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+type V3 = [f64; 3];
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalize(v: V3) -> V3 {
+    let l = dot(v, v).sqrt();
+    v.map(|c| c / l)
+}
+
+fn cross(a: V3, b: V3) -> V3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// A GGX visible normal for a viewer at `w` (w.z > 0), Heitz 2018 ("Sampling the GGX
+/// distribution of visible normals", JCGT 7(4), listing 1).
+fn sample_visible_normal(w: V3, alpha: f64, rng: &mut Rng) -> V3 {
+    if alpha <= 0.0 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vh = normalize([alpha * w[0], alpha * w[1], w[2]]);
+    let lensq = vh[0] * vh[0] + vh[1] * vh[1];
+    let t1 = if lensq > 0.0 { [-vh[1] / lensq.sqrt(), vh[0] / lensq.sqrt(), 0.0] } else { [1.0, 0.0, 0.0] };
+    let t2 = cross(vh, t1);
+    let (u1, u2) = (rng.unit(), rng.unit());
+    let r = u1.sqrt();
+    let phi = 2.0 * std::f64::consts::PI * u2;
+    let p1 = r * phi.cos();
+    let s = 0.5 * (1.0 + vh[2]);
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).sqrt() + s * r * phi.sin();
+    let p3 = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+    let nh = [0, 1, 2].map(|k| p1 * t1[k] + p2 * t2[k] + p3 * vh[k]);
+    normalize([alpha * nh[0], alpha * nh[1], nh[2].max(0.0)])
+}
+
+/// Mirror of the travel direction `d` about the normal `m`.
+fn reflect(d: V3, m: V3) -> V3 {
+    let k = 2.0 * dot(d, m);
+    [0, 1, 2].map(|i| d[i] - k * m[i])
+}
+
+/// The travel direction after refraction through `m` (facing the incident side, m·d < 0)
+/// from index n_i into n_t; None under total internal reflection.
+fn refract(d: V3, m: V3, eta: f64) -> Option<V3> {
+    let cos_i = -dot(d, m);
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    (k >= 0.0).then(|| normalize([0, 1, 2].map(|i| eta * d[i] + (eta * cos_i - k.sqrt()) * m[i])))
+}
+
+/// Where a photon is, travelling in direction `d`.
+enum State {
+    /// Above the interface, travelling down onto it.
+    Above(V3),
+    /// In the pigment layer, just below the interface, travelling down to the base.
+    Down(V3),
+    /// In the pigment layer, travelling up onto the interface.
+    Up(V3),
+}
+
+enum Fate {
+    Specular,
+    Diffuse(f64),
+    Absorbed,
+}
+
+/// Follows one photon of channel `c` arriving from direction `wi` (unit, wi.z > 0).
+fn follow(wi: V3, layers: &Layers, film: &FilmTables, alpha: f64, c: usize, rng: &mut Rng) -> Fate {
+    let Stack { n0, n2, .. } = film.stack;
+    let tau = layers.optical_depth[c].max(0.0);
+    let kd = layers.albedo[c].clamp(0.0, 1.0);
+    let mut state = State::Above(wi.map(|v| -v));
+    let mut entered = false;
+    for _ in 0..MAX_EVENTS {
+        state = match state {
+            State::Above(d) => {
+                let m = sample_visible_normal(d.map(|v| -v), alpha, rng);
+                let r = FilmTables::lookup(&film.above, -dot(d, m), c);
+                let refracted = if rng.unit() < r { None } else { refract(d, m, n0 / n2) };
+                match refracted {
+                    None => {
+                        let out = reflect(d, m);
+                        if out[2] > 0.0 {
+                            return if entered { Fate::Diffuse(out[2]) } else { Fate::Specular };
+                        }
+                        State::Above(out)
+                    }
+                    Some(t) => {
+                        entered = true;
+                        // Into the layer; a refraction that grazes back up (rough top)
+                        // meets the interface again at once.
+                        if t[2] < 0.0 { State::Down(t) } else { State::Up(t) }
+                    }
+                }
+            }
+            State::Down(d) => {
+                // Down through the layer, the base, and up through the layer again: each
+                // traversal at its own cosine survives with exp(−τ/|μ|).
+                if rng.unit() >= (-tau / d[2].abs()).exp() || rng.unit() >= kd {
+                    return Fate::Absorbed;
+                }
+                // Lambertian: cos θ = √u, uniform azimuth.
+                let (u1, u2) = (rng.unit(), rng.unit());
+                let (cos, phi) = (u1.sqrt(), 2.0 * std::f64::consts::PI * u2);
+                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                let up = [sin * phi.cos(), sin * phi.sin(), cos];
+                if rng.unit() >= (-tau / cos.max(1e-300)).exp() {
+                    return Fate::Absorbed;
+                }
+                State::Up(up)
+            }
+            State::Up(d) => {
+                // The microsurface seen from below: normals point down.
+                let m = sample_visible_normal(d, alpha, rng).map(|v| -v);
+                let r = FilmTables::lookup(&film.below, -dot(d, m), c);
+                let refracted = if rng.unit() < r { None } else { refract(d, m, n2 / n0) };
+                match refracted {
+                    None => {
+                        let back = reflect(d, m);
+                        if back[2] < 0.0 { State::Down(back) } else { State::Up(back) }
+                    }
+                    Some(t) if t[2] > 0.0 => return Fate::Diffuse(t[2]),
+                    Some(t) => State::Above(t),
+                }
+            }
+        };
+    }
+    Fate::Absorbed
+}
+
+/// Walks `photons` photons per channel from direction `wi` (need not be normalised; the
+/// normal is +z) through the stack of `layers` with the film of `film`.
+pub fn walk(layers: &Layers, film: &FilmTables, wi: V3, photons: u64, bins: usize, seed: u64) -> WalkResult {
+    let wi = normalize(wi);
+    let alpha = if layers.roughness <= 0.0 { 0.0 } else { (layers.roughness * layers.roughness).max(super::ALPHA_MIN) };
+    let mut specular = [0u64; 3];
+    let mut diffuse = [0u64; 3];
+    let mut binned = vec![[0u64; 3]; bins.max(1)];
+    for c in 0..3 {
+        let mut rng = Rng(seed ^ (0x5151_0000 + c as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
+        for _ in 0..photons {
+            match follow(wi, layers, film, alpha, c, &mut rng) {
+                Fate::Specular => specular[c] += 1,
+                Fate::Diffuse(cos_o) => {
+                    diffuse[c] += 1;
+                    let b = ((cos_o * binned.len() as f64) as usize).min(binned.len() - 1);
+                    binned[b][c] += 1;
+                }
+                Fate::Absorbed => {}
+            }
+        }
+    }
+    let n = photons as f64;
+    let p = |k: [u64; 3]| k.map(|v| v as f64 / n);
+    let sigma = |p: [f64; 3]| p.map(|v| (v * (1.0 - v) / n).sqrt());
+    let (s, d) = (p(specular), p(diffuse));
+    WalkResult {
+        photons,
+        specular: s,
+        diffuse: d,
+        specular_sigma: sigma(s),
+        diffuse_sigma: sigma(d),
+        diffuse_bins: binned.into_iter().map(p).collect(),
+    }
+}
