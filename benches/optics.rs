@@ -5,7 +5,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use snakeskin::optics::brdf::{Layers32, Model};
+use snakeskin::optics::brdf::{Layers, Model};
 use snakeskin::optics::film::Stack;
 use snakeskin::optics::lut::Lut;
 use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
@@ -26,14 +26,7 @@ fn methods(c: &mut Criterion) {
     group.bench_function("lut", |b| b.iter(|| lut.lookup_f32(black_box(d), black_box(cos0))));
     group.finish();
 
-    let layers = Layers32 {
-        n0: 1.0,
-        n2: 2.0,
-        roughness: 0.35,
-        optical_depth: [0.6; 3],
-        albedo: [0.4, 0.3, 0.2],
-        thickness_nm: 400.0,
-    };
+    let layers = Layers::of_stack(Stack::THESIS, 400.0, 0.35, [0.6; 3], [0.4, 0.3, 0.2]).to_f32(400.0);
     for model in Model::ALL {
         c.bench_function(&format!("brdf_f32_lut_{}", model.name()), |b| {
             b.iter(|| {

@@ -19,6 +19,9 @@ struct Layers {
     thickness_nm: f32,
     optical_depth: vec3<f32>,
     albedo: vec3<f32>,
+    // The stack's bounce terms (layered model): K sent back to the base, E escaping.
+    k: vec3<f32>,
+    e: vec3<f32>,
 }
 
 fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
@@ -74,33 +77,127 @@ fn thesis_ambient_diffuse(layers: Layers, cos_o: f32, f_o: vec3<f32>) -> vec3<f3
     return base;
 }
 
+// ---- The layered model (optics::brdf::layered). ----
+
+// The rough lobe at (mu, r), bilinear in the film bind group's lobe_table
+// (optics::brdf::energy::lookup_f32): its albedo E1 for F = 1 and the three-point Gauss rule
+// over its microfacet cosines.
+struct Lobe {
+    albedo: f32,
+    cos: vec3<f32>,
+    // The third weight is 1 minus these two.
+    weight: vec2<f32>,
+}
+
+fn lobe_at(cos: f32, roughness: f32) -> Lobe {
+    let x = clamp(cos, 0.0, 1.0) * f32(E1_MU - 1u);
+    let y = clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
+    let i = min(u32(x), E1_MU - 2u);
+    let j = min(u32(y), E1_ROUGHNESS - 2u);
+    let fx = x - f32(i);
+    let fy = y - f32(j);
+    let k00 = 2u * (j * E1_MU + i);
+    let k01 = 2u * ((j + 1u) * E1_MU + i);
+    let a = mix(mix(lobe_table[k00], lobe_table[k00 + 2u], fx), mix(lobe_table[k01], lobe_table[k01 + 2u], fx), fy);
+    let b = mix(
+        mix(lobe_table[k00 + 1u], lobe_table[k00 + 3u], fx),
+        mix(lobe_table[k01 + 1u], lobe_table[k01 + 3u], fx),
+        fy,
+    );
+    return Lobe(a.x, a.yzw, b.xy);
+}
+
+// a(mu) = (1 - s(mu)) exp(-tau / cos_t(mu)): the light that reaches the base, s what the
+// rough lobe reflects (coupling).
+fn layered_entering(layers: Layers, cos: f32, s: vec3<f32>) -> vec3<f32> {
+    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    let k = (1.0 - eta2) + eta2 * cos * cos;
+    if (k <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    var a = vec3<f32>(1.0) - s;
+    if (HAS_ABSORPTION) {
+        a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) / max(sqrt(k), COS_MIN));
+    }
+    return a;
+}
+
+// (n0/n2)^2 k_d a(mu_i) a(mu_o) / (pi (1 - k_d K)).
+fn layered_diffuse(layers: Layers, cos_i: f32, cos_o: f32, s_i: vec3<f32>, s_o: vec3<f32>) -> vec3<f32> {
+    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    let kd = clamp(layers.albedo, vec3<f32>(0.0), vec3<f32>(1.0));
+    let a = layered_entering(layers, cos_i, s_i) * layered_entering(layers, cos_o, s_o);
+    return eta2 * kd * a / (PI * (vec3<f32>(1.0) - kd * layers.k));
+}
+
+// a(mu_o) k_d E / (1 - k_d K): the directional diffuse reflectance, by reciprocity the
+// response to a uniform sky.
+fn layered_ambient_diffuse(layers: Layers, cos_o: f32, s_o: vec3<f32>) -> vec3<f32> {
+    let kd = clamp(layers.albedo, vec3<f32>(0.0), vec3<f32>(1.0));
+    return layered_entering(layers, cos_o, s_o) * kd * layers.e / (vec3<f32>(1.0) - kd * layers.k);
+}
+
 // ---- The model seam (optics::brdf::Model). ----
 
-fn diffuse_lobe(layers: Layers, cos_i: f32, cos_o: f32, f_i: vec3<f32>, f_o: vec3<f32>) -> vec3<f32> {
+// What the top reflects by itself from a direction at cosine `cos` (Model::coupling): the
+// diffuse lobe lets 1 minus this in, the ambient mirror term is the sky times this. The
+// thesis: the film F(cos); the layered model: E1 times the film at the lobe's microfacet
+// angles (three-point Gauss rule).
+fn coupling(layers: Layers, cos: f32) -> vec3<f32> {
     switch BRDF_MODEL {
+        case MODEL_LAYERED: {
+            let l = lobe_at(cos, layers.roughness);
+            let f1 = film_clamped(layers, l.cos.x);
+            let f2 = film_clamped(layers, l.cos.y);
+            let f3 = film_clamped(layers, l.cos.z);
+            return l.albedo * (l.weight.x * f1 + l.weight.y * f2 + (1.0 - l.weight.x - l.weight.y) * f3);
+        }
+        case MODEL_THESIS: {
+            return film_clamped(layers, cos);
+        }
         default: {
-            return thesis_diffuse(layers, cos_i, cos_o, f_i, f_o);
+            return film_clamped(layers, cos);
         }
     }
 }
 
-// The ambient term's diffuse part towards a view at cosine cos_o (Model::ambient_diffuse):
-// multiplies the sky radiance along the normal.
-fn ambient_diffuse(layers: Layers, cos_o: f32, f_o: vec3<f32>) -> vec3<f32> {
+fn diffuse_lobe(layers: Layers, cos_i: f32, cos_o: f32, s_i: vec3<f32>, s_o: vec3<f32>) -> vec3<f32> {
     switch BRDF_MODEL {
+        case MODEL_LAYERED: {
+            return layered_diffuse(layers, cos_i, cos_o, s_i, s_o);
+        }
+        case MODEL_THESIS: {
+            return thesis_diffuse(layers, cos_i, cos_o, s_i, s_o);
+        }
         default: {
-            return thesis_ambient_diffuse(layers, cos_o, f_o);
+            return thesis_diffuse(layers, cos_i, cos_o, s_i, s_o);
+        }
+    }
+}
+
+// The ambient term's diffuse part towards a view at cosine cos_o, s_o = coupling there
+// (Model::ambient_diffuse): multiplies the sky radiance along the normal.
+fn ambient_diffuse(layers: Layers, cos_o: f32, s_o: vec3<f32>) -> vec3<f32> {
+    switch BRDF_MODEL {
+        case MODEL_LAYERED: {
+            return layered_ambient_diffuse(layers, cos_o, s_o);
+        }
+        case MODEL_THESIS: {
+            return thesis_ambient_diffuse(layers, cos_o, s_o);
+        }
+        default: {
+            return thesis_ambient_diffuse(layers, cos_o, s_o);
         }
     }
 }
 
 fn skin_brdf(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
     let n = safe_normalize(normal, vec3<f32>(0.0, 0.0, 1.0));
-    let f_o = film_clamped(layers, max(dot(n, safe_normalize(wo_in, vec3<f32>(0.0))), COS_MIN));
-    return skin_brdf_seen(layers, normal, wi_in, wo_in, f_o, true);
+    let cos_o = max(dot(n, safe_normalize(wo_in, vec3<f32>(0.0))), COS_MIN);
+    return skin_brdf_seen(layers, normal, wi_in, wo_in, coupling(layers, cos_o), true);
 }
 
-// The BRDF with the film's reflectance towards the viewer, f_o = F(max(n.wo, COS_MIN)),
+// The BRDF with the model's coupling towards the viewer, s_o = coupling(max(n.wo, COS_MIN)),
 // computed by the caller: a pixel lit by several lights (and the ambient term) looks it up
 // once instead of once per light. `with_diffuse` = false gives the specular lobe alone.
 fn skin_brdf_seen(
@@ -108,7 +205,7 @@ fn skin_brdf_seen(
     normal: vec3<f32>,
     wi_in: vec3<f32>,
     wo_in: vec3<f32>,
-    f_o: vec3<f32>,
+    s_o: vec3<f32>,
     with_diffuse: bool,
 ) -> vec3<f32> {
     let n = safe_normalize(normal, vec3<f32>(0.0, 0.0, 1.0));
@@ -133,7 +230,7 @@ fn skin_brdf_seen(
     let f_h = film_clamped(layers, abs(dot(wo, h)));
     var diffuse = vec3<f32>(0.0);
     if (with_diffuse) {
-        diffuse = diffuse_lobe(layers, cos_i, cos_o, film_clamped(layers, cos_i), f_o);
+        diffuse = diffuse_lobe(layers, cos_i, cos_o, coupling(layers, cos_i), s_o);
     }
     return f_h * spec + diffuse;
 }

@@ -7,6 +7,8 @@ struct Sample {
     wo_n0: vec4<f32>,
     tau_n2: vec4<f32>,
     albedo: vec4<f32>,
+    k: vec4<f32>,
+    e: vec4<f32>,
 }
 
 @group(1) @binding(0) var<storage, read> samples: array<Sample>;
@@ -19,6 +21,15 @@ fn eval_samples(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let s = samples[i];
-    let layers = Layers(s.wo_n0.w, s.tau_n2.w, s.normal_roughness.w, s.wi_thickness.w, s.tau_n2.xyz, s.albedo.xyz);
+    let layers = Layers(
+        s.wo_n0.w,
+        s.tau_n2.w,
+        s.normal_roughness.w,
+        s.wi_thickness.w,
+        s.tau_n2.xyz,
+        s.albedo.xyz,
+        s.k.xyz,
+        s.e.xyz,
+    );
     results[i] = vec4<f32>(skin_brdf(layers, s.normal_roughness.xyz, s.wi_thickness.xyz, s.wo_n0.xyz), 1.0);
 }

@@ -5,7 +5,7 @@
 // specialised for one method carries only its code (the constant is resolved before the
 // driver compiles the shader). The codes, the LUT's thickness axis (FINE_MAX_NM,
 // COARSE_MAX_NM), the rgb3 wavelengths and the Belcour–Barla fits come from the generated
-// prelude (render::shaders).
+// prelude (render::engine::shaders).
 
 override FILM_METHOD: u32 = FILM_LUT;
 
@@ -27,6 +27,9 @@ struct FilmInfo {
 @group(0) @binding(3) var lut_sampler: sampler;
 // spectral-N: per band (centre nm, then linear-sRGB weights).
 @group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
+// The rough lobe's table (optics::brdf::energy, read by brdf.wgsl's lobe_at): per (mu, r)
+// entry, row-major by roughness, (E1, c1, c2, c3) then (w1, w2, 0, 0).
+@group(0) @binding(4) var<storage, read> lobe_table: array<vec4<f32>>;
 
 // Film colour at thickness d (nm) and incidence cosine c: the table's texel coordinates
 // as in optics::lut::Lut::lookup_f32, then one filtered fetch at those coordinates.

@@ -17,6 +17,9 @@ struct Scene {
     film: vec4<f32>,
     // rgb: pigment optical depth tau = sigma0 * delta1.
     optical_depth: vec4<f32>,
+    // The stack's K and E (rgb) per roughness row of E1_TABLE (LayerOptics::bounce_table).
+    bounce_k: array<vec4<f32>, E1_ROUGHNESS>,
+    bounce_e: array<vec4<f32>, E1_ROUGHNESS>,
 }
 
 @group(1) @binding(0) var<uniform> scene: Scene;

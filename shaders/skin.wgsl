@@ -10,17 +10,25 @@ override VIEW_MAP: u32 = VIEW_SHADED;
 // Which half of the G-buffer fs_gbuffer writes (two passes keep each under 32 bytes/pixel).
 override GBUFFER_PART: u32 = 0u;
 
+// The pixel's layers; K and E interpolated between the roughness rows (exact: they are
+// linear in r between rows, LayerOptics::bounce_table).
 fn layers_of(m: Material) -> Layers {
-    return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, scene.optical_depth.rgb, m.albedo);
+    let y = clamp(m.roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
+    let j = min(u32(y), E1_ROUGHNESS - 2u);
+    let f = y - f32(j);
+    let k = mix(scene.bounce_k[j].rgb, scene.bounce_k[j + 1u].rgb, f);
+    let e = mix(scene.bounce_e[j].rgb, scene.bounce_e[j + 1u].rgb, f);
+    return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, scene.optical_depth.rgb, m.albedo, k, e);
 }
 
 // Ambient light from the sky gradient, as reference::shade_pixel: the sky seen along the
-// mirror direction is reflected by the film; the sky seen along the normal goes through
+// mirror direction is reflected by the top (the model's coupling: the film for the thesis,
+// the rough lobe's albedo for the layered model); the sky seen along the normal goes through
 // the layer model (brdf.wgsl's ambient_diffuse).
-fn ambient(m: Material, n: vec3<f32>, wo: vec3<f32>, f_o: vec3<f32>, with_diffuse: bool) -> vec3<f32> {
-    var result = sky(reflect(-wo, n)) * f_o;
+fn ambient(m: Material, n: vec3<f32>, wo: vec3<f32>, s_o: vec3<f32>, with_diffuse: bool) -> vec3<f32> {
+    var result = sky(reflect(-wo, n)) * s_o;
     if (with_diffuse) {
-        result += sky(n) * ambient_diffuse(layers_of(m), max(dot(n, wo), COS_MIN), f_o);
+        result += sky(n) * ambient_diffuse(layers_of(m), max(dot(n, wo), COS_MIN), s_o);
     }
     return result;
 }
@@ -40,17 +48,17 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
         return radiance + sky(n) * m.albedo;
     }
     let layers = layers_of(m);
-    // The film towards the viewer, shared by both lights and the ambient term.
-    let f_o = clamp(film_rgb(m.thickness_nm, max(dot(m.normal, wo), COS_MIN)), vec3<f32>(0.0), vec3<f32>(1.0));
+    // What the top reflects towards the viewer, shared by both lights and the ambient term.
+    let s_o = coupling(layers, max(dot(m.normal, wo), COS_MIN));
     for (var i = 0u; i < 2u; i++) {
         let wi = scene.light_dir[i].xyz;
         let cos_i = max(dot(m.normal, wi), 0.0);
         if (scene.light_dir[i].w > 0.0 && cos_i > 0.0) {
-            let f = skin_brdf_seen(layers, m.normal, wi, wo, f_o, STAGE == STAGE_ALL);
+            let f = skin_brdf_seen(layers, m.normal, wi, wo, s_o, STAGE == STAGE_ALL);
             radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * f * cos_i;
         }
     }
-    return radiance + ambient(m, m.normal, wo, f_o, STAGE == STAGE_ALL);
+    return radiance + ambient(m, m.normal, wo, s_o, STAGE == STAGE_ALL);
 }
 
 fn map_view(m: Material) -> vec3<f32> {

@@ -4,7 +4,8 @@
 
 use proptest::prelude::*;
 use snakeskin::optics::accuracy::{GRID_MATERIALS, Sample, grid};
-use snakeskin::optics::brdf::{ALPHA_MIN, Layers, Layers32, Model};
+use snakeskin::optics::brdf::walk::FilmTables;
+use snakeskin::optics::brdf::{ALPHA_MIN, Layers, Model};
 use snakeskin::optics::film::{Stack, airy, incoherent};
 use snakeskin::optics::lab::{ciede2000, linear_srgb_to_lab};
 use snakeskin::optics::lut::Lut;
@@ -12,8 +13,9 @@ use snakeskin::optics::methods::{
     gaussian_fit_f32, gaussian_fit_f64, rgb3_f32, rgb3_f64, spectral_n_f32, spectral_n_f64,
 };
 
-fn white_layers(stack: Stack, roughness: f64) -> Layers {
-    Layers { n0: stack.n0, n2: stack.n2, roughness, optical_depth: [0.0; 3], albedo: [1.0; 3] }
+/// k_d = 1, τ = 0, with the stack's K and E for the film at `thickness_nm`.
+fn white_layers(stack: Stack, thickness_nm: f64, roughness: f64) -> Layers {
+    Layers::of_stack(stack, thickness_nm, roughness, [0.0; 3], [1.0; 3])
 }
 
 #[test]
@@ -21,11 +23,11 @@ fn furnace_machinery_integrates_known_cases() {
     // No film reflection: all light reaches the white Lambertian base, albedo exactly 1.
     // (The thesis model has no (n0/n2)² factor: with no film at all its diffuse lobe is the
     // bare Lambertian base, which the integrator must return as 1.)
-    let layers = white_layers(Stack::THESIS, 0.5);
+    let layers = white_layers(Stack::THESIS, 400.0, 0.5);
     let a = Model::Thesis.furnace_albedo(&layers, 0.7, &|_| [0.0; 3], 64);
     assert!(a.iter().all(|v| (v - 1.0).abs() < 2e-3), "{a:?}");
     // A perfect mirror film on a smooth surface at normal view reflects everything.
-    let mirror = white_layers(Stack::THESIS, 0.0);
+    let mirror = white_layers(Stack::THESIS, 400.0, 0.0);
     for model in Model::ALL {
         let a = model.furnace_albedo(&mirror, 1.0, &|_| [1.0; 3], 64);
         assert!(a.iter().all(|v| (v - 1.0).abs() < 2e-3), "{model:?} {a:?}");
@@ -34,22 +36,25 @@ fn furnace_machinery_integrates_known_cases() {
 
 #[test]
 fn white_furnace_never_exceeds_one() {
+    // Every model, the film from a small LUT: never more than 1 (2e-3: the stratified
+    // quadrature's error, measured on the known cases above). The thesis model loses 6–14 %
+    // (PHYSICS.md) and the layered model's energy is held to its own bounds below; this is
+    // the stability check over the film's extremes.
     let mut worst: f64 = 0.0;
     let stacks =
         [GRID_MATERIALS.to_vec(), vec![Stack { n0: 1.0, n1: 1.0, n2: 1.5 }, Stack { n0: 1.0, n1: 2.5, n2: 1.2 }]]
             .concat();
-    for (stack, model) in stacks.into_iter().flat_map(|s| Model::ALL.map(|m| (s, m))) {
+    for stack in stacks {
         let lut = Lut::bake(stack, 16, 64, 8);
         for thickness in [0.0, 250.0, 400.0, 900.0, 2400.0, 1e7] {
             let film = |c: f64| lut.lookup_f64(thickness, c);
             for roughness in [0.0, 0.05, 0.2, 0.5, 1.0] {
                 for cos_o in [1.0, 0.7, 0.3, 0.1, 0.02] {
-                    let a = model.furnace_albedo(&white_layers(stack, roughness), cos_o, &film, 48);
+                    let a = Model::Thesis.furnace_albedo(&white_layers(stack, thickness, roughness), cos_o, &film, 48);
                     worst = a.iter().cloned().fold(worst, f64::max);
-                    // 2e-3: the stratified quadrature's error, measured on the known cases above.
                     assert!(
                         a.iter().all(|v| *v <= 1.0 + 2e-3),
-                        "{model:?} {stack:?} d={thickness} r={roughness} cos={cos_o}: {a:?}"
+                        "{stack:?} d={thickness} r={roughness} cos={cos_o}: {a:?}"
                     );
                 }
             }
@@ -59,13 +64,53 @@ fn white_furnace_never_exceeds_one() {
 }
 
 #[test]
+fn layered_model_keeps_the_white_furnace() {
+    // The stack reflects everything (k_d = 1, τ = 0), so the albedo must be 1: smooth top
+    // (r = 0) within 0.005 at every angle, rough within 0.02 up to 70° and 0.05 beyond
+    // (the targets). The film is the exact one (tabulated over the cosine), the one
+    // K and E are computed from, so what is measured is the model, not a film method.
+    let stacks = [GRID_MATERIALS.to_vec(), vec![Stack { n0: 1.0, n1: 2.5, n2: 1.2 }]].concat();
+    let mut worst = [0.0f64; 3];
+    for stack in stacks {
+        for thickness in [0.0, 250.0, 900.0, 2400.0] {
+            let tables = FilmTables::new(stack, thickness);
+            let film = |c: f64| tables.above(c);
+            for roughness in [0.0, 0.05, 0.2, 0.5, 0.8, 1.0] {
+                for cos_o in [1.0, 0.7, 0.35, 0.1, 0.02] {
+                    let a = Model::Layered.furnace_albedo(&white_layers(stack, thickness, roughness), cos_o, &film, 64);
+                    let err = a.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
+                    let (regime, bound) = if roughness == 0.0 {
+                        (0, 0.005)
+                    } else if cos_o >= 70f64.to_radians().cos() {
+                        (1, 0.02)
+                    } else {
+                        (2, 0.05)
+                    };
+                    worst[regime] = worst[regime].max(err);
+                    assert!(err <= bound, "{stack:?} d={thickness} r={roughness} cos={cos_o}: {a:?}");
+                }
+            }
+        }
+    }
+    eprintln!(
+        "layered furnace: max |albedo − 1| {:.4} smooth, {:.4} rough θ ≤ 70°, {:.4} rough beyond",
+        worst[0], worst[1], worst[2]
+    );
+}
+
+#[test]
 fn furnace_with_the_exact_spectral_film() {
     let stack = Stack::THESIS;
     let film = |c: f64| snakeskin::optics::film_rgb_reference(stack, 400.0, c);
     for model in Model::ALL {
         for (roughness, cos_o) in [(0.3, 0.9), (0.8, 0.2)] {
-            let a = model.furnace_albedo(&white_layers(stack, roughness), cos_o, &film, 16);
-            assert!(a.iter().all(|v| *v <= 1.0 + 5e-3 && *v > 0.3), "{model:?} {a:?}");
+            let a = model.furnace_albedo(&white_layers(stack, 400.0, roughness), cos_o, &film, 16);
+            // The thesis model: never above 1; the layered model: within its rough bound.
+            let ok = match model {
+                Model::Thesis => a.iter().all(|v| *v <= 1.0 + 5e-3 && *v > 0.3),
+                Model::Layered => a.iter().all(|v| (v - 1.0).abs() <= 0.02),
+            };
+            assert!(ok, "{model:?} {a:?}");
         }
     }
 }
@@ -86,8 +131,9 @@ proptest! {
         tau in prop_oneof![Just(0.0), 0.0f64..60.0], albedo in 0.0f64..1.0,
         film_r in prop_oneof![Just(0.0), Just(1.0), -0.1f64..1.1],
         model in proptest::sample::select(Model::ALL.to_vec()),
+        k in prop_oneof![Just(0.0), Just(0.999), 0.0f64..1.0], e in 0.0f64..1.0,
     ) {
-        let layers = Layers { n0, n2, roughness, optical_depth: [tau; 3], albedo: [albedo; 3] };
+        let layers = Layers { n0, n2, roughness, optical_depth: [tau; 3], albedo: [albedo; 3], k: [k; 3], e: [e; 3] };
         let normal = if zero_normal { [0.0; 3] } else { [nx, ny, nz] };
         let value = model.eval(&layers, normal, unit(ti, pi), unit(to, po), &|_| [film_r; 3]);
         for v in value.total() {
@@ -119,16 +165,8 @@ fn f32_brdf_follows_the_f64_brdf() {
     {
         for t in 0..20 {
             let thickness = 100.0 * t as f64;
-            let layers =
-                Layers { n0: 1.0, n2: 2.0, roughness, optical_depth: [0.6, 0.3, 0.1], albedo: [0.5, 0.4, 0.2] };
-            let layers32 = Layers32 {
-                n0: 1.0,
-                n2: 2.0,
-                roughness: roughness as f32,
-                optical_depth: [0.6, 0.3, 0.1],
-                albedo: [0.5, 0.4, 0.2],
-                thickness_nm: thickness as f32,
-            };
+            let layers = Layers::of_stack(stack, 400.0, roughness, [0.6, 0.3, 0.1], [0.5, 0.4, 0.2]);
+            let layers32 = layers.to_f32(thickness);
             let (wi, wo) = (unit(0.3 + 0.1 * i as f64, 0.5), unit(0.2 + 0.07 * t as f64, 2.0));
             let n = [0.1, -0.05, 1.0];
             let f64v = model.eval(&layers, n, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
@@ -199,7 +237,7 @@ fn thick_films_converge_to_the_incoherent_limit() {
 
 #[test]
 fn roughness_zero_uses_the_documented_floor() {
-    let layers = Layers { n0: 1.0, n2: 2.0, roughness: 0.0, optical_depth: [0.0; 3], albedo: [0.0; 3] };
+    let layers = Layers::of_stack(Stack::THESIS, 400.0, 0.0, [0.0; 3], [0.0; 3]);
     // At the mirror direction D = 1 / (π α²) with α = ALPHA_MIN and G2 = 1: f = D / 4.
     let expected = 1.0 / (std::f64::consts::PI * ALPHA_MIN * ALPHA_MIN) / 4.0;
     for model in Model::ALL {

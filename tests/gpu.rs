@@ -3,7 +3,7 @@
 //! skip with a printed reason, unless SNAKESKIN_REQUIRE_GPU=1 (set in .ci/run), which makes
 //! a missing adapter a failure.
 
-use snakeskin::optics::brdf::{Layers32, Model};
+use snakeskin::optics::brdf::{Layers, Model};
 use snakeskin::optics::film::Stack;
 use snakeskin::optics::lut::Lut;
 use snakeskin::render::engine::material::round_to_f16;
@@ -60,23 +60,21 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
     let mut layers = Vec::new();
     let mut samples = Vec::new();
     for i in 0..10_000 {
-        let l = Layers32 {
-            n0: 1.0,
-            n2: 2.0,
-            // Every 10th sample is a mirror (roughness 0) or fully rough, the extremes.
-            roughness: match i % 10 {
-                0 => 0.0,
-                1 => 1.0,
-                _ => 0.02 + 0.98 * rng.next(),
-            },
-            optical_depth: [rng.next() * 3.0, rng.next() * 3.0, rng.next() * 3.0],
-            albedo: [rng.next(), rng.next(), rng.next()],
-            thickness_nm: match i % 7 {
-                0 => 0.0,
-                1 => 1.0e7,
-                _ => rng.next() * 3000.0,
-            },
+        // Every 10th sample is a mirror (roughness 0) or fully rough, the extremes.
+        let roughness = match i % 10 {
+            0 => 0.0,
+            1 => 1.0,
+            _ => 0.02 + 0.98 * rng.next(),
         };
+        let tau = [rng.next() * 3.0, rng.next() * 3.0, rng.next() * 3.0].map(f64::from);
+        let albedo = [rng.next(), rng.next(), rng.next()].map(f64::from);
+        let thickness_nm = match i % 7 {
+            0 => 0.0,
+            1 => 1.0e7,
+            _ => rng.next() * 3000.0,
+        };
+        // K and E from the film at 400 nm (as the renderer: one thickness per material).
+        let l = Layers::of_stack(stack, 400.0, roughness as f64, tau, albedo).to_f32(thickness_nm as f64);
         // Mostly upper hemisphere (where the BRDF is non-zero), some anywhere.
         let upper = i % 5 != 0;
         let normal = if i % 50 == 0 {
@@ -141,7 +139,6 @@ fn bench_gpu_reports_both_costs() {
 
 #[test]
 fn every_gpu_film_method_matches_its_cpu_f32_twin() {
-    use snakeskin::optics::brdf::Layers;
     use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
     use snakeskin::render::engine::film::GpuFilmMethod;
     use snakeskin::render::reference::brdf_eval::eval_timed;
@@ -152,14 +149,11 @@ fn every_gpu_film_method_matches_its_cpu_f32_twin() {
     let mut inputs = Vec::new();
     let mut samples = Vec::new();
     for i in 0..4000 {
-        let l = Layers32 {
-            n0: 1.0,
-            n2: 2.0,
-            roughness: 0.05 + 0.95 * rng.next(),
-            optical_depth: [rng.next(), rng.next(), rng.next()],
-            albedo: [rng.next(), rng.next(), rng.next()],
-            thickness_nm: if i % 9 == 0 { 2.4e6 } else { rng.next() * 2500.0 },
-        };
+        let roughness = 0.05 + 0.95 * rng.next() as f64;
+        let tau = [rng.next(), rng.next(), rng.next()].map(f64::from);
+        let albedo = [rng.next(), rng.next(), rng.next()].map(f64::from);
+        let thickness_nm = if i % 9 == 0 { 2.4e6 } else { rng.next() as f64 * 2500.0 };
+        let l = Layers::of_stack(stack, 400.0, roughness, tau, albedo).to_f32(thickness_nm);
         let (wi, wo) = (rng.direction(true), rng.direction(true));
         samples.push(GpuSample::new(&l, [0.0, 0.0, 1.0], wi, wo));
         inputs.push((l, wi, wo));
@@ -171,9 +165,8 @@ fn every_gpu_film_method_matches_its_cpu_f32_twin() {
         (GpuFilmMethod::SpectralN(32), |d, c| spectral_n_f32(1.0, 1.55, 2.0, d, c, 32)),
         (GpuFilmMethod::GaussianFit, |d, c| gaussian_fit_f32(1.0, 1.55, 2.0, d, c)),
     ];
-    for (method, film) in methods {
-        let (gpu_values, _) =
-            eval_timed(&gpu, Model::Thesis, stack, &lut, method, &samples, 1).expect("gpu evaluation");
+    for (model, (method, film)) in Model::ALL.into_iter().flat_map(|m| methods.map(|f| (m, f))) {
+        let (gpu_values, _) = eval_timed(&gpu, model, stack, &lut, method, &samples, 1).expect("gpu evaluation");
         let mut worst = 0.0f64;
         for ((l, wi, wo), g) in inputs.iter().zip(&gpu_values) {
             let layers = Layers {
@@ -182,21 +175,23 @@ fn every_gpu_film_method_matches_its_cpu_f32_twin() {
                 roughness: l.roughness as f64,
                 optical_depth: l.optical_depth.map(|v| v as f64),
                 albedo: l.albedo.map(|v| v as f64),
+                k: l.k.map(|v| v as f64),
+                e: l.e.map(|v| v as f64),
             };
             let d = l.thickness_nm;
-            let cpu = Model::Thesis
+            let cpu = model
                 .eval(&layers, [0.0, 0.0, 1.0], wi.map(|v| v as f64), wo.map(|v| v as f64), &|c| {
                     film(d, c as f32).map(|v| v as f64)
                 })
                 .total();
             for c in 0..3 {
-                assert!(g[c].is_finite(), "{}: not finite", method.name());
+                assert!(g[c].is_finite(), "{model:?} {}: not finite", method.name());
                 worst = worst.max((g[c] as f64 - cpu[c]).abs() / (1.0 + cpu[c].abs()));
             }
         }
-        eprintln!("{}: max |gpu - cpu| / (1 + cpu) = {worst:e}", method.name());
+        eprintln!("{model:?} {}: max |gpu - cpu| / (1 + cpu) = {worst:e}", method.name());
         // The CPU side here is the f64 BRDF around the f32 film method; the f32 BRDF itself
         // deviates from f64 by up to 2.1e-3 (`brdf stress`), so 5e-3 bounds the film twins.
-        assert!(worst < 5e-3, "{}: GPU and CPU differ by {worst}", method.name());
+        assert!(worst < 5e-3, "{model:?} {}: GPU and CPU differ by {worst}", method.name());
     }
 }

@@ -54,13 +54,9 @@ fn smooth_top_closed_form_matches_the_random_walk() {
         let stack = stacks[case % stacks.len()];
         let thickness_nm = 2000.0 * rng.unit();
         let tau = [0.0, 0.4, 1.0, 2.0 * rng.unit()];
-        let layers = Layers {
-            n0: stack.n0,
-            n2: stack.n2,
-            roughness: 0.0,
-            optical_depth: [tau[case % 4], tau[(case + 1) % 4], 0.3 * rng.unit()],
-            albedo: [0.05 + 0.9 * rng.unit(), 0.05 + 0.9 * rng.unit(), 1.0],
-        };
+        let optical_depth = [tau[case % 4], tau[(case + 1) % 4], 0.3 * rng.unit()];
+        let albedo = [0.05 + 0.9 * rng.unit(), 0.05 + 0.9 * rng.unit(), 1.0];
+        let layers = Layers::of_stack(stack, thickness_nm, 0.0, optical_depth, albedo);
         let cos_i = 0.05 + 0.95 * rng.unit();
         let wi = [(1.0 - cos_i * cos_i).sqrt(), 0.0, cos_i];
         let top = SmoothTop::new(stack, thickness_nm);
@@ -120,7 +116,7 @@ fn rough_walk_conserves_energy_in_the_white_furnace() {
     let stack = Stack::THESIS;
     let tables = FilmTables::new(stack, 400.0);
     for roughness in [0.3, 0.7, 1.0] {
-        let layers = Layers { n0: 1.0, n2: 2.0, roughness, optical_depth: [0.0; 3], albedo: [1.0; 3] };
+        let layers = Layers::of_stack(stack, 400.0, roughness, [0.0; 3], [1.0; 3]);
         for cos_i in [1.0f64, 0.5, 0.1] {
             let wi = [(1.0 - cos_i * cos_i).sqrt(), 0.0, cos_i];
             let walked = walk(&layers, &tables, wi, 20_000, 1, 3);
@@ -129,7 +125,7 @@ fn rough_walk_conserves_energy_in_the_white_furnace() {
         }
     }
     // Negative control: with absorption photons are lost.
-    let layers = Layers { n0: 1.0, n2: 2.0, roughness: 0.5, optical_depth: [0.5; 3], albedo: [1.0; 3] };
+    let layers = Layers::of_stack(stack, 400.0, 0.5, [0.5; 3], [1.0; 3]);
     let walked = walk(&layers, &tables, [0.0, 0.0, 1.0], 20_000, 1, 3);
     assert!(walked.total().iter().all(|v| *v < 0.9), "{:?}", walked.total());
 }

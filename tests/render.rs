@@ -9,6 +9,7 @@ mod common;
 use common::{gpu_or_skip, gpu_required, snakeskin};
 use snakeskin::graph::{NodeCache, evaluate};
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+use snakeskin::optics::brdf::Model;
 use snakeskin::render::Renderer;
 use snakeskin::render::engine::film::GpuFilmMethod;
 use snakeskin::render::engine::prepare::material_maps;
@@ -73,13 +74,32 @@ fn gpu_render_matches_the_cpu_spectral_reference() {
     let Some(gpu) = gpu_or_skip("gpu_render_matches_the_cpu_spectral_reference") else { return };
     let renderer = Renderer::new(gpu);
     let material = material(&renderer, &[], GpuFilmMethod::Lut);
-    let (report, _) = reference_check(&renderer, &material, &close_up(), 200, 125).unwrap();
-    eprintln!(
-        "reference: {} px, mean {:.3}, p99 {:.3}, max {:.3}",
-        report.pixels, report.mean_de, report.p99_de, report.max_de
-    );
-    assert!(report.pixels > 5000, "{} pixels", report.pixels);
-    assert!(report.mean_de <= 1.0, "mean CIEDE2000 {}", report.mean_de);
+    // Every layer model: the shader's lobes and ambient term against their CPU twins.
+    for model in Model::ALL {
+        let settings = FrameSettings { model, ..close_up() };
+        let (report, _) = reference_check(&renderer, &material, &settings, 200, 125).unwrap();
+        eprintln!(
+            "{model:?} reference: {} px, mean {:.3}, p99 {:.3}, max {:.3}",
+            report.pixels, report.mean_de, report.p99_de, report.max_de
+        );
+        assert!(report.pixels > 5000, "{} pixels", report.pixels);
+        assert!(report.mean_de <= 1.0, "{model:?}: mean CIEDE2000 {}", report.mean_de);
+    }
+}
+
+#[test]
+fn the_reference_check_catches_a_wrong_model() {
+    // Negative control: the GPU frame shaded with one model against the CPU reference of
+    // the other must fail (the models differ by ΔE 4–23 on ordinary colours, PHYSICS.md).
+    let Some(gpu) = gpu_or_skip("the_reference_check_catches_a_wrong_model") else { return };
+    let renderer = Renderer::new(gpu);
+    let material = material(&renderer, &[], GpuFilmMethod::Lut);
+    let thesis = FrameSettings { samples: 1, model: Model::Thesis, ..close_up() };
+    let layered = FrameSettings { model: Model::Layered, ..thesis };
+    let image = renderer.render_image(&thesis, &material, 160, 100).unwrap();
+    let gbuffer = renderer.render_gbuffer(&thesis, &material, 160, 100).unwrap();
+    let report = snakeskin::render::reference::frame::compare(&image, &gbuffer, &layered, &material.optics);
+    assert!(report.mean_de > 2.0, "the thesis frame passed as the layered model: mean {}", report.mean_de);
 }
 
 #[test]

@@ -169,7 +169,7 @@ pub fn rgb3_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32
 /// code): per channel amplitude, centre and variance, plus a second lobe for X, normalised
 /// by 1.0685e-7 so that S(0) is illuminant E's white, XYZ = (1, 1, 1).
 /// (amplitude, centre, variance) per lobe: X, Y, Z, then X's second lobe. `film.wgsl` reads
-/// them from `render::shaders::generated_constants` (as `BB_AMP`, `BB_POS`, `BB_VAR`).
+/// them from `render::engine::shaders::generated_constants` (as `BB_AMP`, `BB_POS`, `BB_VAR`).
 pub const BB_LOBES: [(f64, f64, f64); 4] = [
     (5.4856e-13, 1.6810e+06, 4.3278e+09),
     (4.4201e-13, 1.7953e+06, 9.3046e+09),

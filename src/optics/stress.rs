@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use super::brdf::{Layers, Layers32, Model};
+use super::brdf::{Layers, Model};
 use super::film::{Stack, airy, incoherent};
 use super::lut::Lut;
 use crate::ops::hash;
@@ -21,13 +21,25 @@ pub struct StressReport {
     /// Smallest and largest of R_s, R_p, R, T_s, T_p, T seen (must stay in [0, 1]).
     pub min_r: f64,
     pub max_r: f64,
-    /// Largest white-furnace albedo (k_d = 1, τ = 0) over the furnace subset.
+    /// Largest white-furnace albedo (k_d = 1, τ = 0) over the furnace subset, for the
+    /// models that must never reflect more than arrives (the thesis model).
     pub max_albedo: f64,
+    /// Smallest and largest white-furnace albedo of each model (the layered model holds
+    /// albedo 1 within its furnace bounds; here K and E are the film's at 400 nm while the
+    /// film itself is drawn from 0 to 10 mm, so a little more spread is expected).
+    pub furnace_by_model: Vec<ModelFurnace>,
     /// Largest |f32 − f64| / (1 + |f64|) of the BRDF.
     pub max_f32_dev: f64,
     pub furnace_evaluations: u64,
     /// The layer models every sample went through (the bounds above are over all of them).
     pub models: Vec<&'static str>,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ModelFurnace {
+    pub model: &'static str,
+    pub min_albedo: f64,
+    pub max_albedo: f64,
 }
 
 /// The materials the stress draws from: the thesis default and its edge cases.
@@ -92,6 +104,10 @@ pub fn run(samples: u64, seed: u64) -> StressReport {
         total.min_r = total.min_r.min(p.min_r);
         total.max_r = total.max_r.max(p.max_r);
         total.max_albedo = total.max_albedo.max(p.max_albedo);
+        for (t, q) in total.furnace_by_model.iter_mut().zip(&p.furnace_by_model) {
+            t.min_albedo = t.min_albedo.min(q.min_albedo);
+            t.max_albedo = t.max_albedo.max(q.max_albedo);
+        }
         total.max_f32_dev = total.max_f32_dev.max(p.max_f32_dev);
         total.furnace_evaluations += p.furnace_evaluations;
     }
@@ -109,6 +125,10 @@ fn empty() -> StressReport {
         max_f32_dev: 0.0,
         furnace_evaluations: 0,
         models: Model::ALL.iter().map(|m| m.name()).collect(),
+        furnace_by_model: Model::ALL
+            .iter()
+            .map(|m| ModelFurnace { model: m.name(), min_albedo: f64::INFINITY, max_albedo: f64::NEG_INFINITY })
+            .collect(),
     }
 }
 
@@ -156,15 +176,10 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
     }
 
     let lut = &luts[material];
-    let layers = Layers { n0: stack.n0, n2: stack.n2, roughness, optical_depth: [tau; 3], albedo: [1.0, 0.5, 0.0] };
-    let layers32 = Layers32 {
-        n0: stack.n0 as f32,
-        n2: stack.n2 as f32,
-        roughness: roughness as f32,
-        optical_depth: [tau as f32; 3],
-        albedo: [1.0, 0.5, 0.0],
-        thickness_nm: thickness as f32,
-    };
+    // K and E for the film at 400 nm (they vary little with thickness, and the film from
+    // below at every sampled thickness would cost 30,000 Airy sums a sample).
+    let layers = Layers::of_stack(stack, 400.0, roughness, [tau; 3], [1.0, 0.5, 0.0]);
+    let layers32 = layers.to_f32(thickness);
     for model in Model::ALL {
         let value = model.eval(&layers, normal, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();
         let value32 =
@@ -187,11 +202,16 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
         let white = Layers { optical_depth: [0.0; 3], albedo: [1.0; 3], ..layers };
         let cos_o = draw.pick(&[1.0, 1e-3, -1.0]);
         let cos_o = if cos_o < 0.0 { draw.unit() } else { cos_o };
-        for model in Model::ALL {
+        for (m, model) in Model::ALL.into_iter().enumerate() {
             let albedo = model.furnace_albedo(&white, cos_o, &|c| lut.lookup_f64(thickness, c), 32);
             count(acc, &albedo);
             acc.furnace_evaluations += 1;
-            acc.max_albedo = albedo.iter().cloned().fold(acc.max_albedo, f64::max);
+            if model == Model::Thesis {
+                acc.max_albedo = albedo.iter().cloned().fold(acc.max_albedo, f64::max);
+            }
+            let f = &mut acc.furnace_by_model[m];
+            f.min_albedo = albedo.iter().cloned().fold(f.min_albedo, f64::min);
+            f.max_albedo = albedo.iter().cloned().fold(f.max_albedo, f64::max);
         }
     }
 }

@@ -20,8 +20,10 @@
 
 use std::f64::consts::PI;
 
-use super::thesis::cos_transmitted;
-use super::{BrdfValue, Layers};
+use std::sync::{Arc, Mutex};
+
+use super::energy;
+use super::{BrdfValue, Layers, cos_transmitted};
 use crate::optics::film::Stack;
 use crate::optics::film_rgb_reference;
 use crate::optics::spectrum::{Observer, xyz_to_linear_srgb};
@@ -47,11 +49,14 @@ fn white() -> [f64; 3] {
 /// perfect reflector's colour, so that R = 1 is exactly (1, 1, 1) and the transmittance
 /// colour is exactly 1 − R (R + T = 1 at every wavelength for the lossless film): energy
 /// balances hold to rounding, not to the 1e-3 of the white point. Total internal reflection
-/// (no propagating wave in n2) gives R = 1.
+/// (no propagating wave in n2) gives R = 1. A saturated film colour can fall outside the
+/// sRGB gamut (a channel below 0); it is clamped to [0, 1] per channel, as every model
+/// clamps the film, so R and 1 − R stay probabilities and the models and the references
+/// read the same film.
 pub fn reflectance(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
     let white = white();
     let r = film_rgb_reference(stack, thickness_nm, cos0);
-    [0, 1, 2].map(|c| r[c] / white[c])
+    [0, 1, 2].map(|c| (r[c] / white[c]).clamp(0.0, 1.0))
 }
 
 /// Gauss–Legendre nodes and weights on [a, b] (Newton's iteration on P_n).
@@ -103,17 +108,41 @@ pub struct SmoothTop {
     pub thickness_nm: f64,
     /// (μ in the pigment layer, quadrature weight, colour of R_b(μ)).
     below: Vec<(f64, f64, [f64; 3])>,
+    /// Per roughness row, per node: the probability of being sent back down under the
+    /// layered model's coupling (`k_e_row`).
+    coupled: Vec<Vec<[f64; 3]>>,
 }
 
 impl SmoothTop {
     pub fn new(stack: Stack, thickness_nm: f64) -> SmoothTop {
         let cuts = kinks(stack);
-        let below = cuts
+        let below: Vec<(f64, f64, [f64; 3])> = cuts
             .windows(2)
             .flat_map(|w| gauss_legendre(NODES_PER_SEGMENT, w[0], w[1]))
             .map(|(mu, weight)| (mu, weight, reflectance(reversed(stack), thickness_nm, mu)))
             .collect();
-        SmoothTop { stack, thickness_nm, below }
+        let (n0, n2) = (stack.n0, stack.n2);
+        let coupled = (0..energy::E1_ROUGHNESS)
+            .map(|row| {
+                let r = row as f64 / (energy::E1_ROUGHNESS - 1) as f64;
+                below
+                    .iter()
+                    .map(|&(mu, _, rb)| {
+                        let sin2_out = (n2 / n0) * (n2 / n0) * (1.0 - mu * mu);
+                        if sin2_out >= 1.0 {
+                            return [1.0; 3];
+                        }
+                        let mu_out = (1.0 - sin2_out).sqrt();
+                        if row == 0 {
+                            // A mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
+                            return rb;
+                        }
+                        energy::specular_albedo(mu_out, r, &|c| reflectance(stack, thickness_nm, c))
+                    })
+                    .collect()
+            })
+            .collect();
+        SmoothTop { stack, thickness_nm, below, coupled }
     }
 
     /// K (sent back to the base per bounce) and E (escaping per bounce) per channel for
@@ -128,6 +157,33 @@ impl SmoothTop {
             }
         }
         (k, e)
+    }
+
+    /// K and E per channel as the `layered` model couples them to a rough top at roughness
+    /// row `row` of the energy table (r = row / (E1_ROUGHNESS − 1)): a direction inside the
+    /// escape cone, at cosine μo outside, leaves with probability 1 − s(μo) (s the light the
+    /// rough lobe reflects, `energy::specular_albedo`, with this film); outside the cone it
+    /// is totally reflected. Row 0 is `k_e`
+    /// (F(μo) = R_b(μ) by reciprocity of the lossless film); for τ = 0, K + E = 1 in every
+    /// row, so the furnace holds.
+    pub fn k_e_row(&self, tau: [f64; 3], row: usize) -> ([f64; 3], [f64; 3]) {
+        let (mut k, mut e) = ([0.0; 3], [0.0; 3]);
+        for (node, &(mu, weight, _)) in self.below.iter().enumerate() {
+            let r_eff = self.coupled[row][node];
+            for c in 0..3 {
+                let tau = tau[c].max(0.0);
+                k[c] += weight * 2.0 * mu * r_eff[c] * (-2.0 * tau / mu).exp();
+                e[c] += weight * 2.0 * mu * (1.0 - r_eff[c]) * (-tau / mu).exp();
+            }
+        }
+        (k, e)
+    }
+
+    /// `k_e_row` at every roughness row of the energy table: K and E are linear in r
+    /// between rows (E₁ is interpolated linearly in r), so interpolating these rows is exact;
+    /// the shader does that per pixel (`Scene.bounce`).
+    pub fn bounce_table(&self, tau: [f64; 3]) -> BounceTable {
+        BounceTable { rows: (0..energy::E1_ROUGHNESS).map(|row| self.k_e_row(tau, row)).collect() }
     }
 
     /// The film's transmittance colour from above at cosine `cos0`.
@@ -172,6 +228,41 @@ impl SmoothTop {
     }
 }
 
+/// K and E per roughness row (`SmoothTop::bounce_table`).
+#[derive(Debug, Clone)]
+pub struct BounceTable {
+    pub rows: Vec<([f64; 3], [f64; 3])>,
+}
+
+impl BounceTable {
+    /// K and E at perceptual roughness `roughness`, interpolated between rows.
+    pub fn at(&self, roughness: f64) -> ([f64; 3], [f64; 3]) {
+        let x = roughness.clamp(0.0, 1.0) * (self.rows.len() - 1) as f64;
+        let i = (x as usize).min(self.rows.len() - 2);
+        let f = x - i as f64;
+        let (a, b) = (self.rows[i], self.rows[i + 1]);
+        let mix = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|c| p[c] * (1.0 - f) + q[c] * f);
+        (mix(a.0, b.0), mix(a.1, b.1))
+    }
+}
+
+/// `SmoothTop::new` for a (stack, thickness), kept for reuse: the renderer, the reference
+/// frame and the window ask for the same few materials every frame (32 kept).
+pub fn cached(stack: Stack, thickness_nm: f64) -> Arc<SmoothTop> {
+    static CACHE: Mutex<Vec<Arc<SmoothTop>>> = Mutex::new(Vec::new());
+    let same = |t: &SmoothTop| t.stack == stack && t.thickness_nm.to_bits() == thickness_nm.to_bits();
+    if let Some(top) = CACHE.lock().expect("transport cache").iter().find(|t| same(t)) {
+        return top.clone();
+    }
+    let top = Arc::new(SmoothTop::new(stack, thickness_nm));
+    let mut cache = CACHE.lock().expect("transport cache");
+    if cache.len() >= 32 {
+        cache.remove(0);
+    }
+    cache.push(top.clone());
+    top
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -195,13 +286,26 @@ mod tests {
             for c in 0..3 {
                 assert!((k[c] + e[c] - 1.0).abs() < 1e-9, "{stack:?} K {k:?} E {e:?}");
             }
-            let layers =
-                Layers { n0: stack.n0, n2: stack.n2, roughness: 0.0, optical_depth: [0.0; 3], albedo: [1.0; 3] };
+            let layers = Layers::of_stack(stack, 420.0, 0.0, [0.0; 3], [1.0; 3]);
             for cos_i in [1.0, 0.7, 0.3, 0.05] {
                 let a = top.albedo(&layers, cos_i).total();
                 assert!(a.iter().all(|v| (v - 1.0).abs() < 1e-9), "{stack:?} cos {cos_i}: {a:?}");
             }
         }
+    }
+
+    #[test]
+    fn rough_coupling_keeps_k_plus_e_one_and_meets_the_smooth_top_at_zero() {
+        let top = SmoothTop::new(Stack::THESIS, 400.0);
+        for row in [0, 5, 10, 15] {
+            let (k, e) = top.k_e_row([0.0; 3], row);
+            assert!((0..3).all(|c| (k[c] + e[c] - 1.0).abs() < 1e-9), "row {row}: {k:?} {e:?}");
+        }
+        let (k0, e0) = top.k_e_row([0.5, 0.2, 0.0], 0);
+        let (k, e) = top.k_e([0.5, 0.2, 0.0]);
+        assert!((0..3).all(|c| (k0[c] - k[c]).abs() < 1e-12 && (e0[c] - e[c]).abs() < 1e-12));
+        // Rougher tops reflect less by the lobe, so more escapes.
+        assert!(top.k_e_row([0.0; 3], 15).1[1] > e[1] - 1e-12);
     }
 
     #[test]

@@ -4,7 +4,9 @@
 //! reference renderer — and `shaders/brdf.wgsl` selects the same model by its `BRDF_MODEL`
 //! override constant, whose values come from [`Model::code`]. The references, the stress
 //! and furnace tests and `snakeskin brdf eval` all take a `Model`, so a new model is added
-//! in one place (a file beside `thesis.rs`, one arm per match here and in the WGSL).
+//! in one place: a file beside `thesis.rs`, one arm per match here, in `brdf.wgsl`'s
+//! `coupling`, `diffuse_lobe` and `ambient_diffuse`, and its `MODEL_*` name in
+//! `render::engine::shaders`.
 //!
 //! ```text
 //! f = D(h) G2(wi, wo) F(|wo·h|, d) / (4 |n·wi| |n·wo|) + f_diff(model)
@@ -18,15 +20,17 @@
 //! finite; a zero-length or non-finite normal falls back to the tangent-space up vector;
 //! directions below the shading horizon give 0; cosines are floored at COS_MIN after that
 //! test so grazing angles give finite values. These numbers reach the WGSL from here
-//! (`render::shaders::generated_constants`), never by copy.
+//! (`render::engine::shaders::generated_constants`), never by copy.
 
+pub mod accuracy;
+pub mod energy;
 pub mod exact;
 pub mod ggx;
+pub mod layered;
 pub mod thesis;
 pub mod walk;
 
 pub use ggx::{ggx_d, ggx_d_sin, smith_g2, smith_lambda};
-pub use thesis::cos_transmitted;
 
 /// Smallest GGX α: roughness 0 would make D a Dirac delta. 1e-3 keeps D's peak
 /// 1 / (π α²) ≈ 3.2e5, finite in f32, and is a mirror to the eye.
@@ -42,15 +46,20 @@ pub enum Model {
     /// The thesis' eq. 4.21 (Weidlich & Wilkie 2007 single scatter): kept for comparison.
     #[default]
     Thesis,
+    /// The stack's transport: (n0/n2)², the internal-reflection series 1 / (1 − k_d K) and
+    /// the rough top's energy coupling (`layered.rs`).
+    Layered,
 }
 
 impl Model {
-    pub const ALL: [Model; 1] = [Model::Thesis];
-    pub const ACCEPTED: &'static str = "thesis";
+    pub const ALL: [Model; 2] = [Model::Thesis, Model::Layered];
+    /// The names, for error messages (a test ties it to `ALL`).
+    pub const ACCEPTED: &'static str = "thesis, layered";
 
     pub fn name(self) -> &'static str {
         match self {
             Model::Thesis => "thesis",
+            Model::Layered => "layered",
         }
     }
 
@@ -62,28 +71,51 @@ impl Model {
     pub fn code(self) -> u32 {
         match self {
             Model::Thesis => 0,
+            Model::Layered => 1,
         }
     }
 
-    /// The diffuse lobe (f64) at floored cosines with the film's clamped reflectance there.
+    /// The diffuse lobe (f64) at floored cosines with the model's `coupling` there.
     fn diffuse(self, layers: &Layers, cos_i: f64, cos_o: f64, f_i: [f64; 3], f_o: [f64; 3]) -> [f64; 3] {
         match self {
             Model::Thesis => thesis::diffuse(layers, cos_i, cos_o, f_i, f_o),
+            Model::Layered => layered::diffuse(layers, cos_i, cos_o, f_i, f_o),
         }
     }
 
     fn diffuse_f32(self, layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o: [f32; 3]) -> [f32; 3] {
         match self {
             Model::Thesis => thesis::diffuse_f32(layers, cos_i, cos_o, f_i, f_o),
+            Model::Layered => layered::diffuse_f32(layers, cos_i, cos_o, f_i, f_o),
         }
     }
 
-    /// The ambient term's diffuse part towards a view at cosine `cos_o` with the film's
-    /// reflectance `f_o` there: multiplies the sky radiance along the normal (the reference
-    /// renderer's twin of `brdf.wgsl`'s `ambient_diffuse`).
-    pub fn ambient_diffuse(self, layers: &Layers, cos_o: f64, f_o: [f64; 3]) -> [f64; 3] {
+    /// What the top reflects by itself from a direction at cosine `cos`, per channel: the
+    /// diffuse lobe lets 1 minus this into the stack, and the ambient term's mirror part is
+    /// the sky times this. The thesis: the film F(cos) (`film` clamped to [0, 1]); the
+    /// layered model: the rough lobe's albedo with the film read at its microfacet angles
+    /// (`energy::specular_albedo`). `brdf.wgsl`'s `coupling`.
+    pub fn coupling(self, cos: f64, roughness: f64, film: &dyn Fn(f64) -> [f64; 3]) -> [f64; 3] {
         match self {
-            Model::Thesis => thesis::ambient_diffuse(layers, cos_o, f_o),
+            Model::Thesis => film(cos),
+            Model::Layered => energy::specular_albedo(cos, roughness, film),
+        }
+    }
+
+    fn coupling_f32(self, cos: f32, roughness: f32, film: &dyn Fn(f32) -> [f32; 3]) -> [f32; 3] {
+        match self {
+            Model::Thesis => film(cos),
+            Model::Layered => energy::specular_albedo_f32(cos, roughness, film),
+        }
+    }
+
+    /// The ambient term's diffuse part towards a view at cosine `cos_o`, with `s_o` the
+    /// model's `coupling` there: multiplies the sky radiance along the normal (the reference
+    /// renderer's twin of `brdf.wgsl`'s `ambient_diffuse`).
+    pub fn ambient_diffuse(self, layers: &Layers, cos_o: f64, s_o: [f64; 3]) -> [f64; 3] {
+        match self {
+            Model::Thesis => thesis::ambient_diffuse(layers, cos_o, s_o),
+            Model::Layered => layered::ambient_diffuse(layers, cos_o, s_o),
         }
     }
 }
@@ -99,6 +131,40 @@ pub struct Layers {
     pub optical_depth: [f64; 3],
     /// Albedo k_d of the Lambertian base.
     pub albedo: [f64; 3],
+    /// K: the fraction of the base's diffuse light the top sends back down per bounce, per
+    /// channel (the `layered` model; `of_stack` computes it).
+    pub k: [f64; 3],
+    /// E: the fraction that escapes per bounce.
+    pub e: [f64; 3],
+}
+
+impl Layers {
+    /// The layers of a material: its stack, film thickness (for K and E: the film seen from
+    /// below), roughness, optical depth and base albedo.
+    pub fn of_stack(
+        stack: super::film::Stack,
+        thickness_nm: f64,
+        roughness: f64,
+        optical_depth: [f64; 3],
+        albedo: [f64; 3],
+    ) -> Layers {
+        let (k, e) = exact::cached(stack, thickness_nm).bounce_table(optical_depth).at(roughness);
+        Layers { n0: stack.n0, n2: stack.n2, roughness, optical_depth, albedo, k, e }
+    }
+
+    /// The f32 form, with the film thickness the LUT is read at.
+    pub fn to_f32(&self, thickness_nm: f64) -> Layers32 {
+        Layers32 {
+            n0: self.n0 as f32,
+            n2: self.n2 as f32,
+            roughness: self.roughness as f32,
+            optical_depth: self.optical_depth.map(|v| v as f32),
+            albedo: self.albedo.map(|v| v as f32),
+            thickness_nm: thickness_nm as f32,
+            k: self.k.map(|v| v as f32),
+            e: self.e.map(|v| v as f32),
+        }
+    }
 }
 
 /// The BRDF split into its two lobes (each RGB, per steradian).
@@ -122,6 +188,15 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 fn normalize(v: [f64; 3]) -> Option<[f64; 3]> {
     let len = dot(v, v).sqrt();
     (len.is_finite() && len > LENGTH_MIN).then(|| v.map(|c| c / len))
+}
+
+/// Cosine of the direction refracted into the pigment layer (Snell's law n0 sin θ =
+/// n2 sin θ_t; the film's parallel faces do not change it); None under total internal
+/// reflection (no light enters). Every model reads it.
+pub fn cos_transmitted(n0: f64, n2: f64, cos: f64) -> Option<f64> {
+    let eta2 = (n0 / n2) * (n0 / n2);
+    let k = (1.0 - eta2) + eta2 * cos * cos;
+    (k > 0.0).then(|| k.sqrt())
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -160,7 +235,8 @@ impl Model {
         let f_h = film_clamped(dot(wo, h).abs());
         let spec_scale = d * g2 / (4.0 * cos_i * cos_o);
         let specular = f_h.map(|f| f * spec_scale);
-        let diffuse = self.diffuse(layers, cos_i, cos_o, film_clamped(cos_i), film_clamped(cos_o));
+        let (r, film) = (layers.roughness, &film_clamped);
+        let diffuse = self.diffuse(layers, cos_i, cos_o, self.coupling(cos_i, r, film), self.coupling(cos_o, r, film));
         BrdfValue { specular, diffuse }
     }
 
@@ -193,7 +269,9 @@ impl Model {
         let nxh = [n[1] * h[2] - n[2] * h[1], n[2] * h[0] - n[0] * h[2], n[0] * h[1] - n[1] * h[0]];
         let spec = ggx::specular_scale_f32(cos_h, dot32(nxh, nxh), cos_i, cos_o, alpha * alpha);
         let f_h = film(dot32(wo, h).abs());
-        let diffuse = self.diffuse_f32(layers, cos_i, cos_o, film(cos_i), film(cos_o));
+        let (r, film) = (layers.roughness, &film);
+        let (s_i, s_o) = (self.coupling_f32(cos_i, r, film), self.coupling_f32(cos_o, r, film));
+        let diffuse = self.diffuse_f32(layers, cos_i, cos_o, s_i, s_o);
         [0, 1, 2].map(|c| f_h[c] * spec + diffuse[c])
     }
 
@@ -254,6 +332,8 @@ pub struct Layers32 {
     pub optical_depth: [f32; 3],
     pub albedo: [f32; 3],
     pub thickness_nm: f32,
+    pub k: [f32; 3],
+    pub e: [f32; 3],
 }
 
 fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
@@ -269,4 +349,20 @@ fn normalize32(v: [f32; 3]) -> Option<[f32; 3]> {
 /// not finite (so 1 − F is a valid transmittance).
 fn film_clamped(rgb: [f64; 3]) -> [f64; 3] {
     rgb.map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 1.0 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_model_has_one_name_and_code_and_accepted_lists_them() {
+        let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();
+        assert_eq!(Model::ACCEPTED, names.join(", "));
+        for m in Model::ALL {
+            assert_eq!(Model::parse(m.name()), Some(m));
+            assert_eq!(Model::ALL.iter().filter(|o| o.code() == m.code()).count(), 1);
+        }
+        assert_eq!(Model::parse("lambert"), None);
+    }
 }

@@ -12,15 +12,7 @@
 
 use std::f64::consts::PI;
 
-use super::{COS_MIN, Layers, Layers32};
-
-/// Cosine of the refracted direction in the pigment layer; None under total internal
-/// reflection (no light enters).
-pub fn cos_transmitted(n0: f64, n2: f64, cos: f64) -> Option<f64> {
-    let eta2 = (n0 / n2) * (n0 / n2);
-    let k = (1.0 - eta2) + eta2 * cos * cos;
-    (k > 0.0).then(|| k.sqrt())
-}
+use super::{COS_MIN, Layers, Layers32, cos_transmitted};
 
 /// The diffuse lobe at cosines `cos_i`, `cos_o` (already floored at COS_MIN) with the film's
 /// reflectance `f_i`, `f_o` at those cosines (clamped to [0, 1]).

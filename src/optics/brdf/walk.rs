@@ -39,13 +39,20 @@ pub struct FilmTables {
 impl FilmTables {
     pub fn new(stack: Stack, thickness_nm: f64) -> FilmTables {
         let cos = |i: usize| i as f64 / (TABLE_SIZE - 1) as f64;
-        // Colours relative to the white point (`exact::reflectance`): R is a probability.
-        let normalise = |rgb: [f64; 3]| rgb.map(|v| v.clamp(0.0, 1.0));
+        // Colours relative to the white point and in [0, 1] (`exact::reflectance`): R is a
+        // probability.
         FilmTables {
             stack,
-            above: (0..TABLE_SIZE).map(|i| normalise(reflectance(stack, thickness_nm, cos(i)))).collect(),
-            below: (0..TABLE_SIZE).map(|i| normalise(reflectance(reversed(stack), thickness_nm, cos(i)))).collect(),
+            above: (0..TABLE_SIZE).map(|i| reflectance(stack, thickness_nm, cos(i))).collect(),
+            below: (0..TABLE_SIZE).map(|i| reflectance(reversed(stack), thickness_nm, cos(i))).collect(),
         }
+    }
+
+    /// The film's reflectance colour from above at cosine `cos` (interpolated; within 1e-5
+    /// of `exact::reflectance`): a film function for the models that agrees with the one K
+    /// and E are computed from.
+    pub fn above(&self, cos: f64) -> [f64; 3] {
+        [0, 1, 2].map(|c| FilmTables::lookup(&self.above, cos, c))
     }
 
     fn lookup(table: &[[f64; 3]], cos: f64, channel: usize) -> f64 {
@@ -156,7 +163,8 @@ enum State {
 
 enum Fate {
     Specular,
-    Diffuse(f64),
+    /// Left after entering the stack, at cos θo, after this many base reflections.
+    Diffuse(f64, usize),
     Absorbed,
 }
 
@@ -166,7 +174,7 @@ fn follow(wi: V3, layers: &Layers, film: &FilmTables, alpha: f64, c: usize, rng:
     let tau = layers.optical_depth[c].max(0.0);
     let kd = layers.albedo[c].clamp(0.0, 1.0);
     let mut state = State::Above(wi.map(|v| -v));
-    let mut entered = false;
+    let (mut entered, mut bounces) = (false, 0);
     for _ in 0..MAX_EVENTS {
         state = match state {
             State::Above(d) => {
@@ -177,7 +185,7 @@ fn follow(wi: V3, layers: &Layers, film: &FilmTables, alpha: f64, c: usize, rng:
                     None => {
                         let out = reflect(d, m);
                         if out[2] > 0.0 {
-                            return if entered { Fate::Diffuse(out[2]) } else { Fate::Specular };
+                            return if entered { Fate::Diffuse(out[2], bounces) } else { Fate::Specular };
                         }
                         State::Above(out)
                     }
@@ -195,6 +203,7 @@ fn follow(wi: V3, layers: &Layers, film: &FilmTables, alpha: f64, c: usize, rng:
                 if rng.unit() >= (-tau / d[2].abs()).exp() || rng.unit() >= kd {
                     return Fate::Absorbed;
                 }
+                bounces += 1;
                 // Lambertian: cos θ = √u, uniform azimuth.
                 let (u1, u2) = (rng.unit(), rng.unit());
                 let (cos, phi) = (u1.sqrt(), 2.0 * std::f64::consts::PI * u2);
@@ -215,7 +224,7 @@ fn follow(wi: V3, layers: &Layers, film: &FilmTables, alpha: f64, c: usize, rng:
                         let back = reflect(d, m);
                         if back[2] < 0.0 { State::Down(back) } else { State::Up(back) }
                     }
-                    Some(t) if t[2] > 0.0 => return Fate::Diffuse(t[2]),
+                    Some(t) if t[2] > 0.0 => return Fate::Diffuse(t[2], bounces),
                     Some(t) => State::Above(t),
                 }
             }
@@ -237,7 +246,7 @@ pub fn walk(layers: &Layers, film: &FilmTables, wi: V3, photons: u64, bins: usiz
         for _ in 0..photons {
             match follow(wi, layers, film, alpha, c, &mut rng) {
                 Fate::Specular => specular[c] += 1,
-                Fate::Diffuse(cos_o) => {
+                Fate::Diffuse(cos_o, _) => {
                     diffuse[c] += 1;
                     let b = ((cos_o * binned.len() as f64) as usize).min(binned.len() - 1);
                     binned[b][c] += 1;
@@ -258,4 +267,62 @@ pub fn walk(layers: &Layers, film: &FilmTables, wi: V3, photons: u64, bins: usiz
         diffuse_sigma: sigma(d),
         diffuse_bins: binned.into_iter().map(p).collect(),
     }
+}
+
+/// Photons of one walk sorted by their fate: the specular ones, and the diffuse ones by how
+/// many times the base reflected them. The base's albedo k_d enters only as k_d^n for a
+/// photon reflected n times, so one walk with a white base (k_d = 1; absorption in the
+/// layer still walked) gives the albedo for every k_d: A(k_d) = (S + Σ_n h_n k_d^n) / N.
+#[derive(Debug, Clone)]
+pub struct BounceTally {
+    pub photons: u64,
+    pub specular: [u64; 3],
+    /// `escaped_after[n][c]`: channel-c photons that left after n base reflections.
+    pub escaped_after: Vec<[u64; 3]>,
+}
+
+impl BounceTally {
+    /// The directional albedo for base albedo `albedo`, and its standard error.
+    pub fn albedo(&self, albedo: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let n = self.photons as f64;
+        let mut mean = [0.0; 3];
+        let mut sigma = [0.0; 3];
+        for c in 0..3 {
+            let kd = albedo[c].clamp(0.0, 1.0);
+            let (mut first, mut second) = (self.specular[c] as f64, self.specular[c] as f64);
+            for (bounces, counts) in self.escaped_after.iter().enumerate() {
+                let x = kd.powi(bounces as i32);
+                first += counts[c] as f64 * x;
+                second += counts[c] as f64 * x * x;
+            }
+            mean[c] = first / n;
+            sigma[c] = ((second / n - mean[c] * mean[c]).max(0.0) / n).sqrt();
+        }
+        (mean, sigma)
+    }
+}
+
+/// Walks `photons` photons per channel with a white base (the `albedo` of `layers` is not
+/// used) and tallies them by base reflections (`BounceTally`).
+pub fn walk_bounces(layers: &Layers, film: &FilmTables, wi: V3, photons: u64, seed: u64) -> BounceTally {
+    let wi = normalize(wi);
+    let alpha = if layers.roughness <= 0.0 { 0.0 } else { (layers.roughness * layers.roughness).max(super::ALPHA_MIN) };
+    let white = Layers { albedo: [1.0; 3], ..*layers };
+    let mut tally = BounceTally { photons, specular: [0; 3], escaped_after: Vec::new() };
+    for c in 0..3 {
+        let mut rng = Rng(seed ^ (0x5151_0000 + c as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
+        for _ in 0..photons {
+            match follow(wi, &white, film, alpha, c, &mut rng) {
+                Fate::Specular => tally.specular[c] += 1,
+                Fate::Diffuse(_, bounces) => {
+                    if tally.escaped_after.len() <= bounces {
+                        tally.escaped_after.resize(bounces + 1, [0; 3]);
+                    }
+                    tally.escaped_after[bounces][c] += 1;
+                }
+                Fate::Absorbed => {}
+            }
+        }
+    }
+    tally
 }

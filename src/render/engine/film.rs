@@ -71,6 +71,17 @@ struct FilmInfo {
     xyz_to_rgb: [[f32; 4]; 3],
 }
 
+/// The rough lobe's table (`optics::brdf::energy`) as `film.wgsl`'s `lobe_table`: per (μ, r)
+/// entry, row-major by roughness, two vec4s: (E₁, c₁, c₂, c₃) and (w₁, w₂, 0, 0).
+fn lobe_table() -> Vec<[f32; 4]> {
+    let t = crate::optics::brdf::energy::tables();
+    (0..t.albedo.len())
+        .flat_map(|k| {
+            [[t.albedo[k], t.cos[0][k], t.cos[1][k], t.cos[2][k]], [t.weight[0][k], t.weight[1][k], 0.0, 0.0]]
+        })
+        .collect()
+}
+
 /// The bind group layout of `film.wgsl`'s group 0.
 pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
@@ -81,6 +92,7 @@ pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             texture_entry(1, visibility, true),
             storage_entry(2, visibility, true),
             sampler_entry(3, visibility),
+            storage_entry(4, visibility, true),
         ],
     })
 }
@@ -151,6 +163,7 @@ impl FilmBinding {
             ..Default::default()
         });
         let band_buffer = buffer("film bands", bytemuck::cast_slice(&band_table), wgpu::BufferUsages::STORAGE);
+        let lobe_buffer = buffer("rough lobe", bytemuck::cast_slice(&lobe_table()), wgpu::BufferUsages::STORAGE);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("film"),
             layout,
@@ -159,6 +172,7 @@ impl FilmBinding {
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&lut_view) },
                 wgpu::BindGroupEntry { binding: 2, resource: band_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&sampler) },
+                wgpu::BindGroupEntry { binding: 4, resource: lobe_buffer.as_entire_binding() },
             ],
         });
         FilmBinding { stack, n_bands: bands.centres_nm.len(), bind_group }

@@ -5,6 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
+use crate::optics::brdf::energy::E1_ROUGHNESS;
 use crate::optics::film::Stack;
 use crate::preset::Preset;
 use crate::render::engine::film::GpuFilmMethod;
@@ -200,6 +201,26 @@ impl LayerOptics {
         self.thickness_range_nm.1 <= 0.0 || self.stack.n1 == self.stack.n0
     }
 
+    /// The film thickness K and E (the stack's bounce terms) are computed at: the middle of
+    /// the map's range. K varies little with thickness (PHYSICS.md: 0.77–0.79 for the
+    /// thesis materials over 0–2000 nm); `bench layered` measures what this costs.
+    pub fn bounce_thickness_nm(&self) -> f64 {
+        0.5 * (self.thickness_range_nm.0 + self.thickness_range_nm.1)
+    }
+
+    /// K and E per roughness row, as the shader interpolates them.
+    pub fn bounce_table(&self) -> crate::optics::brdf::exact::BounceTable {
+        crate::optics::brdf::exact::cached(self.stack, self.bounce_thickness_nm()).bounce_table(self.optical_depth)
+    }
+
+    /// The per-pixel layers of this material (the CPU reference's twin of the shader's
+    /// `layers_of`).
+    pub fn layers(&self, roughness: f64, albedo: [f64; 3]) -> crate::optics::brdf::Layers {
+        let (k, e) = self.bounce_table().at(roughness);
+        let Stack { n0, n2, .. } = self.stack;
+        crate::optics::brdf::Layers { n0, n2, roughness, optical_depth: self.optical_depth, albedo, k, e }
+    }
+
     pub fn has_absorption(&self) -> bool {
         self.optical_depth.iter().any(|t| *t > 0.0)
     }
@@ -223,6 +244,9 @@ pub struct SceneUniform {
     pub sky_bottom: [f32; 4],
     pub film: [f32; 4],
     pub optical_depth: [f32; 4],
+    /// K and E (rgb) per roughness row of the energy table (`LayerOptics::bounce_table`).
+    pub bounce_k: [[f32; 4]; E1_ROUGHNESS],
+    pub bounce_e: [[f32; 4]; E1_ROUGHNESS],
 }
 
 impl SceneUniform {
@@ -239,6 +263,7 @@ impl SceneUniform {
         let p = camera.position();
         let rgb4 = |c: [f32; 3]| [c[0], c[1], c[2], 0.0];
         let tau = optics.optical_depth.map(|t| t as f32);
+        let bounce = optics.bounce_table();
         SceneUniform {
             view_proj: camera.view_proj(aspect).to_cols_array_2d(),
             camera: [p.x, p.y, p.z, 0.0],
@@ -253,6 +278,8 @@ impl SceneUniform {
                 optics.stack.n2 as f32,
             ],
             optical_depth: [tau[0], tau[1], tau[2], 0.0],
+            bounce_k: std::array::from_fn(|i| rgb4(bounce.rows[i].0.map(|v| v as f32))),
+            bounce_e: std::array::from_fn(|i| rgb4(bounce.rows[i].1.map(|v| v as f32))),
         }
     }
 }

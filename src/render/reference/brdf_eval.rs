@@ -5,7 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-use crate::optics::brdf::{Layers32, Model};
+use crate::optics::brdf::{Layers, Layers32, Model};
 use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
 use crate::render::engine::film::{self, FilmBinding, GpuFilmMethod};
@@ -13,7 +13,7 @@ use crate::render::engine::gpu::{map_read, storage_entry};
 use crate::render::engine::shaders::shader_programs;
 use crate::render::{Gpu, GpuError};
 
-/// One BRDF query, laid out as the shader's `Sample` (five vec4s).
+/// One BRDF query, laid out as the shader's `Sample` (seven vec4s).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct GpuSample {
@@ -22,6 +22,8 @@ pub struct GpuSample {
     pub wo_n0: [f32; 4],
     pub tau_n2: [f32; 4],
     pub albedo: [f32; 4],
+    pub k: [f32; 4],
+    pub e: [f32; 4],
 }
 
 impl GpuSample {
@@ -34,6 +36,8 @@ impl GpuSample {
             wo_n0: [wo[0], wo[1], wo[2], layers.n0],
             tau_n2: [a, b, c, layers.n2],
             albedo: [r, g, bl, 0.0],
+            k: [layers.k[0], layers.k[1], layers.k[2], 0.0],
+            e: [layers.e[0], layers.e[1], layers.e[2], 0.0],
         }
     }
 }
@@ -159,17 +163,15 @@ pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBen
     use std::hint::black_box;
 
     let lut = Lut::bake_default(Stack::THESIS);
+    let tau = [0.6, 0.4, 0.2];
+    let bounce = crate::optics::brdf::exact::cached(Stack::THESIS, 1000.0).bounce_table(tau);
     let unit = |i: usize, k: u32| crate::ops::hash::unit(i as i32, (i >> 31) as i32, k, 7);
     let inputs: Vec<(Layers32, [f32; 3], [f32; 3])> = (0..count)
         .map(|i| {
-            let layers = Layers32 {
-                n0: 1.0,
-                n2: 2.0,
-                roughness: 0.05 + 0.9 * unit(i, 0),
-                optical_depth: [0.6, 0.4, 0.2],
-                albedo: [0.5, 0.4, 0.3],
-                thickness_nm: 2000.0 * unit(i, 1),
-            };
+            let roughness = 0.05 + 0.9 * unit(i, 0) as f64;
+            let (k, e) = bounce.at(roughness);
+            let layers = Layers { n0: 1.0, n2: 2.0, roughness, optical_depth: tau, albedo: [0.5, 0.4, 0.3], k, e };
+            let layers = layers.to_f32(2000.0 * unit(i, 1) as f64);
             let dir = |a: f32, b: f32| {
                 let phi = b * std::f32::consts::TAU;
                 let sin = (1.0 - a * a).sqrt();

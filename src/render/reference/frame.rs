@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use crate::Error;
-use crate::optics::brdf::{COS_MIN, Layers};
+use crate::optics::brdf::COS_MIN;
 use crate::optics::film_rgb_reference;
 use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
 use crate::render::engine::renderer::{FrameSettings, GBuffer, Material, Renderer};
@@ -104,13 +104,7 @@ pub fn shade_pixel(gbuffer: &GBuffer, i: usize, settings: &FrameSettings, optics
         computed.borrow_mut().push((cos.to_bits(), rgb));
         rgb
     };
-    let layers = Layers {
-        n0: optics.stack.n0,
-        n2: optics.stack.n2,
-        roughness: nr[3],
-        optical_depth: optics.optical_depth,
-        albedo: [albedo[0], albedo[1], albedo[2]],
-    };
+    let layers = optics.layers(nr[3], [albedo[0], albedo[1], albedo[2]]);
     let lighting = &settings.lighting;
     let mut radiance = [0.0; 3];
     for light in [&lighting.key, &lighting.fill] {
@@ -127,13 +121,14 @@ pub fn shade_pixel(gbuffer: &GBuffer, i: usize, settings: &FrameSettings, optics
     // Ambient, as skin.wgsl's `ambient`: the sky along the mirror direction reflected by the
     // film, the sky along the normal through the layer model.
     let cos_o = dot(n, wo).max(COS_MIN);
-    let f_o = film(cos_o).map(|v| v.clamp(0.0, 1.0));
+    let film_clamped = |c: f64| film(c).map(|v| v.clamp(0.0, 1.0));
+    let s_o = settings.model.coupling(cos_o, layers.roughness, &film_clamped);
     let mirror = [0, 1, 2].map(|c| -wo[c] + 2.0 * dot(n, wo) * n[c]);
     let sky_mirror = sky(lighting, mirror);
     let sky_normal = sky(lighting, n);
-    let diffuse = settings.model.ambient_diffuse(&layers, cos_o, f_o);
+    let diffuse = settings.model.ambient_diffuse(&layers, cos_o, s_o);
     for c in 0..3 {
-        radiance[c] += sky_mirror[c] * f_o[c] + sky_normal[c] * diffuse[c];
+        radiance[c] += sky_mirror[c] * s_o[c] + sky_normal[c] * diffuse[c];
     }
     radiance
 }

@@ -22,7 +22,53 @@ pub fn run(command: BenchCommand) -> Result<()> {
         BenchCommand::Irid { json, plot, d_step_nm, angle_step_deg, lut_sweep } => {
             irid(json, plot.as_deref(), d_step_nm, angle_step_deg, lut_sweep)
         }
+        BenchCommand::Layered { json, photons } => layered(json, photons),
     }
+}
+
+/// The base colours of every built-in species (back and belly), linear sRGB, each once.
+fn species_colours() -> Result<Vec<[f64; 3]>> {
+    let mut colours: Vec<[f64; 3]> = Vec::new();
+    for (name, _) in snakeskin::preset::library::all() {
+        let preset = snakeskin::preset::load(name, &[], None)?.preset;
+        for c in [preset.color.base, preset.belly.color] {
+            let linear = c.to_linear().map(f64::from);
+            if !colours.contains(&linear) {
+                colours.push(linear);
+            }
+        }
+    }
+    Ok(colours)
+}
+
+fn layered(json: bool, photons: u64) -> Result<()> {
+    let colours = species_colours()?;
+    let progress = Progress::spinner("walking photons through the stack");
+    let report = snakeskin::optics::brdf::accuracy::run(&colours, photons);
+    progress.finish();
+    if json {
+        println!("{}", serde_json::to_string(&report)?);
+        return Ok(());
+    }
+    println!(
+        "{} points ({} colours), {} photons per channel per walk; reference noise: mean ΔE00 {:.3}, max {:.3}",
+        report.points,
+        colours.len(),
+        report.photons_per_channel,
+        report.reference_noise_mean_de,
+        report.reference_noise_max_de
+    );
+    println!(
+        "{:<10} {:>8} {:>8} {:>8} {:>12} {:>12} {:>10}",
+        "model", "mean ΔE", "p95 ΔE", "max ΔE", "furnace≤70°", "furnace all", "ns/eval"
+    );
+    for m in &report.models {
+        println!(
+            "{:<10} {:>8.3} {:>8.3} {:>8.3} {:>12.4} {:>12.4} {:>10.1}",
+            m.name, m.mean_de, m.p95_de, m.max_de, m.max_furnace_err_to_70, m.max_furnace_err, m.ns_per_eval
+        );
+    }
+    Ok(())
 }
 
 fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_deg: f64, sweep: bool) -> Result<()> {

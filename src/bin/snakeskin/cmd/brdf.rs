@@ -85,13 +85,8 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
 fn eval_json(args: &EvalArgs) -> Result<String> {
     let stack = stack_of(&args.stack);
     check(stack, args.thickness_nm, 0.0, None)?;
-    let layers = Layers {
-        n0: stack.n0,
-        n2: stack.n2,
-        roughness: args.roughness,
-        optical_depth: args.absorption.map(|a| a * args.pigment_thickness),
-        albedo: args.albedo,
-    };
+    let optical_depth = args.absorption.map(|a| a * args.pigment_thickness);
+    let layers = Layers::of_stack(stack, args.thickness_nm, args.roughness, optical_depth, args.albedo);
     let film = |c: f64| film_colour(args.method, stack, args.thickness_nm, c);
     let value = args.model.eval(&layers, args.normal, args.wi, args.wo, &film);
     let json = serde_json::json!({

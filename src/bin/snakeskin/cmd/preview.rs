@@ -23,6 +23,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     let settings = FrameSettings {
         view: args.layers,
         method: args.method,
+        model: args.model,
         exposure: args.exposure,
         ground: !args.no_ground,
         snakes: args.snakes,
