@@ -14,6 +14,7 @@ use serde::Serialize;
 
 use super::frame::reference_check;
 use crate::Error;
+use crate::optics::brdf::Model;
 use crate::optics::lut::Lut;
 use crate::preset::LoadedPreset;
 use crate::render::engine::film::GpuFilmMethod;
@@ -40,6 +41,8 @@ pub struct RenderBench {
     pub skin_ms: f64,
     pub plain_ms: f64,
     pub ratio: f64,
+    /// skin-layered / plain-pbr, one snake (the layered model, LUT film).
+    pub layered_ratio: f64,
     pub skin_20_ms: f64,
     pub plain_20_ms: f64,
     pub variants: Vec<VariantTiming>,
@@ -151,27 +154,29 @@ pub fn bench_render(
     let base = FrameSettings { ground: false, ..FrameSettings::default() };
     let no_film = LayerOptics { thickness_range_nm: (0.0, 0.0), ..optics };
     let no_absorption = LayerOptics { optical_depth: [0.0; 3], ..optics };
-    let variants: Vec<(String, LayerOptics, GpuFilmMethod, bool)> = vec![
-        ("plain-pbr".into(), optics, GpuFilmMethod::Lut, true),
-        ("skin-lut".into(), optics, GpuFilmMethod::Lut, false),
-        ("skin-no-film".into(), no_film, GpuFilmMethod::Lut, false),
-        ("skin-no-absorption".into(), no_absorption, GpuFilmMethod::Lut, false),
-        ("skin-rgb3".into(), optics, GpuFilmMethod::Rgb3, false),
-        ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false),
-        ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false),
+    let (thesis, layered) = (Model::Thesis, Model::Layered);
+    let variants: Vec<(String, LayerOptics, GpuFilmMethod, bool, Model)> = vec![
+        ("plain-pbr".into(), optics, GpuFilmMethod::Lut, true, thesis),
+        ("skin-lut".into(), optics, GpuFilmMethod::Lut, false, thesis),
+        ("skin-layered".into(), optics, GpuFilmMethod::Lut, false, layered),
+        ("skin-no-film".into(), no_film, GpuFilmMethod::Lut, false, thesis),
+        ("skin-no-absorption".into(), no_absorption, GpuFilmMethod::Lut, false, thesis),
+        ("skin-rgb3".into(), optics, GpuFilmMethod::Rgb3, false, thesis),
+        ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false, thesis),
+        ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false, thesis),
     ];
     // All variants are timed round-robin, one frame each per round, so that a shared
     // machine's drift (other jobs, clock changes) affects every variant alike; the first
     // three rounds are warm-up (pipeline compilation, caches).
     let mut runs = Vec::new();
     for snakes in [1u32, 20] {
-        for (name, variant_optics, method, plain) in &variants {
+        for (name, variant_optics, method, plain, model) in &variants {
             if snakes == 20 && !matches!(name.as_str(), "plain-pbr" | "skin-lut") {
                 continue;
             }
             let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method));
             let camera = crate::render::engine::scene::Camera::framing(snakes);
-            let settings = FrameSettings { method: *method, plain: *plain, snakes, camera, ..base };
+            let settings = FrameSettings { method: *method, plain: *plain, model: *model, snakes, camera, ..base };
             runs.push((name.clone(), snakes, material, settings, Vec::with_capacity(options.frames)));
         }
     }
@@ -215,6 +220,7 @@ pub fn bench_render(
         skin_ms: find("skin-lut", 1),
         plain_ms: find("plain-pbr", 1),
         ratio: find("skin-lut", 1) / find("plain-pbr", 1),
+        layered_ratio: find("skin-layered", 1) / find("plain-pbr", 1),
         skin_20_ms: find("skin-lut", 20),
         plain_20_ms: find("plain-pbr", 20),
         variants: timings,

@@ -155,7 +155,7 @@ fn render(preset: &str, size: ImageSize, frames: u64, map_size: u64, reference: 
     for v in &result.variants {
         println!("{:<22} {:>7} {:>10.3} {:>10.3} {:>10.3}", v.name, v.snakes, v.median_ms, v.p10_ms, v.p90_ms);
     }
-    println!("skin / plain: {:.3}", result.ratio);
+    println!("skin / plain: {:.3} (thesis model), {:.3} (layered model)", result.ratio, result.layered_ratio);
     println!(
         "reference ({}x{}, {} px): CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3}",
         result.reference_width,
