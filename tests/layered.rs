@@ -5,21 +5,9 @@
 //! closed form's alone.
 
 use snakeskin::optics::brdf::exact::{SmoothTop, gauss_legendre};
-use snakeskin::optics::brdf::walk::{FilmTables, walk};
+use snakeskin::optics::brdf::walk::{FilmTables, Rng, walk};
 use snakeskin::optics::brdf::{Layers, Model};
 use snakeskin::optics::film::Stack;
-
-/// SplitMix64 for the random cases (fixed seed: the same cases every run).
-struct Rng(u64);
-impl Rng {
-    fn unit(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 const PHOTONS: u64 = 100_000;
 const BINS: usize = 6;

@@ -19,10 +19,11 @@
 use rayon::prelude::*;
 
 use super::walk::{FilmTables, walk_bounces};
-use super::{Layers, Model};
+use super::{Layers, Layers32, Model};
 use crate::optics::accuracy::GRID_MATERIALS;
 use crate::optics::film::Stack;
 use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
+use crate::optics::lut::Lut;
 
 pub const TAUS: [f64; 3] = [0.0, 0.4, 1.0];
 pub const THICKNESSES_NM: [f64; 2] = [250.0, 650.0];
@@ -187,8 +188,7 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
 /// CPU f32 cost of `Model::eval_f32` with the default LUT, median of five passes over
 /// 200,000 deterministic inputs on one core.
 pub fn ns_per_eval(model: Model) -> f64 {
-    use std::hint::black_box;
-    let lut = crate::optics::lut::Lut::bake_default(Stack::THESIS);
+    let lut = Lut::bake_default(Stack::THESIS);
     let layers = Layers::of_stack(Stack::THESIS, 400.0, 0.35, [0.6, 0.4, 0.2], [0.5, 0.4, 0.3]);
     let count = 200_000;
     let inputs: Vec<_> = (0..count)
@@ -204,15 +204,22 @@ pub fn ns_per_eval(model: Model) -> f64 {
             (l, dir(u(2), u(3)), dir(u(4), u(5)))
         })
         .collect();
+    median_ns_per_eval(model, &inputs, &lut)
+}
+
+/// One core's cost of `Model::eval_f32` over `inputs` (layers, wi, wo; normal +z), ns per
+/// evaluation, median of five passes (`bench layered` and `bench gpu` time the CPU here).
+pub fn median_ns_per_eval(model: Model, inputs: &[(Layers32, [f32; 3], [f32; 3])], lut: &Lut) -> f64 {
+    use std::hint::black_box;
     let mut times: Vec<f64> = (0..5)
         .map(|_| {
             let start = std::time::Instant::now();
             let mut acc = 0.0f32;
-            for (l, wi, wo) in &inputs {
-                acc += model.eval_f32(black_box(l), [0.0, 0.0, 1.0], *wi, *wo, &lut)[1];
+            for (l, wi, wo) in inputs {
+                acc += model.eval_f32(black_box(l), [0.0, 0.0, 1.0], *wi, *wo, lut)[1];
             }
             black_box(acc);
-            start.elapsed().as_secs_f64() * 1e9 / count as f64
+            start.elapsed().as_secs_f64() * 1e9 / inputs.len().max(1) as f64
         })
         .collect();
     times.sort_by(f64::total_cmp);

@@ -23,7 +23,7 @@
 
 use std::sync::OnceLock;
 
-use super::ggx::{ggx_d_sin, smith_g2};
+use super::ggx::{ggx_d_sin, smith_g2, stratified_half_vectors};
 use super::{ALPHA_MIN, COS_MIN};
 
 /// Table entries over μ ∈ [0, 1] and over r ∈ [0, 1] (uniform in both).
@@ -67,30 +67,15 @@ pub fn lobe(cos_o: f64, roughness: f64) -> Lobe {
     let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
     let alpha = (roughness * roughness).clamp(ALPHA_MIN, 1.0);
     let (mut sum, mut moments) = (0.0, [0.0; 5]);
-    for a in 0..STRATA {
-        for b in 0..STRATA {
-            let (u1, u2) = ((a as f64 + 0.5) / STRATA as f64, (b as f64 + 0.5) / STRATA as f64);
-            let cos_h = (1.0 / (1.0 + alpha * alpha * u1 / (1.0 - u1))).sqrt();
-            let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
-            let phi = 2.0 * std::f64::consts::PI * u2;
-            let h = [sin_h * phi.cos(), sin_h * phi.sin(), cos_h];
-            let wo_h = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2];
-            if wo_h <= 0.0 {
-                continue;
-            }
-            let cos_i = 2.0 * wo_h * h[2] - wo[2];
-            if cos_i <= 0.0 {
-                continue;
-            }
-            // f cos θi / pdf with pdf(wi) = D cos θh / (4 |wo·h|).
-            let g2 = smith_g2(cos_i.max(COS_MIN), cos_o, alpha);
-            let d = ggx_d_sin(cos_h, sin_h * sin_h, alpha);
-            let f = d * g2 / (4.0 * cos_i.max(COS_MIN) * cos_o);
-            let value = f * cos_i / (d * cos_h / (4.0 * wo_h));
-            sum += value;
-            for (k, m) in moments.iter_mut().enumerate() {
-                *m += value * wo_h.powi(k as i32 + 1);
-            }
+    for hv in stratified_half_vectors(wo, alpha, STRATA) {
+        // f cos θi / pdf(wi) with F = 1.
+        let cos_i = hv.wi[2];
+        let f = ggx_d_sin(hv.cos_h, hv.sin_h * hv.sin_h, alpha) * smith_g2(cos_i.max(COS_MIN), cos_o, alpha)
+            / (4.0 * cos_i.max(COS_MIN) * cos_o);
+        let value = f * cos_i / hv.pdf_wi;
+        sum += value;
+        for (k, m) in moments.iter_mut().enumerate() {
+            *m += value * hv.wo_h.powi(k as i32 + 1);
         }
     }
     let albedo = (sum / (STRATA * STRATA) as f64).min(1.0);

@@ -284,28 +284,11 @@ impl Model {
         let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
         let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
         let mut spec = [0.0; 3];
-        for a in 0..n {
-            for b in 0..n {
-                let (u1, u2) = ((a as f64 + 0.5) / n as f64, (b as f64 + 0.5) / n as f64);
-                // GGX sampling of h with pdf D(h) cos θh: tan² θh = α² u1 / (1 − u1).
-                let cos_h = (1.0 / (1.0 + alpha * alpha * u1 / (1.0 - u1))).sqrt();
-                let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
-                let phi = 2.0 * std::f64::consts::PI * u2;
-                let h = [sin_h * phi.cos(), sin_h * phi.sin(), cos_h];
-                let wo_h = dot(wo, h);
-                if wo_h <= 0.0 {
-                    continue;
-                }
-                let wi = [0, 1, 2].map(|k| 2.0 * wo_h * h[k] - wo[k]);
-                if wi[2] <= 0.0 {
-                    continue;
-                }
-                // f cos θi / pdf(wi) with pdf(wi) = D cos θh / (4 |wo·h|).
-                let value = self.eval(&Layers { albedo: [0.0; 3], ..*layers }, [0.0, 0.0, 1.0], wi, wo, film);
-                let pdf = ggx_d_sin(cos_h, sin_h * sin_h, alpha) * cos_h / (4.0 * wo_h);
-                for (s, v) in spec.iter_mut().zip(value.specular) {
-                    *s += v * wi[2] / pdf;
-                }
+        for hv in ggx::stratified_half_vectors(wo, alpha, n) {
+            // f cos θi / pdf(wi).
+            let value = self.eval(&Layers { albedo: [0.0; 3], ..*layers }, [0.0, 0.0, 1.0], hv.wi, wo, film);
+            for (s, v) in spec.iter_mut().zip(value.specular) {
+                *s += v * hv.wi[2] / hv.pdf_wi;
             }
         }
         let spec = spec.map(|s| s / (n * n) as f64);

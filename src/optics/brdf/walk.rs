@@ -89,10 +89,11 @@ impl WalkResult {
 }
 
 /// SplitMix64: a small, fast generator whose streams are fixed by the seed.
-struct Rng(u64);
+pub struct Rng(pub u64);
 
 impl Rng {
-    fn unit(&mut self) -> f64 {
+    /// Uniform in [0, 1) with 53 random bits.
+    pub fn unit(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);

@@ -160,8 +160,6 @@ pub struct GpuBench {
 /// 11 and 1 dispatches, median of five pairs; a difference that is not positive means the
 /// timing is meaningless and is an error, not a zero. CPU: median of five passes.
 pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBench, GpuError> {
-    use std::hint::black_box;
-
     let lut = Lut::bake_default(Stack::THESIS);
     let tau = [0.6, 0.4, 0.2];
     let bounce = crate::optics::brdf::exact::cached(Stack::THESIS, 1000.0).bounce_table(tau);
@@ -198,24 +196,14 @@ pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBen
         )));
     }
 
-    let mut cpu: Vec<f64> = (0..5)
-        .map(|_| {
-            let start = std::time::Instant::now();
-            let mut acc = 0.0f32;
-            for (l, wi, wo) in &inputs {
-                acc += model.eval_f32(black_box(l), [0.0, 0.0, 1.0], *wi, *wo, &lut)[1];
-            }
-            black_box(acc);
-            start.elapsed().as_secs_f64() * 1e3 * 1e6 / count as f64
-        })
-        .collect();
-    cpu.sort_by(f64::total_cmp);
+    // ns per evaluation is ms per million evaluations.
+    let cpu_ms = crate::optics::brdf::accuracy::median_ns_per_eval(model, &inputs, &lut);
     Ok(GpuBench {
         adapter: gpu.describe(),
         model: model.name(),
         samples: count,
         gpu_ms_per_million: gpu_ms,
-        cpu_f32_ms_per_million: cpu[2],
+        cpu_f32_ms_per_million: cpu_ms,
         cpu_threads: 1,
     })
 }
