@@ -292,6 +292,39 @@ mod commands {
     }
 
     #[test]
+    fn brdf_albedo_answers_for_every_model_and_reference() {
+        let albedo = |extra: &[&str]| {
+            let mut args = vec!["brdf", "albedo", "--angle-deg", "40"];
+            args.extend_from_slice(extra);
+            let (code, out, err) = run(&args);
+            assert_eq!(code, 0, "{err}");
+            let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+            let get = |key: &str| -> Vec<f64> {
+                v[key].as_array().map(|a| a.iter().map(|x| x.as_f64().unwrap()).collect()).unwrap_or_default()
+            };
+            (get("albedo"), get("specular"), get("diffuse"), get("sigma"))
+        };
+        // A lossless stack reflects everything: exactly for the closed form, within the
+        // furnace bound for the layered model; the thesis model loses energy (negative control).
+        let lossless = ["--albedo", "1", "--absorption", "0", "--roughness", "0.3"];
+        let (a, s, d, _) = albedo(&[&lossless[..], &["--model", "reference"]].concat());
+        assert!(a.iter().all(|v| (v - 1.0).abs() < 1e-6), "{a:?}");
+        assert!((0..3).all(|c| (s[c] + d[c] - a[c]).abs() < 1e-12));
+        let (a, _, _, _) = albedo(&[&lossless[..], &["--model", "layered"]].concat());
+        assert!(a.iter().all(|v| (v - 1.0).abs() < 0.02), "{a:?}");
+        let (a, _, _, _) = albedo(&[&lossless[..], &["--model", "thesis"]].concat());
+        assert!(a.iter().any(|v| *v < 0.95), "the thesis model keeps energy it should lose: {a:?}");
+        // The photon walk meets the closed form for a smooth top, within 4σ.
+        let coloured = ["--albedo", "0.5,0.3,0.2", "--absorption", "0.4", "--roughness", "0"];
+        let (exact, _, _, _) = albedo(&[&coloured[..], &["--model", "reference"]].concat());
+        let (walked, _, _, sigma) =
+            albedo(&[&coloured[..], &["--model", "stochastic", "--photons", "100000"]].concat());
+        for c in 0..3 {
+            assert!((walked[c] - exact[c]).abs() <= 4.0 * sigma[c] + 1e-4, "{c}: {walked:?} ± {sigma:?} vs {exact:?}");
+        }
+    }
+
+    #[test]
     fn brdf_stress_reports_every_key_and_no_nan() {
         let (code, out, err) = run(&["brdf", "stress", "--samples", "4000", "--json"]);
         assert_eq!(code, 0, "{err}");

@@ -277,6 +277,11 @@ pub enum BrdfCommand {
     },
     /// The full multi-layer BRDF for given directions and layer parameters (JSON).
     Eval(EvalArgs),
+    /// The directional albedo for light from one angle, by numerical integration of a
+    /// model or by a reference: {"model","albedo":[r,g,b],"specular":[r,g,b],"diffuse":[r,g,b]}
+    /// (and "sigma" for the stochastic reference). With --albedo 1 and no absorption the
+    /// stack loses nothing: the answer should be 1 (see --model).
+    Albedo(AlbedoArgs),
     /// A thin-film colour chart PNG: thickness 0..2000 nm across, angle 0..89° down.
     Chart {
         #[command(flatten)]
@@ -321,6 +326,17 @@ pub struct EvalArgs {
     /// Shading normal, x,y,z (a zero vector falls back to 0,0,1, as a blank normal map does).
     #[arg(long, value_parser = parse_vec3, default_value = "0,0,1", allow_hyphen_values = true)]
     pub normal: [f64; 3],
+    #[command(flatten)]
+    pub layer: LayerArgs,
+    /// Layer model under the top interface: thesis (PHYSICS.md's eq. 4.21 diffuse lobe) or
+    /// layered (the stack's transport).
+    #[arg(long, default_value = "thesis", value_parser = parse_model)]
+    pub model: Model,
+}
+
+/// The layer parameters `brdf eval` and `brdf albedo` share.
+#[derive(Debug, Args)]
+pub struct LayerArgs {
     /// Film thickness in nm (thesis δ0), 0 to 10^7 (10 mm).
     #[arg(long, default_value_t = thesis::FILM_THICKNESS_NM, value_parser = parse_thickness_nm)]
     pub thickness_nm: f64,
@@ -341,9 +357,52 @@ pub struct EvalArgs {
     /// Film colour method (as for `brdf color`).
     #[arg(long, default_value = "spectral", value_parser = parse_method)]
     pub method: Method,
-    /// Layer model under the top interface (thesis: PHYSICS.md's eq. 4.21 diffuse lobe).
-    #[arg(long, default_value = "thesis", value_parser = parse_model)]
-    pub model: Model,
+}
+
+#[derive(Debug, Args)]
+pub struct AlbedoArgs {
+    #[command(flatten)]
+    pub stack: StackArgs,
+    /// Angle of the light from the normal in degrees, 0 to 90 (by reciprocity also the
+    /// view angle of the albedo seen under a uniform sky).
+    #[arg(long, value_parser = parse_angle_deg)]
+    pub angle_deg: f64,
+    #[command(flatten)]
+    pub layer: LayerArgs,
+    /// thesis | layered: the model's BRDF integrated over the hemisphere (64 × 64
+    /// stratified half vectors for the specular lobe, 4096 midpoints in cos θ for the
+    /// diffuse lobe; within 2e-3 of the exact albedo on known cases). reference: the
+    /// smooth-top closed form of PHYSICS.md (roughness ignored; Gauss–Legendre, ~1e-9).
+    /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
+    /// standard error per channel. The references read the exact 1 nm film (--method is
+    /// for the models).
+    #[arg(long, default_value = "thesis", value_parser = parse_albedo_model)]
+    pub model: AlbedoModel,
+    /// Photons per channel for --model stochastic, 1000 to 100,000,000 (σ ∝ 1/√N).
+    #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1000..=100_000_000))]
+    pub photons: u64,
+}
+
+/// What `brdf albedo` integrates: a real-time model or one of the references.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AlbedoModel {
+    Model(Model),
+    Reference,
+    Stochastic,
+}
+
+fn parse_albedo_model(text: &str) -> Result<AlbedoModel, String> {
+    match text {
+        "reference" => Ok(AlbedoModel::Reference),
+        "stochastic" => Ok(AlbedoModel::Stochastic),
+        _ => Model::parse(text)
+            .map(AlbedoModel::Model)
+            .ok_or_else(|| format!("accepted: {}, reference, stochastic", Model::ACCEPTED)),
+    }
+}
+
+fn parse_angle_deg(text: &str) -> Result<f64, String> {
+    bounded(text, (0.0, 90.0))
 }
 
 #[derive(Debug, Subcommand)]
@@ -558,15 +617,15 @@ mod tests {
         let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.command else { panic!("parsed as brdf eval") };
         let stack = (args.stack.n0, args.stack.n1, args.stack.n2);
         assert_eq!(stack, (thesis::AMBIENT_IOR, thesis::FILM_IOR, thesis::PIGMENT_IOR));
-        assert_eq!(args.absorption, [thesis::ABSORPTION; 3]);
-        assert_eq!(args.pigment_thickness, thesis::PIGMENT_THICKNESS);
-        assert_eq!(args.thickness_nm, thesis::FILM_THICKNESS_NM);
+        assert_eq!(args.layer.absorption, [thesis::ABSORPTION; 3]);
+        assert_eq!(args.layer.pigment_thickness, thesis::PIGMENT_THICKNESS);
+        assert_eq!(args.layer.thickness_nm, thesis::FILM_THICKNESS_NM);
         // The model's text default is the library's default model.
         assert_eq!(args.model, Model::default());
         // Negative control: a value given on the command line is not the default.
         let cli =
             Cli::try_parse_from(["snakeskin", "brdf", "eval", "--wi", "0,0,1", "--wo", "0,0,1", "--absorption", "0.5"]);
         let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.unwrap().command else { panic!() };
-        assert_ne!(args.absorption, [thesis::ABSORPTION; 3]);
+        assert_ne!(args.layer.absorption, [thesis::ABSORPTION; 3]);
     }
 }

@@ -6,10 +6,12 @@ use std::io::{BufRead, BufReader, Read, Write};
 use anyhow::Result;
 use serde::Deserialize;
 
-use crate::cli::{BrdfCommand, EvalArgs, StackArgs};
+use crate::cli::{AlbedoArgs, AlbedoModel, BrdfCommand, EvalArgs, LayerArgs, StackArgs};
 use crate::output::{ensure_parent_folder, path_line, printable};
 use snakeskin::Error;
-use snakeskin::optics::brdf::Layers;
+use snakeskin::optics::brdf::exact::SmoothTop;
+use snakeskin::optics::brdf::walk::{FilmTables, walk};
+use snakeskin::optics::brdf::{BrdfValue, Layers};
 use snakeskin::optics::film::{Stack, airy};
 use snakeskin::optics::methods::Method;
 use snakeskin::optics::query::{chart, check, film_colour};
@@ -84,10 +86,8 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
 
 fn eval_json(args: &EvalArgs) -> Result<String> {
     let stack = stack_of(&args.stack);
-    check(stack, args.thickness_nm, 0.0, None)?;
-    let optical_depth = args.absorption.map(|a| a * args.pigment_thickness);
-    let layers = Layers::of_stack(stack, args.thickness_nm, args.roughness, optical_depth, args.albedo);
-    let film = |c: f64| film_colour(args.method, stack, args.thickness_nm, c);
+    let (layers, l) = layers_of(&args.stack, &args.layer)?;
+    let film = |c: f64| film_colour(l.method, stack, l.thickness_nm, c);
     let value = args.model.eval(&layers, args.normal, args.wi, args.wo, &film);
     let json = serde_json::json!({
         "model": args.model.name(),
@@ -95,6 +95,47 @@ fn eval_json(args: &EvalArgs) -> Result<String> {
         "specular": value.specular,
         "diffuse": value.diffuse,
     });
+    Ok(json.to_string())
+}
+
+/// The layers of `brdf eval` and `brdf albedo`, checked.
+fn layers_of<'a>(stack: &StackArgs, l: &'a LayerArgs) -> Result<(Layers, &'a LayerArgs)> {
+    let stack = stack_of(stack);
+    check(stack, l.thickness_nm, 0.0, None)?;
+    let optical_depth = l.absorption.map(|a| a * l.pigment_thickness);
+    Ok((Layers::of_stack(stack, l.thickness_nm, l.roughness, optical_depth, l.albedo), l))
+}
+
+fn albedo_json(args: &AlbedoArgs) -> Result<String> {
+    let stack = stack_of(&args.stack);
+    let (layers, l) = layers_of(&args.stack, &args.layer)?;
+    let cos = args.angle_deg.to_radians().cos();
+    let (name, value, sigma) = match args.model {
+        AlbedoModel::Model(model) => {
+            let film = |c: f64| film_colour(l.method, stack, l.thickness_nm, c);
+            let total = model.furnace_albedo(&layers, cos, &film, 64);
+            let specular = model.furnace_albedo(&Layers { albedo: [0.0; 3], ..layers }, cos, &film, 64);
+            let diffuse = [0, 1, 2].map(|c| total[c] - specular[c]);
+            (model.name(), BrdfValue { specular, diffuse }, None)
+        }
+        AlbedoModel::Reference => ("reference", SmoothTop::new(stack, l.thickness_nm).albedo(&layers, cos), None),
+        AlbedoModel::Stochastic => {
+            let tables = FilmTables::new(stack, l.thickness_nm);
+            let wi = [(1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos];
+            let walked = walk(&layers, &tables, wi, args.photons, 1, 1);
+            let value = BrdfValue { specular: walked.specular, diffuse: walked.diffuse };
+            ("stochastic", value, Some(walked.total_sigma()))
+        }
+    };
+    let mut json = serde_json::json!({
+        "model": name,
+        "albedo": value.total(),
+        "specular": value.specular,
+        "diffuse": value.diffuse,
+    });
+    if let Some(sigma) = sigma {
+        json["sigma"] = serde_json::json!(sigma);
+    }
     Ok(json.to_string())
 }
 
@@ -176,6 +217,10 @@ pub fn run(command: BrdfCommand) -> Result<()> {
         }
         BrdfCommand::Eval(args) => {
             println!("{}", eval_json(&args)?);
+            Ok(())
+        }
+        BrdfCommand::Albedo(args) => {
+            println!("{}", albedo_json(&args)?);
             Ok(())
         }
         BrdfCommand::Stress { samples, seed, json } => {
