@@ -8,7 +8,7 @@ override STAGE: u32 = STAGE_ALL;
 // VIEW_SHADED = shade; VIEW_COLOR ... VIEW_IRIDESCENCE = show that map unlit.
 override VIEW_MAP: u32 = VIEW_SHADED;
 // Which half of the G-buffer fs_gbuffer writes (two passes keep each under 32 bytes/pixel).
-override GBUFFER_PART: u32 = 0u;
+override GBUFFER_PART: u32 = GBUFFER_POSITION_NORMAL;
 
 // The pixel's layers; K and E interpolated between the roughness rows (exact: they are
 // linear in r between rows, LayerOptics::bounce_table).
@@ -101,7 +101,7 @@ struct GBuffer {
 fn fs_gbuffer(in: VertexOut) -> GBuffer {
     let m = sample_material(in);
     var out: GBuffer;
-    if (GBUFFER_PART == 0u) {
+    if (GBUFFER_PART == GBUFFER_POSITION_NORMAL) {
         out.first = vec4<f32>(in.world, m.thickness_nm);
         out.second = vec4<f32>(m.normal, m.roughness);
     } else {

@@ -1,6 +1,7 @@
-//! GPU side, split by role: `engine` (device, pipelines, targets, frames, the WGSL programs
-//! and their generated constants), `reference` (readback, the CPU reference a frame is
-//! measured against, the BRDF twin evaluation, the frame benchmark), `window` (the
+//! GPU side, split by role: `engine` (device, pipelines, targets, frames and their readback
+//! into images and G-buffers, the WGSL programs and their generated constants), `reference`
+//! (what is measured on what the engine reads back: the CPU reference a frame is compared
+//! with, the BRDF twin evaluation, the frame benchmark), `window` (the
 //! interactive preview: app, panel, live reload; behind the default-on `window` feature, so a
 //! headless build skips winit and egui) and `figures` (documentation figures, the species
 //! sheet, the pattern gallery).

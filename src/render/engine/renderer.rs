@@ -24,6 +24,13 @@ pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSr
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const MSAA_SAMPLES: u32 = 4;
+/// `tonemap.wgsl`'s modes: the PBR Neutral curve, or none (the map viewer shows values).
+pub const TONE_MAP_CURVE: u32 = 0;
+pub const TONE_MAP_NONE: u32 = 1;
+/// `skin.wgsl`'s `GBUFFER_PART`s: (position, thickness) + (normal, roughness), then
+/// (albedo, coverage) + (geometric normal, height).
+pub const GBUFFER_POSITION_NORMAL: u32 = 0;
+pub const GBUFFER_ALBEDO_GEOMETRY: u32 = 1;
 
 /// Where a frame's tone-mapped result goes: any 8-bit sRGB view.
 #[derive(Clone, Copy)]
@@ -472,7 +479,7 @@ impl Renderer {
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) {
         self.write_scene(settings, material, targets.width as f32 / targets.height as f32);
-        let mode: u32 = if matches!(settings.view, View::Map(_)) { 1 } else { 0 };
+        let mode: u32 = if matches!(settings.view, View::Map(_)) { TONE_MAP_NONE } else { TONE_MAP_CURVE };
         let tone: [u32; 4] = [settings.exposure.to_bits(), mode, 0, 0];
         self.gpu.queue.write_buffer(&targets.tonemap_uniform, 0, bytemuck::cast_slice(&tone));
         let program = if settings.plain { Program::Plain } else { Program::Skin };
@@ -594,7 +601,7 @@ impl Renderer {
         // Depth only: the colour targets of `Targets` are not used here.
         let depth = self.targets(width, height, 1).depth;
         let mut parts = Vec::new();
-        for part in 0..2 {
+        for part in [GBUFFER_POSITION_NORMAL, GBUFFER_ALBEDO_GEOMETRY] {
             let make = || self.readable_target("gbuffer", GBUFFER_FORMAT, width, height);
             let (first, second) = (make(), make());
             let pipeline = self.pipeline(self.key(Program::GBuffer(part), settings, material, 1));

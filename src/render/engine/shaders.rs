@@ -16,7 +16,9 @@ use crate::optics::lut::{COARSE_MAX_NM, FINE_MAX_NM};
 use crate::optics::methods::{BB_LOBES, GAUSSIAN_FIT_HARMONICS, RGB3_BAND_NM, RGB3_NM, bb_amplitude};
 
 use super::film::GpuFilmMethod;
+use super::renderer::{GBUFFER_ALBEDO_GEOMETRY, GBUFFER_POSITION_NORMAL, TONE_MAP_CURVE, TONE_MAP_NONE};
 use super::scene::{Stage, View};
+use crate::render::reference::frame::{PBR_NEUTRAL_DESATURATION, PBR_NEUTRAL_OFFSET, PBR_NEUTRAL_START_COMPRESSION};
 
 /// Film colour by method (LUT lookup and the analytic methods).
 pub const FILM_WGSL: &str = include_str!("../../../shaders/film.wgsl");
@@ -68,6 +70,13 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("GAUSSIAN_FIT_HARMONICS", "u32", format!("{GAUSSIAN_FIT_HARMONICS}u")),
         // The axes of the rough lobe's table (optics::brdf::energy; the table itself is a
         // storage buffer of the film bind group, render::engine::film).
+        ("PBR_NEUTRAL_OFFSET", "f32", f32_literal(PBR_NEUTRAL_OFFSET)),
+        ("PBR_NEUTRAL_START_COMPRESSION", "f32", f32_literal(PBR_NEUTRAL_START_COMPRESSION)),
+        ("PBR_NEUTRAL_DESATURATION", "f32", f32_literal(PBR_NEUTRAL_DESATURATION)),
+        ("TONE_MAP_CURVE", "u32", format!("{TONE_MAP_CURVE}u")),
+        ("TONE_MAP_NONE", "u32", format!("{TONE_MAP_NONE}u")),
+        ("GBUFFER_POSITION_NORMAL", "u32", format!("{GBUFFER_POSITION_NORMAL}u")),
+        ("GBUFFER_ALBEDO_GEOMETRY", "u32", format!("{GBUFFER_ALBEDO_GEOMETRY}u")),
         ("E1_MU", "u32", format!("{E1_MU}u")),
         ("E1_ROUGHNESS", "u32", format!("{E1_ROUGHNESS}u")),
     ];

@@ -57,12 +57,20 @@ fn sky(lighting: &Lighting, d: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|c| lighting.sky_bottom[c] as f64 + (lighting.sky_top[c] as f64 - lighting.sky_bottom[c] as f64) * t)
 }
 
+/// Khronos PBR Neutral (KHR PBR Neutral Tone Mapper, 2024): the toe offset F90 = 0.04, the
+/// compression start 0.8 − F90 and the desaturation 0.15. `tonemap.wgsl` reads them from
+/// the generated prelude.
+pub const PBR_NEUTRAL_OFFSET: f64 = 0.04;
+pub const PBR_NEUTRAL_START_COMPRESSION: f64 = 0.8 - PBR_NEUTRAL_OFFSET;
+pub const PBR_NEUTRAL_DESATURATION: f64 = 0.15;
+
 /// Khronos PBR Neutral tone mapping (the twin of `tonemap.wgsl`'s `pbr_neutral`).
 pub fn pbr_neutral(color: [f64; 3]) -> [f64; 3] {
-    const START_COMPRESSION: f64 = 0.8 - 0.04;
-    const DESATURATION: f64 = 0.15;
+    const START_COMPRESSION: f64 = PBR_NEUTRAL_START_COMPRESSION;
+    const DESATURATION: f64 = PBR_NEUTRAL_DESATURATION;
     let x = color[0].min(color[1]).min(color[2]);
-    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+    // The toe: x − x² / (4 F90) below 2 F90 (= x − 6.25 x² for F90 = 0.04).
+    let offset = if x < 2.0 * PBR_NEUTRAL_OFFSET { x - x * x / (4.0 * PBR_NEUTRAL_OFFSET) } else { PBR_NEUTRAL_OFFSET };
     let mut c = color.map(|v| v - offset);
     let peak = c[0].max(c[1]).max(c[2]);
     if peak < START_COMPRESSION {
