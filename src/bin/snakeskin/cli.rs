@@ -476,6 +476,10 @@ pub enum BenchCommand {
         /// report says what it makes in ΔE).
         #[arg(long, default_value_t = 40_000, value_parser = clap::value_parser!(u64).range(1000..=10_000_000))]
         photons: u64,
+        /// Write an SVG plot of error (mean, p95, max ΔE00) against CPU cost, one point per
+        /// model.
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
     },
 }
 

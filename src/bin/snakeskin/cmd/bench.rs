@@ -22,7 +22,7 @@ pub fn run(command: BenchCommand) -> Result<()> {
         BenchCommand::Irid { json, plot, d_step_nm, angle_step_deg, lut_sweep } => {
             irid(json, plot.as_deref(), d_step_nm, angle_step_deg, lut_sweep)
         }
-        BenchCommand::Layered { json, photons } => layered(json, photons),
+        BenchCommand::Layered { json, photons, plot } => layered(json, photons, plot.as_deref()),
     }
 }
 
@@ -41,11 +41,30 @@ fn species_colours() -> Result<Vec<[f64; 3]>> {
     Ok(colours)
 }
 
-fn layered(json: bool, photons: u64) -> Result<()> {
+fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<()> {
+    if let Some(path) = plot {
+        ensure_parent_folder(path)?;
+    }
     let colours = species_colours()?;
     let progress = Progress::spinner("walking photons through the stack");
     let report = snakeskin::optics::brdf::accuracy::run(&colours, photons);
     progress.finish();
+    if let Some(path) = plot {
+        // The same plot as `bench irid`'s, one point per model.
+        let points: Vec<snakeskin::optics::accuracy::MethodReport> = report
+            .models
+            .iter()
+            .map(|m| snakeskin::optics::accuracy::MethodReport {
+                name: m.name.to_string(),
+                mean_de: m.mean_de,
+                p95_de: m.p95_de,
+                max_de: m.max_de,
+                ns_per_eval: m.ns_per_eval,
+            })
+            .collect();
+        let svg = snakeskin::optics::plot::error_vs_cost_svg(&points, snakeskin::optics::brdf::Model::default().name());
+        snakeskin::export::write_file_atomically(path, svg.into_bytes())?;
+    }
     if json {
         println!("{}", serde_json::to_string(&report)?);
         return Ok(());
