@@ -179,6 +179,13 @@ impl SmoothTop {
         (k, e)
     }
 
+    /// `bounce_table(tau).at(roughness)` from the two rows it needs (`Layers::of_stack`, once
+    /// per sample in `brdf stress`, would otherwise compute all sixteen).
+    pub fn k_e_at(&self, tau: [f64; 3], roughness: f64) -> ([f64; 3], [f64; 3]) {
+        let (i, f) = row_of(roughness);
+        mix_rows(self.k_e_row(tau, i), self.k_e_row(tau, i + 1), f)
+    }
+
     /// `k_e_row` at every roughness row of the energy table: K and E are linear in r
     /// between rows (E₁ is interpolated linearly in r), so interpolating these rows is exact;
     /// the shader does that per pixel (`Scene.bounce`).
@@ -235,15 +242,30 @@ pub struct BounceTable {
 }
 
 impl BounceTable {
+    /// Zeros in every row: for a model that does not read K and E.
+    pub fn unused() -> BounceTable {
+        BounceTable { rows: vec![([0.0; 3], [0.0; 3]); energy::E1_ROUGHNESS] }
+    }
+
     /// K and E at perceptual roughness `roughness`, interpolated between rows.
     pub fn at(&self, roughness: f64) -> ([f64; 3], [f64; 3]) {
-        let x = roughness.clamp(0.0, 1.0) * (self.rows.len() - 1) as f64;
-        let i = (x as usize).min(self.rows.len() - 2);
-        let f = x - i as f64;
-        let (a, b) = (self.rows[i], self.rows[i + 1]);
-        let mix = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|c| p[c] * (1.0 - f) + q[c] * f);
-        (mix(a.0, b.0), mix(a.1, b.1))
+        let (i, f) = row_of(roughness);
+        mix_rows(self.rows[i], self.rows[i + 1], f)
     }
+}
+
+/// The roughness row below `roughness` and the weight of the one above (rows uniform in r).
+fn row_of(roughness: f64) -> (usize, f64) {
+    let x = roughness.clamp(0.0, 1.0) * (energy::E1_ROUGHNESS - 1) as f64;
+    let i = (x as usize).min(energy::E1_ROUGHNESS - 2);
+    (i, x - i as f64)
+}
+
+type KE = ([f64; 3], [f64; 3]);
+
+fn mix_rows(a: KE, b: KE, f: f64) -> KE {
+    let mix = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|c| p[c] * (1.0 - f) + q[c] * f);
+    (mix(a.0, b.0), mix(a.1, b.1))
 }
 
 /// `SmoothTop::new` for a (stack, thickness), kept for reuse: the renderer, the reference

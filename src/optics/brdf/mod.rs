@@ -75,6 +75,16 @@ impl Model {
         }
     }
 
+    /// Whether the model reads the stack's bounce terms K and E (`Layers::k`, `e`): callers
+    /// skip computing them (the film seen from below, ~10⁶ Airy sums per new film thickness)
+    /// for models that do not.
+    pub fn reads_bounce(self) -> bool {
+        match self {
+            Model::Thesis => false,
+            Model::Layered => true,
+        }
+    }
+
     /// The diffuse lobe (f64) at floored cosines with the model's `coupling` there.
     fn diffuse(self, layers: &Layers, cos_i: f64, cos_o: f64, f_i: [f64; 3], f_o: [f64; 3]) -> [f64; 3] {
         match self {
@@ -148,7 +158,7 @@ impl Layers {
         optical_depth: [f64; 3],
         albedo: [f64; 3],
     ) -> Layers {
-        let (k, e) = exact::cached(stack, thickness_nm).bounce_table(optical_depth).at(roughness);
+        let (k, e) = exact::cached(stack, thickness_nm).k_e_at(optical_depth, roughness);
         Layers { n0: stack.n0, n2: stack.n2, roughness, optical_depth, albedo, k, e }
     }
 

@@ -234,16 +234,26 @@ fn follow(wi: V3, layers: &Layers, film: &FilmTables, alpha: f64, c: usize, rng:
     Fate::Absorbed
 }
 
+/// GGX α of the walk's top: 0 (a mirror, m = n) for roughness 0, else roughness² floored
+/// at ALPHA_MIN as in the models.
+fn walk_alpha(layers: &Layers) -> f64 {
+    if layers.roughness <= 0.0 { 0.0 } else { (layers.roughness * layers.roughness).max(super::ALPHA_MIN) }
+}
+
+/// Each channel's own stream, fixed by the seed.
+fn channel_rng(seed: u64, channel: usize) -> Rng {
+    Rng(seed ^ (0x5151_0000 + channel as u64).wrapping_mul(0x2545_f491_4f6c_dd1d))
+}
+
 /// Walks `photons` photons per channel from direction `wi` (need not be normalised; the
 /// normal is +z) through the stack of `layers` with the film of `film`.
 pub fn walk(layers: &Layers, film: &FilmTables, wi: V3, photons: u64, bins: usize, seed: u64) -> WalkResult {
-    let wi = normalize(wi);
-    let alpha = if layers.roughness <= 0.0 { 0.0 } else { (layers.roughness * layers.roughness).max(super::ALPHA_MIN) };
+    let (wi, alpha) = (normalize(wi), walk_alpha(layers));
     let mut specular = [0u64; 3];
     let mut diffuse = [0u64; 3];
     let mut binned = vec![[0u64; 3]; bins.max(1)];
     for c in 0..3 {
-        let mut rng = Rng(seed ^ (0x5151_0000 + c as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
+        let mut rng = channel_rng(seed, c);
         for _ in 0..photons {
             match follow(wi, layers, film, alpha, c, &mut rng) {
                 Fate::Specular => specular[c] += 1,
@@ -306,12 +316,11 @@ impl BounceTally {
 /// Walks `photons` photons per channel with a white base (the `albedo` of `layers` is not
 /// used) and tallies them by base reflections (`BounceTally`).
 pub fn walk_bounces(layers: &Layers, film: &FilmTables, wi: V3, photons: u64, seed: u64) -> BounceTally {
-    let wi = normalize(wi);
-    let alpha = if layers.roughness <= 0.0 { 0.0 } else { (layers.roughness * layers.roughness).max(super::ALPHA_MIN) };
+    let (wi, alpha) = (normalize(wi), walk_alpha(layers));
     let white = Layers { albedo: [1.0; 3], ..*layers };
     let mut tally = BounceTally { photons, specular: [0; 3], escaped_after: Vec::new() };
     for c in 0..3 {
-        let mut rng = Rng(seed ^ (0x5151_0000 + c as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
+        let mut rng = channel_rng(seed, c);
         for _ in 0..photons {
             match follow(wi, &white, film, alpha, c, &mut rng) {
                 Fate::Specular => tally.specular[c] += 1,

@@ -431,7 +431,7 @@ impl Renderer {
     }
 
     fn write_scene(&self, settings: &FrameSettings, material: &Material, aspect: f32) {
-        let uniform = SceneUniform::new(&settings.camera, aspect, &settings.lighting, &material.optics);
+        let uniform = SceneUniform::new(&settings.camera, aspect, &settings.lighting, &material.optics, settings.model);
         self.gpu.queue.write_buffer(&self.scene_buffer, 0, bytemuck::bytes_of(&uniform));
     }
 

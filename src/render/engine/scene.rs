@@ -5,6 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
+use crate::optics::brdf::Model;
 use crate::optics::brdf::energy::E1_ROUGHNESS;
 use crate::optics::film::Stack;
 use crate::preset::Preset;
@@ -208,15 +209,25 @@ impl LayerOptics {
         0.5 * (self.thickness_range_nm.0 + self.thickness_range_nm.1)
     }
 
-    /// K and E per roughness row, as the shader interpolates them.
-    pub fn bounce_table(&self) -> crate::optics::brdf::exact::BounceTable {
+    /// K and E per roughness row, as the shader interpolates them; zeros for a model that
+    /// does not read them (so the thesis model's frames, and the window's thickness slider
+    /// under it, never compute the film seen from below).
+    pub fn bounce_table(&self, model: Model) -> crate::optics::brdf::exact::BounceTable {
+        if !model.reads_bounce() {
+            return crate::optics::brdf::exact::BounceTable::unused();
+        }
         crate::optics::brdf::exact::cached(self.stack, self.bounce_thickness_nm()).bounce_table(self.optical_depth)
     }
 
-    /// The per-pixel layers of this material (the CPU reference's twin of the shader's
-    /// `layers_of`).
-    pub fn layers(&self, roughness: f64, albedo: [f64; 3]) -> crate::optics::brdf::Layers {
-        let (k, e) = self.bounce_table().at(roughness);
+    /// The per-pixel layers of this material with its `bounce_table` (the CPU reference's
+    /// twin of the shader's `layers_of`).
+    pub fn layers(
+        &self,
+        bounce: &crate::optics::brdf::exact::BounceTable,
+        roughness: f64,
+        albedo: [f64; 3],
+    ) -> crate::optics::brdf::Layers {
+        let (k, e) = bounce.at(roughness);
         let Stack { n0, n2, .. } = self.stack;
         crate::optics::brdf::Layers { n0, n2, roughness, optical_depth: self.optical_depth, albedo, k, e }
     }
@@ -250,7 +261,7 @@ pub struct SceneUniform {
 }
 
 impl SceneUniform {
-    pub fn new(camera: &Camera, aspect: f32, lighting: &Lighting, optics: &LayerOptics) -> SceneUniform {
+    pub fn new(camera: &Camera, aspect: f32, lighting: &Lighting, optics: &LayerOptics, model: Model) -> SceneUniform {
         let light = |l: &Light| {
             let d = l.direction.normalize();
             (
@@ -263,7 +274,7 @@ impl SceneUniform {
         let p = camera.position();
         let rgb4 = |c: [f32; 3]| [c[0], c[1], c[2], 0.0];
         let tau = optics.optical_depth.map(|t| t as f32);
-        let bounce = optics.bounce_table();
+        let bounce = optics.bounce_table(model);
         SceneUniform {
             view_proj: camera.view_proj(aspect).to_cols_array_2d(),
             camera: [p.x, p.y, p.z, 0.0],

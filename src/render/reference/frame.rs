@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use crate::Error;
 use crate::optics::brdf::COS_MIN;
+use crate::optics::brdf::exact::BounceTable;
 use crate::optics::film_rgb_reference;
 use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
 use crate::render::engine::renderer::{FrameSettings, GBuffer, Material, Renderer};
@@ -93,7 +94,13 @@ pub fn srgb_decode(encoded: f64) -> f64 {
 }
 
 /// Linear radiance of one covered pixel (stage "all"), the twin of `skin.wgsl`'s `shade`.
-pub fn shade_pixel(gbuffer: &GBuffer, i: usize, settings: &FrameSettings, optics: &LayerOptics) -> [f64; 3] {
+pub fn shade_pixel(
+    gbuffer: &GBuffer,
+    i: usize,
+    settings: &FrameSettings,
+    optics: &LayerOptics,
+    bounce: &BounceTable,
+) -> [f64; 3] {
     let pt = gbuffer.position_thickness[i].map(|v| v as f64);
     let nr = gbuffer.normal_roughness[i].map(|v| v as f64);
     let albedo = gbuffer.albedo_coverage[i].map(|v| v as f64);
@@ -112,7 +119,7 @@ pub fn shade_pixel(gbuffer: &GBuffer, i: usize, settings: &FrameSettings, optics
         computed.borrow_mut().push((cos.to_bits(), rgb));
         rgb
     };
-    let layers = optics.layers(nr[3], [albedo[0], albedo[1], albedo[2]]);
+    let layers = optics.layers(bounce, nr[3], [albedo[0], albedo[1], albedo[2]]);
     let lighting = &settings.lighting;
     let mut radiance = [0.0; 3];
     for light in [&lighting.key, &lighting.fill] {
@@ -153,6 +160,8 @@ pub fn compare(
     settings: &FrameSettings,
     optics: &LayerOptics,
 ) -> ReferenceReport {
+    // K and E per roughness row, once for the frame (the shader's `Scene.bounce`).
+    let bounce = optics.bounce_table(settings.model);
     let exposure = settings.exposure as f64;
     let de: Vec<Option<f64>> = (0..(gbuffer.width * gbuffer.height) as usize)
         .into_par_iter()
@@ -160,7 +169,7 @@ pub fn compare(
             if !gbuffer.covered(i) {
                 return None;
             }
-            let cpu = display(shade_pixel(gbuffer, i, settings, optics), exposure).map(srgb_decode);
+            let cpu = display(shade_pixel(gbuffer, i, settings, optics, &bounce), exposure).map(srgb_decode);
             let px = gpu_image.as_raw()[4 * i..4 * i + 3].iter().map(|v| srgb_decode(*v as f64 / 255.0));
             let gpu: Vec<f64> = px.collect();
             Some(ciede2000(linear_srgb_to_lab(cpu), linear_srgb_to_lab([gpu[0], gpu[1], gpu[2]])))

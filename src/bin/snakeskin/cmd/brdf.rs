@@ -86,7 +86,7 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
 
 fn eval_json(args: &EvalArgs) -> Result<String> {
     let stack = stack_of(&args.stack);
-    let (layers, l) = layers_of(&args.stack, &args.layer)?;
+    let (layers, l) = (layers_of(&args.stack, &args.layer)?, &args.layer);
     let film = |c: f64| film_colour(l.method, stack, l.thickness_nm, c);
     let value = args.model.eval(&layers, args.normal, args.wi, args.wo, &film);
     let json = serde_json::json!({
@@ -99,16 +99,16 @@ fn eval_json(args: &EvalArgs) -> Result<String> {
 }
 
 /// The layers of `brdf eval` and `brdf albedo`, checked.
-fn layers_of<'a>(stack: &StackArgs, l: &'a LayerArgs) -> Result<(Layers, &'a LayerArgs)> {
+fn layers_of(stack: &StackArgs, l: &LayerArgs) -> Result<Layers> {
     let stack = stack_of(stack);
     check(stack, l.thickness_nm, 0.0, None)?;
     let optical_depth = l.absorption.map(|a| a * l.pigment_thickness);
-    Ok((Layers::of_stack(stack, l.thickness_nm, l.roughness, optical_depth, l.albedo), l))
+    Ok(Layers::of_stack(stack, l.thickness_nm, l.roughness, optical_depth, l.albedo))
 }
 
 fn albedo_json(args: &AlbedoArgs) -> Result<String> {
     let stack = stack_of(&args.stack);
-    let (layers, l) = layers_of(&args.stack, &args.layer)?;
+    let (layers, l) = (layers_of(&args.stack, &args.layer)?, &args.layer);
     let cos = args.angle_deg.to_radians().cos();
     let (name, value, sigma) = match args.model {
         AlbedoModel::Model(model) => {
