@@ -57,6 +57,9 @@ pub struct LayeredBench {
     /// Furnace error of each model per (roughness, angle): rows of
     /// (model, roughness, angle_deg, max |albedo − 1| over materials and films).
     pub furnace: Vec<(&'static str, f64, f64, f64)>,
+    /// Where each model's error lies: rows of (model, roughness, angle_deg, mean ΔE00, max
+    /// ΔE00) over materials, τ, films and colours.
+    pub error_by_roughness_angle: Vec<(&'static str, f64, f64, f64, f64)>,
 }
 
 struct Point {
@@ -131,13 +134,17 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
     let mut noise = Vec::new();
     let mut models = Vec::new();
     let mut furnace_rows = Vec::new();
+    let mut error_rows = Vec::new();
     for (m, model) in Model::ALL.iter().enumerate() {
         let mut de = Vec::new();
+        let mut de_at: Vec<((f64, f64), f64)> = Vec::new();
         let (mut furnace_max, mut furnace_70) = (0.0f64, 0.0f64);
         for (p, (reference, per_model, furnace)) in points.iter().zip(&results) {
             for (k, (r, sigma)) in reference.iter().enumerate() {
                 let lab_r = linear_srgb_to_lab(*r);
-                de.push(ciede2000(linear_srgb_to_lab(per_model[m][k]), lab_r));
+                let e = ciede2000(linear_srgb_to_lab(per_model[m][k]), lab_r);
+                de.push(e);
+                de_at.push(((p.roughness, p.angle_deg), e));
                 if m == 0 {
                     let shifted = [0, 1, 2].map(|c| r[c] + sigma[c]);
                     noise.push(ciede2000(linear_srgb_to_lab(shifted), lab_r));
@@ -160,6 +167,9 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
                     .map(|(_, (_, _, f))| f[m].iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max))
                     .fold(0.0, f64::max);
                 furnace_rows.push((model.name(), roughness, angle, worst));
+                let here: Vec<f64> = de_at.iter().filter(|(k, _)| *k == (roughness, angle)).map(|(_, e)| *e).collect();
+                let mean = here.iter().sum::<f64>() / here.len().max(1) as f64;
+                error_rows.push((model.name(), roughness, angle, mean, here.iter().cloned().fold(0.0, f64::max)));
             }
         }
         de.sort_by(f64::total_cmp);
@@ -182,6 +192,7 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
         reference_noise_mean_de: noise.iter().sum::<f64>() / noise.len().max(1) as f64,
         reference_noise_max_de: noise.iter().cloned().fold(0.0, f64::max),
         furnace: furnace_rows,
+        error_by_roughness_angle: error_rows,
     }
 }
 

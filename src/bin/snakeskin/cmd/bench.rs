@@ -87,6 +87,11 @@ fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<(
             m.name, m.mean_de, m.p95_de, m.max_de, m.max_furnace_err_to_70, m.max_furnace_err, m.ns_per_eval
         );
     }
+    println!("\nwhere the error lies (mean / max ΔE00 over materials, τ, films and colours):");
+    println!("{:<10} {:>9} {:>9} {:>8} {:>8}", "model", "roughness", "angle°", "mean", "max");
+    for (name, roughness, angle, mean, max) in &report.error_by_roughness_angle {
+        println!("{name:<10} {roughness:>9.2} {angle:>9.0} {mean:>8.3} {max:>8.3}");
+    }
     Ok(())
 }
 
