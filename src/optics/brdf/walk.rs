@@ -395,8 +395,8 @@ mod tests {
     /// must draw D(m) max(0, w·m) there too. Its moments against quadrature.
     #[test]
     fn visible_normals_are_right_above_and_below_the_horizon() {
-        for (wz, alpha) in [(0.7, 0.5), (0.1, 0.8), (-0.3, 0.6), (-0.8, 0.3), (-0.05, 0.9)] {
-            let w: V3 = [(1.0 - wz * wz as f64).sqrt(), 0.0, wz];
+        for (wz, alpha) in [(0.7f64, 0.5), (0.1, 0.8), (-0.3, 0.6), (-0.8, 0.3), (-0.05, 0.9)] {
+            let w: V3 = [(1.0 - wz * wz).sqrt(), 0.0, wz];
             // Quadrature of D(m) max(0, w·m) over the upper hemisphere of m.
             let (n_t, n_p) = (400, 400);
             let (mut norm, mut mean) = (0.0, [0.0; 3]);
