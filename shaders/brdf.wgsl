@@ -7,7 +7,7 @@
 // ALPHA_MIN and COS_MIN (the GGX alpha floor and the cosine floor) come from the prelude.
 
 // Film colour comes from film_rgb (film.wgsl, prepended before this file).
-override BRDF_MODEL: u32 = MODEL_THESIS;
+override BRDF_MODEL: u32 = MODEL_LAYERED;
 // False for a pipeline specialised to a material with no absorption (tau = 0): the
 // attenuation and the refracted path length are skipped.
 override HAS_ABSORPTION: bool = true;
@@ -137,7 +137,31 @@ fn layered_ambient_diffuse(layers: Layers, cos_o: f32, s_o: vec3<f32>) -> vec3<f
     return layered_entering(layers, cos_o, s_o) * kd * layers.e / (vec3<f32>(1.0) - kd * layers.k);
 }
 
+// k_d = c / (exp(-tau) E + c K), at most 1: the base albedo that shows the visible diffuse
+// colour c (optics::brdf::layered::base_albedo).
+fn layered_base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, k: vec3<f32>, e: vec3<f32>) -> vec3<f32> {
+    let c = max(colour, vec3<f32>(0.0));
+    let denominator = exp(-max(optical_depth, vec3<f32>(0.0))) * e + c * k;
+    return select(vec3<f32>(0.0), min(c / denominator, vec3<f32>(1.0)), denominator > vec3<f32>(0.0));
+}
+
 // ---- The model seam (optics::brdf::Model). ----
+
+// The base albedo k_d behind a colour-map value (Model::base_albedo): the thesis reads the
+// map as k_d; the layered model as the visible diffuse colour, inverted through the stack.
+fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, k: vec3<f32>, e: vec3<f32>) -> vec3<f32> {
+    switch BRDF_MODEL {
+        case MODEL_LAYERED: {
+            return layered_base_albedo(colour, optical_depth, k, e);
+        }
+        case MODEL_THESIS: {
+            return colour;
+        }
+        default: {
+            return colour;
+        }
+    }
+}
 
 // What the top reflects by itself from a direction at cosine `cos` (Model::coupling): the
 // diffuse lobe lets 1 minus this in, the ambient mirror term is the sky times this. The

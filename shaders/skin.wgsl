@@ -11,14 +11,17 @@ override VIEW_MAP: u32 = VIEW_SHADED;
 override GBUFFER_PART: u32 = GBUFFER_POSITION_NORMAL;
 
 // The pixel's layers; K and E interpolated between the roughness rows (exact: they are
-// linear in r between rows, LayerOptics::bounce_table).
+// linear in r between rows, LayerOptics::bounce_table), the base albedo recovered from the
+// colour map as the model reads it (base_albedo; LayerOptics::layers is the CPU twin).
 fn layers_of(m: Material) -> Layers {
     let y = clamp(m.roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
     let j = min(u32(y), E1_ROUGHNESS - 2u);
     let f = y - f32(j);
     let k = mix(scene.bounce_k[j].rgb, scene.bounce_k[j + 1u].rgb, f);
     let e = mix(scene.bounce_e[j].rgb, scene.bounce_e[j + 1u].rgb, f);
-    return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, scene.optical_depth.rgb, m.albedo, k, e);
+    let tau = scene.optical_depth.rgb;
+    let kd = base_albedo(m.albedo, tau, k, e);
+    return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, tau, kd, k, e);
 }
 
 // Ambient light from the sky gradient, as reference::shade_pixel: the sky seen along the

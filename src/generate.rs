@@ -57,6 +57,11 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// The preset as loaded (overrides applied, colours clamped to what the stack shows).
+    pub fn loaded(&self) -> &LoadedPreset {
+        &self.loaded
+    }
+
     /// Validates the request and estimates its peak memory; refuses a set whose estimate
     /// exceeds the memory available (`Error::Memory`, before any allocation).
     pub fn new(request: &GenerateRequest) -> Result<Plan, Error> {

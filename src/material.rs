@@ -23,6 +23,13 @@ pub mod thesis {
     pub const ABSORPTION: f64 = 0.6;
 }
 
+/// The preset default of σ0: a clear pigment layer. The thesis' 0.6 (`thesis::ABSORPTION`)
+/// read the colour map as the base albedo; now that colours mean the visible colour
+/// (`preset::visible`), τ = 0.6 over n2 = 2 caps every visible colour at 0.07 linear
+/// (sRGB #4c4c4c): no built-in species' colours could be shown. Absorption stays a preset
+/// key for stacks whose colours it can reach.
+pub const DEFAULT_ABSORPTION: f64 = 0.0;
+
 /// The five maps of a set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum MapKind {
@@ -61,7 +68,7 @@ impl MapKind {
     /// What a sample of the map means, for the manifest.
     pub fn meaning(self, convention: NormalConvention) -> String {
         match self {
-            MapKind::Color => "base colour (albedo k_d of the Lambertian base layer)".into(),
+            MapKind::Color => "visible diffuse colour (the manifest's color_means)".into(),
             MapKind::Height => "relative surface height, 0 = lowest".into(),
             MapKind::Normal => {
                 let y = match convention {
@@ -176,7 +183,7 @@ impl Default for Optics {
             pigment_ior: thesis::PIGMENT_IOR,
             film_thickness_nm: thesis::FILM_THICKNESS_NM,
             pigment_thickness: thesis::PIGMENT_THICKNESS,
-            absorption: Absorption([thesis::ABSORPTION; 3]),
+            absorption: Absorption([DEFAULT_ABSORPTION; 3]),
         }
     }
 }

@@ -27,7 +27,18 @@ pub struct Manifest {
     pub maps: Vec<MapEntry>,
     pub iridescence: IridescenceRange,
     pub optics: Optics,
+    /// What the colour map's values are (`COLOR_MEANS`).
+    pub color_means: String,
+    /// Preset colours the stack cannot show, clamped to its limit (`preset::visible`).
+    pub clamped_colors: Vec<crate::preset::visible::ClampedColour>,
 }
+
+/// The colour map's convention, for the manifest: the visible colour, which the renderer
+/// inverts through the stack (`optics::brdf::layered::visible_colour`).
+pub const COLOR_MEANS: &str = "visible diffuse colour: the stack's diffuse reflectance at normal incidence per \
+     unit of light the top lets in, exp(-tau) k_d E / (1 - k_d K) (a glTF baseColor under a dielectric top); \
+     the layered model recovers the base albedo k_d = c / (exp(-tau) E + c K) per pixel, the thesis model \
+     reads the map as k_d itself";
 
 #[derive(Debug, Serialize)]
 pub struct MapEntry {
@@ -86,6 +97,8 @@ pub fn manifest(
         maps: files.iter().map(entry).collect(),
         iridescence: IridescenceRange { min_nm, max_nm },
         optics: p.optics.clone(),
+        color_means: COLOR_MEANS.into(),
+        clamped_colors: loaded.clamped_colours.clone(),
     }
 }
 

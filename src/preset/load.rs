@@ -34,6 +34,9 @@ pub struct LoadedPreset {
     pub preset: Preset,
     /// FNV-1a 64 of the resolved preset (after overrides), as 16 hex digits.
     pub content_hash: String,
+    /// Colour keys the stack cannot show, clamped to its limit (`visible`): callers report
+    /// them, the manifest lists them.
+    pub clamped_colours: Vec<super::visible::ClampedColour>,
 }
 
 /// The largest preset file accepted, in bytes. Built-in presets are 1–8 KiB; a megabyte is
@@ -156,11 +159,16 @@ pub fn parse_with_seed(
             .collect();
         return Err(PresetError::Invalid { file: source.display.clone(), problems: located });
     }
+    let mut clamped_colours = super::visible::clamp_to_visible(&mut preset);
+    for c in &mut clamped_colours {
+        c.line = key_line(&source.text, &c.key).filter(|_| !overrides.iter().any(|(k, _)| *k == c.key));
+    }
     let canonical = canonical_text(&preset);
     Ok(LoadedPreset {
         name: source.name.clone(),
         preset,
         content_hash: format!("{:016x}", fnv1a64(canonical.as_bytes())),
+        clamped_colours,
     })
 }
 

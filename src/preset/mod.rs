@@ -6,6 +6,7 @@ pub mod library;
 mod load;
 pub mod schema;
 pub mod validate;
+pub mod visible;
 
 pub use error::{LocatedProblem, Location, PresetError};
 pub use load::{

@@ -39,8 +39,21 @@ impl<'de> Deserialize<'de> for Srgb8 {
 
 impl Serialize for Srgb8 {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&self.to_string())
+    }
+}
+
+impl std::fmt::Display for Srgb8 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let [r, g, b] = self.0;
-        serializer.serialize_str(&format!("#{r:02x}{g:02x}{b:02x}"))
+        write!(f, "#{r:02x}{g:02x}{b:02x}")
+    }
+}
+
+impl Srgb8 {
+    /// The largest 8-bit sRGB code whose linear value (`to_linear`) is at most `linear`.
+    pub fn encode_floor(linear: f64) -> u8 {
+        (0..=255u8).rev().find(|&code| Srgb8([code; 3]).to_linear()[0] as f64 <= linear).unwrap_or(0)
     }
 }
 

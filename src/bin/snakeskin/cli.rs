@@ -161,10 +161,11 @@ pub struct PreviewArgs {
     /// Film colour method: lut (default), rgb3, spectral-N (e.g. spectral-16), gaussian-fit.
     #[arg(long, default_value = "lut", value_name = "M", value_parser = parse_gpu_method)]
     pub method: GpuFilmMethod,
-    /// Layer model: thesis (default; the thesis' eq. 4.21) or layered (the stack's
-    /// transport: (n0/n2)², internal reflection, the rough top's energy coupling). The
-    /// colour map is still the base albedo k_d, so species look darker under `layered`.
-    #[arg(long, default_value = "thesis", value_parser = parse_model)]
+    /// Layer model: layered (default; the stack's transport: (n0/n2)², internal
+    /// reflection, the rough top's energy coupling; the colour map is the visible colour
+    /// and the base albedo is recovered from it) or thesis (the thesis' eq. 4.21, which
+    /// reads the colour map as the base albedo k_d), for comparison.
+    #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
     /// Map resolution for the preview (pixels per side).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
@@ -328,9 +329,9 @@ pub struct EvalArgs {
     pub normal: [f64; 3],
     #[command(flatten)]
     pub layer: LayerArgs,
-    /// Layer model under the top interface: thesis (PHYSICS.md's eq. 4.21 diffuse lobe) or
-    /// layered (the stack's transport).
-    #[arg(long, default_value = "thesis", value_parser = parse_model)]
+    /// Layer model under the top interface: layered (default; the stack's transport) or
+    /// thesis (PHYSICS.md's eq. 4.21 diffuse lobe).
+    #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
 }
 
@@ -351,7 +352,8 @@ pub struct LayerArgs {
     /// Pigment layer thickness δ1 (optical depth τ = σ0 δ1), 0 to 100.
     #[arg(long, default_value_t = thesis::PIGMENT_THICKNESS, value_parser = parse_pigment_thickness)]
     pub pigment_thickness: f64,
-    /// Base albedo k_d, linear r,g,b (or one value), each 0 to 1.
+    /// Base albedo k_d, linear r,g,b (or one value), each 0 to 1: the Lambertian base
+    /// itself, not the visible colour a colour map holds.
     #[arg(long, value_parser = parse_albedo, default_value = "1")]
     pub albedo: [f64; 3],
     /// Film colour method (as for `brdf color`).
@@ -376,7 +378,7 @@ pub struct AlbedoArgs {
     /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
     /// standard error per channel. The references read the exact 1 nm film (--method is
     /// for the models).
-    #[arg(long, default_value = "thesis", value_parser = parse_albedo_model)]
+    #[arg(long, default_value = "layered", value_parser = parse_albedo_model)]
     pub model: AlbedoModel,
     /// Photons per channel for --model stochastic, 1000 to 100,000,000 (σ ∝ 1/√N).
     #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1000..=100_000_000))]

@@ -65,3 +65,35 @@ pub fn diffuse_f32(layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o
         eta2 * kd * a_i[c] * a_o[c] / (std::f32::consts::PI * (1.0 - kd * layers.k[c]))
     })
 }
+
+/// What the colour map means under the `layered` model: the **visible diffuse colour**, the
+/// stack's diffuse reflectance at normal incidence per unit of light the top lets in,
+///
+/// ```text
+/// c = R_d(μ = 1) / (1 − s(1)) = exp(−τ) k_d E / (1 − k_d K)
+/// ```
+///
+/// (`R_d` of `exact::SmoothTop::albedo`; τ along the normal; K and E the material's bounce
+/// terms at the pixel's roughness). It is what glTF's `baseColor` means under a dielectric
+/// top (the base weighted by what the top transmits), so a colour map is a base colour
+/// other tools read right. `base_albedo` inverts it per pixel.
+pub fn visible_colour(albedo: f64, optical_depth: f64, k: f64, e: f64) -> f64 {
+    let kd = albedo.clamp(0.0, 1.0);
+    (-optical_depth.max(0.0)).exp() * kd * e / (1.0 - kd * k)
+}
+
+/// The brightest visible colour the stack can show (k_d = 1): exp(−τ) E / (1 − K). For a
+/// lossless stack (τ = 0) E = 1 − K and the limit is 1; absorption lowers it fast (the
+/// thesis stack, τ = 0.6: 0.07).
+pub fn visible_limit(optical_depth: f64, k: f64, e: f64) -> f64 {
+    visible_colour(1.0, optical_depth, k, e)
+}
+
+/// The base albedo k_d that shows the visible colour `colour`:
+/// k_d = c / (exp(−τ) E + c K), the closed-form inverse of `visible_colour`; colours beyond
+/// `visible_limit` give k_d = 1 (the limit), and a stack that shows nothing (E = 0) gives 0.
+pub fn base_albedo(colour: f64, optical_depth: f64, k: f64, e: f64) -> f64 {
+    let c = colour.max(0.0);
+    let denominator = (-optical_depth.max(0.0)).exp() * e + c * k;
+    if denominator > 0.0 { (c / denominator).min(1.0) } else { 0.0 }
+}

@@ -219,17 +219,21 @@ impl LayerOptics {
         crate::optics::brdf::exact::cached(self.stack, self.bounce_thickness_nm()).bounce_table(self.optical_depth)
     }
 
-    /// The per-pixel layers of this material with its `bounce_table` (the CPU reference's
-    /// twin of the shader's `layers_of`).
+    /// The per-pixel layers of this material with its `bounce_table`, the base albedo
+    /// recovered from the colour map's `colour` as `model` reads it (`Model::base_albedo`):
+    /// the CPU reference's twin of the shader's `layers_of`.
     pub fn layers(
         &self,
+        model: Model,
         bounce: &crate::optics::brdf::exact::BounceTable,
         roughness: f64,
-        albedo: [f64; 3],
+        colour: [f64; 3],
     ) -> crate::optics::brdf::Layers {
         let (k, e) = bounce.at(roughness);
         let Stack { n0, n2, .. } = self.stack;
-        crate::optics::brdf::Layers { n0, n2, roughness, optical_depth: self.optical_depth, albedo, k, e }
+        let layers =
+            crate::optics::brdf::Layers { n0, n2, roughness, optical_depth: self.optical_depth, albedo: colour, k, e };
+        crate::optics::brdf::Layers { albedo: model.base_albedo(colour, &layers), ..layers }
     }
 
     pub fn has_absorption(&self) -> bool {

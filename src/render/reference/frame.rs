@@ -119,7 +119,7 @@ pub fn shade_pixel(
         computed.borrow_mut().push((cos.to_bits(), rgb));
         rgb
     };
-    let layers = optics.layers(bounce, nr[3], [albedo[0], albedo[1], albedo[2]]);
+    let layers = optics.layers(settings.model, bounce, nr[3], [albedo[0], albedo[1], albedo[2]]);
     let lighting = &settings.lighting;
     let mut radiance = [0.0; 3];
     for light in [&lighting.key, &lighting.fill] {

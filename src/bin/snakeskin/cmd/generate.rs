@@ -29,6 +29,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         options: BuildOptions { normal_convention: convention },
     };
     let plan = Plan::new(&request)?;
+    crate::output::report_clamped_colours(&source.preset, plan.loaded());
     let memory = plan.memory();
     if memory.is_tight() {
         eprintln!(

@@ -1,0 +1,113 @@
+//! Colour maps mean the colour you see: a colour-map value is the stack's visible diffuse
+//! colour, the layered model recovers the base albedo from it in closed form, and preset
+//! colours the stack cannot show are clamped and reported, never silently.
+
+mod common;
+
+use common::*;
+use snakeskin::optics::brdf::exact::SmoothTop;
+use snakeskin::optics::brdf::walk::Rng;
+use snakeskin::optics::brdf::{Layers, Model, layered};
+use snakeskin::optics::film::Stack;
+
+/// The visible colour by its definition, from the smooth-top closed form (an independent
+/// formula: `exact::SmoothTop::albedo`'s geometric series): the diffuse reflectance at
+/// normal incidence over what the top lets in, R_d(1) / (1 − F(1)).
+fn visible_by_closed_form(top: &SmoothTop, tau: [f64; 3], kd: [f64; 3]) -> [f64; 3] {
+    let layers = Layers::of_stack(top.stack, top.thickness_nm, 0.0, tau, kd);
+    let albedo = top.albedo(&layers, 1.0);
+    let transmitted = top.transmittance(1.0);
+    [0, 1, 2].map(|c| albedo.diffuse[c] / transmitted[c])
+}
+
+#[test]
+fn visible_colour_to_base_albedo_and_back_within_1e_4() {
+    let mut rng = Rng(77);
+    let stacks = [Stack::THESIS, Stack { n0: 1.0, n1: 1.56, n2: 1.33 }, Stack { n0: 1.33, n1: 1.55, n2: 2.0 }];
+    let mut checked = 0;
+    let mut thesis_worst: f64 = 0.0;
+    for case in 0..60 {
+        let stack = stacks[case % stacks.len()];
+        let thickness_nm = 1500.0 * rng.unit();
+        let top = SmoothTop::new(stack, thickness_nm);
+        let tau = [0.0, 0.05, 0.3 * rng.unit(), 1.5 * rng.unit()][case % 4];
+        let (k, e) = top.k_e([tau; 3]);
+        let limit = layered::visible_limit(tau, k[0], e[0]);
+        // Colours from black to the limit (a lossless stack reaches 1).
+        let colour = [0, 1, 2].map(|_| limit * rng.unit());
+        let layers = Layers { albedo: colour, ..Layers::of_stack(stack, thickness_nm, 0.0, [tau; 3], [0.0; 3]) };
+        let kd = Model::Layered.base_albedo(colour, &layers);
+        let back = visible_by_closed_form(&top, [tau; 3], kd);
+        for c in 0..3 {
+            assert!(
+                (back[c] - colour[c]).abs() <= 1e-4,
+                "{stack:?} d={thickness_nm:.0} τ={tau:.3}: colour {colour:?} → k_d {kd:?} → {back:?}"
+            );
+        }
+        checked += 1;
+        // Negative control: the thesis model reads the map as k_d, so what it shows
+        // through the stack is not the map's colour.
+        let thesis_kd = Model::Thesis.base_albedo(colour, &layers);
+        let thesis_back = visible_by_closed_form(&top, [tau; 3], thesis_kd);
+        thesis_worst = thesis_worst.max((0..3).map(|c| (thesis_back[c] - colour[c]).abs()).fold(0.0, f64::max));
+    }
+    assert_eq!(checked, 60);
+    assert!(thesis_worst > 0.05, "the thesis reading should miss the colour: {thesis_worst}");
+}
+
+#[test]
+fn colours_beyond_the_limit_give_the_limit_and_black_stays_black() {
+    let (tau, k, e) = (0.6, 0.106, 0.117);
+    let limit = layered::visible_limit(tau, k, e);
+    assert!((layered::base_albedo(limit, tau, k, e) - 1.0).abs() < 1e-12);
+    assert_eq!(layered::base_albedo(0.8, tau, k, e), 1.0);
+    assert_eq!(layered::base_albedo(0.0, tau, k, e), 0.0);
+    assert_eq!(layered::base_albedo(0.5, tau, k, 0.0), 1.0, "a stack that shows nothing: the brightest base");
+}
+
+const WHITE_UNDER_INK: &str = r##"
+[color]
+base = "#e0e0e0"
+variation = 0.0
+
+[belly]
+color = "#ffffff"
+
+[optics]
+absorption = 2.5
+"##;
+
+#[test]
+fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let preset = write_preset(dir.path(), "ink.toml", WHITE_UNDER_INK);
+    let out_dir = dir.path().join("out");
+    let out = snakeskin(&["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    // The key, its line in the file, the limit and what it became.
+    assert!(err.contains("ink.toml:3: color.base = \"#e0e0e0\" is brighter than this layer stack can show"), "{err}");
+    assert!(err.contains("belly.color = \"#ffffff\""), "{err}");
+    assert!(err.contains("at most linear [0.001, 0.001, 0.001]"), "{err}");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("ink.material.json")).unwrap()).unwrap();
+    let clamped = manifest["clamped_colors"].as_array().unwrap();
+    // The two written, and the belly pattern colour's default (no line).
+    assert_eq!(clamped.len(), 3, "{clamped:?}");
+    assert!(clamped[2]["line"].is_null());
+    assert_eq!(clamped[0]["key"], "color.base");
+    assert!(manifest["color_means"].as_str().unwrap().starts_with("visible diffuse colour"));
+    // The map holds what the stack can show: nothing brighter than the limit's 8-bit code.
+    let limit_code = clamped[0]["clamped_to"].as_str().unwrap()[1..3].to_string();
+    let limit_code = u8::from_str_radix(&limit_code, 16).unwrap();
+    let map = image::open(out_dir.join("ink_color.png")).unwrap().to_rgb8();
+    assert!(map.pixels().all(|p| p.0.iter().all(|&v| v <= limit_code)), "map brighter than {limit_code}");
+
+    // Negative control: the same colours over a clear pigment layer are shown as written.
+    let clear = write_preset(dir.path(), "clear.toml", &WHITE_UNDER_INK.replace("absorption = 2.5", ""));
+    let out = snakeskin(&["generate", &clear, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
+    assert!(out.status.success() && !stderr(&out).contains("brighter"), "{}", stderr(&out));
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("clear.material.json")).unwrap()).unwrap();
+    assert!(manifest["clamped_colors"].as_array().unwrap().is_empty());
+}
