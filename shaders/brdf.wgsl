@@ -80,13 +80,14 @@ fn thesis_ambient_diffuse(layers: Layers, cos_o: f32, f_o: vec3<f32>) -> vec3<f3
 // ---- The layered model (optics::brdf::layered). ----
 
 // The rough lobe at (mu, r), bilinear in the film bind group's lobe_table
-// (optics::brdf::energy::lookup_f32): its albedo E1 for F = 1 and the three-point Gauss rule
-// over its microfacet cosines.
+// (optics::brdf::energy::lookup_f32): its albedo E1 for F = 1, the three-point Gauss rule
+// over its microfacet cosines, and its multiple-scatter scale.
 struct Lobe {
     albedo: f32,
     cos: vec3<f32>,
     // The third weight is 1 minus these two.
     weight: vec2<f32>,
+    ms_scale: f32,
 }
 
 fn lobe_at(cos: f32, roughness: f32) -> Lobe {
@@ -104,7 +105,7 @@ fn lobe_at(cos: f32, roughness: f32) -> Lobe {
         mix(lobe_table[k01 + 1u], lobe_table[k01 + 3u], fx),
         fy,
     );
-    return Lobe(a.x, a.yzw, b.xy);
+    return Lobe(a.x, a.yzw, b.xy, b.z);
 }
 
 // a(mu) = (1 - s(mu)) exp(-tau / cos_t(mu)): the light that reaches the base, s what the
@@ -163,24 +164,33 @@ fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, k: vec3<f32>, e: vec
     }
 }
 
-// What the top reflects by itself from a direction at cosine `cos` (Model::coupling): the
-// diffuse lobe lets 1 minus this in, the ambient mirror term is the sky times this. The
-// thesis: the film F(cos); the layered model: E1 times the film at the lobe's microfacet
-// angles (three-point Gauss rule).
-fn coupling(layers: Layers, cos: f32) -> vec3<f32> {
+// What the top does by itself for light from a direction (energy::Top): the share it
+// reflects (the diffuse lobe lets 1 minus this in, the ambient mirror term is the sky times
+// this) and the amplitude of its multiple-scatter lobe, f_ms = ms_i ms_o.
+struct Top {
+    reflected: vec3<f32>,
+    ms: vec3<f32>,
+}
+
+// The top at cosine `cos` (Model::coupling). The thesis: the film F(cos), no multiple
+// scattering; the layered model: E1 times the film at the lobe's microfacet angles
+// (three-point Gauss rule) plus the multiple scattering (1 - E1) <F> F(c1).
+fn coupling(layers: Layers, cos: f32) -> Top {
     switch BRDF_MODEL {
         case MODEL_LAYERED: {
             let l = lobe_at(cos, layers.roughness);
             let f1 = film_clamped(layers, l.cos.x);
             let f2 = film_clamped(layers, l.cos.y);
             let f3 = film_clamped(layers, l.cos.z);
-            return l.albedo * (l.weight.x * f1 + l.weight.y * f2 + (1.0 - l.weight.x - l.weight.y) * f3);
+            let mean = l.weight.x * f1 + l.weight.y * f2 + (1.0 - l.weight.x - l.weight.y) * f3;
+            let g = mean * f1;
+            return Top(l.albedo * mean + (1.0 - l.albedo) * g, l.ms_scale * sqrt(g));
         }
         case MODEL_THESIS: {
-            return film_clamped(layers, cos);
+            return Top(film_clamped(layers, cos), vec3<f32>(0.0));
         }
         default: {
-            return film_clamped(layers, cos);
+            return Top(film_clamped(layers, cos), vec3<f32>(0.0));
         }
     }
 }
@@ -221,7 +231,7 @@ fn skin_brdf(layers: Layers, normal: vec3<f32>, wi_in: vec3<f32>, wo_in: vec3<f3
     return skin_brdf_seen(layers, normal, wi_in, wo_in, coupling(layers, cos_o), true);
 }
 
-// The BRDF with the model's coupling towards the viewer, s_o = coupling(max(n.wo, COS_MIN)),
+// The BRDF with the model's top towards the viewer, top_o = coupling(max(n.wo, COS_MIN)),
 // computed by the caller: a pixel lit by several lights (and the ambient term) looks it up
 // once instead of once per light. `with_diffuse` = false gives the specular lobe alone.
 fn skin_brdf_seen(
@@ -229,7 +239,7 @@ fn skin_brdf_seen(
     normal: vec3<f32>,
     wi_in: vec3<f32>,
     wo_in: vec3<f32>,
-    s_o: vec3<f32>,
+    top_o: Top,
     with_diffuse: bool,
 ) -> vec3<f32> {
     let n = safe_normalize(normal, vec3<f32>(0.0, 0.0, 1.0));
@@ -252,9 +262,10 @@ fn skin_brdf_seen(
     let nxh = cross(n, h);
     let spec = specular_scale(cos_h, dot(nxh, nxh), cos_i, cos_o, alpha * alpha);
     let f_h = film_clamped(layers, abs(dot(wo, h)));
+    let top_i = coupling(layers, cos_i);
     var diffuse = vec3<f32>(0.0);
     if (with_diffuse) {
-        diffuse = diffuse_lobe(layers, cos_i, cos_o, coupling(layers, cos_i), s_o);
+        diffuse = diffuse_lobe(layers, cos_i, cos_o, top_i.reflected, top_o.reflected);
     }
-    return f_h * spec + diffuse;
+    return f_h * spec + top_i.ms * top_o.ms + diffuse;
 }

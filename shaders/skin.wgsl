@@ -26,7 +26,8 @@ fn layers_of(m: Material) -> Layers {
 
 // Ambient light from the sky gradient, as reference::shade_pixel: the sky seen along the
 // mirror direction is reflected by the top (the model's coupling: the film for the thesis,
-// the rough lobe's albedo for the layered model); the sky seen along the normal goes through
+// the rough top's reflected share for the layered model, its multiple scattering taken
+// along the mirror too); the sky seen along the normal goes through
 // the layer model (brdf.wgsl's ambient_diffuse).
 fn ambient(m: Material, n: vec3<f32>, wo: vec3<f32>, s_o: vec3<f32>, with_diffuse: bool) -> vec3<f32> {
     var result = sky(reflect(-wo, n)) * s_o;
@@ -51,17 +52,17 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
         return radiance + sky(n) * m.albedo;
     }
     let layers = layers_of(m);
-    // What the top reflects towards the viewer, shared by both lights and the ambient term.
-    let s_o = coupling(layers, max(dot(m.normal, wo), COS_MIN));
+    // What the top does towards the viewer, shared by both lights and the ambient term.
+    let top_o = coupling(layers, max(dot(m.normal, wo), COS_MIN));
     for (var i = 0u; i < 2u; i++) {
         let wi = scene.light_dir[i].xyz;
         let cos_i = max(dot(m.normal, wi), 0.0);
         if (scene.light_dir[i].w > 0.0 && cos_i > 0.0) {
-            let f = skin_brdf_seen(layers, m.normal, wi, wo, s_o, STAGE == STAGE_ALL);
+            let f = skin_brdf_seen(layers, m.normal, wi, wo, top_o, STAGE == STAGE_ALL);
             radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * f * cos_i;
         }
     }
-    return radiance + ambient(m, m.normal, wo, s_o, STAGE == STAGE_ALL);
+    return radiance + ambient(m, m.normal, wo, top_o.reflected, STAGE == STAGE_ALL);
 }
 
 fn map_view(m: Material) -> vec3<f32> {

@@ -137,7 +137,7 @@ impl SmoothTop {
                             // A mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
                             return rb;
                         }
-                        energy::specular_albedo(mu_out, r, &|c| reflectance(stack, thickness_nm, c))
+                        energy::top(mu_out, r, &|c| reflectance(stack, thickness_nm, c)).reflected
                     })
                     .collect()
             })
@@ -162,7 +162,7 @@ impl SmoothTop {
     /// K and E per channel as the `layered` model couples them to a rough top at roughness
     /// row `row` of the energy table (r = row / (E1_ROUGHNESS − 1)): a direction inside the
     /// escape cone, at cosine μo outside, leaves with probability 1 − s(μo) (s the light the
-    /// rough lobe reflects, `energy::specular_albedo`, with this film); outside the cone it
+    /// rough top reflects, `energy::top`, with this film); outside the cone it
     /// is totally reflected. Row 0 is `k_e`
     /// (F(μo) = R_b(μ) by reciprocity of the lossless film); for τ = 0, K + E = 1 in every
     /// row, so the furnace holds.

@@ -2,14 +2,15 @@
 //! transport, exactly"), with the rough top coupled to it by energy (`energy`).
 //!
 //! ```text
-//! s(μ)   = E₁(μ, r) ⟨F⟩                                  what the rough lobe reflects
+//! s(μ)   = E₁ ⟨F⟩ + (1 − E₁) ⟨F⟩ F(c₁)                 what the rough top reflects
+//! f_ms   = ms(μi) ms(μo)                                 its multiple scattering
 //! a(μ)   = (1 − s(μ)) exp(−τ / cos_t(μ))                light that enters and reaches the base
 //! f_diff = (n0/n2)² k_d a(μi) a(μo) / (π (1 − k_d K))
 //! ambient diffuse (sky along the normal) = a(μo) k_d E / (1 − k_d K)
 //! ```
 //!
-//! with ⟨F⟩ the film read at the lobe's microfacet angles (`energy`; `Model::coupling`
-//! passes s in).
+//! with ⟨F⟩ the film read at the lobe's microfacet angles and F(c₁) at the most grazing
+//! of them (`energy::top`; `Model::coupling` passes s in).
 //!
 //! K and E (per channel, per material, per roughness) come with the layers
 //! (`Layers::of_stack`: the film seen from below, `exact::SmoothTop::bounce_table`). At r = 0

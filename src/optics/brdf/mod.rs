@@ -101,22 +101,24 @@ impl Model {
         }
     }
 
-    /// What the top reflects by itself from a direction at cosine `cos`, per channel: the
-    /// diffuse lobe lets 1 minus this into the stack, and the ambient term's mirror part is
-    /// the sky times this. The thesis: the film F(cos) (`film` clamped to [0, 1]); the
-    /// layered model: the rough lobe's albedo with the film read at its microfacet angles
-    /// (`energy::specular_albedo`). `brdf.wgsl`'s `coupling`.
-    pub fn coupling(self, cos: f64, roughness: f64, film: &dyn Fn(f64) -> [f64; 3]) -> [f64; 3] {
+    /// What the top does by itself for light from a direction at cosine `cos`, per channel
+    /// (`energy::Top`): the share it reflects (the diffuse lobe lets 1 minus this into the
+    /// stack, and the ambient term's mirror part is the sky times this) and the amplitude
+    /// of its multiple-scatter lobe. The thesis: the film F(cos) (`film` clamped to [0, 1]),
+    /// no multiple scattering; the layered model: the rough lobe's albedo with the film read
+    /// at its microfacet angles plus its multiple scattering (`energy::top`). `brdf.wgsl`'s
+    /// `coupling`.
+    pub fn coupling(self, cos: f64, roughness: f64, film: &dyn Fn(f64) -> [f64; 3]) -> energy::Top<f64> {
         match self {
-            Model::Thesis => film(cos),
-            Model::Layered => energy::specular_albedo(cos, roughness, film),
+            Model::Thesis => energy::Top { reflected: film(cos), ms_amplitude: [0.0; 3] },
+            Model::Layered => energy::top(cos, roughness, film),
         }
     }
 
-    fn coupling_f32(self, cos: f32, roughness: f32, film: &dyn Fn(f32) -> [f32; 3]) -> [f32; 3] {
+    fn coupling_f32(self, cos: f32, roughness: f32, film: &dyn Fn(f32) -> [f32; 3]) -> energy::Top<f32> {
         match self {
-            Model::Thesis => film(cos),
-            Model::Layered => energy::specular_albedo_f32(cos, roughness, film),
+            Model::Thesis => energy::Top { reflected: film(cos), ms_amplitude: [0.0; 3] },
+            Model::Layered => energy::top_f32(cos, roughness, film),
         }
     }
 
@@ -192,7 +194,16 @@ impl Layers {
     }
 }
 
-/// The BRDF split into its two lobes (each RGB, per steradian).
+/// The BRDF's lobes: the single-scatter specular lobe, the top's multiple scattering and
+/// the diffuse lobe (each RGB, per steradian).
+struct Lobes {
+    single: [f64; 3],
+    multiple: [f64; 3],
+    diffuse: [f64; 3],
+}
+
+/// The BRDF split into its two lobes (each RGB, per steradian): what the top reflects
+/// (single and multiple scattering) and what comes from under it.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct BrdfValue {
     pub specular: [f64; 3],
@@ -230,7 +241,8 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 impl Model {
     /// Evaluates the BRDF. `film(cos)` returns the film's RGB reflectance at incidence cosine
-    /// `cos` (the caller binds the material, thickness and method).
+    /// `cos` (the caller binds the material, thickness and method). The specular part is
+    /// the single-scatter lobe plus the top's multiple scattering.
     pub fn eval(
         self,
         layers: &Layers,
@@ -239,18 +251,30 @@ impl Model {
         wo: [f64; 3],
         film: &dyn Fn(f64) -> [f64; 3],
     ) -> BrdfValue {
-        let n = normalize(normal).unwrap_or([0.0, 0.0, 1.0]);
-        let (Some(wi), Some(wo)) = (normalize(wi), normalize(wo)) else {
+        let Some(lobes) = self.eval_lobes(layers, normal, wi, wo, film) else {
             return BrdfValue::ZERO;
         };
+        let specular = [0, 1, 2].map(|c| lobes.single[c] + lobes.multiple[c]);
+        BrdfValue { specular, diffuse: lobes.diffuse }
+    }
+
+    /// The BRDF's three lobes, or None where it is zero (below the horizon, no direction).
+    fn eval_lobes(
+        self,
+        layers: &Layers,
+        normal: [f64; 3],
+        wi: [f64; 3],
+        wo: [f64; 3],
+        film: &dyn Fn(f64) -> [f64; 3],
+    ) -> Option<Lobes> {
+        let n = normalize(normal).unwrap_or([0.0, 0.0, 1.0]);
+        let (wi, wo) = (normalize(wi)?, normalize(wo)?);
         let (cos_i, cos_o) = (dot(n, wi), dot(n, wo));
         if !(cos_i > 0.0 && cos_o > 0.0) {
-            return BrdfValue::ZERO;
+            return None;
         }
         let (cos_i, cos_o) = (cos_i.max(COS_MIN), cos_o.max(COS_MIN));
-        let Some(h) = normalize([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]) else {
-            return BrdfValue::ZERO;
-        };
+        let h = normalize([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]])?;
         let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
         let film_clamped = |c: f64| film_clamped(film(c.clamp(0.0, 1.0)));
 
@@ -259,10 +283,13 @@ impl Model {
         let g2 = smith_g2(cos_i, cos_o, alpha);
         let f_h = film_clamped(dot(wo, h).abs());
         let spec_scale = d * g2 / (4.0 * cos_i * cos_o);
-        let specular = f_h.map(|f| f * spec_scale);
         let (r, film) = (layers.roughness, &film_clamped);
-        let diffuse = self.diffuse(layers, cos_i, cos_o, self.coupling(cos_i, r, film), self.coupling(cos_o, r, film));
-        BrdfValue { specular, diffuse }
+        let (top_i, top_o) = (self.coupling(cos_i, r, film), self.coupling(cos_o, r, film));
+        Some(Lobes {
+            single: f_h.map(|f| f * spec_scale),
+            multiple: [0, 1, 2].map(|c| top_i.ms_amplitude[c] * top_o.ms_amplitude[c]),
+            diffuse: self.diffuse(layers, cos_i, cos_o, top_i.reflected, top_o.reflected),
+        })
     }
 
     /// The f32 fast path, film colour from the material's LUT: the CPU twin of the shader.
@@ -295,15 +322,16 @@ impl Model {
         let spec = ggx::specular_scale_f32(cos_h, dot32(nxh, nxh), cos_i, cos_o, alpha * alpha);
         let f_h = film(dot32(wo, h).abs());
         let (r, film) = (layers.roughness, &film);
-        let (s_i, s_o) = (self.coupling_f32(cos_i, r, film), self.coupling_f32(cos_o, r, film));
-        let diffuse = self.diffuse_f32(layers, cos_i, cos_o, s_i, s_o);
-        [0, 1, 2].map(|c| f_h[c] * spec + diffuse[c])
+        let (top_i, top_o) = (self.coupling_f32(cos_i, r, film), self.coupling_f32(cos_o, r, film));
+        let diffuse = self.diffuse_f32(layers, cos_i, cos_o, top_i.reflected, top_o.reflected);
+        [0, 1, 2].map(|c| f_h[c] * spec + top_i.ms_amplitude[c] * top_o.ms_amplitude[c] + diffuse[c])
     }
 
     /// White-furnace albedo ∫ f(wi, wo) cos θi dωi for view cosine `cos_o`, with k_d = 1 and
-    /// τ = 0 passed in `layers`. The specular lobe is integrated in half-vector space with
-    /// stratified GGX sampling (exact for any α, however peaked); the diffuse lobe, which
-    /// depends on θi only, by the midpoint rule in cos θi. `n` strata per axis.
+    /// τ = 0 passed in `layers`. The single-scatter lobe is integrated in half-vector space
+    /// with stratified GGX sampling (exact for any α, however peaked); the multiple-scatter
+    /// and diffuse lobes, which depend on θi only, by the midpoint rule in cos θi. `n`
+    /// strata per axis.
     pub fn furnace_albedo(self, layers: &Layers, cos_o: f64, film: &dyn Fn(f64) -> [f64; 3], n: usize) -> [f64; 3] {
         let cos_o = cos_o.clamp(COS_MIN, 1.0);
         let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
@@ -311,8 +339,10 @@ impl Model {
         let mut spec = [0.0; 3];
         for hv in ggx::stratified_half_vectors(wo, alpha, n) {
             // f cos θi / pdf(wi).
-            let value = self.eval(&Layers { albedo: [0.0; 3], ..*layers }, [0.0, 0.0, 1.0], hv.wi, wo, film);
-            for (s, v) in spec.iter_mut().zip(value.specular) {
+            let Some(value) = self.eval_lobes(layers, [0.0, 0.0, 1.0], hv.wi, wo, film) else {
+                continue;
+            };
+            for (s, v) in spec.iter_mut().zip(value.single) {
                 *s += v * hv.wi[2] / hv.pdf_wi;
             }
         }
@@ -322,9 +352,11 @@ impl Model {
             // ∫ over the hemisphere of g(θi) cos θi dω = 2π ∫ g(μ) μ dμ.
             let mu = (a as f64 + 0.5) / (n * n) as f64;
             let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
-            let value = self.eval(layers, [0.0, 0.0, 1.0], wi, wo, film);
-            for (d, v) in diffuse.iter_mut().zip(value.diffuse) {
-                *d += v * mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
+            let Some(value) = self.eval_lobes(layers, [0.0, 0.0, 1.0], wi, wo, film) else {
+                continue;
+            };
+            for (c, d) in diffuse.iter_mut().enumerate() {
+                *d += (value.multiple[c] + value.diffuse[c]) * mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
             }
         }
         [0, 1, 2].map(|c| spec[c] + diffuse[c])

@@ -72,12 +72,13 @@ struct FilmInfo {
 }
 
 /// The rough lobe's table (`optics::brdf::energy`) as `film.wgsl`'s `lobe_table`: per (μ, r)
-/// entry, row-major by roughness, two vec4s: (E₁, c₁, c₂, c₃) and (w₁, w₂, 0, 0).
+/// entry, row-major by roughness, two vec4s: (E₁, c₁, c₂, c₃) and (w₁, w₂, multiple-scatter
+/// scale, 0).
 fn lobe_table() -> Vec<[f32; 4]> {
     let t = crate::optics::brdf::energy::tables();
     (0..t.albedo.len())
         .flat_map(|k| {
-            [[t.albedo[k], t.cos[0][k], t.cos[1][k], t.cos[2][k]], [t.weight[0][k], t.weight[1][k], 0.0, 0.0]]
+            [[t.albedo[k], t.cos[0][k], t.cos[1][k], t.cos[2][k]], [t.weight[0][k], t.weight[1][k], t.ms_scale[k], 0.0]]
         })
         .collect()
 }
