@@ -60,6 +60,8 @@ pub struct LayeredBench {
     /// Where each model's error lies: rows of (model, roughness, angle_deg, mean ΔE00, max
     /// ΔE00) over materials, τ, films and colours.
     pub error_by_roughness_angle: Vec<(&'static str, f64, f64, f64, f64)>,
+    /// The same by optical depth: (model, τ, mean ΔE00, max ΔE00).
+    pub error_by_optical_depth: Vec<(&'static str, f64, f64, f64)>,
 }
 
 struct Point {
@@ -135,9 +137,11 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
     let mut models = Vec::new();
     let mut furnace_rows = Vec::new();
     let mut error_rows = Vec::new();
+    let mut depth_rows = Vec::new();
     for (m, model) in Model::ALL.iter().enumerate() {
         let mut de = Vec::new();
         let mut de_at: Vec<((f64, f64), f64)> = Vec::new();
+        let mut de_by_tau: Vec<(f64, f64)> = Vec::new();
         let (mut furnace_max, mut furnace_70) = (0.0f64, 0.0f64);
         for (p, (reference, per_model, furnace)) in points.iter().zip(&results) {
             for (k, (r, sigma)) in reference.iter().enumerate() {
@@ -145,6 +149,7 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
                 let e = ciede2000(linear_srgb_to_lab(per_model[m][k]), lab_r);
                 de.push(e);
                 de_at.push(((p.roughness, p.angle_deg), e));
+                de_by_tau.push((p.tau, e));
                 if m == 0 {
                     let shifted = [0, 1, 2].map(|c| r[c] + sigma[c]);
                     noise.push(ciede2000(linear_srgb_to_lab(shifted), lab_r));
@@ -172,6 +177,11 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
                 error_rows.push((model.name(), roughness, angle, mean, here.iter().cloned().fold(0.0, f64::max)));
             }
         }
+        for tau in TAUS {
+            let here: Vec<f64> = de_by_tau.iter().filter(|(t, _)| *t == tau).map(|(_, e)| *e).collect();
+            let mean = here.iter().sum::<f64>() / here.len().max(1) as f64;
+            depth_rows.push((model.name(), tau, mean, here.iter().cloned().fold(0.0, f64::max)));
+        }
         de.sort_by(f64::total_cmp);
         let mean = de.iter().sum::<f64>() / de.len() as f64;
         let p95 = de[((de.len() as f64 * 0.95) as usize).min(de.len() - 1)];
@@ -193,6 +203,7 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
         reference_noise_max_de: noise.iter().cloned().fold(0.0, f64::max),
         furnace: furnace_rows,
         error_by_roughness_angle: error_rows,
+        error_by_optical_depth: depth_rows,
     }
 }
 

@@ -41,8 +41,8 @@ pub struct RenderBench {
     pub skin_ms: f64,
     pub plain_ms: f64,
     pub ratio: f64,
-    /// skin-layered / plain-pbr, one snake (the layered model, LUT film).
-    pub layered_ratio: f64,
+    /// skin-thesis / plain-pbr, one snake (the thesis model, LUT film).
+    pub thesis_ratio: f64,
     pub skin_20_ms: f64,
     pub plain_20_ms: f64,
     pub variants: Vec<VariantTiming>,
@@ -154,16 +154,17 @@ pub fn bench_render(
     let base = FrameSettings { ground: false, ..FrameSettings::default() };
     let no_film = LayerOptics { thickness_range_nm: (0.0, 0.0), ..optics };
     let no_absorption = LayerOptics { optical_depth: [0.0; 3], ..optics };
-    let (thesis, layered) = (Model::Thesis, Model::Layered);
+    // Every skin variant shades with the default model but `skin-thesis`.
+    let (default, thesis) = (Model::default(), Model::Thesis);
     let variants: Vec<(String, LayerOptics, GpuFilmMethod, bool, Model)> = vec![
-        ("plain-pbr".into(), optics, GpuFilmMethod::Lut, true, thesis),
-        ("skin-lut".into(), optics, GpuFilmMethod::Lut, false, thesis),
-        ("skin-layered".into(), optics, GpuFilmMethod::Lut, false, layered),
-        ("skin-no-film".into(), no_film, GpuFilmMethod::Lut, false, thesis),
-        ("skin-no-absorption".into(), no_absorption, GpuFilmMethod::Lut, false, thesis),
-        ("skin-rgb3".into(), optics, GpuFilmMethod::Rgb3, false, thesis),
-        ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false, thesis),
-        ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false, thesis),
+        ("plain-pbr".into(), optics, GpuFilmMethod::Lut, true, default),
+        ("skin-lut".into(), optics, GpuFilmMethod::Lut, false, default),
+        ("skin-thesis".into(), optics, GpuFilmMethod::Lut, false, thesis),
+        ("skin-no-film".into(), no_film, GpuFilmMethod::Lut, false, default),
+        ("skin-no-absorption".into(), no_absorption, GpuFilmMethod::Lut, false, default),
+        ("skin-rgb3".into(), optics, GpuFilmMethod::Rgb3, false, default),
+        ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false, default),
+        ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false, default),
     ];
     // All variants are timed round-robin, one frame each per round, so that a shared
     // machine's drift (other jobs, clock changes) affects every variant alike; the first
@@ -220,7 +221,7 @@ pub fn bench_render(
         skin_ms: find("skin-lut", 1),
         plain_ms: find("plain-pbr", 1),
         ratio: find("skin-lut", 1) / find("plain-pbr", 1),
-        layered_ratio: find("skin-layered", 1) / find("plain-pbr", 1),
+        thesis_ratio: find("skin-thesis", 1) / find("plain-pbr", 1),
         skin_20_ms: find("skin-lut", 20),
         plain_20_ms: find("plain-pbr", 20),
         variants: timings,

@@ -92,6 +92,10 @@ fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<(
     for (name, roughness, angle, mean, max) in &report.error_by_roughness_angle {
         println!("{name:<10} {roughness:>9.2} {angle:>9.0} {mean:>8.3} {max:>8.3}");
     }
+    println!("{:<10} {:>9} {:>8} {:>8}", "model", "τ", "mean", "max");
+    for (name, tau, mean, max) in &report.error_by_optical_depth {
+        println!("{name:<10} {tau:>9.2} {mean:>8.3} {max:>8.3}");
+    }
     Ok(())
 }
 
@@ -179,7 +183,10 @@ fn render(preset: &str, size: ImageSize, frames: u64, map_size: u64, reference: 
     for v in &result.variants {
         println!("{:<22} {:>7} {:>10.3} {:>10.3} {:>10.3}", v.name, v.snakes, v.median_ms, v.p10_ms, v.p90_ms);
     }
-    println!("skin / plain: {:.3} (thesis model), {:.3} (layered model)", result.ratio, result.layered_ratio);
+    println!(
+        "skin / plain: {:.3} (layered model, the default), {:.3} (thesis model)",
+        result.ratio, result.thesis_ratio
+    );
     println!(
         "reference ({}x{}, {} px): CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3}",
         result.reference_width,
