@@ -262,10 +262,15 @@ fn skin_brdf_seen(
     let nxh = cross(n, h);
     let spec = specular_scale(cos_h, dot(nxh, nxh), cos_i, cos_o, alpha * alpha);
     let f_h = film_clamped(layers, abs(dot(wo, h)));
-    let top_i = coupling(layers, cos_i);
-    var diffuse = vec3<f32>(0.0);
-    if (with_diffuse) {
-        diffuse = diffuse_lobe(layers, cos_i, cos_o, top_i.reflected, top_o.reflected);
+    // The top at the light's cosine: for the diffuse lobe, and the multiple scattering
+    // (which only the layered model has: the thesis' specular stage reads no more film).
+    var result = f_h * spec;
+    if (with_diffuse || BRDF_MODEL == MODEL_LAYERED) {
+        let top_i = coupling(layers, cos_i);
+        result += top_i.ms * top_o.ms;
+        if (with_diffuse) {
+            result += diffuse_lobe(layers, cos_i, cos_o, top_i.reflected, top_o.reflected);
+        }
     }
-    return f_h * spec + top_i.ms * top_o.ms + diffuse;
+    return result;
 }

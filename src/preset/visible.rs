@@ -7,8 +7,10 @@
 //! the preset is loaded, and reported with the key, the line and the limit — never
 //! silently — so the maps, the renderer and any tool that reads the colour map agree.
 //!
-//! The limit is taken at the preset's scale roughness (`roughness.base`) and at the
-//! middle of its film thickness range, where the renderer takes K and E.
+//! The limit is the smallest over every roughness (the roughness map varies per pixel), at
+//! the middle of the film thickness range, where the renderer takes K and E. The colour
+//! map, the renderer's per-pixel inversion (which holds k_d at 1) and any tool that reads
+//! the map then agree.
 
 use super::schema::{Preset, Srgb8};
 use crate::optics::brdf::{Model, layered};
@@ -22,21 +24,42 @@ pub struct ClampedColour {
     /// The key's line in the preset file, where it is written there (not for `--set`).
     pub line: Option<usize>,
     pub requested: String,
-    /// The brightest colour of that hue the stack shows, per channel (what the maps use).
+    /// The brightest colour of that hue the stack shows (what the maps use).
     pub clamped_to: String,
-    /// The stack's limit per channel, linear.
+    /// The stack's limit per channel for this key, linear.
     pub limit_linear: [f64; 3],
 }
 
+impl ClampedColour {
+    /// The warning for `preset` (its file or name), as every command prints it.
+    pub fn message(&self, preset: &str) -> String {
+        let line = self.line.map(|l| format!(":{l}")).unwrap_or_default();
+        let [r, g, b] = self.limit_linear;
+        format!(
+            "warning: {preset}{line}: {} = \"{}\" is brighter than this layer stack can show (colours mean the \
+             visible colour; with its absorption the stack shows at most linear [{r:.3}, {g:.3}, {b:.3}]); clamped \
+             to \"{}\". Lower optics.absorption or the colour to keep it.",
+            self.key, self.requested, self.clamped_to
+        )
+    }
+}
+
 /// The brightest visible colour per channel (linear) of the preset's stack, or None when
-/// it is lossless (τ = 0 in every channel: every colour can be shown).
+/// it is lossless (τ = 0 in every channel: every colour can be shown). The smallest over
+/// every roughness, since the roughness map varies per pixel; 1 in a channel without
+/// absorption (its K + E = 1: exactly 1, not 1 up to rounding).
 pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
     let optics = LayerOptics::from_preset(preset);
     if !optics.has_absorption() {
         return None;
     }
-    let (k, e) = optics.bounce_table(Model::Layered).at(preset.roughness.base);
-    Some([0, 1, 2].map(|c| layered::visible_limit(optics.optical_depth[c], k[c], e[c])))
+    let bounce = optics.bounce_table(Model::Layered);
+    Some([0, 1, 2].map(|c| {
+        if optics.optical_depth[c] <= 0.0 {
+            return 1.0;
+        }
+        bounce.rows.iter().map(|(k, e)| layered::visible_limit(optics.optical_depth[c], k[c], e[c])).fold(1.0, f64::min)
+    }))
 }
 
 /// Every colour key of a preset with its value, mutable.
@@ -56,27 +79,32 @@ fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
     keys
 }
 
-/// Clamps every colour key beyond the stack's limit to it (per channel, rounded down so
-/// the 8-bit colour stays within it) and returns what was clamped.
+/// Clamps every colour key the stack cannot show and returns what was clamped. A colour
+/// keeps its hue and saturation: all three channels are scaled by the one factor that
+/// brings the brightest-over-its-limit channel to the limit (rounded down to 8 bits). The
+/// back's colour variation brightens `color.base` by up to (1 + `color.variation`)
+/// (`maps::color`), so that key is held to the limit over that factor.
 pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
     let Some(limit) = visible_limit(preset) else {
         return Vec::new();
     };
+    let variation = 1.0 + preset.color.variation.max(0.0);
     let mut clamped = Vec::new();
     for (key, colour) in colour_keys(preset) {
-        let linear = colour.to_linear();
-        if (0..3).all(|c| linear[c] as f64 <= limit[c]) {
+        let headroom = if key == "color.base" { variation } else { 1.0 };
+        let allowed = limit.map(|l| l / headroom);
+        let linear = colour.to_linear().map(f64::from);
+        let factor = (0..3).filter(|&c| linear[c] > allowed[c]).map(|c| allowed[c] / linear[c]).fold(1.0, f64::min);
+        if factor >= 1.0 {
             continue;
         }
-        let shown = Srgb8(
-            [0, 1, 2].map(|c| if linear[c] as f64 <= limit[c] { colour.0[c] } else { Srgb8::encode_floor(limit[c]) }),
-        );
+        let shown = Srgb8([0, 1, 2].map(|c| Srgb8::encode_floor(linear[c] * factor)));
         clamped.push(ClampedColour {
             key,
             line: None,
             requested: colour.to_string(),
             clamped_to: shown.to_string(),
-            limit_linear: limit,
+            limit_linear: allowed,
         });
         *colour = shown;
     }

@@ -438,8 +438,8 @@ pub enum BenchCommand {
         /// Evaluations per dispatch.
         #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1000..=16_000_000))]
         samples: u64,
-        /// Layer model to evaluate.
-        #[arg(long, default_value = "thesis", value_parser = parse_model)]
+        /// Layer model to evaluate: layered (default) or thesis.
+        #[arg(long, default_value = "layered", value_parser = parse_model)]
         model: Model,
         /// Print one JSON object.
         #[arg(long)]

@@ -106,12 +106,6 @@ pub fn ensure_folder(folder: &Path) -> anyhow::Result<()> {
 /// were clamped to (`snakeskin::preset::visible`).
 pub fn report_clamped_colours(preset: &str, loaded: &snakeskin::preset::LoadedPreset) {
     for c in &loaded.clamped_colours {
-        let line = c.line.map(|l| format!(":{l}")).unwrap_or_default();
-        eprintln!(
-            "warning: {preset}{line}: {} = \"{}\" is brighter than this layer stack can show (colours mean the \
-             visible colour; with its absorption the stack shows at most linear [{:.3}, {:.3}, {:.3}]); clamped to \
-             \"{}\". Lower optics.absorption or the colour to keep it.",
-            c.key, c.requested, c.limit_linear[0], c.limit_linear[1], c.limit_linear[2], c.clamped_to
-        );
+        eprintln!("{}", c.message(preset));
     }
 }

@@ -92,7 +92,8 @@ pub fn visible_limit(optical_depth: f64, k: f64, e: f64) -> f64 {
 
 /// The base albedo k_d that shows the visible colour `colour`:
 /// k_d = c / (exp(−τ) E + c K), the closed-form inverse of `visible_colour`; colours beyond
-/// `visible_limit` give k_d = 1 (the limit), and a stack that shows nothing (E = 0) gives 0.
+/// `visible_limit` give k_d = 1 (the limit); a stack that shows nothing (E = 0) gives 1 for
+/// any colour but black (its limit is 0), and black gives 0.
 pub fn base_albedo(colour: f64, optical_depth: f64, k: f64, e: f64) -> f64 {
     let c = colour.max(0.0);
     let denominator = (-optical_depth.max(0.0)).exp() * e + c * k;

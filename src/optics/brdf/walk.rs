@@ -1,6 +1,6 @@
 //! The stochastic reference: photons followed one by one through the stack, with a rough
-//! (GGX) or smooth top, in the manner of Guo, Hašan & Zhao 2018 (position-free layered
-//! transport) and pbrt-v4's `LayeredBxDF`. It shares no formula with `exact.rs` beyond the
+//! (GGX) or smooth top: position-free layered transport (as Guo, Hašan & Zhao 2018 and
+//! pbrt-v4's `LayeredBxDF`), with the rough top walked as a microsurface (below). It shares no formula with `exact.rs` beyond the
 //! film's reflectance, so the closed form's geometric series, its escape cone, its (n0/n2)²
 //! and its K and E are checked against a simulation of the physics they describe.
 //!

@@ -153,7 +153,11 @@ pub fn bench_render(
     let lut = Lut::bake_default(optics.stack);
     let base = FrameSettings { ground: false, ..FrameSettings::default() };
     let no_film = LayerOptics { thickness_range_nm: (0.0, 0.0), ..optics };
-    let no_absorption = LayerOptics { optical_depth: [0.0; 3], ..optics };
+    // The other side of the absorption switch from the preset's (built-in presets have
+    // none: τ = 0.3 then shows what the attenuation costs).
+    let switched = if optics.has_absorption() { [0.0; 3] } else { [0.3; 3] };
+    let absorption_switched = LayerOptics { optical_depth: switched, ..optics };
+    let switched_name = if optics.has_absorption() { "skin-no-absorption" } else { "skin-absorption" };
     // Every skin variant shades with the default model but `skin-thesis`.
     let (default, thesis) = (Model::default(), Model::Thesis);
     let variants: Vec<(String, LayerOptics, GpuFilmMethod, bool, Model)> = vec![
@@ -161,7 +165,7 @@ pub fn bench_render(
         ("skin-lut".into(), optics, GpuFilmMethod::Lut, false, default),
         ("skin-thesis".into(), optics, GpuFilmMethod::Lut, false, thesis),
         ("skin-no-film".into(), no_film, GpuFilmMethod::Lut, false, default),
-        ("skin-no-absorption".into(), no_absorption, GpuFilmMethod::Lut, false, default),
+        (switched_name.into(), absorption_switched, GpuFilmMethod::Lut, false, default),
         ("skin-rgb3".into(), optics, GpuFilmMethod::Rgb3, false, default),
         ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false, default),
         ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false, default),
