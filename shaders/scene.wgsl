@@ -17,9 +17,10 @@ struct Scene {
     film: vec4<f32>,
     // rgb: pigment optical depth tau = sigma0 * delta1.
     optical_depth: vec4<f32>,
-    // The stack's K and E (rgb) per roughness row of E1_TABLE (LayerOptics::bounce_table).
-    bounce_k: array<vec4<f32>, E1_ROUGHNESS>,
-    bounce_e: array<vec4<f32>, E1_ROUGHNESS>,
+    // The stack's K and E (rgb) per film thickness (BOUNCE_THICKNESSES evenly over film.xy)
+    // and roughness row, entry thickness * E1_ROUGHNESS + row (LayerOptics::bounce_grid).
+    bounce_k: array<vec4<f32>, BOUNCE_ENTRIES>,
+    bounce_e: array<vec4<f32>, BOUNCE_ENTRIES>,
 }
 
 @group(1) @binding(0) var<uniform> scene: Scene;

@@ -11,14 +11,32 @@ override VIEW_MAP: u32 = VIEW_SHADED;
 override GBUFFER_PART: u32 = GBUFFER_POSITION_NORMAL;
 
 // The pixel's layers; K and E interpolated between the roughness rows (exact: they are
-// linear in r between rows, LayerOptics::bounce_table), the base albedo recovered from the
-// colour map as the model reads it (base_albedo; LayerOptics::layers is the CPU twin).
+// linear in r between rows) and then between the film thicknesses (BounceGrid::at), the
+// base albedo recovered from the colour map as the model reads it (base_albedo;
+// LayerOptics::layers is the CPU twin).
 fn layers_of(m: Material) -> Layers {
     let y = clamp(m.roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
     let j = min(u32(y), E1_ROUGHNESS - 2u);
     let f = y - f32(j);
-    let k = mix(scene.bounce_k[j].rgb, scene.bounce_k[j + 1u].rgb, f);
-    let e = mix(scene.bounce_e[j].rgb, scene.bounce_e[j + 1u].rgb, f);
+    var x = 0.0;
+    if (scene.film.y > scene.film.x) {
+        x = clamp((m.thickness_nm - scene.film.x) / (scene.film.y - scene.film.x), 0.0, 1.0);
+    }
+    x *= f32(BOUNCE_THICKNESSES - 1u);
+    let t = min(u32(x), BOUNCE_THICKNESSES - 2u);
+    let ft = x - f32(t);
+    let a = t * E1_ROUGHNESS + j;
+    let b = a + E1_ROUGHNESS;
+    let k = mix(
+        mix(scene.bounce_k[a].rgb, scene.bounce_k[a + 1u].rgb, f),
+        mix(scene.bounce_k[b].rgb, scene.bounce_k[b + 1u].rgb, f),
+        ft,
+    );
+    let e = mix(
+        mix(scene.bounce_e[a].rgb, scene.bounce_e[a + 1u].rgb, f),
+        mix(scene.bounce_e[b].rgb, scene.bounce_e[b + 1u].rgb, f),
+        ft,
+    );
     let tau = scene.optical_depth.rgb;
     let kd = base_albedo(m.albedo, tau, k, e);
     return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, tau, kd, k, e);

@@ -245,3 +245,45 @@ fn roughness_zero_uses_the_documented_floor() {
         assert!((v.specular[0] - expected).abs() / expected < 1e-9, "{model:?} {v:?}");
     }
 }
+
+/// The renderer takes K and E per film thickness (`BounceGrid`): the white furnace holds
+/// across a material's whole thickness range, not only at its middle.
+#[test]
+fn the_renderer_keeps_the_furnace_across_the_thickness_range() {
+    use snakeskin::render::engine::scene::{BOUNCE_THICKNESSES, BounceGrid, LayerOptics};
+    let worst = |optics: &LayerOptics, grid: &BounceGrid| {
+        let lut = snakeskin::optics::lut::Lut::bake_default(optics.stack);
+        let (lo, hi) = optics.thickness_range_nm;
+        let (mut to_70, mut beyond): (f64, f64) = (0.0, 0.0);
+        for k in 0..=20 {
+            // Nodes and the points halfway between them.
+            let d = lo + (hi - lo) * k as f64 / 20.0;
+            for roughness in [0.0, 0.3, 0.6, 1.0] {
+                for cos in [1.0, 0.5, 0.2] {
+                    let layers = optics.layers(Model::Layered, grid, d, roughness, [1.0; 3]);
+                    let a = Model::Layered.furnace_albedo(&layers, cos, &|c| lut.lookup_f64(d, c), 24);
+                    let err = a.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
+                    if cos >= 70f64.to_radians().cos() { to_70 = to_70.max(err) } else { beyond = beyond.max(err) }
+                }
+            }
+        }
+        (to_70, beyond)
+    };
+    for (stack, range) in [
+        (Stack::THESIS, (150.0, 350.0)),
+        (Stack::THESIS, (0.0, 200.0)),
+        (Stack { n0: 1.0, n1: 1.56, n2: 1.33 }, (0.0, 200.0)),
+    ] {
+        let optics = LayerOptics { stack, thickness_range_nm: range, optical_depth: [0.0; 3] };
+        let grid = optics.bounce_grid(Model::Layered);
+        assert_eq!(grid.tables.len(), BOUNCE_THICKNESSES);
+        let (to_70, beyond) = worst(&optics, &grid);
+        assert!(to_70 <= 0.02 && beyond <= 0.05, "{stack:?} {range:?}: {to_70} up to 70°, {beyond} beyond");
+        // Negative control: K and E of the middle thickness everywhere, as the first version.
+        let middle = grid.tables[BOUNCE_THICKNESSES / 2].clone();
+        let flat = BounceGrid { tables: vec![middle; BOUNCE_THICKNESSES], ..grid };
+        let (flat_70, _) = worst(&optics, &flat);
+        eprintln!("{stack:?} {range:?}: grid {to_70:.4} / {beyond:.4}; middle thickness alone {flat_70:.4} up to 70°");
+        assert!(flat_70 > 0.03, "{stack:?} {range:?}: the middle thickness alone gave {flat_70}");
+    }
+}

@@ -7,8 +7,8 @@
 //! the preset is loaded, and reported with the key, the line and the limit — never
 //! silently — so the maps, the renderer and any tool that reads the colour map agree.
 //!
-//! The limit is the smallest over every roughness (the roughness map varies per pixel), at
-//! the middle of the film thickness range, where the renderer takes K and E. The colour
+//! The limit is the smallest over the film thicknesses and roughnesses the renderer takes K
+//! and E at (both maps vary per pixel). The colour
 //! map, the renderer's per-pixel inversion (which holds k_d at 1) and any tool that reads
 //! the map then agree.
 
@@ -46,19 +46,19 @@ impl ClampedColour {
 
 /// The brightest visible colour per channel (linear) of the preset's stack, or None when
 /// it is lossless (τ = 0 in every channel: every colour can be shown). The smallest over
-/// every roughness, since the roughness map varies per pixel; 1 in a channel without
+/// every film thickness and roughness, since both maps vary per pixel; 1 in a channel without
 /// absorption (its K + E = 1: exactly 1, not 1 up to rounding).
 pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
     let optics = LayerOptics::from_preset(preset);
     if !optics.has_absorption() {
         return None;
     }
-    let bounce = optics.bounce_table(Model::Layered);
+    let bounce = optics.bounce_grid(Model::Layered);
     Some([0, 1, 2].map(|c| {
         if optics.optical_depth[c] <= 0.0 {
             return 1.0;
         }
-        bounce.rows.iter().map(|(k, e)| layered::visible_limit(optics.optical_depth[c], k[c], e[c])).fold(1.0, f64::min)
+        bounce.rows().map(|(k, e)| layered::visible_limit(optics.optical_depth[c], k[c], e[c])).fold(1.0, f64::min)
     }))
 }
 

@@ -12,8 +12,9 @@
 //! with ⟨F⟩ the film read at the lobe's microfacet angles and F(c₁) at the most grazing
 //! of them (`energy::top`; `Model::coupling` passes s in).
 //!
-//! K and E (per channel, per material, per roughness) come with the layers
-//! (`Layers::of_stack`: the film seen from below, `exact::SmoothTop::bounce_table`). At r = 0
+//! K and E (per channel, per material, per roughness, per film thickness) come with the
+//! layers (`Layers::of_stack`: the film seen from below, `exact::SmoothTop::bounce_table`;
+//! the renderer interpolates them over thickness, `render::engine::scene::BounceGrid`). At r = 0
 //! this is the smooth-top closed form exactly, up to the film colour method. f64, f32 (the
 //! shader's twin) and the ambient term read one formula.
 

@@ -202,34 +202,45 @@ impl LayerOptics {
         self.thickness_range_nm.1 <= 0.0 || self.stack.n1 == self.stack.n0
     }
 
-    /// The film thickness K and E (the stack's bounce terms) are computed at: the middle of
-    /// the map's range. K varies little with thickness (PHYSICS.md: 0.77–0.79 for the
-    /// thesis materials over 0–2000 nm); `bench layered` measures what this costs.
-    pub fn bounce_thickness_nm(&self) -> f64 {
-        0.5 * (self.thickness_range_nm.0 + self.thickness_range_nm.1)
+    /// The film thicknesses K and E (the stack's bounce terms) are computed at:
+    /// `BOUNCE_THICKNESSES` evenly over the map's range.
+    pub fn bounce_thicknesses_nm(&self) -> [f64; BOUNCE_THICKNESSES] {
+        let (lo, hi) = self.thickness_range_nm;
+        std::array::from_fn(|i| lo + (hi - lo) * i as f64 / (BOUNCE_THICKNESSES - 1) as f64)
     }
 
-    /// K and E per roughness row, as the shader interpolates them; zeros for a model that
-    /// does not read them (so the thesis model's frames, and the window's thickness slider
-    /// under it, never compute the film seen from below).
-    pub fn bounce_table(&self, model: Model) -> crate::optics::brdf::exact::BounceTable {
+    /// K and E per film thickness and roughness row, as the shader interpolates them; zeros
+    /// for a model that does not read them (so the thesis model's frames, and the window's
+    /// thickness slider under it, never compute the film seen from below).
+    pub fn bounce_grid(&self, model: Model) -> BounceGrid {
+        use rayon::prelude::*;
         if !model.reads_bounce() {
-            return crate::optics::brdf::exact::BounceTable::unused();
+            return BounceGrid {
+                range_nm: self.thickness_range_nm,
+                tables: vec![crate::optics::brdf::exact::BounceTable::unused(); BOUNCE_THICKNESSES],
+            };
         }
-        crate::optics::brdf::exact::cached(self.stack, self.bounce_thickness_nm()).bounce_table(self.optical_depth)
+        let tables = self
+            .bounce_thicknesses_nm()
+            .par_iter()
+            .map(|&d| crate::optics::brdf::exact::cached(self.stack, d).bounce_table(self.optical_depth))
+            .collect();
+        BounceGrid { range_nm: self.thickness_range_nm, tables }
     }
 
-    /// The per-pixel layers of this material with its `bounce_table`, the base albedo
-    /// recovered from the colour map's `colour` as `model` reads it (`Model::base_albedo`):
-    /// the CPU reference's twin of the shader's `layers_of`.
+    /// The per-pixel layers of this material with its `bounce_grid` at the pixel's film
+    /// thickness and roughness, the base albedo recovered from the colour map's `colour` as
+    /// `model` reads it (`Model::base_albedo`): the CPU reference's twin of the shader's
+    /// `layers_of`.
     pub fn layers(
         &self,
         model: Model,
-        bounce: &crate::optics::brdf::exact::BounceTable,
+        bounce: &BounceGrid,
+        thickness_nm: f64,
         roughness: f64,
         colour: [f64; 3],
     ) -> crate::optics::brdf::Layers {
-        let (k, e) = bounce.at(roughness);
+        let (k, e) = bounce.at(thickness_nm, roughness);
         let Stack { n0, n2, .. } = self.stack;
         let layers =
             crate::optics::brdf::Layers { n0, n2, roughness, optical_depth: self.optical_depth, albedo: colour, k, e };
@@ -248,6 +259,44 @@ impl LayerOptics {
     }
 }
 
+/// Film thicknesses K and E are tabulated at over a material's thickness range. K depends
+/// on the film: with K and E of the middle thickness alone, the white furnace of the
+/// thesis stack was off by up to 0.115 over a 200 nm range (150–350 nm; 0.097 over
+/// 0–200 nm, 0.076 over 300–500 nm). Eight points, 29 nm apart over the default range,
+/// keep the interpolated K within the furnace's tolerance (tests/render.rs,
+/// `the_renderer_keeps_the_furnace_across_the_thickness_range`); 8 × 16 rows is also an
+/// array size the uniform's Pod layout takes.
+pub const BOUNCE_THICKNESSES: usize = 8;
+
+/// K and E of a material per film thickness (`BOUNCE_THICKNESSES` evenly over `range_nm`)
+/// and roughness row: `LayerOptics::bounce_grid`, read by the shader's `layers_of` and the
+/// CPU reference alike.
+#[derive(Debug, Clone)]
+pub struct BounceGrid {
+    pub range_nm: (f64, f64),
+    pub tables: Vec<crate::optics::brdf::exact::BounceTable>,
+}
+
+impl BounceGrid {
+    /// K and E at a film thickness and roughness: linear in roughness between rows, then in
+    /// thickness between tables (as `skin.wgsl`'s `layers_of`).
+    pub fn at(&self, thickness_nm: f64, roughness: f64) -> ([f64; 3], [f64; 3]) {
+        let (lo, hi) = self.range_nm;
+        let x = if hi > lo { ((thickness_nm - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.0 };
+        let x = x * (BOUNCE_THICKNESSES - 1) as f64;
+        let i = (x as usize).min(BOUNCE_THICKNESSES - 2);
+        let f = x - i as f64;
+        let (a, b) = (self.tables[i].at(roughness), self.tables[i + 1].at(roughness));
+        let mix = |p: [f64; 3], q: [f64; 3]| [0, 1, 2].map(|c| p[c] * (1.0 - f) + q[c] * f);
+        (mix(a.0, b.0), mix(a.1, b.1))
+    }
+
+    /// Every (K, E) row of every thickness.
+    pub fn rows(&self) -> impl Iterator<Item = &([f64; 3], [f64; 3])> {
+        self.tables.iter().flat_map(|t| t.rows.iter())
+    }
+}
+
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct SceneUniform {
@@ -259,9 +308,10 @@ pub struct SceneUniform {
     pub sky_bottom: [f32; 4],
     pub film: [f32; 4],
     pub optical_depth: [f32; 4],
-    /// K and E (rgb) per roughness row of the energy table (`LayerOptics::bounce_table`).
-    pub bounce_k: [[f32; 4]; E1_ROUGHNESS],
-    pub bounce_e: [[f32; 4]; E1_ROUGHNESS],
+    /// K and E (rgb) per film thickness and roughness row (`LayerOptics::bounce_grid`),
+    /// entry `thickness * E1_ROUGHNESS + row`.
+    pub bounce_k: [[f32; 4]; E1_ROUGHNESS * BOUNCE_THICKNESSES],
+    pub bounce_e: [[f32; 4]; E1_ROUGHNESS * BOUNCE_THICKNESSES],
 }
 
 impl SceneUniform {
@@ -278,7 +328,8 @@ impl SceneUniform {
         let p = camera.position();
         let rgb4 = |c: [f32; 3]| [c[0], c[1], c[2], 0.0];
         let tau = optics.optical_depth.map(|t| t as f32);
-        let bounce = optics.bounce_table(model);
+        let bounce = optics.bounce_grid(model);
+        let rows: Vec<&([f64; 3], [f64; 3])> = bounce.rows().collect();
         SceneUniform {
             view_proj: camera.view_proj(aspect).to_cols_array_2d(),
             camera: [p.x, p.y, p.z, 0.0],
@@ -293,8 +344,8 @@ impl SceneUniform {
                 optics.stack.n2 as f32,
             ],
             optical_depth: [tau[0], tau[1], tau[2], 0.0],
-            bounce_k: std::array::from_fn(|i| rgb4(bounce.rows[i].0.map(|v| v as f32))),
-            bounce_e: std::array::from_fn(|i| rgb4(bounce.rows[i].1.map(|v| v as f32))),
+            bounce_k: std::array::from_fn(|i| rgb4(rows[i].0.map(|v| v as f32))),
+            bounce_e: std::array::from_fn(|i| rgb4(rows[i].1.map(|v| v as f32))),
         }
     }
 }

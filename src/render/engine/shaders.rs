@@ -14,6 +14,7 @@ use crate::optics::brdf::{ALPHA_MIN, COS_MIN, LENGTH_MIN, Model};
 use crate::optics::fast::{BOX_NARROW_RAD, HARMONICS_DENOM_MIN, Q_NEGLIGIBLE, SINC_SMALL};
 use crate::optics::lut::{COARSE_MAX_NM, FINE_MAX_NM};
 use crate::optics::methods::{BB_LOBES, GAUSSIAN_FIT_HARMONICS, RGB3_BAND_NM, RGB3_NM, bb_amplitude};
+use crate::render::engine::scene::BOUNCE_THICKNESSES;
 
 use super::film::GpuFilmMethod;
 use super::renderer::{GBUFFER_ALBEDO_GEOMETRY, GBUFFER_POSITION_NORMAL, TONE_MAP_CURVE, TONE_MAP_NONE};
@@ -79,6 +80,10 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("GBUFFER_ALBEDO_GEOMETRY", "u32", format!("{GBUFFER_ALBEDO_GEOMETRY}u")),
         ("E1_MU", "u32", format!("{E1_MU}u")),
         ("E1_ROUGHNESS", "u32", format!("{E1_ROUGHNESS}u")),
+        // K and E's film thicknesses (render::engine::scene::BOUNCE_THICKNESSES) and the
+        // scene uniform's table length.
+        ("BOUNCE_THICKNESSES", "u32", format!("{BOUNCE_THICKNESSES}u")),
+        ("BOUNCE_ENTRIES", "u32", format!("{}u", E1_ROUGHNESS * BOUNCE_THICKNESSES)),
     ];
     let code = |v: u32| format!("{v}u");
     for (name, method) in [

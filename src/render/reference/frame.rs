@@ -11,10 +11,10 @@ use rayon::prelude::*;
 
 use crate::Error;
 use crate::optics::brdf::COS_MIN;
-use crate::optics::brdf::exact::BounceTable;
 use crate::optics::film_rgb_reference;
 use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
 use crate::render::engine::renderer::{FrameSettings, GBuffer, Material, Renderer};
+use crate::render::engine::scene::BounceGrid;
 use crate::render::engine::scene::{LayerOptics, Lighting, Stage, View};
 
 /// The GPU frame at one sample per pixel against the CPU reference (stage "all").
@@ -99,7 +99,7 @@ pub fn shade_pixel(
     i: usize,
     settings: &FrameSettings,
     optics: &LayerOptics,
-    bounce: &BounceTable,
+    bounce: &BounceGrid,
 ) -> [f64; 3] {
     let pt = gbuffer.position_thickness[i].map(|v| v as f64);
     let nr = gbuffer.normal_roughness[i].map(|v| v as f64);
@@ -119,7 +119,7 @@ pub fn shade_pixel(
         computed.borrow_mut().push((cos.to_bits(), rgb));
         rgb
     };
-    let layers = optics.layers(settings.model, bounce, nr[3], [albedo[0], albedo[1], albedo[2]]);
+    let layers = optics.layers(settings.model, bounce, thickness, nr[3], [albedo[0], albedo[1], albedo[2]]);
     let lighting = &settings.lighting;
     let mut radiance = [0.0; 3];
     for light in [&lighting.key, &lighting.fill] {
@@ -161,7 +161,7 @@ pub fn compare(
     optics: &LayerOptics,
 ) -> ReferenceReport {
     // K and E per roughness row, once for the frame (the shader's `Scene.bounce`).
-    let bounce = optics.bounce_table(settings.model);
+    let bounce = optics.bounce_grid(settings.model);
     let exposure = settings.exposure as f64;
     let de: Vec<Option<f64>> = (0..(gbuffer.width * gbuffer.height) as usize)
         .into_par_iter()
