@@ -204,7 +204,8 @@ fn next_height(w: V3, h: f64, alpha: f64, u: f64) -> Option<f64> {
 
 enum Fate {
     /// Reflected without entering the stack, after this many intersections with the
-    /// microsurface (1: single scattering).
+    /// microsurface (1: single scattering; read by the test of the walk's single scattering).
+    #[cfg_attr(not(test), allow(dead_code))]
     Specular(usize),
     /// Left after entering the stack, at cos θo, after this many base reflections.
     Diffuse(f64, usize),
