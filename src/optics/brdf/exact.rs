@@ -148,12 +148,19 @@ impl SmoothTop {
     /// K (sent back to the base per bounce) and E (escaping per bounce) per channel for
     /// optical depth τ per channel.
     pub fn k_e(&self, tau: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        self.integrate(tau, |_, rb| rb)
+    }
+
+    /// K = ∫ 2μ R(μ) exp(−2τ/μ) dμ and E = ∫ 2μ (1 − R(μ)) exp(−τ/μ) dμ over the nodes, with
+    /// `sent_back(node, R_b)` the probability a direction at that node is sent back down.
+    fn integrate(&self, tau: [f64; 3], sent_back: impl Fn(usize, [f64; 3]) -> [f64; 3]) -> ([f64; 3], [f64; 3]) {
         let (mut k, mut e) = ([0.0; 3], [0.0; 3]);
-        for &(mu, weight, rb) in &self.below {
+        for (node, &(mu, weight, rb)) in self.below.iter().enumerate() {
+            let r = sent_back(node, rb);
             for c in 0..3 {
                 let tau = tau[c].max(0.0);
-                k[c] += weight * 2.0 * mu * rb[c] * (-2.0 * tau / mu).exp();
-                e[c] += weight * 2.0 * mu * (1.0 - rb[c]) * (-tau / mu).exp();
+                k[c] += weight * 2.0 * mu * r[c] * (-2.0 * tau / mu).exp();
+                e[c] += weight * 2.0 * mu * (1.0 - r[c]) * (-tau / mu).exp();
             }
         }
         (k, e)
@@ -167,16 +174,7 @@ impl SmoothTop {
     /// (F(μo) = R_b(μ) by reciprocity of the lossless film); for τ = 0, K + E = 1 in every
     /// row, so the furnace holds.
     pub fn k_e_row(&self, tau: [f64; 3], row: usize) -> ([f64; 3], [f64; 3]) {
-        let (mut k, mut e) = ([0.0; 3], [0.0; 3]);
-        for (node, &(mu, weight, _)) in self.below.iter().enumerate() {
-            let r_eff = self.coupled[row][node];
-            for c in 0..3 {
-                let tau = tau[c].max(0.0);
-                k[c] += weight * 2.0 * mu * r_eff[c] * (-2.0 * tau / mu).exp();
-                e[c] += weight * 2.0 * mu * (1.0 - r_eff[c]) * (-tau / mu).exp();
-            }
-        }
-        (k, e)
+        self.integrate(tau, |node, _| self.coupled[row][node])
     }
 
     /// `bounce_table(tau).at(roughness)` from the two rows it needs (`Layers::of_stack`, once

@@ -267,26 +267,12 @@ impl Model {
         wo: [f64; 3],
         film: &dyn Fn(f64) -> [f64; 3],
     ) -> Option<Lobes> {
-        let n = normalize(normal).unwrap_or([0.0, 0.0, 1.0]);
-        let (wi, wo) = (normalize(wi)?, normalize(wo)?);
-        let (cos_i, cos_o) = (dot(n, wi), dot(n, wo));
-        if !(cos_i > 0.0 && cos_o > 0.0) {
-            return None;
-        }
-        let (cos_i, cos_o) = (cos_i.max(COS_MIN), cos_o.max(COS_MIN));
-        let h = normalize([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]])?;
-        let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
+        let (single, cos_i, cos_o) = single_lobe(layers, normal, wi, wo, film)?;
         let film_clamped = |c: f64| film_clamped(film(c.clamp(0.0, 1.0)));
-
-        let nxh = cross(n, h);
-        let d = ggx_d_sin(dot(n, h).clamp(0.0, 1.0), dot(nxh, nxh), alpha);
-        let g2 = smith_g2(cos_i, cos_o, alpha);
-        let f_h = film_clamped(dot(wo, h).abs());
-        let spec_scale = d * g2 / (4.0 * cos_i * cos_o);
         let (r, film) = (layers.roughness, &film_clamped);
         let (top_i, top_o) = (self.coupling(cos_i, r, film), self.coupling(cos_o, r, film));
         Some(Lobes {
-            single: f_h.map(|f| f * spec_scale),
+            single,
             multiple: [0, 1, 2].map(|c| top_i.ms_amplitude[c] * top_o.ms_amplitude[c]),
             diffuse: self.diffuse(layers, cos_i, cos_o, top_i.reflected, top_o.reflected),
         })
@@ -339,10 +325,10 @@ impl Model {
         let mut spec = [0.0; 3];
         for hv in ggx::stratified_half_vectors(wo, alpha, n) {
             // f cos θi / pdf(wi).
-            let Some(value) = self.eval_lobes(layers, [0.0, 0.0, 1.0], hv.wi, wo, film) else {
+            let Some((single, _, _)) = single_lobe(layers, [0.0, 0.0, 1.0], hv.wi, wo, film) else {
                 continue;
             };
-            for (s, v) in spec.iter_mut().zip(value.single) {
+            for (s, v) in spec.iter_mut().zip(single) {
                 *s += v * hv.wi[2] / hv.pdf_wi;
             }
         }
@@ -361,6 +347,32 @@ impl Model {
         }
         [0, 1, 2].map(|c| spec[c] + diffuse[c])
     }
+}
+
+/// The single-scatter specular lobe every model shares, with the floored cosines of wi
+/// and wo; None where the BRDF is zero (below the horizon, no direction).
+fn single_lobe(
+    layers: &Layers,
+    normal: [f64; 3],
+    wi: [f64; 3],
+    wo: [f64; 3],
+    film: &dyn Fn(f64) -> [f64; 3],
+) -> Option<([f64; 3], f64, f64)> {
+    let n = normalize(normal).unwrap_or([0.0, 0.0, 1.0]);
+    let (wi, wo) = (normalize(wi)?, normalize(wo)?);
+    let (cos_i, cos_o) = (dot(n, wi), dot(n, wo));
+    if !(cos_i > 0.0 && cos_o > 0.0) {
+        return None;
+    }
+    let (cos_i, cos_o) = (cos_i.max(COS_MIN), cos_o.max(COS_MIN));
+    let h = normalize([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]])?;
+    let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
+    let nxh = cross(n, h);
+    let d = ggx_d_sin(dot(n, h).clamp(0.0, 1.0), dot(nxh, nxh), alpha);
+    let g2 = smith_g2(cos_i, cos_o, alpha);
+    let f_h = film_clamped(film(dot(wo, h).abs().clamp(0.0, 1.0)));
+    let spec_scale = d * g2 / (4.0 * cos_i * cos_o);
+    Some((f_h.map(|f| f * spec_scale), cos_i, cos_o))
 }
 
 /// f32 layer parameters for the fast path.

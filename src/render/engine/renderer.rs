@@ -14,7 +14,7 @@ use super::gpu::{Gpu, GpuError};
 use super::gpu::{map_read, texture_entry, uniform_entry};
 use super::material::{self, MaterialMaps, MaterialTextures};
 use super::mesh::{BodyShape, Mesh, Vertex};
-use super::scene::{Camera, LayerOptics, Lighting, SceneUniform, Stage, View};
+use super::scene::{BounceGrid, Camera, LayerOptics, Lighting, SceneUniform, Stage, View};
 use super::shaders::program;
 use crate::optics::brdf::Model;
 use crate::optics::lut::Lut;
@@ -132,6 +132,10 @@ pub struct Renderer {
     ground: GpuMesh,
     instances: Mutex<(u32, wgpu::Buffer)>,
     single_instance: wgpu::Buffer,
+    /// The last material's K and E (`LayerOptics::bounce_grid`), kept while its optics and
+    /// model stay the same: every frame writes them to the scene uniform, and rebuilding
+    /// them is eight tables of film-from-below integrals.
+    bounce: Mutex<Option<(LayerOptics, Model, std::sync::Arc<BounceGrid>)>>,
 }
 
 struct GpuMesh {
@@ -241,6 +245,7 @@ impl Renderer {
             ground,
             instances,
             single_instance,
+            bounce: Mutex::new(None),
             gpu,
         }
     }
@@ -431,7 +436,18 @@ impl Renderer {
     }
 
     fn write_scene(&self, settings: &FrameSettings, material: &Material, aspect: f32) {
-        let uniform = SceneUniform::new(&settings.camera, aspect, &settings.lighting, &material.optics, settings.model);
+        let bounce = {
+            let mut last = self.bounce.lock().expect("bounce grid");
+            match &*last {
+                Some((optics, model, grid)) if *optics == material.optics && *model == settings.model => grid.clone(),
+                _ => {
+                    let grid = std::sync::Arc::new(material.optics.bounce_grid(settings.model));
+                    *last = Some((material.optics, settings.model, grid.clone()));
+                    grid
+                }
+            }
+        };
+        let uniform = SceneUniform::new(&settings.camera, aspect, &settings.lighting, &material.optics, &bounce);
         self.gpu.queue.write_buffer(&self.scene_buffer, 0, bytemuck::bytes_of(&uniform));
     }
 

@@ -315,7 +315,15 @@ pub struct SceneUniform {
 }
 
 impl SceneUniform {
-    pub fn new(camera: &Camera, aspect: f32, lighting: &Lighting, optics: &LayerOptics, model: Model) -> SceneUniform {
+    /// The uniform for a frame of a material with `optics` and its `bounce` grid for the
+    /// frame's model (`LayerOptics::bounce_grid`).
+    pub fn new(
+        camera: &Camera,
+        aspect: f32,
+        lighting: &Lighting,
+        optics: &LayerOptics,
+        bounce: &BounceGrid,
+    ) -> SceneUniform {
         let light = |l: &Light| {
             let d = l.direction.normalize();
             (
@@ -328,7 +336,6 @@ impl SceneUniform {
         let p = camera.position();
         let rgb4 = |c: [f32; 3]| [c[0], c[1], c[2], 0.0];
         let tau = optics.optical_depth.map(|t| t as f32);
-        let bounce = optics.bounce_grid(model);
         let rows: Vec<&([f64; 3], [f64; 3])> = bounce.rows().collect();
         SceneUniform {
             view_proj: camera.view_proj(aspect).to_cols_array_2d(),
