@@ -9,6 +9,8 @@ use snakeskin::optics::brdf::exact::SmoothTop;
 use snakeskin::optics::brdf::walk::Rng;
 use snakeskin::optics::brdf::{Layers, Model, layered};
 use snakeskin::optics::film::Stack;
+use snakeskin::preset::visible::visible_limit;
+use snakeskin::preset::{PresetSource, parse};
 
 /// The visible colour by its definition, from the smooth-top closed form (an independent
 /// formula: `exact::SmoothTop::albedo`'s geometric series): the diffuse reflectance at
@@ -68,6 +70,8 @@ fn colours_beyond_the_limit_give_the_limit_and_black_stays_black() {
 const WHITE_UNDER_INK: &str = r##"
 [color]
 base = "#e0c0a0"
+scale_tone = 0.1
+scale_hue = 0.05
 
 [belly]
 color = "#ffffff"
@@ -75,6 +79,11 @@ color = "#ffffff"
 [optics]
 absorption = 0.3
 "##;
+
+/// The largest 8-bit code of channel `c` in a PNG.
+fn map_max(path: &std::path::Path, c: usize) -> u8 {
+    image::open(path).unwrap().to_rgb8().pixels().map(|p| p.0[c]).max().unwrap()
+}
 
 #[test]
 fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limit() {
@@ -92,18 +101,26 @@ fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limi
         serde_json::from_slice(&std::fs::read(out_dir.join("ink.material.json")).unwrap()).unwrap();
     let clamped = manifest["clamped_colors"].as_array().unwrap();
     assert_eq!(clamped.len(), 2, "{clamped:?}");
-    assert_eq!(clamped[1]["line"], 6, "belly.color is on line 6 of the file");
+    assert_eq!(clamped[1]["line"], 8, "belly.color is on line 8 of the file");
     assert_eq!(clamped[0]["key"], "color.base");
     assert!(manifest["color_means"].as_str().unwrap().starts_with("visible diffuse colour"));
     // A clamped colour keeps its hue: the channels keep their order.
     let code = |hex: &str, c: usize| u8::from_str_radix(&hex[1 + 2 * c..3 + 2 * c], 16).unwrap();
     let base_shown = clamped[0]["clamped_to"].as_str().unwrap();
     assert!(code(base_shown, 0) > code(base_shown, 2), "{base_shown} lost its hue");
-    // The map holds what the stack can show, the back's colour variation (default 0.15)
-    // included: nothing brighter than the brightest clamped colour's 8-bit codes.
-    let bound = (0..3)
-        .map(|c| clamped.iter().map(|k| code(k["clamped_to"].as_str().unwrap(), c)).max().unwrap())
-        .collect::<Vec<u8>>();
+    // The map holds what the stack can show, the back's colour variation (default 0.15) and
+    // the per-scale tone and hue (1.1 × 1.05 at most) included: a key's limit is the stack's
+    // over that brightening, so nothing in the map is brighter than the stack's limit.
+    let srgb = |linear: f64| {
+        let v = if linear <= 0.0031308 { 12.92 * linear } else { 1.055 * linear.powf(1.0 / 2.4) - 0.055 };
+        (v.clamp(0.0, 1.0) * 255.0).ceil() as u8
+    };
+    let source = PresetSource { name: "ink".into(), display: "ink.toml".into(), text: WHITE_UNDER_INK.into() };
+    let stack_limit = visible_limit(&parse(&source, &[]).unwrap().preset).expect("an absorbing stack has a limit");
+    let bound = (0..3).map(|c| srgb(stack_limit[c])).collect::<Vec<u8>>();
+    // Negative control of the bound itself: the brightening reaches it (within a few codes).
+    let brightest = (0..3).map(|c| map_max(&out_dir.join("ink_color.png"), c)).collect::<Vec<u8>>();
+    assert!((0..3).all(|c| brightest[c] + 8 >= bound[c]), "bound {bound:?} far above the map's {brightest:?}");
     let map = image::open(out_dir.join("ink_color.png")).unwrap().to_rgb8();
     assert!(map.pixels().all(|p| (0..3).all(|c| p.0[c] <= bound[c])), "map brighter than {bound:?}");
 

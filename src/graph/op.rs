@@ -6,8 +6,9 @@ use std::borrow::Cow;
 
 use crate::ops::filters::{self, BlendMode, NormalConvention};
 use crate::ops::noise::{FractalNoise, NoiseKind};
+use crate::ops::scale_colour::{ScaleChannels, ScaleColour};
 use crate::ops::scales::ScaleField;
-use crate::ops::shapes::{self, Axis, Blotches, SpotGrid};
+use crate::ops::shapes::{self, Axis, BellyMarks, Blotches, SpotGrid};
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Op {
@@ -21,8 +22,8 @@ pub enum Op {
     Bands { axis: Axis, centres: Vec<f32>, half_width: f32, softness: f32 },
     /// A dorsal series of blotches (tiny-skia coverage). No inputs.
     Blotches(Blotches),
-    /// Checkered ventral plates. No inputs.
-    BellyChecker { rows_v: u32, belly_width: f32, softness: f32 },
+    /// Marks on the ventral plates. No inputs.
+    BellyMarks(BellyMarks),
     /// Inputs: a mask and the scale field; replaces each pixel's mask value by the value at
     /// its scale's centre, by `amount` (colour that follows scale boundaries).
     SnapToScales { amount: f32, centre_u: usize, centre_v: usize },
@@ -42,6 +43,8 @@ pub enum Op {
     Colorize { low: [f32; 3], high: [f32; 3] },
     /// Inputs: RGB base and a mask; mixes a constant colour in where the mask is set.
     Tint { color: [f32; 3], opacity: f32 },
+    /// Inputs: RGB colour and the scale field; colour per scale (`ops::scale_colour`).
+    ScaleColour(ScaleColour),
     /// Height to a tangent-space normal.
     HeightToNormal { slope: f32, convention: NormalConvention },
 }
@@ -50,12 +53,9 @@ impl Op {
     /// How many inputs the operation takes (checked when a node is added).
     pub fn arity(&self) -> std::ops::RangeInclusive<usize> {
         match self {
-            Op::Noise(_)
-            | Op::Scales(_)
-            | Op::Bands { .. }
-            | Op::Blotches(_)
-            | Op::BellyChecker { .. }
-            | Op::Spots(_) => 0..=0,
+            Op::Noise(_) | Op::Scales(_) | Op::Bands { .. } | Op::Blotches(_) | Op::BellyMarks(_) | Op::Spots(_) => {
+                0..=0
+            }
             Op::Channel { .. }
             | Op::Levels { .. }
             | Op::Threshold { .. }
@@ -63,7 +63,7 @@ impl Op {
             | Op::Sobel { .. }
             | Op::Colorize { .. }
             | Op::HeightToNormal { .. } => 1..=1,
-            Op::SnapToScales { .. } | Op::Tint { .. } => 2..=2,
+            Op::SnapToScales { .. } | Op::Tint { .. } | Op::ScaleColour(_) => 2..=2,
             Op::Blend { .. } => 2..=3,
         }
     }
@@ -74,14 +74,17 @@ impl Op {
         match self {
             Op::Scales(field) => field.outputs.len(),
             Op::Colorize { .. } | Op::HeightToNormal { .. } => 3,
-            Op::Levels { .. } | Op::Threshold { .. } | Op::Blur { .. } | Op::Blend { .. } | Op::Tint { .. } => {
-                inputs.first().copied().unwrap_or(1)
-            }
+            Op::Levels { .. }
+            | Op::Threshold { .. }
+            | Op::Blur { .. }
+            | Op::Blend { .. }
+            | Op::Tint { .. }
+            | Op::ScaleColour(_) => inputs.first().copied().unwrap_or(1),
             Op::Noise(_)
             | Op::Channel { .. }
             | Op::Bands { .. }
             | Op::Blotches(_)
-            | Op::BellyChecker { .. }
+            | Op::BellyMarks(_)
             | Op::SnapToScales { .. }
             | Op::Spots(_)
             | Op::Sobel { .. } => 1,
@@ -101,7 +104,10 @@ impl Op {
 
     /// True for operations that can write their result into their first input's buffer.
     pub fn in_place(&self) -> bool {
-        matches!(self, Op::Levels { .. } | Op::Threshold { .. } | Op::Blend { .. } | Op::Tint { .. })
+        matches!(
+            self,
+            Op::Levels { .. } | Op::Threshold { .. } | Op::Blend { .. } | Op::Tint { .. } | Op::ScaleColour(_)
+        )
     }
 
     /// Evaluates the operation. `first` is the first input (owned when the evaluator could
@@ -116,9 +122,7 @@ impl Op {
                 shapes::bands(width, height, *axis, centres, *half_width, *softness)
             }
             Op::Blotches(b) => shapes::blotches(width, height, b),
-            Op::BellyChecker { rows_v, belly_width, softness } => {
-                shapes::belly_checker(width, height, *rows_v, *belly_width, *softness)
-            }
+            Op::BellyMarks(marks) => shapes::belly_marks(width, height, marks),
             Op::SnapToScales { amount, centre_u, centre_v } => {
                 filters::snap_to_scales(input(), rest[0], *amount, *centre_u, *centre_v)
             }
@@ -133,6 +137,7 @@ impl Op {
             Op::Threshold { level, softness } => filters::threshold(owned(first), *level, *softness),
             Op::Blend { mode, opacity } => filters::blend(owned(first), rest[0], rest.get(1).copied(), *mode, *opacity),
             Op::Tint { color, opacity } => tint(owned(first), rest[0], *color, *opacity),
+            Op::ScaleColour(colour) => colour.apply(owned(first), rest[0]),
         }
     }
 
@@ -150,7 +155,7 @@ impl Op {
             Op::Channel { index } => format!("channel {index}"),
             Op::Bands { axis, centres, .. } => format!("bands {axis:?} n={}", centres.len()).to_lowercase(),
             Op::Blotches(b) => format!("blotches {:?} n={}", b.shape, b.count).to_lowercase(),
-            Op::BellyChecker { .. } => "belly checker".into(),
+            Op::BellyMarks(m) => format!("belly {:?}", m.kind).to_lowercase(),
             Op::SnapToScales { amount, .. } => format!("snap to scales {amount:.2}"),
             Op::Spots(g) => format!("spots {}x{}", g.across, g.along),
             Op::Levels { .. } => "levels".into(),
@@ -161,6 +166,7 @@ impl Op {
             Op::Colorize { .. } => "colorize".into(),
             Op::Tint { .. } => "tint".into(),
             Op::HeightToNormal { .. } => "height to normal".into(),
+            Op::ScaleColour(c) => format!("colour per scale tone={:.2} speckle={:.2}", c.tone, c.speckle),
         }
     }
 }
@@ -206,11 +212,25 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             imbrication,
             edge_softness,
             belly_width,
+            vertebral_width,
+            lowest_row_width,
+            smooth_rows,
             seed,
             outputs,
         }) => {
-            (shape, rows, seed, outputs).hash(h);
-            for x in [aspect, size, keel_height, keel_width, jitter, imbrication, edge_softness, belly_width] {
+            (shape, rows, smooth_rows, seed, outputs).hash(h);
+            for x in [
+                aspect,
+                size,
+                keel_height,
+                keel_width,
+                jitter,
+                imbrication,
+                edge_softness,
+                belly_width,
+                vertebral_width,
+                lowest_row_width,
+            ] {
                 float(h, *x);
             }
         }
@@ -228,10 +248,11 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
                 float(h, *x);
             }
         }
-        Op::BellyChecker { rows_v, belly_width, softness } => {
-            rows_v.hash(h);
-            float(h, *belly_width);
-            float(h, *softness);
+        Op::BellyMarks(BellyMarks { kind, rows_v, belly_width, amount, softness, seed }) => {
+            (kind, rows_v, seed).hash(h);
+            for x in [belly_width, amount, softness] {
+                float(h, *x);
+            }
         }
         Op::SnapToScales { amount, centre_u, centre_v } => {
             (centre_u, centre_v).hash(h);
@@ -271,6 +292,23 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
         Op::HeightToNormal { slope, convention } => {
             convention.hash(h);
             float(h, *slope);
+        }
+        Op::ScaleColour(ScaleColour {
+            tone,
+            hue,
+            edge,
+            tip,
+            speckle,
+            speckle_color,
+            skin,
+            speckle_cells,
+            seed,
+            channels: ScaleChannels { crevice, random, inside, along },
+        }) => {
+            (speckle_cells, seed, crevice, random, inside, along, skin.is_some()).hash(h);
+            for x in [tone, hue, edge, tip, speckle].into_iter().chain(speckle_color).chain(skin.iter().flatten()) {
+                float(h, *x);
+            }
         }
     }
 }

@@ -8,8 +8,9 @@ use crate::graph::{GraphBuilder, NodeId, Op};
 use crate::ops::filters::BlendMode;
 use crate::ops::hash::derive_seed;
 use crate::ops::noise::{FractalNoise, NoiseKind};
-use crate::ops::scales::channel;
-use crate::ops::shapes::{Axis, BlotchShape, Blotches, SpotGrid};
+use crate::ops::scale_colour::{SPECKLES_PER_SCALE, ScaleChannels, ScaleColour};
+use crate::ops::scales::{Lattice, channel};
+use crate::ops::shapes::{Axis, BellyMarkKind, BellyMarks, BlotchShape, Blotches, SpotGrid};
 use crate::preset::Preset;
 use crate::preset::schema::{Arrangement, BellyPattern, NoiseChoice, PatternKind, PatternLayer, PatternShape, Srgb8};
 
@@ -28,18 +29,36 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
     if b.width > 0.0 {
         let mask = g.add(
             "belly.mask",
-            Op::Bands { axis: Axis::U, centres: vec![0.0], half_width: b.width as f32 * 0.5, softness: b.blend as f32 },
+            Op::Bands {
+                axis: Axis::U,
+                centres: vec![0.0],
+                half_width: belly_colour_half_width(preset, s),
+                softness: b.blend as f32,
+            },
             &[],
         );
         color = g.add("belly.tint", Op::Tint { color: b.color.to_linear(), opacity: 1.0 }, &[color, mask]);
-        if b.pattern == BellyPattern::Checkered {
-            let rows_v = s.field.lattice().rows_v as u32;
-            let checker =
-                g.add("belly.checker", Op::BellyChecker { rows_v, belly_width: b.width as f32, softness: 0.004 }, &[]);
+        let kind = match b.pattern {
+            BellyPattern::None => None,
+            BellyPattern::Checkered => Some(BellyMarkKind::Checkered),
+            BellyPattern::Spots => Some(BellyMarkKind::Spots),
+            BellyPattern::HalfMoons => Some(BellyMarkKind::HalfMoons),
+            BellyPattern::MedianStripe => Some(BellyMarkKind::MedianStripe),
+        };
+        if let Some(kind) = kind {
+            let marks = BellyMarks {
+                kind,
+                rows_v: s.field.lattice().rows_v as u32,
+                belly_width: plate_band_width(preset, s),
+                amount: b.pattern_amount as f32,
+                softness: 0.004,
+                seed: derive_seed(preset.seed, "belly"),
+            };
+            let mask = g.add("belly.marks", Op::BellyMarks(marks), &[]);
             color = g.add(
-                "belly.checker_tint",
+                "belly.marks_tint",
                 Op::Tint { color: b.pattern_color.to_linear(), opacity: 1.0 },
-                &[color, checker],
+                &[color, mask],
             );
         }
         outside_belly = Some(g.add(
@@ -59,6 +78,10 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
         color = pattern_layer(g, s, &context, i, layer, color);
     }
 
+    if let Some(op) = per_scale(preset, s) {
+        color = g.add("color.per_scale", Op::ScaleColour(op), &[color, s.scales]);
+    }
+
     let k = preset.color.between_scales as f32;
     let shade = g.add(
         "color.scale_shade",
@@ -66,6 +89,69 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
         &[s.crevice],
     );
     g.add("color.out", Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[color, shade])
+}
+
+/// The ventral band's width: the plates' whole columns (`ops::scales::Lattice`) when the
+/// preset draws plates, else `belly.width` as written.
+fn plate_band_width(preset: &Preset, s: &Shared) -> f32 {
+    if preset.belly.plates { s.field.lattice().belly_width() } else { preset.belly.width as f32 }
+}
+
+/// Half the width of the belly colour's band: the plates, and `belly.up_rows` dorsal rows
+/// each side where the belly colour runs up onto the lowest rows.
+fn belly_colour_half_width(preset: &Preset, s: &Shared) -> f32 {
+    let up = preset.belly.up_rows;
+    if !preset.belly.plates || up == 0 {
+        return 0.5 * plate_band_width(preset, s);
+    }
+    let lattice = s.field.lattice();
+    let edge = (lattice.belly_cols / 2) as usize + up as usize;
+    lattice.bounds[edge.min(lattice.bounds.len() / 2)]
+}
+
+/// The per-scale colour of the preset (`ops::scale_colour`), or None when every one of its
+/// keys is off (the node is then not in the graph).
+fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
+    let c = &preset.color;
+    let any = c.scale_tone > 0.0
+        || c.scale_hue > 0.0
+        || c.edge_tone != 0.0
+        || c.tip_tone != 0.0
+        || c.speckle > 0.0
+        || c.skin.is_some();
+    any.then(|| ScaleColour {
+        tone: c.scale_tone as f32,
+        hue: c.scale_hue as f32,
+        edge: c.edge_tone as f32,
+        tip: c.tip_tone as f32,
+        speckle: c.speckle as f32,
+        speckle_color: c.speckle_color.to_linear(),
+        skin: c.skin.map(Srgb8::to_linear),
+        speckle_cells: s.field.lattice().cols as u32 * SPECKLES_PER_SCALE,
+        seed: derive_seed(preset.seed, "per_scale"),
+        channels: ScaleChannels {
+            crevice: s.channel_index(channel::CREVICE),
+            random: s.field.output_index(channel::CELL_RANDOM).unwrap_or(0),
+            inside: s.field.output_index(channel::INSIDE).unwrap_or(0),
+            along: s.field.output_index(channel::ALONG).unwrap_or(0),
+        },
+    })
+}
+
+/// The scale-field channels the per-scale colour reads, for `scale_outputs`.
+pub(super) fn per_scale_channels(preset: &Preset) -> Vec<usize> {
+    let c = &preset.color;
+    let mut channels = Vec::new();
+    if c.scale_tone > 0.0 || c.scale_hue > 0.0 {
+        channels.push(channel::CELL_RANDOM);
+    }
+    if c.edge_tone != 0.0 {
+        channels.push(channel::INSIDE);
+    }
+    if c.tip_tone != 0.0 {
+        channels.push(channel::ALONG);
+    }
+    channels
 }
 
 fn perlin(cells_u: u32, cells_v: u32, octaves: u32, gain: f32, seed: u32) -> Op {
@@ -79,6 +165,7 @@ fn levels(g: &mut GraphBuilder, name: &str, input: NodeId, lo: f32, hi: f32) -> 
 /// The raw coverage shapes of a layer, each with its colour.
 fn shapes(
     g: &mut GraphBuilder,
+    lattice: &Lattice,
     layer: &PatternLayer,
     name: &dyn Fn(&str) -> String,
     seed: u32,
@@ -90,6 +177,14 @@ fn shapes(
             let n = g.add(name("noise"), perlin(3, 3, 4, 0.5, seed), &[]);
             let amount = layer.amount as f32;
             vec![(levels(g, &name("shape"), n, amount * 0.6, amount), layer.color)]
+        }
+        PatternKind::Stripes if layer.rows.len() == 2 => {
+            // On named scale rows (`Lattice::row_span_u`), mirrored about the spine.
+            let (u0, u1) = lattice.row_span_u(layer.rows[0] as f32, layer.rows[1] as f32);
+            let half_width = 0.5 * (u1 - u0);
+            let centres = vec![0.5 * (u0 + u1), 1.0 - 0.5 * (u0 + u1)];
+            let op = Op::Bands { axis: Axis::U, centres, half_width, softness: 0.002 };
+            vec![(g.add(name("shape"), op, &[]), layer.color)]
         }
         PatternKind::Stripes => {
             // `amount` stripes each side of the dorsal midline (u = 0.5), centre to centre
@@ -200,7 +295,7 @@ fn pattern_layer(
     let prefix = format!("pattern{i}");
     let seed = derive_seed(context.seed, &prefix);
     let mut color = below;
-    let parts = shapes(g, layer, &|part: &str| format!("{prefix}.{part}"), seed);
+    let parts = shapes(g, &s.field.lattice(), layer, &|part: &str| format!("{prefix}.{part}"), seed);
     let many = parts.len() > 1;
     for (k, (shape, tint)) in parts.into_iter().enumerate() {
         let name = |part: &str| if many { format!("{prefix}.{k}.{part}") } else { format!("{prefix}.{part}") };

@@ -51,6 +51,9 @@ pub fn scale_field(preset: &Preset) -> ScaleField {
         imbrication: s.imbrication as f32,
         edge_softness: s.edge_softness as f32,
         belly_width: if preset.belly.plates { preset.belly.width as f32 } else { 0.0 },
+        vertebral_width: s.vertebral_width as f32,
+        lowest_row_width: s.lowest_row_width as f32,
+        smooth_rows: s.smooth_rows,
         seed: derive_seed(preset.seed, "scales"),
         outputs: scale_outputs(preset),
     }
@@ -71,6 +74,11 @@ fn scale_outputs(preset: &Preset) -> Vec<usize> {
     }
     if preset.pattern.iter().any(|p| p.scale_aligned > 0.0) {
         outputs.extend([channel::CENTRE_U, channel::CENTRE_V]);
+    }
+    for c in color::per_scale_channels(preset) {
+        if !outputs.contains(&c) {
+            outputs.push(c);
+        }
     }
     outputs
 }

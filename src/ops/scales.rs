@@ -39,7 +39,13 @@ pub mod channel {
     /// Texture coordinates of the visible scale's centre (for colour that follows scales).
     pub const CENTRE_U: usize = 6;
     pub const CENTRE_V: usize = 7;
-    pub const COUNT: usize = 8;
+    /// Distance inside the visible scale's outline, in scale-cell widths (0 off every
+    /// scale): how far a pixel lies from its scale's edge, for lighter or darker rims.
+    pub const INSIDE: usize = 8;
+    /// Dorsal scale row of the visible scale, 1 the lowest (next to the ventral plates),
+    /// (rows + 1) / 2 the vertebral row; 0 on the ventral plates and between scales.
+    pub const ROW: usize = 9;
+    pub const COUNT: usize = 10;
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -68,15 +74,31 @@ pub struct ScaleField {
     /// Width of the rounded rim of each scale, in scale widths.
     pub edge_softness: f32,
     /// Width of the ventral band as a fraction of the circumference; 0 disables plates.
+    /// The band is rounded to whole scale columns (`Lattice`), so exactly `rows` dorsal rows
+    /// lie between its edges.
     pub belly_width: f32,
+    /// Width of the vertebral row (the row on the spine) relative to the others, ≥ 1.
+    pub vertebral_width: f32,
+    /// Width of the lowest dorsal row (next to the ventral plates) relative to the others.
+    pub lowest_row_width: f32,
+    /// The lowest this many dorsal rows carry no keel.
+    pub smooth_rows: u32,
     pub seed: u32,
     /// Which `channel`s the node outputs, in order (memory: 4 bytes per pixel each, so the
     /// graph asks only for those its maps read).
     pub outputs: Vec<usize>,
 }
 
-/// The lattice's integer layout derived from the parameters.
-#[derive(Debug, Clone, Copy)]
+/// The lattice's layout derived from the parameters.
+///
+/// Columns run around the body: the ventral band (centred on u = 0, an even number
+/// `belly_cols` of columns, one plate per row across them) and exactly `rows` dorsal columns
+/// between its edges, so `rows` means what a herpetologist counts: the dorsal scale rows
+/// from one side's ventrals to the other's. With an odd row count the vertebral row is
+/// centred on the spine (u = 0.5). Columns may differ in width (an enlarged vertebral row, a
+/// wider lowest row): `bounds` holds each column's left edge in u, and lattice x is u warped
+/// piecewise linearly through them, so a wider column holds wider scales.
+#[derive(Debug, Clone)]
 pub struct Lattice {
     pub cols: i32,
     pub rows_v: i32,
@@ -84,14 +106,112 @@ pub struct Lattice {
     pub stagger: i32,
     /// Actual cell length / width after rounding `rows_v` to an integer.
     pub aspect: f32,
+    /// Columns of the ventral band (even; 0 without plates).
+    pub belly_cols: i32,
+    /// u of every column edge, cols + 1 entries from 0 to 1.
+    pub bounds: Vec<f32>,
+    uniform: bool,
+}
+
+impl Lattice {
+    /// The ventral band's width, fraction of the circumference (whole columns).
+    pub fn belly_width(&self) -> f32 {
+        2.0 * self.bounds[(self.belly_cols / 2) as usize]
+    }
+
+    /// Dorsal row of column `c` (any integer; wrapped): 1 the lowest, 0 in the ventral band.
+    pub fn row_of(&self, c: i32) -> i32 {
+        let c = c.rem_euclid(self.cols);
+        let half = self.belly_cols / 2;
+        if c < half || c >= self.cols - half {
+            return 0;
+        }
+        (c - half).min(self.cols - half - 1 - c) + 1
+    }
+
+    /// Lattice x (columns) of texture u in [0, 1).
+    #[inline]
+    pub fn x_of(&self, u: f32) -> f32 {
+        if self.uniform {
+            return u * self.cols as f32;
+        }
+        let c = (self.bounds.partition_point(|b| *b <= u).max(1) - 1).min(self.cols as usize - 1);
+        let (a, b) = (self.bounds[c], self.bounds[c + 1]);
+        c as f32 + (u - a) / (b - a)
+    }
+
+    /// Texture u of lattice x (any real; wrapped into [0, 1)).
+    pub fn u_of(&self, x: f32) -> f32 {
+        let n = self.cols as f32;
+        let x = x.rem_euclid(n);
+        if self.uniform {
+            return (x / n).rem_euclid(1.0);
+        }
+        let c = (x as usize).min(self.cols as usize - 1);
+        let (a, b) = (self.bounds[c], self.bounds[c + 1]);
+        (a + (x - c as f32) * (b - a)).rem_euclid(1.0)
+    }
+
+    /// The u range, on the side u > 0.5, from the start of dorsal row `first` to the end of
+    /// row `last` (1 the lowest; fractions reach into a row, 0.5 its middle); mirrored, the
+    /// same rows on the other side span 1 − that range.
+    pub fn row_span_u(&self, first: f32, last: f32) -> (f32, f32) {
+        // Row k on the far side is column cols − half − k (its left edge).
+        let half = (self.belly_cols / 2) as f32;
+        let x_of_row_edge = |k: f32| self.cols as f32 - half - k + 1.0;
+        let (x0, x1) = (x_of_row_edge(last + 1.0), x_of_row_edge(first));
+        let u = |x: f32| if x >= self.cols as f32 { 1.0 } else { self.u_of(x) };
+        (u(x0), u(x1))
+    }
 }
 
 impl ScaleField {
     pub fn lattice(&self) -> Lattice {
-        let cols = self.rows.max(1) as i32;
-        let rows_v = ((cols as f32 / self.aspect).round() as i32).max(1);
+        let rows = self.rows.max(1) as i32;
+        // Relative width of each dorsal row, 1 the lowest.
+        let vertebral = (rows % 2 == 1).then_some((rows + 1) / 2);
+        let width_of_row = |k: i32| {
+            if Some(k) == vertebral {
+                self.vertebral_width.max(0.1)
+            } else if k == 1 {
+                self.lowest_row_width.max(0.1)
+            } else {
+                1.0
+            }
+        };
+        let dorsal: f32 = (1..=rows).map(|k| width_of_row(k.min(rows + 1 - k))).sum();
+        let belly_cols = if self.belly_width > 0.0 {
+            // Even, at least 2: an equal number of plate columns each side of u = 0.
+            let bw = self.belly_width.min(0.9);
+            2 * ((dorsal * bw / (2.0 * (1.0 - bw))).round() as i32).max(1)
+        } else {
+            0
+        };
+        let cols = rows + belly_cols;
+        let half = belly_cols / 2;
+        let widths: Vec<f32> =
+            (0..cols)
+                .map(|c| {
+                    if c < half || c >= cols - half {
+                        1.0
+                    } else {
+                        width_of_row((c - half).min(cols - half - 1 - c) + 1)
+                    }
+                })
+                .collect();
+        let uniform = widths.iter().all(|w| *w == 1.0);
+        let total: f32 = widths.iter().sum();
+        let mut bounds = Vec::with_capacity(cols as usize + 1);
+        let mut acc = 0.0f32;
+        for w in &widths {
+            bounds.push(if uniform { bounds.len() as f32 / cols as f32 } else { acc / total });
+            acc += w;
+        }
+        bounds.push(1.0);
+        // The cell aspect is that of an ordinary (width 1) column, 1 / total of u wide.
+        let rows_v = ((total / self.aspect).round() as i32).max(1);
         let stagger = cols / 2;
-        Lattice { cols, rows_v, stagger, aspect: cols as f32 / rows_v as f32 }
+        Lattice { cols, rows_v, stagger, aspect: total / rows_v as f32, belly_cols, bounds, uniform }
     }
 }
 
@@ -151,11 +271,13 @@ struct Candidate {
     /// Texture coordinates of the scale's centre, wrapped into [0, 1).
     centre_u: f32,
     centre_v: f32,
+    /// Dorsal row (`Lattice::row_of`), 0 for a ventral plate.
+    row: i32,
 }
 
 /// The lattice is shifted by a quarter row along v so that no row of scale edges lies
 /// exactly on the texture's v seam (a crevice there would be real but would read as a seam).
-const ROW_PHASE: f32 = 0.25;
+pub const ROW_PHASE: f32 = 0.25;
 
 /// Where a scale's rim meets the scale underneath, the surface falls to this fraction of the
 /// lower scale's height: a groove, not a hole.
@@ -244,10 +366,11 @@ impl ScaleField {
         let lattice = self.lattice();
         let table = CellTable::new(self, &lattice);
         let geo = Geometry::new(self.shape, 0.5 * lattice.aspect);
+        let belly_half = 0.5 * lattice.belly_width();
         Image::from_fn(width, height, self.outputs.len(), |u, v, out| {
             let mut all = [0.0f32; channel::COUNT];
             let dist_belly = u.min(1.0 - u);
-            if self.belly_width > 0.0 && dist_belly < self.belly_width * 0.5 {
+            if dist_belly < belly_half {
                 self.ventral_pixel(&lattice, dist_belly, v, &mut all);
             } else if self.shape == ScaleShape::Hexagon {
                 self.hexagon_pixel(&lattice, &table, u, v, &mut all);
@@ -297,13 +420,13 @@ impl ScaleField {
             let dome = smoothstep(0.0, 0.35, inside);
             0.45 + 0.15 * dome + 0.3 * self.imbrication * along
         };
-        let x = u * lattice.cols as f32;
+        let x = lattice.x_of(u);
         let y = v * lattice.rows_v as f32 - ROW_PHASE;
         let c0 = floor_i32(x);
         // The nine neighbouring cells are visited in explicit loops, as in `hexagon_pixel`:
         // a shared helper returning them as an array measured 3x slower at 2048².
-        // (inside, lx, ly, random, cx, cy) of the top scale so far.
-        let mut top: Option<(f32, f32, f32, f32, f32, f32)> = None;
+        // (inside, lx, ly, random, cx, cy, column) of the top scale so far.
+        let mut top: Option<(f32, f32, f32, f32, f32, f32, i32)> = None;
         let mut under_height = 0.0f32;
         for dc in -1..=1 {
             let c = c0 + dc;
@@ -330,12 +453,12 @@ impl ScaleField {
                         if let Some(t) = top {
                             under_height = under_height.max(profile(t.0, t.2));
                         }
-                        top = Some((inside, lx, ly, cell.random, cx, cy));
+                        top = Some((inside, lx, ly, cell.random, cx, cy, c));
                     }
                 }
             }
         }
-        let Some((inside, lx, ly, random, cx, cy)) = top else {
+        let Some((inside, lx, ly, random, cx, cy, column)) = top else {
             return self.write_scale(None, 0.0, self.keel_height, out);
         };
         let rim = smoothstep(0.0, soft, inside);
@@ -347,8 +470,9 @@ impl ScaleField {
             y: ly,
             half_len: geo.b,
             random,
-            centre_u: (cx / lattice.cols as f32).rem_euclid(1.0),
+            centre_u: lattice.u_of(cx),
             centre_v: ((cy + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+            row: lattice.row_of(column),
         };
         self.write_scale(Some(top), height, self.keel_height, out);
     }
@@ -356,10 +480,11 @@ impl ScaleField {
     fn hexagon_pixel(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32, out: &mut [f32]) {
         // Voronoi cell of the jittered lattice: nearest centre, then the distance to the
         // nearest bisector with any other centre is the distance to the cell's edge.
-        let x = u * lattice.cols as f32;
+        let x = lattice.x_of(u);
         let y = v * lattice.rows_v as f32 - ROW_PHASE;
         let c0 = floor_i32(x);
         let mut centres = [(0.0f32, 0.0f32, 0.0f32, 1.0f32, 0.0f32); 9];
+        let mut columns = [0i32; 9];
         let mut n = 0;
         for dc in -1..=1 {
             let c = c0 + dc;
@@ -369,6 +494,7 @@ impl ScaleField {
                 let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
                 // Isotropic coordinates: along-body distances scaled by the cell aspect.
                 centres[n] = (cx, cy * lattice.aspect, cell.random, cell.inv_size, cell.cos);
+                columns[n] = c;
                 n += 1;
             }
         }
@@ -395,8 +521,9 @@ impl ScaleField {
             y: p.1 - c1.1,
             half_len,
             random: c1.2,
-            centre_u: (c1.0 / lattice.cols as f32).rem_euclid(1.0),
+            centre_u: lattice.u_of(c1.0),
             centre_v: ((c1.1 / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+            row: lattice.row_of(columns[nearest]),
         };
         let soft = self.edge_softness.max(1e-4);
         let along = (cand.y / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
@@ -419,8 +546,12 @@ impl ScaleField {
                 out[channel::CELL_RANDOM] = 0.0;
                 out[channel::CENTRE_U] = -1.0;
                 out[channel::CENTRE_V] = -1.0;
+                out[channel::INSIDE] = 0.0;
+                out[channel::ROW] = 0.0;
             }
             Some(c) => {
+                // The lowest `smooth_rows` dorsal rows carry no keel.
+                let keel_height = if c.row > 0 && c.row as u32 <= self.smooth_rows { 0.0 } else { keel_height };
                 let along = (c.y / c.half_len * 0.5 + 0.5).clamp(0.0, 1.0);
                 let hw = half_width(self.shape);
                 let radial = ((c.x / hw).powi(2) + (c.y / c.half_len).powi(2)).sqrt().min(1.0);
@@ -440,6 +571,8 @@ impl ScaleField {
                 out[channel::CELL_RANDOM] = c.random;
                 out[channel::CENTRE_U] = c.centre_u;
                 out[channel::CENTRE_V] = c.centre_v;
+                out[channel::INSIDE] = c.inside.max(0.0);
+                out[channel::ROW] = c.row as f32;
             }
         }
     }
@@ -448,9 +581,10 @@ impl ScaleField {
     /// dorsal scales (the thesis stretches normal scales "from the middle", §4.2.2).
     fn ventral_pixel(&self, lattice: &Lattice, dist_belly: f32, v: f32, out: &mut [f32]) {
         let soft = self.edge_softness.max(1e-4);
-        let half_band = self.belly_width * 0.5;
-        // Distances in dorsal scale widths, the unit of `edge_softness`.
-        let to_side = (half_band - dist_belly) * lattice.cols as f32;
+        let half_band = lattice.belly_width() * 0.5;
+        // Distances in dorsal scale widths, the unit of `edge_softness` (a plate column is
+        // one ordinary column wide).
+        let to_side = (half_band - dist_belly) / lattice.bounds[1];
         let y = v * lattice.rows_v as f32 - ROW_PHASE;
         let r0 = floor_i32(y);
         let half_len = 0.5 * self.size.max(0.5);
@@ -475,6 +609,7 @@ impl ScaleField {
                     random,
                     centre_u: 0.0,
                     centre_v: ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+                    row: 0,
                 };
                 best = Some((h, cand));
             }

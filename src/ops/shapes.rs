@@ -202,22 +202,90 @@ pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
     rasterise(width, height, pb, FillRule::Winding)
 }
 
-/// Checkered ventral plates: in the belly band (centred on u = 0), a square on the left
-/// outer third of every other plate row and on the right outer third of the rows between,
-/// inset from the plate edges; the middle third stays plain (so nothing meets the seam).
-pub fn belly_checker(width: usize, height: usize, rows_v: u32, belly_width: f32, softness: f32) -> Image {
-    let half = belly_width * 0.5;
-    let rows = rows_v.max(1) as f32;
-    let soft = softness.max(0.5 / width as f32);
+/// What the ventral plates carry (`BellyMarks`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BellyMarkKind {
+    /// A square on the left outer third of every other plate and on the right outer third
+    /// of the plates between (corn snakes).
+    Checkered,
+    /// Scattered dark marks: on each plate, with probability `amount`, one oval at a random
+    /// place across it (ball pythons' "scattered black markings").
+    Spots,
+    /// Half-moons on the plates' free posterior edges, alternating sides, present on each
+    /// plate with probability `amount`.
+    HalfMoons,
+    /// A stripe along the ventral midline, `amount` of the band wide.
+    MedianStripe,
+}
+
+/// Marks on the ventral plates, aligned with the scale field's plates (the same rows and
+/// row phase, `ops::scales::ROW_PHASE`), inside the belly band centred on u = 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BellyMarks {
+    pub kind: BellyMarkKind,
+    /// Plates per tile (the scale lattice's rows along v).
+    pub rows_v: u32,
+    /// The band's width, fraction of the circumference.
+    pub belly_width: f32,
+    /// Probability per plate (spots, half-moons) or stripe width over the band's (stripe).
+    pub amount: f32,
+    /// Edge softness, fraction of the circumference.
+    pub softness: f32,
+    pub seed: u32,
+}
+
+pub fn belly_marks(width: usize, height: usize, marks: &BellyMarks) -> Image {
+    let half = marks.belly_width * 0.5;
+    let rows = marks.rows_v.max(1) as f32;
+    let soft = marks.softness.max(0.5 / width.min(height) as f32);
+    // Plate r spans y = v · rows − ROW_PHASE ∈ [r, r + 1); `along` runs 0 → 1 head to tail.
+    let phase = super::scales::ROW_PHASE;
+    let ramp = |distance_inside: f32| ((distance_inside - 0.3 * soft) / soft).clamp(0.0, 1.0);
     Image::gray_from_fn(width, height, |u, v| {
         let (side, d) = if u < 0.5 { (0, u) } else { (1, 1.0 - u) };
-        let r = (v * rows) as i32;
-        if (r + side) % 2 == 1 || d > half || d < half / 3.0 {
+        if d > half {
             return 0.0;
         }
-        // Inset: fade out near the plate's ends and the square's sides.
-        let along = (v * rows).fract();
-        let edge = (along.min(1.0 - along) / rows).min(half - d).min(d - half / 3.0);
-        ((edge - 0.3 * soft) / soft).clamp(0.0, 1.0)
+        let y = v * rows - phase;
+        let r = super::image::floor_i32(y);
+        let along = y - r as f32;
+        let plate = r.rem_euclid(marks.rows_v.max(1) as i32);
+        // Signed position across the band, −1 (one side's edge) .. 1 (the other's).
+        let across = if side == 0 { d / half } else { -d / half };
+        let to_ends = along.min(1.0 - along) / rows;
+        match marks.kind {
+            BellyMarkKind::Checkered => {
+                if (r + side) % 2 == 1 || d < half / 3.0 {
+                    return 0.0;
+                }
+                ramp(to_ends.min(half - d).min(d - half / 3.0))
+            }
+            BellyMarkKind::Spots => {
+                if super::hash::unit(plate, 0, 0, marks.seed) >= marks.amount {
+                    return 0.0;
+                }
+                // An oval half a plate long, a sixth of the band wide, kept off the seam
+                // (u = 0) and the band's edges.
+                let centre = 0.2 + 0.65 * super::hash::unit(plate, 0, 1, marks.seed);
+                let centre = if super::hash::unit(plate, 0, 2, marks.seed) < 0.5 { centre } else { -centre };
+                let (rx, ry) = (half / 6.0, 0.25 / rows);
+                let dx = (across - centre) * half / rx;
+                let dy = (along - 0.5) / rows / ry;
+                let r_norm = (dx * dx + dy * dy).sqrt();
+                ramp((1.0 - r_norm) * rx.min(ry))
+            }
+            BellyMarkKind::HalfMoons => {
+                if super::hash::unit(plate, 0, 0, marks.seed) >= marks.amount {
+                    return 0.0;
+                }
+                // A half-disc resting on the plate's posterior edge, on alternate sides.
+                let centre = if plate % 2 == 0 { 0.5 } else { -0.5 };
+                let radius = (0.45 / rows).min(half * 0.3);
+                let dx = (across - centre) * half;
+                let dy = (1.0 - along) / rows;
+                ramp(radius - (dx * dx + dy * dy).sqrt())
+            }
+            BellyMarkKind::MedianStripe => ramp(marks.amount * half - d),
+        }
     })
 }

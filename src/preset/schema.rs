@@ -148,6 +148,12 @@ pub struct Scales {
     pub imbrication: f64,
     /// Width of a scale's rounded rim, in scale widths.
     pub edge_softness: f64,
+    /// Width of the vertebral row relative to the other rows (kraits: enlarged).
+    pub vertebral_width: f64,
+    /// Width of the lowest dorsal row, next to the ventral plates, relative to the others.
+    pub lowest_row_width: f64,
+    /// The lowest this many dorsal rows are smooth when the scales are keeled.
+    pub smooth_rows: u32,
 }
 
 impl Default for Scales {
@@ -163,6 +169,9 @@ impl Default for Scales {
             jitter: 0.1,
             imbrication: 0.6,
             edge_softness: 0.06,
+            vertebral_width: 1.0,
+            lowest_row_width: 1.0,
+            smooth_rows: 0,
         }
     }
 }
@@ -293,6 +302,12 @@ pub struct PatternLayer {
     /// boundaries); 0 leaves it free, 1 colours each scale by the pattern at its centre.
     #[serde(default)]
     pub scale_aligned: f64,
+    /// Stripes: the dorsal scale rows the stripe covers, `[first, last]`, counted from the
+    /// lowest row (1, next to the ventral plates) to the vertebral row; fractions reach into
+    /// a row (9.5 = from the middle of row 9). Mirrored on both sides; overrides `offset`,
+    /// `position`, `size` and `amount`.
+    #[serde(default)]
+    pub rows: Vec<f64>,
 }
 
 impl PatternLayer {
@@ -357,6 +372,11 @@ pub struct Belly {
     /// plate in `pattern_color`, as in corn snakes).
     pub pattern: BellyPattern,
     pub pattern_color: Srgb8,
+    /// Spots and half-moons: the share of plates that carry one; median stripe: its width
+    /// over the band's.
+    pub pattern_amount: f64,
+    /// The belly colour runs up onto this many of the lowest dorsal rows each side.
+    pub up_rows: u32,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
@@ -364,6 +384,9 @@ pub struct Belly {
 pub enum BellyPattern {
     None,
     Checkered,
+    Spots,
+    HalfMoons,
+    MedianStripe,
 }
 
 impl Default for Belly {
@@ -375,6 +398,8 @@ impl Default for Belly {
             blend: 0.03,
             pattern: BellyPattern::None,
             pattern_color: Srgb8([0x18, 0x16, 0x14]),
+            pattern_amount: 0.5,
+            up_rows: 0,
         }
     }
 }
@@ -388,11 +413,38 @@ pub struct ColorParams {
     pub variation: f64,
     /// Darkening of the skin between scales, 0..1.
     pub between_scales: f64,
+    /// Per-scale brightness jitter (± this fraction, one value per scale).
+    pub scale_tone: f64,
+    /// Per-scale warm/cool jitter (± this fraction on red against blue, one per scale).
+    pub scale_hue: f64,
+    /// Scale rims lighter (> 0) or darker (< 0), −1..1.
+    pub edge_tone: f64,
+    /// Free posterior tips lighter (> 0) or darker (< 0), −1..1.
+    pub tip_tone: f64,
+    /// Melanophore speckle inside scales: the fraction of fine dot sites that carry a dot.
+    pub speckle: f64,
+    pub speckle_color: Srgb8,
+    /// The colour of the skin between scales where they part; unset keeps the colour
+    /// underneath (darkened by `between_scales`).
+    pub skin: Option<Srgb8>,
 }
 
 impl Default for ColorParams {
     fn default() -> Self {
-        ColorParams { base: Srgb8([0x5a, 0x6b, 0x3c]), variation: 0.15, between_scales: 0.35 }
+        ColorParams {
+            base: Srgb8([0x5a, 0x6b, 0x3c]),
+            variation: 0.15,
+            between_scales: 0.35,
+            // A few per cent per scale: photographs of any snake show neighbouring scales of
+            // one colour differing slightly in tone; 0 gives the flat look of vector art.
+            scale_tone: 0.06,
+            scale_hue: 0.02,
+            edge_tone: 0.0,
+            tip_tone: 0.0,
+            speckle: 0.0,
+            speckle_color: Srgb8([0x16, 0x14, 0x12]),
+            skin: None,
+        }
     }
 }
 

@@ -20,6 +20,8 @@ pub mod ranges {
     pub const KEEL_WIDTH: (f64, f64) = (0.01, 0.5);
     pub const JITTER: (f64, f64) = (0.0, 0.5);
     pub const EDGE_SOFTNESS: (f64, f64) = (0.005, 0.5);
+    /// Relative row widths: a krait's vertebral row is about twice the others.
+    pub const ROW_WIDTH: (f64, f64) = (0.5, 3.0);
     pub const STRIPES_PER_SIDE: (f64, f64) = (1.0, 16.0);
     pub const SPOTS_AROUND: (f64, f64) = (1.0, 64.0);
     pub const RINGS_PER_TILE: (f64, f64) = (1.0, 32.0);
@@ -34,6 +36,10 @@ pub mod ranges {
     pub const NORMAL_STRENGTH: (f64, f64) = (0.0, 10.0);
     pub const GRAIN: (f64, f64) = (0.0, 0.2);
     pub const ROUGHNESS_VARIATION: (f64, f64) = (0.0, 0.5);
+    /// Per-scale tone and hue jitter: ± half the colour at most.
+    pub const SCALE_JITTER: (f64, f64) = (0.0, 0.5);
+    /// Rim and tip tone: −1 black .. +1 twice as bright.
+    pub const SIGNED_UNIT: (f64, f64) = (-1.0, 1.0);
     pub const SPREAD_NM: (f64, f64) = (0.0, 2000.0);
     /// Refractive indices of real dielectrics; 1 is vacuum.
     pub const IOR: (f64, f64) = (1.0, 3.0);
@@ -84,6 +90,14 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
     c.range("scales.jitter", s.jitter, JITTER);
     c.range("scales.imbrication", s.imbrication, UNIT);
     c.range("scales.edge_softness", s.edge_softness, EDGE_SOFTNESS);
+    c.range("scales.vertebral_width", s.vertebral_width, ROW_WIDTH);
+    c.range("scales.lowest_row_width", s.lowest_row_width, ROW_WIDTH);
+    if s.smooth_rows > s.rows / 2 {
+        c.problems.push(Problem {
+            key: "scales.smooth_rows".into(),
+            message: format!("must be an integer in [0, {}] (half of `rows`), got {}", s.rows / 2, s.smooth_rows),
+        });
+    }
 
     if preset.pattern.len() > MAX_PATTERN_LAYERS {
         c.problems.push(Problem {
@@ -146,6 +160,25 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
             c.problems.push(Problem { key: key("widths"), message: "must sum to at most 1 (one repeat)".into() });
         }
         c.range(key("scale_aligned"), p.scale_aligned, UNIT);
+        if !p.rows.is_empty() {
+            let top = (preset.scales.rows as f64 + 1.0) / 2.0;
+            let ok = p.kind == PatternKind::Stripes
+                && p.rows.len() == 2
+                && p.rows.iter().all(|r| r.is_finite())
+                && 0.5 <= p.rows[0]
+                && p.rows[0] <= p.rows[1]
+                && p.rows[1] <= top;
+            if !ok {
+                c.problems.push(Problem {
+                    key: key("rows"),
+                    message: format!(
+                        "must be [first, last] dorsal rows with 0.5 ≤ first ≤ last ≤ {top} (the vertebral row of \
+                         {} rows), for kind \"stripes\" only; got {:?}",
+                        preset.scales.rows, p.rows
+                    ),
+                });
+            }
+        }
         c.range(key("length"), p.length, BLOTCH_LENGTH);
         c.range(key("size"), p.size, PATTERN_SIZE);
         c.range(key("offset"), p.offset, PATTERN_OFFSET);
@@ -156,8 +189,24 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
 
     c.range("belly.width", preset.belly.width, BELLY_WIDTH);
     c.range("belly.blend", preset.belly.blend, BELLY_BLEND);
+    c.range("belly.pattern_amount", preset.belly.pattern_amount, UNIT);
+    if preset.belly.up_rows > s.rows / 2 {
+        c.problems.push(Problem {
+            key: "belly.up_rows".into(),
+            message: format!(
+                "must be an integer in [0, {}] (half of `scales.rows`), got {}",
+                s.rows / 2,
+                preset.belly.up_rows
+            ),
+        });
+    }
     c.range("color.variation", preset.color.variation, UNIT);
     c.range("color.between_scales", preset.color.between_scales, UNIT);
+    c.range("color.scale_tone", preset.color.scale_tone, SCALE_JITTER);
+    c.range("color.scale_hue", preset.color.scale_hue, SCALE_JITTER);
+    c.range("color.edge_tone", preset.color.edge_tone, SIGNED_UNIT);
+    c.range("color.tip_tone", preset.color.tip_tone, SIGNED_UNIT);
+    c.range("color.speckle", preset.color.speckle, UNIT);
     c.range("height.normal_strength", preset.height.normal_strength, NORMAL_STRENGTH);
     c.range("height.grain", preset.height.grain, GRAIN);
     let r = &preset.roughness;

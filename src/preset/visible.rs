@@ -62,13 +62,27 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
     }))
 }
 
+/// The most the per-scale colour brightens a pixel (`ops::scale_colour`): tone and hue
+/// (red by up to (1 + tone)(1 + hue)), rim and tip where they lighten.
+pub fn per_scale_gain(preset: &Preset) -> f64 {
+    let c = &preset.color;
+    (1.0 + c.scale_tone.max(0.0))
+        * (1.0 + c.scale_hue.max(0.0))
+        * (1.0 + c.edge_tone.max(0.0))
+        * (1.0 + c.tip_tone.max(0.0))
+}
+
 /// Every colour key of a preset with its value, mutable.
 fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
     let mut keys: Vec<(String, &mut Srgb8)> = vec![
         ("color.base".into(), &mut preset.color.base),
         ("belly.color".into(), &mut preset.belly.color),
         ("belly.pattern_color".into(), &mut preset.belly.pattern_color),
+        ("color.speckle_color".into(), &mut preset.color.speckle_color),
     ];
+    if let Some(skin) = preset.color.skin.as_mut() {
+        keys.push(("color.skin".into(), skin));
+    }
     for (i, layer) in preset.pattern.iter_mut().enumerate() {
         keys.push((format!("pattern.{i}.color"), &mut layer.color));
         keys.push((format!("pattern.{i}.outline_color"), &mut layer.outline_color));
@@ -82,16 +96,24 @@ fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
 /// Clamps every colour key the stack cannot show and returns what was clamped. A colour
 /// keeps its hue and saturation: all three channels are scaled by the one factor that
 /// brings the brightest-over-its-limit channel to the limit (rounded down to 8 bits). The
-/// back's colour variation brightens `color.base` by up to (1 + `color.variation`)
-/// (`maps::color`), so that key is held to the limit over that factor.
+/// map brightens colours beyond their keys in two places, and the keys keep headroom for
+/// both: the per-scale colour (`ops::scale_colour`: tone, warm hue, lighter rims and tips)
+/// by up to `per_scale_gain` on every key, and the back's colour variation `color.base` by
+/// up to (1 + `color.variation`) more (`maps::color`).
 pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
     let Some(limit) = visible_limit(preset) else {
         return Vec::new();
     };
+    let per_scale = per_scale_gain(preset);
     let variation = 1.0 + preset.color.variation.max(0.0);
     let mut clamped = Vec::new();
     for (key, colour) in colour_keys(preset) {
-        let headroom = if key == "color.base" { variation } else { 1.0 };
+        // Speckle and skin are mixed in after the brightening: they show as written.
+        let headroom = match key.as_str() {
+            "color.base" => variation * per_scale,
+            "color.speckle_color" | "color.skin" => 1.0,
+            _ => per_scale,
+        };
         let allowed = limit.map(|l| l / headroom);
         let linear = colour.to_linear().map(f64::from);
         let factor = (0..3).filter(|&c| linear[c] > allowed[c]).map(|c| allowed[c] / linear[c]).fold(1.0, f64::min);

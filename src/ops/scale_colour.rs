@@ -1,0 +1,158 @@
+//! Colour that lives in scales: each scale of a real snake is one field of pigment cells,
+//! so it carries its own tone, its rim and its free tip are often lighter or darker than
+//! its middle, melanophores sit in it as fine dark specks, and where scales part the skin
+//! between them shows its own colour. One pass over the colour map and the scale field
+//! does all of it, keyed by scale identity (`channel::CELL_RANDOM`, the same over a whole
+//! scale), so a scale's tone never changes inside it and never leaks into its neighbour.
+//!
+//! Per pixel, in this order (w_s = 1 − crevice, the weight of the scale's own surface):
+//!
+//! ```text
+//! skin     c ← mix(c, skin, crevice)                        where scales part
+//! tone     c ← c (1 + tone (2ρ₁ − 1) w_s)                    ρ₁ the scale's random number
+//! hue      R ← R (1 + hue (2ρ₂ − 1) w_s), B ← B (1 − …)      warmer or cooler, ρ₂ = hash(ρ₁)
+//! rim      c ← c (1 + edge (1 − smoothstep(0, RIM_WIDTH, inside)) w_s)
+//! tip      c ← c (1 + tip smoothstep(TIP_START, 1, along) w_s)
+//! speckle  c ← mix(c, speckle colour, dot coverage · w_s)
+//! ```
+//!
+//! Every change is a factor or a mix, so black stays black and a key at 0 leaves the
+//! pixel's bytes as they were. The speckle dots lie on a fixed grid of `SPECKLES_PER_SCALE`
+//! cells per scale width in both directions (texture space is isotropic), one dot at most
+//! per cell, present with probability `speckle`: the same dots at every resolution, and the
+//! grid is a whole number of cells per texture, so the map still tiles.
+
+use super::hash;
+use super::image::{Image, floor_i32};
+
+/// Rim band, in scale-cell widths from the outline inward: about an eighth of a scale's
+/// width, the margin that reads as "edged" in photographs of e.g. Natrix or Philodryas.
+pub const RIM_WIDTH: f32 = 0.12;
+/// The free tip starts this far along the scale (0 anterior, 1 posterior edge).
+pub const TIP_START: f32 = 0.7;
+/// Speckle grid cells per scale width: melanophore clusters a fraction of a scale across.
+pub const SPECKLES_PER_SCALE: u32 = 6;
+/// Dot radius in speckle cells.
+const DOT_RADIUS: f32 = 0.28;
+
+/// Scale-field channel positions the kernel reads (indices into the scales image).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ScaleChannels {
+    pub crevice: usize,
+    pub random: usize,
+    pub inside: usize,
+    pub along: usize,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScaleColour {
+    /// Per-scale brightness jitter, ± this fraction.
+    pub tone: f32,
+    /// Per-scale warm/cool jitter, ± this fraction on red against blue.
+    pub hue: f32,
+    /// Rim brightening (> 0) or darkening (< 0), −1..1.
+    pub edge: f32,
+    /// Free-tip brightening (> 0) or darkening (< 0), −1..1.
+    pub tip: f32,
+    /// Fraction of speckle cells that carry a dot, 0..1.
+    pub speckle: f32,
+    pub speckle_color: [f32; 3],
+    /// The skin between scales, where they part; None keeps the colour underneath.
+    pub skin: Option<[f32; 3]>,
+    /// Speckle grid cells around the texture (= along it): scale columns × SPECKLES_PER_SCALE.
+    pub speckle_cells: u32,
+    pub seed: u32,
+    pub channels: ScaleChannels,
+}
+
+#[inline]
+fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+impl ScaleColour {
+    /// Applies the per-scale colour to `colour` (linear RGB) with the scale field `scales`.
+    pub fn apply(&self, colour: Image, scales: &Image) -> Image {
+        let (width, height) = (colour.width, colour.height);
+        let ch = colour.channels;
+        let sc = scales.channels;
+        let k = self.channels;
+        let cells = self.speckle_cells.max(1) as f32;
+        // Anti-aliasing band of a dot's edge: one pixel, in speckle cells.
+        let aa = cells / width.min(height).max(1) as f32;
+        let mut out = colour;
+        use rayon::prelude::*;
+        out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
+            let v = (y as f32 + 0.5) / height as f32;
+            let field = scales.row(y);
+            for x in 0..width {
+                let f = &field[x * sc..(x + 1) * sc];
+                let px = &mut row[x * ch..x * ch + ch.min(3)];
+                let crevice = f[k.crevice].clamp(0.0, 1.0);
+                let own = 1.0 - crevice;
+                if let Some(skin) = self.skin {
+                    for (c, s) in px.iter_mut().zip(skin) {
+                        *c += (s - *c) * crevice;
+                    }
+                }
+                if own <= 0.0 {
+                    continue;
+                }
+                let random = f[k.random];
+                let mut gain = [1.0f32; 3];
+                if self.tone != 0.0 {
+                    let t = 1.0 + self.tone * (2.0 * random - 1.0) * own;
+                    gain = gain.map(|g| g * t);
+                }
+                if self.hue != 0.0 {
+                    let second = hash::unit(random.to_bits() as i32, 0, 7, self.seed);
+                    let warm = self.hue * (2.0 * second - 1.0) * own;
+                    gain[0] *= 1.0 + warm;
+                    gain[2] *= 1.0 - warm;
+                }
+                if self.edge != 0.0 {
+                    let rim = 1.0 - smoothstep(0.0, RIM_WIDTH, f[k.inside]);
+                    gain = gain.map(|g| g * (1.0 + self.edge * rim * own));
+                }
+                if self.tip != 0.0 {
+                    let tip = smoothstep(TIP_START, 1.0, f[k.along]);
+                    gain = gain.map(|g| g * (1.0 + self.tip * tip * own));
+                }
+                for (c, g) in px.iter_mut().zip(gain) {
+                    *c *= g;
+                }
+                if self.speckle > 0.0 {
+                    let u = (x as f32 + 0.5) / width as f32;
+                    let dot = self.dot(u * cells, v * cells, aa) * own;
+                    for (c, s) in px.iter_mut().zip(self.speckle_color) {
+                        *c += (s - *c) * dot;
+                    }
+                }
+            }
+        });
+        out
+    }
+
+    /// Coverage of the speckle dot near (gx, gy), in grid-cell units.
+    fn dot(&self, gx: f32, gy: f32, aa: f32) -> f32 {
+        let n = self.speckle_cells.max(1) as i32;
+        let (cx, cy) = (floor_i32(gx), floor_i32(gy));
+        let mut coverage = 0.0f32;
+        // A dot is jittered by at most a quarter cell, so it reaches only the 3 × 3 cells.
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let (i, j) = (cx + dx, cy + dy);
+                let (wi, wj) = (i.rem_euclid(n), j.rem_euclid(n));
+                if hash::unit(wi, wj, 0, self.seed) >= self.speckle {
+                    continue;
+                }
+                let ox = i as f32 + 0.5 + 0.25 * hash::signed(wi, wj, 1, self.seed);
+                let oy = j as f32 + 0.5 + 0.25 * hash::signed(wi, wj, 2, self.seed);
+                let d = ((gx - ox).powi(2) + (gy - oy).powi(2)).sqrt();
+                coverage = coverage.max(1.0 - smoothstep(DOT_RADIUS - aa * 0.5, DOT_RADIUS + aa * 0.5, d));
+            }
+        }
+        coverage
+    }
+}

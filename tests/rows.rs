@@ -1,0 +1,149 @@
+//! Row-aware scales: `scales.rows` is the dorsal row count a herpetologist makes (from one
+//! side's ventral plates over the spine to the other's), rows can differ in width, keels
+//! can stop at the lowest rows, and stripes and the belly colour can name rows.
+
+use std::collections::BTreeSet;
+
+use snakeskin::graph::evaluate;
+use snakeskin::maps::{BuildOptions, MapKind, build_graph, scale_field};
+use snakeskin::ops::Image;
+use snakeskin::ops::scales::channel;
+use snakeskin::preset::{Preset, PresetSource, parse};
+
+const SIZE: usize = 384;
+
+fn preset(text: &str) -> Preset {
+    let source = PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
+    parse(&source, &[]).unwrap_or_else(|e| panic!("{e}\n{text}")).preset
+}
+
+fn field(text: &str) -> Image {
+    let mut f = scale_field(&preset(text));
+    f.outputs = (0..channel::COUNT).collect();
+    f.render(SIZE, SIZE)
+}
+
+fn colour(text: &str) -> Image {
+    let graph = build_graph(&preset(text), BuildOptions::default());
+    evaluate(&graph, &[MapKind::Color], SIZE, SIZE, &|_, _| {}).maps.remove(&MapKind::Color).unwrap()
+}
+
+fn pixels(img: &Image) -> impl Iterator<Item = &[f32]> {
+    img.data.chunks_exact(img.channels)
+}
+
+#[test]
+fn the_dorsal_rows_between_the_ventral_plates_are_the_row_count() {
+    for (rows, belly, shape) in
+        [(19u32, 0.22, "leaf"), (17, 0.3, "diamond"), (23, 0.15, "hexagon"), (45, 0.2, "hexagon")]
+    {
+        let text = format!("[scales]\nrows = {rows}\nshape = \"{shape}\"\njitter = 0\n[belly]\nwidth = {belly}\n");
+        let f = field(&text);
+        // Every scale of the dorsal rows has its own centre column: count them.
+        let centres: BTreeSet<u32> =
+            pixels(&f).filter(|p| p[channel::ROW] > 0.0).map(|p| (p[channel::CENTRE_U] * 1e4).round() as u32).collect();
+        assert_eq!(centres.len(), rows as usize, "{shape}, belly {belly}: dorsal columns");
+        let row_numbers: BTreeSet<u32> = pixels(&f).map(|p| p[channel::ROW] as u32).filter(|r| *r > 0).collect();
+        let expected: BTreeSet<u32> = (1..=rows.div_ceil(2)).collect();
+        assert_eq!(row_numbers, expected, "{shape}: row numbers 1 (lowest) to the vertebral row");
+    }
+}
+
+/// Pixels per row number, on the scales' own surface.
+fn pixels_per_row(f: &Image, rows: u32) -> Vec<usize> {
+    let mut count = vec![0; rows.div_ceil(2) as usize + 1];
+    for p in pixels(f) {
+        count[p[channel::ROW] as usize] += 1;
+    }
+    count
+}
+
+#[test]
+fn an_enlarged_vertebral_row_and_a_wider_lowest_row_take_their_share() {
+    let base = "[scales]\nrows = 17\nshape = \"hexagon\"\njitter = 0\n";
+    let plain = pixels_per_row(&field(base), 17);
+    let wide = pixels_per_row(&field(&format!("{base}vertebral_width = 2\nlowest_row_width = 1.5\n")), 17);
+    let ratio = |counts: &[usize], a: usize, b: usize| counts[a] as f64 / counts[b] as f64;
+    // The vertebral row is one column, the others two (one each side): 2 × 0.5 = 1 with
+    // equal widths, twice that at width 2.
+    assert!((ratio(&plain, 9, 5) - 0.5).abs() < 0.05, "plain {plain:?}");
+    assert!((ratio(&wide, 9, 5) - 1.0).abs() < 0.08, "vertebral ×2: {wide:?}");
+    // The plates cover a little of the lowest row's hexagons, so it holds under 1 of an
+    // ordinary row's share at equal widths; widened, 1.5 times that.
+    let widened = ratio(&wide, 1, 5) / ratio(&plain, 1, 5);
+    assert!((widened - 1.5).abs() < 0.08, "lowest ×1.5: {widened}, {plain:?} → {wide:?}");
+}
+
+#[test]
+fn smooth_rows_have_no_keel_and_the_rest_do() {
+    let f = field("[scales]\nrows = 19\nkeeled = true\nsmooth_rows = 2\njitter = 0\n");
+    let mut keel_by_row = [0.0f32; 11];
+    for p in pixels(&f) {
+        let row = p[channel::ROW] as usize;
+        keel_by_row[row] = keel_by_row[row].max(p[channel::KEEL]);
+    }
+    assert_eq!(&keel_by_row[0..3], &[0.0, 0.0, 0.0], "plates and rows 1–2 are smooth: {keel_by_row:?}");
+    assert!(keel_by_row[3..].iter().all(|k| *k > 0.5), "rows 3 and up are keeled: {keel_by_row:?}");
+}
+
+/// Colour pixels at scale centres (the middle of each scale), with their row.
+fn centres_by_row(text: &str) -> Vec<(u32, [f32; 3])> {
+    let (f, c) = (field(text), colour(text));
+    pixels(&f)
+        .zip(pixels(&c))
+        .filter(|(p, _)| p[channel::RADIAL] < 0.3 && p[channel::CREVICE] == 0.0)
+        .map(|(p, c)| (p[channel::ROW] as u32, [c[0], c[1], c[2]]))
+        .collect()
+}
+
+#[test]
+fn a_stripe_on_named_rows_covers_those_rows_and_no_others() {
+    let base = "seed = 2\n[scales]\nrows = 19\njitter = 0\n[color]\nbase = \"#202020\"\nvariation = 0\nscale_tone = 0\n\
+                scale_hue = 0\n";
+    let striped =
+        format!("{base}[[pattern]]\nkind = \"stripes\"\ncolor = \"#f0f0f0\"\nrows = [2, 3]\nedge_distortion = 0\n");
+    let (mut on, mut off, mut on_total, mut off_total) = (0, 0, 0, 0);
+    for (row, c) in centres_by_row(&striped) {
+        let light = c[1] > 0.5;
+        if row == 2 || row == 3 {
+            on_total += 1;
+            on += light as usize;
+        } else if row > 0 {
+            off_total += 1;
+            off += light as usize;
+        }
+    }
+    assert!(on as f64 > 0.99 * on_total as f64, "rows 2–3: {on} of {on_total} centres striped");
+    assert_eq!(off, 0, "{off} of {off_total} centres of other rows striped");
+}
+
+#[test]
+fn the_belly_colour_runs_up_the_lowest_rows() {
+    let text = |up: u32| {
+        format!(
+            "[scales]\nrows = 19\njitter = 0\n[color]\nbase = \"#202020\"\nvariation = 0\nscale_tone = 0\nscale_hue = 0\n\
+             [belly]\ncolor = \"#f0f0f0\"\nblend = 0\nup_rows = {up}\n"
+        )
+    };
+    for up in [0, 2] {
+        for (row, c) in centres_by_row(&text(up)) {
+            let belly_coloured = c[1] > 0.5;
+            assert_eq!(belly_coloured, row <= up, "up_rows {up}: row {row} centre {c:?}");
+        }
+    }
+}
+
+#[test]
+fn row_keys_are_checked() {
+    let source = |text: &str| PresetSource { name: "t".into(), display: "t.toml".into(), text: text.into() };
+    for (text, key) in [
+        ("[scales]\nrows = 19\nsmooth_rows = 12\n", "scales.smooth_rows"),
+        ("[scales]\nvertebral_width = 5\n", "scales.vertebral_width"),
+        ("[belly]\nup_rows = 30\n", "belly.up_rows"),
+        ("[[pattern]]\nkind = \"stripes\"\ncolor = \"#ffffff\"\nrows = [3, 12]\n", "pattern.0.rows"),
+        ("[[pattern]]\nkind = \"spots\"\ncolor = \"#ffffff\"\nrows = [1, 2]\n", "pattern.0.rows"),
+    ] {
+        let err = parse(&source(text), &[]).expect_err(key).to_string();
+        assert!(err.contains(key), "{key}: {err}");
+    }
+}
