@@ -130,6 +130,9 @@ fn presets_list_prints_names_first_and_show_prints_toml() {
     let text = stdout(&out);
     let listed: Vec<String> = text.lines().skip(1).map(|l| l.split_whitespace().next().unwrap().to_string()).collect();
     assert_eq!(listed, library::names());
+    // The library: at least 32 species, each with its own scientific name.
+    let species: std::collections::BTreeSet<&str> = text.lines().skip(1).filter_map(|l| l.get(27..52)).collect();
+    assert!(listed.len() >= 32 && species.len() == listed.len(), "{} presets, {} species", listed.len(), species.len());
     // Each line shows the common name and the category.
     let line = text.lines().find(|l| l.starts_with("crotalus-atrox")).unwrap();
     assert!(line.contains("Crotalus atrox") && line.contains("Western diamondback rattlesnake"), "{line}");

@@ -27,11 +27,13 @@ fn transpose(img: &Image) -> Image {
 }
 
 /// Asserts the seam (last row → first row) jumps no more than 1.5× the larger of the jumps
-/// just beside it and the mean jump between neighbouring rows.
+/// just beside it and the mean jump between neighbouring rows. "Beside" is the largest of
+/// the four jumps on each side: fine random texture (melanophore speckle on a pale belly)
+/// makes any one pair of rows jump by chance, while a real seam jumps more than all of them.
 fn assert_rows_seamless(img: &Image, what: &str) {
     let n = img.height;
     let seam = row_jump(img, n - 1, 0);
-    let beside = row_jump(img, 0, 1).max(row_jump(img, n - 2, n - 1));
+    let beside = (0..4).map(|k| row_jump(img, k, k + 1).max(row_jump(img, n - 2 - k, n - 1 - k))).fold(0.0, f64::max);
     let mean = (0..n - 1).map(|y| row_jump(img, y, y + 1)).sum::<f64>() / (n - 1) as f64;
     let limit = 1.5 * beside.max(mean);
     assert!(seam <= limit, "{what}: seam jump {seam:.5} > 1.5 × max(beside {beside:.5}, mean {mean:.5})");

@@ -18,16 +18,23 @@ use snakeskin::render::engine::scene::{Camera, LayerOptics, Stage, View};
 use snakeskin::render::reference::frame::reference_check;
 use snakeskin::render::reference::frame::srgb_encode;
 
-const PRESET: &str = "erythrolamprus-miliaris";
+/// An iridescent species (its sources report iridescence, so it has a film).
+const PRESET: &str = "xenopeltis-unicolor";
+/// A light-coloured species without a film, where the layer models' colours differ most.
+const PLAIN_PRESET: &str = "erythrolamprus-miliaris";
 const MAP_SIZE: usize = 256;
 
-fn load(overrides: &[(&str, &str)]) -> snakeskin::preset::LoadedPreset {
+fn load(preset: &str, overrides: &[(&str, &str)]) -> snakeskin::preset::LoadedPreset {
     let overrides: Vec<(String, String)> = overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-    snakeskin::preset::load(PRESET, &overrides, None).unwrap()
+    snakeskin::preset::load(preset, &overrides, None).unwrap()
 }
 
 fn material(renderer: &Renderer, overrides: &[(&str, &str)], method: GpuFilmMethod) -> Material {
-    let loaded = load(overrides);
+    material_of(renderer, PRESET, overrides, method)
+}
+
+fn material_of(renderer: &Renderer, preset: &str, overrides: &[(&str, &str)], method: GpuFilmMethod) -> Material {
+    let loaded = load(preset, overrides);
     let maps = material_maps(&loaded, MAP_SIZE).unwrap();
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = snakeskin::optics::lut::Lut::bake(optics.stack, 32, 128, 32);
@@ -96,7 +103,7 @@ fn the_reference_check_catches_a_wrong_model() {
     // no internal reflection and reads the map as k_d).
     let Some(gpu) = gpu_or_skip("the_reference_check_catches_a_wrong_model") else { return };
     let renderer = Renderer::new(gpu);
-    let material = material(&renderer, &[("optics.absorption", "0.3")], GpuFilmMethod::Lut);
+    let material = material_of(&renderer, PLAIN_PRESET, &[("optics.absorption", "0.3")], GpuFilmMethod::Lut);
     let thesis = FrameSettings { samples: 1, model: Model::Thesis, ..close_up() };
     let layered = FrameSettings { model: Model::Layered, ..thesis };
     let image = renderer.render_image(&thesis, &material, 160, 100).unwrap();
@@ -117,7 +124,7 @@ fn the_reference_check_catches_a_wrong_film() {
     let image = renderer.render_image(&settings, &wrong, 160, 100).unwrap();
     let gbuffer = renderer.render_gbuffer(&settings, &right, 160, 100).unwrap();
     let report = snakeskin::render::reference::frame::compare(&image, &gbuffer, &settings, &right.optics);
-    assert!(report.mean_de > 2.0, "a 150 nm thinner film went unnoticed: mean {}", report.mean_de);
+    assert!(report.mean_de > 2.0, "a 170 nm thinner film went unnoticed: mean {}", report.mean_de);
 }
 
 /// Mean squared Laplacian of luminance over pixels whose 3×3 neighbourhood is all snake.
@@ -292,8 +299,8 @@ fn the_window_runs_frames_under_xvfb() {
 
 #[test]
 fn live_reload_re_evaluates_only_the_changed_nodes() {
-    let before = load(&[]);
-    let after = load(&[("belly.color", "\"#203040\"")]);
+    let before = load(PRESET, &[]);
+    let after = load(PRESET, &[("belly.color", "\"#203040\"")]);
     let mut cache = NodeCache::new();
     let size = 64;
     let (_, first) = cache.evaluate(&build_graph(&before.preset, BuildOptions::default()), &MapKind::ALL, size, size);
@@ -319,8 +326,8 @@ fn a_colour_edit_re_evaluates_only_colour_nodes() {
     let size = 64;
     let ran_for_others = |edit: (&str, &str)| {
         let mut cache = NodeCache::new();
-        cache.evaluate(&build_graph(&load(&[]).preset, BuildOptions::default()), &MapKind::ALL, size, size);
-        let edited = build_graph(&load(&[edit]).preset, BuildOptions::default());
+        cache.evaluate(&build_graph(&load(PRESET, &[]).preset, BuildOptions::default()), &MapKind::ALL, size, size);
+        let edited = build_graph(&load(PRESET, &[edit]).preset, BuildOptions::default());
         cache.evaluate(&edited, &others, size, size).1.evaluated
     };
     assert_eq!(ran_for_others(("belly.color", "\"#203040\"")), 0, "a colour edit re-ran non-colour nodes");
@@ -425,7 +432,7 @@ fn the_window_reloads_the_preset_file_on_save() {
     }
     let dir = tempfile::tempdir().unwrap();
     let preset = dir.path().join("snake.toml");
-    let original = snakeskin::preset::library::get(PRESET).unwrap();
+    let original = snakeskin::preset::library::get(PLAIN_PRESET).unwrap();
     std::fs::write(&preset, original).unwrap();
     let mut child = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])

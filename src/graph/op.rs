@@ -242,9 +242,9 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
                 float(h, *x);
             }
         }
-        Op::Blotches(Blotches { shape, count, half_width, length, jitter, seed }) => {
-            (shape, count, seed).hash(h);
-            for x in [half_width, length, jitter] {
+        Op::Blotches(Blotches { shape, count, half_width, length, jitter, offset, staggered, phase, scale, seed }) => {
+            (shape, count, staggered, seed).hash(h);
+            for x in [half_width, length, jitter, offset, phase, scale] {
                 float(h, *x);
             }
         }

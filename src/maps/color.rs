@@ -166,6 +166,7 @@ fn levels(g: &mut GraphBuilder, name: &str, input: NodeId, lo: f32, hi: f32) -> 
 fn shapes(
     g: &mut GraphBuilder,
     lattice: &Lattice,
+    (jitter, scale_size): (f32, f32),
     layer: &PatternLayer,
     name: &dyn Fn(&str) -> String,
     seed: u32,
@@ -205,7 +206,7 @@ fn shapes(
             // A colour sequence repeated `amount` times along the body; widths are
             // fractions of one repeat (default: one ring of `size`, or equal parts).
             let repeats = layer.amount.round().max(1.0) as f32;
-            let (colors, widths): (Vec<Srgb8>, Vec<f32>) = if layer.colors.is_empty() {
+            let (colors, mut widths): (Vec<Srgb8>, Vec<f32>) = if layer.colors.is_empty() {
                 (vec![layer.color], vec![size.min(1.0)])
             } else if layer.widths.is_empty() {
                 let n = layer.colors.len();
@@ -213,6 +214,9 @@ fn shapes(
             } else {
                 (layer.colors.clone(), layer.widths.iter().map(|w| *w as f32).collect())
             };
+            if fully_snapped(layer) {
+                widths = rings_of_whole_scales(&widths, lattice.rows_v as f32 / repeats, jitter, scale_size);
+            }
             // Start half way into the first colour, so the texture's v seam falls inside a
             // ring rather than on the boundary between two.
             let mut start = -0.5 * widths.first().copied().unwrap_or(0.0);
@@ -225,35 +229,9 @@ fn shapes(
             }
             out
         }
-        PatternKind::Spots => {
-            let across = layer.amount.round().max(1.0) as u32;
-            let grid = SpotGrid {
-                across,
-                along: across,
-                radius: size,
-                jitter: 0.35,
-                alternate: layer.arrangement == Arrangement::Alternating,
-                checkered: layer.arrangement == Arrangement::Checkered,
-                hole: if layer.shape == PatternShape::Ring { 0.55 } else { 0.0 },
-                seed,
-            };
-            vec![(g.add(name("shape"), Op::Spots(grid), &[]), layer.color)]
-        }
+        PatternKind::Spots => vec![(g.add(name("shape"), Op::Spots(spot_grid(layer, seed)), &[]), layer.color)],
         PatternKind::Blotches => {
-            let shape = match layer.shape {
-                PatternShape::Diamond => BlotchShape::Diamond,
-                PatternShape::Saddle => BlotchShape::Saddle,
-                _ => BlotchShape::Round,
-            };
-            let blotches = Blotches {
-                shape,
-                count: layer.amount.round().max(1.0) as u32,
-                half_width: size,
-                length: layer.length as f32,
-                jitter: 0.3,
-                seed,
-            };
-            vec![(g.add(name("shape"), Op::Blotches(blotches), &[]), layer.color)]
+            vec![(g.add(name("shape"), Op::Blotches(blotches(layer, seed, 1.0)), &[]), layer.color)]
         }
         PatternKind::Irregular => {
             let kind = match layer.noise {
@@ -269,6 +247,96 @@ fn shapes(
             vec![(g.add(name("shape"), Op::Blur { sigma: size * 0.04 }, &[binary]), layer.color)]
         }
     }
+}
+
+/// The blotch series of a `blotches` layer, every blotch scaled by `scale` (a composite
+/// mark's centre is the same series drawn smaller).
+fn blotches(layer: &PatternLayer, seed: u32, scale: f32) -> Blotches {
+    let shape = match layer.shape {
+        PatternShape::Diamond => BlotchShape::Diamond,
+        PatternShape::Saddle => BlotchShape::Saddle,
+        PatternShape::Chevron => BlotchShape::Chevron,
+        PatternShape::Hourglass => BlotchShape::Hourglass,
+        PatternShape::Zigzag => BlotchShape::Zigzag,
+        PatternShape::Round | PatternShape::Ring => BlotchShape::Round,
+    };
+    Blotches {
+        shape,
+        count: layer.amount.round().max(1.0) as u32,
+        half_width: layer.size as f32,
+        length: layer.length as f32,
+        jitter: 0.3,
+        offset: layer.offset as f32,
+        staggered: layer.arrangement == Arrangement::Alternating,
+        phase: layer.phase as f32,
+        scale,
+        seed,
+    }
+}
+
+/// The spot grid of a `spots` layer.
+fn spot_grid(layer: &PatternLayer, seed: u32) -> SpotGrid {
+    let across = layer.amount.round().max(1.0) as u32;
+    SpotGrid {
+        across,
+        along: across,
+        radius: layer.size as f32,
+        jitter: 0.35,
+        alternate: layer.arrangement == Arrangement::Alternating,
+        checkered: layer.arrangement == Arrangement::Checkered,
+        hole: if layer.shape == PatternShape::Ring { 0.55 } else { 0.0 },
+        seed,
+    }
+}
+
+/// The centre of a composite mark: the layer's blotches or spots drawn at `center_size`
+/// of their size about their own centres (None for other kinds or without `center_color`).
+fn centre_shape(layer: &PatternLayer, seed: u32) -> Option<Op> {
+    layer.center_color?;
+    let k = layer.center_size as f32;
+    match layer.kind {
+        PatternKind::Blotches => Some(Op::Blotches(blotches(layer, seed, k))),
+        PatternKind::Spots => {
+            let grid = spot_grid(layer, seed);
+            Some(Op::Spots(SpotGrid { radius: grid.radius * k, ..grid }))
+        }
+        _ => None,
+    }
+}
+
+/// A layer snapped fully to whole scales (each scale takes the pattern at its centre).
+fn fully_snapped(layer: &PatternLayer) -> bool {
+    layer.scale_aligned >= 1.0
+}
+
+/// Ring widths (fractions of one repeat) for a ring sequence drawn in whole scales, so that
+/// its topology survives the snapping (each scale takes the colour at its centre). Every
+/// band is made at least `(max(1, L) + j)` cells long, with j the scale jitter (a centre moves
+/// by at most j / 2 of a cell along the body, `ops::scales::CellTable`) and L the longest
+/// scale outline in cells (`size` × (1 + 0.4 j)):
+/// - at least 1 + j: the centres of each scale column are one cell apart, so the band holds
+///   a centre in every column, and a one-scale ring stays closed round the body (in zigzag,
+///   the columns being staggered by half a cell);
+/// - at least L + j: the scales either side of the band have centres more than L apart
+///   along the body, further than two outlines of length ≤ L reach, so they never touch.
+///
+/// The wider bands give up the difference in proportion; a sequence too tight for it keeps
+/// equal shares. `cells_per_repeat` = scale rows along the body per repeat.
+pub fn rings_of_whole_scales(widths: &[f32], cells_per_repeat: f32, jitter: f32, size: f32) -> Vec<f32> {
+    let j = jitter.clamp(0.0, 0.5);
+    let longest = (size * (1.0 + 0.4 * j)).max(1.0);
+    let floor = (longest + j) / cells_per_repeat.max(1e-3);
+    let total: f32 = widths.iter().sum();
+    let narrow: f32 = widths.iter().filter(|w| **w < floor).map(|_| floor).sum();
+    let wide: f32 = widths.iter().filter(|w| **w >= floor).sum();
+    if narrow == 0.0 {
+        return widths.to_vec();
+    }
+    if narrow >= total || wide <= 0.0 {
+        return vec![total / widths.len().max(1) as f32; widths.len()];
+    }
+    let scale = (total - narrow) / wide;
+    widths.iter().map(|w| if *w < floor { floor } else { w * scale }).collect()
 }
 
 /// What every pattern layer shares.
@@ -295,12 +363,24 @@ fn pattern_layer(
     let prefix = format!("pattern{i}");
     let seed = derive_seed(context.seed, &prefix);
     let mut color = below;
-    let parts = shapes(g, &s.field.lattice(), layer, &|part: &str| format!("{prefix}.{part}"), seed);
+    let parts = shapes(
+        g,
+        &s.field.lattice(),
+        (s.field.jitter, s.field.size),
+        layer,
+        &|part: &str| format!("{prefix}.{part}"),
+        seed,
+    );
     let many = parts.len() > 1;
     for (k, (shape, tint)) in parts.into_iter().enumerate() {
         let name = |part: &str| if many { format!("{prefix}.{k}.{part}") } else { format!("{prefix}.{part}") };
         let mut mask = shape;
-        if let (true, Some(n)) = (layer.edge_distortion > 0.0 && layer.kind != PatternKind::Solid, distortion_noise) {
+        // A ring sequence in whole scales keeps its topology (`rings_of_whole_scales`) only
+        // with straight band edges: no distortion there.
+        let distort = layer.edge_distortion > 0.0
+            && layer.kind != PatternKind::Solid
+            && !(layer.kind == PatternKind::Rings && fully_snapped(layer));
+        if let (true, Some(n)) = (distort, distortion_noise) {
             // Thesis §4.2.1.2: blend with noise, then threshold, for ragged edges. The shape is
             // softened first so that adding noise moves its edges instead of leaving them.
             let d = layer.edge_distortion as f32;
@@ -320,6 +400,19 @@ fn pattern_layer(
         if let (Some(outside), false) = (outside_belly, layer.over_belly) {
             mask = g.add(name("off_belly"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, outside]);
         }
+        if let Some(border_color) = layer.border_color.filter(|_| layer.border_size > 0.0) {
+            // A pale border round the mark and its outline: the mask dilated by blurring
+            // and a low threshold (a blurred edge falls to 0.1 at 1.28 σ outside it).
+            let reach = (layer.border_size + 0.5 * layer.outline_size) as f32;
+            let soft = g.add(name("border_blur"), Op::Blur { sigma: reach / 1.28 }, &[mask]);
+            let mut border = g.add(name("border"), Op::Threshold { level: 0.1, softness: 0.05 }, &[soft]);
+            border = snapped_and_off_belly(g, s, context, layer, &name("border"), border);
+            color = g.add(
+                name("border_tint"),
+                Op::Tint { color: border_color.to_linear(), opacity: layer.opacity as f32 },
+                &[color, border],
+            );
+        }
         color =
             g.add(name("tint"), Op::Tint { color: tint.to_linear(), opacity: layer.opacity as f32 }, &[color, mask]);
         if layer.outline_size > 0.0 {
@@ -335,5 +428,40 @@ fn pattern_layer(
             );
         }
     }
+    if let (Some(centre_color), Some(op)) = (layer.center_color, centre_shape(layer, seed)) {
+        // The composite mark's centre, over the mark and its outline.
+        let mut centre = g.add(format!("{prefix}.centre"), op, &[]);
+        centre = snapped_and_off_belly(g, s, context, layer, &format!("{prefix}.centre"), centre);
+        color = g.add(
+            format!("{prefix}.centre_tint"),
+            Op::Tint { color: centre_color.to_linear(), opacity: layer.opacity as f32 },
+            &[color, centre],
+        );
+    }
     color
+}
+
+/// A composite mark's extra mask (centre, border) snapped to scales and kept off the belly
+/// as the layer's own mask is.
+fn snapped_and_off_belly(
+    g: &mut GraphBuilder,
+    s: &Shared,
+    context: &LayerContext,
+    layer: &PatternLayer,
+    name: &str,
+    mut mask: NodeId,
+) -> NodeId {
+    if layer.scale_aligned > 0.0 {
+        let op = Op::SnapToScales {
+            amount: layer.scale_aligned as f32,
+            centre_u: s.channel_index(channel::CENTRE_U),
+            centre_v: s.channel_index(channel::CENTRE_V),
+        };
+        mask = g.add(format!("{name}_scale_aligned"), op, &[mask, s.scales]);
+    }
+    if let (Some(outside), false) = (context.outside_belly, layer.over_belly) {
+        mask =
+            g.add(format!("{name}_off_belly"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, outside]);
+    }
+    mask
 }

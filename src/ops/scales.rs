@@ -283,6 +283,25 @@ pub const ROW_PHASE: f32 = 0.25;
 /// lower scale's height: a groove, not a hole.
 const CREVICE_FLOOR: f32 = 0.8;
 
+/// How far a scale's free edge stands above the scale it overlaps, over the height range at
+/// full imbrication: the visible overlap step of imbricate scales (the edge's thickness).
+const LIP_STEP: f32 = 0.08;
+
+/// The height of a scale near its outline, `t` = distance inside / rim width: the surface
+/// rounds over a quarter circle (a rounded lip, not a linear bevel) down to the lip's foot,
+/// which stands `LIP_STEP` × imbrication above the scale underneath (an overlap step: the
+/// first version let the rim fall into a groove below it) — or down to the skin where
+/// nothing lies underneath.
+#[inline]
+fn free_edge(profile: f32, t: f32, under_height: f32, imbrication: f32) -> f32 {
+    let t = t.clamp(0.0, 1.0);
+    let round = (1.0 - (1.0 - t) * (1.0 - t)).sqrt();
+    // Where a scale lies underneath, the top scale's edge rests on it: never lower than the
+    // scale underneath plus the step (its thickness), even where its own dome has fallen.
+    let foot = if under_height > 0.0 { under_height + LIP_STEP * imbrication } else { 0.0 };
+    (foot + round * (profile - foot).max(0.0)).max(CREVICE_FLOOR * under_height)
+}
+
 /// Half-width of a diamond in cell widths (see `inside_distance`).
 const DIAMOND_HALF_WIDTH: f32 = 1.0;
 
@@ -461,9 +480,7 @@ impl ScaleField {
         let Some((inside, lx, ly, random, cx, cy, column)) = top else {
             return self.write_scale(None, 0.0, self.keel_height, out);
         };
-        let rim = smoothstep(0.0, soft, inside);
-        // Groove depth: the rim falls to a fraction of the surface underneath, not below it.
-        let height = (rim * profile(inside, ly)).max(CREVICE_FLOOR * under_height);
+        let height = free_edge(profile(inside, ly), inside / soft, under_height, self.imbrication);
         let top = Candidate {
             inside,
             x: lx,
@@ -588,32 +605,42 @@ impl ScaleField {
         let y = v * lattice.rows_v as f32 - ROW_PHASE;
         let r0 = floor_i32(y);
         let half_len = 0.5 * self.size.max(0.5);
-        let mut best: Option<(f32, Candidate)> = None;
+        // The most anterior plate covering the pixel lies on top (its free posterior edge over
+        // the next plate, as the dorsal scales); the others are the surface underneath.
+        let mut top: Option<(i32, f32, f32, f32)> = None; // (row, inside, along, profile)
+        let mut under_height = 0.0f32;
+        // Plates are gently convex across the belly.
+        let across = (dist_belly / half_band).min(1.0);
+        let dome = 0.06 * (1.0 - across * across);
         for r in r0 - 1..=r0 + 1 {
-            let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * lattice.aspect;
             let to_end = (half_len - (y - (r as f32 + 0.5)).abs()) * lattice.aspect;
             let inside = to_side.min(to_end);
             if inside <= 0.0 {
                 continue;
             }
             let along = ((y - (r as f32 + 0.5)) / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
-            let h = smoothstep(0.0, soft, inside) * (0.45 + 0.1 + 0.3 * self.imbrication * along);
-            if best.as_ref().is_none_or(|(bh, _)| h > *bh) {
-                let random = hash::unit(-1, r.rem_euclid(lattice.rows_v), 4, self.seed);
-                let x = dist_belly / half_band * 0.5;
-                let cand = Candidate {
-                    inside,
-                    x,
-                    y: ly,
-                    half_len: 0.5 * lattice.aspect,
-                    random,
-                    centre_u: 0.0,
-                    centre_v: ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
-                    row: 0,
-                };
-                best = Some((h, cand));
+            let profile = 0.45 + 0.1 + dome + 0.3 * self.imbrication * along;
+            match top {
+                Some(_) => under_height = under_height.max(profile),
+                None => top = Some((r, inside, along, profile)),
             }
         }
+        let best = top.map(|(r, inside, _, profile)| {
+            let h = free_edge(profile, inside / soft, under_height, self.imbrication);
+            let random = hash::unit(-1, r.rem_euclid(lattice.rows_v), 4, self.seed);
+            let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * lattice.aspect;
+            let cand = Candidate {
+                inside,
+                x: dist_belly / half_band * 0.5,
+                y: ly,
+                half_len: 0.5 * lattice.aspect,
+                random,
+                centre_u: 0.0,
+                centre_v: ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+                row: 0,
+            };
+            (h, cand)
+        });
         match best {
             // Ventral plates carry no keel.
             Some((h, cand)) => self.write_scale(Some(cand), h, 0.0, out),

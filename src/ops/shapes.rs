@@ -133,13 +133,24 @@ pub enum BlotchShape {
     Diamond,
     /// A band over the back reaching down the flanks, with rounded corners.
     Saddle,
+    /// A V across the back, its apex on the series' centre line pointing towards the tail
+    /// and its arms reaching forward down the sides (a puff adder's "backwardly-directed"
+    /// chevrons); the arms are a third of the mark's length thick.
+    Chevron,
+    /// Narrow at the centre line, wide at its sides: a crossband whose length along the body
+    /// at the centre is a third of that at its ends (a copperhead's or a Bitis' hourglass).
+    Hourglass,
+    /// One continuous band zigzagging along the body about the centre line, `half_width`
+    /// to either side; each blotch is one zig and one zag (an adder's dorsal zigzag).
+    Zigzag,
 }
 
-/// A dorsal series of blotches centred on the spine (u = 0.5), repeated along the body.
+/// A series of blotches along the body: on the spine (u = 0.5), or two series mirrored
+/// at 0.5 ± `offset`, side by side or staggered by half a spacing.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Blotches {
     pub shape: BlotchShape,
-    /// Blotches per tile along the body.
+    /// Blotches per tile along the body (per series).
     pub count: u32,
     /// Half-width around the body, fraction of the circumference.
     pub half_width: f32,
@@ -147,59 +158,139 @@ pub struct Blotches {
     pub length: f32,
     /// Random offset and size change, 0..1.
     pub jitter: f32,
+    /// Distance of the series' centre line from the spine, fraction of the circumference;
+    /// above 0, two mirrored series.
+    pub offset: f32,
+    /// The mirrored series shifted by half a spacing (staggered, not paired).
+    pub staggered: bool,
+    /// Shift of the whole series along the body, in spacings.
+    pub phase: f32,
+    /// Every blotch scaled about its centre (1 as drawn; a composite mark's centre < 1).
+    pub scale: f32,
     pub seed: u32,
 }
 
-/// Rasterises blotches into an anti-aliased coverage mask (tiny-skia), wrapping along v.
+/// Rasterises blotches into an anti-aliased coverage mask (tiny-skia), wrapping along v
+/// and around u.
 pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
     let (w, h) = (width as f32, height as f32);
     let count = b.count.max(1);
     let spacing = h / count as f32;
     let mut pb = PathBuilder::new();
+    let sides: &[(f32, f32)] =
+        if b.offset > 0.0 { &[(1.0, 0.0), (-1.0, if b.staggered { 0.5 } else { 0.0 })] } else { &[(0.0, 0.0)] };
+    if b.shape == BlotchShape::Zigzag {
+        for &(side, shift) in sides {
+            zigzag(&mut pb, b, (0.5 + side * b.offset) * w, (b.phase + shift) * spacing, spacing, w, h);
+        }
+        return rasterise(width, height, pb, FillRule::Winding);
+    }
     for i in 0..count as i32 {
         let jx = hash::signed(i, 0, 0, b.seed) * b.jitter * 0.05;
         let jy = hash::signed(i, 0, 1, b.seed) * b.jitter * 0.2;
-        let js = 1.0 + hash::signed(i, 0, 2, b.seed) * b.jitter * 0.3;
-        let cx = (0.5 + jx) * w;
+        let js = (1.0 + hash::signed(i, 0, 2, b.seed) * b.jitter * 0.3) * b.scale;
         let hw = b.half_width * js * w;
         let hl = 0.5 * b.length * js * spacing;
-        for copy in [-1.0f32, 0.0, 1.0] {
-            let cy = (i as f32 + 0.5 + jy) * spacing + copy * h;
-            if cy + hl < 0.0 || cy - hl > h {
-                continue;
-            }
-            match b.shape {
-                BlotchShape::Round => {
-                    if let Some(rect) = tiny_skia::Rect::from_xywh(cx - hw, cy - hl, 2.0 * hw, 2.0 * hl) {
-                        pb.push_oval(rect);
+        for &(side, shift) in sides {
+            // The mirrored series mirrors the jitter too, so a pair is symmetric.
+            let cx = (0.5 + side * b.offset + if side < 0.0 { -jx } else { jx }) * w;
+            for copy_v in [-1.0f32, 0.0, 1.0] {
+                let cy = (i as f32 + 0.5 + jy + b.phase + shift) * spacing + copy_v * h;
+                for copy_u in [-1.0f32, 0.0, 1.0] {
+                    let cx = cx + copy_u * w;
+                    if cy + hl < 0.0 || cy - hl > h || cx + hw < 0.0 || cx - hw > w {
+                        continue;
                     }
-                }
-                BlotchShape::Diamond => {
-                    pb.move_to(cx, cy - hl);
-                    pb.line_to(cx + hw, cy);
-                    pb.line_to(cx, cy + hl);
-                    pb.line_to(cx - hw, cy);
-                    pb.close();
-                }
-                BlotchShape::Saddle => {
-                    // A rounded rectangle: corners of radius min(hw, hl) / 2 as quadratics.
-                    let r = 0.5 * hw.min(hl);
-                    let (x0, x1, y0, y1) = (cx - hw, cx + hw, cy - hl, cy + hl);
-                    pb.move_to(x0 + r, y0);
-                    pb.line_to(x1 - r, y0);
-                    pb.quad_to(x1, y0, x1, y0 + r);
-                    pb.line_to(x1, y1 - r);
-                    pb.quad_to(x1, y1, x1 - r, y1);
-                    pb.line_to(x0 + r, y1);
-                    pb.quad_to(x0, y1, x0, y1 - r);
-                    pb.line_to(x0, y0 + r);
-                    pb.quad_to(x0, y0, x0 + r, y0);
-                    pb.close();
+                    push_blotch(&mut pb, b.shape, cx, cy, hw, hl);
                 }
             }
         }
     }
     rasterise(width, height, pb, FillRule::Winding)
+}
+
+/// One blotch centred at (cx, cy) pixels with half-width `hw` and half-length `hl`.
+fn push_blotch(pb: &mut PathBuilder, shape: BlotchShape, cx: f32, cy: f32, hw: f32, hl: f32) {
+    match shape {
+        BlotchShape::Round => {
+            if let Some(rect) = tiny_skia::Rect::from_xywh(cx - hw, cy - hl, 2.0 * hw, 2.0 * hl) {
+                pb.push_oval(rect);
+            }
+        }
+        BlotchShape::Diamond => {
+            pb.move_to(cx, cy - hl);
+            pb.line_to(cx + hw, cy);
+            pb.line_to(cx, cy + hl);
+            pb.line_to(cx - hw, cy);
+            pb.close();
+        }
+        BlotchShape::Saddle => {
+            // A rounded rectangle: corners of radius min(hw, hl) / 2 as quadratics.
+            let r = 0.5 * hw.min(hl);
+            let (x0, x1, y0, y1) = (cx - hw, cx + hw, cy - hl, cy + hl);
+            pb.move_to(x0 + r, y0);
+            pb.line_to(x1 - r, y0);
+            pb.quad_to(x1, y0, x1, y0 + r);
+            pb.line_to(x1, y1 - r);
+            pb.quad_to(x1, y1, x1 - r, y1);
+            pb.line_to(x0 + r, y1);
+            pb.quad_to(x0, y1, x0, y1 - r);
+            pb.line_to(x0, y0 + r);
+            pb.quad_to(x0, y0, x0 + r, y0);
+            pb.close();
+        }
+        BlotchShape::Chevron => {
+            // Centre line from the arms' front ends (cy − rise) to the apex (cy + rise),
+            // thickened by ±t along the body.
+            let t = hl / 3.0;
+            let rise = hl - t;
+            pb.move_to(cx - hw, cy - rise - t);
+            pb.line_to(cx, cy + rise - t);
+            pb.line_to(cx + hw, cy - rise - t);
+            pb.line_to(cx + hw, cy - rise + t);
+            pb.line_to(cx, cy + rise + t);
+            pb.line_to(cx - hw, cy - rise + t);
+            pb.close();
+        }
+        BlotchShape::Hourglass => {
+            let waist = hl / 3.0;
+            pb.move_to(cx - hw, cy - hl);
+            pb.line_to(cx, cy - waist);
+            pb.line_to(cx + hw, cy - hl);
+            pb.line_to(cx + hw, cy + hl);
+            pb.line_to(cx, cy + waist);
+            pb.line_to(cx - hw, cy + hl);
+            pb.close();
+        }
+        BlotchShape::Zigzag => unreachable!("a zigzag is one band, see `zigzag`"),
+    }
+}
+
+/// A continuous zigzag band about x = `cx`: vertices alternate ±`half_width` every half
+/// spacing; the band is `length` spacings thick along the body. Drawn over the
+/// tile plus one spacing each end so it wraps along v without a seam.
+fn zigzag(pb: &mut PathBuilder, b: &Blotches, cx: f32, start: f32, spacing: f32, w: f32, h: f32) {
+    let start = start.rem_euclid(spacing);
+    let amplitude = b.half_width * b.scale * w;
+    let thick = 0.5 * b.length.clamp(0.05, 1.0) * spacing * b.scale;
+    let count = (h / spacing).round() as i32;
+    for copy_u in [-1.0f32, 0.0, 1.0] {
+        let x0 = cx + copy_u * w;
+        if x0 + amplitude + thick < 0.0 || x0 - amplitude - thick > w {
+            continue;
+        }
+        // Each segment a quadrilateral between successive vertices, thickened along v.
+        for k in -2..=2 * count + 1 {
+            let (ya, yb) = (start + k as f32 * 0.5 * spacing, start + (k + 1) as f32 * 0.5 * spacing);
+            let xa = x0 + if k.rem_euclid(2) == 0 { -amplitude } else { amplitude };
+            let xb = x0 + if k.rem_euclid(2) == 0 { amplitude } else { -amplitude };
+            pb.move_to(xa, ya - thick);
+            pb.line_to(xb, yb - thick);
+            pb.line_to(xb, yb + thick);
+            pb.line_to(xa, ya + thick);
+            pb.close();
+        }
+    }
 }
 
 /// What the ventral plates carry (`BellyMarks`).

@@ -224,6 +224,9 @@ pub enum PatternShape {
     Ring,
     Diamond,
     Saddle,
+    Chevron,
+    Hourglass,
+    Zigzag,
 }
 
 /// How spots are laid out in rows.
@@ -308,6 +311,22 @@ pub struct PatternLayer {
     /// `position`, `size` and `amount`.
     #[serde(default)]
     pub rows: Vec<f64>,
+    /// Blotches: shift of the series along the body, in spacings (0.5 puts a flank series
+    /// between the blotches of a dorsal one).
+    #[serde(default)]
+    pub phase: f64,
+    /// Blotches and spots: a composite mark's centre, in this colour (none: no centre).
+    #[serde(default)]
+    pub center_color: Option<Srgb8>,
+    /// Blotches and spots: the centre's size as a fraction of the mark's.
+    #[serde(default = "PatternLayer::default_center_size")]
+    pub center_size: f64,
+    /// A border outside the mark (and outside its outline), in this colour (none: none).
+    #[serde(default)]
+    pub border_color: Option<Srgb8>,
+    /// The border's width, fraction of the circumference.
+    #[serde(default = "PatternLayer::default_border_size")]
+    pub border_size: f64,
 }
 
 impl PatternLayer {
@@ -328,6 +347,12 @@ impl PatternLayer {
     }
     fn default_noise() -> NoiseChoice {
         NoiseChoice::Perlin
+    }
+    fn default_center_size() -> f64 {
+        0.5
+    }
+    fn default_border_size() -> f64 {
+        0.01
     }
     fn default_length() -> f64 {
         0.6

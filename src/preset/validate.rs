@@ -31,6 +31,8 @@ pub mod ranges {
     pub const PATTERN_SIZE: (f64, f64) = (0.001, 0.5);
     pub const PATTERN_OFFSET: (f64, f64) = (0.0, 0.5);
     pub const OUTLINE_SIZE: (f64, f64) = (0.0, 0.1);
+    /// A composite mark's centre, as a fraction of the mark.
+    pub const CENTER_SIZE: (f64, f64) = (0.05, 0.95);
     pub const BELLY_WIDTH: (f64, f64) = (0.0, 0.6);
     pub const BELLY_BLEND: (f64, f64) = (0.0, 0.2);
     pub const NORMAL_STRENGTH: (f64, f64) = (0.0, 10.0);
@@ -129,7 +131,14 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
         }
         let shapes: &[PatternShape] = match p.kind {
             PatternKind::Spots => &[PatternShape::Round, PatternShape::Ring],
-            PatternKind::Blotches => &[PatternShape::Round, PatternShape::Diamond, PatternShape::Saddle],
+            PatternKind::Blotches => &[
+                PatternShape::Round,
+                PatternShape::Diamond,
+                PatternShape::Saddle,
+                PatternShape::Chevron,
+                PatternShape::Hourglass,
+                PatternShape::Zigzag,
+            ],
             _ => &[PatternShape::Round],
         };
         if !shapes.contains(&p.shape) {
@@ -160,6 +169,9 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
             c.problems.push(Problem { key: key("widths"), message: "must sum to at most 1 (one repeat)".into() });
         }
         c.range(key("scale_aligned"), p.scale_aligned, UNIT);
+        c.range(key("phase"), p.phase, UNIT);
+        c.range(key("center_size"), p.center_size, CENTER_SIZE);
+        c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
         if !p.rows.is_empty() {
             let top = (preset.scales.rows as f64 + 1.0) / 2.0;
             let ok = p.kind == PatternKind::Stripes

@@ -414,7 +414,7 @@ pub enum BenchCommand {
     /// reference comparison (mean and p99 CIEDE2000).
     Render {
         /// Preset to render.
-        #[arg(default_value = "erythrolamprus-miliaris")]
+        #[arg(default_value = "xenopeltis-unicolor")]
         preset: String,
         /// Frame size WIDTHxHEIGHT (use 1920x1080 on a real GPU).
         #[arg(long, default_value = "1280x720", value_parser = parse_image_size)]

@@ -84,6 +84,88 @@ pub const VARIANTS: &[(&str, MapKind, &str)] = &[
         "[[pattern]]\nkind = \"spots\"\ncolor = \"#201810\"\namount = 8\nsize = 0.03\nscale_aligned = 1.0\n",
     ),
     ("checkered belly", MapKind::Color, "[belly]\nwidth = 0.3\ncolor = \"#e8dcb8\"\npattern = \"checkered\"\n"),
+    // The vocabulary of colour that lives in scales, composite marks, belly marks and rows.
+    (
+        "per-scale tone, dark rims, speckle",
+        MapKind::Color,
+        "[color]\nbase = \"#8a7a50\"\nscale_tone = 0.15\nedge_tone = -0.6\nspeckle = 0.25\n",
+    ),
+    (
+        "light tips, pale skin between scales",
+        MapKind::Color,
+        "[scales]\nsize = 0.9\n[color]\nbase = \"#4a5a2a\"\ntip_tone = 0.6\nskin = \"#e8e0c8\"\n",
+    ),
+    (
+        "composite: centre, dark edge, pale border",
+        MapKind::Color,
+        "[color]\nbase = \"#a89878\"\n[[pattern]]\nkind = \"blotches\"\ncolor = \"#7a5a3a\"\namount = 3\nsize = 0.12\n\
+         length = 0.7\noutline_size = 0.008\noutline_color = \"#201810\"\nborder_color = \"#f0e4c8\"\n\
+         border_size = 0.01\ncenter_color = \"#d0c098\"\ncenter_size = 0.45\n",
+    ),
+    (
+        "staggered pairs over a flank series",
+        MapKind::Color,
+        "[color]\nbase = \"#9a8058\"\n[[pattern]]\nkind = \"blotches\"\nshape = \"saddle\"\ncolor = \"#3a2a1c\"\n\
+         amount = 4\nsize = 0.07\nlength = 0.5\noffset = 0.09\narrangement = \"alternating\"\noutline_size = 0.006\n\
+         outline_color = \"#f0e8d0\"\n[[pattern]]\nkind = \"blotches\"\ncolor = \"#2a1a10\"\namount = 4\nsize = 0.03\n\
+         length = 0.3\noffset = 0.27\narrangement = \"aligned\"\nphase = 0.5\n",
+    ),
+    (
+        "chevrons",
+        MapKind::Color,
+        "[color]\nbase = \"#b8985e\"\n[[pattern]]\nkind = \"blotches\"\nshape = \"chevron\"\ncolor = \"#22180f\"\n\
+         amount = 4\nsize = 0.3\nlength = 0.8\nborder_color = \"#e0cc94\"\nborder_size = 0.01\n",
+    ),
+    (
+        "hourglasses",
+        MapKind::Color,
+        "[color]\nbase = \"#b08a60\"\n[[pattern]]\nkind = \"blotches\"\nshape = \"hourglass\"\ncolor = \"#4a2a18\"\n\
+         amount = 4\nsize = 0.28\nlength = 0.7\noutline_size = 0.006\n",
+    ),
+    (
+        "zigzag",
+        MapKind::Color,
+        "[color]\nbase = \"#8a8478\"\n[[pattern]]\nkind = \"blotches\"\nshape = \"zigzag\"\ncolor = \"#1c1a18\"\n\
+         amount = 5\nsize = 0.08\nlength = 0.6\n",
+    ),
+    (
+        "stripes on rows 2–3 and the vertebral row",
+        MapKind::Color,
+        "[color]\nbase = \"#2a2e24\"\n[[pattern]]\nkind = \"stripes\"\ncolor = \"#d8d070\"\nrows = [9.5, 10]\n\
+         [[pattern]]\nkind = \"stripes\"\ncolor = \"#c8c878\"\nrows = [2, 3]\n",
+    ),
+    (
+        "rings in whole scales",
+        MapKind::Color,
+        "[scales]\nrows = 15\n[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\namount = 1\nover_belly = true\n\
+         colors = [\"#121110\", \"#e8c828\", \"#c42018\", \"#e8c828\"]\nwidths = [0.3, 0.06, 0.58, 0.06]\n\
+         scale_aligned = 1.0\n",
+    ),
+    (
+        "belly: scattered spots",
+        MapKind::Color,
+        "[belly]\nwidth = 0.3\ncolor = \"#e8dcb8\"\npattern = \"spots\"\npattern_amount = 0.6\n",
+    ),
+    (
+        "belly: half-moons, colour up 2 rows",
+        MapKind::Color,
+        "[belly]\nwidth = 0.3\ncolor = \"#e89030\"\npattern = \"half_moons\"\npattern_amount = 0.8\nup_rows = 2\n",
+    ),
+    (
+        "belly: median stripe",
+        MapKind::Color,
+        "[belly]\nwidth = 0.3\ncolor = \"#e8dcb8\"\npattern = \"median_stripe\"\npattern_amount = 0.3\n",
+    ),
+    (
+        "enlarged vertebral row",
+        MapKind::Height,
+        "[scales]\nshape = \"hexagon\"\nsize = 0.95\nrows = 15\nvertebral_width = 2.2\n",
+    ),
+    (
+        "keels off the lowest 3 rows",
+        MapKind::Height,
+        "[scales]\nshape = \"diamond\"\nkeeled = true\nkeel_height = 1.0\nsmooth_rows = 3\n",
+    ),
 ];
 
 /// Renders every variant at `tile` pixels and tiles them `columns` wide into one PNG.

@@ -1,0 +1,170 @@
+//! Composite marks and the blotch shapes: each does what its name says, measured on the
+//! mask or the colour map (where a centre, a border, a pair, a chevron's apex lies).
+
+use snakeskin::graph::evaluate;
+use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+use snakeskin::ops::Image;
+use snakeskin::ops::shapes::{BlotchShape, Blotches, blotches};
+use snakeskin::preset::{PresetSource, parse};
+
+const SIZE: usize = 256;
+
+fn series(shape: BlotchShape, offset: f32, staggered: bool) -> Blotches {
+    Blotches {
+        shape,
+        count: 4,
+        half_width: 0.2,
+        length: 0.8,
+        jitter: 0.3,
+        offset,
+        staggered,
+        phase: 0.0,
+        scale: 1.0,
+        seed: 11,
+    }
+}
+
+fn at(mask: &Image, x: usize, y: usize) -> f32 {
+    mask.data[(y % SIZE) * SIZE + x % SIZE]
+}
+
+#[test]
+fn paired_series_mirror_about_the_spine_and_staggered_ones_are_half_a_spacing_apart() {
+    let pair = blotches(SIZE, SIZE, &Blotches { half_width: 0.05, ..series(BlotchShape::Round, 0.15, false) });
+    let stagger = blotches(SIZE, SIZE, &Blotches { half_width: 0.05, ..series(BlotchShape::Round, 0.15, true) });
+    let (mut asymmetric, mut shifted_off, mut covered) = (0.0f32, 0.0f32, 0.0f32);
+    let half_spacing = SIZE / 8;
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            asymmetric = asymmetric.max((at(&pair, x, y) - at(&pair, SIZE - 1 - x, y)).abs());
+            if x >= SIZE / 2 {
+                // The series at u < 0.5 is the one shifted (by half a spacing, tailwards).
+                shifted_off =
+                    shifted_off.max((at(&stagger, x, y) - at(&stagger, SIZE - 1 - x, y + half_spacing)).abs());
+            }
+            covered += at(&pair, x, y);
+        }
+    }
+    assert!(covered > 500.0, "the pair drew almost nothing: {covered}");
+    // Antialiasing of a mirrored outline differs by up to a few dozen 8-bit coverage levels.
+    assert!(asymmetric < 0.2, "paired series not mirrored: {asymmetric}");
+    assert!(shifted_off < 0.2, "staggered series not half a spacing apart: {shifted_off}");
+    // Negative control: the staggered series is not mirrored in place.
+    let unshifted = (0..SIZE * SIZE)
+        .map(|i| (at(&stagger, i % SIZE, i / SIZE) - at(&stagger, SIZE - 1 - i % SIZE, i / SIZE)).abs())
+        .fold(0.0f32, f32::max);
+    assert!(unshifted > 0.5, "a staggered series looked paired");
+}
+
+/// Mean v (pixels) of the mask in column x over the first blotch (y in 0..SIZE / 4).
+fn mean_y(mask: &Image, x: usize) -> (f32, f32) {
+    let (mut sum, mut n) = (0.0, 0.0);
+    for y in 0..SIZE / 4 {
+        let m = at(mask, x, y);
+        sum += m * y as f32;
+        n += m;
+    }
+    (sum / n.max(1e-6), n)
+}
+
+#[test]
+fn a_chevron_points_to_the_tail_and_an_hourglass_is_narrow_at_the_spine() {
+    let no_jitter = |shape| Blotches { jitter: 0.0, ..series(shape, 0.0, false) };
+    let chevron = blotches(SIZE, SIZE, &no_jitter(BlotchShape::Chevron));
+    let (spine, side) = (SIZE / 2, SIZE / 2 + (0.8 * 0.2 * SIZE as f32) as usize);
+    let ((y_spine, _), (y_side, _)) = (mean_y(&chevron, spine), mean_y(&chevron, side));
+    // v grows towards the tail: the apex (spine) lies behind the arms' ends.
+    assert!(y_spine > y_side + 5.0, "chevron apex at {y_spine}, arms at {y_side}");
+
+    let hourglass = blotches(SIZE, SIZE, &no_jitter(BlotchShape::Hourglass));
+    let ((_, n_spine), (_, n_side)) = (mean_y(&hourglass, spine), mean_y(&hourglass, side));
+    assert!(n_spine < 0.6 * n_side, "hourglass {n_spine} px long at the spine, {n_side} at the side");
+    // Negative control: a saddle is as long at the spine as at its sides.
+    let saddle = blotches(SIZE, SIZE, &no_jitter(BlotchShape::Saddle));
+    let ((_, s_spine), (_, s_side)) = (mean_y(&saddle, spine), mean_y(&saddle, side));
+    assert!((s_spine - s_side).abs() < 0.1 * s_side, "saddle {s_spine} vs {s_side}");
+}
+
+#[test]
+fn a_zigzag_is_one_band_from_head_to_tail() {
+    let zigzag =
+        blotches(SIZE, SIZE, &Blotches { half_width: 0.08, length: 0.2, ..series(BlotchShape::Zigzag, 0.0, false) });
+    // Every row of the tile crosses the band, and consecutive rows' crossings overlap
+    // (8-connected), so the band never breaks along the body.
+    let span = |y: usize| {
+        let xs: Vec<usize> = (0..SIZE).filter(|x| at(&zigzag, *x, y) > 0.5).collect();
+        (*xs.first().unwrap_or(&usize::MAX), *xs.last().unwrap_or(&0))
+    };
+    for y in 0..SIZE {
+        let (a, b) = (span(y), span(y + 1));
+        assert!(a.0 <= a.1, "row {y} misses the zigzag");
+        assert!(a.0 <= b.1 + 1 && b.0 <= a.1 + 1, "rows {y} and {} do not touch: {a:?} {b:?}", y + 1);
+    }
+    // It does zig: the band's centre moves across by most of its amplitude.
+    let centres: Vec<f32> = (0..SIZE)
+        .map(|y| {
+            let (sum, n) =
+                (0..SIZE).fold((0.0, 0.0), |(s, n), x| (s + at(&zigzag, x, y) * x as f32, n + at(&zigzag, x, y)));
+            sum / n
+        })
+        .collect();
+    let swing = centres.iter().cloned().fold(f32::MIN, f32::max) - centres.iter().cloned().fold(f32::MAX, f32::min);
+    // (A straight band does not swing at all; this one's vertices are ±20 px.)
+    assert!(swing > 0.06 * SIZE as f32, "the zigzag swings only {swing} px");
+}
+
+fn colour(text: &str) -> Image {
+    let source = PresetSource { name: "t".into(), display: "test".into(), text: text.into() };
+    let loaded = parse(&source, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    evaluate(&graph, &[MapKind::Color], SIZE, SIZE, &|_, _| {}).maps.remove(&MapKind::Color).unwrap()
+}
+
+const MARK: &str = "seed = 3\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\nscale_hue = 0\n\
+                    [[pattern]]\nkind = \"blotches\"\ncolor = \"#202020\"\namount = 3\nsize = 0.12\nlength = 0.7\n\
+                    edge_distortion = 0\n";
+
+fn pixel(img: &Image, i: usize) -> [f32; 3] {
+    [img.data[i * 3], img.data[i * 3 + 1], img.data[i * 3 + 2]]
+}
+
+#[test]
+fn a_composite_centre_lies_inside_the_mark_and_a_border_outside_it() {
+    let plain = colour(MARK);
+    let centred = colour(&format!("{MARK}center_color = \"#f0f0f0\"\ncenter_size = 0.5\n"));
+    let bordered = colour(&format!("{MARK}border_color = \"#f0f0f0\"\nborder_size = 0.02\n"));
+    let mark = snakeskin::preset::schema::Srgb8([0x20; 3]).to_linear();
+    let base = snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear();
+    let near = |a: [f32; 3], b: [f32; 3]| (0..3).all(|c| (a[c] - b[c]).abs() < 1e-4);
+    let (mut centre_px, mut border_px) = (0, 0);
+    for i in 0..SIZE * SIZE {
+        if !near(pixel(&centred, i), pixel(&plain, i)) {
+            assert!(near(pixel(&plain, i), mark), "the centre reaches outside the mark at pixel {i}");
+            centre_px += 1;
+        }
+        if !near(pixel(&bordered, i), pixel(&plain, i)) {
+            // The border lies outside the mark (antialiased edge pixels excepted).
+            assert!(!near(pixel(&plain, i), mark), "the border covers the mark at pixel {i}");
+            border_px += 1;
+        }
+    }
+    let mark_px = (0..SIZE * SIZE).filter(|i| near(pixel(&plain, *i), mark)).count();
+    // A centre at half the size covers about a quarter of the mark.
+    let share = centre_px as f64 / mark_px as f64;
+    assert!((0.15..0.35).contains(&share), "centre covers {share:.2} of the mark");
+    assert!(border_px > mark_px / 5, "border of {border_px} px round {mark_px} px of mark");
+    // The border hugs the mark: no border pixel is far from a mark pixel (0.02 of the
+    // circumference is 5 px at 256; allow the blur's tail and the edge's antialiasing).
+    let is_mark: Vec<bool> = (0..SIZE * SIZE).map(|i| !near(pixel(&plain, i), base)).collect();
+    for i in (0..SIZE * SIZE).filter(|i| !near(pixel(&bordered, *i), pixel(&plain, *i))) {
+        let (x, y) = ((i % SIZE) as isize, (i / SIZE) as isize);
+        let close = (-9..=9isize).any(|dy| {
+            (-9..=9isize).any(|dx| {
+                let (xx, yy) =
+                    ((x + dx).rem_euclid(SIZE as isize) as usize, (y + dy).rem_euclid(SIZE as isize) as usize);
+                is_mark[yy * SIZE + xx]
+            })
+        });
+        assert!(close, "a border pixel at ({x}, {y}) is more than 9 px from the mark");
+    }
+}

@@ -1,0 +1,102 @@
+//! Marks made of whole scales keep their topology: a ring one scale wide, drawn in whole
+//! scales (`scale_aligned = 1`), stays closed round the body, and the rings either side of
+//! it never touch (the rule that tells a coral snake's pattern) — checked on the colour map
+//! by connectivity, at every size from 128 to 1024, with jittered scales.
+
+use std::collections::VecDeque;
+
+use snakeskin::graph::evaluate;
+use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+use snakeskin::ops::Image;
+use snakeskin::preset::{PresetSource, parse};
+
+const BLACK: [f32; 3] = [0.0, 0.0, 0.0];
+const YELLOW: [f32; 3] = [0.9, 0.8, 0.0];
+const RED: [f32; 3] = [0.8, 0.0, 0.0];
+
+/// A coral-snake triad whose yellow rings (5 % of a repeat) are narrower than one scale.
+fn preset(scale_aligned: f64, seed: u64) -> String {
+    format!(
+        "seed = {seed}\n[scales]\nrows = 15\njitter = 0.3\n[color]\nbase = \"#000000\"\nvariation = 0\nbetween_scales = 0\n\
+         scale_tone = 0\nscale_hue = 0\n[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\namount = 1\n\
+         colors = [\"#000000\", \"#f3e700\", \"#e70000\", \"#f3e700\"]\nwidths = [0.3, 0.05, 0.6, 0.05]\n\
+         over_belly = true\nedge_distortion = 0.3\nscale_aligned = {scale_aligned}\n"
+    )
+}
+
+/// Each pixel's nearest ring colour: 0 black, 1 yellow, 2 red.
+fn classes(text: &str, size: usize) -> Vec<u8> {
+    let source = PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
+    let loaded = parse(&source, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    let colour: Image =
+        evaluate(&graph, &[MapKind::Color], size, size, &|_, _| {}).maps.remove(&MapKind::Color).unwrap();
+    colour
+        .data
+        .chunks_exact(3)
+        .map(|p| {
+            let d = |c: [f32; 3]| (0..3).map(|k| (p[k] - c[k]).powi(2)).sum::<f32>();
+            [d(BLACK), d(YELLOW), d(RED)].iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).unwrap().0 as u8
+        })
+        .collect()
+}
+
+fn neighbours(i: usize, size: usize) -> [usize; 4] {
+    let (x, y) = (i % size, i / size);
+    let wrap = |v: isize| v.rem_euclid(size as isize) as usize;
+    [
+        y * size + wrap(x as isize - 1),
+        y * size + wrap(x as isize + 1),
+        wrap(y as isize - 1) * size + x,
+        wrap(y as isize + 1) * size + x,
+    ]
+}
+
+/// Whether the yellow pixels hold a 4-connected path from the left edge across the whole
+/// width (the texture wraps at its edges, so that path closes the ring round the body).
+fn a_yellow_ring_goes_round(class: &[u8], size: usize) -> bool {
+    let mut seen = vec![false; class.len()];
+    let mut queue: VecDeque<usize> = (0..size).map(|y| y * size).filter(|i| class[*i] == 1).collect();
+    for i in &queue {
+        seen[*i] = true;
+    }
+    while let Some(i) = queue.pop_front() {
+        if i % size == size - 1 {
+            return true;
+        }
+        for n in neighbours(i, size) {
+            // Only rightward progress through the interior; no wrapping back across x = 0.
+            if !seen[n] && class[n] == 1 && !(i % size == 0 && n % size == size - 1) {
+                seen[n] = true;
+                queue.push_back(n);
+            }
+        }
+    }
+    false
+}
+
+fn red_touches_black(class: &[u8], size: usize) -> usize {
+    (0..class.len()).filter(|i| class[*i] == 2 && neighbours(*i, size).iter().any(|n| class[*n] == 0)).count()
+}
+
+#[test]
+fn a_ring_one_scale_wide_stays_closed_and_keeps_red_from_black_at_every_size() {
+    for seed in [1, 2, 3] {
+        for size in [128, 256, 512, 1024] {
+            let class = classes(&preset(1.0, seed), size);
+            assert!(a_yellow_ring_goes_round(&class, size), "seed {seed}, size {size}: the yellow ring is broken");
+            assert_eq!(red_touches_black(&class, size), 0, "seed {seed}, size {size}: red touches black");
+        }
+    }
+}
+
+#[test]
+fn the_same_ring_at_its_written_width_breaks_when_scales_are_snapped_by_their_centres() {
+    // Negative control: without the whole-scale widths (almost full snapping, 0.99, keeps
+    // the written widths), a ring narrower than a scale misses the centres of some columns.
+    let broken = [1, 2, 3].iter().any(|seed| {
+        let class = classes(&preset(0.99, *seed), 256);
+        !a_yellow_ring_goes_round(&class, 256) || red_touches_black(&class, 256) > 0
+    });
+    assert!(broken, "the control ring survived: the test could not see a break");
+}
