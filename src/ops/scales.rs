@@ -120,8 +120,10 @@ impl Lattice {
     }
 
     /// Dorsal row of column `c` (any integer; wrapped): 1 the lowest, 0 in the ventral band.
+    #[inline]
     pub fn row_of(&self, c: i32) -> i32 {
-        let c = c.rem_euclid(self.cols);
+        // The callers pass columns at most one period out: a branch, not a division.
+        let c = if (0..self.cols).contains(&c) { c } else { c.rem_euclid(self.cols) };
         let half = self.belly_cols / 2;
         if c < half || c >= self.cols - half {
             return 0;
@@ -141,15 +143,25 @@ impl Lattice {
     }
 
     /// Texture u of lattice x (any real; wrapped into [0, 1)).
+    #[inline]
     pub fn u_of(&self, x: f32) -> f32 {
         let n = self.cols as f32;
-        let x = x.rem_euclid(n);
+        // Per pixel, x lies at most one period out: wrap by a branch (`rem_euclid` on f32 is
+        // a libm call).
+        let x = if x < 0.0 {
+            x + n
+        } else if x >= n {
+            x - n
+        } else {
+            x
+        };
+        let x = if (0.0..n).contains(&x) { x } else { x.rem_euclid(n) };
         if self.uniform {
-            return (x / n).rem_euclid(1.0);
+            return (x / n).min(1.0 - f32::EPSILON);
         }
         let c = (x as usize).min(self.cols as usize - 1);
         let (a, b) = (self.bounds[c], self.bounds[c + 1]);
-        (a + (x - c as f32) * (b - a)).rem_euclid(1.0)
+        (a + (x - c as f32) * (b - a)).min(1.0 - f32::EPSILON)
     }
 
     /// The u range, on the side u > 0.5, from the start of dorsal row `first` to the end of

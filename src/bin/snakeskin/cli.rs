@@ -55,6 +55,12 @@ pub enum Command {
         /// Tiles per row.
         #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u64).range(1..=64))]
         columns: u64,
+        /// Also write one close-up per capability of the skin vocabulary into this folder: a
+        /// 512 × 512 crop of the colour map beside the same crop of the normal map, both
+        /// generated at 1024 × 1024 (per-scale colour, composite marks, rings in whole
+        /// scales, belly marks, rows, imbricate geometry).
+        #[arg(long, value_name = "DIR")]
+        closeups: Option<PathBuf>,
     },
     /// Render a preset on a snake body with the multi-layer BRDF: headless to a PNG (--out)
     /// or in a window with sliders and live reload (--window).

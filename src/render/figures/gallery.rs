@@ -210,6 +210,98 @@ fn gray_to_display(image: &Image) -> Image {
     Image { width: image.width, height: image.height, channels: 3, data }
 }
 
+/// One close-up per capability of the skin vocabulary: (file stem, the crop's top-left corner
+/// as a fraction of the map, preset text). Generated at `CLOSEUP_MAP` pixels; the crop is
+/// `CLOSEUP_CROP` pixels square.
+pub const CLOSEUPS: &[(&str, (f32, f32), &str)] = &[
+    (
+        "per-scale-colour",
+        (0.25, 0.0),
+        "seed = 4\n[scales]\nsize = 0.95\n[color]\nbase = \"#8a7a50\"\nscale_tone = 0.12\nscale_hue = 0.04\n\
+         edge_tone = -0.5\ntip_tone = 0.35\nspeckle = 0.2\nskin = \"#e0d8c0\"\n",
+    ),
+    (
+        "composite-marks",
+        (0.25, 0.0),
+        "seed = 5\n[scales]\nshape = \"diamond\"\nkeeled = true\n[color]\nbase = \"#b08a60\"\n[[pattern]]\n\
+         kind = \"blotches\"\nshape = \"hourglass\"\ncolor = \"#3a2418\"\namount = 2\nsize = 0.22\nlength = 0.6\n\
+         border_color = \"#e8d090\"\nborder_size = 0.008\n[[pattern]]\nkind = \"blotches\"\ncolor = \"#7a5a3a\"\n\
+         amount = 2\nsize = 0.06\nlength = 0.5\noffset = 0.2\narrangement = \"aligned\"\nphase = 0.5\n\
+         outline_size = 0.006\noutline_color = \"#201810\"\ncenter_color = \"#e0d0b0\"\ncenter_size = 0.4\n",
+    ),
+    (
+        "rings-in-whole-scales",
+        (0.25, 0.0),
+        "seed = 6\n[scales]\nrows = 15\n[color]\nbase = \"#c42018\"\n[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\n\
+         amount = 1\nover_belly = true\ncolors = [\"#121110\", \"#e8c828\", \"#c42018\", \"#e8c828\"]\n\
+         widths = [0.3, 0.06, 0.58, 0.06]\nscale_aligned = 1.0\n",
+    ),
+    (
+        "belly-marks",
+        (0.75, 0.0),
+        "seed = 7\n[color]\nbase = \"#3a4048\"\n[belly]\nwidth = 0.3\ncolor = \"#e89030\"\npattern = \"half_moons\"\n\
+         pattern_amount = 0.8\nup_rows = 2\n",
+    ),
+    (
+        "rows",
+        (0.25, 0.0),
+        "seed = 8\n[scales]\nshape = \"hexagon\"\nsize = 0.95\nrows = 15\nvertebral_width = 2.2\n[color]\n\
+         base = \"#202020\"\n[[pattern]]\nkind = \"stripes\"\ncolor = \"#e8d040\"\nrows = [7.5, 8]\n",
+    ),
+    (
+        "imbricate-geometry",
+        (0.25, 0.0),
+        "seed = 9\n[scales]\nshape = \"leaf\"\nkeeled = true\nkeel_height = 0.8\nsmooth_rows = 2\nimbrication = 0.8\n\
+         [color]\nbase = \"#6b7a3a\"\n",
+    ),
+];
+
+/// The size the close-ups are generated at, and the crop's side.
+pub const CLOSEUP_MAP: usize = 1024;
+pub const CLOSEUP_CROP: usize = 512;
+
+/// Writes `<stem>.png` per close-up into `dir` (colour crop left, normal crop right; every
+/// file atomically); returns the paths.
+pub fn write_closeups(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, Error> {
+    CLOSEUPS
+        .par_iter()
+        .map(|(stem, (u0, v0), text)| {
+            let source =
+                PresetSource { name: stem.to_string(), display: format!("close-up {stem:?}"), text: text.to_string() };
+            let loaded = parse(&source, &[])?;
+            let graph = build_graph(&loaded.preset, BuildOptions::default());
+            let maps = evaluate(&graph, &[MapKind::Color, MapKind::Normal], CLOSEUP_MAP, CLOSEUP_MAP, &|_, _| {}).maps;
+            let (n, c) = (CLOSEUP_MAP, CLOSEUP_CROP);
+            let (x0, y0) = ((u0 * n as f32) as usize, (v0 * n as f32) as usize);
+            let mut out = Image::new(2 * c, c, 3);
+            for (k, map) in [MapKind::Color, MapKind::Normal].iter().enumerate() {
+                let img = &maps[map];
+                for y in 0..c {
+                    for x in 0..c {
+                        let (sx, sy) = ((x0 + x) % n, (y0 + y) % n);
+                        for ch in 0..3 {
+                            // The normal map's [-1, 1] shown as its PNG stores it, (n + 1) / 2,
+                            // as the linear value that sRGB encoding turns into that code.
+                            let v = img.data[(sy * n + sx) * 3 + ch];
+                            let v = if *map == MapKind::Normal { srgb_to_linear((v + 1.0) * 0.5) } else { v };
+                            out.data[(y * 2 * c + k * c + x) * 3 + ch] = v;
+                        }
+                    }
+                }
+            }
+            let path = dir.join(format!("{stem}.png"));
+            write_file_atomically(&path, encode_png(MapKind::Color, &out)?)?;
+            Ok(path)
+        })
+        .collect()
+}
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1).
+fn srgb_to_linear(encoded: f32) -> f32 {
+    let e = encoded.clamp(0.0, 1.0);
+    if e <= 0.04045 { e / 12.92 } else { ((e + 0.055) / 1.055).powf(2.4) }
+}
+
 /// Renders and writes the gallery PNG atomically.
 pub fn write(path: &std::path::Path, tile: usize, columns: usize) -> Result<(), Error> {
     let sheet = render(tile, columns)?;

@@ -23,7 +23,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Bench { command } => bench::run(command),
         Command::Preview(args) => preview::run(args),
         Command::Figures { preset, out, size, map_size } => figures::run(&preset, &out, size, map_size),
-        Command::Gallery { out, tile, columns } => gallery::run(&out, tile as usize, columns as usize),
+        Command::Gallery { out, tile, columns, closeups } => {
+            gallery::run(&out, tile as usize, columns as usize, closeups.as_deref())
+        }
         Command::Sheet { out, tile, columns, map_size } => sheet::run(&out, tile, columns, map_size as usize),
         Command::Presets { command } => presets::run(command),
     }
