@@ -95,3 +95,22 @@ fn half_moons_rest_on_the_posterior_edge() {
         assert!(along > 0.45, "a half-moon pixel at {along:.2} of its plate, not at the posterior edge");
     }
 }
+
+#[test]
+fn a_checkered_plate_carries_its_square_on_one_side_only_across_the_seam() {
+    let (changed, _) = marked("checkered");
+    let rows_v = scale_field(&preset(&text("checkered"))).lattice().rows_v as usize;
+    let plate = |y: usize| {
+        (((y as f32 + 0.5) / SIZE as f32 * rows_v as f32 - snakeskin::ops::scales::ROW_PHASE).floor() as i64)
+            .rem_euclid(rows_v as i64)
+    };
+    let mut sides: std::collections::BTreeMap<i64, std::collections::BTreeSet<bool>> = Default::default();
+    for (x, y) in changed {
+        sides.entry(plate(y)).or_default().insert(x < SIZE / 2);
+    }
+    // Including the plate the texture's v seam cuts in two (its rows at the top and bottom).
+    for (p, s) in &sides {
+        assert_eq!(s.len(), 1, "plate {p} is marked on both sides");
+    }
+    assert!(sides.len() >= rows_v * 3 / 4, "only {} of {rows_v} plates marked", sides.len());
+}

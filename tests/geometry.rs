@@ -51,6 +51,7 @@ fn a_free_edge_stands_a_step_above_the_scale_it_overlaps() {
         }
         // Negative control: without imbrication there is no overlap step.
         let flat = steps(&preset(0.0), x);
+        assert!(flat.len() >= 8, "{part}: the control crossed only {} edges", flat.len());
         assert!(flat.iter().all(|s| *s < 0.01), "{part}: steps without imbrication: {flat:?}");
     }
 }

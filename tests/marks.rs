@@ -89,17 +89,35 @@ fn a_chevron_points_to_the_tail_and_an_hourglass_is_narrow_at_the_spine() {
 fn a_zigzag_is_one_band_from_head_to_tail() {
     let zigzag =
         blotches(SIZE, SIZE, &Blotches { half_width: 0.08, length: 0.2, ..series(BlotchShape::Zigzag, 0.0, false) });
-    // Every row of the tile crosses the band, and consecutive rows' crossings overlap
-    // (8-connected), so the band never breaks along the body.
-    let span = |y: usize| {
-        let xs: Vec<usize> = (0..SIZE).filter(|x| at(&zigzag, *x, y) > 0.5).collect();
-        (*xs.first().unwrap_or(&usize::MAX), *xs.last().unwrap_or(&0))
-    };
-    for y in 0..SIZE {
-        let (a, b) = (span(y), span(y + 1));
-        assert!(a.0 <= a.1, "row {y} misses the zigzag");
-        assert!(a.0 <= b.1 + 1 && b.0 <= a.1 + 1, "rows {y} and {} do not touch: {a:?} {b:?}", y + 1);
+    // Flood fill (4-connected: pieces touching at a corner do not count as one band) from the
+    // covered pixels of the first row, not wrapping along v: the band must reach the last
+    // row, and be the only band (every covered pixel reached).
+    let covered = |x: usize, y: usize| at(&zigzag, x, y) > 0.5;
+    let mut seen = vec![false; SIZE * SIZE];
+    let mut stack: Vec<(usize, usize)> = (0..SIZE).filter(|x| covered(*x, 0)).map(|x| (x, 0)).collect();
+    assert!(!stack.is_empty(), "the first row misses the zigzag");
+    while let Some((x, y)) = stack.pop() {
+        if seen[y * SIZE + x] {
+            continue;
+        }
+        seen[y * SIZE + x] = true;
+        for (dx, dy) in [(0i32, -1i32), (-1, 0), (1, 0), (0, 1)] {
+            let (nx, ny) = ((x as i32 + dx).rem_euclid(SIZE as i32) as usize, y as i32 + dy);
+            if (0..SIZE as i32).contains(&ny) && covered(nx, ny as usize) && !seen[ny as usize * SIZE + nx] {
+                stack.push((nx, ny as usize));
+            }
+        }
     }
+    let reached_last_row = (0..SIZE).any(|x| seen[(SIZE - 1) * SIZE + x]);
+    let total = (0..SIZE * SIZE).filter(|i| covered(i % SIZE, i / SIZE)).count();
+    let reached = seen.iter().filter(|s| **s).count();
+    assert!(reached_last_row, "the zigzag breaks before the tail end of the tile");
+    assert_eq!(reached, total, "the zigzag falls apart into pieces");
+    // Nowhere thinner than half its usual crossing: at the vertices too.
+    let mut counts: Vec<usize> = (0..SIZE).map(|y| (0..SIZE).filter(|x| covered(*x, y)).count()).collect();
+    let thinnest = *counts.iter().min().unwrap();
+    counts.sort();
+    assert!(thinnest * 2 >= counts[SIZE / 2], "the band thins to {thinnest} px against {} typical", counts[SIZE / 2]);
     // It does zig: the band's centre moves across by most of its amplitude.
     let centres: Vec<f32> = (0..SIZE)
         .map(|y| {
@@ -133,6 +151,9 @@ fn a_composite_centre_lies_inside_the_mark_and_a_border_outside_it() {
     let plain = colour(MARK);
     let centred = colour(&format!("{MARK}center_color = \"#f0f0f0\"\ncenter_size = 0.5\n"));
     let bordered = colour(&format!("{MARK}border_color = \"#f0f0f0\"\nborder_size = 0.02\n"));
+    // A chevron's centre (the V drawn smaller about its middle) stays inside the V too.
+    let chevron = MARK.replace("amount = 3", "amount = 3\nshape = \"chevron\"");
+    let (v_plain, v_centred) = (colour(&chevron), colour(&format!("{chevron}center_color = \"#f0f0f0\"\n")));
     let mark = snakeskin::preset::schema::Srgb8([0x20; 3]).to_linear();
     let base = snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear();
     let near = |a: [f32; 3], b: [f32; 3]| (0..3).all(|c| (a[c] - b[c]).abs() < 1e-4);
@@ -148,6 +169,15 @@ fn a_composite_centre_lies_inside_the_mark_and_a_border_outside_it() {
             border_px += 1;
         }
     }
+    let mut v_centre_px = 0;
+    for i in 0..SIZE * SIZE {
+        if !near(pixel(&v_centred, i), pixel(&v_plain, i)) {
+            // Inside the V's coverage (its antialiased edge included), never on the ground.
+            assert!(!near(pixel(&v_plain, i), base), "a chevron's centre reaches outside the V at pixel {i}");
+            v_centre_px += 1;
+        }
+    }
+    assert!(v_centre_px > 50, "the chevron's centre is almost empty: {v_centre_px} px");
     let mark_px = (0..SIZE * SIZE).filter(|i| near(pixel(&plain, *i), mark)).count();
     // A centre at half the size covers about a quarter of the mark.
     let share = centre_px as f64 / mark_px as f64;

@@ -24,7 +24,9 @@ fn preset(scale_aligned: f64, seed: u64) -> String {
     )
 }
 
-/// Each pixel's nearest ring colour: 0 black, 1 yellow, 2 red.
+/// Each pixel's ring colour: 0 black, 1 yellow, 2 red, 3 none of them (the antialiased edge
+/// of an unsnapped band in the skin between scales blends black and yellow into a dark
+/// yellow, which is neither; a nearest-colour rule would call it red).
 fn classes(text: &str, size: usize) -> Vec<u8> {
     let source = PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
     let loaded = parse(&source, &[]).unwrap_or_else(|e| panic!("{e}"));
@@ -35,8 +37,16 @@ fn classes(text: &str, size: usize) -> Vec<u8> {
         .data
         .chunks_exact(3)
         .map(|p| {
-            let d = |c: [f32; 3]| (0..3).map(|k| (p[k] - c[k]).powi(2)).sum::<f32>();
-            [d(BLACK), d(YELLOW), d(RED)].iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).unwrap().0 as u8
+            let near = |c: [f32; 3]| (0..3).all(|k| (p[k] - c[k]).abs() < 0.15);
+            if near(BLACK) {
+                0
+            } else if near(YELLOW) {
+                1
+            } else if near(RED) {
+                2
+            } else {
+                3
+            }
         })
         .collect()
 }
@@ -82,7 +92,7 @@ fn red_touches_black(class: &[u8], size: usize) -> usize {
 #[test]
 fn a_ring_one_scale_wide_stays_closed_and_keeps_red_from_black_at_every_size() {
     for seed in [1, 2, 3] {
-        for size in [128, 256, 512, 1024] {
+        for size in [64, 128, 256, 512, 1024] {
             let class = classes(&preset(1.0, seed), size);
             assert!(a_yellow_ring_goes_round(&class, size), "seed {seed}, size {size}: the yellow ring is broken");
             assert_eq!(red_touches_black(&class, size), 0, "seed {seed}, size {size}: red touches black");

@@ -166,7 +166,7 @@ fn levels(g: &mut GraphBuilder, name: &str, input: NodeId, lo: f32, hi: f32) -> 
 fn shapes(
     g: &mut GraphBuilder,
     lattice: &Lattice,
-    (jitter, scale_size): (f32, f32),
+    ring_floor_cells: f32,
     layer: &PatternLayer,
     name: &dyn Fn(&str) -> String,
     seed: u32,
@@ -215,7 +215,7 @@ fn shapes(
                 (layer.colors.clone(), layer.widths.iter().map(|w| *w as f32).collect())
             };
             if fully_snapped(layer) {
-                widths = rings_of_whole_scales(&widths, lattice.rows_v as f32 / repeats, jitter, scale_size);
+                widths = rings_of_whole_scales(&widths, lattice.rows_v as f32 / repeats, ring_floor_cells);
             }
             // Start half way into the first colour, so the texture's v seam falls inside a
             // ring rather than on the boundary between two.
@@ -311,32 +311,39 @@ fn fully_snapped(layer: &PatternLayer) -> bool {
 
 /// Ring widths (fractions of one repeat) for a ring sequence drawn in whole scales, so that
 /// its topology survives the snapping (each scale takes the colour at its centre). Every
-/// band is made at least `(max(1, L) + j)` cells long, with j the scale jitter (a centre moves
-/// by at most j / 2 of a cell along the body, `ops::scales::CellTable`) and L the longest
-/// scale outline in cells (`size` × (1 + 0.4 j)):
+/// band — and the gap the sequence leaves in its repeat, if any — is made at least
+/// `reach + j` cells long, with j the scale jitter (a centre moves by at most j / 2 of a
+/// cell along the body, `ops::scales::CellTable`) and `reach` the longest a scale reaches
+/// along the body (`ScaleField::longest_reach_cells`, at least one cell):
 /// - at least 1 + j: the centres of each scale column are one cell apart, so the band holds
 ///   a centre in every column, and a one-scale ring stays closed round the body (in zigzag,
 ///   the columns being staggered by half a cell);
-/// - at least L + j: the scales either side of the band have centres more than L apart
-///   along the body, further than two outlines of length ≤ L reach, so they never touch.
+/// - at least reach + j: the scales either side of the band have centres further apart
+///   along the body than two outlines reach, so they never touch.
 ///
 /// The wider bands give up the difference in proportion; a sequence too tight for it keeps
-/// equal shares. `cells_per_repeat` = scale rows along the body per repeat.
-pub fn rings_of_whole_scales(widths: &[f32], cells_per_repeat: f32, jitter: f32, size: f32) -> Vec<f32> {
-    let j = jitter.clamp(0.0, 0.5);
-    let longest = (size * (1.0 + 0.4 * j)).max(1.0);
-    let floor = (longest + j) / cells_per_repeat.max(1e-3);
-    let total: f32 = widths.iter().sum();
-    let narrow: f32 = widths.iter().filter(|w| **w < floor).map(|_| floor).sum();
-    let wide: f32 = widths.iter().filter(|w| **w >= floor).sum();
-    if narrow == 0.0 {
-        return widths.to_vec();
+/// equal shares. `cells_per_repeat` = scale rows along the body per repeat. (Measured:
+/// with the outline's length alone, no rotation, red met black at 2048² with jitter 0.3.)
+pub fn rings_of_whole_scales(widths: &[f32], cells_per_repeat: f32, floor_cells: f32) -> Vec<f32> {
+    let floor = floor_cells / cells_per_repeat.max(1e-3);
+    let drawn: f32 = widths.iter().sum();
+    // The uncoloured rest of the repeat is a band too: it separates repeats.
+    let gap = (1.0 - drawn).max(0.0);
+    let mut all = widths.to_vec();
+    if gap > 1e-6 {
+        all.push(gap);
     }
-    if narrow >= total || wide <= 0.0 {
-        return vec![total / widths.len().max(1) as f32; widths.len()];
-    }
-    let scale = (total - narrow) / wide;
-    widths.iter().map(|w| if *w < floor { floor } else { w * scale }).collect()
+    let narrow: f32 = all.iter().filter(|w| **w < floor).map(|_| floor).sum();
+    let wide: f32 = all.iter().filter(|w| **w >= floor).sum();
+    let widened: Vec<f32> = if narrow == 0.0 {
+        all
+    } else if narrow >= 1.0 || wide <= 0.0 {
+        vec![1.0 / all.len() as f32; all.len()]
+    } else {
+        let scale = (1.0 - narrow) / wide;
+        all.iter().map(|w| if *w < floor { floor } else { w * scale }).collect()
+    };
+    widened[..widths.len()].to_vec()
 }
 
 /// What every pattern layer shares.
@@ -363,15 +370,11 @@ fn pattern_layer(
     let prefix = format!("pattern{i}");
     let seed = derive_seed(context.seed, &prefix);
     let mut color = below;
-    let parts = shapes(
-        g,
-        &s.field.lattice(),
-        (s.field.jitter, s.field.size),
-        layer,
-        &|part: &str| format!("{prefix}.{part}"),
-        seed,
-    );
+    let lattice = s.field.lattice();
+    let ring_floor_cells = s.field.longest_reach_cells(&lattice) + s.field.jitter.clamp(0.0, 0.5);
+    let parts = shapes(g, &lattice, ring_floor_cells, layer, &|part: &str| format!("{prefix}.{part}"), seed);
     let many = parts.len() > 1;
+    let mut last_mask = None;
     for (k, (shape, tint)) in parts.into_iter().enumerate() {
         let name = |part: &str| if many { format!("{prefix}.{k}.{part}") } else { format!("{prefix}.{part}") };
         let mut mask = shape;
@@ -415,6 +418,7 @@ fn pattern_layer(
         }
         color =
             g.add(name("tint"), Op::Tint { color: tint.to_linear(), opacity: layer.opacity as f32 }, &[color, mask]);
+        last_mask = Some(mask);
         if layer.outline_size > 0.0 {
             // Thesis §4.2.1.6: edge detection, blur and binarise, then colour the outline.
             let sigma = layer.outline_size as f32 * 0.5;
@@ -428,10 +432,16 @@ fn pattern_layer(
             );
         }
     }
-    if let (Some(centre_color), Some(op)) = (layer.center_color, centre_shape(layer, seed)) {
-        // The composite mark's centre, over the mark and its outline.
+    if let (Some(centre_color), Some(op), Some(mark)) = (layer.center_color, centre_shape(layer, seed), last_mask) {
+        // The composite mark's centre, over the mark and its outline, and never outside the
+        // mark (a chevron or zigzag scaled about its centre moves its arms sideways).
         let mut centre = g.add(format!("{prefix}.centre"), op, &[]);
         centre = snapped_and_off_belly(g, s, context, layer, &format!("{prefix}.centre"), centre);
+        centre = g.add(
+            format!("{prefix}.centre_in_mark"),
+            Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 },
+            &[centre, mark],
+        );
         color = g.add(
             format!("{prefix}.centre_tint"),
             Op::Tint { color: centre_color.to_linear(), opacity: layer.opacity as f32 },

@@ -387,6 +387,28 @@ impl Geometry {
 }
 
 impl ScaleField {
+    /// The longest reach of any one scale along the body, in cell lengths: the outline's
+    /// full extent along v at the largest size and rotation the jitter gives (`CellTable`:
+    /// size × (1 ± 0.4 j), angle ± 0.6 j), at least one cell. Scales whose centres lie
+    /// further apart along the body than this (plus the centre jitter, ± j / 2 each) cannot
+    /// touch: what keeps a ring drawn in whole scales from letting its neighbours meet.
+    pub fn longest_reach_cells(&self, lattice: &Lattice) -> f32 {
+        let j = self.jitter.clamp(0.0, 0.5);
+        let size = self.size * (1.0 + 0.4 * j);
+        let reach = match self.shape {
+            // Voronoi cells: one cell along the body, however they are jittered.
+            ScaleShape::Hexagon => 1.0,
+            ScaleShape::Leaf | ScaleShape::Diamond => {
+                // Half-length 0.5 cell lengths, half-width in cell widths = 1 / aspect cell
+                // lengths; rotated by θ the outline reaches b cos θ + a sin θ along v.
+                let (b, a) = (0.5 * size, half_width(self.shape) * size / lattice.aspect);
+                let theta = 0.6 * j;
+                2.0 * (b * theta.cos() + a * theta.sin())
+            }
+        };
+        reach.max(1.0)
+    }
+
     /// Position of `channel` among the outputs.
     pub fn output_index(&self, channel: usize) -> Option<usize> {
         self.outputs.iter().position(|c| *c == channel)

@@ -284,6 +284,10 @@ fn zigzag(pb: &mut PathBuilder, b: &Blotches, cx: f32, start: f32, spacing: f32,
             let (ya, yb) = (start + k as f32 * 0.5 * spacing, start + (k + 1) as f32 * 0.5 * spacing);
             let xa = x0 + if k.rem_euclid(2) == 0 { -amplitude } else { amplitude };
             let xb = x0 + if k.rem_euclid(2) == 0 { amplitude } else { -amplitude };
+            // Every quadrilateral traced the same way round (clockwise on screen), so that
+            // under the nonzero rule the overlaps at the vertices add instead of cancelling
+            // (traced alternately, the band broke at every vertex).
+            let (xa, ya, xb, yb) = if xb >= xa { (xa, ya, xb, yb) } else { (xb, yb, xa, ya) };
             pb.move_to(xa, ya - thick);
             pb.line_to(xb, yb - thick);
             pb.line_to(xb, yb + thick);
@@ -346,7 +350,10 @@ pub fn belly_marks(width: usize, height: usize, marks: &BellyMarks) -> Image {
         let to_ends = along.min(1.0 - along) / rows;
         match marks.kind {
             BellyMarkKind::Checkered => {
-                if (r + side) % 2 == 1 || d < half / 3.0 {
+                // By the wrapped plate index, so the plate across the v seam is one plate
+                // (with an odd plate count, the two plates either side of the seam carry
+                // their square on the same side).
+                if (plate + side).rem_euclid(2) == 1 || d < half / 3.0 {
                     return 0.0;
                 }
                 ramp(to_ends.min(half - d).min(d - half / 3.0))

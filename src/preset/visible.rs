@@ -86,6 +86,12 @@ fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
     for (i, layer) in preset.pattern.iter_mut().enumerate() {
         keys.push((format!("pattern.{i}.color"), &mut layer.color));
         keys.push((format!("pattern.{i}.outline_color"), &mut layer.outline_color));
+        if let Some(centre) = layer.center_color.as_mut() {
+            keys.push((format!("pattern.{i}.center_color"), centre));
+        }
+        if let Some(border) = layer.border_color.as_mut() {
+            keys.push((format!("pattern.{i}.border_color"), border));
+        }
         for (j, colour) in layer.colors.iter_mut().enumerate() {
             keys.push((format!("pattern.{i}.colors.{j}"), colour));
         }
@@ -108,10 +114,11 @@ pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
     let variation = 1.0 + preset.color.variation.max(0.0);
     let mut clamped = Vec::new();
     for (key, colour) in colour_keys(preset) {
-        // Speckle and skin are mixed in after the brightening: they show as written.
+        // Speckle is mixed in after the brightening: it shows as written. (Skin is mixed in
+        // before it, and brightened where scales only partly part, as every other key.)
         let headroom = match key.as_str() {
             "color.base" => variation * per_scale,
-            "color.speckle_color" | "color.skin" => 1.0,
+            "color.speckle_color" => 1.0,
             _ => per_scale,
         };
         let allowed = limit.map(|l| l / headroom);
