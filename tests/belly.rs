@@ -2,22 +2,21 @@
 //! the place its name says, judged by the scale field (which pixels are plates, where each
 //! plate is).
 
-use snakeskin::graph::evaluate;
-use snakeskin::maps::{BuildOptions, MapKind, build_graph, scale_field};
+mod common;
+
+use snakeskin::maps::scale_field;
 use snakeskin::ops::Image;
 use snakeskin::ops::scales::channel;
-use snakeskin::preset::{Preset, PresetSource, parse};
+use snakeskin::preset::Preset;
 
 const SIZE: usize = 384;
 
 fn preset(text: &str) -> Preset {
-    let source = PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
-    parse(&source, &[]).unwrap_or_else(|e| panic!("{e}\n{text}")).preset
+    common::preset_from(text)
 }
 
 fn colour(text: &str) -> Image {
-    let graph = build_graph(&preset(text), BuildOptions::default());
-    evaluate(&graph, &[MapKind::Color], SIZE, SIZE, &|_, _| {}).maps.remove(&MapKind::Color).unwrap()
+    common::colour_map(text, SIZE)
 }
 
 fn text(pattern: &str) -> String {

@@ -3,20 +3,17 @@
 //! overlap front to back the same way, and keels fade towards the scale's attached base.
 //! Measured on the scale field's own channels along the body.
 
-use snakeskin::maps::scale_field;
+mod common;
+
 use snakeskin::ops::Image;
 use snakeskin::ops::scales::channel;
-use snakeskin::preset::{PresetSource, parse};
 
 /// Fine enough that the next scale's own rise over one pixel (its dome near its tip) stays
 /// well under the step.
 const SIZE: usize = 1024;
 
 fn field(text: &str) -> Image {
-    let source = PresetSource { name: "t".into(), display: "test".into(), text: text.into() };
-    let mut f = scale_field(&parse(&source, &[]).unwrap_or_else(|e| panic!("{e}")).preset);
-    f.outputs = (0..channel::COUNT).collect();
-    f.render(SIZE, SIZE)
+    common::full_scale_field(text, SIZE)
 }
 
 fn get(f: &Image, x: usize, y: usize, c: usize) -> f32 {

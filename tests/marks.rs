@@ -1,13 +1,16 @@
 //! Composite marks and the blotch shapes: each does what its name says, measured on the
 //! mask or the colour map (where a centre, a border, a pair, a chevron's apex lies).
 
-use snakeskin::graph::evaluate;
-use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+mod common;
+
 use snakeskin::ops::Image;
 use snakeskin::ops::shapes::{BlotchShape, Blotches, blotches};
-use snakeskin::preset::{PresetSource, parse};
 
 const SIZE: usize = 256;
+
+fn colour(text: &str) -> Image {
+    common::colour_map(text, SIZE)
+}
 
 fn series(shape: BlotchShape, offset: f32, staggered: bool) -> Blotches {
     Blotches {
@@ -129,13 +132,6 @@ fn a_zigzag_is_one_band_from_head_to_tail() {
     let swing = centres.iter().cloned().fold(f32::MIN, f32::max) - centres.iter().cloned().fold(f32::MAX, f32::min);
     // (A straight band does not swing at all; this one's vertices are ±20 px.)
     assert!(swing > 0.06 * SIZE as f32, "the zigzag swings only {swing} px");
-}
-
-fn colour(text: &str) -> Image {
-    let source = PresetSource { name: "t".into(), display: "test".into(), text: text.into() };
-    let loaded = parse(&source, &[]).unwrap_or_else(|e| panic!("{e}"));
-    let graph = build_graph(&loaded.preset, BuildOptions::default());
-    evaluate(&graph, &[MapKind::Color], SIZE, SIZE, &|_, _| {}).maps.remove(&MapKind::Color).unwrap()
 }
 
 const MARK: &str = "seed = 3\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\nscale_hue = 0\n\

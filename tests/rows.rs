@@ -2,30 +2,22 @@
 //! side's ventral plates over the spine to the other's), rows can differ in width, keels
 //! can stop at the lowest rows, and stripes and the belly colour can name rows.
 
+mod common;
+
 use std::collections::BTreeSet;
 
-use snakeskin::graph::evaluate;
-use snakeskin::maps::{BuildOptions, MapKind, build_graph, scale_field};
 use snakeskin::ops::Image;
 use snakeskin::ops::scales::channel;
-use snakeskin::preset::{Preset, PresetSource, parse};
+use snakeskin::preset::{PresetSource, parse};
 
 const SIZE: usize = 384;
 
-fn preset(text: &str) -> Preset {
-    let source = PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
-    parse(&source, &[]).unwrap_or_else(|e| panic!("{e}\n{text}")).preset
+fn colour(text: &str) -> Image {
+    common::colour_map(text, SIZE)
 }
 
 fn field(text: &str) -> Image {
-    let mut f = scale_field(&preset(text));
-    f.outputs = (0..channel::COUNT).collect();
-    f.render(SIZE, SIZE)
-}
-
-fn colour(text: &str) -> Image {
-    let graph = build_graph(&preset(text), BuildOptions::default());
-    evaluate(&graph, &[MapKind::Color], SIZE, SIZE, &|_, _| {}).maps.remove(&MapKind::Color).unwrap()
+    common::full_scale_field(text, SIZE)
 }
 
 fn pixels(img: &Image) -> impl Iterator<Item = &[f32]> {

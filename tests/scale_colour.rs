@@ -2,16 +2,24 @@
 //! and nowhere else, judged by the scale field itself (which scale a pixel belongs to, how
 //! far it lies from the scale's edge, where the skin shows between scales).
 
+mod common;
+
 use std::collections::BTreeMap;
 
-use snakeskin::graph::evaluate;
-use snakeskin::maps::{BuildOptions, MapKind, build_graph, scale_field};
 use snakeskin::ops::Image;
 use snakeskin::ops::scale_colour::{RIM_WIDTH, TIP_START};
 use snakeskin::ops::scales::channel;
-use snakeskin::preset::{Preset, PresetSource, parse};
+use snakeskin::preset::{PresetSource, parse};
 
 const SIZE: usize = 256;
+
+fn colour(text: &str) -> Image {
+    common::colour_map(text, SIZE)
+}
+
+fn field(text: &str) -> Image {
+    common::full_scale_field(text, SIZE)
+}
 
 /// Every per-scale key off: the reference each test changes one key against. Scales a
 /// little smaller than their cells, so the skin shows between them.
@@ -26,23 +34,6 @@ fn with(key: &str) -> String {
     }
     let lines: String = keys.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
     format!("{PLAIN}{lines}")
-}
-
-fn preset(text: &str) -> Preset {
-    let source = PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
-    parse(&source, &[]).unwrap_or_else(|e| panic!("{e}\n{text}")).preset
-}
-
-fn colour(text: &str) -> Image {
-    let graph = build_graph(&preset(text), BuildOptions::default());
-    evaluate(&graph, &[MapKind::Color], SIZE, SIZE, &|_, _| {}).maps.remove(&MapKind::Color).unwrap()
-}
-
-/// The scale field of `text` with every channel, in `channel` order.
-fn field(text: &str) -> Image {
-    let mut f = scale_field(&preset(text));
-    f.outputs = (0..channel::COUNT).collect();
-    f.render(SIZE, SIZE)
 }
 
 fn pixels(img: &Image) -> impl Iterator<Item = &[f32]> {

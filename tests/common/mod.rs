@@ -66,3 +66,24 @@ pub fn gpu_or_skip(test: &str) -> Option<snakeskin::render::Gpu> {
 pub fn gpu_required() -> bool {
     std::env::var("SNAKESKIN_REQUIRE_GPU").is_ok_and(|v| v == "1")
 }
+
+/// A preset parsed from TOML text (panics with the error and the text).
+pub fn preset_from(text: &str) -> snakeskin::preset::Preset {
+    let source = snakeskin::preset::PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
+    snakeskin::preset::parse(&source, &[]).unwrap_or_else(|e| panic!("{e}\n{text}")).preset
+}
+
+/// The colour map of a preset's TOML text at `size` × `size` (linear, f32).
+pub fn colour_map(text: &str, size: usize) -> snakeskin::ops::Image {
+    use snakeskin::maps::{BuildOptions, MapKind, build_graph};
+    let graph = build_graph(&preset_from(text), BuildOptions::default());
+    snakeskin::graph::evaluate(&graph, &[MapKind::Color], size, size, &|_, _| {}).maps.remove(&MapKind::Color).unwrap()
+}
+
+/// The scale field of a preset's TOML text with every channel, in `ops::scales::channel`
+/// order (the maps' own field asks only for the channels they read).
+pub fn full_scale_field(text: &str, size: usize) -> snakeskin::ops::Image {
+    let mut field = snakeskin::maps::scale_field(&preset_from(text));
+    field.outputs = (0..snakeskin::ops::scales::channel::COUNT).collect();
+    field.render(size, size)
+}
