@@ -9,7 +9,7 @@ use crate::ops::filters::BlendMode;
 use crate::ops::hash::derive_seed;
 use crate::ops::noise::{FractalNoise, NoiseKind};
 use crate::ops::scale_colour::{SPECKLES_PER_SCALE, ScaleChannels, ScaleColour};
-use crate::ops::scales::{Lattice, channel};
+use crate::ops::scales::channel;
 use crate::ops::shapes::{Axis, BellyMarkKind, BellyMarks, BlotchShape, Blotches, SpotGrid};
 use crate::preset::Preset;
 use crate::preset::schema::{Arrangement, BellyPattern, NoiseChoice, PatternKind, PatternLayer, PatternShape, Srgb8};
@@ -48,7 +48,7 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
         if let Some(kind) = kind {
             let marks = BellyMarks {
                 kind,
-                rows_v: s.field.lattice().rows_v as u32,
+                rows_v: s.lattice.rows_v as u32,
                 belly_width: plate_band_width(preset, s),
                 amount: b.pattern_amount as f32,
                 softness: 0.004,
@@ -94,7 +94,7 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
 /// The ventral band's width: the plates' whole columns (`ops::scales::Lattice`) when the
 /// preset draws plates, else `belly.width` as written.
 fn plate_band_width(preset: &Preset, s: &Shared) -> f32 {
-    if preset.belly.plates { s.field.lattice().belly_width() } else { preset.belly.width as f32 }
+    if preset.belly.plates { s.lattice.belly_width() } else { preset.belly.width as f32 }
 }
 
 /// Half the width of the belly colour's band: the plates, and `belly.up_rows` dorsal rows
@@ -104,9 +104,8 @@ fn belly_colour_half_width(preset: &Preset, s: &Shared) -> f32 {
     if !preset.belly.plates || up == 0 {
         return 0.5 * plate_band_width(preset, s);
     }
-    let lattice = s.field.lattice();
-    let edge = (lattice.belly_cols / 2) as usize + up as usize;
-    lattice.bounds[edge.min(lattice.bounds.len() / 2)]
+    let edge = (s.lattice.belly_cols / 2) as usize + up as usize;
+    s.lattice.bounds[edge.min(s.lattice.bounds.len() / 2)]
 }
 
 /// The per-scale colour of the preset (`ops::scale_colour`), or None when every one of its
@@ -127,7 +126,7 @@ fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
         speckle: c.speckle as f32,
         speckle_color: c.speckle_color.to_linear(),
         skin: c.skin.map(Srgb8::to_linear),
-        speckle_cells: s.field.lattice().cols as u32 * SPECKLES_PER_SCALE,
+        speckle_cells: s.lattice.cols as u32 * SPECKLES_PER_SCALE,
         seed: derive_seed(preset.seed, "per_scale"),
         channels: ScaleChannels {
             crevice: s.channel_index(channel::CREVICE),
@@ -165,8 +164,7 @@ fn levels(g: &mut GraphBuilder, name: &str, input: NodeId, lo: f32, hi: f32) -> 
 /// The raw coverage shapes of a layer, each with its colour.
 fn shapes(
     g: &mut GraphBuilder,
-    lattice: &Lattice,
-    ring_floor_cells: f32,
+    s: &Shared,
     layer: &PatternLayer,
     name: &dyn Fn(&str) -> String,
     seed: u32,
@@ -181,7 +179,7 @@ fn shapes(
         }
         PatternKind::Stripes if layer.rows.len() == 2 => {
             // On named scale rows (`Lattice::row_span_u`), mirrored about the spine.
-            let (u0, u1) = lattice.row_span_u(layer.rows[0] as f32, layer.rows[1] as f32);
+            let (u0, u1) = s.lattice.row_span_u(layer.rows[0] as f32, layer.rows[1] as f32);
             let half_width = 0.5 * (u1 - u0);
             let centres = vec![0.5 * (u0 + u1), 1.0 - 0.5 * (u0 + u1)];
             let op = Op::Bands { axis: Axis::U, centres, half_width, softness: 0.002 };
@@ -215,7 +213,8 @@ fn shapes(
                 (layer.colors.clone(), layer.widths.iter().map(|w| *w as f32).collect())
             };
             if fully_snapped(layer) {
-                widths = rings_of_whole_scales(&widths, lattice.rows_v as f32 / repeats, ring_floor_cells);
+                let floor_cells = s.field.longest_reach_cells(&s.lattice) + s.field.jitter.clamp(0.0, 0.5);
+                widths = rings_of_whole_scales(&widths, s.lattice.rows_v as f32 / repeats, floor_cells);
             }
             // Start half way into the first colour, so the texture's v seam falls inside a
             // ring rather than on the boundary between two.
@@ -366,13 +365,11 @@ fn pattern_layer(
     layer: &PatternLayer,
     below: NodeId,
 ) -> NodeId {
-    let LayerContext { outside_belly, distortion_noise, .. } = *context;
+    let LayerContext { distortion_noise, .. } = *context;
     let prefix = format!("pattern{i}");
     let seed = derive_seed(context.seed, &prefix);
     let mut color = below;
-    let lattice = s.field.lattice();
-    let ring_floor_cells = s.field.longest_reach_cells(&lattice) + s.field.jitter.clamp(0.0, 0.5);
-    let parts = shapes(g, &lattice, ring_floor_cells, layer, &|part: &str| format!("{prefix}.{part}"), seed);
+    let parts = shapes(g, s, layer, &|part: &str| format!("{prefix}.{part}"), seed);
     let many = parts.len() > 1;
     let mut last_mask = None;
     for (k, (shape, tint)) in parts.into_iter().enumerate() {
@@ -392,24 +389,14 @@ fn pattern_layer(
             let moved = g.add(name("distorted"), Op::Blend { mode: BlendMode::Add, opacity: 1.0 }, &[soft, offset]);
             mask = g.add(name("mask"), Op::Threshold { level: 0.5, softness: 0.04 }, &[moved]);
         }
-        if layer.scale_aligned > 0.0 {
-            let op = Op::SnapToScales {
-                amount: layer.scale_aligned as f32,
-                centre_u: s.channel_index(channel::CENTRE_U),
-                centre_v: s.channel_index(channel::CENTRE_V),
-            };
-            mask = g.add(name("scale_aligned"), op, &[mask, s.scales]);
-        }
-        if let (Some(outside), false) = (outside_belly, layer.over_belly) {
-            mask = g.add(name("off_belly"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, outside]);
-        }
+        mask = snapped_and_off_belly(g, s, context, layer, &name, mask);
         if let Some(border_color) = layer.border_color.filter(|_| layer.border_size > 0.0) {
             // A pale border round the mark and its outline: the mask dilated by blurring
             // and a low threshold (a blurred edge falls to 0.1 at 1.28 σ outside it).
             let reach = (layer.border_size + 0.5 * layer.outline_size) as f32;
             let soft = g.add(name("border_blur"), Op::Blur { sigma: reach / 1.28 }, &[mask]);
             let mut border = g.add(name("border"), Op::Threshold { level: 0.1, softness: 0.05 }, &[soft]);
-            border = snapped_and_off_belly(g, s, context, layer, &name("border"), border);
+            border = snapped_and_off_belly(g, s, context, layer, &|p| name(&format!("border_{p}")), border);
             color = g.add(
                 name("border_tint"),
                 Op::Tint { color: border_color.to_linear(), opacity: layer.opacity as f32 },
@@ -436,7 +423,7 @@ fn pattern_layer(
         // The composite mark's centre, over the mark and its outline, and never outside the
         // mark (a chevron or zigzag scaled about its centre moves its arms sideways).
         let mut centre = g.add(format!("{prefix}.centre"), op, &[]);
-        centre = snapped_and_off_belly(g, s, context, layer, &format!("{prefix}.centre"), centre);
+        centre = snapped_and_off_belly(g, s, context, layer, &|p| format!("{prefix}.centre_{p}"), centre);
         centre = g.add(
             format!("{prefix}.centre_in_mark"),
             Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 },
@@ -451,14 +438,15 @@ fn pattern_layer(
     color
 }
 
-/// A composite mark's extra mask (centre, border) snapped to scales and kept off the belly
-/// as the layer's own mask is.
+/// A mask of the layer (the mark's own, or a composite mark's centre or border) snapped to
+/// whole scales as far as `scale_aligned` says, and kept off the belly unless `over_belly`;
+/// `name(part)` names the nodes.
 fn snapped_and_off_belly(
     g: &mut GraphBuilder,
     s: &Shared,
     context: &LayerContext,
     layer: &PatternLayer,
-    name: &str,
+    name: &dyn Fn(&str) -> String,
     mut mask: NodeId,
 ) -> NodeId {
     if layer.scale_aligned > 0.0 {
@@ -467,11 +455,10 @@ fn snapped_and_off_belly(
             centre_u: s.channel_index(channel::CENTRE_U),
             centre_v: s.channel_index(channel::CENTRE_V),
         };
-        mask = g.add(format!("{name}_scale_aligned"), op, &[mask, s.scales]);
+        mask = g.add(name("scale_aligned"), op, &[mask, s.scales]);
     }
     if let (Some(outside), false) = (context.outside_belly, layer.over_belly) {
-        mask =
-            g.add(format!("{name}_off_belly"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, outside]);
+        mask = g.add(name("off_belly"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, outside]);
     }
     mask
 }

@@ -11,7 +11,7 @@ use crate::graph::{Graph, GraphBuilder, NodeId, Op};
 use crate::ops::filters::{BlendMode, NormalConvention};
 use crate::ops::hash::derive_seed;
 use crate::ops::noise::{FractalNoise, NoiseKind};
-use crate::ops::scales::{ScaleField, ScaleShape, channel};
+use crate::ops::scales::{Lattice, ScaleField, ScaleShape, channel};
 use crate::preset::Preset;
 use crate::preset::schema::{self, IridescenceGradient};
 
@@ -87,6 +87,8 @@ fn scale_outputs(preset: &Preset) -> Vec<usize> {
 pub(crate) struct Shared {
     pub scales: NodeId,
     pub field: ScaleField,
+    /// `field.lattice()`, computed once.
+    pub lattice: Lattice,
     pub crevice: NodeId,
     pub scale_height: NodeId,
     pub grain: NodeId,
@@ -126,7 +128,7 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
         }),
         &[],
     );
-    let shared = Shared { scales, field, crevice, scale_height, grain };
+    let shared = Shared { scales, field, lattice, crevice, scale_height, grain };
 
     let color = color::build(&mut g, preset, &shared);
     g.set_output(MapKind::Color, color);
@@ -136,14 +138,14 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
 
     // The normal follows the physical surface: undo the height map's stretch.
     let (low, high) = height_range(preset);
-    let slope = preset.height.normal_strength as f32 / lattice.cols as f32 * (high - low);
+    let slope = preset.height.normal_strength as f32 / shared.lattice.cols as f32 * (high - low);
     let normal = g.add("normal.out", Op::HeightToNormal { slope, convention: options.normal_convention }, &[height]);
     g.set_output(MapKind::Normal, normal);
 
     let roughness = build_roughness(&mut g, preset, &shared);
     g.set_output(MapKind::Roughness, roughness);
 
-    let iridescence = build_iridescence(&mut g, preset, &shared, lattice.cols as u32);
+    let iridescence = build_iridescence(&mut g, preset, &shared, shared.lattice.cols as u32);
     g.set_output(MapKind::Iridescence, iridescence);
     g.finish()
 }

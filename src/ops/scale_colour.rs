@@ -86,6 +86,9 @@ impl ScaleColour {
         out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
             let v = (y as f32 + 0.5) / height as f32;
             let field = scales.row(y);
+            // The scale's second random number, hashed once per run of pixels of one scale
+            // (a scale spans many pixels of a row), not once per pixel.
+            let mut second_of: (u32, f32) = (u32::MAX, 0.0);
             for x in 0..width {
                 let f = &field[x * sc..(x + 1) * sc];
                 let px = &mut row[x * ch..x * ch + ch.min(3)];
@@ -106,7 +109,10 @@ impl ScaleColour {
                     gain = gain.map(|g| g * t);
                 }
                 if self.hue != 0.0 {
-                    let second = hash::unit(random.to_bits() as i32, 0, 7, self.seed);
+                    if second_of.0 != random.to_bits() {
+                        second_of = (random.to_bits(), hash::unit(random.to_bits() as i32, 0, 7, self.seed));
+                    }
+                    let second = second_of.1;
                     let warm = self.hue * (2.0 * second - 1.0) * own;
                     gain[0] *= 1.0 + warm;
                     gain[2] *= 1.0 - warm;

@@ -641,7 +641,7 @@ impl ScaleField {
         let half_len = 0.5 * self.size.max(0.5);
         // The most anterior plate covering the pixel lies on top (its free posterior edge over
         // the next plate, as the dorsal scales); the others are the surface underneath.
-        let mut top: Option<(i32, f32, f32, f32)> = None; // (row, inside, along, profile)
+        let mut top: Option<(i32, f32, f32)> = None; // (row, inside, profile)
         let mut under_height = 0.0f32;
         // Plates are gently convex across the belly.
         let across = (dist_belly / half_band).min(1.0);
@@ -656,10 +656,10 @@ impl ScaleField {
             let profile = 0.45 + 0.1 + dome + 0.3 * self.imbrication * along;
             match top {
                 Some(_) => under_height = under_height.max(profile),
-                None => top = Some((r, inside, along, profile)),
+                None => top = Some((r, inside, profile)),
             }
         }
-        let best = top.map(|(r, inside, _, profile)| {
+        let best = top.map(|(r, inside, profile)| {
             let h = free_edge(profile, inside / soft, under_height, self.imbrication);
             let random = hash::unit(-1, r.rem_euclid(lattice.rows_v), 4, self.seed);
             let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * lattice.aspect;

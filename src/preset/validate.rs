@@ -94,12 +94,8 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
     c.range("scales.edge_softness", s.edge_softness, EDGE_SOFTNESS);
     c.range("scales.vertebral_width", s.vertebral_width, ROW_WIDTH);
     c.range("scales.lowest_row_width", s.lowest_row_width, ROW_WIDTH);
-    if s.smooth_rows > s.rows / 2 {
-        c.problems.push(Problem {
-            key: "scales.smooth_rows".into(),
-            message: format!("must be an integer in [0, {}] (half of `rows`), got {}", s.rows / 2, s.smooth_rows),
-        });
-    }
+    // At most half the rows each side: the rows from one side's plates to the spine.
+    c.int_range("scales.smooth_rows", s.smooth_rows, (0, s.rows / 2));
 
     if preset.pattern.len() > MAX_PATTERN_LAYERS {
         c.problems.push(Problem {
@@ -202,16 +198,7 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
     c.range("belly.width", preset.belly.width, BELLY_WIDTH);
     c.range("belly.blend", preset.belly.blend, BELLY_BLEND);
     c.range("belly.pattern_amount", preset.belly.pattern_amount, UNIT);
-    if preset.belly.up_rows > s.rows / 2 {
-        c.problems.push(Problem {
-            key: "belly.up_rows".into(),
-            message: format!(
-                "must be an integer in [0, {}] (half of `scales.rows`), got {}",
-                s.rows / 2,
-                preset.belly.up_rows
-            ),
-        });
-    }
+    c.int_range("belly.up_rows", preset.belly.up_rows, (0, s.rows / 2));
     c.range("color.variation", preset.color.variation, UNIT);
     c.range("color.between_scales", preset.color.between_scales, UNIT);
     c.range("color.scale_tone", preset.color.scale_tone, SCALE_JITTER);
