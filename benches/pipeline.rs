@@ -39,7 +39,7 @@ fn operations(c: &mut Criterion) {
     let size = 1024;
     let mut group = c.benchmark_group("ops_1024");
     group.sample_size(10);
-    let field = scale_field(&loaded.preset);
+    let field = scale_field(&loaded.preset, snakeskin::maps::Layout::Tile);
     group.bench_function("scales", |b| b.iter(|| field.render(size, size)));
     for (name, kind) in [("perlin_4oct", NoiseKind::Perlin), ("cellular_4oct", NoiseKind::Cellular)] {
         let op = Op::Noise(FractalNoise { kind, cells_u: 8, cells_v: 8, octaves: 4, gain: 0.5, seed: 1 });
@@ -50,7 +50,7 @@ fn operations(c: &mut Criterion) {
             .eval(None, &[], size, size);
     group.bench_function("blur_sigma_0.005", |b| b.iter(|| filters::blur(&noise, 0.005)));
     group.bench_function("height_to_normal", |b| {
-        b.iter(|| filters::height_to_normal(&noise, 0.05, filters::NormalConvention::OpenGl))
+        b.iter(|| filters::height_to_normal(&noise, 0.05, filters::NormalConvention::OpenGl, 1.0))
     });
     group.finish();
 }

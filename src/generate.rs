@@ -38,6 +38,10 @@ pub struct GenerateReport {
     pub created_folder: bool,
 }
 
+/// The tallest map written (a body atlas is `body.length` widths tall): PNG readers and GPU
+/// uploads commonly stop at 65535 rows, and the memory check refuses most sets before that.
+pub const MAX_HEIGHT: usize = 65_535;
+
 pub fn check_size(size: u64) -> Result<usize, Error> {
     if size < *SIZE_RANGE.start() as u64 || size > *SIZE_RANGE.end() as u64 {
         return Err(Error::Size { size });
@@ -50,6 +54,8 @@ pub fn check_size(size: u64) -> Result<usize, Error> {
 pub struct Plan {
     request: GenerateRequest,
     size: usize,
+    /// Image height: `size` for the tile, `size` × `body.length` for the body layout.
+    height: usize,
     loaded: LoadedPreset,
     graph: Graph,
     memory: MemoryCheck,
@@ -68,25 +74,35 @@ impl Plan {
         let start = Instant::now();
         let size = check_size(request.size)?;
         let loaded = preset::load(&request.preset, &request.overrides, request.seed)?;
+        let height = request.options.layout.height(&loaded.preset, size);
+        if height > MAX_HEIGHT {
+            return Err(Error::Height { width: size, height, max: MAX_HEIGHT });
+        }
         let graph = build_graph(&loaded.preset, request.options);
-        let estimate = crate::memory::estimate_generate_bytes(&graph, &request.maps, size);
+        let estimate = crate::memory::estimate_generate_bytes(&graph, &request.maps, size, height);
         let memory = MemoryCheck::against_available(estimate);
-        memory.refuse_if_over(&format!("--size {size}"))?;
-        Ok(Plan { request: request.clone(), size, loaded, graph, memory, start })
+        let what = if height == size { format!("--size {size}") } else { format!("--size {size} ({size} x {height})") };
+        memory.refuse_if_over(&what)?;
+        Ok(Plan { request: request.clone(), size, height, loaded, graph, memory, start })
     }
 
     pub fn memory(&self) -> MemoryCheck {
         self.memory
     }
 
+    /// Width and height of the maps.
+    pub fn dimensions(&self) -> (usize, usize) {
+        (self.size, self.height)
+    }
+
     /// Runs the plan. `progress(done, total)` reports node evaluations.
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
-        let Plan { request, size, loaded, graph, start, .. } = self;
+        let Plan { request, size, height, loaded, graph, start, .. } = self;
         let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
         // Each map is quantised to its file format the moment it is finished, freeing its f32
         // buffer; PNG compression then runs for all maps in parallel.
         let mut quantized: Vec<Quantized> = Vec::new();
-        let stats = evaluate_into(&graph, &request.maps, size, size, progress, &mut |map, image| {
+        let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
             quantized.push(export::quantize(map, &image));
         });
         quantized.sort_by_key(|q| q.map);
@@ -97,7 +113,7 @@ impl Plan {
         drop(quantized);
         let entries: Vec<(MapKind, String, String)> =
             kinds.iter().zip(&files).map(|(m, (name, bytes))| (*m, name.clone(), sha256_hex(bytes))).collect();
-        let manifest = export::manifest(&loaded, size, &entries, request.options.normal_convention);
+        let manifest = export::manifest(&loaded, (size, height), &entries, request.options);
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
         let manifest_name = export::manifest_file_name(&loaded.name);
         let encode_time = encode_start.elapsed();

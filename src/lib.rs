@@ -33,6 +33,11 @@ pub enum Error {
     Export(#[from] export::ExportError),
     #[error("invalid --size {size}: accepted sizes are {lo} to {hi} pixels", lo = SIZE_RANGE.start(), hi = SIZE_RANGE.end())]
     Size { size: u64 },
+    #[error(
+        "a body atlas {width} wide is {height} tall (body.length widths), over the {max} rows a map may have; use a \
+         smaller --size"
+    )]
+    Height { width: usize, height: usize, max: usize },
     /// An optics query outside what the physics covers (`snakeskin brdf`).
     #[error("invalid query: {0}")]
     Query(String),

@@ -151,8 +151,9 @@ impl MapFormat {
 }
 
 /// Normal map convention: OpenGL (+Y up, glTF, Blender) or DirectX (+Y down, Unreal).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum NormalConvention {
+    #[default]
     OpenGl,
     DirectX,
 }

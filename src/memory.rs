@@ -23,10 +23,10 @@ const FIXED_OVERHEAD_BYTES: u64 = 64 * MIB;
 /// Estimated peak bytes of `generate` for `maps` at `size`²: the graph's live buffers at
 /// their worst point, plus every quantised map (held until encoding) and its PNG (at most
 /// the quantised size with the fast filter; held until written), plus a fixed overhead.
-pub fn estimate_generate_bytes(graph: &Graph, maps: &[MapKind], size: usize) -> u64 {
-    let pixels = (size * size) as u64;
+pub fn estimate_generate_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> u64 {
+    let pixels = (width * height) as u64;
     let quantized: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * pixels).sum();
-    estimate_peak_bytes(graph, maps, size, size) + 2 * quantized + FIXED_OVERHEAD_BYTES
+    estimate_peak_bytes(graph, maps, width, height) + 2 * quantized + FIXED_OVERHEAD_BYTES
 }
 
 /// An estimate next to the memory available for it.

@@ -4,7 +4,7 @@
 
 mod common;
 
-use snakeskin::maps::scale_field;
+use snakeskin::maps::{Layout, scale_field};
 use snakeskin::ops::Image;
 use snakeskin::ops::scales::channel;
 use snakeskin::preset::Preset;
@@ -29,7 +29,7 @@ fn text(pattern: &str) -> String {
 /// Pixels (x, y) whose colour the belly pattern changed, and the plate field.
 fn marked(pattern: &str) -> (Vec<(usize, usize)>, Image) {
     let (plain, marks) = (colour(&text("none")), colour(&text(pattern)));
-    let mut f = scale_field(&preset(&text(pattern)));
+    let mut f = scale_field(&preset(&text(pattern)), Layout::Tile);
     f.outputs = (0..channel::COUNT).collect();
     let field = f.render(SIZE, SIZE);
     let changed = (0..SIZE * SIZE)
@@ -73,7 +73,7 @@ fn the_median_stripe_is_centred_and_as_wide_as_asked() {
 fn spots_and_half_moons_mark_about_the_share_of_plates_asked() {
     for pattern in ["spots", "half_moons"] {
         let (changed, _) = marked(pattern);
-        let rows_v = scale_field(&preset(&text(pattern))).lattice().rows_v as usize;
+        let rows_v = scale_field(&preset(&text(pattern)), Layout::Tile).lattice().rows_v as usize;
         // The plate of a pixel: the same phase as the scale field's plates.
         let plate = |y: usize| {
             (((y as f32 + 0.5) / SIZE as f32 * rows_v as f32 - snakeskin::ops::scales::ROW_PHASE).floor() as i64)
@@ -88,7 +88,7 @@ fn spots_and_half_moons_mark_about_the_share_of_plates_asked() {
 #[test]
 fn half_moons_rest_on_the_posterior_edge() {
     let (changed, _) = marked("half_moons");
-    let rows_v = scale_field(&preset(&text("half_moons"))).lattice().rows_v as f32;
+    let rows_v = scale_field(&preset(&text("half_moons")), Layout::Tile).lattice().rows_v as f32;
     for (_, y) in changed {
         let along = ((y as f32 + 0.5) / SIZE as f32 * rows_v - snakeskin::ops::scales::ROW_PHASE).rem_euclid(1.0);
         assert!(along > 0.45, "a half-moon pixel at {along:.2} of its plate, not at the posterior edge");
@@ -98,7 +98,7 @@ fn half_moons_rest_on_the_posterior_edge() {
 #[test]
 fn a_checkered_plate_carries_its_square_on_one_side_only_across_the_seam() {
     let (changed, _) = marked("checkered");
-    let rows_v = scale_field(&preset(&text("checkered"))).lattice().rows_v as usize;
+    let rows_v = scale_field(&preset(&text("checkered")), Layout::Tile).lattice().rows_v as usize;
     let plate = |y: usize| {
         (((y as f32 + 0.5) / SIZE as f32 * rows_v as f32 - snakeskin::ops::scales::ROW_PHASE).floor() as i64)
             .rem_euclid(rows_v as i64)

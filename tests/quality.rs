@@ -2,42 +2,11 @@
 
 mod common;
 
-use common::PATTERNED;
+use common::{PATTERNED, assert_rows_seamless, transpose};
 use snakeskin::graph::evaluate;
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::ops::Image;
 use snakeskin::preset::{library, parse, read_source};
-
-/// Mean absolute difference between rows `a` and `b` (all channels).
-fn row_jump(img: &Image, a: usize, b: usize) -> f64 {
-    let (ra, rb) = (img.row(a), img.row(b));
-    ra.iter().zip(rb).map(|(x, y)| (x - y).abs() as f64).sum::<f64>() / ra.len() as f64
-}
-
-fn transpose(img: &Image) -> Image {
-    let mut t = Image::new(img.height, img.width, img.channels);
-    for y in 0..img.height {
-        for x in 0..img.width {
-            for c in 0..img.channels {
-                t.data[(x * img.height + y) * img.channels + c] = img.data[(y * img.width + x) * img.channels + c];
-            }
-        }
-    }
-    t
-}
-
-/// Asserts the seam (last row → first row) jumps no more than 1.5× the larger of the jumps
-/// just beside it and the mean jump between neighbouring rows. "Beside" is the largest of
-/// the four jumps on each side: fine random texture (melanophore speckle on a pale belly)
-/// makes any one pair of rows jump by chance, while a real seam jumps more than all of them.
-fn assert_rows_seamless(img: &Image, what: &str) {
-    let n = img.height;
-    let seam = row_jump(img, n - 1, 0);
-    let beside = (0..4).map(|k| row_jump(img, k, k + 1).max(row_jump(img, n - 2 - k, n - 1 - k))).fold(0.0, f64::max);
-    let mean = (0..n - 1).map(|y| row_jump(img, y, y + 1)).sum::<f64>() / (n - 1) as f64;
-    let limit = 1.5 * beside.max(mean);
-    assert!(seam <= limit, "{what}: seam jump {seam:.5} > 1.5 × max(beside {beside:.5}, mean {mean:.5})");
-}
 
 #[test]
 fn every_preset_and_map_tiles_seamlessly() {

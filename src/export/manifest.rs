@@ -10,8 +10,8 @@ use serde::Serialize;
 
 use super::ExportError;
 use super::atomic::sha256_hex;
-use crate::maps::thickness_range_nm;
-use crate::material::{MapKind, NormalConvention, Optics};
+use crate::maps::{BuildOptions, Layout, body_plan, thickness_range_nm};
+use crate::material::{MapKind, Optics};
 use crate::preset::LoadedPreset;
 
 #[derive(Debug, Serialize)]
@@ -24,6 +24,14 @@ pub struct Manifest {
     pub seed: u64,
     pub width: usize,
     pub height: usize,
+    /// `tile` (a square that tiles both ways) or `body` (the whole snake, snout at v = 0).
+    pub layout: String,
+    /// Body layout: the counts the atlas was drawn with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub counts: Option<Counts>,
+    /// Body layout: the v range (0 snout .. 1 tail tip) of each region.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regions: Option<Regions>,
     pub maps: Vec<MapEntry>,
     pub iridescence: IridescenceRange,
     pub optics: Optics,
@@ -39,6 +47,28 @@ pub const COLOR_MEANS: &str = "visible diffuse colour: the stack's diffuse refle
      unit of light the top lets in, exp(-tau) k_d E / (1 - k_d K) (a glTF baseColor under a dielectric top); \
      the layered model recovers the base albedo k_d = c / (exp(-tau) E + c K) per pixel, the thesis model \
      reads the map as k_d itself";
+
+#[derive(Debug, Serialize)]
+pub struct Counts {
+    pub ventrals: u32,
+    pub subcaudals: u32,
+    /// Marks of the first counted pattern layer (`pattern.N.count`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dorsal_marks: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tail_bands: Option<u32>,
+}
+
+/// [start, end] in v of each region of a body atlas.
+#[derive(Debug, Serialize)]
+pub struct Regions {
+    pub head: [f32; 2],
+    pub neck: [f32; 2],
+    pub trunk: [f32; 2],
+    /// The vent: the last ventral plate's length either side of it.
+    pub vent: [f32; 2],
+    pub tail: [f32; 2],
+}
 
 #[derive(Debug, Serialize)]
 pub struct MapEntry {
@@ -67,11 +97,29 @@ pub fn manifest_file_name(set_name: &str) -> String {
 /// The manifest of a set; `files` are (map, file name, SHA-256 of the file).
 pub fn manifest(
     loaded: &LoadedPreset,
-    size: usize,
+    (width, height): (usize, usize),
     files: &[(MapKind, String, String)],
-    convention: NormalConvention,
+    options: BuildOptions,
 ) -> Manifest {
     let p = &loaded.preset;
+    let convention = options.normal_convention;
+    let body = (options.layout == Layout::Body).then(|| body_plan(p));
+    let counts = body.map(|b| Counts {
+        ventrals: b.ventrals,
+        subcaudals: b.subcaudals,
+        dorsal_marks: p.pattern.iter().find_map(|l| l.count),
+        tail_bands: (p.body.tail_bands > 0).then_some(p.body.tail_bands),
+    });
+    let regions = body.map(|b| {
+        let plate = (b.vent - b.head_end) / b.ventrals.max(1) as f32;
+        Regions {
+            head: [0.0, b.head_end],
+            neck: [b.head_end, b.neck_end],
+            trunk: [b.neck_end, b.vent],
+            vent: [b.vent - plate, b.vent + plate],
+            tail: [b.vent, 1.0],
+        }
+    });
     let (min_nm, max_nm) = thickness_range_nm(p);
     let entry = |(map, file, sha256): &(MapKind, String, String)| {
         let format = map.format();
@@ -92,8 +140,11 @@ pub fn manifest(
         preset_hash: loaded.content_hash.clone(),
         species: p.species.clone(),
         seed: p.seed,
-        width: size,
-        height: size,
+        width,
+        height,
+        layout: options.layout.name().into(),
+        counts,
+        regions,
         maps: files.iter().map(entry).collect(),
         iridescence: IridescenceRange { min_nm, max_nm },
         optics: p.optics.clone(),

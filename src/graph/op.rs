@@ -4,6 +4,7 @@
 use crate::ops::Image;
 use std::borrow::Cow;
 
+use crate::ops::body::{AlongProfile, HeadMark};
 use crate::ops::filters::{self, BlendMode, NormalConvention};
 use crate::ops::noise::{FractalNoise, NoiseKind};
 use crate::ops::scale_colour::{ScaleChannels, ScaleColour};
@@ -46,16 +47,26 @@ pub enum Op {
     /// Inputs: RGB colour and the scale field; colour per scale (`ops::scale_colour`).
     ScaleColour(ScaleColour),
     /// Height to a tangent-space normal.
-    HeightToNormal { slope: f32, convention: NormalConvention },
+    /// `v_extent`: the image's height in texture widths (1 tile, the body's length).
+    HeightToNormal { slope: f32, convention: NormalConvention, v_extent: f32 },
+    /// A mask varying along the body only (`ops::body::AlongProfile`). No inputs.
+    Along(AlongProfile),
+    /// A mark on the head or neck of a body atlas (`ops::body::HeadMark`). No inputs.
+    HeadMark(HeadMark),
 }
 
 impl Op {
     /// How many inputs the operation takes (checked when a node is added).
     pub fn arity(&self) -> std::ops::RangeInclusive<usize> {
         match self {
-            Op::Noise(_) | Op::Scales(_) | Op::Bands { .. } | Op::Blotches(_) | Op::BellyMarks(_) | Op::Spots(_) => {
-                0..=0
-            }
+            Op::Noise(_)
+            | Op::Scales(_)
+            | Op::Bands { .. }
+            | Op::Blotches(_)
+            | Op::BellyMarks(_)
+            | Op::Spots(_)
+            | Op::Along(_)
+            | Op::HeadMark(_) => 0..=0,
             Op::Channel { .. }
             | Op::Levels { .. }
             | Op::Threshold { .. }
@@ -87,6 +98,8 @@ impl Op {
             | Op::BellyMarks(_)
             | Op::SnapToScales { .. }
             | Op::Spots(_)
+            | Op::Along(_)
+            | Op::HeadMark(_)
             | Op::Sobel { .. } => 1,
         }
     }
@@ -130,7 +143,11 @@ impl Op {
             Op::Blur { sigma } => filters::blur(input(), *sigma),
             Op::Sobel { edge_sigma } => filters::sobel(input(), *edge_sigma),
             Op::Colorize { low, high } => filters::colorize(input(), *low, *high),
-            Op::HeightToNormal { slope, convention } => filters::height_to_normal(input(), *slope, *convention),
+            Op::HeightToNormal { slope, convention, v_extent } => {
+                filters::height_to_normal(input(), *slope, *convention, *v_extent)
+            }
+            Op::Along(profile) => profile.render(width, height),
+            Op::HeadMark(mark) => crate::ops::body::head_mark(width, height, mark),
             Op::Levels { in_low, in_high, out_low, out_high } => {
                 filters::levels(owned(first), *in_low, *in_high, *out_low, *out_high)
             }
@@ -166,6 +183,8 @@ impl Op {
             Op::Colorize { .. } => "colorize".into(),
             Op::Tint { .. } => "tint".into(),
             Op::HeightToNormal { .. } => "height to normal".into(),
+            Op::Along(p) => format!("along the body, {} knots", p.knots.len()),
+            Op::HeadMark(m) => format!("head mark {:?}", m.shape).to_lowercase(),
             Op::ScaleColour(c) => format!("colour per scale tone={:.2} speckle={:.2}", c.tone, c.speckle),
         }
     }
@@ -216,9 +235,15 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             lowest_row_width,
             smooth_rows,
             seed,
+            length,
+            body,
             outputs,
         }) => {
             (shape, rows, smooth_rows, seed, outputs).hash(h);
+            float(h, *length);
+            if let Some(b) = body {
+                b.hash_into(h);
+            }
             for x in [
                 aspect,
                 size,
@@ -242,14 +267,29 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
                 float(h, *x);
             }
         }
-        Op::Blotches(Blotches { shape, count, half_width, length, jitter, offset, staggered, phase, scale, seed }) => {
+        Op::Blotches(Blotches {
+            shape,
+            count,
+            half_width,
+            length,
+            jitter,
+            offset,
+            staggered,
+            phase,
+            scale,
+            span,
+            seed,
+        }) => {
             (shape, count, staggered, seed).hash(h);
-            for x in [half_width, length, jitter, offset, phase, scale] {
+            for x in [half_width, length, jitter, offset, phase, scale, &span.0, &span.1] {
                 float(h, *x);
             }
         }
-        Op::BellyMarks(BellyMarks { kind, rows_v, belly_width, amount, softness, seed }) => {
+        Op::BellyMarks(BellyMarks { kind, rows_v, body, belly_width, amount, softness, seed }) => {
             (kind, rows_v, seed).hash(h);
+            if let Some(b) = body {
+                b.hash_into(h);
+            }
             for x in [belly_width, amount, softness] {
                 float(h, *x);
             }
@@ -289,10 +329,13 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
                 float(h, *x);
             }
         }
-        Op::HeightToNormal { slope, convention } => {
+        Op::HeightToNormal { slope, convention, v_extent } => {
             convention.hash(h);
             float(h, *slope);
+            float(h, *v_extent);
         }
+        Op::Along(profile) => profile.hash_into(h),
+        Op::HeadMark(mark) => mark.hash_into(h),
         Op::ScaleColour(ScaleColour {
             tone,
             hue,
@@ -302,10 +345,11 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             speckle_color,
             skin,
             speckle_cells,
+            speckle_cells_v,
             seed,
             channels: ScaleChannels { crevice, random, inside, along },
         }) => {
-            (speckle_cells, seed, crevice, random, inside, along, skin.is_some()).hash(h);
+            (speckle_cells, speckle_cells_v, seed, crevice, random, inside, along, skin.is_some()).hash(h);
             for x in [tone, hue, edge, tip, speckle].into_iter().chain(speckle_color).chain(skin.iter().flatten()) {
                 float(h, *x);
             }

@@ -17,12 +17,16 @@ use crate::preset::schema::{Arrangement, BellyPattern, NoiseChoice, PatternKind,
 pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
     let base = preset.color.base.to_linear();
     let var = preset.color.variation as f32;
-    let noise = g.add("color.variation_noise", perlin(4, 4, 5, 0.55, derive_seed(preset.seed, "color")), &[]);
+    let noise =
+        g.add("color.variation_noise", perlin(4, s.along_count(4), 5, 0.55, derive_seed(preset.seed, "color")), &[]);
     let mut color = g.add(
         "color.base",
         Op::Colorize { low: base.map(|c| c * (1.0 - var)), high: base.map(|c| c * (1.0 + var)) },
         &[noise],
     );
+    if let Some(plan) = &s.body {
+        color = super::body::tail_shift(g, preset, plan, color);
+    }
 
     let b = &preset.belly;
     let mut outside_belly = None;
@@ -49,6 +53,7 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
             let marks = BellyMarks {
                 kind,
                 rows_v: s.lattice.rows_v as u32,
+                body: s.body,
                 belly_width: plate_band_width(preset, s),
                 amount: b.pattern_amount as f32,
                 softness: 0.004,
@@ -71,11 +76,18 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
     // One distortion noise for every layer (shared, so it is evaluated once).
     let distorted = preset.pattern.iter().any(|l| l.edge_distortion > 0.0 && l.kind != PatternKind::Solid);
     let distortion_noise = distorted.then(|| {
-        g.add("pattern.distortion_noise", perlin(24, 24, 3, 0.5, derive_seed(preset.seed, "distortion")), &[])
+        g.add(
+            "pattern.distortion_noise",
+            perlin(24, s.along_count(24), 3, 0.5, derive_seed(preset.seed, "distortion")),
+            &[],
+        )
     });
     let context = LayerContext { seed: preset.seed, outside_belly, distortion_noise };
     for (i, layer) in preset.pattern.iter().enumerate() {
         color = pattern_layer(g, s, &context, i, layer, color);
+    }
+    if let Some(plan) = &s.body {
+        color = super::body::marks(g, preset, s, plan, outside_belly, color);
     }
 
     if let Some(op) = per_scale(preset, s) {
@@ -127,6 +139,7 @@ fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
         speckle_color: c.speckle_color.to_linear(),
         skin: c.skin.map(Srgb8::to_linear),
         speckle_cells: s.lattice.cols as u32 * SPECKLES_PER_SCALE,
+        speckle_cells_v: s.along_count(s.lattice.cols as u32 * SPECKLES_PER_SCALE),
         seed: derive_seed(preset.seed, "per_scale"),
         channels: ScaleChannels {
             crevice: s.channel_index(channel::CREVICE),
@@ -173,7 +186,7 @@ fn shapes(
     match layer.kind {
         PatternKind::Solid => {
             // Full coverage, modulated by broad noise so the tint is not flat.
-            let n = g.add(name("noise"), perlin(3, 3, 4, 0.5, seed), &[]);
+            let n = g.add(name("noise"), perlin(3, s.along_count(3), 4, 0.5, seed), &[]);
             let amount = layer.amount as f32;
             vec![(levels(g, &name("shape"), n, amount * 0.6, amount), layer.color)]
         }
@@ -203,7 +216,9 @@ fn shapes(
         PatternKind::Rings => {
             // A colour sequence repeated `amount` times along the body; widths are
             // fractions of one repeat (default: one ring of `size`, or equal parts).
-            let repeats = layer.amount.round().max(1.0) as f32;
+            let (repeats, span) = series(s, layer);
+            let repeats = repeats as f32;
+            let span_len = span.1 - span.0;
             let (colors, mut widths): (Vec<Srgb8>, Vec<f32>) = if layer.colors.is_empty() {
                 (vec![layer.color], vec![size.min(1.0)])
             } else if layer.widths.is_empty() {
@@ -214,23 +229,27 @@ fn shapes(
             };
             if fully_snapped(layer) {
                 let floor_cells = s.field.longest_reach_cells(&s.lattice) + s.field.jitter.clamp(0.0, 0.5);
-                widths = rings_of_whole_scales(&widths, s.lattice.rows_v as f32 / repeats, floor_cells);
+                widths = rings_of_whole_scales(&widths, s.lattice.rows_v as f32 * span_len / repeats, floor_cells);
             }
             // Start half way into the first colour, so the texture's v seam falls inside a
-            // ring rather than on the boundary between two.
-            let mut start = -0.5 * widths.first().copied().unwrap_or(0.0);
+            // ring rather than on the boundary between two (a counted series starts at the
+            // start of the trunk).
+            let mut start = if span == (0.0, 1.0) { -0.5 * widths.first().copied().unwrap_or(0.0) } else { 0.0 };
             let mut out = Vec::new();
             for (k, (color, width)) in colors.into_iter().zip(widths).enumerate() {
-                let centres = (0..repeats as usize).map(|r| (r as f32 + start + width * 0.5) / repeats).collect();
-                let op = Op::Bands { axis: Axis::V, centres, half_width: width * 0.5 / repeats, softness: 0.002 };
+                let centres = (0..repeats as usize)
+                    .map(|r| span.0 + (r as f32 + start + width * 0.5) / repeats * span_len)
+                    .collect();
+                let half_width = width * 0.5 / repeats * span_len;
+                let op = Op::Bands { axis: Axis::V, centres, half_width, softness: 0.002 / s.along };
                 out.push((g.add(name(&format!("ring{k}")), op, &[]), color));
                 start += width;
             }
             out
         }
-        PatternKind::Spots => vec![(g.add(name("shape"), Op::Spots(spot_grid(layer, seed)), &[]), layer.color)],
+        PatternKind::Spots => vec![(g.add(name("shape"), Op::Spots(spot_grid(s, layer, seed)), &[]), layer.color)],
         PatternKind::Blotches => {
-            vec![(g.add(name("shape"), Op::Blotches(blotches(layer, seed, 1.0)), &[]), layer.color)]
+            vec![(g.add(name("shape"), Op::Blotches(blotches(s, layer, seed, 1.0)), &[]), layer.color)]
         }
         PatternKind::Irregular => {
             let kind = match layer.noise {
@@ -238,7 +257,8 @@ fn shapes(
                 NoiseChoice::Cellular => NoiseKind::Cellular,
             };
             let cells = (1.0 / size).round().clamp(1.0, 256.0) as u32;
-            let noise = FractalNoise { kind, cells_u: cells, cells_v: cells, octaves: 3, gain: 0.45, seed };
+            let noise =
+                FractalNoise { kind, cells_u: cells, cells_v: s.along_count(cells), octaves: 3, gain: 0.45, seed };
             let n = g.add(name("noise"), Op::Noise(noise), &[]);
             // Higher amount, lower threshold, more coverage; fBm sits mostly in [0.3, 0.7].
             let level = 0.7 - 0.4 * layer.amount as f32;
@@ -250,7 +270,7 @@ fn shapes(
 
 /// The blotch series of a `blotches` layer, every blotch scaled by `scale` (a composite
 /// mark's centre is the same series drawn smaller).
-fn blotches(layer: &PatternLayer, seed: u32, scale: f32) -> Blotches {
+fn blotches(s: &Shared, layer: &PatternLayer, seed: u32, scale: f32) -> Blotches {
     let shape = match layer.shape {
         PatternShape::Diamond => BlotchShape::Diamond,
         PatternShape::Saddle => BlotchShape::Saddle,
@@ -259,9 +279,11 @@ fn blotches(layer: &PatternLayer, seed: u32, scale: f32) -> Blotches {
         PatternShape::Zigzag => BlotchShape::Zigzag,
         PatternShape::Round | PatternShape::Ring => BlotchShape::Round,
     };
+    let (count, span) = series(s, layer);
     Blotches {
         shape,
-        count: layer.amount.round().max(1.0) as u32,
+        count,
+        span,
         half_width: layer.size as f32,
         length: layer.length as f32,
         jitter: 0.3,
@@ -274,11 +296,11 @@ fn blotches(layer: &PatternLayer, seed: u32, scale: f32) -> Blotches {
 }
 
 /// The spot grid of a `spots` layer.
-fn spot_grid(layer: &PatternLayer, seed: u32) -> SpotGrid {
+fn spot_grid(s: &Shared, layer: &PatternLayer, seed: u32) -> SpotGrid {
     let across = layer.amount.round().max(1.0) as u32;
     SpotGrid {
         across,
-        along: across,
+        along: s.along_count(across),
         radius: layer.size as f32,
         jitter: 0.35,
         alternate: layer.arrangement == Arrangement::Alternating,
@@ -290,16 +312,39 @@ fn spot_grid(layer: &PatternLayer, seed: u32) -> SpotGrid {
 
 /// The centre of a composite mark: the layer's blotches or spots drawn at `center_size`
 /// of their size about their own centres (None for other kinds or without `center_color`).
-fn centre_shape(layer: &PatternLayer, seed: u32) -> Option<Op> {
+fn centre_shape(s: &Shared, layer: &PatternLayer, seed: u32) -> Option<Op> {
     layer.center_color?;
     let k = layer.center_size as f32;
     match layer.kind {
-        PatternKind::Blotches => Some(Op::Blotches(blotches(layer, seed, k))),
+        PatternKind::Blotches => Some(Op::Blotches(blotches(s, layer, seed, k))),
         PatternKind::Spots => {
-            let grid = spot_grid(layer, seed);
+            let grid = spot_grid(s, layer, seed);
             Some(Op::Spots(SpotGrid { radius: grid.radius * k, ..grid }))
         }
         _ => None,
+    }
+}
+
+/// How many marks (blotches, or repeats of a ring sequence) a layer draws over the
+/// texture, and the stretch of v (fractions) they are spread over: `amount` per tile over
+/// the tile; on the body, `count` over the trunk (neck to vent) where the preset counts
+/// them — continued down the tail at the same spacing unless the tail has bands of its own
+/// (`body.tail_bands`) — else `amount` per circumference over the whole length.
+fn series(s: &Shared, layer: &PatternLayer) -> (u32, (f32, f32)) {
+    let amount = layer.amount.round().max(1.0) as u32;
+    match (&s.body, layer.count) {
+        (Some(plan), Some(count)) => {
+            let count = count.max(1);
+            if s.tail_bands > 0 {
+                // A tail with bands of its own: the series ends at the vent.
+                return (count, (plan.neck_end, plan.vent));
+            }
+            // Otherwise the series runs on down the tail at the trunk's spacing.
+            let spacing = (plan.vent - plan.neck_end) / count as f32;
+            let on_tail = ((1.0 - plan.vent) / spacing).floor() as u32;
+            (count + on_tail, (plan.neck_end, plan.neck_end + (count + on_tail) as f32 * spacing))
+        }
+        _ => (s.along_count(amount), (0.0, 1.0)),
     }
 }
 
@@ -375,6 +420,13 @@ fn pattern_layer(
     for (k, (shape, tint)) in parts.into_iter().enumerate() {
         let name = |part: &str| if many { format!("{prefix}.{k}.{part}") } else { format!("{prefix}.{part}") };
         let mut mask = shape;
+        if let Some(plan) = &s.body {
+            // A counted series starts at the end of the neck; every other layer runs from
+            // the end of the head. The head carries its own marks (`body.head_mark`).
+            let region = super::body::layer_region(plan, layer.count.is_some(), s.tail_bands > 0);
+            let region = g.add(name("region"), Op::Along(region), &[]);
+            mask = g.add(name("in_region"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, region]);
+        }
         // A ring sequence in whole scales keeps its topology (`rings_of_whole_scales`) only
         // with straight band edges: no distortion there.
         let distort = layer.edge_distortion > 0.0
@@ -419,7 +471,7 @@ fn pattern_layer(
             );
         }
     }
-    if let (Some(centre_color), Some(op), Some(mark)) = (layer.center_color, centre_shape(layer, seed), last_mask) {
+    if let (Some(centre_color), Some(op), Some(mark)) = (layer.center_color, centre_shape(s, layer, seed), last_mask) {
         // The composite mark's centre, over the mark and its outline, and never outside the
         // mark (a chevron or zigzag scaled about its centre moves its arms sideways).
         let mut centre = g.add(format!("{prefix}.centre"), op, &[]);

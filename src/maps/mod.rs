@@ -5,9 +5,11 @@
 //! `normal.*`, `roughness.*` and `iridescence.*` their own map. Which maps share which nodes is
 //! what makes `--maps roughness` cheap: it never reaches a colour or pattern node.
 
+mod body;
 mod color;
 
 use crate::graph::{Graph, GraphBuilder, NodeId, Op};
+use crate::ops::body::BodyPlan;
 use crate::ops::filters::{BlendMode, NormalConvention};
 use crate::ops::hash::derive_seed;
 use crate::ops::noise::{FractalNoise, NoiseKind};
@@ -17,15 +19,54 @@ use crate::preset::schema::{self, IridescenceGradient};
 
 pub use crate::material::MapKind;
 
-/// Choices that are not part of the preset (they do not change the skin, only its encoding).
-#[derive(Debug, Clone, Copy)]
-pub struct BuildOptions {
-    pub normal_convention: NormalConvention,
+/// What one texture set covers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Layout {
+    /// A square that tiles both ways: one circumference around, one along (the default).
+    #[default]
+    Tile,
+    /// The whole snake, snout (top) to tail tip (bottom): `body.length` widths long.
+    Body,
 }
 
-impl Default for BuildOptions {
-    fn default() -> Self {
-        BuildOptions { normal_convention: NormalConvention::OpenGl }
+impl Layout {
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Tile => "tile",
+            Layout::Body => "body",
+        }
+    }
+
+    /// Image height for a width: the tile is square; the body is `body.length` widths long
+    /// (so a pixel covers the same length of skin both ways).
+    pub fn height(self, preset: &Preset, width: usize) -> usize {
+        match self {
+            Layout::Tile => width,
+            Layout::Body => ((width as f64 * preset.body.length).round() as usize).max(1),
+        }
+    }
+}
+
+/// Choices that are not part of the preset (they do not change the skin, only its encoding
+/// and extent).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BuildOptions {
+    pub normal_convention: NormalConvention,
+    pub layout: Layout,
+}
+
+/// The body layout's regions and counts from the preset (`[body]`).
+pub fn body_plan(preset: &Preset) -> BodyPlan {
+    let b = &preset.body;
+    let head_end = b.head_fraction as f32;
+    BodyPlan {
+        length: b.length as f32,
+        head_end,
+        neck_end: head_end + b.neck_fraction as f32,
+        vent: 1.0 - b.tail_fraction as f32,
+        ventrals: b.ventrals,
+        subcaudals: b.subcaudals,
+        head_shields: b.head_scales == schema::HeadScales::Shields,
     }
 }
 
@@ -34,8 +75,9 @@ pub fn thickness_range_nm(preset: &Preset) -> (f64, f64) {
     crate::material::thickness_range_nm(preset.optics.film_thickness_nm, preset.iridescence.spread_nm)
 }
 
-pub fn scale_field(preset: &Preset) -> ScaleField {
+pub fn scale_field(preset: &Preset, layout: Layout) -> ScaleField {
     let s = &preset.scales;
+    let body = (layout == Layout::Body).then(|| body_plan(preset));
     ScaleField {
         shape: match s.shape {
             schema::ScaleShape::Leaf => ScaleShape::Leaf,
@@ -55,6 +97,8 @@ pub fn scale_field(preset: &Preset) -> ScaleField {
         lowest_row_width: s.lowest_row_width as f32,
         smooth_rows: s.smooth_rows,
         seed: derive_seed(preset.seed, "scales"),
+        length: body.map_or(1.0, |b| b.length),
+        body,
         outputs: scale_outputs(preset),
     }
 }
@@ -92,6 +136,12 @@ pub(crate) struct Shared {
     pub crevice: NodeId,
     pub scale_height: NodeId,
     pub grain: NodeId,
+    /// The texture's length along the body in circumferences (1 for the tile).
+    pub along: f32,
+    /// The body layout's plan (None for the tile).
+    pub body: Option<BodyPlan>,
+    /// Bands on the tail (`body.tail_bands`): a counted series then ends at the vent.
+    pub tail_bands: u32,
 }
 
 impl Shared {
@@ -104,13 +154,24 @@ impl Shared {
     pub fn channel(&self, g: &mut GraphBuilder, name: &str, channel: usize) -> NodeId {
         g.add(name, Op::Channel { index: self.channel_index(channel) }, &[self.scales])
     }
+
+    /// A count per circumference along the body (noise cells, rings, spots) over the whole
+    /// texture: unchanged for the tile, times the body's length (rounded) for the body.
+    pub fn along_count(&self, per_circumference: u32) -> u32 {
+        if self.body.is_none() {
+            return per_circumference;
+        }
+        ((per_circumference as f32 * self.along).round() as u32).max(1)
+    }
 }
 
 /// Builds the whole graph for a preset; evaluation later picks the part it needs.
 pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     let mut g = GraphBuilder::new();
-    let field = scale_field(preset);
+    let field = scale_field(preset, options.layout);
     let lattice = field.lattice();
+    let body = field.body;
+    let along = field.length;
     let scales = g.add("scales", Op::Scales(field.clone()), &[]);
     let index = |channel: usize| field.output_index(channel).expect("height and crevice are always output");
     let crevice = g.add("scales.crevice", Op::Channel { index: index(channel::CREVICE) }, &[scales]);
@@ -128,7 +189,17 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
         }),
         &[],
     );
-    let shared = Shared { scales, field, lattice, crevice, scale_height, grain };
+    let shared = Shared {
+        scales,
+        field,
+        lattice,
+        crevice,
+        scale_height,
+        grain,
+        along,
+        body,
+        tail_bands: preset.body.tail_bands,
+    };
 
     let color = color::build(&mut g, preset, &shared);
     g.set_output(MapKind::Color, color);
@@ -139,7 +210,11 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     // The normal follows the physical surface: undo the height map's stretch.
     let (low, high) = height_range(preset);
     let slope = preset.height.normal_strength as f32 / shared.lattice.cols as f32 * (high - low);
-    let normal = g.add("normal.out", Op::HeightToNormal { slope, convention: options.normal_convention }, &[height]);
+    let normal = g.add(
+        "normal.out",
+        Op::HeightToNormal { slope, convention: options.normal_convention, v_extent: along },
+        &[height],
+    );
     g.set_output(MapKind::Normal, normal);
 
     let roughness = build_roughness(&mut g, preset, &shared);
@@ -221,7 +296,7 @@ fn build_iridescence(g: &mut GraphBuilder, preset: &Preset, s: &Shared, cols: u3
         Op::Noise(FractalNoise {
             kind: NoiseKind::Perlin,
             cells_u: (cols / 2).max(1),
-            cells_v: (cols / 2).max(1),
+            cells_v: s.along_count((cols / 2).max(1)),
             octaves: 4,
             gain: 0.55,
             seed: derive_seed(preset.seed, "iridescence"),

@@ -334,8 +334,15 @@ pub use crate::material::NormalConvention;
 /// Tangent-space normal (unit XYZ in [-1, 1]) from a height map by central differences.
 /// `slope_per_unit_height` is the surface rise, in texture widths, of the full height range
 /// (so the result does not change with resolution).
-pub fn height_to_normal(height: &Image, slope_per_unit_height: f32, convention: NormalConvention) -> Image {
-    let (w, h) = (height.width as f32, height.height as f32);
+/// `v_extent` is the image's height in texture widths (1 for the square tile, the body's
+/// length for the body layout), so that both axes are differentiated in the same unit.
+pub fn height_to_normal(
+    height: &Image,
+    slope_per_unit_height: f32,
+    convention: NormalConvention,
+    v_extent: f32,
+) -> Image {
+    let (w, h) = (height.width as f32, height.height as f32 / v_extent);
     neighbourhood(height, 3, |c, l, r, up, here, down, out| {
         // dh/du with u in texture widths: (h[x+1] - h[x-1]) / (2 / w).
         let dhdx = (here[r] - here[l]) * 0.5 * w;
@@ -409,10 +416,10 @@ mod tests {
     #[test]
     fn normals_are_unit_and_flat_height_points_up() {
         let flat = Image::new(16, 16, 1);
-        let n = height_to_normal(&flat, 1.0, NormalConvention::OpenGl);
+        let n = height_to_normal(&flat, 1.0, NormalConvention::OpenGl, 1.0);
         assert!(n.data.chunks(3).all(|p| p == [0.0, 0.0, 1.0]));
         let ramp = Image::gray_from_fn(32, 32, |u, v| (u * std::f32::consts::TAU).sin() * 0.1 + v * 0.0);
-        let n = height_to_normal(&ramp, 1.0, NormalConvention::OpenGl);
+        let n = height_to_normal(&ramp, 1.0, NormalConvention::OpenGl, 1.0);
         for p in n.data.chunks(3) {
             assert!(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs() < 1e-5);
         }
@@ -422,8 +429,8 @@ mod tests {
     fn opengl_green_points_up_the_image_on_a_slope_rising_down() {
         // Height grows with image y (downwards): the surface faces up the image, +Y in OpenGL.
         let ramp = Image::gray_from_fn(16, 16, |_, v| (v * std::f32::consts::TAU).sin());
-        let gl = height_to_normal(&ramp, 0.1, NormalConvention::OpenGl);
-        let dx = height_to_normal(&ramp, 0.1, NormalConvention::DirectX);
+        let gl = height_to_normal(&ramp, 0.1, NormalConvention::OpenGl, 1.0);
+        let dx = height_to_normal(&ramp, 0.1, NormalConvention::DirectX, 1.0);
         let i = (16 + 3) * 3; // pixel (3, 1): near v = 0 the slope is positive
         assert!(gl.data[i + 1] > 0.0 && dx.data[i + 1] < 0.0);
     }

@@ -2,6 +2,7 @@
 //! resvg keeps `filter/`): each function takes images and parameters and returns an image.
 //! Everything is defined in normalised coordinates and wraps around, so outputs tile.
 
+pub mod body;
 pub mod filters;
 pub mod hash;
 pub mod image;

@@ -61,6 +61,8 @@ pub struct ScaleColour {
     pub skin: Option<[f32; 3]>,
     /// Speckle grid cells around the texture (= along it): scale columns × SPECKLES_PER_SCALE.
     pub speckle_cells: u32,
+    /// Speckle grid cells along the texture (= `speckle_cells` for the square tile).
+    pub speckle_cells_v: u32,
     pub seed: u32,
     pub channels: ScaleChannels,
 }
@@ -79,6 +81,7 @@ impl ScaleColour {
         let sc = scales.channels;
         let k = self.channels;
         let cells = self.speckle_cells.max(1) as f32;
+        let cells_v = self.speckle_cells_v.max(1) as f32;
         // Anti-aliasing band of a dot's edge: one pixel, in speckle cells.
         let aa = cells / width.min(height).max(1) as f32;
         let mut out = colour;
@@ -130,7 +133,7 @@ impl ScaleColour {
                 }
                 if self.speckle > 0.0 {
                     let u = (x as f32 + 0.5) / width as f32;
-                    let dot = self.dot(u * cells, v * cells, aa) * own;
+                    let dot = self.dot(u * cells, v * cells_v, aa) * own;
                     for (c, s) in px.iter_mut().zip(self.speckle_color) {
                         *c += (s - *c) * dot;
                     }
@@ -142,14 +145,14 @@ impl ScaleColour {
 
     /// Coverage of the speckle dot near (gx, gy), in grid-cell units.
     fn dot(&self, gx: f32, gy: f32, aa: f32) -> f32 {
-        let n = self.speckle_cells.max(1) as i32;
+        let (n, n_v) = (self.speckle_cells.max(1) as i32, self.speckle_cells_v.max(1) as i32);
         let (cx, cy) = (floor_i32(gx), floor_i32(gy));
         let mut coverage = 0.0f32;
         // A dot is jittered by at most a quarter cell, so it reaches only the 3 × 3 cells.
         for dy in -1..=1 {
             for dx in -1..=1 {
                 let (i, j) = (cx + dx, cy + dy);
-                let (wi, wj) = (i.rem_euclid(n), j.rem_euclid(n));
+                let (wi, wj) = (i.rem_euclid(n), j.rem_euclid(n_v));
                 if hash::unit(wi, wj, 0, self.seed) >= self.speckle {
                     continue;
                 }

@@ -19,6 +19,7 @@
 //! Per-cell jitter (position, size, rotation) is drawn once per cell into a table, so the
 //! per-pixel loop does lookups, not hashing.
 
+use super::body::{BodyPlan, HEAD_TOP_HALF_U, Plate};
 use super::hash;
 use super::image::{Image, floor_i32};
 
@@ -84,6 +85,11 @@ pub struct ScaleField {
     /// The lowest this many dorsal rows carry no keel.
     pub smooth_rows: u32,
     pub seed: u32,
+    /// The texture's extent along the body in circumferences (its height over its width):
+    /// 1 for the tile, the body's length for the body layout.
+    pub length: f32,
+    /// The body layout's regions and plate counts (None: the tile, plates one per lattice row).
+    pub body: Option<BodyPlan>,
     /// Which `channel`s the node outputs, in order (memory: 4 bytes per pixel each, so the
     /// graph asks only for those its maps read).
     pub outputs: Vec<usize>,
@@ -220,10 +226,11 @@ impl ScaleField {
             acc += w;
         }
         bounds.push(1.0);
-        // The cell aspect is that of an ordinary (width 1) column, 1 / total of u wide.
-        let rows_v = ((total / self.aspect).round() as i32).max(1);
+        // The cell aspect is that of an ordinary (width 1) column, 1 / total of u wide; the
+        // texture is `length` circumferences long.
+        let rows_v = ((total / self.aspect * self.length).round() as i32).max(1);
         let stagger = cols / 2;
-        Lattice { cols, rows_v, stagger, aspect: total / rows_v as f32, belly_cols, bounds, uniform }
+        Lattice { cols, rows_v, stagger, aspect: total * self.length / rows_v as f32, belly_cols, bounds, uniform }
     }
 }
 
@@ -420,10 +427,19 @@ impl ScaleField {
         let table = CellTable::new(self, &lattice);
         let geo = Geometry::new(self.shape, 0.5 * lattice.aspect);
         let belly_half = 0.5 * lattice.belly_width();
+        let shields = match &self.body {
+            Some(b) if b.head_shields => b.shields(),
+            _ => Vec::new(),
+        };
         Image::from_fn(width, height, self.outputs.len(), |u, v, out| {
             let mut all = [0.0f32; channel::COUNT];
             let dist_belly = u.min(1.0 - u);
-            if dist_belly < belly_half {
+            let plate = self.body.as_ref().map(|b| (b, b.plate_at(v)));
+            if !shields.is_empty() && self.shield_pixel(&lattice, &shields, u, v, &mut all) {
+                // A head shield.
+            } else if let Some((body, Some(plate))) = plate.filter(|_| dist_belly < belly_half) {
+                self.body_plate_pixel(&lattice, body, plate.index as f32 + plate.along, plate, dist_belly, u, &mut all);
+            } else if dist_belly < belly_half && plate.is_none() {
                 self.ventral_pixel(&lattice, dist_belly, v, &mut all);
             } else if self.shape == ScaleShape::Hexagon {
                 self.hexagon_pixel(&lattice, &table, u, v, &mut all);
@@ -628,15 +644,51 @@ impl ScaleField {
         }
     }
 
-    /// Ventral plates: one wide plate per row across the belly band, overlapping like the
-    /// dorsal scales (the thesis stretches normal scales "from the middle", §4.2.2).
+    /// Ventral plates of the tile: one wide plate per lattice row across the belly band.
     fn ventral_pixel(&self, lattice: &Lattice, dist_belly: f32, v: f32, out: &mut [f32]) {
+        let rows = PlateRows {
+            y: v * lattice.rows_v as f32 - ROW_PHASE,
+            aspect: lattice.aspect,
+            divided: false,
+            centre_v: &|r| ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+            identity: &|r| r.rem_euclid(lattice.rows_v),
+        };
+        self.plate_pixel(lattice, &rows, dist_belly, 0, out);
+    }
+
+    /// Ventral plates and subcaudals of the body layout, counted (`BodyPlan::plate_at`);
+    /// subcaudals are divided at the midline, as in most snakes.
+    #[allow(clippy::too_many_arguments)]
+    fn body_plate_pixel(
+        &self,
+        lattice: &Lattice,
+        body: &BodyPlan,
+        y: f32,
+        plate: super::body::PlatePosition,
+        dist_belly: f32,
+        u: f32,
+        out: &mut [f32],
+    ) {
+        // Plate length over an ordinary column's width (both in circumferences).
+        let aspect = plate.length_v * body.length / lattice.bounds[1];
+        let rows =
+            PlateRows { y, aspect, divided: plate.subcaudal, centre_v: &|r| body.plate_centre_v(r), identity: &|r| r };
+        self.plate_pixel(lattice, &rows, dist_belly, if u < 0.5 { 0 } else { 1 }, out);
+    }
+
+    /// One wide plate per row of `rows` across the belly band, overlapping like the dorsal
+    /// scales (the thesis stretches normal scales "from the middle", §4.2.2).
+    fn plate_pixel(&self, lattice: &Lattice, rows: &PlateRows, dist_belly: f32, side: i32, out: &mut [f32]) {
         let soft = self.edge_softness.max(1e-4);
         let half_band = lattice.belly_width() * 0.5;
         // Distances in dorsal scale widths, the unit of `edge_softness` (a plate column is
         // one ordinary column wide).
-        let to_side = (half_band - dist_belly) / lattice.bounds[1];
-        let y = v * lattice.rows_v as f32 - ROW_PHASE;
+        let mut to_side = (half_band - dist_belly) / lattice.bounds[1];
+        if rows.divided {
+            // Paired plates meet at the midline (u = 0).
+            to_side = to_side.min(dist_belly / lattice.bounds[1]);
+        }
+        let y = rows.y;
         let r0 = floor_i32(y);
         let half_len = 0.5 * self.size.max(0.5);
         // The most anterior plate covering the pixel lies on top (its free posterior edge over
@@ -647,7 +699,7 @@ impl ScaleField {
         let across = (dist_belly / half_band).min(1.0);
         let dome = 0.06 * (1.0 - across * across);
         for r in r0 - 1..=r0 + 1 {
-            let to_end = (half_len - (y - (r as f32 + 0.5)).abs()) * lattice.aspect;
+            let to_end = (half_len - (y - (r as f32 + 0.5)).abs()) * rows.aspect;
             let inside = to_side.min(to_end);
             if inside <= 0.0 {
                 continue;
@@ -661,16 +713,18 @@ impl ScaleField {
         }
         let best = top.map(|(r, inside, profile)| {
             let h = free_edge(profile, inside / soft, under_height, self.imbrication);
-            let random = hash::unit(-1, r.rem_euclid(lattice.rows_v), 4, self.seed);
-            let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * lattice.aspect;
+            let id = (rows.identity)(r);
+            let random =
+                if rows.divided { hash::unit(-2 - side, id, 4, self.seed) } else { hash::unit(-1, id, 4, self.seed) };
+            let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * rows.aspect;
             let cand = Candidate {
                 inside,
                 x: dist_belly / half_band * 0.5,
                 y: ly,
-                half_len: 0.5 * lattice.aspect,
+                half_len: 0.5 * rows.aspect,
                 random,
                 centre_u: 0.0,
-                centre_v: ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+                centre_v: (rows.centre_v)(r),
                 row: 0,
             };
             (h, cand)
@@ -681,4 +735,54 @@ impl ScaleField {
             None => self.write_scale(None, 0.0, 0.0, out),
         }
     }
+
+    /// A head shield of the body layout (`BodyPlan::shields`), if (u, v) lies on one:
+    /// large plates with a rounded rim, domed, without keels. Elsewhere on the head the
+    /// lattice's small scales continue. Returns false off every shield.
+    fn shield_pixel(&self, lattice: &Lattice, shields: &[Plate], u: f32, v: f32, out: &mut [f32]) -> bool {
+        let Some(body) = &self.body else { return false };
+        if v > body.head_end * 1.02 || (u - 0.5).abs() > HEAD_TOP_HALF_U {
+            return false;
+        }
+        let (x, y) = (u, v * body.length);
+        let best = shields
+            .iter()
+            .filter(|p| v >= p.v_range.0 - 0.001 && v <= p.v_range.1 + 0.001)
+            .map(|p| (p.inside(x, y), p))
+            .max_by(|a, b| a.0.total_cmp(&b.0));
+        let Some((inside_circ, plate)) = best.filter(|(d, _)| *d > 0.0) else { return false };
+        // In ordinary column widths, the unit of `edge_softness`.
+        let cell = lattice.bounds[1];
+        let inside = inside_circ / cell;
+        let soft = self.edge_softness.max(1e-4);
+        let half_len = 0.5 * (plate.v_range.1 - plate.v_range.0) * body.length / cell;
+        let cand = Candidate {
+            inside,
+            x: (u - plate.centre_uv.0) / cell,
+            y: (v - plate.centre_uv.1) * body.length / cell,
+            half_len: half_len.max(1e-3),
+            random: hash::unit(-3, plate.id, 4, self.seed),
+            centre_u: plate.centre_uv.0,
+            centre_v: plate.centre_uv.1,
+            row: 0,
+        };
+        let h = smoothstep(0.0, soft, inside) * (0.55 + 0.15 * smoothstep(0.0, 1.0, inside));
+        self.write_scale(Some(cand), h, 0.0, out);
+        true
+    }
+}
+
+/// A sequence of plates along the belly: the tile's lattice rows or the body's counted
+/// ventrals and subcaudals.
+struct PlateRows<'a> {
+    /// Plate coordinate of the pixel: plate r spans [r, r + 1).
+    y: f32,
+    /// Plate length over an ordinary column's width.
+    aspect: f32,
+    /// Divided at the midline (subcaudals).
+    divided: bool,
+    /// v of plate r's centre, for the scale field's CENTRE_V.
+    centre_v: &'a dyn Fn(i32) -> f32,
+    /// Plate r's identity for its random number.
+    identity: &'a dyn Fn(i32) -> i32,
 }

@@ -167,6 +167,9 @@ pub struct Blotches {
     pub phase: f32,
     /// Every blotch scaled about its centre (1 as drawn; a composite mark's centre < 1).
     pub scale: f32,
+    /// The stretch of v the `count` blotches are spread over, fractions of the image: (0, 1)
+    /// for the tile; the trunk for a counted series of the body layout.
+    pub span: (f32, f32),
     pub seed: u32,
 }
 
@@ -175,13 +178,14 @@ pub struct Blotches {
 pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
     let (w, h) = (width as f32, height as f32);
     let count = b.count.max(1);
-    let spacing = h / count as f32;
+    let spacing = (b.span.1 - b.span.0) * h / count as f32;
+    let origin = b.span.0 * h;
     let mut pb = PathBuilder::new();
     let sides: &[(f32, f32)] =
         if b.offset > 0.0 { &[(1.0, 0.0), (-1.0, if b.staggered { 0.5 } else { 0.0 })] } else { &[(0.0, 0.0)] };
     if b.shape == BlotchShape::Zigzag {
         for &(side, shift) in sides {
-            zigzag(&mut pb, b, (0.5 + side * b.offset) * w, (b.phase + shift) * spacing, spacing, w, h);
+            zigzag(&mut pb, b, (0.5 + side * b.offset) * w, origin + (b.phase + shift) * spacing, spacing, w, h);
         }
         return rasterise(width, height, pb, FillRule::Winding);
     }
@@ -195,7 +199,7 @@ pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
             // The mirrored series mirrors the jitter too, so a pair is symmetric.
             let cx = (0.5 + side * b.offset + if side < 0.0 { -jx } else { jx }) * w;
             for copy_v in [-1.0f32, 0.0, 1.0] {
-                let cy = (i as f32 + 0.5 + jy + b.phase + shift) * spacing + copy_v * h;
+                let cy = origin + (i as f32 + 0.5 + jy + b.phase + shift) * spacing + copy_v * h;
                 for copy_u in [-1.0f32, 0.0, 1.0] {
                     let cx = cx + copy_u * w;
                     if cy + hl < 0.0 || cy - hl > h || cx + hw < 0.0 || cx - hw > w {
@@ -320,6 +324,8 @@ pub struct BellyMarks {
     pub kind: BellyMarkKind,
     /// Plates per tile (the scale lattice's rows along v).
     pub rows_v: u32,
+    /// The body layout's counted plates (then `rows_v` is unused).
+    pub body: Option<super::body::BodyPlan>,
     /// The band's width, fraction of the circumference.
     pub belly_width: f32,
     /// Probability per plate (spots, half-moons) or stripe width over the band's (stripe).
@@ -341,13 +347,21 @@ pub fn belly_marks(width: usize, height: usize, marks: &BellyMarks) -> Image {
         if d > half {
             return 0.0;
         }
-        let y = v * rows - phase;
-        let r = super::image::floor_i32(y);
-        let along = y - r as f32;
-        let plate = r.rem_euclid(marks.rows_v.max(1) as i32);
+        // (plate, position along it, its length in circumferences)
+        let (plate, along, plate_len) = match &marks.body {
+            None => {
+                let y = v * rows - phase;
+                let r = super::image::floor_i32(y);
+                (r.rem_euclid(marks.rows_v.max(1) as i32), y - r as f32, 1.0 / rows)
+            }
+            Some(body) => match body.plate_at(v) {
+                Some(p) => (p.index, p.along, p.length_v * body.length),
+                None => return 0.0,
+            },
+        };
         // Signed position across the band, −1 (one side's edge) .. 1 (the other's).
         let across = if side == 0 { d / half } else { -d / half };
-        let to_ends = along.min(1.0 - along) / rows;
+        let to_ends = along.min(1.0 - along) * plate_len;
         match marks.kind {
             BellyMarkKind::Checkered => {
                 // By the wrapped plate index, so the plate across the v seam is one plate
@@ -366,9 +380,9 @@ pub fn belly_marks(width: usize, height: usize, marks: &BellyMarks) -> Image {
                 // (u = 0) and the band's edges.
                 let centre = 0.2 + 0.65 * super::hash::unit(plate, 0, 1, marks.seed);
                 let centre = if super::hash::unit(plate, 0, 2, marks.seed) < 0.5 { centre } else { -centre };
-                let (rx, ry) = (half / 6.0, 0.25 / rows);
+                let (rx, ry) = (half / 6.0, 0.25 * plate_len);
                 let dx = (across - centre) * half / rx;
-                let dy = (along - 0.5) / rows / ry;
+                let dy = (along - 0.5) * plate_len / ry;
                 let r_norm = (dx * dx + dy * dy).sqrt();
                 ramp((1.0 - r_norm) * rx.min(ry))
             }
@@ -378,9 +392,9 @@ pub fn belly_marks(width: usize, height: usize, marks: &BellyMarks) -> Image {
                 }
                 // A half-disc resting on the plate's posterior edge, on alternate sides.
                 let centre = if plate % 2 == 0 { 0.5 } else { -0.5 };
-                let radius = (0.45 / rows).min(half * 0.3);
+                let radius = (0.45 * plate_len).min(half * 0.3);
                 let dx = (across - centre) * half;
-                let dy = (1.0 - along) / rows;
+                let dy = (1.0 - along) * plate_len;
                 ramp(radius - (dx * dx + dy * dy).sqrt())
             }
             BellyMarkKind::MedianStripe => ramp(marks.amount * half - d),

@@ -116,6 +116,9 @@ pub struct Preset {
     pub iridescence: IridescenceParams,
     #[serde(default)]
     pub optics: Optics,
+    /// The whole animal (`generate --layout body`): proportions, counts, head and tail.
+    #[serde(default)]
+    pub body: Body,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
@@ -327,6 +330,11 @@ pub struct PatternLayer {
     /// The border's width, fraction of the circumference.
     #[serde(default = "PatternLayer::default_border_size")]
     pub border_size: f64,
+    /// Body layout only: the number of marks (blotches, or repeats of a ring sequence)
+    /// along the trunk, from the neck to the vent, as counted in the literature; unset, the
+    /// tile's `amount` per circumference continues over the whole body.
+    #[serde(default)]
+    pub count: Option<u32>,
 }
 
 impl PatternLayer {
@@ -535,3 +543,108 @@ impl Default for IridescenceParams {
 }
 
 pub use crate::material::{Absorption, Optics};
+
+/// Small head scales or large head shields (`body.head_scales`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadScales {
+    /// Large symmetrical plates on top of the head (rostral, internasals, prefrontals,
+    /// frontal, supraoculars, parietals): most colubrids and elapids.
+    Shields,
+    /// Small head scales continuing the body's lattice: most vipers, boas and pythons.
+    Small,
+}
+
+/// A mark on the head or neck (`[[body.head_mark]]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadMarkKind {
+    /// The whole top and sides of the head, down to the lips.
+    Cap,
+    /// The front of the head, to just before the eyes.
+    Snout,
+    /// A V on top of the head, its apex forward between the eyes (vipers).
+    V,
+    /// A V with a second, backward V: an X on the crown (Vipera berus).
+    X,
+    /// A forward-pointing arrowhead between the eyes running onto the neck (corn snakes).
+    Spearhead,
+    /// A stripe from behind the eye to the angle of the jaw, each side.
+    PostocularStripe,
+    /// A band round the neck just behind the head.
+    Collar,
+    /// The lip scales along both jaws.
+    Lips,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct HeadMark {
+    pub kind: HeadMarkKind,
+    pub color: Srgb8,
+    /// Relative size of the mark (1 the stylised default).
+    #[serde(default = "HeadMark::default_size")]
+    pub size: f64,
+}
+
+impl HeadMark {
+    fn default_size() -> f64 {
+        1.0
+    }
+}
+
+/// The whole snake, snout to tail tip (`[body]`): used by the body layout only; the tile
+/// layout ignores it. Lengths are fractions of the total length.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Body {
+    /// Total length over the midbody circumference: the atlas is this many widths long.
+    pub length: f64,
+    /// Head length over total length.
+    pub head_fraction: f64,
+    /// Neck (between the head and the trunk) over total length.
+    pub neck_fraction: f64,
+    /// Tail (vent to tip) over total length.
+    pub tail_fraction: f64,
+    /// Ventral plates from the neck to the vent.
+    pub ventrals: u32,
+    /// Subcaudal plates (pairs, where divided) from the vent to the tip.
+    pub subcaudals: u32,
+    pub head_scales: HeadScales,
+    /// The colour the back shifts to toward the tail (none: no shift).
+    pub tail_color: Option<Srgb8>,
+    /// Where along the trunk (0 neck .. 1 vent) the shift to `tail_color` starts.
+    pub tail_shift_start: f64,
+    /// Dark bands round the tail.
+    pub tail_bands: u32,
+    pub tail_band_color: Srgb8,
+    /// Each band's share of its repeat.
+    pub tail_band_width: f64,
+    /// A solid colour over the tail's tip (none: no tip colour).
+    pub tip_color: Option<Srgb8>,
+    /// The tip colour's share of the tail's length.
+    pub tip_fraction: f64,
+    pub head_mark: Vec<HeadMark>,
+}
+
+impl Default for Body {
+    fn default() -> Self {
+        Body {
+            length: 12.0,
+            head_fraction: 0.04,
+            neck_fraction: 0.03,
+            tail_fraction: 0.18,
+            ventrals: 200,
+            subcaudals: 60,
+            head_scales: HeadScales::Shields,
+            tail_color: None,
+            tail_shift_start: 0.5,
+            tail_bands: 0,
+            tail_band_color: Srgb8([0x14, 0x12, 0x10]),
+            tail_band_width: 0.5,
+            tip_color: None,
+            tip_fraction: 0.1,
+            head_mark: Vec::new(),
+        }
+    }
+}

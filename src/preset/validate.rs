@@ -54,6 +54,19 @@ pub mod ranges {
     pub const MAX_PATTERN_LAYERS: usize = 16;
     /// Colours (and widths) of one layer's ring sequence: a coral-snake triad needs 4.
     pub const MAX_LAYER_COLORS: usize = 32;
+    /// Total length over circumference: stout vipers about 6, whipsnakes above 30.
+    pub const BODY_LENGTH: (f64, f64) = (4.0, 40.0);
+    pub const HEAD_FRACTION: (f64, f64) = (0.01, 0.15);
+    pub const NECK_FRACTION: (f64, f64) = (0.0, 0.15);
+    pub const TAIL_FRACTION: (f64, f64) = (0.02, 0.5);
+    /// Ventral counts in snakes run from about 100 to over 400.
+    pub const VENTRALS: (u32, u32) = (60, 500);
+    pub const SUBCAUDALS: (u32, u32) = (5, 250);
+    pub const TAIL_BANDS: (u32, u32) = (0, 60);
+    /// Marks counted along the trunk.
+    pub const MARK_COUNT: (u32, u32) = (1, 200);
+    pub const HEAD_MARK_SIZE: (f64, f64) = (0.3, 2.0);
+    pub const MAX_HEAD_MARKS: usize = 16;
 }
 
 #[derive(Default)]
@@ -193,6 +206,15 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
         c.range(key("outline_size"), p.outline_size, OUTLINE_SIZE);
         c.range(key("edge_distortion"), p.edge_distortion, UNIT);
         c.range(key("opacity"), p.opacity, UNIT);
+        if let Some(count) = p.count {
+            c.int_range(&key("count"), count, MARK_COUNT);
+            if !matches!(p.kind, PatternKind::Blotches | PatternKind::Rings) {
+                c.problems.push(Problem {
+                    key: key("count"),
+                    message: format!("counts marks of kind \"blotches\" or \"rings\" only, not {:?}", p.kind),
+                });
+            }
+        }
     }
 
     c.range("belly.width", preset.belly.width, BELLY_WIDTH);
@@ -216,6 +238,36 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
     c.range("roughness.per_scale", r.per_scale, ROUGHNESS_VARIATION);
     c.range("iridescence.spread_nm", preset.iridescence.spread_nm, SPREAD_NM);
     c.range("iridescence.noise", preset.iridescence.noise, UNIT);
+
+    let b = &preset.body;
+    c.range("body.length", b.length, BODY_LENGTH);
+    c.range("body.head_fraction", b.head_fraction, HEAD_FRACTION);
+    c.range("body.neck_fraction", b.neck_fraction, NECK_FRACTION);
+    c.range("body.tail_fraction", b.tail_fraction, TAIL_FRACTION);
+    if b.head_fraction + b.neck_fraction + b.tail_fraction > 0.8 {
+        c.problems.push(Problem {
+            key: "body.tail_fraction".into(),
+            message: format!(
+                "head, neck and tail together must leave at least 0.2 of the length to the trunk, got {} + {} + {}",
+                b.head_fraction, b.neck_fraction, b.tail_fraction
+            ),
+        });
+    }
+    c.int_range("body.ventrals", b.ventrals, VENTRALS);
+    c.int_range("body.subcaudals", b.subcaudals, SUBCAUDALS);
+    c.range("body.tail_shift_start", b.tail_shift_start, UNIT);
+    c.int_range("body.tail_bands", b.tail_bands, TAIL_BANDS);
+    c.range("body.tail_band_width", b.tail_band_width, (0.05, 0.95));
+    c.range("body.tip_fraction", b.tip_fraction, UNIT);
+    if b.head_mark.len() > MAX_HEAD_MARKS {
+        c.problems.push(Problem {
+            key: "body.head_mark".into(),
+            message: format!("at most {MAX_HEAD_MARKS} head marks, got {}", b.head_mark.len()),
+        });
+    }
+    for (i, m) in b.head_mark.iter().enumerate() {
+        c.range(format!("body.head_mark.{i}.size"), m.size, HEAD_MARK_SIZE);
+    }
 
     let o = &preset.optics;
     c.range("optics.ambient_ior", o.ambient_ior, IOR);

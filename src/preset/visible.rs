@@ -96,6 +96,17 @@ fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
             keys.push((format!("pattern.{i}.colors.{j}"), colour));
         }
     }
+    let body = &mut preset.body;
+    keys.push(("body.tail_band_color".into(), &mut body.tail_band_color));
+    if let Some(tail) = body.tail_color.as_mut() {
+        keys.push(("body.tail_color".into(), tail));
+    }
+    if let Some(tip) = body.tip_color.as_mut() {
+        keys.push(("body.tip_color".into(), tip));
+    }
+    for (i, mark) in body.head_mark.iter_mut().enumerate() {
+        keys.push((format!("body.head_mark.{i}.color"), &mut mark.color));
+    }
     keys
 }
 

@@ -83,7 +83,38 @@ pub fn colour_map(text: &str, size: usize) -> snakeskin::ops::Image {
 /// The scale field of a preset's TOML text with every channel, in `ops::scales::channel`
 /// order (the maps' own field asks only for the channels they read).
 pub fn full_scale_field(text: &str, size: usize) -> snakeskin::ops::Image {
-    let mut field = snakeskin::maps::scale_field(&preset_from(text));
+    let mut field = snakeskin::maps::scale_field(&preset_from(text), snakeskin::maps::Layout::Tile);
     field.outputs = (0..snakeskin::ops::scales::channel::COUNT).collect();
     field.render(size, size)
+}
+
+/// Mean absolute difference between rows `a` and `b` (all channels).
+pub fn row_jump(img: &snakeskin::ops::Image, a: usize, b: usize) -> f64 {
+    let (ra, rb) = (img.row(a), img.row(b));
+    ra.iter().zip(rb).map(|(x, y)| (x - y).abs() as f64).sum::<f64>() / ra.len() as f64
+}
+
+pub fn transpose(img: &snakeskin::ops::Image) -> snakeskin::ops::Image {
+    let mut t = snakeskin::ops::Image::new(img.height, img.width, img.channels);
+    for y in 0..img.height {
+        for x in 0..img.width {
+            for c in 0..img.channels {
+                t.data[(x * img.height + y) * img.channels + c] = img.data[(y * img.width + x) * img.channels + c];
+            }
+        }
+    }
+    t
+}
+
+/// Asserts the seam (last row → first row) jumps no more than 1.5× the larger of the jumps
+/// just beside it and the mean jump between neighbouring rows. "Beside" is the largest of
+/// the four jumps on each side: fine random texture (melanophore speckle on a pale belly)
+/// makes any one pair of rows jump by chance, while a real seam jumps more than all of them.
+pub fn assert_rows_seamless(img: &snakeskin::ops::Image, what: &str) {
+    let n = img.height;
+    let seam = row_jump(img, n - 1, 0);
+    let beside = (0..4).map(|k| row_jump(img, k, k + 1).max(row_jump(img, n - 2 - k, n - 1 - k))).fold(0.0, f64::max);
+    let mean = (0..n - 1).map(|y| row_jump(img, y, y + 1)).sum::<f64>() / (n - 1) as f64;
+    let limit = 1.5 * beside.max(mean);
+    assert!(seam <= limit, "{what}: seam jump {seam:.5} > 1.5 × max(beside {beside:.5}, mean {mean:.5})");
 }

@@ -94,9 +94,14 @@ pub enum Command {
         /// Cells per row.
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
         columns: u32,
-        /// Map resolution per species (pixels per side).
+        /// Map resolution per species (pixels per side; a body atlas's width).
         #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u64).range(64..=4096))]
         map_size: u64,
+        /// tile: each species' tile and a render; body: each species' whole body atlas on
+        /// its side (snout left) with its counts, and a render of the whole snake (--tile
+        /// is then the strip's height, one circumference).
+        #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
+        layout: LayoutArg,
     },
     /// List or show the built-in species presets.
     Presets {
@@ -135,12 +140,18 @@ pub struct GenerateArgs {
     /// Output folder (created if missing).
     #[arg(short, long, default_value = ".", value_name = "DIR")]
     pub out: PathBuf,
-    /// Width and height of every map in pixels (16 to 16384).
+    /// Width of every map in pixels (16 to 16384); the tile is square, a body atlas is
+    /// `body.length` widths tall.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(16..=16384))]
     pub size: u64,
     /// Normal map convention: opengl (+Y up, glTF/Blender) or directx (+Y down, Unreal).
     #[arg(long, value_enum, default_value_t = Convention::Opengl)]
     pub normal_convention: Convention,
+    /// What the set covers: tile (a square that repeats both ways) or body (the whole
+    /// snake, snout at the top, tail tip at the bottom, with the preset's [body] counts,
+    /// head shields and marks, and tail; u still wraps round the body).
+    #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
+    pub layout: LayoutArg,
     /// Print per-node evaluations, time and buffer size after the run.
     #[arg(long)]
     pub stats: bool,
@@ -173,9 +184,14 @@ pub struct PreviewArgs {
     /// reads the colour map as the base albedo k_d), for comparison.
     #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
-    /// Map resolution for the preview (pixels per side).
+    /// Map resolution for the preview (pixels per side; a body atlas's width, narrowed
+    /// if it would be more than 8192 rows long).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
     pub map_size: u64,
+    /// tile (the default: the tile repeated along the body) or body (a body atlas on the
+    /// whole snake: head marks on the head, the tail's pattern on the tail).
+    #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
+    pub layout: LayoutArg,
     /// With --window: render N frames, print the mean frame time and exit.
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
@@ -204,6 +220,21 @@ pub struct GraphArgs {
     /// Print Graphviz DOT (render with `dot -Tsvg`); otherwise a plain list of nodes.
     #[arg(long)]
     pub dot: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LayoutArg {
+    Tile,
+    Body,
+}
+
+impl LayoutArg {
+    pub fn layout(self) -> snakeskin::maps::Layout {
+        match self {
+            LayoutArg::Tile => snakeskin::maps::Layout::Tile,
+            LayoutArg::Body => snakeskin::maps::Layout::Body,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]

@@ -16,6 +16,9 @@ use crate::ops::Image;
 pub struct MaterialMaps {
     pub width: usize,
     pub height: usize,
+    /// The body plan of a body atlas (v clamps at the snout and tail tip instead of
+    /// repeating, and the renderer draws the atlas' own body); None for the tile.
+    pub atlas: Option<crate::ops::body::BodyPlan>,
     pub albedo_roughness: Vec<Vec<[f32; 4]>>,
     pub normal_height: Vec<Vec<[f32; 4]>>,
     pub thickness: Vec<Vec<f32>>,
@@ -46,6 +49,7 @@ impl MaterialMaps {
         Ok(MaterialMaps {
             width: w,
             height: h,
+            atlas: None,
             albedo_roughness: mip_chain(ar, w, h),
             normal_height: mip_chain(nh, w, h),
             thickness: mip_chain(t, w, h),
@@ -213,7 +217,11 @@ impl MaterialTextures {
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("maps"),
             address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
+            address_mode_v: if maps.atlas.is_some() {
+                wgpu::AddressMode::ClampToEdge
+            } else {
+                wgpu::AddressMode::Repeat
+            },
             address_mode_w: wgpu::AddressMode::Repeat,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,

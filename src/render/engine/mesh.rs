@@ -12,6 +12,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
+use crate::ops::body::BodyPlan;
+
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct Vertex {
@@ -43,6 +45,10 @@ pub struct BodyShape {
     /// Rings along the body and vertices around it.
     pub rings: usize,
     pub segments: usize,
+    /// A body atlas (the whole snake in one texture, `generate --layout body`): v runs once
+    /// from the snout (0) to the tail tip (1) and the head, neck and tail take the atlas'
+    /// proportions; None repeats a tile every circumference.
+    pub atlas: Option<BodyPlan>,
 }
 
 impl Default for BodyShape {
@@ -55,11 +61,24 @@ impl Default for BodyShape {
             flatten: 0.85,
             rings: 480,
             segments: 64,
+            atlas: None,
         }
     }
 }
 
 impl BodyShape {
+    /// The body for a body atlas: the centre line of the default, a radius that makes the
+    /// body `plan.length` circumferences long (so a texel covers the same skin both ways),
+    /// and the atlas' head, neck and tail. More rings than the default, so that the short
+    /// head still has several.
+    pub fn for_atlas(plan: &BodyPlan) -> BodyShape {
+        let base = BodyShape { rings: 1200, atlas: Some(*plan), ..BodyShape::default() };
+        let n = 2000;
+        let arc: f32 =
+            (1..=n).map(|i| (base.centre(i as f32 / n as f32) - base.centre((i - 1) as f32 / n as f32)).length()).sum();
+        BodyShape { radius: arc / (2.0 * std::f32::consts::PI * plan.length.max(1.0)), ..base }
+    }
+
     /// Centre line at s ∈ [0, 1] (0 = snout), lying on the ground plane y = radius.
     pub fn centre(&self, s: f32) -> Vec3 {
         let x = (s - 0.5) * self.length * 0.8;
@@ -70,21 +89,25 @@ impl BodyShape {
     /// Body radius at s: an elliptical head cap, a slight neck, full body, and a long taper
     /// over the last 30 % to a point.
     pub fn radius_at(&self, s: f32) -> f32 {
-        const HEAD: f32 = 0.035;
-        const TAIL_START: f32 = 0.7;
+        // The tile's body: a head cap over the first 3.5 %, the neck to 8 %, the taper from
+        // 70 %; an atlas puts them where its regions are.
+        let (head, neck, tail_start) = match &self.atlas {
+            Some(p) => (p.head_end, p.neck_end.max(p.head_end + 1e-3), p.vent),
+            None => (0.035, 0.08, 0.7),
+        };
         let s = s.clamp(0.0, 1.0);
-        let profile = if s < HEAD {
-            let x = 1.0 - s / HEAD;
+        let profile = if s < head {
+            let x = 1.0 - s / head;
             (1.0 - x * x).max(0.0).sqrt() * 0.9
-        } else if s < 0.08 {
+        } else if s < neck {
             // Head (0.9) narrowing to the neck (0.75), then widening to the body.
-            let t = (s - HEAD) / (0.08 - HEAD);
+            let t = (s - head) / (neck - head);
             0.9 - 0.15 * (std::f32::consts::PI * t).sin()
-        } else if s < TAIL_START {
-            let t = ((s - 0.08) / 0.2).min(1.0);
+        } else if s < tail_start {
+            let t = ((s - neck) / 0.2).min(1.0);
             0.9 + 0.1 * (t * std::f32::consts::FRAC_PI_2).sin()
         } else {
-            let t = (s - TAIL_START) / (1.0 - TAIL_START);
+            let t = (s - tail_start) / (1.0 - tail_start);
             (1.0 - t).powf(1.3)
         };
         self.radius * profile
@@ -117,7 +140,8 @@ impl BodyShape {
             let (a, b) = (i as f32 - 1.0, i as f32);
             arc[i] = arc[i - 1] + (self.centre(b / rings as f32) - self.centre(a / rings as f32)).length();
         }
-        let repeat = self.texture_length();
+        // The tile repeats every circumference; an atlas spans the whole length once.
+        let repeat = if self.atlas.is_some() { arc[rings] } else { self.texture_length() };
         let mut vertices = Vec::with_capacity((rings + 1) * (segments + 1));
         let (du, ds) = (1e-3f32, 1e-3f32);
         for (i, arc_i) in arc.iter().enumerate() {

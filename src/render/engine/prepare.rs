@@ -9,7 +9,7 @@ use super::renderer::{Material, Renderer};
 use super::scene::LayerOptics;
 use crate::Error;
 use crate::graph::{NodeCache, evaluate};
-use crate::maps::{BuildOptions, MapKind, build_graph};
+use crate::maps::{BuildOptions, Layout, MapKind, body_plan, build_graph};
 use crate::optics::lut::Lut;
 use crate::preset::LoadedPreset;
 
@@ -18,20 +18,51 @@ pub const IMAGE_RANGE: std::ops::RangeInclusive<u32> = 16..=8192;
 
 /// Generates the five maps of `preset` at `map_size`² for rendering.
 pub fn material_maps(loaded: &LoadedPreset, map_size: usize) -> Result<MaterialMaps, Error> {
-    let graph = build_graph(&loaded.preset, BuildOptions::default());
-    let evaluation = evaluate(&graph, &MapKind::ALL, map_size, map_size, &|_, _| {});
-    MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))
+    material_maps_in(loaded, map_size, Layout::Tile)
+}
+
+/// The tallest texture the preview uploads: wgpu's default limit for 2-D textures.
+pub const MAX_TEXTURE_SIDE: usize = 8192;
+
+/// The maps in a layout: the tile at `map_size`², or a body atlas `map_size` wide — narrower
+/// if its length would pass `MAX_TEXTURE_SIDE` rows.
+pub fn material_maps_in(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> Result<MaterialMaps, Error> {
+    let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
+    let (width, height) = map_dimensions(loaded, map_size, layout);
+    let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
+    packed(&evaluation.maps, loaded, layout)
+}
+
+/// Width and height of the preview's maps (`material_maps_in`).
+fn map_dimensions(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> (usize, usize) {
+    let mut width = map_size;
+    while layout.height(&loaded.preset, width) > MAX_TEXTURE_SIDE && width > 16 {
+        width /= 2;
+    }
+    (width, layout.height(&loaded.preset, width))
+}
+
+fn packed(
+    maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>,
+    loaded: &LoadedPreset,
+    layout: Layout,
+) -> Result<MaterialMaps, Error> {
+    let mut packed = MaterialMaps::from_maps(maps).map_err(|e| Error::Preview(e.to_string()))?;
+    packed.atlas = (layout == Layout::Body).then(|| body_plan(&loaded.preset));
+    Ok(packed)
 }
 
 /// The same through a node cache: after an edit only changed nodes run (live reload).
 pub fn material_maps_cached(
     loaded: &LoadedPreset,
     map_size: usize,
+    layout: Layout,
     cache: &mut NodeCache,
 ) -> Result<(MaterialMaps, crate::graph::CacheStats), Error> {
-    let graph = build_graph(&loaded.preset, BuildOptions::default());
-    let (maps, stats) = cache.evaluate(&graph, &MapKind::ALL, map_size, map_size);
-    Ok((MaterialMaps::from_maps(&maps).map_err(|e| Error::Preview(e.to_string()))?, stats))
+    let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
+    let (width, height) = map_dimensions(loaded, map_size, layout);
+    let (maps, stats) = cache.evaluate(&graph, &MapKind::ALL, width, height);
+    Ok((packed(&maps, loaded, layout)?, stats))
 }
 
 /// A material ready to draw: maps, optics and film tables for `method`.
@@ -41,7 +72,18 @@ pub fn upload_material(
     map_size: usize,
     method: GpuFilmMethod,
 ) -> Result<Material, Error> {
-    let maps = material_maps(loaded, map_size)?;
+    upload_material_in(renderer, loaded, map_size, method, Layout::Tile)
+}
+
+/// `upload_material` in a layout (a body atlas is drawn on its own whole-snake body).
+pub fn upload_material_in(
+    renderer: &Renderer,
+    loaded: &LoadedPreset,
+    map_size: usize,
+    method: GpuFilmMethod,
+    layout: Layout,
+) -> Result<Material, Error> {
+    let maps = material_maps_in(loaded, map_size, layout)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);
     Ok(renderer.material(&maps, optics, &lut, bands_for(method)))

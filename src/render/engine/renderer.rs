@@ -101,6 +101,8 @@ pub struct Material {
     pub optics: LayerOptics,
     film: FilmBinding,
     textures: MaterialTextures,
+    /// The body this material is drawn on, when it is not the tile's (a body atlas).
+    mesh: Option<GpuMesh>,
 }
 
 /// Render targets for one size and sample count.
@@ -261,6 +263,7 @@ impl Renderer {
             optics,
             film: FilmBinding::new(device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands),
             textures: MaterialTextures::new(device, &self.gpu.queue, &self.material_layout, maps),
+            mesh: maps.atlas.map(|plan| GpuMesh::new(device, &BodyShape::for_atlas(&plan).mesh())),
         }
     }
 
@@ -274,6 +277,7 @@ impl Renderer {
     /// Replaces the maps of a material (live reload).
     pub fn retexture(&self, material: &mut Material, maps: &MaterialMaps) {
         material.textures = MaterialTextures::new(&self.gpu.device, &self.gpu.queue, &self.material_layout, maps);
+        material.mesh = maps.atlas.map(|plan| GpuMesh::new(&self.gpu.device, &BodyShape::for_atlas(&plan).mesh()));
     }
 
     pub fn targets(&self, width: u32, height: u32, samples: u32) -> Targets {
@@ -477,10 +481,11 @@ impl Renderer {
         pass.set_bind_group(1, &self.scene_group, &[]);
         pass.set_bind_group(2, &material.textures.bind_group, &[]);
         pass.set_pipeline(pipeline);
-        pass.set_vertex_buffer(0, self.body.vertices.slice(..));
+        let body = material.mesh.as_ref().unwrap_or(&self.body);
+        pass.set_vertex_buffer(0, body.vertices.slice(..));
         pass.set_vertex_buffer(1, instances.slice(..));
-        pass.set_index_buffer(self.body.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..self.body.count, 0, 0..snakes.max(1));
+        pass.set_index_buffer(body.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..body.count, 0, 0..snakes.max(1));
     }
 
     /// Records a whole frame: the scene pass (timestamps around it if given) and the tone

@@ -11,7 +11,7 @@ use image::{Rgb, RgbImage, imageops};
 use crate::Error;
 use crate::export::write_file_atomically;
 use crate::graph::evaluate;
-use crate::maps::{BuildOptions, MapKind, build_graph};
+use crate::maps::{BuildOptions, Layout, MapKind, body_plan, build_graph};
 use crate::optics::lut::Lut;
 use crate::preset::library;
 use crate::render::engine::film::GpuFilmMethod;
@@ -68,12 +68,7 @@ pub fn draw_text(image: &mut RgbImage, x: u32, y: u32, text: &str, color: Rgb<u8
 
 /// The linear colour map as an sRGB image, box-filtered down to `tile` × `tile`.
 fn colour_tile(maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>, tile: u32) -> RgbImage {
-    let color = &maps[&MapKind::Color];
-    let full = RgbImage::from_fn(color.width as u32, color.height as u32, |x, y| {
-        let i = (y as usize * color.width + x as usize) * color.channels;
-        Rgb([0, 1, 2].map(|c| crate::export::linear_to_srgb8(color.data[i + c])))
-    });
-    imageops::resize(&full, tile, tile, imageops::FilterType::Triangle)
+    imageops::resize(&colour_image(maps), tile, tile, imageops::FilterType::Triangle)
 }
 
 /// Renders the contact sheet; `progress(done, total)` after each species.
@@ -129,14 +124,108 @@ pub fn render_sheet(
     Ok(sheet)
 }
 
-/// Renders the sheet and writes it as a PNG (atomically).
+/// The body sheet (`sheet --layout body`): per species its whole body atlas laid on its
+/// side — snout at the left, tail tip at the right, the spine along the middle of the strip
+/// and the belly at its edges — beside a render of the whole snake, under the label and a
+/// line with the counts the atlas was drawn with. `options.tile` is the strip's height for
+/// a body 12 circumferences long (longer bodies get longer strips, all at one scale);
+/// `options.map_size` the atlas' width (its circumference) in pixels.
+pub fn render_body_sheet(
+    renderer: &Renderer,
+    options: SheetOptions,
+    progress: &dyn Fn(usize, usize),
+) -> Result<RgbImage, Error> {
+    let presets = library::all();
+    let loaded: Vec<_> =
+        presets.iter().map(|(name, _)| crate::preset::load(name, &[], None)).collect::<Result<_, _>>()?;
+    let columns = options.columns.max(1);
+    let circumference = options.tile;
+    let longest = loaded.iter().map(|l| l.preset.body.length).fold(1.0f64, f64::max);
+    let strip_w = (longest * circumference as f64).round() as u32;
+    let render_h = 2 * circumference;
+    let render_w = 2 * render_h;
+    let label_h = LABEL_HEIGHT + 8 * LABEL_SCALE + 6;
+    let (cell_w, cell_h) = (strip_w + render_w + 12, label_h + render_h + 8);
+    let rows = (presets.len() as u32).div_ceil(columns);
+    let mut sheet = RgbImage::from_pixel(cell_w * columns, cell_h * rows, BACKGROUND);
+    let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
+    let options_body = BuildOptions { layout: Layout::Body, ..BuildOptions::default() };
+    for (i, ((name, _), loaded)) in presets.iter().zip(&loaded).enumerate() {
+        progress(i, presets.len());
+        let preset = &loaded.preset;
+        let graph = build_graph(preset, options_body);
+        let (width, height) = (options.map_size, Layout::Body.height(preset, options.map_size));
+        let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
+        let mut maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
+        maps.atlas = Some(body_plan(preset));
+        let optics = LayerOptics::from_preset(preset);
+        let lut_index = match luts.iter().position(|(s, _)| *s == optics.stack) {
+            Some(k) => k,
+            None => {
+                luts.push((optics.stack, Lut::bake_default(optics.stack)));
+                luts.len() - 1
+            }
+        };
+        let material = renderer.material(&maps, optics, &luts[lut_index].1, 1);
+        let settings = FrameSettings {
+            camera: Camera::framing(1),
+            method: GpuFilmMethod::Lut,
+            ground: false,
+            ..FrameSettings::default()
+        };
+        let render = renderer.render_image(&settings, &material, render_w, render_h)?;
+        let render = image::DynamicImage::ImageRgba8(render).into_rgb8();
+        // The atlas on its side: rotate so v (snout → tail) runs left to right, scaled to
+        // `circumference` pixels round the body and the body's length along.
+        let atlas = colour_image(&evaluation.maps);
+        let strip = imageops::rotate270(&atlas);
+        let length_px = (preset.body.length * circumference as f64).round() as u32;
+        let strip = imageops::resize(&strip, length_px, circumference, imageops::FilterType::Triangle);
+
+        let (x0, y0) = ((i as u32 % columns) * cell_w, (i as u32 / columns) * cell_h);
+        let category = preset.category.map(|c| format!(" ({})", c.name())).unwrap_or_default();
+        let fits = (cell_w as usize - 12) / (8 * LABEL_SCALE as usize);
+        let clip = |text: String| text.chars().take(fits).collect::<String>();
+        let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
+        let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
+        let b = &preset.body;
+        let marks =
+            preset.pattern.iter().find_map(|l| l.count).map(|n| format!(", {n} dorsal marks")).unwrap_or_default();
+        let bands = if b.tail_bands > 0 { format!(", {} tail bands", b.tail_bands) } else { String::new() };
+        let third = clip(format!("{} ventrals, {} subcaudals{marks}{bands}", b.ventrals, b.subcaudals));
+        draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
+        draw_text(&mut sheet, x0 + 6, y0 + 8 + 8 * LABEL_SCALE, &second, MUTED);
+        draw_text(&mut sheet, x0 + 6, y0 + 12 + 16 * LABEL_SCALE, &third, MUTED);
+        let strip_y = y0 + label_h + (render_h - circumference) / 2;
+        imageops::replace(&mut sheet, &strip, (x0 + 6) as i64, strip_y as i64);
+        imageops::replace(&mut sheet, &render, (x0 + strip_w + 12) as i64, (y0 + label_h) as i64);
+    }
+    progress(presets.len(), presets.len());
+    Ok(sheet)
+}
+
+/// The linear colour map as an sRGB image at full size.
+fn colour_image(maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>) -> RgbImage {
+    let color = &maps[&MapKind::Color];
+    RgbImage::from_fn(color.width as u32, color.height as u32, |x, y| {
+        let i = (y as usize * color.width + x as usize) * color.channels;
+        Rgb([0, 1, 2].map(|c| crate::export::linear_to_srgb8(color.data[i + c])))
+    })
+}
+
+/// Renders the sheet (the tile's, or the whole bodies' with `layout` body) and writes it as
+/// a PNG (atomically).
 pub fn write_sheet(
     renderer: &Renderer,
     path: &Path,
     options: SheetOptions,
+    layout: Layout,
     progress: &dyn Fn(usize, usize),
 ) -> Result<PathBuf, Error> {
-    let sheet = render_sheet(renderer, options, progress)?;
+    let sheet = match layout {
+        Layout::Tile => render_sheet(renderer, options, progress)?,
+        Layout::Body => render_body_sheet(renderer, options, progress)?,
+    };
     let mut bytes = Vec::new();
     sheet
         .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)

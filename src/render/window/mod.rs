@@ -35,6 +35,8 @@ pub struct WindowOptions {
     pub overrides: Vec<(String, String)>,
     pub seed: Option<u64>,
     pub map_size: usize,
+    /// The tile repeated along the body, or a body atlas on its whole snake.
+    pub layout: crate::maps::Layout,
     pub size: (u32, u32),
     /// Render this many frames, then exit (tests, benchmarks).
     pub frames: Option<u32>,
@@ -90,7 +92,7 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let loaded = crate::preset::load(&options.preset, &options.overrides, options.seed)?;
     let sliders = Sliders::from_preset(&loaded.preset);
     let mut cache = NodeCache::new();
-    let (maps, _) = material_maps_cached(&loaded, options.map_size, &mut cache)?;
+    let (maps, _) = material_maps_cached(&loaded, options.map_size, options.layout, &mut cache)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);
 

@@ -57,8 +57,8 @@ pub fn spawn_map_worker(
     let (reload_out, reloads) = channel();
     let (changed_tx, changed_rx) = channel::<()>();
     let watcher = watch_preset(&options.preset, changed_tx);
-    let (spec, overrides, seed, map_size) =
-        (options.preset.clone(), options.overrides.clone(), options.seed, options.map_size);
+    let (spec, overrides, seed, map_size, layout) =
+        (options.preset.clone(), options.overrides.clone(), options.seed, options.map_size, options.layout);
     std::thread::spawn(move || {
         while changed_rx.recv().is_ok() {
             // Editors save in bursts (truncate, write, rename): let the file settle.
@@ -69,7 +69,7 @@ pub fn spawn_map_worker(
                 for c in &loaded.clamped_colours {
                     eprintln!("{}", c.message(&spec));
                 }
-                let (maps, stats) = material_maps_cached(&loaded, map_size, &mut cache)?;
+                let (maps, stats) = material_maps_cached(&loaded, map_size, layout, &mut cache)?;
                 Ok(Reloaded { maps, sliders: Sliders::from_preset(&loaded.preset), stats, took: start.elapsed() })
             });
             if reload_out.send(result).is_err() {

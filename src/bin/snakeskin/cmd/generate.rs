@@ -26,7 +26,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         size: args.size,
         maps: args.preset.maps.0.clone(),
         out_dir: args.out.clone(),
-        options: BuildOptions { normal_convention: convention },
+        options: BuildOptions { normal_convention: convention, layout: args.layout.layout() },
     };
     let plan = Plan::new(&request)?;
     crate::output::report_clamped_colours(&source.preset, plan.loaded());

@@ -26,7 +26,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Gallery { out, tile, columns, closeups } => {
             gallery::run(&out, tile as usize, columns as usize, closeups.as_deref())
         }
-        Command::Sheet { out, tile, columns, map_size } => sheet::run(&out, tile, columns, map_size as usize),
+        Command::Sheet { out, tile, columns, map_size, layout } => {
+            sheet::run(&out, tile, columns, map_size as usize, layout.layout())
+        }
         Command::Presets { command } => presets::run(command),
     }
 }

@@ -7,7 +7,7 @@ use crate::output::{ensure_parent_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::Error;
 use snakeskin::render::Renderer;
-use snakeskin::render::engine::prepare::upload_material;
+use snakeskin::render::engine::prepare::upload_material_in;
 use snakeskin::render::engine::renderer::FrameSettings;
 use snakeskin::render::engine::scene::Camera;
 use snakeskin::render::figures::write_png;
@@ -41,7 +41,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     }
     let bar = Progress::spinner("generating maps and baking the film LUT");
     let renderer = Renderer::headless()?;
-    let material = upload_material(&renderer, &loaded, args.map_size as usize, args.method)?;
+    let material = upload_material_in(&renderer, &loaded, args.map_size as usize, args.method, args.layout.layout())?;
     bar.message("rendering");
     let (width, height) = (args.size.width, args.size.height);
     let image = renderer.render_image(&settings, &material, width, height)?;
@@ -67,6 +67,7 @@ fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
         overrides: args.source.overrides.clone(),
         seed: args.source.seed,
         map_size: args.map_size as usize,
+        layout: args.layout.layout(),
         size: (args.size.width, args.size.height),
         frames: args.frames,
         settings,

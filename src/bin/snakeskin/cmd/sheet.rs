@@ -9,12 +9,13 @@ use crate::progress::Progress;
 use snakeskin::render::Renderer;
 use snakeskin::render::figures::sheet::{SheetOptions, write_sheet};
 
-pub fn run(out: &Path, tile: u32, columns: u32, map_size: usize) -> Result<()> {
+pub fn run(out: &Path, tile: u32, columns: u32, map_size: usize, layout: snakeskin::maps::Layout) -> Result<()> {
     ensure_parent_folder(out)?;
     let renderer = Renderer::headless()?;
     let bar = Progress::counting("{spinner} sheet [{bar:30}] {pos}/{len} species {elapsed}");
-    let written =
-        write_sheet(&renderer, out, SheetOptions { tile, columns, map_size }, &|done, total| bar.update(done, total))?;
+    let written = write_sheet(&renderer, out, SheetOptions { tile, columns, map_size }, layout, &|done, total| {
+        bar.update(done, total)
+    })?;
     bar.finish();
     println!("{}", path_line(&written));
     Ok(())

@@ -1,0 +1,127 @@
+//! The body layout's own colour nodes (`generate --layout body`): the ground shifting to
+//! the tail's colour, bands round the tail, a coloured tail tip and the head's marks.
+//! Everything else — scales, counted plates, the pattern layers — comes from the same
+//! builders as the tile, with counts along the body (`Shared::along_count`, `series`).
+
+use super::Shared;
+use crate::graph::{GraphBuilder, NodeId, Op};
+use crate::ops::body::{AlongProfile, BodyPlan, HeadMark, HeadMarkShape};
+use crate::ops::filters::BlendMode;
+use crate::ops::scales::channel;
+use crate::preset::Preset;
+use crate::preset::schema::HeadMarkKind;
+
+/// About two pixels of a 1024-wide atlas twelve widths long, in v: the soft edge of region
+/// boundaries (an edge that is not anti-aliased reads as a seam).
+const EDGE_V: f32 = 1.6e-4;
+
+/// Where a pattern layer lies along the body: a counted series from the end of the neck
+/// (to the vent when the tail has bands of its own, `ends_at_vent`), any other layer from
+/// the end of the head to the tip.
+pub(super) fn layer_region(plan: &BodyPlan, counted: bool, ends_at_vent: bool) -> AlongProfile {
+    if counted && !ends_at_vent {
+        AlongProfile { knots: vec![(plan.neck_end - EDGE_V, 0.0), (plan.neck_end, 1.0)] }
+    } else if counted {
+        AlongProfile {
+            knots: vec![
+                (plan.neck_end - EDGE_V, 0.0),
+                (plan.neck_end, 1.0),
+                (plan.vent, 1.0),
+                (plan.vent + EDGE_V, 0.0),
+            ],
+        }
+    } else {
+        AlongProfile { knots: vec![(plan.head_end, 0.0), (plan.head_end + EDGE_V, 1.0)] }
+    }
+}
+
+/// The ground colour shifting to `body.tail_color` from `tail_shift_start` of the trunk to
+/// the vent, and that colour over the whole tail (before the belly and the pattern layers,
+/// which keep their own colours).
+pub(super) fn tail_shift(g: &mut GraphBuilder, preset: &Preset, plan: &BodyPlan, color: NodeId) -> NodeId {
+    let Some(tail) = preset.body.tail_color else { return color };
+    let start = plan.neck_end + (plan.vent - plan.neck_end) * preset.body.tail_shift_start as f32;
+    let knots = if start >= plan.vent {
+        vec![(plan.vent, 0.0), (plan.vent + EDGE_V, 1.0)]
+    } else {
+        vec![(start, 0.0), (plan.vent, 1.0)]
+    };
+    let ramp = g.add("body.tail_shift", Op::Along(AlongProfile { knots }), &[]);
+    g.add("body.tail_color", Op::Tint { color: tail.to_linear(), opacity: 1.0 }, &[color, ramp])
+}
+
+/// Tail bands, the tail tip and head marks over the pattern layers.
+pub(super) fn marks(
+    g: &mut GraphBuilder,
+    preset: &Preset,
+    s: &Shared,
+    plan: &BodyPlan,
+    outside_belly: Option<NodeId>,
+    mut color: NodeId,
+) -> NodeId {
+    let b = &preset.body;
+    let snap = preset.pattern.iter().map(|l| l.scale_aligned).fold(0.0f64, f64::max);
+    if b.tail_bands > 0 {
+        // `tail_bands` dark bands spread evenly from the vent to the tip, each
+        // `tail_band_width` of its repeat, centred in it.
+        let n = b.tail_bands as f32;
+        let repeat = (1.0 - plan.vent) / n;
+        let half = 0.5 * b.tail_band_width as f32 * repeat;
+        let mut knots = Vec::new();
+        for i in 0..b.tail_bands {
+            let centre = plan.vent + (i as f32 + 0.5) * repeat;
+            knots.extend([
+                (centre - half - EDGE_V, 0.0),
+                (centre - half, 1.0),
+                (centre + half, 1.0),
+                (centre + half + EDGE_V, 0.0),
+            ]);
+        }
+        let mut mask = g.add("body.tail_bands", Op::Along(AlongProfile { knots }), &[]);
+        if snap > 0.0 {
+            let op = Op::SnapToScales {
+                amount: snap as f32,
+                centre_u: s.channel_index(channel::CENTRE_U),
+                centre_v: s.channel_index(channel::CENTRE_V),
+            };
+            mask = g.add("body.tail_bands_aligned", op, &[mask, s.scales]);
+        }
+        if let Some(outside) = outside_belly {
+            mask = g.add(
+                "body.tail_bands_off_belly",
+                Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 },
+                &[mask, outside],
+            );
+        }
+        color = g.add(
+            "body.tail_bands_tint",
+            Op::Tint { color: b.tail_band_color.to_linear(), opacity: 1.0 },
+            &[color, mask],
+        );
+    }
+    if let Some(tip) = b.tip_color {
+        let start = 1.0 - (1.0 - plan.vent) * b.tip_fraction as f32;
+        let mask = g.add("body.tip", Op::Along(AlongProfile { knots: vec![(start - EDGE_V, 0.0), (start, 1.0)] }), &[]);
+        color = g.add("body.tip_tint", Op::Tint { color: tip.to_linear(), opacity: 1.0 }, &[color, mask]);
+    }
+    for (i, m) in b.head_mark.iter().enumerate() {
+        let shape = match m.kind {
+            HeadMarkKind::Cap => HeadMarkShape::Cap,
+            HeadMarkKind::Snout => HeadMarkShape::Snout,
+            HeadMarkKind::V => HeadMarkShape::V,
+            HeadMarkKind::X => HeadMarkShape::X,
+            HeadMarkKind::Spearhead => HeadMarkShape::Spearhead,
+            HeadMarkKind::PostocularStripe => HeadMarkShape::PostocularStripe,
+            HeadMarkKind::Collar => HeadMarkShape::Collar,
+            HeadMarkKind::Lips => HeadMarkShape::Lips,
+        };
+        let mark = HeadMark { shape, size: m.size as f32, plan: *plan };
+        let mask = g.add(format!("body.head_mark{i}"), Op::HeadMark(mark), &[]);
+        color = g.add(
+            format!("body.head_mark{i}_tint"),
+            Op::Tint { color: m.color.to_linear(), opacity: 1.0 },
+            &[color, mask],
+        );
+    }
+    color
+}

@@ -1,0 +1,382 @@
+//! The whole snake in one texture (the `body` layout): where the head, neck, trunk and tail
+//! lie along v, how the ventral and subcaudal plates are counted over them, the head's
+//! shields and marks in a head-local frame, and masks that vary along the body.
+//!
+//! Why a separate module? The scale field (plates, shields), the belly marks (plates) and
+//! the colour graph (regions, head marks) must agree on one geometry; it is written here
+//! once. The texture stays isotropic: one texture width is one circumference, and the body
+//! is `length` widths long, so every kernel keeps its pixel units; what changes is that v
+//! runs from the snout (0) to the tail tip (1) instead of repeating.
+
+use super::image::{Image, floor_i32};
+
+/// The regions and counts of a body atlas, as fractions of the total length (v).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyPlan {
+    /// Image height over width: the body's length in circumferences.
+    pub length: f32,
+    /// End of the head (start of the neck).
+    pub head_end: f32,
+    /// End of the neck (start of the trunk, where counted dorsal marks begin).
+    pub neck_end: f32,
+    /// The vent (end of the ventral plates, start of the tail).
+    pub vent: f32,
+    pub ventrals: u32,
+    pub subcaudals: u32,
+    /// Large head shields (else small head scales: the body's lattice continues).
+    pub head_shields: bool,
+}
+
+/// Where a pixel lies on the belly's plate sequence (`BodyPlan::plate_at`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlatePosition {
+    /// Plate index (0 the first ventral; subcaudals continue after the last ventral).
+    pub index: i32,
+    /// Position along the plate, 0 its anterior end .. 1 its posterior end.
+    pub along: f32,
+    /// The plate's length in v.
+    pub length_v: f32,
+    /// A subcaudal (divided at the midline) rather than a ventral.
+    pub subcaudal: bool,
+}
+
+impl BodyPlan {
+    /// Plate coordinate at v: `ventrals` plates from the end of the head to the vent,
+    /// `subcaudals` from the vent to the tip; None on the head (chin and throat scales).
+    pub fn plate_coordinate(&self, v: f32) -> Option<(f32, f32, bool)> {
+        if v < self.head_end {
+            None
+        } else if v < self.vent {
+            let len = (self.vent - self.head_end) / self.ventrals.max(1) as f32;
+            Some(((v - self.head_end) / len, len, false))
+        } else {
+            let len = (1.0 - self.vent) / self.subcaudals.max(1) as f32;
+            Some((self.ventrals as f32 + (v - self.vent) / len, len, true))
+        }
+    }
+
+    pub fn plate_at(&self, v: f32) -> Option<PlatePosition> {
+        let (y, length_v, subcaudal) = self.plate_coordinate(v)?;
+        let index = floor_i32(y);
+        Some(PlatePosition { index, along: y - index as f32, length_v, subcaudal })
+    }
+
+    /// The v of the centre of plate `index`.
+    pub fn plate_centre_v(&self, index: i32) -> f32 {
+        let n = self.ventrals as i32;
+        if index < n {
+            self.head_end + (index as f32 + 0.5) * (self.vent - self.head_end) / self.ventrals.max(1) as f32
+        } else {
+            self.vent + ((index - n) as f32 + 0.5) * (1.0 - self.vent) / self.subcaudals.max(1) as f32
+        }
+    }
+
+    /// Head-local coordinates of (u, v): `x` across the top of the head (−1 .. 1 spans the
+    /// shields, `HEAD_TOP_HALF_U` of the circumference each side of the spine), `s` from
+    /// the snout tip (0) to the back of the head (1), beyond 1 on the neck.
+    pub fn head_local(&self, u: f32, v: f32) -> (f32, f32) {
+        ((u - 0.5) / HEAD_TOP_HALF_U, v / self.head_end.max(1e-6))
+    }
+
+    /// One head-local x unit and one s unit in circumferences (the texture's isotropic unit).
+    pub fn head_units(&self) -> (f32, f32) {
+        (HEAD_TOP_HALF_U, self.head_end * self.length)
+    }
+
+    pub fn hash_into<H: std::hash::Hasher>(&self, h: &mut H) {
+        use std::hash::Hash;
+        (self.ventrals, self.subcaudals, self.head_shields).hash(h);
+        for x in [self.length, self.head_end, self.neck_end, self.vent] {
+            x.to_bits().hash(h);
+        }
+    }
+}
+
+/// Half the width of the head's top (where the shields lie), fraction of the circumference:
+/// the top of a snake's head spans roughly the upper 40 % of its girth, the rest being the
+/// sides (labials) and the chin.
+pub const HEAD_TOP_HALF_U: f32 = 0.2;
+
+/// A head shield: its name, whether it is paired (mirrored about the spine), and its outline.
+pub type Shield = (&'static str, bool, &'static [(f32, f32)]);
+
+/// The head shields of a colubrid or elapid head, stylised, as convex polygons in head-local
+/// coordinates (x across, −1 .. 1; s from the snout, 0 .. 1), right-hand side only for the
+/// paired plates (mirrored). From the snout: rostral, internasals, prefrontals, frontal with
+/// the supraoculars beside it, parietals. Neighbouring plates share edges, so the crevice
+/// between them is where their outlines meet.
+pub const SHIELDS: [Shield; 6] = [
+    ("rostral", false, &[(-0.30, 0.0), (0.30, 0.0), (0.36, 0.07), (0.0, 0.12), (-0.36, 0.07)]),
+    ("internasal", true, &[(0.0, 0.12), (0.36, 0.07), (0.50, 0.12), (0.46, 0.24), (0.0, 0.24)]),
+    ("prefrontal", true, &[(0.0, 0.24), (0.46, 0.24), (0.58, 0.30), (0.50, 0.40), (0.0, 0.40)]),
+    ("frontal", false, &[(-0.28, 0.40), (0.28, 0.40), (0.24, 0.60), (0.0, 0.72), (-0.24, 0.60)]),
+    ("supraocular", true, &[(0.28, 0.40), (0.50, 0.40), (0.64, 0.44), (0.64, 0.58), (0.24, 0.60)]),
+    ("parietal", true, &[(0.0, 0.72), (0.24, 0.60), (0.64, 0.58), (0.66, 0.80), (0.40, 1.0), (0.0, 1.0)]),
+];
+
+/// A convex polygon in the texture's isotropic units (circumferences, v scaled by the
+/// body's length), with its centre, for the shields' per-pixel distance.
+#[derive(Debug, Clone)]
+pub struct Plate {
+    /// Edge lines as (unit inward normal, offset): inside distance = min(n · p − c).
+    edges: Vec<([f32; 2], f32)>,
+    /// Centre in texture coordinates (u, v).
+    pub centre_uv: (f32, f32),
+    /// Extent along v (texture fraction), for a position along the plate.
+    pub v_range: (f32, f32),
+    pub id: i32,
+}
+
+impl Plate {
+    /// Distance inside the plate (negative outside), in circumferences, of the point
+    /// (x, y) in isotropic units (u, v × length).
+    #[inline]
+    pub fn inside(&self, x: f32, y: f32) -> f32 {
+        self.edges.iter().fold(f32::MAX, |d, (n, c)| d.min(n[0] * x + n[1] * y - c))
+    }
+}
+
+impl BodyPlan {
+    /// Every head shield as a plate in isotropic texture units (mirrored pairs included).
+    pub fn shields(&self) -> Vec<Plate> {
+        let (ux, us) = self.head_units();
+        let mut plates = Vec::new();
+        for (id, (_, paired, points)) in SHIELDS.iter().enumerate() {
+            let sides: &[f32] = if *paired { &[1.0, -1.0] } else { &[1.0] };
+            for (k, side) in sides.iter().enumerate() {
+                // To isotropic units: x · ux around the body from the spine, s · us along it.
+                let pts: Vec<[f32; 2]> = points.iter().map(|(x, s)| [0.5 + side * x * ux, s * us]).collect();
+                let n = pts.len() as f32;
+                let centre = pts.iter().fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+                let mut edges = Vec::new();
+                for i in 0..pts.len() {
+                    let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+                    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+                    let len = (dx * dx + dy * dy).sqrt().max(1e-9);
+                    let mut normal = [-dy / len, dx / len];
+                    // Point the normal at the centre (mirroring reverses the winding).
+                    if normal[0] * (centre[0] - a[0]) + normal[1] * (centre[1] - a[1]) < 0.0 {
+                        normal = [-normal[0], -normal[1]];
+                    }
+                    edges.push((normal, normal[0] * a[0] + normal[1] * a[1]));
+                }
+                let (lo, hi) = pts.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| (lo.min(p[1]), hi.max(p[1])));
+                let to_v = |y: f32| y / self.length;
+                plates.push(Plate {
+                    edges,
+                    centre_uv: (centre[0], to_v(centre[1])),
+                    v_range: (to_v(lo), to_v(hi)),
+                    id: (id * 2 + k) as i32,
+                });
+            }
+        }
+        plates
+    }
+}
+
+/// A mark on the head or neck (`body.head_mark`), drawn in head-local coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum HeadMarkShape {
+    Cap,
+    Snout,
+    V,
+    X,
+    Spearhead,
+    PostocularStripe,
+    Collar,
+    Lips,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeadMark {
+    pub shape: HeadMarkShape,
+    pub size: f32,
+    pub plan: BodyPlan,
+}
+
+/// Half-width of the head's sides down to the lips, fraction of the circumference from the
+/// spine: the cap covers this much, the lips lie just below it.
+const HEAD_SIDE_HALF_U: f32 = 0.32;
+
+/// Distance from p to the segment a–b.
+fn segment_distance(p: (f32, f32), a: (f32, f32), b: (f32, f32)) -> f32 {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let t = (((p.0 - a.0) * dx + (p.1 - a.1) * dy) / (dx * dx + dy * dy).max(1e-12)).clamp(0.0, 1.0);
+    ((p.0 - a.0 - t * dx).powi(2) + (p.1 - a.1 - t * dy).powi(2)).sqrt()
+}
+
+impl HeadMark {
+    /// Signed distance inside the mark at (u, v), in circumferences (positive inside).
+    pub fn inside(&self, u: f32, v: f32) -> f32 {
+        let p = &self.plan;
+        let (ux, us) = p.head_units();
+        let k = self.size;
+        let du = (u - 0.5).abs();
+        // Isotropic head-local point: x and s in circumferences.
+        let (x, s) = ((u - 0.5), v * p.length);
+        let head = us; // head length in circumferences
+        let band = |lo: f32, hi: f32, value: f32| (value - lo).min(hi - value);
+        // Segments in head-local units (x in shield half-widths, s in head lengths),
+        // mirrored about the spine.
+        let arm = |a: (f32, f32), b: (f32, f32), half_width: f32| {
+            let q = (du, s);
+            let (a, b) = ((a.0 * ux, a.1 * head), (b.0 * ux, b.1 * head));
+            half_width * ux - segment_distance(q, a, b)
+        };
+        match self.shape {
+            HeadMarkShape::Cap => band(-1.0, k * head, s).min(HEAD_SIDE_HALF_U - du),
+            HeadMarkShape::Snout => band(-1.0, 0.35 * k * head, s).min(HEAD_SIDE_HALF_U - du),
+            // Apex forward between the eyes, arms back to the angles of the jaw.
+            HeadMarkShape::V => arm((0.0, 0.38), (0.75, 1.1), 0.12 * k),
+            HeadMarkShape::X => {
+                let d = (x, s);
+                let (a, b) = ((-0.55 * ux, 0.35 * head), (0.55 * ux, 1.05 * head));
+                let one = segment_distance(d, a, b);
+                let two = segment_distance(d, (-a.0, a.1), (-b.0, b.1));
+                0.12 * k * ux - one.min(two)
+            }
+            HeadMarkShape::Spearhead => {
+                // A triangle, apex forward between the eyes, base on the neck.
+                let apex = 0.3 * head;
+                let base = (1.0 + 0.6 * k) * head;
+                let half = 0.55 * k * ux;
+                let t = ((s - apex) / (base - apex)).clamp(0.0, 1.0);
+                (half * t - du).min(s - apex).min(base - s)
+            }
+            HeadMarkShape::PostocularStripe => arm((0.62, 0.45), (1.45, 1.0), 0.10 * k),
+            HeadMarkShape::Collar => {
+                let neck = (p.neck_end - p.head_end).max(0.005) * p.length;
+                band(head, head + 0.7 * k * neck, s).min(0.42 - du)
+            }
+            HeadMarkShape::Lips => band(0.05 * head, 0.95 * head, s).min(band(HEAD_SIDE_HALF_U - 0.02, 0.40, du)),
+        }
+    }
+
+    pub fn hash_into<H: std::hash::Hasher>(&self, h: &mut H) {
+        use std::hash::Hash;
+        self.shape.hash(h);
+        self.size.to_bits().hash(h);
+        self.plan.hash_into(h);
+    }
+}
+
+/// Coverage of a head mark, anti-aliased over one pixel.
+pub fn head_mark(width: usize, height: usize, mark: &HeadMark) -> Image {
+    // One pixel in circumferences (the texture is isotropic: width = one circumference).
+    let pixel = 1.0 / width as f32;
+    // Only the head and neck can carry a mark: rows beyond stay 0.
+    let last = (((mark.plan.neck_end + 0.3 * mark.plan.head_end) * height as f32).ceil() as usize).min(height);
+    let mut image = Image::new(width, height, 1);
+    use rayon::prelude::*;
+    image.data[..last * width].par_chunks_mut(width).enumerate().for_each(|(y, row)| {
+        let v = (y as f32 + 0.5) / height as f32;
+        for (x, out) in row.iter_mut().enumerate() {
+            let u = (x as f32 + 0.5) / width as f32;
+            *out = (mark.inside(u, v) / pixel + 0.5).clamp(0.0, 1.0);
+        }
+    });
+    image
+}
+
+/// A mask that varies along the body only: piecewise linear through `knots` (v, value),
+/// constant beyond the first and last (region masks, colour ramps, tail bands).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlongProfile {
+    pub knots: Vec<(f32, f32)>,
+}
+
+impl AlongProfile {
+    pub fn value(&self, v: f32) -> f32 {
+        let k = &self.knots;
+        let Some(first) = k.first() else { return 0.0 };
+        if v <= first.0 {
+            return first.1;
+        }
+        let i = k.partition_point(|(kv, _)| *kv <= v);
+        if i >= k.len() {
+            return k[k.len() - 1].1;
+        }
+        let ((v0, a), (v1, b)) = (k[i - 1], k[i]);
+        if v1 <= v0 { b } else { a + (b - a) * (v - v0) / (v1 - v0) }
+    }
+
+    pub fn render(&self, width: usize, height: usize) -> Image {
+        let mut image = Image::new(width, height, 1);
+        for (y, row) in image.data.chunks_exact_mut(width).enumerate() {
+            row.fill(self.value((y as f32 + 0.5) / height as f32));
+        }
+        image
+    }
+
+    pub fn hash_into<H: std::hash::Hasher>(&self, h: &mut H) {
+        use std::hash::Hash;
+        self.knots.len().hash(h);
+        for (v, x) in &self.knots {
+            v.to_bits().hash(h);
+            x.to_bits().hash(h);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan() -> BodyPlan {
+        BodyPlan {
+            length: 12.0,
+            head_end: 0.04,
+            neck_end: 0.07,
+            vent: 0.82,
+            ventrals: 200,
+            subcaudals: 60,
+            head_shields: true,
+        }
+    }
+
+    #[test]
+    fn shields_are_convex_and_do_not_overlap() {
+        // Convex: every vertex of a plate lies inside (or on) every edge line of it.
+        for (name, _, pts) in SHIELDS {
+            let n = pts.len();
+            let mut sign = 0.0f32;
+            for i in 0..n {
+                let (a, b, c) = (pts[i], pts[(i + 1) % n], pts[(i + 2) % n]);
+                let cross = (b.0 - a.0) * (c.1 - b.1) - (b.1 - a.1) * (c.0 - b.0);
+                assert!(cross * sign >= 0.0, "{name} is not convex at vertex {}", i + 1);
+                if cross != 0.0 {
+                    sign = cross.signum();
+                }
+            }
+        }
+        // No point lies well inside two plates.
+        let plates = plan().shields();
+        for i in 0..200 {
+            for j in 0..200 {
+                let (x, y) = (0.3 + 0.4 * i as f32 / 200.0, 0.48 * j as f32 / 200.0);
+                let inside = plates.iter().filter(|p| p.inside(x, y) > 1e-4).count();
+                assert!(inside <= 1, "({x}, {y}) lies in {inside} plates");
+            }
+        }
+    }
+
+    #[test]
+    fn plates_are_counted_from_the_head_to_the_tip() {
+        let p = plan();
+        assert_eq!(p.plate_at(0.01), None);
+        assert_eq!(p.plate_at(0.0401).unwrap().index, 0);
+        assert_eq!(p.plate_at(0.8199).unwrap().index, 199);
+        let first_sub = p.plate_at(0.8201).unwrap();
+        assert_eq!((first_sub.index, first_sub.subcaudal), (200, true));
+        assert_eq!(p.plate_at(0.99999).unwrap().index, 259);
+        assert!((p.plate_centre_v(0) - (0.04 + 0.5 * 0.78 / 200.0)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn along_profile_interpolates_and_holds_its_ends() {
+        let p = AlongProfile { knots: vec![(0.2, 0.0), (0.4, 1.0), (0.4, 0.0)] };
+        assert_eq!(p.value(0.0), 0.0);
+        assert!((p.value(0.3) - 0.5).abs() < 1e-6);
+        assert_eq!(p.value(0.5), 0.0);
+    }
+}

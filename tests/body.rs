@@ -1,0 +1,222 @@
+//! The body layout counts what the preset says: ventral plates along the belly, subcaudals
+//! on the tail, dorsal marks along the spine and bands on the tail, each counted on the
+//! generated maps (the height map's plate edges, the colour map's marks) within ±1 of the
+//! preset; u still wraps round the body.
+//!
+//! The counters know nothing of the generator: plates are the sharp drops of the height
+//! profile at each plate's free edge, marks are runs of rows where most pixels near the
+//! spine are nearer the mark's colour than any other colour the preset uses. Each is also
+//! run on a changed preset (a negative control: a counter that echoed the preset's number,
+//! or found a fixed one, would fail there).
+
+mod common;
+
+use common::{assert_rows_seamless, transpose};
+use snakeskin::graph::evaluate;
+use snakeskin::maps::{BuildOptions, Layout, MapKind, body_plan, build_graph};
+use snakeskin::ops::Image;
+use snakeskin::preset::schema::Srgb8;
+use snakeskin::preset::{Preset, load};
+
+/// Atlas width: a plate of the longest-bodied species here (Liasis, 287 ventrals over
+/// 0.78 of 12 widths) is about 8 pixels long.
+const WIDTH: usize = 256;
+
+fn preset(name: &str, overrides: &[(&str, &str)]) -> Preset {
+    let overrides: Vec<(String, String)> = overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    load(name, &overrides, None).unwrap_or_else(|e| panic!("{name}: {e}")).preset
+}
+
+fn body_map(preset: &Preset, map: MapKind) -> Image {
+    let graph = build_graph(preset, BuildOptions { layout: Layout::Body, ..BuildOptions::default() });
+    let height = Layout::Body.height(preset, WIDTH);
+    evaluate(&graph, &[map], WIDTH, height, &|_, _| {}).maps.remove(&map).unwrap()
+}
+
+/// The rows of an image `height` tall between v0 and v1.
+fn rows_of(height: usize, v0: f32, v1: f32) -> std::ops::Range<usize> {
+    (v0 * height as f32).ceil() as usize..(v1 * height as f32).floor() as usize
+}
+
+/// Plate edges in rows `rows` of the height map's column at u = 0.06 (on the ventral band,
+/// off the subcaudals' midline seam): drops of more than 0.12 of the height range over two
+/// rows (a free edge falls by about 0.2, over one row or, when it straddles a pixel
+/// boundary, two), drops within three rows counted once.
+fn plate_edges(height: &Image, rows: std::ops::Range<usize>) -> usize {
+    let x = (0.06 * height.width as f32) as usize;
+    let h = |y: usize| height.data[y * height.width + x];
+    let mut count = 0;
+    let mut last = None;
+    for y in rows.start..rows.end - 2 {
+        if h(y + 2) - h(y) < -0.12 {
+            if last.is_none_or(|l| y > l + 3) {
+                count += 1;
+            }
+            last = Some(y);
+        }
+    }
+    count
+}
+
+fn linear(c: Srgb8) -> [f32; 3] {
+    c.to_linear()
+}
+
+fn distance(a: &[f32], b: [f32; 3]) -> f32 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f32>().sqrt()
+}
+
+/// Runs of rows (in `rows`) where more than half the pixels within ±2 % of the
+/// circumference of the spine are nearer `mark` than any of `others`; gaps of two rows or
+/// less join runs.
+fn marks_along_spine(colour: &Image, rows: std::ops::Range<usize>, mark: [f32; 3], others: &[[f32; 3]]) -> usize {
+    let w = colour.width;
+    let (x0, x1) = ((0.48 * w as f32) as usize, (0.52 * w as f32) as usize);
+    let is_mark: Vec<bool> = rows
+        .clone()
+        .map(|y| {
+            let near = (x0..x1)
+                .filter(|x| {
+                    let px = &colour.data[(y * w + x) * 3..(y * w + x) * 3 + 3];
+                    let own = distance(px, mark);
+                    others.iter().all(|o| own < distance(px, *o))
+                })
+                .count();
+            2 * near > x1 - x0
+        })
+        .collect();
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    let mut y = 0;
+    while y < is_mark.len() {
+        if is_mark[y] {
+            let start = y;
+            while y < is_mark.len() && is_mark[y] {
+                y += 1;
+            }
+            match runs.last_mut() {
+                Some(last) if start - last.1 <= 2 => last.1 = y,
+                _ => runs.push((start, y)),
+            }
+        } else {
+            y += 1;
+        }
+    }
+    // Slivers where a narrow tip of a mark crosses the band are not marks: a run counts
+    // when it is at least a quarter of the median run's length (and three rows).
+    let mut lengths: Vec<usize> = runs.iter().map(|(a, b)| b - a).collect();
+    lengths.sort_unstable();
+    let median = lengths.get(lengths.len() / 2).copied().unwrap_or(0);
+    runs.iter().filter(|(a, b)| b - a >= 3 && 4 * (b - a) >= median).count()
+}
+
+/// Every colour the preset's pattern layers and ground use, except `mark`.
+fn other_colours(p: &Preset, mark: Srgb8) -> Vec<[f32; 3]> {
+    let mut all = vec![p.color.base];
+    for l in &p.pattern {
+        all.push(l.color);
+        all.push(l.outline_color);
+        all.extend(l.center_color);
+        all.extend(l.border_color);
+        all.extend(l.colors.iter().copied());
+    }
+    all.into_iter().filter(|c| *c != mark).map(linear).collect()
+}
+
+fn assert_within_one(what: &str, found: usize, expected: u32) {
+    assert!(
+        (found as i64 - expected as i64).abs() <= 1,
+        "{what}: counted {found} on the maps, the preset says {expected}"
+    );
+}
+
+fn check_plates(name: &str, overrides: &[(&str, &str)]) {
+    let p = preset(name, overrides);
+    let plan = body_plan(&p);
+    let height = body_map(&p, MapKind::Height);
+    let h = height.height;
+    let ventrals = plate_edges(&height, rows_of(h, plan.head_end, plan.vent));
+    let subcaudals = plate_edges(&height, rows_of(h, plan.vent, 1.0));
+    assert_within_one(&format!("{name} {overrides:?} ventrals"), ventrals, plan.ventrals);
+    assert_within_one(&format!("{name} {overrides:?} subcaudals"), subcaudals, plan.subcaudals);
+}
+
+#[test]
+fn ventral_and_subcaudal_plates_are_counted_as_the_preset_says() {
+    for name in ["natrix-natrix", "liasis-mackloti", "bitis-arietans", "bungarus-fasciatus"] {
+        check_plates(name, &[]);
+    }
+    // Negative control: other counts are found as such.
+    check_plates("natrix-natrix", &[("body.ventrals", "120"), ("body.subcaudals", "30")]);
+}
+
+fn check_marks(name: &str, overrides: &[(&str, &str)]) {
+    let p = preset(name, overrides);
+    let plan = body_plan(&p);
+    let layer = p.pattern.iter().find(|l| l.count.is_some()).expect("a counted layer");
+    let mark = layer.colors.first().copied().unwrap_or(layer.color);
+    let colour = body_map(&p, MapKind::Color);
+    let trunk = rows_of(colour.height, plan.neck_end, plan.vent);
+    let found = marks_along_spine(&colour, trunk, linear(mark), &other_colours(&p, mark));
+    assert_within_one(&format!("{name} {overrides:?} dorsal marks"), found, layer.count.unwrap());
+}
+
+#[test]
+fn dorsal_marks_along_the_spine_are_counted_as_the_preset_says() {
+    // Diamonds, saddles, a ring sequence and chevrons.
+    for name in ["crotalus-atrox", "lampropeltis-triangulum", "bungarus-fasciatus", "bitis-arietans"] {
+        check_marks(name, &[]);
+    }
+    check_marks("crotalus-atrox", &[("pattern.0.count", "15")]);
+}
+
+fn check_tail_bands(name: &str, overrides: &[(&str, &str)]) {
+    let p = preset(name, overrides);
+    let plan = body_plan(&p);
+    let colour = body_map(&p, MapKind::Color);
+    let band = p.body.tail_band_color;
+    let mut others = other_colours(&p, band);
+    others.extend(p.body.tail_color.map(linear));
+    let found = marks_along_spine(&colour, rows_of(colour.height, plan.vent, 1.0), linear(band), &others);
+    assert_within_one(&format!("{name} {overrides:?} tail bands"), found, p.body.tail_bands);
+}
+
+#[test]
+fn tail_bands_are_counted_as_the_preset_says() {
+    for name in ["crotalus-atrox", "bitis-arietans", "boa-constrictor"] {
+        check_tail_bands(name, &[]);
+    }
+    check_tail_bands("crotalus-atrox", &[("body.tail_bands", "8")]);
+}
+
+#[test]
+fn a_body_atlas_still_wraps_round_the_body() {
+    for name in ["pantherophis-guttatus", "vipera-berus"] {
+        let p = preset(name, &[]);
+        let graph = build_graph(&p, BuildOptions { layout: Layout::Body, ..BuildOptions::default() });
+        let height = Layout::Body.height(&p, 128);
+        assert_eq!(height, (128.0 * p.body.length).round() as usize);
+        let eval = evaluate(&graph, &MapKind::ALL, 128, height, &|_, _| {});
+        for (map, img) in &eval.maps {
+            assert_rows_seamless(&transpose(img), &format!("{name} body {map} columns"));
+        }
+    }
+}
+
+#[test]
+fn the_head_differs_from_the_trunk() {
+    // Head shields: the head's height map has far fewer plate edges per row than the
+    // trunk's small dorsal scales; head marks: a black cap colours the head only.
+    let p = preset("leiopython-albertisii", &[]);
+    let plan = body_plan(&p);
+    let colour = body_map(&p, MapKind::Color);
+    let cap = p.body.head_mark.iter().find(|m| m.kind == snakeskin::preset::schema::HeadMarkKind::Cap).unwrap();
+    let cap_colour = linear(cap.color);
+    let w = colour.width;
+    let near_cap = |y: usize| {
+        let px = &colour.data[(y * w + w / 2) * 3..(y * w + w / 2) * 3 + 3];
+        distance(px, cap_colour) < 0.05
+    };
+    let h = colour.height as f32;
+    assert!(near_cap((0.5 * plan.head_end * h) as usize), "the cap is on the head");
+    assert!(!near_cap((0.5 * h) as usize), "and not on the trunk");
+}
