@@ -43,14 +43,14 @@ fn operations(c: &mut Criterion) {
     group.bench_function("scales", |b| b.iter(|| field.render(size, size)));
     for (name, kind) in [("perlin_4oct", NoiseKind::Perlin), ("cellular_4oct", NoiseKind::Cellular)] {
         let op = Op::Noise(FractalNoise { kind, cells_u: 8, cells_v: 8, octaves: 4, gain: 0.5, seed: 1 });
-        group.bench_function(name, |b| b.iter(|| op.eval(None, &[], size, size)));
+        group.bench_function(name, |b| b.iter(|| op.eval(None, &[], snakeskin::ops::Frame::whole(size, size))));
     }
     let noise =
         Op::Noise(FractalNoise { kind: NoiseKind::Perlin, cells_u: 8, cells_v: 8, octaves: 1, gain: 0.5, seed: 1 })
-            .eval(None, &[], size, size);
-    group.bench_function("blur_sigma_0.005", |b| b.iter(|| filters::blur(&noise, 0.005)));
+            .eval(None, &[], snakeskin::ops::Frame::whole(size, size));
+    group.bench_function("blur_sigma_0.005", |b| b.iter(|| filters::blur(&noise, 0.005, true)));
     group.bench_function("height_to_normal", |b| {
-        b.iter(|| filters::height_to_normal(&noise, 0.05, filters::NormalConvention::OpenGl, 1.0))
+        b.iter(|| filters::height_to_normal(&noise, 0.05, filters::NormalConvention::OpenGl, 1.0, noise.height, true))
     });
     group.finish();
 }

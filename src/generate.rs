@@ -8,10 +8,11 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use crate::export::{self, Quantized, SetLock, sha256_hex};
-use crate::graph::{EvalStats, Graph, evaluate_into};
+use crate::graph::{EvalStats, Graph, evaluate_into, evaluate_rows};
 use crate::maps::{BuildOptions, build_graph};
 use crate::material::MapKind;
 use crate::memory::MemoryCheck;
+use crate::ops::Frame;
 use crate::preset::{self, LoadedPreset};
 use crate::{Error, SIZE_RANGE};
 
@@ -79,7 +80,12 @@ impl Plan {
             return Err(Error::Height { width: size, height, max: MAX_HEIGHT });
         }
         let graph = build_graph(&loaded.preset, request.options);
-        let estimate = crate::memory::estimate_generate_bytes(&graph, &request.maps, size, height);
+        let estimate = if height > size {
+            let strip = strip_rows(&graph, &request.maps, size, height);
+            crate::memory::estimate_strips_bytes(&graph, &request.maps, size, height, strip)
+        } else {
+            crate::memory::estimate_generate_bytes(&graph, &request.maps, size, height)
+        };
         let memory = MemoryCheck::against_available(estimate);
         let what = if height == size { format!("--size {size}") } else { format!("--size {size} ({size} x {height})") };
         memory.refuse_if_over(&what)?;
@@ -99,24 +105,30 @@ impl Plan {
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
         let Plan { request, size, height, loaded, graph, start, .. } = self;
         let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
-        // Each map is quantised to its file format the moment it is finished, freeing its f32
-        // buffer; PNG compression then runs for all maps in parallel.
-        let mut quantized: Vec<Quantized> = Vec::new();
-        let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
-            quantized.push(export::quantize(map, &image));
-        });
-        quantized.sort_by_key(|q| q.map);
-        let kinds: Vec<MapKind> = quantized.iter().map(|q| q.map).collect();
-
+        let (kinds, files, stats, encode_time) = if height > size {
+            // A body atlas: strip by strip, each encoded as it is done (memory bounded by a
+            // strip, not the body's length).
+            strips(&graph, &request.maps, &loaded.name, size, height, progress)?
+        } else {
+            // Each map is quantised to its file format the moment it is finished, freeing its
+            // f32 buffer; PNG compression then runs for all maps in parallel.
+            let mut quantized: Vec<Quantized> = Vec::new();
+            let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
+                quantized.push(export::quantize(map, &image));
+            });
+            quantized.sort_by_key(|q| q.map);
+            let kinds: Vec<MapKind> = quantized.iter().map(|q| q.map).collect();
+            let encode_start = Instant::now();
+            let files = export::encode_all(&loaded.name, &quantized)?;
+            (kinds, files, stats, encode_start.elapsed())
+        };
         let encode_start = Instant::now();
-        let files = export::encode_all(&loaded.name, &quantized)?;
-        drop(quantized);
         let entries: Vec<(MapKind, String, String)> =
             kinds.iter().zip(&files).map(|(m, (name, bytes))| (*m, name.clone(), sha256_hex(bytes))).collect();
         let manifest = export::manifest(&loaded, (size, height), &entries, request.options);
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
         let manifest_name = export::manifest_file_name(&loaded.name);
-        let encode_time = encode_start.elapsed();
+        let encode_time = encode_time + encode_start.elapsed();
 
         let written = lock.write(&files, (&manifest_name, &json))?;
         Ok(GenerateReport {
@@ -127,6 +139,65 @@ impl Plan {
             created_folder: lock.created_folder,
         })
     }
+}
+
+/// Rows of texture per strip of a long texture, as a multiple of its width: two widths hold
+/// about what a square tile of 1.4× the width would, and the margins (`Graph::row_reach`,
+/// typically a tenth of a width each side for patterned species) then cost about a tenth.
+pub const STRIP_WIDTHS: usize = 2;
+
+/// Rows a strip is evaluated over, margins included (for the memory estimate).
+fn strip_rows(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> usize {
+    (STRIP_WIDTHS * width + 2 * graph.row_reach(maps, width)).min(height)
+}
+
+/// (maps, their files' names and bytes, merged stats, encode time) of a long texture
+/// evaluated in strips: each strip over its rows plus `Graph::row_reach` rows each side
+/// (so its kept rows are exactly the whole texture's), its margins cropped, its rows
+/// appended to each map's PNG stream.
+#[allow(clippy::type_complexity)]
+fn strips(
+    graph: &Graph,
+    maps: &[MapKind],
+    name: &str,
+    width: usize,
+    height: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(Vec<MapKind>, Vec<(String, Vec<u8>)>, EvalStats, Duration), Error> {
+    use rayon::prelude::*;
+    let margin = graph.row_reach(maps, width);
+    let step = STRIP_WIDTHS * width;
+    let count = height.div_ceil(step);
+    let mut kinds: Vec<MapKind> = maps.iter().copied().filter(|m| graph.output(*m).is_some()).collect();
+    kinds.sort();
+    kinds.dedup();
+    let mut encoders =
+        kinds.iter().map(|m| export::RowEncoder::new(*m, width, height)).collect::<Result<Vec<_>, _>>()?;
+    let mut stats = EvalStats::default();
+    let mut encode_time = Duration::ZERO;
+    for k in 0..count {
+        let (start, end) = (k * step, ((k + 1) * step).min(height));
+        let row0 = start.saturating_sub(margin);
+        let frame =
+            Frame { width, height: (end + margin).min(height) - row0, full_height: height, row0, wraps_v: false };
+        let nodes = &|done: usize, total: usize| progress(k * total + done, count * total);
+        let mut band: Vec<(MapKind, crate::ops::Image)> = Vec::new();
+        let strip_stats = evaluate_rows(graph, maps, frame, nodes, &mut |map, image| band.push((map, image)));
+        stats.merge(strip_stats);
+        band.sort_by_key(|(m, _)| *m);
+        let t = Instant::now();
+        encoders
+            .par_iter_mut()
+            .zip(&band)
+            .try_for_each(|(encoder, (_, image))| encoder.write_rows(image, start - row0..end - row0))?;
+        encode_time += t.elapsed();
+    }
+    let t = Instant::now();
+    let files = encoders
+        .into_par_iter()
+        .map(|e| Ok((export::map_file_name(name, e.map), e.finish()?)))
+        .collect::<Result<Vec<_>, export::ExportError>>()?;
+    Ok((kinds, files, stats, encode_time + t.elapsed()))
 }
 
 /// Plans and runs a whole generation.

@@ -29,6 +29,18 @@ pub fn estimate_generate_bytes(graph: &Graph, maps: &[MapKind], width: usize, he
     estimate_peak_bytes(graph, maps, width, height) + 2 * quantized + FIXED_OVERHEAD_BYTES
 }
 
+/// Estimated peak bytes of a set evaluated in strips (a body atlas, `generate::STRIP_ROWS`):
+/// one strip's live buffers at their worst (`strip_rows` rows, margins included), plus the
+/// PNG files growing as rows are encoded (at most the quantised size of the whole set with
+/// the fast filter), plus the fixed overhead.
+pub fn estimate_strips_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize, strip_rows: usize) -> u64 {
+    let pixels = (width * height) as u64;
+    let files: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * pixels).sum();
+    let strip_pixels = (width * strip_rows) as u64;
+    let strip_quantized: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * strip_pixels).sum();
+    estimate_peak_bytes(graph, maps, width, strip_rows) + 2 * strip_quantized + files + FIXED_OVERHEAD_BYTES
+}
+
 /// An estimate next to the memory available for it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MemoryCheck {

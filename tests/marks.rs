@@ -34,8 +34,14 @@ fn at(mask: &Image, x: usize, y: usize) -> f32 {
 
 #[test]
 fn paired_series_mirror_about_the_spine_and_staggered_ones_are_half_a_spacing_apart() {
-    let pair = blotches(SIZE, SIZE, &Blotches { half_width: 0.05, ..series(BlotchShape::Round, 0.15, false) });
-    let stagger = blotches(SIZE, SIZE, &Blotches { half_width: 0.05, ..series(BlotchShape::Round, 0.15, true) });
+    let pair = blotches(
+        snakeskin::ops::Frame::whole(SIZE, SIZE),
+        &Blotches { half_width: 0.05, ..series(BlotchShape::Round, 0.15, false) },
+    );
+    let stagger = blotches(
+        snakeskin::ops::Frame::whole(SIZE, SIZE),
+        &Blotches { half_width: 0.05, ..series(BlotchShape::Round, 0.15, true) },
+    );
     let (mut asymmetric, mut shifted_off, mut covered) = (0.0f32, 0.0f32, 0.0f32);
     let half_spacing = SIZE / 8;
     for y in 0..SIZE {
@@ -74,25 +80,27 @@ fn mean_y(mask: &Image, x: usize) -> (f32, f32) {
 #[test]
 fn a_chevron_points_to_the_tail_and_an_hourglass_is_narrow_at_the_spine() {
     let no_jitter = |shape| Blotches { jitter: 0.0, ..series(shape, 0.0, false) };
-    let chevron = blotches(SIZE, SIZE, &no_jitter(BlotchShape::Chevron));
+    let chevron = blotches(snakeskin::ops::Frame::whole(SIZE, SIZE), &no_jitter(BlotchShape::Chevron));
     let (spine, side) = (SIZE / 2, SIZE / 2 + (0.8 * 0.2 * SIZE as f32) as usize);
     let ((y_spine, _), (y_side, _)) = (mean_y(&chevron, spine), mean_y(&chevron, side));
     // v grows towards the tail: the apex (spine) lies behind the arms' ends.
     assert!(y_spine > y_side + 5.0, "chevron apex at {y_spine}, arms at {y_side}");
 
-    let hourglass = blotches(SIZE, SIZE, &no_jitter(BlotchShape::Hourglass));
+    let hourglass = blotches(snakeskin::ops::Frame::whole(SIZE, SIZE), &no_jitter(BlotchShape::Hourglass));
     let ((_, n_spine), (_, n_side)) = (mean_y(&hourglass, spine), mean_y(&hourglass, side));
     assert!(n_spine < 0.6 * n_side, "hourglass {n_spine} px long at the spine, {n_side} at the side");
     // Negative control: a saddle is as long at the spine as at its sides.
-    let saddle = blotches(SIZE, SIZE, &no_jitter(BlotchShape::Saddle));
+    let saddle = blotches(snakeskin::ops::Frame::whole(SIZE, SIZE), &no_jitter(BlotchShape::Saddle));
     let ((_, s_spine), (_, s_side)) = (mean_y(&saddle, spine), mean_y(&saddle, side));
     assert!((s_spine - s_side).abs() < 0.1 * s_side, "saddle {s_spine} vs {s_side}");
 }
 
 #[test]
 fn a_zigzag_is_one_band_from_head_to_tail() {
-    let zigzag =
-        blotches(SIZE, SIZE, &Blotches { half_width: 0.08, length: 0.2, ..series(BlotchShape::Zigzag, 0.0, false) });
+    let zigzag = blotches(
+        snakeskin::ops::Frame::whole(SIZE, SIZE),
+        &Blotches { half_width: 0.08, length: 0.2, ..series(BlotchShape::Zigzag, 0.0, false) },
+    );
     // Flood fill (4-connected: pieces touching at a corner do not count as one band) from the
     // covered pixels of the first row, not wrapping along v: the band must reach the last
     // row, and be the only band (every covered pixel reached).

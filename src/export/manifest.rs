@@ -50,9 +50,13 @@ pub const COLOR_MEANS: &str = "visible diffuse colour: the stack's diffuse refle
 
 #[derive(Debug, Serialize)]
 pub struct Counts {
-    pub ventrals: u32,
-    pub subcaudals: u32,
-    /// Marks of the first counted pattern layer (`pattern.N.count`), if any.
+    /// Ventral and subcaudal plates, where the belly draws plates (`belly.plates`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ventrals: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subcaudals: Option<u32>,
+    /// Marks of the first counted pattern layer (`pattern.N.count`) on the trunk, neck to
+    /// vent, if any (without tail bands the series runs on down the tail at its spacing).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dorsal_marks: Option<u32>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -104,9 +108,10 @@ pub fn manifest(
     let p = &loaded.preset;
     let convention = options.normal_convention;
     let body = (options.layout == Layout::Body).then(|| body_plan(p));
+    let plates = p.belly.plates && p.belly.width > 0.0;
     let counts = body.map(|b| Counts {
-        ventrals: b.ventrals,
-        subcaudals: b.subcaudals,
+        ventrals: plates.then_some(b.ventrals),
+        subcaudals: plates.then_some(b.subcaudals),
         dorsal_marks: p.pattern.iter().find_map(|l| l.count),
         tail_bands: (p.body.tail_bands > 0).then_some(p.body.tail_bands),
     });

@@ -111,6 +111,76 @@ pub fn encode_png(map: MapKind, image: &Image) -> Result<Vec<u8>, ExportError> {
     encode_quantized(&quantize(map, image))
 }
 
+/// A PNG written a band of rows at a time (a body atlas too long to hold as one image):
+/// the same format as `encode_quantized` (`MapKind::format`, fast compression, adaptive
+/// filter), into memory.
+pub struct RowEncoder {
+    pub map: MapKind,
+    writer: png::StreamWriter<'static, SharedBuffer>,
+    buffer: SharedBuffer,
+}
+
+/// The file's bytes, shared with the PNG writer: `StreamWriter::finish` consumes the writer
+/// (its drop writes the end chunk), so the bytes are read back through this handle.
+#[derive(Clone, Default)]
+struct SharedBuffer(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+
+impl std::io::Write for SharedBuffer {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.0.lock().expect("PNG buffer").extend_from_slice(bytes);
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl RowEncoder {
+    pub fn new(map: MapKind, width: usize, height: usize) -> Result<RowEncoder, ExportError> {
+        let format = map.format();
+        let error = |e: png::EncodingError| ExportError::Encode { map, message: e.to_string() };
+        let buffer = SharedBuffer::default();
+        let mut encoder = png::Encoder::new(buffer.clone(), width as u32, height as u32);
+        encoder.set_color(if format.channels == 3 { png::ColorType::Rgb } else { png::ColorType::Grayscale });
+        encoder.set_depth(if format.bit_depth == 16 { png::BitDepth::Sixteen } else { png::BitDepth::Eight });
+        encoder.set_compression(png::Compression::Fast);
+        encoder.set_filter(png::Filter::Adaptive);
+        let writer = encoder.write_header().map_err(error)?.into_stream_writer().map_err(error)?;
+        Ok(RowEncoder { map, writer, buffer })
+    }
+
+    /// Appends whole rows of the map (the image's rows `rows`).
+    pub fn write_rows(&mut self, image: &Image, rows: std::ops::Range<usize>) -> Result<(), ExportError> {
+        use std::io::Write;
+        let stride = image.width * image.channels;
+        let band = Image {
+            width: image.width,
+            height: rows.len(),
+            channels: image.channels,
+            data: image.data[rows.start * stride..rows.end * stride].to_vec(),
+        };
+        let mut q = quantize(self.map, &band);
+        if q.color == ExtendedColorType::L16 {
+            // PNG stores 16-bit samples big-endian; `quantize` gives native order.
+            for pair in q.samples.chunks_exact_mut(2) {
+                let v = u16::from_ne_bytes([pair[0], pair[1]]);
+                pair.copy_from_slice(&v.to_be_bytes());
+            }
+        }
+        self.writer.write_all(&q.samples).map_err(|e| ExportError::Encode { map: self.map, message: e.to_string() })
+    }
+
+    /// The finished file's bytes (every row must have been written).
+    pub fn finish(self) -> Result<Vec<u8>, ExportError> {
+        let map = self.map;
+        let error = |e: png::EncodingError| ExportError::Encode { map, message: e.to_string() };
+        self.writer.finish().map_err(error)?;
+        let bytes = std::mem::take(&mut *self.buffer.0.lock().expect("PNG buffer"));
+        Ok(bytes)
+    }
+}
+
 /// Encodes quantised maps in parallel; returns (file name, bytes) in the given order.
 pub fn encode_all(preset_name: &str, maps: &[Quantized]) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
     maps.par_iter().map(|q| Ok((map_file_name(preset_name, q.map), encode_quantized(q)?))).collect()

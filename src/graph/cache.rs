@@ -54,8 +54,7 @@ impl NodeCache {
         let (_, stats) = evaluate_with(
             graph,
             maps,
-            width,
-            height,
+            crate::ops::Frame::whole(width, height),
             &|_, _| {},
             &mut |map, image| {
                 outputs.insert(map, image);

@@ -24,7 +24,7 @@ use super::cache::{CacheStats, NodeCache};
 use super::op::hash_op;
 use super::{Graph, NodeId};
 use crate::material::MapKind;
-use crate::ops::Image;
+use crate::ops::{Frame, Image};
 
 /// How many nodes past the next one in builder order the scheduler may start early.
 const LOOKAHEAD: usize = 6;
@@ -48,6 +48,23 @@ pub struct EvalStats {
 }
 
 impl EvalStats {
+    /// Adds another evaluation's figures (strips of one texture): node times and
+    /// evaluations summed by node, the larger peak, the walls summed.
+    pub fn merge(&mut self, other: EvalStats) {
+        for node in other.nodes {
+            match self.nodes.iter_mut().find(|n| n.name == node.name) {
+                Some(n) => {
+                    n.evaluations += node.evaluations;
+                    n.time += node.time;
+                    n.bytes = n.bytes.max(node.bytes);
+                }
+                None => self.nodes.push(node),
+            }
+        }
+        self.peak_bytes = self.peak_bytes.max(other.peak_bytes);
+        self.wall += other.wall;
+    }
+
     pub fn get(&self, name: &str) -> Option<&NodeStats> {
         self.nodes.iter().find(|n| n.name == name)
     }
@@ -84,7 +101,20 @@ pub fn evaluate_into(
     progress: &(dyn Fn(usize, usize) + Sync),
     sink: &mut dyn FnMut(MapKind, Image),
 ) -> EvalStats {
-    evaluate_with(graph, maps, width, height, progress, sink, CachePolicy::None).0
+    evaluate_with(graph, maps, Frame::whole(width, height), progress, sink, CachePolicy::None).0
+}
+
+/// `evaluate_into` over the rows of `frame` only: a strip of a texture too long to hold at
+/// once (`generate`'s body atlas). The maps' rows match the whole texture's except within
+/// `Graph::row_reach` of a strip edge inside the texture, which the caller crops.
+pub fn evaluate_rows(
+    graph: &Graph,
+    maps: &[MapKind],
+    frame: Frame,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    sink: &mut dyn FnMut(MapKind, Image),
+) -> EvalStats {
+    evaluate_with(graph, maps, frame, progress, sink, CachePolicy::None).0
 }
 
 /// What the evaluator keeps between evaluations: the one difference between a one-shot
@@ -103,17 +133,17 @@ pub enum CachePolicy<'a> {
 pub fn evaluate_with(
     graph: &Graph,
     maps: &[MapKind],
-    width: usize,
-    height: usize,
+    frame: Frame,
     progress: &(dyn Fn(usize, usize) + Sync),
     sink: &mut dyn FnMut(MapKind, Image),
     mut policy: CachePolicy,
 ) -> (EvalStats, CacheStats) {
     let start = Instant::now();
+    let frame = Frame { wraps_v: graph.wraps_v(), ..frame };
     let reachable = graph.reachable(maps);
     let keys: Vec<u64> = match policy {
         CachePolicy::None => Vec::new(),
-        CachePolicy::Keep(_) => node_keys(graph, &reachable, width, height),
+        CachePolicy::Keep(_) => node_keys(graph, &reachable, frame),
     };
     let cached = |id: NodeId| match &policy {
         CachePolicy::None => None,
@@ -194,7 +224,7 @@ pub fn evaluate_with(
                 };
                 let rest: Vec<&Image> = node.inputs.iter().skip(1).map(input).collect();
                 let t = Instant::now();
-                let image = node.op.eval(first, &rest, width, height);
+                let image = node.op.eval(first, &rest, frame);
                 (id, image, t.elapsed())
             })
             .collect();
@@ -239,14 +269,14 @@ pub fn evaluate_with(
 
 /// Cache keys of the reachable nodes (in topological order, so inputs come first): the
 /// operation with every parameter (`hash_op`), the size and the inputs' keys.
-fn node_keys(graph: &Graph, reachable: &[NodeId], width: usize, height: usize) -> Vec<u64> {
+fn node_keys(graph: &Graph, reachable: &[NodeId], frame: Frame) -> Vec<u64> {
     use std::hash::{Hash, Hasher};
     let mut keys = vec![0u64; graph.nodes().len()];
     for &id in reachable {
         let node = graph.node(id);
         let mut hasher = std::collections::hash_map::DefaultHasher::new();
         hash_op(&node.op, &mut hasher);
-        (width, height).hash(&mut hasher);
+        frame.hash(&mut hasher);
         for input in &node.inputs {
             keys[input.0].hash(&mut hasher);
         }

@@ -13,7 +13,7 @@ mod op;
 
 pub use cache::{CacheStats, NodeCache};
 pub use dot::to_dot;
-pub use eval::{EvalStats, Evaluation, NodeStats, estimate_peak_bytes, evaluate, evaluate_into};
+pub use eval::{EvalStats, Evaluation, NodeStats, estimate_peak_bytes, evaluate, evaluate_into, evaluate_rows};
 pub use op::Op;
 
 use std::collections::BTreeMap;
@@ -35,6 +35,8 @@ pub struct Node {
 pub struct Graph {
     nodes: Vec<Node>,
     outputs: BTreeMap<MapKind, NodeId>,
+    /// The texture does not repeat along v (a body atlas): filters clamp at its ends.
+    open_v: bool,
 }
 
 impl Graph {
@@ -52,6 +54,25 @@ impl Graph {
 
     pub fn outputs(&self) -> &BTreeMap<MapKind, NodeId> {
         &self.outputs
+    }
+
+    /// Whether the texture repeats along v (the tile) or not (a body atlas).
+    pub fn wraps_v(&self) -> bool {
+        !self.open_v
+    }
+
+    /// The rows above and below a pixel that the maps' values there depend on at `width`:
+    /// the longest chain of neighbourhood reads (`Op::row_reach`) through the graph. A strip
+    /// of a long texture evaluated with this margin each side keeps its inner rows exact.
+    pub fn row_reach(&self, maps: &[MapKind], width: usize) -> usize {
+        // Nodes are in topological order: a node's reach is its own plus its inputs' largest.
+        let mut reach = vec![0usize; self.nodes.len()];
+        for id in self.reachable(maps) {
+            let node = &self.nodes[id.0];
+            let inputs = node.inputs.iter().map(|i| reach[i.0]).max().unwrap_or(0);
+            reach[id.0] = inputs + node.op.row_reach(width);
+        }
+        maps.iter().filter_map(|m| self.output(*m)).map(|id| reach[id.0]).max().unwrap_or(0)
     }
 
     /// Every node that the given maps depend on, in topological (id) order.
@@ -106,6 +127,11 @@ impl GraphBuilder {
 
     pub fn set_output(&mut self, map: MapKind, id: NodeId) {
         self.graph.outputs.insert(map, id);
+    }
+
+    /// Marks the texture as not repeating along v (a body atlas).
+    pub fn set_open_v(&mut self) {
+        self.graph.open_v = true;
     }
 
     pub fn finish(self) -> Graph {

@@ -1,7 +1,7 @@
 //! The operations a node can perform, and the one `match` that dispatches them to the pixel
 //! kernels in `ops`.
 
-use crate::ops::Image;
+use crate::ops::{Frame, Image};
 use std::borrow::Cow;
 
 use crate::ops::body::{AlongProfile, HeadMark};
@@ -27,7 +27,9 @@ pub enum Op {
     BellyMarks(BellyMarks),
     /// Inputs: a mask and the scale field; replaces each pixel's mask value by the value at
     /// its scale's centre, by `amount` (colour that follows scale boundaries).
-    SnapToScales { amount: f32, centre_u: usize, centre_v: usize },
+    /// `reach`: how far (texture widths) a pixel may lie from its scale's centre along the
+    /// body, for the margin of a strip (`row_reach`).
+    SnapToScales { amount: f32, centre_u: usize, centre_v: usize, reach: f32 },
     /// A jittered grid of round spots (tiny-skia coverage). No inputs.
     Spots(SpotGrid),
     /// Linear remap of the input range to the output range.
@@ -123,38 +125,52 @@ impl Op {
         )
     }
 
-    /// Evaluates the operation. `first` is the first input (owned when the evaluator could
-    /// hand its buffer over, see `in_place`), `rest` the others in input order.
-    pub fn eval(&self, first: Option<Cow<'_, Image>>, rest: &[&Image], width: usize, height: usize) -> Image {
+    /// How many rows above and below a pixel the operation reads: what a strip of a long
+    /// texture must carry as margin so that its kept rows equal the whole texture's
+    /// (`Graph::row_reach` sums them along the graph).
+    pub fn row_reach(&self, width: usize) -> usize {
+        match self {
+            // Three passes of boxes (or a Gaussian) of about 3 σ together, and a pixel more.
+            Op::Blur { sigma } => (3.5 * sigma * width as f32).ceil() as usize + 2,
+            Op::Sobel { .. } | Op::HeightToNormal { .. } => 1,
+            Op::SnapToScales { reach, .. } => (reach * width as f32).ceil() as usize + 2,
+            _ => 0,
+        }
+    }
+
+    /// Evaluates the operation over the rows of `frame`. `first` is the first input (owned
+    /// when the evaluator could hand its buffer over, see `in_place`), `rest` the others in
+    /// input order.
+    pub fn eval(&self, first: Option<Cow<'_, Image>>, rest: &[&Image], frame: Frame) -> Image {
         let input = || first.as_deref().expect("operation has an input");
         match self {
-            Op::Noise(noise) => crate::ops::noise::render(noise, width, height),
-            Op::Scales(field) => field.render(width, height),
+            Op::Noise(noise) => crate::ops::noise::render(noise, frame),
+            Op::Scales(field) => field.render_in(frame),
             Op::Channel { index } => filters::extract_channel(input(), *index),
             Op::Bands { axis, centres, half_width, softness } => {
-                shapes::bands(width, height, *axis, centres, *half_width, *softness)
+                shapes::bands(frame, *axis, centres, *half_width, *softness)
             }
-            Op::Blotches(b) => shapes::blotches(width, height, b),
-            Op::BellyMarks(marks) => shapes::belly_marks(width, height, marks),
-            Op::SnapToScales { amount, centre_u, centre_v } => {
-                filters::snap_to_scales(input(), rest[0], *amount, *centre_u, *centre_v)
+            Op::Blotches(b) => shapes::blotches(frame, b),
+            Op::BellyMarks(marks) => shapes::belly_marks(frame, marks),
+            Op::SnapToScales { amount, centre_u, centre_v, .. } => {
+                filters::snap_to_scales(input(), rest[0], *amount, *centre_u, *centre_v, frame)
             }
-            Op::Spots(grid) => shapes::spots(width, height, grid),
-            Op::Blur { sigma } => filters::blur(input(), *sigma),
-            Op::Sobel { edge_sigma } => filters::sobel(input(), *edge_sigma),
+            Op::Spots(grid) => shapes::spots(frame, grid),
+            Op::Blur { sigma } => filters::blur(input(), *sigma, frame.wraps_v),
+            Op::Sobel { edge_sigma } => filters::sobel(input(), *edge_sigma, frame.wraps_v),
             Op::Colorize { low, high } => filters::colorize(input(), *low, *high),
             Op::HeightToNormal { slope, convention, v_extent } => {
-                filters::height_to_normal(input(), *slope, *convention, *v_extent)
+                filters::height_to_normal(input(), *slope, *convention, *v_extent, frame.full_height, frame.wraps_v)
             }
-            Op::Along(profile) => profile.render(width, height),
-            Op::HeadMark(mark) => crate::ops::body::head_mark(width, height, mark),
+            Op::Along(profile) => profile.render(frame),
+            Op::HeadMark(mark) => crate::ops::body::head_mark(frame, mark),
             Op::Levels { in_low, in_high, out_low, out_high } => {
                 filters::levels(owned(first), *in_low, *in_high, *out_low, *out_high)
             }
             Op::Threshold { level, softness } => filters::threshold(owned(first), *level, *softness),
             Op::Blend { mode, opacity } => filters::blend(owned(first), rest[0], rest.get(1).copied(), *mode, *opacity),
             Op::Tint { color, opacity } => tint(owned(first), rest[0], *color, *opacity),
-            Op::ScaleColour(colour) => colour.apply(owned(first), rest[0]),
+            Op::ScaleColour(colour) => colour.apply(owned(first), rest[0], frame),
         }
     }
 
@@ -294,9 +310,10 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
                 float(h, *x);
             }
         }
-        Op::SnapToScales { amount, centre_u, centre_v } => {
+        Op::SnapToScales { amount, centre_u, centre_v, reach } => {
             (centre_u, centre_v).hash(h);
             float(h, *amount);
+            float(h, *reach);
         }
         Op::Spots(SpotGrid { across, along, radius, jitter, alternate, checkered, hole, seed }) => {
             (across, along, alternate, checkered, seed).hash(h);

@@ -67,14 +67,16 @@ pub(super) fn marks(
         let n = b.tail_bands as f32;
         let repeat = (1.0 - plan.vent) / n;
         let half = 0.5 * b.tail_band_width as f32 * repeat;
+        // The edge within a quarter of the band and of the gap, so the knots stay in order.
+        let edge = EDGE_V.min(0.25 * half).min(0.25 * (0.5 * repeat - half));
         let mut knots = Vec::new();
         for i in 0..b.tail_bands {
             let centre = plan.vent + (i as f32 + 0.5) * repeat;
             knots.extend([
-                (centre - half - EDGE_V, 0.0),
+                (centre - half - edge, 0.0),
                 (centre - half, 1.0),
                 (centre + half, 1.0),
-                (centre + half + EDGE_V, 0.0),
+                (centre + half + edge, 0.0),
             ]);
         }
         let mut mask = g.add("body.tail_bands", Op::Along(AlongProfile { knots }), &[]);
@@ -83,6 +85,7 @@ pub(super) fn marks(
                 amount: snap as f32,
                 centre_u: s.channel_index(channel::CENTRE_U),
                 centre_v: s.channel_index(channel::CENTRE_V),
+                reach: s.snap_reach(),
             };
             mask = g.add("body.tail_bands_aligned", op, &[mask, s.scales]);
         }
@@ -99,7 +102,7 @@ pub(super) fn marks(
             &[color, mask],
         );
     }
-    if let Some(tip) = b.tip_color {
+    if let Some(tip) = b.tip_color.filter(|_| b.tip_fraction > 0.0) {
         let start = 1.0 - (1.0 - plan.vent) * b.tip_fraction as f32;
         let mask = g.add("body.tip", Op::Along(AlongProfile { knots: vec![(start - EDGE_V, 0.0), (start, 1.0)] }), &[]);
         color = g.add("body.tip_tint", Op::Tint { color: tip.to_linear(), opacity: 1.0 }, &[color, mask]);
@@ -116,7 +119,15 @@ pub(super) fn marks(
             HeadMarkKind::Lips => HeadMarkShape::Lips,
         };
         let mark = HeadMark { shape, size: m.size as f32, plan: *plan };
-        let mask = g.add(format!("body.head_mark{i}"), Op::HeadMark(mark), &[]);
+        let mut mask = g.add(format!("body.head_mark{i}"), Op::HeadMark(mark), &[]);
+        if let Some(outside) = outside_belly {
+            // Off the belly plates (a collar round the neck stops at them).
+            mask = g.add(
+                format!("body.head_mark{i}_off_belly"),
+                Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 },
+                &[mask, outside],
+            );
+        }
         color = g.add(
             format!("body.head_mark{i}_tint"),
             Op::Tint { color: m.color.to_linear(), opacity: 1.0 },

@@ -417,16 +417,21 @@ fn pattern_layer(
     let parts = shapes(g, s, layer, &|part: &str| format!("{prefix}.{part}"), seed);
     let many = parts.len() > 1;
     let mut last_mask = None;
+    // On a body atlas, where along the body the layer lies: a counted series from the end of
+    // the neck, every other layer from the end of the head (the head has its own marks). The
+    // region clips what is painted — the mark, its border, outline and centre — not the
+    // shapes they are derived from, so a mark cut by a region edge gets no outline along it.
+    let region = s.body.map(|plan| {
+        let profile = super::body::layer_region(&plan, layer.count.is_some(), s.tail_bands > 0);
+        g.add(format!("{prefix}.region"), Op::Along(profile), &[])
+    });
+    let clip = |g: &mut GraphBuilder, name: String, mask: NodeId| match region {
+        Some(region) => g.add(name, Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, region]),
+        None => mask,
+    };
     for (k, (shape, tint)) in parts.into_iter().enumerate() {
         let name = |part: &str| if many { format!("{prefix}.{k}.{part}") } else { format!("{prefix}.{part}") };
         let mut mask = shape;
-        if let Some(plan) = &s.body {
-            // A counted series starts at the end of the neck; every other layer runs from
-            // the end of the head. The head carries its own marks (`body.head_mark`).
-            let region = super::body::layer_region(plan, layer.count.is_some(), s.tail_bands > 0);
-            let region = g.add(name("region"), Op::Along(region), &[]);
-            mask = g.add(name("in_region"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, region]);
-        }
         // A ring sequence in whole scales keeps its topology (`rings_of_whole_scales`) only
         // with straight band edges: no distortion there.
         let distort = layer.edge_distortion > 0.0
@@ -449,21 +454,24 @@ fn pattern_layer(
             let soft = g.add(name("border_blur"), Op::Blur { sigma: reach / 1.28 }, &[mask]);
             let mut border = g.add(name("border"), Op::Threshold { level: 0.1, softness: 0.05 }, &[soft]);
             border = snapped_and_off_belly(g, s, context, layer, &|p| name(&format!("border_{p}")), border);
+            border = clip(g, name("border_in_region"), border);
             color = g.add(
                 name("border_tint"),
                 Op::Tint { color: border_color.to_linear(), opacity: layer.opacity as f32 },
                 &[color, border],
             );
         }
+        let painted = clip(g, name("in_region"), mask);
         color =
-            g.add(name("tint"), Op::Tint { color: tint.to_linear(), opacity: layer.opacity as f32 }, &[color, mask]);
+            g.add(name("tint"), Op::Tint { color: tint.to_linear(), opacity: layer.opacity as f32 }, &[color, painted]);
         last_mask = Some(mask);
         if layer.outline_size > 0.0 {
             // Thesis §4.2.1.6: edge detection, blur and binarise, then colour the outline.
             let sigma = layer.outline_size as f32 * 0.5;
             let soft = g.add(name("outline_blur"), Op::Blur { sigma }, &[mask]);
             let edges = g.add(name("outline_edges"), Op::Sobel { edge_sigma: sigma }, &[soft]);
-            let outline = g.add(name("outline"), Op::Threshold { level: 0.35, softness: 0.1 }, &[edges]);
+            let mut outline = g.add(name("outline"), Op::Threshold { level: 0.35, softness: 0.1 }, &[edges]);
+            outline = clip(g, name("outline_in_region"), outline);
             color = g.add(
                 name("outline_tint"),
                 Op::Tint { color: layer.outline_color.to_linear(), opacity: layer.opacity as f32 },
@@ -481,6 +489,7 @@ fn pattern_layer(
             Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 },
             &[centre, mark],
         );
+        centre = clip(g, format!("{prefix}.centre_in_region"), centre);
         color = g.add(
             format!("{prefix}.centre_tint"),
             Op::Tint { color: centre_color.to_linear(), opacity: layer.opacity as f32 },
@@ -506,6 +515,7 @@ fn snapped_and_off_belly(
             amount: layer.scale_aligned as f32,
             centre_u: s.channel_index(channel::CENTRE_U),
             centre_v: s.channel_index(channel::CENTRE_V),
+            reach: s.snap_reach(),
         };
         mask = g.add(name("scale_aligned"), op, &[mask, s.scales]);
     }

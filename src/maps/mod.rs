@@ -67,6 +67,7 @@ pub fn body_plan(preset: &Preset) -> BodyPlan {
         ventrals: b.ventrals,
         subcaudals: b.subcaudals,
         head_shields: b.head_scales == schema::HeadScales::Shields,
+        divided_subcaudals: b.divided_subcaudals,
     }
 }
 
@@ -155,6 +156,14 @@ impl Shared {
         g.add(name, Op::Channel { index: self.channel_index(channel) }, &[self.scales])
     }
 
+    /// How far (texture widths) a pixel can lie from its scale's centre along the body:
+    /// the scale's longest reach plus its centre jitter, in cell lengths, times a cell's
+    /// length (`SnapToScales::reach`).
+    pub fn snap_reach(&self) -> f32 {
+        let cells = self.field.longest_reach_cells(&self.lattice) + self.field.jitter.clamp(0.0, 0.5);
+        cells * self.along / self.lattice.rows_v as f32
+    }
+
     /// A count per circumference along the body (noise cells, rings, spots) over the whole
     /// texture: unchanged for the tile, times the body's length (rounded) for the body.
     pub fn along_count(&self, per_circumference: u32) -> u32 {
@@ -169,6 +178,9 @@ impl Shared {
 pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     let mut g = GraphBuilder::new();
     let field = scale_field(preset, options.layout);
+    if options.layout == Layout::Body {
+        g.set_open_v();
+    }
     let lattice = field.lattice();
     let body = field.body;
     let along = field.length;

@@ -8,7 +8,7 @@
 //! is `length` widths long, so every kernel keeps its pixel units; what changes is that v
 //! runs from the snout (0) to the tail tip (1) instead of repeating.
 
-use super::image::{Image, floor_i32};
+use super::image::{Frame, Image, floor_i32};
 
 /// The regions and counts of a body atlas, as fractions of the total length (v).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +25,8 @@ pub struct BodyPlan {
     pub subcaudals: u32,
     /// Large head shields (else small head scales: the body's lattice continues).
     pub head_shields: bool,
+    /// Subcaudals in pairs, divided at the midline (most snakes), or single.
+    pub divided_subcaudals: bool,
 }
 
 /// Where a pixel lies on the belly's plate sequence (`BodyPlan::plate_at`).
@@ -71,21 +73,16 @@ impl BodyPlan {
         }
     }
 
-    /// Head-local coordinates of (u, v): `x` across the top of the head (−1 .. 1 spans the
-    /// shields, `HEAD_TOP_HALF_U` of the circumference each side of the spine), `s` from
-    /// the snout tip (0) to the back of the head (1), beyond 1 on the neck.
-    pub fn head_local(&self, u: f32, v: f32) -> (f32, f32) {
-        ((u - 0.5) / HEAD_TOP_HALF_U, v / self.head_end.max(1e-6))
-    }
-
-    /// One head-local x unit and one s unit in circumferences (the texture's isotropic unit).
+    /// One head-local unit in circumferences (the texture's isotropic unit): x across the
+    /// top of the head (−1 .. 1 spans the shields, `HEAD_TOP_HALF_U` of the circumference
+    /// each side of the spine) and s from the snout tip (0) to the back of the head (1).
     pub fn head_units(&self) -> (f32, f32) {
         (HEAD_TOP_HALF_U, self.head_end * self.length)
     }
 
     pub fn hash_into<H: std::hash::Hasher>(&self, h: &mut H) {
         use std::hash::Hash;
-        (self.ventrals, self.subcaudals, self.head_shields).hash(h);
+        (self.ventrals, self.subcaudals, self.head_shields, self.divided_subcaudals).hash(h);
         for x in [self.length, self.head_end, self.neck_end, self.vent] {
             x.to_bits().hash(h);
         }
@@ -248,7 +245,9 @@ impl HeadMark {
                 let neck = (p.neck_end - p.head_end).max(0.005) * p.length;
                 band(head, head + 0.7 * k * neck, s).min(0.42 - du)
             }
-            HeadMarkShape::Lips => band(0.05 * head, 0.95 * head, s).min(band(HEAD_SIDE_HALF_U - 0.02, 0.40, du)),
+            HeadMarkShape::Lips => {
+                band(0.05 * head, 0.95 * head, s).min(band(HEAD_SIDE_HALF_U - 0.02, HEAD_SIDE_HALF_U + 0.08 * k, du))
+            }
         }
     }
 
@@ -260,16 +259,22 @@ impl HeadMark {
     }
 }
 
-/// Coverage of a head mark, anti-aliased over one pixel.
-pub fn head_mark(width: usize, height: usize, mark: &HeadMark) -> Image {
+/// Coverage of a head mark over the rows of `frame`, anti-aliased over one pixel.
+pub fn head_mark(frame: Frame, mark: &HeadMark) -> Image {
+    let (width, height) = (frame.width, frame.height);
     // One pixel in circumferences (the texture is isotropic: width = one circumference).
     let pixel = 1.0 / width as f32;
-    // Only the head and neck can carry a mark: rows beyond stay 0.
-    let last = (((mark.plan.neck_end + 0.3 * mark.plan.head_end) * height as f32).ceil() as usize).min(height);
+    // Only the head and neck can carry a mark: rows beyond the furthest any shape reaches
+    // stay 0 (a spearhead's base, a collar's end, a cap of size k, the V's arms).
+    let (p, k) = (&mark.plan, mark.size);
+    let reach_v =
+        (p.head_end * (1.3 + 0.6 * k).max(k)).max(p.head_end + 0.7 * k * (p.neck_end - p.head_end).max(0.005));
+    let last_row = (reach_v * frame.full_height as f32).ceil() as usize + 2;
+    let last = last_row.saturating_sub(frame.row0).min(height);
     let mut image = Image::new(width, height, 1);
     use rayon::prelude::*;
     image.data[..last * width].par_chunks_mut(width).enumerate().for_each(|(y, row)| {
-        let v = (y as f32 + 0.5) / height as f32;
+        let v = frame.v(y);
         for (x, out) in row.iter_mut().enumerate() {
             let u = (x as f32 + 0.5) / width as f32;
             *out = (mark.inside(u, v) / pixel + 0.5).clamp(0.0, 1.0);
@@ -300,10 +305,10 @@ impl AlongProfile {
         if v1 <= v0 { b } else { a + (b - a) * (v - v0) / (v1 - v0) }
     }
 
-    pub fn render(&self, width: usize, height: usize) -> Image {
-        let mut image = Image::new(width, height, 1);
-        for (y, row) in image.data.chunks_exact_mut(width).enumerate() {
-            row.fill(self.value((y as f32 + 0.5) / height as f32));
+    pub fn render(&self, frame: Frame) -> Image {
+        let mut image = Image::new(frame.width, frame.height, 1);
+        for (y, row) in image.data.chunks_exact_mut(frame.width).enumerate() {
+            row.fill(self.value(frame.v(y)));
         }
         image
     }
@@ -331,6 +336,7 @@ mod tests {
             ventrals: 200,
             subcaudals: 60,
             head_shields: true,
+            divided_subcaudals: true,
         }
     }
 

@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::image::Image;
+use super::image::{Frame, Image};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum BlendMode {
@@ -112,18 +112,20 @@ fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
 /// sampled exactly; beyond, three successive box filters of Kovesi's widths (P. Kovesi,
 /// "Fast almost-Gaussian filtering", DICTA 2010) match the Gaussian's variance at a cost
 /// independent of sigma (running sums), which is what keeps large blurs cheap at 4K.
-pub fn blur(input: &Image, sigma: f32) -> Image {
+/// `wraps_v`: rows wrap round (the tile) or the first and last rows repeat outward (a body
+/// atlas, whose snout and tail tip are not neighbours).
+pub fn blur(input: &Image, sigma: f32, wraps_v: bool) -> Image {
     let sigma_px = sigma * input.width as f32;
     if sigma_px < 0.33 {
         return input.clone();
     }
     if sigma_px <= 2.0 {
-        return gaussian_blur(input, sigma_px);
+        return gaussian_blur(input, sigma_px, wraps_v);
     }
     let mut image = input.clone();
     for width in box_widths(sigma_px) {
         image = box_pass_horizontal(&image, width / 2);
-        image = box_pass_vertical(&image, width / 2);
+        image = box_pass_vertical(&image, width / 2, wraps_v);
     }
     image
 }
@@ -168,7 +170,7 @@ fn box_pass_horizontal(input: &Image, r: usize) -> Image {
 
 /// Mean over y − r ..= y + r along columns, wrap-around; blocks of columns run in parallel,
 /// each sweeping down the image with a row of running sums.
-fn box_pass_vertical(input: &Image, r: usize) -> Image {
+fn box_pass_vertical(input: &Image, r: usize, wraps_v: bool) -> Image {
     const BLOCK: usize = 256;
     let (w, h, ch) = (input.width, input.height, input.channels);
     let stride = w * ch;
@@ -179,7 +181,7 @@ fn box_pass_vertical(input: &Image, r: usize) -> Image {
         .into_par_iter()
         .map(|start| {
             let len = BLOCK.min(stride - start);
-            let row_at = |y: isize| &input.data[y.rem_euclid(h as isize) as usize * stride + start..][..len];
+            let row_at = |y: isize| &input.data[edge_row(y, h, wraps_v) * stride + start..][..len];
             let mut sum = vec![0.0f64; len];
             for y in -(r as isize)..=r as isize {
                 for (s, v) in sum.iter_mut().zip(row_at(y)) {
@@ -209,7 +211,7 @@ fn box_pass_vertical(input: &Image, r: usize) -> Image {
     out
 }
 
-fn gaussian_blur(input: &Image, sigma_px: f32) -> Image {
+fn gaussian_blur(input: &Image, sigma_px: f32, wraps_v: bool) -> Image {
     let kernel = gaussian_kernel(sigma_px);
     let radius = (kernel.len() / 2) as isize;
     let (w, h, ch) = (input.width, input.height, input.channels);
@@ -236,7 +238,7 @@ fn gaussian_blur(input: &Image, sigma_px: f32) -> Image {
     let mut out = Image::new(w, h, ch);
     out.data.par_chunks_mut(w * ch).enumerate().for_each(|(y, row)| {
         for (k, weight) in kernel.iter().enumerate() {
-            let sy = (y as isize + k as isize - radius).rem_euclid(h as isize) as usize;
+            let sy = edge_row(y as isize + k as isize - radius, h, wraps_v);
             for (o, s) in row.iter_mut().zip(tmp.row(sy)) {
                 *o += weight * s;
             }
@@ -247,7 +249,17 @@ fn gaussian_blur(input: &Image, sigma_px: f32) -> Image {
 
 /// Moves a mask towards its value at each pixel's scale centre (channels `centre_u`,
 /// `centre_v` of the scale field; negative where no scale covers the pixel).
-pub fn snap_to_scales(mask: &Image, scales: &Image, amount: f32, centre_u: usize, centre_v: usize) -> Image {
+/// In a strip (`frame`), a centre outside the strip's rows reads its nearest row: the strip's
+/// margin (`Op::row_reach`) keeps that out of the rows that are kept.
+pub fn snap_to_scales(
+    mask: &Image,
+    scales: &Image,
+    amount: f32,
+    centre_u: usize,
+    centre_v: usize,
+    frame: Frame,
+) -> Image {
+    let full = frame.full_height;
     Image::from_fn(mask.width, mask.height, 1, |u, v, out| {
         let x = (u * mask.width as f32) as usize;
         let y = (v * mask.height as f32) as usize;
@@ -258,11 +270,50 @@ pub fn snap_to_scales(mask: &Image, scales: &Image, amount: f32, centre_u: usize
             own
         } else {
             let cx = ((cu * mask.width as f32) as isize).min(mask.width as isize - 1);
-            let cy = ((cv * mask.height as f32) as isize).min(mask.height as isize - 1);
+            let cy = if frame.wraps_v {
+                ((cv * full as f32) as isize).min(full as isize - 1)
+            } else {
+                // A body atlas: a centre beyond the snout or the tail tip reads the end row.
+                ((cv * full as f32).floor() as isize).clamp(0, full as isize - 1)
+            };
+            let cy =
+                if frame.height == full { cy } else { (cy - frame.row0 as isize).clamp(0, frame.height as isize - 1) };
             let centre = mask.at_wrapped(cx, cy, 0);
             own + (centre - own) * amount
         };
     })
+}
+
+/// `resample_bilinear_wrapped` for the rows of `frame` (width `width`), from the coarse
+/// rows `first`, `first + 1`, ... of a periodic grid `coarse_height` rows tall, of which
+/// `src` holds as many as the frame needs (row k of `src` is coarse row `first + k`,
+/// wrapped). For the whole texture this computes what `resample_bilinear_wrapped` does, with
+/// the same arithmetic.
+pub fn resample_bilinear_rows(src: &Image, width: usize, frame: Frame, coarse_height: usize, first: usize) -> Image {
+    let (sw, ch) = (src.width, src.channels);
+    let columns: Vec<(usize, usize, f32)> = (0..width)
+        .map(|x| {
+            let fx = (x as f32 + 0.5) / width as f32 * sw as f32;
+            let x0 = fx.floor();
+            let i0 = (x0 as isize).rem_euclid(sw as isize) as usize;
+            (i0, (i0 + 1) % sw, fx - x0)
+        })
+        .collect();
+    let mut out = Image::new(width, frame.height, ch);
+    out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
+        let fy = ((frame.row0 + y) as f32 + 0.5) / frame.full_height as f32 * coarse_height as f32;
+        let y0 = fy.floor();
+        let k = y0 as usize - first;
+        let (r0, r1, ty) = (src.row(k), src.row(k + 1), fy - y0);
+        for (x, &(i0, i1, tx)) in columns.iter().enumerate() {
+            for c in 0..ch {
+                let a = r0[i0 * ch + c] + (r0[i1 * ch + c] - r0[i0 * ch + c]) * tx;
+                let b = r1[i0 * ch + c] + (r1[i1 * ch + c] - r1[i0 * ch + c]) * tx;
+                row[x * ch + c] = a + (b - a) * ty;
+            }
+        }
+    });
+    out
 }
 
 /// Bilinear resampling of a periodic image whose sample (i, j) sits at (i / w, j / h).
@@ -297,16 +348,23 @@ pub fn resample_bilinear_wrapped(src: &Image, width: usize, height: usize) -> Im
 /// Calls `f(centre, left, right, up, here, down, out)` for every pixel: sample offsets of the
 /// pixel and its wrapped left and right neighbours within a row (channel 0), the wrapped
 /// rows above, at and below it, and the pixel's output (no modulo per sample).
-fn neighbourhood<F>(input: &Image, channels_out: usize, f: F) -> Image
+/// Row `y` of an image `h` rows tall, wrapped round (`wraps_v`) or clamped to the nearest
+/// row. For `y` within one image of the range, wrapping matches `rem_euclid`.
+#[inline]
+fn edge_row(y: isize, h: usize, wraps_v: bool) -> usize {
+    if wraps_v { y.rem_euclid(h as isize) as usize } else { y.clamp(0, h as isize - 1) as usize }
+}
+
+fn neighbourhood<F>(input: &Image, channels_out: usize, wraps_v: bool, f: F) -> Image
 where
     F: Fn(usize, usize, usize, &[f32], &[f32], &[f32], &mut [f32]) + Sync,
 {
     let (w, h, ch) = (input.width, input.height, input.channels);
     let mut out = Image::new(w, h, channels_out);
     out.data.par_chunks_mut(w * channels_out).enumerate().for_each(|(y, row)| {
-        let up = input.row((y + h - 1) % h);
+        let up = input.row(edge_row(y as isize - 1, h, wraps_v));
         let here = input.row(y);
-        let down = input.row((y + 1) % h);
+        let down = input.row(edge_row(y as isize + 1, h, wraps_v));
         for (x, px) in row.chunks_exact_mut(channels_out).enumerate() {
             let (l, r) = (((x + w - 1) % w) * ch, ((x + 1) % w) * ch);
             f(x * ch, l, r, up, here, down, px);
@@ -319,10 +377,10 @@ where
 /// step edge blurred by a Gaussian of `edge_sigma` (normalised units) peaks at 1: the peak
 /// slope of such an edge is 1 / (sqrt(2π) σ) per pixel and Sobel's x kernel weighs the
 /// central difference by 4 (so 8 × slope per pixel).
-pub fn sobel(input: &Image, edge_sigma: f32) -> Image {
+pub fn sobel(input: &Image, edge_sigma: f32, wraps_v: bool) -> Image {
     let sigma_px = (edge_sigma * input.width as f32).max(0.5);
     let norm = (2.0 * std::f32::consts::PI).sqrt() * sigma_px / 8.0;
-    neighbourhood(input, 1, |c, l, r, up, here, down, out| {
+    neighbourhood(input, 1, wraps_v, |c, l, r, up, here, down, out| {
         let gx = (up[r] + 2.0 * here[r] + down[r]) - (up[l] + 2.0 * here[l] + down[l]);
         let gy = (down[l] + 2.0 * down[c] + down[r]) - (up[l] + 2.0 * up[c] + up[r]);
         out[0] = ((gx * gx + gy * gy).sqrt() * norm).min(1.0);
@@ -334,16 +392,19 @@ pub use crate::material::NormalConvention;
 /// Tangent-space normal (unit XYZ in [-1, 1]) from a height map by central differences.
 /// `slope_per_unit_height` is the surface rise, in texture widths, of the full height range
 /// (so the result does not change with resolution).
-/// `v_extent` is the image's height in texture widths (1 for the square tile, the body's
-/// length for the body layout), so that both axes are differentiated in the same unit.
+/// `v_extent` is the texture's height in texture widths (1 for the square tile, the body's
+/// length for the body layout) and `full_height` its rows (a strip's texture's), so that both
+/// axes are differentiated in the same unit.
 pub fn height_to_normal(
     height: &Image,
     slope_per_unit_height: f32,
     convention: NormalConvention,
     v_extent: f32,
+    full_height: usize,
+    wraps_v: bool,
 ) -> Image {
-    let (w, h) = (height.width as f32, height.height as f32 / v_extent);
-    neighbourhood(height, 3, |c, l, r, up, here, down, out| {
+    let (w, h) = (height.width as f32, full_height as f32 / v_extent);
+    neighbourhood(height, 3, wraps_v, |c, l, r, up, here, down, out| {
         // dh/du with u in texture widths: (h[x+1] - h[x-1]) / (2 / w).
         let dhdx = (here[r] - here[l]) * 0.5 * w;
         let dhdy = (down[c] - up[c]) * 0.5 * h;
@@ -368,7 +429,7 @@ mod tests {
     fn blur_preserves_mean_and_wraps() {
         let img = Image::gray_from_fn(64, 32, |u, _| if u < 0.1 { 1.0 } else { 0.0 });
         let mean = |i: &Image| i.data.iter().sum::<f32>() / i.data.len() as f32;
-        let blurred = blur(&img, 0.05);
+        let blurred = blur(&img, 0.05, true);
         assert!((mean(&img) - mean(&blurred)).abs() < 1e-4);
         // The bright band at the left edge bleeds across the seam to the right edge.
         assert!(blurred.data[63] > 0.05);
@@ -383,8 +444,8 @@ mod tests {
             impulse.data[y * 256] = 1.0;
         }
         for sigma_px in [2.5f32, 6.0, 17.0] {
-            let approx = blur(&impulse, sigma_px / 256.0);
-            let exact = gaussian_blur(&impulse, sigma_px);
+            let approx = blur(&impulse, sigma_px / 256.0, true);
+            let exact = gaussian_blur(&impulse, sigma_px, true);
             let row = |img: &Image| img.row(2).to_vec();
             let (a, e) = (row(&approx), row(&exact));
             let variance = |r: &[f32]| {
@@ -408,7 +469,7 @@ mod tests {
     fn sobel_of_blurred_step_peaks_near_one() {
         let step = Image::gray_from_fn(256, 8, |u, _| if (0.25..0.75).contains(&u) { 1.0 } else { 0.0 });
         let sigma = 0.02;
-        let edges = sobel(&blur(&step, sigma), sigma);
+        let edges = sobel(&blur(&step, sigma, true), sigma, true);
         let peak = edges.data.iter().cloned().fold(0.0, f32::max);
         assert!((peak - 1.0).abs() < 0.1, "peak {peak}");
     }
@@ -416,10 +477,10 @@ mod tests {
     #[test]
     fn normals_are_unit_and_flat_height_points_up() {
         let flat = Image::new(16, 16, 1);
-        let n = height_to_normal(&flat, 1.0, NormalConvention::OpenGl, 1.0);
+        let n = height_to_normal(&flat, 1.0, NormalConvention::OpenGl, 1.0, flat.height, true);
         assert!(n.data.chunks(3).all(|p| p == [0.0, 0.0, 1.0]));
         let ramp = Image::gray_from_fn(32, 32, |u, v| (u * std::f32::consts::TAU).sin() * 0.1 + v * 0.0);
-        let n = height_to_normal(&ramp, 1.0, NormalConvention::OpenGl, 1.0);
+        let n = height_to_normal(&ramp, 1.0, NormalConvention::OpenGl, 1.0, ramp.height, true);
         for p in n.data.chunks(3) {
             assert!(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs() < 1e-5);
         }
@@ -429,8 +490,8 @@ mod tests {
     fn opengl_green_points_up_the_image_on_a_slope_rising_down() {
         // Height grows with image y (downwards): the surface faces up the image, +Y in OpenGL.
         let ramp = Image::gray_from_fn(16, 16, |_, v| (v * std::f32::consts::TAU).sin());
-        let gl = height_to_normal(&ramp, 0.1, NormalConvention::OpenGl, 1.0);
-        let dx = height_to_normal(&ramp, 0.1, NormalConvention::DirectX, 1.0);
+        let gl = height_to_normal(&ramp, 0.1, NormalConvention::OpenGl, 1.0, ramp.height, true);
+        let dx = height_to_normal(&ramp, 0.1, NormalConvention::DirectX, 1.0, ramp.height, true);
         let i = (16 + 3) * 3; // pixel (3, 1): near v = 0 the slope is positive
         assert!(gl.data[i + 1] > 0.0 && dx.data[i + 1] < 0.0);
     }

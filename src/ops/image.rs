@@ -6,6 +6,38 @@
 
 use rayon::prelude::*;
 
+/// The rows of the texture an image holds: all of them (the tile, a preview) or a strip of a
+/// long body atlas evaluated a piece at a time (`generate::strips`). Generators place their
+/// pixels by the texture's full height, so a strip holds exactly the rows the whole texture
+/// would; filters that look at neighbours see only the strip, which is why strips are
+/// evaluated with a margin (`Graph::row_reach`) and cropped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Frame {
+    pub width: usize,
+    /// Rows in this image.
+    pub height: usize,
+    /// Rows in the whole texture.
+    pub full_height: usize,
+    /// The texture row of this image's first row.
+    pub row0: usize,
+    /// The texture repeats along v (the tile); a body atlas does not (its first and last
+    /// rows are the snout and the tail tip), and filters then clamp at its ends.
+    pub wraps_v: bool,
+}
+
+impl Frame {
+    /// The whole texture.
+    pub fn whole(width: usize, height: usize) -> Frame {
+        Frame { width, height, full_height: height, row0: 0, wraps_v: true }
+    }
+
+    /// Texture v of the centre of this image's row `y`.
+    #[inline]
+    pub fn v(&self, y: usize) -> f32 {
+        ((self.row0 + y) as f32 + 0.5) * (1.0 / self.full_height as f32)
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Image {
     pub width: usize,
@@ -34,6 +66,31 @@ impl Image {
             }
         });
         image
+    }
+
+    /// `from_fn` over the rows of `frame`: v is the texture's, not the image's.
+    pub fn from_fn_in<F>(frame: Frame, channels: usize, pixel: F) -> Self
+    where
+        F: Fn(f32, f32, &mut [f32]) + Sync,
+    {
+        let (width, height) = (frame.width, frame.height);
+        let mut image = Image::new(width, height, channels);
+        let (inv_w, inv_h) = (1.0 / width as f32, 1.0 / frame.full_height as f32);
+        image.data.par_chunks_mut(width * channels).enumerate().for_each(|(y, row)| {
+            let v = ((frame.row0 + y) as f32 + 0.5) * inv_h;
+            for (x, out) in row.chunks_exact_mut(channels).enumerate() {
+                pixel((x as f32 + 0.5) * inv_w, v, out);
+            }
+        });
+        image
+    }
+
+    /// A single-channel `from_fn_in`.
+    pub fn gray_from_fn_in<F>(frame: Frame, value: F) -> Self
+    where
+        F: Fn(f32, f32) -> f32 + Sync,
+    {
+        Image::from_fn_in(frame, 1, |u, v, out| out[0] = value(u, v))
     }
 
     /// A single-channel image from `value(u, v)` at pixel centres.

@@ -11,4 +11,4 @@ pub mod scale_colour;
 pub mod scales;
 pub mod shapes;
 
-pub use image::Image;
+pub use image::{Frame, Image};

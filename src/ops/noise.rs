@@ -15,7 +15,7 @@ use std::f32::consts::FRAC_1_SQRT_2;
 use noise::permutationtable::{NoiseHasher, PermutationTable};
 
 use super::hash;
-use super::image::{Image, floor_i32};
+use super::image::{Frame, Image, floor_i32};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum NoiseKind {
@@ -210,16 +210,39 @@ impl NoiseSampler {
 /// resolution, and every output size sees the same samples (resolution independence).
 pub const SAMPLES_PER_CELL: u32 = 8;
 
-/// Renders fractal noise at `width` × `height`, sampling at most `SAMPLES_PER_CELL` per
-/// finest-octave cell and upsampling bilinearly (wrap-around) when that is coarser.
-pub fn render(noise: &FractalNoise, width: usize, height: usize) -> Image {
+/// Renders fractal noise over `frame`'s rows, sampling at most `SAMPLES_PER_CELL` per
+/// finest-octave cell and upsampling bilinearly (wrap-around) when that is coarser. A strip
+/// samples only the coarse rows its own rows interpolate between, so strips of a texture
+/// hold exactly the rows the whole texture would.
+pub fn render(noise: &FractalNoise, frame: Frame) -> Image {
+    let (width, height) = (frame.width, frame.full_height);
     let sampler = NoiseSampler::new(noise);
     let (pu, pv) = sampler.finest_periods();
     let (cw, ch) = ((pu * SAMPLES_PER_CELL) as usize, (pv * SAMPLES_PER_CELL) as usize);
     if cw >= width || ch >= height {
-        return Image::gray_from_fn(width, height, |u, v| sampler.sample(u, v));
+        return Image::gray_from_fn_in(frame, |u, v| sampler.sample(u, v));
     }
-    // Sample on a coarse grid whose points are at i / cw (not pixel centres), then interpolate.
-    let coarse = Image::gray_from_fn(cw, ch, |u, v| sampler.sample(u - 0.5 / cw as f32, v - 0.5 / ch as f32));
-    super::filters::resample_bilinear_wrapped(&coarse, width, height)
+    // Sample on a coarse grid whose points are at i / cw (not pixel centres), then interpolate:
+    // coarse row j holds v = j / ch, computed as the whole grid's `from_fn` would.
+    let (inv_cw, inv_ch) = (1.0 / cw as f32, 1.0 / ch as f32);
+    let coarse_row = |j: usize, out: &mut [f32]| {
+        let v = (j as f32 + 0.5) * inv_ch;
+        for (i, o) in out.iter_mut().enumerate() {
+            let u = (i as f32 + 0.5) * inv_cw;
+            *o = sampler.sample(u - 0.5 / cw as f32, v - 0.5 / ch as f32);
+        }
+    };
+    // The coarse rows this frame's rows interpolate between (wrapped), in order.
+    let first = coarse_index(frame.row0, height, ch);
+    let last = coarse_index(frame.row0 + frame.height - 1, height, ch) + 1;
+    let rows: Vec<usize> = (first..=last).map(|j| j % ch).collect();
+    let mut coarse = Image::new(cw, rows.len(), 1);
+    use rayon::prelude::*;
+    coarse.data.par_chunks_mut(cw).zip(&rows).for_each(|(out, &j)| coarse_row(j, out));
+    super::filters::resample_bilinear_rows(&coarse, width, frame, ch, first)
+}
+
+/// The coarse row at or above texture row `y` (`resample_bilinear_rows`' j0).
+fn coarse_index(y: usize, height: usize, coarse_height: usize) -> usize {
+    ((y as f32 + 0.5) / height as f32 * coarse_height as f32).floor() as usize
 }

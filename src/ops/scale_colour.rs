@@ -75,8 +75,9 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 
 impl ScaleColour {
     /// Applies the per-scale colour to `colour` (linear RGB) with the scale field `scales`.
-    pub fn apply(&self, colour: Image, scales: &Image) -> Image {
-        let (width, height) = (colour.width, colour.height);
+    /// `frame`: the rows of the texture the images hold.
+    pub fn apply(&self, colour: Image, scales: &Image, frame: super::image::Frame) -> Image {
+        let (width, height) = (colour.width, frame.full_height);
         let ch = colour.channels;
         let sc = scales.channels;
         let k = self.channels;
@@ -87,7 +88,7 @@ impl ScaleColour {
         let mut out = colour;
         use rayon::prelude::*;
         out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
-            let v = (y as f32 + 0.5) / height as f32;
+            let v = ((frame.row0 + y) as f32 + 0.5) / height as f32;
             let field = scales.row(y);
             // The scale's second random number, hashed once per run of pixels of one scale
             // (a scale spans many pixels of a row), not once per pixel.

@@ -416,6 +416,13 @@ impl ScaleField {
         reach.max(1.0)
     }
 
+    /// A scale centre's v: wrapped into [0, 1) on the tile, as it is on a body atlas (whose
+    /// snout and tail tip are not neighbours; a centre just beyond an end stays there).
+    #[inline]
+    fn wrap_v(&self, v: f32) -> f32 {
+        if self.body.is_some() { v } else { v.rem_euclid(1.0) }
+    }
+
     /// Position of `channel` among the outputs.
     pub fn output_index(&self, channel: usize) -> Option<usize> {
         self.outputs.iter().position(|c| *c == channel)
@@ -423,6 +430,11 @@ impl ScaleField {
 
     /// Evaluates the scale field at every pixel: one image channel per entry of `outputs`.
     pub fn render(&self, width: usize, height: usize) -> Image {
+        self.render_in(super::image::Frame::whole(width, height))
+    }
+
+    /// `render` over the rows of `frame` (a strip of a long texture).
+    pub fn render_in(&self, frame: super::image::Frame) -> Image {
         let lattice = self.lattice();
         let table = CellTable::new(self, &lattice);
         let geo = Geometry::new(self.shape, 0.5 * lattice.aspect);
@@ -431,14 +443,14 @@ impl ScaleField {
             Some(b) if b.head_shields => b.shields(),
             _ => Vec::new(),
         };
-        Image::from_fn(width, height, self.outputs.len(), |u, v, out| {
+        Image::from_fn_in(frame, self.outputs.len(), |u, v, out| {
             let mut all = [0.0f32; channel::COUNT];
             let dist_belly = u.min(1.0 - u);
             let plate = self.body.as_ref().map(|b| (b, b.plate_at(v)));
             if !shields.is_empty() && self.shield_pixel(&lattice, &shields, u, v, &mut all) {
                 // A head shield.
             } else if let Some((body, Some(plate))) = plate.filter(|_| dist_belly < belly_half) {
-                self.body_plate_pixel(&lattice, body, plate.index as f32 + plate.along, plate, dist_belly, u, &mut all);
+                self.body_plate_pixel(&lattice, body, plate.index as f32 + plate.along, dist_belly, u, &mut all);
             } else if dist_belly < belly_half && plate.is_none() {
                 self.ventral_pixel(&lattice, dist_belly, v, &mut all);
             } else if self.shape == ScaleShape::Hexagon {
@@ -538,7 +550,7 @@ impl ScaleField {
             half_len: geo.b,
             random,
             centre_u: lattice.u_of(cx),
-            centre_v: ((cy + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+            centre_v: self.wrap_v((cy + ROW_PHASE) / lattice.rows_v as f32),
             row: lattice.row_of(column),
         };
         self.write_scale(Some(top), height, self.keel_height, out);
@@ -589,7 +601,7 @@ impl ScaleField {
             half_len,
             random: c1.2,
             centre_u: lattice.u_of(c1.0),
-            centre_v: ((c1.1 / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+            centre_v: self.wrap_v((c1.1 / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32),
             row: lattice.row_of(columns[nearest]),
         };
         let soft = self.edge_softness.max(1e-4);
@@ -648,8 +660,7 @@ impl ScaleField {
     fn ventral_pixel(&self, lattice: &Lattice, dist_belly: f32, v: f32, out: &mut [f32]) {
         let rows = PlateRows {
             y: v * lattice.rows_v as f32 - ROW_PHASE,
-            aspect: lattice.aspect,
-            divided: false,
+            plate: &|_| Some((lattice.aspect, false)),
             centre_v: &|r| ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
             identity: &|r| r.rem_euclid(lattice.rows_v),
         };
@@ -657,22 +668,24 @@ impl ScaleField {
     }
 
     /// Ventral plates and subcaudals of the body layout, counted (`BodyPlan::plate_at`);
-    /// subcaudals are divided at the midline, as in most snakes.
-    #[allow(clippy::too_many_arguments)]
-    fn body_plate_pixel(
-        &self,
-        lattice: &Lattice,
-        body: &BodyPlan,
-        y: f32,
-        plate: super::body::PlatePosition,
-        dist_belly: f32,
-        u: f32,
-        out: &mut [f32],
-    ) {
-        // Plate length over an ordinary column's width (both in circumferences).
-        let aspect = plate.length_v * body.length / lattice.bounds[1];
-        let rows =
-            PlateRows { y, aspect, divided: plate.subcaudal, centre_v: &|r| body.plate_centre_v(r), identity: &|r| r };
+    /// subcaudals divided at the midline where the preset says so (most snakes). `y` is the
+    /// pixel's plate coordinate.
+    fn body_plate_pixel(&self, lattice: &Lattice, body: &BodyPlan, y: f32, dist_belly: f32, u: f32, out: &mut [f32]) {
+        let total = (body.ventrals + body.subcaudals) as i32;
+        let plate = |r: i32| {
+            if !(0..total).contains(&r) {
+                return None;
+            }
+            let subcaudal = r >= body.ventrals as i32;
+            let length_v = if subcaudal {
+                (1.0 - body.vent) / body.subcaudals.max(1) as f32
+            } else {
+                (body.vent - body.head_end) / body.ventrals.max(1) as f32
+            };
+            // Plate length over an ordinary column's width (both in circumferences).
+            Some((length_v * body.length / lattice.bounds[1], subcaudal && body.divided_subcaudals))
+        };
+        let rows = PlateRows { y, plate: &plate, centre_v: &|r| body.plate_centre_v(r), identity: &|r| r };
         self.plate_pixel(lattice, &rows, dist_belly, if u < 0.5 { 0 } else { 1 }, out);
     }
 
@@ -683,24 +696,25 @@ impl ScaleField {
         let half_band = lattice.belly_width() * 0.5;
         // Distances in dorsal scale widths, the unit of `edge_softness` (a plate column is
         // one ordinary column wide).
-        let mut to_side = (half_band - dist_belly) / lattice.bounds[1];
-        if rows.divided {
-            // Paired plates meet at the midline (u = 0).
-            to_side = to_side.min(dist_belly / lattice.bounds[1]);
-        }
+        let to_side = (half_band - dist_belly) / lattice.bounds[1];
+        // Paired plates meet at the midline (u = 0).
+        let to_side_divided = to_side.min(dist_belly / lattice.bounds[1]);
         let y = rows.y;
         let r0 = floor_i32(y);
         let half_len = 0.5 * self.size.max(0.5);
         // The most anterior plate covering the pixel lies on top (its free posterior edge over
         // the next plate, as the dorsal scales); the others are the surface underneath.
-        let mut top: Option<(i32, f32, f32)> = None; // (row, inside, profile)
+        let mut top: Option<(i32, f32, f32, f32, bool)> = None; // (row, inside, profile, aspect, divided)
         let mut under_height = 0.0f32;
         // Plates are gently convex across the belly.
         let across = (dist_belly / half_band).min(1.0);
         let dome = 0.06 * (1.0 - across * across);
         for r in r0 - 1..=r0 + 1 {
-            let to_end = (half_len - (y - (r as f32 + 0.5)).abs()) * rows.aspect;
-            let inside = to_side.min(to_end);
+            // Each plate with its own length and division (a ventral overhanging the vent
+            // stays a ventral); none before the first or after the last.
+            let Some((aspect, divided)) = (rows.plate)(r) else { continue };
+            let to_end = (half_len - (y - (r as f32 + 0.5)).abs()) * aspect;
+            let inside = if divided { to_side_divided } else { to_side }.min(to_end);
             if inside <= 0.0 {
                 continue;
             }
@@ -708,20 +722,20 @@ impl ScaleField {
             let profile = 0.45 + 0.1 + dome + 0.3 * self.imbrication * along;
             match top {
                 Some(_) => under_height = under_height.max(profile),
-                None => top = Some((r, inside, profile)),
+                None => top = Some((r, inside, profile, aspect, divided)),
             }
         }
-        let best = top.map(|(r, inside, profile)| {
+        let best = top.map(|(r, inside, profile, aspect, divided)| {
             let h = free_edge(profile, inside / soft, under_height, self.imbrication);
             let id = (rows.identity)(r);
             let random =
-                if rows.divided { hash::unit(-2 - side, id, 4, self.seed) } else { hash::unit(-1, id, 4, self.seed) };
-            let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * rows.aspect;
+                if divided { hash::unit(-2 - side, id, 4, self.seed) } else { hash::unit(-1, id, 4, self.seed) };
+            let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * aspect;
             let cand = Candidate {
                 inside,
                 x: dist_belly / half_band * 0.5,
                 y: ly,
-                half_len: 0.5 * rows.aspect,
+                half_len: 0.5 * aspect,
                 random,
                 centre_u: 0.0,
                 centre_v: (rows.centre_v)(r),
@@ -777,10 +791,9 @@ impl ScaleField {
 struct PlateRows<'a> {
     /// Plate coordinate of the pixel: plate r spans [r, r + 1).
     y: f32,
-    /// Plate length over an ordinary column's width.
-    aspect: f32,
-    /// Divided at the midline (subcaudals).
-    divided: bool,
+    /// Plate r's length over an ordinary column's width, and whether it is divided at the
+    /// midline (subcaudals); None where there is no plate r.
+    plate: &'a dyn Fn(i32) -> Option<(f32, bool)>,
     /// v of plate r's centre, for the scale field's CENTRE_V.
     centre_v: &'a dyn Fn(i32) -> f32,
     /// Plate r's identity for its random number.

@@ -9,7 +9,7 @@
 use tiny_skia::{FillRule, Mask, PathBuilder, Transform};
 
 use super::hash;
-use super::image::Image;
+use super::image::{Frame, Image};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Axis {
@@ -19,11 +19,11 @@ pub enum Axis {
     V,
 }
 
-/// A smooth periodic band profile over `n` samples: coverage of bands centred on `centres`
-/// (fractions of the period) with half-width `half_width` and edge width `softness`.
-fn band_profile(n: usize, centres: &[f32], half_width: f32, softness: f32) -> Vec<f32> {
+/// A smooth periodic band profile over samples `range` of `n`: coverage of bands centred on
+/// `centres` (fractions of the period) with half-width `half_width` and edge width `softness`.
+fn band_profile(n: usize, range: std::ops::Range<usize>, centres: &[f32], half_width: f32, softness: f32) -> Vec<f32> {
     let soft = softness.max(0.5 / n as f32);
-    (0..n)
+    range
         .map(|i| {
             let t = (i as f32 + 0.5) / n as f32;
             centres.iter().fold(0.0f32, |acc, &c| {
@@ -38,17 +38,19 @@ fn band_profile(n: usize, centres: &[f32], half_width: f32, softness: f32) -> Ve
 
 /// Coverage of bands along one axis with smooth edges; `centres`, `half_width` and
 /// `softness` are fractions of the image along that axis.
-pub fn bands(width: usize, height: usize, axis: Axis, centres: &[f32], half_width: f32, softness: f32) -> Image {
+pub fn bands(frame: Frame, axis: Axis, centres: &[f32], half_width: f32, softness: f32) -> Image {
+    let (width, height) = (frame.width, frame.height);
     let mut image = Image::new(width, height, 1);
     match axis {
         Axis::U => {
-            let profile = band_profile(width, centres, half_width, softness);
+            let profile = band_profile(width, 0..width, centres, half_width, softness);
             for row in image.data.chunks_exact_mut(width) {
                 row.copy_from_slice(&profile);
             }
         }
         Axis::V => {
-            let profile = band_profile(height, centres, half_width, softness);
+            let rows = frame.row0..frame.row0 + height;
+            let profile = band_profile(frame.full_height, rows, centres, half_width, softness);
             for (row, value) in image.data.chunks_exact_mut(width).zip(profile) {
                 row.fill(value);
             }
@@ -78,8 +80,9 @@ pub struct SpotGrid {
 }
 
 /// Rasterises the spot grid into an anti-aliased coverage mask in [0, 1].
-pub fn spots(width: usize, height: usize, grid: &SpotGrid) -> Image {
-    let (w, h) = (width as f32, height as f32);
+pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
+    let (w, h) = (frame.width as f32, frame.full_height as f32);
+    let (top, bottom) = (frame.row0 as f32, (frame.row0 + frame.height) as f32);
     let mut pb = PathBuilder::new();
     let (across, along) = (grid.across.max(1), grid.along.max(1));
     for row in 0..along as i32 {
@@ -98,7 +101,7 @@ pub fn spots(width: usize, height: usize, grid: &SpotGrid) -> Image {
             for oy in [-1.0f32, 0.0, 1.0] {
                 for ox in [-1.0f32, 0.0, 1.0] {
                     let (x, y) = ((cu + ox) * w, (cv + oy) * h);
-                    if x + r_px >= 0.0 && x - r_px <= w && y + r_px >= 0.0 && y - r_px <= h {
+                    if x + r_px >= 0.0 && x - r_px <= w && y + r_px >= top && y - r_px <= bottom {
                         pb.push_circle(x, y, r_px.max(0.1));
                         if grid.hole > 0.0 {
                             // Even-odd filling turns the inner circle into a hole.
@@ -110,17 +113,20 @@ pub fn spots(width: usize, height: usize, grid: &SpotGrid) -> Image {
         }
     }
     // Even-odd: ring spots are a circle with its inner circle as a hole.
-    rasterise(width, height, pb, FillRule::EvenOdd)
+    rasterise(frame, pb, FillRule::EvenOdd)
 }
 
-/// Fills the path into an anti-aliased coverage mask in [0, 1] (all zero if there is
-/// nothing to fill or the size is unusable).
-fn rasterise(width: usize, height: usize, pb: PathBuilder, rule: FillRule) -> Image {
+/// Fills the path (in texture pixels) into an anti-aliased coverage mask in [0, 1] over the
+/// rows of `frame` (all zero if there is nothing to fill or the size is unusable).
+fn rasterise(frame: Frame, pb: PathBuilder, rule: FillRule) -> Image {
+    let (width, height) = (frame.width, frame.height);
     let mut out = Image::new(width, height, 1);
     let (Some(mut mask), Some(path)) = (Mask::new(width as u32, height as u32), pb.finish()) else {
         return out;
     };
-    mask.fill_path(&path, rule, true, Transform::identity());
+    let transform =
+        if frame.row0 == 0 { Transform::identity() } else { Transform::from_translate(0.0, -(frame.row0 as f32)) };
+    mask.fill_path(&path, rule, true, transform);
     for (o, &m) in out.data.iter_mut().zip(mask.data()) {
         *o = m as f32 / 255.0;
     }
@@ -175,8 +181,9 @@ pub struct Blotches {
 
 /// Rasterises blotches into an anti-aliased coverage mask (tiny-skia), wrapping along v
 /// and around u.
-pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
-    let (w, h) = (width as f32, height as f32);
+pub fn blotches(frame: Frame, b: &Blotches) -> Image {
+    let (w, h) = (frame.width as f32, frame.full_height as f32);
+    let (top, bottom) = (frame.row0 as f32, (frame.row0 + frame.height) as f32);
     let count = b.count.max(1);
     let spacing = (b.span.1 - b.span.0) * h / count as f32;
     let origin = b.span.0 * h;
@@ -187,7 +194,7 @@ pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
         for &(side, shift) in sides {
             zigzag(&mut pb, b, (0.5 + side * b.offset) * w, origin + (b.phase + shift) * spacing, spacing, w, h);
         }
-        return rasterise(width, height, pb, FillRule::Winding);
+        return rasterise(frame, pb, FillRule::Winding);
     }
     for i in 0..count as i32 {
         let jx = hash::signed(i, 0, 0, b.seed) * b.jitter * 0.05;
@@ -202,7 +209,7 @@ pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
                 let cy = origin + (i as f32 + 0.5 + jy + b.phase + shift) * spacing + copy_v * h;
                 for copy_u in [-1.0f32, 0.0, 1.0] {
                     let cx = cx + copy_u * w;
-                    if cy + hl < 0.0 || cy - hl > h || cx + hw < 0.0 || cx - hw > w {
+                    if cy + hl < top || cy - hl > bottom || cx + hw < 0.0 || cx - hw > w {
                         continue;
                     }
                     push_blotch(&mut pb, b.shape, cx, cy, hw, hl);
@@ -210,7 +217,7 @@ pub fn blotches(width: usize, height: usize, b: &Blotches) -> Image {
             }
         }
     }
-    rasterise(width, height, pb, FillRule::Winding)
+    rasterise(frame, pb, FillRule::Winding)
 }
 
 /// One blotch centred at (cx, cy) pixels with half-width `hw` and half-length `hl`.
@@ -335,33 +342,40 @@ pub struct BellyMarks {
     pub seed: u32,
 }
 
-pub fn belly_marks(width: usize, height: usize, marks: &BellyMarks) -> Image {
+pub fn belly_marks(frame: Frame, marks: &BellyMarks) -> Image {
+    let (width, height) = (frame.width, frame.full_height);
     let half = marks.belly_width * 0.5;
     let rows = marks.rows_v.max(1) as f32;
     let soft = marks.softness.max(0.5 / width.min(height) as f32);
     // Plate r spans y = v · rows − ROW_PHASE ∈ [r, r + 1); `along` runs 0 → 1 head to tail.
     let phase = super::scales::ROW_PHASE;
     let ramp = |distance_inside: f32| ((distance_inside - 0.3 * soft) / soft).clamp(0.0, 1.0);
-    Image::gray_from_fn(width, height, |u, v| {
+    Image::gray_from_fn_in(frame, |u, v| {
         let (side, d) = if u < 0.5 { (0, u) } else { (1, 1.0 - u) };
         if d > half {
             return 0.0;
         }
-        // (plate, position along it, its length in circumferences)
+        // (plate, position along it, its length in circumferences: None on the tile, whose
+        // plates are 1 / rows long, written as a division as it always was)
         let (plate, along, plate_len) = match &marks.body {
             None => {
                 let y = v * rows - phase;
                 let r = super::image::floor_i32(y);
-                (r.rem_euclid(marks.rows_v.max(1) as i32), y - r as f32, 1.0 / rows)
+                (r.rem_euclid(marks.rows_v.max(1) as i32), y - r as f32, None)
             }
             Some(body) => match body.plate_at(v) {
-                Some(p) => (p.index, p.along, p.length_v * body.length),
+                Some(p) => (p.index, p.along, Some(p.length_v * body.length)),
                 None => return 0.0,
             },
         };
+        // A length in plates, in circumferences.
+        let plates = |x: f32| match plate_len {
+            None => x / rows,
+            Some(len) => x * len,
+        };
         // Signed position across the band, −1 (one side's edge) .. 1 (the other's).
         let across = if side == 0 { d / half } else { -d / half };
-        let to_ends = along.min(1.0 - along) * plate_len;
+        let to_ends = plates(along.min(1.0 - along));
         match marks.kind {
             BellyMarkKind::Checkered => {
                 // By the wrapped plate index, so the plate across the v seam is one plate
@@ -380,9 +394,9 @@ pub fn belly_marks(width: usize, height: usize, marks: &BellyMarks) -> Image {
                 // (u = 0) and the band's edges.
                 let centre = 0.2 + 0.65 * super::hash::unit(plate, 0, 1, marks.seed);
                 let centre = if super::hash::unit(plate, 0, 2, marks.seed) < 0.5 { centre } else { -centre };
-                let (rx, ry) = (half / 6.0, 0.25 * plate_len);
+                let (rx, ry) = (half / 6.0, plates(0.25));
                 let dx = (across - centre) * half / rx;
-                let dy = (along - 0.5) * plate_len / ry;
+                let dy = plates(along - 0.5) / ry;
                 let r_norm = (dx * dx + dy * dy).sqrt();
                 ramp((1.0 - r_norm) * rx.min(ry))
             }
@@ -392,9 +406,9 @@ pub fn belly_marks(width: usize, height: usize, marks: &BellyMarks) -> Image {
                 }
                 // A half-disc resting on the plate's posterior edge, on alternate sides.
                 let centre = if plate % 2 == 0 { 0.5 } else { -0.5 };
-                let radius = (0.45 * plate_len).min(half * 0.3);
+                let radius = plates(0.45).min(half * 0.3);
                 let dx = (across - centre) * half;
-                let dy = (1.0 - along) * plate_len;
+                let dy = plates(1.0 - along);
                 ramp(radius - (dx * dx + dy * dy).sqrt())
             }
             BellyMarkKind::MedianStripe => ramp(marks.amount * half - d),

@@ -606,10 +606,12 @@ pub struct Body {
     pub neck_fraction: f64,
     /// Tail (vent to tip) over total length.
     pub tail_fraction: f64,
-    /// Ventral plates from the neck to the vent.
+    /// Ventral plates from the end of the head to the vent.
     pub ventrals: u32,
     /// Subcaudal plates (pairs, where divided) from the vent to the tip.
     pub subcaudals: u32,
+    /// Subcaudals in pairs, divided at the midline (most snakes), or single (kraits, boas).
+    pub divided_subcaudals: bool,
     pub head_scales: HeadScales,
     /// The colour the back shifts to toward the tail (none: no shift).
     pub tail_color: Option<Srgb8>,
@@ -636,6 +638,7 @@ impl Default for Body {
             tail_fraction: 0.18,
             ventrals: 200,
             subcaudals: 60,
+            divided_subcaudals: true,
             head_scales: HeadScales::Shields,
             tail_color: None,
             tail_shift_start: 0.5,

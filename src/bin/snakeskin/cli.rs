@@ -88,7 +88,9 @@ pub enum Command {
         /// Output PNG file.
         #[arg(short, long, value_name = "FILE.png")]
         out: PathBuf,
-        /// Tile size in pixels (colour map tile × tile, render 2·tile × tile).
+        /// Tile size in pixels (colour map tile × tile, render 2·tile × tile; with --layout
+        /// body: the strip's height, one circumference, the strip length·tile long, the
+        /// render 4·tile × 2·tile).
         #[arg(long, default_value_t = 224, value_parser = clap::value_parser!(u32).range(64..=1024))]
         tile: u32,
         /// Cells per row.
@@ -141,7 +143,7 @@ pub struct GenerateArgs {
     #[arg(short, long, default_value = ".", value_name = "DIR")]
     pub out: PathBuf,
     /// Width of every map in pixels (16 to 16384); the tile is square, a body atlas is
-    /// `body.length` widths tall.
+    /// `body.length` widths tall (at most 65535 rows: 5461 wide at the default length 12).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(16..=16384))]
     pub size: u64,
     /// Normal map convention: opengl (+Y up, glTF/Blender) or directx (+Y down, Unreal).
@@ -149,7 +151,8 @@ pub struct GenerateArgs {
     pub normal_convention: Convention,
     /// What the set covers: tile (a square that repeats both ways) or body (the whole
     /// snake, snout at the top, tail tip at the bottom, with the preset's [body] counts,
-    /// head shields and marks, and tail; u still wraps round the body).
+    /// head shields and marks, and tail; u still wraps round the body, v does not).
+    /// A body atlas is generated a strip at a time: memory does not grow with its length.
     #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
     pub layout: LayoutArg,
     /// Print per-node evaluations, time and buffer size after the run.

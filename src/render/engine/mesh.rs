@@ -73,10 +73,22 @@ impl BodyShape {
     /// head still has several.
     pub fn for_atlas(plan: &BodyPlan) -> BodyShape {
         let base = BodyShape { rings: 1200, atlas: Some(*plan), ..BodyShape::default() };
-        let n = 2000;
-        let arc: f32 =
-            (1..=n).map(|i| (base.centre(i as f32 / n as f32) - base.centre((i - 1) as f32 / n as f32)).length()).sum();
-        BodyShape { radius: arc / (2.0 * std::f32::consts::PI * plan.length.max(1.0)), ..base }
+        let arc = *base.arc_table(2000).last().expect("arc table");
+        // The cross-section is an ellipse of semi-axes r and flatten · r: its perimeter
+        // (Ramanujan's approximation) is the circumference one texture width spans.
+        let (a, b) = (1.0, base.flatten);
+        let perimeter = std::f32::consts::PI * (3.0 * (a + b) - ((3.0 * a + b) * (a + 3.0 * b)).sqrt());
+        BodyShape { radius: arc / (perimeter * plan.length.max(1.0)), ..base }
+    }
+
+    /// Arc length of the centre line from the snout to s = i / n, i = 0 ..= n.
+    fn arc_table(&self, n: usize) -> Vec<f32> {
+        let mut arc = vec![0.0f32; n + 1];
+        for i in 1..=n {
+            let (a, b) = (i as f32 - 1.0, i as f32);
+            arc[i] = arc[i - 1] + (self.centre(b / n as f32) - self.centre(a / n as f32)).length();
+        }
+        arc
     }
 
     /// Centre line at s ∈ [0, 1] (0 = snout), lying on the ground plane y = radius.
@@ -119,12 +131,14 @@ impl BodyShape {
     }
 
     /// A point on the surface at body parameter s and around-angle u (0 = belly, 0.5 = back).
-    fn surface(&self, s: f32, u: f32) -> (Vec3, Vec3) {
+    /// `along`: the body's shape at s (`radius_at`'s parameter): s itself for the tile's
+    /// body, the arc-length fraction for an atlas (whose regions are placed by length).
+    fn surface(&self, s: f32, u: f32, along: &dyn Fn(f32) -> f32) -> (Vec3, Vec3) {
         let c = self.centre(s);
         let ahead = (self.centre((s + 1e-3).min(1.0)) - self.centre((s - 1e-3).max(0.0))).normalize();
         let right = ahead.cross(Vec3::Y).normalize();
         let up = right.cross(ahead);
-        let r = self.radius_at(s);
+        let r = self.radius_at(along(s));
         let phi = 2.0 * std::f32::consts::PI * u;
         let lift = Vec3::Y * self.radius * self.flatten;
         let offset = up * (-phi.cos() * r * self.flatten) + right * (phi.sin() * r);
@@ -135,11 +149,20 @@ impl BodyShape {
     pub fn mesh(&self) -> Mesh {
         let (rings, segments) = (self.rings.max(4), self.segments.max(3));
         // Arc length along the centre line at each ring gives v.
-        let mut arc = vec![0.0f32; rings + 1];
-        for i in 1..=rings {
-            let (a, b) = (i as f32 - 1.0, i as f32);
-            arc[i] = arc[i - 1] + (self.centre(b / rings as f32) - self.centre(a / rings as f32)).length();
-        }
+        let arc = self.arc_table(rings);
+        // An atlas places its regions by length along the body (its v), so the body's shape
+        // is taken at the arc fraction too, not at the curve parameter (on the S-curve they
+        // differ by up to a fifth of the head's length).
+        let fine = if self.atlas.is_some() { self.arc_table(4 * rings) } else { Vec::new() };
+        let along = |s: f32| -> f32 {
+            if fine.is_empty() {
+                return s;
+            }
+            let x = s.clamp(0.0, 1.0) * (fine.len() - 1) as f32;
+            let i = (x as usize).min(fine.len() - 2);
+            let t = x - i as f32;
+            (fine[i] + (fine[i + 1] - fine[i]) * t) / fine[fine.len() - 1]
+        };
         // The tile repeats every circumference; an atlas spans the whole length once.
         let repeat = if self.atlas.is_some() { arc[rings] } else { self.texture_length() };
         let mut vertices = Vec::with_capacity((rings + 1) * (segments + 1));
@@ -148,10 +171,10 @@ impl BodyShape {
             let s = i as f32 / rings as f32;
             for j in 0..=segments {
                 let u = j as f32 / segments as f32;
-                let (p, centre) = self.surface(s, u);
-                let dpdu = self.surface(s, u + du).0 - self.surface(s, u - du).0;
+                let (p, centre) = self.surface(s, u, &along);
+                let dpdu = self.surface(s, u + du, &along).0 - self.surface(s, u - du, &along).0;
                 let (s0, s1) = ((s - ds).max(0.0), (s + ds).min(1.0));
-                let dpds = self.surface(s1, u).0 - self.surface(s0, u).0;
+                let dpds = self.surface(s1, u, &along).0 - self.surface(s0, u, &along).0;
                 let outward = p - centre;
                 let mut normal = dpdu.cross(dpds).normalize_or_zero();
                 if normal == Vec3::ZERO {

@@ -33,11 +33,15 @@ pub fn material_maps_in(loaded: &LoadedPreset, map_size: usize, layout: Layout) 
     packed(&evaluation.maps, loaded, layout)
 }
 
-/// Width and height of the preview's maps (`material_maps_in`).
-fn map_dimensions(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> (usize, usize) {
+/// Width and height of the preview's maps (`material_maps_in`): `map_size` wide, or the
+/// widest that keeps a body atlas within `MAX_TEXTURE_SIDE` rows.
+pub fn map_dimensions(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> (usize, usize) {
     let mut width = map_size;
-    while layout.height(&loaded.preset, width) > MAX_TEXTURE_SIDE && width > 16 {
-        width /= 2;
+    if layout.height(&loaded.preset, width) > MAX_TEXTURE_SIDE {
+        width = ((MAX_TEXTURE_SIDE as f64 / loaded.preset.body.length).floor() as usize).max(16);
+        while layout.height(&loaded.preset, width) > MAX_TEXTURE_SIDE && width > 16 {
+            width -= 1;
+        }
     }
     (width, layout.height(&loaded.preset, width))
 }

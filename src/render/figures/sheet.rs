@@ -154,7 +154,7 @@ pub fn render_body_sheet(
         progress(i, presets.len());
         let preset = &loaded.preset;
         let graph = build_graph(preset, options_body);
-        let (width, height) = (options.map_size, Layout::Body.height(preset, options.map_size));
+        let (width, height) = crate::render::engine::prepare::map_dimensions(loaded, options.map_size, Layout::Body);
         let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
         let mut maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
         maps.atlas = Some(body_plan(preset));
