@@ -376,7 +376,7 @@ fn the_contact_sheet_renders_every_preset() {
     let Some(gpu) = gpu_or_skip("the_contact_sheet_renders_every_preset") else { return };
     let renderer = Renderer::new(gpu);
     let tile = 64;
-    let options = SheetOptions { tile, columns: 4, map_size: 64 };
+    let options = SheetOptions { tile, columns: 4, map_size: 64, closeups: false };
     let calls = std::sync::atomic::AtomicUsize::new(0);
     let sheet = render_sheet(&renderer, options, &|_, _| {
         calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);

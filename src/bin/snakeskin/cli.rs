@@ -104,6 +104,12 @@ pub enum Command {
         /// is then the strip's height, one circumference).
         #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
         layout: LayoutArg,
+        /// With --layout body: only these species (comma-separated built-in names).
+        #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+        species: Vec<String>,
+        /// With --layout body: also a close-up of each species' head and tail.
+        #[arg(long)]
+        closeups: bool,
     },
     /// List or show the built-in species presets.
     Presets {

@@ -33,6 +33,22 @@ pub struct SheetOptions {
     pub tile: u32,
     pub columns: u32,
     pub map_size: usize,
+    /// Body sheet: also a close-up render of each species' head and of its tail.
+    pub closeups: bool,
+}
+
+/// Close-up cameras on a body atlas's snake (`BodyShape::for_atlas`): the head seen from
+/// above and the side, and the last part of the tail.
+pub fn head_and_tail_cameras(plan: &crate::ops::body::BodyPlan) -> [Camera; 2] {
+    let shape = crate::render::engine::mesh::BodyShape::for_atlas(plan);
+    let lift = glam::Vec3::Y * shape.radius * shape.flatten;
+    let head = shape.centre(0.5 * plan.head_end.max(0.01)) + lift;
+    let tail = shape.centre(1.0 - 0.5 * (1.0 - plan.vent)) + lift;
+    let distance = 16.0 * shape.radius;
+    [
+        Camera { target: head, yaw_deg: -60.0, pitch_deg: 45.0, distance, fov_y_deg: 35.0 },
+        Camera { target: tail, yaw_deg: 30.0, pitch_deg: 45.0, distance: 2.2 * distance, fov_y_deg: 35.0 },
+    ]
 }
 
 /// The camera for sheet renders: the mid-body, close enough to read the pattern.
@@ -133,9 +149,16 @@ pub fn render_sheet(
 pub fn render_body_sheet(
     renderer: &Renderer,
     options: SheetOptions,
+    species: &[String],
     progress: &dyn Fn(usize, usize),
 ) -> Result<RgbImage, Error> {
-    let presets = library::all();
+    let presets: Vec<(&str, &str)> = if species.is_empty() {
+        library::all().to_vec()
+    } else {
+        species.iter().map(|name| library::all().iter().find(|(n, _)| n == name).copied().ok_or_else(|| {
+            Error::Preview(format!("no built-in species {name}; `snakeskin presets list` shows them"))
+        })).collect::<Result<_, _>>()?
+    };
     let loaded: Vec<_> =
         presets.iter().map(|(name, _)| crate::preset::load(name, &[], None)).collect::<Result<_, _>>()?;
     let columns = options.columns.max(1);
@@ -145,7 +168,8 @@ pub fn render_body_sheet(
     let render_h = 2 * circumference;
     let render_w = 2 * render_h;
     let label_h = LABEL_HEIGHT + 8 * LABEL_SCALE + 6;
-    let (cell_w, cell_h) = (strip_w + render_w + 12, label_h + render_h + 8);
+    let closeups_w = if options.closeups { 2 * (render_h + 6) } else { 0 };
+    let (cell_w, cell_h) = (strip_w + render_w + closeups_w + 12, label_h + render_h + 8);
     let rows = (presets.len() as u32).div_ceil(columns);
     let mut sheet = RgbImage::from_pixel(cell_w * columns, cell_h * rows, BACKGROUND);
     let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
@@ -199,6 +223,15 @@ pub fn render_body_sheet(
         let strip_y = y0 + label_h + (render_h - circumference) / 2;
         imageops::replace(&mut sheet, &strip, (x0 + 6) as i64, strip_y as i64);
         imageops::replace(&mut sheet, &render, (x0 + strip_w + 12) as i64, (y0 + label_h) as i64);
+        if options.closeups {
+            for (k, camera) in head_and_tail_cameras(&body_plan(preset)).into_iter().enumerate() {
+                let settings = FrameSettings { camera, ..settings };
+                let close = renderer.render_image(&settings, &material, render_h, render_h)?;
+                let close = image::DynamicImage::ImageRgba8(close).into_rgb8();
+                let x = x0 + strip_w + 12 + render_w + 6 + k as u32 * (render_h + 6);
+                imageops::replace(&mut sheet, &close, x as i64, (y0 + label_h) as i64);
+            }
+        }
     }
     progress(presets.len(), presets.len());
     Ok(sheet)
@@ -220,11 +253,12 @@ pub fn write_sheet(
     path: &Path,
     options: SheetOptions,
     layout: Layout,
+    species: &[String],
     progress: &dyn Fn(usize, usize),
 ) -> Result<PathBuf, Error> {
     let sheet = match layout {
         Layout::Tile => render_sheet(renderer, options, progress)?,
-        Layout::Body => render_body_sheet(renderer, options, progress)?,
+        Layout::Body => render_body_sheet(renderer, options, species, progress)?,
     };
     let mut bytes = Vec::new();
     sheet

@@ -26,8 +26,14 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Gallery { out, tile, columns, closeups } => {
             gallery::run(&out, tile as usize, columns as usize, closeups.as_deref())
         }
-        Command::Sheet { out, tile, columns, map_size, layout } => {
-            sheet::run(&out, tile, columns, map_size as usize, layout.layout())
+        Command::Sheet { out, tile, columns, map_size, layout, species, closeups } => {
+            let options = snakeskin::render::figures::sheet::SheetOptions {
+                tile,
+                columns,
+                map_size: map_size as usize,
+                closeups,
+            };
+            sheet::run(&out, options, layout.layout(), &species)
         }
         Command::Presets { command } => presets::run(command),
     }

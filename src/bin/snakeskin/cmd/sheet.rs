@@ -9,11 +9,11 @@ use crate::progress::Progress;
 use snakeskin::render::Renderer;
 use snakeskin::render::figures::sheet::{SheetOptions, write_sheet};
 
-pub fn run(out: &Path, tile: u32, columns: u32, map_size: usize, layout: snakeskin::maps::Layout) -> Result<()> {
+pub fn run(out: &Path, options: SheetOptions, layout: snakeskin::maps::Layout, species: &[String]) -> Result<()> {
     ensure_parent_folder(out)?;
     let renderer = Renderer::headless()?;
     let bar = Progress::counting("{spinner} sheet [{bar:30}] {pos}/{len} species {elapsed}");
-    let written = write_sheet(&renderer, out, SheetOptions { tile, columns, map_size }, layout, &|done, total| {
+    let written = write_sheet(&renderer, out, options, layout, species, &|done, total| {
         bar.update(done, total)
     })?;
     bar.finish();
