@@ -284,11 +284,10 @@ pub fn snap_to_scales(
     })
 }
 
-/// `resample_bilinear_wrapped` for the rows of `frame` (width `width`), from the coarse
-/// rows `first`, `first + 1`, ... of a periodic grid `coarse_height` rows tall, of which
-/// `src` holds as many as the frame needs (row k of `src` is coarse row `first + k`,
-/// wrapped). For the whole texture this computes what `resample_bilinear_wrapped` does, with
-/// the same arithmetic.
+/// Bilinear resampling of a periodic grid whose sample (i, j) sits at (i / w, j / h), over
+/// the rows of `frame` (width `width`): `src` holds the coarse rows `first`, `first + 1`, ...
+/// of a grid `coarse_height` rows tall (row k of `src` is coarse row `first + k`, wrapped),
+/// as many as the frame's rows interpolate between.
 pub fn resample_bilinear_rows(src: &Image, width: usize, frame: Frame, coarse_height: usize, first: usize) -> Image {
     let (sw, ch) = (src.width, src.channels);
     let columns: Vec<(usize, usize, f32)> = (0..width)
@@ -305,35 +304,6 @@ pub fn resample_bilinear_rows(src: &Image, width: usize, frame: Frame, coarse_he
         let y0 = fy.floor();
         let k = y0 as usize - first;
         let (r0, r1, ty) = (src.row(k), src.row(k + 1), fy - y0);
-        for (x, &(i0, i1, tx)) in columns.iter().enumerate() {
-            for c in 0..ch {
-                let a = r0[i0 * ch + c] + (r0[i1 * ch + c] - r0[i0 * ch + c]) * tx;
-                let b = r1[i0 * ch + c] + (r1[i1 * ch + c] - r1[i0 * ch + c]) * tx;
-                row[x * ch + c] = a + (b - a) * ty;
-            }
-        }
-    });
-    out
-}
-
-/// Bilinear resampling of a periodic image whose sample (i, j) sits at (i / w, j / h).
-pub fn resample_bilinear_wrapped(src: &Image, width: usize, height: usize) -> Image {
-    let (sw, sh, ch) = (src.width, src.height, src.channels);
-    // Per column: the two source columns and the weight; no modulo in the pixel loop.
-    let columns: Vec<(usize, usize, f32)> = (0..width)
-        .map(|x| {
-            let fx = (x as f32 + 0.5) / width as f32 * sw as f32;
-            let x0 = fx.floor();
-            let i0 = (x0 as isize).rem_euclid(sw as isize) as usize;
-            (i0, (i0 + 1) % sw, fx - x0)
-        })
-        .collect();
-    let mut out = Image::new(width, height, ch);
-    out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
-        let fy = (y as f32 + 0.5) / height as f32 * sh as f32;
-        let y0 = fy.floor();
-        let j0 = (y0 as isize).rem_euclid(sh as isize) as usize;
-        let (r0, r1, ty) = (src.row(j0), src.row((j0 + 1) % sh), fy - y0);
         for (x, &(i0, i1, tx)) in columns.iter().enumerate() {
             for c in 0..ch {
                 let a = r0[i0 * ch + c] + (r0[i1 * ch + c] - r0[i0 * ch + c]) * tx;

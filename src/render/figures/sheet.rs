@@ -87,6 +87,19 @@ fn colour_tile(maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>, ti
     imageops::resize(&colour_image(maps), tile, tile, imageops::FilterType::Triangle)
 }
 
+/// The film LUT for `optics`, baked once per distinct stack (most species share the thesis'
+/// indices).
+fn lut_for<'a>(luts: &'a mut Vec<(crate::optics::film::Stack, Lut)>, optics: LayerOptics) -> &'a Lut {
+    let index = match luts.iter().position(|(s, _)| *s == optics.stack) {
+        Some(k) => k,
+        None => {
+            luts.push((optics.stack, Lut::bake_default(optics.stack)));
+            luts.len() - 1
+        }
+    };
+    &luts[index].1
+}
+
 /// Renders the contact sheet; `progress(done, total)` after each species.
 pub fn render_sheet(
     renderer: &Renderer,
@@ -106,15 +119,7 @@ pub fn render_sheet(
         let evaluation = evaluate(&graph, &MapKind::ALL, options.map_size, options.map_size, &|_, _| {});
         let maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
         let optics = LayerOptics::from_preset(&loaded.preset);
-        // Most species share the thesis' indices: bake each distinct stack once.
-        let lut_index = match luts.iter().position(|(s, _)| *s == optics.stack) {
-            Some(k) => k,
-            None => {
-                luts.push((optics.stack, Lut::bake_default(optics.stack)));
-                luts.len() - 1
-            }
-        };
-        let material = renderer.material(&maps, optics, &luts[lut_index].1, 1);
+        let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1);
         let settings = FrameSettings {
             camera: sheet_camera(),
             method: GpuFilmMethod::Lut,
@@ -155,9 +160,14 @@ pub fn render_body_sheet(
     let presets: Vec<(&str, &str)> = if species.is_empty() {
         library::all().to_vec()
     } else {
-        species.iter().map(|name| library::all().iter().find(|(n, _)| n == name).copied().ok_or_else(|| {
-            Error::Preview(format!("no built-in species {name}; `snakeskin presets list` shows them"))
-        })).collect::<Result<_, _>>()?
+        species
+            .iter()
+            .map(|name| {
+                library::all().iter().find(|(n, _)| n == name).copied().ok_or_else(|| {
+                    Error::Preview(format!("no built-in species {name}; `snakeskin presets list` shows them"))
+                })
+            })
+            .collect::<Result<_, _>>()?
     };
     let loaded: Vec<_> =
         presets.iter().map(|(name, _)| crate::preset::load(name, &[], None)).collect::<Result<_, _>>()?;
@@ -183,14 +193,7 @@ pub fn render_body_sheet(
         let mut maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
         maps.atlas = Some(body_plan(preset));
         let optics = LayerOptics::from_preset(preset);
-        let lut_index = match luts.iter().position(|(s, _)| *s == optics.stack) {
-            Some(k) => k,
-            None => {
-                luts.push((optics.stack, Lut::bake_default(optics.stack)));
-                luts.len() - 1
-            }
-        };
-        let material = renderer.material(&maps, optics, &luts[lut_index].1, 1);
+        let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1);
         let settings = FrameSettings {
             camera: Camera::framing(1),
             method: GpuFilmMethod::Lut,

@@ -13,9 +13,7 @@ pub fn run(out: &Path, options: SheetOptions, layout: snakeskin::maps::Layout, s
     ensure_parent_folder(out)?;
     let renderer = Renderer::headless()?;
     let bar = Progress::counting("{spinner} sheet [{bar:30}] {pos}/{len} species {elapsed}");
-    let written = write_sheet(&renderer, out, options, layout, species, &|done, total| {
-        bar.update(done, total)
-    })?;
+    let written = write_sheet(&renderer, out, options, layout, species, &|done, total| bar.update(done, total))?;
     bar.finish();
     println!("{}", path_line(&written));
     Ok(())
