@@ -89,7 +89,7 @@ fn colour_tile(maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>, ti
 
 /// The film LUT for `optics`, baked once per distinct stack (most species share the thesis'
 /// indices).
-fn lut_for<'a>(luts: &'a mut Vec<(crate::optics::film::Stack, Lut)>, optics: LayerOptics) -> &'a Lut {
+fn lut_for(luts: &mut Vec<(crate::optics::film::Stack, Lut)>, optics: LayerOptics) -> &Lut {
     let index = match luts.iter().position(|(s, _)| *s == optics.stack) {
         Some(k) => k,
         None => {
