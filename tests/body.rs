@@ -264,3 +264,41 @@ fn a_body_atlas_written_in_strips_equals_the_whole_atlas() {
         }
     }
 }
+
+/// Pixels nearer `mark` than any of `others` in the rows of `rows`.
+fn mark_pixels(colour: &Image, rows: std::ops::Range<usize>, mark: [f32; 3], others: &[[f32; 3]]) -> usize {
+    let w = colour.width;
+    rows.flat_map(|y| (0..w).map(move |x| (y, x)))
+        .filter(|(y, x)| {
+            let px = &colour.data[(y * w + x) * 3..(y * w + x) * 3 + 3];
+            let own = distance(px, mark);
+            others.iter().all(|o| own < distance(px, *o))
+        })
+        .count()
+}
+
+#[test]
+fn a_series_can_widen_toward_the_tail() {
+    // The last fifth of the trunk against the first: saddles drawn 3 × as wide at the vent
+    // cover far more; the same series without widening (the control) about the same.
+    let ratio = |widen: &str| {
+        let p = preset("boa-constrictor", &[("pattern.0.widen_to_tail", widen), ("body.tail_color", "\"#9a8a72\"")]);
+        let plan = body_plan(&p);
+        let colour = body_map(&p, MapKind::Color);
+        let layer = &p.pattern[0];
+        let others = other_colours(&p, layer.color);
+        let h = colour.height;
+        let trunk = plan.vent - plan.neck_end;
+        let first = rows_of(h, plan.neck_end, plan.neck_end + 0.2 * trunk);
+        let last = rows_of(h, plan.vent - 0.2 * trunk, plan.vent);
+        let (a, b) = (
+            mark_pixels(&colour, first, linear(layer.color), &others),
+            mark_pixels(&colour, last, linear(layer.color), &others),
+        );
+        b as f64 / a.max(1) as f64
+    };
+    let (plain, widened) = (ratio("1"), ratio("3"));
+    eprintln!("last fifth over first fifth of the trunk: {plain:.2} plain, {widened:.2} widened 3 ×");
+    assert!((0.7..1.4).contains(&plain), "without widening the ends match: {plain:.2}");
+    assert!(widened > 1.8, "widened 3 ×, the last fifth carries {widened:.2} × the first's mark");
+}

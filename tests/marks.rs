@@ -24,6 +24,7 @@ fn series(shape: BlotchShape, offset: f32, staggered: bool) -> Blotches {
         phase: 0.0,
         scale: 1.0,
         span: (0.0, 1.0),
+        widen: 1.0,
         seed: 11,
     }
 }

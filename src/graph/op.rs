@@ -294,10 +294,11 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             phase,
             scale,
             span,
+            widen,
             seed,
         }) => {
             (shape, count, staggered, seed).hash(h);
-            for x in [half_width, length, jitter, offset, phase, scale, &span.0, &span.1] {
+            for x in [half_width, length, jitter, offset, phase, scale, &span.0, &span.1, widen] {
                 float(h, *x);
             }
         }

@@ -280,10 +280,13 @@ fn blotches(s: &Shared, layer: &PatternLayer, seed: u32, scale: f32) -> Blotches
         PatternShape::Round | PatternShape::Ring => BlotchShape::Round,
     };
     let (count, span) = series(s, layer);
+    // Widening along a counted body series only: the tile has no tail to widen toward.
+    let widen = if s.body.is_some() && layer.count.is_some() { layer.widen_to_tail as f32 } else { 1.0 };
     Blotches {
         shape,
         count,
         span,
+        widen,
         half_width: layer.size as f32,
         length: layer.length as f32,
         jitter: 0.3,

@@ -176,6 +176,9 @@ pub struct Blotches {
     /// The stretch of v the `count` blotches are spread over, fractions of the image: (0, 1)
     /// for the tile; the trunk for a counted series of the body layout.
     pub span: (f32, f32),
+    /// Half-width of the last blotch of the span over the first's, growing linearly along it
+    /// (1: all alike; saddles that widen into bands toward the tail above 1).
+    pub widen: f32,
     pub seed: u32,
 }
 
@@ -200,7 +203,11 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
         let jx = hash::signed(i, 0, 0, b.seed) * b.jitter * 0.05;
         let jy = hash::signed(i, 0, 1, b.seed) * b.jitter * 0.2;
         let js = (1.0 + hash::signed(i, 0, 2, b.seed) * b.jitter * 0.3) * b.scale;
-        let hw = b.half_width * js * w;
+        let mut hw = b.half_width * js * w;
+        if b.widen != 1.0 {
+            let t = ((i as f32 + 0.5) / count as f32).clamp(0.0, 1.0);
+            hw *= 1.0 + (b.widen - 1.0) * t;
+        }
         let hl = 0.5 * b.length * js * spacing;
         for &(side, shift) in sides {
             // The mirrored series mirrors the jitter too, so a pair is symmetric.

@@ -335,6 +335,10 @@ pub struct PatternLayer {
     /// tile's `amount` per circumference continues over the whole body.
     #[serde(default)]
     pub count: Option<u32>,
+    /// Body layout, a counted blotch series: the last mark's half-width over the first's,
+    /// growing linearly along the body (saddles that widen into bands toward the tail).
+    #[serde(default = "PatternLayer::default_widen_to_tail")]
+    pub widen_to_tail: f64,
 }
 
 impl PatternLayer {
@@ -361,6 +365,9 @@ impl PatternLayer {
     }
     fn default_border_size() -> f64 {
         0.01
+    }
+    fn default_widen_to_tail() -> f64 {
+        1.0
     }
     fn default_length() -> f64 {
         0.6

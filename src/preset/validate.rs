@@ -67,6 +67,9 @@ pub mod ranges {
     pub const MARK_COUNT: (u32, u32) = (1, 200);
     pub const HEAD_MARK_SIZE: (f64, f64) = (0.3, 2.0);
     pub const MAX_HEAD_MARKS: usize = 16;
+    /// A counted series' last blotch over its first: a saddle of half-width 0.1 becomes a
+    /// band round the body at 5.
+    pub const WIDEN_TO_TAIL: (f64, f64) = (0.25, 6.0);
 }
 
 #[derive(Default)]
@@ -206,6 +209,7 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
         c.range(key("outline_size"), p.outline_size, OUTLINE_SIZE);
         c.range(key("edge_distortion"), p.edge_distortion, UNIT);
         c.range(key("opacity"), p.opacity, UNIT);
+        c.range(key("widen_to_tail"), p.widen_to_tail, WIDEN_TO_TAIL);
         if let Some(count) = p.count {
             c.int_range(&key("count"), count, MARK_COUNT);
             if !matches!(p.kind, PatternKind::Blotches | PatternKind::Rings) {
