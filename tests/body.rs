@@ -302,3 +302,57 @@ fn a_series_can_widen_toward_the_tail() {
     assert!((0.7..1.4).contains(&plain), "without widening the ends match: {plain:.2}");
     assert!(widened > 1.8, "widened 3 ×, the last fifth carries {widened:.2} × the first's mark");
 }
+
+#[test]
+fn the_manifest_records_the_layout_counts_and_regions() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let out = common::snakeskin(&["generate", "crotalus-atrox", "-o", d, "--size", "64", "--layout", "body"]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let text = std::fs::read_to_string(dir.path().join("crotalus-atrox.material.json")).unwrap();
+    let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let p = preset("crotalus-atrox", &[]);
+    assert_eq!(m["layout"], "body");
+    assert_eq!(m["width"], 64);
+    assert_eq!(m["height"], (64.0 * p.body.length).round() as u64);
+    assert_eq!(m["counts"]["ventrals"], p.body.ventrals);
+    assert_eq!(m["counts"]["subcaudals"], p.body.subcaudals);
+    assert_eq!(m["counts"]["dorsal_marks"], 25);
+    assert_eq!(m["counts"]["tail_bands"], p.body.tail_bands);
+    // The regions tile v from the snout (0) to the tail tip (1), in order.
+    let range = |name: &str| [m["regions"][name][0].as_f64().unwrap(), m["regions"][name][1].as_f64().unwrap()];
+    let (head, neck, trunk, tail) = (range("head"), range("neck"), range("trunk"), range("tail"));
+    assert_eq!(head[0], 0.0);
+    assert_eq!(tail[1], 1.0);
+    for (a, b) in [(head, neck), (neck, trunk), (trunk, tail)] {
+        assert!((a[1] - b[0]).abs() < 1e-6 && a[0] < a[1], "{a:?} then {b:?}");
+    }
+    let vent = range("vent");
+    assert!(vent[0] < trunk[1] && trunk[1] < vent[1]);
+
+    // The tile's manifest says so and has neither.
+    let out = common::snakeskin(&["generate", "crotalus-atrox", "-o", d, "--size", "64"]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let text = std::fs::read_to_string(dir.path().join("crotalus-atrox.material.json")).unwrap();
+    let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(m["layout"], "tile");
+    assert!(m.get("counts").is_none() && m.get("regions").is_none());
+}
+
+#[test]
+fn a_body_atlas_too_long_or_a_bad_body_key_is_refused_with_its_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().join("out");
+    let d = d.to_str().unwrap();
+    // 16384 wide × 12 = 196608 rows: over the rows a map may have.
+    let out = common::snakeskin(&["generate", "crotalus-atrox", "-o", d, "--size", "16384", "--layout", "body"]);
+    assert_eq!(out.status.code(), Some(2), "{}", common::stderr(&out));
+    assert!(common::stderr(&out).contains("body.length"), "{}", common::stderr(&out));
+    for (key, value) in [("body.ventrals", "10"), ("body.tail_fraction", "0.9"), ("pattern.0.widen_to_tail", "9")] {
+        let set = format!("{key}={value}");
+        let out = common::snakeskin(&["generate", "crotalus-atrox", "-o", d, "--layout", "body", "--set", &set]);
+        assert_eq!(out.status.code(), Some(2), "{set}: {}", common::stderr(&out));
+        assert!(common::stderr(&out).contains(key), "{set}: {}", common::stderr(&out));
+    }
+    assert!(!std::path::Path::new(d).exists(), "nothing may be written");
+}
