@@ -37,6 +37,8 @@ pub struct GenerateReport {
     pub total_time: Duration,
     /// True when the output folder did not exist and was created.
     pub created_folder: bool,
+    /// A body atlas's strips: (strips, rows per strip, margin rows each side).
+    pub strips: Option<(usize, usize, usize)>,
 }
 
 /// The tallest map written (a body atlas is `body.length` widths tall): PNG readers and GPU
@@ -105,6 +107,10 @@ impl Plan {
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
         let Plan { request, size, height, loaded, graph, start, .. } = self;
         let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
+        let strip_layout = (height > size).then(|| {
+            let step = STRIP_WIDTHS * size;
+            (height.div_ceil(step), step, graph.row_reach(&request.maps, size))
+        });
         let (kinds, files, stats, encode_time) = if height > size {
             // A body atlas: strip by strip, each encoded as it is done (memory bounded by a
             // strip, not the body's length).
@@ -137,6 +143,7 @@ impl Plan {
             encode_time,
             total_time: start.elapsed(),
             created_folder: lock.created_folder,
+            strips: strip_layout,
         })
     }
 }

@@ -54,6 +54,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
             memory.estimate_bytes as f64 / MIB,
             memory.available_bytes as f64 / MIB
         );
+        if let Some((count, rows, margin)) = report.strips {
+            eprintln!("body atlas: {count} strips of {rows} rows, each with {margin} rows of margin each side");
+        }
         eprintln!(
             "encode + write: {:.1} ms, total: {:.1} ms",
             report.encode_time.as_secs_f64() * 1e3,
