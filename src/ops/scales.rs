@@ -416,8 +416,8 @@ impl ScaleField {
         reach.max(1.0)
     }
 
-    /// A scale centre's v: wrapped into [0, 1) on the tile, as it is on a body atlas (whose
-    /// snout and tail tip are not neighbours; a centre just beyond an end stays there).
+    /// A scale centre's v: wrapped into [0, 1) on the tile; left as it is on a body atlas,
+    /// whose snout and tail tip are not neighbours (a centre just beyond an end stays there).
     #[inline]
     fn wrap_v(&self, v: f32) -> f32 {
         if self.body.is_some() { v } else { v.rem_euclid(1.0) }
