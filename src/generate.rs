@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use crate::export::{self, Quantized, SetLock, sha256_hex};
 use crate::graph::{EvalStats, Graph, evaluate_into, evaluate_rows};
 use crate::maps::{BuildOptions, build_graph};
-use crate::material::MapKind;
+use crate::material::{FileFormat, MapKind};
 use crate::memory::MemoryCheck;
 use crate::ops::Frame;
 use crate::preset::{self, LoadedPreset};
@@ -27,6 +27,8 @@ pub struct GenerateRequest {
     pub maps: Vec<MapKind>,
     pub out_dir: PathBuf,
     pub options: BuildOptions,
+    /// PNG (the default) or OpenEXR.
+    pub format: FileFormat,
 }
 
 #[derive(Debug)]
@@ -78,11 +80,23 @@ impl Plan {
         let size = check_size(request.size)?;
         let loaded = preset::load(&request.preset, &request.overrides, request.seed)?;
         let height = request.options.layout.height(&loaded.preset, size);
+        if height > size && request.format == FileFormat::Exr {
+            return Err(Error::Unsupported(
+                "--format exr with --layout body: a body atlas is written a strip at a time, which only the PNG writer \
+                 does so far; use --format png, or --layout tile for OpenEXR"
+                    .into(),
+            ));
+        }
         if height > MAX_HEIGHT {
             return Err(Error::Height { width: size, height, max: MAX_HEIGHT });
         }
         let graph = build_graph(&loaded.preset, request.options);
-        let estimate = if height > size {
+        let estimate = if request.format == FileFormat::Exr {
+            // The finished maps are kept as f32 until encoded; each file at most their size.
+            let floats: u64 = request.maps.iter().map(|m| 4 * m.exr_channels().0.len() as u64).sum();
+            crate::memory::estimate_generate_bytes(&graph, &request.maps, size, height)
+                + 2 * floats * (size * height) as u64
+        } else if height > size {
             let strip = strip_rows(&graph, &request.maps, size, height);
             crate::memory::estimate_strips_bytes(&graph, &request.maps, size, height, strip)
         } else {
@@ -111,7 +125,26 @@ impl Plan {
             let step = STRIP_WIDTHS * size;
             (height.div_ceil(step), step, graph.row_reach(&request.maps, size))
         });
-        let (kinds, files, stats, encode_time) = if height > size {
+        let (kinds, files, stats, encode_time) = if request.format == FileFormat::Exr {
+            let mut finished: Vec<(MapKind, crate::ops::Image)> = Vec::new();
+            let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
+                finished.push((map, image));
+            });
+            finished.sort_by_key(|(m, _)| *m);
+            let encode_start = Instant::now();
+            let range = crate::maps::thickness_range_nm(&loaded.preset);
+            use rayon::prelude::*;
+            let files = finished
+                .par_iter()
+                .map(|(map, image)| {
+                    Ok((
+                        export::map_file_name_in(&loaded.name, *map, FileFormat::Exr),
+                        export::encode_exr(*map, image, range)?,
+                    ))
+                })
+                .collect::<Result<Vec<_>, export::ExportError>>()?;
+            (finished.iter().map(|(m, _)| *m).collect(), files, stats, encode_start.elapsed())
+        } else if height > size {
             // A body atlas: strip by strip, each encoded as it is done (memory bounded by a
             // strip, not the body's length).
             strips(&graph, &request.maps, &loaded.name, size, height, progress)?
@@ -131,7 +164,7 @@ impl Plan {
         let encode_start = Instant::now();
         let entries: Vec<(MapKind, String, String)> =
             kinds.iter().zip(&files).map(|(m, (name, bytes))| (*m, name.clone(), sha256_hex(bytes))).collect();
-        let manifest = export::manifest(&loaded, (size, height), &entries, request.options);
+        let manifest = export::manifest(&loaded, (size, height), &entries, request.options, request.format);
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
         let manifest_name = export::manifest_file_name(&loaded.name);
         let encode_time = encode_time + encode_start.elapsed();

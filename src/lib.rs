@@ -38,6 +38,9 @@ pub enum Error {
          smaller --size"
     )]
     Height { width: usize, height: usize, max: usize },
+    /// A combination of options the tool does not support (yet).
+    #[error("{0}")]
+    Unsupported(String),
     /// An optics query outside what the physics covers (`snakeskin brdf`).
     #[error("invalid query: {0}")]
     Query(String),

@@ -83,6 +83,56 @@ impl MapKind {
     }
 }
 
+/// The file format a set's maps are written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum FileFormat {
+    /// 8- and 16-bit PNG, in the formats of `MapKind::format` (the default).
+    #[default]
+    Png,
+    /// OpenEXR with float samples in physical units (`MapKind::exr_channels`).
+    Exr,
+}
+
+impl FileFormat {
+    pub fn name(self) -> &'static str {
+        match self {
+            FileFormat::Png => "png",
+            FileFormat::Exr => "exr",
+        }
+    }
+}
+
+impl MapKind {
+    /// OpenEXR layout: channel names and bits per sample (16 = half, 32 = float). Colour and
+    /// roughness in half (11 significant bits, finer than the PNG's 8); height, the normal and
+    /// the film thickness (in nm, up to 10 mm: PHYSICS.md's bound) need float.
+    pub fn exr_channels(self) -> (&'static [&'static str], u32) {
+        match self {
+            MapKind::Color => (&["R", "G", "B"], 16),
+            MapKind::Height => (&["Y"], 32),
+            MapKind::Normal => (&["R", "G", "B"], 32),
+            MapKind::Roughness => (&["Y"], 16),
+            MapKind::Iridescence => (&["Y"], 32),
+        }
+    }
+
+    /// What a sample means in an OpenEXR file (linear floats, no encoding to undo).
+    pub fn exr_meaning(self, convention: NormalConvention) -> String {
+        match self {
+            MapKind::Normal => {
+                let y = match convention {
+                    NormalConvention::OpenGl => "OpenGL convention, +Y up",
+                    NormalConvention::DirectX => "DirectX convention, +Y down",
+                };
+                format!("tangent-space unit normal, rgb = xyz in [-1, 1], {y}")
+            }
+            MapKind::Iridescence => "film thickness in nm".into(),
+            MapKind::Color => "visible diffuse colour (the manifest's color_means), linear".into(),
+            other => other.meaning(convention),
+        }
+    }
+}
+
 impl fmt::Display for MapKind {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         f.write_str(self.name())

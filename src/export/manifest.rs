@@ -11,7 +11,7 @@ use serde::Serialize;
 use super::ExportError;
 use super::atomic::sha256_hex;
 use crate::maps::{BuildOptions, Layout, body_plan, thickness_range_nm};
-use crate::material::{MapKind, Optics};
+use crate::material::{FileFormat, MapKind, Optics};
 use crate::preset::LoadedPreset;
 
 #[derive(Debug, Serialize)]
@@ -26,6 +26,8 @@ pub struct Manifest {
     pub height: usize,
     /// `tile` (a square that tiles both ways) or `body` (the whole snake, snout at v = 0).
     pub layout: String,
+    /// `png` or `exr` (the maps' file format; each entry gives its samples).
+    pub format: String,
     /// Body layout: the counts the atlas was drawn with.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub counts: Option<Counts>,
@@ -104,6 +106,7 @@ pub fn manifest(
     (width, height): (usize, usize),
     files: &[(MapKind, String, String)],
     options: BuildOptions,
+    format: FileFormat,
 ) -> Manifest {
     let p = &loaded.preset;
     let convention = options.normal_convention;
@@ -126,16 +129,30 @@ pub fn manifest(
         }
     });
     let (min_nm, max_nm) = thickness_range_nm(p);
-    let entry = |(map, file, sha256): &(MapKind, String, String)| {
-        let format = map.format();
-        MapEntry {
-            map: map.name().into(),
-            file: file.clone(),
-            color_space: format.color_space().into(),
-            channels: format.channels,
-            bit_depth: format.bit_depth,
-            meaning: map.meaning(convention),
-            sha256: sha256.clone(),
+    let entry = |(map, file, sha256): &(MapKind, String, String)| match format {
+        FileFormat::Png => {
+            let f = map.format();
+            MapEntry {
+                map: map.name().into(),
+                file: file.clone(),
+                color_space: f.color_space().into(),
+                channels: f.channels,
+                bit_depth: f.bit_depth,
+                meaning: map.meaning(convention),
+                sha256: sha256.clone(),
+            }
+        }
+        FileFormat::Exr => {
+            let (names, bits) = map.exr_channels();
+            MapEntry {
+                map: map.name().into(),
+                file: file.clone(),
+                color_space: "linear".into(),
+                channels: names.len() as u32,
+                bit_depth: bits,
+                meaning: map.exr_meaning(convention),
+                sha256: sha256.clone(),
+            }
         }
     };
     Manifest {
@@ -148,6 +165,7 @@ pub fn manifest(
         width,
         height,
         layout: options.layout.name().into(),
+        format: format.name().into(),
         counts,
         regions,
         maps: files.iter().map(entry).collect(),

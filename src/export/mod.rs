@@ -17,7 +17,7 @@ use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::{ExtendedColorType, ImageEncoder};
 use rayon::prelude::*;
 
-use crate::material::{Encoding, MapKind};
+use crate::material::{Encoding, FileFormat, MapKind};
 use crate::ops::Image;
 
 #[derive(Debug, thiserror::Error)]
@@ -44,9 +44,44 @@ impl ExportError {
     }
 }
 
-/// File name of a map for a preset name.
+/// File name of a map for a preset name (PNG).
 pub fn map_file_name(preset_name: &str, map: MapKind) -> String {
-    format!("{preset_name}_{}.png", map.name())
+    map_file_name_in(preset_name, map, FileFormat::Png)
+}
+
+/// File name of a map for a preset name in a file format.
+pub fn map_file_name_in(preset_name: &str, map: MapKind, format: FileFormat) -> String {
+    format!("{preset_name}_{}.{}", map.name(), format.name())
+}
+
+/// Encodes one map as OpenEXR (`MapKind::exr_channels`): linear floats in physical units —
+/// the colour map's linear values, the normal's xyz in [-1, 1], the film thickness in nm
+/// (`thickness_nm` = the manifest's range the map's [0, 1] spans).
+pub fn encode_exr(map: MapKind, image: &Image, thickness_nm: (f64, f64)) -> Result<Vec<u8>, ExportError> {
+    use exr::prelude::*;
+    let (names, bits) = map.exr_channels();
+    let (w, h, ch) = (image.width, image.height, image.channels);
+    let value = |x: f32| match map {
+        MapKind::Iridescence => (thickness_nm.0 + x as f64 * (thickness_nm.1 - thickness_nm.0)) as f32,
+        _ => x,
+    };
+    let channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = names
+        .iter()
+        .enumerate()
+        .map(|(c, name)| {
+            let samples = image.data.iter().skip(c.min(ch - 1)).step_by(ch).map(|x| value(*x));
+            let data = if bits == 16 {
+                FlatSamples::F16(samples.map(f16::from_f32).collect())
+            } else {
+                FlatSamples::F32(samples.collect())
+            };
+            AnyChannel::new(*name, data)
+        })
+        .collect();
+    let exr_image = exr::image::Image::from_channels((w, h), AnyChannels::sort(channels));
+    let mut bytes = Cursor::new(Vec::new());
+    exr_image.write().to_buffered(&mut bytes).map_err(|e| ExportError::Encode { map, message: e.to_string() })?;
+    Ok(bytes.into_inner())
 }
 
 /// sRGB encoding of a linear value (IEC 61966-2-1), 8 bits.

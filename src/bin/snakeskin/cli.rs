@@ -161,6 +161,11 @@ pub struct GenerateArgs {
     /// A body atlas is generated a strip at a time: memory does not grow with its length.
     #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
     pub layout: LayoutArg,
+    /// File format: png (8/16-bit, the default) or exr (OpenEXR floats in physical units:
+    /// linear half colour and roughness, float height, normal xyz in [-1, 1] and film
+    /// thickness in nm; tile layout only for now).
+    #[arg(long, value_enum, default_value_t = FormatArg::Png)]
+    pub format: FormatArg,
     /// Print per-node evaluations, time and buffer size after the run.
     #[arg(long)]
     pub stats: bool,
@@ -229,6 +234,21 @@ pub struct GraphArgs {
     /// Print Graphviz DOT (render with `dot -Tsvg`); otherwise a plain list of nodes.
     #[arg(long)]
     pub dot: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FormatArg {
+    Png,
+    Exr,
+}
+
+impl FormatArg {
+    pub fn format(self) -> snakeskin::material::FileFormat {
+        match self {
+            FormatArg::Png => snakeskin::material::FileFormat::Png,
+            FormatArg::Exr => snakeskin::material::FileFormat::Exr,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -27,6 +27,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         maps: args.preset.maps.0.clone(),
         out_dir: args.out.clone(),
         options: BuildOptions { normal_convention: convention, layout: args.layout.layout() },
+        format: args.format.format(),
     };
     let plan = Plan::new(&request)?;
     crate::output::report_clamped_colours(&source.preset, plan.loaded());
