@@ -96,9 +96,9 @@ impl Plan {
             let floats: u64 = request.maps.iter().map(|m| 4 * m.exr_channels().0.len() as u64).sum();
             crate::memory::estimate_generate_bytes(&graph, &request.maps, size, height)
                 + 2 * floats * (size * height) as u64
-        } else if height > size {
-            let strip = strip_rows(&graph, &request.maps, size, height);
-            crate::memory::estimate_strips_bytes(&graph, &request.maps, size, height, strip)
+        } else if let Some(strips) = strips_of(&graph, &request.maps, size, height) {
+            let rows = (strips.rows + 2 * strips.margin).min(height);
+            crate::memory::estimate_strips_bytes(&graph, &request.maps, size, height, rows)
         } else {
             crate::memory::estimate_generate_bytes(&graph, &request.maps, size, height)
         };
@@ -121,10 +121,7 @@ impl Plan {
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
         let Plan { request, size, height, loaded, graph, start, .. } = self;
         let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
-        let strip_layout = (height > size).then(|| {
-            let step = STRIP_WIDTHS * size;
-            (height.div_ceil(step), step, graph.row_reach(&request.maps, size))
-        });
+        let strip_layout = strips_of(&graph, &request.maps, size, height);
         let (kinds, files, stats, encode_time) = if request.format == FileFormat::Exr {
             let mut finished: Vec<(MapKind, crate::ops::Image)> = Vec::new();
             let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
@@ -144,10 +141,10 @@ impl Plan {
                 })
                 .collect::<Result<Vec<_>, export::ExportError>>()?;
             (finished.iter().map(|(m, _)| *m).collect(), files, stats, encode_start.elapsed())
-        } else if height > size {
+        } else if let Some(layout) = strip_layout {
             // A body atlas: strip by strip, each encoded as it is done (memory bounded by a
             // strip, not the body's length).
-            strips(&graph, &request.maps, &loaded.name, size, height, progress)?
+            strips(&graph, &request.maps, &loaded.name, size, height, layout, progress)?
         } else {
             // Each map is quantised to its file format the moment it is finished, freeing its
             // f32 buffer; PNG compression then runs for all maps in parallel.
@@ -176,7 +173,7 @@ impl Plan {
             encode_time,
             total_time: start.elapsed(),
             created_folder: lock.created_folder,
-            strips: strip_layout,
+            strips: strip_layout.map(|s| (s.count, s.rows, s.margin)),
         })
     }
 }
@@ -186,9 +183,19 @@ impl Plan {
 /// typically a tenth of a width each side for patterned species) then cost about a tenth.
 pub const STRIP_WIDTHS: usize = 2;
 
-/// Rows a strip is evaluated over, margins included (for the memory estimate).
-fn strip_rows(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> usize {
-    (STRIP_WIDTHS * width + 2 * graph.row_reach(maps, width)).min(height)
+/// How a texture taller than wide is cut: `count` strips of `rows` rows, each evaluated
+/// with `margin` more rows each side (`Graph::row_reach`).
+#[derive(Debug, Clone, Copy)]
+struct Strips {
+    count: usize,
+    rows: usize,
+    margin: usize,
+}
+
+/// The strips of a `width` × `height` texture, or None for a square (evaluated whole).
+fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Option<Strips> {
+    let rows = STRIP_WIDTHS * width;
+    (height > width).then(|| Strips { count: height.div_ceil(rows), rows, margin: graph.row_reach(maps, width) })
 }
 
 /// (maps, their files' names and bytes, merged stats, encode time) of a long texture
@@ -202,12 +209,10 @@ fn strips(
     name: &str,
     width: usize,
     height: usize,
+    Strips { count, rows: step, margin }: Strips,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Vec<MapKind>, Vec<(String, Vec<u8>)>, EvalStats, Duration), Error> {
     use rayon::prelude::*;
-    let margin = graph.row_reach(maps, width);
-    let step = STRIP_WIDTHS * width;
-    let count = height.div_ceil(step);
     let mut kinds: Vec<MapKind> = maps.iter().copied().filter(|m| graph.output(*m).is_some()).collect();
     kinds.sort();
     kinds.dedup();

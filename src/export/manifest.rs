@@ -119,7 +119,7 @@ pub fn manifest(
         tail_bands: (p.body.tail_bands > 0).then_some(p.body.tail_bands),
     });
     let regions = body.map(|b| {
-        let plate = (b.vent - b.head_end) / b.ventrals.max(1) as f32;
+        let plate = b.plate_length_v(false);
         Regions {
             head: [0.0, b.head_end],
             neck: [b.head_end, b.neck_end],

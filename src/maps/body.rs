@@ -6,8 +6,6 @@
 use super::Shared;
 use crate::graph::{GraphBuilder, NodeId, Op};
 use crate::ops::body::{AlongProfile, BodyPlan, HeadMark, HeadMarkShape};
-use crate::ops::filters::BlendMode;
-use crate::ops::scales::channel;
 use crate::preset::Preset;
 use crate::preset::schema::HeadMarkKind;
 
@@ -81,21 +79,9 @@ pub(super) fn marks(
         }
         let mut mask = g.add("body.tail_bands", Op::Along(AlongProfile { knots }), &[]);
         if snap > 0.0 {
-            let op = Op::SnapToScales {
-                amount: snap as f32,
-                centre_u: s.channel_index(channel::CENTRE_U),
-                centre_v: s.channel_index(channel::CENTRE_V),
-                reach: s.snap_reach(),
-            };
-            mask = g.add("body.tail_bands_aligned", op, &[mask, s.scales]);
+            mask = s.snap(g, "body.tail_bands_aligned".into(), mask, snap as f32);
         }
-        if let Some(outside) = outside_belly {
-            mask = g.add(
-                "body.tail_bands_off_belly",
-                Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 },
-                &[mask, outside],
-            );
-        }
+        mask = super::masked(g, "body.tail_bands_off_belly".into(), mask, outside_belly);
         color = g.add(
             "body.tail_bands_tint",
             Op::Tint { color: b.tail_band_color.to_linear(), opacity: 1.0 },
@@ -119,15 +105,9 @@ pub(super) fn marks(
             HeadMarkKind::Lips => HeadMarkShape::Lips,
         };
         let mark = HeadMark { shape, size: m.size as f32, plan: *plan };
-        let mut mask = g.add(format!("body.head_mark{i}"), Op::HeadMark(mark), &[]);
-        if let Some(outside) = outside_belly {
-            // Off the belly plates (a collar round the neck stops at them).
-            mask = g.add(
-                format!("body.head_mark{i}_off_belly"),
-                Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 },
-                &[mask, outside],
-            );
-        }
+        let mask = g.add(format!("body.head_mark{i}"), Op::HeadMark(mark), &[]);
+        // Off the belly plates (a collar round the neck stops at them).
+        let mask = super::masked(g, format!("body.head_mark{i}_off_belly"), mask, outside_belly);
         color = g.add(
             format!("body.head_mark{i}_tint"),
             Op::Tint { color: m.color.to_linear(), opacity: 1.0 },

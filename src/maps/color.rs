@@ -24,7 +24,7 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
         Op::Colorize { low: base.map(|c| c * (1.0 - var)), high: base.map(|c| c * (1.0 + var)) },
         &[noise],
     );
-    if let Some(plan) = &s.body {
+    if let Some(plan) = &s.body() {
         color = super::body::tail_shift(g, preset, plan, color);
     }
 
@@ -53,7 +53,7 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
             let marks = BellyMarks {
                 kind,
                 rows_v: s.lattice.rows_v as u32,
-                body: s.body,
+                body: s.body(),
                 belly_width: plate_band_width(preset, s),
                 amount: b.pattern_amount as f32,
                 softness: 0.004,
@@ -86,7 +86,7 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
     for (i, layer) in preset.pattern.iter().enumerate() {
         color = pattern_layer(g, s, &context, i, layer, color);
     }
-    if let Some(plan) = &s.body {
+    if let Some(plan) = &s.body() {
         color = super::body::marks(g, preset, s, plan, outside_belly, color);
     }
 
@@ -241,7 +241,7 @@ fn shapes(
                     .map(|r| span.0 + (r as f32 + start + width * 0.5) / repeats * span_len)
                     .collect();
                 let half_width = width * 0.5 / repeats * span_len;
-                let op = Op::Bands { axis: Axis::V, centres, half_width, softness: 0.002 / s.along };
+                let op = Op::Bands { axis: Axis::V, centres, half_width, softness: 0.002 / s.field.length };
                 out.push((g.add(name(&format!("ring{k}")), op, &[]), color));
                 start += width;
             }
@@ -281,7 +281,7 @@ fn blotches(s: &Shared, layer: &PatternLayer, seed: u32, scale: f32) -> Blotches
     };
     let (count, span) = series(s, layer);
     // Widening along a counted body series only: the tile has no tail to widen toward.
-    let widen = if s.body.is_some() && layer.count.is_some() { layer.widen_to_tail as f32 } else { 1.0 };
+    let widen = if s.body().is_some() && layer.count.is_some() { layer.widen_to_tail as f32 } else { 1.0 };
     Blotches {
         shape,
         count,
@@ -335,7 +335,7 @@ fn centre_shape(s: &Shared, layer: &PatternLayer, seed: u32) -> Option<Op> {
 /// (`body.tail_bands`) — else `amount` per circumference over the whole length.
 fn series(s: &Shared, layer: &PatternLayer) -> (u32, (f32, f32)) {
     let amount = layer.amount.round().max(1.0) as u32;
-    match (&s.body, layer.count) {
+    match (s.body(), layer.count) {
         (Some(plan), Some(count)) => {
             let count = count.max(1);
             if s.tail_bands > 0 {
@@ -424,14 +424,11 @@ fn pattern_layer(
     // the neck, every other layer from the end of the head (the head has its own marks). The
     // region clips what is painted — the mark, its border, outline and centre — not the
     // shapes they are derived from, so a mark cut by a region edge gets no outline along it.
-    let region = s.body.map(|plan| {
+    let region = s.body().map(|plan| {
         let profile = super::body::layer_region(&plan, layer.count.is_some(), s.tail_bands > 0);
         g.add(format!("{prefix}.region"), Op::Along(profile), &[])
     });
-    let clip = |g: &mut GraphBuilder, name: String, mask: NodeId| match region {
-        Some(region) => g.add(name, Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, region]),
-        None => mask,
-    };
+    let clip = |g: &mut GraphBuilder, name: String, mask: NodeId| super::masked(g, name, mask, region);
     for (k, (shape, tint)) in parts.into_iter().enumerate() {
         let name = |part: &str| if many { format!("{prefix}.{k}.{part}") } else { format!("{prefix}.{part}") };
         let mut mask = shape;
@@ -514,16 +511,8 @@ fn snapped_and_off_belly(
     mut mask: NodeId,
 ) -> NodeId {
     if layer.scale_aligned > 0.0 {
-        let op = Op::SnapToScales {
-            amount: layer.scale_aligned as f32,
-            centre_u: s.channel_index(channel::CENTRE_U),
-            centre_v: s.channel_index(channel::CENTRE_V),
-            reach: s.snap_reach(),
-        };
-        mask = g.add(name("scale_aligned"), op, &[mask, s.scales]);
+        mask = s.snap(g, name("scale_aligned"), mask, layer.scale_aligned as f32);
     }
-    if let (Some(outside), false) = (context.outside_belly, layer.over_belly) {
-        mask = g.add(name("off_belly"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, outside]);
-    }
-    mask
+    let outside = context.outside_belly.filter(|_| !layer.over_belly);
+    super::masked(g, name("off_belly"), mask, outside)
 }

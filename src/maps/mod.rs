@@ -128,6 +128,14 @@ fn scale_outputs(preset: &Preset) -> Vec<usize> {
     outputs
 }
 
+/// The product of two masks (a mask kept to where another is set), or `mask` itself.
+pub(crate) fn masked(g: &mut GraphBuilder, name: String, mask: NodeId, by: Option<NodeId>) -> NodeId {
+    match by {
+        Some(by) => g.add(name, Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[mask, by]),
+        None => mask,
+    }
+}
+
 /// Nodes that several maps read.
 pub(crate) struct Shared {
     pub scales: NodeId,
@@ -137,10 +145,6 @@ pub(crate) struct Shared {
     pub crevice: NodeId,
     pub scale_height: NodeId,
     pub grain: NodeId,
-    /// The texture's length along the body in circumferences (1 for the tile).
-    pub along: f32,
-    /// The body layout's plan (None for the tile).
-    pub body: Option<BodyPlan>,
     /// Bands on the tail (`body.tail_bands`): a counted series then ends at the vent.
     pub tail_bands: u32,
 }
@@ -161,16 +165,33 @@ impl Shared {
     /// length (`SnapToScales::reach`).
     pub fn snap_reach(&self) -> f32 {
         let cells = self.field.longest_reach_cells(&self.lattice) + self.field.jitter.clamp(0.0, 0.5);
-        cells * self.along / self.lattice.rows_v as f32
+        cells * self.field.length / self.lattice.rows_v as f32
+    }
+
+    /// The body layout's plan (None for the tile): the scale field's.
+    pub fn body(&self) -> Option<BodyPlan> {
+        self.field.body
+    }
+
+    /// Moves a mask to its value at each pixel's scale centre, by `amount`
+    /// (`Op::SnapToScales`: colour that follows scale boundaries).
+    pub fn snap(&self, g: &mut GraphBuilder, name: String, mask: NodeId, amount: f32) -> NodeId {
+        let op = Op::SnapToScales {
+            amount,
+            centre_u: self.channel_index(channel::CENTRE_U),
+            centre_v: self.channel_index(channel::CENTRE_V),
+            reach: self.snap_reach(),
+        };
+        g.add(name, op, &[mask, self.scales])
     }
 
     /// A count per circumference along the body (noise cells, rings, spots) over the whole
     /// texture: unchanged for the tile, times the body's length (rounded) for the body.
     pub fn along_count(&self, per_circumference: u32) -> u32 {
-        if self.body.is_none() {
+        if self.field.body.is_none() {
             return per_circumference;
         }
-        ((per_circumference as f32 * self.along).round() as u32).max(1)
+        ((per_circumference as f32 * self.field.length).round() as u32).max(1)
     }
 }
 
@@ -182,7 +203,6 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
         g.set_open_v();
     }
     let lattice = field.lattice();
-    let body = field.body;
     let along = field.length;
     let scales = g.add("scales", Op::Scales(field.clone()), &[]);
     let index = |channel: usize| field.output_index(channel).expect("height and crevice are always output");
@@ -201,17 +221,7 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
         }),
         &[],
     );
-    let shared = Shared {
-        scales,
-        field,
-        lattice,
-        crevice,
-        scale_height,
-        grain,
-        along,
-        body,
-        tail_bands: preset.body.tail_bands,
-    };
+    let shared = Shared { scales, field, lattice, crevice, scale_height, grain, tail_bands: preset.body.tail_bands };
 
     let color = color::build(&mut g, preset, &shared);
     g.set_output(MapKind::Color, color);

@@ -49,11 +49,21 @@ impl BodyPlan {
         if v < self.head_end {
             None
         } else if v < self.vent {
-            let len = (self.vent - self.head_end) / self.ventrals.max(1) as f32;
+            let len = self.plate_length_v(false);
             Some(((v - self.head_end) / len, len, false))
         } else {
-            let len = (1.0 - self.vent) / self.subcaudals.max(1) as f32;
+            let len = self.plate_length_v(true);
             Some((self.ventrals as f32 + (v - self.vent) / len, len, true))
+        }
+    }
+
+    /// The length in v of a ventral plate (`subcaudal` false) or of a subcaudal.
+    #[inline]
+    pub fn plate_length_v(&self, subcaudal: bool) -> f32 {
+        if subcaudal {
+            (1.0 - self.vent) / self.subcaudals.max(1) as f32
+        } else {
+            (self.vent - self.head_end) / self.ventrals.max(1) as f32
         }
     }
 
@@ -67,9 +77,9 @@ impl BodyPlan {
     pub fn plate_centre_v(&self, index: i32) -> f32 {
         let n = self.ventrals as i32;
         if index < n {
-            self.head_end + (index as f32 + 0.5) * (self.vent - self.head_end) / self.ventrals.max(1) as f32
+            self.head_end + (index as f32 + 0.5) * self.plate_length_v(false)
         } else {
-            self.vent + ((index - n) as f32 + 0.5) * (1.0 - self.vent) / self.subcaudals.max(1) as f32
+            self.vent + ((index - n) as f32 + 0.5) * self.plate_length_v(true)
         }
     }
 

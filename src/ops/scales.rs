@@ -446,13 +446,14 @@ impl ScaleField {
         Image::from_fn_in(frame, self.outputs.len(), |u, v, out| {
             let mut all = [0.0f32; channel::COUNT];
             let dist_belly = u.min(1.0 - u);
-            let plate = self.body.as_ref().map(|b| (b, b.plate_at(v)));
+            // The body's plate coordinate, only where the belly band is (None on the head).
+            let plate = || self.body.as_ref().map(|b| (b, b.plate_coordinate(v).map(|(y, _, _)| y)));
             if !shields.is_empty() && self.shield_pixel(&lattice, &shields, u, v, &mut all) {
                 // A head shield.
-            } else if let Some((body, Some(plate))) = plate.filter(|_| dist_belly < belly_half) {
-                self.body_plate_pixel(&lattice, body, plate.index as f32 + plate.along, dist_belly, u, &mut all);
-            } else if dist_belly < belly_half && plate.is_none() {
+            } else if dist_belly < belly_half && self.body.is_none() {
                 self.ventral_pixel(&lattice, dist_belly, v, &mut all);
+            } else if let Some((body, Some(y))) = (dist_belly < belly_half).then(plate).flatten() {
+                self.body_plate_pixel(&lattice, body, y, dist_belly, u, &mut all);
             } else if self.shape == ScaleShape::Hexagon {
                 self.hexagon_pixel(&lattice, &table, u, v, &mut all);
             } else {
@@ -677,13 +678,9 @@ impl ScaleField {
                 return None;
             }
             let subcaudal = r >= body.ventrals as i32;
-            let length_v = if subcaudal {
-                (1.0 - body.vent) / body.subcaudals.max(1) as f32
-            } else {
-                (body.vent - body.head_end) / body.ventrals.max(1) as f32
-            };
             // Plate length over an ordinary column's width (both in circumferences).
-            Some((length_v * body.length / lattice.bounds[1], subcaudal && body.divided_subcaudals))
+            let aspect = body.plate_length_v(subcaudal) * body.length / lattice.bounds[1];
+            Some((aspect, subcaudal && body.divided_subcaudals))
         };
         let rows = PlateRows { y, plate: &plate, centre_v: &|r| body.plate_centre_v(r), identity: &|r| r };
         self.plate_pixel(lattice, &rows, dist_belly, if u < 0.5 { 0 } else { 1 }, out);
