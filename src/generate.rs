@@ -7,7 +7,8 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::export::{self, Quantized, SetLock, sha256_hex};
+use crate::export::pack::{Pack, TextureEncoder, TextureSpec, texture_file_name};
+use crate::export::{self, MapEntry, Quantized, SetLock, sha256_hex};
 use crate::graph::{EvalStats, Graph, evaluate_into, evaluate_rows};
 use crate::maps::{BuildOptions, build_graph};
 use crate::material::{FileFormat, MapKind};
@@ -29,6 +30,9 @@ pub struct GenerateRequest {
     pub options: BuildOptions,
     /// PNG (the default) or OpenEXR.
     pub format: FileFormat,
+    /// Write an engine's packed textures (`export::pack`) instead of the maps; `maps` is
+    /// then ignored (the pack says which maps it reads).
+    pub pack: Option<Pack>,
 }
 
 #[derive(Debug)]
@@ -63,8 +67,16 @@ pub struct Plan {
     height: usize,
     loaded: LoadedPreset,
     graph: Graph,
+    /// The maps evaluated: the request's, or those its pack reads.
+    maps: Vec<MapKind>,
     memory: MemoryCheck,
     start: Instant,
+}
+
+/// Whether a preset has a film (a thickness above zero): without one there is no
+/// iridescence to export.
+pub fn has_film(preset: &crate::preset::Preset) -> bool {
+    preset.optics.film_thickness_nm > 0.0
 }
 
 impl Plan {
@@ -87,25 +99,37 @@ impl Plan {
                     .into(),
             ));
         }
+        if request.pack.is_some() && request.format == FileFormat::Exr {
+            return Err(Error::Unsupported(
+                "--pack with --format exr: packed textures are 8- and 16-bit PNG, as the engines import them; leave \
+                 out --format exr, or --pack for OpenEXR maps"
+                    .into(),
+            ));
+        }
         if height > MAX_HEIGHT {
             return Err(Error::Height { width: size, height, max: MAX_HEIGHT });
         }
         let graph = build_graph(&loaded.preset, request.options);
-        let estimate = if request.format == FileFormat::Exr {
-            // The finished maps are kept as f32 until encoded; each file at most their size.
-            let floats: u64 = request.maps.iter().map(|m| 4 * m.exr_channels().0.len() as u64).sum();
-            crate::memory::estimate_generate_bytes(&graph, &request.maps, size, height)
-                + 2 * floats * (size * height) as u64
-        } else if let Some(strips) = strips_of(&graph, &request.maps, size, height) {
+        let maps = match request.pack {
+            Some(pack) => pack.maps(has_film(&loaded.preset)),
+            None => request.maps.clone(),
+        };
+        let strips = strips_of(&graph, &maps, size, height);
+        let estimate = if request.format == FileFormat::Exr || (request.pack.is_some() && strips.is_none()) {
+            // The finished maps are kept as f32 until encoded or packed; each file at most
+            // their size.
+            let floats: u64 = maps.iter().map(|m| 4 * m.exr_channels().0.len() as u64).sum();
+            crate::memory::estimate_generate_bytes(&graph, &maps, size, height) + 2 * floats * (size * height) as u64
+        } else if let Some(strips) = strips {
             let rows = (strips.rows + 2 * strips.margin).min(height);
-            crate::memory::estimate_strips_bytes(&graph, &request.maps, size, height, rows)
+            crate::memory::estimate_strips_bytes(&graph, &maps, size, height, rows)
         } else {
-            crate::memory::estimate_generate_bytes(&graph, &request.maps, size, height)
+            crate::memory::estimate_generate_bytes(&graph, &maps, size, height)
         };
         let memory = MemoryCheck::against_available(estimate);
         let what = if height == size { format!("--size {size}") } else { format!("--size {size} ({size} x {height})") };
         memory.refuse_if_over(&what)?;
-        Ok(Plan { request: request.clone(), size, height, loaded, graph, memory, start })
+        Ok(Plan { request: request.clone(), size, height, loaded, graph, maps, memory, start })
     }
 
     pub fn memory(&self) -> MemoryCheck {
@@ -119,6 +143,9 @@ impl Plan {
 
     /// Runs the plan. `progress(done, total)` reports node evaluations.
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
+        if let Some(pack) = self.request.pack {
+            return self.run_pack(pack, progress);
+        }
         let Plan { request, size, height, loaded, graph, start, .. } = self;
         let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
         let strip_layout = strips_of(&graph, &request.maps, size, height);
@@ -159,9 +186,13 @@ impl Plan {
             (kinds, files, stats, encode_start.elapsed())
         };
         let encode_start = Instant::now();
-        let entries: Vec<(MapKind, String, String)> =
-            kinds.iter().zip(&files).map(|(m, (name, bytes))| (*m, name.clone(), sha256_hex(bytes))).collect();
-        let manifest = export::manifest(&loaded, (size, height), &entries, request.options, request.format);
+        let convention = request.options.normal_convention;
+        let entries: Vec<MapEntry> = kinds
+            .iter()
+            .zip(&files)
+            .map(|(m, (name, bytes))| MapEntry::for_map(*m, name, sha256_hex(bytes), request.format, convention))
+            .collect();
+        let manifest = export::manifest(&loaded, (size, height), entries, request.options, request.format.name(), None);
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
         let manifest_name = export::manifest_file_name(&loaded.name);
         let encode_time = encode_time + encode_start.elapsed();
@@ -176,6 +207,107 @@ impl Plan {
             strips: strip_layout.map(|s| (s.count, s.rows, s.margin)),
         })
     }
+}
+
+impl Plan {
+    /// Evaluates the maps the plan's pack reads and packs them (`export::pack`), a band of
+    /// rows at a time (a strip of a body atlas, or the whole tile): (each texture with its
+    /// PNG bytes, merged stats, encode time). Nothing is written.
+    #[allow(clippy::type_complexity)]
+    pub fn pack_textures(
+        &self,
+        pack: Pack,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<(Vec<(TextureSpec, Vec<u8>)>, EvalStats, Duration), Error> {
+        use rayon::prelude::*;
+        let (width, height) = (self.size, self.height);
+        let specs = pack.textures(has_film(&self.loaded.preset));
+        let mut encoders =
+            specs.into_iter().map(|s| TextureEncoder::new(s, width, height)).collect::<Result<Vec<_>, _>>()?;
+        let mut encode_time = Duration::ZERO;
+        let strips = strips_of(&self.graph, &self.maps, width, height);
+        let stats = for_each_band(&self.graph, &self.maps, width, height, strips, progress, &mut |band, rows| {
+            let t = Instant::now();
+            encoders.par_iter_mut().try_for_each(|e| e.write_rows(band, rows.clone()))?;
+            encode_time += t.elapsed();
+            Ok(())
+        })?;
+        let t = Instant::now();
+        let textures = encoders
+            .into_par_iter()
+            .map(|e| {
+                let spec = e.spec.clone();
+                Ok((spec, e.finish()?))
+            })
+            .collect::<Result<Vec<_>, export::ExportError>>()?;
+        Ok((textures, stats, encode_time + t.elapsed()))
+    }
+
+    /// `run` for a pack: the packed textures and a manifest naming them.
+    fn run_pack(self, pack: Pack, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
+        let lock = SetLock::acquire(&self.request.out_dir, &self.loaded.name)?;
+        let (textures, stats, encode_time) = self.pack_textures(pack, progress)?;
+        let name = &self.loaded.name;
+        let files: Vec<(String, Vec<u8>)> =
+            textures.iter().map(|(spec, bytes)| (texture_file_name(name, spec), bytes.clone())).collect();
+        let entries: Vec<MapEntry> = textures
+            .iter()
+            .zip(&files)
+            .map(|((spec, _), (file, bytes))| MapEntry::for_texture(spec, file, sha256_hex(bytes)))
+            .collect();
+        let options = self.request.options;
+        let manifest =
+            export::manifest(&self.loaded, (self.size, self.height), entries, options, "png", Some(pack.name()));
+        let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
+        let written = lock.write(&files, (&export::manifest_file_name(name), &json))?;
+        let strips = strips_of(&self.graph, &self.maps, self.size, self.height);
+        Ok(GenerateReport {
+            files: written,
+            stats,
+            encode_time,
+            total_time: self.start.elapsed(),
+            created_folder: lock.created_folder,
+            strips: strips.map(|s| (s.count, s.rows, s.margin)),
+        })
+    }
+}
+
+/// Takes a band of evaluated maps and the rows of it that belong to the texture.
+type BandSink<'a> = dyn FnMut(&[(MapKind, crate::ops::Image)], std::ops::Range<usize>) -> Result<(), Error> + 'a;
+
+/// Evaluates `maps` a band of rows at a time and hands each band to `sink` with the rows of
+/// it that belong to the texture (the rest is margin): the whole texture at once when it is
+/// square (`strips` None), else strip by strip, each over its rows plus `Graph::row_reach`
+/// rows each side, so its kept rows are exactly the whole texture's.
+fn for_each_band(
+    graph: &Graph,
+    maps: &[MapKind],
+    width: usize,
+    height: usize,
+    strips: Option<Strips>,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    sink: &mut BandSink,
+) -> Result<EvalStats, Error> {
+    let Strips { count, rows: step, margin } = strips.unwrap_or(Strips { count: 1, rows: height, margin: 0 });
+    let mut stats = EvalStats::default();
+    for k in 0..count {
+        let (start, end) = (k * step, ((k + 1) * step).min(height));
+        let row0 = start.saturating_sub(margin);
+        let frame = Frame {
+            width,
+            height: (end + margin).min(height) - row0,
+            full_height: height,
+            row0,
+            wraps_v: strips.is_none(),
+        };
+        let nodes = &|done: usize, total: usize| progress(k * total + done, count * total);
+        let mut band: Vec<(MapKind, crate::ops::Image)> = Vec::new();
+        let strip_stats = evaluate_rows(graph, maps, frame, nodes, &mut |map, image| band.push((map, image)));
+        stats.merge(strip_stats);
+        band.sort_by_key(|(m, _)| *m);
+        sink(&band, start - row0..end - row0)?;
+    }
+    Ok(stats)
 }
 
 /// Rows of texture per strip of a long texture, as a multiple of its width: two widths hold
@@ -209,7 +341,7 @@ fn strips(
     name: &str,
     width: usize,
     height: usize,
-    Strips { count, rows: step, margin }: Strips,
+    layout: Strips,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Vec<MapKind>, Vec<(String, Vec<u8>)>, EvalStats, Duration), Error> {
     use rayon::prelude::*;
@@ -218,25 +350,16 @@ fn strips(
     kinds.dedup();
     let mut encoders =
         kinds.iter().map(|m| export::RowEncoder::new(*m, width, height)).collect::<Result<Vec<_>, _>>()?;
-    let mut stats = EvalStats::default();
     let mut encode_time = Duration::ZERO;
-    for k in 0..count {
-        let (start, end) = (k * step, ((k + 1) * step).min(height));
-        let row0 = start.saturating_sub(margin);
-        let frame =
-            Frame { width, height: (end + margin).min(height) - row0, full_height: height, row0, wraps_v: false };
-        let nodes = &|done: usize, total: usize| progress(k * total + done, count * total);
-        let mut band: Vec<(MapKind, crate::ops::Image)> = Vec::new();
-        let strip_stats = evaluate_rows(graph, maps, frame, nodes, &mut |map, image| band.push((map, image)));
-        stats.merge(strip_stats);
-        band.sort_by_key(|(m, _)| *m);
+    let stats = for_each_band(graph, maps, width, height, Some(layout), progress, &mut |band, rows| {
         let t = Instant::now();
         encoders
             .par_iter_mut()
-            .zip(&band)
-            .try_for_each(|(encoder, (_, image))| encoder.write_rows(image, start - row0..end - row0))?;
+            .zip(band)
+            .try_for_each(|(encoder, (_, image))| encoder.write_rows(image, rows.clone()))?;
         encode_time += t.elapsed();
-    }
+        Ok(())
+    })?;
     let t = Instant::now();
     let files = encoders
         .into_par_iter()

@@ -3,12 +3,13 @@
 //! The pipeline is "parse first, then run": a preset is read and validated (`preset`), turned
 //! into a node graph (`maps`), evaluated on demand (`graph`) with pure pixel kernels (`ops`),
 //! and written atomically (`export`). `material` is the one home of what a set means (map
-//! formats, layer optics, thesis defaults); `generate` plans and runs one set; `render` is
+//! formats, layer optics, thesis defaults); `generate` plans and runs one set, `gltf_export` puts one on a mesh as glTF; `render` is
 //! the wgpu preview. The library neither parses command lines nor prints: the `snakeskin`
 //! binary (`src/bin/snakeskin/`) does both.
 
 pub mod export;
 pub mod generate;
+pub mod gltf_export;
 pub mod graph;
 pub mod maps;
 pub mod material;

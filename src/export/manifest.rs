@@ -10,8 +10,9 @@ use serde::Serialize;
 
 use super::ExportError;
 use super::atomic::sha256_hex;
+use super::pack::TextureSpec;
 use crate::maps::{BuildOptions, Layout, body_plan, thickness_range_nm};
-use crate::material::{FileFormat, MapKind, Optics};
+use crate::material::{FileFormat, MapKind, NormalConvention, Optics};
 use crate::preset::LoadedPreset;
 
 #[derive(Debug, Serialize)]
@@ -28,6 +29,10 @@ pub struct Manifest {
     pub layout: String,
     /// `png` or `exr` (the maps' file format; each entry gives its samples).
     pub format: String,
+    /// The engine the textures are packed for (`generate --pack`), if any: `maps` then
+    /// lists the packed textures, each with what its channels hold.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pack: Option<String>,
     /// Body layout: the counts the atlas was drawn with.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub counts: Option<Counts>,
@@ -88,6 +93,44 @@ pub struct MapEntry {
     pub sha256: String,
 }
 
+impl MapEntry {
+    /// The entry of one of the set's maps in a file format.
+    pub fn for_map(map: MapKind, file: &str, sha256: String, format: FileFormat, convention: NormalConvention) -> Self {
+        let (color_space, channels, bit_depth, meaning) = match format {
+            FileFormat::Png => {
+                let f = map.format();
+                (f.color_space(), f.channels, f.bit_depth, map.meaning(convention))
+            }
+            FileFormat::Exr => {
+                let (names, bits) = map.exr_channels();
+                ("linear", names.len() as u32, bits, map.exr_meaning(convention))
+            }
+        };
+        MapEntry {
+            map: map.name().into(),
+            file: file.into(),
+            color_space: color_space.into(),
+            channels,
+            bit_depth,
+            meaning,
+            sha256,
+        }
+    }
+
+    /// The entry of a packed texture (`export::pack`).
+    pub fn for_texture(spec: &TextureSpec, file: &str, sha256: String) -> Self {
+        MapEntry {
+            map: spec.suffix.into(),
+            file: file.into(),
+            color_space: if spec.srgb { "srgb" } else { "linear" }.into(),
+            channels: spec.channels.len() as u32,
+            bit_depth: spec.bit_depth,
+            meaning: spec.meaning.into(),
+            sha256,
+        }
+    }
+}
+
 #[derive(Debug, Serialize)]
 pub struct IridescenceRange {
     /// Thickness at sample value 0 and at the maximum sample value.
@@ -100,16 +143,17 @@ pub fn manifest_file_name(set_name: &str) -> String {
     format!("{set_name}.material.json")
 }
 
-/// The manifest of a set; `files` are (map, file name, SHA-256 of the file).
+/// The manifest of a set: `entries` its files, `format` their file format's name, `pack`
+/// the engine they are packed for.
 pub fn manifest(
     loaded: &LoadedPreset,
     (width, height): (usize, usize),
-    files: &[(MapKind, String, String)],
+    entries: Vec<MapEntry>,
     options: BuildOptions,
-    format: FileFormat,
+    format: &str,
+    pack: Option<&str>,
 ) -> Manifest {
     let p = &loaded.preset;
-    let convention = options.normal_convention;
     let body = (options.layout == Layout::Body).then(|| body_plan(p));
     let plates = p.belly.plates && p.belly.width > 0.0;
     let counts = body.map(|b| Counts {
@@ -129,32 +173,6 @@ pub fn manifest(
         }
     });
     let (min_nm, max_nm) = thickness_range_nm(p);
-    let entry = |(map, file, sha256): &(MapKind, String, String)| match format {
-        FileFormat::Png => {
-            let f = map.format();
-            MapEntry {
-                map: map.name().into(),
-                file: file.clone(),
-                color_space: f.color_space().into(),
-                channels: f.channels,
-                bit_depth: f.bit_depth,
-                meaning: map.meaning(convention),
-                sha256: sha256.clone(),
-            }
-        }
-        FileFormat::Exr => {
-            let (names, bits) = map.exr_channels();
-            MapEntry {
-                map: map.name().into(),
-                file: file.clone(),
-                color_space: "linear".into(),
-                channels: names.len() as u32,
-                bit_depth: bits,
-                meaning: map.exr_meaning(convention),
-                sha256: sha256.clone(),
-            }
-        }
-    };
     Manifest {
         generator: "snakeskin".into(),
         generator_version: env!("CARGO_PKG_VERSION").into(),
@@ -165,10 +183,11 @@ pub fn manifest(
         width,
         height,
         layout: options.layout.name().into(),
-        format: format.name().into(),
+        format: format.into(),
+        pack: pack.map(String::from),
         counts,
         regions,
-        maps: files.iter().map(entry).collect(),
+        maps: entries,
         iridescence: IridescenceRange { min_nm, max_nm },
         optics: p.optics.clone(),
         color_means: COLOR_MEANS.into(),

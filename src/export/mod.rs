@@ -5,10 +5,12 @@
 //! one core, the largest single cost after generation.
 
 mod atomic;
+pub mod gltf;
 mod manifest;
+pub mod pack;
 
 pub use atomic::{SetLock, create_folder, sha256_hex, write_file_atomically};
-pub use manifest::{Manifest, VerifiedSet, manifest, manifest_file_name, verify_set};
+pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 
 use std::io::Cursor;
 use std::path::PathBuf;
@@ -35,6 +37,10 @@ pub enum ExportError {
     NotAFolder { path: PathBuf },
     #[error("set {manifest}: {problem}")]
     Verify { manifest: PathBuf, problem: String },
+    #[error("cannot encode the packed {texture} texture: {message}")]
+    Pack { texture: &'static str, message: String },
+    #[error("cannot write the glTF file: {0}")]
+    Gltf(String),
 }
 
 impl ExportError {
@@ -158,7 +164,7 @@ pub struct RowEncoder {
 /// The file's bytes, shared with the PNG writer: `StreamWriter::finish` consumes the writer
 /// (its drop writes the end chunk), so the bytes are read back through this handle.
 #[derive(Clone, Default)]
-struct SharedBuffer(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+pub(crate) struct SharedBuffer(pub(crate) std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
 
 impl std::io::Write for SharedBuffer {
     fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {

@@ -32,6 +32,10 @@ pub struct Cli {
 pub enum Command {
     /// Generate a texture set: <out>/<name>_<map>.png and <out>/<name>.material.json.
     Generate(GenerateArgs),
+    /// Export a preset as glTF 2.0 (.glb, or .gltf with its images beside it): the snake (or
+    /// a sphere or plane) with the maps as a metallic-roughness material, the film as
+    /// KHR_materials_iridescence and the base's index as KHR_materials_ior.
+    Export(ExportArgs),
     /// Print the node graph the requested maps need.
     Graph(GraphArgs),
     /// Query the optics: exact thin-film reflectance and film colour (JSON output).
@@ -166,9 +170,71 @@ pub struct GenerateArgs {
     /// thickness in nm; tile layout only for now).
     #[arg(long, value_enum, default_value_t = FormatArg::Png)]
     pub format: FormatArg,
+    /// Write the textures an engine reads instead of the maps: gltf (base colour, OpenGL
+    /// normal, occlusion-roughness-metallic, film thickness), unreal (ORM, DirectX normal,
+    /// height) or unity-hdrp (mask map with smoothness in alpha, OpenGL normal, height);
+    /// see the README's packing table. Sets the normal convention the engine expects.
+    #[arg(long, value_enum, value_name = "ENGINE", conflicts_with_all = ["normal_convention", "format"])]
+    pub pack: Option<PackArg>,
     /// Print per-node evaluations, time and buffer size after the run.
     #[arg(long)]
     pub stats: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    #[command(flatten)]
+    pub source: PresetSource,
+    /// The file to write: NAME.glb (everything in one binary file) or NAME.gltf (JSON, with
+    /// NAME.bin and NAME_<texture>.png beside it).
+    #[arg(long, value_name = "FILE")]
+    pub gltf: PathBuf,
+    /// Texture width in pixels (a body atlas is `body.length` widths tall; WebGL viewers
+    /// commonly load textures up to 16384 texels a side).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(16..=16384))]
+    pub size: u64,
+    /// snake (the preview's body), sphere (the material alone, tile layout) or plane.
+    #[arg(long, value_enum, default_value_t = MeshArg::Snake)]
+    pub mesh: MeshArg,
+    /// tile (the tile repeated along the body) or body (a body atlas once over the whole
+    /// snake: head, neck, tail).
+    #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
+    pub layout: LayoutArg,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MeshArg {
+    Snake,
+    Sphere,
+    Plane,
+}
+
+impl MeshArg {
+    pub fn kind(self) -> snakeskin::gltf_export::MeshKind {
+        match self {
+            MeshArg::Snake => snakeskin::gltf_export::MeshKind::Snake,
+            MeshArg::Sphere => snakeskin::gltf_export::MeshKind::Sphere,
+            MeshArg::Plane => snakeskin::gltf_export::MeshKind::Plane,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PackArg {
+    Gltf,
+    Unreal,
+    UnityHdrp,
+}
+
+impl PackArg {
+    pub fn pack(self) -> snakeskin::export::pack::Pack {
+        use snakeskin::export::pack::Pack;
+        match self {
+            PackArg::Gltf => Pack::Gltf,
+            PackArg::Unreal => Pack::Unreal,
+            PackArg::UnityHdrp => Pack::UnityHdrp,
+        }
+    }
 }
 
 #[derive(Debug, Args)]

@@ -242,6 +242,82 @@ impl Mesh {
         Mesh { vertices, indices: vec![0, 2, 1, 0, 3, 2] }
     }
 
+    /// A flat `width` × `height` rectangle in the xy plane facing +z, centred on the origin,
+    /// the texture once over it (u left to right, v top to bottom as in the image).
+    pub fn plane(width: f32, height: f32) -> Mesh {
+        let corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let vertices = corners
+            .iter()
+            .map(|&[u, v]| Vertex {
+                position: [(u - 0.5) * width, (0.5 - v) * height, 0.0],
+                normal: [0.0, 0.0, 1.0],
+                // +x is +u; cross(+z, +x) = +y is up the image (−v): w = +1.
+                tangent: [1.0, 0.0, 0.0, 1.0],
+                uv: [u, v],
+            })
+            .collect();
+        // Counter-clockwise seen from +z.
+        Mesh { vertices, indices: vec![0, 3, 1, 1, 3, 2] }
+    }
+
+    /// A sphere of `radius` about the origin, +y up, the texture `repeats` times around the
+    /// equator (u) and `repeats / 2` times from pole to pole (v, top to bottom), so texels
+    /// stay square at the equator. The poles' degenerate triangles are left out.
+    pub fn sphere(radius: f32, repeats: f32, rings: usize, segments: usize) -> Mesh {
+        let (rings, segments) = (rings.max(3), segments.max(4));
+        let mut vertices = Vec::with_capacity((rings + 1) * (segments + 1));
+        for i in 0..=rings {
+            let v = i as f32 / rings as f32;
+            let theta = std::f32::consts::PI * v;
+            for j in 0..=segments {
+                let u = j as f32 / segments as f32;
+                let phi = 2.0 * std::f32::consts::PI * u;
+                let normal = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+                // ∂P/∂u (its direction does not depend on θ, so it is defined at the poles).
+                let tangent = Vec3::new(-phi.sin(), 0.0, -phi.cos());
+                // Up the image (−v) is towards the north pole: −∂P/∂θ.
+                let up_image = -Vec3::new(theta.cos() * phi.cos(), -theta.sin(), -theta.cos() * phi.sin());
+                let sign = if normal.cross(tangent).dot(up_image) >= 0.0 { 1.0 } else { -1.0 };
+                vertices.push(Vertex {
+                    position: (normal * radius).to_array(),
+                    normal: normal.to_array(),
+                    tangent: [tangent.x, tangent.y, tangent.z, sign],
+                    uv: [u * repeats, v * repeats * 0.5],
+                });
+            }
+        }
+        let stride = (segments + 1) as u32;
+        let mut indices = Vec::with_capacity(rings * segments * 6);
+        for i in 0..rings as u32 {
+            for j in 0..segments as u32 {
+                let a = i * stride + j;
+                let b = a + stride;
+                if i > 0 {
+                    indices.extend_from_slice(&[a, a + 1, b]);
+                }
+                if i + 1 < rings as u32 {
+                    indices.extend_from_slice(&[b, a + 1, b + 1]);
+                }
+            }
+        }
+        let mut mesh = Mesh { vertices, indices };
+        mesh.orient_outward();
+        mesh
+    }
+
+    /// The mesh without zero-area triangles (a tube's closed ends, where a ring collapses to
+    /// a point): nothing a renderer would draw, but validators flag them.
+    pub fn without_degenerate_triangles(mut self) -> Mesh {
+        let vertices = &self.vertices;
+        let area = |t: &[u32]| {
+            let p = |k: usize| Vec3::from(vertices[t[k] as usize].position);
+            (p(1) - p(0)).cross(p(2) - p(0)).length()
+        };
+        let indices: Vec<u32> = self.indices.chunks_exact(3).filter(|t| area(t) > 1e-12).flatten().copied().collect();
+        self.indices = indices;
+        self
+    }
+
     /// Axis-aligned bounds (min, max).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.vertices.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), v| {

@@ -28,6 +28,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         out_dir: args.out.clone(),
         options: BuildOptions { normal_convention: convention, layout: args.layout.layout() },
         format: args.format.format(),
+        pack: args.pack.map(|p| p.pack()),
     };
     let plan = Plan::new(&request)?;
     crate::output::report_clamped_colours(&source.preset, plan.loaded());

@@ -3,6 +3,7 @@
 
 mod bench;
 mod brdf;
+mod export;
 mod figures;
 mod gallery;
 mod generate;
@@ -18,6 +19,7 @@ use crate::cli::{Cli, Command};
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Generate(args) => generate::run(args),
+        Command::Export(args) => export::run(args),
         Command::Graph(args) => graph::run(args),
         Command::Brdf { command } => brdf::run(command),
         Command::Bench { command } => bench::run(command),

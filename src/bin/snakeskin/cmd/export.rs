@@ -1,0 +1,27 @@
+//! `snakeskin export --gltf FILE`: a preset on a mesh as glTF 2.0, with a progress bar.
+
+use anyhow::Result;
+
+use crate::cli::ExportArgs;
+use crate::output::path_line;
+use crate::progress::Progress;
+use snakeskin::gltf_export::{ExportRequest, export};
+
+pub fn run(args: ExportArgs) -> Result<()> {
+    let request = ExportRequest {
+        preset: args.source.preset.clone(),
+        overrides: args.source.overrides.clone(),
+        seed: args.source.seed,
+        size: args.size,
+        layout: args.layout.layout(),
+        mesh: args.mesh.kind(),
+        out: args.gltf.clone(),
+    };
+    let bar = Progress::counting("{spinner} exporting [{bar:30}] {pos}/{len} nodes {elapsed}");
+    let report = export(&request, &|done, total| bar.update(done, total))?;
+    bar.finish();
+    for file in &report.files {
+        println!("{}", path_line(file));
+    }
+    Ok(())
+}

@@ -1,0 +1,357 @@
+//! glTF 2.0 export: one mesh with the set's packed textures (`Pack::Gltf`) as a metallic-
+//! roughness material, the film as `KHR_materials_iridescence` and the pigment layer's index
+//! as `KHR_materials_ior`, written as one binary `.glb` or as a `.gltf` with its buffer and
+//! images beside it.
+//!
+//! What glTF can carry of the layer stack: the film (index n1, thickness range in nm, the
+//! thickness texture) over a dielectric base of index n2, with the base colour as the
+//! visible diffuse colour (`COLOR_MEANS`: the stack's diffuse reflectance per unit of light
+//! the top lets in, which is what glTF's base colour under a dielectric top is). What it
+//! cannot: the absorbing pigment layer's thickness and σ (folded into the visible colour),
+//! an ambient index n0 other than air, and the internal-reflection series' angle dependence.
+//! Every extension value is written explicitly: the spec's defaults (film index 1.3,
+//! 100–400 nm, base index 1.5) are not ours.
+//!
+//! Spec: https://registry.khronos.org/glTF/specs/2.0/glTF-2.0.html and the extensions'
+//! READMEs in KhronosGroup/glTF (KHR_materials_iridescence, KHR_materials_ior).
+
+use serde_json::{Value, json};
+
+use super::ExportError;
+use crate::render::engine::mesh::Mesh;
+
+/// glTF's numeric constants (glTF 2.0 spec, 5.1 accessors, 5.11 buffer views, 5.26 samplers).
+mod gl {
+    pub const FLOAT: u32 = 5126;
+    pub const UNSIGNED_INT: u32 = 5125;
+    pub const ARRAY_BUFFER: u32 = 34962;
+    pub const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+    pub const LINEAR: u32 = 9729;
+    pub const LINEAR_MIPMAP_LINEAR: u32 = 9987;
+    pub const REPEAT: u32 = 10497;
+    pub const CLAMP_TO_EDGE: u32 = 33071;
+    pub const TRIANGLES: u32 = 4;
+}
+
+/// The material's numbers (the preset's optics and the manifest's thickness range).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GltfMaterial {
+    /// n2: the index of the base under the film (KHR_materials_ior).
+    pub base_ior: f64,
+    /// The film, if the preset has one: (n1, minimum nm, maximum nm).
+    pub film: Option<(f64, f64, f64)>,
+    /// Whether the texture repeats along v (a tile) or spans it once (a body atlas).
+    pub repeat_v: bool,
+}
+
+/// The textures a glTF material reads, as PNG bytes (`Pack::Gltf`'s files).
+#[derive(Debug, Clone)]
+pub struct GltfTextures {
+    pub base_color: Vec<u8>,
+    pub normal: Vec<u8>,
+    /// Occlusion (R, 1 without an AO map), roughness (G), metallic (B).
+    pub orm: Vec<u8>,
+    /// Film thickness in G (grey), when there is a film.
+    pub thickness: Option<Vec<u8>>,
+    /// Whether `orm`'s R channel holds a real ambient occlusion map.
+    pub occlusion: bool,
+}
+
+/// A glTF document before it is written: the JSON and the binary buffer; images are in the
+/// buffer (GLB) or in their own files (`.gltf`).
+struct Document {
+    json: Value,
+    bin: Vec<u8>,
+}
+
+/// The binary buffer being filled, with its buffer views and accessors.
+#[derive(Default)]
+struct Buffer {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Buffer {
+    /// Appends `bytes` as a buffer view at a 4-byte-aligned offset (accessors of floats
+    /// must be aligned); returns the view's index.
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let mut view = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
+        if let Some(t) = target {
+            view["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(view);
+        self.views.len() - 1
+    }
+
+    /// A vertex attribute of `components` floats per vertex; returns the accessor's index.
+    /// `bounds`: write its min and max (POSITION must, glTF 2.0 §3.7.2.1).
+    fn attribute(&mut self, values: &[f32], components: usize, kind: &str, bounds: bool) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes, Some(gl::ARRAY_BUFFER));
+        let mut accessor =
+            json!({ "bufferView": view, "componentType": gl::FLOAT, "count": values.len() / components, "type": kind });
+        if bounds {
+            let mut lo = vec![f32::MAX; components];
+            let mut hi = vec![f32::MIN; components];
+            for chunk in values.chunks_exact(components) {
+                for (k, v) in chunk.iter().enumerate() {
+                    lo[k] = lo[k].min(*v);
+                    hi[k] = hi[k].max(*v);
+                }
+            }
+            accessor["min"] = json!(lo);
+            accessor["max"] = json!(hi);
+        }
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    /// Triangle indices as u32; returns the accessor's index.
+    fn indices(&mut self, indices: &[u32]) -> usize {
+        let bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+        let view = self.view(&bytes, Some(gl::ELEMENT_ARRAY_BUFFER));
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": gl::UNSIGNED_INT,
+            "count": indices.len(),
+            "type": "SCALAR",
+            "min": [indices.iter().min().copied().unwrap_or(0)],
+            "max": [indices.iter().max().copied().unwrap_or(0)],
+        }));
+        self.accessors.len() - 1
+    }
+}
+
+/// Where the images go: into the buffer (GLB) or beside the file under these names.
+enum Images<'a> {
+    Embedded,
+    Files(&'a [String]),
+}
+
+fn document(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfTextures, images: Images) -> Document {
+    let mut buffer = Buffer::default();
+    let v = &mesh.vertices;
+    let position = buffer.attribute(&v.iter().flat_map(|v| v.position).collect::<Vec<_>>(), 3, "VEC3", true);
+    let normal = buffer.attribute(&v.iter().flat_map(|v| v.normal).collect::<Vec<_>>(), 3, "VEC3", false);
+    let tangent = buffer.attribute(&v.iter().flat_map(|v| v.tangent).collect::<Vec<_>>(), 4, "VEC4", false);
+    let uv = buffer.attribute(&v.iter().flat_map(|v| v.uv).collect::<Vec<_>>(), 2, "VEC2", false);
+    let indices = buffer.indices(&mesh.indices);
+
+    let mut pngs: Vec<(&str, &[u8])> =
+        vec![("basecolor", &textures.base_color), ("normal", &textures.normal), ("orm", &textures.orm)];
+    if let Some(t) = &textures.thickness {
+        pngs.push(("thickness", t));
+    }
+    let image_list: Vec<Value> = pngs
+        .iter()
+        .enumerate()
+        .map(|(k, (role, bytes))| match &images {
+            Images::Embedded => {
+                let index = buffer.view(bytes, None);
+                json!({ "name": format!("{name}_{role}"), "bufferView": index, "mimeType": "image/png" })
+            }
+            Images::Files(names) => json!({ "name": format!("{name}_{role}"), "uri": names[k] }),
+        })
+        .collect();
+    let texture_list: Vec<Value> = (0..pngs.len()).map(|k| json!({ "sampler": 0, "source": k })).collect();
+
+    let pbr = json!({
+        "baseColorTexture": { "index": 0, "texCoord": 0 },
+        "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
+        "metallicRoughnessTexture": { "index": 2, "texCoord": 0 },
+        // The texture's B is 0 (a dielectric) and G the roughness itself.
+        "metallicFactor": 1.0,
+        "roughnessFactor": 1.0,
+    });
+    let mut mat = json!({
+        "name": name,
+        "normalTexture": { "index": 1, "texCoord": 0, "scale": 1.0 },
+        "doubleSided": false,
+        "alphaMode": "OPAQUE",
+    });
+    if textures.occlusion {
+        mat["occlusionTexture"] = json!({ "index": 2, "texCoord": 0, "strength": 1.0 });
+    }
+    let mut extensions = serde_json::Map::new();
+    let mut used = vec!["KHR_materials_ior"];
+    extensions.insert("KHR_materials_ior".into(), json!({ "ior": material.base_ior }));
+    if let Some((film_ior, min_nm, max_nm)) = material.film {
+        used.push("KHR_materials_iridescence");
+        let mut film = json!({
+            "iridescenceFactor": 1.0,
+            "iridescenceIor": film_ior,
+            "iridescenceThicknessMinimum": min_nm,
+            "iridescenceThicknessMaximum": max_nm,
+        });
+        if textures.thickness.is_some() {
+            film["iridescenceThicknessTexture"] = json!({ "index": 3, "texCoord": 0 });
+        }
+        extensions.insert("KHR_materials_iridescence".into(), film);
+    }
+    mat["extensions"] = Value::Object(extensions);
+    mat["pbrMetallicRoughness"] = pbr;
+    used.sort();
+
+    let Buffer { bin, views, accessors } = buffer;
+    let buffer = match &images {
+        Images::Embedded => json!({ "byteLength": bin.len() }),
+        Images::Files(_) => json!({ "byteLength": bin.len(), "uri": format!("{name}.bin") }),
+    };
+    let json = json!({
+        "asset": { "version": "2.0", "generator": format!("snakeskin {}", env!("CARGO_PKG_VERSION")) },
+        "extensionsUsed": used,
+        "scene": 0,
+        "scenes": [{ "name": name, "nodes": [0] }],
+        "nodes": [{ "name": name, "mesh": 0 }],
+        "meshes": [{
+            "name": name,
+            "primitives": [{
+                "attributes": { "POSITION": position, "NORMAL": normal, "TANGENT": tangent, "TEXCOORD_0": uv },
+                "indices": indices,
+                "material": 0,
+                "mode": gl::TRIANGLES,
+            }],
+        }],
+        "materials": [mat],
+        "textures": texture_list,
+        "images": image_list,
+        "samplers": [{
+            "magFilter": gl::LINEAR,
+            "minFilter": gl::LINEAR_MIPMAP_LINEAR,
+            // u wraps round the body; v repeats on a tile, spans a body atlas once.
+            "wrapS": gl::REPEAT,
+            "wrapT": if material.repeat_v { gl::REPEAT } else { gl::CLAMP_TO_EDGE },
+        }],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [buffer],
+    });
+    Document { json, bin }
+}
+
+/// GLB chunk types (glTF 2.0, 4.4.3): "JSON" and "BIN\0" as little-endian u32.
+const GLB_MAGIC: u32 = 0x4654_6C67;
+const CHUNK_JSON: u32 = 0x4E4F_534A;
+const CHUNK_BIN: u32 = 0x004E_4942;
+
+/// A binary glTF (.glb): header, JSON chunk (padded with spaces), BIN chunk (padded with
+/// zeros), every chunk 4-byte aligned; at most 4 GiB in all (the header's u32 length).
+pub fn glb(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfTextures) -> Result<Vec<u8>, ExportError> {
+    let Document { json, mut bin } = document(name, mesh, material, textures, Images::Embedded);
+    let mut text = serde_json::to_vec(&json).map_err(|e| ExportError::Gltf(e.to_string()))?;
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let total = 12 + 8 + text.len() + 8 + bin.len();
+    let total32 = u32::try_from(total)
+        .map_err(|_| ExportError::Gltf(format!("{total} bytes is over GLB's 4 GiB; use a smaller --size")))?;
+    let mut out = Vec::with_capacity(total);
+    for word in [GLB_MAGIC, 2, total32, text.len() as u32, CHUNK_JSON] {
+        out.extend_from_slice(&word.to_le_bytes());
+    }
+    out.extend_from_slice(&text);
+    for word in [bin.len() as u32, CHUNK_BIN] {
+        out.extend_from_slice(&word.to_le_bytes());
+    }
+    out.extend_from_slice(&bin);
+    Ok(out)
+}
+
+/// A `.gltf` with its buffer (`NAME.bin`) and images beside it: (file name, bytes), the
+/// `.gltf` last (it names the others, so it is the set's commit record).
+pub fn gltf_files(
+    name: &str,
+    mesh: &Mesh,
+    material: GltfMaterial,
+    textures: &GltfTextures,
+) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
+    let mut roles = vec!["basecolor", "normal", "orm"];
+    if textures.thickness.is_some() {
+        roles.push("thickness");
+    }
+    let names: Vec<String> = roles.iter().map(|r| format!("{name}_{r}.png")).collect();
+    let Document { json, bin } = document(name, mesh, material, textures, Images::Files(&names));
+    let text = serde_json::to_vec_pretty(&json).map_err(|e| ExportError::Gltf(e.to_string()))?;
+    let mut files = vec![(format!("{name}.bin"), bin)];
+    let pngs = [Some(&textures.base_color), Some(&textures.normal), Some(&textures.orm), textures.thickness.as_ref()];
+    for (file, bytes) in names.iter().zip(pngs.into_iter().flatten()) {
+        files.push((file.clone(), bytes.clone()));
+    }
+    files.push((format!("{name}.gltf"), text));
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::engine::mesh::Mesh;
+
+    fn parse_glb(bytes: &[u8]) -> (Value, Vec<u8>) {
+        let word = |k: usize| u32::from_le_bytes(bytes[k..k + 4].try_into().unwrap()) as usize;
+        assert_eq!(word(0) as u32, GLB_MAGIC);
+        assert_eq!(word(4), 2);
+        assert_eq!(word(8), bytes.len());
+        let json_len = word(12);
+        assert_eq!(word(16) as u32, CHUNK_JSON);
+        assert_eq!(json_len % 4, 0);
+        let json: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+        let bin_start = 20 + json_len;
+        let bin_len = word(bin_start);
+        assert_eq!(word(bin_start + 4) as u32, CHUNK_BIN);
+        (json, bytes[bin_start + 8..bin_start + 8 + bin_len].to_vec())
+    }
+
+    #[test]
+    fn glb_round_trips_the_mesh_and_writes_every_film_value() {
+        let mesh = Mesh::plane(1.0, 1.0);
+        let textures = GltfTextures {
+            base_color: vec![1, 2, 3],
+            normal: vec![4, 5],
+            orm: vec![6],
+            thickness: Some(vec![7, 8, 9, 10, 11]),
+            occlusion: false,
+        };
+        let material = GltfMaterial { base_ior: 1.56, film: Some((1.33, 250.0, 450.0)), repeat_v: true };
+        let (json, bin) = parse_glb(&glb("snake", &mesh, material, &textures).unwrap());
+        let film = &json["materials"][0]["extensions"]["KHR_materials_iridescence"];
+        assert_eq!(film["iridescenceIor"], 1.33);
+        assert_eq!(film["iridescenceThicknessMinimum"], 250.0);
+        assert_eq!(film["iridescenceThicknessMaximum"], 450.0);
+        assert_eq!(film["iridescenceFactor"], 1.0);
+        assert_eq!(json["materials"][0]["extensions"]["KHR_materials_ior"]["ior"], 1.56);
+        // The positions read back from the buffer are the mesh's.
+        let accessor =
+            &json["accessors"][json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize];
+        let view = &json["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+        let offset = view["byteOffset"].as_u64().unwrap() as usize;
+        assert_eq!(offset % 4, 0);
+        let first: Vec<f32> =
+            (0..3).map(|k| f32::from_le_bytes(bin[offset + 4 * k..offset + 4 * k + 4].try_into().unwrap())).collect();
+        assert_eq!(first, mesh.vertices[0].position.to_vec());
+        // The thickness image is the fourth and its bytes are in the buffer.
+        let image = &json["images"][3];
+        let view = &json["bufferViews"][image["bufferView"].as_u64().unwrap() as usize];
+        let (o, n) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+        assert_eq!(&bin[o..o + n], &[7, 8, 9, 10, 11]);
+    }
+
+    #[test]
+    fn no_film_writes_no_iridescence_extension() {
+        let mesh = Mesh::plane(1.0, 1.0);
+        let textures =
+            GltfTextures { base_color: vec![1], normal: vec![2], orm: vec![3], thickness: None, occlusion: false };
+        let material = GltfMaterial { base_ior: 2.0, film: None, repeat_v: false };
+        let (json, _) = parse_glb(&glb("s", &mesh, material, &textures).unwrap());
+        assert_eq!(json["extensionsUsed"], json!(["KHR_materials_ior"]));
+        assert!(json["materials"][0]["extensions"].get("KHR_materials_iridescence").is_none());
+        assert_eq!(json["samplers"][0]["wrapT"], gl::CLAMP_TO_EDGE);
+    }
+}

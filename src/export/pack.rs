@@ -1,0 +1,359 @@
+//! Packed textures: the files an engine or a glTF material reads, each channel taken from one
+//! of the set's maps (or a constant) with its own transfer — glTF's occlusion-roughness-
+//! metallic, Unreal's DirectX-convention normal, Unity HDRP's mask map with smoothness in
+//! alpha. One table (`Pack::textures`) says what every packed file holds; the encoder, the
+//! manifest, the glTF writer and the README's packing table all follow it.
+//!
+//! Packed files are written a band of rows at a time (`TextureEncoder`), like a body atlas's
+//! maps, so a pack costs no more memory than the set it is packed from.
+
+use std::io::Write;
+use std::ops::Range;
+
+use crate::material::MapKind;
+use crate::ops::Image;
+
+use super::{ExportError, SharedBuffer, linear_to_srgb8};
+
+/// How one channel of a packed texture is made from a map's linear sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Transfer {
+    /// sRGB transfer function (IEC 61966-2-1), for colour textures.
+    Srgb,
+    /// The value as is, on [0, 1].
+    Unit,
+    /// A signed value on [-1, 1] stored as x · 0.5 + 0.5 (a normal's x, y, z).
+    SignedUnit,
+    /// −x, then as `SignedUnit`: the green channel of a DirectX-convention normal from the
+    /// graph's OpenGL-convention normal.
+    NegatedSignedUnit,
+    /// 1 − x: smoothness from perceptual roughness (Unity).
+    Complement,
+}
+
+/// One channel of a packed texture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Channel {
+    /// Channel `channel` of `map`, through `transfer`.
+    Map { map: MapKind, channel: usize, transfer: Transfer },
+    /// The same value everywhere, on [0, 1] (metallic 0, occlusion 1 without an AO map).
+    Constant(u8),
+}
+
+impl Channel {
+    const fn map(map: MapKind, channel: usize, transfer: Transfer) -> Channel {
+        Channel::Map { map, channel, transfer }
+    }
+}
+
+/// One packed file: its name in the set, channels, bit depth and what it means.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextureSpec {
+    /// File name suffix: `<set>_<suffix>.png`.
+    pub suffix: &'static str,
+    pub channels: Vec<Channel>,
+    /// 8, or 16 for a single-channel map that keeps the set's 16-bit precision (height).
+    pub bit_depth: u32,
+    /// True for colour (sRGB) textures; data textures are linear.
+    pub srgb: bool,
+    /// What each channel holds, in the engine's own words (the manifest and the README).
+    pub meaning: &'static str,
+}
+
+/// The engines a set can be packed for (`generate --pack`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Pack {
+    /// glTF 2.0's core textures and KHR_materials_iridescence's thickness (`export --gltf`
+    /// embeds exactly these).
+    Gltf,
+    /// Unreal Engine: ORM, DirectX-convention normal.
+    Unreal,
+    /// Unity's High Definition Render Pipeline (Lit shader).
+    UnityHdrp,
+}
+
+const RGB_SRGB: [Channel; 3] = [
+    Channel::map(MapKind::Color, 0, Transfer::Srgb),
+    Channel::map(MapKind::Color, 1, Transfer::Srgb),
+    Channel::map(MapKind::Color, 2, Transfer::Srgb),
+];
+const NORMAL_OPENGL: [Channel; 3] = [
+    Channel::map(MapKind::Normal, 0, Transfer::SignedUnit),
+    Channel::map(MapKind::Normal, 1, Transfer::SignedUnit),
+    Channel::map(MapKind::Normal, 2, Transfer::SignedUnit),
+];
+const NORMAL_DIRECTX: [Channel; 3] = [
+    Channel::map(MapKind::Normal, 0, Transfer::SignedUnit),
+    Channel::map(MapKind::Normal, 1, Transfer::NegatedSignedUnit),
+    Channel::map(MapKind::Normal, 2, Transfer::SignedUnit),
+];
+/// No ambient occlusion map: fully unoccluded.
+const NO_OCCLUSION: Channel = Channel::Constant(255);
+const NOT_METALLIC: Channel = Channel::Constant(0);
+const ROUGHNESS: Channel = Channel::map(MapKind::Roughness, 0, Transfer::Unit);
+const THICKNESS: Channel = Channel::map(MapKind::Iridescence, 0, Transfer::Unit);
+const HEIGHT: Channel = Channel::map(MapKind::Height, 0, Transfer::Unit);
+
+impl Pack {
+    pub const ALL: [Pack; 3] = [Pack::Gltf, Pack::Unreal, Pack::UnityHdrp];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Pack::Gltf => "gltf",
+            Pack::Unreal => "unreal",
+            Pack::UnityHdrp => "unity-hdrp",
+        }
+    }
+
+    /// The packed files, in order. `film`: whether the preset has a film (a thickness
+    /// texture is written only then).
+    pub fn textures(self, film: bool) -> Vec<TextureSpec> {
+        let base_color = TextureSpec {
+            suffix: "basecolor",
+            channels: RGB_SRGB.to_vec(),
+            bit_depth: 8,
+            srgb: true,
+            meaning: "RGB: visible diffuse colour (the manifest's color_means), sRGB",
+        };
+        // glTF, Unreal and HDRP all take the thickness as a [0, 1] value remapped to a
+        // range in nm given with the material (glTF: iridescenceThicknessMinimum/Maximum,
+        // read from G; a grey image has it in every channel).
+        let thickness = TextureSpec {
+            suffix: "thickness",
+            channels: vec![THICKNESS],
+            bit_depth: 8,
+            srgb: false,
+            meaning: "grey: film thickness, min_nm + value * (max_nm - min_nm) (the manifest's iridescence range)",
+        };
+        let height = TextureSpec {
+            suffix: "height",
+            channels: vec![HEIGHT],
+            bit_depth: 16,
+            srgb: false,
+            meaning: "grey: relative surface height, 0 = lowest (displacement or parallax)",
+        };
+        let mut textures = match self {
+            Pack::Gltf => vec![
+                base_color,
+                TextureSpec {
+                    suffix: "normal",
+                    channels: NORMAL_OPENGL.to_vec(),
+                    bit_depth: 8,
+                    srgb: false,
+                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as glTF requires",
+                },
+                TextureSpec {
+                    suffix: "orm",
+                    channels: vec![NO_OCCLUSION, ROUGHNESS, NOT_METALLIC],
+                    bit_depth: 8,
+                    srgb: false,
+                    meaning: "R: occlusion (1 = none), G: perceptual roughness, B: metallic (0)",
+                },
+            ],
+            Pack::Unreal => vec![
+                base_color,
+                TextureSpec {
+                    suffix: "normal",
+                    channels: NORMAL_DIRECTX.to_vec(),
+                    bit_depth: 8,
+                    srgb: false,
+                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, DirectX convention (+Y down, green flipped)",
+                },
+                TextureSpec {
+                    suffix: "orm",
+                    channels: vec![NO_OCCLUSION, ROUGHNESS, NOT_METALLIC],
+                    bit_depth: 8,
+                    srgb: false,
+                    meaning: "R: ambient occlusion (1 = none), G: roughness, B: metallic (0)",
+                },
+                height,
+            ],
+            Pack::UnityHdrp => vec![
+                base_color,
+                TextureSpec {
+                    suffix: "normal",
+                    channels: NORMAL_OPENGL.to_vec(),
+                    bit_depth: 8,
+                    srgb: false,
+                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as Unity expects",
+                },
+                TextureSpec {
+                    suffix: "mask",
+                    channels: vec![
+                        NOT_METALLIC,
+                        NO_OCCLUSION,
+                        Channel::Constant(0),
+                        Channel::map(MapKind::Roughness, 0, Transfer::Complement),
+                    ],
+                    bit_depth: 8,
+                    srgb: false,
+                    meaning: "R: metallic (0), G: ambient occlusion (1 = none), B: detail mask (0), A: smoothness = 1 - roughness",
+                },
+                height,
+            ],
+        };
+        if film {
+            textures.push(thickness);
+        }
+        textures
+    }
+
+    /// The maps a pack's textures read, in `MapKind` order.
+    pub fn maps(self, film: bool) -> Vec<MapKind> {
+        let mut maps: Vec<MapKind> = self
+            .textures(film)
+            .iter()
+            .flat_map(|t| t.channels.iter())
+            .filter_map(|c| match c {
+                Channel::Map { map, .. } => Some(*map),
+                Channel::Constant(_) => None,
+            })
+            .collect();
+        maps.sort();
+        maps.dedup();
+        maps
+    }
+}
+
+impl std::str::FromStr for Pack {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Pack, String> {
+        Pack::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| format!("unknown pack {s:?}; accepted: gltf, unreal, unity-hdrp"))
+    }
+}
+
+/// File name of a packed texture.
+pub fn texture_file_name(set_name: &str, spec: &TextureSpec) -> String {
+    format!("{set_name}_{}.png", spec.suffix)
+}
+
+fn quantize8(x: f32) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
+
+fn quantize16(x: f32) -> u16 {
+    (x.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16
+}
+
+impl Transfer {
+    /// The stored value on [0, 1] of a linear sample.
+    fn apply(self, x: f32) -> f32 {
+        match self {
+            Transfer::Srgb => linear_to_srgb8(x) as f32 / 255.0,
+            Transfer::Unit => x,
+            Transfer::SignedUnit => x * 0.5 + 0.5,
+            Transfer::NegatedSignedUnit => -x * 0.5 + 0.5,
+            Transfer::Complement => 1.0 - x,
+        }
+    }
+}
+
+/// A packed PNG written a band of rows at a time.
+pub struct TextureEncoder {
+    pub spec: TextureSpec,
+    writer: png::StreamWriter<'static, SharedBuffer>,
+    buffer: SharedBuffer,
+}
+
+impl TextureEncoder {
+    pub fn new(spec: TextureSpec, width: usize, height: usize) -> Result<TextureEncoder, ExportError> {
+        let error = |e: png::EncodingError| ExportError::Pack { texture: spec.suffix, message: e.to_string() };
+        let buffer = SharedBuffer::default();
+        let mut encoder = png::Encoder::new(buffer.clone(), width as u32, height as u32);
+        encoder.set_color(match spec.channels.len() {
+            1 => png::ColorType::Grayscale,
+            3 => png::ColorType::Rgb,
+            4 => png::ColorType::Rgba,
+            n => unreachable!("a packed texture has 1, 3 or 4 channels, not {n}"),
+        });
+        encoder.set_depth(if spec.bit_depth == 16 { png::BitDepth::Sixteen } else { png::BitDepth::Eight });
+        if spec.srgb {
+            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        }
+        encoder.set_compression(png::Compression::Fast);
+        encoder.set_filter(png::Filter::Adaptive);
+        let writer = encoder.write_header().map_err(error)?.into_stream_writer().map_err(error)?;
+        Ok(TextureEncoder { spec, writer, buffer })
+    }
+
+    /// Appends the rows `rows` of a band of maps (each map the set's f32 image of the band).
+    pub fn write_rows(&mut self, band: &[(MapKind, Image)], rows: Range<usize>) -> Result<(), ExportError> {
+        let texture = self.spec.suffix;
+        let sources: Vec<(Option<&Image>, Channel)> = self
+            .spec
+            .channels
+            .iter()
+            .map(|c| match c {
+                Channel::Map { map, .. } => {
+                    let image = band.iter().find(|(m, _)| m == map).map(|(_, i)| i);
+                    image.map(|i| (Some(i), *c)).ok_or_else(|| ExportError::Pack {
+                        texture,
+                        message: format!("the {map} map was not evaluated"),
+                    })
+                }
+                Channel::Constant(_) => Ok((None, *c)),
+            })
+            .collect::<Result<_, _>>()?;
+        let width = band.first().map_or(0, |(_, i)| i.width);
+        let bytes_per_sample = (self.spec.bit_depth / 8) as usize;
+        let mut samples = Vec::with_capacity(rows.len() * width * sources.len() * bytes_per_sample);
+        for y in rows {
+            for x in 0..width {
+                for (image, channel) in &sources {
+                    let value = match (image, channel) {
+                        (Some(image), Channel::Map { channel, transfer, .. }) => {
+                            transfer.apply(image.data[(y * image.width + x) * image.channels + channel])
+                        }
+                        (_, Channel::Constant(v)) => *v as f32 / 255.0,
+                        (None, Channel::Map { .. }) => unreachable!("sources resolved above"),
+                    };
+                    if bytes_per_sample == 2 {
+                        samples.extend_from_slice(&quantize16(value).to_be_bytes());
+                    } else {
+                        samples.push(quantize8(value));
+                    }
+                }
+            }
+        }
+        self.writer.write_all(&samples).map_err(|e| ExportError::Pack { texture, message: e.to_string() })
+    }
+
+    /// The finished file's bytes (every row must have been written).
+    pub fn finish(self) -> Result<Vec<u8>, ExportError> {
+        let texture = self.spec.suffix;
+        self.writer.finish().map_err(|e| ExportError::Pack { texture, message: e.to_string() })?;
+        Ok(std::mem::take(&mut *self.buffer.0.lock().expect("PNG buffer")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_pack_reads_colour_normal_and_roughness_and_the_film_only_when_there_is_one() {
+        for pack in Pack::ALL {
+            let with = pack.maps(true);
+            let without = pack.maps(false);
+            for m in [MapKind::Color, MapKind::Normal, MapKind::Roughness] {
+                assert!(with.contains(&m) && without.contains(&m), "{pack:?} lacks {m}");
+            }
+            assert!(with.contains(&MapKind::Iridescence) && !without.contains(&MapKind::Iridescence));
+            let names: Vec<_> = pack.textures(true).iter().map(|t| t.suffix).collect();
+            let mut unique = names.clone();
+            unique.dedup();
+            assert_eq!(names, unique, "{pack:?} has two textures of one name");
+        }
+    }
+
+    #[test]
+    fn transfers_match_the_engines_conventions() {
+        // DirectX green is the OpenGL green mirrored about 0.5; smoothness is 1 - roughness.
+        assert_eq!(Transfer::NegatedSignedUnit.apply(0.6), 1.0 - Transfer::SignedUnit.apply(0.6));
+        assert_eq!(Transfer::Complement.apply(0.25), 0.75);
+        assert_eq!(Transfer::Srgb.apply(0.5), linear_to_srgb8(0.5) as f32 / 255.0);
+    }
+}

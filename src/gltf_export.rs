@@ -1,0 +1,134 @@
+//! `snakeskin export`: a preset as a glTF 2.0 file that opens right in a viewer or an
+//! engine. The maps are evaluated and packed as glTF reads them (`Pack::Gltf`, a band of
+//! rows at a time, like `generate`), then put on a mesh — the preview's snake (the tile
+//! repeated along it, or a body atlas once over it), or a sphere or plane to look at the
+//! material alone — and written atomically: one `.glb`, or a `.gltf` with its buffer and
+//! images beside it, the `.gltf` renamed last.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use crate::export::gltf::{GltfMaterial, GltfTextures, glb, gltf_files};
+use crate::export::pack::Pack;
+use crate::export::{SetLock, write_file_atomically};
+use crate::generate::{GenerateRequest, Plan, has_film};
+use crate::graph::EvalStats;
+use crate::maps::{Layout, body_plan, thickness_range_nm};
+use crate::material::{FileFormat, MapKind};
+use crate::render::engine::mesh::{BodyShape, Mesh};
+use crate::{Error, maps::BuildOptions};
+
+/// The mesh the material is put on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshKind {
+    /// The preview's snake: a tile repeated every circumference, or a body atlas once.
+    Snake,
+    /// A unit sphere, the tile twice round the equator (the material alone).
+    Sphere,
+    /// A 1 m square (a tile once), or a 1 m wide strip `body.length` long (a body atlas).
+    Plane,
+}
+
+#[derive(Debug, Clone)]
+pub struct ExportRequest {
+    pub preset: String,
+    pub overrides: Vec<(String, String)>,
+    pub seed: Option<u64>,
+    /// Texture width in pixels.
+    pub size: u64,
+    pub layout: Layout,
+    pub mesh: MeshKind,
+    /// The file to write: `.glb` (one file) or `.gltf` (with `.bin` and PNGs beside it).
+    pub out: PathBuf,
+}
+
+#[derive(Debug)]
+pub struct ExportReport {
+    pub files: Vec<PathBuf>,
+    pub stats: EvalStats,
+    pub encode_time: Duration,
+    pub total_time: Duration,
+}
+
+/// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
+fn is_binary(path: &Path) -> Result<bool, Error> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("glb") => Ok(true),
+        Some("gltf") => Ok(false),
+        _ => Err(Error::Unsupported(format!(
+            "--gltf {}: the file name must end in .glb (one binary file) or .gltf (JSON with its buffer and images \
+             beside it)",
+            path.display()
+        ))),
+    }
+}
+
+/// The mesh for a request (the snake's mesh without its closed ends' zero-area triangles).
+pub fn mesh_for(kind: MeshKind, layout: Layout, preset: &crate::preset::Preset) -> Mesh {
+    match (kind, layout) {
+        (MeshKind::Snake, Layout::Tile) => BodyShape::default().mesh(),
+        (MeshKind::Snake, Layout::Body) => BodyShape::for_atlas(&body_plan(preset)).mesh(),
+        (MeshKind::Sphere, _) => Mesh::sphere(0.5, 2.0, 64, 128),
+        (MeshKind::Plane, Layout::Tile) => Mesh::plane(1.0, 1.0),
+        (MeshKind::Plane, Layout::Body) => Mesh::plane(1.0, preset.body.length as f32),
+    }
+    .without_degenerate_triangles()
+}
+
+/// Plans, evaluates and writes one glTF export.
+pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<ExportReport, Error> {
+    let start = Instant::now();
+    let binary = is_binary(&request.out)?;
+    if request.mesh == MeshKind::Sphere && request.layout == Layout::Body {
+        return Err(Error::Unsupported(
+            "--mesh sphere with --layout body: a body atlas spans a whole snake; put it on --mesh snake or plane"
+                .into(),
+        ));
+    }
+    let dir = request.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
+    let name = request
+        .out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .filter(|s| !s.is_empty())
+        .ok_or_else(|| Error::Unsupported(format!("--gltf {}: no file name", request.out.display())))?;
+    let plan = Plan::new(&GenerateRequest {
+        preset: request.preset.clone(),
+        overrides: request.overrides.clone(),
+        seed: request.seed,
+        size: request.size,
+        maps: vec![MapKind::Color, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence],
+        out_dir: dir.clone(),
+        options: BuildOptions { layout: request.layout, ..BuildOptions::default() },
+        format: FileFormat::Png,
+        pack: Some(Pack::Gltf),
+    })?;
+    let preset = &plan.loaded().preset;
+    let film = has_film(preset).then(|| {
+        let (min_nm, max_nm) = thickness_range_nm(preset);
+        (preset.optics.film_ior, min_nm, max_nm)
+    });
+    let material = GltfMaterial { base_ior: preset.optics.pigment_ior, film, repeat_v: request.layout == Layout::Tile };
+    let mesh = mesh_for(request.mesh, request.layout, preset);
+    let (textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
+    let texture = |suffix: &str| textures.iter().find(|(s, _)| s.suffix == suffix).map(|(_, b)| b.clone());
+    let missing = |suffix: &str| Error::Internal(format!("the glTF pack has no {suffix} texture"));
+    let textures = GltfTextures {
+        base_color: texture("basecolor").ok_or_else(|| missing("basecolor"))?,
+        normal: texture("normal").ok_or_else(|| missing("normal"))?,
+        orm: texture("orm").ok_or_else(|| missing("orm"))?,
+        thickness: texture("thickness"),
+        occlusion: false,
+    };
+    let files = if binary {
+        let bytes = glb(&name, &mesh, material, &textures)?;
+        crate::export::create_folder(&dir)?;
+        vec![write_file_atomically(&request.out, bytes)?]
+    } else {
+        let mut files = gltf_files(&name, &mesh, material, &textures)?;
+        let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
+        let lock = SetLock::acquire(&dir, &name)?;
+        lock.write(&files, (&gltf_name, &gltf_bytes))?
+    };
+    Ok(ExportReport { files, stats, encode_time, total_time: start.elapsed() })
+}

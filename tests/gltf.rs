@@ -1,0 +1,159 @@
+//! glTF export checked in the tools that open it: the Khronos glTF-Validator (0 errors and
+//! 0 warnings on snakes, spheres and planes of several species, binary and JSON, tile and
+//! body layout) and three.js's GLTFLoader in headless Chromium (the material parses as
+//! iridescent with the preset's film index and thickness range, the frame is not blank, and
+//! turning the film off changes it clearly). Both run Node from `tests/interop` (its
+//! packages pinned in package-lock.json: `npm ci --prefix tests/interop`); without Node,
+//! the packages or Chromium the tests skip, unless SNAKESKIN_REQUIRE_BROWSER=1 (set in
+//! .ci/run), which makes a missing tool a failure.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::{snakeskin, stderr};
+use serde_json::Value;
+
+fn interop() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/interop")
+}
+
+fn browser_required() -> bool {
+    std::env::var("SNAKESKIN_REQUIRE_BROWSER").is_ok_and(|v| v == "1")
+}
+
+fn chromium() -> PathBuf {
+    std::env::var_os("CHROMIUM").map(PathBuf::from).unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"))
+}
+
+/// Whether the tools are there (`needs_browser`: Chromium too); prints why not and returns
+/// false when the test may skip, panics when SNAKESKIN_REQUIRE_BROWSER=1.
+fn tools_or_skip(test: &str, needs_browser: bool) -> bool {
+    let mut missing = Vec::new();
+    if Command::new("node").arg("--version").output().map(|o| !o.status.success()).unwrap_or(true) {
+        missing.push("node (Debian package nodejs)".to_string());
+    }
+    for package in ["gltf-validator", "three", "puppeteer-core"] {
+        if !interop().join("node_modules").join(package).is_dir() {
+            missing.push(format!("tests/interop/node_modules/{package} (run `npm ci --prefix tests/interop`)"));
+        }
+    }
+    if needs_browser && !chromium().is_file() {
+        missing.push(format!("{} (Debian package chromium, or set CHROMIUM)", chromium().display()));
+    }
+    if missing.is_empty() {
+        return true;
+    }
+    let why = format!("missing {}", missing.join(", "));
+    assert!(!browser_required(), "{test}: SNAKESKIN_REQUIRE_BROWSER=1 but {why}");
+    eprintln!("{test}: SKIPPED: {why}");
+    false
+}
+
+/// Runs a script in tests/interop; one JSON value per output line.
+fn node(script: &str, args: &[&Path]) -> Vec<Value> {
+    let out = Command::new("node").arg(interop().join(script)).args(args).output().expect("run node");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "node {script} failed:\n{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    text.lines().map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}"))).collect()
+}
+
+fn export(dir: &Path, preset: &str, file: &str, extra: &[&str]) -> PathBuf {
+    let path = dir.join(file);
+    let mut args = vec!["export", preset, "--gltf", path.to_str().unwrap(), "--size", "128"];
+    args.extend_from_slice(extra);
+    let out = snakeskin(&args);
+    assert!(out.status.success(), "export {preset} {extra:?}: {}", stderr(&out));
+    path
+}
+
+#[test]
+fn the_khronos_validator_finds_no_error_and_no_warning() {
+    if !tools_or_skip("validator", false) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let gltf_dir = dir.path().join("json");
+    // (file, species): an iridescent species, a banded one, one without a film, each as a
+    // snake and a sphere; a plane; a body atlas; a .gltf with its files beside it.
+    let mut files: Vec<(PathBuf, &str)> = Vec::new();
+    for species in ["xenopeltis-unicolor", "bungarus-fasciatus", "crotalus-atrox"] {
+        files.push((export(dir.path(), species, &format!("{species}-snake.glb"), &[]), species));
+        files.push((export(dir.path(), species, &format!("{species}-sphere.glb"), &["--mesh", "sphere"]), species));
+    }
+    files.push((export(dir.path(), "loxocemus-bicolor", "plane.glb", &["--mesh", "plane"]), "loxocemus-bicolor"));
+    let body = export(dir.path(), "lampropeltis-triangulum", "body.glb", &["--layout", "body"]);
+    files.push((body, "lampropeltis-triangulum"));
+    files.push((export(&gltf_dir, "liasis-mackloti", "liasis.gltf", &["--mesh", "sphere"]), "liasis-mackloti"));
+
+    let paths: Vec<&Path> = files.iter().map(|(p, _)| p.as_path()).collect();
+    let reports = node("validate.mjs", &paths);
+    assert_eq!(reports.len(), files.len());
+    for (report, (_, species)) in reports.iter().zip(&files) {
+        eprintln!(
+            "{}: {} errors, {} warnings, {} infos",
+            report["file"], report["errors"], report["warnings"], report["infos"]
+        );
+        assert_eq!(report["errors"], 0, "{report:#}");
+        assert_eq!(report["warnings"], 0, "{report:#}");
+        // The iridescence extension is declared exactly where the preset has a film.
+        let declared = report["extensions"].as_array().unwrap().iter().any(|e| e == "KHR_materials_iridescence");
+        let film = snakeskin::generate::has_film(&snakeskin::preset::load(species, &[], None).unwrap().preset);
+        assert_eq!(declared, film, "{species}: {report:#}");
+    }
+    assert!(reports.iter().any(|r| r["file"].as_str().unwrap().contains("crotalus")));
+
+    // Negative control: the same validator on a file with one wrong number (the POSITION
+    // accessor's max no longer bounds its data) reports an error.
+    let gltf_path = gltf_dir.join("liasis.gltf");
+    let mut json: Value = serde_json::from_slice(&std::fs::read(&gltf_path).unwrap()).unwrap();
+    let position = json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize;
+    json["accessors"][position]["max"][0] = serde_json::json!(-10.0);
+    let broken = gltf_dir.join("broken.gltf");
+    std::fs::write(&broken, serde_json::to_vec(&json).unwrap()).unwrap();
+    let report = &node("validate.mjs", &[&broken])[0];
+    assert!(report["errors"].as_u64().unwrap() > 0, "the validator missed a wrong POSITION max: {report:#}");
+}
+
+/// CIEDE2000 of one just-noticeable difference is about 1; a film that a viewer shows moves
+/// the snake's colours by far more than that. Mean over the snake's pixels.
+const FILM_VISIBLE_DELTA_E00: f64 = 3.0;
+
+#[test]
+fn three_js_reads_the_film_and_renders_it() {
+    if !tools_or_skip("three.js", true) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let glb = export(dir.path(), "xenopeltis-unicolor", "xeno.glb", &[]);
+    let result = &node("render.mjs", &[&glb])[0];
+    eprintln!("three.js: {result:#}");
+    assert!(result.get("error").is_none(), "{result:#}");
+    let preset = snakeskin::preset::load("xenopeltis-unicolor", &[], None).unwrap().preset;
+    let (min_nm, max_nm) = snakeskin::maps::thickness_range_nm(&preset);
+    let m = &result["material"];
+    assert_eq!(m["type"], "MeshPhysicalMaterial");
+    assert_eq!(m["iridescence"], 1.0);
+    let close = |v: &Value, want: f64| (v.as_f64().unwrap() - want).abs() < 1e-6;
+    assert!(close(&m["iridescenceIOR"], preset.optics.film_ior), "{m}");
+    assert!(close(&m["iridescenceThicknessMinimum"], min_nm), "{m}");
+    assert!(close(&m["iridescenceThicknessMaximum"], max_nm), "{m}");
+    assert!(close(&m["ior"], preset.optics.pigment_ior), "{m}");
+    for map in ["hasThicknessMap", "hasMap", "hasNormalMap", "hasRoughnessMap"] {
+        assert_eq!(m[map], true, "{map}: {m}");
+    }
+    // Not blank: the snake covers part of the frame and is not one flat colour.
+    assert!(result["coverage"].as_f64().unwrap() > 0.02, "{result:#}");
+    assert!(result["luma_std"].as_f64().unwrap() > 5.0, "{result:#}");
+    let delta = result["delta_e00_mean"].as_f64().unwrap();
+    assert!(delta > FILM_VISIBLE_DELTA_E00, "turning the film off changed the frame by only ΔE00 {delta}");
+
+    // Negative control: a species without a film has no iridescence, and turning it "off"
+    // changes nothing.
+    let plain = export(dir.path(), "crotalus-atrox", "crotalus.glb", &[]);
+    let result = &node("render.mjs", &[&plain])[0];
+    assert_eq!(result["material"]["iridescence"], 0.0, "{result:#}");
+    let delta = result["delta_e00_mean"].as_f64().unwrap();
+    assert!(delta < 0.5, "a snake without a film changed by ΔE00 {delta}");
+}

@@ -1,0 +1,122 @@
+//! `generate --pack`: every packed texture's channels read back against the plain maps of
+//! the same preset and seed (written by the ordinary map writer), under each engine's
+//! convention — glTF's occlusion-roughness-metallic, Unreal's DirectX green, Unity HDRP's
+//! smoothness = 1 − roughness in the mask map's alpha — for a tile and a body atlas.
+
+mod common;
+
+use std::path::Path;
+
+use common::{snakeskin, stderr};
+use image::DynamicImage;
+
+fn generate(dir: &Path, preset: &str, extra: &[&str]) {
+    let mut args = vec!["generate", preset, "-o", dir.to_str().unwrap(), "--size", "64"];
+    args.extend_from_slice(extra);
+    let out = snakeskin(&args);
+    assert!(out.status.success(), "generate {extra:?}: {}", stderr(&out));
+}
+
+fn read(dir: &Path, file: &str) -> DynamicImage {
+    image::open(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"))
+}
+
+/// Largest difference between two channel sequences (after `f` on the second).
+fn worst(a: impl Iterator<Item = i32>, b: impl Iterator<Item = i32>, f: impl Fn(i32) -> i32) -> i32 {
+    a.zip(b).map(|(x, y)| (x - f(y)).abs()).max().unwrap()
+}
+
+fn channel(img: &DynamicImage, c: usize) -> Vec<i32> {
+    let rgba = img.to_rgba8();
+    rgba.pixels().map(|p| p.0[c] as i32).collect()
+}
+
+fn check_packs(preset: &str, layout: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = dir.path().join("plain");
+    generate(&plain, preset, &["--layout", layout]);
+    let name = preset;
+    let colour = read(&plain, &format!("{name}_color.png"));
+    let normal = read(&plain, &format!("{name}_normal.png"));
+    let rough = channel(&read(&plain, &format!("{name}_roughness.png")), 0);
+    let height16 = read(&plain, &format!("{name}_height.png")).to_luma16();
+    let thickness16 = read(&plain, &format!("{name}_iridescence.png")).to_luma16();
+    let film = snakeskin::generate::has_film(&snakeskin::preset::load(preset, &[], None).unwrap().preset);
+
+    for pack in ["gltf", "unreal", "unity-hdrp"] {
+        let out = dir.path().join(pack);
+        generate(&out, preset, &["--layout", layout, "--pack", pack]);
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join(format!("{name}.material.json"))).unwrap()).unwrap();
+        assert_eq!(manifest["pack"], pack);
+        let files: Vec<&str> = manifest["maps"].as_array().unwrap().iter().map(|m| m["map"].as_str().unwrap()).collect();
+
+        // The base colour is the colour map, byte for byte.
+        let base = read(&out, &format!("{name}_basecolor.png"));
+        assert_eq!(base.to_rgb8().as_raw(), colour.to_rgb8().as_raw(), "{pack} base colour");
+
+        // The normal: OpenGL as written, or DirectX (green mirrored) for Unreal.
+        let packed_normal = read(&out, &format!("{name}_normal.png"));
+        for c in [0, 2] {
+            assert_eq!(channel(&packed_normal, c), channel(&normal, c), "{pack} normal channel {c}");
+        }
+        let green = (channel(&packed_normal, 1), channel(&normal, 1));
+        if pack == "unreal" {
+            assert!(worst(green.0.into_iter(), green.1.into_iter(), |g| 255 - g) <= 1, "unreal green is not flipped");
+        } else {
+            assert_eq!(green.0, green.1, "{pack} green");
+        }
+
+        // Roughness (and occlusion, metallic) where each engine reads them.
+        if pack == "unity-hdrp" {
+            let mask = read(&out, &format!("{name}_mask.png"));
+            assert!(channel(&mask, 0).iter().all(|&v| v == 0), "metallic");
+            assert!(channel(&mask, 1).iter().all(|&v| v == 255), "occlusion");
+            let smooth = channel(&mask, 3);
+            assert!(worst(smooth.into_iter(), rough.clone().into_iter(), |r| 255 - r) <= 1, "smoothness");
+        } else {
+            let orm = read(&out, &format!("{name}_orm.png"));
+            assert!(channel(&orm, 0).iter().all(|&v| v == 255), "{pack} occlusion");
+            assert_eq!(channel(&orm, 1), rough, "{pack} roughness in G");
+            assert!(channel(&orm, 2).iter().all(|&v| v == 0), "{pack} metallic in B");
+        }
+
+        // Height (16-bit, as the set's) for the engines that displace.
+        if pack != "gltf" {
+            let h = read(&out, &format!("{name}_height.png")).to_luma16();
+            assert_eq!(h.as_raw(), height16.as_raw(), "{pack} height");
+        }
+
+        // The film's thickness, 8-bit, where there is a film; none where there is not.
+        assert_eq!(files.contains(&"thickness"), film, "{pack}: {files:?}");
+        if film {
+            let t = read(&out, &format!("{name}_thickness.png")).to_luma8();
+            let eight = thickness16.as_raw().iter().map(|&v| (v as f64 / 65535.0 * 255.0).round() as i32);
+            assert!(worst(t.as_raw().iter().map(|&v| v as i32), eight, |v| v) <= 1, "{pack} thickness");
+        }
+    }
+}
+
+#[test]
+fn packed_channels_are_the_maps_under_each_engines_convention() {
+    check_packs("xenopeltis-unicolor", "tile");
+    check_packs("crotalus-atrox", "tile");
+}
+
+#[test]
+fn a_body_atlas_packs_strip_by_strip_like_its_maps() {
+    check_packs("liasis-mackloti", "body");
+}
+
+#[test]
+fn pack_refuses_options_that_contradict_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for extra in [["--format", "exr"], ["--normal-convention", "directx"]] {
+        let mut args = vec!["generate", "xenopeltis-unicolor", "-o", dir.path().to_str().unwrap(), "--pack", "unreal"];
+        args.extend_from_slice(&extra);
+        let out = snakeskin(&args);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("--pack"), "{}", stderr(&out));
+    }
+    assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "a refused run wrote files");
+}
