@@ -49,7 +49,8 @@ fn check_packs(preset: &str, layout: &str) {
         let manifest: serde_json::Value =
             serde_json::from_slice(&std::fs::read(out.join(format!("{name}.material.json"))).unwrap()).unwrap();
         assert_eq!(manifest["pack"], pack);
-        let files: Vec<&str> = manifest["maps"].as_array().unwrap().iter().map(|m| m["map"].as_str().unwrap()).collect();
+        let files: Vec<&str> =
+            manifest["maps"].as_array().unwrap().iter().map(|m| m["map"].as_str().unwrap()).collect();
 
         // The base colour is the colour map, byte for byte.
         let base = read(&out, &format!("{name}_basecolor.png"));
