@@ -33,6 +33,11 @@ pub struct GenerateRequest {
     /// Write an engine's packed textures (`export::pack`) instead of the maps; `maps` is
     /// then ignored (the pack says which maps it reads).
     pub pack: Option<Pack>,
+    /// With a pack: fill its occlusion channel from the ambient occlusion map (otherwise 1).
+    pub ao: bool,
+    /// A batch job's key (`batch::Job::key`), recorded in the manifest so a resumed batch
+    /// knows the set is this job's.
+    pub job: Option<String>,
 }
 
 #[derive(Debug)]
@@ -111,7 +116,7 @@ impl Plan {
         }
         let graph = build_graph(&loaded.preset, request.options);
         let maps = match request.pack {
-            Some(pack) => pack.maps(has_film(&loaded.preset)),
+            Some(pack) => pack.maps(has_film(&loaded.preset), request.ao),
             None => request.maps.clone(),
         };
         let strips = strips_of(&graph, &maps, size, height);
@@ -192,7 +197,9 @@ impl Plan {
             .zip(&files)
             .map(|(m, (name, bytes))| MapEntry::for_map(*m, name, sha256_hex(bytes), request.format, convention))
             .collect();
-        let manifest = export::manifest(&loaded, (size, height), entries, request.options, request.format.name(), None);
+        let mut manifest =
+            export::manifest(&loaded, (size, height), entries, request.options, request.format.name(), None);
+        manifest.job = request.job.clone();
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
         let manifest_name = export::manifest_file_name(&loaded.name);
         let encode_time = encode_time + encode_start.elapsed();
@@ -221,7 +228,7 @@ impl Plan {
     ) -> Result<(Vec<(TextureSpec, Vec<u8>)>, EvalStats, Duration), Error> {
         use rayon::prelude::*;
         let (width, height) = (self.size, self.height);
-        let specs = pack.textures(has_film(&self.loaded.preset));
+        let specs = pack.textures(has_film(&self.loaded.preset), self.request.ao);
         let mut encoders =
             specs.into_iter().map(|s| TextureEncoder::new(s, width, height)).collect::<Result<Vec<_>, _>>()?;
         let mut encode_time = Duration::ZERO;
@@ -256,8 +263,9 @@ impl Plan {
             .map(|((spec, _), (file, bytes))| MapEntry::for_texture(spec, file, sha256_hex(bytes)))
             .collect();
         let options = self.request.options;
-        let manifest =
+        let mut manifest =
             export::manifest(&self.loaded, (self.size, self.height), entries, options, "png", Some(pack.name()));
+        manifest.job = self.request.job.clone();
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
         let written = lock.write(&files, (&export::manifest_file_name(name), &json))?;
         let strips = strips_of(&self.graph, &self.maps, self.size, self.height);

@@ -40,6 +40,8 @@ pub struct ExportRequest {
     pub mesh: MeshKind,
     /// The file to write: `.glb` (one file) or `.gltf` (with `.bin` and PNGs beside it).
     pub out: PathBuf,
+    /// Compute the ambient occlusion map into the ORM texture's R (`occlusionTexture`).
+    pub ao: bool,
 }
 
 #[derive(Debug)]
@@ -102,6 +104,8 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         options: BuildOptions { layout: request.layout, ..BuildOptions::default() },
         format: FileFormat::Png,
         pack: Some(Pack::Gltf),
+        ao: request.ao,
+        job: None,
     })?;
     let preset = &plan.loaded().preset;
     let film = has_film(preset).then(|| {
@@ -118,7 +122,7 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         normal: texture("normal").ok_or_else(|| missing("normal"))?,
         orm: texture("orm").ok_or_else(|| missing("orm"))?,
         thickness: texture("thickness"),
-        occlusion: false,
+        occlusion: request.ao,
     };
     let files = if binary {
         let bytes = glb(&name, &mesh, material, &textures)?;

@@ -3,10 +3,11 @@
 //! The pipeline is "parse first, then run": a preset is read and validated (`preset`), turned
 //! into a node graph (`maps`), evaluated on demand (`graph`) with pure pixel kernels (`ops`),
 //! and written atomically (`export`). `material` is the one home of what a set means (map
-//! formats, layer optics, thesis defaults); `generate` plans and runs one set, `gltf_export` puts one on a mesh as glTF; `render` is
+//! formats, layer optics, thesis defaults); `generate` plans and runs one set, `gltf_export` puts one on a mesh as glTF, `batch` runs many; `render` is
 //! the wgpu preview. The library neither parses command lines nor prints: the `snakeskin`
 //! binary (`src/bin/snakeskin/`) does both.
 
+pub mod batch;
 pub mod export;
 pub mod generate;
 pub mod gltf_export;
@@ -32,6 +33,8 @@ pub enum Error {
     Preset(#[from] preset::PresetError),
     #[error(transparent)]
     Export(#[from] export::ExportError),
+    #[error(transparent)]
+    Batch(#[from] batch::BatchError),
     #[error("invalid --size {size}: accepted sizes are {lo} to {hi} pixels", lo = SIZE_RANGE.start(), hi = SIZE_RANGE.end())]
     Size { size: u64 },
     #[error(

@@ -30,7 +30,7 @@ pub mod thesis {
 /// key for stacks whose colours it can reach.
 pub const DEFAULT_ABSORPTION: f64 = 0.0;
 
-/// The five maps of a set.
+/// The maps a set can have: the five of every set, and ambient occlusion on request.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum MapKind {
     Color,
@@ -38,11 +38,18 @@ pub enum MapKind {
     Normal,
     Roughness,
     Iridescence,
+    /// Ambient occlusion from the height map (`ops::occlusion`): only when asked for by
+    /// name or filled into a pack's occlusion channel (`--ao`), never part of "all".
+    Ao,
 }
 
 impl MapKind {
     pub const ALL: [MapKind; 5] =
         [MapKind::Color, MapKind::Height, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence];
+
+    /// Every map there is, `ALL` and the maps made only on request.
+    pub const EVERY: [MapKind; 6] =
+        [MapKind::Color, MapKind::Height, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence, MapKind::Ao];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -51,6 +58,7 @@ impl MapKind {
             MapKind::Normal => "normal",
             MapKind::Roughness => "roughness",
             MapKind::Iridescence => "iridescence",
+            MapKind::Ao => "ao",
         }
     }
 
@@ -62,6 +70,7 @@ impl MapKind {
             MapKind::Normal => MapFormat { encoding: Encoding::SignedUnit, channels: 3, bit_depth: 8 },
             MapKind::Roughness => MapFormat { encoding: Encoding::Linear, channels: 1, bit_depth: 8 },
             MapKind::Iridescence => MapFormat { encoding: Encoding::Linear, channels: 1, bit_depth: 16 },
+            MapKind::Ao => MapFormat { encoding: Encoding::Linear, channels: 1, bit_depth: 8 },
         }
     }
 
@@ -79,6 +88,7 @@ impl MapKind {
             }
             MapKind::Roughness => "perceptual roughness r; GGX alpha = r^2 (glTF)".into(),
             MapKind::Iridescence => "film thickness: min_nm + value / 65535 * (max_nm - min_nm)".into(),
+            MapKind::Ao => "ambient occlusion: the cosine-weighted share of the sky a point sees, 1 = open".into(),
         }
     }
 }
@@ -113,6 +123,7 @@ impl MapKind {
             MapKind::Normal => (&["R", "G", "B"], 32),
             MapKind::Roughness => (&["Y"], 16),
             MapKind::Iridescence => (&["Y"], 32),
+            MapKind::Ao => (&["Y"], 16),
         }
     }
 
@@ -142,24 +153,27 @@ impl fmt::Display for MapKind {
 impl FromStr for MapKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        MapKind::ALL
+        MapKind::EVERY
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown map {s:?}; accepted: color, height, normal, roughness, iridescence"))
+            .ok_or_else(|| format!("unknown map {s:?}; accepted: color, height, normal, roughness, iridescence, ao"))
     }
 }
 
-/// Parses a comma-separated map list ("color,height"); "all" or empty means all five. The
-/// result is in `MapKind` order, each map once.
+/// Parses a comma-separated map list ("color,height"); "all" or empty means the five of
+/// every set (`MapKind::ALL`), and "all,ao" adds ambient occlusion. The result is in
+/// `MapKind` order, each map once.
 pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
     if list.trim().is_empty() || list.trim() == "all" {
         return Ok(MapKind::ALL.to_vec());
     }
     let mut out = Vec::new();
     for item in list.split(',').map(str::trim) {
-        let map: MapKind = item.parse()?;
-        if !out.contains(&map) {
-            out.push(map);
+        let maps = if item == "all" { MapKind::ALL.to_vec() } else { vec![item.parse()?] };
+        for map in maps {
+            if !out.contains(&map) {
+                out.push(map);
+            }
         }
     }
     out.sort();

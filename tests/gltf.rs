@@ -82,7 +82,10 @@ fn the_khronos_validator_finds_no_error_and_no_warning() {
         files.push((export(dir.path(), species, &format!("{species}-snake.glb"), &[]), species));
         files.push((export(dir.path(), species, &format!("{species}-sphere.glb"), &["--mesh", "sphere"]), species));
     }
-    files.push((export(dir.path(), "loxocemus-bicolor", "plane.glb", &["--mesh", "plane"]), "loxocemus-bicolor"));
+    files.push((
+        export(dir.path(), "loxocemus-bicolor", "plane.glb", &["--mesh", "plane", "--ao"]),
+        "loxocemus-bicolor",
+    ));
     let body = export(dir.path(), "lampropeltis-triangulum", "body.glb", &["--layout", "body"]);
     files.push((body, "lampropeltis-triangulum"));
     files.push((export(&gltf_dir, "liasis-mackloti", "liasis.gltf", &["--mesh", "sphere"]), "liasis-mackloti"));
@@ -103,6 +106,20 @@ fn the_khronos_validator_finds_no_error_and_no_warning() {
         assert_eq!(declared, film, "{species}: {report:#}");
     }
     assert!(reports.iter().any(|r| r["file"].as_str().unwrap().contains("crotalus")));
+    // --ao references the ORM texture as the occlusion texture too; without it, no
+    // occlusion texture (occlusion 1 is glTF's default).
+    let material = |path: &Path| {
+        let bytes = std::fs::read(path).unwrap();
+        let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        let json: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+        json["materials"][0].clone()
+    };
+    let with_ao = material(&dir.path().join("plane.glb"));
+    assert_eq!(
+        with_ao["occlusionTexture"]["index"],
+        with_ao["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"]
+    );
+    assert!(material(&dir.path().join("crotalus-atrox-snake.glb")).get("occlusionTexture").is_none());
 
     // Negative control: the same validator on a file with one wrong number (the POSITION
     // accessor's max no longer bounds its data) reports an error.

@@ -11,7 +11,11 @@ use common::{snakeskin, stderr};
 use image::DynamicImage;
 
 fn generate(dir: &Path, preset: &str, extra: &[&str]) {
-    let mut args = vec!["generate", preset, "-o", dir.to_str().unwrap(), "--size", "64"];
+    generate_at(dir, preset, "64", extra)
+}
+
+fn generate_at(dir: &Path, preset: &str, size: &str, extra: &[&str]) {
+    let mut args = vec!["generate", preset, "-o", dir.to_str().unwrap(), "--size", size];
     args.extend_from_slice(extra);
     let out = snakeskin(&args);
     assert!(out.status.success(), "generate {extra:?}: {}", stderr(&out));
@@ -107,6 +111,30 @@ fn packed_channels_are_the_maps_under_each_engines_convention() {
 #[test]
 fn a_body_atlas_packs_strip_by_strip_like_its_maps() {
     check_packs("liasis-mackloti", "body");
+}
+
+#[test]
+fn ao_fills_the_occlusion_channel_and_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = "crotalus-atrox";
+    // 256 wide: the scales' relief spans pixels enough to occlude (at 64 it hardly does).
+    generate_at(dir.path(), name, "256", &["--maps", "ao"]);
+    let ao = channel(&read(dir.path(), &format!("{name}_ao.png")), 0);
+    // The skin's overlaps and keels occlude, a little (the relief is the normal map's, a
+    // fraction of a scale's width): at 256 wide, about 2 % of the pixels below 250/255.
+    let occluded = ao.iter().filter(|&&v| v < 250).count() as f64 / ao.len() as f64;
+    assert!(occluded > 0.005, "hardly any occlusion: {occluded}");
+    for (pack, file, c) in [("gltf", "orm", 0), ("unreal", "orm", 0), ("unity-hdrp", "mask", 1)] {
+        let out = dir.path().join(pack);
+        generate_at(&out, name, "256", &["--pack", pack, "--ao"]);
+        assert_eq!(channel(&read(&out, &format!("{name}_{file}.png")), c), ao, "{pack} occlusion");
+    }
+    // "all" is the five maps of every set: no ambient occlusion unless named.
+    let all = dir.path().join("all");
+    generate(&all, name, &[]);
+    assert!(!all.join(format!("{name}_ao.png")).exists());
+    let out = snakeskin(&["generate", name, "-o", all.to_str().unwrap(), "--ao"]);
+    assert_eq!(out.status.code(), Some(2), "--ao without --pack: {}", stderr(&out));
 }
 
 #[test]

@@ -46,6 +46,9 @@ pub struct Manifest {
     pub color_means: String,
     /// Preset colours the stack cannot show, clamped to its limit (`preset::visible`).
     pub clamped_colors: Vec<crate::preset::visible::ClampedColour>,
+    /// The batch job that wrote the set (`batch::Job::key`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub job: Option<String>,
 }
 
 /// The colour map's convention, for the manifest: the visible colour, which the renderer
@@ -192,6 +195,7 @@ pub fn manifest(
         optics: p.optics.clone(),
         color_means: COLOR_MEANS.into(),
         clamped_colors: loaded.clamped_colours.clone(),
+        job: None,
     }
 }
 

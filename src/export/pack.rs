@@ -89,6 +89,7 @@ const NORMAL_DIRECTX: [Channel; 3] = [
 ];
 /// No ambient occlusion map: fully unoccluded.
 const NO_OCCLUSION: Channel = Channel::Constant(255);
+const OCCLUSION: Channel = Channel::map(MapKind::Ao, 0, Transfer::Unit);
 const NOT_METALLIC: Channel = Channel::Constant(0);
 const ROUGHNESS: Channel = Channel::map(MapKind::Roughness, 0, Transfer::Unit);
 const THICKNESS: Channel = Channel::map(MapKind::Iridescence, 0, Transfer::Unit);
@@ -106,8 +107,10 @@ impl Pack {
     }
 
     /// The packed files, in order. `film`: whether the preset has a film (a thickness
-    /// texture is written only then).
-    pub fn textures(self, film: bool) -> Vec<TextureSpec> {
+    /// texture is written only then); `ao`: whether the occlusion channel holds the
+    /// ambient occlusion map (`ops::occlusion`) or 1 everywhere.
+    pub fn textures(self, film: bool, ao: bool) -> Vec<TextureSpec> {
+        let occlusion = if ao { OCCLUSION } else { NO_OCCLUSION };
         let base_color = TextureSpec {
             suffix: "basecolor",
             channels: RGB_SRGB.to_vec(),
@@ -144,10 +147,10 @@ impl Pack {
                 },
                 TextureSpec {
                     suffix: "orm",
-                    channels: vec![NO_OCCLUSION, ROUGHNESS, NOT_METALLIC],
+                    channels: vec![occlusion, ROUGHNESS, NOT_METALLIC],
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "R: occlusion (1 = none), G: perceptual roughness, B: metallic (0)",
+                    meaning: "R: occlusion (1 = open; 1 everywhere without --ao), G: perceptual roughness, B: metallic (0)",
                 },
             ],
             Pack::Unreal => vec![
@@ -161,10 +164,10 @@ impl Pack {
                 },
                 TextureSpec {
                     suffix: "orm",
-                    channels: vec![NO_OCCLUSION, ROUGHNESS, NOT_METALLIC],
+                    channels: vec![occlusion, ROUGHNESS, NOT_METALLIC],
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "R: ambient occlusion (1 = none), G: roughness, B: metallic (0)",
+                    meaning: "R: ambient occlusion (1 = open; 1 everywhere without --ao), G: roughness, B: metallic (0)",
                 },
                 height,
             ],
@@ -181,13 +184,13 @@ impl Pack {
                     suffix: "mask",
                     channels: vec![
                         NOT_METALLIC,
-                        NO_OCCLUSION,
+                        occlusion,
                         Channel::Constant(0),
                         Channel::map(MapKind::Roughness, 0, Transfer::Complement),
                     ],
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "R: metallic (0), G: ambient occlusion (1 = none), B: detail mask (0), A: smoothness = 1 - roughness",
+                    meaning: "R: metallic (0), G: ambient occlusion (1 = open; 1 everywhere without --ao), B: detail mask (0), A: smoothness = 1 - roughness",
                 },
                 height,
             ],
@@ -199,9 +202,9 @@ impl Pack {
     }
 
     /// The maps a pack's textures read, in `MapKind` order.
-    pub fn maps(self, film: bool) -> Vec<MapKind> {
+    pub fn maps(self, film: bool, ao: bool) -> Vec<MapKind> {
         let mut maps: Vec<MapKind> = self
-            .textures(film)
+            .textures(film, ao)
             .iter()
             .flat_map(|t| t.channels.iter())
             .filter_map(|c| match c {
@@ -336,13 +339,14 @@ mod tests {
     #[test]
     fn every_pack_reads_colour_normal_and_roughness_and_the_film_only_when_there_is_one() {
         for pack in Pack::ALL {
-            let with = pack.maps(true);
-            let without = pack.maps(false);
+            let with = pack.maps(true, true);
+            let without = pack.maps(false, false);
             for m in [MapKind::Color, MapKind::Normal, MapKind::Roughness] {
                 assert!(with.contains(&m) && without.contains(&m), "{pack:?} lacks {m}");
             }
             assert!(with.contains(&MapKind::Iridescence) && !without.contains(&MapKind::Iridescence));
-            let names: Vec<_> = pack.textures(true).iter().map(|t| t.suffix).collect();
+            assert!(with.contains(&MapKind::Ao) && !without.contains(&MapKind::Ao));
+            let names: Vec<_> = pack.textures(true, true).iter().map(|t| t.suffix).collect();
             let mut unique = names.clone();
             unique.dedup();
             assert_eq!(names, unique, "{pack:?} has two textures of one name");

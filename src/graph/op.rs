@@ -55,6 +55,9 @@ pub enum Op {
     Along(AlongProfile),
     /// A mark on the head or neck of a body atlas (`ops::body::HeadMark`). No inputs.
     HeadMark(HeadMark),
+    /// Height to ambient occlusion (`ops::occlusion`): `slope` as `HeightToNormal`'s, the
+    /// horizon searched `radius` texture widths out; `v_extent` as `HeightToNormal`'s.
+    Occlusion { slope: f32, radius: f32, v_extent: f32 },
 }
 
 impl Op {
@@ -75,7 +78,8 @@ impl Op {
             | Op::Blur { .. }
             | Op::Sobel { .. }
             | Op::Colorize { .. }
-            | Op::HeightToNormal { .. } => 1..=1,
+            | Op::HeightToNormal { .. }
+            | Op::Occlusion { .. } => 1..=1,
             Op::SnapToScales { .. } | Op::Tint { .. } | Op::ScaleColour(_) => 2..=2,
             Op::Blend { .. } => 2..=3,
         }
@@ -102,6 +106,7 @@ impl Op {
             | Op::Spots(_)
             | Op::Along(_)
             | Op::HeadMark(_)
+            | Op::Occlusion { .. }
             | Op::Sobel { .. } => 1,
         }
     }
@@ -134,6 +139,8 @@ impl Op {
             Op::Blur { sigma } => (3.5 * sigma * width as f32).ceil() as usize + 2,
             Op::Sobel { .. } | Op::HeightToNormal { .. } => 1,
             Op::SnapToScales { reach, .. } => (reach * width as f32).ceil() as usize + 2,
+            // Pixels are square: a texture width is `width` rows.
+            Op::Occlusion { radius, .. } => crate::ops::occlusion::row_reach(*radius, width as f32),
             _ => 0,
         }
     }
@@ -164,6 +171,10 @@ impl Op {
             }
             Op::Along(profile) => profile.render(frame),
             Op::HeadMark(mark) => crate::ops::body::head_mark(frame, mark),
+            Op::Occlusion { slope, radius, v_extent } => {
+                let rows_per_width = frame.full_height as f32 / v_extent;
+                crate::ops::occlusion::horizon_occlusion(input(), *slope, *radius, rows_per_width, frame.wraps_v)
+            }
             Op::Levels { in_low, in_high, out_low, out_high } => {
                 filters::levels(owned(first), *in_low, *in_high, *out_low, *out_high)
             }
@@ -199,6 +210,7 @@ impl Op {
             Op::Colorize { .. } => "colorize".into(),
             Op::Tint { .. } => "tint".into(),
             Op::HeightToNormal { .. } => "height to normal".into(),
+            Op::Occlusion { radius, .. } => format!("ambient occlusion radius={radius:.4}"),
             Op::Along(p) => format!("along the body, {} knots", p.knots.len()),
             Op::HeadMark(m) => format!("head mark {:?}", m.shape).to_lowercase(),
             Op::ScaleColour(c) => format!("colour per scale tone={:.2} speckle={:.2}", c.tone, c.speckle),
@@ -351,6 +363,11 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             convention.hash(h);
             float(h, *slope);
             float(h, *v_extent);
+        }
+        Op::Occlusion { slope, radius, v_extent } => {
+            for x in [slope, radius, v_extent] {
+                float(h, *x);
+            }
         }
         Op::Along(profile) => profile.hash_into(h),
         Op::HeadMark(mark) => mark.hash_into(h),

@@ -239,6 +239,12 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     );
     g.set_output(MapKind::Normal, normal);
 
+    // Occlusion of the same surface the normal map shades, its horizon searched one scale
+    // width out (the overlap steps and keels that shade a scale lie within it).
+    let ao_radius = 1.0 / shared.lattice.cols as f32;
+    let ao = g.add("ao.out", Op::Occlusion { slope, radius: ao_radius, v_extent: along }, &[height]);
+    g.set_output(MapKind::Ao, ao);
+
     let roughness = build_roughness(&mut g, preset, &shared);
     g.set_output(MapKind::Roughness, roughness);
 

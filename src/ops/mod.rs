@@ -7,6 +7,7 @@ pub mod filters;
 pub mod hash;
 pub mod image;
 pub mod noise;
+pub mod occlusion;
 pub mod scale_colour;
 pub mod scales;
 pub mod shapes;

@@ -36,6 +36,9 @@ pub enum Command {
     /// a sphere or plane) with the maps as a metallic-roughness material, the film as
     /// KHR_materials_iridescence and the base's index as KHR_materials_ior.
     Export(ExportArgs),
+    /// Run many sets from a jobs file (resumable: done jobs are skipped; --shard K/N for
+    /// array jobs). See the README's "Batch runs".
+    Batch(BatchArgs),
     /// Print the node graph the requested maps need.
     Graph(GraphArgs),
     /// Query the optics: exact thin-film reflectance and film colour (JSON output).
@@ -140,7 +143,8 @@ pub struct PresetSource {
 pub struct PresetArgs {
     #[command(flatten)]
     pub source: PresetSource,
-    /// Maps to produce, comma-separated: color, height, normal, roughness, iridescence (default: all).
+    /// Maps to produce, comma-separated: color, height, normal, roughness, iridescence, and ao
+    /// (ambient occlusion, only when named); "all" is the first five ("all,ao" adds it).
     #[arg(long, default_value = "all", value_name = "LIST", value_parser = parse_maps)]
     pub maps: MapList,
 }
@@ -176,6 +180,10 @@ pub struct GenerateArgs {
     /// see the README's packing table. Sets the normal convention the engine expects.
     #[arg(long, value_enum, value_name = "ENGINE", conflicts_with_all = ["normal_convention", "format"])]
     pub pack: Option<PackArg>,
+    /// With --pack: compute the ambient occlusion map (horizon-based, from the height map)
+    /// into the pack's occlusion channel instead of 1 everywhere.
+    #[arg(long, requires = "pack")]
+    pub ao: bool,
     /// Print per-node evaluations, time and buffer size after the run.
     #[arg(long)]
     pub stats: bool,
@@ -200,6 +208,36 @@ pub struct ExportArgs {
     /// snake: head, neck, tail).
     #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
     pub layout: LayoutArg,
+    /// Compute the ambient occlusion map into the ORM texture's R and reference it as the
+    /// material's occlusionTexture (otherwise occlusion is 1 and not referenced).
+    #[arg(long)]
+    pub ao: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct BatchArgs {
+    /// The jobs file: [[job]] tables with `preset` (a built-in name or a .toml path relative
+    /// to the jobs file) and optional `seeds = [..]`, `sizes = [..]`, `maps = "color,normal"`,
+    /// `format = "png"|"exr"`, `pack = "gltf"|"unreal"|"unity-hdrp"`, `layout = "tile"|"body"`
+    /// and `set = { "scales.rows" = 23 }`. Every combination of seeds and sizes is one job.
+    #[arg(value_name = "JOBS.toml")]
+    pub jobs: PathBuf,
+    /// Output folder: each job writes DIR/<preset>/<layout>-<size>-seed<seed>-<format>/, and
+    /// the run an index of its jobs (DIR/index.json, or index.shard-K-of-N.json).
+    #[arg(short, long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Run only the jobs whose index is K modulo N (K from 0): one array task's share, the
+    /// same split on every machine (Slurm: $SLURM_ARRAY_TASK_ID/N; Kubernetes Indexed Job:
+    /// $JOB_COMPLETION_INDEX/N).
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<snakeskin::batch::Shard>,
+    /// List the shard's jobs and whether each is done, without running any.
+    #[arg(long)]
+    pub list: bool,
+}
+
+fn parse_shard(s: &str) -> Result<snakeskin::batch::Shard, String> {
+    s.parse().map_err(|e: snakeskin::batch::BatchError| e.to_string())
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

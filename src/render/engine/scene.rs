@@ -147,7 +147,8 @@ impl View {
     /// Parses `--layers`: a stage name or `map:NAME`.
     pub fn parse(name: &str) -> Option<View> {
         if let Some(map) = name.strip_prefix("map:") {
-            return map.parse().ok().map(View::Map);
+            // The five maps the renderer binds; ambient occlusion is not one of them.
+            return crate::maps::MapKind::ALL.into_iter().find(|m| m.name() == map).map(View::Map);
         }
         Stage::parse(name).map(View::Shaded)
     }
@@ -174,6 +175,7 @@ impl View {
             View::Map(crate::maps::MapKind::Normal) => 3,
             View::Map(crate::maps::MapKind::Roughness) => 4,
             View::Map(crate::maps::MapKind::Iridescence) => 5,
+            View::Map(crate::maps::MapKind::Ao) => unreachable!("View::parse offers only MapKind::ALL"),
         }
     }
 }

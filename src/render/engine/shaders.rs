@@ -119,6 +119,7 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
             MapKind::Normal => "VIEW_NORMAL",
             MapKind::Roughness => "VIEW_ROUGHNESS",
             MapKind::Iridescence => "VIEW_IRIDESCENCE",
+            MapKind::Ao => unreachable!("not in MapKind::ALL"),
         };
         c.push((name, "u32", code(View::Map(map).map_code())));
     }

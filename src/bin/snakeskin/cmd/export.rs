@@ -16,6 +16,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
         layout: args.layout.layout(),
         mesh: args.mesh.kind(),
         out: args.gltf.clone(),
+        ao: args.ao,
     };
     let bar = Progress::counting("{spinner} exporting [{bar:30}] {pos}/{len} nodes {elapsed}");
     let report = export(&request, &|done, total| bar.update(done, total))?;

@@ -29,6 +29,8 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         options: BuildOptions { normal_convention: convention, layout: args.layout.layout() },
         format: args.format.format(),
         pack: args.pack.map(|p| p.pack()),
+        ao: args.ao,
+        job: None,
     };
     let plan = Plan::new(&request)?;
     crate::output::report_clamped_colours(&source.preset, plan.loaded());

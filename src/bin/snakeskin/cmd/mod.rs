@@ -1,6 +1,7 @@
 //! One file per command: each turns its typed arguments into library calls and prints the
 //! result. Nothing here computes anything the library could not do without it.
 
+mod batch;
 mod bench;
 mod brdf;
 mod export;
@@ -20,6 +21,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Generate(args) => generate::run(args),
         Command::Export(args) => export::run(args),
+        Command::Batch(args) => batch::run(args),
         Command::Graph(args) => graph::run(args),
         Command::Brdf { command } => brdf::run(command),
         Command::Bench { command } => bench::run(command),

@@ -1,0 +1,399 @@
+//! `snakeskin batch JOBS.toml -o DIR`: many sets in one command, resumable and shardable.
+//!
+//! A jobs file lists `[[job]]` tables; each expands to one job per combination of its
+//! `seeds` and `sizes`. Every job has a key (`Job::key`: SHA-256 of the loaded preset's
+//! content hash, the overrides and every option that changes the output bytes) that its set's
+//! manifest records as `"job"`. A job whose folder holds a manifest with its key, whose files
+//! match their recorded SHA-256, is done and skipped, so a run that was killed is resumed by
+//! running the same command again: sets are written atomically (`export::SetLock`), so a
+//! killed job left either its complete old set or nothing, and only unfinished jobs run.
+//! `--shard K/N` runs the jobs whose index is K modulo N (K from 0), the same split on every
+//! machine, for array jobs (Slurm, Kubernetes Indexed Jobs). At the end an index of the
+//! run's jobs, their folders and manifests is written next to them.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::export::pack::Pack;
+use crate::export::{sha256_hex, verify_set, write_file_atomically};
+use crate::generate::{GenerateRequest, Plan};
+use crate::maps::{BuildOptions, Layout};
+use crate::material::{FileFormat, MapKind, parse_map_list};
+use crate::{Error, SIZE_RANGE};
+
+/// At most this many jobs per file (after expansion): a typo such as `sizes = [..]` with a
+/// thousand entries is refused before anything runs.
+pub const MAX_JOBS: usize = 100_000;
+/// Jobs files are small; anything larger is refused unread.
+pub const MAX_FILE_BYTES: u64 = 1 << 20;
+
+#[derive(Debug, thiserror::Error)]
+pub enum BatchError {
+    #[error("cannot read jobs file {path}: {source}")]
+    Read { path: PathBuf, source: std::io::Error },
+    #[error("jobs file {path} is {bytes} bytes; jobs files are limited to {limit} bytes")]
+    TooLarge { path: PathBuf, bytes: u64, limit: u64 },
+    /// TOML syntax, an unknown key or a wrong type, at a line and column.
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse { path: PathBuf, line: usize, column: usize, message: String },
+    /// A value outside what a job accepts.
+    #[error("{path}: job {job} ({preset}): {message}")]
+    Invalid { path: PathBuf, job: usize, preset: String, message: String },
+    #[error("{path}: no [[job]] tables; a jobs file lists jobs as [[job]] tables with at least a preset key")]
+    Empty { path: PathBuf },
+    #[error("{path}: {count} jobs after expanding seeds and sizes; at most {max} per file")]
+    TooMany { path: PathBuf, count: usize, max: usize },
+    #[error("invalid --shard {0:?}: expected K/N with 0 <= K < N, e.g. 0/4 (K is the array index)")]
+    Shard(String),
+}
+
+/// One `[[job]]` table as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JobTable {
+    preset: String,
+    #[serde(default)]
+    seeds: Vec<u64>,
+    #[serde(default)]
+    sizes: Vec<u64>,
+    maps: Option<String>,
+    format: Option<String>,
+    pack: Option<String>,
+    layout: Option<String>,
+    /// `--set` overrides: dotted key to TOML value.
+    #[serde(default)]
+    set: std::collections::BTreeMap<String, toml::Value>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JobsFile {
+    #[serde(default)]
+    job: Vec<JobTable>,
+}
+
+/// One set to make.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Job {
+    /// Position in the expanded list (what `--shard` splits on).
+    pub index: usize,
+    /// The preset as given (a built-in name, or a path resolved against the jobs file).
+    pub preset: String,
+    pub overrides: Vec<(String, String)>,
+    /// None: the preset's own seed.
+    pub seed: Option<u64>,
+    pub size: u64,
+    pub maps: Vec<MapKind>,
+    pub format: FileFormat,
+    pub pack: Option<Pack>,
+    pub layout: Layout,
+}
+
+/// The default size of a job without `sizes`.
+pub const DEFAULT_SIZE: u64 = 1024;
+
+impl Job {
+    /// The job's folder under the output folder: `<preset>/<layout>-<size>-seed<seed>-<what>`.
+    pub fn folder(&self, preset_name: &str, seed: u64) -> PathBuf {
+        let what = match self.pack {
+            Some(p) => format!("pack-{}", p.name()),
+            None => self.format.name().to_string(),
+        };
+        let maps = if self.pack.is_none() && self.maps != MapKind::ALL {
+            format!("-{}", self.maps.iter().map(|m| m.name()).collect::<Vec<_>>().join("+"))
+        } else {
+            String::new()
+        };
+        Path::new(preset_name).join(format!("{}-{}-seed{seed}-{what}{maps}", self.layout.name(), self.size))
+    }
+
+    /// The job's key: what its output bytes depend on (the preset's content and seed, the
+    /// overrides, the options and the generator's version).
+    pub fn key(&self, preset_hash: &str, seed: u64) -> String {
+        let description = serde_json::json!({
+            "generator_version": env!("CARGO_PKG_VERSION"),
+            "preset_hash": preset_hash,
+            "overrides": self.overrides,
+            "seed": seed,
+            "size": self.size,
+            "maps": self.maps.iter().map(|m| m.name()).collect::<Vec<_>>(),
+            "format": self.format.name(),
+            "pack": self.pack.map(|p| p.name()),
+            "layout": self.layout.name(),
+        });
+        sha256_hex(description.to_string().as_bytes())
+    }
+}
+
+/// Line and column (1-based) of a byte offset.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+/// Reads and expands a jobs file; every value is checked before any job runs.
+pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
+    let read = |source| BatchError::Read { path: path.into(), source };
+    let meta = std::fs::metadata(path).map_err(read)?;
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(BatchError::TooLarge { path: path.into(), bytes: meta.len(), limit: MAX_FILE_BYTES });
+    }
+    let text = std::fs::read_to_string(path).map_err(read)?;
+    let file: JobsFile = toml::from_str(&text).map_err(|e| {
+        let (line, column) = e.span().map_or((1, 1), |s| line_column(&text, s.start));
+        BatchError::Parse { path: path.into(), line, column, message: e.message().to_string() }
+    })?;
+    if file.job.is_empty() {
+        return Err(BatchError::Empty { path: path.into() });
+    }
+    let base = path.parent().unwrap_or(Path::new("."));
+    let count: usize = file.job.iter().map(|t| t.seeds.len().max(1).saturating_mul(t.sizes.len().max(1))).sum();
+    if count > MAX_JOBS {
+        return Err(BatchError::TooMany { path: path.into(), count, max: MAX_JOBS });
+    }
+    let mut jobs = Vec::with_capacity(count);
+    for (k, table) in file.job.iter().enumerate() {
+        let invalid = |message: String| BatchError::Invalid {
+            path: path.into(),
+            job: k + 1,
+            preset: table.preset.clone(),
+            message,
+        };
+        // A preset path is relative to the jobs file; a bare name is a built-in preset.
+        let preset = if table.preset.ends_with(".toml") && Path::new(&table.preset).is_relative() {
+            base.join(&table.preset).to_string_lossy().into_owned()
+        } else {
+            table.preset.clone()
+        };
+        let maps = match &table.maps {
+            Some(list) => parse_map_list(list).map_err(|e| invalid(format!("maps: {e}")))?,
+            None => MapKind::ALL.to_vec(),
+        };
+        let format = match table.format.as_deref() {
+            None | Some("png") => FileFormat::Png,
+            Some("exr") => FileFormat::Exr,
+            Some(other) => return Err(invalid(format!("format {other:?}: accepted: png, exr"))),
+        };
+        let pack =
+            table.pack.as_deref().map(str::parse::<Pack>).transpose().map_err(|e| invalid(format!("pack: {e}")))?;
+        let layout = match table.layout.as_deref() {
+            None | Some("tile") => Layout::Tile,
+            Some("body") => Layout::Body,
+            Some(other) => return Err(invalid(format!("layout {other:?}: accepted: tile, body"))),
+        };
+        let (lo, hi) = (*SIZE_RANGE.start() as u64, *SIZE_RANGE.end() as u64);
+        if let Some(bad) = table.sizes.iter().find(|s| !(lo..=hi).contains(*s)) {
+            return Err(invalid(format!("size {bad}: accepted sizes are {lo} to {hi} pixels")));
+        }
+        let overrides: Vec<(String, String)> = table.set.iter().map(|(k, v)| (k.clone(), v.to_string())).collect();
+        let seeds: Vec<Option<u64>> =
+            if table.seeds.is_empty() { vec![None] } else { table.seeds.iter().copied().map(Some).collect() };
+        let sizes = if table.sizes.is_empty() { vec![DEFAULT_SIZE] } else { table.sizes.clone() };
+        for &seed in &seeds {
+            for &size in &sizes {
+                jobs.push(Job {
+                    index: jobs.len(),
+                    preset: preset.clone(),
+                    overrides: overrides.clone(),
+                    seed,
+                    size,
+                    maps: maps.clone(),
+                    format,
+                    pack,
+                    layout,
+                });
+            }
+        }
+    }
+    Ok(jobs)
+}
+
+/// `--shard K/N`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = BatchError;
+    fn from_str(s: &str) -> Result<Shard, BatchError> {
+        let bad = || BatchError::Shard(s.into());
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count): (usize, usize) =
+            (k.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+impl Shard {
+    pub const ALL: Shard = Shard { index: 0, count: 1 };
+
+    pub fn contains(&self, job: &Job) -> bool {
+        job.index % self.count == self.index
+    }
+}
+
+/// What happened to one job.
+#[derive(Debug, Clone, Serialize)]
+pub struct JobOutcome {
+    pub index: usize,
+    pub preset: String,
+    pub seed: u64,
+    pub size: u64,
+    /// The set's folder, relative to the output folder.
+    pub folder: PathBuf,
+    pub manifest: PathBuf,
+    pub key: String,
+    /// `done` (run now), `skipped` (already complete with this key) or, from `list`, `to do`.
+    pub status: &'static str,
+}
+
+#[derive(Debug, Serialize)]
+pub struct BatchIndex {
+    pub generator: String,
+    pub generator_version: String,
+    pub jobs_file: PathBuf,
+    /// `K/N`.
+    pub shard: String,
+    pub jobs: Vec<JobOutcome>,
+}
+
+/// The index file's name for a shard (`index.json` for an unsharded run).
+pub fn index_file_name(shard: Shard) -> String {
+    if shard == Shard::ALL {
+        "index.json".into()
+    } else {
+        format!("index.shard-{}-of-{}.json", shard.index, shard.count)
+    }
+}
+
+/// True when `folder` holds a complete set whose manifest records `key`.
+fn is_done(manifest: &Path, key: &str) -> bool {
+    let Ok(text) = std::fs::read(manifest) else { return false };
+    let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return false };
+    json["job"].as_str() == Some(key) && verify_set(manifest).is_ok()
+}
+
+/// A job resolved against its preset and the output folder.
+struct Resolved {
+    outcome: JobOutcome,
+    /// Whether its set is complete with its key.
+    done: bool,
+}
+
+fn resolve(job: &Job, out: &Path) -> Result<Resolved, Error> {
+    let loaded = crate::preset::load(&job.preset, &job.overrides, job.seed)?;
+    let seed = loaded.preset.seed;
+    let key = job.key(&loaded.content_hash, seed);
+    let folder = job.folder(&loaded.name, seed);
+    let manifest = folder.join(crate::export::manifest_file_name(&loaded.name));
+    let done = is_done(&out.join(&manifest), &key);
+    let status = if done { "skipped" } else { "to do" };
+    let outcome =
+        JobOutcome { index: job.index, preset: loaded.name, seed, size: job.size, folder, manifest, key, status };
+    Ok(Resolved { outcome, done })
+}
+
+/// The shard's jobs with their folders and whether each is already done ("skipped" when
+/// run, "to do" otherwise); nothing is run or written.
+pub fn list(jobs: &[Job], out: &Path, shard: Shard) -> Result<Vec<JobOutcome>, Error> {
+    jobs.iter().filter(|j| shard.contains(j)).map(|j| resolve(j, out).map(|r| r.outcome)).collect()
+}
+
+/// Runs the shard's jobs in order; `progress(done, total, outcome)` after each job.
+pub fn run(
+    jobs_file: &Path,
+    jobs: &[Job],
+    out: &Path,
+    shard: Shard,
+    progress: &mut dyn FnMut(usize, usize, &JobOutcome),
+) -> Result<BatchIndex, Error> {
+    let mine: Vec<&Job> = jobs.iter().filter(|j| shard.contains(j)).collect();
+    let mut outcomes = Vec::with_capacity(mine.len());
+    for (k, job) in mine.iter().enumerate() {
+        let Resolved { mut outcome, done } = resolve(job, out)?;
+        if !done {
+            let request = GenerateRequest {
+                preset: job.preset.clone(),
+                overrides: job.overrides.clone(),
+                seed: job.seed,
+                size: job.size,
+                maps: job.maps.clone(),
+                out_dir: out.join(&outcome.folder),
+                options: BuildOptions { layout: job.layout, ..BuildOptions::default() },
+                format: job.format,
+                pack: job.pack,
+                ao: false,
+                job: Some(outcome.key.clone()),
+            };
+            Plan::new(&request)?.run(&|_, _| {})?;
+            outcome.status = "done";
+        }
+        progress(k + 1, mine.len(), &outcome);
+        outcomes.push(outcome);
+    }
+    let index = BatchIndex {
+        generator: "snakeskin".into(),
+        generator_version: env!("CARGO_PKG_VERSION").into(),
+        jobs_file: jobs_file.into(),
+        shard: format!("{}/{}", shard.index, shard.count),
+        jobs: outcomes,
+    };
+    let json = serde_json::to_vec_pretty(&index).map_err(|e| Error::Internal(format!("index: {e}")))?;
+    crate::export::create_folder(out)?;
+    write_file_atomically(&out.join(index_file_name(shard)), json)?;
+    Ok(index)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn jobs(text: &str) -> Result<Vec<Job>, BatchError> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("jobs.toml");
+        std::fs::write(&path, text).unwrap();
+        load_jobs(&path)
+    }
+
+    #[test]
+    fn every_combination_of_seeds_and_sizes_is_one_job() {
+        let list = jobs("[[job]]\npreset = \"natrix-natrix\"\nseeds = [1, 2, 3]\nsizes = [64, 128]\n\n[[job]]\npreset = \"boa-constrictor\"\npack = \"unreal\"\n").unwrap();
+        assert_eq!(list.len(), 7);
+        assert_eq!(list.iter().map(|j| j.index).collect::<Vec<_>>(), (0..7).collect::<Vec<_>>());
+        assert_eq!(list[6].pack, Some(Pack::Unreal));
+        assert_eq!(list[6].size, DEFAULT_SIZE);
+        // Shards partition the jobs.
+        let shards: Vec<Shard> = (0..3).map(|k| Shard { index: k, count: 3 }).collect();
+        for job in &list {
+            assert_eq!(shards.iter().filter(|s| s.contains(job)).count(), 1);
+        }
+    }
+
+    #[test]
+    fn bad_jobs_files_name_the_line_or_the_job() {
+        let e = jobs("[[job]]\npreset = \"natrix-natrix\"\nsize = [64]\n").unwrap_err().to_string();
+        assert!(e.contains(":3:") && e.contains("size"), "{e}");
+        let e = jobs("[[job]]\npreset = \"natrix-natrix\"\nsizes = [8]\n").unwrap_err().to_string();
+        assert!(e.contains("job 1") && e.contains("size 8"), "{e}");
+        let e = jobs("[[job]]\npreset = \"a\"\npack = \"godot\"\n").unwrap_err().to_string();
+        assert!(e.contains("unreal"), "{e}");
+        assert!(matches!(jobs("").unwrap_err(), BatchError::Empty { .. }));
+        let many = format!(
+            "[[job]]\npreset = \"a\"\nseeds = [{}]\nsizes = [64, 128]\n",
+            (0..60_000).map(|s| s.to_string()).collect::<Vec<_>>().join(",")
+        );
+        assert!(matches!(jobs(&many).unwrap_err(), BatchError::TooMany { .. }));
+        for bad in ["4/4", "1", "a/2", "0/0"] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+        assert_eq!("3/4".parse::<Shard>().unwrap(), Shard { index: 3, count: 4 });
+    }
+}

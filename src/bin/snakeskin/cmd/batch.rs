@@ -1,0 +1,36 @@
+//! `snakeskin batch JOBS.toml -o DIR [--shard K/N] [--list]`: many sets, resumable, with a
+//! progress bar over jobs and one summary line.
+
+use anyhow::Result;
+
+use crate::cli::BatchArgs;
+use crate::output::path_line;
+use crate::progress::Progress;
+use snakeskin::batch::{self, Shard};
+
+pub fn run(args: BatchArgs) -> Result<()> {
+    let jobs = batch::load_jobs(&args.jobs).map_err(snakeskin::Error::from)?;
+    let shard = args.shard.unwrap_or(Shard::ALL);
+    if args.list {
+        for job in batch::list(&jobs, &args.out, shard)? {
+            println!("{:>6}  {:<7}  {}", job.index, job.status, path_line(&args.out.join(&job.folder)));
+        }
+        return Ok(());
+    }
+    let bar = Progress::counting("{spinner} batch [{bar:30}] {pos}/{len} jobs {elapsed} {msg}");
+    let index = batch::run(&args.jobs, &jobs, &args.out, shard, &mut |done, total, outcome| {
+        bar.update(done, total);
+        bar.message(&format!("{} {}", outcome.status, outcome.folder.display()));
+    })?;
+    bar.finish();
+    let ran = index.jobs.iter().filter(|j| j.status == "done").count();
+    let skipped = index.jobs.len() - ran;
+    println!(
+        "{} jobs of {} in shard {}: {ran} run, {skipped} already done; index: {}",
+        index.jobs.len(),
+        jobs.len(),
+        index.shard,
+        path_line(&args.out.join(batch::index_file_name(shard)))
+    );
+    Ok(())
+}

@@ -1,0 +1,172 @@
+//! `snakeskin batch`: a batch killed with SIGKILL and run again redoes only the jobs that had
+//! not finished, leaves the finished ones untouched, and ends with exactly the files of an
+//! uninterrupted run; shards split the jobs with nothing run twice or left out.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant, SystemTime};
+
+use common::{snakeskin, stderr, stdout};
+
+/// Every file under `dir` (relative path → bytes), index files left out (they record what
+/// each run did, which differs between the runs compared).
+fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<PathBuf, Vec<u8>>) {
+        for entry in std::fs::read_dir(dir).unwrap().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else if !path.file_name().unwrap().to_string_lossy().starts_with("index") {
+                out.insert(path.strip_prefix(root).unwrap().into(), std::fs::read(&path).unwrap());
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(dir, dir, &mut out);
+    out
+}
+
+/// The manifests under `dir` with each file's modification time, for "left untouched".
+fn manifests(dir: &Path) -> BTreeMap<PathBuf, SystemTime> {
+    tree(dir)
+        .into_keys()
+        .filter(|p| p.to_string_lossy().ends_with(".material.json"))
+        .map(|p| {
+            let modified = std::fs::metadata(dir.join(&p)).unwrap().modified().unwrap();
+            (p, modified)
+        })
+        .collect()
+}
+
+fn jobs_file(dir: &Path, species: &[&str], seeds: &str, size: u32) -> PathBuf {
+    let text: String =
+        species.iter().map(|s| format!("[[job]]\npreset = \"{s}\"\nseeds = {seeds}\nsizes = [{size}]\n\n")).collect();
+    let path = dir.join("jobs.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn summary_counts(out: &std::process::Output) -> (usize, usize) {
+    // "40 jobs of 40 in shard 0/1: 33 run, 7 already done; index: …"
+    let text = stdout(out);
+    let after = text.split(": ").nth(1).unwrap_or_else(|| panic!("no summary in {text:?}"));
+    let numbers: Vec<usize> =
+        after.split(|c: char| !c.is_ascii_digit()).filter_map(|n| n.parse().ok()).take(2).collect();
+    (numbers[0], numbers[1])
+}
+
+const SPECIES: [&str; 20] = [
+    "acanthophis-antarcticus",
+    "ahaetulla-nasuta",
+    "bitis-arietans",
+    "bitis-gabonica",
+    "boa-constrictor",
+    "bothrops-alternatus",
+    "bungarus-fasciatus",
+    "corallus-caninus",
+    "crotalus-atrox",
+    "dendroaspis-polylepis",
+    "diadophis-punctatus",
+    "elaphe-climacophora",
+    "epicrates-cenchria",
+    "hydrophis-platurus",
+    "lampropeltis-triangulum",
+    "liasis-mackloti",
+    "micrurus-diastema",
+    "natrix-natrix",
+    "python-regius",
+    "xenopeltis-unicolor",
+];
+
+#[test]
+fn a_killed_batch_resumes_with_only_the_unfinished_jobs_and_the_same_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &SPECIES, "[1, 2]", 512);
+    let (whole, resumed) = (dir.path().join("whole"), dir.path().join("resumed"));
+
+    // The reference: one uninterrupted run.
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", whole.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(summary_counts(&out), (40, 0), "{}", stdout(&out));
+    assert_eq!(manifests(&whole).len(), 40);
+
+    // The same batch, killed with SIGKILL once a few sets are complete.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["batch", jobs.to_str().unwrap(), "-o", resumed.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while (if resumed.is_dir() { manifests(&resumed).len() } else { 0 }) < 6 {
+        assert!(start.elapsed() < Duration::from_secs(300), "the batch made no progress");
+        assert!(child.try_wait().unwrap().is_none(), "the batch ended before it could be killed");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().unwrap(); // SIGKILL: no destructor, no cleanup
+    child.wait().unwrap();
+    let finished = manifests(&resumed);
+    assert!(finished.len() < 40, "the kill came too late to test anything");
+
+    // Run again: only the unfinished jobs run, and the finished sets are not rewritten.
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", resumed.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (ran, skipped) = summary_counts(&out);
+    assert_eq!(skipped, finished.len(), "{}", stdout(&out));
+    assert_eq!(ran + skipped, 40);
+    let after = manifests(&resumed);
+    for (manifest, modified) in &finished {
+        assert_eq!(after[manifest], *modified, "{} was rewritten", manifest.display());
+    }
+
+    // Every file as in the uninterrupted run, and nothing else (no temporaries, no locks).
+    let (a, b) = (tree(&whole), tree(&resumed));
+    assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+    for (path, bytes) in &a {
+        assert!(b[path] == *bytes, "{} differs from the uninterrupted run", path.display());
+    }
+
+    // A third run has nothing to do; the index lists all 40 jobs.
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", resumed.to_str().unwrap()]);
+    assert_eq!(summary_counts(&out), (0, 40), "{}", stdout(&out));
+    let index: serde_json::Value = serde_json::from_slice(&std::fs::read(resumed.join("index.json")).unwrap()).unwrap();
+    assert_eq!(index["jobs"].as_array().unwrap().len(), 40);
+}
+
+#[test]
+fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix", "python-regius", "vipera-berus"], "[1, 2, 3]", 32);
+    let out_dir = dir.path().join("out");
+    let mut total = 0;
+    for k in 0..4 {
+        let shard = format!("{k}/4");
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--shard", &shard]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let (ran, skipped) = summary_counts(&out);
+        assert_eq!(skipped, 0, "shard {shard} found another shard's job done: {}", stdout(&out));
+        total += ran;
+        assert!(out_dir.join(format!("index.shard-{k}-of-4.json")).is_file());
+    }
+    assert_eq!(total, 9);
+    assert_eq!(manifests(&out_dir).len(), 9);
+
+    // The same jobs with a different preset value are different jobs: a set written for
+    // other options is not taken for this one.
+    let text =
+        std::fs::read_to_string(&jobs).unwrap().replace("sizes = [32]", "sizes = [32]\nset = { \"scales.rows\" = 17 }");
+    std::fs::write(&jobs, text).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert_eq!(summary_counts(&out), (9, 0), "{}", stdout(&out));
+
+    // A bad jobs file is refused with its line, exit 2, and nothing written.
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nseed = [1]\n").unwrap();
+    let empty = dir.path().join("empty");
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:3:"), "{}", stderr(&out));
+    assert!(!empty.exists());
+}
