@@ -97,13 +97,6 @@ impl Plan {
         let size = check_size(request.size)?;
         let loaded = preset::load(&request.preset, &request.overrides, request.seed)?;
         let height = request.options.layout.height(&loaded.preset, size);
-        if height > size && request.format == FileFormat::Exr {
-            return Err(Error::Unsupported(
-                "--format exr with --layout body: a body atlas is written a strip at a time, which only the PNG writer \
-                 does so far; use --format png, or --layout tile for OpenEXR"
-                    .into(),
-            ));
-        }
         if request.pack.is_some() && request.format == FileFormat::Exr {
             return Err(Error::Unsupported(
                 "--pack with --format exr: packed textures are 8- and 16-bit PNG, as the engines import them; leave \
@@ -120,11 +113,18 @@ impl Plan {
             None => request.maps.clone(),
         };
         let strips = strips_of(&graph, &maps, size, height);
-        let estimate = if request.format == FileFormat::Exr || (request.pack.is_some() && strips.is_none()) {
-            // The finished maps are kept as f32 until encoded or packed; each file at most
-            // their size.
-            let floats: u64 = maps.iter().map(|m| 4 * m.exr_channels().0.len() as u64).sum();
-            crate::memory::estimate_generate_bytes(&graph, &maps, size, height) + 2 * floats * (size * height) as u64
+        // The finished maps kept as f32 until encoded or packed, and their files (each at
+        // most their size).
+        let floats: u64 = maps.iter().map(|m| 4 * m.exr_channels().0.len() as u64).sum();
+        let held = 2 * floats * (size * height) as u64;
+        let estimate = if request.format == FileFormat::Exr
+            && let Some(strips) = strips
+        {
+            // OpenEXR of a body atlas: evaluated in strips, the rows gathered into whole maps.
+            let rows = (strips.rows + 2 * strips.margin).min(height);
+            crate::memory::estimate_strips_bytes(&graph, &maps, size, height, rows) + held
+        } else if request.format == FileFormat::Exr || (request.pack.is_some() && strips.is_none()) {
+            crate::memory::estimate_generate_bytes(&graph, &maps, size, height) + held
         } else if let Some(strips) = strips {
             let rows = (strips.rows + 2 * strips.margin).min(height);
             crate::memory::estimate_strips_bytes(&graph, &maps, size, height, rows)
@@ -155,10 +155,30 @@ impl Plan {
         let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
         let strip_layout = strips_of(&graph, &request.maps, size, height);
         let (kinds, files, stats, encode_time) = if request.format == FileFormat::Exr {
+            // The maps as f32, whole: a square evaluated at once, a body atlas strip by strip
+            // with each strip's rows copied into place (the OpenEXR writer takes whole
+            // images; the graph's buffers stay a strip's).
             let mut finished: Vec<(MapKind, crate::ops::Image)> = Vec::new();
-            let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
-                finished.push((map, image));
-            });
+            let stats =
+                for_each_band(&graph, &request.maps, size, height, strip_layout, progress, &mut |band, rows| {
+                    for (map, image) in band {
+                        let stride = image.width * image.channels;
+                        let band_rows = &image.data[rows.start * stride..rows.end * stride];
+                        match finished.iter_mut().find(|(m, _)| m == map) {
+                            Some((_, whole)) => whole.data.extend_from_slice(band_rows),
+                            None => {
+                                let mut whole = crate::ops::Image::new(size, 0, image.channels);
+                                whole.data.reserve_exact(stride * height);
+                                whole.data.extend_from_slice(band_rows);
+                                finished.push((*map, whole));
+                            }
+                        }
+                    }
+                    Ok(())
+                })?;
+            for (_, image) in &mut finished {
+                image.height = height;
+            }
             finished.sort_by_key(|(m, _)| *m);
             let encode_start = Instant::now();
             let range = crate::maps::thickness_range_nm(&loaded.preset);

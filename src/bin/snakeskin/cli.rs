@@ -171,7 +171,7 @@ pub struct GenerateArgs {
     pub layout: LayoutArg,
     /// File format: png (8/16-bit, the default) or exr (OpenEXR floats in physical units:
     /// linear half colour and roughness, float height, normal xyz in [-1, 1] and film
-    /// thickness in nm; tile layout only for now).
+    /// thickness in nm; a body atlas's float maps are held whole until written).
     #[arg(long, value_enum, default_value_t = FormatArg::Png)]
     pub format: FormatArg,
     /// Write the textures an engine reads instead of the maps: gltf (base colour, OpenGL
