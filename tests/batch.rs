@@ -30,15 +30,26 @@ fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 }
 
 /// The manifests under `dir` with each file's modification time, for "left untouched".
+/// Safe while a batch is writing there: files that vanish between listing and reading
+/// (its temporaries, renamed into place) are passed over.
 fn manifests(dir: &Path) -> BTreeMap<PathBuf, SystemTime> {
-    tree(dir)
-        .into_keys()
-        .filter(|p| p.to_string_lossy().ends_with(".material.json"))
-        .map(|p| {
-            let modified = std::fs::metadata(dir.join(&p)).unwrap().modified().unwrap();
-            (p, modified)
-        })
-        .collect()
+    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<PathBuf, SystemTime>) {
+        let Ok(entries) = std::fs::read_dir(dir) else { return };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let Ok(meta) = std::fs::symlink_metadata(&path) else { continue };
+            if meta.is_dir() {
+                walk(root, &path, out);
+            } else if path.to_string_lossy().ends_with(".material.json")
+                && let Ok(modified) = meta.modified()
+            {
+                out.insert(path.strip_prefix(root).unwrap().into(), modified);
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(dir, dir, &mut out);
+    out
 }
 
 fn jobs_file(dir: &Path, species: &[&str], seeds: &str, size: u32) -> PathBuf {
@@ -101,7 +112,7 @@ fn a_killed_batch_resumes_with_only_the_unfinished_jobs_and_the_same_files() {
         .spawn()
         .unwrap();
     let start = Instant::now();
-    while (if resumed.is_dir() { manifests(&resumed).len() } else { 0 }) < 6 {
+    while manifests(&resumed).len() < 6 {
         assert!(start.elapsed() < Duration::from_secs(300), "the batch made no progress");
         assert!(child.try_wait().unwrap().is_none(), "the batch ended before it could be killed");
         std::thread::sleep(Duration::from_millis(20));
