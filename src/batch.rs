@@ -301,13 +301,39 @@ fn resolve(job: &Job, out: &Path) -> Result<Resolved, Error> {
     Ok(Resolved { outcome, done })
 }
 
-/// The shard's jobs with their folders and whether each is already done ("skipped" when
-/// run, "to do" otherwise); nothing is run or written.
+/// The shard's jobs with their folders and whether each is already done (`done` or
+/// `to do`); nothing is run or written.
 pub fn list(jobs: &[Job], out: &Path, shard: Shard) -> Result<Vec<JobOutcome>, Error> {
-    jobs.iter().filter(|j| shard.contains(j)).map(|j| resolve(j, out).map(|r| r.outcome)).collect()
+    jobs.iter()
+        .filter(|j| shard.contains(j))
+        .map(|j| {
+            let Resolved { mut outcome, done } = resolve(j, out)?;
+            outcome.status = if done { "done" } else { "to do" };
+            Ok(outcome)
+        })
+        .collect()
 }
 
-/// Runs the shard's jobs in order; `progress(done, total, outcome)` after each job.
+/// The generation a job asks for, with its key for the manifest.
+fn request(job: &Job, out: &Path, outcome: &JobOutcome) -> GenerateRequest {
+    GenerateRequest {
+        preset: job.preset.clone(),
+        overrides: job.overrides.clone(),
+        seed: job.seed,
+        size: job.size,
+        maps: job.maps.clone(),
+        out_dir: out.join(&outcome.folder),
+        options: BuildOptions { layout: job.layout, ..BuildOptions::default() },
+        format: job.format,
+        pack: job.pack,
+        ao: false,
+        job: Some(outcome.key.clone()),
+    }
+}
+
+/// Runs the shard's jobs in order; `progress(done, total, outcome)` after each job. Every
+/// job of the shard is planned first (preset loaded and validated, memory checked), so a bad
+/// job stops the run before any set is written, not in the middle of it.
 pub fn run(
     jobs_file: &Path,
     jobs: &[Job],
@@ -316,24 +342,18 @@ pub fn run(
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
     let mine: Vec<&Job> = jobs.iter().filter(|j| shard.contains(j)).collect();
+    let mut resolved = Vec::with_capacity(mine.len());
+    for job in &mine {
+        let r = resolve(job, out)?;
+        if !r.done {
+            Plan::new(&request(job, out, &r.outcome))?;
+        }
+        resolved.push(r);
+    }
     let mut outcomes = Vec::with_capacity(mine.len());
-    for (k, job) in mine.iter().enumerate() {
-        let Resolved { mut outcome, done } = resolve(job, out)?;
+    for (k, (job, Resolved { mut outcome, done })) in mine.iter().zip(resolved).enumerate() {
         if !done {
-            let request = GenerateRequest {
-                preset: job.preset.clone(),
-                overrides: job.overrides.clone(),
-                seed: job.seed,
-                size: job.size,
-                maps: job.maps.clone(),
-                out_dir: out.join(&outcome.folder),
-                options: BuildOptions { layout: job.layout, ..BuildOptions::default() },
-                format: job.format,
-                pack: job.pack,
-                ao: false,
-                job: Some(outcome.key.clone()),
-            };
-            Plan::new(&request)?.run(&|_, _| {})?;
+            Plan::new(&request(job, out, &outcome))?.run(&|_, _| {})?;
             outcome.status = "done";
         }
         progress(k + 1, mine.len(), &outcome);

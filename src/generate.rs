@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use crate::export::pack::{Pack, TextureEncoder, TextureSpec, texture_file_name};
 use crate::export::{self, MapEntry, Quantized, SetLock, sha256_hex};
 use crate::graph::{EvalStats, Graph, evaluate_into, evaluate_rows};
-use crate::maps::{BuildOptions, build_graph};
+use crate::maps::{BuildOptions, build_graph, has_film};
 use crate::material::{FileFormat, MapKind};
 use crate::memory::MemoryCheck;
 use crate::ops::Frame;
@@ -76,12 +76,6 @@ pub struct Plan {
     maps: Vec<MapKind>,
     memory: MemoryCheck,
     start: Instant,
-}
-
-/// Whether a preset has a film (a thickness above zero): without one there is no
-/// iridescence to export.
-pub fn has_film(preset: &crate::preset::Preset) -> bool {
-    preset.optics.film_thickness_nm > 0.0
 }
 
 impl Plan {

@@ -11,9 +11,9 @@ use std::time::{Duration, Instant};
 use crate::export::gltf::{GltfMaterial, GltfTextures, glb, gltf_files};
 use crate::export::pack::Pack;
 use crate::export::{SetLock, write_file_atomically};
-use crate::generate::{GenerateRequest, Plan, has_film};
+use crate::generate::{GenerateRequest, Plan};
 use crate::graph::EvalStats;
-use crate::maps::{Layout, body_plan, thickness_range_nm};
+use crate::maps::{Layout, body_plan, has_film, thickness_range_nm};
 use crate::material::{FileFormat, MapKind};
 use crate::render::engine::mesh::{BodyShape, Mesh};
 use crate::{Error, maps::BuildOptions};
@@ -47,6 +47,8 @@ pub struct ExportRequest {
 #[derive(Debug)]
 pub struct ExportReport {
     pub files: Vec<PathBuf>,
+    /// The textures' width and height in pixels.
+    pub dimensions: (usize, usize),
     pub stats: EvalStats,
     pub encode_time: Duration,
     pub total_time: Duration,
@@ -115,6 +117,7 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
     let material = GltfMaterial { base_ior: preset.optics.pigment_ior, film, repeat_v: request.layout == Layout::Tile };
     let mesh = mesh_for(request.mesh, request.layout, preset);
     let (textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
+    let dimensions = plan.dimensions();
     let texture = |suffix: &str| textures.iter().find(|(s, _)| s.suffix == suffix).map(|(_, b)| b.clone());
     let missing = |suffix: &str| Error::Internal(format!("the glTF pack has no {suffix} texture"));
     let textures = GltfTextures {
@@ -134,5 +137,5 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         let lock = SetLock::acquire(&dir, &name)?;
         lock.write(&files, (&gltf_name, &gltf_bytes))?
     };
-    Ok(ExportReport { files, stats, encode_time, total_time: start.elapsed() })
+    Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed() })
 }

@@ -267,6 +267,13 @@ pub fn thickness_range_nm(film_thickness_nm: f64, spread_nm: f64) -> (f64, f64) 
     (min, min + spread_nm)
 }
 
+/// True when the film changes nothing: no thickness anywhere in its range, or the film's
+/// index equal to the ambient medium's. The renderer then skips it, and exports leave it out
+/// (no thickness texture, no glTF iridescence).
+pub fn film_is_inert(thickness_range_nm: (f64, f64), ambient_ior: f64, film_ior: f64) -> bool {
+    thickness_range_nm.1 <= 0.0 || film_ior == ambient_ior
+}
+
 /// σ0, written as one number or `[r, g, b]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Absorption(pub [f64; 3]);

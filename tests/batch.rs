@@ -180,4 +180,12 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("jobs.toml:3:"), "{}", stderr(&out));
     assert!(!empty.exists());
+
+    // A job that cannot run (an unknown preset) stops the batch before any job runs.
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n[[job]]\npreset = \"no-such-snake\"\n")
+        .unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("no-such-snake"), "{}", stderr(&out));
+    assert!(manifests(&empty).is_empty(), "a set was written before the bad job was found");
 }

@@ -102,7 +102,7 @@ fn the_khronos_validator_finds_no_error_and_no_warning() {
         assert_eq!(report["warnings"], 0, "{report:#}");
         // The iridescence extension is declared exactly where the preset has a film.
         let declared = report["extensions"].as_array().unwrap().iter().any(|e| e == "KHR_materials_iridescence");
-        let film = snakeskin::generate::has_film(&snakeskin::preset::load(species, &[], None).unwrap().preset);
+        let film = snakeskin::maps::has_film(&snakeskin::preset::load(species, &[], None).unwrap().preset);
         assert_eq!(declared, film, "{species}: {report:#}");
     }
     assert!(reports.iter().any(|r| r["file"].as_str().unwrap().contains("crotalus")));

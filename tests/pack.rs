@@ -45,7 +45,7 @@ fn check_packs(preset: &str, layout: &str) {
     let rough = channel(&read(&plain, &format!("{name}_roughness.png")), 0);
     let height16 = read(&plain, &format!("{name}_height.png")).to_luma16();
     let thickness16 = read(&plain, &format!("{name}_iridescence.png")).to_luma16();
-    let film = snakeskin::generate::has_film(&snakeskin::preset::load(preset, &[], None).unwrap().preset);
+    let film = snakeskin::maps::has_film(&snakeskin::preset::load(preset, &[], None).unwrap().preset);
 
     for pack in ["gltf", "unreal", "unity-hdrp"] {
         let out = dir.path().join(pack);
@@ -140,7 +140,7 @@ fn ao_fills_the_occlusion_channel_and_only_when_asked() {
 #[test]
 fn pack_refuses_options_that_contradict_it() {
     let dir = tempfile::tempdir().unwrap();
-    for extra in [["--format", "exr"], ["--normal-convention", "directx"]] {
+    for extra in [["--format", "exr"], ["--normal-convention", "directx"], ["--maps", "color"]] {
         let mut args = vec!["generate", "xenopeltis-unicolor", "-o", dir.path().to_str().unwrap(), "--pack", "unreal"];
         args.extend_from_slice(&extra);
         let out = snakeskin(&args);

@@ -76,6 +76,12 @@ pub fn thickness_range_nm(preset: &Preset) -> (f64, f64) {
     crate::material::thickness_range_nm(preset.optics.film_thickness_nm, preset.iridescence.spread_nm)
 }
 
+/// Whether the preset's film shows at all (`material::film_is_inert`).
+pub fn has_film(preset: &Preset) -> bool {
+    let o = &preset.optics;
+    !crate::material::film_is_inert(thickness_range_nm(preset), o.ambient_ior, o.film_ior)
+}
+
 pub fn scale_field(preset: &Preset, layout: Layout) -> ScaleField {
     let s = &preset.scales;
     let body = (layout == Layout::Body).then(|| body_plan(preset));

@@ -178,7 +178,7 @@ pub struct GenerateArgs {
     /// normal, occlusion-roughness-metallic, film thickness), unreal (ORM, DirectX normal,
     /// height) or unity-hdrp (mask map with smoothness in alpha, OpenGL normal, height);
     /// see the README's packing table. Sets the normal convention the engine expects.
-    #[arg(long, value_enum, value_name = "ENGINE", conflicts_with_all = ["normal_convention", "format"])]
+    #[arg(long, value_enum, value_name = "ENGINE", conflicts_with_all = ["normal_convention", "format", "maps"])]
     pub pack: Option<PackArg>,
     /// With --pack: compute the ambient occlusion map (horizon-based, from the height map)
     /// into the pack's occlusion channel instead of 1 everywhere.

@@ -201,7 +201,7 @@ impl LayerOptics {
 
     /// True when the film changes nothing: zero thickness everywhere or n1 equal to n0.
     pub fn film_is_inert(&self) -> bool {
-        self.thickness_range_nm.1 <= 0.0 || self.stack.n1 == self.stack.n0
+        crate::material::film_is_inert(self.thickness_range_nm, self.stack.n0, self.stack.n1)
     }
 
     /// The film thicknesses K and E (the stack's bounce terms) are computed at:
