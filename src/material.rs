@@ -87,7 +87,11 @@ impl MapKind {
                 format!("tangent-space normal, rgb = xyz * 0.5 + 0.5, {y}")
             }
             MapKind::Roughness => "perceptual roughness r; GGX alpha = r^2 (glTF)".into(),
-            MapKind::Iridescence => "film thickness: min_nm + value / 65535 * (max_nm - min_nm)".into(),
+            MapKind::Iridescence => {
+                "film thickness: min_nm + value / 65535 * (max_nm - min_nm); all 0 where the preset has no film \
+                 (the manifest's iridescence.film false)"
+                    .into()
+            }
             MapKind::Ao => "ambient occlusion: the cosine-weighted share of the sky a point sees, 1 = open".into(),
         }
     }

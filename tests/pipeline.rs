@@ -206,3 +206,25 @@ fn buffers_are_freed_after_their_last_consumer() {
     let outputs: usize = eval.maps.values().map(|m| m.bytes()).sum();
     assert!(eval.stats.peak_bytes >= outputs);
 }
+
+#[test]
+fn a_species_without_a_film_evaluates_no_film_nodes() {
+    // Decided from the preset before evaluation: without a film (crotalus-atrox: 0 nm, no
+    // spread) the thickness map is one constant node; with one (the control) the gradient
+    // and noise nodes run. Counted from the evaluator's own statistics, not timed.
+    for (name, film) in [("crotalus-atrox", false), ("xenopeltis-unicolor", true)] {
+        let preset = snakeskin::preset::load(name, &[], None).unwrap().preset;
+        assert_eq!(snakeskin::maps::has_film(&preset), film, "{name}");
+        let graph = build_graph(&preset, BuildOptions::default());
+        let eval = evaluate(&graph, &[MapKind::Iridescence], 64, 64, &|_, _| {});
+        let names: Vec<&str> = eval.stats.nodes.iter().map(|n| n.name.as_str()).collect();
+        assert_eq!(names.contains(&"iridescence.noise"), film, "{name}: {names:?}");
+        if !film {
+            assert_eq!(names, ["iridescence.out"], "{name}");
+            assert!(eval.maps[&MapKind::Iridescence].data.iter().all(|&x| x == 0.0));
+        }
+        // `graph` shows the same.
+        let dot = stdout(&snakeskin(&["graph", name, "--maps", "iridescence", "--dot"]));
+        assert_eq!(dot.contains("iridescence.noise"), film, "{name}: {dot}");
+    }
+}

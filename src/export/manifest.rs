@@ -136,6 +136,9 @@ impl MapEntry {
 
 #[derive(Debug, Serialize)]
 pub struct IridescenceRange {
+    /// Whether the preset's film shows at all (`maps::has_film`). Without one the
+    /// iridescence map is constant 0 and its range means nothing.
+    pub film: bool,
     /// Thickness at sample value 0 and at the maximum sample value.
     pub min_nm: f64,
     pub max_nm: f64,
@@ -191,7 +194,7 @@ pub fn manifest(
         counts,
         regions,
         maps: entries,
-        iridescence: IridescenceRange { min_nm, max_nm },
+        iridescence: IridescenceRange { film: crate::maps::has_film(p), min_nm, max_nm },
         optics: p.optics.clone(),
         color_means: COLOR_MEANS.into(),
         clamped_colors: loaded.clamped_colours.clone(),

@@ -15,6 +15,9 @@ use crate::ops::shapes::{self, Axis, BellyMarks, Blotches, SpotGrid};
 pub enum Op {
     /// Tileable fractal noise in [0, 1]. No inputs.
     Noise(FractalNoise),
+    /// The same value everywhere (a map the preset makes meaningless, such as the film
+    /// thickness of a species without a film). No inputs.
+    Constant { value: f32 },
     /// The multi-channel scale field (`ops::scales::channel`). No inputs.
     Scales(ScaleField),
     /// One channel of the input.
@@ -65,6 +68,7 @@ impl Op {
     pub fn arity(&self) -> std::ops::RangeInclusive<usize> {
         match self {
             Op::Noise(_)
+            | Op::Constant { .. }
             | Op::Scales(_)
             | Op::Bands { .. }
             | Op::Blotches(_)
@@ -98,6 +102,7 @@ impl Op {
             | Op::Tint { .. }
             | Op::ScaleColour(_) => inputs.first().copied().unwrap_or(1),
             Op::Noise(_)
+            | Op::Constant { .. }
             | Op::Channel { .. }
             | Op::Bands { .. }
             | Op::Blotches(_)
@@ -152,6 +157,11 @@ impl Op {
         let input = || first.as_deref().expect("operation has an input");
         match self {
             Op::Noise(noise) => crate::ops::noise::render(noise, frame),
+            Op::Constant { value } => {
+                let mut image = Image::new(frame.width, frame.height, 1);
+                image.data.fill(*value);
+                image
+            }
             Op::Scales(field) => field.render_in(frame),
             Op::Channel { index } => filters::extract_channel(input(), *index),
             Op::Bands { axis, centres, half_width, softness } => {
@@ -195,6 +205,7 @@ impl Op {
                 };
                 format!("noise {kind} {}x{} octaves={}", n.cells_u, n.cells_v, n.octaves)
             }
+            Op::Constant { value } => format!("constant {value}"),
             Op::Scales(s) => format!("scales {:?} rows={}", s.shape, s.rows).to_lowercase(),
             Op::Channel { index } => format!("channel {index}"),
             Op::Bands { axis, centres, .. } => format!("bands {axis:?} n={}", centres.len()).to_lowercase(),
@@ -288,6 +299,7 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             }
         }
         Op::Channel { index } => index.hash(h),
+        Op::Constant { value } => float(h, *value),
         Op::Bands { axis, centres, half_width, softness } => {
             axis.hash(h);
             centres.len().hash(h);

@@ -309,6 +309,11 @@ fn build_roughness(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId 
 }
 
 fn build_iridescence(g: &mut GraphBuilder, preset: &Preset, s: &Shared, cols: u32) -> NodeId {
+    if !has_film(preset) {
+        // No film shows (`has_film`): any thickness means the same, so the map is a
+        // constant 0 and none of the gradient and noise nodes below is built or evaluated.
+        return g.add("iridescence.out", Op::Constant { value: 0.0 }, &[]);
+    }
     let p = &preset.iridescence;
     let gradient = match p.gradient {
         IridescenceGradient::Vertical => s.channel(g, "iridescence.gradient", channel::ALONG),
