@@ -186,30 +186,43 @@ impl BodyShape {
                 }
                 let tangent = dpdu.normalize_or(normal.any_orthonormal_vector());
                 // "Up the image" is −v, i.e. towards the head.
-                let up_image = -dpds;
-                let sign = if normal.cross(tangent).dot(up_image) >= 0.0 { 1.0 } else { -1.0 };
-                vertices.push(Vertex {
-                    position: p.to_array(),
-                    normal: normal.to_array(),
-                    tangent: [tangent.x, tangent.y, tangent.z, sign],
-                    uv: [u, arc_i / repeat],
-                });
+                vertices.push(Vertex::new(p, normal, tangent, -dpds, [u, arc_i / repeat]));
             }
         }
-        let stride = (segments + 1) as u32;
-        let mut indices = Vec::with_capacity(rings * segments * 6);
-        for i in 0..rings as u32 {
-            for j in 0..segments as u32 {
-                let a = i * stride + j;
-                let b = a + stride;
-                // Counter-clockwise seen from outside (checked by the winding test).
-                indices.extend_from_slice(&[a, a + 1, b, b, a + 1, b + 1]);
-            }
-        }
-        let mut mesh = Mesh { vertices, indices };
+        let mut mesh = Mesh { vertices, indices: grid_indices(rings, segments) };
         mesh.orient_outward();
         mesh
     }
+}
+
+impl Vertex {
+    /// A vertex whose tangent's `w` makes `w · cross(normal, tangent)` point `up_image`
+    /// (towards −v: OpenGL's and glTF's bitangent).
+    fn new(position: Vec3, normal: Vec3, tangent: Vec3, up_image: Vec3, uv: [f32; 2]) -> Vertex {
+        let sign = if normal.cross(tangent).dot(up_image) >= 0.0 { 1.0 } else { -1.0 };
+        Vertex {
+            position: position.to_array(),
+            normal: normal.to_array(),
+            tangent: [tangent.x, tangent.y, tangent.z, sign],
+            uv,
+        }
+    }
+}
+
+/// Two triangles per quad of a grid of `rings + 1` rows of `segments + 1` vertices (row-major),
+/// counter-clockwise when row index and column index grow like v and u; `orient_outward`
+/// fixes the winding of surfaces parametrised the other way.
+fn grid_indices(rings: usize, segments: usize) -> Vec<u32> {
+    let stride = (segments + 1) as u32;
+    let mut indices = Vec::with_capacity(rings * segments * 6);
+    for i in 0..rings as u32 {
+        for j in 0..segments as u32 {
+            let a = i * stride + j;
+            let b = a + stride;
+            indices.extend_from_slice(&[a, a + 1, b, b, a + 1, b + 1]);
+        }
+    }
+    indices
 }
 
 impl Mesh {
@@ -262,7 +275,7 @@ impl Mesh {
 
     /// A sphere of `radius` about the origin, +y up, the texture `repeats` times around the
     /// equator (u) and `repeats / 2` times from pole to pole (v, top to bottom), so texels
-    /// stay square at the equator. The poles' degenerate triangles are left out.
+    /// stay square at the equator. The poles' zero-area triangles are left out.
     pub fn sphere(radius: f32, repeats: f32, rings: usize, segments: usize) -> Mesh {
         let (rings, segments) = (rings.max(3), segments.max(4));
         let mut vertices = Vec::with_capacity((rings + 1) * (segments + 1));
@@ -277,32 +290,13 @@ impl Mesh {
                 let tangent = Vec3::new(-phi.sin(), 0.0, -phi.cos());
                 // Up the image (−v) is towards the north pole: −∂P/∂θ.
                 let up_image = -Vec3::new(theta.cos() * phi.cos(), -theta.sin(), -theta.cos() * phi.sin());
-                let sign = if normal.cross(tangent).dot(up_image) >= 0.0 { 1.0 } else { -1.0 };
-                vertices.push(Vertex {
-                    position: (normal * radius).to_array(),
-                    normal: normal.to_array(),
-                    tangent: [tangent.x, tangent.y, tangent.z, sign],
-                    uv: [u * repeats, v * repeats * 0.5],
-                });
+                let uv = [u * repeats, v * repeats * 0.5];
+                vertices.push(Vertex::new(normal * radius, normal, tangent, up_image, uv));
             }
         }
-        let stride = (segments + 1) as u32;
-        let mut indices = Vec::with_capacity(rings * segments * 6);
-        for i in 0..rings as u32 {
-            for j in 0..segments as u32 {
-                let a = i * stride + j;
-                let b = a + stride;
-                if i > 0 {
-                    indices.extend_from_slice(&[a, a + 1, b]);
-                }
-                if i + 1 < rings as u32 {
-                    indices.extend_from_slice(&[b, a + 1, b + 1]);
-                }
-            }
-        }
-        let mut mesh = Mesh { vertices, indices };
+        let mut mesh = Mesh { vertices, indices: grid_indices(rings, segments) };
         mesh.orient_outward();
-        mesh
+        mesh.without_degenerate_triangles()
     }
 
     /// The mesh without zero-area triangles (a tube's closed ends, where a ring collapses to
