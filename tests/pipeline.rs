@@ -228,3 +228,25 @@ fn a_species_without_a_film_evaluates_no_film_nodes() {
         assert_eq!(dot.contains("iridescence.noise"), film, "{name}: {dot}");
     }
 }
+
+#[test]
+fn zero_film_noise_runs_no_noise_node_and_changes_nothing() {
+    // iridescence.noise = 0: the noise and its blend are not built. The map equals that of a
+    // noise too weak to move any sample (1e-30, which keeps both nodes): skipping them is
+    // pure speed. The control: the tiny-noise graph does run the noise node.
+    let map = |noise: &str| {
+        let preset =
+            snakeskin::preset::load("xenopeltis-unicolor", &[("iridescence.noise".into(), noise.into())], None)
+                .unwrap()
+                .preset;
+        let eval =
+            evaluate(&build_graph(&preset, BuildOptions::default()), &[MapKind::Iridescence], 64, 64, &|_, _| {});
+        let ran_noise = eval.stats.nodes.iter().any(|n| n.name == "iridescence.noise");
+        (eval.maps[&MapKind::Iridescence].data.clone(), ran_noise)
+    };
+    let (skipped, ran_skipped) = map("0");
+    let (tiny, ran_tiny) = map("1e-30");
+    assert!(!ran_skipped && ran_tiny);
+    let worst = skipped.iter().zip(&tiny).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    assert!(worst < 1e-20, "skipping the zero noise changed the map by {worst}");
+}

@@ -330,19 +330,24 @@ fn build_iridescence(g: &mut GraphBuilder, preset: &Preset, s: &Shared, cols: u3
     // Blend with the scale shape so the film thins into the crevices (thesis §4.2.5).
     let shaped =
         g.add("iridescence.shaped", Op::Blend { mode: BlendMode::Multiply, opacity: 0.5 }, &[gradient, s.scale_height]);
-    let noise = g.add(
-        "iridescence.noise",
-        Op::Noise(FractalNoise {
-            kind: NoiseKind::Perlin,
-            cells_u: (cols / 2).max(1),
-            cells_v: s.along_count((cols / 2).max(1)),
-            octaves: 4,
-            gain: 0.55,
-            seed: derive_seed(preset.seed, "iridescence"),
-        }),
-        &[],
-    );
-    let mixed =
-        g.add("iridescence.mixed", Op::Blend { mode: BlendMode::Mix, opacity: p.noise as f32 }, &[shaped, noise]);
+    // Without noise the blend would give its base back exactly (b + (l − b) · 0 = b), so
+    // neither the noise nor the blend is built.
+    let mixed = if p.noise == 0.0 {
+        shaped
+    } else {
+        let noise = g.add(
+            "iridescence.noise",
+            Op::Noise(FractalNoise {
+                kind: NoiseKind::Perlin,
+                cells_u: (cols / 2).max(1),
+                cells_v: s.along_count((cols / 2).max(1)),
+                octaves: 4,
+                gain: 0.55,
+                seed: derive_seed(preset.seed, "iridescence"),
+            }),
+            &[],
+        );
+        g.add("iridescence.mixed", Op::Blend { mode: BlendMode::Mix, opacity: p.noise as f32 }, &[shaped, noise])
+    };
     g.add("iridescence.out", Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 0.0, out_high: 1.0 }, &[mixed])
 }
