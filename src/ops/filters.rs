@@ -122,12 +122,15 @@ pub fn blur(input: &Image, sigma: f32, wraps_v: bool) -> Image {
     if sigma_px <= 2.0 {
         return gaussian_blur(input, sigma_px, wraps_v);
     }
-    let mut image = input.clone();
-    for width in box_widths(sigma_px) {
-        image = box_pass_horizontal(&image, width / 2);
-        image = box_pass_vertical(&image, width / 2, wraps_v);
+    // Two buffers, ping-ponged through the six passes: each pass overwrites every value of
+    // its output, so no pass needs a fresh (page-faulting) image.
+    let (w, h, ch) = (input.width, input.height, input.channels);
+    let (mut across, mut out) = (Image::new(w, h, ch), Image::new(w, h, ch));
+    for (pass, width) in box_widths(sigma_px).into_iter().enumerate() {
+        box_pass_horizontal(if pass == 0 { input } else { &out }, width / 2, &mut across);
+        box_pass_vertical(&across, width / 2, wraps_v, &mut out);
     }
-    image
+    out
 }
 
 /// Odd box widths whose three-fold convolution has variance sigma² (Kovesi 2010, eq. 4-5).
@@ -144,71 +147,83 @@ fn box_widths(sigma: f32) -> [usize; 3] {
     [0, 1, 2].map(|i| if i < m { lower.max(1) as usize } else { (lower + 2).max(1) as usize })
 }
 
-/// Mean over x − r ..= x + r along rows, wrap-around, by a running sum (f64 accumulators
-/// so long rows do not drift).
-fn box_pass_horizontal(input: &Image, r: usize) -> Image {
+/// Mean over x − r ..= x + r along rows into `out` (same size), wrap-around, by a running
+/// sum (f64 accumulators so long rows do not drift).
+fn box_pass_horizontal(input: &Image, r: usize, out: &mut Image) {
     let (w, ch) = (input.width, input.channels);
-    let mut out = Image::new(w, input.height, ch);
     let norm = 1.0 / (2 * r + 1) as f64;
-    out.data.par_chunks_mut(w * ch).enumerate().for_each(|(y, row)| {
-        let src = input.row(y);
-        // The row's channel padded with its own wrap-around: no modulo in the sweep.
-        let mut padded = vec![0.0f64; w + 2 * r + 1];
-        for c in 0..ch {
-            for (i, p) in padded.iter_mut().enumerate() {
-                *p = src[(i as isize - r as isize).rem_euclid(w as isize) as usize * ch + c] as f64;
+    out.data.par_chunks_mut(w * ch).enumerate().for_each_init(
+        || vec![0.0f64; w + 2 * r + 1],
+        |padded, (y, row)| {
+            let src = input.row(y);
+            // The row's channel padded with its own wrap-around: no modulo in the sweep.
+            for c in 0..ch {
+                for (i, p) in padded.iter_mut().enumerate() {
+                    *p = src[(i as isize - r as isize).rem_euclid(w as isize) as usize * ch + c] as f64;
+                }
+                let mut sum: f64 = padded[..2 * r + 1].iter().sum();
+                for x in 0..w {
+                    row[x * ch + c] = (sum * norm) as f32;
+                    sum += padded[x + 2 * r + 1] - padded[x];
+                }
             }
-            let mut sum: f64 = padded[..2 * r + 1].iter().sum();
-            for x in 0..w {
-                row[x * ch + c] = (sum * norm) as f32;
-                sum += padded[x + 2 * r + 1] - padded[x];
-            }
-        }
-    });
-    out
+        },
+    );
 }
 
-/// Mean over y − r ..= y + r along columns, wrap-around; blocks of columns run in parallel,
-/// each sweeping down the image with a row of running sums.
-fn box_pass_vertical(input: &Image, r: usize, wraps_v: bool) -> Image {
+/// Mean over y − r ..= y + r along columns into `out` (same size), wrap-around. Blocks of
+/// columns sweep down the image in parallel, each with a row of running sums; every band of
+/// rows, the blocks' results are copied into the output's rows (the sweep must run top to
+/// bottom for the sums to be the same at any thread count, and the bands keep the copies
+/// in cache).
+fn box_pass_vertical(input: &Image, r: usize, wraps_v: bool, out: &mut Image) {
     const BLOCK: usize = 256;
-    let (w, h, ch) = (input.width, input.height, input.channels);
-    let stride = w * ch;
+    const BAND: usize = 64;
+    struct Block {
+        start: usize,
+        sum: Vec<f64>,
+        /// The block's values for the current band of rows, row-major.
+        tile: Vec<f32>,
+    }
+    let (h, stride) = (input.height, input.width * input.channels);
     let norm = 1.0 / (2 * r + 1) as f64;
-    let blocks: Vec<(usize, Vec<f32>)> = (0..stride)
+    let row_at = |y: isize, start: usize, len: usize| &input.data[edge_row(y, h, wraps_v) * stride + start..][..len];
+    let mut blocks: Vec<Block> = (0..stride)
         .step_by(BLOCK)
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .map(|start| {
-            let len = BLOCK.min(stride - start);
-            let row_at = |y: isize| &input.data[edge_row(y, h, wraps_v) * stride + start..][..len];
-            let mut sum = vec![0.0f64; len];
-            for y in -(r as isize)..=r as isize {
-                for (s, v) in sum.iter_mut().zip(row_at(y)) {
-                    *s += *v as f64;
-                }
+        .map(|start| Block { start, sum: vec![0.0; BLOCK.min(stride - start)], tile: Vec::new() })
+        .collect();
+    blocks.par_iter_mut().for_each(|b| {
+        let len = b.sum.len();
+        for y in -(r as isize)..=r as isize {
+            for (s, v) in b.sum.iter_mut().zip(row_at(y, b.start, len)) {
+                *s += *v as f64;
             }
-            let mut block = vec![0.0f32; len * h];
-            for y in 0..h {
-                for (o, s) in block[y * len..(y + 1) * len].iter_mut().zip(&sum) {
+        }
+        b.tile = vec![0.0; len * BAND];
+    });
+    for band in (0..h).step_by(BAND) {
+        let rows = BAND.min(h - band);
+        blocks.par_iter_mut().for_each(|b| {
+            let len = b.sum.len();
+            for i in 0..rows {
+                let y = band + i;
+                for (o, s) in b.tile[i * len..(i + 1) * len].iter_mut().zip(&b.sum) {
                     *o = (*s * norm) as f32;
                 }
-                let (add, sub) = (row_at(y as isize + r as isize + 1), row_at(y as isize - r as isize));
-                for ((s, a), b) in sum.iter_mut().zip(add).zip(sub) {
-                    *s += *a as f64 - *b as f64;
+                let (add, sub) =
+                    (row_at(y as isize + r as isize + 1, b.start, len), row_at(y as isize - r as isize, b.start, len));
+                for ((s, a), d) in b.sum.iter_mut().zip(add).zip(sub) {
+                    *s += *a as f64 - *d as f64;
                 }
             }
-            (start, block)
-        })
-        .collect();
-    let mut out = Image::new(w, h, ch);
-    for (start, block) in blocks {
-        let len = block.len() / h;
-        for y in 0..h {
-            out.data[y * stride + start..][..len].copy_from_slice(&block[y * len..(y + 1) * len]);
-        }
+        });
+        out.data[band * stride..(band + rows) * stride].par_chunks_mut(stride).enumerate().for_each(|(i, row)| {
+            for b in &blocks {
+                let len = b.sum.len();
+                row[b.start..b.start + len].copy_from_slice(&b.tile[i * len..(i + 1) * len]);
+            }
+        });
     }
-    out
 }
 
 fn gaussian_blur(input: &Image, sigma_px: f32, wraps_v: bool) -> Image {

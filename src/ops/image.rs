@@ -38,7 +38,7 @@ impl Frame {
     }
 }
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct Image {
     pub width: usize,
     pub height: usize,
@@ -46,9 +46,23 @@ pub struct Image {
     pub data: Vec<f32>,
 }
 
+/// Buffers go back to the pool (`super::pool`) rather than to the allocator.
+impl Drop for Image {
+    fn drop(&mut self) {
+        super::pool::give(std::mem::take(&mut self.data));
+    }
+}
+
+impl Clone for Image {
+    fn clone(&self) -> Self {
+        let data = super::pool::take_copy(&self.data);
+        Image { width: self.width, height: self.height, channels: self.channels, data }
+    }
+}
+
 impl Image {
     pub fn new(width: usize, height: usize, channels: usize) -> Self {
-        Image { width, height, channels, data: vec![0.0; width * height * channels] }
+        Image { width, height, channels, data: super::pool::take_zeroed(width * height * channels) }
     }
 
     /// Fills a new image row by row in parallel; `pixel(u, v, out)` receives the pixel centre

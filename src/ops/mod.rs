@@ -8,6 +8,7 @@ pub mod hash;
 pub mod image;
 pub mod noise;
 pub mod occlusion;
+pub mod pool;
 pub mod scale_colour;
 pub mod scales;
 pub mod shapes;

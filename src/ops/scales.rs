@@ -21,6 +21,8 @@
 
 use super::body::{BodyPlan, HEAD_TOP_HALF_U, Plate};
 use super::hash;
+use rayon::prelude::*;
+
 use super::image::{Image, floor_i32};
 
 /// Channel layout of the scale field.
@@ -443,26 +445,76 @@ impl ScaleField {
             Some(b) if b.head_shields => b.shields(),
             _ => Vec::new(),
         };
-        Image::from_fn_in(frame, self.outputs.len(), |u, v, out| {
-            let mut all = [0.0f32; channel::COUNT];
-            let dist_belly = u.min(1.0 - u);
-            // The body's plate coordinate, only where the belly band is (None on the head).
-            let plate = || self.body.as_ref().map(|b| (b, b.plate_coordinate(v).map(|(y, _, _)| y)));
-            if !shields.is_empty() && self.shield_pixel(&lattice, &shields, u, v, &mut all) {
-                // A head shield.
-            } else if dist_belly < belly_half && self.body.is_none() {
-                self.ventral_pixel(&lattice, dist_belly, v, &mut all);
-            } else if let Some((body, Some(y))) = (dist_belly < belly_half).then(plate).flatten() {
-                self.body_plate_pixel(&lattice, body, y, dist_belly, u, &mut all);
-            } else if self.shape == ScaleShape::Hexagon {
-                self.hexagon_pixel(&lattice, &table, u, v, &mut all);
-            } else {
-                self.imbricate_pixel(&lattice, &table, &geo, u, v, &mut all);
+        let imbricate = matches!(self.shape, ScaleShape::Leaf | ScaleShape::Diamond);
+        // Lattice x of every pixel column (`Lattice::x_of` is a binary search over the
+        // column edges when rows differ in width).
+        let inv_w = 1.0 / frame.width as f32;
+        let columns: Vec<(f32, f32)> = (0..frame.width)
+            .map(|i| {
+                let u = (i as f32 + 0.5) * inv_w;
+                (u, lattice.x_of(u))
+            })
+            .collect();
+        let channels = self.outputs.len();
+        let mut image = Image::new(frame.width, frame.height, channels);
+        image.data.par_chunks_mut(frame.width * channels).enumerate().for_each(|(row_index, row)| {
+            let v = frame.v(row_index);
+            let y = v * lattice.rows_v as f32 - ROW_PHASE;
+            let candidates = if imbricate { self.row_candidates(&lattice, &table, &geo, y) } else { Vec::new() };
+            for (&(u, x), out) in columns.iter().zip(row.chunks_exact_mut(channels)) {
+                let mut all = [0.0f32; channel::COUNT];
+                let dist_belly = u.min(1.0 - u);
+                // The body's plate coordinate, only where the belly band is (None on the head).
+                let plate = || self.body.as_ref().map(|b| (b, b.plate_coordinate(v).map(|(y, _, _)| y)));
+                if !shields.is_empty() && self.shield_pixel(&lattice, &shields, u, v, &mut all) {
+                    // A head shield.
+                } else if dist_belly < belly_half && self.body.is_none() {
+                    self.ventral_pixel(&lattice, dist_belly, v, &mut all);
+                } else if let Some((body, Some(y))) = (dist_belly < belly_half).then(plate).flatten() {
+                    self.body_plate_pixel(&lattice, body, y, dist_belly, u, &mut all);
+                } else if self.shape == ScaleShape::Hexagon {
+                    self.hexagon_pixel(&lattice, &table, u, v, &mut all);
+                } else {
+                    self.imbricate_pixel(&lattice, &geo, &candidates, x, &mut all);
+                }
+                for (o, c) in out.iter_mut().zip(&self.outputs) {
+                    *o = all[*c];
+                }
             }
-            for (o, c) in out.iter_mut().zip(&self.outputs) {
-                *o = all[*c];
+        });
+        image
+    }
+
+    /// The candidate scales of one row of pixels (lattice row coordinate `y`): for every
+    /// column from −1 to `cols` (a pixel's column and its neighbours), the three cells
+    /// around `y`, in the order `imbricate_pixel` visits them. What depends only on the row
+    /// is computed here once instead of at every pixel, and each candidate gets the range of
+    /// lattice x outside which its bounding box cannot hold the pixel (most of the nine are
+    /// then rejected by two comparisons).
+    fn row_candidates(&self, lattice: &Lattice, table: &CellTable, geo: &Geometry, y: f32) -> Vec<RowCandidate> {
+        let mut candidates = Vec::with_capacity(3 * (lattice.cols as usize + 2));
+        for c in -1..=lattice.cols {
+            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
+            let r0 = floor_i32(y - shift);
+            for dr in -1..=1 {
+                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
+                let py = (y - cy) * lattice.aspect;
+                let (x_min, x_max) = box_x_range(geo, cell, py);
+                candidates.push(RowCandidate {
+                    cx,
+                    cy,
+                    py,
+                    cos: cell.cos,
+                    sin: cell.sin,
+                    inv_size: cell.inv_size,
+                    random: cell.random,
+                    column: c,
+                    x_min: cx as f64 + x_min,
+                    x_max: cx as f64 + x_max,
+                });
             }
-        })
+        }
+        candidates
     }
 
     /// Lattice position of the jittered centre of cell (c, r), c unwrapped by at most one
@@ -491,7 +543,8 @@ impl ScaleField {
         (c as f32 + 0.5 + cell.dx, r as f32 + 0.5 + shift + cell.dy, cell)
     }
 
-    fn imbricate_pixel(&self, lattice: &Lattice, table: &CellTable, geo: &Geometry, u: f32, v: f32, out: &mut [f32]) {
+    /// `x`: the pixel's lattice x; `candidates`: its row's (`row_candidates`).
+    fn imbricate_pixel(&self, lattice: &Lattice, geo: &Geometry, candidates: &[RowCandidate], x: f32, out: &mut [f32]) {
         // Roof tiles: of the scales covering a pixel, the most anterior (smallest centre v)
         // lies on top, its free posterior edge over the scale behind. Its rim falls towards
         // the scale underneath, which leaves a groove along every free edge: the visible
@@ -502,41 +555,37 @@ impl ScaleField {
             let dome = smoothstep(0.0, 0.35, inside);
             0.45 + 0.15 * dome + 0.3 * self.imbrication * along
         };
-        let x = lattice.x_of(u);
-        let y = v * lattice.rows_v as f32 - ROW_PHASE;
         let c0 = floor_i32(x);
-        // The nine neighbouring cells are visited in explicit loops, as in `hexagon_pixel`:
-        // a shared helper returning them as an array measured 3x slower at 2048².
+        // The nine neighbouring cells, columns c0 − 1 ..= c0 + 1 (entries from column −1).
+        let first = (3 * c0).clamp(0, candidates.len() as i32 - 9) as usize;
+        let (x_f64, mut top): (f64, Option<(f32, f32, f32, f32, f32, f32, i32)>) = (x as f64, None);
         // (inside, lx, ly, random, cx, cy, column) of the top scale so far.
-        let mut top: Option<(f32, f32, f32, f32, f32, f32, i32)> = None;
         let mut under_height = 0.0f32;
-        for dc in -1..=1 {
-            let c = c0 + dc;
-            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
-            let r0 = floor_i32(y - shift);
-            for dr in -1..=1 {
-                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
-                // To isotropic units (cell widths), rotate by the jitter angle, scale by size.
-                let px = x - cx;
-                let py = (y - cy) * lattice.aspect;
-                let lx = (px * cell.cos + py * cell.sin) * cell.inv_size;
-                let ly = (-px * cell.sin + py * cell.cos) * cell.inv_size;
-                // Every shape lies inside its |x| < half-width, |y| < b box: skip the rest.
-                if lx.abs() >= geo.half_width || ly.abs() >= geo.b {
-                    continue;
-                }
-                let inside = geo.inside(lx, ly) / cell.inv_size;
-                if inside <= 0.0 {
-                    continue;
-                }
-                match top {
-                    Some(t) if cy >= t.5 => under_height = under_height.max(profile(inside, ly)),
-                    _ => {
-                        if let Some(t) = top {
-                            under_height = under_height.max(profile(t.0, t.2));
-                        }
-                        top = Some((inside, lx, ly, cell.random, cx, cy, c));
+        for cand in &candidates[first..first + 9] {
+            if x_f64 < cand.x_min || x_f64 > cand.x_max {
+                continue;
+            }
+            let (cx, cy) = (cand.cx, cand.cy);
+            // To isotropic units (cell widths), rotate by the jitter angle, scale by size.
+            let px = x - cx;
+            let py = cand.py;
+            let lx = (px * cand.cos + py * cand.sin) * cand.inv_size;
+            let ly = (-px * cand.sin + py * cand.cos) * cand.inv_size;
+            // Every shape lies inside its |x| < half-width, |y| < b box: skip the rest.
+            if lx.abs() >= geo.half_width || ly.abs() >= geo.b {
+                continue;
+            }
+            let inside = geo.inside(lx, ly) / cand.inv_size;
+            if inside <= 0.0 {
+                continue;
+            }
+            match top {
+                Some(t) if cy >= t.5 => under_height = under_height.max(profile(inside, ly)),
+                _ => {
+                    if let Some(t) = top {
+                        under_height = under_height.max(profile(t.0, t.2));
                     }
+                    top = Some((inside, lx, ly, cand.random, cx, cy, cand.column));
                 }
             }
         }
@@ -795,4 +844,48 @@ struct PlateRows<'a> {
     centre_v: &'a dyn Fn(i32) -> f32,
     /// Plate r's identity for its random number.
     identity: &'a dyn Fn(i32) -> i32,
+}
+
+/// One candidate scale of a row of pixels (`ScaleField::row_candidates`).
+struct RowCandidate {
+    /// The cell's jittered centre in lattice units.
+    cx: f32,
+    cy: f32,
+    /// The row's offset from the centre along the body, isotropic units: (y − cy) × aspect.
+    py: f32,
+    cos: f32,
+    sin: f32,
+    inv_size: f32,
+    random: f32,
+    column: i32,
+    /// Lattice x outside which the scale's bounding box misses the row (conservative).
+    x_min: f64,
+    x_max: f64,
+}
+
+/// The range of px = x − cx (lattice units) where a cell's rotated bounding box,
+/// |lx| < half-width and |ly| < b with lx = (px cos + py sin) / size and
+/// ly = (−px sin + py cos) / size, can hold a pixel at row offset `py`. The box is widened
+/// by 1e-4 cell widths and the range by 1e-4 more: f32 rounding moves the per-pixel test by
+/// under 1e-5, so culling by this range never rejects a pixel the exact test would accept.
+/// Empty (min > max) where the box misses the row.
+fn box_x_range(geo: &Geometry, cell: &CellJitter, py: f32) -> (f64, f64) {
+    const MARGIN: f64 = 1e-4;
+    let (cos, sin, size) = (cell.cos as f64, cell.sin as f64, 1.0 / cell.inv_size as f64);
+    let py = py as f64;
+    let (hw, b) = ((geo.half_width as f64 + MARGIN) * size, (geo.b as f64 + MARGIN) * size);
+    if cos <= 0.0 {
+        return (f64::NEG_INFINITY, f64::INFINITY);
+    }
+    // |px cos + py sin| < hw.
+    let (mut lo, mut hi) = ((-hw - py * sin) / cos, (hw - py * sin) / cos);
+    // |−px sin + py cos| < b.
+    if sin.abs() > 1e-9 {
+        let (a, z) = ((py * cos - b) / sin, (py * cos + b) / sin);
+        lo = lo.max(a.min(z));
+        hi = hi.min(a.max(z));
+    } else if (py * cos).abs() >= b {
+        return (1.0, -1.0);
+    }
+    (lo - MARGIN, hi + MARGIN)
 }
