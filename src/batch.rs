@@ -355,6 +355,11 @@ pub fn run(
         if !done {
             Plan::new(&request(job, out, &outcome))?.run(&|_, _| {})?;
             outcome.status = "done";
+        } else {
+            // A run killed after committing this set but before removing its lock file left
+            // an empty `.NAME.lock` behind: taking the lock and letting it go removes it (and
+            // leaves the set alone; a set some other run holds is left as it is).
+            let _ = crate::export::SetLock::acquire(&out.join(&outcome.folder), &outcome.preset);
         }
         progress(k + 1, mine.len(), &outcome);
         outcomes.push(outcome);

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use crate::export::pack::{Pack, TextureEncoder, TextureSpec, texture_file_name};
-use crate::export::{self, MapEntry, Quantized, SetLock, sha256_hex};
+use crate::export::{self, MapEntry, SetLock, sha256_hex};
 use crate::graph::{EvalStats, Graph, evaluate_into, evaluate_rows};
 use crate::maps::{BuildOptions, build_graph, has_film};
 use crate::material::{FileFormat, MapKind};
@@ -48,7 +48,8 @@ pub struct GenerateReport {
     pub total_time: Duration,
     /// True when the output folder did not exist and was created.
     pub created_folder: bool,
-    /// A body atlas's strips: (strips, rows per strip, margin rows each side).
+    /// The strips of a body atlas or of a tile too large to evaluate whole: (strips, rows
+    /// per strip, margin rows each side).
     pub strips: Option<(usize, usize, usize)>,
 }
 
@@ -187,22 +188,42 @@ impl Plan {
                 })
                 .collect::<Result<Vec<_>, export::ExportError>>()?;
             (finished.iter().map(|(m, _)| *m).collect(), files, stats, encode_start.elapsed())
+        } else if let Some(layout) = strip_layout.filter(|_| height == size) {
+            // A tile too large to evaluate whole: strip by strip, each map's rows quantised
+            // into the whole map's samples as they come, each map compressed as it completes
+            // (the same PNG bytes as a tile evaluated whole).
+            tile_strips(&graph, &request.maps, &loaded.name, size, layout, progress)?
         } else if let Some(layout) = strip_layout {
             // A body atlas: strip by strip, each encoded as it is done (memory bounded by a
             // strip, not the body's length).
             strips(&graph, &request.maps, &loaded.name, size, height, layout, progress)?
         } else {
             // Each map is quantised to its file format the moment it is finished, freeing its
-            // f32 buffer; PNG compression then runs for all maps in parallel.
-            let mut quantized: Vec<Quantized> = Vec::new();
-            let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
-                quantized.push(export::quantize(map, &image));
+            // f32 buffer, and compressed on a thread of its own while the graph goes on: the
+            // quantised samples are freed as soon as their PNG is done (at 4096² they were
+            // 200 MB held to the end), and compression fills the moments the graph leaves a
+            // core idle.
+            let name = loaded.name.as_str();
+            let (stats, mut encoded) = std::thread::scope(|scope| {
+                let mut encoders = Vec::new();
+                let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
+                    let quantized = export::quantize(map, &image);
+                    drop(image);
+                    encoders.push(scope.spawn(move || {
+                        let t = Instant::now();
+                        let png = export::encode_quantized(&quantized);
+                        (map, png.map(|bytes| (export::map_file_name(name, map), bytes)), t.elapsed())
+                    }));
+                });
+                let encoded: Vec<_> =
+                    encoders.into_iter().map(|h| h.join().expect("a PNG encoder thread panicked")).collect();
+                (stats, encoded)
             });
-            quantized.sort_by_key(|q| q.map);
-            let kinds: Vec<MapKind> = quantized.iter().map(|q| q.map).collect();
-            let encode_start = Instant::now();
-            let files = export::encode_all(&loaded.name, &quantized)?;
-            (kinds, files, stats, encode_start.elapsed())
+            encoded.sort_by_key(|(map, _, _)| *map);
+            let encode_time = encoded.iter().map(|(_, _, t)| *t).sum();
+            let kinds: Vec<MapKind> = encoded.iter().map(|(map, _, _)| *map).collect();
+            let files = encoded.into_iter().map(|(_, file, _)| file).collect::<Result<Vec<_>, _>>()?;
+            (kinds, files, stats, encode_time)
         };
         let encode_start = Instant::now();
         let convention = request.options.normal_convention;
@@ -310,26 +331,78 @@ fn for_each_band(
     progress: &(dyn Fn(usize, usize) + Sync),
     sink: &mut BandSink,
 ) -> Result<EvalStats, Error> {
-    let Strips { count, rows: step, margin } = strips.unwrap_or(Strips { count: 1, rows: height, margin: 0 });
+    let frames = strip_frames(width, height, strips);
     let mut stats = EvalStats::default();
-    for k in 0..count {
-        let (start, end) = (k * step, ((k + 1) * step).min(height));
-        let row0 = start.saturating_sub(margin);
-        let frame = Frame {
-            width,
-            height: (end + margin).min(height) - row0,
-            full_height: height,
-            row0,
-            wraps_v: strips.is_none(),
-        };
-        let nodes = &|done: usize, total: usize| progress(k * total + done, count * total);
+    for (k, (frame, kept)) in frames.iter().enumerate() {
+        let nodes = &|done: usize, total: usize| progress(k * total + done, frames.len() * total);
         let mut band: Vec<(MapKind, crate::ops::Image)> = Vec::new();
-        let strip_stats = evaluate_rows(graph, maps, frame, nodes, &mut |map, image| band.push((map, image)));
+        let strip_stats = evaluate_rows(graph, maps, *frame, nodes, &mut |map, image| band.push((map, image)));
         stats.merge(strip_stats);
         band.sort_by_key(|(m, _)| *m);
-        sink(&band, start - row0..end - row0)?;
+        sink(&band, kept.clone())?;
     }
     Ok(stats)
+}
+
+/// Like `for_each_band`, but hands each map of a strip to `sink` the moment it is finished
+/// (with the rows of it that belong to the texture), so a strip's finished maps are not
+/// held as f32 until its last one is done: at 4096² that was 335 MB of a 2048-row strip's
+/// five maps.
+fn for_each_strip_map(
+    graph: &Graph,
+    maps: &[MapKind],
+    width: usize,
+    height: usize,
+    strips: Option<Strips>,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    sink: &mut dyn FnMut(MapKind, crate::ops::Image, std::ops::Range<usize>) -> Result<(), Error>,
+) -> Result<EvalStats, Error> {
+    let frames = strip_frames(width, height, strips);
+    let mut stats = EvalStats::default();
+    for (k, (frame, kept)) in frames.iter().enumerate() {
+        let nodes = &|done: usize, total: usize| progress(k * total + done, frames.len() * total);
+        let mut failed = None;
+        let strip_stats = evaluate_rows(graph, maps, *frame, nodes, &mut |map, image| {
+            if failed.is_none() {
+                failed = sink(map, image, kept.clone()).err();
+            }
+        });
+        if let Some(error) = failed {
+            return Err(error);
+        }
+        stats.merge(strip_stats);
+    }
+    Ok(stats)
+}
+
+/// The frame of each strip (its rows plus its margins) and the rows of it that belong to the
+/// texture. The tile repeats along v, so its strips' margins run round the seam (the first
+/// strip's margin above is the texture's last rows); a body atlas's stop at its ends.
+fn strip_frames(width: usize, height: usize, strips: Option<Strips>) -> Vec<(Frame, std::ops::Range<usize>)> {
+    let Some(Strips { count, rows: step, margin }) = strips else {
+        return vec![(Frame::whole(width, height), 0..height)];
+    };
+    let wraps = height == width;
+    (0..count)
+        .map(|k| {
+            let (start, end) = (k * step, ((k + 1) * step).min(height));
+            if wraps {
+                let row0 = (start + height - margin) % height;
+                let frame = Frame { width, height: end - start + 2 * margin, full_height: height, row0, wraps_v: true };
+                (frame, margin..margin + end - start)
+            } else {
+                let row0 = start.saturating_sub(margin);
+                let frame = Frame {
+                    width,
+                    height: (end + margin).min(height) - row0,
+                    full_height: height,
+                    row0,
+                    wraps_v: false,
+                };
+                (frame, start - row0..end - row0)
+            }
+        })
+        .collect()
 }
 
 /// Rows of texture per strip of a long texture, as a multiple of its width: two widths hold
@@ -346,10 +419,51 @@ struct Strips {
     margin: usize,
 }
 
-/// The strips of a `width` × `height` texture, or None for a square (evaluated whole).
+/// The node buffers a square tile may hold at once and still be evaluated whole: the speed
+/// issue's memory target (peak resident ≤ 1 GiB at 4096² for every species) less what else
+/// is resident then (the quantised maps waiting for their encoders, the program). At 2048²
+/// every built-in species fits whole, so the common sizes pay no margins. Measured at 4096²:
+/// Erythrolamprus' 768 MiB of buffers peaked at 847 MB resident.
+pub const TILE_BUFFER_BUDGET_BYTES: u64 = 800 << 20;
+
+/// The node buffers of one strip of a tile too large to evaluate whole: less than the whole
+/// tile's budget, because a strip's set also holds every map of the whole tile quantised
+/// until its last strip is in (168 MB at 4096²) and the buffer pool (`ops::pool`). Measured
+/// at 4096²: Bitis gabonica's 537 MiB strips peaked at 770 MB resident.
+pub const STRIP_BUFFER_BUDGET_BYTES: u64 = 560 << 20;
+
+/// The strips of a `width` × `height` texture, or None to evaluate it whole. A long texture
+/// (the body atlas) is cut every `STRIP_WIDTHS` widths. A square tile is whole unless its
+/// buffers would exceed `TILE_BUFFER_BUDGET_BYTES`; then it is cut into the fewest of 2, 4,
+/// 8 or 16 strips whose buffers, margins included, fit `STRIP_BUFFER_BUDGET_BYTES` (the
+/// margins are recomputed rows, so fewer strips cost less time), or the most of them if none
+/// fits. `SNAKESKIN_TILE_BUDGET_MIB` replaces both budgets (how the tests send small tiles
+/// through strips).
 fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Option<Strips> {
-    let rows = STRIP_WIDTHS * width;
-    (height > width).then(|| Strips { count: height.div_ceil(rows), rows, margin: graph.row_reach(maps, width) })
+    let margin = graph.row_reach(maps, width);
+    if height > width {
+        let rows = STRIP_WIDTHS * width;
+        return Some(Strips { count: height.div_ceil(rows), rows, margin });
+    }
+    let set_budget = std::env::var("SNAKESKIN_TILE_BUDGET_MIB").ok().and_then(|v| v.trim().parse::<u64>().ok());
+    let buffers = |rows: usize| crate::graph::estimate_peak_bytes(graph, maps, width, rows);
+    if buffers(height) <= set_budget.map_or(TILE_BUFFER_BUDGET_BYTES, |mib| mib << 20) {
+        return None;
+    }
+    let fits = |rows: usize| buffers(rows) <= set_budget.map_or(STRIP_BUFFER_BUDGET_BYTES, |mib| mib << 20);
+    let mut best = None;
+    for count in [2, 4, 8, 16] {
+        let rows = height.div_ceil(count);
+        // A strip with its margins must stay shorter than the texture.
+        if rows + 2 * margin >= height {
+            break;
+        }
+        best = Some(Strips { count, rows, margin });
+        if fits(rows + 2 * margin) {
+            break;
+        }
+    }
+    best
 }
 
 /// (maps, their files' names and bytes, merged stats, encode time) of a long texture
@@ -370,17 +484,45 @@ fn strips(
     let mut kinds: Vec<MapKind> = maps.iter().copied().filter(|m| graph.output(*m).is_some()).collect();
     kinds.sort();
     kinds.dedup();
-    let mut encoders =
-        kinds.iter().map(|m| export::RowEncoder::new(*m, width, height)).collect::<Result<Vec<_>, _>>()?;
+    let encoders = kinds.iter().map(|m| export::RowEncoder::new(*m, width, height)).collect::<Result<Vec<_>, _>>()?;
     let mut encode_time = Duration::ZERO;
-    let stats = for_each_band(graph, maps, width, height, Some(layout), progress, &mut |band, rows| {
-        let t = Instant::now();
-        encoders
-            .par_iter_mut()
-            .zip(band)
-            .try_for_each(|(encoder, (_, image))| encoder.write_rows(image, rows.clone()))?;
-        encode_time += t.elapsed();
-        Ok(())
+    // Each map's rows are quantised the moment the map is finished in a strip (its f32
+    // buffer then freed) and compressed by the map's own thread, in order, while the graph
+    // goes on.
+    let (stats, encoders) = std::thread::scope(|scope| {
+        let mut senders = Vec::new();
+        let mut threads = Vec::new();
+        for mut encoder in encoders {
+            let (send, receive) = std::sync::mpsc::channel::<Vec<u8>>();
+            senders.push((encoder.map, send));
+            threads.push(scope.spawn(move || {
+                let mut time = Duration::ZERO;
+                for samples in receive {
+                    let t = Instant::now();
+                    encoder.write_samples(&samples)?;
+                    time += t.elapsed();
+                }
+                Ok::<_, export::ExportError>((encoder, time))
+            }));
+        }
+        let stats = for_each_strip_map(graph, maps, width, height, Some(layout), progress, &mut |map, image, rows| {
+            let t = Instant::now();
+            let samples = export::RowEncoder::samples(map, &image, rows);
+            drop(image);
+            encode_time += t.elapsed();
+            let (_, send) = senders.iter().find(|(m, _)| *m == map).expect("an encoder per map");
+            // A closed channel means the encoder failed: its error comes from the join below.
+            let _ = send.send(samples);
+            Ok(())
+        });
+        drop(senders);
+        let mut encoders = Vec::new();
+        for thread in threads {
+            let (encoder, time) = thread.join().expect("a PNG encoder thread panicked")?;
+            encode_time += time;
+            encoders.push(encoder);
+        }
+        stats.map(|s| (s, encoders))
     })?;
     let t = Instant::now();
     let files = encoders
@@ -388,6 +530,72 @@ fn strips(
         .map(|e| Ok((export::map_file_name(name, e.map), e.finish()?)))
         .collect::<Result<Vec<_>, export::ExportError>>()?;
     Ok((kinds, files, stats, encode_time + t.elapsed()))
+}
+
+/// `strips` for a square tile: (maps, their files' names and bytes, merged stats, encode
+/// time). Each map's rows go into its quantised samples as the strips finish it (an f32
+/// strip is freed at once; the quantised tile is a quarter to an eighth of its f32 size)
+/// and each map is compressed on its own thread as soon as its last strip is in, by the
+/// encoder of a tile evaluated whole, so the files are byte for byte the same.
+#[allow(clippy::type_complexity)]
+fn tile_strips(
+    graph: &Graph,
+    maps: &[MapKind],
+    name: &str,
+    size: usize,
+    layout: Strips,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(Vec<MapKind>, Vec<(String, Vec<u8>)>, EvalStats, Duration), Error> {
+    let mut kinds: Vec<MapKind> = maps.iter().copied().filter(|m| graph.output(*m).is_some()).collect();
+    kinds.sort();
+    kinds.dedup();
+    let mut tiles: Vec<export::Quantized> = Vec::new();
+    let mut rows_in = vec![0usize; kinds.len()];
+    let mut quantise_time = Duration::ZERO;
+    let (stats, mut encoded) = std::thread::scope(|scope| {
+        let mut encoders = Vec::new();
+        let stats = for_each_strip_map(graph, maps, size, size, Some(layout), progress, &mut |map, image, rows| {
+            let t = Instant::now();
+            let stride = image.width * image.channels;
+            let band = crate::ops::Image {
+                width: image.width,
+                height: rows.len(),
+                channels: image.channels,
+                data: image.data[rows.start * stride..rows.end * stride].to_vec(),
+            };
+            drop(image);
+            let quantized = export::quantize(map, &band);
+            let index = kinds.iter().position(|k| *k == map).expect("a requested map");
+            match tiles.iter_mut().find(|q| q.map == map) {
+                Some(tile) => tile.samples.extend_from_slice(&quantized.samples),
+                None => {
+                    let mut tile = export::Quantized { height: size, ..quantized };
+                    tile.samples.reserve_exact(tile.samples.len() / rows.len() * (size - rows.len()));
+                    tiles.push(tile);
+                }
+            }
+            rows_in[index] += rows.len();
+            if rows_in[index] == size {
+                let position = tiles.iter().position(|q| q.map == map).expect("just filled");
+                let tile = tiles.swap_remove(position);
+                encoders.push(scope.spawn(move || {
+                    let t = Instant::now();
+                    let png = export::encode_quantized(&tile);
+                    (map, png.map(|bytes| (export::map_file_name(name, map), bytes)), t.elapsed())
+                }));
+            }
+            quantise_time += t.elapsed();
+            Ok(())
+        });
+        let encoded: Vec<_> = encoders.into_iter().map(|h| h.join().expect("a PNG encoder thread panicked")).collect();
+        (stats, encoded)
+    });
+    let stats = stats?;
+    encoded.sort_by_key(|(map, _, _)| *map);
+    let encode_time = quantise_time + encoded.iter().map(|(_, _, t)| *t).sum::<Duration>();
+    let kinds: Vec<MapKind> = encoded.iter().map(|(map, _, _)| *map).collect();
+    let files = encoded.into_iter().map(|(_, file, _)| file).collect::<Result<Vec<_>, _>>()?;
+    Ok((kinds, files, stats, encode_time))
 }
 
 /// Plans and runs a whole generation.

@@ -250,3 +250,40 @@ fn zero_film_noise_runs_no_noise_node_and_changes_nothing() {
     let worst = skipped.iter().zip(&tiny).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
     assert!(worst < 1e-20, "skipping the zero noise changed the map by {worst}");
 }
+
+#[test]
+fn zero_amplitudes_and_invisible_layers_run_none_of_their_nodes_and_change_nothing() {
+    // Decided from the preset before evaluation: no colour variation (its noise), no height
+    // grain and no roughness variation (the grain noise, when both are 0), a pattern layer
+    // at opacity 0 (all its nodes). Each against a value too small to move any sample
+    // (1e-30, which keeps the nodes): the maps are identical, so the skip is pure speed.
+    // The controls: the tiny values do run the nodes.
+    let run = |overrides: &[(&str, &str)]| {
+        let overrides: Vec<(String, String)> = overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+        let preset = snakeskin::preset::load("crotalus-atrox", &overrides, None).unwrap().preset;
+        let eval = evaluate(&build_graph(&preset, BuildOptions::default()), &MapKind::ALL, 96, 96, &|_, _| {});
+        let names: Vec<String> = eval.stats.nodes.iter().map(|n| n.name.clone()).collect();
+        (eval.maps, names)
+    };
+    type Overrides<'a> = &'a [(&'a str, &'a str)];
+    let cases: [(Overrides, Overrides, &[&str]); 3] = [
+        (&[("color.variation", "0")], &[("color.variation", "1e-30")], &["color.variation_noise"]),
+        (
+            &[("height.grain", "0"), ("roughness.variation", "0")],
+            &[("height.grain", "1e-30"), ("roughness.variation", "1e-30")],
+            &["noise.grain", "height.grain", "height.sum", "roughness.noise"],
+        ),
+        (&[("pattern.0.opacity", "0")], &[("pattern.0.opacity", "1e-30")], &["pattern0.shape", "pattern0.tint"]),
+    ];
+    for (zero, tiny, skipped) in cases {
+        let (zero_maps, zero_names) = run(zero);
+        let (tiny_maps, tiny_names) = run(tiny);
+        for node in skipped {
+            assert!(!zero_names.iter().any(|n| n == node), "{zero:?}: {node} ran: {zero_names:?}");
+            assert!(tiny_names.iter().any(|n| n == node), "{tiny:?}: {node} did not run (the control)");
+        }
+        for (map, image) in &zero_maps {
+            assert!(image.data == tiny_maps[map].data, "{zero:?}: the {map} map changed");
+        }
+    }
+}

@@ -193,7 +193,14 @@ impl RowEncoder {
 
     /// Appends whole rows of the map (the image's rows `rows`).
     pub fn write_rows(&mut self, image: &Image, rows: std::ops::Range<usize>) -> Result<(), ExportError> {
-        use std::io::Write;
+        let samples = Self::samples(self.map, image, rows);
+        self.write_samples(&samples)
+    }
+
+    /// The file's samples of the image's rows `rows` (quantised, 16-bit big-endian): the
+    /// cheap half of `write_rows`, so a caller can quantise as maps finish and compress on
+    /// another thread (`write_samples`).
+    pub fn samples(map: MapKind, image: &Image, rows: std::ops::Range<usize>) -> Vec<u8> {
         let stride = image.width * image.channels;
         let band = Image {
             width: image.width,
@@ -201,7 +208,7 @@ impl RowEncoder {
             channels: image.channels,
             data: image.data[rows.start * stride..rows.end * stride].to_vec(),
         };
-        let mut q = quantize(self.map, &band);
+        let mut q = quantize(map, &band);
         if q.color == ExtendedColorType::L16 {
             // PNG stores 16-bit samples big-endian; `quantize` gives native order.
             for pair in q.samples.chunks_exact_mut(2) {
@@ -209,7 +216,13 @@ impl RowEncoder {
                 pair.copy_from_slice(&v.to_be_bytes());
             }
         }
-        self.writer.write_all(&q.samples).map_err(|e| ExportError::Encode { map: self.map, message: e.to_string() })
+        q.samples
+    }
+
+    /// Appends samples from `samples` (whole rows, in order).
+    pub fn write_samples(&mut self, samples: &[u8]) -> Result<(), ExportError> {
+        use std::io::Write;
+        self.writer.write_all(samples).map_err(|e| ExportError::Encode { map: self.map, message: e.to_string() })
     }
 
     /// The finished file's bytes (every row must have been written).

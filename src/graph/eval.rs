@@ -263,6 +263,7 @@ pub fn evaluate_with(
     if let CachePolicy::Keep(cache) = &mut policy {
         cache.replace(kept);
     }
+    crate::ops::pool::clear();
     let cache_stats = CacheStats { evaluated: total, reused: reachable.len() - total };
     (EvalStats { nodes: stats.into_values().collect(), peak_bytes, wall: start.elapsed() }, cache_stats)
 }

@@ -154,6 +154,17 @@ impl Op {
     /// when the evaluator could hand its buffer over, see `in_place`), `rest` the others in
     /// input order.
     pub fn eval(&self, first: Option<Cow<'_, Image>>, rest: &[&Image], frame: Frame) -> Image {
+        if self.is_generator() && frame.crosses_seam() {
+            // Generators place pixels by texture row: the rows before the seam and those
+            // after it, each evaluated as any strip, are exactly the texture's.
+            let (before, after) = frame.split_at_seam();
+            let (top, bottom) = (self.eval(None, &[], before), self.eval(None, &[], after));
+            let mut image = Image::new(frame.width, frame.height, top.channels);
+            let (upper, lower) = image.data.split_at_mut(top.data.len());
+            upper.copy_from_slice(&top.data);
+            lower.copy_from_slice(&bottom.data);
+            return image;
+        }
         let input = || first.as_deref().expect("operation has an input");
         match self {
             Op::Noise(noise) => crate::ops::noise::render(noise, frame),
@@ -193,6 +204,22 @@ impl Op {
             Op::Tint { color, opacity } => tint(owned(first), rest[0], *color, *opacity),
             Op::ScaleColour(colour) => colour.apply(owned(first), rest[0], frame),
         }
+    }
+
+    /// Operations without inputs, which compute their pixels from the frame's texture rows.
+    fn is_generator(&self) -> bool {
+        matches!(
+            self,
+            Op::Noise(_)
+                | Op::Constant { .. }
+                | Op::Scales(_)
+                | Op::Bands { .. }
+                | Op::Blotches(_)
+                | Op::BellyMarks(_)
+                | Op::Spots(_)
+                | Op::Along(_)
+                | Op::HeadMark(_)
+        )
     }
 
     /// A short description for stats and DOT labels.
@@ -235,14 +262,18 @@ fn owned(first: Option<Cow<'_, Image>>) -> Image {
 }
 
 fn tint(base: Image, mask: &Image, color: [f32; 3], opacity: f32) -> Image {
+    use rayon::prelude::*;
     let mut out = base;
-    let ch = out.channels;
-    for (px, m) in out.data.chunks_exact_mut(ch).zip(mask.data.chunks_exact(mask.channels)) {
-        let w = m[0] * opacity;
-        for c in 0..ch.min(3) {
-            px[c] += (color[c] - px[c]) * w;
+    let (ch, width) = (out.channels, out.width);
+    // Rows in parallel, as every other per-pixel kernel (this one ran on one thread).
+    out.data.par_chunks_mut(ch * width).zip(mask.data.par_chunks(mask.channels * width)).for_each(|(row, mask_row)| {
+        for (px, m) in row.chunks_exact_mut(ch).zip(mask_row.chunks_exact(mask.channels)) {
+            let w = m[0] * opacity;
+            for c in 0..ch.min(3) {
+                px[c] += (color[c] - px[c]) * w;
+            }
         }
-    }
+    });
     out
 }
 

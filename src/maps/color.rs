@@ -17,8 +17,13 @@ use crate::preset::schema::{Arrangement, BellyPattern, NoiseChoice, PatternKind,
 pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
     let base = preset.color.base.to_linear();
     let var = preset.color.variation as f32;
-    let noise =
-        g.add("color.variation_noise", perlin(4, s.along_count(4), 5, 0.55, derive_seed(preset.seed, "color")), &[]);
+    // Without variation both ends of the colour ramp are the base colour, whatever the noise
+    // (low + (high − low)·t is low exactly), so the noise is not evaluated.
+    let noise = if var == 0.0 {
+        g.add("color.no_variation", Op::Constant { value: 0.0 }, &[])
+    } else {
+        g.add("color.variation_noise", perlin(4, s.along_count(4), 5, 0.55, derive_seed(preset.seed, "color")), &[])
+    };
     let mut color = g.add(
         "color.base",
         Op::Colorize { low: base.map(|c| c * (1.0 - var)), high: base.map(|c| c * (1.0 + var)) },
@@ -74,7 +79,8 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
     }
 
     // One distortion noise for every layer (shared, so it is evaluated once).
-    let distorted = preset.pattern.iter().any(|l| l.edge_distortion > 0.0 && l.kind != PatternKind::Solid);
+    let distorted =
+        preset.pattern.iter().any(|l| l.edge_distortion > 0.0 && l.kind != PatternKind::Solid && l.opacity > 0.0);
     let distortion_noise = distorted.then(|| {
         g.add(
             "pattern.distortion_noise",
@@ -84,7 +90,11 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
     });
     let context = LayerContext { seed: preset.seed, outside_belly, distortion_noise };
     for (i, layer) in preset.pattern.iter().enumerate() {
-        color = pattern_layer(g, s, &context, i, layer, color);
+        // A layer at opacity 0 leaves every colour as it is (each of its tints adds
+        // (colour − below) × 0): none of its nodes is built.
+        if layer.opacity > 0.0 {
+            color = pattern_layer(g, s, &context, i, layer, color);
+        }
     }
     if let Some(plan) = &s.body() {
         color = super::body::marks(g, preset, s, plan, outside_belly, color);

@@ -291,8 +291,15 @@ pub fn snap_to_scales(
                 // A body atlas: a centre beyond the snout or the tail tip reads the end row.
                 ((cv * full as f32).floor() as isize).clamp(0, full as isize - 1)
             };
-            let cy =
-                if frame.height == full { cy } else { (cy - frame.row0 as isize).clamp(0, frame.height as isize - 1) };
+            let cy = if frame.height == full {
+                cy
+            } else {
+                // Relative to the strip; in a strip over the tile's seam a centre in the
+                // texture's first rows lies below the strip's first (last-texture) rows.
+                let relative = cy - frame.row0 as isize;
+                let relative = if frame.wraps_v && relative < 0 { relative + full as isize } else { relative };
+                relative.clamp(0, frame.height as isize - 1)
+            };
             let centre = mask.at_wrapped(cx, cy, 0);
             own + (centre - own) * amount
         };

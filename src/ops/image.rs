@@ -34,7 +34,28 @@ impl Frame {
     /// Texture v of the centre of this image's row `y`.
     #[inline]
     pub fn v(&self, y: usize) -> f32 {
-        ((self.row0 + y) as f32 + 0.5) * (1.0 / self.full_height as f32)
+        (self.texture_row(y) as f32 + 0.5) * (1.0 / self.full_height as f32)
+    }
+
+    /// The texture row of this image's row `y`. A strip of a repeating texture may run over
+    /// the last row into the first: the tile evaluated in strips (`generate`), whose first
+    /// strip's margin above row 0 is the texture's last rows.
+    #[inline]
+    pub fn texture_row(&self, y: usize) -> usize {
+        let row = self.row0 + y;
+        if row >= self.full_height && self.wraps_v { row - self.full_height } else { row }
+    }
+
+    /// The rows run over the texture's last row into its first.
+    pub fn crosses_seam(&self) -> bool {
+        self.wraps_v && self.row0 + self.height > self.full_height
+    }
+
+    /// The rows up to the texture's last and those from its first: two frames that do not
+    /// cross the seam, which a generator evaluates as it would any strip (`Op::eval`).
+    pub fn split_at_seam(&self) -> (Frame, Frame) {
+        let above = self.full_height - self.row0;
+        (Frame { height: above, ..*self }, Frame { row0: 0, height: self.height - above, ..*self })
     }
 }
 
@@ -91,7 +112,7 @@ impl Image {
         let mut image = Image::new(width, height, channels);
         let (inv_w, inv_h) = (1.0 / width as f32, 1.0 / frame.full_height as f32);
         image.data.par_chunks_mut(width * channels).enumerate().for_each(|(y, row)| {
-            let v = ((frame.row0 + y) as f32 + 0.5) * inv_h;
+            let v = (frame.texture_row(y) as f32 + 0.5) * inv_h;
             for (x, out) in row.chunks_exact_mut(channels).enumerate() {
                 pixel((x as f32 + 0.5) * inv_w, v, out);
             }

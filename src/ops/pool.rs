@@ -5,18 +5,17 @@
 //! on free, so every new buffer page-faults 4096 pages that the kernel zeroes one by one.
 //! Measured with `perf` on a 2K set, 18 % of the run was kernel time, almost all of it those
 //! faults. Zeroing a recycled buffer in place costs a fraction of that. The pool holds at
-//! most `MAX_BUFFERS` buffers, so it adds at most that many buffers to the peak resident
-//! memory; `clear` empties it (the evaluator does, when it finishes).
+//! most `MAX_BYTES`, all it can add to the peak resident memory; `clear` empties it (the evaluator does, when it finishes).
 //!
 //! Contents never leak from one image to the next: `take_zeroed` zeroes what it returns and
 //! `take_copy` overwrites all of it.
 
 use std::sync::Mutex;
 
-/// Buffers kept for reuse at most. Two covers the common case (a kernel frees its input
-/// just as the next one allocates its output, on each of two threads) without holding much
-/// memory: at 4096² two single-channel buffers are 128 MiB.
-const MAX_BUFFERS: usize = 2;
+/// Bytes kept for reuse at most, the pool's whole addition to the peak resident memory: six
+/// single-channel buffers at 2048², one at 4096² (where page faults weigh less against the
+/// work per buffer and the 1 GiB memory target weighs more).
+const MAX_BYTES: usize = 96 << 20;
 
 /// Buffers smaller than this are left to the allocator, which serves them from its heap
 /// without page faults anyway (glibc maps allocations above 128 KiB to 32 MiB).
@@ -60,8 +59,12 @@ pub fn give(buffer: Vec<f32>) {
     if buffer.len() < MIN_LEN {
         return;
     }
+    let bytes = |b: &Vec<f32>| b.len() * std::mem::size_of::<f32>();
+    if bytes(&buffer) > MAX_BYTES {
+        return;
+    }
     let mut pool = POOL.lock().unwrap_or_else(|p| p.into_inner());
-    if pool.len() == MAX_BUFFERS {
+    while pool.iter().map(bytes).sum::<usize>() + bytes(&buffer) > MAX_BYTES {
         pool.remove(0);
     }
     pool.push(buffer);

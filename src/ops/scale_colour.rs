@@ -88,7 +88,7 @@ impl ScaleColour {
         let mut out = colour;
         use rayon::prelude::*;
         out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
-            let v = ((frame.row0 + y) as f32 + 0.5) / height as f32;
+            let v = (frame.texture_row(y) as f32 + 0.5) / height as f32;
             let field = scales.row(y);
             // The scale's second random number, hashed once per run of pixels of one scale
             // (a scale spans many pixels of a row), not once per pixel.

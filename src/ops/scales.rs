@@ -558,8 +558,9 @@ impl ScaleField {
         let c0 = floor_i32(x);
         // The nine neighbouring cells, columns c0 − 1 ..= c0 + 1 (entries from column −1).
         let first = (3 * c0).clamp(0, candidates.len() as i32 - 9) as usize;
-        let (x_f64, mut top): (f64, Option<(f32, f32, f32, f32, f32, f32, i32)>) = (x as f64, None);
+        let x_f64 = x as f64;
         // (inside, lx, ly, random, cx, cy, column) of the top scale so far.
+        let mut top: Option<(f32, f32, f32, f32, f32, f32, i32)> = None;
         let mut under_height = 0.0f32;
         for cand in &candidates[first..first + 9] {
             if x_f64 < cand.x_min || x_f64 > cand.x_max {

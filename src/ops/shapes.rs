@@ -81,8 +81,9 @@ pub struct SpotGrid {
 
 /// Rasterises the spot grid into an anti-aliased coverage mask in [0, 1].
 pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
+    let drawn = drawn_rows(frame);
     let (w, h) = (frame.width as f32, frame.full_height as f32);
-    let (top, bottom) = (frame.row0 as f32, (frame.row0 + frame.height) as f32);
+    let (top, bottom) = (drawn.row0 as f32, (drawn.row0 + drawn.height) as f32);
     let mut pb = PathBuilder::new();
     let (across, along) = (grid.across.max(1), grid.along.max(1));
     for row in 0..along as i32 {
@@ -113,21 +114,33 @@ pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
         }
     }
     // Even-odd: ring spots are a circle with its inner circle as a hole.
-    rasterise(frame, pb, FillRule::EvenOdd)
+    rasterise(frame, drawn, pb, FillRule::EvenOdd)
+}
+
+/// The rows a shape node draws for `frame`: the whole tile when `frame` is a strip of it,
+/// else `frame`'s own. tiny-skia's anti-aliased coverage of a pixel can depend on the
+/// mask's extent and on the other copies in the path (measured: one 8-bit step at one pixel
+/// on the seam of a strip of Crotalus at 256²), so a strip of the tile takes its rows from
+/// a mask of the whole tile (one byte per pixel). A body atlas is drawn strip by strip: it
+/// is not periodic, and its strips are checked against the whole atlas (`tests/body.rs`).
+fn drawn_rows(frame: Frame) -> Frame {
+    if frame.wraps_v && frame.height < frame.full_height { Frame::whole(frame.width, frame.full_height) } else { frame }
 }
 
 /// Fills the path (in texture pixels) into an anti-aliased coverage mask in [0, 1] over the
-/// rows of `frame` (all zero if there is nothing to fill or the size is unusable).
-fn rasterise(frame: Frame, pb: PathBuilder, rule: FillRule) -> Image {
+/// rows of `frame`, drawing the rows of `drawn` (which hold `frame`'s; all zero if there is
+/// nothing to fill or the size is unusable).
+fn rasterise(frame: Frame, drawn: Frame, pb: PathBuilder, rule: FillRule) -> Image {
     let (width, height) = (frame.width, frame.height);
     let mut out = Image::new(width, height, 1);
-    let (Some(mut mask), Some(path)) = (Mask::new(width as u32, height as u32), pb.finish()) else {
+    let (Some(mut mask), Some(path)) = (Mask::new(width as u32, drawn.height as u32), pb.finish()) else {
         return out;
     };
     let transform =
-        if frame.row0 == 0 { Transform::identity() } else { Transform::from_translate(0.0, -(frame.row0 as f32)) };
+        if drawn.row0 == 0 { Transform::identity() } else { Transform::from_translate(0.0, -(drawn.row0 as f32)) };
     mask.fill_path(&path, rule, true, transform);
-    for (o, &m) in out.data.iter_mut().zip(mask.data()) {
+    let first = (frame.row0 - drawn.row0) * width;
+    for (o, &m) in out.data.iter_mut().zip(&mask.data()[first..first + width * height]) {
         *o = m as f32 / 255.0;
     }
     out
@@ -185,8 +198,9 @@ pub struct Blotches {
 /// Rasterises blotches into an anti-aliased coverage mask (tiny-skia), wrapping along v
 /// and around u.
 pub fn blotches(frame: Frame, b: &Blotches) -> Image {
+    let drawn = drawn_rows(frame);
     let (w, h) = (frame.width as f32, frame.full_height as f32);
-    let (top, bottom) = (frame.row0 as f32, (frame.row0 + frame.height) as f32);
+    let (top, bottom) = (drawn.row0 as f32, (drawn.row0 + drawn.height) as f32);
     let count = b.count.max(1);
     let spacing = (b.span.1 - b.span.0) * h / count as f32;
     let origin = b.span.0 * h;
@@ -197,7 +211,7 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
         for &(side, shift) in sides {
             zigzag(&mut pb, b, (0.5 + side * b.offset) * w, origin + (b.phase + shift) * spacing, spacing, w, h);
         }
-        return rasterise(frame, pb, FillRule::Winding);
+        return rasterise(frame, drawn, pb, FillRule::Winding);
     }
     for i in 0..count as i32 {
         let jx = hash::signed(i, 0, 0, b.seed) * b.jitter * 0.05;
@@ -224,7 +238,7 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
             }
         }
     }
-    rasterise(frame, pb, FillRule::Winding)
+    rasterise(frame, drawn, pb, FillRule::Winding)
 }
 
 /// One blotch centred at (cx, cy) pixels with half-width `hw` and half-length `hl`.

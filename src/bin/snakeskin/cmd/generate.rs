@@ -59,10 +59,10 @@ pub fn run(args: GenerateArgs) -> Result<()> {
             memory.available_bytes as f64 / MIB
         );
         if let Some((count, rows, margin)) = report.strips {
-            eprintln!("body atlas: {count} strips of {rows} rows, each with {margin} rows of margin each side");
+            eprintln!("evaluated in {count} strips of {rows} rows, each with {margin} rows of margin each side");
         }
         eprintln!(
-            "encode + write: {:.1} ms, total: {:.1} ms",
+            "encode + write: {:.1} ms (each map's time summed; PNG compression overlaps the graph), total: {:.1} ms",
             report.encode_time.as_secs_f64() * 1e3,
             report.total_time.as_secs_f64() * 1e3
         );
