@@ -6,7 +6,12 @@
 //! manifest records as `"job"`. A job whose folder holds a manifest with its key, whose files
 //! match their recorded SHA-256, is done and skipped, so a run that was killed is resumed by
 //! running the same command again: sets are written atomically (`export::SetLock`), so a
-//! killed job left either its complete old set or nothing, and only unfinished jobs run.
+//! killed job left either its complete old set or no manifest (maps without one, which no
+//! reader accepts), and only unfinished jobs run. Every job has its own folder: jobs that
+//! differ only in their `set` overrides get the overrides' hash in the folder name, a job
+//! listed twice runs once (the later one is a `duplicate`), and two different jobs that would
+//! still share a folder (two preset files with the same name) are refused before anything
+//! runs, in every shard alike.
 //! `--shard K/N` runs the jobs whose index is K modulo N (K from 0), the same split on every
 //! machine, for array jobs (Slurm, Kubernetes Indexed Jobs). At the end an index of the
 //! run's jobs, their folders and manifests is written next to them.
@@ -46,6 +51,12 @@ pub enum BatchError {
     TooMany { path: PathBuf, count: usize, max: usize },
     #[error("invalid --shard {0:?}: expected K/N with 0 <= K < N, e.g. 0/4 (K is the array index)")]
     Shard(String),
+    /// Two different jobs whose sets would go to the same folder and overwrite each other.
+    #[error(
+        "{path}: jobs {first} and {second} ({preset}) would both write {folder} with different output; give the \
+         presets different names (a preset's name is its `name` key or its file name)"
+    )]
+    SameFolder { path: PathBuf, first: usize, second: usize, preset: String, folder: PathBuf },
 }
 
 /// One `[[job]]` table as written.
@@ -78,6 +89,8 @@ struct JobsFile {
 pub struct Job {
     /// Position in the expanded list (what `--shard` splits on).
     pub index: usize,
+    /// The `[[job]]` table it came from, counted from 1 (for messages).
+    pub table: usize,
     /// The preset as given (a built-in name, or a path resolved against the jobs file).
     pub preset: String,
     pub overrides: Vec<(String, String)>,
@@ -94,7 +107,10 @@ pub struct Job {
 pub const DEFAULT_SIZE: u64 = 1024;
 
 impl Job {
-    /// The job's folder under the output folder: `<preset>/<layout>-<size>-seed<seed>-<what>`.
+    /// The job's folder under the output folder:
+    /// `<preset>/<layout>-<size>-seed<seed>-<format or pack>[-<maps>][-set<hash>]`, where
+    /// `<hash>` is the first 8 hex digits of the overrides' SHA-256 (jobs that differ only in
+    /// their overrides must not share a folder).
     pub fn folder(&self, preset_name: &str, seed: u64) -> PathBuf {
         let what = match self.pack {
             Some(p) => format!("pack-{}", p.name()),
@@ -105,7 +121,12 @@ impl Job {
         } else {
             String::new()
         };
-        Path::new(preset_name).join(format!("{}-{}-seed{seed}-{what}{maps}", self.layout.name(), self.size))
+        let overrides = if self.overrides.is_empty() {
+            String::new()
+        } else {
+            format!("-set{}", &sha256_hex(serde_json::json!(self.overrides).to_string().as_bytes())[..8])
+        };
+        Path::new(preset_name).join(format!("{}-{}-seed{seed}-{what}{maps}{overrides}", self.layout.name(), self.size))
     }
 
     /// The job's key: what its output bytes depend on (the preset's content and seed, the
@@ -196,6 +217,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
             for &size in &sizes {
                 jobs.push(Job {
                     index: jobs.len(),
+                    table: k + 1,
                     preset: preset.clone(),
                     overrides: overrides.clone(),
                     seed,
@@ -251,8 +273,12 @@ pub struct JobOutcome {
     pub folder: PathBuf,
     pub manifest: PathBuf,
     pub key: String,
-    /// `done` (run now), `skipped` (already complete with this key) or, from `list`, `to do`.
+    /// `done` (run now), `skipped` (already complete with this key), `duplicate` (the same
+    /// job as `duplicate_of`, which makes its set) or, from `list`, `to do`.
     pub status: &'static str,
+    /// The index of the earlier identical job, for a `duplicate`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub duplicate_of: Option<usize>,
 }
 
 #[derive(Debug, Serialize)]
@@ -288,30 +314,74 @@ struct Resolved {
     done: bool,
 }
 
-fn resolve(job: &Job, out: &Path) -> Result<Resolved, Error> {
+/// `check`: whether to look for its finished set (reading and hashing its files).
+fn resolve(job: &Job, out: &Path, check: bool) -> Result<Resolved, Error> {
     let loaded = crate::preset::load(&job.preset, &job.overrides, job.seed)?;
     let seed = loaded.preset.seed;
     let key = job.key(&loaded.content_hash, seed);
     let folder = job.folder(&loaded.name, seed);
     let manifest = folder.join(crate::export::manifest_file_name(&loaded.name));
-    let done = is_done(&out.join(&manifest), &key);
+    let done = check && is_done(&out.join(&manifest), &key);
     let status = if done { "skipped" } else { "to do" };
-    let outcome =
-        JobOutcome { index: job.index, preset: loaded.name, seed, size: job.size, folder, manifest, key, status };
+    let outcome = JobOutcome {
+        index: job.index,
+        preset: loaded.name,
+        seed,
+        size: job.size,
+        folder,
+        manifest,
+        key,
+        status,
+        duplicate_of: None,
+    };
     Ok(Resolved { outcome, done })
+}
+
+/// Resolves every job of the file (not only the shard's, so that every shard finds the same
+/// duplicates and refuses the same clashes; only the shard's sets are checked on disk): a
+/// job identical to an earlier one is marked its `duplicate`; two different jobs bound for
+/// one folder are an error.
+fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Result<Vec<Resolved>, Error> {
+    let mut first_in: std::collections::HashMap<PathBuf, usize> = std::collections::HashMap::new();
+    let mut resolved: Vec<Resolved> = Vec::with_capacity(jobs.len());
+    for job in jobs {
+        let mut r = resolve(job, out, shard.contains(job))?;
+        if let Some(&earlier) = first_in.get(&r.outcome.folder) {
+            let first = &resolved[earlier].outcome;
+            if first.key != r.outcome.key {
+                return Err(BatchError::SameFolder {
+                    path: jobs_file.into(),
+                    first: jobs[earlier].table,
+                    second: job.table,
+                    preset: r.outcome.preset,
+                    folder: r.outcome.folder,
+                }
+                .into());
+            }
+            r.outcome.status = "duplicate";
+            r.outcome.duplicate_of = Some(first.index);
+        } else {
+            first_in.insert(r.outcome.folder.clone(), resolved.len());
+        }
+        resolved.push(r);
+    }
+    Ok(resolved)
 }
 
 /// The shard's jobs with their folders and whether each is already done (`done` or
 /// `to do`); nothing is run or written.
-pub fn list(jobs: &[Job], out: &Path, shard: Shard) -> Result<Vec<JobOutcome>, Error> {
-    jobs.iter()
-        .filter(|j| shard.contains(j))
-        .map(|j| {
-            let Resolved { mut outcome, done } = resolve(j, out)?;
-            outcome.status = if done { "done" } else { "to do" };
-            Ok(outcome)
+pub fn list(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Result<Vec<JobOutcome>, Error> {
+    Ok(resolve_all(jobs_file, jobs, out, shard)?
+        .into_iter()
+        .zip(jobs)
+        .filter(|(_, j)| shard.contains(j))
+        .map(|(Resolved { mut outcome, done }, _)| {
+            if outcome.duplicate_of.is_none() {
+                outcome.status = if done { "done" } else { "to do" };
+            }
+            outcome
         })
-        .collect()
+        .collect())
 }
 
 /// The generation a job asks for, with its key for the manifest.
@@ -341,18 +411,18 @@ pub fn run(
     shard: Shard,
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
-    let mine: Vec<&Job> = jobs.iter().filter(|j| shard.contains(j)).collect();
-    let mut resolved = Vec::with_capacity(mine.len());
-    for job in &mine {
-        let r = resolve(job, out)?;
-        if !r.done {
+    let (mine, resolved): (Vec<&Job>, Vec<Resolved>) =
+        jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
+    for (job, r) in mine.iter().zip(&resolved) {
+        if !r.done && r.outcome.duplicate_of.is_none() {
             Plan::new(&request(job, out, &r.outcome))?;
         }
-        resolved.push(r);
     }
     let mut outcomes = Vec::with_capacity(mine.len());
     for (k, (job, Resolved { mut outcome, done })) in mine.iter().zip(resolved).enumerate() {
-        if !done {
+        if outcome.duplicate_of.is_some() {
+            // Its set is the earlier job's (in this shard or another).
+        } else if !done {
             Plan::new(&request(job, out, &outcome))?.run(&|_, _| {})?;
             outcome.status = "done";
         } else {

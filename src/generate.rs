@@ -102,11 +102,11 @@ impl Plan {
         if height > MAX_HEIGHT {
             return Err(Error::Height { width: size, height, max: MAX_HEIGHT });
         }
-        let graph = build_graph(&loaded.preset, request.options);
         let maps = match request.pack {
             Some(pack) => pack.maps(has_film(&loaded.preset), request.ao),
             None => request.maps.clone(),
         };
+        let graph = build_graph(&loaded.preset, request.options).for_maps(&maps);
         let strips = strips_of(&graph, &maps, size, height);
         // The finished maps kept as f32 until encoded or packed, and their files (each at
         // most their size).
@@ -429,15 +429,16 @@ pub const TILE_BUFFER_BUDGET_BYTES: u64 = 800 << 20;
 /// The node buffers of one strip of a tile too large to evaluate whole: less than the whole
 /// tile's budget, because a strip's set also holds every map of the whole tile quantised
 /// until its last strip is in (168 MB at 4096²) and the buffer pool (`ops::pool`). Measured
-/// at 4096²: Bitis gabonica's 537 MiB strips peaked at 770 MB resident.
-pub const STRIP_BUFFER_BUDGET_BYTES: u64 = 560 << 20;
+/// at 4096²: the largest peak over the built-in species, Elaphe climacophora in three
+/// strips, 906 MiB resident.
+pub const STRIP_BUFFER_BUDGET_BYTES: u64 = 640 << 20;
 
 /// The strips of a `width` × `height` texture, or None to evaluate it whole. A long texture
 /// (the body atlas) is cut every `STRIP_WIDTHS` widths. A square tile is whole unless its
-/// buffers would exceed `TILE_BUFFER_BUDGET_BYTES`; then it is cut into the fewest of 2, 4,
-/// 8 or 16 strips whose buffers, margins included, fit `STRIP_BUFFER_BUDGET_BYTES` (the
-/// margins are recomputed rows, so fewer strips cost less time), or the most of them if none
-/// fits. `SNAKESKIN_TILE_BUDGET_MIB` replaces both budgets (how the tests send small tiles
+/// buffers would exceed `TILE_BUFFER_BUDGET_BYTES`; then it is cut into the fewest strips
+/// (2 to 16) whose buffers, margins included, fit `STRIP_BUFFER_BUDGET_BYTES` (the margins
+/// are recomputed rows, so fewer strips cost less time: measured at 4096², three strips
+/// instead of four took Natrix natrix from 5.5–5.7 s to 5.0 s), or 16 if none fits. `SNAKESKIN_TILE_BUDGET_MIB` replaces both budgets (how the tests send small tiles
 /// through strips).
 fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Option<Strips> {
     let margin = graph.row_reach(maps, width);
@@ -452,7 +453,7 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
     }
     let fits = |rows: usize| buffers(rows) <= set_budget.map_or(STRIP_BUFFER_BUDGET_BYTES, |mib| mib << 20);
     let mut best = None;
-    for count in [2, 4, 8, 16] {
+    for count in 2..=16 {
         let rows = height.div_ceil(count);
         // A strip with its margins must stay shorter than the texture.
         if rows + 2 * margin >= height {

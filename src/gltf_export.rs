@@ -3,12 +3,13 @@
 //! rows at a time, like `generate`), then put on a mesh — the preview's snake (the tile
 //! repeated along it, or a body atlas once over it), or a sphere or plane to look at the
 //! material alone — and written atomically: one `.glb`, or a `.gltf` with its buffer and
-//! images beside it, the `.gltf` renamed last.
+//! images (`NAME.ROLE.png`, named apart from a texture set's `NAME_MAP.png`) beside it, the
+//! `.gltf` renamed last.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use crate::export::gltf::{GltfMaterial, GltfTextures, glb, gltf_files};
+use crate::export::gltf::{GltfMaterial, GltfTextures, glb, gltf_files, gltf_image_file_name};
 use crate::export::pack::Pack;
 use crate::export::{SetLock, write_file_atomically};
 use crate::generate::{GenerateRequest, Plan};
@@ -135,7 +136,19 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         let mut files = gltf_files(&name, &mesh, material, &textures)?;
         let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
         let lock = SetLock::acquire(&dir, &name)?;
-        lock.write(&files, (&gltf_name, &gltf_bytes))?
+        let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
+        // An earlier export of this name with a film left its thickness image, which no
+        // file references now: under the lock, after the commit, it goes.
+        if textures.thickness.is_none() {
+            let stale = dir.join(gltf_image_file_name(&name, "thickness"));
+            match std::fs::remove_file(&stale) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(crate::export::ExportError::Io { path: stale, source: e }.into());
+                }
+                _ => {}
+            }
+        }
+        written
     };
     Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed() })
 }

@@ -194,3 +194,63 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert!(stderr(&out).contains("no-such-snake"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "a set was written before the bad job was found");
 }
+
+#[test]
+fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    // Three different jobs of one preset (two differ only in their overrides) and a fourth
+    // that repeats the first.
+    std::fs::write(
+        &jobs,
+        "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n\
+         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { \"scales.rows\" = 17 }\n\n\
+         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { \"scales.rows\" = 23 }\n\n\
+         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n",
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("3 run, 0 already done, 1 duplicates"), "{}", stdout(&out));
+    let sets = manifests(&out_dir);
+    assert_eq!(sets.len(), 3, "{sets:?}");
+    // Each set is complete and is its own job's (a set overwritten by another job's maps
+    // would fail its hashes or carry the other job's key).
+    let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out_dir.join("index.json")).unwrap()).unwrap();
+    let index = index["jobs"].as_array().unwrap();
+    assert_eq!(index[3]["status"], "duplicate");
+    assert_eq!(index[3]["duplicate_of"], 0);
+    for job in &index[..3] {
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out_dir.join(job["manifest"].as_str().unwrap())).unwrap()).unwrap();
+        assert_eq!(manifest["job"], job["key"]);
+    }
+    // The same run again has nothing to do: every set is settled (its files match the
+    // hashes its manifest records).
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert!(stdout(&out).contains("0 run, 3 already done, 1 duplicates"), "{}", stdout(&out));
+    assert_eq!(manifests(&out_dir), sets, "a settled set was written again");
+
+    // Two different preset files with one name would share a folder: refused, in every
+    // shard, before anything is written.
+    let preset =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/natrix-natrix.toml")).unwrap();
+    for (sub, rows) in [("a", 19), ("b", 21)] {
+        std::fs::create_dir(dir.path().join(sub)).unwrap();
+        let text = preset.replacen("rows = 19", &format!("rows = {rows}"), 1);
+        std::fs::write(dir.path().join(sub).join("snake.toml"), text).unwrap();
+    }
+    std::fs::write(
+        &jobs,
+        "[[job]]\npreset = \"a/snake.toml\"\nsizes = [32]\n\n[[job]]\npreset = \"b/snake.toml\"\nsizes = [32]\n",
+    )
+    .unwrap();
+    let empty = dir.path().join("empty");
+    for shard in ["0/2", "1/2"] {
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--shard", shard]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains("jobs 1 and 2 (snake) would both write"), "{}", stderr(&out));
+    }
+    assert!(!empty.exists());
+}

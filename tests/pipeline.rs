@@ -287,3 +287,46 @@ fn zero_amplitudes_and_invisible_layers_run_none_of_their_nodes_and_change_nothi
         }
     }
 }
+
+#[test]
+fn a_map_written_alone_computes_only_its_scale_channels_and_the_same_samples() {
+    // `Graph::for_maps`, as `generate --maps` and every pack use it: the scale field of a
+    // graph for some maps stores only the channels their nodes read, its readers
+    // renumbered. Every map written alone must equal that map of the whole set, sample for
+    // sample (a wrong renumbering reads another channel and fails this).
+    use snakeskin::graph::{Graph, Op};
+    use snakeskin::ops::scales::channel;
+    let field = |g: &Graph| {
+        g.nodes()
+            .iter()
+            .find_map(|n| match &n.op {
+                Op::Scales(f) => Some(f.outputs.clone()),
+                _ => None,
+            })
+            .unwrap()
+    };
+    for name in ["crotalus-atrox", "xenopeltis-unicolor", "bitis-gabonica", PATTERNED] {
+        let loaded = parse(&read_source(name).unwrap(), &[]).unwrap();
+        let whole = build_graph(&loaded.preset, BuildOptions::default());
+        let all = evaluate(&whole, &MapKind::ALL, 96, 96, &|_, _| {}).maps;
+        assert_eq!(field(&whole.for_maps(&MapKind::ALL)), field(&whole), "{name}: the whole set lost a channel");
+        for map in MapKind::ALL {
+            let alone = evaluate(&whole.for_maps(&[map]), &[map], 96, 96, &|_, _| {}).maps;
+            assert!(alone[&map].data == all[&map].data, "{name}: the {map} map alone differs from the set's");
+        }
+        // The roughness map reads the crevices, and the keels and the per-scale random value
+        // where the preset roughens keels and varies roughness by scale (`maps::build_roughness`).
+        let r = &loaded.preset.roughness;
+        let mut wanted = vec![channel::CREVICE];
+        if loaded.preset.scales.keeled && r.keel > 0.0 {
+            wanted.push(channel::KEEL);
+        }
+        if r.per_scale > 0.0 {
+            wanted.push(channel::CELL_RANDOM);
+        }
+        let mut got = field(&whole.for_maps(&[MapKind::Roughness]));
+        got.sort_unstable();
+        assert_eq!(got, wanted, "{name}: the roughness map's scale field");
+        assert!(field(&whole).len() > wanted.len(), "{name}: the control: the whole set reads more");
+    }
+}

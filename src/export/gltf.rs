@@ -57,6 +57,19 @@ pub struct GltfTextures {
     pub occlusion: bool,
 }
 
+impl GltfTextures {
+    /// The images by role, in the order the material's texture indices count them (0 base
+    /// colour, 1 normal, 2 ORM, 3 thickness when there is one).
+    fn images(&self) -> Vec<(&'static str, &[u8])> {
+        let mut images: Vec<(&'static str, &[u8])> =
+            vec![("basecolor", &self.base_color), ("normal", &self.normal), ("orm", &self.orm)];
+        if let Some(thickness) = &self.thickness {
+            images.push(("thickness", thickness));
+        }
+        images
+    }
+}
+
 /// A glTF document before it is written: the JSON and the binary buffer; images are in the
 /// buffer (GLB) or in their own files (`.gltf`).
 struct Document {
@@ -142,11 +155,7 @@ fn document(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfText
     let uv = buffer.attribute(&v.iter().flat_map(|v| v.uv).collect::<Vec<_>>(), 2, "VEC2", false);
     let indices = buffer.indices(&mesh.indices);
 
-    let mut pngs: Vec<(&str, &[u8])> =
-        vec![("basecolor", &textures.base_color), ("normal", &textures.normal), ("orm", &textures.orm)];
-    if let Some(t) = &textures.thickness {
-        pngs.push(("thickness", t));
-    }
+    let pngs = textures.images();
     let image_list: Vec<Value> = pngs
         .iter()
         .enumerate()
@@ -155,7 +164,7 @@ fn document(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfText
                 let index = buffer.view(bytes, None);
                 json!({ "name": format!("{name}_{role}"), "bufferView": index, "mimeType": "image/png" })
             }
-            Images::Files(names) => json!({ "name": format!("{name}_{role}"), "uri": names[k] }),
+            Images::Files(names) => json!({ "name": format!("{name}_{role}"), "uri": uri_reference(&names[k]) }),
         })
         .collect();
     let texture_list: Vec<Value> = (0..pngs.len()).map(|k| json!({ "sampler": 0, "source": k })).collect();
@@ -200,7 +209,7 @@ fn document(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfText
     let Buffer { bin, views, accessors } = buffer;
     let buffer = match &images {
         Images::Embedded => json!({ "byteLength": bin.len() }),
-        Images::Files(_) => json!({ "byteLength": bin.len(), "uri": format!("{name}.bin") }),
+        Images::Files(_) => json!({ "byteLength": bin.len(), "uri": uri_reference(&format!("{name}.bin")) }),
     };
     let json = json!({
         "asset": { "version": "2.0", "generator": format!("snakeskin {}", env!("CARGO_PKG_VERSION")) },
@@ -273,20 +282,38 @@ pub fn gltf_files(
     material: GltfMaterial,
     textures: &GltfTextures,
 ) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
-    let mut roles = vec!["basecolor", "normal", "orm"];
-    if textures.thickness.is_some() {
-        roles.push("thickness");
-    }
-    let names: Vec<String> = roles.iter().map(|r| format!("{name}_{r}.png")).collect();
+    let images = textures.images();
+    let names: Vec<String> = images.iter().map(|(role, _)| gltf_image_file_name(name, role)).collect();
     let Document { json, bin } = document(name, mesh, material, textures, Images::Files(&names));
     let text = serde_json::to_vec_pretty(&json).map_err(|e| ExportError::Gltf(e.to_string()))?;
     let mut files = vec![(format!("{name}.bin"), bin)];
-    let pngs = [Some(&textures.base_color), Some(&textures.normal), Some(&textures.orm), textures.thickness.as_ref()];
-    for (file, bytes) in names.iter().zip(pngs.into_iter().flatten()) {
-        files.push((file.clone(), bytes.clone()));
+    for (file, (_, bytes)) in names.iter().zip(images) {
+        files.push((file.clone(), bytes.to_vec()));
     }
     files.push((format!("{name}.gltf"), text));
     Ok(files)
+}
+
+/// The file name of a `.gltf`'s image beside it: `NAME.ROLE.png`. A dot, not the `_` of a
+/// texture set's files (`NAME_normal.png`, `NAME_basecolor.png` of `--pack gltf`), so that a
+/// `.gltf` exported into a set's folder under the set's name overwrites none of its files.
+pub fn gltf_image_file_name(name: &str, role: &str) -> String {
+    format!("{name}.{role}.png")
+}
+
+/// A file name as a relative URI reference (RFC 3986 §2): every byte but the unreserved
+/// characters percent-encoded, so that a name with a space, `#`, `%` or `?` still names
+/// its file (glTF 2.0 §3.3: `uri` is a URI reference, relative to the `.gltf`).
+fn uri_reference(file_name: &str) -> String {
+    let mut out = String::with_capacity(file_name.len());
+    for byte in file_name.bytes() {
+        if byte.is_ascii_alphanumeric() || b"-._~".contains(&byte) {
+            out.push(byte as char);
+        } else {
+            out.push_str(&format!("%{byte:02X}"));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

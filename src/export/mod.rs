@@ -97,11 +97,13 @@ pub fn linear_to_srgb8(linear: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
-fn unit_to_u8(x: f32) -> u8 {
+/// A sample on [0, 1] to 8 bits, rounded to nearest (every map and packed channel).
+pub(crate) fn unit_to_u8(x: f32) -> u8 {
     (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 
-fn unit_to_u16(x: f32) -> u16 {
+/// A sample on [0, 1] to 16 bits, rounded to nearest.
+pub(crate) fn unit_to_u16(x: f32) -> u16 {
     (x.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16
 }
 

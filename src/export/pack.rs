@@ -13,7 +13,7 @@ use std::ops::Range;
 use crate::material::MapKind;
 use crate::ops::Image;
 
-use super::{ExportError, SharedBuffer, linear_to_srgb8};
+use super::{ExportError, SharedBuffer, linear_to_srgb8, unit_to_u8, unit_to_u16};
 
 /// How one channel of a packed texture is made from a map's linear sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -233,14 +233,6 @@ pub fn texture_file_name(set_name: &str, spec: &TextureSpec) -> String {
     format!("{set_name}_{}.png", spec.suffix)
 }
 
-fn quantize8(x: f32) -> u8 {
-    (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
-}
-
-fn quantize16(x: f32) -> u16 {
-    (x.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16
-}
-
 impl Transfer {
     /// The stored value on [0, 1] of a linear sample.
     fn apply(self, x: f32) -> f32 {
@@ -314,9 +306,9 @@ impl TextureEncoder {
                         (None, Channel::Map { .. }) => unreachable!("sources resolved above"),
                     };
                     if bytes_per_sample == 2 {
-                        samples.extend_from_slice(&quantize16(value).to_be_bytes());
+                        samples.extend_from_slice(&unit_to_u16(value).to_be_bytes());
                     } else {
-                        samples.push(quantize8(value));
+                        samples.push(unit_to_u8(value));
                     }
                 }
             }
@@ -348,7 +340,9 @@ mod tests {
             assert!(with.contains(&MapKind::Ao) && !without.contains(&MapKind::Ao));
             let names: Vec<_> = pack.textures(true, true).iter().map(|t| t.suffix).collect();
             let mut unique = names.clone();
+            unique.sort_unstable();
             unique.dedup();
+            unique.sort_by_key(|u| names.iter().position(|n| n == u));
             assert_eq!(names, unique, "{pack:?} has two textures of one name");
         }
     }

@@ -75,6 +75,50 @@ impl Graph {
         maps.iter().filter_map(|m| self.output(*m)).map(|id| reach[id.0]).max().unwrap_or(0)
     }
 
+    /// The graph for writing `maps` only: the other maps' outputs are dropped, and each
+    /// scale field computes and stores only the channels the remaining nodes read (a field
+    /// of ten channels at 2048² is 160 MiB; `--maps roughness` reads three), its readers
+    /// renumbered. Every channel is computed per pixel alone, so the maps' values are
+    /// exactly those of the whole graph. A field that some node reads whole is left as it is.
+    pub fn for_maps(&self, maps: &[MapKind]) -> Graph {
+        let mut graph = self.clone();
+        graph.outputs.retain(|map, _| maps.contains(map));
+        let live = graph.reachable(maps);
+        let fields: Vec<NodeId> =
+            live.iter().copied().filter(|id| matches!(graph.nodes[id.0].op, Op::Scales(_))).collect();
+        for field_id in fields {
+            // (reader, which of its inputs) for every live node that reads the field.
+            let readers: Vec<(usize, usize)> = live
+                .iter()
+                .flat_map(|id| {
+                    let inputs = &graph.nodes[id.0].inputs;
+                    inputs.iter().enumerate().filter(|(_, i)| **i == field_id).map(move |(k, _)| (id.0, k))
+                })
+                .collect();
+            let mut read = Vec::new();
+            let mut whole = false;
+            for &(reader, input) in &readers {
+                match graph.nodes[reader].op.channel_reads_mut(input) {
+                    Some(indices) => read.extend(indices.into_iter().map(|i| *i)),
+                    None => whole = true,
+                }
+            }
+            let Op::Scales(field) = &mut graph.nodes[field_id.0].op else { unreachable!() };
+            read.sort_unstable();
+            read.dedup();
+            if whole || read.len() == field.outputs.len() {
+                continue;
+            }
+            field.outputs = read.iter().map(|&i| field.outputs[i]).collect();
+            for &(reader, input) in &readers {
+                for index in graph.nodes[reader].op.channel_reads_mut(input).into_iter().flatten() {
+                    *index = read.binary_search(index).expect("every read channel is kept");
+                }
+            }
+        }
+        graph
+    }
+
     /// Every node that the given maps depend on, in topological (id) order.
     pub fn reachable(&self, maps: &[MapKind]) -> Vec<NodeId> {
         self.reachable_until(maps, |_| false)

@@ -113,10 +113,13 @@ pub fn scale_field(preset: &Preset, layout: Layout) -> ScaleField {
 /// The scale-field channels this preset's maps read (each costs 4 bytes per pixel).
 fn scale_outputs(preset: &Preset) -> Vec<usize> {
     let mut outputs = vec![channel::HEIGHT, channel::CREVICE];
-    outputs.push(match preset.iridescence.gradient {
-        IridescenceGradient::Vertical => channel::ALONG,
-        IridescenceGradient::Radial => channel::RADIAL,
-    });
+    // The film's gradient, only where a film shows (`build_iridescence` reads it then only).
+    if has_film(preset) {
+        outputs.push(match preset.iridescence.gradient {
+            IridescenceGradient::Vertical => channel::ALONG,
+            IridescenceGradient::Radial => channel::RADIAL,
+        });
+    }
     if preset.scales.keeled && preset.roughness.keel > 0.0 {
         outputs.push(channel::KEEL);
     }

@@ -475,7 +475,7 @@ impl ScaleField {
                 } else if self.shape == ScaleShape::Hexagon {
                     self.hexagon_pixel(&lattice, &table, u, v, &mut all);
                 } else {
-                    self.imbricate_pixel(&lattice, &geo, &candidates, x, &mut all);
+                    self.imbricate_pixel(&geo, &candidates, x, &mut all);
                 }
                 for (o, c) in out.iter_mut().zip(&self.outputs) {
                     *o = all[*c];
@@ -508,7 +508,9 @@ impl ScaleField {
                     sin: cell.sin,
                     inv_size: cell.inv_size,
                     random: cell.random,
-                    column: c,
+                    centre_u: lattice.u_of(cx),
+                    centre_v: self.wrap_v((cy + ROW_PHASE) / lattice.rows_v as f32),
+                    row: lattice.row_of(c),
                     x_min: cx as f64 + x_min,
                     x_max: cx as f64 + x_max,
                 });
@@ -544,7 +546,7 @@ impl ScaleField {
     }
 
     /// `x`: the pixel's lattice x; `candidates`: its row's (`row_candidates`).
-    fn imbricate_pixel(&self, lattice: &Lattice, geo: &Geometry, candidates: &[RowCandidate], x: f32, out: &mut [f32]) {
+    fn imbricate_pixel(&self, geo: &Geometry, candidates: &[RowCandidate], x: f32, out: &mut [f32]) {
         // Roof tiles: of the scales covering a pixel, the most anterior (smallest centre v)
         // lies on top, its free posterior edge over the scale behind. Its rim falls towards
         // the scale underneath, which leaves a groove along every free edge: the visible
@@ -559,8 +561,8 @@ impl ScaleField {
         // The nine neighbouring cells, columns c0 − 1 ..= c0 + 1 (entries from column −1).
         let first = (3 * c0).clamp(0, candidates.len() as i32 - 9) as usize;
         let x_f64 = x as f64;
-        // (inside, lx, ly, random, cx, cy, column) of the top scale so far.
-        let mut top: Option<(f32, f32, f32, f32, f32, f32, i32)> = None;
+        // (inside, lx, ly, candidate) of the top scale so far.
+        let mut top: Option<(f32, f32, f32, &RowCandidate)> = None;
         let mut under_height = 0.0f32;
         for cand in &candidates[first..first + 9] {
             if x_f64 < cand.x_min || x_f64 > cand.x_max {
@@ -581,16 +583,16 @@ impl ScaleField {
                 continue;
             }
             match top {
-                Some(t) if cy >= t.5 => under_height = under_height.max(profile(inside, ly)),
+                Some(t) if cy >= t.3.cy => under_height = under_height.max(profile(inside, ly)),
                 _ => {
                     if let Some(t) = top {
                         under_height = under_height.max(profile(t.0, t.2));
                     }
-                    top = Some((inside, lx, ly, cand.random, cx, cy, cand.column));
+                    top = Some((inside, lx, ly, cand));
                 }
             }
         }
-        let Some((inside, lx, ly, random, cx, cy, column)) = top else {
+        let Some((inside, lx, ly, cand)) = top else {
             return self.write_scale(None, 0.0, self.keel_height, out);
         };
         let height = free_edge(profile(inside, ly), inside / soft, under_height, self.imbrication);
@@ -599,10 +601,10 @@ impl ScaleField {
             x: lx,
             y: ly,
             half_len: geo.b,
-            random,
-            centre_u: lattice.u_of(cx),
-            centre_v: self.wrap_v((cy + ROW_PHASE) / lattice.rows_v as f32),
-            row: lattice.row_of(column),
+            random: cand.random,
+            centre_u: cand.centre_u,
+            centre_v: cand.centre_v,
+            row: cand.row,
         };
         self.write_scale(Some(top), height, self.keel_height, out);
     }
@@ -858,7 +860,11 @@ struct RowCandidate {
     sin: f32,
     inv_size: f32,
     random: f32,
-    column: i32,
+    /// What `Candidate` carries of the scale, computed once per row instead of per pixel:
+    /// its centre in texture space and its dorsal row.
+    centre_u: f32,
+    centre_v: f32,
+    row: i32,
     /// Lattice x outside which the scale's bounding box misses the row (conservative).
     x_min: f64,
     x_max: f64,

@@ -12,8 +12,8 @@ pub fn run(args: BatchArgs) -> Result<()> {
     let jobs = batch::load_jobs(&args.jobs).map_err(snakeskin::Error::from)?;
     let shard = args.shard.unwrap_or(Shard::ALL);
     if args.list {
-        for job in batch::list(&jobs, &args.out, shard)? {
-            println!("{:>6}  {:<7}  {}", job.index, job.status, path_line(&args.out.join(&job.folder)));
+        for job in batch::list(&args.jobs, &jobs, &args.out, shard)? {
+            println!("{:>6}  {:<9}  {}", job.index, job.status, path_line(&args.out.join(&job.folder)));
         }
         return Ok(());
     }
@@ -24,9 +24,11 @@ pub fn run(args: BatchArgs) -> Result<()> {
     })?;
     bar.finish();
     let ran = index.jobs.iter().filter(|j| j.status == "done").count();
-    let skipped = index.jobs.len() - ran;
+    let duplicates = index.jobs.iter().filter(|j| j.status == "duplicate").count();
+    let skipped = index.jobs.len() - ran - duplicates;
+    let duplicates = if duplicates > 0 { format!(", {duplicates} duplicates of another job") } else { String::new() };
     println!(
-        "{} jobs of {} in shard {}: {ran} run, {skipped} already done; index: {}",
+        "{} jobs of {} in shard {}: {ran} run, {skipped} already done{duplicates}; index: {}",
         index.jobs.len(),
         jobs.len(),
         index.shard,
