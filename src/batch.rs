@@ -200,6 +200,12 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         };
         let pack =
             table.pack.as_deref().map(str::parse::<Pack>).transpose().map_err(|e| invalid(format!("pack: {e}")))?;
+        // A pack decides its own maps and format (the folder name leaves them out too).
+        if pack.is_some() && (table.maps.is_some() || table.format.is_some()) {
+            return Err(invalid(
+                "pack: a pack writes its own textures as PNG; leave out maps and format, or pack".into(),
+            ));
+        }
         let layout = match table.layout.as_deref() {
             None | Some("tile") => Layout::Tile,
             Some("body") => Layout::Body,
@@ -480,6 +486,8 @@ mod tests {
         assert!(e.contains("job 1") && e.contains("size 8"), "{e}");
         let e = jobs("[[job]]\npreset = \"a\"\npack = \"godot\"\n").unwrap_err().to_string();
         assert!(e.contains("unreal"), "{e}");
+        let e = jobs("[[job]]\npreset = \"a\"\npack = \"unreal\"\nformat = \"exr\"\n").unwrap_err().to_string();
+        assert!(e.contains("leave out maps and format"), "{e}");
         assert!(matches!(jobs("").unwrap_err(), BatchError::Empty { .. }));
         let many = format!(
             "[[job]]\npreset = \"a\"\nseeds = [{}]\nsizes = [64, 128]\n",

@@ -438,7 +438,8 @@ pub const STRIP_BUFFER_BUDGET_BYTES: u64 = 640 << 20;
 /// buffers would exceed `TILE_BUFFER_BUDGET_BYTES`; then it is cut into the fewest strips
 /// (2 to 16) whose buffers, margins included, fit `STRIP_BUFFER_BUDGET_BYTES` (the margins
 /// are recomputed rows, so fewer strips cost less time: measured at 4096², three strips
-/// instead of four took Natrix natrix from 5.5–5.7 s to 5.0 s), or 16 if none fits. `SNAKESKIN_TILE_BUDGET_MIB` replaces both budgets (how the tests send small tiles
+/// instead of four took Natrix natrix from 5.5–5.7 s to 5.0 s); if none fits, the most
+/// strips whose margins still leave each shorter than the texture (None if even two cannot). `SNAKESKIN_TILE_BUDGET_MIB` replaces both budgets (how the tests send small tiles
 /// through strips).
 fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Option<Strips> {
     let margin = graph.row_reach(maps, width);
@@ -458,6 +459,11 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
         // A strip with its margins must stay shorter than the texture.
         if rows + 2 * margin >= height {
             break;
+        }
+        // Every strip must hold rows: with `rows` per strip, `count` strips must not start
+        // one past the end (height 100 in 14 strips of 8 would put the last at row 104).
+        if rows * (count - 1) >= height {
+            continue;
         }
         best = Some(Strips { count, rows, margin });
         if fits(rows + 2 * margin) {
