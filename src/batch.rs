@@ -295,6 +295,10 @@ pub struct BatchIndex {
     /// `K/N`.
     pub shard: String,
     pub jobs: Vec<JobOutcome>,
+    /// How many jobs ran at once (`fitting_concurrency`); not written to the index, whose
+    /// bytes do not depend on it.
+    #[serde(skip)]
+    pub concurrency: usize,
 }
 
 /// The index file's name for a shard (`index.json` for an unsharded run).
@@ -407,50 +411,134 @@ fn request(job: &Job, out: &Path, outcome: &JobOutcome) -> GenerateRequest {
     }
 }
 
-/// Runs the shard's jobs in order; `progress(done, total, outcome)` after each job. Every
-/// job of the shard is planned first (preset loaded and validated, memory checked), so a bad
-/// job stops the run before any set is written, not in the middle of it.
+/// How many jobs `run` runs at once unless told: two, or one on a one-core machine. One
+/// job keeps both cores busy through its graph, but not through its start (preset, lattice
+/// set-up) and its end (the last PNG's compression, the manifest's hashes): two jobs fill
+/// each other's gaps (measured in BENCHMARKS.md, "Batch throughput").
+pub fn default_concurrency() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get()).min(2)
+}
+
+/// At most this many jobs at once (`--concurrent`).
+pub const MAX_CONCURRENCY: usize = 16;
+
+/// The most jobs that may run at once: at most `requested`, and only as many as the largest
+/// estimates (`Plan`'s peak memory) fit in the available memory together; at least one (a
+/// job that does not fit alone was refused when it was planned).
+pub fn fitting_concurrency(requested: usize, mut estimates: Vec<u64>, available_bytes: u64) -> usize {
+    estimates.sort_unstable_by(|a, b| b.cmp(a));
+    let mut total = 0u64;
+    let mut fit = 0;
+    for e in estimates.iter().take(requested.max(1)) {
+        total = total.saturating_add(*e);
+        if total > available_bytes {
+            break;
+        }
+        fit += 1;
+    }
+    fit.max(1)
+}
+
+/// Runs the shard's jobs, up to `concurrency` at once (each job's graph still uses every
+/// core; bounded by memory: `fitting_concurrency`); `progress(done, total, outcome)` as each
+/// job finishes, in the order they finish. Every job of the shard is planned first (preset
+/// loaded and validated, memory checked), so a bad job stops the run before any set is
+/// written, not in the middle of it. A job that fails at run time stops the run: no new job
+/// starts, the running ones finish (each set is written atomically), and the first error is
+/// returned. The index lists the jobs in their order, whatever order they finished in, and
+/// the files are the same at any concurrency (every set's bytes are).
 pub fn run(
     jobs_file: &Path,
     jobs: &[Job],
     out: &Path,
     shard: Shard,
+    concurrency: usize,
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
     let (mine, resolved): (Vec<&Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
+    let mut estimates = Vec::new();
     for (job, r) in mine.iter().zip(&resolved) {
         if !r.done && r.outcome.duplicate_of.is_none() {
-            Plan::new(&request(job, out, &r.outcome))?;
+            estimates.push(Plan::new(&request(job, out, &r.outcome))?.memory().estimate_bytes);
         }
     }
-    let mut outcomes = Vec::with_capacity(mine.len());
-    for (k, (job, Resolved { mut outcome, done })) in mine.iter().zip(resolved).enumerate() {
-        if outcome.duplicate_of.is_some() {
-            // Its set is the earlier job's (in this shard or another).
-        } else if !done {
-            Plan::new(&request(job, out, &outcome))?.run(&|_, _| {})?;
-            outcome.status = "done";
-        } else {
-            // A run killed after committing this set but before removing its lock file left
-            // an empty `.NAME.lock` behind: taking the lock and letting it go removes it (and
-            // leaves the set alone; a set some other run holds is left as it is).
-            let _ = crate::export::SetLock::acquire(&out.join(&outcome.folder), &outcome.preset);
+    let concurrency =
+        fitting_concurrency(concurrency.clamp(1, MAX_CONCURRENCY), estimates, crate::memory::available_bytes());
+    let total = mine.len();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let work: Vec<(&Job, Resolved)> = mine.into_iter().zip(resolved).collect();
+    let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
+    let mut first_error = None;
+    std::thread::scope(|scope| {
+        let (sender, receiver) = std::sync::mpsc::channel::<(usize, Result<JobOutcome, Error>)>();
+        for _ in 0..concurrency.min(total) {
+            let sender = sender.clone();
+            let (work, next, stop) = (&work, &next, &stop);
+            scope.spawn(move || {
+                while !stop.load(std::sync::atomic::Ordering::SeqCst) {
+                    let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                    let Some((job, resolved)) = work.get(k) else { break };
+                    let result = run_one(job, resolved, out);
+                    if result.is_err() {
+                        stop.store(true, std::sync::atomic::Ordering::SeqCst);
+                    }
+                    if sender.send((k, result)).is_err() {
+                        break;
+                    }
+                }
+            });
         }
-        progress(k + 1, mine.len(), &outcome);
-        outcomes.push(outcome);
+        drop(sender);
+        let mut done = 0;
+        for (k, result) in receiver {
+            match result {
+                Ok(outcome) => {
+                    done += 1;
+                    progress(done, total, &outcome);
+                    finished[k] = Some(outcome);
+                }
+                Err(e) => {
+                    first_error.get_or_insert(e);
+                }
+            }
+        }
+    });
+    if let Some(e) = first_error {
+        return Err(e);
     }
+    let outcomes: Vec<JobOutcome> = finished.into_iter().flatten().collect();
     let index = BatchIndex {
         generator: "snakeskin".into(),
         generator_version: env!("CARGO_PKG_VERSION").into(),
         jobs_file: jobs_file.into(),
         shard: format!("{}/{}", shard.index, shard.count),
         jobs: outcomes,
+        concurrency,
     };
     let json = serde_json::to_vec_pretty(&index).map_err(|e| Error::Internal(format!("index: {e}")))?;
     crate::export::create_folder(out)?;
     write_file_atomically(&out.join(index_file_name(shard)), json)?;
     Ok(index)
+}
+
+/// One job: a duplicate's set is the earlier job's, a done job is left as it is, any other
+/// is generated.
+fn run_one(job: &Job, resolved: &Resolved, out: &Path) -> Result<JobOutcome, Error> {
+    let mut outcome = resolved.outcome.clone();
+    if outcome.duplicate_of.is_some() {
+        // Its set is the earlier job's (in this shard or another).
+    } else if !resolved.done {
+        Plan::new(&request(job, out, &outcome))?.run(&|_, _| {})?;
+        outcome.status = "done";
+    } else {
+        // A run killed after committing this set but before removing its lock file left an
+        // empty `.NAME.lock` behind: taking the lock and letting it go removes it (and leaves
+        // the set alone; a set some other run holds is left as it is).
+        let _ = crate::export::SetLock::acquire(&out.join(&outcome.folder), &outcome.preset);
+    }
+    Ok(outcome)
 }
 
 #[cfg(test)]
@@ -462,6 +550,21 @@ mod tests {
         let path = dir.path().join("jobs.toml");
         std::fs::write(&path, text).unwrap();
         load_jobs(&path)
+    }
+
+    #[test]
+    fn jobs_run_at_once_only_as_far_as_the_largest_fit_in_memory_together() {
+        // Estimates 5, 4, 3, 1 (any order): 2 at once need 9, 3 need 12.
+        let estimates = vec![3, 5, 1, 4];
+        assert_eq!(fitting_concurrency(2, estimates.clone(), 100), 2);
+        assert_eq!(fitting_concurrency(8, estimates.clone(), 100), 4);
+        assert_eq!(fitting_concurrency(3, estimates.clone(), 11), 2);
+        assert_eq!(fitting_concurrency(3, estimates.clone(), 9), 2);
+        assert_eq!(fitting_concurrency(3, estimates.clone(), 8), 1);
+        // A job that does not fit alone was refused when planned; the run still takes one.
+        assert_eq!(fitting_concurrency(2, estimates, 2), 1);
+        assert_eq!(fitting_concurrency(2, vec![], 0), 1);
+        assert_eq!(fitting_concurrency(0, vec![1, 1], 10), 1);
     }
 
     #[test]

@@ -61,7 +61,7 @@ fn jobs_file(dir: &Path, species: &[&str], seeds: &str, size: u32) -> PathBuf {
 }
 
 fn summary_counts(out: &std::process::Output) -> (usize, usize) {
-    // "40 jobs of 40 in shard 0/1: 33 run, 7 already done; index: …"
+    // "40 jobs of 40 in shard 0/1, up to 2 at once: 33 run, 7 already done; index: …"
     let text = stdout(out);
     let after = text.split(": ").nth(1).unwrap_or_else(|| panic!("no summary in {text:?}"));
     let numbers: Vec<usize> =
@@ -253,4 +253,30 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
         assert!(stderr(&out).contains("jobs 1 and 2 (snake) would both write"), "{}", stderr(&out));
     }
     assert!(!empty.exists());
+}
+
+#[test]
+fn jobs_run_at_once_write_the_files_and_the_index_of_jobs_run_one_at_a_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let species = ["natrix-natrix", "python-regius", "vipera-berus", "micrurus-diastema", "boa-constrictor"];
+    let jobs = jobs_file(dir.path(), &species, "[1, 2]", 48);
+    let (one, three) = (dir.path().join("one"), dir.path().join("three"));
+    for (out_dir, n) in [(&one, "1"), (&three, "3")] {
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--concurrent", n]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert_eq!(summary_counts(&out), (10, 0), "{}", stdout(&out));
+        assert!(stdout(&out).contains(&format!("up to {n} at once")), "{}", stdout(&out));
+    }
+    let (a, b) = (tree(&one), tree(&three));
+    assert_eq!(a.len(), b.len());
+    for (path, bytes) in &a {
+        assert!(b.get(path) == Some(bytes), "{} differs between 1 and 3 jobs at once", path.display());
+    }
+    // The index lists the jobs in their order, not in the order they finished.
+    let index = |d: &Path| std::fs::read(d.join("index.json")).unwrap();
+    assert!(index(&one) == index(&three), "the index depends on how many jobs ran at once");
+
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", one.to_str().unwrap(), "--concurrent", "17"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("1..=16") || stderr(&out).contains("16"), "{}", stderr(&out));
 }

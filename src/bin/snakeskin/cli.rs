@@ -234,6 +234,12 @@ pub struct BatchArgs {
     /// List the shard's jobs and whether each is done, without running any.
     #[arg(long)]
     pub list: bool,
+    /// How many jobs run at once, 1 to 16 (default: 2, or 1 on a one-core machine). Each job
+    /// still uses every core; running two fills the gaps at each job's start and end. Peak
+    /// memory is the sum of the running jobs' (fewer run at once if the largest jobs would
+    /// not fit in the available memory together). Files are the same at any value.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=16))]
+    pub concurrent: Option<u16>,
 }
 
 fn parse_shard(s: &str) -> Result<snakeskin::batch::Shard, String> {

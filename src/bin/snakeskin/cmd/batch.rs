@@ -1,4 +1,4 @@
-//! `snakeskin batch JOBS.toml -o DIR [--shard K/N] [--list]`: many sets, resumable, with a
+//! `snakeskin batch JOBS.toml -o DIR [--shard K/N] [--concurrent N] [--list]`: many sets, resumable, with a
 //! progress bar over jobs and one summary line.
 
 use anyhow::Result;
@@ -18,7 +18,8 @@ pub fn run(args: BatchArgs) -> Result<()> {
         return Ok(());
     }
     let bar = Progress::counting("{spinner} batch [{bar:30}] {pos}/{len} jobs {elapsed} {msg}");
-    let index = batch::run(&args.jobs, &jobs, &args.out, shard, &mut |done, total, outcome| {
+    let concurrency = args.concurrent.map_or_else(batch::default_concurrency, usize::from);
+    let index = batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut |done, total, outcome| {
         bar.update(done, total);
         bar.message(&format!("{} {}", outcome.status, outcome.folder.display()));
     })?;
@@ -28,10 +29,11 @@ pub fn run(args: BatchArgs) -> Result<()> {
     let skipped = index.jobs.len() - ran - duplicates;
     let duplicates = if duplicates > 0 { format!(", {duplicates} duplicates of another job") } else { String::new() };
     println!(
-        "{} jobs of {} in shard {}: {ran} run, {skipped} already done{duplicates}; index: {}",
+        "{} jobs of {} in shard {}, up to {} at once: {ran} run, {skipped} already done{duplicates}; index: {}",
         index.jobs.len(),
         jobs.len(),
         index.shard,
+        index.concurrency,
         path_line(&args.out.join(batch::index_file_name(shard)))
     );
     Ok(())
