@@ -90,26 +90,50 @@ struct Lobe {
     ms_scale: f32,
 }
 
-fn lobe_at(cos: f32, roughness: f32) -> Lobe {
+// The lobe table's cell at (mu, r): the indices of its lower corners (two vec4s per entry)
+// and the bilinear weights.
+struct LobeCell {
+    k00: u32,
+    k01: u32,
+    fx: f32,
+    fy: f32,
+}
+
+fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
     let x = clamp(cos, 0.0, 1.0) * f32(E1_MU - 1u);
     let y = clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
     let i = min(u32(x), E1_MU - 2u);
     let j = min(u32(y), E1_ROUGHNESS - 2u);
-    let fx = x - f32(i);
-    let fy = y - f32(j);
-    let k00 = 2u * (j * E1_MU + i);
-    let k01 = 2u * ((j + 1u) * E1_MU + i);
-    let a = mix(mix(lobe_table[k00], lobe_table[k00 + 2u], fx), mix(lobe_table[k01], lobe_table[k01 + 2u], fx), fy);
+    return LobeCell(2u * (j * E1_MU + i), 2u * ((j + 1u) * E1_MU + i), x - f32(i), y - f32(j));
+}
+
+fn lobe_at(cos: f32, roughness: f32) -> Lobe {
+    let c = lobe_cell(cos, roughness);
+    let a = mix(
+        mix(lobe_table[c.k00], lobe_table[c.k00 + 2u], c.fx),
+        mix(lobe_table[c.k01], lobe_table[c.k01 + 2u], c.fx),
+        c.fy,
+    );
     let b = mix(
-        mix(lobe_table[k00 + 1u], lobe_table[k00 + 3u], fx),
-        mix(lobe_table[k01 + 1u], lobe_table[k01 + 3u], fx),
-        fy,
+        mix(lobe_table[c.k00 + 1u], lobe_table[c.k00 + 3u], c.fx),
+        mix(lobe_table[c.k01 + 1u], lobe_table[c.k01 + 3u], c.fx),
+        c.fy,
     );
     return Lobe(a.x, a.yzw, b.xy, b.z);
 }
 
-// a(mu) = (1 - s(mu)) exp(-tau / cos_t(mu)): the light that reaches the base, s what the
-// rough lobe reflects (coupling).
+// cos_eff(mu, r): the cosine at which the light the rough top lets in crosses the pigment
+// layer, bilinear in the lobe table's fourth slot (this material's optics::brdf::path
+// table; PathTable::at_f32).
+fn path_cos_at(cos: f32, roughness: f32) -> f32 {
+    let c = lobe_cell(cos, roughness);
+    let lower = mix(lobe_table[c.k00 + 1u].w, lobe_table[c.k00 + 3u].w, c.fx);
+    let upper = mix(lobe_table[c.k01 + 1u].w, lobe_table[c.k01 + 3u].w, c.fx);
+    return mix(lower, upper, c.fy);
+}
+
+// a(mu) = (1 - s(mu)) exp(-tau / cos_eff(mu, r)): the light that reaches the base, s what
+// the rough lobe reflects (coupling).
 fn layered_entering(layers: Layers, cos: f32, s: vec3<f32>) -> vec3<f32> {
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
     let k = (1.0 - eta2) + eta2 * cos * cos;
@@ -118,9 +142,18 @@ fn layered_entering(layers: Layers, cos: f32, s: vec3<f32>) -> vec3<f32> {
     }
     var a = vec3<f32>(1.0) - s;
     if (HAS_ABSORPTION) {
-        a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) / max(sqrt(k), COS_MIN));
+        a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) / max(path_cos_at(cos, layers.roughness), COS_MIN));
     }
     return a;
+}
+
+// t1 = exp(-tau / cos_eff(1, r)): what the pigment layer lets through of the light the top
+// lets in at normal incidence (optics::brdf::layered::normal_transmittance).
+fn normal_transmittance(optical_depth: vec3<f32>, roughness: f32) -> vec3<f32> {
+    if (!HAS_ABSORPTION) {
+        return vec3<f32>(1.0);
+    }
+    return exp(-max(optical_depth, vec3<f32>(0.0)) / max(path_cos_at(1.0, roughness), COS_MIN));
 }
 
 // (n0/n2)^2 k_d a(mu_i) a(mu_o) / (pi (1 - k_d K)).
@@ -138,11 +171,11 @@ fn layered_ambient_diffuse(layers: Layers, cos_o: f32, s_o: vec3<f32>) -> vec3<f
     return layered_entering(layers, cos_o, s_o) * kd * layers.e / (vec3<f32>(1.0) - kd * layers.k);
 }
 
-// k_d = c / (exp(-tau) E + c K), at most 1: the base albedo that shows the visible diffuse
-// colour c (optics::brdf::layered::base_albedo).
-fn layered_base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, k: vec3<f32>, e: vec3<f32>) -> vec3<f32> {
+// k_d = c / (t1 E + c K), at most 1: the base albedo that shows the visible diffuse colour c
+// (optics::brdf::layered::base_albedo; t1 normal_transmittance).
+fn layered_base_albedo(colour: vec3<f32>, t1: vec3<f32>, k: vec3<f32>, e: vec3<f32>) -> vec3<f32> {
     let c = max(colour, vec3<f32>(0.0));
-    let denominator = exp(-max(optical_depth, vec3<f32>(0.0))) * e + c * k;
+    let denominator = t1 * e + c * k;
     return select(vec3<f32>(0.0), min(c / denominator, vec3<f32>(1.0)), denominator > vec3<f32>(0.0));
 }
 
@@ -150,10 +183,10 @@ fn layered_base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, k: vec3<f32>
 
 // The base albedo k_d behind a colour-map value (Model::base_albedo): the thesis reads the
 // map as k_d; the layered model as the visible diffuse colour, inverted through the stack.
-fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, k: vec3<f32>, e: vec3<f32>) -> vec3<f32> {
+fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, roughness: f32, k: vec3<f32>, e: vec3<f32>) -> vec3<f32> {
     switch BRDF_MODEL {
         case MODEL_LAYERED: {
-            return layered_base_albedo(colour, optical_depth, k, e);
+            return layered_base_albedo(colour, normal_transmittance(optical_depth, roughness), k, e);
         }
         case MODEL_THESIS: {
             return colour;

@@ -28,7 +28,8 @@ struct FilmInfo {
 // spectral-N: per band (centre nm, then linear-sRGB weights).
 @group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
 // The rough lobe's table (optics::brdf::energy, read by brdf.wgsl's lobe_at): per (mu, r)
-// entry, row-major by roughness, (E1, c1, c2, c3) then (w1, w2, 0, 0).
+// entry, row-major by roughness, (E1, c1, c2, c3) then (w1, w2, multiple-scatter scale,
+// cos_eff): the last is this material's optics::brdf::path table (brdf.wgsl's path_cos_at).
 @group(0) @binding(4) var<storage, read> lobe_table: array<vec4<f32>>;
 
 // Film colour at thickness d (nm) and incidence cosine c: the table's texel coordinates

@@ -38,7 +38,7 @@ fn layers_of(m: Material) -> Layers {
         ft,
     );
     let tau = scene.optical_depth.rgb;
-    let kd = base_albedo(m.albedo, tau, k, e);
+    let kd = base_albedo(m.albedo, tau, m.roughness, k, e);
     return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, tau, kd, k, e);
 }
 

@@ -54,8 +54,9 @@ pub struct Manifest {
 /// The colour map's convention, for the manifest: the visible colour, which the renderer
 /// inverts through the stack (`optics::brdf::layered::visible_colour`).
 pub const COLOR_MEANS: &str = "visible diffuse colour: the stack's diffuse reflectance at normal incidence per \
-     unit of light the top lets in, exp(-tau) k_d E / (1 - k_d K) (a glTF baseColor under a dielectric top); \
-     the layered model recovers the base albedo k_d = c / (exp(-tau) E + c K) per pixel, the thesis model \
+     unit of light the top lets in, t1 k_d E / (1 - k_d K) with t1 = exp(-tau / cos_eff(1, roughness)) the \
+     pigment layer's transmittance along the rough top's path (exp(-tau) under a smooth top) (a glTF baseColor \
+     under a dielectric top); the layered model recovers the base albedo k_d = c / (t1 E + c K) per pixel, the thesis model \
      reads the map as k_d itself";
 
 #[derive(Debug, Serialize)]

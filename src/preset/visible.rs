@@ -2,8 +2,8 @@
 //! skin (`optics::brdf::layered::visible_colour`: the stack's diffuse reflectance at normal
 //! incidence, per unit of light the top lets in), not the base albedo behind the film and
 //! the pigment layer; the renderer recovers the base albedo per pixel. A stack with
-//! absorption cannot show every colour: with k_d = 1 it shows exp(−τ) E / (1 − K) at most
-//! (0.07 for the thesis' τ = 0.6 over n2 = 2). Colours beyond that are clamped to it when
+//! absorption cannot show every colour: with k_d = 1 it shows t₁ E / (1 − K) at most
+//! (`layered::normal_transmittance`; 0.07 for the thesis' τ = 0.6 over n2 = 2 and a smooth top). Colours beyond that are clamped to it when
 //! the preset is loaded, and reported with the key, the line and the limit — never
 //! silently — so the maps, the renderer and any tool that reads the colour map agree.
 //!
@@ -13,6 +13,7 @@
 //! the map then agree.
 
 use super::schema::{Preset, Srgb8};
+use crate::optics::brdf::energy::E1_ROUGHNESS;
 use crate::optics::brdf::{Model, layered};
 use crate::render::engine::scene::LayerOptics;
 
@@ -54,11 +55,22 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
         return None;
     }
     let bounce = optics.bounce_grid(Model::Layered);
+    // Row j of every thickness's table is at roughness j / (E1_ROUGHNESS − 1).
+    let t1: Vec<[f64; 3]> = (0..E1_ROUGHNESS)
+        .map(|j| {
+            let roughness = j as f64 / (E1_ROUGHNESS - 1) as f64;
+            layered::normal_transmittance(optics.stack.n0, optics.stack.n2, roughness, optics.optical_depth)
+        })
+        .collect();
     Some([0, 1, 2].map(|c| {
         if optics.optical_depth[c] <= 0.0 {
             return 1.0;
         }
-        bounce.rows().map(|(k, e)| layered::visible_limit(optics.optical_depth[c], k[c], e[c])).fold(1.0, f64::min)
+        bounce
+            .rows()
+            .enumerate()
+            .map(|(row, (k, e))| layered::visible_limit(t1[row % E1_ROUGHNESS][c], k[c], e[c]))
+            .fold(1.0, f64::min)
     }))
 }
 

@@ -148,19 +148,27 @@ impl SmoothTop {
     /// K (sent back to the base per bounce) and E (escaping per bounce) per channel for
     /// optical depth τ per channel.
     pub fn k_e(&self, tau: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-        self.integrate(tau, |_, rb| rb)
+        self.integrate(tau, |_, rb| rb, |_, mu| mu)
     }
 
-    /// K = ∫ 2μ R(μ) exp(−2τ/μ) dμ and E = ∫ 2μ (1 − R(μ)) exp(−τ/μ) dμ over the nodes, with
-    /// `sent_back(node, R_b)` the probability a direction at that node is sent back down.
-    fn integrate(&self, tau: [f64; 3], sent_back: impl Fn(usize, [f64; 3]) -> [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    /// K = ∫ 2μ R(μ) exp(−2τ/μ) dμ and E = ∫ 2μ (1 − R(μ)) exp(−τ/μ_e) dμ over the nodes,
+    /// with `sent_back(node, R_b)` the probability a direction at that node is sent back
+    /// down and `escape_cos(node, μ)` the cosine μ_e of the escaping light's path (μ itself
+    /// under a smooth top).
+    fn integrate(
+        &self,
+        tau: [f64; 3],
+        sent_back: impl Fn(usize, [f64; 3]) -> [f64; 3],
+        escape_cos: impl Fn(usize, f64) -> f64,
+    ) -> ([f64; 3], [f64; 3]) {
         let (mut k, mut e) = ([0.0; 3], [0.0; 3]);
         for (node, &(mu, weight, rb)) in self.below.iter().enumerate() {
             let r = sent_back(node, rb);
+            let mu_e = escape_cos(node, mu);
             for c in 0..3 {
                 let tau = tau[c].max(0.0);
                 k[c] += weight * 2.0 * mu * r[c] * (-2.0 * tau / mu).exp();
-                e[c] += weight * 2.0 * mu * (1.0 - r[c]) * (-tau / mu).exp();
+                e[c] += weight * 2.0 * mu * (1.0 - r[c]) * (-tau / mu_e).exp();
             }
         }
         (k, e)
@@ -173,8 +181,23 @@ impl SmoothTop {
     /// is totally reflected. Row 0 is `k_e`
     /// (F(μo) = R_b(μ) by reciprocity of the lossless film); for τ = 0, K + E = 1 in every
     /// row, so the furnace holds.
+    ///
+    /// With absorption, light that escapes through the rough top crosses the pigment layer
+    /// on the way out as the light the top lets in does on the way in (reciprocity): E takes
+    /// exp(−τ / cos_eff(μo, r)) (`path`) where the smooth top has exp(−τ / μ), so that E is
+    /// the hemispherical escape of the model's own diffuse lobe. K keeps the smooth path.
     pub fn k_e_row(&self, tau: [f64; 3], row: usize) -> ([f64; 3], [f64; 3]) {
-        self.integrate(tau, |node, _| self.coupled[row][node])
+        let sent_back = |node: usize, _| self.coupled[row][node];
+        if row == 0 || tau.iter().all(|t| *t <= 0.0) {
+            return self.integrate(tau, sent_back, |_, mu| mu);
+        }
+        let (n0, n2) = (self.stack.n0, self.stack.n2);
+        let path = super::path::cached(n0, n2);
+        let r = row as f64 / (energy::E1_ROUGHNESS - 1) as f64;
+        self.integrate(tau, sent_back, |_, mu| {
+            let sin2_out = (n2 / n0) * (n2 / n0) * (1.0 - mu * mu);
+            if sin2_out < 1.0 { path.at((1.0 - sin2_out).sqrt(), r).max(super::COS_MIN) } else { mu }
+        })
     }
 
     /// `bounce_table(tau).at(roughness)` from the two rows it needs (`Layers::of_stack`, once

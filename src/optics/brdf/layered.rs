@@ -4,13 +4,15 @@
 //! ```text
 //! s(μ)   = E₁ ⟨F⟩ + (1 − E₁) ⟨F⟩ F(c₁)                 what the rough top reflects
 //! f_ms   = ms(μi) ms(μo)                                 its multiple scattering
-//! a(μ)   = (1 − s(μ)) exp(−τ / cos_t(μ))                light that enters and reaches the base
+//! a(μ)   = (1 − s(μ)) exp(−τ / cos_eff(μ, r))           light that enters and reaches the base
 //! f_diff = (n0/n2)² k_d a(μi) a(μo) / (π (1 − k_d K))
 //! ambient diffuse (sky along the normal) = a(μo) k_d E / (1 − k_d K)
 //! ```
 //!
 //! with ⟨F⟩ the film read at the lobe's microfacet angles and F(c₁) at the most grazing
-//! of them (`energy::top`; `Model::coupling` passes s in).
+//! of them (`energy::top`; `Model::coupling` passes s in), and cos_eff the cosine at which
+//! the light the rough top lets in crosses the pigment layer (`path`: Snell's cos_t at
+//! r = 0, more oblique as the top roughens).
 //!
 //! K and E (per channel, per material, per roughness, per film thickness) come with the
 //! layers (`Layers::of_stack`: the film seen from below, `exact::SmoothTop::bounce_table`;
@@ -25,10 +27,24 @@ use super::{Layers, Layers32, cos_transmitted};
 /// a(μ) per channel: the light from a direction at cosine `cos` that reaches the base,
 /// `s` what the rough lobe reflects there.
 fn entering(layers: &Layers, cos: f64, s: [f64; 3]) -> [f64; 3] {
-    let Some(cos_t) = cos_transmitted(layers.n0, layers.n2, cos) else {
+    if cos_transmitted(layers.n0, layers.n2, cos).is_none() {
         return [0.0; 3];
-    };
-    [0, 1, 2].map(|c| (1.0 - s[c]) * (-layers.optical_depth[c].max(0.0) / cos_t.max(super::COS_MIN)).exp())
+    }
+    if layers.optical_depth.iter().all(|t| *t <= 0.0) {
+        return s.map(|s| 1.0 - s);
+    }
+    let path_cos = super::path::with(layers.n0, layers.n2, |p| p.at(cos, layers.roughness)).max(super::COS_MIN);
+    [0, 1, 2].map(|c| (1.0 - s[c]) * (-layers.optical_depth[c].max(0.0) / path_cos).exp())
+}
+
+/// exp(−τ / cos_eff(1, r)) per channel: what the pigment layer lets through of the light
+/// the top lets in at normal incidence (`visible_colour`'s factor).
+pub fn normal_transmittance(n0: f64, n2: f64, roughness: f64, optical_depth: [f64; 3]) -> [f64; 3] {
+    if optical_depth.iter().all(|t| *t <= 0.0) {
+        return [1.0; 3];
+    }
+    let path_cos = super::path::with(n0, n2, |p| p.at(1.0, roughness)).max(super::COS_MIN);
+    optical_depth.map(|t| (-t.max(0.0) / path_cos).exp())
 }
 
 pub fn diffuse(layers: &Layers, cos_i: f64, cos_o: f64, f_i: [f64; 3], f_o: [f64; 3]) -> [f64; 3] {
@@ -54,8 +70,12 @@ fn entering_f32(layers: &Layers32, cos: f32, s: [f32; 3]) -> [f32; 3] {
     if k <= 0.0 {
         return [0.0; 3];
     }
-    let cos_t = k.sqrt().max(super::COS_MIN as f32);
-    [0, 1, 2].map(|c| (1.0 - s[c]) * (-layers.optical_depth[c].max(0.0) / cos_t).exp())
+    if layers.optical_depth.iter().all(|t| *t <= 0.0) {
+        return s.map(|s| 1.0 - s);
+    }
+    let path_cos = super::path::with(layers.n0 as f64, layers.n2 as f64, |p| p.at_f32(cos, layers.roughness))
+        .max(super::COS_MIN as f32);
+    [0, 1, 2].map(|c| (1.0 - s[c]) * (-layers.optical_depth[c].max(0.0) / path_cos).exp())
 }
 
 /// The f32 diffuse lobe, as `brdf.wgsl`'s `layered_diffuse`.
@@ -72,31 +92,33 @@ pub fn diffuse_f32(layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o
 /// stack's diffuse reflectance at normal incidence per unit of light the top lets in,
 ///
 /// ```text
-/// c = R_d(μ = 1) / (1 − s(1)) = exp(−τ) k_d E / (1 − k_d K)
+/// c = R_d(μ = 1) / (1 − s(1)) = t₁ k_d E / (1 − k_d K),   t₁ = exp(−τ / cos_eff(1, r))
 /// ```
 ///
-/// (`R_d` of `exact::SmoothTop::albedo`; τ along the normal; K and E the material's bounce
-/// terms at the pixel's roughness). It is what glTF's `baseColor` means under a dielectric
-/// top (the base weighted by what the top transmits), so a colour map is a base colour
-/// other tools read right. `base_albedo` inverts it per pixel.
-pub fn visible_colour(albedo: f64, optical_depth: f64, k: f64, e: f64) -> f64 {
+/// (`R_d` of `exact::SmoothTop::albedo`, where t₁ = exp(−τ); t₁ the pigment layer's
+/// transmittance along the path of the light the top lets in at normal incidence,
+/// `normal_transmittance`; K and E the material's bounce terms at the pixel's roughness).
+/// It is what glTF's `baseColor` means under a dielectric top (the base weighted by what the
+/// top transmits), so a colour map is a base colour other tools read right. `base_albedo`
+/// inverts it per pixel.
+pub fn visible_colour(albedo: f64, normal_transmittance: f64, k: f64, e: f64) -> f64 {
     let kd = albedo.clamp(0.0, 1.0);
-    (-optical_depth.max(0.0)).exp() * kd * e / (1.0 - kd * k)
+    normal_transmittance * kd * e / (1.0 - kd * k)
 }
 
-/// The brightest visible colour the stack can show (k_d = 1): exp(−τ) E / (1 − K). For a
-/// lossless stack (τ = 0) E = 1 − K and the limit is 1; absorption lowers it fast (the
-/// thesis stack, τ = 0.6: 0.07).
-pub fn visible_limit(optical_depth: f64, k: f64, e: f64) -> f64 {
-    visible_colour(1.0, optical_depth, k, e)
+/// The brightest visible colour the stack can show (k_d = 1): t₁ E / (1 − K). For a
+/// lossless stack (τ = 0) t₁ = 1, E = 1 − K and the limit is 1; absorption lowers it fast
+/// (the thesis stack, τ = 0.6: 0.07).
+pub fn visible_limit(normal_transmittance: f64, k: f64, e: f64) -> f64 {
+    visible_colour(1.0, normal_transmittance, k, e)
 }
 
 /// The base albedo k_d that shows the visible colour `colour`:
-/// k_d = c / (exp(−τ) E + c K), the closed-form inverse of `visible_colour`; colours beyond
+/// k_d = c / (t₁ E + c K), the closed-form inverse of `visible_colour`; colours beyond
 /// `visible_limit` give k_d = 1 (the limit); a stack that shows nothing (E = 0) gives 1 for
 /// any colour but black (its limit is 0), and black gives 0.
-pub fn base_albedo(colour: f64, optical_depth: f64, k: f64, e: f64) -> f64 {
+pub fn base_albedo(colour: f64, normal_transmittance: f64, k: f64, e: f64) -> f64 {
     let c = colour.max(0.0);
-    let denominator = (-optical_depth.max(0.0)).exp() * e + c * k;
+    let denominator = normal_transmittance * e + c * k;
     if denominator > 0.0 { (c / denominator).min(1.0) } else { 0.0 }
 }

@@ -27,6 +27,7 @@ pub mod energy;
 pub mod exact;
 pub mod ggx;
 pub mod layered;
+pub mod path;
 pub mod thesis;
 pub mod walk;
 
@@ -131,7 +132,8 @@ impl Model {
         match self {
             Model::Thesis => colour,
             Model::Layered => {
-                [0, 1, 2].map(|c| layered::base_albedo(colour[c], layers.optical_depth[c], layers.k[c], layers.e[c]))
+                let t1 = layered::normal_transmittance(layers.n0, layers.n2, layers.roughness, layers.optical_depth);
+                [0, 1, 2].map(|c| layered::base_albedo(colour[c], t1[c], layers.k[c], layers.e[c]))
             }
         }
     }

@@ -129,6 +129,12 @@ fn cross(a: V3, b: V3) -> V3 {
 /// visible normals", JCGT 7(4), listing 1): density D(m) max(0, w·m) / A(w). It holds for
 /// `w` below the horizon too (tested), which the height walk needs.
 fn sample_visible_normal(w: V3, alpha: f64, rng: &mut Rng) -> V3 {
+    let (u1, u2) = (rng.unit(), rng.unit());
+    visible_normal_at(w, alpha, u1, u2)
+}
+
+/// `sample_visible_normal` at the uniforms (u1, u2) (for quadratures).
+pub fn visible_normal_at(w: V3, alpha: f64, u1: f64, u2: f64) -> V3 {
     if alpha <= 0.0 {
         return [0.0, 0.0, 1.0];
     }
@@ -136,7 +142,6 @@ fn sample_visible_normal(w: V3, alpha: f64, rng: &mut Rng) -> V3 {
     let lensq = vh[0] * vh[0] + vh[1] * vh[1];
     let t1 = if lensq > 0.0 { [-vh[1] / lensq.sqrt(), vh[0] / lensq.sqrt(), 0.0] } else { [1.0, 0.0, 0.0] };
     let t2 = cross(vh, t1);
-    let (u1, u2) = (rng.unit(), rng.unit());
     let r = u1.sqrt();
     let phi = 2.0 * std::f64::consts::PI * u2;
     let p1 = r * phi.cos();
@@ -283,6 +288,53 @@ fn follow(wi: V3, layers: &Layers, film: &FilmTables, alpha: f64, c: usize, rng:
         }
     }
     Fate::Absorbed
+}
+
+/// The cosines, in the pigment layer, at which photons arriving from `wi` (unit, wi.z > 0)
+/// leave a rough top of GGX α between media n0 (above) and n2 (below) downward: the top
+/// walked alone as `follow` walks it (heights, visible normals, reflection or refraction at
+/// each microfacet, light reflected or refracted more than once followed), with the plain
+/// Fresnel reflectance of n0 | n2 at each microfacet. Photons reflected away are not listed.
+/// `path::PathTable` is built from these.
+pub fn transmitted_cosines(wi: V3, alpha: f64, n0: f64, n2: f64, photons: u64, seed: u64) -> Vec<f64> {
+    let reflectance = |n_from: f64, n_to: f64, cos: f64| {
+        let (rs, rp) = crate::optics::film::fresnel(n_from, n_to, cos.clamp(0.0, 1.0));
+        0.5 * (rs + rp)
+    };
+    let mut rng = Rng(seed);
+    let mut cosines = Vec::with_capacity(photons as usize);
+    for _ in 0..photons {
+        let (mut d, mut h, mut outside) = (wi.map(|v| -v), 1.0, true);
+        for _ in 0..MAX_EVENTS {
+            let u = rng.unit();
+            let next = if outside { next_height(d, h, alpha, u) } else { next_height(d.map(|v| -v), h, alpha, u) };
+            match next {
+                Some(next) => h = next,
+                None if outside => break,
+                None => {
+                    cosines.push(d[2].abs());
+                    break;
+                }
+            }
+            let m = if outside {
+                sample_visible_normal(d.map(|v| -v), alpha, &mut rng)
+            } else {
+                sample_visible_normal(d, alpha, &mut rng).map(|v| -v)
+            };
+            let cos = -dot(d, m);
+            let (r, eta) =
+                if outside { (reflectance(n0, n2, cos), n0 / n2) } else { (reflectance(n2, n0, cos), n2 / n0) };
+            match if rng.unit() < r { None } else { refract(d, m, eta) } {
+                None => d = reflect(d, m),
+                Some(t) => {
+                    d = t;
+                    outside = !outside;
+                    h = -h;
+                }
+            }
+        }
+    }
+    cosines
 }
 
 /// GGX α of the walk's top: 0 (a mirror, m = n) for roughness 0, else roughness² floored

@@ -73,12 +73,15 @@ struct FilmInfo {
 
 /// The rough lobe's table (`optics::brdf::energy`) as `film.wgsl`'s `lobe_table`: per (μ, r)
 /// entry, row-major by roughness, two vec4s: (E₁, c₁, c₂, c₃) and (w₁, w₂, multiple-scatter
-/// scale, 0).
-fn lobe_table() -> Vec<[f32; 4]> {
+/// scale, cos_eff), the last from the material's path table (`optics::brdf::path`, the same
+/// grid).
+fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
     let t = crate::optics::brdf::energy::tables();
+    let path = crate::optics::brdf::path::cached(stack.n0, stack.n2);
     (0..t.albedo.len())
         .flat_map(|k| {
-            [[t.albedo[k], t.cos[0][k], t.cos[1][k], t.cos[2][k]], [t.weight[0][k], t.weight[1][k], t.ms_scale[k], 0.0]]
+            let second = [t.weight[0][k], t.weight[1][k], t.ms_scale[k], path.cos_eff[k] as f32];
+            [[t.albedo[k], t.cos[0][k], t.cos[1][k], t.cos[2][k]], second]
         })
         .collect()
 }
@@ -164,7 +167,7 @@ impl FilmBinding {
             ..Default::default()
         });
         let band_buffer = buffer("film bands", bytemuck::cast_slice(&band_table), wgpu::BufferUsages::STORAGE);
-        let lobe_buffer = buffer("rough lobe", bytemuck::cast_slice(&lobe_table()), wgpu::BufferUsages::STORAGE);
+        let lobe_buffer = buffer("rough lobe", bytemuck::cast_slice(&lobe_table(stack)), wgpu::BufferUsages::STORAGE);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("film"),
             layout,
