@@ -122,10 +122,10 @@ fn lobe_at(cos: f32, roughness: f32) -> Lobe {
     return Lobe(a.x, a.yzw, b.xy, b.z);
 }
 
-// cos_eff(mu, r): the cosine at which the light the rough top lets in crosses the pigment
-// layer, bilinear in the lobe table's fourth slot (this material's optics::brdf::path
-// table; PathTable::at_f32).
-fn path_cos_at(cos: f32, roughness: f32) -> f32 {
+// cos_eff(mu, r) - cos_t(mu): how much more obliquely than Snell's law the light the rough
+// top lets in crosses the pigment layer, bilinear in the lobe table's fourth slot (this
+// material's optics::brdf::path table; PathTable::cos_eff_f32).
+fn path_delta_at(cos: f32, roughness: f32) -> f32 {
     let c = lobe_cell(cos, roughness);
     let lower = mix(lobe_table[c.k00 + 1u].w, lobe_table[c.k00 + 3u].w, c.fx);
     let upper = mix(lobe_table[c.k01 + 1u].w, lobe_table[c.k01 + 3u].w, c.fx);
@@ -142,7 +142,8 @@ fn layered_entering(layers: Layers, cos: f32, s: vec3<f32>) -> vec3<f32> {
     }
     var a = vec3<f32>(1.0) - s;
     if (HAS_ABSORPTION) {
-        a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) / max(path_cos_at(cos, layers.roughness), COS_MIN));
+        let path_cos = max(sqrt(k) + path_delta_at(cos, layers.roughness), COS_MIN);
+        a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) / path_cos);
     }
     return a;
 }
@@ -153,7 +154,7 @@ fn normal_transmittance(optical_depth: vec3<f32>, roughness: f32) -> vec3<f32> {
     if (!HAS_ABSORPTION) {
         return vec3<f32>(1.0);
     }
-    return exp(-max(optical_depth, vec3<f32>(0.0)) / max(path_cos_at(1.0, roughness), COS_MIN));
+    return exp(-max(optical_depth, vec3<f32>(0.0)) / max(1.0 + path_delta_at(1.0, roughness), COS_MIN));
 }
 
 // (n0/n2)^2 k_d a(mu_i) a(mu_o) / (pi (1 - k_d K)).

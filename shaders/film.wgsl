@@ -29,7 +29,8 @@ struct FilmInfo {
 @group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
 // The rough lobe's table (optics::brdf::energy, read by brdf.wgsl's lobe_at): per (mu, r)
 // entry, row-major by roughness, (E1, c1, c2, c3) then (w1, w2, multiple-scatter scale,
-// cos_eff): the last is this material's optics::brdf::path table (brdf.wgsl's path_cos_at).
+// cos_eff - cos_t): the last is this material's optics::brdf::path table (brdf.wgsl's
+// path_delta_at).
 @group(0) @binding(4) var<storage, read> lobe_table: array<vec4<f32>>;
 
 // Film colour at thickness d (nm) and incidence cosine c: the table's texel coordinates

@@ -477,6 +477,9 @@ pub fn run(
             let sender = sender.clone();
             let (work, next, stop) = (&work, &next, &stop);
             scope.spawn(move || {
+                // A job that panics stops the queue too (the panic reaches the caller when
+                // the scope ends).
+                let _stop_on_panic = StopOnPanic(stop);
                 while !stop.load(std::sync::atomic::Ordering::SeqCst) {
                     let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
                     let Some((job, resolved)) = work.get(k) else { break };
@@ -500,12 +503,15 @@ pub fn run(
                     finished[k] = Some(outcome);
                 }
                 Err(e) => {
-                    first_error.get_or_insert(e);
+                    // The error of the earliest job, whichever failed first.
+                    if first_error.as_ref().is_none_or(|(j, _)| k < *j) {
+                        first_error = Some((k, e));
+                    }
                 }
             }
         }
     });
-    if let Some(e) = first_error {
+    if let Some((_, e)) = first_error {
         return Err(e);
     }
     let outcomes: Vec<JobOutcome> = finished.into_iter().flatten().collect();
@@ -523,6 +529,17 @@ pub fn run(
     Ok(index)
 }
 
+/// Sets the flag when the thread unwinds (`run`'s workers).
+struct StopOnPanic<'a>(&'a std::sync::atomic::AtomicBool);
+
+impl Drop for StopOnPanic<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+    }
+}
+
 /// One job: a duplicate's set is the earlier job's, a done job is left as it is, any other
 /// is generated.
 fn run_one(job: &Job, resolved: &Resolved, out: &Path) -> Result<JobOutcome, Error> {
@@ -530,7 +547,9 @@ fn run_one(job: &Job, resolved: &Resolved, out: &Path) -> Result<JobOutcome, Err
     if outcome.duplicate_of.is_some() {
         // Its set is the earlier job's (in this shard or another).
     } else if !resolved.done {
-        Plan::new(&request(job, out, &outcome))?.run(&|_, _| {})?;
+        // Checked against the available memory with the other jobs when the run was planned
+        // (`fitting_concurrency`); the jobs running beside this one hold part of it now.
+        Plan::within_checked_budget(&request(job, out, &outcome))?.run(&|_, _| {})?;
         outcome.status = "done";
     } else {
         // A run killed after committing this set but before removing its lock file left an

@@ -88,6 +88,24 @@ impl Plan {
     /// Validates the request and estimates its peak memory; refuses a set whose estimate
     /// exceeds the memory available (`Error::Memory`, before any allocation).
     pub fn new(request: &GenerateRequest) -> Result<Plan, Error> {
+        let plan = Plan::unchecked(request)?;
+        let what = if plan.height == plan.size {
+            format!("--size {}", plan.size)
+        } else {
+            format!("--size {} ({} x {})", plan.size, plan.size, plan.height)
+        };
+        plan.memory.refuse_if_over(&what)?;
+        Ok(plan)
+    }
+
+    /// `new` without refusing a set whose estimate exceeds the memory available now: for a
+    /// batch, which checked its jobs against the available memory before any ran, and whose
+    /// other running jobs hold part of it when a later one starts.
+    pub fn within_checked_budget(request: &GenerateRequest) -> Result<Plan, Error> {
+        Plan::unchecked(request)
+    }
+
+    fn unchecked(request: &GenerateRequest) -> Result<Plan, Error> {
         let start = Instant::now();
         let size = check_size(request.size)?;
         let loaded = preset::load(&request.preset, &request.overrides, request.seed)?;
@@ -127,8 +145,6 @@ impl Plan {
             crate::memory::estimate_generate_bytes(&graph, &maps, size, height)
         };
         let memory = MemoryCheck::against_available(estimate);
-        let what = if height == size { format!("--size {size}") } else { format!("--size {size} ({size} x {height})") };
-        memory.refuse_if_over(&what)?;
         Ok(Plan { request: request.clone(), size, height, loaded, graph, maps, memory, start })
     }
 

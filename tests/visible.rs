@@ -186,3 +186,21 @@ fn the_visible_colour_is_the_rough_models_own_diffuse_reflectance_at_normal_inci
     }
     eprintln!("worst relative difference: {worst:.2e}");
 }
+
+/// The colour limit is taken over the roughnesses the roughness map can reach: a rougher top
+/// lets its light cross the pigment layer more obliquely and shows less, so a smooth preset
+/// is not clamped to what a rough one could show, and a rough one is clamped further.
+#[test]
+fn the_colour_limit_follows_the_roughness_the_preset_can_reach() {
+    let limit_at = |base: f64| {
+        let text = format!(
+            "{WHITE_UNDER_INK}\n[roughness]\nbase = {base}\nvariation = 0.0\nbetween_scales = 0.0\nkeel = 0.0\nper_scale = 0.0\n"
+        );
+        let source = PresetSource { name: "ink".into(), display: "ink.toml".into(), text };
+        visible_limit(&parse(&source, &[]).unwrap().preset).expect("an absorbing stack has a limit")
+    };
+    let (smooth, rough) = (limit_at(0.05), limit_at(0.9));
+    for c in 0..3 {
+        assert!(smooth[c] > 1.05 * rough[c], "channel {c}: smooth {smooth:?}, rough {rough:?}");
+    }
+}

@@ -291,6 +291,17 @@ pub fn height_range(preset: &Preset) -> (f32, f32) {
     (0.3, (0.6 + 0.3 * s.imbrication + keel + preset.height.grain) as f32)
 }
 
+/// The range the roughness map can take (`build_roughness`): the base less its variation and
+/// per-scale offset, up to the base plus every addition at its largest (the crevice and keel
+/// masks reach 1), within [0, 1] as the map is clamped.
+pub fn roughness_range(preset: &Preset) -> (f64, f64) {
+    let r = &preset.roughness;
+    let keel = if preset.scales.keeled { r.keel } else { 0.0 };
+    let lo = r.base - r.variation - r.per_scale;
+    let hi = r.base + r.variation + r.between_scales + keel + r.per_scale;
+    (lo.clamp(0.0, 1.0), hi.clamp(0.0, 1.0))
+}
+
 fn build_roughness(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
     let r = &preset.roughness;
     let (lo, hi) = ((r.base - r.variation) as f32, (r.base + r.variation) as f32);

@@ -47,7 +47,8 @@ impl ClampedColour {
 
 /// The brightest visible colour per channel (linear) of the preset's stack, or None when
 /// it is lossless (τ = 0 in every channel: every colour can be shown). The smallest over
-/// every film thickness and roughness, since both maps vary per pixel; 1 in a channel without
+/// every film thickness and the roughnesses the roughness map can take
+/// (`maps::roughness_range`), since both maps vary per pixel; 1 in a channel without
 /// absorption (its K + E = 1: exactly 1, not 1 up to rounding).
 pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
     let optics = LayerOptics::from_preset(preset);
@@ -55,10 +56,16 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
         return None;
     }
     let bounce = optics.bounce_grid(Model::Layered);
-    // Row j of every thickness's table is at roughness j / (E1_ROUGHNESS − 1).
+    // Row j of every thickness's table is at roughness j / (E1_ROUGHNESS − 1); the rows that
+    // bracket the roughness map's range are the ones a pixel's values come from (a rougher
+    // top shows less: its light crosses the pigment layer more obliquely, so the rows of
+    // roughness the map never reaches would clamp too hard).
+    let (lo, hi) = crate::maps::roughness_range(preset);
+    let steps = (E1_ROUGHNESS - 1) as f64;
+    let rows = (lo * steps).floor() as usize..=((hi * steps).ceil() as usize).min(E1_ROUGHNESS - 1);
     let t1: Vec<[f64; 3]> = (0..E1_ROUGHNESS)
         .map(|j| {
-            let roughness = j as f64 / (E1_ROUGHNESS - 1) as f64;
+            let roughness = j as f64 / steps;
             layered::normal_transmittance(optics.stack.n0, optics.stack.n2, roughness, optics.optical_depth)
         })
         .collect();
@@ -69,6 +76,7 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
         bounce
             .rows()
             .enumerate()
+            .filter(|(row, _)| rows.contains(&(row % E1_ROUGHNESS)))
             .map(|(row, (k, e))| layered::visible_limit(t1[row % E1_ROUGHNESS][c], k[c], e[c]))
             .fold(1.0, f64::min)
     }))

@@ -238,7 +238,7 @@ pub struct BatchArgs {
     /// still uses every core; running two fills the gaps at each job's start and end. Peak
     /// memory is the sum of the running jobs' (fewer run at once if the largest jobs would
     /// not fit in the available memory together). Files are the same at any value.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=16))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=snakeskin::batch::MAX_CONCURRENCY as i64))]
     pub concurrent: Option<u16>,
 }
 

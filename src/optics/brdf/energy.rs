@@ -219,20 +219,58 @@ pub fn tables() -> &'static Tables {
     })
 }
 
+/// A cell of the (μ, r) grid that the lobe tables and the path table (`path::PathTable`)
+/// share, entries row-major by roughness (index r_row × E1_MU + μ_node): the lower corner
+/// and the bilinear weights, as `brdf.wgsl`'s `lobe_cell`.
+#[derive(Debug, Clone, Copy)]
+pub struct GridCell<T> {
+    pub i: usize,
+    pub j: usize,
+    pub fx: T,
+    pub fy: T,
+}
+
+impl GridCell<f64> {
+    pub fn at(cos: f64, roughness: f64) -> GridCell<f64> {
+        let x = cos.clamp(0.0, 1.0) * (E1_MU - 1) as f64;
+        let y = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as f64;
+        let (i, j) = ((x as usize).min(E1_MU - 2), (y as usize).min(E1_ROUGHNESS - 2));
+        GridCell { i, j, fx: x - i as f64, fy: y - j as f64 }
+    }
+
+    /// Bilinear interpolation of a table of the grid.
+    pub fn bilinear(&self, table: &[f64]) -> f64 {
+        let at = |a: usize, b: usize| table[b * E1_MU + a];
+        let lower = at(self.i, self.j) * (1.0 - self.fx) + at(self.i + 1, self.j) * self.fx;
+        let upper = at(self.i, self.j + 1) * (1.0 - self.fx) + at(self.i + 1, self.j + 1) * self.fx;
+        lower * (1.0 - self.fy) + upper * self.fy
+    }
+}
+
+impl GridCell<f32> {
+    pub fn at(cos: f32, roughness: f32) -> GridCell<f32> {
+        let x = cos.clamp(0.0, 1.0) * (E1_MU - 1) as f32;
+        let y = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as f32;
+        let (i, j) = ((x as usize).min(E1_MU - 2), (y as usize).min(E1_ROUGHNESS - 2));
+        GridCell { i, j, fx: x - i as f32, fy: y - j as f32 }
+    }
+
+    /// Bilinear interpolation of a table of the grid.
+    pub fn bilinear(&self, table: &[f32]) -> f32 {
+        let at = |a: usize, b: usize| table[b * E1_MU + a];
+        let lower = at(self.i, self.j) * (1.0 - self.fx) + at(self.i + 1, self.j) * self.fx;
+        let upper = at(self.i, self.j + 1) * (1.0 - self.fx) + at(self.i + 1, self.j + 1) * self.fx;
+        lower * (1.0 - self.fy) + upper * self.fy
+    }
+}
+
 /// The lobe at (cos, r) by bilinear interpolation of the tables (as `brdf.wgsl`'s
 /// `lobe_at`), in f32: [E₁, c₁, c₂, c₃, w₁, w₂, multiple-scatter scale].
 pub fn lookup_f32(cos: f32, roughness: f32) -> [f32; 7] {
     let t = tables();
-    let x = cos.clamp(0.0, 1.0) * (E1_MU - 1) as f32;
-    let y = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as f32;
-    let (i, j) = ((x as usize).min(E1_MU - 2), (y as usize).min(E1_ROUGHNESS - 2));
-    let (fx, fy) = (x - i as f32, y - j as f32);
-    [&t.albedo, &t.cos[0], &t.cos[1], &t.cos[2], &t.weight[0], &t.weight[1], &t.ms_scale].map(|table| {
-        let at = |a: usize, b: usize| table[b * E1_MU + a];
-        let lower = at(i, j) * (1.0 - fx) + at(i + 1, j) * fx;
-        let upper = at(i, j + 1) * (1.0 - fx) + at(i + 1, j + 1) * fx;
-        lower * (1.0 - fy) + upper * fy
-    })
+    let cell = GridCell::<f32>::at(cos, roughness);
+    [&t.albedo, &t.cos[0], &t.cos[1], &t.cos[2], &t.weight[0], &t.weight[1], &t.ms_scale]
+        .map(|table| cell.bilinear(table))
 }
 
 /// What the rough top does by itself for light from a direction (per channel): the share

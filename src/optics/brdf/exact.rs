@@ -108,6 +108,9 @@ pub struct SmoothTop {
     pub thickness_nm: f64,
     /// (μ in the pigment layer, quadrature weight, colour of R_b(μ)).
     below: Vec<(f64, f64, [f64; 3])>,
+    /// Per node: the cosine outside (in n0) of a direction inside the escape cone, None
+    /// beyond it (totally reflected).
+    outside: Vec<Option<f64>>,
     /// Per roughness row, per node: the probability of being sent back down under the
     /// layered model's coupling (`k_e_row`).
     coupled: Vec<Vec<[f64; 3]>>,
@@ -122,17 +125,23 @@ impl SmoothTop {
             .map(|(mu, weight)| (mu, weight, reflectance(reversed(stack), thickness_nm, mu)))
             .collect();
         let (n0, n2) = (stack.n0, stack.n2);
+        let outside: Vec<Option<f64>> = below
+            .iter()
+            .map(|&(mu, _, _)| {
+                let sin2_out = (n2 / n0) * (n2 / n0) * (1.0 - mu * mu);
+                (sin2_out < 1.0).then(|| (1.0 - sin2_out).sqrt())
+            })
+            .collect();
         let coupled = (0..energy::E1_ROUGHNESS)
             .map(|row| {
                 let r = row as f64 / (energy::E1_ROUGHNESS - 1) as f64;
                 below
                     .iter()
-                    .map(|&(mu, _, rb)| {
-                        let sin2_out = (n2 / n0) * (n2 / n0) * (1.0 - mu * mu);
-                        if sin2_out >= 1.0 {
+                    .zip(&outside)
+                    .map(|(&(_, _, rb), mu_out)| {
+                        let Some(mu_out) = *mu_out else {
                             return [1.0; 3];
-                        }
-                        let mu_out = (1.0 - sin2_out).sqrt();
+                        };
                         if row == 0 {
                             // A mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
                             return rb;
@@ -142,7 +151,7 @@ impl SmoothTop {
                     .collect()
             })
             .collect();
-        SmoothTop { stack, thickness_nm, below, coupled }
+        SmoothTop { stack, thickness_nm, below, outside, coupled }
     }
 
     /// K (sent back to the base per bounce) and E (escaping per bounce) per channel for
@@ -191,12 +200,12 @@ impl SmoothTop {
         if row == 0 || tau.iter().all(|t| *t <= 0.0) {
             return self.integrate(tau, sent_back, |_, mu| mu);
         }
-        let (n0, n2) = (self.stack.n0, self.stack.n2);
-        let path = super::path::cached(n0, n2);
+        let path = super::path::cached(self.stack.n0, self.stack.n2);
         let r = row as f64 / (energy::E1_ROUGHNESS - 1) as f64;
-        self.integrate(tau, sent_back, |_, mu| {
-            let sin2_out = (n2 / n0) * (n2 / n0) * (1.0 - mu * mu);
-            if sin2_out < 1.0 { path.at((1.0 - sin2_out).sqrt(), r).max(super::COS_MIN) } else { mu }
+        self.integrate(tau, sent_back, |node, mu| match self.outside[node] {
+            // The direction inside is Snell's cos_t of the one outside.
+            Some(mu_out) => path.cos_eff(mu, mu_out, r),
+            None => mu,
         })
     }
 
@@ -207,9 +216,12 @@ impl SmoothTop {
         mix_rows(self.k_e_row(tau, i), self.k_e_row(tau, i + 1), f)
     }
 
-    /// `k_e_row` at every roughness row of the energy table: K and E are linear in r
-    /// between rows (E₁ is interpolated linearly in r), so interpolating these rows is exact;
-    /// the shader does that per pixel (`Scene.bounce`).
+    /// `k_e_row` at every roughness row of the energy table: K, and E without absorption,
+    /// are linear in r between rows (E₁ is interpolated linearly in r), so interpolating
+    /// these rows is exact for them; with absorption E's exp(−τ / cos_eff) is not linear in
+    /// r, and between rows the interpolated E departs slightly from the lobe's own escape
+    /// (on the rows they agree: tests/visible.rs). The shader interpolates per pixel
+    /// (`Scene.bounce`).
     pub fn bounce_table(&self, tau: [f64; 3]) -> BounceTable {
         BounceTable { rows: (0..energy::E1_ROUGHNESS).map(|row| self.k_e_row(tau, row)).collect() }
     }

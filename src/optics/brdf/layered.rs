@@ -27,13 +27,13 @@ use super::{Layers, Layers32, cos_transmitted};
 /// a(μ) per channel: the light from a direction at cosine `cos` that reaches the base,
 /// `s` what the rough lobe reflects there.
 fn entering(layers: &Layers, cos: f64, s: [f64; 3]) -> [f64; 3] {
-    if cos_transmitted(layers.n0, layers.n2, cos).is_none() {
+    let Some(cos_t) = cos_transmitted(layers.n0, layers.n2, cos) else {
         return [0.0; 3];
-    }
+    };
     if layers.optical_depth.iter().all(|t| *t <= 0.0) {
         return s.map(|s| 1.0 - s);
     }
-    let path_cos = super::path::with(layers.n0, layers.n2, |p| p.at(cos, layers.roughness)).max(super::COS_MIN);
+    let path_cos = super::path::with(layers.n0, layers.n2, |p| p.cos_eff(cos_t, cos, layers.roughness));
     [0, 1, 2].map(|c| (1.0 - s[c]) * (-layers.optical_depth[c].max(0.0) / path_cos).exp())
 }
 
@@ -43,7 +43,7 @@ pub fn normal_transmittance(n0: f64, n2: f64, roughness: f64, optical_depth: [f6
     if optical_depth.iter().all(|t| *t <= 0.0) {
         return [1.0; 3];
     }
-    let path_cos = super::path::with(n0, n2, |p| p.at(1.0, roughness)).max(super::COS_MIN);
+    let path_cos = super::path::with(n0, n2, |p| p.cos_eff(1.0, 1.0, roughness));
     optical_depth.map(|t| (-t.max(0.0) / path_cos).exp())
 }
 
@@ -73,8 +73,8 @@ fn entering_f32(layers: &Layers32, cos: f32, s: [f32; 3]) -> [f32; 3] {
     if layers.optical_depth.iter().all(|t| *t <= 0.0) {
         return s.map(|s| 1.0 - s);
     }
-    let path_cos = super::path::with(layers.n0 as f64, layers.n2 as f64, |p| p.at_f32(cos, layers.roughness))
-        .max(super::COS_MIN as f32);
+    let path_cos =
+        super::path::with(layers.n0 as f64, layers.n2 as f64, |p| p.cos_eff_f32(k.sqrt(), cos, layers.roughness));
     [0, 1, 2].map(|c| (1.0 - s[c]) * (-layers.optical_depth[c].max(0.0) / path_cos).exp())
 }
 
@@ -108,7 +108,7 @@ pub fn visible_colour(albedo: f64, normal_transmittance: f64, k: f64, e: f64) ->
 
 /// The brightest visible colour the stack can show (k_d = 1): t₁ E / (1 − K). For a
 /// lossless stack (τ = 0) t₁ = 1, E = 1 − K and the limit is 1; absorption lowers it fast
-/// (the thesis stack, τ = 0.6: 0.07).
+/// (the thesis stack under a smooth top, τ = 0.6: 0.07).
 pub fn visible_limit(normal_transmittance: f64, k: f64, e: f64) -> f64 {
     visible_colour(1.0, normal_transmittance, k, e)
 }

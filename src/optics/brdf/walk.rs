@@ -129,6 +129,10 @@ fn cross(a: V3, b: V3) -> V3 {
 /// visible normals", JCGT 7(4), listing 1): density D(m) max(0, w·m) / A(w). It holds for
 /// `w` below the horizon too (tested), which the height walk needs.
 fn sample_visible_normal(w: V3, alpha: f64, rng: &mut Rng) -> V3 {
+    // A mirror draws nothing (the walk's random streams are as they were).
+    if alpha <= 0.0 {
+        return [0.0, 0.0, 1.0];
+    }
     let (u1, u2) = (rng.unit(), rng.unit());
     visible_normal_at(w, alpha, u1, u2)
 }
@@ -234,104 +238,122 @@ fn follow(wi: V3, layers: &Layers, film: &FilmTables, alpha: f64, c: usize, rng:
     let Stack { n0, n2, .. } = film.stack;
     let tau = layers.optical_depth[c].max(0.0);
     let kd = layers.albedo[c].clamp(0.0, 1.0);
-    // Travel direction, height (in the frame of the side the photon is on: inside, the
-    // surface is walked mirrored, z → −z) and side.
-    let (mut d, mut h, mut outside) = (wi.map(|v| -v), 1.0, true);
-    let (mut entered, mut bounces) = (false, 0);
-    for event in 0..MAX_EVENTS {
+    let reflectance =
+        |outside: bool, cos: f64| FilmTables::lookup(if outside { &film.above } else { &film.below }, cos, c);
+    let mut photon = OnTop { d: wi.map(|v| -v), h: 1.0, outside: true, entered: false, scatterings: 0 };
+    let mut bounces = 0;
+    while photon.scatterings < MAX_EVENTS {
+        if walk_top(&mut photon, alpha, n0, n2, &reflectance, rng) == Some(Leaves::Up) {
+            return if photon.entered {
+                Fate::Diffuse(photon.d[2], bounces)
+            } else {
+                Fate::Specular(photon.scatterings)
+            };
+        }
+        if photon.scatterings >= MAX_EVENTS {
+            break;
+        }
+        // Down through the layer, the base, and up through the layer again: each traversal
+        // at its own cosine survives with exp(−τ/|μ|).
+        if rng.unit() >= (-tau / photon.d[2].abs()).exp() || rng.unit() >= kd {
+            return Fate::Absorbed;
+        }
+        bounces += 1;
+        // Lambertian: cos θ = √u, uniform azimuth.
+        let (u1, u2) = (rng.unit(), rng.unit());
+        let (cos, phi) = (u1.sqrt(), 2.0 * std::f64::consts::PI * u2);
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        if rng.unit() >= (-tau / cos.max(1e-300)).exp() {
+            return Fate::Absorbed;
+        }
+        // Back at the microsurface from below: mirrored, it starts from the top.
+        (photon.d, photon.h) = ([sin * phi.cos(), sin * phi.sin(), cos], 1.0);
+    }
+    Fate::Absorbed
+}
+
+/// A photon on the rough top: its travel direction, its height (in the frame of the side it
+/// is on: inside, the surface is walked mirrored, z → −z), its side, whether it has crossed
+/// the top yet, and how many microfacets it has met.
+struct OnTop {
+    d: V3,
+    h: f64,
+    outside: bool,
+    entered: bool,
+    scatterings: usize,
+}
+
+/// Where a photon leaves the rough top: up into n0, or down into the pigment layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Leaves {
+    Up,
+    Down,
+}
+
+/// Walks `photon` on the rough top (GGX α between n0 above and n2 below) until it leaves
+/// it, or None after `MAX_EVENTS` microfacets: at each intersection a visible normal is
+/// drawn, and `reflectance(outside, cos)` is the probability that the microfacet at cosine
+/// `cos` reflects it; otherwise it refracts to the other side, where the same surface is
+/// walked mirrored (Heitz et al. 2016's dielectric walk). `follow` and
+/// `transmitted_cosines` share it.
+fn walk_top(
+    photon: &mut OnTop,
+    alpha: f64,
+    n0: f64,
+    n2: f64,
+    reflectance: &dyn Fn(bool, f64) -> f64,
+    rng: &mut Rng,
+) -> Option<Leaves> {
+    while photon.scatterings < MAX_EVENTS {
         let u = rng.unit();
+        let OnTop { d, h, outside, .. } = *photon;
         let next = if outside { next_height(d, h, alpha, u) } else { next_height(d.map(|v| -v), h, alpha, u) };
         match next {
-            Some(next) => h = next,
-            None if outside => {
-                return if entered { Fate::Diffuse(d[2], bounces) } else { Fate::Specular(event) };
-            }
-            None => {
-                // Down through the layer, the base, and up through the layer again: each
-                // traversal at its own cosine survives with exp(−τ/|μ|).
-                if rng.unit() >= (-tau / d[2].abs()).exp() || rng.unit() >= kd {
-                    return Fate::Absorbed;
-                }
-                bounces += 1;
-                // Lambertian: cos θ = √u, uniform azimuth.
-                let (u1, u2) = (rng.unit(), rng.unit());
-                let (cos, phi) = (u1.sqrt(), 2.0 * std::f64::consts::PI * u2);
-                let sin = (1.0 - cos * cos).max(0.0).sqrt();
-                if rng.unit() >= (-tau / cos.max(1e-300)).exp() {
-                    return Fate::Absorbed;
-                }
-                // Back at the microsurface from below: mirrored, it starts from the top.
-                (d, h) = ([sin * phi.cos(), sin * phi.sin(), cos], 1.0);
-                continue;
-            }
+            Some(next) => photon.h = next,
+            None => return Some(if outside { Leaves::Up } else { Leaves::Down }),
         }
+        photon.scatterings += 1;
         // A microfacet facing the photon, drawn from the normals visible along −d: seen
-        // from below, the surface's own normals m visible along d, facing down as −m
-        // (Heitz et al. 2016's dielectric walk).
+        // from below, the surface's own normals m visible along d, facing down as −m.
         let m = if outside {
             sample_visible_normal(d.map(|v| -v), alpha, rng)
         } else {
             sample_visible_normal(d, alpha, rng).map(|v| -v)
         };
         let cos = -dot(d, m);
-        let r = FilmTables::lookup(if outside { &film.above } else { &film.below }, cos, c);
+        let r = reflectance(outside, cos);
         let eta = if outside { n0 / n2 } else { n2 / n0 };
         match if rng.unit() < r { None } else { refract(d, m, eta) } {
-            None => d = reflect(d, m),
+            None => photon.d = reflect(d, m),
             Some(t) => {
-                d = t;
-                outside = !outside;
-                entered = true;
+                photon.d = t;
+                photon.outside = !outside;
+                photon.entered = true;
                 // The other side's frame: heights mirror.
-                h = -h;
+                photon.h = -photon.h;
             }
         }
     }
-    Fate::Absorbed
+    None
 }
 
 /// The cosines, in the pigment layer, at which photons arriving from `wi` (unit, wi.z > 0)
 /// leave a rough top of GGX α between media n0 (above) and n2 (below) downward: the top
-/// walked alone as `follow` walks it (heights, visible normals, reflection or refraction at
-/// each microfacet, light reflected or refracted more than once followed), with the plain
-/// Fresnel reflectance of n0 | n2 at each microfacet. Photons reflected away are not listed.
-/// `path::PathTable` is built from these.
+/// walked alone as `follow` walks it (`walk_top`), with the plain Fresnel reflectance of
+/// n0 | n2 at each microfacet. Photons reflected away are not listed. `path::PathTable` is
+/// built from these.
 pub fn transmitted_cosines(wi: V3, alpha: f64, n0: f64, n2: f64, photons: u64, seed: u64) -> Vec<f64> {
-    let reflectance = |n_from: f64, n_to: f64, cos: f64| {
-        let (rs, rp) = crate::optics::film::fresnel(n_from, n_to, cos.clamp(0.0, 1.0));
+    let reflectance = |outside: bool, cos: f64| {
+        let (from, to) = if outside { (n0, n2) } else { (n2, n0) };
+        let (rs, rp) = crate::optics::film::fresnel(from, to, cos.clamp(0.0, 1.0));
         0.5 * (rs + rp)
     };
     let mut rng = Rng(seed);
     let mut cosines = Vec::with_capacity(photons as usize);
     for _ in 0..photons {
-        let (mut d, mut h, mut outside) = (wi.map(|v| -v), 1.0, true);
-        for _ in 0..MAX_EVENTS {
-            let u = rng.unit();
-            let next = if outside { next_height(d, h, alpha, u) } else { next_height(d.map(|v| -v), h, alpha, u) };
-            match next {
-                Some(next) => h = next,
-                None if outside => break,
-                None => {
-                    cosines.push(d[2].abs());
-                    break;
-                }
-            }
-            let m = if outside {
-                sample_visible_normal(d.map(|v| -v), alpha, &mut rng)
-            } else {
-                sample_visible_normal(d, alpha, &mut rng).map(|v| -v)
-            };
-            let cos = -dot(d, m);
-            let (r, eta) =
-                if outside { (reflectance(n0, n2, cos), n0 / n2) } else { (reflectance(n2, n0, cos), n2 / n0) };
-            match if rng.unit() < r { None } else { refract(d, m, eta) } {
-                None => d = reflect(d, m),
-                Some(t) => {
-                    d = t;
-                    outside = !outside;
-                    h = -h;
-                }
-            }
+        let mut photon = OnTop { d: wi.map(|v| -v), h: 1.0, outside: true, entered: false, scatterings: 0 };
+        if walk_top(&mut photon, alpha, n0, n2, &reflectance, &mut rng) == Some(Leaves::Down) {
+            cosines.push(photon.d[2].abs());
         }
     }
     cosines

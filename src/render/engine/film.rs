@@ -73,14 +73,15 @@ struct FilmInfo {
 
 /// The rough lobe's table (`optics::brdf::energy`) as `film.wgsl`'s `lobe_table`: per (μ, r)
 /// entry, row-major by roughness, two vec4s: (E₁, c₁, c₂, c₃) and (w₁, w₂, multiple-scatter
-/// scale, cos_eff), the last from the material's path table (`optics::brdf::path`, the same
-/// grid).
+/// scale, cos_eff − cos_t), the last from the material's path table (`optics::brdf::path`,
+/// the same grid). Filled for every material, absorbing or not: the window changes the
+/// absorption without a new film binding.
 fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
     let t = crate::optics::brdf::energy::tables();
     let path = crate::optics::brdf::path::cached(stack.n0, stack.n2);
     (0..t.albedo.len())
         .flat_map(|k| {
-            let second = [t.weight[0][k], t.weight[1][k], t.ms_scale[k], path.cos_eff[k] as f32];
+            let second = [t.weight[0][k], t.weight[1][k], t.ms_scale[k], path.delta_f32[k]];
             [[t.albedo[k], t.cos[0][k], t.cos[1][k], t.cos[2][k]], second]
         })
         .collect()

@@ -40,7 +40,11 @@ pub fn spawn_lut_worker() -> (Sender<LutJob>, Receiver<LutResult>) {
             while let Ok(newer) = lut_inbox.try_recv() {
                 job = newer;
             }
-            if lut_outbox.send((job.0, job.1, Lut::bake_default(job.0))).is_err() {
+            let lut = Lut::bake_default(job.0);
+            // The film binding also carries the indices' path table (`FilmBinding::new`):
+            // built here, off the render thread.
+            let _ = crate::optics::brdf::path::cached(job.0.n0, job.0.n2);
+            if lut_outbox.send((job.0, job.1, lut)).is_err() {
                 break;
             }
         }
