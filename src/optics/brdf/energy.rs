@@ -230,39 +230,31 @@ pub struct GridCell<T> {
     pub fy: T,
 }
 
-impl GridCell<f64> {
-    pub fn at(cos: f64, roughness: f64) -> GridCell<f64> {
-        let x = cos.clamp(0.0, 1.0) * (E1_MU - 1) as f64;
-        let y = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as f64;
-        let (i, j) = ((x as usize).min(E1_MU - 2), (y as usize).min(E1_ROUGHNESS - 2));
-        GridCell { i, j, fx: x - i as f64, fy: y - j as f64 }
-    }
+/// `GridCell::at` and `bilinear` for f64 (the reference side) and f32 (the shader's twin,
+/// in f32 arithmetic as the WGSL), written once.
+macro_rules! grid_cell_impl {
+    ($t:ty) => {
+        impl GridCell<$t> {
+            pub fn at(cos: $t, roughness: $t) -> GridCell<$t> {
+                let x = cos.clamp(0.0, 1.0) * (E1_MU - 1) as $t;
+                let y = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as $t;
+                let (i, j) = ((x as usize).min(E1_MU - 2), (y as usize).min(E1_ROUGHNESS - 2));
+                GridCell { i, j, fx: x - i as $t, fy: y - j as $t }
+            }
 
-    /// Bilinear interpolation of a table of the grid.
-    pub fn bilinear(&self, table: &[f64]) -> f64 {
-        let at = |a: usize, b: usize| table[b * E1_MU + a];
-        let lower = at(self.i, self.j) * (1.0 - self.fx) + at(self.i + 1, self.j) * self.fx;
-        let upper = at(self.i, self.j + 1) * (1.0 - self.fx) + at(self.i + 1, self.j + 1) * self.fx;
-        lower * (1.0 - self.fy) + upper * self.fy
-    }
+            /// Bilinear interpolation of a table of the grid.
+            pub fn bilinear(&self, table: &[$t]) -> $t {
+                let at = |a: usize, b: usize| table[b * E1_MU + a];
+                let lower = at(self.i, self.j) * (1.0 - self.fx) + at(self.i + 1, self.j) * self.fx;
+                let upper = at(self.i, self.j + 1) * (1.0 - self.fx) + at(self.i + 1, self.j + 1) * self.fx;
+                lower * (1.0 - self.fy) + upper * self.fy
+            }
+        }
+    };
 }
 
-impl GridCell<f32> {
-    pub fn at(cos: f32, roughness: f32) -> GridCell<f32> {
-        let x = cos.clamp(0.0, 1.0) * (E1_MU - 1) as f32;
-        let y = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as f32;
-        let (i, j) = ((x as usize).min(E1_MU - 2), (y as usize).min(E1_ROUGHNESS - 2));
-        GridCell { i, j, fx: x - i as f32, fy: y - j as f32 }
-    }
-
-    /// Bilinear interpolation of a table of the grid.
-    pub fn bilinear(&self, table: &[f32]) -> f32 {
-        let at = |a: usize, b: usize| table[b * E1_MU + a];
-        let lower = at(self.i, self.j) * (1.0 - self.fx) + at(self.i + 1, self.j) * self.fx;
-        let upper = at(self.i, self.j + 1) * (1.0 - self.fx) + at(self.i + 1, self.j + 1) * self.fx;
-        lower * (1.0 - self.fy) + upper * self.fy
-    }
-}
+grid_cell_impl!(f64);
+grid_cell_impl!(f32);
 
 /// The lobe at (cos, r) by bilinear interpolation of the tables (as `brdf.wgsl`'s
 /// `lobe_at`), in f32: [E₁, c₁, c₂, c₃, w₁, w₂, multiple-scatter scale].
