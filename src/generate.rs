@@ -88,7 +88,7 @@ impl Plan {
     /// Validates the request and estimates its peak memory; refuses a set whose estimate
     /// exceeds the memory available (`Error::Memory`, before any allocation).
     pub fn new(request: &GenerateRequest) -> Result<Plan, Error> {
-        let plan = Plan::unchecked(request)?;
+        let plan = Plan::within_checked_budget(request)?;
         let what = if plan.height == plan.size {
             format!("--size {}", plan.size)
         } else {
@@ -102,10 +102,6 @@ impl Plan {
     /// batch, which checked its jobs against the available memory before any ran, and whose
     /// other running jobs hold part of it when a later one starts.
     pub fn within_checked_budget(request: &GenerateRequest) -> Result<Plan, Error> {
-        Plan::unchecked(request)
-    }
-
-    fn unchecked(request: &GenerateRequest) -> Result<Plan, Error> {
         let start = Instant::now();
         let size = check_size(request.size)?;
         let loaded = preset::load(&request.preset, &request.overrides, request.seed)?;

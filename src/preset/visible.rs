@@ -63,10 +63,10 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
     let (lo, hi) = crate::maps::roughness_range(preset);
     let steps = (E1_ROUGHNESS - 1) as f64;
     let rows = (lo * steps).floor() as usize..=((hi * steps).ceil() as usize).min(E1_ROUGHNESS - 1);
-    let t1: Vec<[f64; 3]> = (0..E1_ROUGHNESS)
+    let t1: Vec<(usize, [f64; 3])> = rows
         .map(|j| {
             let roughness = j as f64 / steps;
-            layered::normal_transmittance(optics.stack.n0, optics.stack.n2, roughness, optics.optical_depth)
+            (j, layered::normal_transmittance(optics.stack.n0, optics.stack.n2, roughness, optics.optical_depth))
         })
         .collect();
     Some([0, 1, 2].map(|c| {
@@ -74,10 +74,10 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
             return 1.0;
         }
         bounce
-            .rows()
-            .enumerate()
-            .filter(|(row, _)| rows.contains(&(row % E1_ROUGHNESS)))
-            .map(|(row, (k, e))| layered::visible_limit(t1[row % E1_ROUGHNESS][c], k[c], e[c]))
+            .tables
+            .iter()
+            .flat_map(|table| t1.iter().map(move |(j, t1)| (t1[c], table.rows[*j])))
+            .map(|(t1, (k, e))| layered::visible_limit(t1, k[c], e[c]))
             .fold(1.0, f64::min)
     }))
 }

@@ -30,21 +30,25 @@ fn entering(layers: &Layers, cos: f64, s: [f64; 3]) -> [f64; 3] {
     let Some(cos_t) = cos_transmitted(layers.n0, layers.n2, cos) else {
         return [0.0; 3];
     };
-    if layers.optical_depth.iter().all(|t| *t <= 0.0) {
-        return s.map(|s| 1.0 - s);
-    }
-    let path_cos = super::path::with(layers.n0, layers.n2, |p| p.cos_eff(cos_t, cos, layers.roughness));
-    [0, 1, 2].map(|c| (1.0 - s[c]) * (-layers.optical_depth[c].max(0.0) / path_cos).exp())
+    let t = path_transmittance(layers.n0, layers.n2, layers.roughness, layers.optical_depth, cos_t, cos);
+    [0, 1, 2].map(|c| (1.0 - s[c]) * t[c])
 }
 
-/// exp(−τ / cos_eff(1, r)) per channel: what the pigment layer lets through of the light
-/// the top lets in at normal incidence (`visible_colour`'s factor).
-pub fn normal_transmittance(n0: f64, n2: f64, roughness: f64, optical_depth: [f64; 3]) -> [f64; 3] {
+/// exp(−τ / cos_eff(μ, r)) per channel: what the pigment layer lets through of the light the
+/// top lets in from a direction at cosine `cos` above, `cos_t` its Snell cosine below (1
+/// without absorption, where the path table is not read).
+fn path_transmittance(n0: f64, n2: f64, roughness: f64, optical_depth: [f64; 3], cos_t: f64, cos: f64) -> [f64; 3] {
     if optical_depth.iter().all(|t| *t <= 0.0) {
         return [1.0; 3];
     }
-    let path_cos = super::path::with(n0, n2, |p| p.cos_eff(1.0, 1.0, roughness));
+    let path_cos = super::path::with(n0, n2, |p| p.cos_eff(cos_t, cos, roughness));
     optical_depth.map(|t| (-t.max(0.0) / path_cos).exp())
+}
+
+/// `path_transmittance` at normal incidence, t₁ = exp(−τ / cos_eff(1, r)) per channel
+/// (`visible_colour`'s factor).
+pub fn normal_transmittance(n0: f64, n2: f64, roughness: f64, optical_depth: [f64; 3]) -> [f64; 3] {
+    path_transmittance(n0, n2, roughness, optical_depth, 1.0, 1.0)
 }
 
 pub fn diffuse(layers: &Layers, cos_i: f64, cos_o: f64, f_i: [f64; 3], f_o: [f64; 3]) -> [f64; 3] {
