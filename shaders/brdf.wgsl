@@ -79,16 +79,21 @@ fn thesis_ambient_diffuse(layers: Layers, cos_o: f32, f_o: vec3<f32>) -> vec3<f3
 
 // ---- The layered model (optics::brdf::layered). ----
 
-// The rough lobe at (mu, r), bilinear in the film bind group's lobe_table
-// (optics::brdf::energy::lookup_f32): its albedo E1 for F = 1, the three-point Gauss rule
-// over its microfacet cosines, and its multiple-scatter scale.
-struct Lobe {
-    albedo: f32,
-    cos: vec3<f32>,
-    // The third weight is 1 minus these two.
-    weight: vec2<f32>,
-    ms_scale: f32,
+// What the top does by itself for light from a direction (energy::Top): the share it
+// reflects (the diffuse lobe lets 1 minus this in, the ambient mirror term is the sky times
+// this), the amplitude of its multiple-scatter lobe, f_ms = ms_i ms_o, and how much more
+// obliquely than Snell's law the light it lets in crosses the pigment layer (cos_eff -
+// cos_t, path_delta_at; 0 for the thesis model, which reads cos_t).
+struct Top {
+    reflected: vec3<f32>,
+    ms: vec3<f32>,
+    path_delta: f32,
 }
+
+// The rough lobe's table (the film bind group's lobe_table, optics::brdf::energy::node):
+// per (mu, r) node two vec4s, (E1, c1, c2, c3) and (w1, w2, multiple-scatter scale, path
+// delta): its albedo for F = 1, the three-point Gauss rule over its microfacet cosines (the
+// third weight is 1 minus the other two), and the pigment layer's path (path_delta_at).
 
 // The lobe table's cell at (mu, r): the indices of its lower corners (two vec4s per entry)
 // and the bilinear weights.
@@ -107,21 +112,6 @@ fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
     return LobeCell(2u * (j * E1_MU + i), 2u * ((j + 1u) * E1_MU + i), x - f32(i), y - f32(j));
 }
 
-fn lobe_at(cos: f32, roughness: f32) -> Lobe {
-    let c = lobe_cell(cos, roughness);
-    let a = mix(
-        mix(lobe_table[c.k00], lobe_table[c.k00 + 2u], c.fx),
-        mix(lobe_table[c.k01], lobe_table[c.k01 + 2u], c.fx),
-        c.fy,
-    );
-    let b = mix(
-        mix(lobe_table[c.k00 + 1u], lobe_table[c.k00 + 3u], c.fx),
-        mix(lobe_table[c.k01 + 1u], lobe_table[c.k01 + 3u], c.fx),
-        c.fy,
-    );
-    return Lobe(a.x, a.yzw, b.xy, b.z);
-}
-
 // cos_eff(mu, r) - cos_t(mu): how much more obliquely than Snell's law the light the rough
 // top lets in crosses the pigment layer, bilinear in the lobe table's fourth slot (this
 // material's optics::brdf::path table; PathTable::cos_eff_f32).
@@ -133,16 +123,16 @@ fn path_delta_at(cos: f32, roughness: f32) -> f32 {
 }
 
 // a(mu) = (1 - s(mu)) exp(-tau / cos_eff(mu, r)): the light that reaches the base, s what
-// the rough lobe reflects (coupling).
-fn layered_entering(layers: Layers, cos: f32, s: vec3<f32>) -> vec3<f32> {
+// the rough lobe reflects and cos_eff - cos_t its path delta (the top at mu: coupling).
+fn layered_entering(layers: Layers, cos: f32, top: Top) -> vec3<f32> {
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
     let k = (1.0 - eta2) + eta2 * cos * cos;
     if (k <= 0.0) {
         return vec3<f32>(0.0);
     }
-    var a = vec3<f32>(1.0) - s;
+    var a = vec3<f32>(1.0) - top.reflected;
     if (HAS_ABSORPTION) {
-        let path_cos = max(sqrt(k) + path_delta_at(cos, layers.roughness), COS_MIN);
+        let path_cos = max(sqrt(k) + top.path_delta, COS_MIN);
         a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) / path_cos);
     }
     return a;
@@ -157,19 +147,30 @@ fn normal_transmittance(optical_depth: vec3<f32>, roughness: f32) -> vec3<f32> {
     return exp(-max(optical_depth, vec3<f32>(0.0)) / max(1.0 + path_delta_at(1.0, roughness), COS_MIN));
 }
 
-// (n0/n2)^2 k_d a(mu_i) a(mu_o) / (pi (1 - k_d K)).
-fn layered_diffuse(layers: Layers, cos_i: f32, cos_o: f32, s_i: vec3<f32>, s_o: vec3<f32>) -> vec3<f32> {
+// (n0/n2)^2 k_d a(mu_i) a(mu_o) / (pi (1 - k_d K)), the two paths through the pigment layer
+// in one exponential (layered::diffuse_f32), with the tops at mu_i and mu_o (coupling).
+fn layered_diffuse(layers: Layers, cos_i: f32, cos_o: f32, top_i: Top, top_o: Top) -> vec3<f32> {
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    let k_i = (1.0 - eta2) + eta2 * cos_i * cos_i;
+    let k_o = (1.0 - eta2) + eta2 * cos_o * cos_o;
+    if (!(k_i > 0.0 && k_o > 0.0)) {
+        return vec3<f32>(0.0);
+    }
     let kd = clamp(layers.albedo, vec3<f32>(0.0), vec3<f32>(1.0));
-    let a = layered_entering(layers, cos_i, s_i) * layered_entering(layers, cos_o, s_o);
+    var a = (vec3<f32>(1.0) - top_i.reflected) * (vec3<f32>(1.0) - top_o.reflected);
+    if (HAS_ABSORPTION) {
+        let inverse_path = 1.0 / max(sqrt(k_i) + top_i.path_delta, COS_MIN)
+            + 1.0 / max(sqrt(k_o) + top_o.path_delta, COS_MIN);
+        a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) * inverse_path);
+    }
     return eta2 * kd * a / (PI * (vec3<f32>(1.0) - kd * layers.k));
 }
 
 // a(mu_o) k_d E / (1 - k_d K): the directional diffuse reflectance, by reciprocity the
 // response to a uniform sky.
-fn layered_ambient_diffuse(layers: Layers, cos_o: f32, s_o: vec3<f32>) -> vec3<f32> {
+fn layered_ambient_diffuse(layers: Layers, cos_o: f32, top_o: Top) -> vec3<f32> {
     let kd = clamp(layers.albedo, vec3<f32>(0.0), vec3<f32>(1.0));
-    return layered_entering(layers, cos_o, s_o) * kd * layers.e / (vec3<f32>(1.0) - kd * layers.k);
+    return layered_entering(layers, cos_o, top_o) * kd * layers.e / (vec3<f32>(1.0) - kd * layers.k);
 }
 
 // k_d = c / (t1 E + c K), at most 1: the base albedo that shows the visible diffuse colour c
@@ -198,63 +199,86 @@ fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, roughness: f32, k: v
     }
 }
 
-// What the top does by itself for light from a direction (energy::Top): the share it
-// reflects (the diffuse lobe lets 1 minus this in, the ambient mirror term is the sky times
-// this) and the amplitude of its multiple-scatter lobe, f_ms = ms_i ms_o.
-struct Top {
-    reflected: vec3<f32>,
-    ms: vec3<f32>,
+// The rule on one roughness row (energy::top_on_row): the lobe's entries k and k + 2 (two
+// vec4s each) mixed by fx, then E1 times the film over the lobe's microfacet angles
+// (three-point Gauss rule) plus the multiple scattering (1 - E1) <F> F(c1).
+fn top_on_row(layers: Layers, k: u32, fx: f32) -> Top {
+    let a = mix(lobe_table[k], lobe_table[k + 2u], fx);
+    let b = mix(lobe_table[k + 1u], lobe_table[k + 3u], fx);
+    let f1 = film_clamped(layers, a.y);
+    let f2 = film_clamped(layers, a.z);
+    let f3 = film_clamped(layers, a.w);
+    let mean = b.x * f1 + b.y * f2 + (1.0 - b.x - b.y) * f3;
+    let g = mean * f1;
+    return Top(a.x * mean + (1.0 - a.x) * g, b.z * sqrt(g), 0.0);
+}
+
+// The layered coupling from the film table's coupling texture (optics::lut::Lut::
+// coupling_f32): the rule on the lobe's roughness rows at the table's cos texels and
+// thickness columns, two filtered fetches at the texel coordinates (cos, roughness,
+// thickness).
+fn coupling_table(layers: Layers, cos: f32) -> Top {
+    let n_cos = f32(film_info.n_cos);
+    let x = clamp(cos, 0.0, 1.0) * (n_cos - 1.0);
+    let rows = f32(E1_ROUGHNESS);
+    let v = (clamp(layers.roughness, 0.0, 1.0) * (rows - 1.0) + 0.5) / rows;
+    let w = (lut_column(layers.thickness_nm) + 0.5) / f32(film_info.n_fine + film_info.n_coarse);
+    let s = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5) / (2.0 * n_cos), v, w), 0.0);
+    let ms = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5 + n_cos) / (2.0 * n_cos), v, w), 0.0);
+    return Top(s.rgb, ms.rgb, s.a);
 }
 
 // The top at cosine `cos` (Model::coupling). The thesis: the film F(cos), no multiple
-// scattering; the layered model: E1 times the film at the lobe's microfacet angles
-// (three-point Gauss rule) plus the multiple scattering (1 - E1) <F> F(c1).
+// scattering; the layered model: the rule on the two roughness rows around the roughness,
+// mixed (energy::top), baked with the table for the LUT film method (coupling_table),
+// evaluated here for the direct methods.
 fn coupling(layers: Layers, cos: f32) -> Top {
     switch BRDF_MODEL {
         case MODEL_LAYERED: {
-            let l = lobe_at(cos, layers.roughness);
-            let f1 = film_clamped(layers, l.cos.x);
-            let f2 = film_clamped(layers, l.cos.y);
-            let f3 = film_clamped(layers, l.cos.z);
-            let mean = l.weight.x * f1 + l.weight.y * f2 + (1.0 - l.weight.x - l.weight.y) * f3;
-            let g = mean * f1;
-            return Top(l.albedo * mean + (1.0 - l.albedo) * g, l.ms_scale * sqrt(g));
+            if (FILM_METHOD == FILM_LUT) {
+                return coupling_table(layers, cos);
+            }
+            let c = lobe_cell(cos, layers.roughness);
+            let lower = top_on_row(layers, c.k00, c.fx);
+            let upper = top_on_row(layers, c.k01, c.fx);
+            let delta = path_delta_at(cos, layers.roughness);
+            return Top(mix(lower.reflected, upper.reflected, c.fy), mix(lower.ms, upper.ms, c.fy), delta);
         }
         case MODEL_THESIS: {
-            return Top(film_clamped(layers, cos), vec3<f32>(0.0));
+            return Top(film_clamped(layers, cos), vec3<f32>(0.0), 0.0);
         }
         default: {
-            return Top(film_clamped(layers, cos), vec3<f32>(0.0));
+            return Top(film_clamped(layers, cos), vec3<f32>(0.0), 0.0);
         }
     }
 }
 
-fn diffuse_lobe(layers: Layers, cos_i: f32, cos_o: f32, s_i: vec3<f32>, s_o: vec3<f32>) -> vec3<f32> {
+fn diffuse_lobe(layers: Layers, cos_i: f32, cos_o: f32, top_i: Top, top_o: Top) -> vec3<f32> {
     switch BRDF_MODEL {
         case MODEL_LAYERED: {
-            return layered_diffuse(layers, cos_i, cos_o, s_i, s_o);
+            return layered_diffuse(layers, cos_i, cos_o, top_i, top_o);
         }
         case MODEL_THESIS: {
-            return thesis_diffuse(layers, cos_i, cos_o, s_i, s_o);
+            return thesis_diffuse(layers, cos_i, cos_o, top_i.reflected, top_o.reflected);
         }
         default: {
-            return thesis_diffuse(layers, cos_i, cos_o, s_i, s_o);
+            return thesis_diffuse(layers, cos_i, cos_o, top_i.reflected, top_o.reflected);
         }
     }
 }
 
-// The ambient term's diffuse part towards a view at cosine cos_o, s_o = coupling there
+// The ambient term's diffuse part towards a view at cosine cos_o, top_o = coupling there
 // (Model::ambient_diffuse): multiplies the sky radiance along the normal.
-fn ambient_diffuse(layers: Layers, cos_o: f32, s_o: vec3<f32>) -> vec3<f32> {
+fn ambient_diffuse(layers: Layers, cos_o: f32, top_o: Top) -> vec3<f32> {
     switch BRDF_MODEL {
         case MODEL_LAYERED: {
-            return layered_ambient_diffuse(layers, cos_o, s_o);
+            return layered_ambient_diffuse(layers, cos_o, top_o);
         }
         case MODEL_THESIS: {
-            return thesis_ambient_diffuse(layers, cos_o, s_o);
+            return thesis_ambient_diffuse(layers, cos_o, top_o.reflected);
         }
         default: {
-            return thesis_ambient_diffuse(layers, cos_o, s_o);
+            return thesis_ambient_diffuse(layers, cos_o, top_o.reflected);
         }
     }
 }
@@ -303,7 +327,7 @@ fn skin_brdf_seen(
         let top_i = coupling(layers, cos_i);
         result += top_i.ms * top_o.ms;
         if (with_diffuse) {
-            result += diffuse_lobe(layers, cos_i, cos_o, top_i.reflected, top_o.reflected);
+            result += diffuse_lobe(layers, cos_i, cos_o, top_i, top_o);
         }
     }
     return result;

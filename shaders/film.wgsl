@@ -27,25 +27,36 @@ struct FilmInfo {
 @group(0) @binding(3) var lut_sampler: sampler;
 // spectral-N: per band (centre nm, then linear-sRGB weights).
 @group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
-// The rough lobe's table (optics::brdf::energy, read by brdf.wgsl's lobe_at): per (mu, r)
-// entry, row-major by roughness, (E1, c1, c2, c3) then (w1, w2, multiple-scatter scale,
+// The rough lobe's table (optics::brdf::energy::node, read by brdf.wgsl's top_on_row): per
+// (mu, r) entry, row-major by roughness, (E1, c1, c2, c3) then (w1, w2, multiple-scatter scale,
 // cos_eff - cos_t): the last is this material's optics::brdf::path table (brdf.wgsl's
 // path_delta_at).
 @group(0) @binding(4) var<storage, read> lobe_table: array<vec4<f32>>;
+// The layered model's coupling baked with the table (optics::lut::Lut::coupling): x = cos
+// texel, the reflected share and the path delta (as lobe_table's fourth slot) in the first
+// n_cos texels and the multiple-scatter amplitude in the next n_cos; y = the rough lobe's roughness row (E1_ROUGHNESS); z = thickness
+// texel, as the table's columns. Half floats, read with the same sampler
+// (brdf.wgsl's coupling_table).
+@group(0) @binding(5) var coupling_texture: texture_3d<f32>;
 
-// Film colour at thickness d (nm) and incidence cosine c: the table's texel coordinates
-// as in optics::lut::Lut::lookup_f32, then one filtered fetch at those coordinates.
-fn film_lut(thickness_nm: f32, cos0: f32) -> vec3<f32> {
+// The table's continuous thickness texel of d (nm), as optics::lut::Lut::column_f32.
+fn lut_column(thickness_nm: f32) -> f32 {
     let d = max(thickness_nm, 0.0);
     let n_fine = f32(film_info.n_fine);
-    let w = n_fine + f32(film_info.n_coarse);
     var x: f32;
     if (d <= FINE_MAX_NM) {
         x = d * ((n_fine - 1.0) / FINE_MAX_NM);
     } else {
         x = (n_fine - 1.0) + (d - FINE_MAX_NM) * (f32(film_info.n_coarse) / (COARSE_MAX_NM - FINE_MAX_NM));
     }
-    x = min(x, w - 1.0);
+    return min(x, n_fine + f32(film_info.n_coarse) - 1.0);
+}
+
+// Film colour at thickness d (nm) and incidence cosine c: the table's texel coordinates
+// as in optics::lut::Lut::lookup_f32, then one filtered fetch at those coordinates.
+fn film_lut(thickness_nm: f32, cos0: f32) -> vec3<f32> {
+    let w = f32(film_info.n_fine + film_info.n_coarse);
+    let x = lut_column(thickness_nm);
     let h = f32(film_info.n_cos);
     let y = clamp(cos0, 0.0, 1.0) * (h - 1.0);
     return textureSampleLevel(lut_texture, lut_sampler, vec2<f32>((x + 0.5) / w, (y + 0.5) / h), 0.0).rgb;

@@ -47,10 +47,10 @@ fn layers_of(m: Material) -> Layers {
 // the rough top's reflected share for the layered model, its multiple scattering taken
 // along the mirror too); the sky seen along the normal goes through
 // the layer model (brdf.wgsl's ambient_diffuse).
-fn ambient(layers: Layers, n: vec3<f32>, wo: vec3<f32>, s_o: vec3<f32>, with_diffuse: bool) -> vec3<f32> {
-    var result = sky(reflect(-wo, n)) * s_o;
+fn ambient(layers: Layers, n: vec3<f32>, wo: vec3<f32>, top_o: Top, with_diffuse: bool) -> vec3<f32> {
+    var result = sky(reflect(-wo, n)) * top_o.reflected;
     if (with_diffuse) {
-        result += sky(n) * ambient_diffuse(layers, max(dot(n, wo), COS_MIN), s_o);
+        result += sky(n) * ambient_diffuse(layers, max(dot(n, wo), COS_MIN), top_o);
     }
     return result;
 }
@@ -80,7 +80,7 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
             radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * f * cos_i;
         }
     }
-    return radiance + ambient(layers, m.normal, wo, top_o.reflected, STAGE == STAGE_ALL);
+    return radiance + ambient(layers, m.normal, wo, top_o, STAGE == STAGE_ALL);
 }
 
 fn map_view(m: Material) -> vec3<f32> {

@@ -287,3 +287,57 @@ fn the_renderer_keeps_the_furnace_across_the_thickness_range() {
         assert!(flat_70 > 0.03, "{stack:?} {range:?}: the middle thickness alone gave {flat_70}");
     }
 }
+
+/// The worst difference between the LUT's coupling table and the rule it tabulates
+/// (`energy::top_f32` with the film read from the same LUT), over `count` deterministic
+/// points (cosine, roughness, and a thickness from `thickness_nm`), in the reflected share
+/// and in the multiple-scatter amplitude.
+fn coupling_table_deviation(
+    lut: &Lut,
+    count: i32,
+    thickness_nm: impl Fn(f32) -> f32,
+    cos: impl Fn(f32) -> f32,
+) -> (f32, f32) {
+    let (mut reflected, mut amplitude) = (0.0f32, 0.0f32);
+    for i in 0..count {
+        let u = |k: u32| snakeskin::ops::hash::unit(i, 0, k, 23);
+        let (d, cos, r) = (thickness_nm(u(0)), cos(u(1)), u(2));
+        let film = |c: f32| lut.lookup_f32(d, c.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
+        let rule = snakeskin::optics::brdf::energy::top_f32(cos, r, &film);
+        let (table, _) = lut.coupling_f32(d, cos, r);
+        for c in 0..3 {
+            reflected = reflected.max((table.reflected[c] - rule.reflected[c]).abs());
+            amplitude = amplitude.max((table.ms_amplitude[c] - rule.ms_amplitude[c]).abs());
+        }
+    }
+    (reflected, amplitude)
+}
+
+#[test]
+fn coupling_table_is_the_rule_it_tabulates() {
+    // On a cos texel of a thickness column the table holds the rule's result and
+    // interpolates between roughness rows as the rule does: the same up to f32 rounding, at
+    // any roughness. Between texels and columns it interpolates the results where the rule
+    // interpolates the lobe and the film (the rule is linear in neither): the reflected
+    // share within 0.005 everywhere (measured ≤ 0.0024 on the four materials, 20,000 points
+    // each), the multiple-scatter amplitude within 0.005 for cos ≥ 0.1 and 0.03 below,
+    // where it rises steeply to ~1.6 at grazing (measured ≤ 0.0045 and ≤ 0.02).
+    for stack in GRID_MATERIALS {
+        let lut = Lut::bake(stack, 64, 256, 64);
+        let fine_step = 2000.0 / 255.0;
+        let on_column = |u: f32| (u * 255.0).floor() * fine_step;
+        let on_texel = |u: f32| (u * 63.0).floor() / 63.0;
+        let (reflected, amplitude) = coupling_table_deviation(&lut, 5_000, on_column, on_texel);
+        assert!(reflected < 2e-6 && amplitude < 2e-6, "{stack:?} on texels: {reflected} {amplitude}");
+        let (reflected, amplitude) = coupling_table_deviation(&lut, 20_000, |u| 3000.0 * u, |u| 0.1 + 0.9 * u);
+        assert!(reflected < 0.005 && amplitude < 0.005, "{stack:?}, cos ≥ 0.1: {reflected} {amplitude}");
+        let (reflected, amplitude) = coupling_table_deviation(&lut, 20_000, |u| 3000.0 * u, |u| 0.1 * u);
+        assert!(reflected < 0.005 && amplitude < 0.03, "{stack:?}, cos < 0.1: {reflected} {amplitude}");
+    }
+    // Negative control: a table whose roughness rows are shifted by one is caught.
+    let mut lut = Lut::bake(Stack::THESIS, 64, 256, 64);
+    let rows = snakeskin::optics::brdf::energy::E1_MU;
+    lut.coupling.rotate_left(rows);
+    let (reflected, _) = coupling_table_deviation(&lut, 5_000, |u| 3000.0 * u, |u| u);
+    assert!(reflected > 0.01, "shifted rows not caught: {reflected}");
+}

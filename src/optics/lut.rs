@@ -8,8 +8,23 @@
 //! thick films already hold the washed-out colour and a lookup can never alias: no moiré at
 //! 2.4 mm (the thesis' Fig. 5.9) or any other thickness. Cos θ axis: `n_cos` texels uniform
 //! over [0, 1].
+//!
+//! **The rough top's coupling, tabulated.** The layered model reads, per direction, what the
+//! rough top reflects (`brdf::energy::top`): the rule on the two roughness rows of the lobe
+//! around the roughness, each three film lookups, six where the thesis model makes one.
+//! Baked with the table on its cos texels, the same rows and its thickness columns, it is
+//! one trilinear fetch (`coupling_f32`; in the shader one filtered 3-D texture fetch per
+//! quantity) that interpolates between rows as the rule does; between cos texels and
+//! thickness columns it interpolates the results where the rule interpolates the lobe and
+//! the film (`tests/brdf.rs` bounds the difference). The f32 twin and the shader read it;
+//! the f64 model evaluates the rule.
 
 use rayon::prelude::*;
+
+use std::sync::{Arc, OnceLock};
+
+use crate::optics::brdf::energy::{self, E1_ROUGHNESS};
+use crate::optics::brdf::path::{self, PathTable};
 
 use super::film::{Stack, airy};
 use super::series::FilmSeries;
@@ -20,11 +35,21 @@ pub const COARSE_MAX_NM: f64 = 20_000.0;
 
 #[derive(Debug, Clone)]
 pub struct Lut {
+    /// The material the table was baked for.
+    pub stack: Stack,
     pub n_cos: usize,
     pub n_fine: usize,
     pub n_coarse: usize,
     /// Row-major: `texels[i_cos * width + i_d]`, linear sRGB reflectance.
     pub texels: Vec<[f32; 3]>,
+    /// The rough top's coupling at the texels' cos nodes, the rough lobe's roughness rows
+    /// and the texels' thickness columns (`bake_coupling`): per entry the reflected share
+    /// (RGB), the pigment layer's path delta (cos_eff − cos_t, `brdf::path`), the
+    /// multiple-scatter amplitude (RGB) and 0 — the two RGBA texels of the shader's
+    /// `coupling_texture` — index `(i_d * E1_ROUGHNESS + i_r) * n_cos + i_cos`.
+    pub coupling: Vec<[f32; 8]>,
+    /// The material's path table (`brdf::path`), fetched on first use (`path`).
+    path: OnceLock<Arc<PathTable>>,
 }
 
 /// Table size chosen from the error/size trade-off measured by `snakeskin bench irid`
@@ -55,7 +80,15 @@ impl Lut {
 
     /// Bakes the table for one material (parallel over angles).
     pub fn bake(stack: Stack, n_cos: usize, n_fine: usize, n_coarse: usize) -> Lut {
-        let mut lut = Lut { n_cos: n_cos.max(2), n_fine: n_fine.max(2), n_coarse: n_coarse.max(1), texels: Vec::new() };
+        let mut lut = Lut {
+            stack,
+            n_cos: n_cos.max(2),
+            n_fine: n_fine.max(2),
+            n_coarse: n_coarse.max(1),
+            texels: Vec::new(),
+            coupling: Vec::new(),
+            path: OnceLock::new(),
+        };
         let width = lut.width();
         let rows: Vec<Vec<[f32; 3]>> = (0..lut.n_cos)
             .into_par_iter()
@@ -77,7 +110,91 @@ impl Lut {
             })
             .collect();
         lut.texels = rows.into_iter().flatten().collect();
+        lut.coupling = lut.bake_coupling();
         lut
+    }
+
+    /// The coupling table from the texels: at each cos texel, roughness row of the rough
+    /// lobe and thickness column, `energy::top_on_row_f32` with the film read along that
+    /// column (linear in cos, as the texture filter reads it), and the material's path
+    /// delta there (the same in every column). Parallel over columns.
+    pub fn bake_coupling(&self) -> Vec<[f32; 8]> {
+        let (w, n_cos) = (self.width(), self.n_cos);
+        let path = self.path();
+        let columns: Vec<Vec<[f32; 8]>> = (0..w)
+            .into_par_iter()
+            .map(|j| {
+                let film = |c: f32| {
+                    let y = c.clamp(0.0, 1.0) * (n_cos - 1) as f32;
+                    let y0 = (y as usize).min(n_cos - 2);
+                    let fy = y - y0 as f32;
+                    let (a, b) = (self.texels[y0 * w + j], self.texels[(y0 + 1) * w + j]);
+                    [0, 1, 2].map(|k| (a[k] + (b[k] - a[k]) * fy).clamp(0.0, 1.0))
+                };
+                let mut column = Vec::with_capacity(E1_ROUGHNESS * n_cos);
+                for i_r in 0..E1_ROUGHNESS {
+                    for i_cos in 0..n_cos {
+                        let cos = i_cos as f32 / (n_cos - 1) as f32;
+                        let top = energy::top_on_row_f32(cos, i_r, &film);
+                        let (s, m) = (top.reflected, top.ms_amplitude);
+                        let r = i_r as f32 / (E1_ROUGHNESS - 1) as f32;
+                        let delta = energy::GridCell::<f32>::at(cos, r).bilinear(&path.delta_f32);
+                        column.push([s[0], s[1], s[2], delta, m[0], m[1], m[2], 0.0]);
+                    }
+                }
+                column
+            })
+            .collect();
+        columns.into_iter().flatten().collect()
+    }
+
+    /// The thickness coordinate x (continuous texel column) of `thickness_nm`, in f32 as the
+    /// shader computes it.
+    #[inline]
+    fn column_f32(&self, thickness_nm: f32) -> f32 {
+        let d = thickness_nm.max(0.0);
+        let fine_step = (FINE_MAX_NM / (self.n_fine - 1) as f64) as f32;
+        let coarse_step = ((COARSE_MAX_NM - FINE_MAX_NM) / self.n_coarse as f64) as f32;
+        let x = if d <= FINE_MAX_NM as f32 {
+            d / fine_step
+        } else {
+            (self.n_fine - 1) as f32 + (d - FINE_MAX_NM as f32) / coarse_step
+        };
+        x.min((self.width() - 1) as f32)
+    }
+
+    /// What the rough top reflects at cosine `cos` and roughness `roughness` through the
+    /// film at `thickness_nm` (`energy::Top`), and the path delta there: the coupling table,
+    /// linear in cos between its texels, in roughness between the rows as
+    /// `energy::top_f32` interpolates them, and between thickness columns (one trilinear
+    /// fetch: `brdf.wgsl`'s `coupling_table`).
+    pub fn coupling_f32(&self, thickness_nm: f32, cos: f32, roughness: f32) -> (energy::Top<f32>, f32) {
+        let x = self.column_f32(thickness_nm);
+        let x0 = x as usize;
+        let (x1, fx) = ((x0 + 1).min(self.width() - 1), x - x0 as f32);
+        let y = cos.clamp(0.0, 1.0) * (self.n_cos - 1) as f32;
+        let y0 = (y as usize).min(self.n_cos - 2);
+        let fy = y - y0 as f32;
+        let z = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as f32;
+        let z0 = (z as usize).min(E1_ROUGHNESS - 2);
+        let fz = z - z0 as f32;
+        let mut v = [0.0f32; 8];
+        for (i_d, wx) in [(x0, 1.0 - fx), (x1, fx)] {
+            for (i_r, wz) in [(z0, 1.0 - fz), (z0 + 1, fz)] {
+                let k = (i_d * E1_ROUGHNESS + i_r) * self.n_cos + y0;
+                let (a, b) = (&self.coupling[k], &self.coupling[k + 1]);
+                for c in 0..8 {
+                    v[c] += wx * wz * (a[c] * (1.0 - fy) + b[c] * fy);
+                }
+            }
+        }
+        (energy::Top { reflected: [v[0], v[1], v[2]], ms_amplitude: [v[4], v[5], v[6]] }, v[3])
+    }
+
+    /// The material's path table (the pigment layer's path under the rough top), looked up
+    /// in the process-wide cache once per table (the coupling table carries its deltas).
+    pub fn path(&self) -> &PathTable {
+        self.path.get_or_init(|| path::cached(self.stack.n0, self.stack.n2))
     }
 
     pub fn bake_default(stack: Stack) -> Lut {
@@ -102,16 +219,8 @@ impl Lut {
     /// f32 bilinear lookup (the shader's texture fetch).
     #[inline]
     pub fn lookup_f32(&self, thickness_nm: f32, cos0: f32) -> [f32; 3] {
-        let d = thickness_nm.max(0.0);
-        let fine_step = (FINE_MAX_NM / (self.n_fine - 1) as f64) as f32;
-        let coarse_step = ((COARSE_MAX_NM - FINE_MAX_NM) / self.n_coarse as f64) as f32;
-        let x = if d <= FINE_MAX_NM as f32 {
-            d / fine_step
-        } else {
-            (self.n_fine - 1) as f32 + (d - FINE_MAX_NM as f32) / coarse_step
-        };
         let w = self.width();
-        let x = x.min((w - 1) as f32);
+        let x = self.column_f32(thickness_nm);
         let y = cos0.clamp(0.0, 1.0) * (self.n_cos - 1) as f32;
         let (x0, y0) = (x as usize, y as usize);
         let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(self.n_cos - 1));

@@ -643,11 +643,13 @@ pub enum BenchCommand {
     /// rough GGX top) on a fixed grid: the four PHYSICS.md materials, τ ∈ {0, 0.4, 1}, films
     /// of 250 and 650 nm, light at 0–85°, roughness 0.05–0.9, every species' base colours.
     /// Reports the reflected colour's ΔE00 (mean, p95, max), the white-furnace error and the
-    /// CPU cost per evaluation. Takes about a minute at the default photon count.
+    /// CPU cost per evaluation (inputs at random thicknesses, and the same sorted by
+    /// thickness as a frame reads them). Takes about a minute at the default photon count.
     Layered {
         /// Print JSON {"models": [{"name","mean_de","p95_de","max_de","max_furnace_err",
-        /// "max_furnace_err_to_70","ns_per_eval"}], "points", "photons_per_channel",
-        /// "reference_noise_mean_de", "reference_noise_max_de", "furnace"}.
+        /// "max_furnace_err_to_70","ns_per_eval","ns_per_eval_coherent"}], "points",
+        /// "photons_per_channel", "reference_noise_mean_de", "reference_noise_max_de",
+        /// "furnace"}.
         #[arg(long)]
         json: bool,
         /// Photons per channel per reference walk, 1000 to 10,000,000 (noise ∝ 1/√N; the

@@ -256,13 +256,12 @@ macro_rules! grid_cell_impl {
 grid_cell_impl!(f64);
 grid_cell_impl!(f32);
 
-/// The lobe at (cos, r) by bilinear interpolation of the tables (as `brdf.wgsl`'s
-/// `lobe_at`), in f32: [E₁, c₁, c₂, c₃, w₁, w₂, multiple-scatter scale].
-pub fn lookup_f32(cos: f32, roughness: f32) -> [f32; 7] {
+/// The lobe at node (i_mu, i_r) of the tables: [E₁, c₁, c₂, c₃, w₁, w₂, multiple-scatter
+/// scale] (two vec4s of `brdf.wgsl`'s `lobe_table`).
+pub fn node(i_mu: usize, i_r: usize) -> [f32; 7] {
     let t = tables();
-    let cell = GridCell::<f32>::at(cos, roughness);
-    [&t.albedo, &t.cos[0], &t.cos[1], &t.cos[2], &t.weight[0], &t.weight[1], &t.ms_scale]
-        .map(|table| cell.bilinear(table))
+    let k = i_r * E1_MU + i_mu;
+    [t.albedo[k], t.cos[0][k], t.cos[1][k], t.cos[2][k], t.weight[0][k], t.weight[1][k], t.ms_scale[k]]
 }
 
 /// What the rough top does by itself for light from a direction (per channel): the share
@@ -274,24 +273,54 @@ pub struct Top<T> {
     pub ms_amplitude: [T; 3],
 }
 
-/// `Top` of the rough lobe at cosine `cos` with the film `film` (its reflectance, clamped to
-/// [0, 1], as a function of the cosine), in f64.
-pub fn top(cos: f64, roughness: f64, film: &dyn Fn(f64) -> [f64; 3]) -> Top<f64> {
-    let [e1, c1, c2, c3, w1, w2, ms_scale] = lookup_f32(cos as f32, roughness as f32).map(f64::from);
-    let (f1, f2, f3) = (film(c1), film(c2), film(c3));
-    let mean = [0, 1, 2].map(|c| w1 * f1[c] + w2 * f2[c] + (1.0 - w1 - w2) * f3[c]);
-    let g = [0, 1, 2].map(|c| mean[c] * f1[c]);
-    Top { reflected: [0, 1, 2].map(|c| e1 * mean[c] + (1.0 - e1) * g[c]), ms_amplitude: g.map(|g| ms_scale * g.sqrt()) }
+/// The coupling on one roughness row and between rows, in f64 and f32 (the shader's twin),
+/// written once.
+///
+/// On a row the lobe's nodes and weights are interpolated in μ and the rule evaluated with
+/// them: on the mirror row that is the film at μ itself, whose curvature near grazing a
+/// linear interpolation of results would miss (the smooth furnace at 89° then loses 0.8 %).
+/// Between rows the rule's *results* are interpolated, not its nodes and weights: the rows
+/// differ in kind (the mirror row has one node of weight 1 at μ, the next two outer nodes
+/// of weight 0.03 and a centre one), and a rule with interpolated weights puts half its
+/// weight on an outer node and reads the grazing film 0.01–0.02 too dark. Interpolated
+/// results also tabulate: the film table's coupling texture holds the rows' results on its
+/// cos nodes and its filter does this interpolation (`optics::lut::Lut::coupling_f32`).
+macro_rules! top_impl {
+    ($t:ty, $on_row:ident, $top:ident) => {
+        /// The rule on roughness row `i_r` at cosine `cos`: E₁ times the film averaged
+        /// over the lobe's microfacet angles (three-point Gauss rule) plus the multiple
+        /// scattering (1 − E₁) ⟨F⟩ F(c₁), the lobe interpolated linearly in μ.
+        pub fn $on_row(cos: $t, i_r: usize, film: &dyn Fn($t) -> [$t; 3]) -> Top<$t> {
+            let cell = GridCell::<$t>::at(cos, 0.0);
+            let (lo, hi) = (node(cell.i, i_r), node(cell.i + 1, i_r));
+            let [e1, c1, c2, c3, w1, w2, ms_scale] =
+                [0, 1, 2, 3, 4, 5, 6].map(|k| lo[k] as $t * (1.0 - cell.fx) + hi[k] as $t * cell.fx);
+            let (f1, f2, f3) = (film(c1), film(c2), film(c3));
+            let mean = [0, 1, 2].map(|c| w1 * f1[c] + w2 * f2[c] + (1.0 - w1 - w2) * f3[c]);
+            let g = [0, 1, 2].map(|c| mean[c] * f1[c]);
+            Top {
+                reflected: [0, 1, 2].map(|c| e1 * mean[c] + (1.0 - e1) * g[c]),
+                ms_amplitude: g.map(|g| ms_scale * g.sqrt()),
+            }
+        }
+
+        /// `Top` of the rough lobe at cosine `cos` and roughness `roughness` with the film
+        /// `film` (its reflectance, clamped to [0, 1], as a function of the cosine): the
+        /// rule on the two roughness rows around `roughness`, interpolated linearly.
+        pub fn $top(cos: $t, roughness: $t, film: &dyn Fn($t) -> [$t; 3]) -> Top<$t> {
+            let cell = GridCell::<$t>::at(cos, roughness);
+            let (lower, upper) = ($on_row(cos, cell.j, film), $on_row(cos, cell.j + 1, film));
+            let mix = |a: $t, b: $t| a * (1.0 - cell.fy) + b * cell.fy;
+            Top {
+                reflected: [0, 1, 2].map(|k| mix(lower.reflected[k], upper.reflected[k])),
+                ms_amplitude: [0, 1, 2].map(|k| mix(lower.ms_amplitude[k], upper.ms_amplitude[k])),
+            }
+        }
+    };
 }
 
-/// The same in f32 (`brdf.wgsl`'s `coupling`).
-pub fn top_f32(cos: f32, roughness: f32, film: &dyn Fn(f32) -> [f32; 3]) -> Top<f32> {
-    let [e1, c1, c2, c3, w1, w2, ms_scale] = lookup_f32(cos, roughness);
-    let (f1, f2, f3) = (film(c1), film(c2), film(c3));
-    let mean = [0, 1, 2].map(|c| w1 * f1[c] + w2 * f2[c] + (1.0 - w1 - w2) * f3[c]);
-    let g = [0, 1, 2].map(|c| mean[c] * f1[c]);
-    Top { reflected: [0, 1, 2].map(|c| e1 * mean[c] + (1.0 - e1) * g[c]), ms_amplitude: g.map(|g| ms_scale * g.sqrt()) }
-}
+top_impl!(f64, top_on_row, top);
+top_impl!(f32, top_on_row_f32, top_f32);
 
 #[cfg(test)]
 mod tests {
@@ -308,7 +337,7 @@ mod tests {
         // half of them send normal light below the horizon).
         let r: Vec<f64> = [0.2, 0.4, 0.6, 0.8, 1.0].iter().map(|r| single_scatter_albedo(1.0, *r)).collect();
         assert!(r.windows(2).all(|w| w[1] < w[0]), "{r:?}");
-        assert!(lookup_f32(1.0, 0.0)[0] == 1.0 && (lookup_f32(1.0, 1.0)[0] as f64 - r[4]).abs() < 1e-6);
+        assert!(node(E1_MU - 1, 0)[0] == 1.0 && (node(E1_MU - 1, E1_ROUGHNESS - 1)[0] as f64 - r[4]).abs() < 1e-6);
     }
 
     #[test]
@@ -357,7 +386,8 @@ mod tests {
                             / n as f64
                     })
                     .sum();
-                let e1 = lookup_f32(mu_o as f32, r as f32)[0] as f64;
+                // With a constant film the rule is E₁ f + (1 − E₁) f², bilinear in E₁.
+                let e1 = (t_o.reflected[0] - f * f) / (f - f * f);
                 let taken = t_o.reflected[0] - e1 * f;
                 assert!((albedo - taken).abs() < 2e-3 * f, "r={r} μ={mu_o}: lobe {albedo}, coupling {taken}");
                 assert!(taken > 0.0);

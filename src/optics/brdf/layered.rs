@@ -22,7 +22,7 @@
 
 use std::f64::consts::PI;
 
-use super::{Layers, Layers32, cos_transmitted};
+use super::{COS_MIN, Layers, Layers32, cos_transmitted};
 
 /// a(μ) per channel: the light from a direction at cosine `cos` that reaches the base,
 /// `s` what the rough lobe reflects there.
@@ -68,27 +68,29 @@ pub fn ambient_diffuse(layers: &Layers, cos_o: f64, f_o: [f64; 3]) -> [f64; 3] {
     })
 }
 
-fn entering_f32(layers: &Layers32, cos: f32, s: [f32; 3]) -> [f32; 3] {
+/// The f32 diffuse lobe, as `brdf.wgsl`'s `layered_diffuse`: the two directions' paths
+/// through the pigment layer attenuate in one exponential, exp(−τ (1/cos_eff,i + 1/cos_eff,o))
+/// (= a(μi) a(μo) / ((1 − s_i)(1 − s_o)), three exponentials instead of six), with the path
+/// deltas cos_eff − cos_t that the coupling table brings for each direction
+/// (`lut::Lut::coupling_f32`).
+pub fn diffuse_f32(layers: &Layers32, cos: [f32; 2], reflected: [[f32; 3]; 2], path_delta: [f32; 2]) -> [f32; 3] {
+    let ([cos_i, cos_o], [f_i, f_o]) = (cos, reflected);
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
-    let k = (1.0 - eta2) + eta2 * cos * cos;
-    if k <= 0.0 {
+    let (k_i, k_o) = ((1.0 - eta2) + eta2 * cos_i * cos_i, (1.0 - eta2) + eta2 * cos_o * cos_o);
+    if !(k_i > 0.0 && k_o > 0.0) {
         return [0.0; 3];
     }
-    if layers.optical_depth.iter().all(|t| *t <= 0.0) {
-        return s.map(|s| 1.0 - s);
-    }
-    let path_cos =
-        super::path::with(layers.n0 as f64, layers.n2 as f64, |p| p.cos_eff_f32(k.sqrt(), cos, layers.roughness));
-    [0, 1, 2].map(|c| (1.0 - s[c]) * (-layers.optical_depth[c].max(0.0) / path_cos).exp())
-}
-
-/// The f32 diffuse lobe, as `brdf.wgsl`'s `layered_diffuse`.
-pub fn diffuse_f32(layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o: [f32; 3]) -> [f32; 3] {
-    let (a_i, a_o) = (entering_f32(layers, cos_i, f_i), entering_f32(layers, cos_o, f_o));
-    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    let absorbing = layers.optical_depth.iter().any(|t| *t > 0.0);
+    let inverse_path = if absorbing {
+        let cos_min = COS_MIN as f32;
+        1.0 / (k_i.sqrt() + path_delta[0]).max(cos_min) + 1.0 / (k_o.sqrt() + path_delta[1]).max(cos_min)
+    } else {
+        0.0
+    };
     [0, 1, 2].map(|c| {
         let kd = layers.albedo[c].clamp(0.0, 1.0);
-        eta2 * kd * a_i[c] * a_o[c] / (std::f32::consts::PI * (1.0 - kd * layers.k[c]))
+        let attenuation = if absorbing { (-layers.optical_depth[c].max(0.0) * inverse_path).exp() } else { 1.0 };
+        eta2 * kd * (1.0 - f_i[c]) * (1.0 - f_o[c]) * attenuation / (std::f32::consts::PI * (1.0 - kd * layers.k[c]))
     })
 }
 

@@ -95,10 +95,19 @@ impl Model {
         }
     }
 
-    fn diffuse_f32(self, layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o: [f32; 3]) -> [f32; 3] {
+    /// The f32 diffuse lobe at the two directions' cosines, with what the top reflects
+    /// there and the path deltas the coupling table brings (the thesis model reads neither).
+    fn diffuse_f32(
+        self,
+        layers: &Layers32,
+        cos: [f32; 2],
+        top: [&energy::Top<f32>; 2],
+        path_delta: [f32; 2],
+    ) -> [f32; 3] {
+        let reflected = [top[0].reflected, top[1].reflected];
         match self {
-            Model::Thesis => thesis::diffuse_f32(layers, cos_i, cos_o, f_i, f_o),
-            Model::Layered => layered::diffuse_f32(layers, cos_i, cos_o, f_i, f_o),
+            Model::Thesis => thesis::diffuse_f32(layers, cos[0], cos[1], reflected[0], reflected[1]),
+            Model::Layered => layered::diffuse_f32(layers, cos, reflected, path_delta),
         }
     }
 
@@ -116,10 +125,17 @@ impl Model {
         }
     }
 
-    fn coupling_f32(self, cos: f32, roughness: f32, film: &dyn Fn(f32) -> [f32; 3]) -> energy::Top<f32> {
+    /// The f32 twin of `coupling` with the film from `lut`, and the path delta there: the
+    /// layered model reads the LUT's coupling table (the rule on the lobe's roughness rows
+    /// per cos texel and thickness column, interpolated between rows as the rule does:
+    /// `Lut::coupling_f32`), as the shader does for the LUT film method.
+    fn coupling_f32(self, cos: f32, layers: &Layers32, lut: &super::lut::Lut) -> (energy::Top<f32>, f32) {
         match self {
-            Model::Thesis => energy::Top { reflected: film(cos), ms_amplitude: [0.0; 3] },
-            Model::Layered => energy::top_f32(cos, roughness, film),
+            Model::Thesis => {
+                let reflected = lut.lookup_f32(layers.thickness_nm, cos.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
+                (energy::Top { reflected, ms_amplitude: [0.0; 3] }, 0.0)
+            }
+            Model::Layered => lut.coupling_f32(layers.thickness_nm, cos, layers.roughness),
         }
     }
 
@@ -309,9 +325,9 @@ impl Model {
         let nxh = [n[1] * h[2] - n[2] * h[1], n[2] * h[0] - n[0] * h[2], n[0] * h[1] - n[1] * h[0]];
         let spec = ggx::specular_scale_f32(cos_h, dot32(nxh, nxh), cos_i, cos_o, alpha * alpha);
         let f_h = film(dot32(wo, h).abs());
-        let (r, film) = (layers.roughness, &film);
-        let (top_i, top_o) = (self.coupling_f32(cos_i, r, film), self.coupling_f32(cos_o, r, film));
-        let diffuse = self.diffuse_f32(layers, cos_i, cos_o, top_i.reflected, top_o.reflected);
+        let ((top_i, delta_i), (top_o, delta_o)) =
+            (self.coupling_f32(cos_i, layers, lut), self.coupling_f32(cos_o, layers, lut));
+        let diffuse = self.diffuse_f32(layers, [cos_i, cos_o], [&top_i, &top_o], [delta_i, delta_o]);
         [0, 1, 2].map(|c| f_h[c] * spec + top_i.ms_amplitude[c] * top_o.ms_amplitude[c] + diffuse[c])
     }
 

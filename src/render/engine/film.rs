@@ -87,6 +87,49 @@ fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
         .collect()
 }
 
+/// The LUT's coupling table (`Lut::coupling`) as `film.wgsl`'s `coupling_texture`: a 3-D
+/// half-float texture of 2 n_cos × E1_ROUGHNESS × the table's thickness columns, the
+/// reflected share and the path delta in the first n_cos texels of a row and the
+/// multiple-scatter amplitude in the next (one texture, one binding; the shader's coordinates never filter across the two
+/// halves, since cos is clamped to the texel centres of its half).
+fn coupling_texture(device: &wgpu::Device, queue: &wgpu::Queue, lut: &Lut) -> wgpu::Texture {
+    use crate::optics::brdf::energy::E1_ROUGHNESS;
+    let mut texels: Vec<u16> = Vec::with_capacity(lut.coupling.len() * 8);
+    for row in lut.coupling.chunks(lut.n_cos) {
+        for half in 0..2 {
+            for entry in row {
+                texels.extend(entry[4 * half..4 * half + 4].iter().map(|v| super::material::f32_to_f16(*v)));
+            }
+        }
+    }
+    let size = wgpu::Extent3d {
+        width: 2 * lut.n_cos as u32,
+        height: E1_ROUGHNESS as u32,
+        depth_or_array_layers: lut.width() as u32,
+    };
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("film coupling"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format: wgpu::TextureFormat::Rgba16Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    queue.write_texture(
+        texture.as_image_copy(),
+        bytemuck::cast_slice(&texels),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(size.width * 8),
+            rows_per_image: Some(size.height),
+        },
+        size,
+    );
+    texture
+}
+
 /// The bind group layout of `film.wgsl`'s group 0.
 pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
@@ -98,6 +141,7 @@ pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             storage_entry(2, visibility, true),
             sampler_entry(3, visibility),
             storage_entry(4, visibility, true),
+            super::gpu::texture_entry_of(5, visibility, true, wgpu::TextureViewDimension::D3),
         ],
     })
 }
@@ -167,6 +211,7 @@ impl FilmBinding {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
+        let coupling_view = coupling_texture(device, queue, lut).create_view(&wgpu::TextureViewDescriptor::default());
         let band_buffer = buffer("film bands", bytemuck::cast_slice(&band_table), wgpu::BufferUsages::STORAGE);
         let lobe_buffer = buffer("rough lobe", bytemuck::cast_slice(&lobe_table(stack)), wgpu::BufferUsages::STORAGE);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -178,6 +223,7 @@ impl FilmBinding {
                 wgpu::BindGroupEntry { binding: 2, resource: band_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&sampler) },
                 wgpu::BindGroupEntry { binding: 4, resource: lobe_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&coupling_view) },
             ],
         });
         FilmBinding { stack, n_bands: bands.centres_nm.len(), bind_group }

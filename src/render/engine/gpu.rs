@@ -97,12 +97,22 @@ pub fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bo
 
 /// A 2D float texture entry of a bind group layout.
 pub fn texture_entry(binding: u32, visibility: wgpu::ShaderStages, filterable: bool) -> wgpu::BindGroupLayoutEntry {
+    texture_entry_of(binding, visibility, filterable, wgpu::TextureViewDimension::D2)
+}
+
+/// A float texture entry of the given dimension.
+pub fn texture_entry_of(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    filterable: bool,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
         ty: wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable },
-            view_dimension: wgpu::TextureViewDimension::D2,
+            view_dimension,
             multisampled: false,
         },
         count: None,
