@@ -335,9 +335,10 @@ fn coupling_table_is_the_rule_it_tabulates() {
         assert!(reflected < 0.005 && amplitude < 0.03, "{stack:?}, cos < 0.1: {reflected} {amplitude}");
     }
     // Negative control: a table whose roughness rows are shifted by one is caught.
-    let mut lut = Lut::bake(Stack::THESIS, 64, 256, 64);
-    let rows = snakeskin::optics::brdf::energy::E1_MU;
-    lut.coupling.rotate_left(rows);
+    let lut = Lut::bake(Stack::THESIS, 64, 256, 64);
+    let mut shifted = lut.coupling().to_vec();
+    shifted.rotate_left(lut.n_cos);
+    let lut = lut.with_coupling(shifted);
     let (reflected, _) = coupling_table_deviation(&lut, 5_000, |u| 3000.0 * u, |u| u);
     assert!(reflected > 0.01, "shifted rows not caught: {reflected}");
 }

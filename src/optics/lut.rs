@@ -13,8 +13,8 @@
 //! rough top reflects (`brdf::energy::top`): the rule on the two roughness rows of the lobe
 //! around the roughness, each three film lookups, six where the thesis model makes one.
 //! Baked with the table on its cos texels, the same rows and its thickness columns, it is
-//! one trilinear fetch (`coupling_f32`; in the shader one filtered 3-D texture fetch per
-//! quantity) that interpolates between rows as the rule does; between cos texels and
+//! one trilinear lookup (`coupling_f32`; in the shader two filtered 3-D texture fetches,
+//! one per RGBA half) that interpolates between rows as the rule does; between cos texels and
 //! thickness columns it interpolates the results where the rule interpolates the lobe and
 //! the film (`tests/brdf.rs` bounds the difference). The f32 twin and the shader read it;
 //! the f64 model evaluates the rule.
@@ -46,8 +46,10 @@ pub struct Lut {
     /// and the texels' thickness columns (`bake_coupling`): per entry the reflected share
     /// (RGB), the pigment layer's path delta (cos_eff − cos_t, `brdf::path`), the
     /// multiple-scatter amplitude (RGB) and 0 — the two RGBA texels of the shader's
-    /// `coupling_texture` — index `(i_d * E1_ROUGHNESS + i_r) * n_cos + i_cos`.
-    pub coupling: Vec<[f32; 8]>,
+    /// `coupling_texture` — index `(i_d * E1_ROUGHNESS + i_r) * n_cos + i_cos`. Baked on
+    /// first use (`coupling`): it needs the material's path table, a photon walk that a
+    /// film-colour query or a thesis-model render should not pay for.
+    coupling: OnceLock<Vec<[f32; 8]>>,
     /// The material's path table (`brdf::path`), fetched on first use (`path`).
     path: OnceLock<Arc<PathTable>>,
 }
@@ -86,7 +88,7 @@ impl Lut {
             n_fine: n_fine.max(2),
             n_coarse: n_coarse.max(1),
             texels: Vec::new(),
-            coupling: Vec::new(),
+            coupling: OnceLock::new(),
             path: OnceLock::new(),
         };
         let width = lut.width();
@@ -110,7 +112,6 @@ impl Lut {
             })
             .collect();
         lut.texels = rows.into_iter().flatten().collect();
-        lut.coupling = lut.bake_coupling();
         lut
     }
 
@@ -118,7 +119,7 @@ impl Lut {
     /// lobe and thickness column, `energy::top_on_row_f32` with the film read along that
     /// column (linear in cos, as the texture filter reads it), and the material's path
     /// delta there (the same in every column). Parallel over columns.
-    pub fn bake_coupling(&self) -> Vec<[f32; 8]> {
+    fn bake_coupling(&self) -> Vec<[f32; 8]> {
         let (w, n_cos) = (self.width(), self.n_cos);
         let path = self.path();
         let columns: Vec<Vec<[f32; 8]>> = (0..w)
@@ -163,6 +164,20 @@ impl Lut {
         x.min((self.width() - 1) as f32)
     }
 
+    /// The coupling table (see the field), baked on first use.
+    pub fn coupling(&self) -> &[[f32; 8]] {
+        self.coupling.get_or_init(|| self.bake_coupling())
+    }
+
+    /// The same table with its entries replaced (tests: the values the GPU holds, rounded
+    /// to half floats; a broken table for a negative control). `table` must have the
+    /// table's length.
+    pub fn with_coupling(mut self, table: Vec<[f32; 8]>) -> Lut {
+        assert_eq!(table.len(), self.width() * E1_ROUGHNESS * self.n_cos, "coupling table length");
+        self.coupling = OnceLock::from(table);
+        self
+    }
+
     /// What the rough top reflects at cosine `cos` and roughness `roughness` through the
     /// film at `thickness_nm` (`energy::Top`), and the path delta there: the coupling table,
     /// linear in cos between its texels, in roughness between the rows as
@@ -178,11 +193,12 @@ impl Lut {
         let z = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as f32;
         let z0 = (z as usize).min(E1_ROUGHNESS - 2);
         let fz = z - z0 as f32;
+        let table = self.coupling();
         let mut v = [0.0f32; 8];
         for (i_d, wx) in [(x0, 1.0 - fx), (x1, fx)] {
             for (i_r, wz) in [(z0, 1.0 - fz), (z0 + 1, fz)] {
                 let k = (i_d * E1_ROUGHNESS + i_r) * self.n_cos + y0;
-                let (a, b) = (&self.coupling[k], &self.coupling[k + 1]);
+                let (a, b) = (&table[k], &table[k + 1]);
                 for c in 0..8 {
                     v[c] += wx * wz * (a[c] * (1.0 - fy) + b[c] * fy);
                 }

@@ -94,8 +94,9 @@ fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
 /// halves, since cos is clamped to the texel centres of its half).
 fn coupling_texture(device: &wgpu::Device, queue: &wgpu::Queue, lut: &Lut) -> wgpu::Texture {
     use crate::optics::brdf::energy::E1_ROUGHNESS;
-    let mut texels: Vec<u16> = Vec::with_capacity(lut.coupling.len() * 8);
-    for row in lut.coupling.chunks(lut.n_cos) {
+    let table = lut.coupling();
+    let mut texels: Vec<u16> = Vec::with_capacity(table.len() * 8);
+    for row in table.chunks(lut.n_cos) {
         for half in 0..2 {
             for entry in row {
                 texels.extend(entry[4 * half..4 * half + 4].iter().map(|v| super::material::f32_to_f16(*v)));
