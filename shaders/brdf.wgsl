@@ -114,12 +114,15 @@ fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
 
 // cos_eff(mu, r) - cos_t(mu): how much more obliquely than Snell's law the light the rough
 // top lets in crosses the pigment layer, bilinear in the lobe table's fourth slot (this
-// material's optics::brdf::path table; PathTable::cos_eff_f32).
-fn path_delta_at(cos: f32, roughness: f32) -> f32 {
-    let c = lobe_cell(cos, roughness);
+// material's optics::brdf::path table; PathTable::cos_eff), in the lobe table's cell c.
+fn path_delta_in(c: LobeCell) -> f32 {
     let lower = mix(lobe_table[c.k00 + 1u].w, lobe_table[c.k00 + 3u].w, c.fx);
     let upper = mix(lobe_table[c.k01 + 1u].w, lobe_table[c.k01 + 3u].w, c.fx);
     return mix(lower, upper, c.fy);
+}
+
+fn path_delta_at(cos: f32, roughness: f32) -> f32 {
+    return path_delta_in(lobe_cell(cos, roughness));
 }
 
 // a(mu) = (1 - s(mu)) exp(-tau / cos_eff(mu, r)): the light that reaches the base, s what
@@ -241,8 +244,7 @@ fn coupling(layers: Layers, cos: f32) -> Top {
             let c = lobe_cell(cos, layers.roughness);
             let lower = top_on_row(layers, c.k00, c.fx);
             let upper = top_on_row(layers, c.k01, c.fx);
-            let delta = path_delta_at(cos, layers.roughness);
-            return Top(mix(lower.reflected, upper.reflected, c.fy), mix(lower.ms, upper.ms, c.fy), delta);
+            return Top(mix(lower.reflected, upper.reflected, c.fy), mix(lower.ms, upper.ms, c.fy), path_delta_in(c));
         }
         case MODEL_THESIS: {
             return Top(film_clamped(layers, cos), vec3<f32>(0.0), 0.0);

@@ -21,10 +21,10 @@
 
 use rayon::prelude::*;
 
-use std::sync::{Arc, OnceLock};
+use std::sync::OnceLock;
 
 use crate::optics::brdf::energy::{self, E1_ROUGHNESS};
-use crate::optics::brdf::path::{self, PathTable};
+use crate::optics::brdf::path;
 
 use super::film::{Stack, airy};
 use super::series::FilmSeries;
@@ -50,8 +50,6 @@ pub struct Lut {
     /// first use (`coupling`): it needs the material's path table, a photon walk that a
     /// film-colour query or a thesis-model render should not pay for.
     coupling: OnceLock<Vec<[f32; 8]>>,
-    /// The material's path table (`brdf::path`), fetched on first use (`path`).
-    path: OnceLock<Arc<PathTable>>,
 }
 
 /// Table size chosen from the error/size trade-off measured by `snakeskin bench irid`
@@ -89,7 +87,6 @@ impl Lut {
             n_coarse: n_coarse.max(1),
             texels: Vec::new(),
             coupling: OnceLock::new(),
-            path: OnceLock::new(),
         };
         let width = lut.width();
         let rows: Vec<Vec<[f32; 3]>> = (0..lut.n_cos)
@@ -121,7 +118,7 @@ impl Lut {
     /// delta there (the same in every column). Parallel over columns.
     fn bake_coupling(&self) -> Vec<[f32; 8]> {
         let (w, n_cos) = (self.width(), self.n_cos);
-        let path = self.path();
+        let path = path::cached(self.stack.n0, self.stack.n2);
         let columns: Vec<Vec<[f32; 8]>> = (0..w)
             .into_par_iter()
             .map(|j| {
@@ -205,12 +202,6 @@ impl Lut {
             }
         }
         (energy::Top { reflected: [v[0], v[1], v[2]], ms_amplitude: [v[4], v[5], v[6]] }, v[3])
-    }
-
-    /// The material's path table (the pigment layer's path under the rough top), looked up
-    /// in the process-wide cache once per table (the coupling table carries its deltas).
-    pub fn path(&self) -> &PathTable {
-        self.path.get_or_init(|| path::cached(self.stack.n0, self.stack.n2))
     }
 
     pub fn bake_default(stack: Stack) -> Lut {

@@ -96,15 +96,8 @@ impl Model {
     }
 
     /// The f32 diffuse lobe at the two directions' cosines, with what the top reflects
-    /// there and the path deltas the coupling table brings (the thesis model reads neither).
-    fn diffuse_f32(
-        self,
-        layers: &Layers32,
-        cos: [f32; 2],
-        top: [&energy::Top<f32>; 2],
-        path_delta: [f32; 2],
-    ) -> [f32; 3] {
-        let reflected = [top[0].reflected, top[1].reflected];
+    /// there and the path deltas the coupling table brings (the thesis model reads no delta).
+    fn diffuse_f32(self, layers: &Layers32, cos: [f32; 2], reflected: [[f32; 3]; 2], path_delta: [f32; 2]) -> [f32; 3] {
         match self {
             Model::Thesis => thesis::diffuse_f32(layers, cos[0], cos[1], reflected[0], reflected[1]),
             Model::Layered => layered::diffuse_f32(layers, cos, reflected, path_delta),
@@ -327,7 +320,7 @@ impl Model {
         let f_h = film(dot32(wo, h).abs());
         let ((top_i, delta_i), (top_o, delta_o)) =
             (self.coupling_f32(cos_i, layers, lut), self.coupling_f32(cos_o, layers, lut));
-        let diffuse = self.diffuse_f32(layers, [cos_i, cos_o], [&top_i, &top_o], [delta_i, delta_o]);
+        let diffuse = self.diffuse_f32(layers, [cos_i, cos_o], [top_i.reflected, top_o.reflected], [delta_i, delta_o]);
         [0, 1, 2].map(|c| f_h[c] * spec + top_i.ms_amplitude[c] * top_o.ms_amplitude[c] + diffuse[c])
     }
 

@@ -40,7 +40,8 @@ pub struct PathTable {
     pub n0: f64,
     pub n2: f64,
     pub delta: Vec<f64>,
-    /// `delta` in f32, as the shader holds it.
+    /// `delta` in f32, as the shader holds it (the lobe table's fourth slot, and the film
+    /// table's coupling texture: `lut::Lut::coupling`).
     pub delta_f32: Vec<f32>,
 }
 
@@ -73,12 +74,6 @@ impl PathTable {
     /// (the caller has it: it decides whether light enters at all).
     pub fn cos_eff(&self, cos_t: f64, cos: f64, roughness: f64) -> f64 {
         (cos_t + GridCell::<f64>::at(cos, roughness).bilinear(&self.delta)).max(COS_MIN)
-    }
-
-    /// The f32 twin of `cos_eff`, as `brdf.wgsl`'s `path_delta_at` reads the lobe table's
-    /// fourth slot.
-    pub fn cos_eff_f32(&self, cos_t: f32, cos: f32, roughness: f32) -> f32 {
-        (cos_t + GridCell::<f32>::at(cos, roughness).bilinear(&self.delta_f32)).max(COS_MIN as f32)
     }
 }
 

@@ -77,12 +77,12 @@ struct FilmInfo {
 /// the same grid). Filled for every material, absorbing or not: the window changes the
 /// absorption without a new film binding.
 fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
-    let t = crate::optics::brdf::energy::tables();
+    use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, node};
     let path = crate::optics::brdf::path::cached(stack.n0, stack.n2);
-    (0..t.albedo.len())
+    (0..E1_MU * E1_ROUGHNESS)
         .flat_map(|k| {
-            let second = [t.weight[0][k], t.weight[1][k], t.ms_scale[k], path.delta_f32[k]];
-            [[t.albedo[k], t.cos[0][k], t.cos[1][k], t.cos[2][k]], second]
+            let [e1, c1, c2, c3, w1, w2, ms_scale] = node(k % E1_MU, k / E1_MU);
+            [[e1, c1, c2, c3], [w1, w2, ms_scale, path.delta_f32[k]]]
         })
         .collect()
 }
@@ -90,8 +90,9 @@ fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
 /// The LUT's coupling table (`Lut::coupling`) as `film.wgsl`'s `coupling_texture`: a 3-D
 /// half-float texture of 2 n_cos × E1_ROUGHNESS × the table's thickness columns, the
 /// reflected share and the path delta in the first n_cos texels of a row and the
-/// multiple-scatter amplitude in the next (one texture, one binding; the shader's coordinates never filter across the two
-/// halves, since cos is clamped to the texel centres of its half).
+/// multiple-scatter amplitude in the next (one texture, one binding; the shader's
+/// coordinates never filter across the two halves, since cos is clamped to the texel
+/// centres of its half).
 fn coupling_texture(device: &wgpu::Device, queue: &wgpu::Queue, lut: &Lut) -> wgpu::Texture {
     use crate::optics::brdf::energy::E1_ROUGHNESS;
     let table = lut.coupling();
