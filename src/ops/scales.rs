@@ -461,6 +461,9 @@ impl ScaleField {
             let v = frame.v(row_index);
             let y = v * lattice.rows_v as f32 - ROW_PHASE;
             let candidates = if imbricate { self.row_candidates(&lattice, &table, &geo, y) } else { Vec::new() };
+            let hexagons =
+                if self.shape == ScaleShape::Hexagon { self.row_hexagons(&lattice, &table, y) } else { Vec::new() };
+            let mut cell = HexagonCell::default();
             for (&(u, x), out) in columns.iter().zip(row.chunks_exact_mut(channels)) {
                 let mut all = [0.0f32; channel::COUNT];
                 let dist_belly = u.min(1.0 - u);
@@ -473,7 +476,7 @@ impl ScaleField {
                 } else if let Some((body, Some(y))) = (dist_belly < belly_half).then(plate).flatten() {
                     self.body_plate_pixel(&lattice, body, y, dist_belly, u, &mut all);
                 } else if self.shape == ScaleShape::Hexagon {
-                    self.hexagon_pixel(&lattice, &table, u, v, &mut all);
+                    self.hexagon_pixel(&lattice, &hexagons, &mut cell, x, y, &mut all);
                 } else {
                     self.imbricate_pixel(&geo, &candidates, x, &mut all);
                 }
@@ -609,53 +612,73 @@ impl ScaleField {
         self.write_scale(Some(top), height, self.keel_height, out);
     }
 
-    fn hexagon_pixel(&self, lattice: &Lattice, table: &CellTable, u: f32, v: f32, out: &mut [f32]) {
-        // Voronoi cell of the jittered lattice: nearest centre, then the distance to the
-        // nearest bisector with any other centre is the distance to the cell's edge.
-        let x = lattice.x_of(u);
-        let y = v * lattice.rows_v as f32 - ROW_PHASE;
-        let c0 = floor_i32(x);
-        let mut centres = [(0.0f32, 0.0f32, 0.0f32, 1.0f32, 0.0f32); 9];
-        let mut columns = [0i32; 9];
-        let mut n = 0;
-        for dc in -1..=1 {
-            let c = c0 + dc;
+    /// The nine centres around every column of one row of pixels (lattice row coordinate
+    /// `y`), in isotropic units, for `hexagon_pixel`: for every column from −1 to `cols`, the
+    /// three cells around `y`. The centres, their texture coordinates and rows depend only on
+    /// the row, so they are computed once per row instead of nine times per pixel.
+    fn row_hexagons(&self, lattice: &Lattice, table: &CellTable, y: f32) -> Vec<HexagonCentre> {
+        let mut centres = Vec::with_capacity(3 * (lattice.cols as usize + 2));
+        for c in -1..=lattice.cols {
             let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
             let r0 = floor_i32(y - shift);
             for dr in -1..=1 {
                 let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
                 // Isotropic coordinates: along-body distances scaled by the cell aspect.
-                centres[n] = (cx, cy * lattice.aspect, cell.random, cell.inv_size, cell.cos);
-                columns[n] = c;
-                n += 1;
+                let cy_iso = cy * lattice.aspect;
+                centres.push(HexagonCentre {
+                    x: cx,
+                    y: cy_iso,
+                    random: cell.random,
+                    centre_u: lattice.u_of(cx),
+                    centre_v: self.wrap_v((cy_iso / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32),
+                    row: lattice.row_of(c),
+                });
             }
         }
+        centres
+    }
+
+    /// `x`, `y`: the pixel's lattice coordinates; `centres`: its row's (`row_hexagons`);
+    /// `cell`: the Voronoi cell of the previous pixel of the row, whose bisectors are reused
+    /// while the nearest centre stays the same (a hexagon spans tens of pixels).
+    fn hexagon_pixel(
+        &self,
+        lattice: &Lattice,
+        centres: &[HexagonCentre],
+        cell: &mut HexagonCell,
+        x: f32,
+        y: f32,
+        out: &mut [f32],
+    ) {
+        // Voronoi cell of the jittered lattice: nearest centre, then the distance to the
+        // nearest bisector with any other centre is the distance to the cell's edge.
+        let c0 = floor_i32(x);
+        // The nine neighbouring cells, columns c0 − 1 ..= c0 + 1 (entries from column −1).
+        let first = (3 * c0).clamp(0, centres.len() as i32 - 9) as usize;
+        let near = &centres[first..first + 9];
         let p = (x, y * lattice.aspect);
-        let d2 = |c: &(f32, f32, f32, f32, f32)| (c.0 - p.0).powi(2) + (c.1 - p.1).powi(2);
-        let nearest = (0..9).min_by(|&i, &j| d2(&centres[i]).total_cmp(&d2(&centres[j]))).unwrap_or(0);
-        let c1 = centres[nearest];
+        let d2: [f32; 9] = std::array::from_fn(|i| (near[i].x - p.0).powi(2) + (near[i].y - p.1).powi(2));
+        let nearest = (0..9).min_by(|&i, &j| d2[i].total_cmp(&d2[j])).unwrap_or(0);
+        if cell.key != Some((first, nearest)) {
+            *cell = HexagonCell::new(near, first, nearest);
+        }
+        let c1 = &near[nearest];
         let mut edge = f32::MAX;
-        for (i, c2) in centres.iter().enumerate() {
-            if i == nearest {
-                continue;
-            }
-            let (dx, dy) = (c2.0 - c1.0, c2.1 - c1.1);
-            let len = (dx * dx + dy * dy).sqrt().max(1e-6);
-            let mid = ((c1.0 + c2.0) * 0.5, (c1.1 + c2.1) * 0.5);
-            edge = edge.min(((mid.0 - p.0) * dx + (mid.1 - p.1) * dy) / len);
+        for b in &cell.bisectors {
+            edge = edge.min(((b.mid.0 - p.0) * b.dx + (b.mid.1 - p.1) * b.dy) / b.len);
         }
         // `size` below 1 opens a gap of skin between the plates.
         let inside = edge - (1.0 - self.size.min(1.0)) * 0.5;
         let half_len = 0.5 * lattice.aspect;
         let cand = Candidate {
             inside,
-            x: p.0 - c1.0,
-            y: p.1 - c1.1,
+            x: p.0 - c1.x,
+            y: p.1 - c1.y,
             half_len,
-            random: c1.2,
-            centre_u: lattice.u_of(c1.0),
-            centre_v: self.wrap_v((c1.1 / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32),
-            row: lattice.row_of(columns[nearest]),
+            random: c1.random,
+            centre_u: c1.centre_u,
+            centre_v: c1.centre_v,
+            row: c1.row,
         };
         let soft = self.edge_softness.max(1e-4);
         let along = (cand.y / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
@@ -847,6 +870,50 @@ struct PlateRows<'a> {
     centre_v: &'a dyn Fn(i32) -> f32,
     /// Plate r's identity for its random number.
     identity: &'a dyn Fn(i32) -> i32,
+}
+
+/// One hexagon centre of a row of pixels (`ScaleField::row_hexagons`).
+struct HexagonCentre {
+    /// The jittered centre in isotropic lattice units (x in columns, y in cell widths).
+    x: f32,
+    y: f32,
+    random: f32,
+    /// Its texture coordinates and dorsal row, as `Candidate` carries them.
+    centre_u: f32,
+    centre_v: f32,
+    row: i32,
+}
+
+/// The bisector between a Voronoi cell's centre and one of its neighbours: the pixel lies
+/// ((mid − p) · (dx, dy)) / len inside it.
+#[derive(Clone, Copy, Default)]
+struct Bisector {
+    mid: (f32, f32),
+    dx: f32,
+    dy: f32,
+    len: f32,
+}
+
+/// The Voronoi cell a row of pixels is in: its key (the first of the nine centres, the
+/// nearest among them) and its eight bisectors, which depend only on the centres.
+#[derive(Default)]
+struct HexagonCell {
+    key: Option<(usize, usize)>,
+    bisectors: [Bisector; 8],
+}
+
+impl HexagonCell {
+    fn new(near: &[HexagonCentre], first: usize, nearest: usize) -> Self {
+        let c1 = &near[nearest];
+        let mut bisectors = [Bisector::default(); 8];
+        for (b, c2) in bisectors.iter_mut().zip(near.iter().enumerate().filter(|(i, _)| *i != nearest).map(|(_, c)| c))
+        {
+            let (dx, dy) = (c2.x - c1.x, c2.y - c1.y);
+            let len = (dx * dx + dy * dy).sqrt().max(1e-6);
+            *b = Bisector { mid: ((c1.x + c2.x) * 0.5, (c1.y + c2.y) * 0.5), dx, dy, len };
+        }
+        HexagonCell { key: Some((first, nearest)), bisectors }
+    }
 }
 
 /// One candidate scale of a row of pixels (`ScaleField::row_candidates`).
