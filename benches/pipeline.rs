@@ -48,7 +48,9 @@ fn operations(c: &mut Criterion) {
     let noise =
         Op::Noise(FractalNoise { kind: NoiseKind::Perlin, cells_u: 8, cells_v: 8, octaves: 1, gain: 0.5, seed: 1 })
             .eval(None, &[], snakeskin::ops::Frame::whole(size, size));
-    group.bench_function("blur_sigma_0.005", |b| b.iter(|| filters::blur(&noise, 0.005, true)));
+    group.bench_function("blur_sigma_0.005", |b| {
+        b.iter(|| filters::blur(std::borrow::Cow::Borrowed(&noise), 0.005, true))
+    });
     group.bench_function("height_to_normal", |b| {
         b.iter(|| filters::height_to_normal(&noise, 0.05, filters::NormalConvention::OpenGl, 1.0, noise.height, true))
     });

@@ -97,7 +97,7 @@ fn a_preset_shows_the_same_skin_at_any_resolution() {
     // detail only the larger map can hold). Tolerances: 0.01 of the range (2.5 8-bit levels)
     // for maps in [0, 1]; 0.02 for the normal map, whose range is [-1, 1] and whose
     // downsampled normals average slopes that the 256² map never resolved.
-    let blur = |img: &Image| filters::blur(img, 1.5 / 256.0, true);
+    let blur = |img: &Image| filters::blur(std::borrow::Cow::Borrowed(img), 1.5 / 256.0, true);
     for spec in ["erythrolamprus-miliaris", PATTERNED] {
         let loaded = parse(&read_source(spec).unwrap(), &[]).unwrap();
         if spec == PATTERNED {

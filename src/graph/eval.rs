@@ -364,7 +364,7 @@ pub fn estimate_peak_bytes(graph: &Graph, maps: &[MapKind], width: usize, height
             let inputs: Vec<usize> = node.inputs.iter().map(|i| channels[i.0]).collect();
             channels[id.0] = node.op.output_channels(&inputs);
             let bytes = channels[id.0] as u64 * pixels * 4;
-            scratch += node.op.scratch_images() as u64 * bytes;
+            scratch += node.op.scratch_images(width) as u64 * bytes;
             live[id.0] = bytes;
             live_bytes += bytes;
             computed[id.0] = true;

@@ -132,12 +132,14 @@ impl Op {
         }
     }
 
-    /// Temporary buffers a kernel allocates besides its output, in output-sized images:
-    /// the blur's transposed copy and its running sums; the coverage pixmap of tiny-skia
-    /// shapes (RGBA8, the size of one f32 channel).
-    pub fn scratch_images(&self) -> usize {
+    /// Temporary buffers a kernel allocates besides its output, in output-sized images, at
+    /// `width` pixels wide: the small blur's horizontal pass and output beside its input
+    /// (`filters::gaussian_blur`; the box blur runs in its input's buffer, or one copy of
+    /// it, with a ring of a band plus the window's rows: 2–4 % of an image at 4096²); the
+    /// coverage pixmap of tiny-skia shapes (RGBA8, the size of one f32 channel).
+    pub fn scratch_images(&self, width: usize) -> usize {
         match self {
-            Op::Blur { .. } => 2,
+            Op::Blur { sigma } if filters::blur_is_gaussian(*sigma, width) => 2,
             Op::Blotches(_) | Op::Spots(_) => 1,
             _ => 0,
         }
@@ -147,7 +149,12 @@ impl Op {
     pub fn in_place(&self) -> bool {
         matches!(
             self,
-            Op::Levels { .. } | Op::Threshold { .. } | Op::Blend { .. } | Op::Tint { .. } | Op::ScaleColour(_)
+            Op::Levels { .. }
+                | Op::Threshold { .. }
+                | Op::Blend { .. }
+                | Op::Tint { .. }
+                | Op::ScaleColour(_)
+                | Op::Blur { .. }
         )
     }
 
@@ -200,7 +207,7 @@ impl Op {
                 filters::snap_to_scales(input(), rest[0], *amount, *centre_u, *centre_v, frame)
             }
             Op::Spots(grid) => shapes::spots(frame, grid),
-            Op::Blur { sigma } => filters::blur(input(), *sigma, frame.wraps_v),
+            Op::Blur { sigma } => filters::blur(first.expect("operation has an input"), *sigma, frame.wraps_v),
             Op::Sobel { edge_sigma } => filters::sobel(input(), *edge_sigma, frame.wraps_v),
             Op::Colorize { low, high } => filters::colorize(input(), *low, *high),
             Op::HeightToNormal { slope, convention, v_extent } => {

@@ -158,6 +158,51 @@ impl Octave {
         }
         best.sqrt()
     }
+
+    /// `cellular` at every (us[i] · period_x, v · period_y) of one row, times `amplitude`,
+    /// added to `out`: the same values bit for bit. The row is cut into runs of one lattice
+    /// cell; per run the nine feature points are looked up once, and what depends only on the
+    /// row (each point's squared distance along v) once per run, not per pixel.
+    fn cellular_row(&self, us: &[f32], v: f32, amplitude: f32, out: &mut [f32]) {
+        let (px, py) = (self.period_x, self.period_y);
+        let wrap = |i: i32, p: i32| {
+            if i < 0 {
+                i + p
+            } else if i >= p {
+                i - p
+            } else {
+                i
+            }
+        };
+        let y = v * py as f32;
+        let iy = floor_i32(y);
+        let wy = iy.rem_euclid(py);
+        let period_x = px as f32;
+        let mut start = 0;
+        while start < us.len() {
+            let ix = floor_i32(us[start] * period_x);
+            let end = start + us[start..].iter().take_while(|&&u| floor_i32(u * period_x) == ix).count();
+            let wx = ix.rem_euclid(px);
+            // Per neighbour: its feature point's lattice x, and its squared distance along v
+            // (`cellular`'s ddx = (ix + dx) + p.x − x, ddy likewise).
+            let mut points = [(0.0f32, 0.0f32); 9];
+            for (k, (dy, dx)) in (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dy, dx))).enumerate() {
+                let p = self.cell(wrap(wx + dx, px), wrap(wy + dy, py));
+                let ddy = (iy + dy) as f32 + p[1] - y;
+                points[k] = ((ix + dx) as f32 + p[0], ddy * ddy);
+            }
+            for (o, &u) in out[start..end].iter_mut().zip(&us[start..end]) {
+                let x = u * period_x;
+                let mut best = f32::MAX;
+                for &(feature_x, ddy2) in &points {
+                    let ddx = feature_x - x;
+                    best = best.min(ddx * ddx + ddy2);
+                }
+                *o += best.sqrt() * amplitude;
+            }
+            start = end;
+        }
+    }
 }
 
 /// Precomputed per-octave lattices; build once per node evaluation.
@@ -203,13 +248,21 @@ impl NoiseSampler {
     /// rather than per pixel. Measured 2.6x faster than per-pixel `sample` for the grain
     /// noise at 2048² (the finest octave has a cell every 5 px there).
     pub fn sample_row(&self, us: &[f32], v: f32, out: &mut [f32]) {
-        if self.kind == NoiseKind::Cellular {
-            for (o, &u) in out.iter_mut().zip(us) {
-                *o = self.sample(u, v);
-            }
-            return;
-        }
         out.fill(0.0);
+        if self.kind == NoiseKind::Cellular {
+            for (octave, &amplitude) in self.octaves.iter().zip(&self.amplitudes) {
+                octave.cellular_row(us, v, amplitude, out);
+            }
+        } else {
+            self.perlin_row(us, v, out);
+        }
+        for o in out.iter_mut() {
+            *o = (*o / self.norm).clamp(0.0, 1.0);
+        }
+    }
+
+    /// The Perlin octaves of `sample_row`, summed into `out`.
+    fn perlin_row(&self, us: &[f32], v: f32, out: &mut [f32]) {
         for (octave, &amplitude) in self.octaves.iter().zip(&self.amplitudes) {
             let y = v * octave.period_y as f32;
             let iy = floor_i32(y);
@@ -242,9 +295,6 @@ impl NoiseSampler {
                 }
                 start = end;
             }
-        }
-        for o in out.iter_mut() {
-            *o = (*o / self.norm).clamp(0.0, 1.0);
         }
     }
 
@@ -299,4 +349,31 @@ pub fn render(noise: &FractalNoise, frame: Frame) -> Image {
 /// The coarse row at or above texture row `y` (`resample_bilinear_rows`' j0).
 fn coarse_index(y: usize, height: usize, coarse_height: usize) -> usize {
     ((y as f32 + 0.5) / height as f32 * coarse_height as f32).floor() as usize
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `sample_row` is `sample` at every pixel of the row, bit for bit, for both kinds: the
+    /// row path only hoists what depends on the row or the lattice cell.
+    #[test]
+    fn a_row_is_its_pixels_bit_for_bit() {
+        for kind in [NoiseKind::Perlin, NoiseKind::Cellular] {
+            for (cells_u, cells_v, octaves, seed) in [(4, 4, 5, 7), (40, 40, 3, 11), (105, 81, 3, 3), (3, 17, 1, 0)] {
+                let sampler = NoiseSampler::new(&FractalNoise { kind, cells_u, cells_v, octaves, gain: 0.5, seed });
+                for width in [37usize, 512, 1000] {
+                    let us: Vec<f32> = (0..width).map(|x| (x as f32 + 0.5) / width as f32).collect();
+                    for v in [0.0f32, 0.013, 0.5, 0.987_654, 0.999_9] {
+                        let mut row = vec![0.0f32; width];
+                        sampler.sample_row(&us, v, &mut row);
+                        for (x, (&u, value)) in us.iter().zip(&row).enumerate() {
+                            let pixel = sampler.sample(u, v);
+                            assert_eq!(value.to_bits(), pixel.to_bits(), "{kind:?} {cells_u}x{cells_v}: x {x} v {v}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
