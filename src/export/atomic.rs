@@ -156,14 +156,27 @@ impl SetLock {
     /// Writes the set: `maps` (file name, bytes) first, then `manifest` (file name, bytes)
     /// as the commit record. See the module documentation for the guarantee.
     pub fn write(&self, maps: &[(String, Vec<u8>)], manifest: (&str, &[u8])) -> Result<Vec<PathBuf>, ExportError> {
-        let dir = &self.dir;
-        let names: Vec<&str> = maps.iter().map(|(n, _)| n.as_str()).chain([manifest.0]).collect();
+        let staged = maps.iter().map(|(name, bytes)| self.stage(name, bytes)).collect::<Result<Vec<_>, _>>()?;
+        self.commit(staged, manifest)
+    }
+
+    /// Writes one map of the set to its temporary now (step 2), so its bytes need not be
+    /// held until the whole set is done: at 4096² the compressed maps of a set are up to
+    /// 90 MB. Nothing is visible until `commit`; a dropped `Staged` deletes its temporary.
+    /// May run on several threads at once, one file name each.
+    pub fn stage(&self, name: &str, bytes: &[u8]) -> Result<Staged, ExportError> {
         // Under the lock no other run can be writing this set: every temporary of it is stale.
-        remove_stale_temporaries(dir, &names, std::time::Duration::ZERO);
-        let mut staged = Vec::new();
-        for (name, bytes) in maps.iter().map(|(n, b)| (n.as_str(), b.as_slice())).chain([manifest]) {
-            staged.push((stage(dir, name, bytes)?, dir.join(name)));
-        }
+        remove_stale_temporaries(&self.dir, &[name], std::time::Duration::ZERO);
+        Ok(Staged { file: stage(&self.dir, name, bytes)?, name: name.into(), sha256: sha256_hex(bytes) })
+    }
+
+    /// Commits staged maps with `manifest` (file name, bytes) as the commit record (steps 3
+    /// and 4). See the module documentation for the guarantee.
+    pub fn commit(&self, maps: Vec<Staged>, manifest: (&str, &[u8])) -> Result<Vec<PathBuf>, ExportError> {
+        let dir = &self.dir;
+        let mut staged: Vec<(tempfile::NamedTempFile, PathBuf)> =
+            maps.into_iter().map(|m| (m.file, dir.join(&m.name))).collect();
+        staged.push((self.stage(manifest.0, manifest.1)?.file, dir.join(manifest.0)));
         for (_, target) in &staged {
             check_target(target)?;
         }
@@ -181,6 +194,16 @@ impl SetLock {
         sync_folder(dir);
         Ok(written)
     }
+}
+
+/// A map of a set written to its temporary (`SetLock::stage`), waiting for `commit`.
+#[derive(Debug)]
+pub struct Staged {
+    file: tempfile::NamedTempFile,
+    /// The file name it takes in the set's folder.
+    pub name: String,
+    /// SHA-256 of its bytes (the manifest's `sha256`).
+    pub sha256: String,
 }
 
 impl Drop for SetLock {

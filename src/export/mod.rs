@@ -9,7 +9,7 @@ pub mod gltf;
 mod manifest;
 pub mod pack;
 
-pub use atomic::{SetLock, create_folder, sha256_hex, write_file_atomically};
+pub use atomic::{SetLock, Staged, create_folder, sha256_hex, write_file_atomically};
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 
 use std::io::Cursor;

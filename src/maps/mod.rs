@@ -354,9 +354,13 @@ fn build_iridescence(g: &mut GraphBuilder, preset: &Preset, s: &Shared, cols: u3
             )
         }
     };
-    // Blend with the scale shape so the film thins into the crevices (thesis §4.2.5).
+    // Blend with the scale shape so the film thins into the crevices (thesis §4.2.5). The
+    // film's own copy of the height channel, extracted here rather than shared with the
+    // height map (`Shared::scale_height`), which would keep it alive from the height map
+    // to here (as `color.crevice`).
+    let scale_height = s.channel(g, "iridescence.scale_height", channel::HEIGHT);
     let shaped =
-        g.add("iridescence.shaped", Op::Blend { mode: BlendMode::Multiply, opacity: 0.5 }, &[gradient, s.scale_height]);
+        g.add("iridescence.shaped", Op::Blend { mode: BlendMode::Multiply, opacity: 0.5 }, &[gradient, scale_height]);
     // Without noise the blend would give its base back exactly (b + (l − b) · 0 = b), so
     // neither the noise nor the blend is built.
     let mixed = if p.noise == 0.0 {
