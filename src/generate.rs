@@ -458,10 +458,11 @@ struct Strips {
 /// is resident then (the quantised maps waiting for their encoders, the program). At 2048²
 /// every built-in species fits whole, so the common sizes pay no margins. Measured at 4096²:
 /// Erythrolamprus' 768 MiB of buffers peaked at 847 MB resident; with the box blur in place
-/// and 64 MiB buffers kept out of the pool, the species whose buffers reach this budget
-/// (832 MiB) peaked at 885–954 MiB resident, and evaluated whole instead of in two or
-/// three strips took 0.55–0.65 of the time (`crotalus-atrox` 3.85 → 2.39 s).
-pub const TILE_BUFFER_BUDGET_BYTES: u64 = 832 << 20;
+/// and 64 MiB buffers kept out of the pool, the species whose buffers reach 832 MiB peaked
+/// at 885–978 MiB resident, and evaluated whole instead of in two or three strips took
+/// 0.55–0.65 of the time (`crotalus-atrox` 3.85 → 2.39 s). 840: the box blur's rows of
+/// scratch (`Op::scratch_rows`), counted since, add up to 8 MiB to the same runs.
+pub const TILE_BUFFER_BUDGET_BYTES: u64 = 840 << 20;
 
 /// The node buffers of one strip of a tile too large to evaluate whole: less than the whole
 /// tile's budget, because a strip's set also holds every map of the whole tile quantised

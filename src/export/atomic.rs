@@ -5,8 +5,9 @@
 //! unpredictable name, so a symlink planted at a guessable name cannot redirect the write —
 //! then renamed over the target. A reader sees the old file or the new one, never a part.
 //!
-//! **Texture sets** (`SetLock`, `SetLock::write`) are several files, and a rename is atomic
-//! only per file, so the set's manifest is its commit record:
+//! **Texture sets** (`SetLock`: `stage` each map, then `commit`; `write` does both) are
+//! several files, and a rename is atomic only per file, so the set's manifest is its commit
+//! record:
 //!
 //! 1. `SetLock::acquire` takes an exclusive advisory lock (`flock`) on `DIR/.NAME.lock`
 //!    before any pixel is computed; a second run on the same set fails at once with a
@@ -15,8 +16,10 @@
 //!    removed when the run ends (a killed run leaves an empty one, reused by the next);
 //!    whoever locks checks that the path still names the file it locked, so removal never
 //!    lets two runs hold the set at once.
-//! 2. Under the lock, temporaries of this set left by a killed run are removed (their
-//!    names end in `.snakeskin-tmp`), then every file is written to a new temporary.
+//! 2. Under the lock, every file is written to a new temporary (`stage`, as soon as its
+//!    bytes exist, so they need not be held), after the temporaries a killed run left for
+//!    that file name are removed (their names end in `.snakeskin-tmp`). A set stages each
+//!    file name once: a second stage of a name would remove the first's temporary.
 //! 3. Before any rename, every target is checked: a folder where a file must go is an
 //!    error, and nothing has changed yet.
 //! 4. The old manifest is removed, the maps are renamed into place, and the new manifest,
@@ -163,7 +166,8 @@ impl SetLock {
     /// Writes one map of the set to its temporary now (step 2), so its bytes need not be
     /// held until the whole set is done: at 4096² the compressed maps of a set are up to
     /// 90 MB. Nothing is visible until `commit`; a dropped `Staged` deletes its temporary.
-    /// May run on several threads at once, one file name each.
+    /// May run on several threads at once, one file name each; each name once per set (the
+    /// removal of stale temporaries before it takes every temporary of that name).
     pub fn stage(&self, name: &str, bytes: &[u8]) -> Result<Staged, ExportError> {
         // Under the lock no other run can be writing this set: every temporary of it is stale.
         remove_stale_temporaries(&self.dir, &[name], std::time::Duration::ZERO);

@@ -365,6 +365,7 @@ pub fn estimate_peak_bytes(graph: &Graph, maps: &[MapKind], width: usize, height
             channels[id.0] = node.op.output_channels(&inputs);
             let bytes = channels[id.0] as u64 * pixels * 4;
             scratch += node.op.scratch_images(width) as u64 * bytes;
+            scratch += node.op.scratch_rows(width) as u64 * channels[id.0] as u64 * width as u64 * 4;
             live[id.0] = bytes;
             live_bytes += bytes;
             computed[id.0] = true;

@@ -133,14 +133,24 @@ impl Op {
     }
 
     /// Temporary buffers a kernel allocates besides its output, in output-sized images, at
-    /// `width` pixels wide: the small blur's horizontal pass and output beside its input
-    /// (`filters::gaussian_blur`; the box blur runs in its input's buffer, or one copy of
-    /// it, with a ring of a band plus the window's rows: 2–4 % of an image at 4096²); the
-    /// coverage pixmap of tiny-skia shapes (RGBA8, the size of one f32 channel).
+    /// `width` pixels wide: the small blur's horizontal pass, and its input, which it still
+    /// holds while it writes a new output (`filters::gaussian_blur`; the estimate has
+    /// counted that input as handed over); the coverage pixmap of tiny-skia shapes (RGBA8,
+    /// the size of one f32 channel).
     pub fn scratch_images(&self, width: usize) -> usize {
         match self {
             Op::Blur { sigma } if filters::blur_is_gaussian(*sigma, width) => 2,
             Op::Blotches(_) | Op::Spots(_) => 1,
+            _ => 0,
+        }
+    }
+
+    /// Temporary memory besides the output and `scratch_images`, in output rows: the box
+    /// blur's ring, tail and tiles (`filters::blur_scratch_rows`: about 200 rows at σ =
+    /// 0.006 and 4096², 5 % of the image; more for wide blurs).
+    pub fn scratch_rows(&self, width: usize) -> usize {
+        match self {
+            Op::Blur { sigma } => filters::blur_scratch_rows(*sigma, width),
             _ => 0,
         }
     }

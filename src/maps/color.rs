@@ -100,17 +100,21 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
         color = super::body::marks(g, preset, s, plan, outside_belly, color);
     }
 
-    if let Some(op) = per_scale(preset, s) {
+    let per_scale = per_scale(preset, s);
+    let reads_field_last = per_scale.is_some();
+    if let Some(op) = per_scale {
         color = g.add("color.per_scale", Op::ScaleColour(op), &[color, s.scales]);
     }
 
     let k = preset.color.between_scales as f32;
-    // The colour's own copy of the crevice channel, extracted here at the end of the colour
-    // chain rather than shared with the height and roughness (`Shared::crevice`): a shared
-    // copy stays alive through every colour layer. One more 16 MiB extraction at 2048²
-    // takes 64 MiB off the peak at 4096² of most patterned species, enough to evaluate
-    // many of them whole instead of in strips.
-    let crevice = s.channel(g, "color.crevice", channel::CREVICE);
+    // Where the per-scale colour keeps the scale field alive to the end of the colour chain
+    // (every built-in species), the colour extracts its own copy of the crevice channel
+    // here rather than share the height and roughness's (`Shared::crevice`), which would
+    // stay alive through every colour layer: one more 16 MiB extraction at 2048² takes
+    // 64 MiB off the peak at 4096² of most patterned species, enough to evaluate many of
+    // them whole instead of in strips. Without it, a late extraction would keep the whole
+    // field alive instead.
+    let crevice = if reads_field_last { s.channel(g, "color.crevice", channel::CREVICE) } else { s.crevice };
     let shade = g.add(
         "color.scale_shade",
         Op::Levels { in_low: 0.0, in_high: 1.0, out_low: 1.0, out_high: 1.0 - k },

@@ -197,6 +197,19 @@ pub fn blur_is_gaussian(sigma: f32, width: usize) -> bool {
     (0.33..=2.0).contains(&sigma_px)
 }
 
+/// The scratch of `blur`'s box passes in image rows of its size (`box_pass`: the ring of a
+/// band plus the window, the tail, a band of tiles and the f64 sums, two rows' worth), at
+/// the widest of the three passes; 0 where the blur samples the Gaussian or is the identity.
+pub fn blur_scratch_rows(sigma: f32, width: usize) -> usize {
+    let sigma_px = sigma * width as f32;
+    if sigma_px < 0.33 || blur_is_gaussian(sigma, width) {
+        return 0;
+    }
+    let r = box_widths(sigma_px).into_iter().max().unwrap_or(1) / 2;
+    let ring = (BOX_BAND + 2 * r + 1 + BOX_ROWS).next_multiple_of(BOX_ROWS);
+    ring + (r + 1) + BOX_BAND + 2
+}
+
 /// Odd box widths whose three-fold convolution has variance sigma² (Kovesi 2010, eq. 4-5).
 fn box_widths(sigma: f32) -> [usize; 3] {
     let n = 3.0f32;
@@ -287,9 +300,15 @@ const BOX_BLOCK: usize = 256;
 /// swept left to right from x = 0 (`box_rows_horizontal`), each column top to bottom from
 /// y = 0 with its running sum started over rows −r ..= r, so the values are the same bits.
 ///
-/// In place: the rows the vertical sweep reads lie at or below the rows already written,
-/// but for the rows past the end (y ≥ h: the first rows again, wrapped, or the last row,
-/// clamped), whose horizontal sweeps are made first and kept aside.
+/// In place: the vertical sweep reads only the ring; the image rows the horizontal sweep
+/// reads into the ring lie below the rows already written (each band's rows are swept before
+/// the band above them is written back), the rows before the first (y < 0: the last rows,
+/// wrapped, or the first, clamped) are swept by the first fill before anything is written,
+/// and the rows past the end (y ≥ h: the first rows again, wrapped, or the last row,
+/// clamped) are swept before anything else and kept aside (`tail`).
+///
+/// Scratch besides the image (`box_pass_scratch_rows`): the ring, the tail, one band of
+/// each block's values and the blocks' f64 sums, counted in image rows.
 fn box_pass(image: &mut Image, r: usize, wraps_v: bool) {
     let (w, h, ch) = (image.width, image.height, image.channels);
     let stride = w * ch;
@@ -448,8 +467,9 @@ pub fn snap_to_scales(
 ) -> Image {
     let full = frame.full_height;
     let (w, h) = (mask.width, mask.height);
-    // The mask's own value at a centre's pixel, wrapped as `Image::at_wrapped` wraps (the
-    // centres computed below lie inside the image but for a body atlas's ends).
+    // The mask's own value at a centre's pixel. The centres computed below always lie
+    // inside the image (clamped); the fallback keeps `Image::at_wrapped`'s meaning, which
+    // the first version read at every pixel, should one ever not.
     let at = |cx: isize, cy: isize| {
         if (0..w as isize).contains(&cx) && (0..h as isize).contains(&cy) {
             mask.data[(cy as usize * w + cx as usize) * mask.channels]

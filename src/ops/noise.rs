@@ -68,6 +68,19 @@ const GRADIENTS: [[f32; 2]; 16] = {
     g
 };
 
+/// A lattice coordinate at most one period outside [0, period), wrapped by a branch (no
+/// division: the cellular kernels wrap nine neighbours per cell).
+#[inline]
+fn wrap_once(i: i32, period: i32) -> i32 {
+    if i < 0 {
+        i + period
+    } else if i >= period {
+        i - period
+    } else {
+        i
+    }
+}
+
 #[inline]
 fn quintic(t: f32) -> f32 {
     t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
@@ -137,21 +150,12 @@ impl Octave {
     fn cellular(&self, x: f32, y: f32) -> f32 {
         let (ix, iy) = (floor_i32(x), floor_i32(y));
         let (px, py) = (self.period_x, self.period_y);
-        let wrap = |i: i32, p: i32| {
-            if i < 0 {
-                i + p
-            } else if i >= p {
-                i - p
-            } else {
-                i
-            }
-        };
         let (wx, wy) = (ix.rem_euclid(px), iy.rem_euclid(py));
         let mut best = f32::MAX;
         for dy in -1..=1 {
-            let cy = wrap(wy + dy, py);
+            let cy = wrap_once(wy + dy, py);
             for dx in -1..=1 {
-                let p = self.cell(wrap(wx + dx, px), cy);
+                let p = self.cell(wrap_once(wx + dx, px), cy);
                 let (ddx, ddy) = ((ix + dx) as f32 + p[0] - x, (iy + dy) as f32 + p[1] - y);
                 best = best.min(ddx * ddx + ddy * ddy);
             }
@@ -165,15 +169,6 @@ impl Octave {
     /// row (each point's squared distance along v) once per run, not per pixel.
     fn cellular_row(&self, us: &[f32], v: f32, amplitude: f32, out: &mut [f32]) {
         let (px, py) = (self.period_x, self.period_y);
-        let wrap = |i: i32, p: i32| {
-            if i < 0 {
-                i + p
-            } else if i >= p {
-                i - p
-            } else {
-                i
-            }
-        };
         let y = v * py as f32;
         let iy = floor_i32(y);
         let wy = iy.rem_euclid(py);
@@ -187,7 +182,7 @@ impl Octave {
             // (`cellular`'s ddx = (ix + dx) + p.x − x, ddy likewise).
             let mut points = [(0.0f32, 0.0f32); 9];
             for (k, (dy, dx)) in (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dy, dx))).enumerate() {
-                let p = self.cell(wrap(wx + dx, px), wrap(wy + dy, py));
+                let p = self.cell(wrap_once(wx + dx, px), wrap_once(wy + dy, py));
                 let ddy = (iy + dy) as f32 + p[1] - y;
                 points[k] = ((ix + dx) as f32 + p[0], ddy * ddy);
             }

@@ -653,6 +653,7 @@ impl ScaleField {
         // Voronoi cell of the jittered lattice: nearest centre, then the distance to the
         // nearest bisector with any other centre is the distance to the cell's edge.
         let c0 = floor_i32(x);
+        debug_assert!((0..lattice.cols).contains(&c0), "lattice x {x} outside the columns");
         // The nine neighbouring cells, columns c0 − 1 ..= c0 + 1 (entries from column −1).
         let first = (3 * c0).clamp(0, centres.len() as i32 - 9) as usize;
         let near = &centres[first..first + 9];
