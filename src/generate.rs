@@ -217,10 +217,10 @@ impl Plan {
             // f32 buffer, and compressed on a thread of its own while the graph goes on: the
             // quantised samples are freed as soon as their PNG is done (at 4096² they were
             // 200 MB held to the end), and compression fills the moments the graph leaves a
-            // core idle.
-            // Each PNG goes to its temporary file as soon as it is compressed (`SetLock::stage`),
-            // so the compressed maps are not held to the end either: measured at 4096²,
-            // `liasis-mackloti`'s 86 MB of PNGs held to the end had taken its peak to 1035 MiB (951 now).
+            // core idle. Each PNG goes to its temporary file as soon as it is compressed
+            // (`SetLock::stage`), so the compressed maps are not held to the end either:
+            // `liasis-mackloti` at 4096² peaked at 1035 MiB with its 86 MB of PNGs held, 951
+            // without.
             let name = loaded.name.as_str();
             let lock = &lock;
             let (stats, mut encoded) = std::thread::scope(|scope| {

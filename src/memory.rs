@@ -23,8 +23,8 @@ const FIXED_OVERHEAD_BYTES: u64 = 64 * MIB;
 /// Estimated peak bytes of `generate` for `maps` at `size`²: the graph's live buffers at
 /// their worst point, plus every quantised map (held until encoding) and its PNG (at most
 /// the quantised size with the fast filter; a whole tile's PNG goes to its temporary file
-/// when compressed, a strip set's when its last strip is in: counting every one held is an
-/// upper bound), plus a fixed overhead.
+/// when compressed, a strip set's are held to the end: counting every one held is an upper
+/// bound), plus a fixed overhead.
 pub fn estimate_generate_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> u64 {
     let pixels = (width * height) as u64;
     let quantized: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * pixels).sum();

@@ -206,8 +206,7 @@ pub fn blur_scratch_rows(sigma: f32, width: usize) -> usize {
         return 0;
     }
     let r = box_widths(sigma_px).into_iter().max().unwrap_or(1) / 2;
-    let ring = (BOX_BAND + 2 * r + 1 + BOX_ROWS).next_multiple_of(BOX_ROWS);
-    ring + (r + 1) + BOX_BAND + 2
+    box_ring_rows(r) + (r + 1) + BOX_BAND + 2
 }
 
 /// Odd box widths whose three-fold convolution has variance sigma² (Kovesi 2010, eq. 4-5).
@@ -286,6 +285,12 @@ fn box_rows_horizontal(sources: &[&[f32]], channels: usize, r: usize, padded: &m
 
 /// Output rows per step of `box_pass`' vertical sweep.
 const BOX_BAND: usize = 64;
+
+/// Rows of `box_pass`' ring at radius `r`: a band plus the window (2r + 1), plus a group
+/// of BOX_ROWS that a fill may make past the band's last, rounded to whole groups.
+fn box_ring_rows(r: usize) -> usize {
+    (BOX_BAND + 2 * r + 1 + BOX_ROWS).next_multiple_of(BOX_ROWS)
+}
 /// Columns (samples of a row) per block of `box_pass`' vertical sweep.
 const BOX_BLOCK: usize = 256;
 
@@ -307,8 +312,8 @@ const BOX_BLOCK: usize = 256;
 /// and the rows past the end (y ≥ h: the first rows again, wrapped, or the last row,
 /// clamped) are swept before anything else and kept aside (`tail`).
 ///
-/// Scratch besides the image (`box_pass_scratch_rows`): the ring, the tail, one band of
-/// each block's values and the blocks' f64 sums, counted in image rows.
+/// Scratch besides the image (`blur_scratch_rows`): the ring, the tail, one band of each
+/// block's values and the blocks' f64 sums, counted in image rows.
 fn box_pass(image: &mut Image, r: usize, wraps_v: bool) {
     let (w, h, ch) = (image.width, image.height, image.channels);
     let stride = w * ch;
@@ -323,9 +328,11 @@ fn box_pass(image: &mut Image, r: usize, wraps_v: bool) {
             |padded, (group, rows)| {
                 let first = start + (group * BOX_ROWS) as isize;
                 let count = rows.len() / stride;
-                let sources: Vec<&[f32]> =
-                    (0..count).map(|k| &data[source_of(first + k as isize) * stride..][..stride]).collect();
-                box_rows_horizontal(&sources, ch, r, padded, rows);
+                let sources: [&[f32]; BOX_ROWS] = std::array::from_fn(|k| {
+                    let y = first + k.min(count - 1) as isize;
+                    &data[source_of(y) * stride..][..stride]
+                });
+                box_rows_horizontal(&sources[..count], ch, r, padded, rows);
             },
         );
     };
@@ -334,7 +341,7 @@ fn box_pass(image: &mut Image, r: usize, wraps_v: bool) {
     sweep(&image.data, h as isize, &mut tail);
     // The ring holds the swept rows y (slot (y + r) mod ring_rows), made in groups of
     // BOX_ROWS starting at y = −r, so a group's slots are contiguous.
-    let ring_rows = (BOX_BAND + 2 * r + 1 + BOX_ROWS).next_multiple_of(BOX_ROWS);
+    let ring_rows = box_ring_rows(r);
     let mut ring = vec![0.0f32; ring_rows * stride];
     let slot = |y: isize| (y + r as isize) as usize % ring_rows;
     // Swept rows made so far: y < made.

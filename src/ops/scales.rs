@@ -495,15 +495,11 @@ impl ScaleField {
     /// lattice x outside which its bounding box cannot hold the pixel (most of the nine are
     /// then rejected by two comparisons).
     fn row_candidates(&self, lattice: &Lattice, table: &CellTable, geo: &Geometry, y: f32) -> Vec<RowCandidate> {
-        let mut candidates = Vec::with_capacity(3 * (lattice.cols as usize + 2));
-        for c in -1..=lattice.cols {
-            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
-            let r0 = floor_i32(y - shift);
-            for dr in -1..=1 {
-                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
+        self.row_cells(lattice, table, y)
+            .map(|(c, cx, cy, cell)| {
                 let py = (y - cy) * lattice.aspect;
                 let (x_min, x_max) = box_x_range(geo, cell, py);
-                candidates.push(RowCandidate {
+                RowCandidate {
                     cx,
                     cy,
                     py,
@@ -516,10 +512,29 @@ impl ScaleField {
                     row: lattice.row_of(c),
                     x_min: cx as f64 + x_min,
                     x_max: cx as f64 + x_max,
-                });
-            }
-        }
-        candidates
+                }
+            })
+            .collect()
+    }
+
+    /// The cells a row of pixels (lattice row coordinate `y`) may see, in the order the
+    /// per-pixel kernels visit them: for every column c from −1 to `cols`, the three cells
+    /// around `y` (rows r0 − 1 ..= r0 + 1 of the staggered column), each as (c, jittered
+    /// centre x, y, jitter).
+    fn row_cells<'t>(
+        &'t self,
+        lattice: &'t Lattice,
+        table: &'t CellTable,
+        y: f32,
+    ) -> impl Iterator<Item = (i32, f32, f32, &'t CellJitter)> + 't {
+        (-1..=lattice.cols).flat_map(move |c| {
+            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
+            let r0 = floor_i32(y - shift);
+            (-1..=1).map(move |dr| {
+                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
+                (c, cx, cy, cell)
+            })
+        })
     }
 
     /// Lattice position of the jittered centre of cell (c, r), c unwrapped by at most one
@@ -617,25 +632,20 @@ impl ScaleField {
     /// three cells around `y`. The centres, their texture coordinates and rows depend only on
     /// the row, so they are computed once per row instead of nine times per pixel.
     fn row_hexagons(&self, lattice: &Lattice, table: &CellTable, y: f32) -> Vec<HexagonCentre> {
-        let mut centres = Vec::with_capacity(3 * (lattice.cols as usize + 2));
-        for c in -1..=lattice.cols {
-            let shift = c as f32 * lattice.stagger as f32 / lattice.cols as f32;
-            let r0 = floor_i32(y - shift);
-            for dr in -1..=1 {
-                let (cx, cy, cell) = self.centre(lattice, table, c, r0 + dr);
+        self.row_cells(lattice, table, y)
+            .map(|(c, cx, cy, cell)| {
                 // Isotropic coordinates: along-body distances scaled by the cell aspect.
                 let cy_iso = cy * lattice.aspect;
-                centres.push(HexagonCentre {
+                HexagonCentre {
                     x: cx,
                     y: cy_iso,
                     random: cell.random,
                     centre_u: lattice.u_of(cx),
                     centre_v: self.wrap_v((cy_iso / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32),
                     row: lattice.row_of(c),
-                });
-            }
-        }
-        centres
+                }
+            })
+            .collect()
     }
 
     /// `x`, `y`: the pixel's lattice coordinates; `centres`: its row's (`row_hexagons`);
