@@ -342,3 +342,32 @@ fn coupling_table_is_the_rule_it_tabulates() {
     let (reflected, _) = coupling_table_deviation(&lut, 5_000, |u| 3000.0 * u, |u| u);
     assert!(reflected > 0.01, "shifted rows not caught: {reflected}");
 }
+
+#[test]
+fn one_coupling_fetch_for_both_directions_is_two_fetches_bit_for_bit() {
+    // `eval_f32` reads the light's and the view's coupling in one call that finds the
+    // (thickness, roughness) corners once; it must be the two single fetches exactly, over
+    // both thickness ranges and beyond, and at the ends of the cos and roughness axes.
+    let lut = Lut::bake(Stack::THESIS, 64, 256, 64);
+    let ends = |u: f32| {
+        if u < 0.1 {
+            0.0
+        } else if u > 0.9 {
+            1.0
+        } else {
+            u
+        }
+    };
+    for i in 0..20_000 {
+        let u = |k: u32| snakeskin::ops::hash::unit(i, 0, k, 29);
+        let (d, r, cos) = (25_000.0 * u(0) * u(0), ends(u(1)), [ends(u(2)), ends(u(3))]);
+        let pair = lut.coupling_pair_f32(d, cos, r);
+        for (k, (top, delta)) in pair.iter().enumerate() {
+            let (single, single_delta) = lut.coupling_f32(d, cos[k], r);
+            let bits = |t: &snakeskin::optics::brdf::energy::Top<f32>, delta: f32| {
+                [t.reflected, t.ms_amplitude].concat().into_iter().chain([delta]).map(f32::to_bits).collect::<Vec<_>>()
+            };
+            assert_eq!(bits(top, *delta), bits(&single, single_delta), "d {d} r {r} cos {cos:?} direction {k}");
+        }
+    }
+}

@@ -118,17 +118,21 @@ impl Model {
         }
     }
 
-    /// The f32 twin of `coupling` with the film from `lut`, and the path delta there: the
-    /// layered model reads the LUT's coupling table (the rule on the lobe's roughness rows
-    /// per cos texel and thickness column, interpolated between rows as the rule does:
-    /// `Lut::coupling_f32`), as the shader does for the LUT film method.
-    fn coupling_f32(self, cos: f32, layers: &Layers32, lut: &super::lut::Lut) -> (energy::Top<f32>, f32) {
+    /// The f32 twin of `coupling` for the light's and the view's cosines, with the film from
+    /// `lut`, and the path delta there: the layered model reads the LUT's coupling table
+    /// (the rule on the lobe's roughness rows per cos texel and thickness column,
+    /// interpolated between rows as the rule does: `Lut::coupling_pair_f32`, one search for
+    /// the pixel's thickness and roughness), as the shader does for the LUT film method.
+    fn coupling_f32(self, cos: [f32; 2], layers: &Layers32, lut: &super::lut::Lut) -> [(energy::Top<f32>, f32); 2] {
         match self {
             Model::Thesis => {
-                let reflected = lut.lookup_f32(layers.thickness_nm, cos.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
-                (energy::Top { reflected, ms_amplitude: [0.0; 3] }, 0.0)
+                let film = |cos: f32| {
+                    let reflected = lut.lookup_f32(layers.thickness_nm, cos.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
+                    (energy::Top { reflected, ms_amplitude: [0.0; 3] }, 0.0)
+                };
+                [film(cos[0]), film(cos[1])]
             }
-            Model::Layered => lut.coupling_f32(layers.thickness_nm, cos, layers.roughness),
+            Model::Layered => lut.coupling_pair_f32(layers.thickness_nm, cos, layers.roughness),
         }
     }
 
@@ -318,8 +322,7 @@ impl Model {
         let nxh = [n[1] * h[2] - n[2] * h[1], n[2] * h[0] - n[0] * h[2], n[0] * h[1] - n[1] * h[0]];
         let spec = ggx::specular_scale_f32(cos_h, dot32(nxh, nxh), cos_i, cos_o, alpha * alpha);
         let f_h = film(dot32(wo, h).abs());
-        let ((top_i, delta_i), (top_o, delta_o)) =
-            (self.coupling_f32(cos_i, layers, lut), self.coupling_f32(cos_o, layers, lut));
+        let [(top_i, delta_i), (top_o, delta_o)] = self.coupling_f32([cos_i, cos_o], layers, lut);
         let diffuse = self.diffuse_f32(layers, [cos_i, cos_o], [top_i.reflected, top_o.reflected], [delta_i, delta_o]);
         [0, 1, 2].map(|c| f_h[c] * spec + top_i.ms_amplitude[c] * top_o.ms_amplitude[c] + diffuse[c])
     }
