@@ -120,7 +120,7 @@ impl Plan {
             Some(pack) => pack.maps(has_film(&loaded.preset), request.ao),
             None => request.maps.clone(),
         };
-        let graph = build_graph(&loaded.preset, request.options).for_maps(&maps);
+        let graph = build_graph(&loaded.preset, request.options).for_maps(&maps).fused(&maps, size, height);
         let strips = strips_of(&graph, &maps, size, height);
         // The finished maps kept as f32 until encoded or packed, and their files (each at
         // most their size).

@@ -64,20 +64,27 @@ fn the_memory_estimate_bounds_the_evaluator_and_knows_every_channel_count() {
     use snakeskin::material::MapKind;
     for (name, _) in snakeskin::preset::library::all() {
         let loaded = snakeskin::preset::load(name, &[], None).unwrap();
-        let graph = build_graph(&loaded.preset, BuildOptions::default());
-        let evaluation = evaluate(&graph, &MapKind::ALL, 48, 48, &|_, _| {});
-        // Every node's output has the channels the estimate assumes.
-        for node_stats in &evaluation.stats.nodes {
-            let node = graph.nodes().iter().find(|n| n.name == node_stats.name).unwrap();
-            let inputs: Vec<usize> = node
-                .inputs
-                .iter()
-                .map(|i| evaluation.stats.get(&graph.node(*i).name).unwrap().bytes / (48 * 48 * 4))
-                .collect();
-            assert_eq!(node.op.output_channels(&inputs) * 48 * 48 * 4, node_stats.bytes, "{name}: {}", node.name);
+        let plain = build_graph(&loaded.preset, BuildOptions::default());
+        // The graph as built and as `generate` runs it, per-pixel chains fused.
+        for graph in [plain.clone(), plain.fused(&MapKind::ALL, 48, 48)] {
+            let evaluation = evaluate(&graph, &MapKind::ALL, 48, 48, &|_, _| {});
+            // Every node's output has the channels the estimate assumes.
+            for node_stats in &evaluation.stats.nodes {
+                let node = graph.nodes().iter().find(|n| n.name == node_stats.name).unwrap();
+                let inputs: Vec<usize> = node
+                    .inputs
+                    .iter()
+                    .map(|i| evaluation.stats.get(&graph.node(*i).name).unwrap().bytes / (48 * 48 * 4))
+                    .collect();
+                assert_eq!(node.op.output_channels(&inputs) * 48 * 48 * 4, node_stats.bytes, "{name}: {}", node.name);
+            }
+            let estimate = estimate_peak_bytes(&graph, &MapKind::ALL, 48, 48);
+            assert!(
+                estimate >= evaluation.stats.peak_bytes as u64,
+                "{name}: {estimate} < {}",
+                evaluation.stats.peak_bytes
+            );
         }
-        let estimate = estimate_peak_bytes(&graph, &MapKind::ALL, 48, 48);
-        assert!(estimate >= evaluation.stats.peak_bytes as u64, "{name}: {estimate} < {}", evaluation.stats.peak_bytes);
     }
 }
 

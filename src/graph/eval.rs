@@ -10,6 +10,8 @@
 //!   builder's order (one map's chain after another) rather than running whole graph levels
 //!   at once keeps few buffers alive: measured at 4096² for a four-layer preset, level
 //!   scheduling peaked at 2.2 GB resident.
+//! - Fused, where the caller asks (`Graph::fused`, as `generate` does): a chain of per-pixel
+//!   nodes is one node that runs a band of rows at a time, with no images in between.
 //!
 //! Results do not depend on scheduling: every node is a pure function of its inputs.
 
@@ -366,6 +368,9 @@ pub fn estimate_peak_bytes(graph: &Graph, maps: &[MapKind], width: usize, height
             let bytes = channels[id.0] as u64 * pixels * 4;
             scratch += node.op.scratch_images(width) as u64 * bytes;
             scratch += node.op.scratch_rows(width) as u64 * channels[id.0] as u64 * width as u64 * 4;
+            if let super::Op::Fused(chain) = &node.op {
+                scratch += chain.scratch_bytes(width, &inputs);
+            }
             live[id.0] = bytes;
             live_bytes += bytes;
             computed[id.0] = true;

@@ -9,11 +9,13 @@
 mod cache;
 mod dot;
 mod eval;
+mod fuse;
 mod op;
 
 pub use cache::{CacheStats, NodeCache};
 pub use dot::to_dot;
 pub use eval::{EvalStats, Evaluation, NodeStats, estimate_peak_bytes, evaluate, evaluate_into, evaluate_rows};
+pub use fuse::{FusedChain, FusedInput, FusedStep};
 pub use op::Op;
 
 use std::collections::BTreeMap;

@@ -11,6 +11,8 @@ use crate::ops::scale_colour::{ScaleChannels, ScaleColour};
 use crate::ops::scales::ScaleField;
 use crate::ops::shapes::{self, Axis, BellyMarks, Blotches, SpotGrid};
 
+use super::fuse::FusedChain;
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Op {
     /// Tileable fractal noise in [0, 1]. No inputs.
@@ -61,6 +63,9 @@ pub enum Op {
     /// Height to ambient occlusion (`ops::occlusion`): `slope` as `HeightToNormal`'s, the
     /// horizon searched `radius` texture widths out; `v_extent` as `HeightToNormal`'s.
     Occlusion { slope: f32, radius: f32, v_extent: f32 },
+    /// A chain of per-pixel operations run a band of rows at a time (`Graph::fused`).
+    /// Inputs: those the chain reads from outside it.
+    Fused(FusedChain),
 }
 
 impl Op {
@@ -86,6 +91,7 @@ impl Op {
             | Op::Occlusion { .. } => 1..=1,
             Op::SnapToScales { .. } | Op::Tint { .. } | Op::ScaleColour(_) => 2..=2,
             Op::Blend { .. } => 2..=3,
+            Op::Fused(_) => 1..=usize::MAX,
         }
     }
 
@@ -110,6 +116,7 @@ impl Op {
     pub fn output_channels(&self, inputs: &[usize]) -> usize {
         match self {
             Op::Scales(field) => field.outputs.len(),
+            Op::Fused(chain) => chain.output_channels(inputs),
             Op::Colorize { .. } | Op::HeightToNormal { .. } => 3,
             Op::Levels { .. }
             | Op::Threshold { .. }
@@ -165,6 +172,20 @@ impl Op {
                 | Op::Tint { .. }
                 | Op::ScaleColour(_)
                 | Op::Blur { .. }
+        ) || matches!(self, Op::Fused(chain) if chain.in_place)
+    }
+
+    /// True for operations whose output pixel depends only on the inputs' pixels at the same
+    /// place, which `Graph::fused` may run a band of rows at a time in one chain.
+    pub fn per_pixel(&self) -> bool {
+        matches!(
+            self,
+            Op::Channel { .. }
+                | Op::Levels { .. }
+                | Op::Threshold { .. }
+                | Op::Blend { .. }
+                | Op::Colorize { .. }
+                | Op::Tint { .. }
         )
     }
 
@@ -236,6 +257,7 @@ impl Op {
             Op::Blend { mode, opacity } => filters::blend(owned(first), rest[0], rest.get(1).copied(), *mode, *opacity),
             Op::Tint { color, opacity } => tint(owned(first), rest[0], *color, *opacity),
             Op::ScaleColour(colour) => colour.apply(owned(first), rest[0], frame),
+            Op::Fused(chain) => chain.eval(first, rest, frame),
         }
     }
 
@@ -285,6 +307,10 @@ impl Op {
             Op::Along(p) => format!("along the body, {} knots", p.knots.len()),
             Op::HeadMark(m) => format!("head mark {:?}", m.shape).to_lowercase(),
             Op::ScaleColour(c) => format!("colour per scale tone={:.2} speckle={:.2}", c.tone, c.speckle),
+            Op::Fused(chain) => {
+                let labels: Vec<String> = chain.steps.iter().map(|step| step.op.label()).collect();
+                format!("fused {}: {}", labels.len(), labels.join(" + "))
+            }
         }
     }
 }
@@ -477,6 +503,12 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             (speckle_cells, speckle_cells_v, seed, crevice, random, inside, along, skin.is_some()).hash(h);
             for x in [tone, hue, edge, tip, speckle].into_iter().chain(speckle_color).chain(skin.iter().flatten()) {
                 float(h, *x);
+            }
+        }
+        Op::Fused(chain) => {
+            for step in &chain.steps {
+                hash_op(&step.op, h);
+                step.inputs.hash(h);
             }
         }
     }

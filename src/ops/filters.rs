@@ -146,9 +146,17 @@ pub fn colorize(input: &Image, low: [f32; 3], high: [f32; 3]) -> Image {
 
 /// Copies one channel out of a multi-channel image.
 pub fn extract_channel(input: &Image, channel: usize) -> Image {
-    let mut out = Image::new(input.width, input.height, 1);
+    extract_channel_rows(input, 0..input.height, channel)
+}
+
+/// Copies one channel of rows `rows` out of a multi-channel image (a fused chain's band,
+/// `graph::FusedChain`, read straight from the whole image).
+pub fn extract_channel_rows(input: &Image, rows: std::ops::Range<usize>, channel: usize) -> Image {
+    let mut out = Image::new(input.width, rows.len(), 1);
+    let row_len = input.channels * input.width;
+    let source = &input.data[rows.start * row_len..rows.end * row_len];
     let channels = input.channels;
-    out.data.par_chunks_mut(input.width).zip(input.data.par_chunks(channels * input.width)).for_each(|(row, src)| {
+    out.data.par_chunks_mut(input.width).zip(source.par_chunks(row_len)).for_each(|(row, src)| {
         for (value, pixel) in row.iter_mut().zip(src.chunks_exact(channels)) {
             *value = pixel[channel];
         }
@@ -568,8 +576,12 @@ where
         let here = input.row(y);
         let down = input.row(edge_row(y as isize + 1, h, wraps_v));
         for (x, px) in row.chunks_exact_mut(channels_out).enumerate() {
-            let (l, r) = (((x + w - 1) % w) * ch, ((x + 1) % w) * ch);
-            f(x * ch, l, r, up, here, down, px);
+            // The columns either side, wrapping round, by comparison: two integer divisions
+            // per pixel cost, one thread at 2048² (`epicrates-cenchria`), 19–21 → 14 ms of
+            // a Sobel and 33–38 → 31 ms of `height to normal`.
+            let left = if x == 0 { w - 1 } else { x - 1 };
+            let right = if x + 1 == w { 0 } else { x + 1 };
+            f(x * ch, left * ch, right * ch, up, here, down, px);
         }
     });
     out
