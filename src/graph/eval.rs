@@ -369,7 +369,7 @@ pub fn estimate_peak_bytes(graph: &Graph, maps: &[MapKind], width: usize, height
             scratch += node.op.scratch_images(width) as u64 * bytes;
             scratch += node.op.scratch_rows(width) as u64 * channels[id.0] as u64 * width as u64 * 4;
             if let super::Op::Fused(chain) = &node.op {
-                scratch += chain.scratch_bytes(width, &inputs);
+                scratch += chain.scratch_bytes(width, height, &inputs);
             }
             live[id.0] = bytes;
             live_bytes += bytes;

@@ -88,14 +88,18 @@ impl FusedChain {
         channels
     }
 
-    /// Bytes of scratch while the chain runs at `width` with inputs of `external` channels:
-    /// per thread, a band of every input that is copied (`copied_inputs`) and of every step
-    /// (an upper bound: a step's band is dropped when its reader has run).
-    pub fn scratch_bytes(&self, width: usize, external: &[usize]) -> u64 {
-        let copied = self.copied_inputs(external.len());
+    /// Bytes of scratch while the chain runs at `width` × `height` with inputs of
+    /// `external` channels: per band in flight (one per thread, at most one per band), a band
+    /// of every input it copies (`copied_inputs`, and the first input, which the in-place
+    /// path always copies) and of every step (an upper bound: a step's band is dropped when
+    /// its reader has run).
+    pub fn scratch_bytes(&self, width: usize, height: usize, external: &[usize]) -> u64 {
+        let mut copied = self.copied_inputs(external.len());
+        copied[0] |= self.in_place;
         let inputs: usize = external.iter().zip(&copied).filter(|(_, c)| **c).map(|(k, _)| k).sum();
         let band_channels = inputs + self.step_channels(external).iter().sum::<usize>();
-        (BAND_ROWS * width * band_channels * 4 * rayon::current_num_threads().max(1)) as u64
+        let in_flight = rayon::current_num_threads().clamp(1, height.div_ceil(BAND_ROWS).max(1));
+        (BAND_ROWS.min(height) * width * band_channels * 4 * in_flight) as u64
     }
 
     /// Which of the node's `count` inputs a band copies: those a step other than a channel
