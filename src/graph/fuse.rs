@@ -18,7 +18,7 @@
 //!
 //! Measured (`--stats`, `natrix-natrix` at 2048², two cores): the roughness map's nine
 //! nodes 77 → 27 ms in two chains, the colour's last three 20 → 14 ms, graph wall 525 →
-//! 491–508 ms; over every species, 2K 0.54 → 0.51 s and 4K 2.17 → 2.05 s at the median
+//! 491–508 ms; over every species, 2K 0.54 → 0.51 s and 4K 2.17 → 2.07 s at the median
 //! (BENCHMARKS.md, "Fused per-pixel chains").
 
 use std::borrow::Cow;
