@@ -16,10 +16,11 @@
 //! sees the buffers that are really allocated; a fold that would raise the estimated peak
 //! is not made (`Graph::fused`).
 //!
-//! Measured (`--stats`, `natrix-natrix` at 2048², two cores): the roughness map's nine
-//! nodes 77 → 27 ms in two chains, the colour's last three 20 → 14 ms, graph wall 525 →
-//! 491–508 ms; over every species, 2K 0.54 → 0.51 s and 4K 2.17 → 2.07 s at the median
-//! (BENCHMARKS.md, "Fused per-pixel chains").
+//! Measured (`--stats`, `natrix-natrix` at 2048², two cores, three runs): the roughness
+//! map's nine nodes 77 → 43–45 ms (two chains and one channel copy, whose fold the memory
+//! guard undid), the height map's four 37 → 21–23 ms, the colour's last three 20 → 14 ms,
+//! graph wall 525 → 491–508 ms; over every species, 2K 0.54 → 0.51 s and 4K 2.17 → 2.07 s
+//! at the median (BENCHMARKS.md, "Fused per-pixel chains").
 
 use std::borrow::Cow;
 use std::ops::Range;
@@ -232,7 +233,7 @@ enum Band<'a> {
 }
 
 /// Rows `rows` of `image` as an image of their own.
-fn band_of(image: &Image, rows: std::ops::Range<usize>) -> Image {
+fn band_of(image: &Image, rows: Range<usize>) -> Image {
     let per_row = image.width * image.channels;
     let data = crate::ops::pool::take_copy(&image.data[rows.start * per_row..rows.end * per_row]);
     Image { width: image.width, height: rows.len(), channels: image.channels, data }
