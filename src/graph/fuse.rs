@@ -254,11 +254,15 @@ impl Graph {
         let count = self.nodes.len();
         let mut consumers = vec![0usize; count];
         let mut reader = vec![None; count];
+        let mut channels = vec![0usize; count];
         for &id in &reachable {
-            for input in &self.nodes[id.0].inputs {
+            let node = &self.nodes[id.0];
+            for input in &node.inputs {
                 consumers[input.0] += 1;
                 reader[input.0] = Some(id);
             }
+            let inputs: Vec<usize> = node.inputs.iter().map(|i| channels[i.0]).collect();
+            channels[id.0] = node.op.output_channels(&inputs);
         }
         let outputs: Vec<NodeId> = maps.iter().filter_map(|m| self.output(*m)).collect();
         let mut folded: Vec<bool> = (0..count)
@@ -276,7 +280,7 @@ impl Graph {
         // reaches furthest in builder order is undone.
         let plain_peak = estimate_peak_bytes(self, maps, width, height);
         loop {
-            let graph = self.fold(maps, &reachable, &folded);
+            let graph = self.fold(maps, &reachable, &channels, &folded);
             if estimate_peak_bytes(&graph, maps, width, height) <= plain_peak {
                 return graph;
             }
@@ -289,15 +293,9 @@ impl Graph {
     }
 
     /// The graph with each node for which `folded` is true folded into its one reader's
-    /// chain (`fused`).
-    fn fold(&self, maps: &[MapKind], reachable: &[NodeId], folded: &[bool]) -> Graph {
+    /// chain (`fused`); `channels`: each reachable node's output channels.
+    fn fold(&self, maps: &[MapKind], reachable: &[NodeId], channels: &[usize], folded: &[bool]) -> Graph {
         let count = self.nodes.len();
-        let mut channels = vec![0usize; count];
-        for &id in reachable {
-            let node = &self.nodes[id.0];
-            let inputs: Vec<usize> = node.inputs.iter().map(|i| channels[i.0]).collect();
-            channels[id.0] = node.op.output_channels(&inputs);
-        }
         let mut new_id: Vec<Option<NodeId>> = vec![None; count];
         let mut nodes: Vec<Node> = Vec::new();
         for &id in reachable {
