@@ -8,9 +8,11 @@ mod atomic;
 pub mod gltf;
 mod manifest;
 pub mod pack;
+mod srgb;
 
 pub use atomic::{SetLock, Staged, create_folder, sha256_hex, write_file_atomically};
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
+pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
 
 use std::io::Cursor;
 use std::path::PathBuf;
@@ -88,13 +90,6 @@ pub fn encode_exr(map: MapKind, image: &Image, thickness_nm: (f64, f64)) -> Resu
     let mut bytes = Cursor::new(Vec::new());
     exr_image.write().to_buffered(&mut bytes).map_err(|e| ExportError::Encode { map, message: e.to_string() })?;
     Ok(bytes.into_inner())
-}
-
-/// sRGB encoding of a linear value (IEC 61966-2-1), 8 bits.
-pub fn linear_to_srgb8(linear: f32) -> u8 {
-    let c = linear.clamp(0.0, 1.0);
-    let s = if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
-    (s * 255.0 + 0.5) as u8
 }
 
 /// A sample on [0, 1] to 8 bits, rounded to nearest (every map and packed channel).

@@ -538,12 +538,37 @@ pub fn resample_bilinear_rows(src: &Image, width: usize, frame: Frame, coarse_he
             (i0, (i0 + 1) % sw, fx - x0)
         })
         .collect();
+    // The pixels between one pair of coarse columns, (first pixel, end, i0, i1): along such a
+    // run both rows' endpoints and differences are the same, so one channel's run is a loop
+    // over contiguous weights that the compiler vectorises (the same operations per pixel as
+    // the general loop below, so the same values). The variation noise at 2048² (`natrix-
+    // natrix`, 512² samples): 21–27 → 9 ms (three runs each).
+    let mut runs: Vec<(usize, usize, usize, usize)> = Vec::new();
+    for (x, &(i0, i1, _)) in columns.iter().enumerate() {
+        match runs.last_mut() {
+            Some(run) if run.2 == i0 => run.1 = x + 1,
+            _ => runs.push((x, x + 1, i0, i1)),
+        }
+    }
+    let weights: Vec<f32> = columns.iter().map(|c| c.2).collect();
     let mut out = Image::new(width, frame.height, ch);
     out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
         let fy = ((frame.row0 + y) as f32 + 0.5) / frame.full_height as f32 * coarse_height as f32;
         let y0 = fy.floor();
         let k = y0 as usize - first;
         let (r0, r1, ty) = (src.row(k), src.row(k + 1), fy - y0);
+        if ch == 1 {
+            for &(start, end, i0, i1) in &runs {
+                let (a0, da) = (r0[i0], r0[i1] - r0[i0]);
+                let (b0, db) = (r1[i0], r1[i1] - r1[i0]);
+                for (o, &tx) in row[start..end].iter_mut().zip(&weights[start..end]) {
+                    let a = a0 + da * tx;
+                    let b = b0 + db * tx;
+                    *o = a + (b - a) * ty;
+                }
+            }
+            return;
+        }
         for (x, &(i0, i1, tx)) in columns.iter().enumerate() {
             for c in 0..ch {
                 let a = r0[i0 * ch + c] + (r0[i1 * ch + c] - r0[i0 * ch + c]) * tx;
