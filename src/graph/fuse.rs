@@ -347,7 +347,10 @@ impl Graph {
                         FusedStep { name: member.name.clone(), op: member.op.clone(), inputs }
                     })
                     .collect();
-                let in_place = channels[external[0].0] == channels[id.0];
+                // Never into the scale field's buffer: it is planar (`Image::plane`), and a
+                // band of it is not a band of rows.
+                let in_place =
+                    channels[external[0].0] == channels[id.0] && !matches!(self.nodes[external[0].0].op, Op::Scales(_));
                 Node {
                     name: node.name.clone(),
                     op: Op::Fused(FusedChain { steps, in_place }),

@@ -214,6 +214,16 @@ impl Op {
             let (before, after) = frame.split_at_seam();
             let (top, bottom) = (self.eval(None, &[], before), self.eval(None, &[], after));
             let mut image = Image::new(frame.width, frame.height, top.channels);
+            if let Op::Scales(_) = self {
+                // The field is planar: each plane is the top's rows, then the bottom's.
+                let plane = frame.width * frame.height;
+                for c in 0..top.channels {
+                    let (upper, lower) = image.data[c * plane..(c + 1) * plane].split_at_mut(top.plane(c).len());
+                    upper.copy_from_slice(top.plane(c));
+                    lower.copy_from_slice(bottom.plane(c));
+                }
+                return image;
+            }
             let (upper, lower) = image.data.split_at_mut(top.data.len());
             upper.copy_from_slice(&top.data);
             lower.copy_from_slice(&bottom.data);
@@ -222,12 +232,8 @@ impl Op {
         let input = || first.as_deref().expect("operation has an input");
         match self {
             Op::Noise(noise) => crate::ops::noise::render(noise, frame),
-            Op::Constant { value } => {
-                let mut image = Image::new(frame.width, frame.height, 1);
-                image.data.fill(*value);
-                image
-            }
-            Op::Scales(field) => field.render_in(frame),
+            Op::Constant { value } => filters::constant(frame.width, frame.height, *value),
+            Op::Scales(field) => field.render_planar(frame),
             Op::Channel { index } => filters::extract_channel(input(), *index),
             Op::Bands { axis, centres, half_width, softness } => {
                 shapes::bands(frame, *axis, centres, *half_width, *softness)

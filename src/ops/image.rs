@@ -1,7 +1,9 @@
 //! The one pixel buffer every node produces: a square-or-rectangular grid of f32 channels.
 //!
 //! Channels are interleaved (`data[(y * width + x) * channels + c]`) so a pixel's channels sit
-//! in one cache line; rows are the unit of parallel work. Everything is f32 in linear units:
+//! in one cache line; rows are the unit of parallel work. One image is planar instead: the
+//! multi-channel scale field, whose readers each take one or two of its channels
+//! (`Image::plane`, `ScaleField::render_planar`). Everything is f32 in linear units:
 //! quantisation happens only in `export`, so no intermediate step loses precision.
 
 use rayon::prelude::*;
@@ -169,6 +171,15 @@ impl Image {
     pub fn row(&self, y: usize) -> &[f32] {
         let stride = self.width * self.channels;
         &self.data[y * stride..(y + 1) * stride]
+    }
+
+    /// Channel `c` of a **planar** image, whose channels lie one after another, each a
+    /// whole row-major plane (the scale field as the graph holds it,
+    /// `ScaleField::render_planar`); for one channel the same as `data`.
+    #[inline]
+    pub fn plane(&self, c: usize) -> &[f32] {
+        let n = self.width * self.height;
+        &self.data[c * n..(c + 1) * n]
     }
 }
 

@@ -79,7 +79,6 @@ impl ScaleColour {
     pub fn apply(&self, colour: Image, scales: &Image, frame: super::image::Frame) -> Image {
         let (width, height) = (colour.width, frame.full_height);
         let ch = colour.channels;
-        let sc = scales.channels;
         let k = self.channels;
         let cells = self.speckle_cells.max(1) as f32;
         let cells_v = self.speckle_cells_v.max(1) as f32;
@@ -89,14 +88,16 @@ impl ScaleColour {
         use rayon::prelude::*;
         out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
             let v = (frame.texture_row(y) as f32 + 0.5) / height as f32;
-            let field = scales.row(y);
+            // The field is planar (`Image::plane`): this row of the four channels read.
+            let field_row = |c: usize| &scales.plane(c)[y * width..(y + 1) * width];
+            let (crevices, randoms, insides, alongs) =
+                (field_row(k.crevice), field_row(k.random), field_row(k.inside), field_row(k.along));
             // The scale's second random number, hashed once per run of pixels of one scale
             // (a scale spans many pixels of a row), not once per pixel.
             let mut second_of: (u32, f32) = (u32::MAX, 0.0);
             for x in 0..width {
-                let f = &field[x * sc..(x + 1) * sc];
                 let px = &mut row[x * ch..x * ch + ch.min(3)];
-                let crevice = f[k.crevice].clamp(0.0, 1.0);
+                let crevice = crevices[x].clamp(0.0, 1.0);
                 let own = 1.0 - crevice;
                 if let Some(skin) = self.skin {
                     for (c, s) in px.iter_mut().zip(skin) {
@@ -106,7 +107,7 @@ impl ScaleColour {
                 if own <= 0.0 {
                     continue;
                 }
-                let random = f[k.random];
+                let random = randoms[x];
                 let mut gain = [1.0f32; 3];
                 if self.tone != 0.0 {
                     let t = 1.0 + self.tone * (2.0 * random - 1.0) * own;
@@ -122,11 +123,11 @@ impl ScaleColour {
                     gain[2] *= 1.0 - warm;
                 }
                 if self.edge != 0.0 {
-                    let rim = 1.0 - smoothstep(0.0, RIM_WIDTH, f[k.inside]);
+                    let rim = 1.0 - smoothstep(0.0, RIM_WIDTH, insides[x]);
                     gain = gain.map(|g| g * (1.0 + self.edge * rim * own));
                 }
                 if self.tip != 0.0 {
-                    let tip = smoothstep(TIP_START, 1.0, f[k.along]);
+                    let tip = smoothstep(TIP_START, 1.0, alongs[x]);
                     gain = gain.map(|g| g * (1.0 + self.tip * tip * own));
                 }
                 for (c, g) in px.iter_mut().zip(gain) {
