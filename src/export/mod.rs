@@ -125,10 +125,16 @@ pub fn quantize(map: MapKind, image: &Image) -> Quantized {
     let (samples, color) = match (format.channels, format.bit_depth) {
         (3, 8) => (image.data.par_iter().map(|&x| unit_to_u8(encode(x))).collect(), ExtendedColorType::Rgb8),
         (1, 8) => (image.data.par_iter().map(|&x| unit_to_u8(encode(x))).collect(), ExtendedColorType::L8),
-        (1, 16) => (
-            image.data.par_iter().flat_map_iter(|&x| unit_to_u16(encode(x)).to_ne_bytes()).collect(),
-            ExtendedColorType::L16,
-        ),
+        (1, 16) => {
+            // Into one buffer of the final size: collecting the bytes of a `flat_map_iter`
+            // grows a vector per rayon task and joins them, and glibc keeps the freed pieces
+            // in its worker arenas.
+            let mut samples = vec![0u8; image.data.len() * 2];
+            samples.par_chunks_mut(2).zip(&image.data).for_each(|(out, &x)| {
+                out.copy_from_slice(&unit_to_u16(encode(x)).to_ne_bytes());
+            });
+            (samples, ExtendedColorType::L16)
+        }
         other => unreachable!("MapKind::format has no {other:?} layout"),
     };
     Quantized { map, width: image.width, height: image.height, samples, color }
@@ -136,7 +142,10 @@ pub fn quantize(map: MapKind, image: &Image) -> Quantized {
 
 /// Encodes a quantised map as PNG bytes.
 pub fn encode_quantized(q: &Quantized) -> Result<Vec<u8>, ExportError> {
-    let mut out = Cursor::new(Vec::new());
+    // Room for the whole file up front (the samples and a margin for incompressible ones):
+    // the pages are resident only as they are written, and a vector grown by doubling
+    // leaves its earlier pieces in the encoder thread's allocator arena.
+    let mut out = Cursor::new(Vec::with_capacity(q.samples.len() + q.samples.len() / 64 + (1 << 16)));
     let encoder = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
     encoder
         .write_image(&q.samples, q.width as u32, q.height as u32, q.color)
