@@ -670,6 +670,53 @@ pub fn height_to_normal(
 mod tests {
     use super::*;
 
+    /// `resample_bilinear_rows` against bilinear interpolation written out per pixel and
+    /// channel (the formula of its general loop), bit for bit: one and three channels,
+    /// widths that do and do not divide the coarse grid's, wider and narrower than it, the
+    /// whole texture and a strip of it. A run path that read a run's neighbour column or
+    /// the wrong weight fails it.
+    #[test]
+    fn upsampling_by_runs_is_bilinear_per_pixel_bit_for_bit() {
+        for (sw, ch) in [(7usize, 1usize), (16, 1), (5, 3), (64, 1)] {
+            let coarse_height = 6;
+            let src = Image::from_fn(sw, coarse_height + 1, ch, |u, v, out| {
+                for (c, o) in out.iter_mut().enumerate() {
+                    *o = (u * 13.7 + v * 5.3 + c as f32).sin();
+                }
+            });
+            for width in [3usize, 37, 64, 100] {
+                let full_height = 48;
+                for (row0, height) in [(0usize, 48usize), (9, 17)] {
+                    let frame = Frame { width, height, full_height, row0, wraps_v: true };
+                    let first = ((row0 as f32 + 0.5) / full_height as f32 * coarse_height as f32).floor() as usize;
+                    let out = resample_bilinear_rows(&src, width, frame, coarse_height, first);
+                    for y in 0..height {
+                        let fy = ((row0 + y) as f32 + 0.5) / full_height as f32 * coarse_height as f32;
+                        let y0 = fy.floor();
+                        let (r0, r1, ty) = (src.row(y0 as usize - first), src.row(y0 as usize - first + 1), fy - y0);
+                        for x in 0..width {
+                            let fx = (x as f32 + 0.5) / width as f32 * sw as f32;
+                            let x0 = fx.floor();
+                            let i0 = (x0 as isize).rem_euclid(sw as isize) as usize;
+                            let (i1, tx) = ((i0 + 1) % sw, fx - x0);
+                            for c in 0..ch {
+                                let a = r0[i0 * ch + c] + (r0[i1 * ch + c] - r0[i0 * ch + c]) * tx;
+                                let b = r1[i0 * ch + c] + (r1[i1 * ch + c] - r1[i0 * ch + c]) * tx;
+                                let expected = a + (b - a) * ty;
+                                let got = out.data[(y * width + x) * ch + c];
+                                assert_eq!(
+                                    got.to_bits(),
+                                    expected.to_bits(),
+                                    "sw {sw} ch {ch} width {width} row0 {row0}: ({x}, {y}, {c})"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn blur_preserves_mean_and_wraps() {
         let img = Image::gray_from_fn(64, 32, |u, _| if u < 0.1 { 1.0 } else { 0.0 });
