@@ -3,7 +3,8 @@
 //! Why: a graph evaluated one buffer per node makes every one-line operation (a levels, a
 //! blend, a channel copy) a pass over whole images in memory, into a new buffer that the
 //! kernel page-faults in. At 2048² such nodes took about a third of a set's node time
-//! (`--stats`: a channel copy 18–23 ms, a levels 14 ms on a fresh buffer, 2–3 ms in place).
+//! (`--stats`: a channel copy 18–23 ms, a levels 14 ms on a fresh buffer, 2–3 ms in place;
+//! figures from before the scale field was planar, which made channel copies cheaper).
 //! A per-pixel node whose only reader is another per-pixel node needs no image of its own:
 //! [`Graph::fused`] folds it into that reader, and the reader (the chain's root, whose
 //! result some other node or a map needs) becomes one [`Op::Fused`] node that runs the
@@ -347,10 +348,11 @@ impl Graph {
                         FusedStep { name: member.name.clone(), op: member.op.clone(), inputs }
                     })
                     .collect();
-                // Never into the scale field's buffer: it is planar (`Image::plane`), and a
-                // band of it is not a band of rows.
-                let in_place =
-                    channels[external[0].0] == channels[id.0] && !matches!(self.nodes[external[0].0].op, Op::Scales(_));
+                // Into the scale field's buffer only where it has one channel: it is planar
+                // (`Image::plane`), and a band of a planar image of several channels is not a
+                // band of rows.
+                let planar = matches!(self.nodes[external[0].0].op, Op::Scales(_)) && channels[external[0].0] > 1;
+                let in_place = channels[external[0].0] == channels[id.0] && !planar;
                 Node {
                     name: node.name.clone(),
                     op: Op::Fused(FusedChain { steps, in_place }),

@@ -22,7 +22,8 @@ pub enum Op {
     Constant { value: f32 },
     /// The multi-channel scale field (`ops::scales::channel`). No inputs.
     Scales(ScaleField),
-    /// One channel of the input.
+    /// One channel of the input, which is the scale field and so planar (`Image::plane`;
+    /// a one-channel image is the same either way).
     Channel { index: usize },
     /// Smooth bands along one axis (stripes, rings, the belly). No inputs.
     Bands { axis: Axis, centres: Vec<f32>, half_width: f32, softness: f32 },
@@ -98,7 +99,8 @@ impl Op {
     /// The channel indices this node reads from its input `input` by position (a
     /// multi-channel scale field), for `Graph::for_maps` to renumber when the field outputs
     /// fewer channels: Some(list) for the ops that address a field's channels, None for an
-    /// op that would read the input whole.
+    /// op that would read the input whole (none reads the field so: it is planar, and only
+    /// these ops read it by plane).
     pub fn channel_reads_mut(&mut self, input: usize) -> Option<Vec<&mut usize>> {
         match (self, input) {
             (Op::Channel { index }, 0) => Some(vec![index]),

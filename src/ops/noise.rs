@@ -275,6 +275,10 @@ impl NoiseSampler {
     /// per-pixel `sample` for the grain noise at 2048² (the finest octave has a cell every
     /// 5 px there).
     pub fn sample_row_with(&self, runs: &RowRuns, us: &[f32], v: f32, out: &mut [f32]) {
+        debug_assert!(
+            runs.0.iter().all(|r| r.last().map_or(us.is_empty(), |last| last.1 == us.len())),
+            "runs found for another row of coordinates"
+        );
         out.fill(0.0);
         if self.kind == NoiseKind::Cellular {
             for ((octave, &amplitude), runs) in self.octaves.iter().zip(&self.amplitudes).zip(&runs.0) {

@@ -444,8 +444,8 @@ impl ScaleField {
     }
 
     /// The field over the rows of `frame` (a strip of a long texture), **planar**: entry k of
-    /// `outputs` is `Image::plane(k)`. Why planar: every reader takes one or two of the
-    /// channels (a channel copy, the snap's centre, the per-scale colour's four), and from
+    /// `outputs` is `Image::plane(k)`. Why planar: every reader takes one to four of
+    /// the channels (a channel copy one, the snap two, the per-scale colour four), and from
     /// interleaved pixels each such read streams the whole field through the cache (at
     /// 2048², six channels: 96 MiB read to copy one 16 MiB channel, 15–17 ms; as a plane,
     /// a 16 MiB copy).
