@@ -170,7 +170,7 @@ impl Plan {
                 for_each_band(&graph, &request.maps, size, height, strip_layout, progress, &mut |band, rows| {
                     for (map, image) in band {
                         let stride = image.width * image.channels;
-                        let band_rows = &image.data[rows.start * stride..rows.end * stride];
+                        let band_rows = image.rows(rows.clone());
                         match finished.iter_mut().find(|(m, _)| m == map) {
                             Some((_, whole)) => whole.data.extend_from_slice(band_rows),
                             None => {
@@ -601,13 +601,7 @@ fn tile_strips(
         let mut encoders = Vec::new();
         let stats = for_each_strip_map(graph, maps, size, size, Some(layout), progress, &mut |map, image, rows| {
             let t = Instant::now();
-            let stride = image.width * image.channels;
-            let band = crate::ops::Image {
-                width: image.width,
-                height: rows.len(),
-                channels: image.channels,
-                data: image.data[rows.start * stride..rows.end * stride].to_vec(),
-            };
+            let band = image.band(rows.clone());
             drop(image);
             let quantized = export::quantize(map, &band);
             let index = kinds.iter().position(|k| *k == map).expect("a requested map");

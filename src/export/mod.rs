@@ -207,14 +207,7 @@ impl RowEncoder {
     /// cheap half of `write_rows`, so a caller can quantise as maps finish and compress on
     /// another thread (`write_samples`).
     pub fn samples(map: MapKind, image: &Image, rows: std::ops::Range<usize>) -> Vec<u8> {
-        let stride = image.width * image.channels;
-        let band = Image {
-            width: image.width,
-            height: rows.len(),
-            channels: image.channels,
-            data: image.data[rows.start * stride..rows.end * stride].to_vec(),
-        };
-        let mut q = quantize(map, &band);
+        let mut q = quantize(map, &image.band(rows));
         if q.color == ExtendedColorType::L16 {
             // PNG stores 16-bit samples big-endian; `quantize` gives native order.
             for pair in q.samples.chunks_exact_mut(2) {

@@ -177,7 +177,7 @@ impl FusedChain {
             .zip(&copied)
             .map(|(input, copy)| match input {
                 Band::Own(image) => Some(image),
-                Band::Rows(image) if *copy => Some(band_of(image, rows.clone())),
+                Band::Rows(image) if *copy => Some(image.band(rows.clone())),
                 Band::Rows(_) => None,
             })
             .collect();
@@ -231,13 +231,6 @@ impl FusedChain {
 enum Band<'a> {
     Rows(&'a Image),
     Own(Image),
-}
-
-/// Rows `rows` of `image` as an image of their own.
-fn band_of(image: &Image, rows: Range<usize>) -> Image {
-    let per_row = image.width * image.channels;
-    let data = crate::ops::pool::take_copy(&image.data[rows.start * per_row..rows.end * per_row]);
-    Image { width: image.width, height: rows.len(), channels: image.channels, data }
 }
 
 impl Graph {

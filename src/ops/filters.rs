@@ -152,9 +152,8 @@ pub fn extract_channel(input: &Image, channel: usize) -> Image {
 /// Copies one channel of rows `rows` out of a planar multi-channel image (a fused chain's
 /// band, `graph::FusedChain`, read straight from the whole field).
 pub fn extract_channel_rows(input: &Image, rows: std::ops::Range<usize>, channel: usize) -> Image {
-    let w = input.width;
-    let source = &input.plane(channel)[rows.start * w..rows.end * w];
-    let mut out = Image::new(w, rows.len(), 1);
+    let source = input.plane_rows(channel, rows.clone());
+    let mut out = Image::new(input.width, rows.len(), 1);
     out.data.par_chunks_mut(FLAT_CHUNK).zip(source.par_chunks(FLAT_CHUNK)).for_each(|(o, s)| o.copy_from_slice(s));
     out
 }

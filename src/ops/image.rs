@@ -2,7 +2,7 @@
 //!
 //! Channels are interleaved (`data[(y * width + x) * channels + c]`) so a pixel's channels sit
 //! in one cache line; rows are the unit of parallel work. One image is planar instead: the
-//! multi-channel scale field, whose readers each take one or two of its channels
+//! multi-channel scale field, whose readers each take one to four of its channels
 //! (`Image::plane`, `ScaleField::render_planar`). Everything is f32 in linear units:
 //! quantisation happens only in `export`, so no intermediate step loses precision.
 
@@ -169,8 +169,20 @@ impl Image {
     /// One row of pixels (all channels).
     #[inline]
     pub fn row(&self, y: usize) -> &[f32] {
+        self.rows(y..y + 1)
+    }
+
+    /// The rows `rows` of pixels (all channels), one after another.
+    #[inline]
+    pub fn rows(&self, rows: std::ops::Range<usize>) -> &[f32] {
         let stride = self.width * self.channels;
-        &self.data[y * stride..(y + 1) * stride]
+        &self.data[rows.start * stride..rows.end * stride]
+    }
+
+    /// The rows `rows` as an image of their own (a copy).
+    pub fn band(&self, rows: std::ops::Range<usize>) -> Image {
+        let data = super::pool::take_copy(self.rows(rows.clone()));
+        Image { width: self.width, height: rows.len(), channels: self.channels, data }
     }
 
     /// Channel `c` of a **planar** image, whose channels lie one after another, each a
@@ -180,6 +192,12 @@ impl Image {
     pub fn plane(&self, c: usize) -> &[f32] {
         let n = self.width * self.height;
         &self.data[c * n..(c + 1) * n]
+    }
+
+    /// The rows `rows` of channel `c` of a planar image (`plane`).
+    #[inline]
+    pub fn plane_rows(&self, c: usize, rows: std::ops::Range<usize>) -> &[f32] {
+        &self.plane(c)[rows.start * self.width..rows.end * self.width]
     }
 }
 

@@ -89,7 +89,7 @@ impl ScaleColour {
         out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
             let v = (frame.texture_row(y) as f32 + 0.5) / height as f32;
             // The field is planar (`Image::plane`): this row of the four channels read.
-            let field_row = |c: usize| &scales.plane(c)[y * width..(y + 1) * width];
+            let field_row = |c: usize| scales.plane_rows(c, y..y + 1);
             let (crevices, randoms, insides, alongs) =
                 (field_row(k.crevice), field_row(k.random), field_row(k.inside), field_row(k.along));
             // The scale's second random number, hashed once per run of pixels of one scale
