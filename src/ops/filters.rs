@@ -163,7 +163,12 @@ pub fn extract_channel_rows(input: &Image, rows: std::ops::Range<usize>, channel
 /// took 8–11 ms).
 pub fn constant(width: usize, height: usize, value: f32) -> Image {
     let mut image = Image::new(width, height, 1);
-    image.data.par_chunks_mut(FLAT_CHUNK).for_each(|chunk| chunk.fill(value));
+    // `Image::new` is zeros already (+0.0); a fresh buffer's pages are then never written
+    // here, so they cost no page faults until read (a species without a film: its
+    // thickness map is 0 everywhere).
+    if value.to_bits() != 0 {
+        image.data.par_chunks_mut(FLAT_CHUNK).for_each(|chunk| chunk.fill(value));
+    }
     image
 }
 

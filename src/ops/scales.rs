@@ -459,6 +459,7 @@ impl ScaleField {
             _ => Vec::new(),
         };
         let imbricate = matches!(self.shape, ScaleShape::Leaf | ScaleShape::Diamond);
+        let heights = self.outputs.contains(&channel::HEIGHT);
         // Lattice x of every pixel column (`Lattice::x_of` is a binary search over the
         // column edges when rows differ in width).
         let inv_w = 1.0 / frame.width as f32;
@@ -499,7 +500,7 @@ impl ScaleField {
                 } else if self.shape == ScaleShape::Hexagon {
                     self.hexagon_pixel(&lattice, &hexagons, &mut cell, x, y, &mut all);
                 } else {
-                    self.imbricate_pixel(&geo, &candidates, &mut sweep, x, &mut all);
+                    self.imbricate_pixel(&geo, &candidates, &mut sweep, heights, x, &mut all);
                 }
                 for (plane, c) in planes.iter_mut().zip(&self.outputs) {
                     plane[i] = all[*c];
@@ -586,7 +587,17 @@ impl ScaleField {
 
     /// `x`: the pixel's lattice x; `candidates`: its row's (`row_candidates`), of which
     /// `sweep` holds those whose range reaches x (the pixels of a row come in order of x).
-    fn imbricate_pixel(&self, geo: &Geometry, candidates: &[RowCandidate], sweep: &mut Sweep, x: f32, out: &mut [f32]) {
+    /// `heights`: whether the maps read the height channel (the only one that needs the
+    /// scale underneath).
+    fn imbricate_pixel(
+        &self,
+        geo: &Geometry,
+        candidates: &[RowCandidate],
+        sweep: &mut Sweep,
+        heights: bool,
+        x: f32,
+        out: &mut [f32],
+    ) {
         // Roof tiles: of the scales covering a pixel, the most anterior (smallest centre v)
         // lies on top, its free posterior edge over the scale behind. Its rim falls towards
         // the scale underneath, which leaves a groove along every free edge: the visible
@@ -612,10 +623,18 @@ impl ScaleField {
             }
             let cand = &candidates[k];
             let Some((inside, lx, ly)) = cand.covers(geo, x) else { continue };
+            // The scale underneath only shapes the height (when the maps read no height,
+            // e.g. `--maps roughness`, its profile is not computed).
             match top {
-                Some(t) if cand.cy >= t.3.cy => under_height = under_height.max(profile(inside, ly)),
+                Some(t) if cand.cy >= t.3.cy => {
+                    if heights {
+                        under_height = under_height.max(profile(inside, ly));
+                    }
+                }
                 _ => {
-                    if let Some(t) = top {
+                    if let Some(t) = top
+                        && heights
+                    {
                         under_height = under_height.max(profile(t.0, t.2));
                     }
                     top = Some((inside, lx, ly, cand));
@@ -625,7 +644,8 @@ impl ScaleField {
         let Some((inside, lx, ly, cand)) = top else {
             return self.write_scale(None, 0.0, self.keel_height, out);
         };
-        let height = free_edge(profile(inside, ly), inside / soft, under_height, self.imbrication);
+        let height =
+            if heights { free_edge(profile(inside, ly), inside / soft, under_height, self.imbrication) } else { 0.0 };
         let top = Candidate {
             inside,
             x: lx,
