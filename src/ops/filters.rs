@@ -165,7 +165,7 @@ pub fn constant(width: usize, height: usize, value: f32) -> Image {
     let mut image = Image::new(width, height, 1);
     // `Image::new` is zeros already (+0.0); a fresh buffer's pages are then never written
     // here, so they cost no page faults until read (a species without a film: its
-    // thickness map is 0 everywhere).
+    // thickness map is 0 everywhere; `crotalus-atrox` at 2048², 3.3–3.7 → 1.5–1.6 ms).
     if value.to_bits() != 0 {
         image.data.par_chunks_mut(FLAT_CHUNK).for_each(|chunk| chunk.fill(value));
     }
