@@ -382,10 +382,12 @@ impl Geometry {
                 // half-width R − d = a and tips at y = ±sqrt(R² − d²) = ±b.
                 let (x, y) = if self.leaf_across { (y, x) } else { (x, y) };
                 let (d, r) = (self.leaf_d, self.leaf_r);
-                let y2 = y * y;
-                let d1 = ((x - d) * (x - d) + y2).sqrt() - r;
-                let d2 = ((x + d) * (x + d) + y2).sqrt() - r;
-                -d1.max(d2)
+                // Inside both circles: the farther centre decides, the one on the other side
+                // of x = 0 (d ≥ 0). |x| + d is |x ∓ d| for that centre, rounded the same, so
+                // this is the larger of the two circle distances bit for bit, with one square
+                // root instead of two.
+                let far = x.abs() + d;
+                -((far * far + y * y).sqrt() - r)
             }
             // Rhombus with half-diagonals a = 1 cell width and b = half a cell length: with
             // columns staggered by half a row, neighbouring rhombi share edges at size 1
@@ -1209,6 +1211,47 @@ mod tests {
             }
         }
         fields
+    }
+
+    /// The leaf's distance inside both circles, written out as the larger of the two circle
+    /// distances (thesis Fig. 4.8's construction).
+    fn two_circles(geo: &Geometry, x: f32, y: f32) -> f32 {
+        let (x, y) = if geo.leaf_across { (y, x) } else { (x, y) };
+        let (d, r) = (geo.leaf_d, geo.leaf_r);
+        let d1 = ((x - d) * (x - d) + y * y).sqrt() - r;
+        let d2 = ((x + d) * (x + d) + y * y).sqrt() - r;
+        -d1.max(d2)
+    }
+
+    /// Points of a grid over the leaf and beyond (both signs, the axes, signed zeros) where
+    /// `inside` differs from `two_circles` in any bit.
+    fn mismatches(geo: &Geometry, inside: impl Fn(f32, f32) -> f32) -> usize {
+        let mut points: Vec<(f32, f32)> = Vec::new();
+        for i in -200..=200 {
+            for j in -200..=200 {
+                points.push((i as f32 * 0.0071, j as f32 * 0.0113));
+            }
+        }
+        points.extend([(0.0, 0.0), (-0.0, 0.3), (0.2, -0.0), (-0.25, 0.0)]);
+        points.iter().filter(|&&(x, y)| inside(x, y).to_bits() != two_circles(geo, x, y).to_bits()).count()
+    }
+
+    #[test]
+    fn the_leaf_with_one_square_root_is_both_circles_bit_for_bit() {
+        // b below and above the leaf's half-width: across and lengthwise.
+        for b in [0.15, 0.4, 0.7, 1.0, 2.0] {
+            let geo = Geometry::new(ScaleShape::Leaf, b);
+            assert_eq!(mismatches(&geo, |x, y| geo.inside(x, y)), 0, "b {b}");
+            // The negative control: the farther centre taken without |x| (right only for
+            // x ≥ 0) is found.
+            let signed = |x: f32, y: f32| {
+                let (x, y) = if geo.leaf_across { (y, x) } else { (x, y) };
+                let far = x + geo.leaf_d;
+                -((far * far + y * y).sqrt() - geo.leaf_r)
+            };
+            // (At b = the half-width the lens is a circle, d = 0, and the two agree.)
+            assert!(geo.leaf_d == 0.0 || mismatches(&geo, signed) > 0, "b {b}");
+        }
     }
 
     #[test]
