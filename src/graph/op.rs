@@ -216,19 +216,15 @@ impl Op {
             let (before, after) = frame.split_at_seam();
             let (top, bottom) = (self.eval(None, &[], before), self.eval(None, &[], after));
             let mut image = Image::new(frame.width, frame.height, top.channels);
-            if let Op::Scales(_) = self {
-                // The field is planar: each plane is the top's rows, then the bottom's.
-                let plane = frame.width * frame.height;
-                for c in 0..top.channels {
-                    let (upper, lower) = image.data[c * plane..(c + 1) * plane].split_at_mut(top.plane(c).len());
-                    upper.copy_from_slice(top.plane(c));
-                    lower.copy_from_slice(bottom.plane(c));
-                }
-                return image;
+            // Each part is the top's rows, then the bottom's: the whole buffer for interleaved
+            // pixels, each plane for the scale field, which is planar (`Image::plane`).
+            let parts = if let Op::Scales(_) = self { top.channels } else { 1 };
+            let (whole, upper_len) = (image.data.len() / parts, top.data.len() / parts);
+            for (p, part) in image.data.chunks_exact_mut(whole.max(1)).enumerate() {
+                let (upper, lower) = part.split_at_mut(upper_len);
+                upper.copy_from_slice(&top.data[p * upper_len..(p + 1) * upper_len]);
+                lower.copy_from_slice(&bottom.data[p * (whole - upper_len)..(p + 1) * (whole - upper_len)]);
             }
-            let (upper, lower) = image.data.split_at_mut(top.data.len());
-            upper.copy_from_slice(&top.data);
-            lower.copy_from_slice(&bottom.data);
             return image;
         }
         let input = || first.as_deref().expect("operation has an input");

@@ -548,18 +548,12 @@ pub fn resample_bilinear_rows(src: &Image, width: usize, frame: Frame, coarse_he
             (i0, (i0 + 1) % sw, fx - x0)
         })
         .collect();
-    // The pixels between one pair of coarse columns, (first pixel, end, i0, i1): along such a
+    // The pixels between one pair of coarse columns, (first pixel, end, i0): along such a
     // run both rows' endpoints and differences are the same, so one channel's run is a loop
     // over contiguous weights that the compiler vectorises (the same operations per pixel as
     // the general loop below, so the same values). The variation noise at 2048² (`natrix-
     // natrix`, 512² samples): 21–27 → 9 ms (three runs each).
-    let mut runs: Vec<(usize, usize, usize, usize)> = Vec::new();
-    for (x, &(i0, i1, _)) in columns.iter().enumerate() {
-        match runs.last_mut() {
-            Some(run) if run.2 == i0 => run.1 = x + 1,
-            _ => runs.push((x, x + 1, i0, i1)),
-        }
-    }
+    let runs = super::image::runs_by(width, |x| columns[x].0);
     let weights: Vec<f32> = columns.iter().map(|c| c.2).collect();
     let mut out = Image::new(width, frame.height, ch);
     out.data.par_chunks_mut(width * ch).enumerate().for_each(|(y, row)| {
@@ -568,7 +562,8 @@ pub fn resample_bilinear_rows(src: &Image, width: usize, frame: Frame, coarse_he
         let k = y0 as usize - first;
         let (r0, r1, ty) = (src.row(k), src.row(k + 1), fy - y0);
         if ch == 1 {
-            for &(start, end, i0, i1) in &runs {
+            for &(start, end, i0) in &runs {
+                let i1 = columns[start].1;
                 let (a0, da) = (r0[i0], r0[i1] - r0[i0]);
                 let (b0, db) = (r1[i0], r1[i1] - r1[i0]);
                 for (o, &tx) in row[start..end].iter_mut().zip(&weights[start..end]) {

@@ -209,3 +209,18 @@ pub fn floor_i32(x: f32) -> i32 {
     let i = x as i32;
     if (i as f32) > x { i - 1 } else { i }
 }
+
+/// The runs of consecutive indices `0..len` with equal `key`, as (first, end, key): the
+/// pixels of a row that share a lattice cell or a pair of coarse columns, so a kernel looks
+/// up what they share once per run (`noise::RowRuns`, `filters::resample_bilinear_rows`).
+pub fn runs_by<K: PartialEq>(len: usize, key: impl Fn(usize) -> K) -> Vec<(usize, usize, K)> {
+    let mut runs: Vec<(usize, usize, K)> = Vec::new();
+    for i in 0..len {
+        let k = key(i);
+        match runs.last_mut() {
+            Some(run) if run.2 == k => run.1 = i + 1,
+            _ => runs.push((i, i + 1, k)),
+        }
+    }
+    runs
+}

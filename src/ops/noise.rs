@@ -168,15 +168,7 @@ impl Octave {
     /// so a render finds them once for all its rows (`RowRuns`).
     fn runs(&self, us: &[f32]) -> Vec<(usize, usize, i32)> {
         let period_x = self.period_x as f32;
-        let mut runs = Vec::new();
-        let mut start = 0;
-        while start < us.len() {
-            let ix = floor_i32(us[start] * period_x);
-            let end = start + us[start..].iter().take_while(|&&u| floor_i32(u * period_x) == ix).count();
-            runs.push((start, end, ix));
-            start = end;
-        }
-        runs
+        super::image::runs_by(us.len(), |i| floor_i32(us[i] * period_x))
     }
 
     /// `cellular` at every (us[i] · period_x, v · period_y) of one row, times `amplitude`,
