@@ -56,6 +56,10 @@ pub struct Lut {
 /// (see BENCHMARKS.md): 64 angles × (256 + 64) thicknesses, 240 KiB as RGB f32.
 pub const DEFAULT_SIZE: (usize, usize, usize) = (64, 256, 64);
 
+/// Thickness columns of a default-size LUT (`Lut::width`): the width of the renderer's film
+/// texture and the depth of its 3-D coupling texture, which a GPU must be able to hold.
+pub const DEFAULT_WIDTH: usize = DEFAULT_SIZE.1 + DEFAULT_SIZE.2;
+
 impl Lut {
     pub fn width(&self) -> usize {
         self.n_fine + self.n_coarse

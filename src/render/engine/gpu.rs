@@ -54,6 +54,7 @@ impl Gpu {
     /// `bench render`).
     pub fn open(adapter: &wgpu::Adapter) -> Result<Gpu, GpuError> {
         let info = adapter.get_info();
+        check_texture_limits(&adapter.limits())?;
         let required_features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("snakeskin"),
@@ -69,6 +70,23 @@ impl Gpu {
     pub fn describe(&self) -> String {
         format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
     }
+}
+
+/// The renderer's largest textures against what the adapter can hold: the film LUT is a 2-D
+/// texture and the coupling table a 3-D texture with one column or layer per LUT thickness
+/// column (`lut::DEFAULT_WIDTH`, 320). Vulkan promises only 256 texels along each axis of a
+/// 3-D texture (`maxImageDimension3D`), so an adapter at that minimum is refused here with
+/// the reason, rather than by a validation error when the texture is made.
+fn check_texture_limits(limits: &wgpu::Limits) -> Result<(), GpuError> {
+    let columns = crate::optics::lut::DEFAULT_WIDTH as u32;
+    if limits.max_texture_dimension_3d < columns || limits.max_texture_dimension_2d < columns {
+        return Err(GpuError::Device(format!(
+            "the adapter's largest 3-D texture is {} texels per axis (2-D: {}); the film's coupling \
+             table needs {columns}",
+            limits.max_texture_dimension_3d, limits.max_texture_dimension_2d
+        )));
+    }
+    Ok(())
 }
 
 /// Maps a buffer for reading, waits for the GPU, and returns a copy of its bytes.
@@ -139,5 +157,22 @@ fn buffer_entry(
         visibility,
         ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
         count: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An adapter at Vulkan's minimum 3-D size is refused with both numbers in the message;
+    /// wgpu's defaults (2048) pass.
+    #[test]
+    fn an_adapter_too_small_for_the_coupling_table_is_refused_with_the_sizes() {
+        assert!(check_texture_limits(&wgpu::Limits::default()).is_ok());
+        let small = wgpu::Limits { max_texture_dimension_3d: 256, ..wgpu::Limits::default() };
+        let message = check_texture_limits(&small).expect_err("256 < 320").to_string();
+        assert!(message.contains("256") && message.contains("320"), "{message}");
+        let just = wgpu::Limits { max_texture_dimension_3d: 320, ..wgpu::Limits::default() };
+        assert!(check_texture_limits(&just).is_ok());
     }
 }
