@@ -307,3 +307,14 @@ pub fn box_colour(stack: Stack, film: &FilmSeries, d: f64, w: f64, cos0: f64) ->
     });
     xyz_to_linear_srgb(xyz)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `DEFAULT_WIDTH`, which the renderer checks a GPU against, is what a default bake makes.
+    #[test]
+    fn a_default_lut_has_default_width_thickness_columns() {
+        assert_eq!(Lut::bake_default(Stack::THESIS).width(), DEFAULT_WIDTH);
+    }
+}
