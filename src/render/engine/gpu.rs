@@ -11,6 +11,9 @@ pub enum GpuError {
     NoAdapter(String),
     #[error("the GPU adapter refused a device: {0}")]
     Device(String),
+    /// The adapter cannot hold a texture the renderer needs (`check_texture_limits`).
+    #[error("the GPU adapter is too small for the preview: {0}")]
+    Limits(String),
     #[error("GPU readback failed: {0}")]
     Readback(String),
     /// A GPU timing that came out meaningless (not positive): noise swamped the work.
@@ -80,7 +83,7 @@ impl Gpu {
 fn check_texture_limits(limits: &wgpu::Limits) -> Result<(), GpuError> {
     let columns = crate::optics::lut::DEFAULT_WIDTH as u32;
     if limits.max_texture_dimension_3d < columns || limits.max_texture_dimension_2d < columns {
-        return Err(GpuError::Device(format!(
+        return Err(GpuError::Limits(format!(
             "the adapter's largest 3-D texture is {} texels per axis (2-D: {}); the film's coupling \
              table needs {columns}",
             limits.max_texture_dimension_3d, limits.max_texture_dimension_2d
