@@ -6,11 +6,13 @@
 # Usage: benches/nodetime.sh [BINARY] [SIZE]   (defaults: target/release/snakeskin, 2048)
 # Output: a Markdown table, operation | nodes | mean ms per species, slowest first.
 set -euo pipefail
+# shellcheck source=lib.sh
+source "$(dirname "$0")/lib.sh"
 bin=${1:-target/release/snakeskin}
 size=${2:-2048}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-presets=$("$bin" presets list | tail -n +2 | awk '{print $1}')
+presets=$(builtin_presets "$bin")
 echo "| operation | nodes | mean ms per species |"
 echo "|---|---:|---:|"
 for preset in $presets; do

@@ -11,6 +11,8 @@
 # in a fixed order each run pays for the file write-back of the run before it. Wall times in
 # ms; the medians over the rounds and their ratios are printed, one line per binary.
 set -euo pipefail
+# shellcheck source=lib.sh
+source "$(dirname "$0")/lib.sh"
 runs=${1:?usage: benches/ratios.sh RUNS [BINARY...]}
 shift
 bins=("${@:-target/release/snakeskin}")
@@ -37,8 +39,7 @@ for round in $(seq "$runs"); do
         echo $((($(date +%s%N) - start) / 1000000)) >>"$times/$b.$name"
     done
 done
-median() { sort -g "$1" | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
-ratio() { echo "$(median "$times/$1.$2") $(median "$times/$1.$3")" | awk '{printf "%d / %d = %.3f", $1, $2, $1 / $2}'; }
+ratio() { echo "$(median <"$times/$1.$2") $(median <"$times/$1.$3")" | awk '{printf "%d / %d = %.3f", $1, $2, $1 / $2}'; }
 for b in "${!bins[@]}"; do
     echo "${bins[$b]}: crotalus-atrox roughness / full $(ratio "$b" crotalus-rough crotalus-full);" \
         "erythrolamprus-miliaris roughness / full $(ratio "$b" erythrolamprus-rough erythrolamprus-full);" \

@@ -11,13 +11,14 @@
 # Output: one tab-separated line per preset: name, 2K median s, 4K median s, 4K peak MiB
 # (the largest of the runs).
 set -euo pipefail
+# shellcheck source=lib.sh
+source "$(dirname "$0")/lib.sh"
 bin=${1:-target/release/snakeskin}
 runs=${2:-3}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-median() { sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
 printf 'preset\t2k_s\t4k_s\t4k_peak_mib\n'
-for preset in $("$bin" presets list | tail -n +2 | awk '{print $1}') tests/data/patterned.toml; do
+for preset in $(builtin_presets "$bin") tests/data/patterned.toml; do
     t2=() t4=() peak=0
     for _ in $(seq "$runs"); do
         t2+=("$( { /usr/bin/time -f '%e' "$bin" generate "$preset" -o "$out" --size 2048 >/dev/null; } 2>&1 | tail -1)")
