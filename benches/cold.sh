@@ -10,14 +10,14 @@
 # Output per round: wall, user and system seconds of the first run after IDLE_S seconds idle,
 # then of the two runs that follow it.
 set -euo pipefail
+# shellcheck source=lib.sh
+source "$(dirname "$0")/lib.sh"
 bin=${1:-target/release/snakeskin}
 preset=${2:-natrix-natrix}
 size=${3:-2048}
 rounds=${4:-3}
 idle=${5:-25}
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
-run() { { /usr/bin/time -f '%e %U %S' "$bin" generate "$preset" -o "$out" --size "$size" >/dev/null; } 2>&1 | tail -1; }
+run() { { /usr/bin/time -f '%e %U %S' "$bin" generate "$preset" -o "$scratch" --size "$size" >/dev/null; } 2>&1 | tail -1; }
 for round in $(seq "$rounds"); do
     sleep "$idle"
     echo "round $round: cold $(run) | then $(run) | then $(run)"

@@ -10,13 +10,11 @@ set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 bin=${1:-target/release/snakeskin}
 size=${2:-2048}
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
 presets=$(builtin_presets "$bin")
 echo "| operation | nodes | mean ms per species |"
 echo "|---|---:|---:|"
 for preset in $presets; do
-    "$bin" generate "$preset" -o "$out" --size "$size" --stats 2>&1
+    "$bin" generate "$preset" -o "$scratch" --size "$size" --stats 2>&1
 done | awk -v species="$(echo "$presets" | wc -l)" '
     # The stats table: a header, then "name operation... evals ms MiB" per node.
     /^node +operation/ { table = 1; next }

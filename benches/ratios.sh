@@ -16,9 +16,9 @@ source "$(dirname "$0")/lib.sh"
 runs=${1:?usage: benches/ratios.sh RUNS [BINARY...]}
 shift
 bins=("${@:-target/release/snakeskin}")
-out=$(mktemp -d)
-times=$(mktemp -d)
-trap 'rm -rf "$out" "$times"' EXIT
+out=$scratch/out
+times=$scratch/times
+mkdir "$out" "$times"
 # name|preset|extra arguments (split on spaces)
 cases=(
     "crotalus-full|crotalus-atrox|"

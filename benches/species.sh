@@ -15,14 +15,12 @@ set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 bin=${1:-target/release/snakeskin}
 runs=${2:-3}
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
 printf 'preset\t2k_s\t4k_s\t4k_peak_mib\n'
 for preset in $(builtin_presets "$bin") tests/data/patterned.toml; do
     t2=() t4=() peak=0
     for _ in $(seq "$runs"); do
-        t2+=("$( { /usr/bin/time -f '%e' "$bin" generate "$preset" -o "$out" --size 2048 >/dev/null; } 2>&1 | tail -1)")
-        line=$( { /usr/bin/time -f '%e %M' "$bin" generate "$preset" -o "$out" --size 4096 >/dev/null; } 2>&1 | tail -1)
+        t2+=("$( { /usr/bin/time -f '%e' "$bin" generate "$preset" -o "$scratch" --size 2048 >/dev/null; } 2>&1 | tail -1)")
+        line=$( { /usr/bin/time -f '%e %M' "$bin" generate "$preset" -o "$scratch" --size 4096 >/dev/null; } 2>&1 | tail -1)
         t4+=("${line% *}")
         kb=${line#* }
         (( kb > peak )) && peak=$kb
