@@ -91,12 +91,14 @@ struct Top {
 }
 
 // The rough lobe's table (the film bind group's lobe_table, optics::brdf::energy::node):
-// per (mu, r) node two vec4s, (E1, c1, c2, c3) and (w1, w2, multiple-scatter scale, path
-// delta): its albedo for F = 1, the three-point Gauss rule over its microfacet cosines (the
-// third weight is 1 minus the other two), and the pigment layer's path (path_delta_at).
+// per (mu, r) node LOBE_VEC4S vec4s, (E1, c1, c2, c3), (w1, w2, multiple-scatter scale, path
+// delta) and (W, c_a, c_b, w_a): its albedo for F = 1, the three-point Gauss rule over its
+// microfacet cosines (the third weight is 1 minus the other two), the pigment layer's path
+// (path_delta_at) and the rule for light that comes straight back through the top
+// (optics::brdf::path::PathTable::through).
 
-// The lobe table's cell at (mu, r): the indices of its lower corners (two vec4s per entry)
-// and the bilinear weights.
+// The lobe table's cell at (mu, r): the indices of its lower corners (LOBE_VEC4S vec4s per
+// entry) and the bilinear weights.
 struct LobeCell {
     k00: u32,
     k01: u32,
@@ -109,15 +111,15 @@ fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
     let y = clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
     let i = min(u32(x), E1_MU - 2u);
     let j = min(u32(y), E1_ROUGHNESS - 2u);
-    return LobeCell(2u * (j * E1_MU + i), 2u * ((j + 1u) * E1_MU + i), x - f32(i), y - f32(j));
+    return LobeCell(LOBE_VEC4S * (j * E1_MU + i), LOBE_VEC4S * ((j + 1u) * E1_MU + i), x - f32(i), y - f32(j));
 }
 
 // cos_eff(mu, r) - cos_t(mu): how much more obliquely than Snell's law the light the rough
 // top lets in crosses the pigment layer, bilinear in the lobe table's fourth slot (this
 // material's optics::brdf::path table; PathTable::cos_eff), in the lobe table's cell c.
 fn path_delta_in(c: LobeCell) -> f32 {
-    let lower = mix(lobe_table[c.k00 + 1u].w, lobe_table[c.k00 + 3u].w, c.fx);
-    let upper = mix(lobe_table[c.k01 + 1u].w, lobe_table[c.k01 + 3u].w, c.fx);
+    let lower = mix(lobe_table[c.k00 + 1u].w, lobe_table[c.k00 + LOBE_VEC4S + 1u].w, c.fx);
+    let upper = mix(lobe_table[c.k01 + 1u].w, lobe_table[c.k01 + LOBE_VEC4S + 1u].w, c.fx);
     return mix(lower, upper, c.fy);
 }
 
@@ -202,18 +204,52 @@ fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, roughness: f32, k: v
     }
 }
 
-// The rule on one roughness row (energy::top_on_row): the lobe's entries k and k + 2 (two
-// vec4s each) mixed by fx, then E1 times the film over the lobe's microfacet angles
-// (three-point Gauss rule) plus the multiple scattering (1 - E1) <F> F(c1).
-fn top_on_row(layers: Layers, k: u32, fx: f32) -> Top {
-    let a = mix(lobe_table[k], lobe_table[k + 2u], fx);
-    let b = mix(lobe_table[k + 1u], lobe_table[k + 3u], fx);
+// The rule's two parts on one roughness row (energy::parts_on_row): the lobe's entries k
+// and k + LOBE_VEC4S mixed by fx; the single scattering E1 <F> (the film over the lobe's
+// microfacet angles, three-point Gauss rule) and what the top reflects beyond it, x: the
+// multiple scattering (1 - E1) <F> F(c1) plus the light that comes straight back through
+// the top, q = (1 - <F>) W (w_a F(c_a) + (1 - w_a) F(c_b)).
+struct RowParts {
+    single: vec3<f32>,
+    beyond: vec3<f32>,
+}
+
+fn parts_on_row(layers: Layers, k: u32, fx: f32) -> RowParts {
+    let a = mix(lobe_table[k], lobe_table[k + LOBE_VEC4S], fx);
+    let b = mix(lobe_table[k + 1u], lobe_table[k + LOBE_VEC4S + 1u], fx);
+    let t = mix(lobe_table[k + 2u], lobe_table[k + LOBE_VEC4S + 2u], fx);
     let f1 = film_clamped(layers, a.y);
     let f2 = film_clamped(layers, a.z);
     let f3 = film_clamped(layers, a.w);
     let mean = b.x * f1 + b.y * f2 + (1.0 - b.x - b.y) * f3;
-    let g = mean * f1;
-    return Top(a.x * mean + (1.0 - a.x) * g, b.z * sqrt(g), 0.0);
+    let q = (1.0 - mean) * t.x * (t.w * film_clamped(layers, t.y) + (1.0 - t.w) * film_clamped(layers, t.z));
+    return RowParts(a.x * mean, (1.0 - a.x) * mean * f1 + q);
+}
+
+// One node of the multiple-scatter normalisation on row j: node = (mu, 2 w mu).
+fn ms_norm_term(layers: Layers, j: u32, node: vec2<f32>) -> vec3<f32> {
+    let x = node.x * f32(E1_MU - 1u);
+    let i = min(u32(x), E1_MU - 2u);
+    return node.y * parts_on_row(layers, LOBE_VEC4S * (j * E1_MU + i), x - f32(i)).beyond;
+}
+
+// X = 2 int x(mu) mu dmu on row j, the multiple-scatter lobe's normalisation
+// (energy::ms_norm_on_row, its rule's eight nodes generated). The LUT film method reads it
+// baked into the coupling texture; the direct methods pay these eight evaluations per row.
+fn ms_norm_on_row(layers: Layers, j: u32) -> vec3<f32> {
+    return ms_norm_term(layers, j, MS_NODE_0) + ms_norm_term(layers, j, MS_NODE_1) + ms_norm_term(layers, j, MS_NODE_2)
+        + ms_norm_term(layers, j, MS_NODE_3) + ms_norm_term(layers, j, MS_NODE_4) + ms_norm_term(layers, j, MS_NODE_5)
+        + ms_norm_term(layers, j, MS_NODE_6) + ms_norm_term(layers, j, MS_NODE_7);
+}
+
+// The rule on one roughness row (energy::top_on_row) at the entry k mixed by fx: the top
+// reflects E1 <F> + x, and its multiple-scatter lobe x(mu_i) x(mu_o) / (pi X) returns the x
+// it takes in every direction.
+fn top_on_row(layers: Layers, k: u32, fx: f32) -> Top {
+    let parts = parts_on_row(layers, k, fx);
+    let norm = ms_norm_on_row(layers, k / (LOBE_VEC4S * E1_MU));
+    let amplitude = select(vec3<f32>(0.0), parts.beyond / sqrt(PI * norm), norm > vec3<f32>(1e-9));
+    return Top(parts.single + parts.beyond, amplitude, 0.0);
 }
 
 // The layered coupling from the film table's coupling texture (optics::lut::Lut::

@@ -127,7 +127,12 @@ proptest! {
         ti in 0.0f64..std::f64::consts::PI, pi in 0.0f64..6.3,
         to in 0.0f64..std::f64::consts::PI, po in 0.0f64..6.3,
         nx in -1.0f64..1.0, ny in -1.0f64..1.0, nz in -1.0f64..1.0, zero_normal in any::<bool>(),
-        n0 in 1.0f64..2.0, n2 in 1.0f64..3.0, roughness in 0.0f64..1.0,
+        // Indices from a set (equal, below and above each other, the extremes): each material
+        // walks its path table (about a second), which 2,000 random materials would repeat
+        // 2,000 times; `path`'s tests walk tables of random indices.
+        n0 in proptest::sample::select(vec![1.0, 1.33, 1.7, 2.0]),
+        n2 in proptest::sample::select(vec![1.0, 1.2, 1.55, 2.9]),
+        roughness in 0.0f64..1.0,
         tau in prop_oneof![Just(0.0), 0.0f64..60.0], albedo in 0.0f64..1.0,
         film_r in prop_oneof![Just(0.0), Just(1.0), -0.1f64..1.1],
         model in proptest::sample::select(Model::ALL.to_vec()),
@@ -303,7 +308,8 @@ fn coupling_table_deviation(
         let u = |k: u32| snakeskin::ops::hash::unit(i, 0, k, 23);
         let (d, cos, r) = (thickness_nm(u(0)), cos(u(1)), u(2));
         let film = |c: f32| lut.lookup_f32(d, c.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
-        let rule = snakeskin::optics::brdf::energy::top_f32(cos, r, &film);
+        let through = &snakeskin::optics::brdf::path::cached(lut.stack.n0, lut.stack.n2).through_f32;
+        let rule = snakeskin::optics::brdf::energy::top_f32(cos, r, &film, through);
         let (table, _) = lut.coupling_f32(d, cos, r);
         for c in 0..3 {
             reflected = reflected.max((table.reflected[c] - rule.reflected[c]).abs());
@@ -319,9 +325,11 @@ fn coupling_table_is_the_rule_it_tabulates() {
     // interpolates between roughness rows as the rule does: the same up to f32 rounding, at
     // any roughness. Between texels and columns it interpolates the results where the rule
     // interpolates the lobe and the film (the rule is linear in neither): the reflected
-    // share within 0.005 everywhere (measured ≤ 0.0024 on the four materials, 20,000 points
-    // each), the multiple-scatter amplitude within 0.005 for cos ≥ 0.1 and 0.03 below,
-    // where it rises steeply to ~1.6 at grazing (measured ≤ 0.0045 and ≤ 0.02).
+    // share within 0.005 everywhere (measured ≤ 0.0029 on the four materials, 20,000 points
+    // each), the multiple-scatter amplitude x / √(π X̄) within 0.008 for cos ≥ 0.1 and 0.12
+    // below, where it rises steeply towards grazing (measured ≤ 0.0068 and ≤ 0.090, nearly
+    // all of it between cos texels: between thickness columns ≤ 0.0014; with the earlier
+    // amplitude (1 − E₁) √g, ≤ 0.0045 and ≤ 0.02).
     for stack in GRID_MATERIALS {
         let lut = Lut::bake(stack, 64, 256, 64);
         let fine_step = 2000.0 / 255.0;
@@ -330,9 +338,9 @@ fn coupling_table_is_the_rule_it_tabulates() {
         let (reflected, amplitude) = coupling_table_deviation(&lut, 5_000, on_column, on_texel);
         assert!(reflected < 2e-6 && amplitude < 2e-6, "{stack:?} on texels: {reflected} {amplitude}");
         let (reflected, amplitude) = coupling_table_deviation(&lut, 20_000, |u| 3000.0 * u, |u| 0.1 + 0.9 * u);
-        assert!(reflected < 0.005 && amplitude < 0.005, "{stack:?}, cos ≥ 0.1: {reflected} {amplitude}");
+        assert!(reflected < 0.005 && amplitude < 0.008, "{stack:?}, cos ≥ 0.1: {reflected} {amplitude}");
         let (reflected, amplitude) = coupling_table_deviation(&lut, 20_000, |u| 3000.0 * u, |u| 0.1 * u);
-        assert!(reflected < 0.005 && amplitude < 0.03, "{stack:?}, cos < 0.1: {reflected} {amplitude}");
+        assert!(reflected < 0.005 && amplitude < 0.12, "{stack:?}, cos < 0.1: {reflected} {amplitude}");
     }
     // Negative control: a table whose roughness rows are shifted by one is caught.
     let lut = Lut::bake(Stack::THESIS, 64, 256, 64);
@@ -369,5 +377,34 @@ fn one_coupling_fetch_for_both_directions_is_two_fetches_bit_for_bit() {
             };
             assert_eq!(bits(top, *delta), bits(&single, single_delta), "d {d} r {r} cos {cos:?} direction {k}");
         }
+    }
+}
+
+/// Light that crosses the rough top and comes straight back through it (in through one
+/// microfacet, out through another, up off a third: `path::PathTable::through`) against
+/// the photon walk of the whole stack, with a black base so that nothing comes back from
+/// it: at 85° and roughness 0.9 on (1, 1.56, 1.33) under a 650 nm film, what the model's
+/// top reflects (its `coupling`) and what the walk returns. Measured: within 0.006 with the
+/// term, 0.011–0.017 too little without it (the negative control).
+#[test]
+fn light_straight_back_through_the_rough_top_meets_the_walk() {
+    use snakeskin::optics::brdf::{energy, path, walk};
+    let stack = Stack { n0: 1.0, n1: 1.56, n2: 1.33 };
+    let film = FilmTables::new(stack, 650.0);
+    let film_fn = |c: f64| film.above(c).map(|v| v.clamp(0.0, 1.0));
+    let mu = 85f64.to_radians().cos();
+    let layers = Layers::of_stack(stack, 650.0, 0.9, [0.0; 3], [0.0; 3]);
+    let walked = walk::walk(&layers, &film, [(1.0 - mu * mu).sqrt(), 0.0, mu], 200_000, 1, 17);
+    let with = energy::top(mu, 0.9, &film_fn, &path::cached(stack.n0, stack.n2).through);
+    let without = energy::top(mu, 0.9, &film_fn, &[]);
+    for c in 0..3 {
+        let reference = walked.total()[c];
+        assert!(walked.diffuse[c] > 0.01, "the walk finds the light that comes straight back: {:?}", walked.diffuse);
+        assert!(
+            (with.reflected[c] - reference).abs() < 0.007,
+            "channel {c}: model {}, walk {reference}",
+            with.reflected[c]
+        );
+        assert!(reference - without.reflected[c] > 0.009, "channel {c}: without the term {}", without.reflected[c]);
     }
 }

@@ -160,7 +160,7 @@ fn the_visible_colour_is_the_rough_models_own_diffuse_reflectance_at_normal_inci
                 let kd = Model::Layered.base_albedo(colour, &Layers { albedo: colour, ..layers });
                 let lit = Layers { albedo: kd, ..layers };
                 // R_d(1) = 2π ∫ f_diff(μ) μ dμ (midpoint rule).
-                let n = 4000;
+                let n = 1000;
                 let mut diffuse = [0.0; 3];
                 for i in 0..n {
                     let mu = (i as f64 + 0.5) / n as f64;
@@ -170,7 +170,7 @@ fn the_visible_colour_is_the_rough_models_own_diffuse_reflectance_at_normal_inci
                         *d += v * mu * 2.0 * std::f64::consts::PI / n as f64;
                     }
                 }
-                let s1 = Model::Layered.coupling(1.0, roughness, &|c| film(c).map(|v| v.clamp(0.0, 1.0))).reflected;
+                let s1 = Model::Layered.coupling(1.0, &layers, &|c| film(c).map(|v| v.clamp(0.0, 1.0))).reflected;
                 for c in 0..3 {
                     let shown = diffuse[c] / (1.0 - s1[c]);
                     let relative = (shown - colour[c]).abs() / colour[c];

@@ -135,9 +135,10 @@ impl Lut {
                 };
                 let mut column = Vec::with_capacity(E1_ROUGHNESS * n_cos);
                 for i_r in 0..E1_ROUGHNESS {
+                    let norm = energy::ms_norm_on_row_f32(i_r, &film, &path.through_f32);
                     for i_cos in 0..n_cos {
                         let cos = i_cos as f32 / (n_cos - 1) as f32;
-                        let top = energy::top_on_row_f32(cos, i_r, &film);
+                        let top = energy::top_on_row_with_f32(cos, i_r, &film, &path.through_f32, norm);
                         let (s, m) = (top.reflected, top.ms_amplitude);
                         let r = i_r as f32 / (E1_ROUGHNESS - 1) as f32;
                         let delta = energy::GridCell::<f32>::at(cos, r).bilinear(&path.delta_f32);

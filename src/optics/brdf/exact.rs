@@ -132,9 +132,9 @@ impl SmoothTop {
                 (sin2_out < 1.0).then(|| (1.0 - sin2_out).sqrt())
             })
             .collect();
+        let through = &super::path::cached(n0, n2).through;
         let coupled = (0..energy::E1_ROUGHNESS)
             .map(|row| {
-                let r = row as f64 / (energy::E1_ROUGHNESS - 1) as f64;
                 below
                     .iter()
                     .zip(&outside)
@@ -146,7 +146,10 @@ impl SmoothTop {
                             // A mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
                             return rb;
                         }
-                        energy::top(mu_out, r, &|c| reflectance(stack, thickness_nm, c)).reflected
+                        // What the top reflects on this row (its single scattering and x).
+                        let film = |c: f64| reflectance(stack, thickness_nm, c);
+                        let (single, beyond) = energy::parts_on_row(mu_out, row, &film, through);
+                        [0, 1, 2].map(|c| single[c] + beyond[c])
                     })
                     .collect()
             })

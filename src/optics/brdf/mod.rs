@@ -109,12 +109,27 @@ impl Model {
     /// stack, and the ambient term's mirror part is the sky times this) and the amplitude
     /// of its multiple-scatter lobe. The thesis: the film F(cos) (`film` clamped to [0, 1]),
     /// no multiple scattering; the layered model: the rough lobe's albedo with the film read
-    /// at its microfacet angles plus its multiple scattering (`energy::top`). `brdf.wgsl`'s
-    /// `coupling`.
-    pub fn coupling(self, cos: f64, roughness: f64, film: &dyn Fn(f64) -> [f64; 3]) -> energy::Top<f64> {
+    /// at its microfacet angles plus its multiple scattering and the light that comes
+    /// straight back through it (`energy::top`, with the material's rule for that:
+    /// `path::PathTable::through`). `layers` gives the roughness and the material's indices.
+    /// `brdf.wgsl`'s `coupling`.
+    pub fn coupling(self, cos: f64, layers: &Layers, film: &dyn Fn(f64) -> [f64; 3]) -> energy::Top<f64> {
         match self {
             Model::Thesis => energy::Top { reflected: film(cos), ms_amplitude: [0.0; 3] },
-            Model::Layered => energy::top(cos, roughness, film),
+            Model::Layered => {
+                path::with(layers.n0, layers.n2, |p| energy::top(cos, layers.roughness, film, &p.through))
+            }
+        }
+    }
+
+    /// `coupling` for the light's and the view's cosines, which share the rough lobe's
+    /// normalisation (`energy::top_pair`).
+    fn coupling_pair(self, cos: [f64; 2], layers: &Layers, film: &dyn Fn(f64) -> [f64; 3]) -> [energy::Top<f64>; 2] {
+        match self {
+            Model::Thesis => cos.map(|c| self.coupling(c, layers, film)),
+            Model::Layered => {
+                path::with(layers.n0, layers.n2, |p| energy::top_pair(cos, layers.roughness, film, &p.through))
+            }
         }
     }
 
@@ -284,8 +299,7 @@ impl Model {
     ) -> Option<Lobes> {
         let (single, cos_i, cos_o) = single_lobe(layers, normal, wi, wo, film)?;
         let film_clamped = |c: f64| film_clamped(film(c.clamp(0.0, 1.0)));
-        let (r, film) = (layers.roughness, &film_clamped);
-        let (top_i, top_o) = (self.coupling(cos_i, r, film), self.coupling(cos_o, r, film));
+        let [top_i, top_o] = self.coupling_pair([cos_i, cos_o], layers, &film_clamped);
         Some(Lobes {
             single,
             multiple: [0, 1, 2].map(|c| top_i.ms_amplitude[c] * top_o.ms_amplitude[c]),

@@ -71,18 +71,23 @@ struct FilmInfo {
     xyz_to_rgb: [[f32; 4]; 3],
 }
 
+/// vec4s per entry of the lobe table (`lobe_table`; the shader's `LOBE_VEC4S`).
+pub const LOBE_VEC4S: usize = 3;
+
 /// The rough lobe's table (`optics::brdf::energy`) as `film.wgsl`'s `lobe_table`: per (μ, r)
-/// entry, row-major by roughness, two vec4s: (E₁, c₁, c₂, c₃) and (w₁, w₂, multiple-scatter
-/// scale, cos_eff − cos_t), the last from the material's path table (`optics::brdf::path`,
-/// the same grid). Filled for every material, absorbing or not: the window changes the
-/// absorption without a new film binding.
+/// entry, row-major by roughness, `LOBE_VEC4S` vec4s: (E₁, c₁, c₂, c₃), (w₁, w₂, 0,
+/// cos_eff − cos_t) and (W, c_a, c_b, w_a), the last five from the material's path table (`optics::brdf::path`, the same grid: the path delta and the rule
+/// for light that comes straight back through the top). Filled for every material,
+/// absorbing or not: the window changes the absorption without a new film binding.
 fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
     use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, node};
     let path = crate::optics::brdf::path::cached(stack.n0, stack.n2);
     (0..E1_MU * E1_ROUGHNESS)
         .flat_map(|k| {
-            let [e1, c1, c2, c3, w1, w2, ms_scale] = node(k % E1_MU, k / E1_MU);
-            [[e1, c1, c2, c3], [w1, w2, ms_scale, path.delta_f32[k]]]
+            let [e1, c1, c2, c3, w1, w2] = node(k % E1_MU, k / E1_MU);
+            let entry: [[f32; 4]; LOBE_VEC4S] =
+                [[e1, c1, c2, c3], [w1, w2, 0.0, path.delta_f32[k]], path.through_f32[k]];
+            entry
         })
         .collect()
 }

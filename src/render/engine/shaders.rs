@@ -9,7 +9,7 @@
 //! checks that no file spells a generated value out.
 
 use crate::maps::MapKind;
-use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS};
+use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, MS_NODES, ms_rule};
 use crate::optics::brdf::{ALPHA_MIN, COS_MIN, LENGTH_MIN, Model};
 use crate::optics::fast::{BOX_NARROW_RAD, HARMONICS_DENOM_MIN, Q_NEGLIGIBLE, SINC_SMALL};
 use crate::optics::lut::{COARSE_MAX_NM, FINE_MAX_NM};
@@ -50,6 +50,9 @@ fn vec4_literal(v: [f64; 4]) -> String {
 }
 
 /// The shared numbers as WGSL `const` declarations: (name, WGSL type, value).
+/// `brdf.wgsl`'s `ms_norm_on_row` sums the rule's nodes one by one.
+const _: () = assert!(MS_NODES == 8, "brdf.wgsl's ms_norm_on_row sums eight nodes");
+
 pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
     let mut c: Vec<(&'static str, &'static str, String)> = vec![
         ("PI", "f32", f32_literal(std::f64::consts::PI)),
@@ -80,11 +83,19 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("GBUFFER_ALBEDO_GEOMETRY", "u32", format!("{GBUFFER_ALBEDO_GEOMETRY}u")),
         ("E1_MU", "u32", format!("{E1_MU}u")),
         ("E1_ROUGHNESS", "u32", format!("{E1_ROUGHNESS}u")),
+        ("LOBE_VEC4S", "u32", format!("{}u", super::film::LOBE_VEC4S)),
         // K and E's film thicknesses (render::engine::scene::BOUNCE_THICKNESSES) and the
         // scene uniform's table length.
         ("BOUNCE_THICKNESSES", "u32", format!("{BOUNCE_THICKNESSES}u")),
         ("BOUNCE_ENTRIES", "u32", format!("{}u", E1_ROUGHNESS * BOUNCE_THICKNESSES)),
     ];
+    // The multiple-scatter lobe's normalisation rule (optics::brdf::energy::ms_rule), one
+    // constant per node: (μ, 2 w μ).
+    const MS_NODE_NAMES: [&str; MS_NODES] =
+        ["MS_NODE_0", "MS_NODE_1", "MS_NODE_2", "MS_NODE_3", "MS_NODE_4", "MS_NODE_5", "MS_NODE_6", "MS_NODE_7"];
+    for (name, &(mu, weight)) in MS_NODE_NAMES.iter().zip(ms_rule()) {
+        c.push((name, "vec2<f32>", format!("vec2<f32>({}, {})", f32_literal(mu), f32_literal(2.0 * weight * mu))));
+    }
     let code = |v: u32| format!("{v}u");
     for (name, method) in [
         ("FILM_LUT", GpuFilmMethod::Lut),

@@ -137,7 +137,7 @@ pub fn shade_pixel(
     // film, the sky along the normal through the layer model.
     let cos_o = dot(n, wo).max(COS_MIN);
     let film_clamped = |c: f64| film(c).map(|v| v.clamp(0.0, 1.0));
-    let s_o = settings.model.coupling(cos_o, layers.roughness, &film_clamped).reflected;
+    let s_o = settings.model.coupling(cos_o, &layers, &film_clamped).reflected;
     let mirror = [0, 1, 2].map(|c| -wo[c] + 2.0 * dot(n, wo) * n[c]);
     let sky_mirror = sky(lighting, mirror);
     let sky_normal = sky(lighting, n);
