@@ -321,7 +321,10 @@ macro_rules! top_impl {
                     [0, 1, 2].map(|c| (1.0 - mean[c]) * w * (w_a * f_a[c] + (1.0 - w_a) * f_b[c]))
                 }
             };
-            ([0, 1, 2].map(|c| e1 * mean[c]), [0, 1, 2].map(|c| (1.0 - e1) * mean[c] * f1[c] + q[c]))
+            // x never more than the light the single scattering leaves (q's reweighting is
+            // an estimate).
+            let single = [0, 1, 2].map(|c| e1 * mean[c]);
+            (single, [0, 1, 2].map(|c| ((1.0 - e1) * mean[c] * f1[c] + q[c]).min(1.0 - single[c])))
         }
 
         /// X̄ = 2 ∫ x(μ) μ dμ on roughness row `i_r`, the multiple-scatter lobe's

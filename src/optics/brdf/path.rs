@@ -33,14 +33,17 @@
 //! ```
 //!
 //! with ⟨F⟩ the film averaged over the rough lobe's microfacet angles (the light's way in,
-//! `energy::top_on_row` has it) and a two-point Gauss rule (nodes c_a, c_b, weight w_a) for
-//! the microfacet cosines of the last reflection from above, weighted by 1 / F_bare (so
-//! that the bare interface gives back the walked q exactly, and a film reweights each
-//! photon's reflection by F / F_bare). W carries the walked fraction. Against walks of the
-//! stack with its film (measured over 96 cases: two film indices, n2 1.33 and 1.55, films
-//! of 150, 250 and 650 nm, 60–85°, roughness 0.6–0.9, two channels) this rule is off by
-//! 0.0005 on average and 0.0065 at most, where q itself averages 0.0075 and reaches 0.046;
-//! the film at the mean cosines alone was off by twice as much on average.
+//! `energy::top_on_row` has it), W the share of the light that entered the bare surface
+//! which came straight back (times the mean of 1 / F_bare below), and a two-point Gauss
+//! rule (nodes c_a, c_b, weight w_a) for the microfacet cosines of the last reflection from
+//! above, weighted by 1 / F_bare (so that a film reweights each photon's reflection by
+//! F / F_bare). The form was chosen against walks of the stack with its film, 96 cases
+//! (two film indices, n2 1.33 and 1.55, films of 150, 250 and 650 nm, 60–85°, roughness
+//! 0.6–0.9, two channels; each case's own walk giving W and the rule): off by 0.0005 on
+//! average and 0.0065 at most, where q itself averages 0.0075 and reaches 0.046; the film
+//! at the mean cosines alone was off by twice as much on average. The table as built (one
+//! rule per roughness row, W a share of what entered: `through_rule`) is checked by
+//! `tests/brdf.rs`'s walk at 85° and by `bench layered` (BENCHMARKS.md).
 
 use std::sync::{Arc, Mutex};
 
@@ -90,7 +93,7 @@ impl PathTable {
         let entries = E1_ROUGHNESS * E1_MU;
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, entries);
         let chunk = entries.div_ceil(threads);
-        let walked: Vec<(f64, (u64, Vec<f64>))> = std::thread::scope(|scope| {
+        let walked: Vec<(f64, ThroughWalk)> = std::thread::scope(|scope| {
             let parts: Vec<_> = (0..entries)
                 .step_by(chunk)
                 .map(|start| {
@@ -103,7 +106,7 @@ impl PathTable {
                 .collect();
             parts.into_iter().flat_map(|part| part.join().expect("path table thread")).collect()
         });
-        let (delta, walks): (Vec<f64>, Vec<(u64, Vec<f64>)>) = walked.into_iter().unzip();
+        let (delta, walks): (Vec<f64>, Vec<ThroughWalk>) = walked.into_iter().unzip();
         let through = through_rule(n0, n2, &walks);
         let delta_f32 = delta.iter().map(|d| *d as f32).collect();
         let through_f32 = through.iter().map(|t| t.map(|v| v as f32)).collect();
@@ -139,13 +142,18 @@ fn entry(n0: f64, n2: f64, k: usize) -> f64 {
     cos_eff - cos_t
 }
 
+/// What `through_walk` found at one entry: photons that entered, photons that came straight
+/// back, the cosines of their last reflection from above.
+type ThroughWalk = (u64, u64, Vec<f64>);
+
 /// Entry k's walk for the rule for light that comes straight back through the top (the
-/// module's q): how many of `THROUGH_PHOTONS` came straight back, and the cosines of their
-/// last reflection from above (`walk::through_cosines`); none on row r = 0.
-fn through_walk(n0: f64, n2: f64, k: usize) -> (u64, Vec<f64>) {
+/// module's q): of `THROUGH_PHOTONS`, how many entered the surface and how many of those
+/// came straight back, and the cosines of their last reflection from above
+/// (`walk::through_cosines`); none on row r = 0.
+fn through_walk(n0: f64, n2: f64, k: usize) -> ThroughWalk {
     let (i_mu, i_r) = (k % E1_MU, k / E1_MU);
     if i_r == 0 {
-        return (0, Vec::new());
+        return (0, 0, Vec::new());
     }
     let mu = (i_mu as f64 / (E1_MU - 1) as f64).max(MU_MIN);
     let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
@@ -160,13 +168,19 @@ fn through_walk(n0: f64, n2: f64, k: usize) -> (u64, Vec<f64>) {
 /// roughness row, from the cosines of all its entries: within a row its nodes move by a few
 /// hundredths with μ (0.47–0.55 and 0.87–0.93 on the roughest row of n0 | n2 = 1 | 1.56),
 /// where an entry's own few dozen photons would scatter them by more, and a row's entries
-/// must share nodes for the rule to interpolate in μ. W carries each entry's own fraction.
+/// must share nodes for the rule to interpolate in μ. W carries each entry's own share: of
+/// the photons that entered the surface, the fraction that came straight back (at most 1;
+/// the film's way in, 1 − ⟨F⟩, scales it in the rule). Over the bare interface's way in as
+/// the lobe reads it, 1 − ⟨F_bare⟩, the fraction measured 2.39 for `bench layered`'s max
+/// against 2.72 with the share, but beyond the critical angle of n0 > n2, where the bare
+/// interface lets almost nothing in, it multiplied a few walked photons without bound (the
+/// stress test's grazing views: the f32 table 15 % off the f64 rule, capped at 1 or not).
 /// A row with fewer than `THROUGH_MIN` such photons in all has none (W = 0).
-fn through_rule(n0: f64, n2: f64, walks: &[(u64, Vec<f64>)]) -> Vec<[f64; 4]> {
+fn through_rule(n0: f64, n2: f64, walks: &[ThroughWalk]) -> Vec<[f64; 4]> {
     let bare = super::walk::bare_interface(n0, n2);
     let mut rule = vec![[0.0, 0.5, 0.5, 1.0]; walks.len()];
     for (i_r, row) in walks.chunks(E1_MU).enumerate().skip(1) {
-        let cosines: Vec<f64> = row.iter().flat_map(|(_, c)| c.iter().copied()).collect();
+        let cosines: Vec<f64> = row.iter().flat_map(|(_, _, c)| c.iter().copied()).collect();
         if cosines.len() < THROUGH_MIN {
             continue;
         }
@@ -176,12 +190,9 @@ fn through_rule(n0: f64, n2: f64, walks: &[(u64, Vec<f64>)]) -> Vec<[f64; 4]> {
         let moment = |p: i32| cosines.iter().zip(&weights).map(|(c, w)| w * c.powi(p)).sum::<f64>() / total;
         let [c_a, c_b, w_a] = super::energy::two_point_rule(moment(1), moment(2), moment(3));
         let mean_inverse = total / cosines.len() as f64;
-        let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
-        for (i_mu, (count, _)) in row.iter().enumerate() {
-            let mu = (i_mu as f64 / (E1_MU - 1) as f64).max(MU_MIN);
-            let q_bare = *count as f64 / THROUGH_PHOTONS as f64;
-            let entering_bare = 1.0 - super::energy::lobe(mu, r).mean(|c| bare(true, c));
-            rule[i_r * E1_MU + i_mu] = [q_bare * mean_inverse / entering_bare.max(1e-9), c_a, c_b, w_a];
+        for (i_mu, (entered, count, _)) in row.iter().enumerate() {
+            let share = if *entered > 0 { *count as f64 / *entered as f64 } else { 0.0 };
+            rule[i_r * E1_MU + i_mu] = [share * mean_inverse, c_a, c_b, w_a];
         }
     }
     rule

@@ -386,23 +386,26 @@ pub fn transmitted_cosines(wi: V3, alpha: f64, n0: f64, n2: f64, photons: u64, s
 /// without reaching the pigment layer. Nearly all of them enter through one microfacet,
 /// leave through another and are reflected by a third from above, near grazing (the
 /// sequences walked, at 85° and roughness 0.9 on n0 | n2 = 1 | 1.33: down-up-reflected
-/// two thirds, the rest with further reflections). Returns their number and, for those
-/// reflected from above, the microfacet cosine of their latest such reflection
-/// (`path::PathTable`'s rule for the film's share of them is built from these).
-pub fn through_cosines(wi: V3, alpha: f64, n0: f64, n2: f64, photons: u64, seed: u64) -> (u64, Vec<f64>) {
+/// two thirds, the rest with further reflections). Returns how many photons entered the
+/// surface at all, how many of those came straight back, and, for those reflected from
+/// above, the microfacet cosine of their latest such reflection (`path::PathTable`'s rule
+/// for the film's share of them is built from these).
+pub fn through_cosines(wi: V3, alpha: f64, n0: f64, n2: f64, photons: u64, seed: u64) -> (u64, u64, Vec<f64>) {
     let reflectance = bare_interface(n0, n2);
     let mut rng = Rng(seed);
-    let (mut count, mut cosines) = (0, Vec::new());
+    let (mut entered, mut count, mut cosines) = (0, 0, Vec::new());
     for _ in 0..photons {
         let mut photon = OnTop::arriving(wi);
-        if walk_top(&mut photon, alpha, n0, n2, &reflectance, &mut rng) == Some(Leaves::Up) && photon.entered {
+        let leaves = walk_top(&mut photon, alpha, n0, n2, &reflectance, &mut rng);
+        entered += u64::from(photon.entered);
+        if leaves == Some(Leaves::Up) && photon.entered {
             count += 1;
             if photon.reflected_cos >= 0.0 {
                 cosines.push(photon.reflected_cos);
             }
         }
     }
-    (count, cosines)
+    (entered, count, cosines)
 }
 
 /// GGX α of the walk's top: 0 (a mirror, m = n) for roughness 0, else roughness² floored
