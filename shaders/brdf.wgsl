@@ -91,8 +91,8 @@ struct Top {
 }
 
 // The rough lobe's table (the film bind group's lobe_table, optics::brdf::energy::node):
-// per (mu, r) node LOBE_VEC4S vec4s, (E1, c1, c2, c3), (w1, w2, multiple-scatter scale, path
-// delta) and (W, c_a, c_b, w_a): its albedo for F = 1, the three-point Gauss rule over its
+// per (mu, r) node LOBE_VEC4S vec4s, (E1, c1, c2, c3), (w1, w2, 0, path delta) and
+// (W, c_a, c_b, w_a): its albedo for F = 1, the three-point Gauss rule over its
 // microfacet cosines (the third weight is 1 minus the other two), the pigment layer's path
 // (path_delta_at) and the rule for light that comes straight back through the top
 // (optics::brdf::path::PathTable::through).

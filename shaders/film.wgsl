@@ -28,9 +28,10 @@ struct FilmInfo {
 // spectral-N: per band (centre nm, then linear-sRGB weights).
 @group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
 // The rough lobe's table (optics::brdf::energy::node, read by brdf.wgsl's top_on_row): per
-// (mu, r) entry, row-major by roughness, (E1, c1, c2, c3) then (w1, w2, multiple-scatter scale,
-// cos_eff - cos_t): the last is this material's optics::brdf::path table (brdf.wgsl's
-// path_delta_at).
+// (mu, r) entry, row-major by roughness, LOBE_VEC4S vec4s: (E1, c1, c2, c3), (w1, w2, 0,
+// cos_eff - cos_t) and (W, c_a, c_b, w_a), the last five from this material's
+// optics::brdf::path table (brdf.wgsl's path_delta_at; the rule for light straight back
+// through the top).
 @group(0) @binding(4) var<storage, read> lobe_table: array<vec4<f32>>;
 // The layered model's coupling baked with the table (optics::lut::Lut::coupling): x = cos
 // texel, the reflected share and the path delta (as lobe_table's fourth slot) in the first
