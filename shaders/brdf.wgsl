@@ -223,7 +223,10 @@ fn parts_on_row(layers: Layers, k: u32, fx: f32) -> RowParts {
     let f3 = film_clamped(layers, a.w);
     let mean = b.x * f1 + b.y * f2 + (1.0 - b.x - b.y) * f3;
     let q = (1.0 - mean) * t.x * (t.w * film_clamped(layers, t.y) + (1.0 - t.w) * film_clamped(layers, t.z));
-    return RowParts(a.x * mean, (1.0 - a.x) * mean * f1 + q);
+    // x never more than the light the single scattering leaves (q's reweighting is an
+    // estimate).
+    let single = a.x * mean;
+    return RowParts(single, min((1.0 - a.x) * mean * f1 + q, vec3<f32>(1.0) - single));
 }
 
 // One node of the multiple-scatter normalisation on row j: node = (mu, 2 w mu).

@@ -54,7 +54,7 @@ use super::{ALPHA_MIN, COS_MIN, cos_transmitted};
 const TAU_REF: f64 = 0.5;
 /// Photons per table entry: the mean of 4,096 values in [0, 1] has σ ≤ 0.5 / 64 ≈ 0.008.
 const PHOTONS: u64 = 4096;
-/// Photons per entry of the rule for light that comes straight back (`Through`): it is
+/// Photons per entry of the rule for light that comes straight back (`through_walk`): it is
 /// about 1 % of the light where it matters, so 16,384 photons give ~160 of them (σ ≈ 8 %
 /// of q, ≤ 0.0015 in reflectance).
 const THROUGH_PHOTONS: u64 = 16_384;
@@ -77,15 +77,16 @@ pub struct PathTable {
     /// table's coupling texture: `lut::Lut::coupling`).
     pub delta_f32: Vec<f32>,
     /// Per entry (the same grid), the rule for light that comes straight back through the
-    /// top (the module's q): [W, c_a, c_b, w_a]. All zero on row r = 0.
+    /// top (the module's q): [W, c_a, c_b, w_a]. W = 0 on row r = 0.
     pub through: Vec<[f64; 4]>,
     /// `through` in f32, as the shader holds it (the lobe table's third vec4).
     pub through_f32: Vec<[f32; 4]>,
 }
 
 impl PathTable {
-    /// The table for indices (n0, n2), walked entry by entry (about 2·10⁶ photon walks,
-    /// about half a second on one core), the entries split over the machine's cores by
+    /// The table for indices (n0, n2), walked entry by entry (about 10⁷ photon walks: 2·10⁶
+    /// for the path, 8·10⁶ for light straight back; 1.05 s on this machine's two cores),
+    /// the entries split over the machine's cores by
     /// plain threads (not the rayon pool: `cached` builds under a lock that callers on the
     /// pool wait for). Each entry has its own seed, so the table is the same on any number
     /// of threads.
