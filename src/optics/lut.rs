@@ -11,7 +11,9 @@
 //!
 //! **The rough top's coupling, tabulated.** The layered model reads, per direction, what the
 //! rough top reflects (`brdf::energy::top`): the rule on the two roughness rows of the lobe
-//! around the roughness, each three film lookups, six where the thesis model makes one.
+//! around the roughness, each five film lookups, and the multiple-scatter lobe's
+//! normalisation on both rows, eight more evaluations of the rule each, where the thesis
+//! model makes one lookup.
 //! Baked with the table on its cos texels, the same rows and its thickness columns, it is
 //! one trilinear lookup (`coupling_f32`; in the shader two filtered 3-D texture fetches,
 //! one per RGBA half) that interpolates between rows as the rule does; between cos texels and
@@ -117,9 +119,11 @@ impl Lut {
     }
 
     /// The coupling table from the texels: at each cos texel, roughness row of the rough
-    /// lobe and thickness column, `energy::top_on_row_f32` with the film read along that
-    /// column (linear in cos, as the texture filter reads it), and the material's path
-    /// delta there (the same in every column). Parallel over columns.
+    /// lobe and thickness column, `energy::top_on_row_with_f32` with the film read along
+    /// that column (linear in cos, as the texture filter reads it) and the row's
+    /// normalisation X̄ for that column (`energy::ms_norm_on_row_f32`, once per column and
+    /// row), and the material's path delta there (the same in every column). Parallel over
+    /// columns.
     fn bake_coupling(&self) -> Vec<[f32; 8]> {
         let (w, n_cos) = (self.width(), self.n_cos);
         let path = path::cached(self.stack.n0, self.stack.n2);

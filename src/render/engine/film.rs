@@ -76,9 +76,10 @@ pub const LOBE_VEC4S: usize = 3;
 
 /// The rough lobe's table (`optics::brdf::energy`) as `film.wgsl`'s `lobe_table`: per (μ, r)
 /// entry, row-major by roughness, `LOBE_VEC4S` vec4s: (E₁, c₁, c₂, c₃), (w₁, w₂, 0,
-/// cos_eff − cos_t) and (W, c_a, c_b, w_a), the last five from the material's path table (`optics::brdf::path`, the same grid: the path delta and the rule
-/// for light that comes straight back through the top). Filled for every material,
-/// absorbing or not: the window changes the absorption without a new film binding.
+/// cos_eff − cos_t) and (W, c_a, c_b, w_a), the last five from the material's path table
+/// (`optics::brdf::path`, the same grid: the path delta and the rule for light that comes
+/// straight back through the top). Filled for every material, absorbing or not: the window
+/// changes the absorption without a new film binding.
 fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
     use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, node};
     let path = crate::optics::brdf::path::cached(stack.n0, stack.n2);
