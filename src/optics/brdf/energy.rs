@@ -301,7 +301,7 @@ pub struct Top<T> {
 /// results also tabulate: the film table's coupling texture holds the rows' results on its
 /// cos nodes and its filter does this interpolation (`optics::lut::Lut::coupling_f32`).
 macro_rules! top_impl {
-    ($t:ty, $parts:ident, $norm:ident, $on_row_with:ident, $on_row:ident, $top_with:ident, $top:ident, $top_pair:ident) => {
+    ($t:ty, $parts:ident, $norm:ident, $on_row_with:ident, $top_with:ident, $top:ident) => {
         /// The rule's two parts on roughness row `i_r` at cosine `cos`, per channel: the
         /// single scattering E₁ ⟨F⟩ (the film averaged over the lobe's microfacet angles by
         /// the three-point Gauss rule) and what the top reflects beyond it,
@@ -347,8 +347,10 @@ macro_rules! top_impl {
             norm
         }
 
-        /// `$on_row` with the row's X̄ given (`$norm`; the film table bakes it once per
-        /// column and row).
+        /// The rule on roughness row `i_r` at cosine `cos` (`$parts`) with the row's X̄
+        /// `norm` (`$norm`; the film table bakes it once per column and row): the top
+        /// reflects E₁ ⟨F⟩ + x, and its multiple-scatter lobe f_ms = x(μi) x(μo) / (π X̄)
+        /// returns the x it takes, in every direction (amplitude x / √(π X̄)).
         pub fn $on_row_with(
             cos: $t,
             i_r: usize,
@@ -364,13 +366,6 @@ macro_rules! top_impl {
             }
         }
 
-        /// The rule on roughness row `i_r` at cosine `cos` (`$parts`): the top reflects
-        /// E₁ ⟨F⟩ + x, and its multiple-scatter lobe f_ms = x(μi) x(μo) / (π X̄) returns the
-        /// x it takes, in every direction (amplitude x / √(π X̄)).
-        pub fn $on_row(cos: $t, i_r: usize, film: &dyn Fn($t) -> [$t; 3], through: &[[$t; 4]]) -> Top<$t> {
-            $on_row_with(cos, i_r, film, through, $norm(i_r, film, through))
-        }
-
         /// `Top` of the rough lobe at cosine `cos` and roughness `roughness` with the film
         /// `film` (its reflectance, clamped to [0, 1], as a function of the cosine) and the
         /// material's rule for light that comes straight back (`through`, as `$parts`): the
@@ -378,18 +373,6 @@ macro_rules! top_impl {
         pub fn $top(cos: $t, roughness: $t, film: &dyn Fn($t) -> [$t; 3], through: &[[$t; 4]]) -> Top<$t> {
             let j = GridCell::<$t>::at(cos, roughness).j;
             $top_with(cos, roughness, film, through, [$norm(j, film, through), $norm(j + 1, film, through)])
-        }
-
-        /// `$top` for the two directions of one evaluation, which share the rows' X̄.
-        pub fn $top_pair(
-            cos: [$t; 2],
-            roughness: $t,
-            film: &dyn Fn($t) -> [$t; 3],
-            through: &[[$t; 4]],
-        ) -> [Top<$t>; 2] {
-            let j = GridCell::<$t>::at(cos[0], roughness).j;
-            let norms = [$norm(j, film, through), $norm(j + 1, film, through)];
-            cos.map(|c| $top_with(c, roughness, film, through, norms))
         }
 
         /// `$top` with the two rows' X̄ given.
@@ -412,17 +395,16 @@ macro_rules! top_impl {
     };
 }
 
-top_impl!(f64, parts_on_row, ms_norm_on_row, top_on_row_with, top_on_row, top_with, top, top_pair);
-top_impl!(
-    f32,
-    parts_on_row_f32,
-    ms_norm_on_row_f32,
-    top_on_row_with_f32,
-    top_on_row_f32,
-    top_with_f32,
-    top_f32,
-    top_pair_f32
-);
+top_impl!(f64, parts_on_row, ms_norm_on_row, top_on_row_with, top_with, top);
+top_impl!(f32, parts_on_row_f32, ms_norm_on_row_f32, top_on_row_with_f32, top_with_f32, top_f32);
+
+/// `top` for the two directions of one evaluation (the f64 model's), which share the rows'
+/// X̄: computed once, not once per direction.
+pub fn top_pair(cos: [f64; 2], roughness: f64, film: &dyn Fn(f64) -> [f64; 3], through: &[[f64; 4]]) -> [Top<f64>; 2] {
+    let j = GridCell::<f64>::at(cos[0], roughness).j;
+    let norms = [ms_norm_on_row(j, film, through), ms_norm_on_row(j + 1, film, through)];
+    cos.map(|c| top_with(c, roughness, film, through, norms))
+}
 
 #[cfg(test)]
 mod tests {

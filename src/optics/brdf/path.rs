@@ -33,7 +33,7 @@
 //! ```
 //!
 //! with ⟨F⟩ the film averaged over the rough lobe's microfacet angles (the light's way in,
-//! `energy::top_on_row` has it), W the share of the light that entered the bare surface
+//! `energy::parts_on_row` has it), W the share of the light that entered the bare surface
 //! which came straight back (times the mean of 1 / F_bare below), and a two-point Gauss
 //! rule (nodes c_a, c_b, weight w_a) for the microfacet cosines of the last reflection from
 //! above, weighted by 1 / F_bare (so that a film reweights each photon's reflection by
