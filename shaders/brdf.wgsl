@@ -22,6 +22,12 @@ struct Layers {
     // The stack's bounce terms (layered model): K sent back to the base, E escaping.
     k: vec3<f32>,
     e: vec3<f32>,
+    // X = 2 int x(mu) mu dmu on the two roughness rows around the roughness, the layered
+    // model's multiple-scatter normalisation (energy::ms_norm_on_row), for the direct film
+    // methods: with_ms_norms computes it once per pixel (every light's coupling and the
+    // ambient one read it); the LUT method reads it baked into the coupling texture.
+    ms_norm_lower: vec3<f32>,
+    ms_norm_upper: vec3<f32>,
 }
 
 fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
@@ -106,11 +112,16 @@ struct LobeCell {
     fy: f32,
 }
 
+// The lobe table's roughness row below `roughness` (GridCell::at's j).
+fn lobe_row(roughness: f32) -> u32 {
+    return min(u32(clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u)), E1_ROUGHNESS - 2u);
+}
+
 fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
     let x = clamp(cos, 0.0, 1.0) * f32(E1_MU - 1u);
     let y = clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
     let i = min(u32(x), E1_MU - 2u);
-    let j = min(u32(y), E1_ROUGHNESS - 2u);
+    let j = lobe_row(roughness);
     return LobeCell(LOBE_VEC4S * (j * E1_MU + i), LOBE_VEC4S * ((j + 1u) * E1_MU + i), x - f32(i), y - f32(j));
 }
 
@@ -238,19 +249,33 @@ fn ms_norm_term(layers: Layers, j: u32, node: vec2<f32>) -> vec3<f32> {
 
 // X = 2 int x(mu) mu dmu on row j, the multiple-scatter lobe's normalisation
 // (energy::ms_norm_on_row, its rule's eight nodes generated). The LUT film method reads it
-// baked into the coupling texture; the direct methods pay these eight evaluations per row.
+// baked into the coupling texture; the direct methods pay these eight evaluations per row,
+// once per pixel (with_ms_norms).
 fn ms_norm_on_row(layers: Layers, j: u32) -> vec3<f32> {
     return ms_norm_term(layers, j, MS_NODE_0) + ms_norm_term(layers, j, MS_NODE_1) + ms_norm_term(layers, j, MS_NODE_2)
         + ms_norm_term(layers, j, MS_NODE_3) + ms_norm_term(layers, j, MS_NODE_4) + ms_norm_term(layers, j, MS_NODE_5)
         + ms_norm_term(layers, j, MS_NODE_6) + ms_norm_term(layers, j, MS_NODE_7);
 }
 
-// The rule on one roughness row (energy::top_on_row) at the entry k mixed by fx: the top
-// reflects E1 <F> + x, and its multiple-scatter lobe x(mu_i) x(mu_o) / (pi X) returns the x
-// it takes in every direction.
-fn top_on_row(layers: Layers, k: u32, fx: f32) -> Top {
+// `layers` with X on the two roughness rows around its roughness filled in, where the
+// coupling evaluates the rule (the layered model's direct film methods): X depends on the
+// film and the roughness only, so a pixel computes it once for every direction it shades
+// (a pixel with two lights and the sky shaded three couplings, each computing both rows').
+fn with_ms_norms(layers: Layers) -> Layers {
+    var result = layers;
+    if (BRDF_MODEL == MODEL_LAYERED && FILM_METHOD != FILM_LUT) {
+        let j = lobe_row(layers.roughness);
+        result.ms_norm_lower = ms_norm_on_row(layers, j);
+        result.ms_norm_upper = ms_norm_on_row(layers, j + 1u);
+    }
+    return result;
+}
+
+// The rule on one roughness row (energy::top_on_row_with) at the entry k mixed by fx, with
+// the row's X `norm`: the top reflects E1 <F> + x, and its multiple-scatter lobe
+// x(mu_i) x(mu_o) / (pi X) returns the x it takes in every direction.
+fn top_on_row(layers: Layers, k: u32, fx: f32, norm: vec3<f32>) -> Top {
     let parts = parts_on_row(layers, k, fx);
-    let norm = ms_norm_on_row(layers, k / (LOBE_VEC4S * E1_MU));
     let amplitude = select(vec3<f32>(0.0), parts.beyond / sqrt(PI * norm), norm > vec3<f32>(1e-9));
     return Top(parts.single + parts.beyond, amplitude, 0.0);
 }
@@ -273,7 +298,7 @@ fn coupling_table(layers: Layers, cos: f32) -> Top {
 // The top at cosine `cos` (Model::coupling). The thesis: the film F(cos), no multiple
 // scattering; the layered model: the rule on the two roughness rows around the roughness,
 // mixed (energy::top), baked with the table for the LUT film method (coupling_table),
-// evaluated here for the direct methods.
+// evaluated here for the direct methods (with X from `layers`: with_ms_norms).
 fn coupling(layers: Layers, cos: f32) -> Top {
     switch BRDF_MODEL {
         case MODEL_LAYERED: {
@@ -281,8 +306,8 @@ fn coupling(layers: Layers, cos: f32) -> Top {
                 return coupling_table(layers, cos);
             }
             let c = lobe_cell(cos, layers.roughness);
-            let lower = top_on_row(layers, c.k00, c.fx);
-            let upper = top_on_row(layers, c.k01, c.fx);
+            let lower = top_on_row(layers, c.k00, c.fx, layers.ms_norm_lower);
+            let upper = top_on_row(layers, c.k01, c.fx, layers.ms_norm_upper);
             return Top(mix(lower.reflected, upper.reflected, c.fy), mix(lower.ms, upper.ms, c.fy), path_delta_in(c));
         }
         case MODEL_THESIS: {

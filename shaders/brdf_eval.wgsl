@@ -21,7 +21,7 @@ fn eval_samples(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let s = samples[i];
-    let layers = Layers(
+    let layers = with_ms_norms(Layers(
         s.wo_n0.w,
         s.tau_n2.w,
         s.normal_roughness.w,
@@ -30,6 +30,8 @@ fn eval_samples(@builtin(global_invocation_id) id: vec3<u32>) {
         s.albedo.xyz,
         s.k.xyz,
         s.e.xyz,
-    );
+        vec3<f32>(0.0),
+        vec3<f32>(0.0),
+    ));
     results[i] = vec4<f32>(skin_brdf(layers, s.normal_roughness.xyz, s.wi_thickness.xyz, s.wo_n0.xyz), 1.0);
 }

@@ -39,7 +39,9 @@ fn layers_of(m: Material) -> Layers {
     );
     let tau = scene.optical_depth.rgb;
     let kd = base_albedo(m.albedo, tau, m.roughness, k, e);
-    return Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, tau, kd, k, e);
+    return with_ms_norms(
+        Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, tau, kd, k, e, vec3<f32>(0.0), vec3<f32>(0.0)),
+    );
 }
 
 // Ambient light from the sky gradient, as reference::shade_pixel: the sky seen along the
