@@ -263,7 +263,7 @@ fn ms_norm_on_row(layers: Layers, j: u32) -> vec3<f32> {
 // (a pixel with two lights and the sky shaded three couplings, each computing both rows').
 fn with_ms_norms(layers: Layers) -> Layers {
     var result = layers;
-    if (BRDF_MODEL == MODEL_LAYERED && FILM_METHOD != FILM_LUT) {
+    if (BRDF_MODEL == MODEL_LAYERED && !coupling_is_baked()) {
         let j = lobe_row(layers.roughness);
         result.ms_norm_lower = ms_norm_on_row(layers, j);
         result.ms_norm_upper = ms_norm_on_row(layers, j + 1u);
@@ -295,6 +295,17 @@ fn coupling_table(layers: Layers, cos: f32) -> Top {
     return Top(s.rgb, ms.rgb, s.a);
 }
 
+// Whether the coupling comes from the coupling texture: for the LUT film method, and for a
+// material without a film (FILM_NONE), whose table holds the plain n0|n2 interface where
+// its thickness is zero (column 0 is the film at d = 0 exactly, optics::lut::Lut::
+// texel_thickness) and at every thickness where n1 = n0. Evaluating the rule instead cost that pipeline X on two
+// rows per pixel and six Fresnel terms per direction where the table costs two fetches (on
+// lavapipe, xenopeltis-unicolor without its film 267 ms a frame against 111 ms for the LUT
+// pipeline with it).
+fn coupling_is_baked() -> bool {
+    return FILM_METHOD == FILM_LUT || FILM_METHOD == FILM_NONE;
+}
+
 // The top at cosine `cos` (Model::coupling). The thesis: the film F(cos), no multiple
 // scattering; the layered model: the rule on the two roughness rows around the roughness,
 // mixed (energy::top), baked with the table for the LUT film method (coupling_table),
@@ -302,7 +313,7 @@ fn coupling_table(layers: Layers, cos: f32) -> Top {
 fn coupling(layers: Layers, cos: f32) -> Top {
     switch BRDF_MODEL {
         case MODEL_LAYERED: {
-            if (FILM_METHOD == FILM_LUT) {
+            if (coupling_is_baked()) {
                 return coupling_table(layers, cos);
             }
             let c = lobe_cell(cos, layers.roughness);
