@@ -489,17 +489,16 @@ impl ScaleField {
                 if self.shape == ScaleShape::Hexagon { self.row_hexagons(&lattice, &table, y) } else { Vec::new() };
             let mut cell = HexagonCell::default();
             let mut sweep = Sweep::new(&candidates);
+            // The plates this row of pixels may see (None on the head, or without plates).
+            let plates = if belly_half > 0.0 { self.plate_row(&lattice, v) } else { None };
             for (i, &(u, x)) in columns.iter().enumerate() {
                 let mut all = [0.0f32; channel::COUNT];
                 let dist_belly = u.min(1.0 - u);
-                // The body's plate coordinate, only where the belly band is (None on the head).
-                let plate = || self.body.as_ref().map(|b| (b, b.plate_coordinate(v).map(|(y, _, _)| y)));
                 if !shields.is_empty() && self.shield_pixel(&lattice, &shields, u, v, &mut all) {
                     // A head shield.
-                } else if dist_belly < belly_half && self.body.is_none() {
-                    self.ventral_pixel(&lattice, dist_belly, v, &mut all);
-                } else if let Some((body, Some(y))) = (dist_belly < belly_half).then(plate).flatten() {
-                    self.body_plate_pixel(&lattice, body, y, dist_belly, u, &mut all);
+                } else if let Some(plates) = plates.as_ref().filter(|_| dist_belly < belly_half) {
+                    // Paired subcaudals: the pixel's side of the midline.
+                    self.plate_pixel(&lattice, plates, dist_belly, if u < 0.5 { 0 } else { 1 }, &mut all);
                 } else if self.shape == ScaleShape::Hexagon {
                     self.hexagon_pixel(&lattice, &hexagons, &mut cell, x, y, &mut all);
                 } else {
@@ -782,21 +781,21 @@ impl ScaleField {
         }
     }
 
-    /// Ventral plates of the tile: one wide plate per lattice row across the belly band.
-    fn ventral_pixel(&self, lattice: &Lattice, dist_belly: f32, v: f32, out: &mut [f32]) {
-        let rows = PlateRows {
-            y: v * lattice.rows_v as f32 - ROW_PHASE,
-            plate: &|_| Some((lattice.aspect, false)),
-            centre_v: &|r| ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
-            identity: &|r| r.rem_euclid(lattice.rows_v),
+    /// The plates a row of pixels at texture v may see (`PlateRow`), or None where the belly
+    /// band holds none (the body's head). The tile: one wide plate per lattice row; the body
+    /// layout: the ventrals and subcaudals, counted (`BodyPlan::plate_at`), subcaudals
+    /// divided at the midline where the preset says so (most snakes). What depends on the
+    /// row alone is computed here once, not at every pixel of the band.
+    fn plate_row(&self, lattice: &Lattice, v: f32) -> Option<PlateRow> {
+        let Some(body) = &self.body else {
+            let rows = PlateRows {
+                plate: &|_| Some((lattice.aspect, false)),
+                centre_v: &|r| ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+                identity: &|r| r.rem_euclid(lattice.rows_v),
+            };
+            return Some(self.plate_row_at(v * lattice.rows_v as f32 - ROW_PHASE, &rows));
         };
-        self.plate_pixel(lattice, &rows, dist_belly, 0, out);
-    }
-
-    /// Ventral plates and subcaudals of the body layout, counted (`BodyPlan::plate_at`);
-    /// subcaudals divided at the midline where the preset says so (most snakes). `y` is the
-    /// pixel's plate coordinate.
-    fn body_plate_pixel(&self, lattice: &Lattice, body: &BodyPlan, y: f32, dist_belly: f32, u: f32, out: &mut [f32]) {
+        let y = body.plate_coordinate(v)?.0;
         let total = (body.ventrals + body.subcaudals) as i32;
         let plate = |r: i32| {
             if !(0..total).contains(&r) {
@@ -807,13 +806,38 @@ impl ScaleField {
             let aspect = body.plate_length_v(subcaudal) * body.length / lattice.bounds[1];
             Some((aspect, subcaudal && body.divided_subcaudals))
         };
-        let rows = PlateRows { y, plate: &plate, centre_v: &|r| body.plate_centre_v(r), identity: &|r| r };
-        self.plate_pixel(lattice, &rows, dist_belly, if u < 0.5 { 0 } else { 1 }, out);
+        let rows = PlateRows { plate: &plate, centre_v: &|r| body.plate_centre_v(r), identity: &|r| r };
+        Some(self.plate_row_at(y, &rows))
     }
 
-    /// One wide plate per row of `rows` across the belly band, overlapping like the dorsal
-    /// scales (the thesis stretches normal scales "from the middle", §4.2.2).
-    fn plate_pixel(&self, lattice: &Lattice, rows: &PlateRows, dist_belly: f32, side: i32, out: &mut [f32]) {
+    /// `plate_row` at plate coordinate `y` (plate r spans [r, r + 1)).
+    fn plate_row_at(&self, y: f32, rows: &PlateRows) -> PlateRow {
+        let r0 = floor_i32(y);
+        let half_len = 0.5 * self.size.max(0.5);
+        let near = [r0 - 1, r0, r0 + 1].map(|r| {
+            // Each plate with its own length and division (a ventral overhanging the vent
+            // stays a ventral); none before the first or after the last.
+            let (aspect, divided) = (rows.plate)(r)?;
+            let along = ((y - (r as f32 + 0.5)) / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
+            let id = (rows.identity)(r);
+            Some(NearPlate {
+                aspect,
+                divided,
+                to_end: (half_len - (y - (r as f32 + 0.5)).abs()) * aspect,
+                rise: 0.3 * self.imbrication * along,
+                random: [hash::unit(-2, id, 4, self.seed), hash::unit(-3, id, 4, self.seed)],
+                random_undivided: hash::unit(-1, id, 4, self.seed),
+                ly: (y - (r as f32 + 0.5)) / half_len * 0.5 * aspect,
+                centre_v: (rows.centre_v)(r),
+            })
+        });
+        PlateRow { near }
+    }
+
+    /// One wide plate per row across the belly band (`plates`: the pixel row's), overlapping
+    /// like the dorsal scales (the thesis stretches normal scales "from the middle",
+    /// §4.2.2); `side` the pixel's side of the midline (0 for u < 1/2), for divided plates.
+    fn plate_pixel(&self, lattice: &Lattice, plates: &PlateRow, dist_belly: f32, side: usize, out: &mut [f32]) {
         let soft = self.edge_softness.max(1e-4);
         let half_band = lattice.belly_width() * 0.5;
         // Distances in dorsal scale widths, the unit of `edge_softness` (a plate column is
@@ -821,55 +845,40 @@ impl ScaleField {
         let to_side = (half_band - dist_belly) / lattice.bounds[1];
         // Paired plates meet at the midline (u = 0).
         let to_side_divided = to_side.min(dist_belly / lattice.bounds[1]);
-        let y = rows.y;
-        let r0 = floor_i32(y);
-        let half_len = 0.5 * self.size.max(0.5);
         // The most anterior plate covering the pixel lies on top (its free posterior edge over
         // the next plate, as the dorsal scales); the others are the surface underneath.
-        let mut top: Option<(i32, f32, f32, f32, bool)> = None; // (row, inside, profile, aspect, divided)
+        let mut top: Option<(&NearPlate, f32, f32)> = None; // (plate, inside, profile)
         let mut under_height = 0.0f32;
         // Plates are gently convex across the belly.
         let across = (dist_belly / half_band).min(1.0);
         let dome = 0.06 * (1.0 - across * across);
-        for r in r0 - 1..=r0 + 1 {
-            // Each plate with its own length and division (a ventral overhanging the vent
-            // stays a ventral); none before the first or after the last.
-            let Some((aspect, divided)) = (rows.plate)(r) else { continue };
-            let to_end = (half_len - (y - (r as f32 + 0.5)).abs()) * aspect;
-            let inside = if divided { to_side_divided } else { to_side }.min(to_end);
+        for plate in plates.near.iter().flatten() {
+            let inside = if plate.divided { to_side_divided } else { to_side }.min(plate.to_end);
             if inside <= 0.0 {
                 continue;
             }
-            let along = ((y - (r as f32 + 0.5)) / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
-            let profile = 0.45 + 0.1 + dome + 0.3 * self.imbrication * along;
+            let profile = 0.45 + 0.1 + dome + plate.rise;
             match top {
                 Some(_) => under_height = under_height.max(profile),
-                None => top = Some((r, inside, profile, aspect, divided)),
+                None => top = Some((plate, inside, profile)),
             }
         }
-        let best = top.map(|(r, inside, profile, aspect, divided)| {
-            let h = free_edge(profile, inside / soft, under_height, self.imbrication);
-            let id = (rows.identity)(r);
-            let random =
-                if divided { hash::unit(-2 - side, id, 4, self.seed) } else { hash::unit(-1, id, 4, self.seed) };
-            let ly = (y - (r as f32 + 0.5)) / half_len * 0.5 * aspect;
-            let cand = Candidate {
-                inside,
-                x: dist_belly / half_band * 0.5,
-                y: ly,
-                half_len: 0.5 * aspect,
-                random,
-                centre_u: 0.0,
-                centre_v: (rows.centre_v)(r),
-                row: 0,
-            };
-            (h, cand)
-        });
-        match best {
-            // Ventral plates carry no keel.
-            Some((h, cand)) => self.write_scale(Some(cand), h, 0.0, out),
-            None => self.write_scale(None, 0.0, 0.0, out),
-        }
+        let Some((plate, inside, profile)) = top else {
+            return self.write_scale(None, 0.0, 0.0, out);
+        };
+        let h = free_edge(profile, inside / soft, under_height, self.imbrication);
+        let cand = Candidate {
+            inside,
+            x: dist_belly / half_band * 0.5,
+            y: plate.ly,
+            half_len: 0.5 * plate.aspect,
+            random: if plate.divided { plate.random[side] } else { plate.random_undivided },
+            centre_u: 0.0,
+            centre_v: plate.centre_v,
+            row: 0,
+        };
+        // Ventral plates carry no keel.
+        self.write_scale(Some(cand), h, 0.0, out);
     }
 
     /// A head shield of the body layout (`BodyPlan::shields`), if (u, v) lies on one:
@@ -953,8 +962,6 @@ impl Sweep {
 /// A sequence of plates along the belly: the tile's lattice rows or the body's counted
 /// ventrals and subcaudals.
 struct PlateRows<'a> {
-    /// Plate coordinate of the pixel: plate r spans [r, r + 1).
-    y: f32,
     /// Plate r's length over an ordinary column's width, and whether it is divided at the
     /// midline (subcaudals); None where there is no plate r.
     plate: &'a dyn Fn(i32) -> Option<(f32, bool)>,
@@ -962,6 +969,31 @@ struct PlateRows<'a> {
     centre_v: &'a dyn Fn(i32) -> f32,
     /// Plate r's identity for its random number.
     identity: &'a dyn Fn(i32) -> i32,
+}
+
+/// The plates around one row of pixels (`ScaleField::plate_row`): rows r0 − 1 ..= r0 + 1
+/// of the plate coordinate, None where there is no plate, in the order `plate_pixel` visits
+/// them.
+struct PlateRow {
+    near: [Option<NearPlate>; 3],
+}
+
+/// What a plate is at one row of pixels, for every pixel of the belly band there.
+struct NearPlate {
+    /// Length over an ordinary column's width, and divided at the midline.
+    aspect: f32,
+    divided: bool,
+    /// Distance from the row to the plate's nearer end, in dorsal scale widths.
+    to_end: f32,
+    /// The plate's rise towards its free posterior edge at this row, 0.3 × imbrication ×
+    /// the position along it.
+    rise: f32,
+    /// The random number of each half of a divided plate (left, right) and of the whole.
+    random: [f32; 2],
+    random_undivided: f32,
+    /// The row's position along the plate (the scale field's local y).
+    ly: f32,
+    centre_v: f32,
 }
 
 /// One hexagon centre of a row of pixels (`ScaleField::row_hexagons`).
