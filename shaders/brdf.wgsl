@@ -25,7 +25,8 @@ struct Layers {
     // X = 2 int x(mu) mu dmu on the two roughness rows around the roughness, the layered
     // model's multiple-scatter normalisation (energy::ms_norm_on_row), for the direct film
     // methods: with_ms_norms computes it once per pixel (every light's coupling and the
-    // ambient one read it); the LUT method reads it baked into the coupling texture.
+    // ambient one read it); the LUT and no-film pipelines read it baked into the coupling
+    // texture (coupling_is_baked).
     ms_norm_lower: vec3<f32>,
     ms_norm_upper: vec3<f32>,
 }
@@ -248,9 +249,9 @@ fn ms_norm_term(layers: Layers, j: u32, node: vec2<f32>) -> vec3<f32> {
 }
 
 // X = 2 int x(mu) mu dmu on row j, the multiple-scatter lobe's normalisation
-// (energy::ms_norm_on_row, its rule's eight nodes generated). The LUT film method reads it
-// baked into the coupling texture; the direct methods pay these eight evaluations per row,
-// once per pixel (with_ms_norms).
+// (energy::ms_norm_on_row, its rule's eight nodes generated). The LUT and no-film
+// pipelines read it baked into the coupling texture (coupling_is_baked); the direct methods
+// pay these eight evaluations per row, once per pixel (with_ms_norms).
 fn ms_norm_on_row(layers: Layers, j: u32) -> vec3<f32> {
     return ms_norm_term(layers, j, MS_NODE_0) + ms_norm_term(layers, j, MS_NODE_1) + ms_norm_term(layers, j, MS_NODE_2)
         + ms_norm_term(layers, j, MS_NODE_3) + ms_norm_term(layers, j, MS_NODE_4) + ms_norm_term(layers, j, MS_NODE_5)
@@ -297,19 +298,21 @@ fn coupling_table(layers: Layers, cos: f32) -> Top {
 
 // Whether the coupling comes from the coupling texture: for the LUT film method, and for a
 // material without a film (FILM_NONE), whose table holds the plain n0|n2 interface where
-// its thickness is zero (column 0 is the film at d = 0 exactly, optics::lut::Lut::
-// texel_thickness) and at every thickness where n1 = n0. Evaluating the rule instead cost that pipeline X on two
-// rows per pixel and six Fresnel terms per direction where the table costs two fetches (on
-// lavapipe, xenopeltis-unicolor without its film 267 ms a frame against 111 ms for the LUT
-// pipeline with it).
+// its thickness is zero (column 0 is the film at d = 0, optics::lut::Lut::texel_thickness)
+// and at every thickness where n1 = n0, as the LUT pipeline holds any film (in the film
+// table's white balance and half floats, linear between cos texels). Evaluating the rule
+// instead cost that pipeline X on two rows per pixel and ten Fresnel terms per direction
+// (five on each row) where the table costs two fetches (on lavapipe, xenopeltis-unicolor
+// without its film 267 ms a frame against 111 ms for the LUT pipeline with it).
 fn coupling_is_baked() -> bool {
     return FILM_METHOD == FILM_LUT || FILM_METHOD == FILM_NONE;
 }
 
 // The top at cosine `cos` (Model::coupling). The thesis: the film F(cos), no multiple
 // scattering; the layered model: the rule on the two roughness rows around the roughness,
-// mixed (energy::top), baked with the table for the LUT film method (coupling_table),
-// evaluated here for the direct methods (with X from `layers`: with_ms_norms).
+// mixed (energy::top), baked with the table for the LUT film method and a material without
+// a film (coupling_table, coupling_is_baked), evaluated here for the direct methods (with X
+// from `layers`: with_ms_norms).
 fn coupling(layers: Layers, cos: f32) -> Top {
     switch BRDF_MODEL {
         case MODEL_LAYERED: {

@@ -1,7 +1,8 @@
 // Film colour F_film(d, cos θ0) as linear sRGB, by the method chosen with the FILM_METHOD
 // override constant: the WGSL twins of optics::lut (FILM_LUT), optics::methods rgb3
 // (FILM_RGB3), spectral-N (FILM_SPECTRAL_N) and gaussian-fit (FILM_GAUSSIAN_FIT), and the
-// plain Fresnel reflectance of n0|n2 for a material without a film (FILM_NONE). A pipeline
+// plain Fresnel reflectance of n0|n2 for a material without a film (FILM_NONE; its layered
+// coupling still reads the coupling texture, brdf.wgsl's coupling_is_baked). A pipeline
 // specialised for one method carries only its code (the constant is resolved before the
 // driver compiles the shader). The codes, the LUT's thickness axis (FINE_MAX_NM,
 // COARSE_MAX_NM), the rgb3 wavelengths and the Belcour–Barla fits come from the generated

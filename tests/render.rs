@@ -204,8 +204,10 @@ fn specialised_pipelines_agree_with_the_general_one() {
     let renderer = Renderer::new(gpu);
     let settings = close_up();
     let (w, h) = (200, 125);
-    // No film: δ0 = 0 everywhere. The specialised pipeline uses the closed-form Fresnel term;
-    // the general one reads the LUT's d = 0 column.
+    // No film: δ0 = 0 everywhere. The specialised pipeline's specular term is the
+    // closed-form Fresnel term, the general one's reads the LUT's d = 0 column; both read
+    // the layered coupling from the coupling texture's d = 0 column (a broken no-film path
+    // there fails this; the table itself is checked against its rule in tests/brdf.rs).
     let mut no_film =
         material(&renderer, &[("optics.film_thickness_nm", "0"), ("iridescence.spread_nm", "0")], GpuFilmMethod::Lut);
     assert!(no_film.optics.film_is_inert());

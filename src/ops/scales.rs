@@ -988,7 +988,8 @@ struct NearPlate {
     /// The plate's rise towards its free posterior edge at this row, 0.3 × imbrication ×
     /// the position along it.
     rise: f32,
-    /// The random number of each half of a divided plate (left, right) and of the whole.
+    /// The random number of each half of a divided plate (u < 1/2, u ≥ 1/2) and of the
+    /// whole.
     random: [f32; 2],
     random_undivided: f32,
     /// The row's position along the plate (the scale field's local y).

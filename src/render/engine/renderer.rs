@@ -433,7 +433,9 @@ impl Renderer {
 
     fn key(&self, program: Program, settings: &FrameSettings, material: &Material, samples: u32) -> PipelineKey {
         let (stage, view_map) = settings.view.codes();
-        // Specialisation: an inert film needs no film code, no absorption no exponential.
+        // Specialisation: an inert film needs no film code (its specular term is the plain
+        // interface; the layered coupling reads the coupling texture), no absorption no
+        // exponential.
         let method = material.optics.specialised_method(settings.method).code();
         let model = settings.model.code();
         PipelineKey { program, stage, view_map, method, model, absorption: material.optics.has_absorption(), samples }
