@@ -223,11 +223,21 @@ impl Plan {
             // without.
             let name = loaded.name.as_str();
             let lock = &lock;
+            // A constant map (a species without a film: its thickness map) is quantised
+            // without an image and compressed from the start: no 4-byte samples to fill and
+            // read back, nothing on the graph's critical path (`xenopeltis-unicolor` without
+            // its film at 2048², BENCHMARKS).
+            let constants: Vec<export::Quantized> = request
+                .maps
+                .iter()
+                .filter_map(|m| graph.constant_output(*m).and_then(|v| export::quantize_constant(*m, size, height, v)))
+                .collect();
+            let evaluated: Vec<MapKind> =
+                request.maps.iter().copied().filter(|m| !constants.iter().any(|q| q.map == *m)).collect();
             let (stats, mut encoded) = std::thread::scope(|scope| {
                 let mut encoders = Vec::new();
-                let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
-                    let quantized = export::quantize(map, &image);
-                    drop(image);
+                let mut encode = |quantized: export::Quantized| {
+                    let map = quantized.map;
                     encoders.push(scope.spawn(move || {
                         let t = Instant::now();
                         let staged = export::encode_quantized(&quantized)
@@ -235,6 +245,12 @@ impl Plan {
                             .and_then(|bytes| Ok(lock.stage(&export::map_file_name(name, map), &bytes)?));
                         (map, staged, t.elapsed())
                     }));
+                };
+                constants.into_iter().for_each(&mut encode);
+                let stats = evaluate_into(&graph, &evaluated, size, height, progress, &mut |map, image| {
+                    let quantized = export::quantize(map, &image);
+                    drop(image);
+                    encode(quantized);
                 });
                 let encoded: Vec<_> =
                     encoders.into_iter().map(|h| h.join().expect("a PNG encoder thread panicked")).collect();

@@ -230,6 +230,40 @@ fn a_species_without_a_film_evaluates_no_film_nodes() {
 }
 
 #[test]
+fn a_constant_map_is_written_without_evaluating_it_and_is_the_evaluated_map_byte_for_byte() {
+    // crotalus-atrox has no film: its thickness map is one constant node, which `generate`
+    // quantises and compresses without evaluating (`Graph::constant_output`). The file must
+    // be the bytes of the map evaluated and quantised as any other; `--stats` must not list
+    // the node. The control, xenopeltis-unicolor (a film), evaluates its map.
+    use snakeskin::export::{encode_quantized, quantize, quantize_constant};
+    for (name, film) in [("crotalus-atrox", false), ("xenopeltis-unicolor", true)] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().to_str().unwrap();
+        let run = snakeskin(&["generate", name, "-o", out, "--size", "96", "--stats"]);
+        assert!(run.status.success(), "{}", stderr(&run));
+        let stats = stderr(&run);
+        assert_eq!(stats.lines().any(|l| l.starts_with("iridescence.out")), film, "{name}: {stats}");
+        let written = std::fs::read(dir.path().join(format!("{name}_iridescence.png"))).unwrap();
+        let preset = snakeskin::preset::load(name, &[], None).unwrap().preset;
+        let graph = build_graph(&preset, BuildOptions::default());
+        assert_eq!(graph.constant_output(MapKind::Iridescence).is_some(), !film, "{name}");
+        let eval = evaluate(&graph, &[MapKind::Iridescence], 96, 96, &|_, _| {});
+        let evaluated = encode_quantized(&quantize(MapKind::Iridescence, &eval.maps[&MapKind::Iridescence])).unwrap();
+        assert!(written == evaluated, "{name}: the written thickness map differs from the evaluated one");
+    }
+    // Any constant, in every single-channel format, is the quantised image's samples; a
+    // map of three channels is not taken.
+    for map in [MapKind::Iridescence, MapKind::Roughness, MapKind::Height] {
+        for value in [0.0f32, 1e-7, 0.37, 1.0, 1.5, -0.2] {
+            let image = snakeskin::ops::Image { width: 5, height: 3, channels: 1, data: vec![value; 15] };
+            let q = quantize_constant(map, 5, 3, value).unwrap();
+            assert_eq!(q.samples, quantize(map, &image).samples, "{map:?} {value}");
+        }
+    }
+    assert!(quantize_constant(MapKind::Color, 5, 3, 0.5).is_none());
+}
+
+#[test]
 fn zero_film_noise_runs_no_noise_node_and_changes_nothing() {
     // iridescence.noise = 0: the noise and its blend are not built. The map equals that of a
     // noise too weak to move any sample (1e-30, which keeps both nodes): skipping them is

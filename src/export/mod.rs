@@ -140,6 +140,24 @@ pub fn quantize(map: MapKind, image: &Image) -> Quantized {
     Quantized { map, width: image.width, height: image.height, samples, color }
 }
 
+/// `quantize` of a `width` × `height` single-channel map that holds `value` everywhere (a
+/// species without a film: its thickness map, `graph::Graph::constant_output`), without
+/// the map's f32 image: one pixel quantised and its samples repeated, the same bytes. Zero
+/// samples come as a fresh zeroed buffer, whose pages the encoder reads without anything
+/// having written them. None for a map of more than one channel.
+pub fn quantize_constant(map: MapKind, width: usize, height: usize, value: f32) -> Option<Quantized> {
+    if map.format().channels != 1 {
+        return None;
+    }
+    let pixel = quantize(map, &Image { width: 1, height: 1, channels: 1, data: vec![value] });
+    let samples = if pixel.samples.iter().all(|b| *b == 0) {
+        vec![0u8; pixel.samples.len() * width * height]
+    } else {
+        pixel.samples.repeat(width * height)
+    };
+    Some(Quantized { width, height, samples, ..pixel })
+}
+
 /// Encodes a quantised map as PNG bytes.
 pub fn encode_quantized(q: &Quantized) -> Result<Vec<u8>, ExportError> {
     // Room for the whole file up front (the samples and a margin for incompressible ones):

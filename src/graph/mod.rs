@@ -58,6 +58,15 @@ impl Graph {
         &self.outputs
     }
 
+    /// The value of `map` where its node is a constant (a species without a film: its
+    /// thickness map): the map needs no evaluation (`export::quantize_constant`).
+    pub fn constant_output(&self, map: MapKind) -> Option<f32> {
+        match self.output(map).map(|id| &self.node(id).op) {
+            Some(Op::Constant { value }) => Some(*value),
+            _ => None,
+        }
+    }
+
     /// Whether the texture repeats along v (the tile) or not (a body atlas).
     pub fn wraps_v(&self) -> bool {
         !self.open_v
