@@ -51,6 +51,9 @@ pub struct GenerateReport {
     /// The strips of a body atlas or of a tile too large to evaluate whole: (strips, rows
     /// per strip, margin rows each side).
     pub strips: Option<(usize, usize, usize)>,
+    /// Maps written as a constant without evaluating their node (a species without a film:
+    /// its thickness map), with the value.
+    pub constant_maps: Vec<(MapKind, f32)>,
 }
 
 /// The tallest map written (a body atlas is `body.length` widths tall): PNG readers and GPU
@@ -161,6 +164,7 @@ impl Plan {
         let Plan { request, size, height, loaded, graph, start, .. } = self;
         let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
         let strip_layout = strips_of(&graph, &request.maps, size, height);
+        let mut constant_maps = Vec::new();
         let (kinds, files, stats, encode_time) = if request.format == FileFormat::Exr {
             // The maps as f32, whole: a square evaluated at once, a body atlas strip by strip
             // with each strip's rows copied into place (the OpenEXR writer takes whole
@@ -234,6 +238,7 @@ impl Plan {
                 .collect();
             let evaluated: Vec<MapKind> =
                 request.maps.iter().copied().filter(|m| !constants.iter().any(|q| q.map == *m)).collect();
+            constant_maps = constants.iter().filter_map(|q| graph.constant_output(q.map).map(|v| (q.map, v))).collect();
             let (stats, mut encoded) = std::thread::scope(|scope| {
                 let mut encoders = Vec::new();
                 let mut encode = |quantized: export::Quantized| {
@@ -290,6 +295,7 @@ impl Plan {
             total_time: start.elapsed(),
             created_folder: lock.created_folder,
             strips: strip_layout.map(|s| (s.count, s.rows, s.margin)),
+            constant_maps,
         })
     }
 }
@@ -354,6 +360,7 @@ impl Plan {
             total_time: self.start.elapsed(),
             created_folder: lock.created_folder,
             strips: strips.map(|s| (s.count, s.rows, s.margin)),
+            constant_maps: Vec::new(),
         })
     }
 }

@@ -243,6 +243,7 @@ fn a_constant_map_is_written_without_evaluating_it_and_is_the_evaluated_map_byte
         assert!(run.status.success(), "{}", stderr(&run));
         let stats = stderr(&run);
         assert_eq!(stats.lines().any(|l| l.starts_with("iridescence.out")), film, "{name}: {stats}");
+        assert_eq!(stats.contains("iridescence map written as the constant 0"), !film, "{name}: {stats}");
         let written = std::fs::read(dir.path().join(format!("{name}_iridescence.png"))).unwrap();
         let preset = snakeskin::preset::load(name, &[], None).unwrap().preset;
         let graph = build_graph(&preset, BuildOptions::default());

@@ -53,6 +53,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     }
     if args.stats {
         print_stats(&report.stats);
+        for (map, value) in &report.constant_maps {
+            eprintln!("{} map written as the constant {value} (its node not evaluated)", map.name());
+        }
         eprintln!(
             "memory estimate before the run: {:.1} MiB (available: {:.0} MiB)",
             memory.estimate_bytes as f64 / MIB,
