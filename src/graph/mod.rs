@@ -59,7 +59,7 @@ impl Graph {
     }
 
     /// The value of `map` where its node is a constant (a species without a film: its
-    /// thickness map): the map needs no evaluation (`export::quantize_constant`).
+    /// thickness map): its samples need not be read from its image (`export::quantize_constant`).
     pub fn constant_output(&self, map: MapKind) -> Option<f32> {
         match self.output(map).map(|id| &self.node(id).op) {
             Some(Op::Constant { value }) => Some(*value),

@@ -54,7 +54,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     if args.stats {
         print_stats(&report.stats);
         for (map, value) in &report.constant_maps {
-            eprintln!("{} map written as the constant {value} (its node not evaluated)", map.name());
+            eprintln!("{} map quantised as the constant {value} (its image not read)", map.name());
         }
         eprintln!(
             "memory estimate before the run: {:.1} MiB (available: {:.0} MiB)",
