@@ -236,11 +236,16 @@ impl Plan {
             let (stats, mut encoded) = std::thread::scope(|scope| {
                 let mut encoders = Vec::new();
                 let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
-                    let constant = graph.constant_output(map).and_then(|v| {
-                        constant_maps.push((map, v));
-                        export::quantize_constant(map, image.width, image.height, v)
-                    });
-                    let quantized = constant.unwrap_or_else(|| export::quantize(map, &image));
+                    let constant = graph
+                        .constant_output(map)
+                        .and_then(|v| Some((v, export::quantize_constant(map, image.width, image.height, v)?)));
+                    let quantized = match constant {
+                        Some((value, quantized)) => {
+                            constant_maps.push((map, value));
+                            quantized
+                        }
+                        None => export::quantize(map, &image),
+                    };
                     drop(image);
                     encoders.push(scope.spawn(move || {
                         let t = Instant::now();

@@ -301,7 +301,7 @@ pub struct Top<T> {
 /// results also tabulate: the film table's coupling texture holds the rows' results on its
 /// cos nodes and its filter does this interpolation (`optics::lut::Lut::coupling_f32`).
 macro_rules! top_impl {
-    ($t:ty, $parts:ident, $norm:ident, $on_row_with:ident, $top_with:ident, $top:ident) => {
+    ($t:ty, $parts:ident, $norm:ident, $norms:ident, $on_row_with:ident, $top_with:ident, $top:ident) => {
         /// The rule's two parts on roughness row `i_r` at cosine `cos`, per channel: the
         /// single scattering E₁ ⟨F⟩ (the film averaged over the lobe's microfacet angles by
         /// the three-point Gauss rule) and what the top reflects beyond it,
@@ -371,8 +371,14 @@ macro_rules! top_impl {
         /// material's rule for light that comes straight back (`through`, as `$parts`): the
         /// rule on the two roughness rows around `roughness`, interpolated linearly.
         pub fn $top(cos: $t, roughness: $t, film: &dyn Fn($t) -> [$t; 3], through: &[[$t; 4]]) -> Top<$t> {
-            let j = GridCell::<$t>::at(cos, roughness).j;
-            $top_with(cos, roughness, film, through, [$norm(j, film, through), $norm(j + 1, film, through)])
+            $top_with(cos, roughness, film, through, $norms(roughness, film, through))
+        }
+
+        /// X̄ (`$norm`) on the two roughness rows around `roughness`, which every cosine's
+        /// rule at that roughness reads.
+        pub fn $norms(roughness: $t, film: &dyn Fn($t) -> [$t; 3], through: &[[$t; 4]]) -> [[$t; 3]; 2] {
+            let j = GridCell::<$t>::at(0.0, roughness).j;
+            [$norm(j, film, through), $norm(j + 1, film, through)]
         }
 
         /// `$top` with the two rows' X̄ given.
@@ -395,14 +401,13 @@ macro_rules! top_impl {
     };
 }
 
-top_impl!(f64, parts_on_row, ms_norm_on_row, top_on_row_with, top_with, top);
-top_impl!(f32, parts_on_row_f32, ms_norm_on_row_f32, top_on_row_with_f32, top_with_f32, top_f32);
+top_impl!(f64, parts_on_row, ms_norm_on_row, ms_norms, top_on_row_with, top_with, top);
+top_impl!(f32, parts_on_row_f32, ms_norm_on_row_f32, ms_norms_f32, top_on_row_with_f32, top_with_f32, top_f32);
 
 /// `top` for the two directions of one evaluation (the f64 model's), which share the rows'
 /// X̄: computed once, not once per direction.
 pub fn top_pair(cos: [f64; 2], roughness: f64, film: &dyn Fn(f64) -> [f64; 3], through: &[[f64; 4]]) -> [Top<f64>; 2] {
-    let j = GridCell::<f64>::at(cos[0], roughness).j;
-    let norms = [ms_norm_on_row(j, film, through), ms_norm_on_row(j + 1, film, through)];
+    let norms = ms_norms(roughness, film, through);
     cos.map(|c| top_with(c, roughness, film, through, norms))
 }
 
