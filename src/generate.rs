@@ -229,8 +229,7 @@ impl Plan {
             let lock = &lock;
             // A constant map (a species without a film: its thickness map) is quantised from
             // its value, not read back from its image (`export::quantize_constant`): the
-            // constant node's zeros are never touched and the samples, zeros too, are written
-            // by no one. Its node still runs, in its place in the schedule: evaluating the
+            // constant node's zeros are never touched. Its node still runs, in its place in the schedule: evaluating the
             // graph without it let the next chains start sooner and raised `crotalus-atrox`'s
             // buffers at 4096² from 768 to 832 MiB (1.0–1.06 GB resident against 0.92–0.95).
             let (stats, mut encoded) = std::thread::scope(|scope| {

@@ -253,7 +253,8 @@ fn a_body_atlas_written_in_strips_equals_the_whole_atlas() {
             let decoded = image::open(&file).unwrap();
             let samples: Vec<u8> = match expected.color {
                 image::ExtendedColorType::L16 => {
-                    decoded.into_luma16().into_raw().iter().flat_map(|v| v.to_ne_bytes()).collect()
+                    // Big-endian, as `quantize` and PNG store them.
+                    decoded.into_luma16().into_raw().iter().flat_map(|v| v.to_be_bytes()).collect()
                 }
                 image::ExtendedColorType::Rgb8 => decoded.into_rgb8().into_raw(),
                 _ => decoded.into_luma8().into_raw(),
@@ -384,7 +385,8 @@ fn a_tile_written_in_strips_equals_the_whole_tile() {
             let decoded = image::open(dir.path().join(snakeskin::export::map_file_name(name, *map))).unwrap();
             let samples: Vec<u8> = match expected.color {
                 image::ExtendedColorType::L16 => {
-                    decoded.into_luma16().into_raw().iter().flat_map(|v| v.to_ne_bytes()).collect()
+                    // Big-endian, as `quantize` and PNG store them.
+                    decoded.into_luma16().into_raw().iter().flat_map(|v| v.to_be_bytes()).collect()
                 }
                 image::ExtendedColorType::Rgb8 => decoded.into_rgb8().into_raw(),
                 _ => decoded.into_luma8().into_raw(),

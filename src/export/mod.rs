@@ -17,8 +17,7 @@ pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
 use std::io::Cursor;
 use std::path::PathBuf;
 
-use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-use image::{ExtendedColorType, ImageEncoder};
+use image::ExtendedColorType;
 use rayon::prelude::*;
 
 use crate::material::{Encoding, FileFormat, MapKind};
@@ -114,7 +113,11 @@ pub struct Quantized {
 }
 
 /// Quantises a map to its file format (`MapKind::format`: encoding, channels, bit depth);
-/// 16-bit samples in native byte order, as `ImageEncoder::write_image` takes them.
+/// 16-bit samples big-endian, the order PNG stores them in, so the encoder takes the
+/// buffer as it is. (`image`'s `PngEncoder` takes native order and swaps into a second
+/// buffer of the map's size: 8 MiB at 2048², whose pages the swap read before writing
+/// them, and a later buffer at those addresses then paid a copy-on-write fault with a TLB
+/// shootdown per page; BENCHMARKS.md, "Copy-on-write faults".)
 pub fn quantize(map: MapKind, image: &Image) -> Quantized {
     let format = map.format();
     let encode = |x: f32| match format.encoding {
@@ -131,7 +134,7 @@ pub fn quantize(map: MapKind, image: &Image) -> Quantized {
             // in its worker arenas.
             let mut samples = vec![0u8; image.data.len() * 2];
             samples.par_chunks_mut(2).zip(&image.data).for_each(|(out, &x)| {
-                out.copy_from_slice(&unit_to_u16(encode(x)).to_ne_bytes());
+                out.copy_from_slice(&unit_to_u16(encode(x)).to_be_bytes());
             });
             (samples, ExtendedColorType::L16)
         }
@@ -142,20 +145,17 @@ pub fn quantize(map: MapKind, image: &Image) -> Quantized {
 
 /// `quantize` of a `width` × `height` single-channel map that holds `value` everywhere (a
 /// species without a film: its thickness map, `graph::Graph::constant_output`), without
-/// the map's f32 image: one pixel quantised and its samples repeated, the same bytes. Zero
-/// samples come as a fresh zeroed buffer, whose pages the encoder reads without anything
-/// having written them. None for a map of more than one channel.
+/// the map's f32 image: one pixel quantised and its samples repeated, the same bytes. Zeros
+/// are written too: a fresh zeroed buffer that the encoder only read mapped the kernel's
+/// shared zero page, and the next buffer the allocator placed there paid a copy-on-write
+/// fault and a TLB shootdown per page (BENCHMARKS.md, "Copy-on-write faults"). None
+/// for a map of more than one channel.
 pub fn quantize_constant(map: MapKind, width: usize, height: usize, value: f32) -> Option<Quantized> {
     if map.format().channels != 1 {
         return None;
     }
     let pixel = quantize(map, &Image { width: 1, height: 1, channels: 1, data: vec![value] });
-    let samples = if pixel.samples.iter().all(|b| *b == 0) {
-        vec![0u8; pixel.samples.len() * width * height]
-    } else {
-        pixel.samples.repeat(width * height)
-    };
-    Some(Quantized { width, height, samples, ..pixel })
+    Some(Quantized { width, height, samples: pixel.samples.repeat(width * height), ..pixel })
 }
 
 /// Encodes a quantised map as PNG bytes.
@@ -163,12 +163,12 @@ pub fn encode_quantized(q: &Quantized) -> Result<Vec<u8>, ExportError> {
     // Room for the whole file up front (the samples and a margin for incompressible ones):
     // the pages are resident only as they are written, and a vector grown by doubling
     // leaves its earlier pieces in the encoder thread's allocator arena.
-    let mut out = Cursor::new(Vec::with_capacity(q.samples.len() + q.samples.len() / 64 + (1 << 16)));
-    let encoder = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
-    encoder
-        .write_image(&q.samples, q.width as u32, q.height as u32, q.color)
-        .map_err(|e| ExportError::Encode { map: q.map, message: e.to_string() })?;
-    Ok(out.into_inner())
+    let mut out = Vec::with_capacity(q.samples.len() + q.samples.len() / 64 + (1 << 16));
+    let error = |e: png::EncodingError| ExportError::Encode { map: q.map, message: e.to_string() };
+    let mut writer = png_encoder(&mut out, q.map, q.width, q.height).write_header().map_err(error)?;
+    writer.write_image_data(&q.samples).map_err(error)?;
+    writer.finish().map_err(error)?;
+    Ok(out)
 }
 
 /// Encodes one map as PNG bytes.
@@ -201,17 +201,28 @@ impl std::io::Write for SharedBuffer {
     }
 }
 
+/// The PNG encoder of every map file (`MapKind::format`'s channels and depth, fast
+/// compression, adaptive filter): whole images (`encode_quantized`) and bands
+/// (`RowEncoder`) write the same bytes.
+fn png_encoder<W: std::io::Write>(out: W, map: MapKind, width: usize, height: usize) -> png::Encoder<'static, W> {
+    let format = map.format();
+    let mut encoder = png::Encoder::new(out, width as u32, height as u32);
+    encoder.set_color(if format.channels == 3 { png::ColorType::Rgb } else { png::ColorType::Grayscale });
+    encoder.set_depth(if format.bit_depth == 16 { png::BitDepth::Sixteen } else { png::BitDepth::Eight });
+    encoder.set_compression(png::Compression::Fast);
+    encoder.set_filter(png::Filter::Adaptive);
+    encoder
+}
+
 impl RowEncoder {
     pub fn new(map: MapKind, width: usize, height: usize) -> Result<RowEncoder, ExportError> {
-        let format = map.format();
         let error = |e: png::EncodingError| ExportError::Encode { map, message: e.to_string() };
         let buffer = SharedBuffer::default();
-        let mut encoder = png::Encoder::new(buffer.clone(), width as u32, height as u32);
-        encoder.set_color(if format.channels == 3 { png::ColorType::Rgb } else { png::ColorType::Grayscale });
-        encoder.set_depth(if format.bit_depth == 16 { png::BitDepth::Sixteen } else { png::BitDepth::Eight });
-        encoder.set_compression(png::Compression::Fast);
-        encoder.set_filter(png::Filter::Adaptive);
-        let writer = encoder.write_header().map_err(error)?.into_stream_writer().map_err(error)?;
+        let writer = png_encoder(buffer.clone(), map, width, height)
+            .write_header()
+            .map_err(error)?
+            .into_stream_writer()
+            .map_err(error)?;
         Ok(RowEncoder { map, writer, buffer })
     }
 
@@ -225,15 +236,7 @@ impl RowEncoder {
     /// cheap half of `write_rows`, so a caller can quantise as maps finish and compress on
     /// another thread (`write_samples`).
     pub fn samples(map: MapKind, image: &Image, rows: std::ops::Range<usize>) -> Vec<u8> {
-        let mut q = quantize(map, &image.band(rows));
-        if q.color == ExtendedColorType::L16 {
-            // PNG stores 16-bit samples big-endian; `quantize` gives native order.
-            for pair in q.samples.chunks_exact_mut(2) {
-                let v = u16::from_ne_bytes([pair[0], pair[1]]);
-                pair.copy_from_slice(&v.to_be_bytes());
-            }
-        }
-        q.samples
+        quantize(map, &image.band(rows)).samples
     }
 
     /// Appends samples from `samples` (whole rows, in order).

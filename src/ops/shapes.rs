@@ -136,6 +136,10 @@ fn rasterise(frame: Frame, drawn: Frame, pb: PathBuilder, rule: FillRule) -> Ima
     let (Some(mut mask), Some(path)) = (Mask::new(width as u32, drawn.height as u32), pb.finish()) else {
         return out;
     };
+    // Written before tiny-skia reads it: the blitter loads a row's coverage before it stores
+    // it, and a fresh page first read maps the shared zero page, so its store then paid a
+    // copy-on-write fault with a TLB shootdown (BENCHMARKS.md, "Copy-on-write faults").
+    mask.data_mut().fill(0);
     let transform =
         if drawn.row0 == 0 { Transform::identity() } else { Transform::from_translate(0.0, -(drawn.row0 as f32)) };
     mask.fill_path(&path, rule, true, transform);
