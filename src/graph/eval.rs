@@ -171,6 +171,11 @@ pub fn evaluate_with(
 
     let (mut consumers, produces) = consumers_and_products(graph, &needed, maps);
 
+    // The pool keeps buffers larger than a 2048² RGB image (a channel at 4096²) only under
+    // the schedule's planned peak (`ops::pool::set_large_budget`): reused instead of
+    // page-faulted afresh, without raising the peak.
+    let planned_peak = (frame.width * frame.height * 4 > crate::ops::pool::MAX_BUFFER_BYTES)
+        .then(|| estimate_peak_bytes(graph, maps, frame.width, frame.height));
     let mut kept: Vec<(u64, Arc<Image>)> = Vec::new();
     let mut stats: BTreeMap<usize, NodeStats> = BTreeMap::new();
     let (mut live_bytes, mut peak_bytes, mut done) = (0usize, 0usize, 0usize);
@@ -201,6 +206,21 @@ pub fn evaluate_with(
         }
         let batch = next_batch(graph, &remaining, &computed, threads);
         remaining.retain(|id| !batch.contains(id));
+        if let Some(planned) = planned_peak {
+            // Large buffers wait in the pool only in the room the planned peak leaves now.
+            let allocated: u64 = batch
+                .iter()
+                .map(|&id| {
+                    let inputs: Vec<usize> = graph.node(id).inputs.iter().map(|i| channels_of(&store, *i)).collect();
+                    let (bytes, scratch) = node_bytes(graph, id, &inputs, frame.width, frame.height);
+                    // A node that overwrites its input allocates no result buffer.
+                    let reuses = in_place && reusable_input(graph, id, &consumers, &produces).is_some();
+                    if reuses { scratch } else { bytes + scratch }
+                })
+                .sum();
+            let room = planned.saturating_sub(live_bytes as u64 + allocated);
+            crate::ops::pool::set_large_budget(usize::try_from(room).unwrap_or(usize::MAX));
+        }
 
         // A node that is the last consumer of its first input may reuse that buffer: take it
         // out of the store now (no other node can still need it), so the kernel runs in
@@ -214,22 +234,29 @@ pub fn evaluate_with(
                 Some(image)
             })
             .collect();
-        let results: Vec<(NodeId, Image, Duration)> = batch
-            .par_iter()
-            .zip(owned)
-            .map(|(&id, owned)| {
-                let node = graph.node(id);
-                let input = |i: &NodeId| store[i.0].as_deref().expect("inputs are computed before their consumers");
-                let first = match owned {
-                    Some(image) => Some(Cow::Owned(image)),
-                    None => node.inputs.first().map(|i| Cow::Borrowed(input(i))),
-                };
-                let rest: Vec<&Image> = node.inputs.iter().skip(1).map(input).collect();
-                let t = Instant::now();
-                let image = node.op.eval(first, &rest, frame);
-                (id, image, t.elapsed())
-            })
-            .collect();
+        // Inside the thread pool: rayon runs a batch of one node on the calling thread,
+        // which is no worker of the pool, and each parallel loop of the node's kernel was
+        // then sent to the pool and waited for, a sleep and a wake-up per loop. A blur's box
+        // passes make about 300: `natrix-natrix`'s at 2048² took 55–57 ms on one thread,
+        // 25 ms in the pool (`--stats` with RAYON_NUM_THREADS=1).
+        let results: Vec<(NodeId, Image, Duration)> = rayon::scope(|_| {
+            batch
+                .par_iter()
+                .zip(owned)
+                .map(|(&id, owned)| {
+                    let node = graph.node(id);
+                    let input = |i: &NodeId| store[i.0].as_deref().expect("inputs are computed before their consumers");
+                    let first = match owned {
+                        Some(image) => Some(Cow::Owned(image)),
+                        None => node.inputs.first().map(|i| Cow::Borrowed(input(i))),
+                    };
+                    let rest: Vec<&Image> = node.inputs.iter().skip(1).map(input).collect();
+                    let t = Instant::now();
+                    let image = node.op.eval(first, &rest, frame);
+                    (id, image, t.elapsed())
+                })
+                .collect()
+        });
 
         for (id, image, time) in results {
             let node = graph.node(id);
@@ -312,6 +339,11 @@ fn consumers_and_products(
 
 /// The first ready node in builder order, plus ready nodes a short way ahead, at most one
 /// per thread: branch parallelism without running far ahead (memory).
+/// Channels of a computed node's buffer.
+fn channels_of(store: &[Option<Arc<Image>>], id: NodeId) -> usize {
+    store[id.0].as_ref().map_or(1, |image| image.channels)
+}
+
 fn next_batch(graph: &Graph, remaining: &[NodeId], computed: &[bool], threads: usize) -> Vec<NodeId> {
     let mut batch = Vec::new();
     for id in remaining.iter().take(LOOKAHEAD) {
@@ -340,13 +372,26 @@ fn reusable_input(
     (node.op.in_place() && used_once && !needed_later).then_some(first)
 }
 
+/// Bytes node `id` allocates when its inputs have `inputs` channels at `width` × `height`:
+/// its result's buffer and the scratch its kernel holds while it runs.
+fn node_bytes(graph: &Graph, id: NodeId, inputs: &[usize], width: usize, height: usize) -> (u64, u64) {
+    let op = &graph.node(id).op;
+    let channels = op.output_channels(inputs) as u64;
+    let bytes = channels * (width as u64) * (height as u64) * 4;
+    let mut scratch = op.scratch_images(width) as u64 * bytes;
+    scratch += op.scratch_rows(width) as u64 * channels * width as u64 * 4;
+    if let super::Op::Fused(chain) = op {
+        scratch += chain.scratch_bytes(width, height, inputs);
+    }
+    (bytes, scratch)
+}
+
 /// The most bytes of node buffers alive at once when `maps` are evaluated at `width` ×
 /// `height`, found by running the evaluator's schedule on buffer sizes instead of buffers
 /// (same batches, same in-place reuse, same releases), plus the scratch buffers of the
 /// kernels running together. Maps are counted until they are handed over.
 pub fn estimate_peak_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> u64 {
     let needed = graph.reachable(maps);
-    let pixels = (width as u64) * (height as u64);
     let (mut consumers, produces) = consumers_and_products(graph, &needed, maps);
     let mut channels = vec![0usize; graph.nodes().len()];
     let mut live = vec![0u64; graph.nodes().len()];
@@ -365,12 +410,8 @@ pub fn estimate_peak_bytes(graph: &Graph, maps: &[MapKind], width: usize, height
             }
             let inputs: Vec<usize> = node.inputs.iter().map(|i| channels[i.0]).collect();
             channels[id.0] = node.op.output_channels(&inputs);
-            let bytes = channels[id.0] as u64 * pixels * 4;
-            scratch += node.op.scratch_images(width) as u64 * bytes;
-            scratch += node.op.scratch_rows(width) as u64 * channels[id.0] as u64 * width as u64 * 4;
-            if let super::Op::Fused(chain) = &node.op {
-                scratch += chain.scratch_bytes(width, height, &inputs);
-            }
+            let (bytes, node_scratch) = node_bytes(graph, id, &inputs, width, height);
+            scratch += node_scratch;
             live[id.0] = bytes;
             live_bytes += bytes;
             computed[id.0] = true;

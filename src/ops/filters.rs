@@ -222,7 +222,9 @@ pub fn blur_scratch_rows(sigma: f32, width: usize) -> usize {
         return 0;
     }
     let r = box_widths(sigma_px).into_iter().max().unwrap_or(1) / 2;
-    box_ring_rows(r) + (r + 1) + BOX_BAND + 2
+    // Each thread's `box_rows_horizontal` scratch, in rows of one channel at least.
+    let sweeps = (box_rows_scratch(width, r) * rayon::current_num_threads()).div_ceil(width);
+    box_ring_rows(r) + (r + 1) + BOX_BAND + 2 + sweeps
 }
 
 /// Odd box widths whose three-fold convolution has variance sigma² (Kovesi 2010, eq. 4-5).
@@ -240,60 +242,67 @@ fn box_widths(sigma: f32) -> [usize; 3] {
 }
 
 /// Rows the horizontal box sweep runs side by side: each row's running sum is a chain of
-/// dependent f64 additions (about 4 cycles each), so four independent chains in one loop
-/// keep the adder busy (each row's sums are exactly those of a row swept alone).
-const BOX_ROWS: usize = 4;
+/// dependent f64 additions (about 4 cycles each), so the rows' chains advance together,
+/// their samples interleaved (`box_rows_horizontal`: the rows' values at one x are
+/// contiguous, and the step at each x is one loop over the rows without index arithmetic
+/// or bounds checks). Each row's sums are exactly those of a row swept alone. A 2048²
+/// one-channel blur of σ = 10 px (three box passes, one thread in the pool): four rows
+/// with a slice each 28.7 ms, eight interleaved 23.5 ms.
+const BOX_ROWS: usize = 8;
 
-/// The horizontal box sweep of up to `BOX_ROWS` rows: the mean over x − r ..= x + r of each
-/// row of `sources` into the matching row of `out`, wrap-around, by a running sum (f64
-/// accumulators so long rows do not drift). `padded`: scratch of `BOX_ROWS` padded rows.
-fn box_rows_horizontal(sources: &[&[f32]], channels: usize, r: usize, padded: &mut [f64], out: &mut [f32]) {
+/// Scratch of one `box_rows_horizontal` call, in f32s: the padded rows (f64) and the rows'
+/// results interleaved, at `width` pixels and radius `r`.
+fn box_rows_scratch(width: usize, r: usize) -> usize {
+    BOX_ROWS * (2 * (width + 2 * r + 1) + width)
+}
+
+/// The horizontal box sweep of `count` ≤ `BOX_ROWS` rows: the mean over x − r ..= x + r of
+/// each row of `sources` into the matching row of `out`, wrap-around, by a running sum (f64
+/// accumulators so long rows do not drift). `sources` has `BOX_ROWS` rows, those past
+/// `count` repeats of a real one (swept, not written). The rows are interleaved, sample i
+/// of row k at i · BOX_ROWS + k, so the rows' values at one x are contiguous: in `padded`
+/// (scratch of `BOX_ROWS` rows padded with their wrap-around, f64) and in `swept` (their
+/// results, scratch of `BOX_ROWS` rows).
+fn box_rows_horizontal(
+    sources: &[&[f32]; BOX_ROWS],
+    count: usize,
+    channels: usize,
+    r: usize,
+    padded: &mut [f64],
+    swept: &mut [f32],
+    out: &mut [f32],
+) {
     let ch = channels;
-    let w = out.len() / sources.len() / ch;
+    let w = out.len() / count / ch;
     let norm = 1.0 / (2 * r + 1) as f64;
-    let padded_len = w + 2 * r + 1;
-    let count = sources.len();
+    let padded = &mut padded[..(w + 2 * r + 1) * BOX_ROWS];
+    let swept = &mut swept[..w * BOX_ROWS];
     for c in 0..ch {
-        // Each row's channel padded with its own wrap-around: no modulo in the sweep.
-        // Padded sample i is the row's sample (i − r) mod w.
-        for (k, src) in sources.iter().enumerate() {
-            let pad = &mut padded[k * padded_len..(k + 1) * padded_len];
-            let mut x = (w - r % w) % w;
-            for p in pad.iter_mut() {
+        // Padded sample i is the row's sample (i − r) mod w: no modulo in the sweep.
+        let mut x = (w - r % w) % w;
+        for lane in padded.as_chunks_mut::<BOX_ROWS>().0 {
+            for (p, src) in lane.iter_mut().zip(sources) {
                 *p = src[x * ch + c] as f64;
-                x += 1;
-                if x == w {
-                    x = 0;
-                }
+            }
+            x += 1;
+            if x == w {
+                x = 0;
             }
         }
-        let mut sums = [0.0f64; BOX_ROWS];
-        for (k, sum) in sums.iter_mut().enumerate().take(count) {
-            *sum = padded[k * padded_len..][..2 * r + 1].iter().sum();
-        }
-        if count == BOX_ROWS {
-            let rows_of = |k: usize| &padded[k * padded_len..(k + 1) * padded_len];
-            let (p0, p1, p2, p3) = (rows_of(0), rows_of(1), rows_of(2), rows_of(3));
-            let (o1, rest) = out.split_at_mut(w * ch);
-            let (o2, rest) = rest.split_at_mut(w * ch);
-            let (o3, o4) = rest.split_at_mut(w * ch);
-            for x in 0..w {
-                o1[x * ch + c] = (sums[0] * norm) as f32;
-                o2[x * ch + c] = (sums[1] * norm) as f32;
-                o3[x * ch + c] = (sums[2] * norm) as f32;
-                o4[x * ch + c] = (sums[3] * norm) as f32;
-                sums[0] += p0[x + 2 * r + 1] - p0[x];
-                sums[1] += p1[x + 2 * r + 1] - p1[x];
-                sums[2] += p2[x + 2 * r + 1] - p2[x];
-                sums[3] += p3[x + 2 * r + 1] - p3[x];
+        // Each row's first window summed in order, as a row swept alone.
+        let mut sums: [f64; BOX_ROWS] =
+            std::array::from_fn(|k| (0..2 * r + 1).map(|i| &padded[i * BOX_ROWS + k]).sum::<f64>());
+        let (lanes, _) = padded.as_chunks::<BOX_ROWS>();
+        let (swept_lanes, _) = swept.as_chunks_mut::<BOX_ROWS>();
+        for ((values, add), sub) in swept_lanes.iter_mut().zip(&lanes[2 * r + 1..]).zip(lanes) {
+            for k in 0..BOX_ROWS {
+                values[k] = (sums[k] * norm) as f32;
+                sums[k] += add[k] - sub[k];
             }
-        } else {
-            for (k, row) in out.chunks_exact_mut(w * ch).enumerate() {
-                let pad = &padded[k * padded_len..(k + 1) * padded_len];
-                for x in 0..w {
-                    row[x * ch + c] = (sums[k] * norm) as f32;
-                    sums[k] += pad[x + 2 * r + 1] - pad[x];
-                }
+        }
+        for (k, row) in out.chunks_exact_mut(w * ch).enumerate().take(count) {
+            for (pixel, values) in row.chunks_exact_mut(ch).zip(swept_lanes.iter()) {
+                pixel[c] = values[k];
             }
         }
     }
@@ -340,15 +349,15 @@ fn box_pass(image: &mut Image, r: usize, wraps_v: bool) {
     // `out`, `count` rows, in groups of BOX_ROWS in parallel.
     let sweep = |data: &[f32], start: isize, out: &mut [f32]| {
         out.par_chunks_mut(BOX_ROWS * stride).enumerate().for_each_init(
-            || vec![0.0f64; BOX_ROWS * padded_len],
-            |padded, (group, rows)| {
+            || (vec![0.0f64; BOX_ROWS * padded_len], vec![0.0f32; BOX_ROWS * w]), // box_rows_scratch
+            |(padded, swept), (group, rows)| {
                 let first = start + (group * BOX_ROWS) as isize;
                 let count = rows.len() / stride;
                 let sources: [&[f32]; BOX_ROWS] = std::array::from_fn(|k| {
                     let y = first + k.min(count - 1) as isize;
                     &data[source_of(y) * stride..][..stride]
                 });
-                box_rows_horizontal(&sources[..count], ch, r, padded, rows);
+                box_rows_horizontal(&sources, count, ch, r, padded, swept, rows);
             },
         );
     };
@@ -793,7 +802,8 @@ mod tests {
     fn fused_box_pass_is_the_two_sweeps_bit_for_bit() {
         // Sizes around the band (64 rows) and block (256 samples) and radii up to more than
         // the height (the rows past the end read again); wrapped and clamped; one and three
-        // channels; values of mixed magnitudes so that rounding shows any change of order.
+        // channels; values of mixed magnitudes (1 and 1e-12, 40 bits apart, so that the f64
+        // sums round: at 1e-6 they were exact and a change of order went unseen).
         let mut seed = 1u32;
         let mut next = || {
             seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
@@ -803,7 +813,7 @@ mod tests {
             let mut image = Image::new(w, h, ch);
             for v in image.data.iter_mut() {
                 let x = next();
-                *v = if x < 0.3 { x * 1e-6 } else { x };
+                *v = if x < 0.3 { x * 1e-12 } else { x };
             }
             for r in [0usize, 1, 5, 20, 70] {
                 for wraps_v in [true, false] {
