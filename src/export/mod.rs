@@ -202,8 +202,8 @@ impl std::io::Write for SharedBuffer {
 }
 
 /// The PNG encoder of every map file (`MapKind::format`'s channels and depth, fast
-/// compression, adaptive filter): whole images (`encode_quantized`) and bands
-/// (`RowEncoder`) write the same bytes.
+/// compression, adaptive filter), for whole images (`encode_quantized`) and for bands
+/// (`RowEncoder`): one format written one way.
 fn png_encoder<W: std::io::Write>(out: W, map: MapKind, width: usize, height: usize) -> png::Encoder<'static, W> {
     let format = map.format();
     let mut encoder = png::Encoder::new(out, width as u32, height as u32);

@@ -337,13 +337,13 @@ fn consumers_and_products(
     (consumers, produces)
 }
 
-/// The first ready node in builder order, plus ready nodes a short way ahead, at most one
-/// per thread: branch parallelism without running far ahead (memory).
 /// Channels of a computed node's buffer.
 fn channels_of(store: &[Option<Arc<Image>>], id: NodeId) -> usize {
     store[id.0].as_ref().map_or(1, |image| image.channels)
 }
 
+/// The first ready node in builder order, plus ready nodes a short way ahead, at most one
+/// per thread: branch parallelism without running far ahead (memory).
 fn next_batch(graph: &Graph, remaining: &[NodeId], computed: &[bool], threads: usize) -> Vec<NodeId> {
     let mut batch = Vec::new();
     for id in remaining.iter().take(LOOKAHEAD) {

@@ -12,6 +12,12 @@
 //!
 //! Contents never leak from one image to the next: `take_zeroed` zeroes what it returns and
 //! `take_copy` overwrites all of it.
+//!
+//! The pool is one for the process: evaluations running at once (a batch runs two jobs)
+//! share it, each setting the large budget from its own schedule before each of its
+//! batches, and the first to finish empties it. Buffers only wait here after an image let
+//! them go, so the pool holds at most the latest budget of memory that was resident a
+//! moment before; with two evaluations it is a cap, not a per-evaluation guarantee.
 
 use std::sync::Mutex;
 
@@ -54,7 +60,7 @@ impl Pool {
 
     /// A waiting buffer of exactly `len` samples.
     fn take(&mut self, len: usize) -> Option<Vec<f32>> {
-        self.buffers.iter().position(|b| b.len() == len).map(|i| self.buffers.swap_remove(i))
+        self.buffers.iter().position(|b| b.len() == len).map(|i| self.buffers.remove(i))
     }
 
     /// Keeps `buffer` if it may wait (see `give`).
