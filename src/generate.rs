@@ -229,9 +229,10 @@ impl Plan {
             let lock = &lock;
             // A constant map (a species without a film: its thickness map) is quantised from
             // its value, not read back from its image (`export::quantize_constant`): the
-            // constant node's zeros are never touched. Its node still runs, in its place in the schedule: evaluating the
-            // graph without it let the next chains start sooner and raised `crotalus-atrox`'s
-            // buffers at 4096² from 768 to 832 MiB (1.0–1.06 GB resident against 0.92–0.95).
+            // constant node's zeros are never touched. Its node still runs, in its place in
+            // the schedule: evaluating the graph without it let the next chains start sooner
+            // and raised `crotalus-atrox`'s buffers at 4096² from 768 to 832 MiB (1.0–1.06 GB
+            // resident against 0.92–0.95).
             let (stats, mut encoded) = std::thread::scope(|scope| {
                 let mut encoders = Vec::new();
                 let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
@@ -481,7 +482,10 @@ struct Strips {
 /// and 64 MiB buffers kept out of the pool, the species whose buffers reach 832 MiB peaked
 /// at 885–978 MiB resident, and evaluated whole instead of in two or three strips took
 /// 0.55–0.65 of the time (`crotalus-atrox` 3.85 → 2.39 s). 840: the box blur's rows of
-/// scratch (`Op::scratch_rows`), counted since, add up to 8 MiB to the same runs.
+/// scratch (`Op::scratch_rows`), counted since, add up to 8 MiB to the same runs (its row
+/// sweeps, counted later still, under 1 MiB a blur on two threads). Since then 64 MiB
+/// buffers do wait in the pool, but only in the room the schedule's planned peak leaves
+/// (`ops::pool::set_large_budget`): the species' 4K peaks stayed at 939–950 MiB.
 pub const TILE_BUFFER_BUDGET_BYTES: u64 = 840 << 20;
 
 /// The node buffers of one strip of a tile too large to evaluate whole: less than the whole

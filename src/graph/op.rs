@@ -155,8 +155,9 @@ impl Op {
     }
 
     /// Temporary memory besides the output and `scratch_images`, in output rows: the box
-    /// blur's ring, tail and tiles (`filters::blur_scratch_rows`: about 200 rows at σ =
-    /// 0.006 and 4096², 5 % of the image; more for wide blurs).
+    /// blur's ring, tail, tiles and each thread's row sweeps (`filters::blur_scratch_rows`:
+    /// about 270 rows at σ = 0.006 and 4096² on two threads, 7 % of the image; more for wide
+    /// blurs and with more threads).
     pub fn scratch_rows(&self, width: usize) -> usize {
         match self {
             Op::Blur { sigma } => filters::blur_scratch_rows(*sigma, width),

@@ -214,16 +214,21 @@ pub fn blur_is_gaussian(sigma: f32, width: usize) -> bool {
 }
 
 /// The scratch of `blur`'s box passes in image rows of its size (`box_pass`: the ring of a
-/// band plus the window, the tail, a band of tiles and the f64 sums, two rows' worth), at
-/// the widest of the three passes; 0 where the blur samples the Gaussian or is the identity.
+/// band plus the window, the tail, a band of tiles, the f64 sums, two rows' worth, and the
+/// row sweeps in flight, `box_rows_scratch` each), at the widest of the three passes; 0
+/// where the blur samples the Gaussian or is the identity. The sweeps' scratch does not
+/// grow with the channels (one channel is swept at a time) but is counted in one-channel
+/// rows, which the caller counts once per channel: an overestimate for a colour blur.
 pub fn blur_scratch_rows(sigma: f32, width: usize) -> usize {
     let sigma_px = sigma * width as f32;
     if sigma_px < 0.33 || blur_is_gaussian(sigma, width) {
         return 0;
     }
     let r = box_widths(sigma_px).into_iter().max().unwrap_or(1) / 2;
-    // Each thread's `box_rows_horizontal` scratch, in rows of one channel at least.
-    let sweeps = (box_rows_scratch(width, r) * rayon::current_num_threads()).div_ceil(width);
+    // The sweeps in flight: one per thread, at most one per group of rows of the largest
+    // fill (the ring).
+    let in_flight = rayon::current_num_threads().min(box_ring_rows(r) / BOX_ROWS).max(1);
+    let sweeps = (box_rows_scratch(width, r) * in_flight).div_ceil(width);
     box_ring_rows(r) + (r + 1) + BOX_BAND + 2 + sweeps
 }
 
@@ -338,7 +343,8 @@ const BOX_BLOCK: usize = 256;
 /// clamped) are swept before anything else and kept aside (`tail`).
 ///
 /// Scratch besides the image (`blur_scratch_rows`): the ring, the tail, one band of each
-/// block's values and the blocks' f64 sums, counted in image rows.
+/// block's values, the blocks' f64 sums and each running sweep's padded and swept rows,
+/// counted in image rows.
 fn box_pass(image: &mut Image, r: usize, wraps_v: bool) {
     let (w, h, ch) = (image.width, image.height, image.channels);
     let stride = w * ch;

@@ -21,8 +21,9 @@
 
 use std::sync::Mutex;
 
-/// Bytes kept for reuse at most, the pool's whole addition to the peak resident memory: six
-/// single-channel buffers at 2048², no image of 4096² (`MAX_BUFFER_BYTES`).
+/// Bytes of buffers up to `MAX_BUFFER_BYTES` kept for reuse at most, the pool's whole
+/// addition to the evaluator's planned peak: six single-channel buffers at 2048² (larger
+/// ones wait only within that plan, `set_large_budget`).
 const MAX_BYTES: usize = 96 << 20;
 
 /// The largest buffer kept unconditionally: an RGB image at 2048² (48 MiB) and anything
@@ -168,6 +169,20 @@ mod tests {
         assert_eq!(pool.buffers[0][0], 2.0, "the two oldest made way");
         assert_eq!(pool.take(SMALL).map(|b| b.len()), Some(SMALL));
         assert!(pool.take(SMALL + 1).is_none(), "only exact lengths");
+    }
+
+    #[test]
+    fn taking_keeps_the_others_oldest_first_and_the_limit_is_inclusive() {
+        let mut pool = Pool::new();
+        for extra in 0..3 {
+            pool.give(vec![extra as f32; SMALL + extra]);
+        }
+        assert_eq!(pool.take(SMALL).map(|b| b[0]), Some(0.0));
+        assert_eq!(pool.buffers.iter().map(|b| b[0]).collect::<Vec<_>>(), [1.0, 2.0], "order kept");
+        // A buffer of exactly MAX_BUFFER_BYTES is small: kept without a large budget.
+        pool.give(vec![3.0; MAX_BUFFER_BYTES / 4]);
+        assert_eq!(pool.bytes(true), 0);
+        assert_eq!(pool.buffers.last().map(|b| b[0]), Some(3.0));
     }
 
     #[test]
