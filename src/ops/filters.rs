@@ -215,7 +215,7 @@ pub fn blur_is_gaussian(sigma: f32, width: usize) -> bool {
 
 /// The scratch of `blur`'s box passes in image rows of its size (`box_pass`: the ring of a
 /// band plus the window, the tail, a band of tiles, the f64 sums, two rows' worth, and the
-/// row sweeps in flight, `box_rows_scratch` each), at the widest of the three passes; 0
+/// row sweeps in flight, a `SweepScratch` each), at the widest of the three passes; 0
 /// where the blur samples the Gaussian or is the identity. The sweeps' scratch does not
 /// grow with the channels (one channel is swept at a time) but is counted in one-channel
 /// rows, which the caller counts once per channel: an overestimate for a colour blur.
@@ -228,7 +228,7 @@ pub fn blur_scratch_rows(sigma: f32, width: usize) -> usize {
     // The sweeps in flight: one per thread, at most one per group of rows of the largest
     // fill (the ring).
     let in_flight = rayon::current_num_threads().min(box_ring_rows(r) / BOX_ROWS).max(1);
-    let sweeps = (box_rows_scratch(width, r) * in_flight).div_ceil(width);
+    let sweeps = (SweepScratch::f32s(width, r) * in_flight).div_ceil(width);
     box_ring_rows(r) + (r + 1) + BOX_BAND + 2 + sweeps
 }
 
@@ -255,33 +255,48 @@ fn box_widths(sigma: f32) -> [usize; 3] {
 /// with a slice each 28.7 ms, eight interleaved 23.5 ms.
 const BOX_ROWS: usize = 8;
 
-/// Scratch of one `box_rows_horizontal` call, in f32s: the padded rows (f64) and the rows'
-/// results interleaved, at `width` pixels and radius `r`.
-fn box_rows_scratch(width: usize, r: usize) -> usize {
-    BOX_ROWS * (2 * (width + 2 * r + 1) + width)
+/// The scratch of one `box_rows_horizontal` call at `width` pixels and radius `r`, rows
+/// interleaved: `BOX_ROWS` rows padded with their wrap-around (f64) and their results.
+struct SweepScratch {
+    padded: Vec<f64>,
+    swept: Vec<f32>,
+}
+
+impl SweepScratch {
+    fn new(width: usize, r: usize) -> SweepScratch {
+        SweepScratch { padded: vec![0.0; Self::padded_len(width, r)], swept: vec![0.0; BOX_ROWS * width] }
+    }
+
+    fn padded_len(width: usize, r: usize) -> usize {
+        BOX_ROWS * (width + 2 * r + 1)
+    }
+
+    /// Its size in f32s (`blur_scratch_rows`).
+    fn f32s(width: usize, r: usize) -> usize {
+        2 * Self::padded_len(width, r) + BOX_ROWS * width
+    }
 }
 
 /// The horizontal box sweep of `count` ≤ `BOX_ROWS` rows: the mean over x − r ..= x + r of
 /// each row of `sources` into the matching row of `out`, wrap-around, by a running sum (f64
 /// accumulators so long rows do not drift). `sources` has `BOX_ROWS` rows, those past
 /// `count` repeats of a real one (swept, not written). The rows are interleaved, sample i
-/// of row k at i · BOX_ROWS + k, so the rows' values at one x are contiguous: in `padded`
-/// (scratch of `BOX_ROWS` rows padded with their wrap-around, f64) and in `swept` (their
-/// results, scratch of `BOX_ROWS` rows).
+/// of row k at i · BOX_ROWS + k, so the rows' values at one x are contiguous: in
+/// `scratch.padded` (the rows padded with their wrap-around, f64) and `scratch.swept`
+/// (their results).
 fn box_rows_horizontal(
     sources: &[&[f32]; BOX_ROWS],
     count: usize,
     channels: usize,
     r: usize,
-    padded: &mut [f64],
-    swept: &mut [f32],
+    scratch: &mut SweepScratch,
     out: &mut [f32],
 ) {
     let ch = channels;
     let w = out.len() / count / ch;
     let norm = 1.0 / (2 * r + 1) as f64;
-    let padded = &mut padded[..(w + 2 * r + 1) * BOX_ROWS];
-    let swept = &mut swept[..w * BOX_ROWS];
+    let padded = &mut scratch.padded[..SweepScratch::padded_len(w, r)];
+    let swept = &mut scratch.swept[..w * BOX_ROWS];
     for c in 0..ch {
         // Padded sample i is the row's sample (i − r) mod w: no modulo in the sweep.
         let mut x = (w - r % w) % w;
@@ -349,21 +364,20 @@ fn box_pass(image: &mut Image, r: usize, wraps_v: bool) {
     let (w, h, ch) = (image.width, image.height, image.channels);
     let stride = w * ch;
     let norm = 1.0 / (2 * r + 1) as f64;
-    let padded_len = w + 2 * r + 1;
     let source_of = |y: isize| edge_row(y, h, wraps_v);
     // Horizontal sweeps of the rows y = start .. start + count (unwrapped, y ≥ −r) into
     // `out`, `count` rows, in groups of BOX_ROWS in parallel.
     let sweep = |data: &[f32], start: isize, out: &mut [f32]| {
         out.par_chunks_mut(BOX_ROWS * stride).enumerate().for_each_init(
-            || (vec![0.0f64; BOX_ROWS * padded_len], vec![0.0f32; BOX_ROWS * w]), // box_rows_scratch
-            |(padded, swept), (group, rows)| {
+            || SweepScratch::new(w, r),
+            |scratch, (group, rows)| {
                 let first = start + (group * BOX_ROWS) as isize;
                 let count = rows.len() / stride;
                 let sources: [&[f32]; BOX_ROWS] = std::array::from_fn(|k| {
                     let y = first + k.min(count - 1) as isize;
                     &data[source_of(y) * stride..][..stride]
                 });
-                box_rows_horizontal(&sources, count, ch, r, padded, swept, rows);
+                box_rows_horizontal(&sources, count, ch, r, scratch, rows);
             },
         );
     };
