@@ -935,6 +935,9 @@ struct Sweep {
     active: Vec<u32>,
     /// The previous pixel's x (the sweep needs x never to decrease).
     last_x: f64,
+    /// The smallest range end among `active` (infinite when none): until x passes it, no
+    /// candidate leaves, and the per-pixel `retain` over `active` is skipped.
+    next_exit: f64,
 }
 
 impl Sweep {
@@ -943,7 +946,7 @@ impl Sweep {
         let mut order: Vec<u32> =
             (0..count).filter(|&k| candidates[k as usize].x_min <= candidates[k as usize].x_max).collect();
         order.sort_by(|a, b| candidates[*a as usize].x_min.total_cmp(&candidates[*b as usize].x_min));
-        Sweep { order, entered: 0, active: Vec::new(), last_x: f64::NEG_INFINITY }
+        Sweep { order, entered: 0, active: Vec::new(), last_x: f64::NEG_INFINITY, next_exit: f64::INFINITY }
     }
 
     /// Moves on to the pixel at `x`, which is not left of the previous one.
@@ -957,9 +960,13 @@ impl Sweep {
             }
             let at = self.active.partition_point(|a| *a < k);
             self.active.insert(at, k);
+            self.next_exit = self.next_exit.min(candidates[k as usize].x_max);
             self.entered += 1;
         }
-        self.active.retain(|&k| candidates[k as usize].x_max >= x);
+        if x > self.next_exit {
+            self.active.retain(|&k| candidates[k as usize].x_max >= x);
+            self.next_exit = self.active.iter().map(|&k| candidates[k as usize].x_max).fold(f64::INFINITY, f64::min);
+        }
     }
 }
 
