@@ -233,9 +233,43 @@ impl Plan {
             // the schedule: evaluating the graph without it let the next chains start sooner
             // and raised `crotalus-atrox`'s buffers at 4096² from 768 to 832 MiB (1.0–1.06 GB
             // resident against 0.92–0.95).
-            let (stats, mut encoded) = std::thread::scope(|scope| {
+            //
+            // The normal map, where it is the height map's normals and nothing else reads it,
+            // is quantised straight from the height map a row at a time
+            // (`Graph::normal_from`), without its node: its f32 image (three samples a pixel,
+            // 192 MiB at 4096²) was written, read once by `quantize` and freed.
+            let normal_direct = graph
+                .normal_from(MapKind::Height)
+                .filter(|_| request.maps.contains(&MapKind::Normal) && request.maps.contains(&MapKind::Height));
+            let evaluated: Vec<MapKind> =
+                request.maps.iter().copied().filter(|m| normal_direct.is_none() || *m != MapKind::Normal).collect();
+            let mut normal_time = None;
+            let (mut stats, mut encoded) = std::thread::scope(|scope| {
                 let mut encoders = Vec::new();
-                let stats = evaluate_into(&graph, &request.maps, size, height, progress, &mut |map, image| {
+                let mut encode = |map: MapKind, quantized: export::Quantized| {
+                    encoders.push(scope.spawn(move || {
+                        let t = Instant::now();
+                        let staged = export::encode_quantized(&quantized)
+                            .map_err(Error::from)
+                            .and_then(|bytes| Ok(lock.stage(&export::map_file_name(name, map), &bytes)?));
+                        (map, staged, t.elapsed())
+                    }));
+                };
+                let stats = evaluate_into(&graph, &evaluated, size, height, progress, &mut |map, image| {
+                    if let (MapKind::Height, Some((slope, convention, v_extent))) = (map, normal_direct) {
+                        let t = Instant::now();
+                        let rows = crate::ops::filters::height_to_normal_rows(
+                            &image,
+                            slope,
+                            convention,
+                            v_extent,
+                            height,
+                            graph.wraps_v(),
+                        );
+                        let normal = export::quantize_rows(MapKind::Normal, image.width, image.height, rows);
+                        normal_time = Some((t.elapsed(), normal.samples.len()));
+                        encode(MapKind::Normal, normal);
+                    }
                     let constant = graph
                         .constant_output(map)
                         .and_then(|v| Some((v, export::quantize_constant(map, image.width, image.height, v)?)));
@@ -247,18 +281,24 @@ impl Plan {
                         None => export::quantize(map, &image),
                     };
                     drop(image);
-                    encoders.push(scope.spawn(move || {
-                        let t = Instant::now();
-                        let staged = export::encode_quantized(&quantized)
-                            .map_err(Error::from)
-                            .and_then(|bytes| Ok(lock.stage(&export::map_file_name(name, map), &bytes)?));
-                        (map, staged, t.elapsed())
-                    }));
+                    encode(map, quantized);
                 });
                 let encoded: Vec<_> =
                     encoders.into_iter().map(|h| h.join().expect("a PNG encoder thread panicked")).collect();
                 (stats, encoded)
             });
+            if let (Some((time, bytes)), Some(node)) = (normal_time, graph.output(MapKind::Normal)) {
+                // `--stats` lists the normal map's step as the node it stands for, with its
+                // time (quantising included) and the bytes of its file samples.
+                let node = graph.node(node);
+                stats.nodes.push(crate::graph::NodeStats {
+                    name: node.name.clone(),
+                    label: format!("{}, quantised from the height map", node.op.label()),
+                    evaluations: 1,
+                    time,
+                    bytes,
+                });
+            }
             encoded.sort_by_key(|(map, _, _)| *map);
             let encode_time = encoded.iter().map(|(_, _, t)| *t).sum();
             let kinds: Vec<MapKind> = encoded.iter().map(|(map, _, _)| *map).collect();

@@ -323,6 +323,52 @@ fn zero_amplitudes_and_invisible_layers_run_none_of_their_nodes_and_change_nothi
 }
 
 #[test]
+fn the_normal_map_quantised_from_the_height_map_is_the_evaluated_map_byte_for_byte() {
+    // A set with the height map quantises its normal map from the height map's image a row
+    // at a time (`Graph::normal_from`), without the normal node; `--maps normal` alone
+    // evaluates the node as before. Both files must be the bytes of the evaluated map
+    // quantised as any other; `--stats` says which way each went.
+    use snakeskin::export::{encode_quantized, quantize};
+    for name in ["natrix-natrix", PATTERNED] {
+        let loaded = parse(&read_source(name).unwrap(), &[]).unwrap();
+        let graph = build_graph(&loaded.preset, BuildOptions::default());
+        let eval = evaluate(&graph, &[MapKind::Normal], 96, 96, &|_, _| {});
+        let evaluated = encode_quantized(&quantize(MapKind::Normal, &eval.maps[&MapKind::Normal])).unwrap();
+        for (maps, direct) in [(None, true), (Some("normal"), false), (Some("height,normal"), true)] {
+            let dir = tempfile::tempdir().unwrap();
+            let out = dir.path().to_str().unwrap();
+            let mut args = vec!["generate", name, "-o", out, "--size", "96", "--stats"];
+            args.extend(maps.iter().flat_map(|m| ["--maps", *m]));
+            let run = snakeskin(&args);
+            assert!(run.status.success(), "{}", stderr(&run));
+            let stats = stderr(&run);
+            assert_eq!(
+                stats.contains("height to normal, quantised from the height map"),
+                direct,
+                "{name} {maps:?}: {stats}"
+            );
+            let written = std::fs::read(dir.path().join(format!("{}_normal.png", loaded.name))).unwrap();
+            assert!(written == evaluated, "{name} {maps:?}: the written normal map differs from the evaluated one");
+        }
+    }
+    // The rows alone against the image, off the tile too: a strip of a body atlas (no wrap
+    // along v, a texture four widths long) and either normal convention.
+    use snakeskin::material::NormalConvention;
+    use snakeskin::ops::filters::{height_to_normal, height_to_normal_rows};
+    let (width, height) = (23, 37);
+    let data = (0..width * height).map(|i| ((i * 7919) % 1000) as f32 / 999.0).collect();
+    let heights = snakeskin::ops::Image { width, height, channels: 1, data };
+    for convention in [NormalConvention::OpenGl, NormalConvention::DirectX] {
+        for (v_extent, full_height, wraps_v) in [(1.0, height, true), (4.0, 92, false)] {
+            let image = height_to_normal(&heights, 0.7, convention, v_extent, full_height, wraps_v);
+            let rows = height_to_normal_rows(&heights, 0.7, convention, v_extent, full_height, wraps_v);
+            let by_rows = snakeskin::export::quantize_rows(MapKind::Normal, width, height, rows);
+            assert_eq!(by_rows.samples, quantize(MapKind::Normal, &image).samples, "{convention:?} {wraps_v}");
+        }
+    }
+}
+
+#[test]
 fn a_map_written_alone_computes_only_its_scale_channels_and_the_same_samples() {
     // `Graph::for_maps`, as `generate --maps` and every pack use it: the scale field of a
     // graph for some maps stores only the channels their nodes read, its readers

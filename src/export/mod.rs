@@ -119,28 +119,81 @@ pub struct Quantized {
 /// them, and a later buffer at those addresses then paid a copy-on-write fault with a TLB
 /// shootdown per page; BENCHMARKS.md, "Copy-on-write faults".)
 pub fn quantize(map: MapKind, image: &Image) -> Quantized {
-    let format = map.format();
-    let encode = |x: f32| match format.encoding {
-        Encoding::Srgb => linear_to_srgb8(x) as f32 / 255.0,
-        Encoding::Linear => x,
-        Encoding::SignedUnit => x * 0.5 + 0.5,
-    };
-    let (samples, color) = match (format.channels, format.bit_depth) {
-        (3, 8) => (image.data.par_iter().map(|&x| unit_to_u8(encode(x))).collect(), ExtendedColorType::Rgb8),
-        (1, 8) => (image.data.par_iter().map(|&x| unit_to_u8(encode(x))).collect(), ExtendedColorType::L8),
-        (1, 16) => {
+    let (samples, color) = match (map.format().channels, map.format().bit_depth) {
+        (_, 8) => {
+            // Collected, not written into a zeroed buffer: a fresh vector's pages are first
+            // touched by the writes themselves.
+            let encode = sample_encoding(map);
+            (image.data.par_iter().map(|&x| unit_to_u8(encode(x))).collect(), color_type(map))
+        }
+        _ => {
             // Into one buffer of the final size: collecting the bytes of a `flat_map_iter`
             // grows a vector per rayon task and joins them, and glibc keeps the freed pieces
             // in its worker arenas.
             let mut samples = vec![0u8; image.data.len() * 2];
-            samples.par_chunks_mut(2).zip(&image.data).for_each(|(out, &x)| {
-                out.copy_from_slice(&unit_to_u16(encode(x)).to_be_bytes());
-            });
-            (samples, ExtendedColorType::L16)
+            let row_bytes = image.width * image.channels * 2;
+            samples.par_chunks_mut(row_bytes.max(1)).zip(image.data.par_chunks((row_bytes / 2).max(1))).for_each(
+                |(out, values)| {
+                    quantize_row(map, values, out);
+                },
+            );
+            (samples, color_type(map))
         }
-        other => unreachable!("MapKind::format has no {other:?} layout"),
     };
     Quantized { map, width: image.width, height: image.height, samples, color }
+}
+
+/// `quantize` of a map given a row at a time by `row` (which writes row y's samples, as
+/// many per pixel as the map's format has channels, into its buffer), the same bytes: for
+/// a map whose last step only feeds the file (the normal map from the height map,
+/// `filters::height_to_normal_rows`), without an image of its f32 samples.
+pub fn quantize_rows(map: MapKind, width: usize, height: usize, row: impl Fn(usize, &mut [f32]) + Sync) -> Quantized {
+    let format = map.format();
+    let row_len = width * format.channels as usize;
+    let row_bytes = row_len * (format.bit_depth as usize / 8);
+    let mut samples = vec![0u8; row_bytes * height];
+    samples.par_chunks_mut(row_bytes.max(1)).enumerate().for_each_init(
+        || vec![0.0f32; row_len],
+        |values, (y, out)| {
+            row(y, values);
+            quantize_row(map, values, out);
+        },
+    );
+    Quantized { map, width, height, samples, color: color_type(map) }
+}
+
+/// A map's f32 samples to the file's scale, before rounding (`MapKind::format`'s encoding).
+fn sample_encoding(map: MapKind) -> impl Fn(f32) -> f32 + Sync {
+    let encoding = map.format().encoding;
+    move |x: f32| match encoding {
+        Encoding::Srgb => linear_to_srgb8(x) as f32 / 255.0,
+        Encoding::Linear => x,
+        Encoding::SignedUnit => x * 0.5 + 0.5,
+    }
+}
+
+/// The file's samples of `values` into `out` (8 bits, or 16 bits big-endian: the order PNG
+/// stores them in): the one quantisation of every map file.
+fn quantize_row(map: MapKind, values: &[f32], out: &mut [u8]) {
+    let encode = sample_encoding(map);
+    if map.format().bit_depth == 8 {
+        for (o, &x) in out.iter_mut().zip(values) {
+            *o = unit_to_u8(encode(x));
+        }
+    } else {
+        for (o, &x) in out.chunks_exact_mut(2).zip(values) {
+            o.copy_from_slice(&unit_to_u16(encode(x)).to_be_bytes());
+        }
+    }
+}
+
+fn color_type(map: MapKind) -> ExtendedColorType {
+    match (map.format().channels, map.format().bit_depth) {
+        (3, 8) => ExtendedColorType::Rgb8,
+        (1, 8) => ExtendedColorType::L8,
+        (1, 16) => ExtendedColorType::L16,
+        other => unreachable!("MapKind::format has no {other:?} layout"),
+    }
 }
 
 /// `quantize` of a `width` × `height` single-channel map that holds `value` everywhere (a

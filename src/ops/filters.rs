@@ -628,22 +628,30 @@ fn neighbourhood<F>(input: &Image, channels_out: usize, wraps_v: bool, f: F) -> 
 where
     F: Fn(usize, usize, usize, &[f32], &[f32], &[f32], &mut [f32]) + Sync,
 {
-    let (w, h, ch) = (input.width, input.height, input.channels);
-    let mut out = Image::new(w, h, channels_out);
-    out.data.par_chunks_mut(w * channels_out).enumerate().for_each(|(y, row)| {
-        let up = input.row(edge_row(y as isize - 1, h, wraps_v));
-        let here = input.row(y);
-        let down = input.row(edge_row(y as isize + 1, h, wraps_v));
-        for (x, px) in row.chunks_exact_mut(channels_out).enumerate() {
-            // The columns either side, wrapping round, by comparison: two integer divisions
-            // per pixel cost, one thread at 2048² (`epicrates-cenchria`), 19–21 → 14 ms of
-            // a Sobel and 33–38 → 31 ms of `height to normal`.
-            let left = if x == 0 { w - 1 } else { x - 1 };
-            let right = if x + 1 == w { 0 } else { x + 1 };
-            f(x * ch, left * ch, right * ch, up, here, down, px);
-        }
+    let mut out = Image::new(input.width, input.height, channels_out);
+    out.data.par_chunks_mut(input.width * channels_out).enumerate().for_each(|(y, row)| {
+        neighbourhood_row(input, y, wraps_v, channels_out, &f, row);
     });
     out
+}
+
+/// Row `y` of `neighbourhood`'s output (`channels_out` samples per pixel) into `row`.
+fn neighbourhood_row<F>(input: &Image, y: usize, wraps_v: bool, channels_out: usize, f: &F, row: &mut [f32])
+where
+    F: Fn(usize, usize, usize, &[f32], &[f32], &[f32], &mut [f32]),
+{
+    let (w, h, ch) = (input.width, input.height, input.channels);
+    let up = input.row(edge_row(y as isize - 1, h, wraps_v));
+    let here = input.row(y);
+    let down = input.row(edge_row(y as isize + 1, h, wraps_v));
+    for (x, px) in row.chunks_exact_mut(channels_out).enumerate() {
+        // The columns either side, wrapping round, by comparison: two integer divisions
+        // per pixel cost, one thread at 2048² (`epicrates-cenchria`), 19–21 → 14 ms of
+        // a Sobel and 33–38 → 31 ms of `height to normal`.
+        let left = if x == 0 { w - 1 } else { x - 1 };
+        let right = if x + 1 == w { 0 } else { x + 1 };
+        f(x * ch, left * ch, right * ch, up, here, down, px);
+    }
 }
 
 /// Sobel gradient magnitude of channel 0, wrap-around. The result is normalised so that a
@@ -676,22 +684,74 @@ pub fn height_to_normal(
     full_height: usize,
     wraps_v: bool,
 ) -> Image {
-    let (w, h) = (height.width as f32, full_height as f32 / v_extent);
-    neighbourhood(height, 3, wraps_v, |c, l, r, up, here, down, out| {
+    let kernel = NormalKernel::new(height, slope_per_unit_height, convention, v_extent, full_height);
+    neighbourhood(height, 3, wraps_v, |c, l, r, up, here, down, out| kernel.at(here[r] - here[l], down[c] - up[c], out))
+}
+
+/// `height_to_normal` a row at a time: a function writing row y of the normal map (three
+/// samples per pixel) into its buffer, the same values bit for bit, so a caller that only
+/// quantises the normals (`export::quantize_rows`) needs no image of them (at 4096², 192 MiB
+/// of f32 written, read back and freed).
+pub fn height_to_normal_rows(
+    height: &Image,
+    slope_per_unit_height: f32,
+    convention: NormalConvention,
+    v_extent: f32,
+    full_height: usize,
+    wraps_v: bool,
+) -> impl Fn(usize, &mut [f32]) + Sync + '_ {
+    let kernel = NormalKernel::new(height, slope_per_unit_height, convention, v_extent, full_height);
+    let at = move |c, l, r, up: &[f32], here: &[f32], down: &[f32], out: &mut [f32]| {
+        kernel.at(here[r] - here[l], down[c] - up[c], out)
+    };
+    move |y, row| neighbourhood_row(height, y, wraps_v, 3, &at, row)
+}
+
+/// The per-pixel normal of `height_to_normal`: central differences of the height, scaled
+/// to texture widths on both axes.
+struct NormalKernel {
+    /// Pixels per texture width across (u) and along (v).
+    per_width_u: f32,
+    per_width_v: f32,
+    slope_per_unit_height: f32,
+    convention: NormalConvention,
+}
+
+impl NormalKernel {
+    fn new(
+        height: &Image,
+        slope_per_unit_height: f32,
+        convention: NormalConvention,
+        v_extent: f32,
+        full_height: usize,
+    ) -> Self {
+        NormalKernel {
+            per_width_u: height.width as f32,
+            per_width_v: full_height as f32 / v_extent,
+            slope_per_unit_height,
+            convention,
+        }
+    }
+
+    /// The normal from the height differences across (right − left) and along (down − up)
+    /// a pixel.
+    #[inline]
+    fn at(&self, across: f32, along: f32, out: &mut [f32]) {
+        let (w, h, slope) = (self.per_width_u, self.per_width_v, self.slope_per_unit_height);
         // dh/du with u in texture widths: (h[x+1] - h[x-1]) / (2 / w).
-        let dhdx = (here[r] - here[l]) * 0.5 * w;
-        let dhdy = (down[c] - up[c]) * 0.5 * h;
-        let sx = -dhdx * slope_per_unit_height;
+        let dhdx = across * 0.5 * w;
+        let dhdy = along * 0.5 * h;
+        let sx = -dhdx * slope;
         // Image y runs down; OpenGL's +Y (bitangent) points up the image.
-        let sy = match convention {
-            NormalConvention::OpenGl => dhdy * slope_per_unit_height,
-            NormalConvention::DirectX => -dhdy * slope_per_unit_height,
+        let sy = match self.convention {
+            NormalConvention::OpenGl => dhdy * slope,
+            NormalConvention::DirectX => -dhdy * slope,
         };
         let len = (sx * sx + sy * sy + 1.0).sqrt();
         out[0] = sx / len;
         out[1] = sy / len;
         out[2] = 1.0 / len;
-    })
+    }
 }
 
 #[cfg(test)]
