@@ -11,7 +11,7 @@ use crate::export::pack::{Pack, TextureEncoder, TextureSpec, texture_file_name};
 use crate::export::{self, MapEntry, SetLock, sha256_hex};
 use crate::graph::{EvalStats, Graph, evaluate_into, evaluate_rows};
 use crate::maps::{BuildOptions, build_graph, has_film};
-use crate::material::{FileFormat, MapKind};
+use crate::material::{FileFormat, MapKind, NormalConvention};
 use crate::memory::MemoryCheck;
 use crate::ops::Frame;
 use crate::preset::{self, LoadedPreset};
@@ -233,16 +233,9 @@ impl Plan {
             // the schedule: evaluating the graph without it let the next chains start sooner
             // and raised `crotalus-atrox`'s buffers at 4096² from 768 to 832 MiB (1.0–1.06 GB
             // resident against 0.92–0.95).
-            //
-            // The normal map, where it is the height map's normals and nothing else reads it,
-            // is quantised straight from the height map a row at a time
-            // (`Graph::normal_from`), without its node: its f32 image (three samples a pixel,
-            // 192 MiB at 4096²) was written, read once by `quantize` and freed.
-            let normal_direct = graph
-                .normal_from(MapKind::Height)
-                .filter(|_| request.maps.contains(&MapKind::Normal) && request.maps.contains(&MapKind::Height));
-            let evaluated: Vec<MapKind> =
-                request.maps.iter().copied().filter(|m| normal_direct.is_none() || *m != MapKind::Normal).collect();
+            // The normal map is quantised from the height map where it can be
+            // (`whole_tile_maps`).
+            let (evaluated, normal_direct) = whole_tile_maps(&graph, &request.maps);
             let mut normal_time = None;
             let (mut stats, mut encoded) = std::thread::scope(|scope| {
                 let mut encoders = Vec::new();
@@ -551,6 +544,9 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
     }
     let set_budget = std::env::var("SNAKESKIN_TILE_BUDGET_MIB").ok().and_then(|v| v.trim().parse::<u64>().ok());
     let buffers = |rows: usize| crate::graph::estimate_peak_bytes(graph, maps, width, rows);
+    // With the normal node, though a tile evaluated whole goes without it (`whole_tile_maps`):
+    // the budget was measured with it, and without it the two species in strips at 4096²
+    // would still not fit (their buffers without it: over 1000 and 920–960 MiB).
     if buffers(height) <= set_budget.map_or(TILE_BUFFER_BUDGET_BYTES, |mib| mib << 20) {
         return None;
     }
@@ -573,6 +569,19 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
         }
     }
     best
+}
+
+/// The maps a tile evaluated whole runs its graph for, and how it makes its normal map:
+/// `maps` less the normal map where that is the height map's normals and nothing else reads
+/// it (`Graph::normal_from`, whose parameters come second), for `generate` quantises it
+/// straight from the height map a row at a time, without the node: its f32 image, three
+/// samples a pixel (192 MiB at 4096²), was written, read once by `quantize` and freed.
+/// Strips and body atlases evaluate the node.
+fn whole_tile_maps(graph: &Graph, maps: &[MapKind]) -> (Vec<MapKind>, Option<(f32, NormalConvention, f32)>) {
+    let direct = graph
+        .normal_from(MapKind::Height)
+        .filter(|_| maps.contains(&MapKind::Normal) && maps.contains(&MapKind::Height));
+    (maps.iter().copied().filter(|m| direct.is_none() || *m != MapKind::Normal).collect(), direct)
 }
 
 /// (maps, their files' names and bytes, merged stats, encode time) of a long texture
