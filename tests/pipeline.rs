@@ -412,6 +412,36 @@ fn a_map_written_alone_computes_only_its_scale_channels_and_the_same_samples() {
 }
 
 #[test]
+fn fusion_never_raises_the_estimated_peak_and_keeps_the_folds_that_do_not() {
+    // `Graph::fused` undoes folds while the estimated peak is above the unfused graph's,
+    // the furthest-reaching first, then tries each undone fold again and keeps those under
+    // the peak that reached. Every preset at 2048² and 4096²: never above the unfused peak.
+    // `natrix-natrix` at 4096²: undoing by reach had unfolded its height and crevice
+    // channel copies too (64 MiB each), which raise nothing; they are folded again.
+    rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap().install(|| {
+        use snakeskin::graph::estimate_peak_bytes;
+        for name in snakeskin::preset::library::all().iter().map(|(name, _)| *name).chain([PATTERNED]) {
+            let loaded = parse(&read_source(name).unwrap(), &[]).unwrap();
+            let plain = build_graph(&loaded.preset, BuildOptions::default()).for_maps(&MapKind::ALL);
+            for size in [2048, 4096] {
+                let fused = plain.fused(&MapKind::ALL, size, size);
+                let (f, p) = (
+                    estimate_peak_bytes(&fused, &MapKind::ALL, size, size),
+                    estimate_peak_bytes(&plain, &MapKind::ALL, size, size),
+                );
+                assert!(f <= p, "{name} at {size}: fused peak {f} above the unfused {p}");
+            }
+        }
+        let loaded = parse(&read_source("natrix-natrix").unwrap(), &[]).unwrap();
+        let fused = build_graph(&loaded.preset, BuildOptions::default()).fused(&MapKind::ALL, 4096, 4096);
+        let names: Vec<&str> = fused.nodes().iter().map(|n| n.name.as_str()).collect();
+        for copy in ["scales.height", "scales.crevice"] {
+            assert!(!names.contains(&copy), "{copy} is a node of its own: {names:?}");
+        }
+    });
+}
+
+#[test]
 fn fused_chains_give_the_same_bits_as_the_nodes_one_by_one() {
     // `Graph::fused` (what `generate` evaluates) runs chains of per-pixel nodes a band of
     // rows at a time with the nodes' own kernels: every map of every preset, tile and body,
