@@ -280,17 +280,22 @@ impl Plan {
                     encoders.into_iter().map(|h| h.join().expect("a PNG encoder thread panicked")).collect();
                 (stats, encoded)
             });
-            if let (Some((time, bytes)), Some(node)) = (normal_time, graph.output(MapKind::Normal)) {
-                // `--stats` lists the normal map's step as the node it stands for, with its
-                // time (quantising included) and the bytes of its file samples.
+            if let (Some((time, bytes)), Some(node), Some(height_node)) =
+                (normal_time, graph.output(MapKind::Normal), graph.output(MapKind::Height))
+            {
+                // `--stats` lists the normal map's step as the node it stands for, after the
+                // height map's (the nodes are in topological order), with its time
+                // (quantising included) and its output: the file's samples.
                 let node = graph.node(node);
-                stats.nodes.push(crate::graph::NodeStats {
+                let after = stats.nodes.iter().position(|n| n.name == graph.node(height_node).name);
+                let entry = crate::graph::NodeStats {
                     name: node.name.clone(),
-                    label: format!("{}, quantised from the height map", node.op.label()),
+                    label: format!("{} {NORMAL_FROM_HEIGHT}", node.op.label()),
                     evaluations: 1,
                     time,
                     bytes,
-                });
+                };
+                stats.nodes.insert(after.map_or(stats.nodes.len(), |i| i + 1), entry);
             }
             encoded.sort_by_key(|(map, _, _)| *map);
             let encode_time = encoded.iter().map(|(_, _, t)| *t).sum();
@@ -570,6 +575,10 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
     }
     best
 }
+
+/// How `--stats` labels the normal map's step where it is quantised from the height map's
+/// rows (after the node's own label, "height to normal"): its output is the file's samples.
+pub const NORMAL_FROM_HEIGHT: &str = "rows → file";
 
 /// The maps a tile evaluated whole runs its graph for, and how it makes its normal map:
 /// `maps` less the normal map where that is the height map's normals and nothing else reads

@@ -119,28 +119,17 @@ pub struct Quantized {
 /// them, and a later buffer at those addresses then paid a copy-on-write fault with a TLB
 /// shootdown per page; BENCHMARKS.md, "Copy-on-write faults".)
 pub fn quantize(map: MapKind, image: &Image) -> Quantized {
-    let (samples, color) = match (map.format().channels, map.format().bit_depth) {
-        (_, 8) => {
-            // Collected, not written into a zeroed buffer: a fresh vector's pages are first
-            // touched by the writes themselves.
-            let encode = sample_encoding(map);
-            (image.data.par_iter().map(|&x| unit_to_u8(encode(x))).collect(), color_type(map))
-        }
-        _ => {
-            // Into one buffer of the final size: collecting the bytes of a `flat_map_iter`
-            // grows a vector per rayon task and joins them, and glibc keeps the freed pieces
-            // in its worker arenas.
-            let mut samples = vec![0u8; image.data.len() * 2];
-            let row_bytes = image.width * image.channels * 2;
-            samples.par_chunks_mut(row_bytes.max(1)).zip(image.data.par_chunks((row_bytes / 2).max(1))).for_each(
-                |(out, values)| {
-                    quantize_row(map, values, out);
-                },
-            );
-            (samples, color_type(map))
-        }
-    };
-    Quantized { map, width: image.width, height: image.height, samples, color }
+    let row_len = image.width * image.channels;
+    let row_bytes = row_len * (map.format().bit_depth as usize / 8);
+    // Into one buffer of the final size, its pages first touched by the rows' writes (a
+    // fresh allocation of this size is mapped zeroed, not written): collecting the bytes
+    // of a `flat_map_iter` grew a vector per rayon task and joined them, and glibc keeps
+    // the freed pieces in its worker arenas.
+    let mut samples = vec![0u8; image.height * row_bytes];
+    samples.par_chunks_mut(row_bytes.max(1)).zip(image.data.par_chunks(row_len.max(1))).for_each(|(out, values)| {
+        quantize_row(map, values, out);
+    });
+    Quantized { map, width: image.width, height: image.height, samples, color: color_type(map) }
 }
 
 /// `quantize` of a map given a row at a time by `row` (which writes row y's samples, as

@@ -283,10 +283,11 @@ impl Graph {
         // evaluated peak varies with the schedule by a 64 MiB channel either way).
         let plain_peak = estimate_peak_bytes(self, maps, width, height);
         let wanted = folded.clone();
-        let mut graph = loop {
+        let (mut graph, peak) = loop {
             let graph = self.fold(maps, &reachable, &channels, &folded);
-            if estimate_peak_bytes(&graph, maps, width, height) <= plain_peak {
-                break graph;
+            let peak = estimate_peak_bytes(&graph, maps, width, height);
+            if peak <= plain_peak {
+                break (graph, peak);
             }
             let furthest = (0..count)
                 .filter(|&i| folded[i])
@@ -294,7 +295,6 @@ impl Graph {
                 .expect("with nothing folded the graph is the plain one");
             folded[furthest] = false;
         };
-        let peak = estimate_peak_bytes(&graph, maps, width, height);
         for i in 0..count {
             if wanted[i] && !folded[i] {
                 folded[i] = true;
