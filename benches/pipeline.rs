@@ -53,7 +53,14 @@ fn operations(c: &mut Criterion) {
         b.iter(|| filters::blur(std::borrow::Cow::Borrowed(&noise), 0.005, true))
     });
     group.bench_function("height_to_normal", |b| {
-        b.iter(|| filters::height_to_normal(&noise, 0.05, filters::NormalConvention::OpenGl, 1.0, noise.height, true))
+        let spec = filters::NormalSpec {
+            slope_per_unit_height: 0.05,
+            convention: filters::NormalConvention::OpenGl,
+            v_extent: 1.0,
+            full_height: noise.height,
+            wraps_v: true,
+        };
+        b.iter(|| filters::height_to_normal(&noise, spec))
     });
     group.finish();
 }

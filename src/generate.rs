@@ -11,9 +11,10 @@ use crate::export::pack::{Pack, TextureEncoder, TextureSpec, texture_file_name};
 use crate::export::{self, MapEntry, SetLock, sha256_hex};
 use crate::graph::{EvalStats, Graph, evaluate_into, evaluate_rows};
 use crate::maps::{BuildOptions, build_graph, has_film};
-use crate::material::{FileFormat, MapKind, NormalConvention};
+use crate::material::{FileFormat, MapKind};
 use crate::memory::MemoryCheck;
 use crate::ops::Frame;
+use crate::ops::filters::NormalSpec;
 use crate::preset::{self, LoadedPreset};
 use crate::{Error, SIZE_RANGE};
 
@@ -235,7 +236,7 @@ impl Plan {
             // resident against 0.92–0.95).
             // The normal map is quantised from the height map where it can be
             // (`whole_tile_maps`).
-            let (evaluated, normal_direct) = whole_tile_maps(&graph, &request.maps);
+            let (evaluated, normal_direct) = whole_tile_maps(&graph, &request.maps, size, height);
             let mut normal_time = None;
             let (mut stats, mut encoded) = std::thread::scope(|scope| {
                 let mut encoders = Vec::new();
@@ -249,16 +250,9 @@ impl Plan {
                     }));
                 };
                 let stats = evaluate_into(&graph, &evaluated, size, height, progress, &mut |map, image| {
-                    if let (MapKind::Height, Some((slope, convention, v_extent))) = (map, normal_direct) {
+                    if let (MapKind::Height, Some(spec)) = (map, normal_direct) {
                         let t = Instant::now();
-                        let rows = crate::ops::filters::height_to_normal_rows(
-                            &image,
-                            slope,
-                            convention,
-                            v_extent,
-                            height,
-                            graph.wraps_v(),
-                        );
+                        let rows = crate::ops::filters::height_to_normal_rows(&image, spec);
                         let normal = export::quantize_rows(MapKind::Normal, image.width, image.height, rows);
                         normal_time = Some((t.elapsed(), normal.samples.len()));
                         encode(MapKind::Normal, normal);
@@ -582,13 +576,14 @@ pub const NORMAL_FROM_HEIGHT: &str = "rows → file";
 
 /// The maps a tile evaluated whole runs its graph for, and how it makes its normal map:
 /// `maps` less the normal map where that is the height map's normals and nothing else reads
-/// it (`Graph::normal_from`, whose parameters come second), for `generate` quantises it
+/// it (`Graph::normal_from`, whose spec comes second), for `generate` quantises it
 /// straight from the height map a row at a time, without the node: its f32 image, three
 /// samples a pixel (192 MiB at 4096²), was written, read once by `quantize` and freed.
 /// Strips and body atlases evaluate the node.
-fn whole_tile_maps(graph: &Graph, maps: &[MapKind]) -> (Vec<MapKind>, Option<(f32, NormalConvention, f32)>) {
+fn whole_tile_maps(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> (Vec<MapKind>, Option<NormalSpec>) {
+    let frame = Frame { wraps_v: graph.wraps_v(), ..Frame::whole(width, height) };
     let direct = graph
-        .normal_from(MapKind::Height)
+        .normal_from(MapKind::Height, frame)
         .filter(|_| maps.contains(&MapKind::Normal) && maps.contains(&MapKind::Height));
     (maps.iter().copied().filter(|m| direct.is_none() || *m != MapKind::Normal).collect(), direct)
 }

@@ -348,17 +348,18 @@ fn the_normal_map_quantised_from_the_height_map_is_the_evaluated_map_byte_for_by
             assert!(written == evaluated, "{name} {maps:?}: the written normal map differs from the evaluated one");
         }
     }
-    // The rows alone against the image, off the tile too: a strip of a body atlas (no wrap
-    // along v, a texture four widths long) and either normal convention.
+    // `quantize_rows` of the rows against `quantize` of the image, off the tile too: a strip
+    // of a body atlas (no wrap along v, a texture four widths long), either convention.
     use snakeskin::material::NormalConvention;
-    use snakeskin::ops::filters::{height_to_normal, height_to_normal_rows};
+    use snakeskin::ops::filters::{NormalSpec, height_to_normal, height_to_normal_rows};
     let (width, height) = (23, 37);
     let data = (0..width * height).map(|i| ((i * 7919) % 1000) as f32 / 999.0).collect();
     let heights = snakeskin::ops::Image { width, height, channels: 1, data };
     for convention in [NormalConvention::OpenGl, NormalConvention::DirectX] {
         for (v_extent, full_height, wraps_v) in [(1.0, height, true), (4.0, 92, false)] {
-            let image = height_to_normal(&heights, 0.7, convention, v_extent, full_height, wraps_v);
-            let rows = height_to_normal_rows(&heights, 0.7, convention, v_extent, full_height, wraps_v);
+            let spec = NormalSpec { slope_per_unit_height: 0.7, convention, v_extent, full_height, wraps_v };
+            let image = height_to_normal(&heights, spec);
+            let rows = height_to_normal_rows(&heights, spec);
             let by_rows = snakeskin::export::quantize_rows(MapKind::Normal, width, height, rows);
             assert_eq!(by_rows.samples, quantize(MapKind::Normal, &image).samples, "{convention:?} {wraps_v}");
         }

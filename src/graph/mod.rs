@@ -67,15 +67,16 @@ impl Graph {
         }
     }
 
-    /// The normal map's step where it is `HeightToNormal` of the output of `from` and no node
-    /// reads it: (slope, convention, v extent). Then a caller that only files the normal
-    /// map can compute it from `from`'s image a row at a time (`generate`, through
+    /// The normal map's step over `frame` where it is `HeightToNormal` of the output of
+    /// `from` and no node reads it. Then a caller that only files the normal map can compute
+    /// it from `from`'s image a row at a time (`generate`, through
     /// `filters::height_to_normal_rows`), without the node.
-    pub fn normal_from(&self, from: MapKind) -> Option<(f32, crate::material::NormalConvention, f32)> {
+    pub fn normal_from(&self, from: MapKind, frame: crate::ops::Frame) -> Option<crate::ops::filters::NormalSpec> {
         let normal = self.output(MapKind::Normal)?;
         let Op::HeightToNormal { slope, convention, v_extent } = self.node(normal).op else { return None };
         let read = self.nodes.iter().any(|n| n.inputs.contains(&normal));
-        (self.node(normal).inputs == [self.output(from)?] && !read).then_some((slope, convention, v_extent))
+        let spec = crate::ops::filters::NormalSpec::in_frame(slope, convention, v_extent, frame);
+        (self.node(normal).inputs == [self.output(from)?] && !read).then_some(spec)
     }
 
     /// Whether the texture repeats along v (the tile) or not (a body atlas).

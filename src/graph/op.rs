@@ -247,7 +247,7 @@ impl Op {
             Op::Sobel { edge_sigma } => filters::sobel(input(), *edge_sigma, frame.wraps_v),
             Op::Colorize { low, high } => filters::colorize(input(), *low, *high),
             Op::HeightToNormal { slope, convention, v_extent } => {
-                filters::height_to_normal(input(), *slope, *convention, *v_extent, frame.full_height, frame.wraps_v)
+                filters::height_to_normal(input(), filters::NormalSpec::in_frame(*slope, *convention, *v_extent, frame))
             }
             Op::Along(profile) => profile.render(frame),
             Op::HeadMark(mark) => crate::ops::body::head_mark(frame, mark),

@@ -670,41 +670,53 @@ pub fn sobel(input: &Image, edge_sigma: f32, wraps_v: bool) -> Image {
 
 pub use crate::material::NormalConvention;
 
+/// How `height_to_normal` turns heights into normals.
+#[derive(Debug, Clone, Copy)]
+pub struct NormalSpec {
+    /// The surface rise, in texture widths, of the full height range (so the result does
+    /// not change with resolution).
+    pub slope_per_unit_height: f32,
+    pub convention: NormalConvention,
+    /// The texture's height in texture widths (1 for the square tile, the body's length for
+    /// the body layout); with `full_height`, its rows (a strip's texture's), both axes are
+    /// differentiated in the same unit.
+    pub v_extent: f32,
+    pub full_height: usize,
+    /// Whether rows wrap round at the top and bottom (the tile) or repeat their edge.
+    pub wraps_v: bool,
+}
+
+impl NormalSpec {
+    /// The normals of `Op::HeightToNormal { slope, convention, v_extent }` over `frame`.
+    pub fn in_frame(slope_per_unit_height: f32, convention: NormalConvention, v_extent: f32, frame: Frame) -> Self {
+        NormalSpec {
+            slope_per_unit_height,
+            convention,
+            v_extent,
+            full_height: frame.full_height,
+            wraps_v: frame.wraps_v,
+        }
+    }
+}
+
 /// Tangent-space normal (unit XYZ in [-1, 1]) from a height map by central differences.
-/// `slope_per_unit_height` is the surface rise, in texture widths, of the full height range
-/// (so the result does not change with resolution).
-/// `v_extent` is the texture's height in texture widths (1 for the square tile, the body's
-/// length for the body layout) and `full_height` its rows (a strip's texture's), so that both
-/// axes are differentiated in the same unit.
-pub fn height_to_normal(
-    height: &Image,
-    slope_per_unit_height: f32,
-    convention: NormalConvention,
-    v_extent: f32,
-    full_height: usize,
-    wraps_v: bool,
-) -> Image {
-    let kernel = NormalKernel::new(height, slope_per_unit_height, convention, v_extent, full_height);
-    neighbourhood(height, 3, wraps_v, |c, l, r, up, here, down, out| kernel.at(here[r] - here[l], down[c] - up[c], out))
+pub fn height_to_normal(height: &Image, spec: NormalSpec) -> Image {
+    let rows = height_to_normal_rows(height, spec);
+    let mut out = Image::new(height.width, height.height, 3);
+    out.data.par_chunks_mut(height.width * 3).enumerate().for_each(|(y, row)| rows(y, row));
+    out
 }
 
 /// `height_to_normal` a row at a time: a function writing row y of the normal map (three
-/// samples per pixel) into its buffer, the same values bit for bit, so a caller that only
-/// quantises the normals (`export::quantize_rows`) needs no image of them (at 4096², 192 MiB
-/// of f32 written, read back and freed).
-pub fn height_to_normal_rows(
-    height: &Image,
-    slope_per_unit_height: f32,
-    convention: NormalConvention,
-    v_extent: f32,
-    full_height: usize,
-    wraps_v: bool,
-) -> impl Fn(usize, &mut [f32]) + Sync + '_ {
-    let kernel = NormalKernel::new(height, slope_per_unit_height, convention, v_extent, full_height);
+/// samples per pixel) into its buffer, so a caller that only quantises the normals
+/// (`export::quantize_rows`) needs no image of them (at 4096², 192 MiB of f32 written, read
+/// back and freed). `height_to_normal` is these rows.
+pub fn height_to_normal_rows(height: &Image, spec: NormalSpec) -> impl Fn(usize, &mut [f32]) + Sync + '_ {
+    let kernel = NormalKernel::new(height, spec);
     let at = move |c, l, r, up: &[f32], here: &[f32], down: &[f32], out: &mut [f32]| {
         kernel.at(here[r] - here[l], down[c] - up[c], out)
     };
-    move |y, row| neighbourhood_row(height, y, wraps_v, 3, &at, row)
+    move |y, row| neighbourhood_row(height, y, spec.wraps_v, 3, &at, row)
 }
 
 /// The per-pixel normal of `height_to_normal`: central differences of the height, scaled
@@ -718,18 +730,12 @@ struct NormalKernel {
 }
 
 impl NormalKernel {
-    fn new(
-        height: &Image,
-        slope_per_unit_height: f32,
-        convention: NormalConvention,
-        v_extent: f32,
-        full_height: usize,
-    ) -> Self {
+    fn new(height: &Image, spec: NormalSpec) -> Self {
         NormalKernel {
             per_width_u: height.width as f32,
-            per_width_v: full_height as f32 / v_extent,
-            slope_per_unit_height,
-            convention,
+            per_width_v: spec.full_height as f32 / spec.v_extent,
+            slope_per_unit_height: spec.slope_per_unit_height,
+            convention: spec.convention,
         }
     }
 
@@ -916,13 +922,18 @@ mod tests {
         assert!((peak - 1.0).abs() < 0.1, "peak {peak}");
     }
 
+    /// A tile's normals: the slope and convention given, one texture tall, wrapping.
+    fn spec(slope_per_unit_height: f32, convention: NormalConvention, full_height: usize) -> NormalSpec {
+        NormalSpec { slope_per_unit_height, convention, v_extent: 1.0, full_height, wraps_v: true }
+    }
+
     #[test]
     fn normals_are_unit_and_flat_height_points_up() {
         let flat = Image::new(16, 16, 1);
-        let n = height_to_normal(&flat, 1.0, NormalConvention::OpenGl, 1.0, flat.height, true);
+        let n = height_to_normal(&flat, spec(1.0, NormalConvention::OpenGl, flat.height));
         assert!(n.data.chunks(3).all(|p| p == [0.0, 0.0, 1.0]));
         let ramp = Image::gray_from_fn(32, 32, |u, v| (u * std::f32::consts::TAU).sin() * 0.1 + v * 0.0);
-        let n = height_to_normal(&ramp, 1.0, NormalConvention::OpenGl, 1.0, ramp.height, true);
+        let n = height_to_normal(&ramp, spec(1.0, NormalConvention::OpenGl, ramp.height));
         for p in n.data.chunks(3) {
             assert!(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs() < 1e-5);
         }
@@ -932,8 +943,8 @@ mod tests {
     fn opengl_green_points_up_the_image_on_a_slope_rising_down() {
         // Height grows with image y (downwards): the surface faces up the image, +Y in OpenGL.
         let ramp = Image::gray_from_fn(16, 16, |_, v| (v * std::f32::consts::TAU).sin());
-        let gl = height_to_normal(&ramp, 0.1, NormalConvention::OpenGl, 1.0, ramp.height, true);
-        let dx = height_to_normal(&ramp, 0.1, NormalConvention::DirectX, 1.0, ramp.height, true);
+        let gl = height_to_normal(&ramp, spec(0.1, NormalConvention::OpenGl, ramp.height));
+        let dx = height_to_normal(&ramp, spec(0.1, NormalConvention::DirectX, ramp.height));
         let i = (16 + 3) * 3; // pixel (3, 1): near v = 0 the slope is positive
         assert!(gl.data[i + 1] > 0.0 && dx.data[i + 1] < 0.0);
     }
