@@ -165,7 +165,12 @@ fn sample_encoding(map: MapKind) -> impl Fn(f32) -> f32 + Sync {
 /// stores them in): the one quantisation of every map file.
 fn quantize_row(map: MapKind, values: &[f32], out: &mut [u8]) {
     let encode = sample_encoding(map);
-    if map.format().bit_depth == 8 {
+    if map.format().bit_depth == 8 && map.format().encoding == Encoding::Srgb {
+        // The sRGB code itself: `sample_encoding` scales it to [0, 1] and `unit_to_u8` gives
+        // the same code back for every code (`tests`), so the round trip (a division and a
+        // multiplication a sample, and the table found a sample at a time) is skipped.
+        srgb::linear_to_srgb8_row(values, out);
+    } else if map.format().bit_depth == 8 {
         for (o, &x) in out.iter_mut().zip(values) {
             *o = unit_to_u8(encode(x));
         }
@@ -300,4 +305,48 @@ impl RowEncoder {
 /// Encodes quantised maps in parallel; returns (file name, bytes) in the given order.
 pub fn encode_all(preset_name: &str, maps: &[Quantized]) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
     maps.par_iter().map(|q| Ok((map_file_name(preset_name, q.map), encode_quantized(q)?))).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `quantize_row`'s sRGB shortcut writes the code where the general path scales it to
+    /// [0, 1] and rounds it back: the same byte for every code. Negative control: a scale of
+    /// 1/256 does not give the codes back.
+    #[test]
+    fn every_srgb_code_comes_back_from_unit() {
+        for k in 0..=255u8 {
+            assert_eq!(unit_to_u8(k as f32 / 255.0), k);
+        }
+        assert!((0..=255u8).any(|k| unit_to_u8(k as f32 / 256.0) != k));
+    }
+
+    /// The colour map's rows against the general per-sample path, over values inside and
+    /// outside [0, 1], the floats next to code boundaries and NaN.
+    #[test]
+    fn srgb_rows_are_the_per_sample_round_trip() {
+        let encode = sample_encoding(MapKind::Color);
+        let mut values: Vec<f32> = (0..=20_000).map(|i| i as f32 / 20_000.0 * 1.2 - 0.1).collect();
+        values.extend([f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -0.0, f32::MIN_POSITIVE, 0.003_130_8]);
+        for k in 1..=255u8 {
+            // The smallest float that encodes to k, and its neighbours.
+            // (Bisection over the bit patterns, which order non-negative floats.)
+            let (mut low, mut high) = (0u32, 1.0f32.to_bits());
+            while low < high {
+                let mid = low + (high - low) / 2;
+                if linear_to_srgb8(f32::from_bits(mid)) >= k { high = mid } else { low = mid + 1 }
+            }
+            let start = f32::from_bits(low);
+            values.extend([
+                f32::from_bits(start.to_bits().saturating_sub(1)),
+                start,
+                f32::from_bits(start.to_bits() + 1),
+            ]);
+        }
+        let mut rows = vec![0u8; values.len()];
+        quantize_row(MapKind::Color, &values, &mut rows);
+        let each: Vec<u8> = values.iter().map(|&x| unit_to_u8(encode(x))).collect();
+        assert_eq!(rows, each);
+    }
 }

@@ -67,11 +67,26 @@ fn table() -> &'static Table {
 /// encodes to 0, as the formula's does.
 #[inline]
 pub fn linear_to_srgb8(linear: f32) -> u8 {
+    encode_linear(table(), linear)
+}
+
+/// `linear_to_srgb8` of every sample of `linear` into `out`, the table found once (the
+/// colour map's quantisation, `export::quantize_row`).
+pub fn linear_to_srgb8_row(linear: &[f32], out: &mut [u8]) {
+    let table = table();
+    for (code, &x) in out.iter_mut().zip(linear) {
+        *code = encode_linear(table, x);
+    }
+}
+
+/// The code of any linear value: clamped to [0, 1], NaN to 0.
+#[inline]
+fn encode_linear(table: &Table, linear: f32) -> u8 {
     let c = linear.clamp(0.0, 1.0);
     if c.is_nan() {
         return 0;
     }
-    encode(table(), c)
+    encode(table, c)
 }
 
 /// The code of `c` (in [0, 1]) from `table`.
