@@ -206,29 +206,32 @@ pub fn evaluate_with(
         }
         let batch = next_batch(graph, &remaining, &computed, threads);
         remaining.retain(|id| !batch.contains(id));
+        // A node that is the last consumer of its first input may reuse that buffer
+        // (`reusable_input`): decided once, for the pool's room and for the hand-over below.
+        let reused: Vec<Option<NodeId>> =
+            batch.iter().map(|&id| reusable_input(graph, id, &consumers, &produces).filter(|_| in_place)).collect();
         if let Some(planned) = planned_peak {
             // Large buffers wait in the pool only in the room the planned peak leaves now.
             let allocated: u64 = batch
                 .iter()
-                .map(|&id| {
+                .zip(&reused)
+                .map(|(&id, reused)| {
                     let inputs: Vec<usize> = graph.node(id).inputs.iter().map(|i| channels_of(&store, *i)).collect();
                     let (bytes, scratch) = node_bytes(graph, id, &inputs, frame.width, frame.height);
                     // A node that overwrites its input allocates no result buffer.
-                    let reuses = in_place && reusable_input(graph, id, &consumers, &produces).is_some();
-                    if reuses { scratch } else { bytes + scratch }
+                    if reused.is_some() { scratch } else { bytes + scratch }
                 })
                 .sum();
             let room = planned.saturating_sub(live_bytes as u64 + allocated);
             crate::ops::pool::set_large_budget(usize::try_from(room).unwrap_or(usize::MAX));
         }
 
-        // A node that is the last consumer of its first input may reuse that buffer: take it
-        // out of the store now (no other node can still need it), so the kernel runs in
-        // place instead of allocating, and page-faulting, a new image.
-        let owned: Vec<Option<Image>> = batch
+        // A reused buffer leaves the store now (no other node can still need it), so the
+        // kernel runs in place instead of allocating, and page-faulting, a new image.
+        let owned: Vec<Option<Image>> = reused
             .iter()
-            .map(|&id| {
-                let first = reusable_input(graph, id, &consumers, &produces).filter(|_| in_place)?;
+            .map(|first| {
+                let first = (*first)?;
                 let image = Arc::try_unwrap(store[first.0].take()?).ok()?;
                 live_bytes -= image.bytes();
                 Some(image)

@@ -628,10 +628,16 @@ fn neighbourhood<F>(input: &Image, channels_out: usize, wraps_v: bool, f: F) -> 
 where
     F: Fn(usize, usize, usize, &[f32], &[f32], &[f32], &mut [f32]) + Sync,
 {
-    let mut out = Image::new(input.width, input.height, channels_out);
-    out.data.par_chunks_mut(input.width * channels_out).enumerate().for_each(|(y, row)| {
-        neighbourhood_row(input, y, wraps_v, channels_out, &f, row);
-    });
+    image_from_rows(input.width, input.height, channels_out, |y, row| {
+        neighbourhood_row(input, y, wraps_v, channels_out, &f, row)
+    })
+}
+
+/// An image whose rows `row` writes (row y into its `width` × `channels` samples), in
+/// parallel.
+fn image_from_rows(width: usize, height: usize, channels: usize, row: impl Fn(usize, &mut [f32]) + Sync) -> Image {
+    let mut out = Image::new(width, height, channels);
+    out.data.par_chunks_mut(width * channels).enumerate().for_each(|(y, samples)| row(y, samples));
     out
 }
 
@@ -701,10 +707,7 @@ impl NormalSpec {
 
 /// Tangent-space normal (unit XYZ in [-1, 1]) from a height map by central differences.
 pub fn height_to_normal(height: &Image, spec: NormalSpec) -> Image {
-    let rows = height_to_normal_rows(height, spec);
-    let mut out = Image::new(height.width, height.height, 3);
-    out.data.par_chunks_mut(height.width * 3).enumerate().for_each(|(y, row)| rows(y, row));
-    out
+    image_from_rows(height.width, height.height, 3, height_to_normal_rows(height, spec))
 }
 
 /// `height_to_normal` a row at a time: a function writing row y of the normal map (three
