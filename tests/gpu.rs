@@ -128,8 +128,11 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
     // thesis 4.3e-4, layered 2.3e-3 (a film of 2362 nm, between coarse columns 562 nm apart,
     // at roughness 0.13, where GGX's peak multiplies the film at the half vector) against
     // 1e-4 + 2 / 512 = 4.0e-3; with 1e-4 alone both failed there.
-    let weight_error = filter_weight_error(&gpu);
+    let weight_error = filter_weight_error(&gpu, wgpu::FilterMode::Linear);
     assert!(weight_error < 1.0 / 128.0, "the linear filter's weights are off by {weight_error}");
+    // Negative control: the probe sees a filter that does not interpolate (weights 0 or 1).
+    let nearest = filter_weight_error(&gpu, wgpu::FilterMode::Nearest);
+    assert!(nearest > 0.49, "the nearest filter read as interpolating: {nearest}");
     let bound = 1e-4 + if weight_error > 1e-6 { 2.0 * weight_error } else { 0.0 };
     eprintln!("linear filter: weights off by up to {weight_error:e}; bound {bound:e}");
     for (model, worst) in worsts {
@@ -137,12 +140,13 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
     }
 }
 
-/// How far the adapter's linear filter is from exact interpolation: the largest error of
-/// the weight it gives a texel, over 4,096 positions between two texels (0 and 1). Exact
+/// How far the adapter's `filter` (the linear one, in use) is from exact interpolation: the
+/// largest error of the weight it gives a texel, over 4,096 positions between two texels (0
+/// and 1). Exact
 /// filtering (lavapipe interpolates in f32) gives ~1e-7; hardware that computes its weights
 /// in fixed point with 8 fractional bits gives up to 1/512 (rounding) or 1/256.
-fn filter_weight_error(gpu: &snakeskin::render::Gpu) -> f32 {
-    use snakeskin::render::engine::gpu::{map_read, sampler_entry, storage_entry, texture_entry};
+fn filter_weight_error(gpu: &snakeskin::render::Gpu, filter: wgpu::FilterMode) -> f32 {
+    use snakeskin::render::engine::gpu::{StorageOutput, sampler_entry, storage_entry, texture_entry};
     use wgpu::util::DeviceExt;
     const SOURCE: &str = "
 @group(0) @binding(0) var ramp: texture_2d<f32>;
@@ -203,23 +207,11 @@ fn probe(@builtin(global_invocation_id) id: vec3<u32>) {
         bytemuck::cast_slice(&texels),
     );
     let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
+        mag_filter: filter,
+        min_filter: filter,
         ..Default::default()
     });
-    let size = (N * 4) as u64;
-    let weights = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("filter probe"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("filter probe readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let weights = StorageOutput::new(device, "filter probe", (N * 4) as u64);
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("filter probe"),
         layout: &layout,
@@ -229,7 +221,7 @@ fn probe(@builtin(global_invocation_id) id: vec3<u32>) {
                 resource: wgpu::BindingResource::TextureView(&texture.create_view(&Default::default())),
             },
             wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
-            wgpu::BindGroupEntry { binding: 2, resource: weights.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: weights.buffer.as_entire_binding() },
         ],
     });
     let mut encoder = device.create_command_encoder(&Default::default());
@@ -239,9 +231,9 @@ fn probe(@builtin(global_invocation_id) id: vec3<u32>) {
         pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups(N.div_ceil(64) as u32, 1, 1);
     }
-    encoder.copy_buffer_to_buffer(&weights, 0, &readback, 0, size);
+    weights.copy_out(&mut encoder);
     gpu.queue.submit([encoder.finish()]);
-    let data = map_read(device, &readback).expect("filter probe readback");
+    let data = weights.read(device).expect("filter probe readback");
     let values: &[f32] = bytemuck::cast_slice(&data);
     values.iter().enumerate().map(|(i, w)| (w - i as f32 / (N - 1) as f32).abs()).fold(0.0, f32::max)
 }

@@ -92,6 +92,37 @@ fn check_texture_limits(limits: &wgpu::Limits) -> Result<(), GpuError> {
     Ok(())
 }
 
+/// A compute shader's storage output and the mappable buffer the CPU reads it from: bind
+/// `buffer`, record `copy_out` after the pass, submit, then `read`.
+pub struct StorageOutput {
+    pub buffer: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    size: u64,
+}
+
+impl StorageOutput {
+    pub fn new(device: &wgpu::Device, label: &str, size: u64) -> StorageOutput {
+        let buffer = |usage| {
+            device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+        };
+        StorageOutput {
+            buffer: buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC),
+            readback: buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
+            size,
+        }
+    }
+
+    /// Records the copy of the output into the mappable buffer.
+    pub fn copy_out(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_buffer_to_buffer(&self.buffer, 0, &self.readback, 0, self.size);
+    }
+
+    /// The output's bytes, once the submission that holds `copy_out` is done (waits for it).
+    pub fn read(&self, device: &wgpu::Device) -> Result<Vec<u8>, GpuError> {
+        map_read(device, &self.readback)
+    }
+}
+
 /// Maps a buffer for reading, waits for the GPU, and returns a copy of its bytes.
 pub fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
     let slice = buffer.slice(..);

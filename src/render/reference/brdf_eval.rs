@@ -9,7 +9,7 @@ use crate::optics::brdf::{Layers, Layers32, Model};
 use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
 use crate::render::engine::film::{self, FilmBinding, GpuFilmMethod};
-use crate::render::engine::gpu::{map_read, storage_entry};
+use crate::render::engine::gpu::{StorageOutput, storage_entry};
 use crate::render::engine::shaders::shader_programs;
 use crate::render::{Gpu, GpuError};
 
@@ -100,25 +100,13 @@ pub fn eval_timed(
         contents: bytemuck::cast_slice(samples),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let size = (samples.len() * 16) as u64;
-    let result_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("results"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let results = StorageOutput::new(device, "results", (samples.len() * 16) as u64);
     let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("samples"),
         layout: &io_layout,
         entries: &[
             wgpu::BindGroupEntry { binding: 0, resource: sample_buffer.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: result_buffer.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: results.buffer.as_entire_binding() },
         ],
     });
 
@@ -133,11 +121,11 @@ pub fn eval_timed(
             pass.dispatch_workgroups((samples.len() as u32).div_ceil(64), 1, 1);
         }
     }
-    encoder.copy_buffer_to_buffer(&result_buffer, 0, &readback, 0, size);
+    results.copy_out(&mut encoder);
     let start = std::time::Instant::now();
     gpu.queue.submit([encoder.finish()]);
 
-    let data = map_read(device, &readback)?;
+    let data = results.read(device)?;
     let elapsed = start.elapsed();
     let values: &[[f32; 4]] = bytemuck::cast_slice(&data);
     Ok((values.iter().map(|v| [v[0], v[1], v[2]]).collect(), elapsed))
