@@ -93,6 +93,24 @@ fn grid() -> Vec<Point> {
 }
 
 /// Runs the comparison with `photons` per channel per walk, over `colours` (linear sRGB).
+/// The most ΔE00 the reference's own noise makes at a point: its colour `r` against `r`
+/// moved by one standard deviation `sigma` per channel, in whichever of the eight
+/// directions (±σ per channel) moves it most. Moving every channel up at once (the
+/// estimate before) changes mostly lightness, where ΔE00 is lenient; the channels' noise is
+/// independent, and against each other they shift hue and chroma, which for dark colours
+/// counts several times more: at 100,000 photons the mean went from 0.11 to 0.46 and the
+/// largest from 0.23 to 1.06, and the model's largest error at roughness 0.05 fell from 1.52
+/// to 0.23 at 1,600,000 photons (BENCHMARKS.md).
+fn noise_de(r: [f64; 3], sigma: [f64; 3]) -> f64 {
+    let lab_r = linear_srgb_to_lab(r);
+    (0..8)
+        .map(|signs: usize| {
+            let shifted = [0, 1, 2].map(|c| (r[c] + if signs >> c & 1 == 1 { sigma[c] } else { -sigma[c] }).max(0.0));
+            ciede2000(linear_srgb_to_lab(shifted), lab_r)
+        })
+        .fold(0.0, f64::max)
+}
+
 pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
     let points = grid();
     // Film tables per (material, thickness): the walk's and the models' film.
@@ -155,8 +173,7 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
                 de_at.push(((p.roughness, p.angle_deg), e));
                 de_by_tau.push((p.tau, e));
                 if m == 0 {
-                    let shifted = [0, 1, 2].map(|c| r[c] + sigma[c]);
-                    noise.push(ciede2000(linear_srgb_to_lab(shifted), lab_r));
+                    noise.push(noise_de(*r, *sigma));
                 }
             }
             if let Some(a) = furnace.get(m) {
@@ -254,4 +271,24 @@ pub fn median_ns_per_eval(model: Model, inputs: &[(Layers32, [f32; 3], [f32; 3])
         .collect();
     times.sort_by(f64::total_cmp);
     times[2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The noise estimate takes the worst of the eight ±σ directions: never less than moving
+    /// every channel up, and for a dark colour several times more (the channels moving
+    /// against each other shift hue). Negative control: the all-up shift alone.
+    #[test]
+    fn the_noise_estimate_takes_the_channels_moving_apart() {
+        let (r, sigma) = ([0.004, 0.006, 0.005], [0.0005; 3]);
+        let all_up = ciede2000(linear_srgb_to_lab(r.map(|v| v + 0.0005)), linear_srgb_to_lab(r));
+        let worst = noise_de(r, sigma);
+        eprintln!("noise ΔE00: worst direction {worst:.3}, all channels up {all_up:.3}");
+        assert!(worst >= all_up);
+        assert!(worst > 2.0 * all_up, "worst {worst}, all channels up {all_up}");
+        // No noise, no difference.
+        assert_eq!(noise_de(r, [0.0; 3]), 0.0);
+    }
 }
