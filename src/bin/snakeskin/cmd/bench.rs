@@ -77,6 +77,13 @@ fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<(
         report.reference_noise_mean_de,
         report.reference_noise_max_de
     );
+    if report.reference_noise_max_de > 0.5 {
+        println!(
+            "  (the reference's own noise moves a colour by up to {:.2} ΔE00: errors of that size may be \
+             its noise; more --photons lower it as 1/√N)",
+            report.reference_noise_max_de
+        );
+    }
     println!(
         "{:<10} {:>8} {:>8} {:>8} {:>12} {:>12} {:>10} {:>14}",
         "model", "mean ΔE", "p95 ΔE", "max ΔE", "furnace≤70°", "furnace all", "ns/eval", "ns/eval coh."
