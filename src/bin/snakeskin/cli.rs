@@ -653,8 +653,9 @@ pub enum BenchCommand {
         #[arg(long)]
         json: bool,
         /// Photons per channel per reference walk, 1000 to 10,000,000 (noise ∝ 1/√N; the
-        /// report says what it makes in ΔE: up to about 1 ΔE00 at 100,000, 0.25 at
-        /// 1,600,000, which BENCHMARKS.md uses and which takes about 7 minutes on two cores).
+        /// report says what it makes in ΔE: up to about 1.7 ΔE00 at the default, 1 at
+        /// 100,000, 0.25 at 1,600,000, which BENCHMARKS.md uses and which takes about 7
+        /// minutes on two cores).
         #[arg(long, default_value_t = 40_000, value_parser = clap::value_parser!(u64).range(1000..=10_000_000))]
         photons: u64,
         /// Write an SVG plot of error (mean, p95, max ΔE00) against CPU cost, one point per

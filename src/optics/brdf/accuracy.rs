@@ -56,7 +56,8 @@ pub struct LayeredBench {
     pub models: Vec<ModelReport>,
     pub points: usize,
     pub photons_per_channel: u64,
-    /// Mean and largest ΔE00 that the reference's own noise (1σ) makes at the points.
+    /// Mean and largest ΔE00 that the reference's own noise makes at the points (`noise_de`:
+    /// the worst corner of each point's ±1σ box).
     pub reference_noise_mean_de: f64,
     pub reference_noise_max_de: f64,
     /// Furnace error of each model per (roughness, angle): rows of
@@ -93,25 +94,25 @@ fn grid() -> Vec<Point> {
     points
 }
 
-/// Runs the comparison with `photons` per channel per walk, over `colours` (linear sRGB).
 /// The most ΔE00 the reference's own noise makes at a point: its colour `r` against `r`
 /// moved by one standard deviation `sigma` per channel, in whichever of the eight
-/// directions (±σ per channel) moves it most. Moving every channel up at once (the
-/// estimate before) changes mostly lightness, where ΔE00 is lenient; the channels' noise is
-/// independent, and against each other they shift hue and chroma, which for dark colours
-/// counts several times more: at 100,000 photons the mean went from 0.11 to 0.46 and the
-/// largest from 0.23 to 1.06, and the model's largest error at roughness 0.05 fell from 1.52
-/// to 0.23 at 1,600,000 photons (BENCHMARKS.md).
+/// directions (±σ per channel, a corner of the 1σ box) moves it most. Moving every channel
+/// up at once (the estimate before) changes mostly lightness, where ΔE00 is lenient; the
+/// channels' noise is independent (`walk`'s per-channel random streams), and against each
+/// other they shift hue and chroma, which for dark colours counts several times more
+/// (BENCHMARKS.md: at 100,000 photons the largest went from 0.23 to 1.06). A bound, not an
+/// expectation: the root mean square over the corners would be the 1σ figure.
 fn noise_de(r: [f64; 3], sigma: [f64; 3]) -> f64 {
     let lab_r = linear_srgb_to_lab(r);
     (0..8)
         .map(|signs: usize| {
-            let shifted = [0, 1, 2].map(|c| (r[c] + if signs >> c & 1 == 1 { sigma[c] } else { -sigma[c] }).max(0.0));
+            let shifted = [0, 1, 2].map(|c| (r[c] + if (signs >> c) & 1 == 1 { sigma[c] } else { -sigma[c] }).max(0.0));
             ciede2000(linear_srgb_to_lab(shifted), lab_r)
         })
         .fold(0.0, f64::max)
 }
 
+/// Runs the comparison with `photons` per channel per walk, over `colours` (linear sRGB).
 pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
     let points = grid();
     // Film tables per (material, thickness): the walk's and the models' film.
@@ -287,7 +288,7 @@ mod tests {
         let all_up = ciede2000(linear_srgb_to_lab(r.map(|v| v + 0.0005)), linear_srgb_to_lab(r));
         let worst = noise_de(r, sigma);
         eprintln!("noise ΔE00: worst direction {worst:.3}, all channels up {all_up:.3}");
-        assert!(worst >= all_up);
+        assert!(worst.is_finite() && worst >= all_up);
         assert!(worst > 2.0 * all_up, "worst {worst}, all channels up {all_up}");
         // No noise, no difference.
         assert_eq!(noise_de(r, [0.0; 3]), 0.0);

@@ -102,12 +102,12 @@ pub struct StorageOutput {
 
 impl StorageOutput {
     pub fn new(device: &wgpu::Device, label: &str, size: u64) -> StorageOutput {
-        let buffer = |usage| {
+        let buffer = |label: &str, usage| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
         StorageOutput {
-            buffer: buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC),
-            readback: buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
+            buffer: buffer(label, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC),
+            readback: buffer(&format!("{label} readback"), wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
             size,
         }
     }

@@ -77,6 +77,8 @@ fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<(
         report.reference_noise_mean_de,
         report.reference_noise_max_de
     );
+    // Half a ΔE00: the colour differences the issue's targets are set in (mean 0.5, max 1.5)
+    // are then not the reference's noise.
     if report.reference_noise_max_de > 0.5 {
         println!(
             "  (the reference's own noise moves a colour by up to {:.2} ΔE00: errors of that size may be \
