@@ -581,9 +581,8 @@ pub const NORMAL_FROM_HEIGHT: &str = "rows → file";
 /// samples a pixel (192 MiB at 4096²), was written, read once by `quantize` and freed.
 /// Strips and body atlases evaluate the node.
 fn whole_tile_maps(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> (Vec<MapKind>, Option<NormalSpec>) {
-    let frame = Frame { wraps_v: graph.wraps_v(), ..Frame::whole(width, height) };
     let direct = graph
-        .normal_from(MapKind::Height, frame)
+        .normal_from(MapKind::Height, graph.frame(Frame::whole(width, height)))
         .filter(|_| maps.contains(&MapKind::Normal) && maps.contains(&MapKind::Height));
     (maps.iter().copied().filter(|m| direct.is_none() || *m != MapKind::Normal).collect(), direct)
 }

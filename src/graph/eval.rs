@@ -141,7 +141,7 @@ pub fn evaluate_with(
     mut policy: CachePolicy,
 ) -> (EvalStats, CacheStats) {
     let start = Instant::now();
-    let frame = Frame { wraps_v: graph.wraps_v(), ..frame };
+    let frame = graph.frame(frame);
     let reachable = graph.reachable(maps);
     let keys: Vec<u64> = match policy {
         CachePolicy::None => Vec::new(),

@@ -84,6 +84,12 @@ impl Graph {
         !self.open_v
     }
 
+    /// `frame` as this graph's nodes see it: wrapping along v where the texture repeats
+    /// (`wraps_v`), the one place the evaluator and `generate`'s direct normal map get it.
+    pub fn frame(&self, frame: crate::ops::Frame) -> crate::ops::Frame {
+        crate::ops::Frame { wraps_v: self.wraps_v(), ..frame }
+    }
+
     /// The rows above and below a pixel that the maps' values there depend on at `width`:
     /// the longest chain of neighbourhood reads (`Op::row_reach`) through the graph. A strip
     /// of a long texture evaluated with this margin each side keeps its inner rows exact.

@@ -173,9 +173,10 @@ fn through_walk(n0: f64, n2: f64, k: usize) -> ThroughWalk {
 /// the photons that entered the surface, the fraction that came straight back (at most 1;
 /// the film's way in, 1 − ⟨F⟩, scales it in the rule). Over the bare interface's way in as
 /// the lobe reads it, 1 − ⟨F_bare⟩, the fraction measured 2.39 for `bench layered`'s max
-/// against 2.72 with the share (both at 100,000 photons), but beyond the critical angle of n0 > n2, where the bare
-/// interface lets almost nothing in, it multiplied a few walked photons without bound (the
-/// stress test's grazing views: the f32 table 15 % off the f64 rule, capped at 1 or not).
+/// against 2.72 with the share (both at 100,000 photons), but beyond the critical angle of
+/// n0 > n2, where the bare interface lets almost nothing in, it multiplied a few walked
+/// photons without bound (the stress test's grazing views: the f32 table 15 % off the f64
+/// rule, capped at 1 or not).
 /// A row with fewer than `THROUGH_MIN` such photons in all has none (W = 0).
 fn through_rule(n0: f64, n2: f64, walks: &[ThroughWalk]) -> Vec<[f64; 4]> {
     let bare = super::walk::bare_interface(n0, n2);

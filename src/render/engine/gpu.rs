@@ -97,7 +97,6 @@ fn check_texture_limits(limits: &wgpu::Limits) -> Result<(), GpuError> {
 pub struct StorageOutput {
     pub buffer: wgpu::Buffer,
     readback: wgpu::Buffer,
-    size: u64,
 }
 
 impl StorageOutput {
@@ -108,13 +107,12 @@ impl StorageOutput {
         StorageOutput {
             buffer: buffer(label, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC),
             readback: buffer(&format!("{label} readback"), wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
-            size,
         }
     }
 
     /// Records the copy of the output into the mappable buffer.
     pub fn copy_out(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.copy_buffer_to_buffer(&self.buffer, 0, &self.readback, 0, self.size);
+        encoder.copy_buffer_to_buffer(&self.buffer, 0, &self.readback, 0, self.buffer.size());
     }
 
     /// The output's bytes, once the submission that holds `copy_out` is done (waits for it).
