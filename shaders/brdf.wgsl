@@ -98,11 +98,13 @@ struct Top {
 }
 
 // The rough lobe's table (the film bind group's lobe_table, optics::brdf::energy::node):
-// per (mu, r) node LOBE_VEC4S vec4s, (E1, c1, c2, c3), (w1, w2, 0, path delta) and
-// (W, c_a, c_b, w_a): its albedo for F = 1, the three-point Gauss rule over its
-// microfacet cosines (the third weight is 1 minus the other two), the pigment layer's path
-// (path_delta_at) and the rule for light that comes straight back through the top
-// (optics::brdf::path::PathTable::through).
+// per (mu, r) node LOBE_VEC4S vec4s, (E1, c1, c2, c3), (c4, c5, w1, path delta),
+// (W, t1, t2, t3), (w2, w3, w4, v1), (b1, b2, b3, v2) and (u1, u2, 0, 0): its albedo for
+// F = 1, the five-point Gauss rule over its microfacet cosines (the last weight of each
+// rule is 1 minus the others), the three-point rule for the second reflection of light it
+// scatters more than once (b, v), the pigment layer's path (path_delta_at) and the rule
+// for light that comes straight back through the top (W and the three-point rule t, u:
+// optics::brdf::path::PathTable::through).
 
 // The lobe table's cell at (mu, r): the indices of its lower corners (LOBE_VEC4S vec4s per
 // entry) and the bilinear weights.
@@ -127,8 +129,9 @@ fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
 }
 
 // cos_eff(mu, r) - cos_t(mu): how much more obliquely than Snell's law the light the rough
-// top lets in crosses the pigment layer, bilinear in the lobe table's fourth slot (this
-// material's optics::brdf::path table; PathTable::cos_eff), in the lobe table's cell c.
+// top lets in crosses the pigment layer, bilinear in the last slot of the lobe table's
+// second vec4 (this material's optics::brdf::path table; PathTable::cos_eff), in the lobe
+// table's cell c.
 fn path_delta_in(c: LobeCell) -> f32 {
     let lower = mix(lobe_table[c.k00 + 1u].w, lobe_table[c.k00 + LOBE_VEC4S + 1u].w, c.fx);
     let upper = mix(lobe_table[c.k01 + 1u].w, lobe_table[c.k01 + LOBE_VEC4S + 1u].w, c.fx);
@@ -218,9 +221,10 @@ fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, roughness: f32, k: v
 
 // The rule's two parts on one roughness row (energy::parts_on_row): the lobe's entries k
 // and k + LOBE_VEC4S mixed by fx; the single scattering E1 <F> (the film over the lobe's
-// microfacet angles, three-point Gauss rule) and what the top reflects beyond it, x: the
-// multiple scattering (1 - E1) <F> F(c1) plus the light that comes straight back through
-// the top, q = (1 - <F>) W (w_a F(c_a) + (1 - w_a) F(c_b)).
+// microfacet angles, five-point Gauss rule) and what the top reflects beyond it, x: the
+// multiple scattering (1 - E1) <F> <F>2 (<F>2 the film over the second reflection's
+// cosines, its three-point rule) plus the light that comes straight back through the top,
+// q = (1 - <F>) W (u1 F(t1) + u2 F(t2) + (1 - u1 - u2) F(t3)).
 struct RowParts {
     single: vec3<f32>,
     beyond: vec3<f32>,
@@ -230,15 +234,20 @@ fn parts_on_row(layers: Layers, k: u32, fx: f32) -> RowParts {
     let a = mix(lobe_table[k], lobe_table[k + LOBE_VEC4S], fx);
     let b = mix(lobe_table[k + 1u], lobe_table[k + LOBE_VEC4S + 1u], fx);
     let t = mix(lobe_table[k + 2u], lobe_table[k + LOBE_VEC4S + 2u], fx);
-    let f1 = film_clamped(layers, a.y);
-    let f2 = film_clamped(layers, a.z);
-    let f3 = film_clamped(layers, a.w);
-    let mean = b.x * f1 + b.y * f2 + (1.0 - b.x - b.y) * f3;
-    let q = (1.0 - mean) * t.x * (t.w * film_clamped(layers, t.y) + (1.0 - t.w) * film_clamped(layers, t.z));
+    let w = mix(lobe_table[k + 3u], lobe_table[k + LOBE_VEC4S + 3u], fx);
+    let s = mix(lobe_table[k + 4u], lobe_table[k + LOBE_VEC4S + 4u], fx);
+    let u = mix(lobe_table[k + 5u], lobe_table[k + LOBE_VEC4S + 5u], fx);
+    let mean = b.z * film_clamped(layers, a.y) + w.x * film_clamped(layers, a.z) + w.y * film_clamped(layers, a.w)
+        + w.z * film_clamped(layers, b.x) + (1.0 - b.z - w.x - w.y - w.z) * film_clamped(layers, b.y);
+    let second = w.w * film_clamped(layers, s.x) + s.w * film_clamped(layers, s.y)
+        + (1.0 - w.w - s.w) * film_clamped(layers, s.z);
+    let back = u.x * film_clamped(layers, t.y) + u.y * film_clamped(layers, t.z)
+        + (1.0 - u.x - u.y) * film_clamped(layers, t.w);
+    let q = (1.0 - mean) * t.x * back;
     // x never more than the light the single scattering leaves (q's reweighting is an
     // estimate).
     let single = a.x * mean;
-    return RowParts(single, min((1.0 - a.x) * mean * f1 + q, vec3<f32>(1.0) - single));
+    return RowParts(single, min((1.0 - a.x) * mean * second + q, vec3<f32>(1.0) - single));
 }
 
 // One node of the multiple-scatter normalisation on row j: node = (mu, 2 w mu).

@@ -29,14 +29,15 @@ struct FilmInfo {
 // spectral-N: per band (centre nm, then linear-sRGB weights).
 @group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
 // The rough lobe's table (optics::brdf::energy::node, read by brdf.wgsl's top_on_row): per
-// (mu, r) entry, row-major by roughness, LOBE_VEC4S vec4s: (E1, c1, c2, c3), (w1, w2, 0,
-// cos_eff - cos_t) and (W, c_a, c_b, w_a), the last five from this material's
-// optics::brdf::path table (brdf.wgsl's path_delta_at; the rule for light straight back
-// through the top).
+// (mu, r) entry, row-major by roughness, LOBE_VEC4S vec4s: (E1, c1, c2, c3), (c4, c5, w1,
+// cos_eff - cos_t), (W, t1, t2, t3), (w2, w3, w4, v1), (b1, b2, b3, v2) and (u1, u2, 0, 0):
+// the lobe's albedo and five-point rule, the second reflection's three-point rule (b, v),
+// and from this material's optics::brdf::path table the path delta (brdf.wgsl's
+// path_delta_at) and the rule for light straight back through the top (W; t, u).
 @group(0) @binding(4) var<storage, read> lobe_table: array<vec4<f32>>;
 // The layered model's coupling baked with the table (optics::lut::Lut::coupling): x = cos
-// texel, the reflected share and the path delta (as lobe_table's fourth slot) in the first
-// n_cos texels and the multiple-scatter amplitude in the next n_cos; y = the rough lobe's
+// texel, the reflected share and the path delta (as in lobe_table's second vec4) in the
+// first n_cos texels and the multiple-scatter amplitude in the next n_cos; y = the rough lobe's
 // roughness row (E1_ROUGHNESS); z = thickness texel, as the table's columns. Half floats,
 // read with the same sampler (brdf.wgsl's coupling_table).
 @group(0) @binding(5) var coupling_texture: texture_3d<f32>;

@@ -29,15 +29,16 @@
 //! the bare interface n0 | n2 does, reweighted by the film:
 //!
 //! ```text
-//! q(μ, r) = (1 − ⟨F⟩) W (w_a F(c_a) + (1 − w_a) F(c_b))
+//! q(μ, r) = (1 − ⟨F⟩) W (u₁ F(t₁) + u₂ F(t₂) + (1 − u₁ − u₂) F(t₃))
 //! ```
 //!
 //! with ⟨F⟩ the film averaged over the rough lobe's microfacet angles (the light's way in,
 //! `energy::parts_on_row` has it), W the share of the light that entered the bare surface
-//! which came straight back (times the mean of 1 / F_bare below), and a two-point Gauss
-//! rule (nodes c_a, c_b, weight w_a) for the microfacet cosines of the last reflection from
+//! which came straight back (times the mean of 1 / F_bare below), and a three-point Gauss
+//! rule (nodes t, weights u) for the microfacet cosines of the last reflection from
 //! above, weighted by 1 / F_bare (so that a film reweights each photon's reflection by
-//! F / F_bare). The form was chosen against walks of the stack with its film, 96 cases
+//! F / F_bare; two points until the lobe's rule grew to five: `through_rule`). The form
+//! was chosen against walks of the stack with its film, 96 cases
 //! (two film indices, n2 1.33 and 1.55, films of 150, 250 and 650 nm, 60–85°, roughness
 //! 0.6–0.9, two channels; each case's own walk giving W and the rule): off by 0.0005 on
 //! average and 0.0065 at most, where q itself averages 0.0075 and reaches 0.046; the film
@@ -61,6 +62,13 @@ const THROUGH_PHOTONS: u64 = 16_384;
 /// Fewer walked photons than this come straight back on a whole roughness row: the row's
 /// rule is 0.
 const THROUGH_MIN: usize = 16;
+/// Nodes of the rule for the last reflection's cosine of light straight back.
+pub const THROUGH_NODES: usize = 3;
+/// Fewest photons straight back from which an entry has its own rule (`through_rule`).
+const THROUGH_ENTRY_MIN: usize = 64;
+/// Slots of an entry of that rule (`PathTable::through`): [W, c₁, c₂, c₃, w₁, w₂] (the third
+/// weight is 1 minus the others).
+pub const THROUGH_LEN: usize = 2 * THROUGH_NODES;
 /// The most grazing light walked (μ = 0 itself never meets the top).
 const MU_MIN: f64 = 1e-3;
 
@@ -73,14 +81,14 @@ pub struct PathTable {
     pub n0: f64,
     pub n2: f64,
     pub delta: Vec<f64>,
-    /// `delta` in f32, as the shader holds it (the lobe table's fourth slot, and the film
-    /// table's coupling texture: `lut::Lut::coupling`).
+    /// `delta` in f32, as the shader holds it (the last slot of the lobe table's second
+    /// vec4, and the film table's coupling texture: `lut::Lut::coupling`).
     pub delta_f32: Vec<f32>,
     /// Per entry (the same grid), the rule for light that comes straight back through the
-    /// top (the module's q): [W, c_a, c_b, w_a]. W = 0 on row r = 0.
-    pub through: Vec<[f64; 4]>,
-    /// `through` in f32, as the shader holds it (the lobe table's third vec4).
-    pub through_f32: Vec<[f32; 4]>,
+    /// top (the module's q): [W, t₁, t₂, t₃, u₁, u₂] (`THROUGH_LEN`). W = 0 on row r = 0.
+    pub through: Vec<[f64; THROUGH_LEN]>,
+    /// `through` in f32, as the shader holds it (the lobe table's third and sixth vec4s).
+    pub through_f32: Vec<[f32; THROUGH_LEN]>,
 }
 
 impl PathTable {
@@ -164,12 +172,17 @@ fn through_walk(n0: f64, n2: f64, k: usize) -> ThroughWalk {
     super::walk::through_cosines(wi, alpha, n0, n2, THROUGH_PHOTONS, seed)
 }
 
-/// The rule [W, c_a, c_b, w_a] per entry from the entries' walks (`through_walk`). The
-/// two-point rule for the last reflection's cosines (weighted by 1 / F_bare) is taken per
-/// roughness row, from the cosines of all its entries: within a row its nodes move by a few
-/// hundredths with μ (0.47–0.55 and 0.87–0.93 on the roughest row of n0 | n2 = 1 | 1.56),
-/// where an entry's own few dozen photons would scatter them by more, and a row's entries
-/// must share nodes for the rule to interpolate in μ. W carries each entry's own share: of
+/// The rule [W, c₁, c₂, c₃, w₁, w₂] per entry from the entries' walks (`through_walk`): W
+/// and the three-point Gauss rule for the last reflection's cosines, weighted by 1 / F_bare
+/// (`energy::Rule::gauss`). An entry whose walk brought at least `THROUGH_ENTRY_MIN` such
+/// photons back has its own rule; the others (normal and near-normal light, where q is
+/// small) take the rule of all their roughness row's cosines. (Until the film's rule grew
+/// to five points, this was a two-point rule per row, whose nodes moved by a few hundredths
+/// with μ: 0.47–0.55 and 0.87–0.93 on the roughest row of n0 | n2 = 1 | 1.56. But a 650 nm
+/// film's colour turns within that spread, and the row's rule read it off at the grazing
+/// entries where q is largest: with the walk's own q and its exact reweighting at k_d = 0,
+/// roughness 0.9 and 85° on (1.33, 1.55, 2.0), the top was 0.5 ΔE00 off the walk, and 2.8
+/// with the row's two-point rule; 1.9 with a three-point rule per row, 1.6 per entry.) W carries each entry's own share: of
 /// the photons that entered the surface, the fraction that came straight back (at most 1;
 /// the film's way in, 1 − ⟨F⟩, scales it in the rule). Over the bare interface's way in as
 /// the lobe reads it, 1 − ⟨F_bare⟩, the fraction measured 2.39 for `bench layered`'s max
@@ -178,23 +191,31 @@ fn through_walk(n0: f64, n2: f64, k: usize) -> ThroughWalk {
 /// photons without bound (the stress test's grazing views: the f32 table 15 % off the f64
 /// rule, capped at 1 or not).
 /// A row with fewer than `THROUGH_MIN` such photons in all has none (W = 0).
-fn through_rule(n0: f64, n2: f64, walks: &[ThroughWalk]) -> Vec<[f64; 4]> {
+fn through_rule(n0: f64, n2: f64, walks: &[ThroughWalk]) -> Vec<[f64; THROUGH_LEN]> {
     let bare = super::walk::bare_interface(n0, n2);
-    let mut rule = vec![[0.0, 0.5, 0.5, 1.0]; walks.len()];
+    let mut rule = vec![[0.0, 0.5, 0.5, 0.5, 1.0, 0.0]; walks.len()];
     for (i_r, row) in walks.chunks(E1_MU).enumerate().skip(1) {
         let cosines: Vec<f64> = row.iter().flat_map(|(_, _, c)| c.iter().copied()).collect();
         if cosines.len() < THROUGH_MIN {
             continue;
         }
-        // The measure of the last reflection's cosines, each weighted by 1 / F_bare there.
-        let weights: Vec<f64> = cosines.iter().map(|c| 1.0 / bare(true, *c).max(1e-9)).collect();
-        let total: f64 = weights.iter().sum();
-        let moment = |p: i32| cosines.iter().zip(&weights).map(|(c, w)| w * c.powi(p)).sum::<f64>() / total;
-        let [c_a, c_b, w_a] = super::energy::two_point_rule(moment(1), moment(2), moment(3));
-        let mean_inverse = total / cosines.len() as f64;
-        for (i_mu, (entered, count, _)) in row.iter().enumerate() {
+        // The rule and the mean of 1 / F_bare of a set of last reflections' cosines, each
+        // weighted by 1 / F_bare there.
+        let rule_of = |cosines: &[f64]| {
+            let weights: Vec<f64> = cosines.iter().map(|c| 1.0 / bare(true, *c).max(1e-9)).collect();
+            let total: f64 = weights.iter().sum();
+            let moment = |p: i32| cosines.iter().zip(&weights).map(|(c, w)| w * c.powi(p)).sum::<f64>() / total;
+            let moments: [f64; 2 * THROUGH_NODES] = std::array::from_fn(|p| moment(p as i32));
+            (super::energy::Rule::<THROUGH_NODES>::gauss(&moments), total / cosines.len() as f64)
+        };
+        let row_rule = rule_of(&cosines);
+        for (i_mu, (entered, count, own)) in row.iter().enumerate() {
             let share = if *entered > 0 { *count as f64 / *entered as f64 } else { 0.0 };
-            rule[i_r * E1_MU + i_mu] = [share * mean_inverse, c_a, c_b, w_a];
+            let (last, mean_inverse) = if own.len() >= THROUGH_ENTRY_MIN { rule_of(own) } else { row_rule };
+            let mut entry = [share * mean_inverse; THROUGH_LEN];
+            entry[1..1 + THROUGH_NODES].copy_from_slice(&last.cos);
+            entry[1 + THROUGH_NODES..].copy_from_slice(&last.weight[..THROUGH_NODES - 1]);
+            rule[i_r * E1_MU + i_mu] = entry;
         }
     }
     rule
@@ -303,9 +324,11 @@ mod tests {
         for (n0, n2) in [(1.0, 1.0), (1.9, 1.1), (1.0, 2.9), (1.5, 1.45), (2.0, 3.0), (1.2, 1.8)] {
             let table = PathTable::new(n0, n2);
             assert!(table.delta.iter().all(|d| d.is_finite()), "{n0} {n2}");
-            for (k, [w, c_a, c_b, w_a]) in table.through.iter().copied().enumerate() {
+            for (k, entry) in table.through.iter().enumerate() {
+                let w = entry[0];
                 assert!(w.is_finite() && w >= 0.0, "{n0} {n2} entry {k}: W {w}");
-                assert!([c_a, c_b, w_a].iter().all(|v| (0.0..=1.0).contains(v)), "{n0} {n2} entry {k}");
+                assert!(entry[1..].iter().all(|v| (0.0..=1.0).contains(v)), "{n0} {n2} entry {k}");
+                assert!(entry[4] + entry[5] <= 1.0 + 1e-12, "{n0} {n2} entry {k}: weights {entry:?}");
                 assert!(k >= E1_MU || w == 0.0, "{n0} {n2}: the mirror row has none");
             }
             if n0 != n2 {

@@ -72,22 +72,31 @@ struct FilmInfo {
 }
 
 /// vec4s per entry of the lobe table (`lobe_table`; the shader's `LOBE_VEC4S`).
-pub const LOBE_VEC4S: usize = 3;
+pub const LOBE_VEC4S: usize = 6;
 
 /// The rough lobe's table (`optics::brdf::energy`) as `film.wgsl`'s `lobe_table`: per (μ, r)
-/// entry, row-major by roughness, `LOBE_VEC4S` vec4s: (E₁, c₁, c₂, c₃), (w₁, w₂, 0,
-/// cos_eff − cos_t) and (W, c_a, c_b, w_a), the last five from the material's path table
-/// (`optics::brdf::path`, the same grid: the path delta and the rule for light that comes
-/// straight back through the top). Filled for every material, absorbing or not: the window
+/// entry, row-major by roughness, `LOBE_VEC4S` vec4s: (E₁, c₁, c₂, c₃), (c₄, c₅, w₁,
+/// cos_eff − cos_t), (W, t₁, t₂, t₃), (w₂, w₃, w₄, v₁), (b₁, b₂, b₃, v₂) and (u₁, u₂, 0, 0):
+/// the lobe's albedo and five-point rule (the last weight of each rule is 1 minus the
+/// others), the second reflection's three-point rule (b, v) and, from the material's path
+/// table (`optics::brdf::path`, the same grid), the path delta and the rule for light that
+/// comes straight back through the top (W and the three-point rule t, u). Filled for every material, absorbing or not: the window
 /// changes the absorption without a new film binding.
 fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
     use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, node};
     let path = crate::optics::brdf::path::cached(stack.n0, stack.n2);
     (0..E1_MU * E1_ROUGHNESS)
         .flat_map(|k| {
-            let [e1, c1, c2, c3, w1, w2] = node(k % E1_MU, k / E1_MU);
-            let entry: [[f32; 4]; LOBE_VEC4S] =
-                [[e1, c1, c2, c3], [w1, w2, 0.0, path.delta_f32[k]], path.through_f32[k]];
+            let [e1, c1, c2, c3, c4, c5, w1, w2, w3, w4, b1, b2, b3, v1, v2] = node(k % E1_MU, k / E1_MU);
+            let [w, t1, t2, t3, u1, u2] = path.through_f32[k];
+            let entry: [[f32; 4]; LOBE_VEC4S] = [
+                [e1, c1, c2, c3],
+                [c4, c5, w1, path.delta_f32[k]],
+                [w, t1, t2, t3],
+                [w2, w3, w4, v1],
+                [b1, b2, b3, v2],
+                [u1, u2, 0.0, 0.0],
+            ];
             entry
         })
         .collect()
