@@ -14,7 +14,7 @@
 //! the lobe. Three points, exact to degree 5, read a 650 nm film under water, (1.33, 1.55,
 //! 2.0) at 85° and roughness 0.9, 26 % too dark in red against the lobe summed over
 //! 400 × 400 strata (0.0496 against 0.0667; five points 0.0642), and `bench layered`'s
-//! furnace rows were 0.0144 at most and 0.0058 up to 70°; with five, 0.0036 and 0.0020.)
+//! furnace rows were 0.0144 at most and 0.0058 up to 70°; with five, 0.0033 and 0.0020.)
 //!
 //! **Multiple scattering.** What the single-scatter lobe misses, 1 − E₁(μ) for F = 1
 //! (Kulla & Conty 2017; it grows with roughness), is light reflected by one microfacet and
@@ -48,7 +48,7 @@
 //! every direction, and did not return q at grazing light: `bench layered`'s max ΔE00 2.64
 //! with it against 2.39 with this lobe, the same rule for q.) The light the top does not
 //! reflect, 1 − E₁⟨F⟩ − x, enters the stack; the white furnace holds at every roughness to
-//! 0.4 % (`bench layered`'s furnace rows: 0.0036 at most, 0.0020 up to 70°; 0.0144 and
+//! 0.4 % (`bench layered`'s furnace rows: 0.0033 at most, 0.0020 up to 70°; 0.0144 and
 //! 0.0058 with the three-point lobe, 0.0209 and 0.0057 with Kulla & Conty's shape). At
 //! r = 0, E₁ = 1, every node is μ, q = 0 and the coupling is the smooth film's
 //! transmittance 1 − F(μ) exactly.
@@ -111,7 +111,8 @@ impl<const N: usize> Rule<N> {
                 };
             }
         }
-        Rule::point(m[1].clamp(0.0, 1.0))
+        debug_assert!(m[1].is_finite(), "moments {m:?}");
+        Rule::point(if m[1].is_finite() { m[1].clamp(0.0, 1.0) } else { 0.5 })
     }
 }
 
@@ -139,10 +140,9 @@ pub fn single_scatter_albedo(cos_o: f64, roughness: f64) -> f64 {
     lobe(cos_o, roughness).albedo
 }
 
-/// The lobe's albedo and the three-point Gauss rule for its distribution of c = |wo·h|:
-/// the nodes are the roots of the degree-3 orthogonal polynomial of that weight (from its
-/// moments up to the fifth), the weights match the moments 0–2. Where the distribution is
-/// too narrow for three distinct nodes (r → 0) the rule falls back to two, then one.
+/// The lobe's albedo and the five-point Gauss rule for its distribution of c = |wo·h|
+/// (`Rule::gauss`, from its moments up to the ninth). Where the distribution is too narrow
+/// for five distinct nodes (r → 0) the rule falls back to fewer, down to one.
 pub fn lobe(cos_o: f64, roughness: f64) -> Lobe {
     let cos_o = cos_o.clamp(COS_MIN, 1.0);
     let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
@@ -179,7 +179,10 @@ fn golub_welsch(m: &[f64], n: usize) -> Option<(Vec<f64>, Vec<f64>)> {
     let mut r = vec![vec![0.0; size]; size];
     for i in 0..n {
         let pivot = hankel(i, i) - (0..i).map(|k| r[k][i] * r[k][i]).sum::<f64>();
-        if pivot <= 1e-13 * hankel(i, i) {
+        // A relative pivot near rounding noise (±2e-13 for distributions a few thousandths
+        // wide) would put a stray node far outside the data: such a distribution gets fewer
+        // nodes. (NaN fails the test too.)
+        if pivot.is_nan() || pivot <= 1e-10 * hankel(i, i) {
             return None;
         }
         r[i][i] = pivot.sqrt();
@@ -208,9 +211,10 @@ fn golub_welsch(m: &[f64], n: usize) -> Option<(Vec<f64>, Vec<f64>)> {
 fn symmetric_eigen(mut a: Vec<Vec<f64>>) -> (Vec<f64>, Vec<f64>) {
     let n = a.len();
     let mut v: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect()).collect();
+    let norm: f64 = a.iter().flatten().map(|x| x * x).sum();
     for _sweep in 0..64 {
         let off: f64 = (0..n).flat_map(|p| (p + 1..n).map(move |q| (p, q))).map(|(p, q)| a[p][q] * a[p][q]).sum();
-        if off < 1e-30 {
+        if off <= 1e-28 * norm {
             break;
         }
         for p in 0..n {
@@ -281,7 +285,9 @@ fn second_reflection(i_mu: usize, i_r: usize, first: &Lobe) -> Rule<SECOND_NODES
     let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
     let alpha = (r * r).max(ALPHA_MIN);
     let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
-    let seed = 0x5ec0_7d00_0000_0000 ^ ((i_r * E1_MU + i_mu) as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    // Not a multiple of SplitMix64's own increment (0x9e37…), which would make one node's
+    // stream another's shifted by a few draws.
+    let seed = 0x5ec0_7d00_0000_0000 ^ ((i_r * E1_MU + i_mu) as u64).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     let (_, paths) = super::walk::multiple_scatter_cosines(wi, alpha, SECOND_PHOTONS, seed);
     if paths.len() < SECOND_MIN {
         return fallback;
@@ -345,8 +351,10 @@ pub fn tables() -> &'static Tables {
     })
 }
 
-/// `f(k)` for k in 0..count, in order, computed on the machine's cores by plain threads.
-fn split_over_threads<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+/// `f(k)` for k in 0..count, in order, computed on the machine's cores by plain threads
+/// (not the rayon pool: the tables are built under locks that callers on the pool wait for).
+/// The lobe tables' walks and `path::PathTable`'s use it.
+pub(super) fn split_over_threads<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, count.max(1));
     let chunk = count.div_ceil(threads).max(1);
     let f = &f;
@@ -355,7 +363,7 @@ fn split_over_threads<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> V
             .step_by(chunk)
             .map(|start| scope.spawn(move || (start..(start + chunk).min(count)).map(f).collect::<Vec<T>>()))
             .collect();
-        parts.into_iter().flat_map(|part| part.join().expect("lobe table thread")).collect()
+        parts.into_iter().flat_map(|part| part.join().expect("table thread")).collect()
     })
 }
 
@@ -589,11 +597,30 @@ mod tests {
             let nonic = |c: f64| 0.3 - c + 2.0 * c * c * c - 0.7 * c.powi(5) + 0.4 * c.powi(8) - 0.2 * c.powi(9);
             let (by_rule, by_sum) = (l.mean(nonic), brute_mean(mu, r, nonic));
             assert!((by_rule - by_sum).abs() < 1e-8, "μ={mu} r={r}: {by_rule} {by_sum}");
-            // Negative control: degree 10 is not integrated exactly (seen where the
-            // distribution is wide; at μ = 0.9 and r = 0.3 the difference is 7e-11).
+            // Negative control: degree 10 is not integrated exactly, by more than five times
+            // the tolerance above where the distribution is wide (measured 1.2e-7 and 3.9e-7;
+            // at μ = 0.9 and r = 0.3, a narrow lobe, 7e-11).
             let decic = |c: f64| c.powi(10);
             let off = l.mean(decic) - brute_mean(mu, r, decic);
-            assert!(r < 0.5 || off.abs() > 1e-9, "μ={mu} r={r}: {off}");
+            eprintln!("μ={mu} r={r}: degree 10 off by {off:e}");
+            assert!(r < 0.5 || off.abs() > 5e-8, "μ={mu} r={r}: {off}");
+        }
+    }
+
+    /// The second reflection's rule as the tables hold it (walked on the machine's cores)
+    /// is each node's own walk, computed here one node at a time: the same at any number
+    /// of threads.
+    #[test]
+    fn the_walked_rule_is_the_same_on_threads_as_node_by_node() {
+        for k in [E1_MU + 5, 7 * E1_MU + 20, E1_ROUGHNESS * E1_MU - 1] {
+            let (i_mu, i_r) = (k % E1_MU, k / E1_MU);
+            let mu = i_mu as f64 / (E1_MU - 1) as f64;
+            let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
+            let alone = second_reflection(i_mu, i_r, &lobe(mu, r));
+            let held = &node(i_mu, i_r)[1 + 2 * LOBE_NODES - 1..];
+            let expected: Vec<f32> =
+                alone.cos.iter().chain(&alone.weight[..SECOND_NODES - 1]).map(|v| *v as f32).collect();
+            assert_eq!(held, &expected[..], "node ({i_mu}, {i_r})");
         }
     }
 
@@ -625,7 +652,7 @@ mod tests {
     /// (650 nm on (1.33, 1.55, 2.0), `bench layered`'s worst cell) and the top is rough (the
     /// lobe grid's nodes at roughness 14/15, 84° and 59°): what the model's top reflects,
     /// E₁⟨F⟩ + x, and what the walk returns (400,000 photons), in ΔE00. Measured 1.82 and
-    /// 1.26. Negative control: the second reflection read at the lobe's most grazing node
+    /// 1.27. Negative control: the second reflection read at the lobe's most grazing node
     /// c₁ (the rule before the walked one) is 2.88 off at 84° (but 0.63 at 59°, where the
     /// product of the two rules, which leaves out that light scattered more than once first
     /// meets the surface at more grazing facets than the single-scatter lobe, reads the
@@ -656,14 +683,17 @@ mod tests {
                 let g = [film(b[0]), film(b[1]), film(b[2])];
                 [0, 1, 2].map(|c| w[0] * g[0][c] + w[1] * g[1][c] + last * g[2][c])
             };
-            let at_c1 = [0, 1, 2].map(|c| model[c] + (1.0 - e1) * mean[c] * (f1[c] - second[c]));
+            let at_c1 =
+                [0, 1, 2].map(|c| single[c] + (x[c] + (1.0 - e1) * mean[c] * (f1[c] - second[c])).min(1.0 - single[c]));
             let de = |a: [f64; 3]| ciede2000(linear_srgb_to_lab(a), linear_srgb_to_lab(walked));
             eprintln!(
                 "μ={mu:.3}: walk {walked:.4?}, model {model:.4?} ({:.2}), F(c₁) {at_c1:.4?} ({:.2})",
                 de(model),
                 de(at_c1)
             );
-            assert!(de(model) < 2.2, "μ={mu}: ΔE00 {}", de(model));
+            // Bounds a few tenths above what was measured at each angle.
+            let bound = if i_mu == 3 { 2.2 } else { 1.6 };
+            assert!(de(model) < bound, "μ={mu}: ΔE00 {}", de(model));
             if i_mu == 3 {
                 assert!(de(at_c1) > 2.5, "μ={mu}: the old rule's ΔE00 {}", de(at_c1));
             }

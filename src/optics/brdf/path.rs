@@ -42,9 +42,10 @@
 //! (two film indices, n2 1.33 and 1.55, films of 150, 250 and 650 nm, 60–85°, roughness
 //! 0.6–0.9, two channels; each case's own walk giving W and the rule): off by 0.0005 on
 //! average and 0.0065 at most, where q itself averages 0.0075 and reaches 0.046; the film
-//! at the mean cosines alone was off by twice as much on average. The table as built (one
-//! rule per roughness row, W a share of what entered: `through_rule`) is checked by
-//! `tests/brdf.rs`'s walk at 85° and by `bench layered` (BENCHMARKS.md).
+//! at the mean cosines alone was off by twice as much on average. The table as built (a
+//! rule per entry where its walk brought enough photons back, else its roughness row's; W a
+//! share of what entered: `through_rule`) is checked by `tests/brdf.rs`'s walk at 85° and
+//! by `bench layered` (BENCHMARKS.md).
 
 use std::sync::{Arc, Mutex};
 
@@ -66,7 +67,7 @@ const THROUGH_MIN: usize = 16;
 pub const THROUGH_NODES: usize = 3;
 /// Fewest photons straight back from which an entry has its own rule (`through_rule`).
 const THROUGH_ENTRY_MIN: usize = 64;
-/// Slots of an entry of that rule (`PathTable::through`): [W, c₁, c₂, c₃, w₁, w₂] (the third
+/// Slots of an entry of that rule (`PathTable::through`): [W, t₁, t₂, t₃, u₁, u₂] (the third
 /// weight is 1 minus the others).
 pub const THROUGH_LEN: usize = 2 * THROUGH_NODES;
 /// The most grazing light walked (μ = 0 itself never meets the top).
@@ -94,27 +95,13 @@ pub struct PathTable {
 impl PathTable {
     /// The table for indices (n0, n2), walked entry by entry (about 10⁷ photon walks: 2·10⁶
     /// for the path, 8·10⁶ for light straight back; 1.05 s on this machine's two cores),
-    /// the entries split over the machine's cores by
-    /// plain threads (not the rayon pool: `cached` builds under a lock that callers on the
-    /// pool wait for). Each entry has its own seed, so the table is the same on any number
-    /// of threads.
+    /// the entries split over the machine's cores by plain threads (`energy::
+    /// split_over_threads`: not the rayon pool, since `cached` builds under a lock that
+    /// callers on the pool wait for). Each entry has its own seed, so the table is the same
+    /// on any number of threads.
     pub fn new(n0: f64, n2: f64) -> PathTable {
-        let entries = E1_ROUGHNESS * E1_MU;
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, entries);
-        let chunk = entries.div_ceil(threads);
-        let walked: Vec<(f64, ThroughWalk)> = std::thread::scope(|scope| {
-            let parts: Vec<_> = (0..entries)
-                .step_by(chunk)
-                .map(|start| {
-                    scope.spawn(move || {
-                        (start..(start + chunk).min(entries))
-                            .map(|k| (entry(n0, n2, k), through_walk(n0, n2, k)))
-                            .collect::<Vec<_>>()
-                    })
-                })
-                .collect();
-            parts.into_iter().flat_map(|part| part.join().expect("path table thread")).collect()
-        });
+        let walked =
+            super::energy::split_over_threads(E1_ROUGHNESS * E1_MU, |k| (entry(n0, n2, k), through_walk(n0, n2, k)));
         let (delta, walks): (Vec<f64>, Vec<ThroughWalk>) = walked.into_iter().unzip();
         let through = through_rule(n0, n2, &walks);
         let delta_f32 = delta.iter().map(|d| *d as f32).collect();
@@ -172,7 +159,7 @@ fn through_walk(n0: f64, n2: f64, k: usize) -> ThroughWalk {
     super::walk::through_cosines(wi, alpha, n0, n2, THROUGH_PHOTONS, seed)
 }
 
-/// The rule [W, c₁, c₂, c₃, w₁, w₂] per entry from the entries' walks (`through_walk`): W
+/// The rule [W, t₁, t₂, t₃, u₁, u₂] per entry from the entries' walks (`through_walk`): W
 /// and the three-point Gauss rule for the last reflection's cosines, weighted by 1 / F_bare
 /// (`energy::Rule::gauss`). An entry whose walk brought at least `THROUGH_ENTRY_MIN` such
 /// photons back has its own rule; the others (normal and near-normal light, where q is
