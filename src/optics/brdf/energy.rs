@@ -94,6 +94,13 @@ impl<const N: usize> Rule<N> {
         self.cos.iter().zip(&self.weight).map(|(c, w)| w * g(*c)).sum()
     }
 
+    /// The rule as the tables hold it: its N nodes, then all but its last weight (the last
+    /// is 1 minus the others: the readers, `top_impl`'s `by_rule` and `brdf.wgsl`'s
+    /// `parts_on_row`, take it so, and interpolated rules keep summing to 1).
+    pub fn slots(&self) -> impl Iterator<Item = f64> + '_ {
+        self.cos.iter().chain(&self.weight[..N - 1]).copied()
+    }
+
     /// The Gauss rule of the distribution on [0, 1] with moments `m` (m[0] = 1, at least 2N
     /// of them): N points where the moments allow (Golub & Welsch 1969: the recurrence of the
     /// distribution's orthogonal polynomials from the Cholesky factor of its Hankel matrix,
@@ -246,7 +253,9 @@ fn symmetric_eigen(mut a: Vec<Vec<f64>>) -> (Vec<f64>, Vec<f64>) {
 /// Slots of a lobe node (`node`): [E₁, c₁ … c₅, w₁ … w₄, b₁ … b₃, v₁, v₂], the lobe's albedo
 /// for F = 1, its rule's nodes and all but its last weight (the last is 1 minus the others),
 /// and the same for the second reflection's rule (`second_reflection`).
-pub const NODE_LEN: usize = 1 + 2 * LOBE_NODES - 1 + 2 * SECOND_NODES - 1;
+pub const NODE_LEN: usize = SECOND_SLOT + 2 * SECOND_NODES - 1;
+/// The slot of a lobe node where the second reflection's rule begins (b₁).
+pub const SECOND_SLOT: usize = 1 + 2 * LOBE_NODES - 1;
 
 /// The lobe's nodes (`NODE_LEN` slots each), row-major by roughness (`t[i_r * E1_MU + i_mu]`).
 pub struct Tables {
@@ -262,7 +271,7 @@ const SECOND_MIN: usize = 128;
 
 /// The Gauss rule for the microfacet cosine of the second reflection of light the rough
 /// top scatters more than once, at lobe node (i_mu, i_r): from the photons of a walk of a
-/// top that reflects everything (`walk::multiple_scatter_cosines`), the three-point rule
+/// top that reflects everything (`walk::second_reflection_cosines`), the three-point rule
 /// of their second cosines' moments. A film reflects such light with the product of its
 /// reflectances along the path; the rule takes it as ⟨F⟩ (the first reflection, the
 /// lobe's rule) times ⟨F⟩₂ (the second, this rule), exact for a film that reflects
@@ -288,13 +297,12 @@ fn second_reflection(i_mu: usize, i_r: usize, first: &Lobe) -> Rule<SECOND_NODES
     // Not a multiple of SplitMix64's own increment (0x9e37…), which would make one node's
     // stream another's shifted by a few draws.
     let seed = 0x5ec0_7d00_0000_0000 ^ ((i_r * E1_MU + i_mu) as u64).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    let (_, paths) = super::walk::multiple_scatter_cosines(wi, alpha, SECOND_PHOTONS, seed);
-    if paths.len() < SECOND_MIN {
+    let cosines = super::walk::second_reflection_cosines(wi, alpha, SECOND_PHOTONS, seed);
+    if cosines.len() < SECOND_MIN {
         return fallback;
     }
-    let n = paths.len() as f64;
-    let m: [f64; 2 * SECOND_NODES] =
-        std::array::from_fn(|k| paths.iter().map(|p| p[1].powi(k as i32)).sum::<f64>() / n);
+    let n = cosines.len() as f64;
+    let m: [f64; 2 * SECOND_NODES] = std::array::from_fn(|k| cosines.iter().map(|c| c.powi(k as i32)).sum::<f64>() / n);
     Rule::gauss(&m)
 }
 
@@ -338,10 +346,8 @@ pub fn tables() -> &'static Tables {
             .zip(&seconds)
             .map(|(l, s)| {
                 let slots = std::iter::once(l.albedo)
-                    .chain(l.rule.cos)
-                    .chain(l.rule.weight[..LOBE_NODES - 1].iter().copied())
-                    .chain(s.cos)
-                    .chain(s.weight[..SECOND_NODES - 1].iter().copied())
+                    .chain(l.rule.slots())
+                    .chain(s.slots())
                     .map(|v| v as f32)
                     .collect::<Vec<f32>>();
                 <[f32; NODE_LEN]>::try_from(slots).expect("a lobe node's slots")
@@ -617,9 +623,8 @@ mod tests {
             let mu = i_mu as f64 / (E1_MU - 1) as f64;
             let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
             let alone = second_reflection(i_mu, i_r, &lobe(mu, r));
-            let held = &node(i_mu, i_r)[1 + 2 * LOBE_NODES - 1..];
-            let expected: Vec<f32> =
-                alone.cos.iter().chain(&alone.weight[..SECOND_NODES - 1]).map(|v| *v as f32).collect();
+            let held = &node(i_mu, i_r)[SECOND_SLOT..];
+            let expected: Vec<f32> = alone.slots().map(|v| v as f32).collect();
             assert_eq!(held, &expected[..], "node ({i_mu}, {i_r})");
         }
     }
@@ -678,7 +683,7 @@ mod tests {
             let (e1, f1) = (v[0], film(v[1]));
             let mean = [0, 1, 2].map(|c| single[c] / e1);
             let second = {
-                let (b, w) = (&v[1 + 2 * LOBE_NODES - 1..], &v[1 + 2 * LOBE_NODES - 1 + SECOND_NODES..]);
+                let (b, w) = (&v[SECOND_SLOT..], &v[SECOND_SLOT + SECOND_NODES..]);
                 let last = 1.0 - w.iter().sum::<f64>();
                 let g = [film(b[0]), film(b[1]), film(b[2])];
                 [0, 1, 2].map(|c| w[0] * g[0][c] + w[1] * g[1][c] + last * g[2][c])

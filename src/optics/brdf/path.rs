@@ -200,8 +200,9 @@ fn through_rule(n0: f64, n2: f64, walks: &[ThroughWalk]) -> Vec<[f64; THROUGH_LE
             let share = if *entered > 0 { *count as f64 / *entered as f64 } else { 0.0 };
             let (last, mean_inverse) = if own.len() >= THROUGH_ENTRY_MIN { rule_of(own) } else { row_rule };
             let mut entry = [share * mean_inverse; THROUGH_LEN];
-            entry[1..1 + THROUGH_NODES].copy_from_slice(&last.cos);
-            entry[1 + THROUGH_NODES..].copy_from_slice(&last.weight[..THROUGH_NODES - 1]);
+            for (slot, value) in entry[1..].iter_mut().zip(last.slots()) {
+                *slot = value;
+            }
             rule[i_r * E1_MU + i_mu] = entry;
         }
     }

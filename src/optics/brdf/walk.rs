@@ -408,30 +408,33 @@ pub fn through_cosines(wi: V3, alpha: f64, n0: f64, n2: f64, photons: u64, seed:
     (entered, count, cosines)
 }
 
-/// The microfacet cosines met by photons arriving from `wi` (unit, wi.z > 0) at a rough
-/// top that reflects everything (F = 1 at every microfacet, so no photon enters), walked as
-/// `follow` walks it, for the photons that meet the surface more than once: its multiple
-/// scattering. A film that reflects F(c) at cosine c returns such a path with probability
-/// Π F(c_k) over its cosines, and the directions after each reflection do not depend on F,
-/// so the mean of that product over these paths (times their share, 1 − E₁) is the film's
-/// multiple scattering exactly. `energy`'s rule for it is built from these.
-pub fn multiple_scatter_cosines(wi: V3, alpha: f64, photons: u64, seed: u64) -> (u64, Vec<Vec<f64>>) {
-    let met = std::cell::RefCell::new(Vec::new());
+/// The microfacet cosine of the second reflection of each photon, of `photons` arriving
+/// from `wi` (unit, wi.z > 0), that meets a rough top more than once: the top reflects
+/// everything (F = 1 at every microfacet, so no photon enters), walked as `follow` walks
+/// it. A film that reflects F(c) at cosine c returns such a path with probability Π F(c_k)
+/// over its cosines, and the directions after each reflection do not depend on F, so
+/// these paths' cosines are the film's multiple scattering exactly; `energy`'s rule for
+/// the second reflection is built from these.
+pub fn second_reflection_cosines(wi: V3, alpha: f64, photons: u64, seed: u64) -> Vec<f64> {
+    let (met, second) = (std::cell::Cell::new(0usize), std::cell::Cell::new(0.0));
     let mirror = |_: bool, cos: f64| {
-        met.borrow_mut().push(cos);
+        if met.get() == 1 {
+            second.set(cos);
+        }
+        met.set(met.get() + 1);
         1.0
     };
     let mut rng = Rng(seed);
-    let mut paths = Vec::new();
+    let mut cosines = Vec::new();
     for _ in 0..photons {
-        met.borrow_mut().clear();
+        met.set(0);
         let mut photon = OnTop::arriving(wi);
         walk_top(&mut photon, alpha, 1.0, 1.0, &mirror, &mut rng);
         if photon.scatterings > 1 {
-            paths.push(met.borrow().clone());
+            cosines.push(second.get());
         }
     }
-    (photons, paths)
+    cosines
 }
 
 /// GGX α of the walk's top: 0 (a mirror, m = n) for roughness 0, else roughness² floored
