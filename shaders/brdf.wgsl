@@ -97,13 +97,14 @@ struct Top {
     path_delta: f32,
 }
 
-// The rough lobe's table (the film bind group's lobe_table, optics::brdf::energy::node):
-// per (mu, r) node LOBE_VEC4S vec4s, (E1, c1, c2, c3), (c4, c5, w1, path delta),
-// (W, t1, t2, t3), (w2, w3, w4, v1), (b1, b2, b3, v2) and (u1, u2, 0, 0): its albedo for
-// F = 1, the five-point Gauss rule over its microfacet cosines (the last weight of each
-// rule is 1 minus the others), the three-point rule for the second reflection of light it
-// scatters more than once (b, v), the pigment layer's path (path_delta_at) and the rule
-// for light that comes straight back through the top (W and the three-point rule t, u:
+// The rough lobe's table (the film bind group's lobe_table, render::engine::film::
+// lobe_table): per (mu, r) entry LOBE_VEC4S vec4s holding its slots in order: the pigment
+// layer's path delta (path_delta_at), the lobe node from LOBE_NODE_SLOT
+// (optics::brdf::energy::node: its albedo E1 for F = 1, the five-point Gauss rule over its
+// microfacet cosines, the last weight 1 minus the others, and the rule for light it
+// scatters more than once, energy::Multiple: nodes a and b, the weights M of the film's
+// products, the share s reflected exactly twice) and from LOBE_THROUGH_SLOT the rule for
+// light that comes straight back through the top (W and a three-point rule:
 // optics::brdf::path::PathTable::through).
 
 // The lobe table's cell at (mu, r): the indices of its lower corners (LOBE_VEC4S vec4s per
@@ -129,12 +130,12 @@ fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
 }
 
 // cos_eff(mu, r) - cos_t(mu): how much more obliquely than Snell's law the light the rough
-// top lets in crosses the pigment layer, bilinear in the last slot of the lobe table's
-// second vec4 (this material's optics::brdf::path table; PathTable::cos_eff), in the lobe
+// top lets in crosses the pigment layer, bilinear in the first slot of the lobe table's
+// entries (this material's optics::brdf::path table; PathTable::cos_eff), in the lobe
 // table's cell c.
 fn path_delta_in(c: LobeCell) -> f32 {
-    let lower = mix(lobe_table[c.k00 + 1u].w, lobe_table[c.k00 + LOBE_VEC4S + 1u].w, c.fx);
-    let upper = mix(lobe_table[c.k01 + 1u].w, lobe_table[c.k01 + LOBE_VEC4S + 1u].w, c.fx);
+    let lower = mix(lobe_table[c.k00].x, lobe_table[c.k00 + LOBE_VEC4S].x, c.fx);
+    let upper = mix(lobe_table[c.k01].x, lobe_table[c.k01 + LOBE_VEC4S].x, c.fx);
     return mix(lower, upper, c.fy);
 }
 
@@ -231,23 +232,56 @@ struct RowParts {
 }
 
 fn parts_on_row(layers: Layers, k: u32, fx: f32) -> RowParts {
-    let a = mix(lobe_table[k], lobe_table[k + LOBE_VEC4S], fx);
-    let b = mix(lobe_table[k + 1u], lobe_table[k + LOBE_VEC4S + 1u], fx);
-    let t = mix(lobe_table[k + 2u], lobe_table[k + LOBE_VEC4S + 2u], fx);
-    let w = mix(lobe_table[k + 3u], lobe_table[k + LOBE_VEC4S + 3u], fx);
-    let s = mix(lobe_table[k + 4u], lobe_table[k + LOBE_VEC4S + 4u], fx);
-    let u = mix(lobe_table[k + 5u], lobe_table[k + LOBE_VEC4S + 5u], fx);
-    let mean = b.z * film_clamped(layers, a.y) + w.x * film_clamped(layers, a.z) + w.y * film_clamped(layers, a.w)
-        + w.z * film_clamped(layers, b.x) + (1.0 - b.z - w.x - w.y - w.z) * film_clamped(layers, b.y);
-    let second = w.w * film_clamped(layers, s.x) + s.w * film_clamped(layers, s.y)
-        + (1.0 - w.w - s.w) * film_clamped(layers, s.z);
-    let back = u.x * film_clamped(layers, t.y) + u.y * film_clamped(layers, t.z)
-        + (1.0 - u.x - u.y) * film_clamped(layers, t.w);
-    let q = (1.0 - mean) * t.x * back;
+    var v: array<vec4<f32>, LOBE_VEC4S>;
+    for (var i = 0u; i < LOBE_VEC4S; i++) {
+        v[i] = mix(lobe_table[k + i], lobe_table[k + LOBE_VEC4S + i], fx);
+    }
+    let e1 = lobe_slot(&v, LOBE_NODE_SLOT);
+    let mean = film_by_rule(layers, &v, LOBE_NODE_SLOT + 1u, LOBE_NODES);
+    // The multiple scattering (energy::Multiple::reflected).
+    var fa: array<vec3<f32>, PAIR_NODES>;
+    var fb: array<vec3<f32>, PAIR_NODES>;
+    for (var i = 0u; i < PAIR_NODES; i++) {
+        fa[i] = film_clamped(layers, lobe_slot(&v, LOBE_NODE_SLOT + PAIR_SLOT + i));
+        fb[i] = film_clamped(layers, lobe_slot(&v, LOBE_NODE_SLOT + PAIR_SLOT + PAIR_NODES + i));
+    }
+    var both = vec3<f32>(0.0);
+    var first = vec3<f32>(0.0);
+    var second = vec3<f32>(0.0);
+    for (var n = 0u; n < PAIR_NODES * PAIR_NODES; n++) {
+        let m = lobe_slot(&v, LOBE_NODE_SLOT + PAIR_WEIGHTS_SLOT + n);
+        let i = n / PAIR_NODES;
+        let j = n % PAIR_NODES;
+        both += m * fa[i] * fb[j];
+        first += m * fa[i];
+        second += m * fb[j];
+    }
+    let twice = lobe_slot(&v, LOBE_NODE_SLOT + SHARE_SLOT);
+    let multiple = twice * both + (1.0 - twice) * first * second * second;
+    let back = film_by_rule(layers, &v, LOBE_THROUGH_SLOT + 1u, THROUGH_NODES);
+    let q = (1.0 - mean) * lobe_slot(&v, LOBE_THROUGH_SLOT) * back;
     // x never more than the light the single scattering leaves (q's reweighting is an
     // estimate).
-    let single = a.x * mean;
-    return RowParts(single, min((1.0 - a.x) * mean * second + q, vec3<f32>(1.0) - single));
+    let single = e1 * mean;
+    return RowParts(single, clamp((1.0 - e1) * multiple + q, vec3<f32>(0.0), vec3<f32>(1.0) - single));
+}
+
+// Slot s of a lobe table entry (its vec4s in order).
+fn lobe_slot(v: ptr<function, array<vec4<f32>, LOBE_VEC4S>>, s: u32) -> f32 {
+    return (*v)[s / 4u][s % 4u];
+}
+
+// The film by a rule of n nodes from slot s of a lobe table entry, then all but the last
+// weight (the last is 1 minus the others): energy::Rule::slots.
+fn film_by_rule(layers: Layers, v: ptr<function, array<vec4<f32>, LOBE_VEC4S>>, s: u32, n: u32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    var last = 1.0;
+    for (var i = 0u; i + 1u < n; i++) {
+        let w = lobe_slot(v, s + n + i);
+        sum += w * film_clamped(layers, lobe_slot(v, s + i));
+        last -= w;
+    }
+    return sum + last * film_clamped(layers, lobe_slot(v, s + n - 1u));
 }
 
 // One node of the multiple-scatter normalisation on row j: node = (mu, 2 w mu).

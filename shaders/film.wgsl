@@ -28,15 +28,14 @@ struct FilmInfo {
 @group(0) @binding(3) var lut_sampler: sampler;
 // spectral-N: per band (centre nm, then linear-sRGB weights).
 @group(0) @binding(2) var<storage, read> bands: array<vec4<f32>>;
-// The rough lobe's table (optics::brdf::energy::node, read by brdf.wgsl's top_on_row): per
-// (mu, r) entry, row-major by roughness, LOBE_VEC4S vec4s: (E1, c1, c2, c3), (c4, c5, w1,
-// cos_eff - cos_t), (W, t1, t2, t3), (w2, w3, w4, v1), (b1, b2, b3, v2) and (u1, u2, 0, 0):
-// the lobe's albedo and five-point rule, the second reflection's three-point rule (b, v),
-// and from this material's optics::brdf::path table the path delta (brdf.wgsl's
-// path_delta_at) and the rule for light straight back through the top (W; t, u).
+// The rough lobe's table (render::engine::film::lobe_table, read by brdf.wgsl's
+// parts_on_row and path_delta_in): per (mu, r) entry, row-major by roughness, LOBE_VEC4S
+// vec4s of slots: this material's path delta (brdf.wgsl's path_delta_at), the lobe node
+// (optics::brdf::energy::node) and this material's rule for light straight back through
+// the top (optics::brdf::path).
 @group(0) @binding(4) var<storage, read> lobe_table: array<vec4<f32>>;
 // The layered model's coupling baked with the table (optics::lut::Lut::coupling): x = cos
-// texel, the reflected share and the path delta (as in lobe_table's second vec4) in the
+// texel, the reflected share and the path delta (as in lobe_table's first slot) in the
 // first n_cos texels and the multiple-scatter amplitude in the next n_cos; y = the rough lobe's
 // roughness row (E1_ROUGHNESS); z = thickness texel, as the table's columns. Half floats,
 // read with the same sampler (brdf.wgsl's coupling_table).

@@ -408,33 +408,53 @@ pub fn through_cosines(wi: V3, alpha: f64, n0: f64, n2: f64, photons: u64, seed:
     (entered, count, cosines)
 }
 
-/// The microfacet cosine of the second reflection of each photon, of `photons` arriving
-/// from `wi` (unit, wi.z > 0), that meets a rough top more than once: the top reflects
-/// everything (F = 1 at every microfacet, so no photon enters), walked as `follow` walks
-/// it. A film that reflects F(c) at cosine c returns such a path with probability Π F(c_k)
-/// over its cosines, and the directions after each reflection do not depend on F, so
-/// these paths' cosines are the film's multiple scattering exactly; `energy`'s rule for
-/// the second reflection is built from these.
-pub fn second_reflection_cosines(wi: V3, alpha: f64, photons: u64, seed: u64) -> Vec<f64> {
-    let (met, second) = (std::cell::Cell::new(0usize), std::cell::Cell::new(0.0));
+/// A photon that a rough top reflecting everything scatters more than once: the microfacet
+/// cosines of its first two reflections and how many reflections it took.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MultipleReflection {
+    pub first: f64,
+    pub second: f64,
+    pub count: usize,
+}
+
+/// Every photon arriving from `wi` (unit, wi.z > 0) that meets a rough top more than once,
+/// walked until `twice` of them have reflected exactly twice or `photons` have arrived (so
+/// that smooth tops, which scatter little more than once, still give enough), and the
+/// number of photons walked. The top reflects everything (F = 1 at every microfacet, so
+/// no photon enters), walked as `follow` walks it. A film that reflects F(c) at cosine c
+/// returns such a path with probability Π F(c_k) over its cosines, and the directions
+/// after each reflection do not depend on F, so these paths are the film's multiple
+/// scattering exactly; `energy`'s rule for it is built from them.
+pub fn multiple_reflections(
+    wi: V3,
+    alpha: f64,
+    twice: usize,
+    photons: u64,
+    seed: u64,
+) -> (Vec<MultipleReflection>, u64) {
+    let (count, first, second) = (std::cell::Cell::new(0usize), std::cell::Cell::new(0.0), std::cell::Cell::new(0.0));
     let mirror = |_: bool, cos: f64| {
-        if met.get() == 1 {
-            second.set(cos);
+        match count.get() {
+            0 => first.set(cos),
+            1 => second.set(cos),
+            _ => {}
         }
-        met.set(met.get() + 1);
+        count.set(count.get() + 1);
         1.0
     };
     let mut rng = Rng(seed);
-    let mut cosines = Vec::new();
-    for _ in 0..photons {
-        met.set(0);
+    let (mut paths, mut walked, mut reflected_twice) = (Vec::new(), 0, 0);
+    while walked < photons && reflected_twice < twice {
+        walked += 1;
+        count.set(0);
         let mut photon = OnTop::arriving(wi);
         walk_top(&mut photon, alpha, 1.0, 1.0, &mirror, &mut rng);
         if photon.scatterings > 1 {
-            cosines.push(second.get());
+            paths.push(MultipleReflection { first: first.get(), second: second.get(), count: count.get() });
+            reflected_twice += usize::from(count.get() == 2);
         }
     }
-    cosines
+    (paths, walked)
 }
 
 /// GGX α of the walk's top: 0 (a mirror, m = n) for roughness 0, else roughness² floored

@@ -10,6 +10,8 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use super::gpu::{sampler_entry, storage_entry, texture_entry, uniform_entry};
+use crate::optics::brdf::energy::NODE_LEN;
+use crate::optics::brdf::path::THROUGH_LEN;
 use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
 use crate::optics::methods::{Bands, Method, d65_white};
@@ -71,32 +73,35 @@ struct FilmInfo {
     xyz_to_rgb: [[f32; 4]; 3],
 }
 
-/// vec4s per entry of the lobe table (`lobe_table`; the shader's `LOBE_VEC4S`).
-pub const LOBE_VEC4S: usize = 6;
+/// Slots per entry of the lobe table (`lobe_table`), in order: the path delta
+/// (cos_eff − cos_t), the lobe node (`energy::node`, `NODE_LEN` slots from
+/// `LOBE_NODE_SLOT`) and the rule for light straight back through the top
+/// (`path::PathTable::through`, `THROUGH_LEN` slots from `LOBE_THROUGH_SLOT`).
+const LOBE_SLOTS: usize = LOBE_THROUGH_SLOT + THROUGH_LEN;
+/// The entry's slot where the lobe node begins (the shader's `LOBE_NODE_SLOT`).
+pub const LOBE_NODE_SLOT: usize = 1;
+/// The entry's slot where the rule for light straight back begins (`LOBE_THROUGH_SLOT`).
+pub const LOBE_THROUGH_SLOT: usize = LOBE_NODE_SLOT + NODE_LEN;
+/// vec4s per entry of the lobe table (the shader's `LOBE_VEC4S`): its slots, in order,
+/// padded with zeros.
+pub const LOBE_VEC4S: usize = LOBE_SLOTS.div_ceil(4);
 
 /// The rough lobe's table (`optics::brdf::energy`) as `film.wgsl`'s `lobe_table`: per (μ, r)
-/// entry, row-major by roughness, `LOBE_VEC4S` vec4s: (E₁, c₁, c₂, c₃), (c₄, c₅, w₁,
-/// cos_eff − cos_t), (W, t₁, t₂, t₃), (w₂, w₃, w₄, v₁), (b₁, b₂, b₃, v₂) and (u₁, u₂, 0, 0):
-/// the lobe's albedo and five-point rule (the last weight of each rule is 1 minus the
-/// others), the second reflection's three-point rule (b, v) and, from the material's path
-/// table (`optics::brdf::path`, the same grid), the path delta and the rule for light that
-/// comes straight back through the top (W and the three-point rule t, u). Filled for every material, absorbing or not: the window
-/// changes the absorption without a new film binding.
+/// entry, row-major by roughness, `LOBE_VEC4S` vec4s holding `LOBE_SLOTS` slots in order:
+/// from the material's path table (`optics::brdf::path`, the same grid) the path delta, then
+/// the lobe's albedo, its five-point rule and the multiple scattering's rule (`energy::node`),
+/// then the rule for light that comes straight back through the top. Filled for every
+/// material, absorbing or not: the window changes the absorption without a new film binding.
 fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
     use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, node};
     let path = crate::optics::brdf::path::cached(stack.n0, stack.n2);
     (0..E1_MU * E1_ROUGHNESS)
         .flat_map(|k| {
-            let [e1, c1, c2, c3, c4, c5, w1, w2, w3, w4, b1, b2, b3, v1, v2] = node(k % E1_MU, k / E1_MU);
-            let [w, t1, t2, t3, u1, u2] = path.through_f32[k];
-            let entry: [[f32; 4]; LOBE_VEC4S] = [
-                [e1, c1, c2, c3],
-                [c4, c5, w1, path.delta_f32[k]],
-                [w, t1, t2, t3],
-                [w2, w3, w4, v1],
-                [b1, b2, b3, v2],
-                [u1, u2, 0.0, 0.0],
-            ];
+            let mut slots = [0.0f32; 4 * LOBE_VEC4S];
+            slots[0] = path.delta_f32[k];
+            slots[LOBE_NODE_SLOT..LOBE_THROUGH_SLOT].copy_from_slice(&node(k % E1_MU, k / E1_MU));
+            slots[LOBE_THROUGH_SLOT..LOBE_SLOTS].copy_from_slice(&path.through_f32[k]);
+            let entry: [[f32; 4]; LOBE_VEC4S] = std::array::from_fn(|v| std::array::from_fn(|c| slots[4 * v + c]));
             entry
         })
         .collect()

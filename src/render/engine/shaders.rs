@@ -9,7 +9,10 @@
 //! checks that no file spells a generated value out.
 
 use crate::maps::MapKind;
-use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, MS_NODES, ms_rule};
+use crate::optics::brdf::energy::{
+    E1_MU, E1_ROUGHNESS, LOBE_NODES, MS_NODES, PAIR_NODES, PAIR_SLOT, PAIR_WEIGHTS_SLOT, SHARE_SLOT, ms_rule,
+};
+use crate::optics::brdf::path::THROUGH_NODES;
 use crate::optics::brdf::{ALPHA_MIN, COS_MIN, LENGTH_MIN, Model};
 use crate::optics::fast::{BOX_NARROW_RAD, HARMONICS_DENOM_MIN, Q_NEGLIGIBLE, SINC_SMALL};
 use crate::optics::lut::{COARSE_MAX_NM, FINE_MAX_NM};
@@ -83,7 +86,17 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("GBUFFER_ALBEDO_GEOMETRY", "u32", format!("{GBUFFER_ALBEDO_GEOMETRY}u")),
         ("E1_MU", "u32", format!("{E1_MU}u")),
         ("E1_ROUGHNESS", "u32", format!("{E1_ROUGHNESS}u")),
+        // The lobe table's entries (render::engine::film::lobe_table) and the slots of a
+        // lobe node (optics::brdf::energy::node).
         ("LOBE_VEC4S", "u32", format!("{}u", super::film::LOBE_VEC4S)),
+        ("LOBE_NODE_SLOT", "u32", format!("{}u", super::film::LOBE_NODE_SLOT)),
+        ("LOBE_THROUGH_SLOT", "u32", format!("{}u", super::film::LOBE_THROUGH_SLOT)),
+        ("LOBE_NODES", "u32", format!("{LOBE_NODES}u")),
+        ("PAIR_NODES", "u32", format!("{PAIR_NODES}u")),
+        ("PAIR_SLOT", "u32", format!("{PAIR_SLOT}u")),
+        ("PAIR_WEIGHTS_SLOT", "u32", format!("{PAIR_WEIGHTS_SLOT}u")),
+        ("SHARE_SLOT", "u32", format!("{SHARE_SLOT}u")),
+        ("THROUGH_NODES", "u32", format!("{THROUGH_NODES}u")),
         // K and E's film thicknesses (render::engine::scene::BOUNCE_THICKNESSES) and the
         // scene uniform's table length.
         ("BOUNCE_THICKNESSES", "u32", format!("{BOUNCE_THICKNESSES}u")),
