@@ -223,9 +223,9 @@ fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, roughness: f32, k: v
 // The rule's two parts on one roughness row (energy::parts_on_row): the lobe's entries k
 // and k + LOBE_VEC4S mixed by fx; the single scattering E1 <F> (the film over the lobe's
 // microfacet angles, five-point Gauss rule) and what the top reflects beyond it, x: the
-// multiple scattering (1 - E1) <F> <F>2 (<F>2 the film over the second reflection's
-// cosines, its three-point rule) plus the light that comes straight back through the top,
-// q = (1 - <F>) W (u1 F(t1) + u2 F(t2) + (1 - u1 - u2) F(t3)).
+// multiple scattering (1 - E1) g, g = s sum_ij M_ij F(a_i) F(b_j) + (1 - s) <F>_a <F>_b^2
+// (energy::Multiple), plus the light that comes straight back through the top,
+// q = (1 - <F>) W <F>_back (its three-point rule).
 struct RowParts {
     single: vec3<f32>,
     beyond: vec3<f32>,
@@ -236,29 +236,38 @@ fn parts_on_row(layers: Layers, k: u32, fx: f32) -> RowParts {
     for (var i = 0u; i < LOBE_VEC4S; i++) {
         v[i] = mix(lobe_table[k + i], lobe_table[k + LOBE_VEC4S + i], fx);
     }
-    let e1 = lobe_slot(&v, LOBE_NODE_SLOT);
-    let mean = film_by_rule(layers, &v, LOBE_NODE_SLOT + 1u, LOBE_NODES);
-    // The multiple scattering (energy::Multiple::reflected).
-    var fa: array<vec3<f32>, PAIR_NODES>;
-    var fb: array<vec3<f32>, PAIR_NODES>;
-    for (var i = 0u; i < PAIR_NODES; i++) {
-        fa[i] = film_clamped(layers, lobe_slot(&v, LOBE_NODE_SLOT + PAIR_SLOT + i));
-        fb[i] = film_clamped(layers, lobe_slot(&v, LOBE_NODE_SLOT + PAIR_SLOT + PAIR_NODES + i));
+    // The film at every cosine the rule reads, in one loop: the lobe's nodes, the multiple
+    // scattering's (a, then b) and light straight back's. (One call site: the direct film
+    // methods' film is long, and Mesa inlines every call; written out, the rule's eighteen
+    // reads at X's sixteen nodes and six couplings made lavapipe compile the rgb3 pipeline
+    // for over ten minutes.)
+    var f: array<vec3<f32>, ROW_FILM_READS>;
+    for (var n = 0u; n < ROW_FILM_READS; n++) {
+        var s = LOBE_THROUGH_SLOT + 1u + n - LOBE_NODES - 2u * PAIR_NODES;
+        if (n < LOBE_NODES) {
+            s = LOBE_NODE_SLOT + 1u + n;
+        } else if (n < LOBE_NODES + 2u * PAIR_NODES) {
+            s = LOBE_NODE_SLOT + PAIR_SLOT + n - LOBE_NODES;
+        }
+        f[n] = film_clamped(layers, lobe_slot(&v, s));
     }
+    let e1 = lobe_slot(&v, LOBE_NODE_SLOT);
+    let mean = by_rule(&v, &f, LOBE_NODE_SLOT + 1u, 0u, LOBE_NODES);
+    // The multiple scattering (energy::Multiple::reflected).
     var both = vec3<f32>(0.0);
     var first = vec3<f32>(0.0);
     var second = vec3<f32>(0.0);
     for (var n = 0u; n < PAIR_NODES * PAIR_NODES; n++) {
         let m = lobe_slot(&v, LOBE_NODE_SLOT + PAIR_WEIGHTS_SLOT + n);
-        let i = n / PAIR_NODES;
-        let j = n % PAIR_NODES;
-        both += m * fa[i] * fb[j];
-        first += m * fa[i];
-        second += m * fb[j];
+        let fa = f[LOBE_NODES + n / PAIR_NODES];
+        let fb = f[LOBE_NODES + PAIR_NODES + n % PAIR_NODES];
+        both += m * fa * fb;
+        first += m * fa;
+        second += m * fb;
     }
     let twice = lobe_slot(&v, LOBE_NODE_SLOT + SHARE_SLOT);
     let multiple = twice * both + (1.0 - twice) * first * second * second;
-    let back = film_by_rule(layers, &v, LOBE_THROUGH_SLOT + 1u, THROUGH_NODES);
+    let back = by_rule(&v, &f, LOBE_THROUGH_SLOT + 1u, LOBE_NODES + 2u * PAIR_NODES, THROUGH_NODES);
     let q = (1.0 - mean) * lobe_slot(&v, LOBE_THROUGH_SLOT) * back;
     // x never more than the light the single scattering leaves (q's reweighting is an
     // estimate).
@@ -271,34 +280,41 @@ fn lobe_slot(v: ptr<function, array<vec4<f32>, LOBE_VEC4S>>, s: u32) -> f32 {
     return (*v)[s / 4u][s % 4u];
 }
 
-// The film by a rule of n nodes from slot s of a lobe table entry, then all but the last
-// weight (the last is 1 minus the others): energy::Rule::slots.
-fn film_by_rule(layers: Layers, v: ptr<function, array<vec4<f32>, LOBE_VEC4S>>, s: u32, n: u32) -> vec3<f32> {
+// A rule of n nodes from slot s of a lobe table entry, then all but the last weight (the
+// last is 1 minus the others: energy::Rule::slots), over the film read at its nodes, f[r..].
+fn by_rule(
+    v: ptr<function, array<vec4<f32>, LOBE_VEC4S>>,
+    f: ptr<function, array<vec3<f32>, ROW_FILM_READS>>,
+    s: u32,
+    r: u32,
+    n: u32,
+) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     var last = 1.0;
     for (var i = 0u; i + 1u < n; i++) {
         let w = lobe_slot(v, s + n + i);
-        sum += w * film_clamped(layers, lobe_slot(v, s + i));
+        sum += w * (*f)[r + i];
         last -= w;
     }
-    return sum + last * film_clamped(layers, lobe_slot(v, s + n - 1u));
+    return sum + last * (*f)[r + n - 1u];
 }
 
-// One node of the multiple-scatter normalisation on row j: node = (mu, 2 w mu).
-fn ms_norm_term(layers: Layers, j: u32, node: vec2<f32>) -> vec3<f32> {
-    let x = node.x * f32(E1_MU - 1u);
-    let i = min(u32(x), E1_MU - 2u);
-    return node.y * parts_on_row(layers, LOBE_VEC4S * (j * E1_MU + i), x - f32(i)).beyond;
-}
-
-// X = 2 int x(mu) mu dmu on row j, the multiple-scatter lobe's normalisation
-// (energy::ms_norm_on_row, its rule's eight nodes generated). The LUT and no-film
-// pipelines read it baked into the coupling texture (coupling_is_baked); the direct methods
-// pay these eight evaluations per row, once per pixel (with_ms_norms).
-fn ms_norm_on_row(layers: Layers, j: u32) -> vec3<f32> {
-    return ms_norm_term(layers, j, MS_NODE_0) + ms_norm_term(layers, j, MS_NODE_1) + ms_norm_term(layers, j, MS_NODE_2)
-        + ms_norm_term(layers, j, MS_NODE_3) + ms_norm_term(layers, j, MS_NODE_4) + ms_norm_term(layers, j, MS_NODE_5)
-        + ms_norm_term(layers, j, MS_NODE_6) + ms_norm_term(layers, j, MS_NODE_7);
+// X = 2 int x(mu) mu dmu on rows j and j + 1, the multiple-scatter lobe's normalisation
+// (energy::ms_norm_on_row, its rule's eight nodes (mu, 2 w mu) generated), in one loop (one
+// call site of parts_on_row, for the reason given there). The LUT and no-film pipelines
+// read it baked into the coupling texture (coupling_is_baked); the direct methods pay these
+// sixteen evaluations once per pixel (with_ms_norms).
+fn ms_norms_from_row(layers: Layers, j: u32) -> array<vec3<f32>, 2> {
+    var nodes = array<vec2<f32>, MS_NODES>(MS_NODE_0, MS_NODE_1, MS_NODE_2, MS_NODE_3, MS_NODE_4, MS_NODE_5, MS_NODE_6, MS_NODE_7);
+    var norms = array<vec3<f32>, 2>(vec3<f32>(0.0), vec3<f32>(0.0));
+    for (var n = 0u; n < 2u * MS_NODES; n++) {
+        let node = nodes[n % MS_NODES];
+        let row = n / MS_NODES;
+        let x = node.x * f32(E1_MU - 1u);
+        let i = min(u32(x), E1_MU - 2u);
+        norms[row] += node.y * parts_on_row(layers, LOBE_VEC4S * ((j + row) * E1_MU + i), x - f32(i)).beyond;
+    }
+    return norms;
 }
 
 // `layers` with X on the two roughness rows around its roughness filled in, where the
@@ -309,8 +325,9 @@ fn with_ms_norms(layers: Layers) -> Layers {
     var result = layers;
     if (BRDF_MODEL == MODEL_LAYERED && !coupling_is_baked()) {
         let j = lobe_row(layers.roughness);
-        result.ms_norm_lower = ms_norm_on_row(layers, j);
-        result.ms_norm_upper = ms_norm_on_row(layers, j + 1u);
+        let norms = ms_norms_from_row(layers, j);
+        result.ms_norm_lower = norms[0];
+        result.ms_norm_upper = norms[1];
     }
     return result;
 }

@@ -2,15 +2,15 @@
 //! transport, exactly"), with the rough top coupled to it by energy (`energy`).
 //!
 //! ```text
-//! s(μ)   = E₁ ⟨F⟩ + (1 − E₁) ⟨F⟩ ⟨F⟩₂ + q             what the rough top reflects
+//! s(μ)   = E₁ ⟨F⟩ + (1 − E₁) g + q                     what the rough top reflects
 //! f_ms   = ms(μi) ms(μo)                                 its multiple scattering
 //! a(μ)   = (1 − s(μ)) exp(−τ / cos_eff(μ, r))           light that enters and reaches the base
 //! f_diff = (n0/n2)² k_d a(μi) a(μo) / (π (1 − k_d K))
 //! ambient diffuse (sky along the normal) = a(μo) k_d E / (1 − k_d K)
 //! ```
 //!
-//! with ⟨F⟩ the film read at the lobe's microfacet angles, ⟨F⟩₂ at those of the second
-//! reflection of the light it scatters more than once and q the light straight back
+//! with ⟨F⟩ the film read at the lobe's microfacet angles, g the share of the light it
+//! scatters more than once that the film reflects (`energy::Multiple`), q the light straight back
 //! through the top (`energy::top`; `Model::coupling` passes s in), and cos_eff the cosine at which
 //! the light the rough top lets in crosses the pigment layer (`path`: Snell's cos_t at
 //! r = 0, more oblique as the top roughens).

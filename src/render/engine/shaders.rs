@@ -10,7 +10,8 @@
 
 use crate::maps::MapKind;
 use crate::optics::brdf::energy::{
-    E1_MU, E1_ROUGHNESS, LOBE_NODES, MS_NODES, PAIR_NODES, PAIR_SLOT, PAIR_WEIGHTS_SLOT, SHARE_SLOT, ms_rule,
+    E1_MU, E1_ROUGHNESS, LOBE_NODES, MS_NODES, PAIR_NODES, PAIR_SLOT, PAIR_WEIGHTS_SLOT, ROW_FILM_READS, SHARE_SLOT,
+    ms_rule,
 };
 use crate::optics::brdf::path::THROUGH_NODES;
 use crate::optics::brdf::{ALPHA_MIN, COS_MIN, LENGTH_MIN, Model};
@@ -97,6 +98,8 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("PAIR_WEIGHTS_SLOT", "u32", format!("{PAIR_WEIGHTS_SLOT}u")),
         ("SHARE_SLOT", "u32", format!("{SHARE_SLOT}u")),
         ("THROUGH_NODES", "u32", format!("{THROUGH_NODES}u")),
+        ("ROW_FILM_READS", "u32", format!("{ROW_FILM_READS}u")),
+        ("MS_NODES", "u32", format!("{MS_NODES}u")),
         // K and E's film thicknesses (render::engine::scene::BOUNCE_THICKNESSES) and the
         // scene uniform's table length.
         ("BOUNCE_THICKNESSES", "u32", format!("{BOUNCE_THICKNESSES}u")),
