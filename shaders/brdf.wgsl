@@ -361,8 +361,9 @@ fn coupling_table(layers: Layers, cos: f32) -> Top {
 // its thickness is zero (column 0 is the film at d = 0, optics::lut::Lut::texel_thickness)
 // and at every thickness where n1 = n0, as the LUT pipeline holds any film (in the film
 // table's white balance and half floats, linear between cos texels). Evaluating the rule
-// instead cost that pipeline X on two rows per pixel and ten Fresnel terms per direction
-// (five on each row) where the table costs two fetches (on lavapipe, xenopeltis-unicolor
+// instead cost that pipeline X on two rows per pixel and, when this was measured, ten
+// Fresnel terms per direction (five on each row; ROW_FILM_READS on each row now) where
+// the table costs two fetches (on lavapipe, xenopeltis-unicolor
 // without its film 267 ms a frame against 111 ms for the LUT pipeline with it).
 fn coupling_is_baked() -> bool {
     return FILM_METHOD == FILM_LUT || FILM_METHOD == FILM_NONE;

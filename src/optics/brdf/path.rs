@@ -82,13 +82,15 @@ pub struct PathTable {
     pub n0: f64,
     pub n2: f64,
     pub delta: Vec<f64>,
-    /// `delta` in f32, as the shader holds it (the last slot of the lobe table's second
-    /// vec4, and the film table's coupling texture: `lut::Lut::coupling`).
+    /// `delta` in f32, as the shader holds it (the first slot of each lobe table entry,
+    /// `render::engine::film::lobe_table`, and the film table's coupling texture:
+    /// `lut::Lut::coupling`).
     pub delta_f32: Vec<f32>,
     /// Per entry (the same grid), the rule for light that comes straight back through the
     /// top (the module's q): [W, t₁, t₂, t₃, u₁, u₂] (`THROUGH_LEN`). W = 0 on row r = 0.
     pub through: Vec<[f64; THROUGH_LEN]>,
-    /// `through` in f32, as the shader holds it (the lobe table's third and sixth vec4s).
+    /// `through` in f32, as the shader holds it (each lobe table entry's slots from
+    /// `render::engine::film::LOBE_THROUGH_SLOT`).
     pub through_f32: Vec<[f32; THROUGH_LEN]>,
 }
 

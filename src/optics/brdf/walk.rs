@@ -419,19 +419,13 @@ pub struct MultipleReflection {
 
 /// Every photon arriving from `wi` (unit, wi.z > 0) that meets a rough top more than once,
 /// walked until `twice` of them have reflected exactly twice or `photons` have arrived (so
-/// that smooth tops, which scatter little more than once, still give enough), and the
-/// number of photons walked. The top reflects everything (F = 1 at every microfacet, so
-/// no photon enters), walked as `follow` walks it. A film that reflects F(c) at cosine c
+/// that smooth tops, which scatter little more than once, still give enough). The top
+/// reflects everything (F = 1 at every microfacet, so no photon enters), walked as
+/// `follow` walks it. A film that reflects F(c) at cosine c
 /// returns such a path with probability Π F(c_k) over its cosines, and the directions
 /// after each reflection do not depend on F, so these paths are the film's multiple
 /// scattering exactly; `energy`'s rule for it is built from them.
-pub fn multiple_reflections(
-    wi: V3,
-    alpha: f64,
-    twice: usize,
-    photons: u64,
-    seed: u64,
-) -> (Vec<MultipleReflection>, u64) {
+pub fn multiple_reflections(wi: V3, alpha: f64, twice: usize, photons: u64, seed: u64) -> Vec<MultipleReflection> {
     let (count, first, second) = (std::cell::Cell::new(0usize), std::cell::Cell::new(0.0), std::cell::Cell::new(0.0));
     let mirror = |_: bool, cos: f64| {
         match count.get() {
@@ -454,7 +448,7 @@ pub fn multiple_reflections(
             reflected_twice += usize::from(count.get() == 2);
         }
     }
-    (paths, walked)
+    paths
 }
 
 /// GGX α of the walk's top: 0 (a mirror, m = n) for roughness 0, else roughness² floored

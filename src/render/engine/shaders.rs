@@ -54,8 +54,8 @@ fn vec4_literal(v: [f64; 4]) -> String {
 }
 
 /// The shared numbers as WGSL `const` declarations: (name, WGSL type, value).
-/// `brdf.wgsl`'s `ms_norm_on_row` sums the rule's nodes one by one.
-const _: () = assert!(MS_NODES == 8, "brdf.wgsl's ms_norm_on_row sums eight nodes");
+/// `brdf.wgsl`'s `ms_norms_from_row` lists the rule's eight node constants in an array.
+const _: () = assert!(MS_NODES == 8, "brdf.wgsl's ms_norms_from_row lists eight nodes");
 
 pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
     let mut c: Vec<(&'static str, &'static str, String)> = vec![
