@@ -317,7 +317,8 @@ const MULTIPLE_MIN: usize = 128;
 ///   cosines: 1.07, 0.98, 0.19, 0.16, 0.87 (right only by cancellation: the first
 ///   reflection of such light is more grazing than single scattering's, and the 43 % that
 ///   reflect three times or more are counted as reflecting twice);
-/// - every path's F(c₁) F(c₂) exactly, further reflections dropped: 2.49, 1.75, 0.77;
+/// - every path's F(c₁) F(c₂) exactly, further reflections dropped: 2.49, 1.75, 0.77,
+///   0.08, 0.34;
 /// - split by the number of reflections, each cosine its own mean: 1.07, 0.69, 0.32, 0.05,
 ///   0.07 (at 0° the two cosines of a path are correlated: where the first facet faces
 ///   the light, the second faces away);
@@ -388,15 +389,26 @@ impl Multiple {
 
     /// g for a film of one channel, `film(c)`.
     pub fn reflected(&self, film: impl Fn(f64) -> f64) -> f64 {
-        let (fa, fb) = (self.first.map(&film), self.second.map(&film));
-        let (mut both, mut first, mut second) = (0.0, 0.0, 0.0);
-        for (i, row) in self.weights.iter().enumerate() {
-            for (j, m) in row.iter().enumerate() {
-                (both, first, second) = (both + m * fa[i] * fb[j], first + m * fa[i], second + m * fb[j]);
-            }
-        }
-        self.twice * both + (1.0 - self.twice) * first * second * second
+        reflected_by_pairs(self.weights.as_flattened(), &self.first.map(&film), &self.second.map(&film), self.twice)
     }
+}
+
+/// g of `Multiple` (its one formula, in f64 here and in f32 on the film table's
+/// interpolated slots, `top_impl!`): the film `fa` at the first reflection's nodes and `fb`
+/// at the second's, `weights` M row by row, `twice` the share of light reflected exactly
+/// twice.
+pub(crate) fn reflected_by_pairs<T>(weights: &[T], fa: &[T; PAIR_NODES], fb: &[T; PAIR_NODES], twice: T) -> T
+where
+    T: Copy + From<f32> + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Mul<Output = T>,
+{
+    debug_assert_eq!(weights.len(), PAIR_NODES * PAIR_NODES, "M has PAIR_NODES² weights");
+    let zero = T::from(0.0);
+    let (mut both, mut first, mut second) = (zero, zero, zero);
+    for (k, &m) in weights.iter().enumerate() {
+        let (i, j) = (k / PAIR_NODES, k % PAIR_NODES);
+        (both, first, second) = (both + m * fa[i] * fb[j], first + m * fa[i], second + m * fb[j]);
+    }
+    twice * both + (T::from(1.0) - twice) * first * second * second
 }
 
 /// The orthonormal polynomials of degree 1 and 2 of a rule's distribution (its own inner
@@ -614,15 +626,9 @@ macro_rules! top_impl {
             let (first, second) = v[PAIR_SLOT..PAIR_WEIGHTS_SLOT].split_at(PAIR_NODES);
             let fa: [[$t; 3]; PAIR_NODES] = std::array::from_fn(|i| film(first[i]));
             let fb: [[$t; 3]; PAIR_NODES] = std::array::from_fn(|j| film(second[j]));
-            let twice = v[SHARE_SLOT];
             let multiple = [0, 1, 2].map(|c| {
-                let (mut both, mut first, mut second) = (0.0, 0.0, 0.0);
-                for (k, m) in v[PAIR_WEIGHTS_SLOT..SHARE_SLOT].iter().enumerate() {
-                    let (i, j) = (k / PAIR_NODES, k % PAIR_NODES);
-                    (both, first, second) =
-                        (both + m * fa[i][c] * fb[j][c], first + m * fa[i][c], second + m * fb[j][c]);
-                }
-                twice * both + (1.0 - twice) * first * second * second
+                let (fa, fb) = (fa.map(|f| f[c]), fb.map(|f| f[c]));
+                reflected_by_pairs(&v[PAIR_WEIGHTS_SLOT..SHARE_SLOT], &fa, &fb, v[SHARE_SLOT])
             });
             let q = match through {
                 [] => [0.0; 3],
@@ -916,9 +922,10 @@ mod tests {
         assert!((uncorrelated - mean(&|a, b| a * b) + covariance).abs() < 1e-9, "w vᵀ misses the covariance");
     }
 
-    /// The tables' rule as `parts_on_row` reads it (interpolated slots, written out per
-    /// channel) is `Multiple::reflected` of the node's own walk: at a node, with no light
-    /// straight back, x = (1 − E₁) g.
+    /// The tables' rule as `parts_on_row` reads it (the node's slots, per channel) is
+    /// `Multiple::reflected` of the node's own walk: at a node, with no light straight
+    /// back, x = (1 − E₁) g. Both evaluate g by `reflected_by_pairs`; this pins the slots
+    /// (nodes, weights row by row, share) to the rule's fields.
     #[test]
     fn parts_on_row_reads_the_multiple_scattering_as_the_rule_says() {
         let film = |c: f64| [0.04 + 0.5 * (1.0 - c).powi(3), 0.2 + 0.1 * (7.0 * c).sin(), 0.3 * c * c];

@@ -420,11 +420,11 @@ pub struct MultipleReflection {
 /// Every photon arriving from `wi` (unit, wi.z > 0) that meets a rough top more than once,
 /// walked until `twice` of them have reflected exactly twice or `photons` have arrived (so
 /// that smooth tops, which scatter little more than once, still give enough). The top
-/// reflects everything (F = 1 at every microfacet, so no photon enters), walked as
-/// `follow` walks it. A film that reflects F(c) at cosine c
-/// returns such a path with probability Π F(c_k) over its cosines, and the directions
-/// after each reflection do not depend on F, so these paths are the film's multiple
-/// scattering exactly; `energy`'s rule for it is built from them.
+/// reflects everything (F = 1 at every microfacet, so no photon enters), walked as `follow`
+/// walks it. A film that reflects F(c) at cosine c returns such a path with probability
+/// Π F(c_k) over its cosines, and the directions after each reflection do not depend on F,
+/// so these paths are the film's multiple scattering exactly; `energy`'s rule for it is
+/// built from them.
 pub fn multiple_reflections(wi: V3, alpha: f64, twice: usize, photons: u64, seed: u64) -> Vec<MultipleReflection> {
     let (count, first, second) = (std::cell::Cell::new(0usize), std::cell::Cell::new(0.0), std::cell::Cell::new(0.0));
     let mirror = |_: bool, cos: f64| {
