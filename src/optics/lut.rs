@@ -11,9 +11,9 @@
 //!
 //! **The rough top's coupling, tabulated.** The layered model reads, per direction, what the
 //! rough top reflects (`brdf::energy::top`): the rule on the two roughness rows of the lobe
-//! around the roughness, each eighteen film lookups (`energy::ROW_FILM_READS`), and the multiple-scatter lobe's
-//! normalisation on both rows, eight more evaluations of the rule each, where the thesis
-//! model makes one lookup.
+//! around the roughness, each eighteen film lookups (`energy::ROW_FILM_READS`), and the
+//! multiple-scatter lobe's normalisation on both rows, eight more evaluations of the rule
+//! each, where the thesis model makes one lookup.
 //! Baked with the table on its cos texels, the same rows and its thickness columns, it is
 //! one trilinear lookup (`coupling_f32`; in the shader two filtered 3-D texture fetches,
 //! one per RGBA half) that interpolates between rows as the rule does; between cos texels and

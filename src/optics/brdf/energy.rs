@@ -594,10 +594,11 @@ macro_rules! top_impl {
         /// single scattering E₁ ⟨F⟩ (the film averaged over the lobe's microfacet angles by
         /// the five-point Gauss rule) and what the top reflects beyond it,
         /// x = (1 − E₁) g + q: the multiple scattering (g by its rule, `Multiple`, here read
-        /// from the node's interpolated slots) and the light that comes straight back through the top,
-        /// q = (1 − ⟨F⟩) W ⟨F⟩_back with the material's rule `through` (W and a three-point
-        /// rule for the last reflection's cosine: `path::PathTable::through`; empty: none).
-        /// The lobe and the rule interpolated linearly in μ.
+        /// from the node's interpolated slots) and the light that comes straight back
+        /// through the top, q = (1 − ⟨F⟩) W ⟨F⟩_back with the material's rule `through` (W
+        /// and a three-point rule for the last reflection's cosine:
+        /// `path::PathTable::through`; empty: none). The lobe and the rule interpolated
+        /// linearly in μ.
         pub fn $parts(
             cos: $t,
             i_r: usize,
