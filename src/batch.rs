@@ -53,8 +53,8 @@ pub enum BatchError {
     Shard(String),
     /// Two different jobs whose sets would go to the same folder and overwrite each other.
     #[error(
-        "{path}: jobs {first} and {second} ({preset}) would both write {folder} with different output; give the \
-         presets different names (a preset's name is its `name` key or its file name)"
+        "{path}: jobs {first} and {second} ({preset}) would both write {folder} with different output; rename one of \
+         the preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)"
     )]
     SameFolder { path: PathBuf, first: usize, second: usize, preset: String, folder: PathBuf },
 }

@@ -78,7 +78,11 @@ impl MapKind {
     pub fn meaning(self, convention: NormalConvention) -> String {
         match self {
             MapKind::Color => "visible diffuse colour (the manifest's color_means)".into(),
-            MapKind::Height => "relative surface height, 0 = lowest".into(),
+            MapKind::Height => {
+                "relative surface height on the preset's fixed scale: 0 = below its deepest groove, 1 = the tallest \
+                 scale it can draw (not stretched to the map's own range)"
+                    .into()
+            }
             MapKind::Normal => {
                 let y = match convention {
                     NormalConvention::OpenGl => "OpenGL convention, +Y up",

@@ -133,7 +133,7 @@ impl Pack {
             channels: vec![HEIGHT],
             bit_depth: 16,
             srgb: false,
-            meaning: "grey: relative surface height, 0 = lowest (displacement or parallax)",
+            meaning: "grey: relative surface height on the preset's fixed scale, as the height map (displacement or parallax)",
         };
         let mut textures = match self {
             Pack::Gltf => vec![

@@ -194,7 +194,8 @@ pub struct ExportArgs {
     #[command(flatten)]
     pub source: PresetSource,
     /// The file to write: NAME.glb (everything in one binary file) or NAME.gltf (JSON, with
-    /// NAME.bin and NAME_<texture>.png beside it).
+    /// NAME.bin and NAME.basecolor.png, NAME.normal.png, NAME.orm.png and,
+    /// with a film, NAME.thickness.png beside it).
     #[arg(long, value_name = "FILE")]
     pub gltf: PathBuf,
     /// Texture width in pixels (a body atlas is `body.length` widths tall; WebGL viewers
@@ -222,8 +223,10 @@ pub struct BatchArgs {
     /// and `set = { "scales.rows" = 23 }`. Every combination of seeds and sizes is one job.
     #[arg(value_name = "JOBS.toml")]
     pub jobs: PathBuf,
-    /// Output folder: each job writes DIR/<preset>/<layout>-<size>-seed<seed>-<format>/, and
-    /// the run an index of its jobs (DIR/index.json, or index.shard-K-of-N.json).
+    /// Output folder: each job writes
+    /// DIR/<preset>/<layout>-<size>-seed<seed>-<format or pack-ENGINE>[-<maps>][-set<hash>]/
+    /// (the maps joined by + when not all five, the overrides' hash when the job has `set`),
+    /// and the run an index of its jobs (DIR/index.json, or index.shard-K-of-N.json).
     #[arg(short, long, value_name = "DIR")]
     pub out: PathBuf,
     /// Run only the jobs whose index is K modulo N (K from 0): one array task's share, the
@@ -384,7 +387,7 @@ pub enum Convention {
 
 #[derive(Debug, Subcommand)]
 pub enum PresetsCommand {
-    /// One preset per line: name, common name, category.
+    /// One preset per line under a header: name, species (scientific name), common name, category.
     List,
     /// Print a preset's TOML.
     Show { name: String },

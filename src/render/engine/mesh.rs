@@ -3,11 +3,13 @@
 //! convention of DESIGN.md (u around the body, seam on the belly; v along it, head to tail).
 //!
 //! Design rule: the texture repeats along the body at the aspect it was generated for: one
-//! texture width is one circumference at the thickest point, and one texture height is the same
-//! length along the body, so scales stay as round as the generator drew them. Near the
-//! tail the circumference shrinks and so do the scales, as on a real snake. Normals and
-//! tangents come from the same parametric surface (finite differences of the grid), so normal
-//! mapping follows `∂P/∂u` and `-∂P/∂v` (OpenGL's +Y points up the image).
+//! texture width is the circumference where it lies, and one texture height is the same
+//! length along the body, so scales stay as round as the generator drew them and shrink with
+//! the girth towards the tail and the snout. Below a quarter of the full girth (the last
+//! tenth of the tail, the snout's tip) they stop shrinking along the body, or v would run
+//! without bound into the point. Normals and tangents come from the same parametric surface
+//! (finite differences of the grid), so normal mapping follows `∂P/∂u` and `-∂P/∂v`
+//! (OpenGL's +Y points up the image).
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -76,9 +78,7 @@ impl BodyShape {
         let arc = *base.arc_table(2000).last().expect("arc table");
         // The cross-section is an ellipse of semi-axes r and flatten · r: its perimeter
         // (Ramanujan's approximation) is the circumference one texture width spans.
-        let (a, b) = (1.0, base.flatten);
-        let perimeter = std::f32::consts::PI * (3.0 * (a + b) - ((3.0 * a + b) * (a + 3.0 * b)).sqrt());
-        BodyShape { radius: arc / (perimeter * plan.length.max(1.0)), ..base }
+        BodyShape { radius: arc / (ellipse_perimeter(base.flatten) * plan.length.max(1.0)), ..base }
     }
 
     /// Arc length of the centre line from the snout to s = i / n, i = 0 ..= n.
@@ -125,9 +125,10 @@ impl BodyShape {
         self.radius * profile
     }
 
-    /// World-space length of one texture repeat along the body (one circumference).
-    pub fn texture_length(&self) -> f32 {
-        2.0 * std::f32::consts::PI * self.radius
+    /// World-space length of one tile repeat along the body at s (`radius_at`'s parameter):
+    /// the circumference there, at least `SMALLEST_TILE_GIRTH` of the full one (module doc).
+    pub fn tile_length_at(&self, s: f32) -> f32 {
+        ellipse_perimeter(self.flatten) * self.radius_at(s).max(SMALLEST_TILE_GIRTH * self.radius)
     }
 
     /// A point on the surface at body parameter s and around-angle u (0 = belly, 0.5 = back).
@@ -163,11 +164,21 @@ impl BodyShape {
             let t = x - i as f32;
             (fine[i] + (fine[i + 1] - fine[i]) * t) / fine[fine.len() - 1]
         };
-        // The tile repeats every circumference; an atlas spans the whole length once.
-        let repeat = if self.atlas.is_some() { arc[rings] } else { self.texture_length() };
+        // An atlas spans the whole length once; the tile repeats every circumference, summed
+        // ring by ring (the midpoint rule: 480 rings put v within 1.2e-3 of 19,200 rings).
+        let v: Vec<f32> = match self.atlas {
+            Some(_) => arc.iter().map(|a| a / arc[rings]).collect(),
+            None => std::iter::once(0.0)
+                .chain((1..=rings).scan(0.0, |v, i| {
+                    let middle = (i as f32 - 0.5) / rings as f32;
+                    *v += (arc[i] - arc[i - 1]) / self.tile_length_at(middle);
+                    Some(*v)
+                }))
+                .collect(),
+        };
         let mut vertices = Vec::with_capacity((rings + 1) * (segments + 1));
         let (du, ds) = (1e-3f32, 1e-3f32);
-        for (i, arc_i) in arc.iter().enumerate() {
+        for (i, v_i) in v.iter().enumerate() {
             let s = i as f32 / rings as f32;
             for j in 0..=segments {
                 let u = j as f32 / segments as f32;
@@ -184,15 +195,35 @@ impl BodyShape {
                 } else if normal.dot(outward) < 0.0 {
                     normal = -normal;
                 }
-                let tangent = dpdu.normalize_or(normal.any_orthonormal_vector());
+                // At a closed end the ring is one point and ∂P/∂u vanishes: the frame takes
+                // the direction round the body from the next ring inwards, so the end's
+                // tangents and their handedness agree with their neighbours'.
+                let round = if dpdu.length() > 1e-9 {
+                    dpdu
+                } else {
+                    let inward = if s < 0.5 { s + 1.0 / rings as f32 } else { s - 1.0 / rings as f32 };
+                    self.surface(inward, u + du, &along).0 - self.surface(inward, u - du, &along).0
+                };
+                let tangent = (round - normal * round.dot(normal)).normalize_or(normal.any_orthonormal_vector());
                 // "Up the image" is −v, i.e. towards the head.
-                vertices.push(Vertex::new(p, normal, tangent, -dpds, [u, arc_i / repeat]));
+                vertices.push(Vertex::new(p, normal, tangent, -dpds, [u, *v_i]));
             }
         }
         let mut mesh = Mesh { vertices, indices: grid_indices(rings, segments) };
         mesh.orient_outward();
         mesh
     }
+}
+
+/// The share of the full girth below which the tile stops shrinking along the body (module
+/// doc): a quarter, reached 90 % of the way to the tail's point (`radius_at`'s taper).
+const SMALLEST_TILE_GIRTH: f32 = 0.25;
+
+/// The perimeter of the cross-section, an ellipse of semi-axes 1 and `flatten`
+/// (Ramanujan's first approximation, within 1e-4 relative for these shapes).
+fn ellipse_perimeter(flatten: f32) -> f32 {
+    let (a, b) = (1.0, flatten);
+    std::f32::consts::PI * (3.0 * (a + b) - ((3.0 * a + b) * (a + 3.0 * b)).sqrt())
 }
 
 impl Vertex {
@@ -282,14 +313,21 @@ impl Mesh {
         for i in 0..=rings {
             let v = i as f32 / rings as f32;
             let theta = std::f32::consts::PI * v;
+            // The poles exactly (sin π is 8.7e-8 in f32), so that their rings are one point
+            // and their triangles are dropped as zero-area below.
+            let (sin_theta, cos_theta) = match i {
+                0 => (0.0, 1.0),
+                _ if i == rings => (0.0, -1.0),
+                _ => theta.sin_cos(),
+            };
             for j in 0..=segments {
                 let u = j as f32 / segments as f32;
                 let phi = 2.0 * std::f32::consts::PI * u;
-                let normal = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+                let normal = Vec3::new(sin_theta * phi.cos(), cos_theta, -sin_theta * phi.sin());
                 // ∂P/∂u (its direction does not depend on θ, so it is defined at the poles).
                 let tangent = Vec3::new(-phi.sin(), 0.0, -phi.cos());
                 // Up the image (−v) is towards the north pole: −∂P/∂θ.
-                let up_image = -Vec3::new(theta.cos() * phi.cos(), -theta.sin(), -theta.cos() * phi.sin());
+                let up_image = -Vec3::new(cos_theta * phi.cos(), -sin_theta, -cos_theta * phi.sin());
                 let uv = [u * repeats, v * repeats * 0.5];
                 vertices.push(Vertex::new(normal * radius, normal, tangent, up_image, uv));
             }
@@ -300,16 +338,28 @@ impl Mesh {
     }
 
     /// The mesh without zero-area triangles (a tube's closed ends, where a ring collapses to
-    /// a point): nothing a renderer would draw, but validators flag them.
-    pub fn without_degenerate_triangles(mut self) -> Mesh {
+    /// a point) and without the vertices no triangle then uses: nothing a renderer would
+    /// draw, but validators and tangent generators trip on them.
+    pub fn without_degenerate_triangles(self) -> Mesh {
         let vertices = &self.vertices;
         let area = |t: &[u32]| {
             let p = |k: usize| Vec3::from(vertices[t[k] as usize].position);
             (p(1) - p(0)).cross(p(2) - p(0)).length()
         };
-        let indices: Vec<u32> = self.indices.chunks_exact(3).filter(|t| area(t) > 1e-12).flatten().copied().collect();
-        self.indices = indices;
-        self
+        let kept: Vec<u32> = self.indices.chunks_exact(3).filter(|t| area(t) > 1e-12).flatten().copied().collect();
+        // Renumber the used vertices in their old order.
+        let mut new_index = vec![u32::MAX; vertices.len()];
+        for &i in &kept {
+            new_index[i as usize] = 0;
+        }
+        let mut used = Vec::with_capacity(vertices.len());
+        for (i, vertex) in vertices.iter().enumerate() {
+            if new_index[i] == 0 {
+                new_index[i] = used.len() as u32;
+                used.push(*vertex);
+            }
+        }
+        Mesh { vertices: used, indices: kept.iter().map(|&i| new_index[i as usize]).collect() }
     }
 
     /// Axis-aligned bounds (min, max).
@@ -375,13 +425,96 @@ mod tests {
         assert!(first.iter().all(|v| (Vec3::from(v.position) - Vec3::from(first[0].position)).length() < 1e-5));
     }
 
+    /// Where a tube's end collapses to a point, each vertex's tangent frame continues the
+    /// next ring's: the same handedness and nearly the same direction round the body.
+    /// Negative control: the frame a vanishing ∂P/∂u would give (any vector orthogonal to
+    /// the normal) has one handedness for the whole ring, which the neighbours do not share.
     #[test]
-    fn v_advances_one_texture_per_circumference() {
-        let shape = BodyShape { rings: 200, segments: 16, ..BodyShape::default() };
+    fn the_closed_ends_frames_continue_the_next_rings() {
+        let shape = BodyShape { rings: 120, segments: 24, ..BodyShape::default() };
         let mesh = shape.mesh();
-        let last = mesh.vertices.last().unwrap();
-        // The S-curve is longer than its chord; the texture repeats several times.
-        let chord_repeats = shape.length * 0.8 / shape.texture_length();
-        assert!(last.uv[1] > chord_repeats && last.uv[1] < 2.0 * chord_repeats, "{}", last.uv[1]);
+        let stride = 25;
+        let tangent = |v: &Vertex| Vec3::new(v.tangent[0], v.tangent[1], v.tangent[2]);
+        for (end, next) in [(0, stride), (120 * stride, 119 * stride)] {
+            for j in 0..stride {
+                let (a, b) = (&mesh.vertices[end + j], &mesh.vertices[next + j]);
+                assert_eq!(a.tangent[3], b.tangent[3], "ring {end} vertex {j}: {a:?} against {b:?}");
+                assert!(tangent(a).dot(tangent(b)) > 0.5, "ring {end} vertex {j}: {a:?} against {b:?}");
+            }
+        }
+    }
+
+    /// The meshes `export --gltf` writes keep no zero-area triangle and no vertex that no
+    /// triangle uses (a sphere's poles, a tube's closed ends), and the triangles kept are
+    /// the tube's own (the same corner positions, in order).
+    #[test]
+    fn exported_meshes_keep_no_zero_area_triangles_or_unused_vertices() {
+        let tube = BodyShape { rings: 60, segments: 12, ..BodyShape::default() }.mesh();
+        for (name, mesh) in [("sphere", Mesh::sphere(0.5, 2.0, 16, 32)), ("tube", tube.clone())] {
+            let clean = mesh.clone().without_degenerate_triangles();
+            let position = |m: &Mesh, i: u32| Vec3::from(m.vertices[i as usize].position);
+            let mut used = vec![false; clean.vertices.len()];
+            for t in clean.indices.chunks_exact(3) {
+                let area = (position(&clean, t[1]) - position(&clean, t[0]))
+                    .cross(position(&clean, t[2]) - position(&clean, t[0]))
+                    .length();
+                assert!(area > 1e-9, "{name}: a zero-area triangle {t:?} ({area})");
+                t.iter().for_each(|&i| used[i as usize] = true);
+            }
+            assert!(used.iter().all(|&u| u), "{name}: {} unused vertices", used.iter().filter(|&&u| !u).count());
+            let corners = |m: &Mesh| -> Vec<Vec3> { m.indices.iter().map(|&i| position(m, i)).collect() };
+            let kept: Vec<Vec3> = mesh
+                .indices
+                .chunks_exact(3)
+                .filter(|t| {
+                    (position(&mesh, t[1]) - position(&mesh, t[0]))
+                        .cross(position(&mesh, t[2]) - position(&mesh, t[0]))
+                        .length()
+                        > 1e-9
+                })
+                .flatten()
+                .map(|&i| position(&mesh, i))
+                .collect();
+            assert_eq!(corners(&clean), kept, "{name}");
+            // `Mesh::sphere` drops its poles' triangles itself.
+            if name == "tube" {
+                assert!(clean.vertices.len() < mesh.vertices.len(), "{name}: nothing dropped");
+            }
+        }
+    }
+
+    /// The tile stays square on the body: for every ring behind the snout's dome and wider
+    /// than a third of the full girth, the ring's length round the body (one texture width) against the length along
+    /// the centre line that one texture height spans there, measured on the mesh's own
+    /// positions and v. Negative control: a repeat of one full-girth circumference (the
+    /// earlier rule) is off by the girth's ratio, ten times the tolerance at a third.
+    #[test]
+    fn the_tile_stays_square_as_the_girth_changes() {
+        let shape = BodyShape { rings: 480, segments: 64, ..BodyShape::default() };
+        let mesh = shape.mesh();
+        let stride = 65;
+        let position = |i: usize, j: usize| Vec3::from(mesh.vertices[i * stride + j].position);
+        let mut checked = 0;
+        for i in 1..480 {
+            let s = i as f32 / 480.0;
+            // Past the snout's dome (its first 3.5 %), where the girth grows by a fifth or more
+            // from one ring to the next and the ring-by-ring sum lags the centre's slope.
+            if s < 0.035 || shape.radius_at(s) < shape.radius / 3.0 {
+                continue;
+            }
+            let round: f32 = (0..64).map(|j| (position(i, j + 1) - position(i, j)).length()).sum();
+            let (next, previous) = (shape.centre((i + 1) as f32 / 480.0), shape.centre((i - 1) as f32 / 480.0));
+            let dv = mesh.vertices[(i + 1) * stride].uv[1] - mesh.vertices[(i - 1) * stride].uv[1];
+            let along_per_texture = (next - previous).length() / dv;
+            let aspect = round / along_per_texture;
+            assert!((aspect - 1.0).abs() < 0.02, "ring {i}: width / height of a texel {aspect}");
+            checked += 1;
+        }
+        assert!(checked > 400, "{checked} rings checked");
+        // Below the smallest girth the tile's length stops shrinking: v at the tail's point
+        // is finite and the tile repeats about twice as often as on the chord at full girth.
+        let last = mesh.vertices.last().unwrap().uv[1];
+        let chord_repeats = shape.length * 0.8 / (ellipse_perimeter(shape.flatten) * shape.radius);
+        assert!(last.is_finite() && last > chord_repeats && last < 3.0 * chord_repeats, "{last}");
     }
 }
