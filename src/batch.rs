@@ -37,6 +37,8 @@ pub const MAX_FILE_BYTES: u64 = 1 << 20;
 pub enum BatchError {
     #[error("cannot read jobs file {path}: {source}")]
     Read { path: PathBuf, source: std::io::Error },
+    #[error("cannot read jobs file {path}: it is {kind}; a jobs file must be a regular file")]
+    NotAFile { path: PathBuf, kind: &'static str },
     #[error("jobs file {path} is {bytes} bytes; jobs files are limited to {limit} bytes")]
     TooLarge { path: PathBuf, bytes: u64, limit: u64 },
     /// TOML syntax, an unknown key or a wrong type, at a line and column.
@@ -45,6 +47,9 @@ pub enum BatchError {
     /// A value outside what a job accepts.
     #[error("{path}: job {job} ({preset}): {message}")]
     Invalid { path: PathBuf, job: usize, preset: String, message: String },
+    /// The job's preset, or its `set` overrides, refused (the preset's own message).
+    #[error("{path}: job {job} ({preset}): {source}")]
+    Preset { path: PathBuf, job: usize, preset: String, source: crate::preset::PresetError },
     #[error("{path}: no [[job]] tables; a jobs file lists jobs as [[job]] tables with at least a preset key")]
     Empty { path: PathBuf },
     #[error("{path}: {count} jobs after expanding seeds and sizes; at most {max} per file")]
@@ -64,10 +69,8 @@ pub enum BatchError {
 #[serde(deny_unknown_fields)]
 struct JobTable {
     preset: String,
-    #[serde(default)]
-    seeds: Vec<u64>,
-    #[serde(default)]
-    sizes: Vec<u64>,
+    seeds: Option<Vec<u64>>,
+    sizes: Option<Vec<u64>>,
     maps: Option<String>,
     format: Option<String>,
     pack: Option<String>,
@@ -157,12 +160,12 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
 
 /// Reads and expands a jobs file; every value is checked before any job runs.
 pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
-    let read = |source| BatchError::Read { path: path.into(), source };
-    let meta = std::fs::metadata(path).map_err(read)?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(BatchError::TooLarge { path: path.into(), bytes: meta.len(), limit: MAX_FILE_BYTES });
-    }
-    let text = std::fs::read_to_string(path).map_err(read)?;
+    use crate::text_file::BoundedReadError;
+    let text = crate::text_file::read_bounded(path, MAX_FILE_BYTES).map_err(|e| match e {
+        BoundedReadError::Io(source) => BatchError::Read { path: path.into(), source },
+        BoundedReadError::NotAFile(kind) => BatchError::NotAFile { path: path.into(), kind },
+        BoundedReadError::TooLarge(bytes) => BatchError::TooLarge { path: path.into(), bytes, limit: MAX_FILE_BYTES },
+    })?;
     let file: JobsFile = toml::from_str(&text).map_err(|e| {
         let (line, column) = e.span().map_or((1, 1), |s| line_column(&text, s.start));
         BatchError::Parse { path: path.into(), line, column, message: e.message().to_string() }
@@ -171,7 +174,8 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         return Err(BatchError::Empty { path: path.into() });
     }
     let base = path.parent().unwrap_or(Path::new("."));
-    let count: usize = file.job.iter().map(|t| t.seeds.len().max(1).saturating_mul(t.sizes.len().max(1))).sum();
+    let listed = |list: &Option<Vec<u64>>| list.as_ref().map_or(1, Vec::len);
+    let count: usize = file.job.iter().map(|t| listed(&t.seeds).saturating_mul(listed(&t.sizes))).sum();
     if count > MAX_JOBS {
         return Err(BatchError::TooMany { path: path.into(), count, max: MAX_JOBS });
     }
@@ -211,14 +215,21 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
             Some("body") => Layout::Body,
             Some(other) => return Err(invalid(format!("layout {other:?}: accepted: tile, body"))),
         };
+        for (key, list) in [("seeds", &table.seeds), ("sizes", &table.sizes)] {
+            if list.as_ref().is_some_and(Vec::is_empty) {
+                return Err(invalid(format!("{key} = []: list at least one, or leave {key} out for the default")));
+            }
+        }
         let (lo, hi) = (*SIZE_RANGE.start() as u64, *SIZE_RANGE.end() as u64);
-        if let Some(bad) = table.sizes.iter().find(|s| !(lo..=hi).contains(*s)) {
+        if let Some(bad) = table.sizes.iter().flatten().find(|s| !(lo..=hi).contains(*s)) {
             return Err(invalid(format!("size {bad}: accepted sizes are {lo} to {hi} pixels")));
         }
         let overrides: Vec<(String, String)> = table.set.iter().map(|(k, v)| (k.clone(), v.to_string())).collect();
-        let seeds: Vec<Option<u64>> =
-            if table.seeds.is_empty() { vec![None] } else { table.seeds.iter().copied().map(Some).collect() };
-        let sizes = if table.sizes.is_empty() { vec![DEFAULT_SIZE] } else { table.sizes.clone() };
+        let seeds: Vec<Option<u64>> = match &table.seeds {
+            Some(seeds) => seeds.iter().copied().map(Some).collect(),
+            None => vec![None],
+        };
+        let sizes = table.sizes.clone().unwrap_or_else(|| vec![DEFAULT_SIZE]);
         for &seed in &seeds {
             for &size in &sizes {
                 jobs.push(Job {
@@ -325,8 +336,13 @@ struct Resolved {
 }
 
 /// `check`: whether to look for its finished set (reading and hashing its files).
-fn resolve(job: &Job, out: &Path, check: bool) -> Result<Resolved, Error> {
-    let loaded = crate::preset::load(&job.preset, &job.overrides, job.seed)?;
+fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resolved, Error> {
+    let loaded = crate::preset::load(&job.preset, &job.overrides, job.seed).map_err(|source| BatchError::Preset {
+        path: jobs_file.into(),
+        job: job.table,
+        preset: job.preset.clone(),
+        source,
+    })?;
     let seed = loaded.preset.seed;
     let key = job.key(&loaded.content_hash, seed);
     let folder = job.folder(&loaded.name, seed);
@@ -355,7 +371,7 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
     let mut first_in: std::collections::HashMap<PathBuf, usize> = std::collections::HashMap::new();
     let mut resolved: Vec<Resolved> = Vec::with_capacity(jobs.len());
     for job in jobs {
-        let mut r = resolve(job, out, shard.contains(job))?;
+        let mut r = resolve(jobs_file, job, out, shard.contains(job))?;
         if let Some(&earlier) = first_in.get(&r.outcome.folder) {
             let first = &resolved[earlier].outcome;
             if first.key != r.outcome.key {

@@ -19,6 +19,7 @@ pub mod ops;
 pub mod optics;
 pub mod preset;
 pub mod render;
+pub mod text_file;
 
 pub use generate::{GenerateReport, GenerateRequest, Plan, generate};
 pub use material::parse_map_list;
@@ -59,6 +60,9 @@ pub enum Error {
          smaller size (or raise SNAKESKIN_MEMORY_LIMIT_MIB if it is set)"
     )]
     Memory { what: String, needed_mib: u64, available_mib: u64 },
+    /// An environment variable the tool reads holds a value it does not accept.
+    #[error("invalid {variable}={value:?}: expected {accepted}")]
+    Environment { variable: &'static str, value: String, accepted: &'static str },
     /// A failure that is not the user's: a bug or a library refusing valid data.
     #[error("internal error: {0}")]
     Internal(String),

@@ -79,10 +79,30 @@ pub fn available_bytes() -> u64 {
     if let Some(cgroup) = cgroup_headroom() {
         available = available.min(cgroup);
     }
-    if let Some(limit) = std::env::var("SNAKESKIN_MEMORY_LIMIT_MIB").ok().and_then(|v| v.trim().parse::<u64>().ok()) {
+    // A malformed value is refused at the command line's start (`limit_from_env`); here it
+    // is ignored rather than failing mid-run.
+    if let Ok(Some(limit)) = limit_from_env() {
         available = available.min(limit.saturating_mul(MIB));
     }
     available
+}
+
+/// The environment variable that caps the memory the tool assumes available, in MiB.
+pub const LIMIT_VARIABLE: &str = "SNAKESKIN_MEMORY_LIMIT_MIB";
+
+/// The user's cap (`LIMIT_VARIABLE`) in MiB, None when unset; a value that is not a whole
+/// number of MiB is an error, not a silently disabled check.
+pub fn limit_from_env() -> Result<Option<u64>, Error> {
+    let invalid = |value: String| Error::Environment {
+        variable: LIMIT_VARIABLE,
+        value,
+        accepted: "a whole number of MiB, e.g. 4096",
+    };
+    match std::env::var(LIMIT_VARIABLE) {
+        Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(std::env::VarError::NotUnicode(v)) => Err(invalid(v.to_string_lossy().into_owned())),
+        Ok(v) => v.trim().parse::<u64>().map(Some).map_err(|_| invalid(v)),
+    }
 }
 
 fn meminfo_available() -> Option<u64> {

@@ -192,7 +192,26 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("no-such-snake"), "{}", stderr(&out));
+    // ... and the message names the jobs file and the job.
+    assert!(stderr(&out).contains("jobs.toml: job 2 (no-such-snake): unknown preset"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "a set was written before the bad job was found");
+
+    // A bad override names its job too; an empty list of seeds or sizes is refused, not
+    // read as the default.
+    for (table, says) in [
+        ("set = { \"scales.rwos\" = 23 }", "jobs.toml: job 2 (natrix-natrix): invalid --set \"scales.rwos=23\""),
+        ("sizes = []", "jobs.toml: job 2 (natrix-natrix): sizes = []: list at least one"),
+        ("seeds = []", "jobs.toml: job 2 (natrix-natrix): seeds = []: list at least one"),
+    ] {
+        let text = format!(
+            "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n[[job]]\npreset = \"natrix-natrix\"\n{table}\n"
+        );
+        std::fs::write(&jobs, text).unwrap();
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{table}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{table}: {}", stderr(&out));
+        assert!(manifests(&empty).is_empty(), "{table}: a set was written before the bad job was found");
+    }
 }
 
 #[test]

@@ -98,6 +98,61 @@ fn an_oversized_benchmark_grid_is_refused() {
     assert!(stderr(&out).contains("grid points"), "{}", stderr(&out));
 }
 
+/// Standard output on a full device: one line naming the failure and exit status 1, for
+/// commands that print a little and a lot. Negative control: a run whose stdout is fine.
+/// The memory cap's variable is read as a whole number of MiB or refused: a typo must not
+/// switch the check off. Negative control: a valid cap still refuses the oversized set.
+#[test]
+fn a_malformed_memory_cap_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("out");
+    for value in ["1M", "1.5", "-5", "abc", ""] {
+        let out = snakeskin_env(
+            &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "32"],
+            &[("SNAKESKIN_MEMORY_LIMIT_MIB", value)],
+        );
+        assert_eq!(out.status.code(), Some(2), "{value:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("invalid SNAKESKIN_MEMORY_LIMIT_MIB="), "{}", stderr(&out));
+        assert!(stderr(&out).contains("a whole number of MiB"), "{}", stderr(&out));
+        assert!(!o.exists(), "{value:?}: nothing may be written");
+    }
+    let out = snakeskin_env(
+        &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "8192"],
+        &[("SNAKESKIN_MEMORY_LIMIT_MIB", " 1024 ")],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("1024 MiB are available"), "{}", stderr(&out));
+}
+
+/// `brdf stress` takes a bounded sample count and prints a table, not a debug dump.
+/// Negative control: a count in range runs.
+#[test]
+fn brdf_stress_is_bounded_and_prints_a_table() {
+    for samples in ["0", "18446744073709551615"] {
+        let out = snakeskin(&["brdf", "stress", "--samples", samples]);
+        assert_eq!(out.status.code(), Some(2), "{samples}: {}", stderr(&out));
+        assert!(stderr(&out).contains("is not in 1..=10000000"), "{}", stderr(&out));
+    }
+    let out = snakeskin(&["brdf", "stress", "--samples", "50"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.starts_with("samples: 50 (layer models: thesis, layered)"), "{text}");
+    assert!(text.contains("white furnace") && !text.contains("StressReport"), "{text}");
+}
+
+#[test]
+fn a_full_stdout_is_an_error_not_a_panic() {
+    let full = || std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    for args in [vec!["presets", "list"], vec!["presets", "show", PRESET], vec!["graph", PRESET]] {
+        let out = Command::new(BIN).args(&args).stdout(full()).stderr(Stdio::piped()).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("error: cannot write to standard output: No space left"), "{}", stderr(&out));
+        assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
+    }
+    let out = snakeskin(&["presets", "list"]);
+    assert_eq!(out.status.code(), Some(0));
+}
+
 #[test]
 fn devices_fifos_and_huge_files_are_not_read() {
     let out = snakeskin(&["generate", "/dev/zero", "-o", "/tmp/never"]);
@@ -133,6 +188,15 @@ fn devices_fifos_and_huge_files_are_not_read() {
     let out = snakeskin(&["generate", huge.to_str().unwrap(), "-o", dir.path().to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("presets are limited to 1048576 bytes"), "{}", stderr(&out));
+
+    // A jobs file is read the same way (without the bound, /dev/zero grew by a gigabyte a
+    // second).
+    let out = snakeskin(&["batch", "/dev/zero", "-o", dir.path().join("out").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs file /dev/zero: it is a device"), "{}", stderr(&out));
+    let out = snakeskin(&["batch", fifo.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("it is a FIFO"), "{}", stderr(&out));
 }
 
 #[test]

@@ -65,50 +65,18 @@ pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     }
 }
 
-/// Reads a preset file: a regular file of at most `MAX_PRESET_BYTES`, in UTF-8. It is
-/// opened without blocking (a FIFO would otherwise wait forever for a writer) and checked
-/// through the open handle, then read with a bound, so neither a device like /dev/zero nor a
-/// file that grows while it is read can exhaust memory.
+/// Reads a preset file: a regular file of at most `MAX_PRESET_BYTES`, in UTF-8
+/// (`text_file::read_bounded`: neither a device like /dev/zero nor a file that grows while
+/// it is read can exhaust memory).
 fn read_bounded(path: &Path) -> Result<String, PresetError> {
-    use std::io::Read;
-    let read_error = |source| PresetError::Read { path: path.into(), source };
-    let mut options = std::fs::OpenOptions::new();
-    options.read(true);
-    #[cfg(unix)]
-    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
-    let file = options.open(path).map_err(read_error)?;
-    let meta = file.metadata().map_err(read_error)?;
-    if !meta.is_file() {
-        return Err(PresetError::NotAFile { path: path.into(), kind: file_kind(&meta) });
-    }
-    if meta.len() > MAX_PRESET_BYTES {
-        return Err(PresetError::TooLarge { path: path.into(), bytes: meta.len(), limit: MAX_PRESET_BYTES });
-    }
-    let mut bytes = Vec::new();
-    file.take(MAX_PRESET_BYTES + 1).read_to_end(&mut bytes).map_err(read_error)?;
-    if bytes.len() as u64 > MAX_PRESET_BYTES {
-        return Err(PresetError::TooLarge { path: path.into(), bytes: bytes.len() as u64, limit: MAX_PRESET_BYTES });
-    }
-    String::from_utf8(bytes)
-        .map_err(|e| read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 text ({e})"))))
-}
-
-fn file_kind(meta: &std::fs::Metadata) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        let t = meta.file_type();
-        if t.is_fifo() {
-            return "a FIFO";
+    use crate::text_file::{BoundedReadError, read_bounded};
+    read_bounded(path, MAX_PRESET_BYTES).map_err(|e| match e {
+        BoundedReadError::Io(source) => PresetError::Read { path: path.into(), source },
+        BoundedReadError::NotAFile(kind) => PresetError::NotAFile { path: path.into(), kind },
+        BoundedReadError::TooLarge(bytes) => {
+            PresetError::TooLarge { path: path.into(), bytes, limit: MAX_PRESET_BYTES }
         }
-        if t.is_char_device() || t.is_block_device() {
-            return "a device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if meta.is_dir() { "a folder" } else { "not a regular file" }
+    })
 }
 
 /// Loads a preset argument (a path or a built-in name) with `--set` overrides and an optional
@@ -321,7 +289,7 @@ fn check_layer_index(root: &toml::Table, segments: &[&str]) -> Result<(), String
 
 fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> Result<(), String> {
     let Some((first, rest)) = segments.split_first() else {
-        *target = value;
+        merge(target, value);
         return Ok(());
     };
     match target {
@@ -329,7 +297,12 @@ fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> 
         toml::Value::Table(t) if *first == "0" && !t.contains_key("0") => set_path(target, rest, value),
         toml::Value::Table(t) => {
             if rest.is_empty() {
-                t.insert(first.to_string(), value);
+                match t.get_mut(*first) {
+                    Some(existing) => merge(existing, value),
+                    None => {
+                        t.insert(first.to_string(), value);
+                    }
+                }
                 return Ok(());
             }
             let child = t.entry(first.to_string()).or_insert_with(|| toml::Value::Table(Default::default()));
@@ -347,6 +320,25 @@ fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> 
     }
 }
 
+/// Puts `value` where `target` is: a table into a table key by key (`--set
+/// 'scales={rows=23}'` changes `rows` and keeps the other scale keys, as `--set
+/// scales.rows=23` does), anything else in place of what was there.
+fn merge(target: &mut toml::Value, value: toml::Value) {
+    match (target, value) {
+        (toml::Value::Table(existing), toml::Value::Table(new)) => {
+            for (key, v) in new {
+                match existing.get_mut(&key) {
+                    Some(slot) => merge(slot, v),
+                    None => {
+                        existing.insert(key, v);
+                    }
+                }
+            }
+        }
+        (target, value) => *target = value,
+    }
+}
+
 fn fnv1a64(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ *b as u64).wrapping_mul(0x0000_0100_0000_01b3))
 }
@@ -357,6 +349,22 @@ mod tests {
 
     fn source(text: &str) -> PresetSource {
         PresetSource { name: "t".into(), display: "t.toml".into(), text: text.into() }
+    }
+
+    /// An inline table given to `--set` merges into the table it names, key by key, as the
+    /// dotted keys would; a value that is not a table replaces what was there. Negative
+    /// control: the merged preset differs from the original only where the table said.
+    #[test]
+    fn an_inline_table_merges_into_the_table_it_names() {
+        let text = "[scales]\nshape = \"hexagon\"\nrows = 19\nsize = 1.5\n";
+        let original = parse(&source(text), &[]).unwrap().preset;
+        let set = |k: &str, v: &str| parse(&source(text), &[(k.into(), v.into())]).unwrap().preset;
+        let merged = set("scales", "{rows = 23}");
+        assert_eq!(merged.scales.rows, 23);
+        assert_eq!(merged.scales.shape, original.scales.shape);
+        assert_eq!(merged.scales.size, original.scales.size);
+        assert_eq!(merged, set("scales.rows", "23"));
+        assert_ne!(merged, original);
     }
 
     #[test]

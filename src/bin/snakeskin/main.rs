@@ -14,6 +14,7 @@ use clap::Parser;
 
 fn main() -> ExitCode {
     output::restore_default_sigpipe();
+    output::stdout_failure_is_an_error();
     output::quiet_vulkan_device_select();
     let cli = cli::Cli::parse();
     match cmd::run(cli) {

@@ -16,6 +16,25 @@ pub fn restore_default_sigpipe() {
     }
 }
 
+/// A standard output that fails for another reason than a closed pipe (a full disk,
+/// `> /dev/full`, an I/O error) is an error like any other: one line on stderr and exit
+/// status 1, not a panic (exit 101). `println!` panics with std's message "failed printing to
+/// stdout: REASON"; the hook turns exactly that panic into the error, at every print site
+/// alike, and leaves every other panic to the default hook.
+pub fn stdout_failure_is_an_error() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload.downcast_ref::<String>().map(String::as_str).or(payload.downcast_ref::<&str>().copied());
+        if let Some(reason) = message.and_then(|m| m.strip_prefix("failed printing to stdout: ")) {
+            use std::io::Write;
+            let _ = writeln!(std::io::stderr(), "error: cannot write to standard output: {}", printable(reason));
+            std::process::exit(1);
+        }
+        default(info);
+    }));
+}
+
 /// Mesa's Vulkan `device_select` layer (an implicit layer, loaded into every Vulkan program)
 /// connects to the Wayland display to order the GPUs; without `XDG_RUNTIME_DIR` libwayland
 /// prints "error: XDG_RUNTIME_DIR is invalid or not set in the environment." twice per run

@@ -228,9 +228,26 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             if json {
                 println!("{}", serde_json::to_string(&report)?);
             } else {
-                println!("{report:#?}");
+                print!("{}", stress_table(&report));
             }
             Ok(())
         }
     }
+}
+
+/// `brdf stress`'s report as text: one line per bound it checks.
+fn stress_table(r: &snakeskin::optics::stress::StressReport) -> String {
+    let mut text = format!("samples: {} (layer models: {})\n", r.samples, r.models.join(", "));
+    text += &format!("NaN: {}, Inf: {}\n", r.nan, r.inf);
+    text += &format!("R and T of the film: {:.6} to {:.6} (must lie in [0, 1])\n", r.min_r, r.max_r);
+    text += &format!("white furnace (k_d = 1, tau = 0), {} evaluations:\n", r.furnace_evaluations);
+    for m in &r.furnace_by_model {
+        if r.furnace_evaluations == 0 {
+            text += &format!("  {:<8} none (too few samples)\n", m.model);
+        } else {
+            text += &format!("  {:<8} albedo {:.6} to {:.6}\n", m.model, m.min_albedo, m.max_albedo);
+        }
+    }
+    text += &format!("f32 against f64, largest |difference| / (1 + |f64|): {:.3e}\n", r.max_f32_dev);
+    text
 }

@@ -18,6 +18,8 @@ use anyhow::Result;
 use crate::cli::{Cli, Command};
 
 pub fn run(cli: Cli) -> Result<()> {
+    // Checked before any command runs, so a typo cannot switch the memory check off.
+    snakeskin::memory::limit_from_env()?;
     match cli.command {
         Command::Generate(args) => generate::run(args),
         Command::Export(args) => export::run(args),
