@@ -138,14 +138,13 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         let lock = SetLock::acquire(&dir, &name)?;
         let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
         // An earlier export of this name with a film left its thickness image, which no
-        // file references now: under the lock, after the commit, it goes.
+        // file references now: under the lock, after the commit, it goes. Whatever stands
+        // there is harmless once the commit is done, so an export that succeeded does not
+        // fail for it (a folder of that name stays, and so does a file that may not go).
         if textures.thickness.is_none() {
             let stale = dir.join(gltf_image_file_name(&name, "thickness"));
-            match std::fs::remove_file(&stale) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(crate::export::ExportError::Io { path: stale, source: e }.into());
-                }
-                _ => {}
+            if std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir()) {
+                let _ = std::fs::remove_file(&stale);
             }
         }
         written

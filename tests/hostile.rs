@@ -259,6 +259,66 @@ fn a_folder_in_the_way_leaves_the_earlier_set_whole() {
     assert!(names.iter().all(|n| !n.contains("tmp")), "{names:?}");
 }
 
+/// A rename that fails during the commit (a file that may not be replaced, a full disk)
+/// undoes the commit, at every one of its renames: moving each old file aside (the manifest
+/// first) and putting each new one in (the manifest last). The earlier set stays byte for
+/// byte, with no temporary left. Negative control: without the undo (seen by disabling
+/// `put_back`) the earlier set has lost its manifest once rename 1 fails.
+#[test]
+fn a_failed_rename_leaves_the_earlier_set_whole() {
+    if !cfg!(debug_assertions) {
+        eprintln!("SKIPPED: the fault hook exists in debug builds only (cargo test without --release)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let before = snapshot(dir.path());
+    assert_eq!(before.len(), 6, "five maps and the manifest: {:?}", before.keys());
+    // Six files aside, six in.
+    for at in 0..12 {
+        let n = at.to_string();
+        let out = generate_into(dir.path(), "2", &[("SNAKESKIN_TEST_FAIL_AT_RENAME", &n)]);
+        assert_eq!(out.status.code(), Some(1), "rename {at}: {}", stderr(&out));
+        assert!(stderr(&out).contains("injected failure"), "rename {at}: {}", stderr(&out));
+        assert_eq!(snapshot(dir.path()), before, "rename {at}: the earlier set changed");
+    }
+    // Past the last rename the hook does not fire: the new set is committed whole.
+    assert!(generate_into(dir.path(), "2", &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "12")]).status.success());
+    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
+    assert_ne!(snapshot(dir.path()), before);
+}
+
+/// A `.gltf` export of a species without a film removes the thickness image an earlier
+/// export with a film left; whatever else stands at that name (here a folder) stays, and
+/// the export, already committed, succeeds. Before, it failed after replacing the other
+/// files (exit 1, "Is a directory").
+#[test]
+fn an_export_is_not_failed_by_what_stands_at_a_stale_image_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let gltf = dir.path().join("s.gltf");
+    let export = |seed: &str| {
+        snakeskin(&[
+            "export",
+            PRESET,
+            "--gltf",
+            gltf.to_str().unwrap(),
+            "--size",
+            "32",
+            "--mesh",
+            "sphere",
+            "--seed",
+            seed,
+        ])
+    };
+    assert!(export("1").status.success());
+    let in_the_way = dir.path().join("s.thickness.png");
+    std::fs::create_dir(&in_the_way).unwrap();
+    let out = export("5");
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(in_the_way.is_dir());
+    assert!(!std::fs::read_to_string(&gltf).unwrap().contains("thickness"));
+}
+
 #[test]
 fn a_kill_during_the_renames_never_leaves_a_manifest_over_mixed_maps() {
     if !cfg!(debug_assertions) {

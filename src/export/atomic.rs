@@ -22,13 +22,16 @@
 //!    file name once: a second stage of a name would remove the first's temporary.
 //! 3. Before any rename, every target is checked: a folder where a file must go is an
 //!    error, and nothing has changed yet.
-//! 4. The old manifest is removed, the maps are renamed into place, and the new manifest,
-//!    which records the SHA-256 of every map, is renamed in last.
+//! 4. The old files are moved aside to temporaries, the old manifest first; then the maps
+//!    are renamed into place, and the new manifest, which records the SHA-256 of every map,
+//!    is renamed in last; then the old files are removed.
 //!
 //! The guarantee: **whenever `NAME.material.json` exists, the maps it names are exactly the
-//! ones it was written with** — `verify_set` checks the hashes. A failure or a kill during
-//! step 4 leaves maps without a manifest (an incomplete set that no reader accepts), never
-//! new maps under an old manifest. An earlier set survives every failure before step 4.
+//! ones it was written with** — `verify_set` checks the hashes. An earlier set survives every
+//! failure: before step 4 nothing has changed, and a rename that fails in step 4 (a file
+//! that may not be replaced, a full disk) undoes the commit — the new files go and the old
+//! ones are renamed back. A kill during step 4 leaves maps without a manifest (an incomplete
+//! set that no reader accepts), never new maps under an old manifest.
 
 use std::fs::{self, File};
 use std::io::Write;
@@ -85,6 +88,14 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
 /// Writes `bytes` to a new exclusive temporary beside `target` and returns it (deleted on
 /// drop unless persisted).
 fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedTempFile, ExportError> {
+    let mut tmp = temporary(dir, target_name).map_err(io_error(dir))?;
+    tmp.write_all(bytes).and_then(|_| tmp.as_file().sync_all()).map_err(io_error(tmp.path()))?;
+    Ok(tmp)
+}
+
+/// A new, empty temporary for `target_name` in `dir` (`.NAME.RANDOM.snakeskin-tmp`, created
+/// exclusively): a map being staged, or the place an old file is moved aside to.
+fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTempFile> {
     let prefix = format!(".{target_name}.");
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(TMP_SUFFIX).rand_bytes(RANDOM_CHARS);
@@ -92,9 +103,7 @@ fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedT
     // `File::create` makes them), readable by whoever reads the user's other files.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut tmp = builder.tempfile_in(dir).map_err(io_error(dir))?;
-    tmp.write_all(bytes).and_then(|_| tmp.as_file().sync_all()).map_err(io_error(tmp.path()))?;
-    Ok(tmp)
+    builder.tempfile_in(dir)
 }
 
 /// Refuses a target that is a folder (a rename over it would fail half-way through a set).
@@ -178,26 +187,90 @@ impl SetLock {
     /// and 4). See the module documentation for the guarantee.
     pub fn commit(&self, maps: Vec<Staged>, manifest: (&str, &[u8])) -> Result<Vec<PathBuf>, ExportError> {
         let dir = &self.dir;
+        let manifest_target = dir.join(manifest.0);
         let mut staged: Vec<(tempfile::NamedTempFile, PathBuf)> =
             maps.into_iter().map(|m| (m.file, dir.join(&m.name))).collect();
-        staged.push((self.stage(manifest.0, manifest.1)?.file, dir.join(manifest.0)));
+        staged.push((self.stage(manifest.0, manifest.1)?.file, manifest_target.clone()));
         for (_, target) in &staged {
             check_target(target)?;
         }
-        let manifest_target = dir.join(manifest.0);
-        match fs::remove_file(&manifest_target) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io_error(&manifest_target)(e)),
-            _ => {}
+        // Step 4a: the old files out of the way, the manifest first (so that from here on no
+        // old manifest names a map that may change). A file that cannot be moved fails here,
+        // before anything new is in place.
+        let mut renames = 0;
+        let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
+        let old_first =
+            std::iter::once(&manifest_target).chain(staged.iter().map(|(_, t)| t).filter(|t| **t != manifest_target));
+        for target in old_first {
+            if fs::symlink_metadata(target).is_err() {
+                continue;
+            }
+            let moved = temporary(dir, &file_name(target)).map_err(io_error(dir)).and_then(|backup| {
+                let backup = backup.into_temp_path();
+                renamed_or_injected_failure(&mut renames, target, &backup).map_err(io_error(target))?;
+                Ok(backup)
+            });
+            match moved {
+                Ok(backup) => aside.push((backup, target.clone())),
+                Err(e) => {
+                    put_back(aside, &[]);
+                    return Err(e);
+                }
+            }
         }
+        // Step 4b: the new files in, the manifest last.
         let mut written = Vec::new();
-        for (renamed, (tmp, target)) in staged.into_iter().enumerate() {
-            fault_point(renamed);
-            tmp.persist(&target).map_err(|e| ExportError::Io { path: target.clone(), source: e.error })?;
+        for (placed, (tmp, target)) in staged.into_iter().enumerate() {
+            fault_point(placed);
+            let tmp = tmp.into_temp_path();
+            if let Err(e) = renamed_or_injected_failure(&mut renames, &tmp, &target) {
+                put_back(aside, &written);
+                return Err(ExportError::Io { path: target, source: e });
+            }
+            // Renamed: nothing is left at the temporary's path to remove.
+            let _ = tmp.keep();
             written.push(target);
         }
         sync_folder(dir);
+        // The old files go (each `TempPath` removes its file when dropped).
+        drop(aside);
         Ok(written)
     }
+}
+
+/// Undoes a commit that failed: removes the new files already in place and renames the old
+/// ones back. Best effort: whatever cannot be undone is left for the error to explain.
+fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf]) {
+    for target in written {
+        let _ = fs::remove_file(target);
+    }
+    for (backup, target) in aside {
+        if fs::rename(&backup, &target).is_ok() {
+            // Renamed back: nothing is left at the backup's path to remove.
+            let _ = backup.keep();
+        }
+    }
+}
+
+/// The file name of a path in the set's folder.
+fn file_name(path: &Path) -> String {
+    path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+}
+
+/// Renames `from` to `to`, counting the commit's renames in `renames`. Test hook (debug
+/// builds only): `SNAKESKIN_TEST_FAIL_AT_RENAME=N` makes the commit's rename N (from 0,
+/// moving the old files aside and then the new ones in) fail with an I/O error instead, as
+/// a file that may not be replaced would, so the rollback can be tested at every step.
+fn renamed_or_injected_failure(renames: &mut usize, from: &Path, to: &Path) -> std::io::Result<()> {
+    let this = *renames;
+    *renames += 1;
+    #[cfg(debug_assertions)]
+    if std::env::var("SNAKESKIN_TEST_FAIL_AT_RENAME").ok().and_then(|v| v.parse::<usize>().ok()) == Some(this) {
+        return Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, "injected failure (test hook)"));
+    }
+    #[cfg(not(debug_assertions))]
+    let _ = this;
+    fs::rename(from, to)
 }
 
 /// A map of a set written to its temporary (`SetLock::stage`), waiting for `commit`.
