@@ -49,7 +49,7 @@ pub enum BatchError {
     Invalid { path: PathBuf, job: usize, preset: String, message: String },
     /// The job's preset, or its `set` overrides, refused (the preset's own message).
     #[error("{path}: job {job} ({preset}): {source}")]
-    Preset { path: PathBuf, job: usize, preset: String, source: crate::preset::PresetError },
+    Preset { path: PathBuf, job: usize, preset: String, source: Box<crate::preset::PresetError> },
     #[error("{path}: no [[job]] tables; a jobs file lists jobs as [[job]] tables with at least a preset key")]
     Empty { path: PathBuf },
     #[error("{path}: {count} jobs after expanding seeds and sizes; at most {max} per file")]
@@ -341,7 +341,7 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         path: jobs_file.into(),
         job: job.table,
         preset: job.preset.clone(),
-        source,
+        source: Box::new(source),
     })?;
     let seed = loaded.preset.seed;
     let key = job.key(&loaded.content_hash, seed);
@@ -471,6 +471,11 @@ pub fn run(
     concurrency: usize,
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
+    // The output folder (a file there is the user's mistake, as for `generate -o`) and the
+    // index's place, before any job runs: a folder in the index's way would otherwise fail
+    // the run after every job.
+    crate::export::create_folder(out)?;
+    crate::export::check_target(&out.join(index_file_name(shard)))?;
     let (mine, resolved): (Vec<&Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
     let mut estimates = Vec::new();

@@ -140,6 +140,41 @@ fn brdf_stress_is_bounded_and_prints_a_table() {
     assert!(text.contains("white furnace") && !text.contains("StressReport"), "{text}");
 }
 
+/// Output files are checked before the work that makes them: a folder where `preview
+/// --reference` or the batch index must go fails at once, with nothing written (before,
+/// preview rendered and wrote its image first, and batch ran every job); `batch -o FILE`
+/// is the user's mistake, as for `generate -o` (exit 2).
+#[test]
+fn outputs_are_checked_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("p.png");
+    let in_the_way = dir.path().join("heat.png");
+    std::fs::create_dir(&in_the_way).unwrap();
+    let args = ["preview", PRESET, "--out", image.to_str().unwrap(), "--size", "64x64", "--map-size", "64"];
+    let out = snakeskin(&[&args[..], &["--reference", in_the_way.to_str().unwrap()]].concat());
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a folder is in the way of this output file"), "{}", stderr(&out));
+    assert!(!image.exists(), "the preview ran before the check");
+
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, format!("[[job]]\npreset = \"{PRESET}\"\nsizes = [32]\n")).unwrap();
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir_all(out_dir.join("index.json")).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a folder is in the way"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 1, "a job ran before the check");
+
+    let a_file = dir.path().join("a-file");
+    std::fs::write(&a_file, "x").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", a_file.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    // Negative control: with the way clear, the batch runs.
+    std::fs::remove_dir(out_dir.join("index.json")).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 #[test]
 fn a_full_stdout_is_an_error_not_a_panic() {
     let full = || std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();

@@ -84,7 +84,7 @@ fn gpu_render_matches_the_cpu_spectral_reference() {
     // Every layer model: the shader's lobes and ambient term against their CPU twins.
     for model in Model::ALL {
         let settings = FrameSettings { model, ..close_up() };
-        let (report, _) = reference_check(&renderer, &material, &settings, 200, 125).unwrap();
+        let (report, _) = reference_check(&renderer, &material, &settings, 200, 125, &|_, _| {}).unwrap();
         eprintln!(
             "{model:?} reference: {} px, mean {:.3}, p99 {:.3}, max {:.3}",
             report.pixels, report.mean_de, report.p99_de, report.max_de
@@ -108,7 +108,7 @@ fn gpu_render_with_absorption_on_a_rough_top_matches_the_cpu_reference() {
     let set = [("optics.absorption", "0.5"), ("roughness.base", "0.9")];
     let material = material_of(&renderer, PLAIN_PRESET, &set, GpuFilmMethod::Lut);
     let settings = FrameSettings { model: Model::Layered, ..close_up() };
-    let (report, _) = reference_check(&renderer, &material, &settings, 200, 125).unwrap();
+    let (report, _) = reference_check(&renderer, &material, &settings, 200, 125, &|_, _| {}).unwrap();
     eprintln!(
         "absorbing, rough: {} px, mean {:.3}, p99 {:.3}, max {:.3}",
         report.pixels, report.mean_de, report.p99_de, report.max_de
@@ -131,7 +131,7 @@ fn the_reference_check_catches_a_wrong_model() {
     let layered = FrameSettings { model: Model::Layered, ..thesis };
     let image = renderer.render_image(&thesis, &material, 160, 100).unwrap();
     let gbuffer = renderer.render_gbuffer(&thesis, &material, 160, 100).unwrap();
-    let report = snakeskin::render::reference::frame::compare(&image, &gbuffer, &layered, &material.optics);
+    let report = snakeskin::render::reference::frame::compare(&image, &gbuffer, &layered, &material.optics, &|_, _| {});
     assert!(report.mean_de > 2.0, "the thesis frame passed as the layered model: mean {}", report.mean_de);
 }
 
@@ -146,7 +146,7 @@ fn the_reference_check_catches_a_wrong_film() {
     let settings = FrameSettings { samples: 1, ..close_up() };
     let image = renderer.render_image(&settings, &wrong, 160, 100).unwrap();
     let gbuffer = renderer.render_gbuffer(&settings, &right, 160, 100).unwrap();
-    let report = snakeskin::render::reference::frame::compare(&image, &gbuffer, &settings, &right.optics);
+    let report = snakeskin::render::reference::frame::compare(&image, &gbuffer, &settings, &right.optics, &|_, _| {});
     assert!(report.mean_de > 2.0, "a 170 nm thinner film went unnoticed: mean {}", report.mean_de);
 }
 
@@ -403,7 +403,7 @@ fn the_contact_sheet_renders_every_preset() {
     let tile = 64;
     let options = SheetOptions { tile, columns: 4, map_size: 64, closeups: false };
     let calls = std::sync::atomic::AtomicUsize::new(0);
-    let sheet = render_sheet(&renderer, options, &|_, _| {
+    let sheet = render_sheet(&renderer, options, &[], &|_, _| {
         calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     })
     .unwrap();
@@ -427,6 +427,13 @@ fn the_contact_sheet_renders_every_preset() {
         let (lo, hi) = (lum.iter().min().unwrap(), lum.iter().max().unwrap());
         assert!(hi - lo > 60, "cell {i} ({}): render looks blank ({lo}..{hi})", library::names()[i as usize]);
     }
+    // `--species` picks cells in the tile layout too (it was ignored there): two species
+    // fill one row of the same cells; a name that is not built in is refused.
+    let two = ["python-regius".to_string(), "natrix-natrix".to_string()];
+    let small = render_sheet(&renderer, options, &two, &|_, _| {}).unwrap();
+    assert_eq!((small.width(), small.height()), (sheet.width(), cell_h));
+    let err = render_sheet(&renderer, options, &["no-such-snake".to_string()], &|_, _| {}).unwrap_err();
+    assert!(err.to_string().contains("no built-in species no-such-snake"), "{err}");
 }
 
 #[test]

@@ -107,7 +107,8 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
 }
 
 /// Refuses a target that is a folder (a rename over it would fail half-way through a set).
-fn check_target(target: &Path) -> Result<(), ExportError> {
+/// Public so that a command can check an output file before the work that makes it.
+pub fn check_target(target: &Path) -> Result<(), ExportError> {
     match fs::symlink_metadata(target) {
         Ok(meta) if meta.is_dir() => Err(ExportError::Io {
             path: target.into(),

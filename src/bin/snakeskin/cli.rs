@@ -111,7 +111,7 @@ pub enum Command {
         /// is then the strip's height, one circumference).
         #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
         layout: LayoutArg,
-        /// With --layout body: only these species (comma-separated built-in names).
+        /// Only these species, in this order (comma-separated built-in names; default: all).
         #[arg(long, value_delimiter = ',', value_name = "NAMES")]
         species: Vec<String>,
         /// With --layout body: also a close-up of each species' head and tail.
@@ -335,7 +335,9 @@ pub struct PreviewArgs {
     #[arg(long)]
     pub close_up: bool,
     /// Also shade the frame on the CPU with the f64 spectral reference, print mean and p99
-    /// CIEDE2000 against the GPU image, and write the error heat map to this PNG.
+    /// CIEDE2000 against the GPU image, and write the error heat map to this PNG. The
+    /// reference costs about 3 ms per covered pixel on two cores: 3.5 minutes at
+    /// --size 480x300 with --close-up, 20 minutes or more at the default size.
     #[arg(long, value_name = "HEATMAP.png")]
     pub reference: Option<PathBuf>,
 }
@@ -536,7 +538,10 @@ pub struct LayerArgs {
     /// itself, not the visible colour a colour map holds.
     #[arg(long, value_parser = parse_albedo, default_value = "1")]
     pub albedo: [f64; 3],
-    /// Film colour method (as for `brdf color`).
+    /// Film colour method (as for `brdf color`). spectral, the default, is the exact 1 nm sum
+    /// and slow where the film is read many times: `brdf albedo` under the layered model
+    /// takes about 100 s on two cores with it, about 3 s with lut (at the defaults and 45°
+    /// they agree within 2e-4).
     #[arg(long, default_value = "spectral", value_parser = parse_method)]
     pub method: Method,
 }

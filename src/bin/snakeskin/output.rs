@@ -103,13 +103,14 @@ pub fn path_line(path: &Path) -> String {
 }
 
 /// Creates the folder a single output file goes into when it is missing, and says so on
-/// stderr. Every command treats output paths alike: `generate -o DIR`, `preview --out`,
-/// `preview --reference`, `sheet -o` and the rest create missing folders with this note.
+/// stderr; refuses a folder standing where the file goes, before any work is done for it.
+/// Every command treats output paths alike: `generate -o DIR`, `preview --out`, `preview
+/// --reference`, `sheet -o` and the rest create missing folders with this note.
 pub fn ensure_parent_folder(file: &Path) -> anyhow::Result<()> {
-    match file.parent().filter(|p| !p.as_os_str().is_empty()) {
-        Some(folder) => ensure_folder(folder),
-        None => Ok(()),
+    if let Some(folder) = file.parent().filter(|p| !p.as_os_str().is_empty()) {
+        ensure_folder(folder)?;
     }
+    Ok(snakeskin::export::check_target(file)?)
 }
 
 /// Creates an output folder when it is missing (`export::create_folder`), with a note on

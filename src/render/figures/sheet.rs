@@ -104,9 +104,10 @@ fn lut_for(luts: &mut Vec<(crate::optics::film::Stack, Lut)>, optics: LayerOptic
 pub fn render_sheet(
     renderer: &Renderer,
     options: SheetOptions,
+    species: &[String],
     progress: &dyn Fn(usize, usize),
 ) -> Result<RgbImage, Error> {
-    let presets = library::all();
+    let presets = chosen_species(species)?;
     let (tile, columns) = (options.tile, options.columns.max(1));
     let (cell_w, cell_h) = (3 * tile, tile + LABEL_HEIGHT);
     let rows = (presets.len() as u32).div_ceil(columns);
@@ -157,18 +158,7 @@ pub fn render_body_sheet(
     species: &[String],
     progress: &dyn Fn(usize, usize),
 ) -> Result<RgbImage, Error> {
-    let presets: Vec<(&str, &str)> = if species.is_empty() {
-        library::all().to_vec()
-    } else {
-        species
-            .iter()
-            .map(|name| {
-                library::all().iter().find(|(n, _)| n == name).copied().ok_or_else(|| {
-                    Error::Preview(format!("no built-in species {name}; `snakeskin presets list` shows them"))
-                })
-            })
-            .collect::<Result<_, _>>()?
-    };
+    let presets = chosen_species(species)?;
     let loaded: Vec<_> =
         presets.iter().map(|(name, _)| crate::preset::load(name, &[], None)).collect::<Result<_, _>>()?;
     let columns = options.columns.max(1);
@@ -249,6 +239,22 @@ fn colour_image(maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>) -
     })
 }
 
+/// The built-in presets named in `species` (all of them when it is empty), in its order; a
+/// name that is not built in is an error naming it.
+fn chosen_species(species: &[String]) -> Result<Vec<(&'static str, &'static str)>, Error> {
+    if species.is_empty() {
+        return Ok(library::all().to_vec());
+    }
+    species
+        .iter()
+        .map(|name| {
+            library::all().iter().find(|(n, _)| n == name).copied().ok_or_else(|| {
+                Error::Preview(format!("no built-in species {name}; `snakeskin presets list` shows them"))
+            })
+        })
+        .collect()
+}
+
 /// Renders the sheet (the tile's, or the whole bodies' with `layout` body) and writes it as
 /// a PNG (atomically).
 pub fn write_sheet(
@@ -260,7 +266,7 @@ pub fn write_sheet(
     progress: &dyn Fn(usize, usize),
 ) -> Result<PathBuf, Error> {
     let sheet = match layout {
-        Layout::Tile => render_sheet(renderer, options, progress)?,
+        Layout::Tile => render_sheet(renderer, options, species, progress)?,
         Layout::Body => render_body_sheet(renderer, options, species, progress)?,
     };
     let mut bytes = Vec::new();

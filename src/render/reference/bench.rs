@@ -215,7 +215,7 @@ pub fn bench_render(
     progress("reference comparison");
     let material = renderer.material(&maps, optics, &lut, 1);
     let (w, h) = options.reference_size;
-    let (report, _) = reference_check(renderer, &material, &base, w, h)?;
+    let (report, _) = reference_check(renderer, &material, &base, w, h, &|_, _| {})?;
     Ok(RenderBench {
         adapter: renderer.gpu.describe(),
         timing: timing_kind,

@@ -24,11 +24,12 @@ pub fn reference_check(
     settings: &FrameSettings,
     width: u32,
     height: u32,
+    progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(ReferenceReport, image::RgbaImage), Error> {
     let settings = FrameSettings { samples: 1, ground: false, view: View::Shaded(Stage::All), ..*settings };
     let image = renderer.render_image(&settings, material, width, height)?;
     let gbuffer = renderer.render_gbuffer(&settings, material, width, height)?;
-    Ok((compare(&image, &gbuffer, &settings, &material.optics), image))
+    Ok((compare(&image, &gbuffer, &settings, &material.optics, progress), image))
 }
 
 /// Mean, 99th percentile and max CIEDE2000 over covered pixels, and the heat map.
@@ -159,15 +160,24 @@ pub fn compare(
     gbuffer: &GBuffer,
     settings: &FrameSettings,
     optics: &LayerOptics,
+    progress: &(dyn Fn(usize, usize) + Sync),
 ) -> ReferenceReport {
     // K and E per roughness row, once for the frame (the shader's `Scene.bounce`).
     let bounce = optics.bounce_grid(settings.model);
     let exposure = settings.exposure as f64;
+    // The spectral shading costs milliseconds a pixel: progress in covered pixels, every
+    // 256 of them.
+    let total = (0..(gbuffer.width * gbuffer.height) as usize).filter(|&i| gbuffer.covered(i)).count();
+    let done = std::sync::atomic::AtomicUsize::new(0);
     let de: Vec<Option<f64>> = (0..(gbuffer.width * gbuffer.height) as usize)
         .into_par_iter()
         .map(|i| {
             if !gbuffer.covered(i) {
                 return None;
+            }
+            let shaded = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            if shaded.is_multiple_of(256) {
+                progress(shaded, total);
             }
             let cpu = display(shade_pixel(gbuffer, i, settings, optics, &bounce), exposure).map(srgb_decode);
             let px = gpu_image.as_raw()[4 * i..4 * i + 3].iter().map(|v| srgb_decode(*v as f64 / 255.0));

@@ -46,16 +46,18 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     let (width, height) = (args.size.width, args.size.height);
     let image = renderer.render_image(&settings, &material, width, height)?;
     let written = write_png(out, &image)?;
+    bar.finish();
     if let Some(heat_path) = &args.reference {
-        bar.message("shading the CPU reference");
-        let (report, _) = reference_check(&renderer, &material, &settings, width, height)?;
+        let bar = Progress::counting("{spinner} CPU reference [{bar:30}] {pos}/{len} pixels {elapsed} (ETA {eta})");
+        let (report, _) =
+            reference_check(&renderer, &material, &settings, width, height, &|done, total| bar.update(done, total))?;
+        bar.finish();
         snakeskin::render::figures::write_rgb_png(heat_path, &report.heat_map(5.0))?;
         eprintln!(
             "reference: {} pixels, CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3} (heat map: black 0 .. yellow >= 5)",
             report.pixels, report.mean_de, report.p99_de, report.max_de
         );
     }
-    bar.finish();
     println!("{}", path_line(&written));
     Ok(())
 }
