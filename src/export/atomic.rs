@@ -30,8 +30,9 @@
 //! ones it was written with** — `verify_set` checks the hashes. An earlier set survives every
 //! failure: before step 4 nothing has changed, and a rename that fails in step 4 (a file
 //! that may not be replaced, a full disk) undoes the commit — the new files go and the old
-//! ones are renamed back. A kill during step 4 leaves maps without a manifest (an incomplete
-//! set that no reader accepts), never new maps under an old manifest.
+//! ones are renamed back. A kill during step 4 leaves no manifest (some maps or none, the
+//! old files in temporaries the next run removes: an incomplete set that no reader
+//! accepts), never new maps under an old manifest.
 
 use std::fs::{self, File};
 use std::io::Write;
