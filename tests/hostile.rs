@@ -98,8 +98,6 @@ fn an_oversized_benchmark_grid_is_refused() {
     assert!(stderr(&out).contains("grid points"), "{}", stderr(&out));
 }
 
-/// Standard output on a full device: one line naming the failure and exit status 1, for
-/// commands that print a little and a lot. Negative control: a run whose stdout is fine.
 /// The memory cap's variable is read as a whole number of MiB or refused: a typo must not
 /// switch the check off. Negative control: a valid cap still refuses the oversized set.
 #[test]
@@ -175,6 +173,8 @@ fn outputs_are_checked_before_the_work() {
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
+/// Standard output on a full device: one line naming the failure and exit status 1, for
+/// commands that print a little and a lot. Negative control: a run whose stdout is fine.
 #[test]
 fn a_full_stdout_is_an_error_not_a_panic() {
     let full = || std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();

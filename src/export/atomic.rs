@@ -209,13 +209,13 @@ impl SetLock {
             }
             let moved = temporary(dir, &file_name(target)).map_err(io_error(dir)).and_then(|backup| {
                 let backup = backup.into_temp_path();
-                renamed_or_injected_failure(&mut renames, target, &backup).map_err(io_error(target))?;
+                injected_failure(&mut renames).and_then(|()| fs::rename(target, &backup)).map_err(io_error(target))?;
                 Ok(backup)
             });
             match moved {
                 Ok(backup) => aside.push((backup, target.clone())),
                 Err(e) => {
-                    put_back(aside, &[]);
+                    put_back(aside, &[], &manifest_target);
                     return Err(e);
                 }
             }
@@ -224,13 +224,12 @@ impl SetLock {
         let mut written = Vec::new();
         for (placed, (tmp, target)) in staged.into_iter().enumerate() {
             fault_point(placed);
-            let tmp = tmp.into_temp_path();
-            if let Err(e) = renamed_or_injected_failure(&mut renames, &tmp, &target) {
-                put_back(aside, &written);
+            if let Err(e) =
+                injected_failure(&mut renames).and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error))
+            {
+                put_back(aside, &written, &manifest_target);
                 return Err(ExportError::Io { path: target, source: e });
             }
-            // Renamed: nothing is left at the temporary's path to remove.
-            let _ = tmp.keep();
             written.push(target);
         }
         sync_folder(dir);
@@ -241,15 +240,23 @@ impl SetLock {
 }
 
 /// Undoes a commit that failed: removes the new files already in place and renames the old
-/// ones back. Best effort: whatever cannot be undone is left for the error to explain.
-fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf]) {
+/// ones back, the maps before the manifest (`aside` holds the manifest first), so that the
+/// old manifest returns only over its own maps. An old file that cannot go back stays in
+/// its temporary (never deleted), and then the old manifest stays aside too: the set is
+/// incomplete, not mixed.
+fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf], manifest: &Path) {
+    let mut whole = true;
     for target in written {
-        let _ = fs::remove_file(target);
+        whole &= fs::remove_file(target).is_ok();
     }
-    for (backup, target) in aside {
-        if fs::rename(&backup, &target).is_ok() {
-            // Renamed back: nothing is left at the backup's path to remove.
+    for (backup, target) in aside.into_iter().rev() {
+        if target == manifest && !whole {
             let _ = backup.keep();
+            continue;
+        }
+        if let Err(e) = backup.persist(&target) {
+            whole = false;
+            let _ = e.path.keep();
         }
     }
 }
@@ -259,11 +266,11 @@ fn file_name(path: &Path) -> String {
     path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
-/// Renames `from` to `to`, counting the commit's renames in `renames`. Test hook (debug
-/// builds only): `SNAKESKIN_TEST_FAIL_AT_RENAME=N` makes the commit's rename N (from 0,
-/// moving the old files aside and then the new ones in) fail with an I/O error instead, as
-/// a file that may not be replaced would, so the rollback can be tested at every step.
-fn renamed_or_injected_failure(renames: &mut usize, from: &Path, to: &Path) -> std::io::Result<()> {
+/// Counts the commit's renames in `renames`. Test hook (debug builds only):
+/// `SNAKESKIN_TEST_FAIL_AT_RENAME=N` makes the commit's rename N (from 0, moving the old
+/// files aside and then the new ones in) fail with an I/O error instead, as a file that may
+/// not be replaced would, so the rollback can be tested at every step.
+fn injected_failure(renames: &mut usize) -> std::io::Result<()> {
     let this = *renames;
     *renames += 1;
     #[cfg(debug_assertions)]
@@ -272,7 +279,7 @@ fn renamed_or_injected_failure(renames: &mut usize, from: &Path, to: &Path) -> s
     }
     #[cfg(not(debug_assertions))]
     let _ = this;
-    fs::rename(from, to)
+    Ok(())
 }
 
 /// A map of a set written to its temporary (`SetLock::stage`), waiting for `commit`.

@@ -6,7 +6,7 @@
 //! texture width is the circumference where it lies, and one texture height is the same
 //! length along the body, so scales stay as round as the generator drew them and shrink with
 //! the girth towards the tail and the snout. Below a quarter of the full girth (the last
-//! tenth of the tail, the snout's tip) they stop shrinking along the body, or v would run
+//! tenth of the body, the snout's tip) they stop shrinking along the body, or v would run
 //! without bound into the point. Normals and tangents come from the same parametric surface
 //! (finite differences of the grid), so normal mapping follows `∂P/∂u` and `-∂P/∂v`
 //! (OpenGL's +Y points up the image).

@@ -175,16 +175,17 @@ pub fn compare(
             if !gbuffer.covered(i) {
                 return None;
             }
+            let cpu = display(shade_pixel(gbuffer, i, settings, optics, &bounce), exposure).map(srgb_decode);
             let shaded = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             if shaded.is_multiple_of(256) {
                 progress(shaded, total);
             }
-            let cpu = display(shade_pixel(gbuffer, i, settings, optics, &bounce), exposure).map(srgb_decode);
             let px = gpu_image.as_raw()[4 * i..4 * i + 3].iter().map(|v| srgb_decode(*v as f64 / 255.0));
             let gpu: Vec<f64> = px.collect();
             Some(ciede2000(linear_srgb_to_lab(cpu), linear_srgb_to_lab([gpu[0], gpu[1], gpu[2]])))
         })
         .collect();
+    progress(total, total);
     let mut values: Vec<f64> = de.iter().flatten().copied().collect();
     values.sort_by(f64::total_cmp);
     let pixels = values.len();
