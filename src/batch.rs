@@ -474,9 +474,7 @@ pub fn run(
     // The output folder (a file there is the user's mistake, as for `generate -o`) and the
     // index's place, before any job runs (a folder in the index's way would otherwise fail
     // the run after every job), and nothing created yet: a refused batch leaves no folder.
-    if std::fs::metadata(out).is_ok_and(|m| !m.is_dir()) {
-        return Err(crate::export::ExportError::NotAFolder { path: out.into() }.into());
-    }
+    crate::export::check_folder(out)?;
     crate::export::check_target(&out.join(index_file_name(shard)))?;
     let (mine, resolved): (Vec<&Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();

@@ -122,10 +122,19 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
 /// Creates an output folder if needed (true when it was created); a path that exists and is
 /// not a folder is `ExportError::NotAFolder`. Every output path goes through here.
 pub fn create_folder(dir: &Path) -> Result<bool, ExportError> {
+    check_folder(dir)?;
+    if dir.is_dir() {
+        return Ok(false);
+    }
+    fs::create_dir_all(dir).map(|_| true).map_err(io_error(dir))
+}
+
+/// An output folder's path, checked without creating anything: a path that exists and is
+/// not a folder is `ExportError::NotAFolder` (a missing one is fine).
+pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
     match fs::metadata(dir) {
-        Ok(meta) if meta.is_dir() => Ok(false),
-        Ok(_) => Err(ExportError::NotAFolder { path: dir.into() }),
-        Err(_) => fs::create_dir_all(dir).map(|_| true).map_err(io_error(dir)),
+        Ok(meta) if !meta.is_dir() => Err(ExportError::NotAFolder { path: dir.into() }),
+        _ => Ok(()),
     }
 }
 

@@ -296,15 +296,6 @@ fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> 
         // `pattern.0` addresses a single `[pattern]` table as layer 0.
         toml::Value::Table(t) if *first == "0" && !t.contains_key("0") => set_path(target, rest, value),
         toml::Value::Table(t) => {
-            if rest.is_empty() {
-                match t.get_mut(*first) {
-                    Some(existing) => merge(existing, value),
-                    None => {
-                        t.insert(first.to_string(), value);
-                    }
-                }
-                return Ok(());
-            }
             let child = t.entry(first.to_string()).or_insert_with(|| toml::Value::Table(Default::default()));
             set_path(child, rest, value)
         }
@@ -327,12 +318,8 @@ fn merge(target: &mut toml::Value, value: toml::Value) {
     match (target, value) {
         (toml::Value::Table(existing), toml::Value::Table(new)) => {
             for (key, v) in new {
-                match existing.get_mut(&key) {
-                    Some(slot) => merge(slot, v),
-                    None => {
-                        existing.insert(key, v);
-                    }
-                }
+                // A key not there yet starts as an empty table, which `v` then replaces or fills.
+                merge(existing.entry(key).or_insert_with(|| toml::Value::Table(Default::default())), v);
             }
         }
         (target, value) => *target = value,
