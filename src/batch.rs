@@ -50,6 +50,9 @@ pub enum BatchError {
     /// The job's preset, or its `set` overrides, refused (the preset's own message).
     #[error("{path}: job {job} ({preset}): {source}")]
     Preset { path: PathBuf, job: usize, preset: String, source: Box<crate::preset::PresetError> },
+    /// The job's `set` table refused: its entries as `key=value`, and why.
+    #[error("{path}: job {job} ({preset}): set {entries:?}: {message}")]
+    Set { path: PathBuf, job: usize, preset: String, entries: String, message: String },
     #[error("{path}: no [[job]] tables; a jobs file lists jobs as [[job]] tables with at least a preset key")]
     Empty { path: PathBuf },
     #[error("{path}: {count} jobs after expanding seeds and sizes; at most {max} per file")]
@@ -150,14 +153,6 @@ impl Job {
     }
 }
 
-/// Line and column (1-based) of a byte offset.
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
-}
-
 /// Reads and expands a jobs file; every value is checked before any job runs.
 pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     use crate::text_file::BoundedReadError;
@@ -167,8 +162,9 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         BoundedReadError::TooLarge(bytes) => BatchError::TooLarge { path: path.into(), bytes, limit: MAX_FILE_BYTES },
     })?;
     let file: JobsFile = toml::from_str(&text).map_err(|e| {
-        let (line, column) = e.span().map_or((1, 1), |s| line_column(&text, s.start));
-        BatchError::Parse { path: path.into(), line, column, message: e.message().to_string() }
+        let described = crate::toml_text::describe(&text, &e);
+        let (line, column) = described.line_column.unwrap_or((1, 1));
+        BatchError::Parse { path: path.into(), line, column, message: described.message }
     })?;
     if file.job.is_empty() {
         return Err(BatchError::Empty { path: path.into() });
@@ -337,11 +333,21 @@ struct Resolved {
 
 /// `check`: whether to look for its finished set (reading and hashing its files).
 fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resolved, Error> {
-    let loaded = crate::preset::load(&job.preset, &job.overrides, job.seed).map_err(|source| BatchError::Preset {
-        path: jobs_file.into(),
-        job: job.table,
-        preset: job.preset.clone(),
-        source: Box::new(source),
+    let loaded = crate::preset::load(&job.preset, &job.overrides, job.seed).map_err(|source| match source {
+        // The preset's message says `--set`, which a jobs file's reader did not write.
+        crate::preset::PresetError::Override { argument, message } => BatchError::Set {
+            path: jobs_file.into(),
+            job: job.table,
+            preset: job.preset.clone(),
+            entries: argument,
+            message,
+        },
+        source => BatchError::Preset {
+            path: jobs_file.into(),
+            job: job.table,
+            preset: job.preset.clone(),
+            source: Box::new(source),
+        },
     })?;
     let seed = loaded.preset.seed;
     let key = job.key(&loaded.content_hash, seed);

@@ -20,6 +20,7 @@ pub mod optics;
 pub mod preset;
 pub mod render;
 pub mod text_file;
+pub mod toml_text;
 
 pub use generate::{GenerateReport, GenerateRequest, Plan, generate};
 pub use material::parse_map_list;

@@ -185,6 +185,13 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("jobs.toml:3:"), "{}", stderr(&out));
     assert!(!empty.exists());
+    // A value of the wrong type names its key, not serde's Rust type.
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = \"big\"\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:3:9: key `job.0.sizes`: invalid type"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("expected an array") && !stderr(&out).contains("sequence"), "{}", stderr(&out));
+    assert!(!empty.exists());
 
     // A job that cannot run (an unknown preset) stops the batch before any job runs.
     std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n[[job]]\npreset = \"no-such-snake\"\n")
@@ -199,7 +206,7 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     // A bad override names its job too; an empty list of seeds or sizes is refused, not
     // read as the default.
     for (table, says) in [
-        ("set = { \"scales.rwos\" = 23 }", "jobs.toml: job 2 (natrix-natrix): invalid --set \"scales.rwos=23\""),
+        ("set = { \"scales.rwos\" = 23 }", "jobs.toml: job 2 (natrix-natrix): set \"scales.rwos=23\": unknown key"),
         ("sizes = []", "jobs.toml: job 2 (natrix-natrix): sizes = []: list at least one"),
         ("seeds = []", "jobs.toml: job 2 (natrix-natrix): seeds = []: list at least one"),
     ] {

@@ -32,11 +32,26 @@ fn toml_syntax_error_names_file_and_line() {
     assert!(err.contains("broken.toml:4:"), "{err}");
 }
 
+/// A wrong type names the line, the dotted key and what is accepted in words, not in
+/// serde's Rust types (`seed = "x"` said only `invalid type: string "x", expected u64`).
 #[test]
-fn type_error_names_line() {
+fn type_error_names_line_and_key() {
     let err = refused("typed.toml", "seed = 1\n[scales]\nrows = \"many\"\n", &[]);
     assert!(err.contains("typed.toml:3:"), "{err}");
-    assert!(err.contains("integer") || err.contains("u32"), "{err}");
+    assert!(err.contains("key `scales.rows`") && err.contains("expected a whole number"), "{err}");
+    assert!(!err.contains("u32"), "{err}");
+    let err = refused("seed.toml", "seed = \"x\"\n", &[]);
+    assert!(err.contains("seed.toml:1:") && err.contains("key `seed`"), "{err}");
+    // Inside an array of tables and an array: the layer's index and the item's.
+    let text = "[[pattern]]\nkind = \"solid\"\ncolor = \"#102030\"\n[[pattern]]\nkind = \"rings\"\ncolors = [\"#ffffff\", 7]\n";
+    let err = refused("nested.toml", text, &[]);
+    assert!(err.contains("key `pattern.1.colors.1`") && err.contains("expected a string"), "{err}");
+    let err = refused("table.toml", "scales = 5\n", &[]);
+    assert!(err.contains("key `scales`") && err.contains("expected a table"), "{err}");
+    let err = refused("float.toml", "[optics]\nfilm_ior = true\n", &[]);
+    assert!(err.contains("key `optics.film_ior`") && err.contains("expected a number"), "{err}");
+    let err = refused("ok.toml", "seed = 1\n", &["--set", "scales.rows=1.5"]);
+    assert!(err.contains("scales.rows=1.5") && err.contains("expected a whole number"), "{err}");
 }
 
 #[test]

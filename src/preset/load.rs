@@ -16,6 +16,7 @@ use super::error::{LocatedProblem, Location, PresetError};
 use super::library;
 use super::schema::Preset;
 use super::validate::validate;
+use crate::toml_text;
 
 /// Preset text and where it came from.
 #[derive(Debug, Clone)]
@@ -107,7 +108,7 @@ pub fn parse_with_seed(
         }
         Preset::deserialize(toml::Value::Table(table)).map_err(|e| PresetError::Override {
             argument: overrides.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" "),
-            message: with_suggestion(e.message()),
+            message: toml_text::in_plain_words(e.message()),
         })?
     };
 
@@ -150,48 +151,15 @@ fn canonical_text(preset: &Preset) -> String {
 }
 
 fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
-    let (line, column) = match error.span() {
-        Some(span) => {
-            let (l, c) = line_column(&source.text, span.start);
-            (Some(l), Some(c))
-        }
-        None => (None, None),
-    };
-    let mut message = error.message().trim_end().to_string();
-    if message.contains("duplicate key") && !message.contains('`') {
-        // Name the key: the span of a duplicate-key error covers it.
-        if let Some(key) = error.span().and_then(|s| source.text.get(s)).map(str::trim).filter(|k| !k.is_empty()) {
-            message = format!("duplicate key `{key}`: each key may appear once per table");
-        }
-    }
+    let described = toml_text::describe(&source.text, error);
     PresetError::Parse {
-        location: Location { file: source.display.clone(), line, column },
-        message: with_suggestion(&message),
+        location: Location {
+            file: source.display.clone(),
+            line: described.line_column.map(|(line, _)| line),
+            column: described.line_column.map(|(_, column)| column),
+        },
+        message: described.message,
     }
-}
-
-/// 1-based line and column of a byte offset.
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |s| s.chars().count()) + 1;
-    (line, column)
-}
-
-/// Rewrites serde's "unknown field `x`, expected one of `a`, `b`" into a message that names
-/// the key, suggests the nearest accepted one, and lists them all.
-fn with_suggestion(message: &str) -> String {
-    let Some(rest) = message.strip_prefix("unknown field `") else {
-        return message.to_string();
-    };
-    let Some((unknown, expected)) = rest.split_once('`') else {
-        return message.to_string();
-    };
-    let accepted: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
-    let nearest =
-        accepted.iter().map(|a| (edit_distance(unknown, a), *a)).filter(|(d, a)| *d <= 2.max(a.len() / 3)).min();
-    let hint = nearest.map(|(_, a)| format!("; did you mean `{a}`?")).unwrap_or_default();
-    format!("unknown key `{unknown}`{hint} (accepted keys here: {})", accepted.join(", "))
 }
 
 /// Levenshtein distance, for "did you mean".
@@ -232,7 +200,7 @@ fn key_line(text: &str, dotted: &str) -> Option<usize> {
         span = Some(key_span);
         value = Some(item.get_ref());
     }
-    span.map(|s| line_column(text, s.start).0)
+    span.map(|s| toml_text::line_column(text, s.start).0)
 }
 
 /// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).
