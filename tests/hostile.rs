@@ -362,24 +362,56 @@ fn an_export_is_not_failed_by_what_stands_at_a_stale_image_name() {
     assert!(!std::fs::read_to_string(&gltf).unwrap().contains("thickness"));
 }
 
+/// A kill at any rename of the commit, or of the undo after a failed rename, leaves the
+/// earlier set whole (a kill before the first rename) or no manifest: an incomplete set that
+/// readers refuse, never a manifest over maps it did not name. Each kill starts from the
+/// earlier set written afresh. A failed rename during the undo too leaves no manifest, and
+/// the old map that could not go back stays in its temporary. Negative controls (seen): the
+/// new manifest put in first fails at the kill before rename 7; the old manifest put back
+/// before its maps fails at the kill before rename 10.
 #[test]
-fn a_kill_during_the_renames_never_leaves_a_manifest_over_mixed_maps() {
+fn a_kill_at_any_rename_or_during_the_undo_never_leaves_a_manifest_over_other_maps() {
     if !fault_hooks_exist() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    assert!(generate_into(dir.path(), "1", &[]).status.success());
-    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
-    for renames_before_kill in [0, 2, 5] {
-        let n = renames_before_kill.to_string();
-        let out = generate_into(dir.path(), "7", &[("SNAKESKIN_TEST_ABORT_AFTER_RENAMES", &n)]);
-        assert!(!out.status.success(), "the fault hook did not fire");
-        // Either no manifest (an incomplete set, refused by readers) or a manifest whose
-        // maps verify — never an old manifest over new maps.
+    let visible = |dir: &Path| -> Vec<(std::path::PathBuf, Vec<u8>)> {
+        snapshot(dir).into_iter().filter(|(p, _)| !p.file_name().unwrap().to_string_lossy().starts_with('.')).collect()
+    };
+    // Six files aside (renames 0-5), six in (6-11). Failing rename 8 undoes the commit: the
+    // two new maps go, the five old maps come back (renames 9-13), then the manifest (14).
+    let kills = (0..12).map(|kill| (None, kill)).chain((9..15).map(|kill| (Some("8"), kill)));
+    for (fail, kill) in kills {
+        assert!(generate_into(dir.path(), "1", &[]).status.success());
+        let earlier = visible(dir.path());
+        assert_eq!(earlier.len(), 6, "five maps and the manifest");
+        let kill_at = kill.to_string();
+        let mut env = vec![("SNAKESKIN_TEST_KILL_AT_RENAME", kill_at.as_str())];
+        env.extend(fail.map(|at| ("SNAKESKIN_TEST_FAIL_AT_RENAME", at)));
+        let out = generate_into(dir.path(), "7", &env);
+        assert_eq!(out.status.code(), Some(137), "fail {fail:?}, kill {kill}: the hook did not fire");
         match snakeskin::export::verify_set(&manifest_of(dir.path())) {
-            Ok(set) => panic!("after {n} renames a manifest claims a complete set: {set:?}"),
-            Err(e) => assert!(e.to_string().contains("incomplete"), "{e}"),
+            Ok(_) => assert!(kill == 0 && visible(dir.path()) == earlier, "fail {fail:?}, kill {kill}: a manifest"),
+            Err(e) => assert!(e.to_string().contains("incomplete"), "fail {fail:?}, kill {kill}: {e}"),
         }
+    }
+    // A failed rename back (11, an old map) after the failed commit (8): no manifest, and the
+    // old map's bytes wait in a temporary, never deleted.
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let earlier = visible(dir.path());
+    let out = generate_into(dir.path(), "7", &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "8,11")]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let err = snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap_err();
+    assert!(err.to_string().contains("incomplete"), "{err}");
+    let kept: Vec<Vec<u8>> = snapshot(dir.path())
+        .into_iter()
+        .filter(|(p, _)| p.to_string_lossy().ends_with(".snakeskin-tmp"))
+        .map(|(_, bytes)| bytes)
+        .collect();
+    let lost: Vec<_> = earlier.iter().filter(|(p, _)| !p.exists()).collect();
+    assert!(!lost.is_empty(), "every old file came back");
+    for (path, bytes) in lost {
+        assert!(kept.contains(bytes), "{path:?} is gone and no temporary holds it");
     }
     // The next run cleans up the killed runs' temporaries and writes a whole set.
     assert!(generate_into(dir.path(), "7", &[]).status.success());

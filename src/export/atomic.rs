@@ -30,9 +30,11 @@
 //! ones it was written with** — `verify_set` checks the hashes. An earlier set survives every
 //! failure: before step 4 nothing has changed, and a rename that fails in step 4 (a file
 //! that may not be replaced, a full disk) undoes the commit — the new files go and the old
-//! ones are renamed back. A kill during step 4 leaves no manifest (some maps or none, the
-//! old files in temporaries the next run removes: an incomplete set that no reader
-//! accepts), never new maps under an old manifest.
+//! ones are renamed back, the manifest last. If a rename of the undo fails too, the old
+//! files that could not go back stay in their temporaries and the old manifest stays aside
+//! with them. A kill during step 4 or its undo leaves no manifest (some maps or none, the
+//! old files in temporaries the next run removes): an incomplete set that no reader
+//! accepts, never maps under a manifest that did not name them.
 
 use std::fs::{self, File};
 use std::io::Write;
@@ -224,19 +226,18 @@ impl SetLock {
             match moved {
                 Ok(backup) => aside.push((backup, target.clone())),
                 Err(e) => {
-                    put_back(aside, &[], &manifest_target);
+                    put_back(aside, &[], &manifest_target, &mut renames);
                     return Err(e);
                 }
             }
         }
         // Step 4b: the new files in, the manifest last.
         let mut written = Vec::new();
-        for (placed, (tmp, target)) in staged.into_iter().enumerate() {
-            fault_point(placed);
+        for (tmp, target) in staged {
             if let Err(e) =
                 injected_failure(&mut renames).and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error))
             {
-                put_back(aside, &written, &manifest_target);
+                put_back(aside, &written, &manifest_target, &mut renames);
                 return Err(ExportError::Io { path: target, source: e });
             }
             written.push(target);
@@ -252,8 +253,8 @@ impl SetLock {
 /// ones back, the maps before the manifest (`aside` holds the manifest first), so that the
 /// old manifest returns only over its own maps. An old file that cannot go back stays in
 /// its temporary (never deleted), and then the old manifest stays aside too: the set is
-/// incomplete, not mixed.
-fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf], manifest: &Path) {
+/// incomplete, not mixed. `renames` counts on from the commit's (`injected_failure`).
+fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf], manifest: &Path, renames: &mut usize) {
     let mut whole = true;
     for target in written {
         whole &= fs::remove_file(target).is_ok();
@@ -263,9 +264,13 @@ fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf], mani
             let _ = backup.keep();
             continue;
         }
-        if let Err(e) = backup.persist(&target) {
+        let back = match injected_failure(renames) {
+            Ok(()) => backup.persist(&target).map_err(|e| e.path),
+            Err(_) => Err(backup),
+        };
+        if let Err(backup) = back {
             whole = false;
-            let _ = e.path.keep();
+            let _ = backup.keep();
         }
     }
 }
@@ -275,16 +280,29 @@ fn file_name(path: &Path) -> String {
     path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
-/// Counts the commit's renames in `renames`. Test hook (debug builds only):
-/// `SNAKESKIN_TEST_FAIL_AT_RENAME=N` makes the commit's rename N (from 0, moving the old
-/// files aside and then the new ones in) fail with an I/O error instead, as a file that may
-/// not be replaced would, so the rollback can be tested at every step.
+/// Counts the commit's renames in `renames`: moving the old files aside, putting the new
+/// ones in, and an undo's renames back, in that order from 0. Test hooks (debug builds
+/// only), so the commit and its undo can be tested at every step:
+/// `SNAKESKIN_TEST_FAIL_AT_RENAME=N[,M...]` makes the renames listed fail with an I/O error,
+/// as a file that may not be replaced would; `SNAKESKIN_TEST_KILL_AT_RENAME=N` ends the
+/// process before rename N with no cleanup at all (`_exit`, as a SIGKILL would: no
+/// destructor runs, temporaries and the lock file stay).
 fn injected_failure(renames: &mut usize) -> std::io::Result<()> {
     let this = *renames;
     *renames += 1;
     #[cfg(debug_assertions)]
-    if std::env::var("SNAKESKIN_TEST_FAIL_AT_RENAME").ok().and_then(|v| v.parse::<usize>().ok()) == Some(this) {
-        return Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, "injected failure (test hook)"));
+    {
+        let listed = |name: &str| {
+            std::env::var(name).is_ok_and(|v| v.split(',').any(|n| n.trim().parse::<usize>().ok() == Some(this)))
+        };
+        #[cfg(unix)]
+        if listed("SNAKESKIN_TEST_KILL_AT_RENAME") {
+            // SAFETY: `_exit` ends the process at once; nothing after it runs.
+            unsafe { libc::_exit(137) };
+        }
+        if listed("SNAKESKIN_TEST_FAIL_AT_RENAME") {
+            return Err(std::io::Error::new(std::io::ErrorKind::PermissionDenied, "injected failure (test hook)"));
+        }
     }
     #[cfg(not(debug_assertions))]
     let _ = this;
@@ -331,20 +349,6 @@ fn sync_folder(dir: &Path) {
     if let Ok(folder) = File::open(dir) {
         let _ = folder.sync_all();
     }
-}
-
-/// Test hook (debug builds only): `SNAKESKIN_TEST_ABORT_AFTER_RENAMES=N` ends the process
-/// after N renames of a set with no cleanup at all (`_exit`, as a SIGKILL would: no
-/// destructor runs, temporaries and the lock file stay), so the kill-during-rename test can
-/// stop a run at an exact point. Release builds ignore it.
-fn fault_point(renamed: usize) {
-    #[cfg(all(debug_assertions, unix))]
-    if std::env::var("SNAKESKIN_TEST_ABORT_AFTER_RENAMES").ok().and_then(|v| v.parse::<usize>().ok()) == Some(renamed) {
-        // SAFETY: `_exit` ends the process at once; nothing after it runs.
-        unsafe { libc::_exit(137) };
-    }
-    #[cfg(not(all(debug_assertions, unix)))]
-    let _ = renamed;
 }
 
 /// Writes one file atomically (exclusive temporary, then rename) to `path`. The folder must
