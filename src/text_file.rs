@@ -35,9 +35,11 @@ pub fn read_bounded(path: &Path, limit: u64) -> Result<String, BoundedReadError>
         return Err(BoundedReadError::TooLarge(meta.len()));
     }
     let mut bytes = Vec::new();
-    file.take(limit + 1).read_to_end(&mut bytes).map_err(BoundedReadError::Io)?;
+    (&file).take(limit + 1).read_to_end(&mut bytes).map_err(BoundedReadError::Io)?;
     if bytes.len() as u64 > limit {
-        return Err(BoundedReadError::TooLarge(bytes.len() as u64));
+        // It grew after the check: its size now, not the limit + 1 bytes that were read.
+        let now = file.metadata().map_or(0, |m| m.len());
+        return Err(BoundedReadError::TooLarge(now.max(bytes.len() as u64)));
     }
     String::from_utf8(bytes).map_err(|e| {
         BoundedReadError::Io(std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 text ({e})")))

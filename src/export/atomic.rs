@@ -35,10 +35,18 @@
 //! with them. A kill during step 4 or its undo leaves no manifest (some maps or none, the
 //! old files in temporaries the next run removes): an incomplete set that no reader
 //! accepts, never maps under a manifest that did not name them.
+//!
+//! **An interrupted run** (Ctrl-C, SIGTERM, SIGHUP: the binary's handler calls
+//! `clean_up_before_exit`) waits for a commit in progress and its undo to end, then removes
+//! its temporaries of new files and its lock files, and no new temporary or commit starts
+//! after that. Without it, a Ctrl-C left hidden temporaries (up to a set's size) and the
+//! lock file until the next run in that folder. The old files a commit moved aside are the
+//! commit's to put back or remove, never the handler's.
 
 use std::fs::{self, File};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 use sha2::{Digest, Sha256};
 
@@ -49,6 +57,42 @@ const TMP_SUFFIX: &str = ".snakeskin-tmp";
 
 /// Random characters in a temporary's name (between `.FILE.` and the suffix).
 const RANDOM_CHARS: usize = 6;
+
+/// This process's temporaries of new files (staged, not yet renamed into place) and the
+/// lock files of the sets it holds: what `clean_up_before_exit` removes.
+#[derive(Default)]
+struct Live {
+    temporaries: Vec<PathBuf>,
+    locks: Vec<PathBuf>,
+}
+
+static LIVE: Mutex<Live> = Mutex::new(Live { temporaries: Vec::new(), locks: Vec::new() });
+
+/// Held by a commit from its first rename to its last (the undo's included), and by
+/// `clean_up_before_exit` from when it begins until the process exits. Taken before `LIVE`.
+static COMMIT: Mutex<()> = Mutex::new(());
+
+/// A poisoned lock still guards valid data here (lists of paths), so it is used as it is.
+fn locked<T>(mutex: &'static Mutex<T>) -> MutexGuard<'static, T> {
+    mutex.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// For a process that is about to exit on a signal: waits for a commit in progress (and its
+/// undo) to end, then removes this process's temporaries of new files and its lock files.
+/// Returns how many files it removed. Both locks stay held, so no temporary or commit starts
+/// before the exit (a thread that tries waits until then). Call it once, then exit.
+pub fn clean_up_before_exit() -> usize {
+    std::mem::forget(locked(&COMMIT));
+    let live = locked(&LIVE);
+    let removed = live.temporaries.iter().chain(&live.locks).filter(|path| fs::remove_file(path).is_ok()).count();
+    std::mem::forget(live);
+    removed
+}
+
+/// `path` is no longer a temporary of a new file (renamed into place).
+fn forget_temporary(path: &Path) {
+    locked(&LIVE).temporaries.retain(|p| p != path);
+}
 
 fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
     move |source| ExportError::Io { path: path.into(), source }
@@ -91,7 +135,14 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
 /// Writes `bytes` to a new exclusive temporary beside `target` and returns it (deleted on
 /// drop unless persisted).
 fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedTempFile, ExportError> {
-    let mut tmp = temporary(dir, target_name).map_err(io_error(dir))?;
+    let mut tmp = {
+        // Created and listed under one lock: once `clean_up_before_exit` has begun, none is
+        // created that it would not remove.
+        let mut live = locked(&LIVE);
+        let tmp = temporary(dir, target_name).map_err(io_error(dir))?;
+        live.temporaries.push(tmp.path().to_path_buf());
+        tmp
+    };
     tmp.write_all(bytes).and_then(|_| tmp.as_file().sync_all()).map_err(io_error(tmp.path()))?;
     Ok(tmp)
 }
@@ -166,6 +217,7 @@ impl SetLock {
             let file = options.open(&path).map_err(io_error(&path))?;
             match file.try_lock() {
                 Ok(()) if same_file(&file, &path) => {
+                    locked(&LIVE).locks.push(path.clone());
                     return Ok(SetLock { dir: dir.into(), path, _file: file, created_folder });
                 }
                 Ok(()) => continue,
@@ -207,6 +259,8 @@ impl SetLock {
         for (_, target) in &staged {
             check_target(target)?;
         }
+        pause_hook(|| "commit".into());
+        let _commit = locked(&COMMIT);
         // Step 4a: the old files out of the way, the manifest first (so that from here on no
         // old manifest names a map that may change). A file that cannot be moved fails here,
         // before anything new is in place.
@@ -234,12 +288,14 @@ impl SetLock {
         // Step 4b: the new files in, the manifest last.
         let mut written = Vec::new();
         for (tmp, target) in staged {
+            let temporary = tmp.path().to_path_buf();
             if let Err(e) =
                 injected_failure(&mut renames).and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error))
             {
                 put_back(aside, &written, &manifest_target, &mut renames);
                 return Err(ExportError::Io { path: target, source: e });
             }
+            forget_temporary(&temporary);
             written.push(target);
         }
         sync_folder(dir);
@@ -290,6 +346,7 @@ fn file_name(path: &Path) -> String {
 fn injected_failure(renames: &mut usize) -> std::io::Result<()> {
     let this = *renames;
     *renames += 1;
+    pause_hook(|| format!("rename-{this}"));
     #[cfg(debug_assertions)]
     {
         let listed = |name: &str| {
@@ -309,6 +366,19 @@ fn injected_failure(renames: &mut usize) -> std::io::Result<()> {
     Ok(())
 }
 
+/// Test hook (debug builds only): `SNAKESKIN_TEST_PAUSE_AT=POINT` stops the run for three
+/// seconds at POINT, `commit` (every file staged, before the commit lock and the first
+/// rename) or `rename-N` (before rename N, see `injected_failure`, the lock held), so that a
+/// test can interrupt the run there.
+fn pause_hook(point: impl Fn() -> String) {
+    #[cfg(debug_assertions)]
+    if std::env::var("SNAKESKIN_TEST_PAUSE_AT").is_ok_and(|at| at == point()) {
+        std::thread::sleep(std::time::Duration::from_secs(3));
+    }
+    #[cfg(not(debug_assertions))]
+    let _ = point;
+}
+
 /// A map of a set written to its temporary (`SetLock::stage`), waiting for `commit`.
 #[derive(Debug)]
 pub struct Staged {
@@ -322,6 +392,8 @@ pub struct Staged {
 impl Drop for SetLock {
     /// Removes the lock file while still holding the lock (see `acquire`).
     fn drop(&mut self) {
+        let mut live = locked(&LIVE);
+        live.locks.retain(|p| *p != self.path);
         let _ = fs::remove_file(&self.path);
     }
 }
@@ -364,6 +436,8 @@ pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, Exp
     // Without a lock, a temporary is only taken as stale once it is older than any write.
     remove_stale_temporaries(dir, &[&name], std::time::Duration::from_secs(600));
     let tmp = stage(dir, &name, &bytes)?;
+    let temporary = tmp.path().to_path_buf();
     tmp.persist(path).map_err(|e| ExportError::Io { path: path.into(), source: e.error })?;
+    forget_temporary(&temporary);
     Ok(path.into())
 }

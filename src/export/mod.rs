@@ -10,7 +10,9 @@ mod manifest;
 pub mod pack;
 mod srgb;
 
-pub use atomic::{SetLock, Staged, check_folder, check_target, create_folder, sha256_hex, write_file_atomically};
+pub use atomic::{
+    SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder, sha256_hex, write_file_atomically,
+};
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
 

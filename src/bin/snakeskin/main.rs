@@ -16,6 +16,8 @@ fn main() -> ExitCode {
     output::restore_default_sigpipe();
     output::stdout_failure_is_an_error();
     output::quiet_vulkan_device_select();
+    // Spawns a thread: after the calls above, which need the process single-threaded.
+    output::clean_up_on_interrupt();
     let cli = cli::Cli::parse();
     match cmd::run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -16,6 +16,35 @@ pub fn restore_default_sigpipe() {
     }
 }
 
+/// Ctrl-C, SIGTERM or SIGHUP end the run without leaving its unfinished files: a commit in
+/// progress ends first (a set is never left mixed), the run's temporaries and lock files
+/// are removed (`export::clean_up_before_exit`), one line says so, and the exit status is
+/// 128 + the signal's number, as a shell reports a process that a signal ended. Before,
+/// the hidden temporaries (up to a set's size) and the lock file stayed until the next run
+/// in that folder.
+pub fn clean_up_on_interrupt() {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+            return;
+        };
+        std::thread::spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                let removed = snakeskin::export::clean_up_before_exit();
+                let name = match signal {
+                    SIGINT => "SIGINT",
+                    SIGTERM => "SIGTERM",
+                    _ => "SIGHUP",
+                };
+                use std::io::Write;
+                let _ = writeln!(std::io::stderr(), "interrupted ({name}): removed {removed} unfinished file(s)");
+                std::process::exit(128 + signal);
+            }
+        });
+    }
+}
+
 /// A standard output that fails for another reason than a closed pipe (a full disk,
 /// `> /dev/full`, an I/O error) is an error like any other: one line on stderr and exit
 /// status 1, not a panic (exit 101). `println!` panics with std's message "failed printing to
