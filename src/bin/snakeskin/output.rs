@@ -21,7 +21,7 @@ pub fn restore_default_sigpipe() {
 /// are removed (`export::clean_up_before_exit`), one line says so, and the exit status is
 /// 128 + the signal's number, as a shell reports a process that a signal ended. Before,
 /// the hidden temporaries (up to a set's size) and the lock file stayed until the next run
-/// in that folder.
+/// in that folder. A second signal exits at once.
 pub fn clean_up_on_interrupt() {
     #[cfg(unix)]
     {
@@ -31,6 +31,13 @@ pub fn clean_up_on_interrupt() {
         };
         std::thread::spawn(move || {
             if let Some(signal) = signals.forever().next() {
+                // A second signal ends the run at once, should the clean-up wait on a commit
+                // that hangs (a rename on a stalled network drive).
+                std::thread::spawn(move || {
+                    if let Some(again) = signals.forever().next() {
+                        std::process::exit(128 + again);
+                    }
+                });
                 let removed = snakeskin::export::clean_up_before_exit();
                 let name = match signal {
                     SIGINT => "SIGINT",
