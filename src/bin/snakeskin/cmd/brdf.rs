@@ -87,7 +87,7 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
 fn eval_json(args: &EvalArgs) -> Result<String> {
     let stack = stack_of(&args.stack);
     let (layers, l) = (layers_of(&args.stack, &args.layer)?, &args.layer);
-    let film = |c: f64| film_colour(l.method, stack, l.thickness_nm, c);
+    let film = |c: f64| film_colour(args.method, stack, l.thickness_nm, c);
     let value = args.model.eval(&layers, args.normal, args.wi, args.wo, &film);
     let json = serde_json::json!({
         "model": args.model.name(),
@@ -112,7 +112,7 @@ fn albedo_json(args: &AlbedoArgs) -> Result<String> {
     let cos = args.angle_deg.to_radians().cos();
     let (name, value, sigma) = match args.model {
         AlbedoModel::Model(model) => {
-            let film = |c: f64| film_colour(l.method, stack, l.thickness_nm, c);
+            let film = |c: f64| film_colour(args.method, stack, l.thickness_nm, c);
             let total = model.furnace_albedo(&layers, cos, &film, 64);
             let specular = model.furnace_albedo(&Layers { albedo: [0.0; 3], ..layers }, cos, &film, 64);
             let diffuse = [0, 1, 2].map(|c| total[c] - specular[c]);
