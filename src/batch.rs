@@ -47,11 +47,11 @@ pub enum BatchError {
     /// A value outside what a job accepts.
     #[error("{path}: job {job} ({preset}): {message}")]
     Invalid { path: PathBuf, job: usize, preset: String, message: String },
-    /// The job's preset, or its `set` overrides, refused (the preset's own message).
+    /// The job's preset refused (the preset's own message).
     #[error("{path}: job {job} ({preset}): {source}")]
     Preset { path: PathBuf, job: usize, preset: String, source: Box<crate::preset::PresetError> },
     /// The job's `set` table refused: its entries as `key=value`, and why.
-    #[error("{path}: job {job} ({preset}): set {entries:?}: {message}")]
+    #[error("{path}: job {job} ({preset}): set `{entries}`: {message}")]
     Set { path: PathBuf, job: usize, preset: String, entries: String, message: String },
     #[error("{path}: no [[job]] tables; a jobs file lists jobs as [[job]] tables with at least a preset key")]
     Empty { path: PathBuf },
@@ -164,7 +164,14 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     let file: JobsFile = toml::from_str(&text).map_err(|e| {
         let described = crate::toml_text::describe(&text, &e);
         let (line, column) = described.line_column.unwrap_or((1, 1));
-        BatchError::Parse { path: path.into(), line, column, message: described.message }
+        // `job.0.sizes` is the first [[job]] table's `sizes`: "job 1", as the other messages
+        // count jobs.
+        let in_job = described.key.as_deref().and_then(|k| k.strip_prefix("job.")).and_then(|k| k.split_once('.'));
+        let message = match in_job.and_then(|(index, key)| Some((index.parse::<usize>().ok()? + 1, key))) {
+            Some((job, key)) => format!("job {job}: key `{key}`: {}", described.message),
+            None => described.keyed_message(),
+        };
+        BatchError::Parse { path: path.into(), line, column, message }
     })?;
     if file.job.is_empty() {
         return Err(BatchError::Empty { path: path.into() });
@@ -341,6 +348,12 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
             preset: job.preset.clone(),
             entries: argument,
             message,
+        },
+        crate::preset::PresetError::Invalid { file, problems } => BatchError::Invalid {
+            path: jobs_file.into(),
+            job: job.table,
+            preset: job.preset.clone(),
+            message: crate::preset::describe_problems(&file, &problems, "its `set` table"),
         },
         source => BatchError::Preset {
             path: jobs_file.into(),

@@ -13,7 +13,7 @@ pub enum BoundedReadError {
     Io(std::io::Error),
     /// Not a regular file: what it is ("a FIFO", "a device", "a folder" ...).
     NotAFile(&'static str),
-    /// Larger than the limit: its size in bytes (as far as it was read).
+    /// Larger than the limit: its size in bytes (its size now, if it grew while it was read).
     TooLarge(u64),
 }
 

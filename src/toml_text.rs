@@ -11,29 +11,41 @@ use toml::de::{DeTable, DeValue};
 pub struct Described {
     /// 1-based line and column where the error's span starts, when it has one.
     pub line_column: Option<(usize, usize)>,
+    /// The dotted key (`scales.rows`, `job.0.sizes`) of a value of the wrong type or
+    /// variant, for the caller to name as its readers count (a jobs file says "job 1").
+    pub key: Option<String>,
     pub message: String,
 }
 
+impl Described {
+    /// The message with its key, if any: ``key `scales.rows`: invalid type: ...``.
+    pub fn keyed_message(&self) -> String {
+        match &self.key {
+            Some(key) => format!("key `{key}`: {}", self.message),
+            None => self.message.clone(),
+        }
+    }
+}
+
 /// `error`, met while reading `text`, located and in plain words: a duplicate key named, an
-/// unknown key with the nearest accepted one, and a value of the wrong type or variant with
+/// unknown key with the nearest accepted one, and for a value of the wrong type or variant
 /// the dotted key it is written under.
 pub fn describe(text: &str, error: &toml::de::Error) -> Described {
     let span = error.span();
     let mut message = in_plain_words(error.message().trim_end());
+    let mut key = None;
     if message.contains("duplicate key") {
         if !message.contains('`') {
             // Name the key: the span of a duplicate-key error covers it.
-            let key = span.clone().and_then(|s| text.get(s)).map(str::trim).filter(|k| !k.is_empty());
-            if let Some(key) = key {
-                message = format!("duplicate key `{key}`: each key may appear once per table");
+            let written = span.clone().and_then(|s| text.get(s)).map(str::trim).filter(|k| !k.is_empty());
+            if let Some(written) = written {
+                message = format!("duplicate key `{written}`: each key may appear once per table");
             }
         }
-    } else if !message.starts_with("unknown key")
-        && let Some(key) = span.clone().and_then(|s| key_at(text, s.start))
-    {
-        message = format!("key `{key}`: {message}");
+    } else if !message.starts_with("unknown key") {
+        key = span.clone().and_then(|s| key_at(text, s.start));
     }
-    Described { line_column: span.map(|s| line_column(text, s.start)), message }
+    Described { line_column: span.map(|s| line_column(text, s.start)), key, message }
 }
 
 /// serde's message in a reader's words: "unknown field" with the nearest accepted key, and
@@ -60,48 +72,58 @@ fn with_suggestion(message: &str) -> String {
         return message.to_string();
     };
     let accepted: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
-    let nearest = accepted
-        .iter()
-        .map(|a| (crate::preset::edit_distance(unknown, a), *a))
-        .filter(|(d, a)| *d <= 2.max(a.len() / 3))
-        .min();
+    let nearest =
+        accepted.iter().map(|a| (edit_distance(unknown, a), *a)).filter(|(d, a)| *d <= 2.max(a.len() / 3)).min();
     let hint = nearest.map(|(_, a)| format!("; did you mean `{a}`?")).unwrap_or_default();
     format!("unknown key `{unknown}`{hint} (accepted keys here: {})", accepted.join(", "))
 }
 
-/// `expected u32` → `expected a whole number`, `expected struct Scales` → `expected a table`.
+/// Levenshtein distance, for "did you mean".
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// serde's words for types in a reader's: what the value is (`invalid type: sequence`) and
+/// what is accepted (`expected u32`, `expected struct Scales`). Only serde's own parts are
+/// rewritten, never the value the message quotes: the value's type after "invalid type: "
+/// and the final ", expected ...".
 fn plain_type_names(message: &str) -> String {
     let mut out = message.to_string();
-    for (rust, plain) in [
-        ("u8", "a whole number"),
-        ("u16", "a whole number"),
-        ("u32", "a whole number"),
-        ("u64", "a whole number"),
-        ("usize", "a whole number"),
-        ("i32", "an integer"),
-        ("i64", "an integer"),
-        ("f32", "a number"),
-        ("f64", "a number"),
-        ("a sequence", "an array"),
-    ] {
-        let rust = format!("expected {rust}");
-        let mut from = 0;
-        while let Some(at) = out[from..].find(&rust).map(|i| i + from) {
-            let end = at + rust.len();
-            // `expected u32` but not `expected u320`.
-            if out[end..].starts_with(|c: char| c.is_alphanumeric() || c == '_') {
-                from = end;
-                continue;
-            }
-            out.replace_range(at..end, &format!("expected {plain}"));
-            from = at;
+    for (serde, plain) in [("sequence", "array"), ("map", "table")] {
+        let from = format!("invalid type: {serde},");
+        if out.starts_with(&from) {
+            out.replace_range(..from.len(), &format!("invalid type: {plain},"));
         }
     }
-    if let Some(at) = out.find("expected struct ") {
-        let name = at + "expected struct ".len();
-        let end = out[name..].find(|c: char| !(c.is_alphanumeric() || c == '_')).map_or(out.len(), |i| name + i);
-        out.replace_range(at..end, "expected a table");
-    }
+    let Some(at) = out.rfind(", expected ") else { return out };
+    let expected = &out[at + ", expected ".len()..];
+    let plain = match expected {
+        "u8" => "a whole number from 0 to 255",
+        "u16" => "a whole number from 0 to 65535",
+        "u32" => "a whole number from 0 to 4294967295",
+        "u64" | "usize" => "a whole number, 0 or more",
+        "i32" | "i64" => "an integer",
+        "f32" | "f64" => "a number",
+        "a sequence" => "an array",
+        other
+            if other
+                .strip_prefix("struct ")
+                .is_some_and(|name| name.chars().all(|c| c.is_alphanumeric() || c == '_')) =>
+        {
+            "a table"
+        }
+        _ => return out,
+    };
+    out.replace_range(at + ", expected ".len().., plain);
     out
 }
 
@@ -137,17 +159,28 @@ fn joined(key: &str, rest: String) -> String {
 mod tests {
     use super::*;
 
-    /// Whole type names only: a name that merely starts like one is left alone.
+    /// serde's parts only, whole names only: the value a message quotes is left as written.
     #[test]
     fn type_names_are_replaced_whole() {
-        assert_eq!(
-            plain_type_names("invalid type: string \"x\", expected u64"),
-            "invalid type: string \"x\", expected a whole number"
-        );
-        assert_eq!(plain_type_names("expected u320 or expected f64"), "expected u320 or expected a number");
-        assert_eq!(
-            plain_type_names("invalid type: integer `5`, expected struct Scales"),
-            "invalid type: integer `5`, expected a table"
-        );
+        let cases = [
+            (
+                "invalid type: string \"x\", expected u64",
+                "invalid type: string \"x\", expected a whole number, 0 or more",
+            ),
+            (
+                "invalid value: integer `-1`, expected u32",
+                "invalid value: integer `-1`, expected a whole number from 0 to 4294967295",
+            ),
+            (
+                "invalid type: string \"expected f64\", expected f64",
+                "invalid type: string \"expected f64\", expected a number",
+            ),
+            ("invalid type: sequence, expected a string", "invalid type: array, expected a string"),
+            ("invalid type: integer `5`, expected struct Scales", "invalid type: integer `5`, expected a table"),
+            ("invalid type: string \"x\", expected u320", "invalid type: string \"x\", expected u320"),
+        ];
+        for (serde, plain) in cases {
+            assert_eq!(plain_type_names(serde), plain);
+        }
     }
 }

@@ -189,7 +189,7 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = \"big\"\n").unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:3:9: key `job.0.sizes`: invalid type"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:3:9: job 1: key `sizes`: invalid type"), "{}", stderr(&out));
     assert!(stderr(&out).contains("expected an array") && !stderr(&out).contains("sequence"), "{}", stderr(&out));
     assert!(!empty.exists());
 
@@ -206,7 +206,11 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     // A bad override names its job too; an empty list of seeds or sizes is refused, not
     // read as the default.
     for (table, says) in [
-        ("set = { \"scales.rwos\" = 23 }", "jobs.toml: job 2 (natrix-natrix): set \"scales.rwos=23\": unknown key"),
+        ("set = { \"scales.rwos\" = 23 }", "jobs.toml: job 2 (natrix-natrix): set `scales.rwos=23`: unknown key"),
+        (
+            "set = { \"scales.rows\" = 0 }",
+            "job 2 (natrix-natrix): built-in preset natrix-natrix (with its `set` table): key `scales.rows` must be",
+        ),
         ("sizes = []", "jobs.toml: job 2 (natrix-natrix): sizes = []: list at least one"),
         ("seeds = []", "jobs.toml: job 2 (natrix-natrix): seeds = []: list at least one"),
     ] {

@@ -46,12 +46,18 @@ fn type_error_names_line_and_key() {
     let text = "[[pattern]]\nkind = \"solid\"\ncolor = \"#102030\"\n[[pattern]]\nkind = \"rings\"\ncolors = [\"#ffffff\", 7]\n";
     let err = refused("nested.toml", text, &[]);
     assert!(err.contains("key `pattern.1.colors.1`") && err.contains("expected a string"), "{err}");
+    // A single `[pattern]` table is layer 0, as the range checks name it.
+    let err = refused("one.toml", "[pattern]\nkind = \"spots\"\ncolor = \"#000000\"\namount = \"x\"\n", &[]);
+    assert!(err.contains("key `pattern.0.amount`") && err.contains("expected a number"), "{err}");
+    // An integer out of the type's range says the range, not "a whole number" alone.
+    let err = refused("negative.toml", "seed = -1\n", &[]);
+    assert!(err.contains("key `seed`") && err.contains("expected a whole number, 0 or more"), "{err}");
     let err = refused("table.toml", "scales = 5\n", &[]);
     assert!(err.contains("key `scales`") && err.contains("expected a table"), "{err}");
     let err = refused("float.toml", "[optics]\nfilm_ior = true\n", &[]);
     assert!(err.contains("key `optics.film_ior`") && err.contains("expected a number"), "{err}");
     let err = refused("ok.toml", "seed = 1\n", &["--set", "scales.rows=1.5"]);
-    assert!(err.contains("scales.rows=1.5") && err.contains("expected a whole number"), "{err}");
+    assert!(err.contains("scales.rows=1.5") && err.contains("expected a whole number from 0 to"), "{err}");
 }
 
 #[test]

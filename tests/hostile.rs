@@ -426,15 +426,31 @@ fn a_kill_at_any_rename_or_during_the_undo_never_leaves_a_manifest_over_other_ma
 
 /// Runs `generate` (seed 7) into `dir` paused at `pause` (`SNAKESKIN_TEST_PAUSE_AT`), sends
 /// it `signal` once `ready` holds for the folder, and returns its exit status and stderr.
+/// With `ignoring`, the run starts with that signal ignored, as `nohup` starts it.
 #[cfg(unix)]
-fn interrupted(dir: &Path, pause: &str, signal: i32, ready: impl Fn(&Path) -> bool) -> (Option<i32>, String) {
-    let mut child = Command::new(BIN)
-        .args(["generate", PRESET, "-o", dir.to_str().unwrap(), "--size", "48", "--seed", "7"])
-        .env("SNAKESKIN_TEST_PAUSE_AT", pause)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+fn interrupted(
+    dir: &Path,
+    pause: &str,
+    signal: i32,
+    ignoring: Option<&str>,
+    ready: impl Fn(&Path) -> bool,
+) -> (Option<i32>, String) {
+    let generate = [BIN, "generate", PRESET, "-o", dir.to_str().unwrap(), "--size", "48", "--seed", "7"];
+    let mut command = match ignoring {
+        // `exec` keeps the shell's pid, and an ignored signal stays ignored across it.
+        Some(name) => {
+            let mut c = Command::new("sh");
+            c.args(["-c", &format!("trap '' {name}; exec \"$@\""), "sh"]).args(generate);
+            c
+        }
+        None => {
+            let mut c = Command::new(BIN);
+            c.args(&generate[1..]);
+            c
+        }
+    };
+    let mut child =
+        command.env("SNAKESKIN_TEST_PAUSE_AT", pause).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
     let start = std::time::Instant::now();
     while !ready(dir) {
         assert!(start.elapsed().as_secs() < 60, "the run never reached {pause}");
@@ -453,13 +469,14 @@ fn hidden_files(dir: &Path) -> Vec<String> {
     names.filter(|n| n.starts_with('.')).collect()
 }
 
-/// Ctrl-C or SIGTERM while the maps wait in their temporaries: the run removes them and
-/// its lock file, exits 128 + the signal, and the earlier set is as it was. Before, the
-/// temporaries and the lock stayed until the next run in that folder (seen: this test
-/// fails without the handler, with the six temporaries and the lock left).
+/// Ctrl-C or SIGTERM while the maps wait in their temporaries: the run removes them, exits
+/// 128 + the signal, and the earlier set is as it was; the lock file stays, empty, for the
+/// next run (as after a kill). Before, the temporaries stayed until the next run in that
+/// folder (seen: this test fails without the handler, with the six temporaries left). A
+/// run started under `nohup` (SIGHUP ignored) is not ended by SIGHUP: it finishes its set.
 #[cfg(unix)]
 #[test]
-fn an_interrupted_run_removes_its_temporaries_and_lock() {
+fn an_interrupted_run_removes_its_temporaries() {
     if !fault_hooks_exist() {
         return;
     }
@@ -469,12 +486,21 @@ fn an_interrupted_run_removes_its_temporaries_and_lock() {
     // Five maps and the manifest staged: the run pauses before its commit.
     let staged = |dir: &Path| hidden_files(dir).iter().filter(|n| n.ends_with(".snakeskin-tmp")).count() == 6;
     for (signal, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
-        let (code, err) = interrupted(dir.path(), "commit", signal, staged);
+        let (code, err) = interrupted(dir.path(), "commit", signal, None, staged);
         assert_eq!(code, Some(128 + signal), "{err}");
-        assert!(err.contains(&format!("interrupted ({name}): removed 7 unfinished file(s)")), "{err}");
-        assert_eq!(hidden_files(dir.path()), Vec::<String>::new());
-        assert_eq!(snapshot(dir.path()), before);
+        assert!(err.contains(&format!("interrupted ({name}): removed 6 unfinished file(s)")), "{err}");
+        assert_eq!(hidden_files(dir.path()), vec![format!(".{PRESET}.lock")]);
+        let visible = |files: &std::collections::BTreeMap<std::path::PathBuf, Vec<u8>>| {
+            files.keys().filter(|p| !p.file_name().unwrap().to_string_lossy().starts_with('.')).count()
+        };
+        let after = snapshot(dir.path());
+        assert_eq!(visible(&after), visible(&before));
+        assert!(before.iter().all(|(path, bytes)| after.get(path) == Some(bytes)), "the earlier set changed");
     }
+    let (code, err) = interrupted(dir.path(), "commit", libc::SIGHUP, Some("HUP"), staged);
+    assert_eq!(code, Some(0), "{err}");
+    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
+    assert_ne!(snapshot(dir.path()), before);
 }
 
 /// A signal during the commit waits for the commit to end: the new set is whole (the
@@ -492,13 +518,13 @@ fn an_interrupt_during_the_commit_waits_for_it() {
     assert!(generate_into(dir.path(), "1", &[]).status.success());
     // Paused before rename 3: the old manifest and two old maps are aside.
     let in_commit = |dir: &Path| !manifest_of(dir).exists();
-    let (code, err) = interrupted(dir.path(), "rename-3", libc::SIGINT, in_commit);
+    let (code, err) = interrupted(dir.path(), "rename-3", libc::SIGINT, None, in_commit);
     assert!(code == Some(130) || code == Some(0), "{code:?}: {err}");
     snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(manifest_of(dir.path())).unwrap()).unwrap();
     assert_eq!(manifest["seed"], 7, "{manifest}");
-    assert_eq!(hidden_files(dir.path()), Vec::<String>::new());
+    assert!(hidden_files(dir.path()).iter().all(|n| !n.ends_with(".snakeskin-tmp")), "{:?}", hidden_files(dir.path()));
 }
 
 #[test]

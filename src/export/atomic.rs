@@ -38,10 +38,12 @@
 //!
 //! **An interrupted run** (Ctrl-C, SIGTERM, SIGHUP: the binary's handler calls
 //! `clean_up_before_exit`) waits for a commit in progress and its undo to end, then removes
-//! its temporaries of new files and its lock files, and no new temporary or commit starts
-//! after that. Without it, a Ctrl-C left hidden temporaries (up to a set's size) and the
-//! lock file until the next run in that folder. The old files a commit moved aside are the
-//! commit's to put back or remove, never the handler's.
+//! its temporaries of new files, and no new temporary or commit starts after that. Without
+//! it, a Ctrl-C left hidden temporaries (up to a set's size) until the next run in that
+//! folder. The old files a commit moved aside are the commit's to put back or remove, never
+//! the handler's. The lock file stays, empty, as after a kill, for the next run to reuse:
+//! removed while the process still ran, it would let another run take the set before this
+//! one's threads have stopped.
 
 use std::fs::{self, File};
 use std::io::Write;
@@ -58,15 +60,9 @@ const TMP_SUFFIX: &str = ".snakeskin-tmp";
 /// Random characters in a temporary's name (between `.FILE.` and the suffix).
 const RANDOM_CHARS: usize = 6;
 
-/// This process's temporaries of new files (staged, not yet renamed into place) and the
-/// lock files of the sets it holds: what `clean_up_before_exit` removes.
-#[derive(Default)]
-struct Live {
-    temporaries: Vec<PathBuf>,
-    locks: Vec<PathBuf>,
-}
-
-static LIVE: Mutex<Live> = Mutex::new(Live { temporaries: Vec::new(), locks: Vec::new() });
+/// This process's temporaries of new files (staged, not yet renamed into place): what
+/// `clean_up_before_exit` removes.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// Held by a commit from its first rename to its last (the undo's included), and by
 /// `clean_up_before_exit` from when it begins until the process exits. Taken before `LIVE`.
@@ -78,20 +74,24 @@ fn locked<T>(mutex: &'static Mutex<T>) -> MutexGuard<'static, T> {
 }
 
 /// For a process that is about to exit on a signal: waits for a commit in progress (and its
-/// undo) to end, then removes this process's temporaries of new files and its lock files.
-/// Returns how many files it removed. Both locks stay held, so no temporary or commit starts
-/// before the exit (a thread that tries waits until then). Call it once, then exit.
+/// undo) to end, then removes this process's temporaries of new files. Returns how many it
+/// removed. Both locks stay held, so no temporary or commit starts before the exit (a
+/// thread that tries waits until then); a second call returns the first one's count.
 pub fn clean_up_before_exit() -> usize {
-    std::mem::forget(locked(&COMMIT));
-    let live = locked(&LIVE);
-    let removed = live.temporaries.iter().chain(&live.locks).filter(|path| fs::remove_file(path).is_ok()).count();
-    std::mem::forget(live);
-    removed
+    static REMOVED: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *REMOVED.get_or_init(|| {
+        std::mem::forget(locked(&COMMIT));
+        let live = locked(&LIVE);
+        let removed = live.iter().filter(|path| fs::remove_file(path).is_ok()).count();
+        std::mem::forget(live);
+        removed
+    })
 }
 
-/// `path` is no longer a temporary of a new file (renamed into place).
+/// `path` is not (or no longer) a temporary of a new file: renamed into place, or the name
+/// of a new temporary that holds an old file moved aside (a name a dropped one had).
 fn forget_temporary(path: &Path) {
-    locked(&LIVE).temporaries.retain(|p| p != path);
+    locked(&LIVE).retain(|p| p != path);
 }
 
 fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
@@ -140,7 +140,7 @@ fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedT
         // created that it would not remove.
         let mut live = locked(&LIVE);
         let tmp = temporary(dir, target_name).map_err(io_error(dir))?;
-        live.temporaries.push(tmp.path().to_path_buf());
+        live.push(tmp.path().to_path_buf());
         tmp
     };
     tmp.write_all(bytes).and_then(|_| tmp.as_file().sync_all()).map_err(io_error(tmp.path()))?;
@@ -217,7 +217,6 @@ impl SetLock {
             let file = options.open(&path).map_err(io_error(&path))?;
             match file.try_lock() {
                 Ok(()) if same_file(&file, &path) => {
-                    locked(&LIVE).locks.push(path.clone());
                     return Ok(SetLock { dir: dir.into(), path, _file: file, created_folder });
                 }
                 Ok(()) => continue,
@@ -274,6 +273,7 @@ impl SetLock {
             }
             let moved = temporary(dir, &file_name(target)).map_err(io_error(dir)).and_then(|backup| {
                 let backup = backup.into_temp_path();
+                forget_temporary(&backup);
                 injected_failure(&mut renames).and_then(|()| fs::rename(target, &backup)).map_err(io_error(target))?;
                 Ok(backup)
             });
@@ -392,8 +392,6 @@ pub struct Staged {
 impl Drop for SetLock {
     /// Removes the lock file while still holding the lock (see `acquire`).
     fn drop(&mut self) {
-        let mut live = locked(&LIVE);
-        live.locks.retain(|p| *p != self.path);
         let _ = fs::remove_file(&self.path);
     }
 }

@@ -23,7 +23,7 @@ pub enum PresetError {
     Parse { location: Location, message: String },
 
     /// Values out of range, one line each.
-    #[error("{}", format_problems(.file, .problems))]
+    #[error("{}", describe_problems(.file, .problems, "--set"))]
     Invalid { file: String, problems: Vec<LocatedProblem> },
 
     #[error("invalid --set {argument:?}: {message}")]
@@ -56,12 +56,14 @@ pub struct LocatedProblem {
     pub message: String,
 }
 
-fn format_problems(file: &str, problems: &[LocatedProblem]) -> String {
+/// One line per problem: the file and line of a key written in the file, or the file
+/// `(with OVERRIDES)` for one that is not (set by `--set`, or by a jobs file's `set`).
+pub fn describe_problems(file: &str, problems: &[LocatedProblem], overrides: &str) -> String {
     problems
         .iter()
         .map(|p| match p.line {
             Some(line) => format!("{file}:{line}: key `{}` {}", p.key, p.message),
-            None => format!("{file} (with --set): key `{}` {}", p.key, p.message),
+            None => format!("{file} (with {overrides}): key `{}` {}", p.key, p.message),
         })
         .collect::<Vec<_>>()
         .join("\n")

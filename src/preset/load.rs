@@ -151,29 +151,21 @@ fn canonical_text(preset: &Preset) -> String {
 }
 
 fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
-    let described = toml_text::describe(&source.text, error);
+    let mut described = toml_text::describe(&source.text, error);
+    // A single `[pattern]` table is layer 0, as the range checks name it: `pattern.0.amount`.
+    if let Some(rest) = described.key.as_deref().and_then(|k| k.strip_prefix("pattern."))
+        && rest.split('.').next().is_none_or(|s| s.parse::<usize>().is_err())
+    {
+        described.key = Some(format!("pattern.0.{rest}"));
+    }
     PresetError::Parse {
         location: Location {
             file: source.display.clone(),
             line: described.line_column.map(|(line, _)| line),
             column: described.line_column.map(|(_, column)| column),
         },
-        message: described.message,
+        message: described.keyed_message(),
     }
-}
-
-/// Levenshtein distance, for "did you mean".
-pub fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, cb) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
-        }
-        prev = cur;
-    }
-    prev[b.len()]
 }
 
 /// Line of a dotted key (`pattern.1.size`) in the preset text, if it is written there.

@@ -8,8 +8,6 @@ pub mod schema;
 pub mod validate;
 pub mod visible;
 
-pub use error::{LocatedProblem, Location, PresetError};
-pub use load::{
-    LoadedPreset, MAX_PRESET_BYTES, PresetSource, edit_distance, load, parse, parse_with_seed, read_source,
-};
+pub use error::{LocatedProblem, Location, PresetError, describe_problems};
+pub use load::{LoadedPreset, MAX_PRESET_BYTES, PresetSource, load, parse, parse_with_seed, read_source};
 pub use schema::Preset;

@@ -1,6 +1,7 @@
 //! What the binary prints, and how: errors once each and free of terminal control codes,
 //! notes about what a command did on the user's behalf, and the usual behaviour of a Unix
-//! tool whose reader goes away (`snakeskin presets list | head -1` ends quietly).
+//! tool whose reader goes away (`snakeskin presets list | head -1` ends quietly) or that
+//! is interrupted (Ctrl-C leaves no unfinished files behind).
 
 use std::path::Path;
 
@@ -17,16 +18,19 @@ pub fn restore_default_sigpipe() {
 }
 
 /// Ctrl-C, SIGTERM or SIGHUP end the run without leaving its unfinished files: a commit in
-/// progress ends first (a set is never left mixed), the run's temporaries and lock files
-/// are removed (`export::clean_up_before_exit`), one line says so, and the exit status is
-/// 128 + the signal's number, as a shell reports a process that a signal ended. Before,
-/// the hidden temporaries (up to a set's size) and the lock file stayed until the next run
-/// in that folder. A second signal exits at once.
+/// progress ends first (a set is never left mixed), the run's temporaries are removed
+/// (`export::clean_up_before_exit`), one line says so, and the exit status is 128 + the
+/// signal's number, as a shell reports a process that a signal ended (or the run's own, if
+/// it finished meanwhile). Before, the hidden temporaries (up to a set's size) stayed until
+/// the next run in that folder. A second signal exits at once. A signal that was ignored
+/// when the process started (`nohup` ignores SIGHUP; a non-interactive shell's background
+/// job, SIGINT) stays ignored.
 pub fn clean_up_on_interrupt() {
     #[cfg(unix)]
     {
         use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
-        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        let caught: Vec<i32> = [SIGINT, SIGTERM, SIGHUP].into_iter().filter(|s| !ignored_from_the_start(*s)).collect();
+        let Ok(mut signals) = signal_hook::iterator::Signals::new(caught) else {
             return;
         };
         std::thread::spawn(move || {
@@ -44,11 +48,23 @@ pub fn clean_up_on_interrupt() {
                     SIGTERM => "SIGTERM",
                     _ => "SIGHUP",
                 };
+                let what = if removed > 0 { format!(": removed {removed} unfinished file(s)") } else { String::new() };
                 use std::io::Write;
-                let _ = writeln!(std::io::stderr(), "interrupted ({name}): removed {removed} unfinished file(s)");
+                let _ = writeln!(std::io::stderr(), "interrupted ({name}){what}");
                 std::process::exit(128 + signal);
             }
         });
+    }
+}
+
+/// Whether `signal`'s disposition is "ignore", as the process inherited it (called before
+/// any handler is installed).
+#[cfg(unix)]
+fn ignored_from_the_start(signal: i32) -> bool {
+    // SAFETY: a query (no new action) into a zeroed `sigaction`, which is plain data.
+    unsafe {
+        let mut current: libc::sigaction = std::mem::zeroed();
+        libc::sigaction(signal, std::ptr::null(), &mut current) == 0 && current.sa_sigaction == libc::SIG_IGN
     }
 }
 
