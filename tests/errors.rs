@@ -56,8 +56,11 @@ fn type_error_names_line_and_key() {
     assert!(err.contains("key `scales`") && err.contains("expected a table"), "{err}");
     let err = refused("float.toml", "[optics]\nfilm_ior = true\n", &[]);
     assert!(err.contains("key `optics.film_ior`") && err.contains("expected a number"), "{err}");
-    let err = refused("ok.toml", "seed = 1\n", &["--set", "scales.rows=1.5"]);
-    assert!(err.contains("scales.rows=1.5") && err.contains("expected a whole number from 0 to"), "{err}");
+    // Of several overrides, the one at fault is named.
+    let err =
+        refused("ok.toml", "seed = 1\n", &["--set", "scales.size=1.1", "--set", "scales.rows=1.5", "--set", "seed=3"]);
+    assert!(err.contains("invalid --set \"scales.rows=1.5\":"), "{err}");
+    assert!(err.contains("expected a whole number from 0 to"), "{err}");
 }
 
 #[test]

@@ -102,13 +102,27 @@ pub fn parse_with_seed(
     let preset = if overrides.is_empty() {
         file_preset
     } else {
-        let mut table: toml::Table = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
+        let file_table: toml::Table = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
+        let mut table = file_table.clone();
         for (key, value) in overrides {
             apply_override(&mut table, key, value)?;
         }
-        Preset::deserialize(toml::Value::Table(table)).map_err(|e| PresetError::Override {
-            argument: overrides.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" "),
-            message: toml_text::in_plain_words(e.message()),
+        Preset::deserialize(toml::Value::Table(table)).map_err(|e| {
+            // Name the one override that makes this error on its own, where one does (a
+            // wrong type); otherwise (a new layer missing a key) all of them.
+            let alone = |(key, value): &&(String, String)| {
+                let mut table = file_table.clone();
+                apply_override(&mut table, key, value).is_ok()
+                    && Preset::deserialize(toml::Value::Table(table)).is_err_and(|a| a.message() == e.message())
+            };
+            let named: Vec<&(String, String)> = match overrides.iter().find(alone) {
+                Some(culprit) => vec![culprit],
+                None => overrides.iter().collect(),
+            };
+            PresetError::Override {
+                argument: named.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" "),
+                message: toml_text::in_plain_words(e.message()),
+            }
         })?
     };
 
