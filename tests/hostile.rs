@@ -267,6 +267,17 @@ fn fault_hooks_exist() -> bool {
     cfg!(debug_assertions)
 }
 
+/// A folder holding a whole set (seed 1) for a test that needs the fault hooks; `None`
+/// where they do not exist (`fault_hooks_exist`).
+fn earlier_set_with_fault_hooks() -> Option<tempfile::TempDir> {
+    if !fault_hooks_exist() {
+        return None;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    Some(dir)
+}
+
 fn manifest_of(dir: &Path) -> std::path::PathBuf {
     dir.join(format!("{PRESET}.material.json"))
 }
@@ -310,11 +321,7 @@ fn a_folder_in_the_way_leaves_the_earlier_set_whole() {
 /// `put_back`) the earlier set has lost its manifest once rename 1 fails.
 #[test]
 fn a_failed_rename_leaves_the_earlier_set_whole() {
-    if !fault_hooks_exist() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let Some(dir) = earlier_set_with_fault_hooks() else { return };
     let before = snapshot(dir.path());
     assert_eq!(before.len(), 6, "five maps and the manifest: {:?}", before.keys());
     // Six files aside, six in.
@@ -477,11 +484,7 @@ fn hidden_files(dir: &Path) -> Vec<String> {
 #[cfg(unix)]
 #[test]
 fn an_interrupted_run_removes_its_temporaries() {
-    if !fault_hooks_exist() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let Some(dir) = earlier_set_with_fault_hooks() else { return };
     let before = snapshot(dir.path());
     // Five maps and the manifest staged: the run pauses before its commit.
     let staged = |dir: &Path| hidden_files(dir).iter().filter(|n| n.ends_with(".snakeskin-tmp")).count() == 6;
@@ -511,11 +514,7 @@ fn an_interrupted_run_removes_its_temporaries() {
 #[cfg(unix)]
 #[test]
 fn an_interrupt_during_the_commit_waits_for_it() {
-    if !fault_hooks_exist() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let Some(dir) = earlier_set_with_fault_hooks() else { return };
     // Paused before rename 3: the old manifest and two old maps are aside.
     let in_commit = |dir: &Path| !manifest_of(dir).exists();
     let (code, err) = interrupted(dir.path(), "rename-3", libc::SIGINT, None, in_commit);
