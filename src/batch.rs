@@ -349,7 +349,7 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
             entries: argument,
             message,
         },
-        crate::preset::PresetError::Invalid { file, problems } => BatchError::Invalid {
+        crate::preset::PresetError::Invalid { file, problems } if !job.overrides.is_empty() => BatchError::Invalid {
             path: jobs_file.into(),
             job: job.table,
             preset: job.preset.clone(),

@@ -274,7 +274,7 @@ impl SetLock {
             let moved = temporary(dir, &file_name(target)).map_err(io_error(dir)).and_then(|backup| {
                 let backup = backup.into_temp_path();
                 forget_temporary(&backup);
-                injected_failure(&mut renames).and_then(|()| fs::rename(target, &backup)).map_err(io_error(target))?;
+                before_rename(&mut renames).and_then(|()| fs::rename(target, &backup)).map_err(io_error(target))?;
                 Ok(backup)
             });
             match moved {
@@ -290,7 +290,7 @@ impl SetLock {
         for (tmp, target) in staged {
             let temporary = tmp.path().to_path_buf();
             if let Err(e) =
-                injected_failure(&mut renames).and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error))
+                before_rename(&mut renames).and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error))
             {
                 put_back(aside, &written, &manifest_target, &mut renames);
                 return Err(ExportError::Io { path: target, source: e });
@@ -309,7 +309,7 @@ impl SetLock {
 /// ones back, the maps before the manifest (`aside` holds the manifest first), so that the
 /// old manifest returns only over its own maps. An old file that cannot go back stays in
 /// its temporary (never deleted), and then the old manifest stays aside too: the set is
-/// incomplete, not mixed. `renames` counts on from the commit's (`injected_failure`).
+/// incomplete, not mixed. `renames` counts on from the commit's (`before_rename`).
 fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf], manifest: &Path, renames: &mut usize) {
     let mut whole = true;
     for target in written {
@@ -320,7 +320,7 @@ fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf], mani
             let _ = backup.keep();
             continue;
         }
-        let back = match injected_failure(renames) {
+        let back = match before_rename(renames) {
             Ok(()) => backup.persist(&target).map_err(|e| e.path),
             Err(_) => Err(backup),
         };
@@ -343,7 +343,7 @@ fn file_name(path: &Path) -> String {
 /// as a file that may not be replaced would; `SNAKESKIN_TEST_KILL_AT_RENAME=N` ends the
 /// process before rename N with no cleanup at all (`_exit`, as a SIGKILL would: no
 /// destructor runs, temporaries and the lock file stay).
-fn injected_failure(renames: &mut usize) -> std::io::Result<()> {
+fn before_rename(renames: &mut usize) -> std::io::Result<()> {
     let this = *renames;
     *renames += 1;
     pause_hook(|| format!("rename-{this}"));
@@ -368,7 +368,7 @@ fn injected_failure(renames: &mut usize) -> std::io::Result<()> {
 
 /// Test hook (debug builds only): `SNAKESKIN_TEST_PAUSE_AT=POINT` stops the run for three
 /// seconds at POINT, `commit` (every file staged, before the commit lock and the first
-/// rename) or `rename-N` (before rename N, see `injected_failure`, the lock held), so that a
+/// rename) or `rename-N` (before rename N, see `before_rename`, the lock held), so that a
 /// test can interrupt the run there.
 fn pause_hook(point: impl Fn() -> String) {
     #[cfg(debug_assertions)]
