@@ -2,7 +2,7 @@
 //! writes (presets, jobs files): where the error is (line and column), which dotted key it
 //! is under, and what is accepted without serde's Rust type names. serde's message for
 //! `seed = "x"` is `invalid type: string "x", expected u64`; here it is ``key `seed`: invalid
-//! type: string "x", expected a whole number``.
+//! type: string "x", expected a whole number, 0 or more``.
 
 use toml::de::{DeTable, DeValue};
 
