@@ -382,15 +382,12 @@ fn a_kill_at_any_rename_or_during_the_undo_never_leaves_a_manifest_over_other_ma
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let visible = |dir: &Path| -> Vec<(std::path::PathBuf, Vec<u8>)> {
-        snapshot(dir).into_iter().filter(|(p, _)| !p.file_name().unwrap().to_string_lossy().starts_with('.')).collect()
-    };
     // Six files aside (renames 0-5), six in (6-11). Failing rename 8 undoes the commit: the
     // two new maps go, the five old maps come back (renames 9-13), then the manifest (14).
     let kills = (0..12).map(|kill| (None, kill)).chain((9..15).map(|kill| (Some("8"), kill)));
     for (fail, kill) in kills {
         assert!(generate_into(dir.path(), "1", &[]).status.success());
-        let earlier = visible(dir.path());
+        let earlier = visible_files(dir.path());
         assert_eq!(earlier.len(), 6, "five maps and the manifest");
         let kill_at = kill.to_string();
         let mut env = vec![("SNAKESKIN_TEST_KILL_AT_RENAME", kill_at.as_str())];
@@ -398,14 +395,16 @@ fn a_kill_at_any_rename_or_during_the_undo_never_leaves_a_manifest_over_other_ma
         let out = generate_into(dir.path(), "7", &env);
         assert_eq!(out.status.code(), Some(137), "fail {fail:?}, kill {kill}: the hook did not fire");
         match snakeskin::export::verify_set(&manifest_of(dir.path())) {
-            Ok(_) => assert!(kill == 0 && visible(dir.path()) == earlier, "fail {fail:?}, kill {kill}: a manifest"),
+            Ok(_) => {
+                assert!(kill == 0 && visible_files(dir.path()) == earlier, "fail {fail:?}, kill {kill}: a manifest")
+            }
             Err(e) => assert!(e.to_string().contains("incomplete"), "fail {fail:?}, kill {kill}: {e}"),
         }
     }
     // A failed rename back (11, an old map) after the failed commit (8): no manifest, and the
     // old map's bytes wait in a temporary, never deleted.
     assert!(generate_into(dir.path(), "1", &[]).status.success());
-    let earlier = visible(dir.path());
+    let earlier = visible_files(dir.path());
     let out = generate_into(dir.path(), "7", &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "8,11")]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let err = snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap_err();
@@ -470,6 +469,11 @@ fn interrupted(
     (out.status.code(), stderr(&out))
 }
 
+/// The folder's files a user sees (`snapshot` without the hidden temporaries and lock).
+fn visible_files(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
+    snapshot(dir).into_iter().filter(|(p, _)| !p.file_name().unwrap().to_string_lossy().starts_with('.')).collect()
+}
+
 #[cfg(unix)]
 fn hidden_files(dir: &Path) -> Vec<String> {
     let names = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned());
@@ -485,7 +489,7 @@ fn hidden_files(dir: &Path) -> Vec<String> {
 #[test]
 fn an_interrupted_run_removes_its_temporaries() {
     let Some(dir) = earlier_set_with_fault_hooks() else { return };
-    let before = snapshot(dir.path());
+    let before = visible_files(dir.path());
     // Five maps and the manifest staged: the run pauses before its commit.
     let staged = |dir: &Path| hidden_files(dir).iter().filter(|n| n.ends_with(".snakeskin-tmp")).count() == 6;
     for (signal, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
@@ -493,17 +497,12 @@ fn an_interrupted_run_removes_its_temporaries() {
         assert_eq!(code, Some(128 + signal), "{err}");
         assert!(err.contains(&format!("interrupted ({name}): removed 6 unfinished file(s)")), "{err}");
         assert_eq!(hidden_files(dir.path()), vec![format!(".{PRESET}.lock")]);
-        let visible = |files: &std::collections::BTreeMap<std::path::PathBuf, Vec<u8>>| {
-            files.keys().filter(|p| !p.file_name().unwrap().to_string_lossy().starts_with('.')).count()
-        };
-        let after = snapshot(dir.path());
-        assert_eq!(visible(&after), visible(&before));
-        assert!(before.iter().all(|(path, bytes)| after.get(path) == Some(bytes)), "the earlier set changed");
+        assert_eq!(visible_files(dir.path()), before, "the earlier set changed");
     }
     let (code, err) = interrupted(dir.path(), "commit", libc::SIGHUP, Some("HUP"), staged);
     assert_eq!(code, Some(0), "{err}");
     snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
-    assert_ne!(snapshot(dir.path()), before);
+    assert_ne!(visible_files(dir.path()), before);
 }
 
 /// A signal during the commit waits for the commit to end: the new set is whole (the
