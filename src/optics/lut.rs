@@ -33,6 +33,16 @@ use super::series::FilmSeries;
 use super::spectrum::{Observer, xyz_to_linear_srgb};
 
 pub const FINE_MAX_NM: f64 = 2000.0;
+
+/// The texels one evaluation reads from the coupling table for its two directions
+/// (`Lut::coupling_pair_start`): the four (thickness column, roughness row) corners, each
+/// corner's first entry and its weight, and per direction the cos texel below its cosine
+/// and the weight of the next.
+#[derive(Debug, Clone, Copy)]
+pub struct CouplingFetch {
+    corners: [(usize, f32); 4],
+    texels: [(usize, f32); 2],
+}
 pub const COARSE_MAX_NM: f64 = 20_000.0;
 
 #[derive(Debug, Clone)]
@@ -131,9 +141,7 @@ impl Lut {
             .into_par_iter()
             .map(|j| {
                 let film = |c: f32| {
-                    let y = c.clamp(0.0, 1.0) * (n_cos - 1) as f32;
-                    let y0 = (y as usize).min(n_cos - 2);
-                    let fy = y - y0 as f32;
+                    let (y0, fy) = self.cos_texel(c);
                     let (a, b) = (self.texels[y0 * w + j], self.texels[(y0 + 1) * w + j]);
                     [0, 1, 2].map(|k| (a[k] + (b[k] - a[k]) * fy).clamp(0.0, 1.0))
                 };
@@ -190,7 +198,7 @@ impl Lut {
     /// `energy::top_f32` interpolates them, and between thickness columns (one trilinear
     /// fetch: `brdf.wgsl`'s `coupling_table`).
     pub fn coupling_f32(&self, thickness_nm: f32, cos: f32, roughness: f32) -> (energy::Top<f32>, f32) {
-        self.coupling_at(self.coupling(), &self.coupling_corners(thickness_nm, roughness), cos)
+        self.coupling_at(self.coupling(), &self.coupling_corners(thickness_nm, roughness), self.cos_texel(cos))
     }
 
     /// `coupling_f32` for the two directions of one evaluation (light and view), which share
@@ -201,10 +209,61 @@ impl Lut {
     /// from 150 to 124 ns with inputs in thickness order and from 218 to 187 ns at random
     /// thicknesses: finding the corners once, each corner's two cos texels read as one
     /// slice with their weights premultiplied, and this function inlined into the pair (which
-    /// lets the two directions' loads overlap; without it 128 / 175 ns).
+    /// lets the two directions' loads overlap; without it 128 / 175 ns). In two halves
+    /// (`coupling_pair_start`, `coupling_pair_read`) for a caller with work to do between them.
     pub fn coupling_pair_f32(&self, thickness_nm: f32, cos: [f32; 2], roughness: f32) -> [(energy::Top<f32>, f32); 2] {
-        let (table, corners) = (self.coupling(), self.coupling_corners(thickness_nm, roughness));
-        [self.coupling_at(table, &corners, cos[0]), self.coupling_at(table, &corners, cos[1])]
+        self.coupling_pair_read(&self.coupling_pair_start(thickness_nm, cos, roughness))
+    }
+
+    /// The first half of `coupling_pair_f32`: finds the texels it reads and asks the memory
+    /// system for their cache lines, and returns at once. The CPU f32 twin starts it as soon
+    /// as it knows the two cosines, so the lines arrive while it evaluates the specular lobe.
+    /// Why: at random thicknesses each evaluation reads eight texel pairs somewhere new in a
+    /// 10.5 MiB table, past a core's L2, and waited for them there. Asked for early, the
+    /// layered model's cost went from 192–198 to 147–154 ns a call, the thesis model's
+    /// 105–110 (1.8× → 1.4×; `bench layered`'s cost loop, one core, BENCHMARKS.md "The
+    /// coupling's lines asked for early"). Asking only for each pair's first line measured
+    /// 176–186 ns: a pair of 32-byte texels usually spans two lines. A hint only: x86-64's
+    /// `prefetcht0`, nothing elsewhere.
+    #[inline(always)]
+    pub fn coupling_pair_start(&self, thickness_nm: f32, cos: [f32; 2], roughness: f32) -> CouplingFetch {
+        let fetch = CouplingFetch {
+            corners: self.coupling_corners(thickness_nm, roughness),
+            texels: cos.map(|c| self.cos_texel(c)),
+        };
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let table = self.coupling();
+            for (y0, _) in fetch.texels {
+                for (first, _) in fetch.corners {
+                    let pair: &[[f32; 8]; 2] = table[first + y0..first + y0 + 2].try_into().expect("two texels");
+                    let (start, end) = (pair.as_ptr() as *const i8, pair[1][7..].as_ptr() as *const i8);
+                    // SAFETY: `prefetcht0` is part of x86-64's baseline SSE, and a prefetch is a
+                    // hint that never faults (both addresses lie in `table` anyway).
+                    unsafe {
+                        _mm_prefetch::<_MM_HINT_T0>(start);
+                        _mm_prefetch::<_MM_HINT_T0>(end);
+                    }
+                }
+            }
+        }
+        fetch
+    }
+
+    /// The second half of `coupling_pair_f32`: the light's and the view's coupling.
+    #[inline(always)]
+    pub fn coupling_pair_read(&self, fetch: &CouplingFetch) -> [(energy::Top<f32>, f32); 2] {
+        let table = self.coupling();
+        fetch.texels.map(|texel| self.coupling_at(table, &fetch.corners, texel))
+    }
+
+    /// The cos texel below `cos` and the weight of the one above it (linear filtering).
+    #[inline(always)]
+    fn cos_texel(&self, cos: f32) -> (usize, f32) {
+        let y = cos.clamp(0.0, 1.0) * (self.n_cos - 1) as f32;
+        let y0 = (y as usize).min(self.n_cos - 2);
+        (y0, y - y0 as f32)
     }
 
     /// The four (thickness column, roughness row) corners of a trilinear coupling fetch:
@@ -226,13 +285,15 @@ impl Lut {
         ]
     }
 
-    /// The coupling at cosine `cos` from `table` (`coupling`), linear between its two cos
-    /// texels, summed over `corners`.
+    /// The coupling at the cos texel `y0` and the weight `fy` of the next (`cos_texel`) from
+    /// `table` (`coupling`), linear between the two texels, summed over `corners`.
     #[inline(always)]
-    fn coupling_at(&self, table: &[[f32; 8]], corners: &[(usize, f32); 4], cos: f32) -> (energy::Top<f32>, f32) {
-        let y = cos.clamp(0.0, 1.0) * (self.n_cos - 1) as f32;
-        let y0 = (y as usize).min(self.n_cos - 2);
-        let fy = y - y0 as f32;
+    fn coupling_at(
+        &self,
+        table: &[[f32; 8]],
+        corners: &[(usize, f32); 4],
+        (y0, fy): (usize, f32),
+    ) -> (energy::Top<f32>, f32) {
         let mut v = [0.0f32; 8];
         for &(first, weight) in corners {
             let [a, b]: &[[f32; 8]; 2] = table[first + y0..first + y0 + 2].try_into().expect("two texels");
