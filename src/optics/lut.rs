@@ -220,11 +220,11 @@ impl Lut {
     /// as it knows the two cosines, so the lines arrive while it evaluates the specular lobe.
     /// Why: at random thicknesses each evaluation reads eight texel pairs somewhere new in a
     /// 10.5 MiB table, past a core's L2, and waited for them there. Asked for early, the
-    /// layered model's cost went from 192–198 to 147–154 ns a call, the thesis model's
-    /// 105–110 (1.8× → 1.4×; `bench layered`'s cost loop, one core, BENCHMARKS.md "The
-    /// coupling's lines asked for early"). Asking only for each pair's first line measured
-    /// 176–186 ns: a pair of 32-byte texels usually spans two lines. A hint only: x86-64's
-    /// `prefetcht0`, nothing elsewhere.
+    /// layered model's cost went from 189–204 to 155–159 ns a call, the thesis model's
+    /// 104–115 (1.65–1.88× → 1.36–1.52×; `bench layered`'s cost loop, one core,
+    /// BENCHMARKS.md "The coupling's lines asked for early"). Asking only for each pair's
+    /// first line measured 176–186 ns: a pair of 32-byte texels usually spans two lines;
+    /// `prefetchnta` 329–367. A hint only: x86-64's `prefetcht0`, nothing elsewhere.
     #[inline(always)]
     pub fn coupling_pair_start(&self, thickness_nm: f32, cos: [f32; 2], roughness: f32) -> CouplingFetch {
         let fetch = CouplingFetch {
