@@ -34,16 +34,17 @@ use super::spectrum::{Observer, xyz_to_linear_srgb};
 
 pub const FINE_MAX_NM: f64 = 2000.0;
 
+pub const COARSE_MAX_NM: f64 = 20_000.0;
+
 /// The texels one evaluation reads from the coupling table for its two directions
 /// (`Lut::coupling_pair_start`): the four (thickness column, roughness row) corners, each
 /// corner's first entry and its weight, and per direction the cos texel below its cosine
 /// and the weight of the next.
 #[derive(Debug, Clone, Copy)]
-pub struct CouplingFetch {
+pub(crate) struct CouplingFetch {
     corners: [(usize, f32); 4],
     texels: [(usize, f32); 2],
 }
-pub const COARSE_MAX_NM: f64 = 20_000.0;
 
 #[derive(Debug, Clone)]
 pub struct Lut {
@@ -219,14 +220,14 @@ impl Lut {
     /// system for their cache lines, and returns at once. The CPU f32 twin starts it as soon
     /// as it knows the two cosines, so the lines arrive while it evaluates the specular lobe.
     /// Why: at random thicknesses each evaluation reads eight texel pairs somewhere new in a
-    /// 10.5 MiB table, past a core's L2, and waited for them there. Asked for early, the
-    /// layered model's cost went from 189–204 to 155–159 ns a call, the thesis model's
-    /// 104–115 (1.65–1.88× → 1.36–1.52×; `bench layered`'s cost loop, one core,
+    /// 10 MiB table, past a core's L2, and waited for them there. Asked for early, the
+    /// layered model's cost went from 189–204 to 155–159 ns a call, against the thesis
+    /// model's 104–115 (1.65–1.88× → 1.36–1.52×; `bench layered`'s cost loop, one core,
     /// BENCHMARKS.md "The coupling's lines asked for early"). Asking only for each pair's
     /// first line measured 176–186 ns: a pair of 32-byte texels usually spans two lines;
     /// `prefetchnta` 329–367. A hint only: x86-64's `prefetcht0`, nothing elsewhere.
     #[inline(always)]
-    pub fn coupling_pair_start(&self, thickness_nm: f32, cos: [f32; 2], roughness: f32) -> CouplingFetch {
+    pub(crate) fn coupling_pair_start(&self, thickness_nm: f32, cos: [f32; 2], roughness: f32) -> CouplingFetch {
         let fetch = CouplingFetch {
             corners: self.coupling_corners(thickness_nm, roughness),
             texels: cos.map(|c| self.cos_texel(c)),
@@ -253,7 +254,7 @@ impl Lut {
 
     /// The second half of `coupling_pair_f32`: the light's and the view's coupling.
     #[inline(always)]
-    pub fn coupling_pair_read(&self, fetch: &CouplingFetch) -> [(energy::Top<f32>, f32); 2] {
+    pub(crate) fn coupling_pair_read(&self, fetch: &CouplingFetch) -> [(energy::Top<f32>, f32); 2] {
         let table = self.coupling();
         fetch.texels.map(|texel| self.coupling_at(table, &fetch.corners, texel))
     }

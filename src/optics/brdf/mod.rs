@@ -135,12 +135,13 @@ impl Model {
 
     /// The f32 twin of `coupling` for the light's and the view's cosines, with the film from
     /// `lut`, and the path delta there, in two halves: this one starts it,
-    /// `finish_coupling_f32` finishes it. The layered model reads the LUT's coupling table (the rule on the lobe's
-    /// roughness rows per cos texel and thickness column, interpolated between rows as the
-    /// rule does: `Lut::coupling_pair_f32`, one search for the pixel's thickness and
-    /// roughness), as the shader does for the LUT film method, and asks for its texels here
-    /// so they load while the caller works on (`Lut::coupling_pair_start`); the thesis model
-    /// reads the film table, small enough to stay cached.
+    /// `finish_coupling_f32` finishes it. The layered model reads the LUT's coupling table
+    /// (the rule on the lobe's roughness rows per cos texel and thickness column,
+    /// interpolated between rows as the rule does: `Lut::coupling_pair_f32`, one search for
+    /// the pixel's thickness and roughness), as the shader does for the LUT film method, and
+    /// asks for its texels here so they load while the caller evaluates the specular lobe
+    /// (`Lut::coupling_pair_start`); the thesis model reads the film table, small enough to
+    /// stay cached.
     #[inline(always)]
     fn start_coupling_f32(self, cos: [f32; 2], layers: &Layers32, lut: &super::lut::Lut) -> PendingCoupling {
         match self {
