@@ -33,6 +33,8 @@ pub mod walk;
 
 pub use ggx::{ggx_d, ggx_d_sin, smith_g2, smith_lambda};
 
+use super::lut::Lut;
+
 /// Smallest GGX α: roughness 0 would make D a Dirac delta. 1e-3 keeps D's peak
 /// 1 / (π α²) ≈ 3.2e5, finite in f32, and is a mirror to the eye.
 pub const ALPHA_MIN: f64 = 1e-3;
@@ -143,7 +145,7 @@ impl Model {
     /// (`Lut::coupling_pair_start`); the thesis model reads the film table, small enough to
     /// stay cached.
     #[inline(always)]
-    fn start_coupling_f32(self, cos: [f32; 2], layers: &Layers32, lut: &super::lut::Lut) -> PendingCoupling {
+    fn start_coupling_f32(self, cos: [f32; 2], layers: &Layers32, lut: &Lut) -> PendingCoupling {
         match self {
             Model::Thesis => PendingCoupling::Film(cos),
             Model::Layered => {
@@ -154,11 +156,7 @@ impl Model {
 
     /// The second half of `start_coupling_f32`: the light's and the view's coupling.
     #[inline(always)]
-    fn finish_coupling_f32(
-        pending: PendingCoupling,
-        layers: &Layers32,
-        lut: &super::lut::Lut,
-    ) -> [(energy::Top<f32>, f32); 2] {
+    fn finish_coupling_f32(pending: PendingCoupling, layers: &Layers32, lut: &Lut) -> [(energy::Top<f32>, f32); 2] {
         match pending {
             PendingCoupling::Film(cos) => cos.map(|cos| {
                 let reflected = lut.lookup_f32(layers.thickness_nm, cos.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
@@ -333,14 +331,7 @@ impl Model {
     }
 
     /// The f32 fast path, film colour from the material's LUT: the CPU twin of the shader.
-    pub fn eval_f32(
-        self,
-        layers: &Layers32,
-        normal: [f32; 3],
-        wi: [f32; 3],
-        wo: [f32; 3],
-        lut: &super::lut::Lut,
-    ) -> [f32; 3] {
+    pub fn eval_f32(self, layers: &Layers32, normal: [f32; 3], wi: [f32; 3], wo: [f32; 3], lut: &Lut) -> [f32; 3] {
         match self {
             Model::Thesis => Model::Thesis.eval_f32_of(layers, normal, wi, wo, lut),
             Model::Layered => Model::Layered.eval_f32_of(layers, normal, wi, wo, lut),
@@ -351,14 +342,7 @@ impl Model {
     /// for the other's branches and code: with one copy, the thesis model measured 108–117
     /// ns a call once the layered model's coupling was started early, against 105–110.
     #[inline(always)]
-    fn eval_f32_of(
-        self,
-        layers: &Layers32,
-        normal: [f32; 3],
-        wi: [f32; 3],
-        wo: [f32; 3],
-        lut: &super::lut::Lut,
-    ) -> [f32; 3] {
+    fn eval_f32_of(self, layers: &Layers32, normal: [f32; 3], wi: [f32; 3], wo: [f32; 3], lut: &Lut) -> [f32; 3] {
         let n = normalize32(normal).unwrap_or([0.0, 0.0, 1.0]);
         let (Some(wi), Some(wo)) = (normalize32(wi), normalize32(wo)) else {
             return [0.0; 3];
