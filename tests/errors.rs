@@ -120,11 +120,13 @@ fn unknown_map_and_preset_are_refused() {
 
 #[test]
 fn unwritable_output_leaves_no_partial_files() {
-    // The output "folder" is a file: creating it fails, nothing else is written.
+    // The output folder lies under a file: it cannot be created, nothing else is written.
+    // The file is named, and the exit is 2 as for `-o FILE` (it was 1, an I/O error).
     let dir = tempfile::tempdir().unwrap();
     let blocker = dir.path().join("blocked");
     std::fs::write(&blocker, b"a file").unwrap();
     let out = snakeskin(&["generate", PATTERNED, "-o", blocker.join("sub").to_str().unwrap(), "--size", "32"]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("blocked exists and is not a folder"), "{}", stderr(&out));
     assert_eq!(snapshot(dir.path()).len(), 1);
 }

@@ -760,3 +760,72 @@ fn preview_reference_into_a_missing_folder_and_no_loader_noise() {
     assert!(err.contains(&format!("note: created folder {}", heat.parent().unwrap().display())), "{err}");
     assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
 }
+
+/// An output path that names something other than a regular file is refused before
+/// anything is written, naming what it is (exit 2): the atomic rename would replace the
+/// thing itself. Run as root, `brdf chart --out /dev/full` had made `/dev/full` a PNG; a
+/// FIFO stands in for the device here (making one needs no privileges), and a symbolic
+/// link, which was replaced by the file where the user meant to write through it, stays a
+/// link. A set's map that is a link is refused with the earlier set untouched. A missing
+/// output folder under a file names the file (exit 2; it was an I/O error, exit 1), and so
+/// does `gallery --closeups` (it wrote the gallery, then failed with "File exists").
+#[cfg(unix)]
+#[test]
+fn outputs_that_are_not_regular_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.png");
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo runs");
+    assert!(made.success());
+    let chart =
+        |out: &Path| snakeskin(&["brdf", "chart", "-o", out.to_str().unwrap(), "--width", "8", "--height", "4"]);
+    let out = chart(&fifo);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("pipe.png is a FIFO (named pipe), not a regular file"), "{}", stderr(&out));
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo(), "the FIFO was replaced");
+
+    let target = dir.path().join("target.png");
+    std::fs::write(&target, b"mine").unwrap();
+    let link = dir.path().join("link.png");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let out = chart(&link);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("link.png is a symbolic link, not a regular file"), "{}", stderr(&out));
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link was replaced");
+    assert_eq!(std::fs::read(&target).unwrap(), b"mine");
+    // Negative control: a regular file there is replaced, as before.
+    let out = chart(&target);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::read(&target).unwrap().starts_with(b"\x89PNG"));
+
+    // A set: its colour map is a link (to a file outside the set).
+    let set = dir.path().join("set");
+    let generate = |size: &str| snakeskin(&["generate", PRESET, "-o", set.to_str().unwrap(), "--size", size]);
+    assert!(generate("16").status.success());
+    let colour = set.join(format!("{PRESET}_color.png"));
+    std::fs::remove_file(&colour).unwrap();
+    std::os::unix::fs::symlink(&target, &colour).unwrap();
+    let before = visible_files(&set);
+    let out = generate("32");
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("_color.png is a symbolic link"), "{}", stderr(&out));
+    assert_eq!(visible_files(&set), before, "the earlier set changed");
+    assert!(std::fs::symlink_metadata(&colour).unwrap().file_type().is_symlink());
+    assert!(hidden_files(&set).iter().all(|n| n.ends_with(".lock")), "{:?}", hidden_files(&set));
+
+    // A folder to create under a file.
+    let a_file = dir.path().join("a-file");
+    std::fs::write(&a_file, b"x").unwrap();
+    let under = a_file.join("sub");
+    let out = snakeskin(&["generate", PRESET, "-o", under.to_str().unwrap(), "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a-file exists and is not a folder"), "{}", stderr(&out));
+
+    // `gallery --closeups` naming a file is refused before the gallery is drawn.
+    let gallery = dir.path().join("gallery.png");
+    let args = ["gallery", "-o", gallery.to_str().unwrap(), "--tile", "16", "--closeups"];
+    let out = snakeskin(&[&args[..], &[a_file.to_str().unwrap()]].concat());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a-file exists and is not a folder"), "{}", stderr(&out));
+    assert!(!gallery.exists(), "the gallery was drawn before the check");
+}

@@ -160,16 +160,49 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
     builder.tempfile_in(dir)
 }
 
-/// Refuses a target that is a folder (a rename over it would fail half-way through a set).
+/// Refuses a target that is a folder (a rename over it would fail half-way through a set),
+/// and one that is anything else but a regular file: the rename would replace a symbolic
+/// link, a device (`-o /dev/null` run as root made `/dev/null` a PNG), a FIFO or a socket
+/// with the output, where the user meant to write through it (`ExportError::NotAFile`).
 /// Public so that a command can check an output file before the work that makes it.
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
-    match fs::symlink_metadata(target) {
-        Ok(meta) if meta.is_dir() => Err(ExportError::Io {
+    let Ok(meta) = fs::symlink_metadata(target) else {
+        return Ok(());
+    };
+    let file_type = meta.file_type();
+    if file_type.is_dir() {
+        return Err(ExportError::Io {
             path: target.into(),
             source: std::io::Error::new(std::io::ErrorKind::IsADirectory, "a folder is in the way of this output file"),
-        }),
-        _ => Ok(()),
+        });
     }
+    let kind = if file_type.is_file() {
+        return Ok(());
+    } else if file_type.is_symlink() {
+        "a symbolic link"
+    } else {
+        special_file_kind(&file_type)
+    };
+    Err(ExportError::NotAFile { path: target.into(), kind })
+}
+
+/// What a file that is neither a regular file, a folder nor a symbolic link is, in words.
+fn special_file_kind(file_type: &fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file_type.is_char_device() || file_type.is_block_device() {
+            return "a device";
+        }
+        if file_type.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if file_type.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = file_type;
+    "a special file"
 }
 
 /// Creates an output folder if needed (true when it was created); a path that exists and is
@@ -183,12 +216,17 @@ pub fn create_folder(dir: &Path) -> Result<bool, ExportError> {
 }
 
 /// An output folder's path, checked without creating anything: a path that exists and is
-/// not a folder is `ExportError::NotAFolder` (a missing one is fine).
+/// not a folder is `ExportError::NotAFolder`, and so is a missing folder under a file
+/// (`-o a-file/sub` names `a-file`); a missing one under folders is fine.
 pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
-    match fs::metadata(dir) {
-        Ok(meta) if !meta.is_dir() => Err(ExportError::NotAFolder { path: dir.into() }),
-        _ => Ok(()),
+    for path in dir.ancestors().filter(|p| !p.as_os_str().is_empty()) {
+        match fs::metadata(path) {
+            Ok(meta) if meta.is_dir() => return Ok(()),
+            Ok(_) => return Err(ExportError::NotAFolder { path: path.into() }),
+            Err(_) => continue,
+        }
     }
+    Ok(())
 }
 
 /// An exclusive lock on one output set (`DIR/.NAME.lock`), held until dropped.

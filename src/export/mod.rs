@@ -38,6 +38,11 @@ pub enum ExportError {
     Busy { dir: PathBuf, name: String },
     #[error("{path} exists and is not a folder; the output option takes the folder to write into")]
     NotAFolder { path: PathBuf },
+    #[error(
+        "{path} is {kind}, not a regular file: snakeskin writes an output whole and renames it over the old one, \
+         which would replace the {kind} itself; give the path of a regular file (or of none), or remove the {kind} first"
+    )]
+    NotAFile { path: PathBuf, kind: &'static str },
     #[error("set {manifest}: {problem}")]
     Verify { manifest: PathBuf, problem: String },
     #[error("cannot encode the packed {texture} texture: {message}")]
@@ -47,9 +52,10 @@ pub enum ExportError {
 }
 
 impl ExportError {
-    /// True when the user's input is at fault: an output path that is not a folder.
+    /// True when the user's input is at fault: an output folder that is not a folder, an
+    /// output file that is something other than a file.
     pub fn is_invalid_input(&self) -> bool {
-        matches!(self, ExportError::NotAFolder { .. })
+        matches!(self, ExportError::NotAFolder { .. } | ExportError::NotAFile { .. })
     }
 }
 

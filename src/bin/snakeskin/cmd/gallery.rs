@@ -4,14 +4,18 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use crate::output::{ensure_parent_folder, path_line};
+use crate::output::{ensure_folder, ensure_parent_folder, path_line};
 
+/// Both outputs are checked before either is drawn: a `--closeups` path that is a file used
+/// to fail after the gallery was written, with the OS's "File exists" and no path.
 pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> Result<()> {
     ensure_parent_folder(out)?;
+    if let Some(dir) = closeups {
+        ensure_folder(dir)?;
+    }
     snakeskin::render::figures::gallery::write(out, tile, columns)?;
     println!("{}", path_line(out));
     if let Some(dir) = closeups {
-        std::fs::create_dir_all(dir)?;
         for path in snakeskin::render::figures::gallery::write_closeups(dir)? {
             println!("{}", path_line(&path));
         }
