@@ -829,3 +829,20 @@ fn outputs_that_are_not_regular_files_are_refused() {
     assert!(stderr(&out).contains("a-file exists and is not a folder"), "{}", stderr(&out));
     assert!(!gallery.exists(), "the gallery was drawn before the check");
 }
+
+/// A preset whose noise lattice outgrows its image does not allocate the lattice: within
+/// the ranges, 128 rows of narrow scales (`scales.aspect = 0.3`) on a body atlas 40 widths
+/// long gave the grain noise 1968 × 262,400 cells in its finest octave, a 4 GiB table,
+/// at `--size 16` (found by a hostile-input sweep: 135 s and over 5 GB, or an abort with a
+/// backtrace under a memory limit). Run here under a 2 GB address-space limit
+/// (`ulimit -v`), where the table's allocation aborted the run (exit 134, seen).
+#[cfg(unix)]
+#[test]
+fn a_set_whose_lattice_outgrows_the_image_stays_small() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = "--size 16 --layout body --set scales.rows=128 --set scales.aspect=0.3 --set body.length=40";
+    let command = format!("ulimit -v 2000000; exec '{BIN}' generate {PRESET} -o '{}' {args}", dir.path().display());
+    let out = Command::new("sh").arg("-c").arg(&command).output().unwrap();
+    assert!(out.status.success(), "{:?}: {}", out.status, stderr(&out));
+    assert_eq!(visible_files(dir.path()).len(), 6, "five maps and the manifest");
+}

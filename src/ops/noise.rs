@@ -86,34 +86,58 @@ fn quintic(t: f32) -> f32 {
     t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
 }
 
+/// Cells of one octave's lattice drawn into a table at most (4 Mi cells, 32 MiB): a larger
+/// lattice draws each cell where it is read. Its size follows the preset, not the image: a
+/// body atlas of 128 rows of narrow scales (`scales.aspect = 0.3`) 40 body widths long asked
+/// the grain noise for 1968 × 262,400 cells in its finest octave, a 4 GiB table that took
+/// minutes to fill at `--size 16`, where a few hundred cells are read. Every built-in
+/// preset's lattices are far smaller (the grain noise of a 2K body atlas: under 1 Mi cells).
+const MAX_TABLE_CELLS: i64 = 1 << 22;
+
 /// One octave's lattice: a gradient (Perlin) or feature point (cellular) per cell, drawn once
-/// so the per-pixel loop does table lookups instead of hashing.
+/// into a table so the per-pixel loop does lookups instead of hashing, or, for a lattice
+/// larger than `MAX_TABLE_CELLS`, drawn where it is read (the same values).
 struct Octave {
+    kind: NoiseKind,
     period_x: i32,
     period_y: i32,
-    /// Per cell, row-major: a unit gradient, or a feature point's offset in [0, 1)².
+    seed: u32,
+    permutation: PermutationTable,
+    /// Per cell, row-major: a unit gradient, or a feature point's offset in [0, 1)². Empty
+    /// for a lattice drawn where it is read.
     cells: Vec<[f32; 2]>,
 }
 
 impl Octave {
     fn new(kind: NoiseKind, period_x: i32, period_y: i32, seed: u32) -> Self {
-        let table = PermutationTable::new(seed);
-        let mut cells = Vec::with_capacity((period_x * period_y) as usize);
-        for y in 0..period_y {
-            for x in 0..period_x {
-                cells.push(match kind {
-                    // The `noise` crate's seeded permutation picks the gradient, as in its Perlin.
-                    NoiseKind::Perlin => GRADIENTS[table.hash(&[x as isize, y as isize]) & 15],
-                    NoiseKind::Cellular => [hash::unit(x, y, 0, seed), hash::unit(x, y, 1, seed)],
-                });
+        let mut octave =
+            Octave { kind, period_x, period_y, seed, permutation: PermutationTable::new(seed), cells: Vec::new() };
+        if period_x as i64 * period_y as i64 <= MAX_TABLE_CELLS {
+            octave.cells.reserve_exact((period_x * period_y) as usize);
+            for y in 0..period_y {
+                for x in 0..period_x {
+                    let cell = octave.draw(x, y);
+                    octave.cells.push(cell);
+                }
             }
         }
-        Octave { period_x, period_y, cells }
+        octave
+    }
+
+    /// The cell at lattice coordinates (x, y), wrapped, drawn from the seed.
+    #[inline]
+    fn draw(&self, x: i32, y: i32) -> [f32; 2] {
+        match self.kind {
+            // The `noise` crate's seeded permutation picks the gradient, as in its Perlin.
+            NoiseKind::Perlin => GRADIENTS[self.permutation.hash(&[x as isize, y as isize]) & 15],
+            NoiseKind::Cellular => [hash::unit(x, y, 0, self.seed), hash::unit(x, y, 1, self.seed)],
+        }
     }
 
     #[inline]
     fn cell(&self, wrapped_x: i32, wrapped_y: i32) -> [f32; 2] {
-        self.cells[(wrapped_y * self.period_x + wrapped_x) as usize]
+        let index = wrapped_y as usize * self.period_x as usize + wrapped_x as usize;
+        self.cells.get(index).copied().unwrap_or_else(|| self.draw(wrapped_x, wrapped_y))
     }
 
     /// Wraps a lattice coordinate and its successor into [0, period) with one division.
@@ -400,5 +424,28 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A lattice drawn where it is read (past `MAX_TABLE_CELLS`) holds the table's cells, so
+    /// a huge lattice changes the cost, not the noise; and one that size is not allocated
+    /// (`a_set_whose_lattice_outgrows_the_image_stays_small` in tests/hostile.rs runs it).
+    /// Negative control: the next octave's seed draws other cells.
+    #[test]
+    fn a_lattice_drawn_where_read_is_the_table() {
+        for kind in [NoiseKind::Perlin, NoiseKind::Cellular] {
+            let table = Octave::new(kind, 37, 23, 91);
+            assert_eq!(table.cells.len(), 37 * 23);
+            let mut drawn = Octave::new(kind, 37, 23, 91);
+            drawn.cells = Vec::new();
+            let other = Octave { cells: Vec::new(), ..Octave::new(kind, 37, 23, 92) };
+            let mut differ = 0;
+            for (x, y) in (0..23).flat_map(|y| (0..37).map(move |x| (x, y))) {
+                assert_eq!(table.cell(x, y), drawn.cell(x, y), "{kind:?} at {x}, {y}");
+                differ += usize::from(other.cell(x, y) != table.cell(x, y));
+            }
+            assert!(differ > 37 * 23 / 2, "{kind:?}: another seed drew {differ} other cells");
+        }
+        let huge = Octave::new(NoiseKind::Perlin, 1968, 262_400, 5);
+        assert!(huge.cells.is_empty() && huge.cells.capacity() == 0);
     }
 }
