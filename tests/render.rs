@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{gpu_or_skip, gpu_required, snakeskin};
+use common::{gpu_or_skip, gpu_required, snakeskin, snakeskin_env};
 use snakeskin::graph::{NodeCache, evaluate};
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::optics::brdf::Model;
@@ -533,4 +533,40 @@ fn twenty_instanced_snakes_are_all_in_view() {
         });
         assert!(on_body, "snake {k} at {p:?} is not in view");
     }
+}
+
+/// `sheet` and `preview` refuse work that would not fit the available memory before they
+/// allocate it, as `generate` does (exit 2, the size named, nothing written): a body sheet
+/// with `--tile 1024` asked for a 4.2 GB canvas at once, and `SNAKESKIN_MEMORY_LIMIT_MIB`
+/// was not consulted by either (found by a hostile-input sweep). Negative control: a small
+/// sheet under the same limit is drawn.
+#[test]
+fn sheet_and_preview_refuse_what_memory_cannot_hold() {
+    if gpu_or_skip("sheet_and_preview_refuse_what_memory_cannot_hold").is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let limit = [("SNAKESKIN_MEMORY_LIMIT_MIB", "300")];
+    let sheet = dir.path().join("sheet.png");
+    let sheet_arg = sheet.to_str().unwrap();
+    let args = ["sheet", "-o", sheet_arg, "--layout", "body", "--tile", "1024", "--columns", "8", "--map-size", "64"];
+    let out = snakeskin_env(&args, &limit);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("a contact sheet of") && err.contains("only 300 MiB are available"), "{err}");
+    assert!(!sheet.exists());
+
+    let image = dir.path().join("p.png");
+    let args = ["preview", "erythrolamprus-miliaris", "--out", image.to_str().unwrap(), "--size", "64x64"];
+    let out = snakeskin_env(&[&args[..], &["--map-size", "4096", "--layout", "body"]].concat(), &limit);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("the preview's set of maps") && err.contains("only 300 MiB"), "{err}");
+    assert!(!image.exists());
+
+    let species = ["--species", "erythrolamprus-miliaris"];
+    let args = ["sheet", "-o", sheet_arg, "--tile", "64", "--columns", "1", "--map-size", "64"];
+    let out = snakeskin_env(&[&args[..], &species].concat(), &limit);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(sheet.exists());
 }

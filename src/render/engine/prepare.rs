@@ -8,8 +8,9 @@ use super::material::MaterialMaps;
 use super::renderer::{Material, Renderer};
 use super::scene::LayerOptics;
 use crate::Error;
-use crate::graph::{NodeCache, evaluate};
+use crate::graph::{Graph, NodeCache, evaluate};
 use crate::maps::{BuildOptions, Layout, MapKind, body_plan, build_graph};
+use crate::memory::{MemoryCheck, estimate_generate_bytes};
 use crate::optics::lut::Lut;
 use crate::preset::LoadedPreset;
 
@@ -29,8 +30,21 @@ pub const MAX_TEXTURE_SIDE: usize = 8192;
 pub fn material_maps_in(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> Result<MaterialMaps, Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
     let (width, height) = map_dimensions(loaded, map_size, layout);
+    check_memory(&graph, (width, height), 0, "the preview's set of maps")?;
     let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
     packed(&evaluation.maps, loaded, layout)
+}
+
+/// Refuses maps of `graph` at `size` (width, height), with `extra_bytes` that the caller
+/// holds beside them (a contact sheet's canvas), when their estimated peak exceeds the
+/// available memory, as `generate` refuses a set (`memory::estimate_generate_bytes`, an
+/// upper bound here: the preview quantises nothing). `what` names the work in the message.
+/// Before, `preview` and `sheet` allocated blindly: a body sheet with `--tile 1024` asked
+/// for a 4.2 GB canvas and `SNAKESKIN_MEMORY_LIMIT_MIB` was not consulted.
+pub fn check_memory(graph: &Graph, size: (usize, usize), extra_bytes: u64, what: &str) -> Result<(), Error> {
+    let (width, height) = size;
+    let estimate = estimate_generate_bytes(graph, &MapKind::ALL, width, height).saturating_add(extra_bytes);
+    MemoryCheck::against_available(estimate).refuse_if_over(&format!("{what} ({width}×{height})"))
 }
 
 /// Width and height of the preview's maps (`material_maps_in`): `map_size` wide, or the
@@ -65,6 +79,7 @@ pub fn material_maps_cached(
 ) -> Result<(MaterialMaps, crate::graph::CacheStats), Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
     let (width, height) = map_dimensions(loaded, map_size, layout);
+    check_memory(&graph, (width, height), 0, "the preview's set of maps")?;
     let (maps, stats) = cache.evaluate(&graph, &MapKind::ALL, width, height);
     Ok((packed(&maps, loaded, layout)?, stats))
 }

@@ -111,11 +111,14 @@ pub fn render_sheet(
     let (tile, columns) = (options.tile, options.columns.max(1));
     let (cell_w, cell_h) = (3 * tile, tile + LABEL_HEIGHT);
     let rows = (presets.len() as u32).div_ceil(columns);
+    let loaded: Vec<_> =
+        presets.iter().map(|(name, _)| crate::preset::load(name, &[], None)).collect::<Result<_, _>>()?;
+    let size = (options.map_size, options.map_size);
+    check_sheet_memory(&loaded, Layout::Tile, |_| size, (cell_w * columns, cell_h * rows))?;
     let mut sheet = RgbImage::from_pixel(cell_w * columns, cell_h * rows, BACKGROUND);
     let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
-    for (i, (name, _)) in presets.iter().enumerate() {
+    for (i, ((name, _), loaded)) in presets.iter().zip(&loaded).enumerate() {
         progress(i, presets.len());
-        let loaded = crate::preset::load(name, &[], None)?;
         let graph = build_graph(&loaded.preset, BuildOptions::default());
         let evaluation = evaluate(&graph, &MapKind::ALL, options.map_size, options.map_size, &|_, _| {});
         let maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
@@ -171,6 +174,10 @@ pub fn render_body_sheet(
     let closeups_w = if options.closeups { 2 * (render_h + 6) } else { 0 };
     let (cell_w, cell_h) = (strip_w + render_w + closeups_w + 12, label_h + render_h + 8);
     let rows = (presets.len() as u32).div_ceil(columns);
+    let map_size = |loaded: &crate::preset::LoadedPreset| {
+        crate::render::engine::prepare::map_dimensions(loaded, options.map_size, Layout::Body)
+    };
+    check_sheet_memory(&loaded, Layout::Body, map_size, (cell_w * columns, cell_h * rows))?;
     let mut sheet = RgbImage::from_pixel(cell_w * columns, cell_h * rows, BACKGROUND);
     let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
     let options_body = BuildOptions { layout: Layout::Body, ..BuildOptions::default() };
@@ -228,6 +235,30 @@ pub fn render_body_sheet(
     }
     progress(presets.len(), presets.len());
     Ok(sheet)
+}
+
+/// Refuses a sheet whose canvas (`canvas` width and height, RGB bytes) and largest species'
+/// maps (`map_size` per preset, in `layout`) would together need more memory than is
+/// available, before the canvas is allocated (`prepare::check_memory`).
+fn check_sheet_memory(
+    loaded: &[crate::preset::LoadedPreset],
+    layout: Layout,
+    map_size: impl Fn(&crate::preset::LoadedPreset) -> (usize, usize),
+    canvas: (u32, u32),
+) -> Result<(), Error> {
+    let canvas_bytes = canvas.0 as u64 * canvas.1 as u64 * 3;
+    let what = format!("a contact sheet of {}×{} pixels, with the maps of its largest species", canvas.0, canvas.1);
+    let largest = loaded.iter().max_by_key(|l| {
+        let (width, height) = map_size(l);
+        width * height
+    });
+    match largest {
+        Some(l) => {
+            let graph = build_graph(&l.preset, BuildOptions { layout, ..BuildOptions::default() });
+            crate::render::engine::prepare::check_memory(&graph, map_size(l), canvas_bytes, &what)
+        }
+        None => Ok(()),
+    }
 }
 
 /// The linear colour map as an sRGB image at full size.
