@@ -29,7 +29,7 @@ pub fn read_bounded(path: &Path, limit: u64) -> Result<String, BoundedReadError>
     let file = options.open(path).map_err(BoundedReadError::Io)?;
     let meta = file.metadata().map_err(BoundedReadError::Io)?;
     if !meta.is_file() {
-        return Err(BoundedReadError::NotAFile(file_kind(&meta)));
+        return Err(BoundedReadError::NotAFile(file_kind(&meta.file_type())));
     }
     if meta.len() > limit {
         return Err(BoundedReadError::TooLarge(meta.len()));
@@ -46,11 +46,13 @@ pub fn read_bounded(path: &Path, limit: u64) -> Result<String, BoundedReadError>
     })
 }
 
-fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+/// What a file that is not a regular file is, in words ("a FIFO", "a device", "a folder",
+/// "a symbolic link" ...): the one wording for input files (here) and output targets
+/// (`export::check_target`).
+pub(crate) fn file_kind(t: &std::fs::FileType) -> &'static str {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
-        let t = meta.file_type();
         if t.is_fifo() {
             return "a FIFO";
         }
@@ -61,5 +63,11 @@ fn file_kind(meta: &std::fs::Metadata) -> &'static str {
             return "a socket";
         }
     }
-    if meta.is_dir() { "a folder" } else { "not a regular file" }
+    if t.is_dir() {
+        "a folder"
+    } else if t.is_symlink() {
+        "a symbolic link"
+    } else {
+        "not a regular file"
+    }
 }

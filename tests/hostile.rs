@@ -780,7 +780,8 @@ fn outputs_that_are_not_regular_files_are_refused() {
         |out: &Path| snakeskin(&["brdf", "chart", "-o", out.to_str().unwrap(), "--width", "8", "--height", "4"]);
     let out = chart(&fifo);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("pipe.png is a FIFO (named pipe), not a regular file"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("pipe.png is a FIFO, not a regular file"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("which would replace it; give the path of a regular file"), "{}", stderr(&out));
     use std::os::unix::fs::FileTypeExt;
     assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo(), "the FIFO was replaced");
 
@@ -842,7 +843,28 @@ fn a_set_whose_lattice_outgrows_the_image_stays_small() {
     let dir = tempfile::tempdir().unwrap();
     let args = "--size 16 --layout body --set scales.rows=128 --set scales.aspect=0.3 --set body.length=40";
     let command = format!("ulimit -v 2000000; exec '{BIN}' generate {PRESET} -o '{}' {args}", dir.path().display());
-    let out = Command::new("sh").arg("-c").arg(&command).output().unwrap();
+    // Two threads and two malloc arenas, so that a machine with many cores does not spend
+    // the address space on thread stacks and arena reservations.
+    let env = [("RAYON_NUM_THREADS", "2"), ("MALLOC_ARENA_MAX", "2")];
+    let out = Command::new("sh").arg("-c").arg(&command).envs(env).output().unwrap();
     assert!(out.status.success(), "{:?}: {}", out.status, stderr(&out));
     assert_eq!(visible_files(dir.path()).len(), 6, "five maps and the manifest");
+}
+
+/// `preview` refuses maps that would not fit the available memory before it makes its
+/// renderer or allocates them, as `generate` does (exit 2, nothing written): under a
+/// 300 MiB limit `--map-size 4096 --layout body` went on to 5.2 GB (found by a hostile-input
+/// sweep). Negative control: the same preview at `--map-size 64` is not refused for memory.
+#[test]
+fn a_preview_memory_cannot_hold_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let limit = [("SNAKESKIN_MEMORY_LIMIT_MIB", "300")];
+    let image = dir.path().join("p.png");
+    let args = ["preview", PRESET, "--out", image.to_str().unwrap(), "--size", "64x64", "--layout", "body"];
+    let out = snakeskin_env(&[&args[..], &["--map-size", "4096"]].concat(), &limit);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the preview's set of maps (682×8184) needs about"), "{}", stderr(&out));
+    assert!(!image.exists());
+    let out = snakeskin_env(&[&args[..], &["--map-size", "64"]].concat(), &limit);
+    assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
 }

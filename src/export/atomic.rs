@@ -176,33 +176,10 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
             source: std::io::Error::new(std::io::ErrorKind::IsADirectory, "a folder is in the way of this output file"),
         });
     }
-    let kind = if file_type.is_file() {
+    if file_type.is_file() {
         return Ok(());
-    } else if file_type.is_symlink() {
-        "a symbolic link"
-    } else {
-        special_file_kind(&file_type)
-    };
-    Err(ExportError::NotAFile { path: target.into(), kind })
-}
-
-/// What a file that is neither a regular file, a folder nor a symbolic link is, in words.
-fn special_file_kind(file_type: &fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if file_type.is_char_device() || file_type.is_block_device() {
-            return "a device";
-        }
-        if file_type.is_fifo() {
-            return "a FIFO (named pipe)";
-        }
-        if file_type.is_socket() {
-            return "a socket";
-        }
     }
-    let _ = file_type;
-    "a special file"
+    Err(ExportError::NotAFile { path: target.into(), kind: crate::text_file::file_kind(&file_type) })
 }
 
 /// Creates an output folder if needed (true when it was created); a path that exists and is

@@ -40,7 +40,7 @@ pub enum ExportError {
     NotAFolder { path: PathBuf },
     #[error(
         "{path} is {kind}, not a regular file: snakeskin writes an output whole and renames it over the old one, \
-         which would replace the {kind} itself; give the path of a regular file (or of none), or remove the {kind} first"
+         which would replace it; give the path of a regular file (or of none)"
     )]
     NotAFile { path: PathBuf, kind: &'static str },
     #[error("set {manifest}: {problem}")]

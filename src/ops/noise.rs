@@ -136,8 +136,10 @@ impl Octave {
 
     #[inline]
     fn cell(&self, wrapped_x: i32, wrapped_y: i32) -> [f32; 2] {
-        let index = wrapped_y as usize * self.period_x as usize + wrapped_x as usize;
-        self.cells.get(index).copied().unwrap_or_else(|| self.draw(wrapped_x, wrapped_y))
+        if self.cells.is_empty() {
+            return self.draw(wrapped_x, wrapped_y);
+        }
+        self.cells[wrapped_y as usize * self.period_x as usize + wrapped_x as usize]
     }
 
     /// Wraps a lattice coordinate and its successor into [0, period) with one division.

@@ -30,7 +30,7 @@ pub const MAX_TEXTURE_SIDE: usize = 8192;
 pub fn material_maps_in(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> Result<MaterialMaps, Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
     let (width, height) = map_dimensions(loaded, map_size, layout);
-    check_memory(&graph, (width, height), 0, "the preview's set of maps")?;
+    check_memory(&graph, (width, height), 0, PREVIEW_MAPS)?;
     let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
     packed(&evaluation.maps, loaded, layout)
 }
@@ -45,6 +45,16 @@ pub fn check_memory(graph: &Graph, size: (usize, usize), extra_bytes: u64, what:
     let (width, height) = size;
     let estimate = estimate_generate_bytes(graph, &MapKind::ALL, width, height).saturating_add(extra_bytes);
     MemoryCheck::against_available(estimate).refuse_if_over(&format!("{what} ({width}×{height})"))
+}
+
+/// What `check_memory` calls the preview's maps.
+const PREVIEW_MAPS: &str = "the preview's set of maps";
+
+/// `material_maps_in`'s memory check alone, for a command to run before it makes its
+/// renderer (so that a machine without a GPU hears about the memory first).
+pub fn check_preview_memory(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> Result<(), Error> {
+    let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
+    check_memory(&graph, map_dimensions(loaded, map_size, layout), 0, PREVIEW_MAPS)
 }
 
 /// Width and height of the preview's maps (`material_maps_in`): `map_size` wide, or the
@@ -79,7 +89,7 @@ pub fn material_maps_cached(
 ) -> Result<(MaterialMaps, crate::graph::CacheStats), Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
     let (width, height) = map_dimensions(loaded, map_size, layout);
-    check_memory(&graph, (width, height), 0, "the preview's set of maps")?;
+    check_memory(&graph, (width, height), 0, PREVIEW_MAPS)?;
     let (maps, stats) = cache.evaluate(&graph, &MapKind::ALL, width, height);
     Ok((packed(&maps, loaded, layout)?, stats))
 }

@@ -237,9 +237,11 @@ pub fn render_body_sheet(
     Ok(sheet)
 }
 
-/// Refuses a sheet whose canvas (`canvas` width and height, RGB bytes) and largest species'
-/// maps (`map_size` per preset, in `layout`) would together need more memory than is
-/// available, before the canvas is allocated (`prepare::check_memory`).
+/// Refuses a sheet whose canvas (`canvas` width and height, RGB bytes) and heaviest
+/// species' maps (`map_size` per preset, in `layout`; the largest of generate's estimates
+/// over the sheet's presets, each graph weighed, not only its size) would together need
+/// more memory than is available, before the canvas is allocated
+/// (`prepare::check_memory`). The renderer exists by then (the command makes it first).
 fn check_sheet_memory(
     loaded: &[crate::preset::LoadedPreset],
     layout: Layout,
@@ -247,18 +249,19 @@ fn check_sheet_memory(
     canvas: (u32, u32),
 ) -> Result<(), Error> {
     let canvas_bytes = canvas.0 as u64 * canvas.1 as u64 * 3;
-    let what = format!("a contact sheet of {}×{} pixels, with the maps of its largest species", canvas.0, canvas.1);
-    let largest = loaded.iter().max_by_key(|l| {
-        let (width, height) = map_size(l);
-        width * height
-    });
-    match largest {
-        Some(l) => {
+    let heaviest = loaded
+        .iter()
+        .map(|l| {
             let graph = build_graph(&l.preset, BuildOptions { layout, ..BuildOptions::default() });
-            crate::render::engine::prepare::check_memory(&graph, map_size(l), canvas_bytes, &what)
-        }
-        None => Ok(()),
-    }
+            let (width, height) = map_size(l);
+            (crate::memory::estimate_generate_bytes(&graph, &MapKind::ALL, width, height), graph, (width, height))
+        })
+        .max_by_key(|(bytes, _, _)| *bytes);
+    let Some((_, graph, size)) = heaviest else {
+        return Ok(());
+    };
+    let what = format!("a contact sheet of {}×{} pixels, with the maps of its heaviest species", canvas.0, canvas.1);
+    crate::render::engine::prepare::check_memory(&graph, size, canvas_bytes, &what)
 }
 
 /// The linear colour map as an sRGB image at full size.

@@ -39,6 +39,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     if let Some(heat_path) = &args.reference {
         ensure_parent_folder(heat_path)?;
     }
+    snakeskin::render::engine::prepare::check_preview_memory(&loaded, args.map_size as usize, args.layout.layout())?;
     let bar = Progress::spinner("generating maps and baking the film LUT");
     let renderer = Renderer::headless()?;
     let material = upload_material_in(&renderer, &loaded, args.map_size as usize, args.method, args.layout.layout())?;
