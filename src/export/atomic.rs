@@ -162,8 +162,9 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
 
 /// Refuses a target that is a folder (a rename over it would fail half-way through a set),
 /// and one that is anything else but a regular file: the rename would replace a symbolic
-/// link, a device (`-o /dev/null` run as root made `/dev/null` a PNG), a FIFO or a socket
-/// with the output, where the user meant to write through it (`ExportError::NotAFile`).
+/// link, a device (`brdf chart --out /dev/full` run as root made `/dev/full` a PNG), a FIFO
+/// or a socket with the output, where the user meant to write through it
+/// (`ExportError::NotAFile`).
 /// Public so that a command can check an output file before the work that makes it.
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
     let Ok(meta) = fs::symlink_metadata(target) else {
