@@ -93,16 +93,28 @@ pub fn parse(source: &PresetSource, overrides: &[(String, String)]) -> Result<Lo
 
 /// `parse`, then the seed replaced by `seed` when given. The seed is set on the parsed
 /// preset, not written into the TOML: TOML integers stop at 2^63 - 1, seeds at 2^64 - 1.
+/// For the same reason a `seed` override is read here as a u64 (`seed_override`; `seed`
+/// wins over it, as `--seed` over `--set seed=`), and the file's seed stays out of the
+/// table the other overrides go into: a file's seed above 2^63 - 1 parses alone, and with
+/// an override made the table's parse fail ("u64 value was too large").
 pub fn parse_with_seed(
     source: &PresetSource,
     overrides: &[(String, String)],
     seed: Option<u64>,
 ) -> Result<LoadedPreset, PresetError> {
     let file_preset: Preset = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
+    let file_seed = file_preset.seed;
+    let (seed_overrides, overrides): (Vec<_>, Vec<_>) = overrides.iter().cloned().partition(|(key, _)| key == "seed");
+    let overridden_seed = match seed_overrides.last() {
+        Some((_, value)) => Some(seed_override(value)?),
+        None => None,
+    };
+    let seed = seed.or(overridden_seed);
+    let overrides = overrides.as_slice();
     let preset = if overrides.is_empty() {
         file_preset
     } else {
-        let file_table: toml::Table = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
+        let file_table = toml::from_str::<WithoutSeed>(&source.text).map_err(|e| parse_error(source, &e))?.rest;
         let mut table = file_table.clone();
         for (key, value) in overrides {
             apply_override(&mut table, key, value)?;
@@ -127,9 +139,7 @@ pub fn parse_with_seed(
     };
 
     let mut preset = preset;
-    if let Some(seed) = seed {
-        preset.seed = seed;
-    }
+    preset.seed = seed.unwrap_or(file_seed);
     let problems = validate(&preset);
     if !problems.is_empty() {
         let overridden = |key: &str| overrides.iter().any(|(k, _)| key == k || key.starts_with(&format!("{k}.")));
@@ -152,6 +162,31 @@ pub fn parse_with_seed(
         preset,
         content_hash: format!("{:016x}", fnv1a64(canonical.as_bytes())),
         clamped_colours,
+    })
+}
+
+/// A preset file's table without its `seed`, which may lie beyond TOML's integers (and so
+/// beyond `toml::Value`'s); `parse_with_seed` sets the seed on the parsed preset.
+#[derive(Deserialize)]
+struct WithoutSeed {
+    #[serde(default, rename = "seed")]
+    _seed: Option<serde::de::IgnoredAny>,
+    #[serde(flatten)]
+    rest: toml::Table,
+}
+
+/// The value of `--set seed=VALUE`: a whole number from 0 to 2^64 − 1, as a TOML integer
+/// or, beyond TOML's 2^63 − 1, in decimal digits.
+fn seed_override(value: &str) -> Result<u64, PresetError> {
+    let digits = value.trim();
+    let parsed = match toml::from_str::<toml::Table>(&format!("v = {value}")).ok().and_then(|mut t| t.remove("v")) {
+        Some(toml::Value::Integer(i)) => u64::try_from(i).ok(),
+        _ if !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit()) => digits.parse().ok(),
+        _ => None,
+    };
+    parsed.ok_or_else(|| PresetError::Override {
+        argument: format!("seed={value}"),
+        message: format!("the seed must be a whole number from 0 to {}", u64::MAX),
     })
 }
 
@@ -364,6 +399,45 @@ mod tests {
         let layers = "[[pattern]]\nkind = \"solid\"\ncolor = \"#000000\"\n[[pattern]]\nkind = \"spots\"\ncolor = \"#102030\"\nsize = 9.0\n";
         let err = parse(&source(layers), &[]).unwrap_err().to_string();
         assert!(err.contains("t.toml:7: key `pattern.1.size`"), "{err}");
+    }
+
+    /// Seeds run to 2^64 − 1, TOML's integers to 2^63 − 1. A file's seed above that parsed
+    /// alone but not with any override (the table's parse refused it); `--set seed=` took it
+    /// for a string. Negative controls: values that are not whole numbers from 0 to 2^64 − 1
+    /// are refused with the range, and `--seed` wins over `--set seed=`.
+    #[test]
+    fn seeds_beyond_toml_integers_survive_overrides() {
+        let big = "seed = 18446744073709551615
+[scales]
+rows = 19
+";
+        let rows = [("scales.rows".to_string(), "23".to_string())];
+        let loaded = parse(&source(big), &rows).unwrap();
+        assert_eq!((loaded.preset.seed, loaded.preset.scales.rows), (u64::MAX, 23));
+        assert_eq!(parse(&source(big), &[]).unwrap().preset.seed, u64::MAX);
+        let set_seed = |value: &str| {
+            parse(
+                &source(
+                    "seed = 1
+",
+                ),
+                &[("seed".into(), value.into())],
+            )
+        };
+        assert_eq!(set_seed("18446744073709551615").unwrap().preset.seed, u64::MAX);
+        assert_eq!(set_seed("9_000").unwrap().preset.seed, 9000);
+        assert_eq!(set_seed("0x10").unwrap().preset.seed, 16);
+        for bad in ["18446744073709551616", "-1", "1.5", "\"7\"", "seven", ""] {
+            let err = set_seed(bad).unwrap_err().to_string();
+            assert!(
+                err.contains(&format!("{:?}", format!("seed={bad}"))) && err.contains("from 0 to 18446744073709551615"),
+                "{err}"
+            );
+        }
+        // The file's seed, not TOML's default, when an override leaves the seed alone.
+        assert_eq!(parse(&source("seed = 7\n"), &rows).unwrap().preset.seed, 7);
+        let both = parse_with_seed(&source(big), &[("seed".into(), "5".into())], Some(6)).unwrap();
+        assert_eq!(both.preset.seed, 6);
     }
 
     #[test]
