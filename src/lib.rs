@@ -52,6 +52,9 @@ pub enum Error {
     Query(String),
     #[error(transparent)]
     Gpu(#[from] render::GpuError),
+    /// A command-line option's value that the command does not accept (`sheet --species`).
+    #[error("invalid {option}: {reason}")]
+    InvalidOption { option: &'static str, reason: String },
     /// A preview option outside what the renderer accepts (`snakeskin preview`).
     #[error("invalid preview option: {0}")]
     Preview(String),

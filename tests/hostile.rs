@@ -868,3 +868,41 @@ fn a_preview_memory_cannot_hold_is_refused() {
     let out = snakeskin_env(&[&args[..], &["--map-size", "64"]].concat(), &limit);
     assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
 }
+
+/// `sheet` checks its options, species and memory before it makes a renderer (parse, then
+/// run), so none of this needs a GPU (exit 2, nothing written, no folder made):
+/// - a sheet that would not fit the available memory: a body sheet with `--tile 1024` asked
+///   for a 4.2 GB canvas at once, and `SNAKESKIN_MEMORY_LIMIT_MIB` was not consulted (found
+///   by a hostile-input sweep; then checked after the renderer was made);
+/// - a species that is not built in (it said "invalid preview option", after the renderer);
+/// - `--closeups` without `--layout body` (it was ignored).
+///
+/// Negative control: a small sheet under the same limit is not refused for memory.
+#[test]
+fn a_sheet_is_checked_before_it_is_rendered() {
+    let dir = tempfile::tempdir().unwrap();
+    let limit = [("SNAKESKIN_MEMORY_LIMIT_MIB", "300")];
+    let sheet = dir.path().join("new").join("sheet.png");
+    let sheet_arg = sheet.to_str().unwrap();
+    let refused = |extra: &[&str], expected: &[&str]| {
+        let args = [&["sheet", "-o", sheet_arg, "--map-size", "64"][..], extra].concat();
+        let out = snakeskin_env(&args, &limit);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
+        for text in expected {
+            assert!(stderr(&out).contains(text), "{extra:?}: {}", stderr(&out));
+        }
+        assert!(!sheet.parent().unwrap().exists(), "{extra:?}: nothing written");
+    };
+    refused(
+        &["--layout", "body", "--tile", "1024", "--columns", "8"],
+        &["a contact sheet of", "the maps of its heaviest species", "only 300 MiB are available"],
+    );
+    refused(
+        &["--species", "python-regius,natrix-natrx"],
+        &["invalid --species: no built-in species \"natrix-natrx\"; did you mean natrix-natrix?"],
+    );
+    refused(&["--closeups"], &["invalid --closeups:", "needs --layout body"]);
+    let small = ["--tile", "64", "--columns", "1", "--species", "erythrolamprus-miliaris"];
+    let out = snakeskin_env(&[&["sheet", "-o", sheet_arg, "--map-size", "64"][..], &small].concat(), &limit);
+    assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
+}

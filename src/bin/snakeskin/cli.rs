@@ -114,7 +114,7 @@ pub enum Command {
         /// Only these species, in this order (comma-separated built-in names; default: all).
         #[arg(long, value_delimiter = ',', value_name = "NAMES")]
         species: Vec<String>,
-        /// With --layout body: also a close-up of each species' head and tail.
+        /// Also a close-up of each species' head and tail (needs --layout body).
         #[arg(long)]
         closeups: bool,
     },

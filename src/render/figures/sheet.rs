@@ -13,7 +13,7 @@ use crate::export::write_file_atomically;
 use crate::graph::evaluate;
 use crate::maps::{BuildOptions, Layout, MapKind, body_plan, build_graph};
 use crate::optics::lut::Lut;
-use crate::preset::library;
+use crate::preset::{LoadedPreset, library};
 use crate::render::engine::film::GpuFilmMethod;
 use crate::render::engine::material::MaterialMaps;
 use crate::render::engine::renderer::{FrameSettings, Renderer};
@@ -35,6 +35,70 @@ pub struct SheetOptions {
     pub map_size: usize,
     /// Body sheet: also a close-up render of each species' head and of its tail.
     pub closeups: bool,
+}
+
+/// A sheet checked and laid out before anything is rendered (`plan_sheet`): its species,
+/// loaded, and where everything goes, on a canvas the memory available can hold. Parse,
+/// then run: a wrong species name or a sheet too large is refused before a renderer is
+/// made (without a GPU, the GPU's error came first).
+pub struct SheetPlan {
+    options: SheetOptions,
+    layout: Layout,
+    species: Vec<(&'static str, LoadedPreset)>,
+    columns: u32,
+    /// One species' cell, and the whole canvas.
+    cell: (u32, u32),
+    canvas: (u32, u32),
+    /// The label's height; the body layout's longest strip and its renders' size.
+    label_h: u32,
+    strip_w: u32,
+    render: (u32, u32),
+}
+
+/// Checks a sheet's options and lays it out (`SheetPlan`): the species named in `species`
+/// (all when empty) must be built in, `closeups` needs the body layout, and the canvas
+/// with the heaviest species' maps must fit in the memory available.
+pub fn plan_sheet(options: SheetOptions, layout: Layout, species: &[String]) -> Result<SheetPlan, Error> {
+    if options.closeups && layout != Layout::Body {
+        return Err(Error::InvalidOption {
+            option: "--closeups",
+            reason: "it draws each body's head and tail, so it needs --layout body".into(),
+        });
+    }
+    let species: Vec<(&'static str, LoadedPreset)> = chosen_species(species)?
+        .into_iter()
+        .map(|(name, _)| Ok((name, crate::preset::load(name, &[], None)?)))
+        .collect::<Result<_, Error>>()?;
+    let columns = options.columns.max(1);
+    let rows = (species.len() as u32).div_ceil(columns);
+    let tile = options.tile;
+    let (cell, label_h, strip_w, render) = match layout {
+        Layout::Tile => ((3 * tile, tile + LABEL_HEIGHT), LABEL_HEIGHT, 0, (2 * tile, tile)),
+        Layout::Body => {
+            // `tile` is the strip's height, one circumference; the longest body sets the
+            // strips' length, all at one scale.
+            let longest = species.iter().map(|(_, l)| l.preset.body.length).fold(1.0f64, f64::max);
+            let strip_w = (longest * tile as f64).round() as u32;
+            let (render_w, render_h) = (4 * tile, 2 * tile);
+            let label_h = LABEL_HEIGHT + 8 * LABEL_SCALE + 6;
+            let closeups_w = if options.closeups { 2 * (render_h + 6) } else { 0 };
+            ((strip_w + render_w + closeups_w + 12, label_h + render_h + 8), label_h, strip_w, (render_w, render_h))
+        }
+    };
+    let canvas = (cell.0 * columns, cell.1 * rows);
+    let plan = SheetPlan { options, layout, species, columns, cell, canvas, label_h, strip_w, render };
+    check_sheet_memory(&plan)?;
+    Ok(plan)
+}
+
+impl SheetPlan {
+    /// The map size of one species' maps: square in the tile layout, its atlas' in the body's.
+    fn map_size(&self, loaded: &LoadedPreset) -> (usize, usize) {
+        match self.layout {
+            Layout::Tile => (self.options.map_size, self.options.map_size),
+            Layout::Body => crate::render::engine::prepare::map_dimensions(loaded, self.options.map_size, Layout::Body),
+        }
+    }
 }
 
 /// Close-up cameras on a body atlas's snake (`BodyShape::for_atlas`): the head seen from
@@ -100,24 +164,27 @@ fn lut_for(luts: &mut Vec<(crate::optics::film::Stack, Lut)>, optics: LayerOptic
     &luts[index].1
 }
 
-/// Renders the contact sheet; `progress(done, total)` after each species.
-pub fn render_sheet(
+/// Renders the contact sheet `plan` lays out (the tile's, or the whole bodies'); `progress(done,
+/// total)` after each species.
+pub fn render_sheet(renderer: &Renderer, plan: &SheetPlan, progress: &dyn Fn(usize, usize)) -> Result<RgbImage, Error> {
+    match plan.layout {
+        Layout::Tile => render_tile_sheet(renderer, plan, progress),
+        Layout::Body => render_body_sheet(renderer, plan, progress),
+    }
+}
+
+/// Per species its colour map tile beside a render of the mid-body, under its label.
+fn render_tile_sheet(
     renderer: &Renderer,
-    options: SheetOptions,
-    species: &[String],
+    plan: &SheetPlan,
     progress: &dyn Fn(usize, usize),
 ) -> Result<RgbImage, Error> {
-    let presets = chosen_species(species)?;
-    let (tile, columns) = (options.tile, options.columns.max(1));
-    let (cell_w, cell_h) = (3 * tile, tile + LABEL_HEIGHT);
-    let rows = (presets.len() as u32).div_ceil(columns);
-    let loaded: Vec<_> =
-        presets.iter().map(|(name, _)| crate::preset::load(name, &[], None)).collect::<Result<_, _>>()?;
-    let size = (options.map_size, options.map_size);
-    check_sheet_memory(&loaded, Layout::Tile, |_| size, (cell_w * columns, cell_h * rows))?;
-    let mut sheet = RgbImage::from_pixel(cell_w * columns, cell_h * rows, BACKGROUND);
+    let (options, tile, columns) = (plan.options, plan.options.tile, plan.columns);
+    let (cell_w, cell_h) = plan.cell;
+    let presets = &plan.species;
+    let mut sheet = RgbImage::from_pixel(plan.canvas.0, plan.canvas.1, BACKGROUND);
     let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
-    for (i, ((name, _), loaded)) in presets.iter().zip(&loaded).enumerate() {
+    for (i, (name, loaded)) in presets.iter().enumerate() {
         progress(i, presets.len());
         let graph = build_graph(&loaded.preset, BuildOptions::default());
         let evaluation = evaluate(&graph, &MapKind::ALL, options.map_size, options.map_size, &|_, _| {});
@@ -130,7 +197,7 @@ pub fn render_sheet(
             ground: false,
             ..FrameSettings::default()
         };
-        let render = renderer.render_image(&settings, &material, 2 * tile, tile)?;
+        let render = renderer.render_image(&settings, &material, plan.render.0, plan.render.1)?;
         let render = image::DynamicImage::ImageRgba8(render).into_rgb8();
 
         let (x0, y0) = ((i as u32 % columns) * cell_w, (i as u32 / columns) * cell_h);
@@ -155,37 +222,23 @@ pub fn render_sheet(
 /// line with the counts the atlas was drawn with. `options.tile` is the strip's height for
 /// a body 12 circumferences long (longer bodies get longer strips, all at one scale);
 /// `options.map_size` the atlas' width (its circumference) in pixels.
-pub fn render_body_sheet(
+fn render_body_sheet(
     renderer: &Renderer,
-    options: SheetOptions,
-    species: &[String],
+    plan: &SheetPlan,
     progress: &dyn Fn(usize, usize),
 ) -> Result<RgbImage, Error> {
-    let presets = chosen_species(species)?;
-    let loaded: Vec<_> =
-        presets.iter().map(|(name, _)| crate::preset::load(name, &[], None)).collect::<Result<_, _>>()?;
-    let columns = options.columns.max(1);
-    let circumference = options.tile;
-    let longest = loaded.iter().map(|l| l.preset.body.length).fold(1.0f64, f64::max);
-    let strip_w = (longest * circumference as f64).round() as u32;
-    let render_h = 2 * circumference;
-    let render_w = 2 * render_h;
-    let label_h = LABEL_HEIGHT + 8 * LABEL_SCALE + 6;
-    let closeups_w = if options.closeups { 2 * (render_h + 6) } else { 0 };
-    let (cell_w, cell_h) = (strip_w + render_w + closeups_w + 12, label_h + render_h + 8);
-    let rows = (presets.len() as u32).div_ceil(columns);
-    let map_size = |loaded: &crate::preset::LoadedPreset| {
-        crate::render::engine::prepare::map_dimensions(loaded, options.map_size, Layout::Body)
-    };
-    check_sheet_memory(&loaded, Layout::Body, map_size, (cell_w * columns, cell_h * rows))?;
-    let mut sheet = RgbImage::from_pixel(cell_w * columns, cell_h * rows, BACKGROUND);
+    let (options, columns, circumference) = (plan.options, plan.columns, plan.options.tile);
+    let (cell_w, cell_h) = plan.cell;
+    let (strip_w, label_h, (render_w, render_h)) = (plan.strip_w, plan.label_h, plan.render);
+    let presets = &plan.species;
+    let mut sheet = RgbImage::from_pixel(plan.canvas.0, plan.canvas.1, BACKGROUND);
     let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
     let options_body = BuildOptions { layout: Layout::Body, ..BuildOptions::default() };
-    for (i, ((name, _), loaded)) in presets.iter().zip(&loaded).enumerate() {
+    for (i, (name, loaded)) in presets.iter().enumerate() {
         progress(i, presets.len());
         let preset = &loaded.preset;
         let graph = build_graph(preset, options_body);
-        let (width, height) = crate::render::engine::prepare::map_dimensions(loaded, options.map_size, Layout::Body);
+        let (width, height) = plan.map_size(loaded);
         let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
         let mut maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
         maps.atlas = Some(body_plan(preset));
@@ -237,23 +290,20 @@ pub fn render_body_sheet(
     Ok(sheet)
 }
 
-/// Refuses a sheet whose canvas (`canvas` width and height, RGB bytes) and heaviest
-/// species' maps (`map_size` per preset, in `layout`; the largest of generate's estimates
-/// over the sheet's presets, each graph weighed, not only its size) would together need
-/// more memory than is available, before the canvas is allocated
-/// (`prepare::check_memory`). The renderer exists by then (the command makes it first).
-fn check_sheet_memory(
-    loaded: &[crate::preset::LoadedPreset],
-    layout: Layout,
-    map_size: impl Fn(&crate::preset::LoadedPreset) -> (usize, usize),
-    canvas: (u32, u32),
-) -> Result<(), Error> {
+/// Refuses a sheet whose canvas (RGB bytes) and heaviest species' maps (the largest of
+/// generate's estimates over the sheet's presets, each graph weighed, not only its size)
+/// would together need more memory than is available (`prepare::check_memory`), before a
+/// renderer or the canvas is made.
+fn check_sheet_memory(plan: &SheetPlan) -> Result<(), Error> {
+    let canvas = plan.canvas;
     let canvas_bytes = canvas.0 as u64 * canvas.1 as u64 * 3;
-    let heaviest = loaded
+    let layout = plan.layout;
+    let heaviest = plan
+        .species
         .iter()
-        .map(|l| {
+        .map(|(_, l)| {
             let graph = build_graph(&l.preset, BuildOptions { layout, ..BuildOptions::default() });
-            let (width, height) = map_size(l);
+            let (width, height) = plan.map_size(l);
             (crate::memory::estimate_generate_bytes(&graph, &MapKind::ALL, width, height), graph, (width, height))
         })
         .max_by_key(|(bytes, _, _)| *bytes);
@@ -274,7 +324,7 @@ fn colour_image(maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>) -
 }
 
 /// The built-in presets named in `species` (all of them when it is empty), in its order; a
-/// name that is not built in is an error naming it.
+/// name that is not built in is an error naming it, and the nearest built-in name.
 fn chosen_species(species: &[String]) -> Result<Vec<(&'static str, &'static str)>, Error> {
     if species.is_empty() {
         return Ok(library::all().to_vec());
@@ -283,26 +333,25 @@ fn chosen_species(species: &[String]) -> Result<Vec<(&'static str, &'static str)
         .iter()
         .map(|name| {
             library::all().iter().find(|(n, _)| n == name).copied().ok_or_else(|| {
-                Error::Preview(format!("no built-in species {name}; `snakeskin presets list` shows them"))
+                let nearest = library::names().into_iter().min_by_key(|n| crate::toml_text::edit_distance(n, name));
+                let hint = nearest.map(|n| format!("did you mean {n}? ")).unwrap_or_default();
+                Error::InvalidOption {
+                    option: "--species",
+                    reason: format!("no built-in species {name:?}; {hint}`snakeskin presets list` shows them all"),
+                }
             })
         })
         .collect()
 }
 
-/// Renders the sheet (the tile's, or the whole bodies' with `layout` body) and writes it as
-/// a PNG (atomically).
+/// Renders the sheet `plan` lays out and writes it as a PNG (atomically).
 pub fn write_sheet(
     renderer: &Renderer,
     path: &Path,
-    options: SheetOptions,
-    layout: Layout,
-    species: &[String],
+    plan: &SheetPlan,
     progress: &dyn Fn(usize, usize),
 ) -> Result<PathBuf, Error> {
-    let sheet = match layout {
-        Layout::Tile => render_sheet(renderer, options, species, progress)?,
-        Layout::Body => render_body_sheet(renderer, options, species, progress)?,
-    };
+    let sheet = render_sheet(renderer, plan, progress)?;
     let mut bytes = Vec::new();
     sheet
         .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
