@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{gpu_or_skip, gpu_required, snakeskin, snakeskin_env};
+use common::{gpu_or_skip, gpu_required, snakeskin};
 use snakeskin::graph::{NodeCache, evaluate};
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::optics::brdf::Model;
