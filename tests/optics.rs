@@ -211,6 +211,17 @@ mod cli {
         let (code, _, err) = snakeskin(&["brdf", "film", "--batch", "-"], "{\"thickness_nm\":1}\n");
         assert_eq!(code, 2);
         assert!(err.contains("-:1") && err.contains("wavelength_nm"), "{err}");
+        // A line carries its own values: a flag beside --batch was silently ignored; it is
+        // refused. Negative control: the same line alone is answered.
+        let line = "{\"thickness_nm\":400,\"wavelength_nm\":500,\"angle_deg\":0}\n";
+        for flags in [&["--angle-deg", "30"][..], &["--n2", "1.33"], &["--thickness-nm", "100"]] {
+            let (code, _, err) = snakeskin(&[&["brdf", "film", "--batch", "-"][..], flags].concat(), line);
+            assert_eq!(code, 2, "{flags:?}: {err}");
+            assert!(err.contains("cannot be used with"), "{flags:?}: {err}");
+        }
+        let (code, _, err) = snakeskin(&["brdf", "color", "--batch", "-", "--method", "lut"], line);
+        assert_eq!(code, 2, "{err}");
+        assert_eq!(snakeskin(&["brdf", "film", "--batch", "-"], line).0, 0);
     }
 }
 

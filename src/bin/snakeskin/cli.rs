@@ -437,8 +437,9 @@ pub enum BrdfCommand {
         #[arg(long, required_unless_present = "batch")]
         angle_deg: Option<f64>,
         /// Read JSON lines {n0, n1, n2, thickness_nm, wavelength_nm, angle_deg} from FILE
-        /// (or - for stdin); print one JSON line per query, in order.
-        #[arg(long, value_name = "FILE")]
+        /// (or - for stdin); print one JSON line per query, in order. Each line carries its
+        /// own values (n0, n1 and n2 default to the thesis'), so the flags above are refused.
+        #[arg(long, value_name = "FILE", conflicts_with_all = ["n0", "n1", "n2", "thickness_nm", "wavelength_nm", "angle_deg"])]
         batch: Option<String>,
     },
     /// The film's reflectance colour in linear sRGB under D65: {"rgb":[r,g,b]}.
@@ -453,8 +454,11 @@ pub enum BrdfCommand {
         /// (e.g. spectral-16), gaussian-fit, lut.
         #[arg(long, default_value = "spectral", value_parser = parse_method)]
         method: Method,
-        /// JSON lines {n0, n1, n2, thickness_nm, angle_deg, method}.
-        #[arg(long, value_name = "FILE")]
+        /// Read JSON lines {n0, n1, n2, thickness_nm, angle_deg, method} from FILE (or - for
+        /// stdin); print one JSON line per query, in order. Each line carries its own values
+        /// (n0, n1 and n2 default to the thesis', method to spectral), so the flags above are
+        /// refused.
+        #[arg(long, value_name = "FILE", conflicts_with_all = ["n0", "n1", "n2", "thickness_nm", "angle_deg", "method"])]
         batch: Option<String>,
     },
     /// The full multi-layer BRDF for given directions and layer parameters (JSON).
