@@ -140,8 +140,9 @@ fn brdf_stress_is_bounded_and_prints_a_table() {
 
 /// Output files are checked before the work that makes them: a folder where `preview
 /// --reference` or the batch index must go fails at once, with nothing written (before,
-/// preview rendered and wrote its image first, and batch ran every job); `batch -o FILE`
-/// is the user's mistake, as for `generate -o` (exit 2).
+/// preview rendered and wrote its image first, and batch ran every job). Both are the
+/// user's to mend (exit 2, as a link there is; it was exit 1, an I/O error), and so is
+/// `batch -o FILE`, as for `generate -o`.
 #[test]
 fn outputs_are_checked_before_the_work() {
     let dir = tempfile::tempdir().unwrap();
@@ -150,7 +151,7 @@ fn outputs_are_checked_before_the_work() {
     std::fs::create_dir(&in_the_way).unwrap();
     let args = ["preview", PRESET, "--out", image.to_str().unwrap(), "--size", "64x64", "--map-size", "64"];
     let out = snakeskin(&[&args[..], &["--reference", in_the_way.to_str().unwrap()]].concat());
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("a folder is in the way of this output file"), "{}", stderr(&out));
     assert!(!image.exists(), "the preview ran before the check");
 
@@ -159,7 +160,7 @@ fn outputs_are_checked_before_the_work() {
     let out_dir = dir.path().join("out");
     std::fs::create_dir_all(out_dir.join("index.json")).unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("a folder is in the way"), "{}", stderr(&out));
     assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 1, "a job ran before the check");
 
@@ -303,7 +304,7 @@ fn a_folder_in_the_way_leaves_the_earlier_set_whole() {
     let before = files(dir.path());
     assert_eq!(before.len(), 5, "four maps and the manifest");
     let out = generate_into(dir.path(), "2", &[]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     let err = stderr(&out);
     assert!(err.contains("a folder is in the way"), "{err}");
     // Nothing was replaced: the maps and the manifest of seed 1 are there, byte for byte.

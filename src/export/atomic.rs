@@ -172,10 +172,7 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
     };
     let file_type = meta.file_type();
     if file_type.is_dir() {
-        return Err(ExportError::Io {
-            path: target.into(),
-            source: std::io::Error::new(std::io::ErrorKind::IsADirectory, "a folder is in the way of this output file"),
-        });
+        return Err(ExportError::FolderInTheWay { path: target.into() });
     }
     if file_type.is_file() {
         return Ok(());

@@ -43,6 +43,10 @@ pub enum ExportError {
          which would replace it; give the path of a regular file (or of none)"
     )]
     NotAFile { path: PathBuf, kind: &'static str },
+    #[error(
+        "cannot write {path}: a folder is in the way of this output file; give the path of a file, or move the folder"
+    )]
+    FolderInTheWay { path: PathBuf },
     #[error("set {manifest}: {problem}")]
     Verify { manifest: PathBuf, problem: String },
     #[error("cannot encode the packed {texture} texture: {message}")]
@@ -53,9 +57,13 @@ pub enum ExportError {
 
 impl ExportError {
     /// True when the user's input is at fault: an output folder that is not a folder, an
-    /// output file that is something other than a file.
+    /// output file that is something other than a file (a folder in its way included, as a
+    /// link there is).
     pub fn is_invalid_input(&self) -> bool {
-        matches!(self, ExportError::NotAFolder { .. } | ExportError::NotAFile { .. })
+        matches!(
+            self,
+            ExportError::NotAFolder { .. } | ExportError::NotAFile { .. } | ExportError::FolderInTheWay { .. }
+        )
     }
 }
 
