@@ -89,6 +89,24 @@ impl Plan {
         &self.loaded
     }
 
+    /// The names of the files the set writes: its maps (or its pack's textures), then its
+    /// manifest.
+    fn file_names(&self) -> Vec<String> {
+        let name = &self.loaded.name;
+        let mut files: Vec<String> = match self.request.pack {
+            Some(pack) => pack
+                .textures(has_film(&self.loaded.preset), self.request.ao)
+                .iter()
+                .map(|spec| texture_file_name(name, spec))
+                .collect(),
+            None => {
+                self.request.maps.iter().map(|map| export::map_file_name_in(name, *map, self.request.format)).collect()
+            }
+        };
+        files.push(export::manifest_file_name(name));
+        files
+    }
+
     /// Validates the request and estimates its peak memory; refuses a set whose estimate
     /// exceeds the memory available (`Error::Memory`, before any allocation).
     pub fn new(request: &GenerateRequest) -> Result<Plan, Error> {
@@ -159,6 +177,12 @@ impl Plan {
 
     /// Runs the plan. `progress(done, total)` reports node evaluations.
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
+        // Every file of the set is checked before the work, not only when the set is
+        // committed: a folder or a link where the last map goes failed after the whole set
+        // had been evaluated and encoded (the commit checks again: the folder may change).
+        for file in self.file_names() {
+            export::check_target(&self.request.out_dir.join(file))?;
+        }
         if let Some(pack) = self.request.pack {
             return self.run_pack(pack, progress);
         }

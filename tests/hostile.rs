@@ -907,3 +907,51 @@ fn a_sheet_is_checked_before_it_is_rendered() {
     let out = snakeskin_env(&[&["sheet", "-o", sheet_arg, "--map-size", "64"][..], &small].concat(), &limit);
     assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
 }
+
+/// Every file of a set is checked before its maps are evaluated: a folder (or a link) where
+/// the last map or a pack's texture goes failed only at the commit, after the whole set had
+/// been evaluated and encoded (seen: 15 progress calls before the error). Counted through
+/// the library's progress callback, which evaluation calls. Negative control: with the way
+/// clear, the same plan evaluates (and reports progress).
+#[test]
+fn a_set_is_checked_for_folders_in_the_way_before_it_is_evaluated() {
+    use snakeskin::export::pack::Pack;
+    use snakeskin::generate::{GenerateRequest, Plan};
+    use snakeskin::material::{FileFormat, MapKind};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let dir = tempfile::tempdir().unwrap();
+    let request = |pack: Option<Pack>| GenerateRequest {
+        preset: PRESET.into(),
+        overrides: Vec::new(),
+        seed: None,
+        size: 64,
+        maps: MapKind::ALL.to_vec(),
+        out_dir: dir.path().into(),
+        options: Default::default(),
+        format: FileFormat::Png,
+        pack,
+        ao: false,
+        job: None,
+    };
+    let run = |pack: Option<Pack>| {
+        let calls = AtomicUsize::new(0);
+        let result = Plan::new(&request(pack)).unwrap().run(&|_, _| {
+            calls.fetch_add(1, Ordering::Relaxed);
+        });
+        (result.map(|_| ()).map_err(|e| e.to_string()), calls.into_inner())
+    };
+    for (pack, in_the_way) in
+        [(None, format!("{PRESET}_iridescence.png")), (Some(Pack::Gltf), format!("{PRESET}.material.json"))]
+    {
+        // The first pass's manifest is a file there: the folder takes its place.
+        let _ = std::fs::remove_file(dir.path().join(&in_the_way));
+        std::fs::create_dir(dir.path().join(&in_the_way)).unwrap();
+        let (result, calls) = run(pack);
+        let err = result.unwrap_err();
+        assert!(err.contains("a folder is in the way") && err.contains(&in_the_way), "{err}");
+        assert_eq!(calls, 0, "{in_the_way}: evaluated before the check");
+        std::fs::remove_dir(dir.path().join(&in_the_way)).unwrap();
+        let (result, calls) = run(pack);
+        assert!(result.is_ok() && calls > 0, "{result:?} {calls}");
+    }
+}
