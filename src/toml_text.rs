@@ -2,7 +2,7 @@
 //! writes (presets, jobs files): where the error is (line and column), which dotted key it
 //! is under, and what is accepted without serde's Rust type names. serde's message for
 //! `seed = "x"` is `invalid type: string "x", expected u64`; here it is ``key `seed`: invalid
-//! type: string "x", expected a whole number, 0 or more``.
+//! type: string "x", expected a whole number``.
 
 use toml::de::{DeTable, DeValue};
 
@@ -95,7 +95,11 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 /// serde's words for types in a reader's: what the value is (`invalid type: sequence`) and
 /// what is accepted (`expected u32`, `expected struct Scales`). Only serde's own parts are
 /// rewritten, never the value the message quotes: the value's type after "invalid type: "
-/// and the final ", expected ...".
+/// and the final ", expected ...". An integer's type range is named only where the value
+/// is a whole number outside it (`-1`, `5000000000`): for `rows = 4.0` it read "expected a
+/// whole number from 0 to 4294967295", which is not the key's range (4 to 128, checked once
+/// the value is a whole number). A whole number beyond i64 is "an integer `…` as i128" in
+/// toml's words: said as the value it is.
 fn plain_type_names(message: &str) -> String {
     let mut out = message.to_string();
     for (serde, plain) in [("sequence", "array"), ("map", "table")] {
@@ -104,13 +108,20 @@ fn plain_type_names(message: &str) -> String {
             out.replace_range(..from.len(), &format!("invalid type: {plain},"));
         }
     }
+    if let Some(rest) = out.strip_prefix("invalid type: integer `")
+        && let Some((digits, tail)) = rest.split_once("` as i128,")
+    {
+        out = format!("invalid value: integer `{digits}`,{tail}");
+    }
     let Some(at) = out.rfind(", expected ") else { return out };
+    let whole_number = out.starts_with("invalid value: integer");
     let expected = &out[at + ", expected ".len()..];
     let plain = match expected {
+        "u8" | "u16" | "u32" | "u64" | "usize" if !whole_number => "a whole number",
         "u8" => "a whole number from 0 to 255",
         "u16" => "a whole number from 0 to 65535",
         "u32" => "a whole number from 0 to 4294967295",
-        "u64" | "usize" => "a whole number, 0 or more",
+        "u64" | "usize" => "a whole number from 0 to 18446744073709551615",
         "i32" | "i64" => "an integer",
         "f32" | "f64" => "a number",
         "a sequence" => "an array",
@@ -163,9 +174,18 @@ mod tests {
     #[test]
     fn type_names_are_replaced_whole() {
         let cases = [
+            ("invalid type: string \"x\", expected u64", "invalid type: string \"x\", expected a whole number"),
             (
-                "invalid type: string \"x\", expected u64",
-                "invalid type: string \"x\", expected a whole number, 0 or more",
+                "invalid type: floating point `4.0`, expected u32",
+                "invalid type: floating point `4.0`, expected a whole number",
+            ),
+            (
+                "invalid type: integer `99999999999999999999` as i128, expected u64",
+                "invalid value: integer `99999999999999999999`, expected a whole number from 0 to 18446744073709551615",
+            ),
+            (
+                "invalid value: integer `5000000000`, expected u32",
+                "invalid value: integer `5000000000`, expected a whole number from 0 to 4294967295",
             ),
             (
                 "invalid value: integer `-1`, expected u32",
