@@ -90,8 +90,9 @@ impl Plan {
     }
 
     /// The names of the files the set writes: its maps (or its pack's textures), then its
-    /// manifest.
-    fn file_names(&self) -> Vec<String> {
+    /// manifest (`run` checks them before the work; tests/hostile.rs checks that they are
+    /// the files written).
+    pub fn file_names(&self) -> Vec<String> {
         let name = &self.loaded.name;
         let mut files: Vec<String> = match self.request.pack {
             Some(pack) => pack

@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use crate::export::gltf::{GltfMaterial, GltfTextures, glb, gltf_files, gltf_image_file_name};
+use crate::export::gltf::{GltfMaterial, GltfTextures, glb, gltf_files, gltf_image_file_name, gltf_side_file_names};
 use crate::export::pack::Pack;
 use crate::export::{SetLock, write_file_atomically};
 use crate::generate::{GenerateRequest, Plan};
@@ -117,6 +117,13 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
     });
     let material = GltfMaterial { base_ior: preset.optics.pigment_ior, film, repeat_v: request.layout == Layout::Tile };
     let mesh = mesh_for(request.mesh, request.layout, preset);
+    // The files it will write, checked before the work (a folder or a link where one goes
+    // was found only when they were written): the `.glb`, or the `.gltf` and its side files.
+    let side_files = if binary { Vec::new() } else { gltf_side_file_names(&name, film.is_some()) };
+    crate::export::check_target(&request.out)?;
+    for file in side_files {
+        crate::export::check_target(&dir.join(file))?;
+    }
     let (textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
     let dimensions = plan.dimensions();
     let texture = |suffix: &str| textures.iter().find(|(s, _)| s.suffix == suffix).map(|(_, b)| b.clone());

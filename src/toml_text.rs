@@ -72,10 +72,19 @@ fn with_suggestion(message: &str) -> String {
         return message.to_string();
     };
     let accepted: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
-    let nearest =
-        accepted.iter().map(|a| (edit_distance(unknown, a), *a)).filter(|(d, a)| *d <= 2.max(a.len() / 3)).min();
-    let hint = nearest.map(|(_, a)| format!("; did you mean `{a}`?")).unwrap_or_default();
+    let hint = nearest(unknown, accepted.iter().copied()).map(|a| format!("; did you mean `{a}`?")).unwrap_or_default();
     format!("unknown key `{unknown}`{hint} (accepted keys here: {})", accepted.join(", "))
+}
+
+/// The accepted name nearest to `unknown`, for "did you mean", if one is near enough: at
+/// most 2 edits, or a third of its length for a long one.
+pub fn nearest<'a>(unknown: &str, accepted: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    accepted
+        .into_iter()
+        .map(|a| (edit_distance(unknown, a), a))
+        .filter(|(d, a)| *d <= 2.max(a.len() / 3))
+        .min()
+        .map(|(_, a)| a)
 }
 
 /// Levenshtein distance, for "did you mean".
@@ -108,8 +117,10 @@ fn plain_type_names(message: &str) -> String {
             out.replace_range(..from.len(), &format!("invalid type: {plain},"));
         }
     }
+    const UNSIGNED: [&str; 5] = ["u8", "u16", "u32", "u64", "usize"];
     if let Some(rest) = out.strip_prefix("invalid type: integer `")
         && let Some((digits, tail)) = rest.split_once("` as i128,")
+        && UNSIGNED.iter().any(|u| tail == format!(" expected {u}"))
     {
         out = format!("invalid value: integer `{digits}`,{tail}");
     }
@@ -182,6 +193,10 @@ mod tests {
             (
                 "invalid type: integer `99999999999999999999` as i128, expected u64",
                 "invalid value: integer `99999999999999999999`, expected a whole number from 0 to 18446744073709551615",
+            ),
+            (
+                "invalid type: integer `99999999999999999999` as i128, expected a string",
+                "invalid type: integer `99999999999999999999` as i128, expected a string",
             ),
             (
                 "invalid value: integer `5000000000`, expected u32",

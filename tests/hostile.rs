@@ -912,7 +912,8 @@ fn a_sheet_is_checked_before_it_is_rendered() {
 /// the last map or a pack's texture goes failed only at the commit, after the whole set had
 /// been evaluated and encoded (seen: 15 progress calls before the error). Counted through
 /// the library's progress callback, which evaluation calls. Negative control: with the way
-/// clear, the same plan evaluates (and reports progress).
+/// clear, the same plan evaluates (and reports progress), and the names checked are the
+/// files it writes (PNG, OpenEXR, a pack).
 #[test]
 fn a_set_is_checked_for_folders_in_the_way_before_it_is_evaluated() {
     use snakeskin::export::pack::Pack;
@@ -920,7 +921,7 @@ fn a_set_is_checked_for_folders_in_the_way_before_it_is_evaluated() {
     use snakeskin::material::{FileFormat, MapKind};
     use std::sync::atomic::{AtomicUsize, Ordering};
     let dir = tempfile::tempdir().unwrap();
-    let request = |pack: Option<Pack>| GenerateRequest {
+    let request = |pack: Option<Pack>, format: FileFormat| GenerateRequest {
         preset: PRESET.into(),
         overrides: Vec::new(),
         seed: None,
@@ -928,30 +929,111 @@ fn a_set_is_checked_for_folders_in_the_way_before_it_is_evaluated() {
         maps: MapKind::ALL.to_vec(),
         out_dir: dir.path().into(),
         options: Default::default(),
-        format: FileFormat::Png,
+        format,
         pack,
         ao: false,
         job: None,
     };
-    let run = |pack: Option<Pack>| {
+    let run = |pack: Option<Pack>, format: FileFormat| {
         let calls = AtomicUsize::new(0);
-        let result = Plan::new(&request(pack)).unwrap().run(&|_, _| {
+        let plan = Plan::new(&request(pack, format)).unwrap();
+        let mut checked = plan.file_names();
+        let result = plan.run(&|_, _| {
             calls.fetch_add(1, Ordering::Relaxed);
         });
-        (result.map(|_| ()).map_err(|e| e.to_string()), calls.into_inner())
+        let written = result.map(|report| {
+            let mut names: Vec<String> =
+                report.files.iter().map(|f| f.file_name().unwrap().to_string_lossy().into_owned()).collect();
+            names.sort();
+            checked.sort();
+            assert_eq!(names, checked, "the files written are the files checked");
+        });
+        (written.map_err(|e| e.to_string()), calls.into_inner())
     };
-    for (pack, in_the_way) in
-        [(None, format!("{PRESET}_iridescence.png")), (Some(Pack::Gltf), format!("{PRESET}.material.json"))]
-    {
+    for (pack, format, in_the_way) in [
+        (None, FileFormat::Png, format!("{PRESET}_iridescence.png")),
+        (None, FileFormat::Exr, format!("{PRESET}_normal.exr")),
+        (Some(Pack::Gltf), FileFormat::Png, format!("{PRESET}.material.json")),
+    ] {
         // The first pass's manifest is a file there: the folder takes its place.
         let _ = std::fs::remove_file(dir.path().join(&in_the_way));
         std::fs::create_dir(dir.path().join(&in_the_way)).unwrap();
-        let (result, calls) = run(pack);
+        let (result, calls) = run(pack, format);
         let err = result.unwrap_err();
         assert!(err.contains("a folder is in the way") && err.contains(&in_the_way), "{err}");
         assert_eq!(calls, 0, "{in_the_way}: evaluated before the check");
         std::fs::remove_dir(dir.path().join(&in_the_way)).unwrap();
-        let (result, calls) = run(pack);
+        let (result, calls) = run(pack, format);
         assert!(result.is_ok() && calls > 0, "{result:?} {calls}");
+    }
+}
+
+/// The commit checks its targets again, since the check before the work can be overtaken (a
+/// folder may appear while the maps are evaluated): a folder that appears between staging
+/// and the commit fails the commit, with the earlier files as they were and no temporary
+/// left. (The command-level tests above now stop at the early check.) Negative control:
+/// with the folder gone, the same set commits.
+#[test]
+fn the_commit_checks_its_targets_again() {
+    use snakeskin::export::{ExportError, SetLock};
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name);
+    std::fs::write(path("s_a.png"), b"old a").unwrap();
+    std::fs::write(path("s.material.json"), b"old manifest").unwrap();
+    let lock = SetLock::acquire(dir.path(), "s").unwrap();
+    let stage = || vec![lock.stage("s_a.png", b"new a").unwrap(), lock.stage("s_b.png", b"new b").unwrap()];
+    let staged = stage();
+    std::fs::create_dir(path("s_b.png")).unwrap();
+    let err = lock.commit(staged, ("s.material.json", b"new manifest")).unwrap_err();
+    assert!(matches!(err, ExportError::FolderInTheWay { .. }), "{err}");
+    assert_eq!(std::fs::read(path("s_a.png")).unwrap(), b"old a");
+    assert_eq!(std::fs::read(path("s.material.json")).unwrap(), b"old manifest");
+    assert_eq!(hidden_files(dir.path()), [".s.lock"], "no temporary left");
+    std::fs::remove_dir(path("s_b.png")).unwrap();
+    lock.commit(stage(), ("s.material.json", b"new manifest")).unwrap();
+    assert_eq!(std::fs::read(path("s_b.png")).unwrap(), b"new b");
+    assert_eq!(std::fs::read(path("s.material.json")).unwrap(), b"new manifest");
+}
+
+/// `export --gltf` checks the files it will write before the work, as `generate` does: a
+/// folder where the `.glb`, the `.gltf` or one of its images goes failed only when they were
+/// written, after the textures had been evaluated and encoded (seen: progress reported
+/// first). Negative control: with the way clear, the export evaluates, and the files checked
+/// are the files it writes.
+#[test]
+fn a_gltf_export_is_checked_for_folders_in_the_way_before_the_work() {
+    use snakeskin::gltf_export::{ExportRequest, MeshKind, export};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let dir = tempfile::tempdir().unwrap();
+    let run = |out: &str| {
+        let request = ExportRequest {
+            preset: PRESET.into(),
+            overrides: Vec::new(),
+            seed: None,
+            size: 32,
+            layout: Default::default(),
+            mesh: MeshKind::Plane,
+            out: dir.path().join(out),
+            ao: false,
+        };
+        let calls = AtomicUsize::new(0);
+        let result = export(&request, &|_, _| {
+            calls.fetch_add(1, Ordering::Relaxed);
+        });
+        (result.map_err(|e| e.to_string()), calls.into_inner())
+    };
+    for (out, in_the_way) in [("s.glb", "s.glb"), ("t.gltf", "t.gltf"), ("t.gltf", "t.orm.png")] {
+        // An earlier pass's file there: the folder takes its place.
+        let _ = std::fs::remove_file(dir.path().join(in_the_way));
+        std::fs::create_dir(dir.path().join(in_the_way)).unwrap();
+        let (result, calls) = run(out);
+        let err = result.unwrap_err();
+        assert!(err.contains("a folder is in the way") && err.contains(in_the_way), "{err}");
+        assert_eq!(calls, 0, "{in_the_way}: evaluated before the check");
+        std::fs::remove_dir(dir.path().join(in_the_way)).unwrap();
+        let (result, calls) = run(out);
+        let report = result.unwrap();
+        assert!(calls > 0);
+        assert!(report.files.iter().any(|f| f.ends_with(in_the_way)), "{:?}", report.files);
     }
 }

@@ -61,13 +61,28 @@ impl GltfTextures {
     /// The images by role, in the order the material's texture indices count them (0 base
     /// colour, 1 normal, 2 ORM, 3 thickness when there is one).
     fn images(&self) -> Vec<(&'static str, &[u8])> {
-        let mut images: Vec<(&'static str, &[u8])> =
-            vec![("basecolor", &self.base_color), ("normal", &self.normal), ("orm", &self.orm)];
+        let mut images: Vec<(&'static str, &[u8])> = vec![&self.base_color, &self.normal, &self.orm]
+            .into_iter()
+            .zip(IMAGE_ROLES)
+            .map(|(bytes, role)| (role, bytes.as_slice()))
+            .collect();
         if let Some(thickness) = &self.thickness {
-            images.push(("thickness", thickness));
+            images.push((IMAGE_ROLES[3], thickness));
         }
         images
     }
+}
+
+/// The roles of a glTF material's images, in its texture indices' order; the last only
+/// with a film.
+const IMAGE_ROLES: [&str; 4] = ["basecolor", "normal", "orm", "thickness"];
+
+/// The files a `.gltf` export named `name` writes beside the `.gltf` (its buffer and its
+/// images; `film`: with the thickness image), for checking them before the work
+/// (`gltf_files` writes them).
+pub fn gltf_side_file_names(name: &str, film: bool) -> Vec<String> {
+    let roles = &IMAGE_ROLES[..if film { 4 } else { 3 }];
+    std::iter::once(format!("{name}.bin")).chain(roles.iter().map(|role| gltf_image_file_name(name, role))).collect()
 }
 
 /// A glTF document before it is written: the JSON and the binary buffer; images are in the

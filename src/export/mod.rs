@@ -44,7 +44,7 @@ pub enum ExportError {
     )]
     NotAFile { path: PathBuf, kind: &'static str },
     #[error(
-        "cannot write {path}: a folder is in the way of this output file; give the path of a file, or move the folder"
+        "cannot write {path}: a folder is in the way of this output file; move or rename the folder, or write elsewhere"
     )]
     FolderInTheWay { path: PathBuf },
     #[error("set {manifest}: {problem}")]

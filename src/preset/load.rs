@@ -175,14 +175,16 @@ struct WithoutSeed {
     rest: toml::Table,
 }
 
-/// The value of `--set seed=VALUE`: a whole number from 0 to 2^64 − 1, as a TOML integer
-/// or, beyond TOML's 2^63 − 1, in decimal digits.
+/// The value of `--set seed=VALUE`: a whole number from 0 to 2^64 − 1, as one TOML integer
+/// (as `apply_override` reads a value) or, beyond TOML's 2^63 − 1, in decimal digits.
 fn seed_override(value: &str) -> Result<u64, PresetError> {
-    let digits = value.trim();
-    let parsed = match toml::from_str::<toml::Table>(&format!("v = {value}")).ok().and_then(|mut t| t.remove("v")) {
-        Some(toml::Value::Integer(i)) => u64::try_from(i).ok(),
-        _ if !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit()) => digits.parse().ok(),
-        _ => None,
+    let parsed = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+        Ok(table) if table.len() == 1 => match table.get("v") {
+            Some(toml::Value::Integer(i)) => u64::try_from(*i).ok(),
+            _ => None,
+        },
+        Ok(_) => None,
+        Err(_) => value.trim().parse::<u64>().ok().filter(|seed| *seed > i64::MAX as u64),
     };
     parsed.ok_or_else(|| PresetError::Override {
         argument: format!("seed={value}"),
@@ -407,27 +409,16 @@ mod tests {
     /// are refused with the range, and `--seed` wins over `--set seed=`.
     #[test]
     fn seeds_beyond_toml_integers_survive_overrides() {
-        let big = "seed = 18446744073709551615
-[scales]
-rows = 19
-";
+        let big = "seed = 18446744073709551615\n[scales]\nrows = 19\n";
         let rows = [("scales.rows".to_string(), "23".to_string())];
         let loaded = parse(&source(big), &rows).unwrap();
         assert_eq!((loaded.preset.seed, loaded.preset.scales.rows), (u64::MAX, 23));
         assert_eq!(parse(&source(big), &[]).unwrap().preset.seed, u64::MAX);
-        let set_seed = |value: &str| {
-            parse(
-                &source(
-                    "seed = 1
-",
-                ),
-                &[("seed".into(), value.into())],
-            )
-        };
+        let set_seed = |value: &str| parse(&source("seed = 1\n"), &[("seed".into(), value.into())]);
         assert_eq!(set_seed("18446744073709551615").unwrap().preset.seed, u64::MAX);
         assert_eq!(set_seed("9_000").unwrap().preset.seed, 9000);
         assert_eq!(set_seed("0x10").unwrap().preset.seed, 16);
-        for bad in ["18446744073709551616", "-1", "1.5", "\"7\"", "seven", ""] {
+        for bad in ["18446744073709551616", "-1", "1.5", "\"7\"", "seven", "", "007", "1\nscales.rows = 5"] {
             let err = set_seed(bad).unwrap_err().to_string();
             assert!(
                 err.contains(&format!("{:?}", format!("seed={bad}"))) && err.contains("from 0 to 18446744073709551615"),

@@ -188,7 +188,8 @@ fn render_tile_sheet(
         progress(i, presets.len());
         let graph = build_graph(&loaded.preset, BuildOptions::default());
         let evaluation = evaluate(&graph, &MapKind::ALL, options.map_size, options.map_size, &|_, _| {});
-        let maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
+        let maps =
+            MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Internal(format!("the sheet's maps: {e}")))?;
         let optics = LayerOptics::from_preset(&loaded.preset);
         let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1);
         let settings = FrameSettings {
@@ -240,7 +241,8 @@ fn render_body_sheet(
         let graph = build_graph(preset, options_body);
         let (width, height) = plan.map_size(loaded);
         let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
-        let mut maps = MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Preview(e.to_string()))?;
+        let mut maps =
+            MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Internal(format!("the sheet's maps: {e}")))?;
         maps.atlas = Some(body_plan(preset));
         let optics = LayerOptics::from_preset(preset);
         let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1);
@@ -333,7 +335,7 @@ fn chosen_species(species: &[String]) -> Result<Vec<(&'static str, &'static str)
         .iter()
         .map(|name| {
             library::all().iter().find(|(n, _)| n == name).copied().ok_or_else(|| {
-                let nearest = library::names().into_iter().min_by_key(|n| crate::toml_text::edit_distance(n, name));
+                let nearest = crate::toml_text::nearest(name, library::names());
                 let hint = nearest.map(|n| format!("did you mean {n}? ")).unwrap_or_default();
                 Error::InvalidOption {
                     option: "--species",
@@ -355,7 +357,7 @@ pub fn write_sheet(
     let mut bytes = Vec::new();
     sheet
         .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| Error::Preview(format!("PNG encoding failed: {e}")))?;
+        .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
     Ok(write_file_atomically(path, bytes)?)
 }
 
