@@ -44,15 +44,16 @@ pub enum BatchError {
     /// TOML syntax, an unknown key or a wrong type, at a line and column.
     #[error("{path}:{line}:{column}: {message}")]
     Parse { path: PathBuf, line: usize, column: usize, message: String },
-    /// A value outside what a job accepts.
-    #[error("{path}: job {job} ({preset}): {message}")]
-    Invalid { path: PathBuf, job: usize, preset: String, message: String },
-    /// The job's preset refused (the preset's own message).
-    #[error("{path}: job {job} ({preset}): {source}")]
-    Preset { path: PathBuf, job: usize, preset: String, source: Box<crate::preset::PresetError> },
-    /// The job's `set` table refused: its entries as `key=value`, and why.
-    #[error("{path}: job {job} ({preset}): set `{entries}`: {message}")]
-    Set { path: PathBuf, job: usize, preset: String, entries: String, message: String },
+    /// A value outside what a job accepts; `line`: where the key is written.
+    #[error("{path}{}: job {job} ({preset}): {message}", at_line(*.line))]
+    Invalid { path: PathBuf, line: Option<usize>, job: usize, preset: String, message: String },
+    /// The job's preset refused (the preset's own message); `line`: the job's `preset` key.
+    #[error("{path}{}: job {job} ({preset}): {source}", at_line(*.line))]
+    Preset { path: PathBuf, line: Option<usize>, job: usize, preset: String, source: Box<crate::preset::PresetError> },
+    /// The job's `set` table refused: its entries as `key=value`, and why; `line`: the
+    /// job's `set` key.
+    #[error("{path}{}: job {job} ({preset}): set `{entries}`: {message}", at_line(*.line))]
+    Set { path: PathBuf, line: Option<usize>, job: usize, preset: String, entries: String, message: String },
     #[error("{path}: no [[job]] tables; a jobs file lists jobs as [[job]] tables with at least a preset key")]
     Empty { path: PathBuf },
     #[error("{path}: {count} jobs after expanding seeds and sizes; at most {max} per file")]
@@ -97,6 +98,8 @@ pub struct Job {
     pub index: usize,
     /// The `[[job]]` table it came from, counted from 1 (for messages).
     pub table: usize,
+    /// Where its keys are written (for messages).
+    pub lines: JobLines,
     /// The preset as given (a built-in name, or a path resolved against the jobs file).
     pub preset: String,
     pub overrides: Vec<(String, String)>,
@@ -153,6 +156,18 @@ impl Job {
     }
 }
 
+/// `:LINE` after a jobs file's path, where the line is known.
+fn at_line(line: Option<usize>) -> String {
+    line.map(|l| format!(":{l}")).unwrap_or_default()
+}
+
+/// Where a job's keys are written in its jobs file (1-based lines), for its messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct JobLines {
+    pub preset: Option<usize>,
+    pub set: Option<usize>,
+}
+
 /// Reads and expands a jobs file; every value is checked before any job runs.
 pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     use crate::text_file::BoundedReadError;
@@ -184,12 +199,15 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     }
     let mut jobs = Vec::with_capacity(count);
     for (k, table) in file.job.iter().enumerate() {
-        let invalid = |message: String| BatchError::Invalid {
+        let line = |key: &str| crate::toml_text::key_line(&text, &format!("job.{k}.{key}"));
+        let invalid = |key: &str, message: String| BatchError::Invalid {
             path: path.into(),
+            line: line(key),
             job: k + 1,
             preset: table.preset.clone(),
             message,
         };
+        let lines = JobLines { preset: line("preset"), set: line("set") };
         // A preset path is relative to the jobs file; a bare name is a built-in preset.
         let preset = if table.preset.ends_with(".toml") && Path::new(&table.preset).is_relative() {
             base.join(&table.preset).to_string_lossy().into_owned()
@@ -197,35 +215,40 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
             table.preset.clone()
         };
         let maps = match &table.maps {
-            Some(list) => parse_map_list(list).map_err(|e| invalid(format!("maps: {e}")))?,
+            Some(list) => parse_map_list(list).map_err(|e| invalid("maps", format!("maps: {e}")))?,
             None => MapKind::ALL.to_vec(),
         };
         let format = match table.format.as_deref() {
             None | Some("png") => FileFormat::Png,
             Some("exr") => FileFormat::Exr,
-            Some(other) => return Err(invalid(format!("format {other:?}: accepted: png, exr"))),
+            Some(other) => return Err(invalid("format", format!("format {other:?}: accepted: png, exr"))),
         };
-        let pack =
-            table.pack.as_deref().map(str::parse::<Pack>).transpose().map_err(|e| invalid(format!("pack: {e}")))?;
+        let pack = table
+            .pack
+            .as_deref()
+            .map(str::parse::<Pack>)
+            .transpose()
+            .map_err(|e| invalid("pack", format!("pack: {e}")))?;
         // A pack decides its own maps and format (the folder name leaves them out too).
         if pack.is_some() && (table.maps.is_some() || table.format.is_some()) {
             return Err(invalid(
+                "pack",
                 "pack: a pack writes its own textures as PNG; leave out maps and format, or pack".into(),
             ));
         }
         let layout = match table.layout.as_deref() {
             None | Some("tile") => Layout::Tile,
             Some("body") => Layout::Body,
-            Some(other) => return Err(invalid(format!("layout {other:?}: accepted: tile, body"))),
+            Some(other) => return Err(invalid("layout", format!("layout {other:?}: accepted: tile, body"))),
         };
         for (key, list) in [("seeds", &table.seeds), ("sizes", &table.sizes)] {
             if list.as_ref().is_some_and(Vec::is_empty) {
-                return Err(invalid(format!("{key} = []: list at least one, or leave {key} out for the default")));
+                return Err(invalid(key, format!("{key} = []: list at least one, or leave {key} out for the default")));
             }
         }
         let (lo, hi) = (*SIZE_RANGE.start() as u64, *SIZE_RANGE.end() as u64);
         if let Some(bad) = table.sizes.iter().flatten().find(|s| !(lo..=hi).contains(*s)) {
-            return Err(invalid(format!("size {bad}: accepted sizes are {lo} to {hi} pixels")));
+            return Err(invalid("sizes", format!("size {bad}: accepted sizes are {lo} to {hi} pixels")));
         }
         let overrides: Vec<(String, String)> = table.set.iter().map(|(k, v)| (k.clone(), v.to_string())).collect();
         let seeds: Vec<Option<u64>> = match &table.seeds {
@@ -238,6 +261,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                 jobs.push(Job {
                     index: jobs.len(),
                     table: k + 1,
+                    lines,
                     preset: preset.clone(),
                     overrides: overrides.clone(),
                     seed,
@@ -344,6 +368,7 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         // The preset's message says `--set`, which a jobs file's reader did not write.
         crate::preset::PresetError::Override { argument, message } => BatchError::Set {
             path: jobs_file.into(),
+            line: job.lines.set,
             job: job.table,
             preset: job.preset.clone(),
             entries: argument,
@@ -351,12 +376,14 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         },
         crate::preset::PresetError::Invalid { file, problems } if !job.overrides.is_empty() => BatchError::Invalid {
             path: jobs_file.into(),
+            line: job.lines.set,
             job: job.table,
             preset: job.preset.clone(),
             message: crate::preset::describe_problems(&file, &problems, "its `set` table"),
         },
         source => BatchError::Preset {
             path: jobs_file.into(),
+            line: job.lines.preset,
             job: job.table,
             preset: job.preset.clone(),
             source: Box::new(source),
@@ -645,7 +672,7 @@ mod tests {
         let e = jobs("[[job]]\npreset = \"natrix-natrix\"\nsize = [64]\n").unwrap_err().to_string();
         assert!(e.contains(":3:") && e.contains("size"), "{e}");
         let e = jobs("[[job]]\npreset = \"natrix-natrix\"\nsizes = [8]\n").unwrap_err().to_string();
-        assert!(e.contains("job 1") && e.contains("size 8"), "{e}");
+        assert!(e.contains("jobs.toml:3: job 1") && e.contains("size 8"), "{e}");
         let e = jobs("[[job]]\npreset = \"a\"\npack = \"godot\"\n").unwrap_err().to_string();
         assert!(e.contains("unreal"), "{e}");
         let e = jobs("[[job]]\npreset = \"a\"\npack = \"unreal\"\nformat = \"exr\"\n").unwrap_err().to_string();

@@ -4,6 +4,8 @@
 //! `seed = "x"` is `invalid type: string "x", expected u64`; here it is ``key `seed`: invalid
 //! type: string "x", expected a whole number``.
 
+use std::ops::Range;
+
 use toml::de::{DeTable, DeValue};
 
 /// A TOML error located in its text.
@@ -149,6 +151,35 @@ fn plain_type_names(message: &str) -> String {
     out
 }
 
+/// The line of a dotted key (`pattern.1.size`, `job.0.set`) in `text`, if it is written
+/// there; an index into an array counts its items (`job.2` is the third `[[job]]`), and
+/// `NAME.0` of a single `[NAME]` table is that table (a preset's one `[pattern]` is layer 0).
+pub fn key_line(text: &str, dotted: &str) -> Option<usize> {
+    let root = DeTable::parse(text).ok()?;
+    let mut span: Option<Range<usize>> = None;
+    let mut value: Option<&DeValue> = None;
+    for segment in dotted.split('.') {
+        let (key_span, item) = match value {
+            None => root.get_ref().iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?,
+            Some(DeValue::Table(t)) if segment == "0" && !t.iter().any(|(k, _)| k.get_ref().as_ref() == "0") => {
+                // `pattern.0` when `pattern` is a single table: the table is layer 0.
+                continue;
+            }
+            Some(DeValue::Table(t)) => {
+                t.iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?
+            }
+            Some(DeValue::Array(items)) => {
+                let item = items.get(segment.parse::<usize>().ok()?)?;
+                (item.span(), item)
+            }
+            Some(_) => break,
+        };
+        span = Some(key_span);
+        value = Some(item.get_ref());
+    }
+    span.map(|s| line_column(text, s.start).0)
+}
+
 /// The dotted key (`scales.rows`, `pattern.1.colors.0`) whose value is written over byte
 /// `offset` of `text`: the key a type error's span points into.
 fn key_at(text: &str, offset: usize) -> Option<String> {
@@ -217,5 +248,24 @@ mod tests {
         for (serde, plain) in cases {
             assert_eq!(plain_type_names(serde), plain);
         }
+    }
+}
+
+#[cfg(test)]
+mod key_line_tests {
+    use super::key_line;
+
+    /// Keys in tables, in arrays of tables, and a single table read as item 0. Negative
+    /// control: a key that is not written has no line.
+    #[test]
+    fn a_dotted_key_has_the_line_it_is_written_on() {
+        let jobs = "# jobs\n[[job]]\npreset = \"a\"\n\n[[job]]\npreset = \"b\"\nset = { \"scales.rows\" = 3 }\n";
+        assert_eq!(key_line(jobs, "job.0.preset"), Some(3));
+        assert_eq!(key_line(jobs, "job.1.preset"), Some(6));
+        assert_eq!(key_line(jobs, "job.1.set"), Some(7));
+        assert_eq!(key_line(jobs, "job.0.set"), None);
+        let preset = "seed = 1\n[pattern]\nkind = \"spots\"\nsize = 9.0\n";
+        assert_eq!(key_line(preset, "pattern.0.size"), Some(4));
+        assert_eq!(key_line(preset, "seed"), Some(1));
     }
 }

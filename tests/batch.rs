@@ -199,20 +199,21 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("no-such-snake"), "{}", stderr(&out));
-    // ... and the message names the jobs file and the job.
-    assert!(stderr(&out).contains("jobs.toml: job 2 (no-such-snake): unknown preset"), "{}", stderr(&out));
+    // ... and the message names the jobs file, the line of the job's preset and the job.
+    assert!(stderr(&out).contains("jobs.toml:6: job 2 (no-such-snake): unknown preset"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "a set was written before the bad job was found");
 
-    // A bad override names its job too; an empty list of seeds or sizes is refused, not
-    // read as the default.
+    // A bad override names its job and the line of its `set` too (they had no line); an
+    // empty list of seeds or sizes is refused, not read as the default, at its line.
     for (table, says) in [
-        ("set = { \"scales.rwos\" = 23 }", "jobs.toml: job 2 (natrix-natrix): set `scales.rwos=23`: unknown key"),
+        ("set = { \"scales.rwos\" = 23 }", "jobs.toml:7: job 2 (natrix-natrix): set `scales.rwos=23`: unknown key"),
         (
             "set = { \"scales.rows\" = 0 }",
-            "job 2 (natrix-natrix): built-in preset natrix-natrix (with its `set` table): key `scales.rows` must be",
+            "jobs.toml:7: job 2 (natrix-natrix): built-in preset natrix-natrix (with its `set` table): key \
+             `scales.rows` must be",
         ),
-        ("sizes = []", "jobs.toml: job 2 (natrix-natrix): sizes = []: list at least one"),
-        ("seeds = []", "jobs.toml: job 2 (natrix-natrix): seeds = []: list at least one"),
+        ("sizes = []", "jobs.toml:7: job 2 (natrix-natrix): sizes = []: list at least one"),
+        ("seeds = []", "jobs.toml:7: job 2 (natrix-natrix): seeds = []: list at least one"),
     ] {
         let text = format!(
             "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n[[job]]\npreset = \"natrix-natrix\"\n{table}\n"

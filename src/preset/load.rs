@@ -6,11 +6,9 @@
 //! the `--set` argument) → range-check (errors name the key, with its line when it came
 //! from the file).
 
-use std::ops::Range;
 use std::path::Path;
 
 use serde::Deserialize;
-use toml::de::{DeTable, DeValue};
 
 use super::error::{LocatedProblem, Location, PresetError};
 use super::library;
@@ -146,7 +144,7 @@ pub fn parse_with_seed(
         let located = problems
             .into_iter()
             .map(|p| {
-                let line = if overridden(&p.key) { None } else { key_line(&source.text, &p.key) };
+                let line = if overridden(&p.key) { None } else { toml_text::key_line(&source.text, &p.key) };
                 LocatedProblem { line, key: p.key, message: p.message }
             })
             .collect();
@@ -154,7 +152,7 @@ pub fn parse_with_seed(
     }
     let mut clamped_colours = super::visible::clamp_to_visible(&mut preset);
     for c in &mut clamped_colours {
-        c.line = key_line(&source.text, &c.key).filter(|_| !overrides.iter().any(|(k, _)| *k == c.key));
+        c.line = toml_text::key_line(&source.text, &c.key).filter(|_| !overrides.iter().any(|(k, _)| *k == c.key));
     }
     let canonical = canonical_text(&preset);
     Ok(LoadedPreset {
@@ -217,33 +215,6 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
         },
         message: described.keyed_message(),
     }
-}
-
-/// Line of a dotted key (`pattern.1.size`) in the preset text, if it is written there.
-fn key_line(text: &str, dotted: &str) -> Option<usize> {
-    let root = DeTable::parse(text).ok()?;
-    let mut span: Option<Range<usize>> = None;
-    let mut value: Option<&DeValue> = None;
-    for segment in dotted.split('.') {
-        let (key_span, item) = match value {
-            None => root.get_ref().iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?,
-            Some(DeValue::Table(t)) if segment == "0" && !t.iter().any(|(k, _)| k.get_ref().as_ref() == "0") => {
-                // `pattern.0` when `pattern` is a single table: the table is layer 0.
-                continue;
-            }
-            Some(DeValue::Table(t)) => {
-                t.iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?
-            }
-            Some(DeValue::Array(items)) => {
-                let item = items.get(segment.parse::<usize>().ok()?)?;
-                (item.span(), item)
-            }
-            Some(_) => break,
-        };
-        span = Some(key_span);
-        value = Some(item.get_ref());
-    }
-    span.map(|s| toml_text::line_column(text, s.start).0)
 }
 
 /// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).
