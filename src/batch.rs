@@ -198,8 +198,9 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         return Err(BatchError::TooMany { path: path.into(), count, max: MAX_JOBS });
     }
     let mut jobs = Vec::with_capacity(count);
+    let key_lines = crate::toml_text::KeyLines::new(&text);
     for (k, table) in file.job.iter().enumerate() {
-        let line = |key: &str| crate::toml_text::key_line(&text, &format!("job.{k}.{key}"));
+        let line = |key: &str| key_lines.line(&format!("job.{k}.{key}"));
         let invalid = |key: &str, message: String| BatchError::Invalid {
             path: path.into(),
             line: line(key),

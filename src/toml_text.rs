@@ -154,30 +154,54 @@ fn plain_type_names(message: &str) -> String {
 /// The line of a dotted key (`pattern.1.size`, `job.0.set`) in `text`, if it is written
 /// there; an index into an array counts its items (`job.2` is the third `[[job]]`), and
 /// `NAME.0` of a single `[NAME]` table is that table (a preset's one `[pattern]` is layer 0).
+/// One key: it parses `text`; for many, `KeyLines`.
 pub fn key_line(text: &str, dotted: &str) -> Option<usize> {
-    let root = DeTable::parse(text).ok()?;
-    let mut span: Option<Range<usize>> = None;
-    let mut value: Option<&DeValue> = None;
-    for segment in dotted.split('.') {
-        let (key_span, item) = match value {
-            None => root.get_ref().iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?,
-            Some(DeValue::Table(t)) if segment == "0" && !t.iter().any(|(k, _)| k.get_ref().as_ref() == "0") => {
-                // `pattern.0` when `pattern` is a single table: the table is layer 0.
-                continue;
-            }
-            Some(DeValue::Table(t)) => {
-                t.iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?
-            }
-            Some(DeValue::Array(items)) => {
-                let item = items.get(segment.parse::<usize>().ok()?)?;
-                (item.span(), item)
-            }
-            Some(_) => break,
-        };
-        span = Some(key_span);
-        value = Some(item.get_ref());
+    KeyLines::new(text).line(dotted)
+}
+
+/// The lines of dotted keys in one text (`key_line`), parsed once: a jobs file asks for
+/// two keys per job, and parsing the file for each made loading it quadratic in its size.
+pub struct KeyLines<'a> {
+    root: Option<toml::Spanned<DeTable<'a>>>,
+    /// The byte offset where each line starts.
+    line_starts: Vec<usize>,
+}
+
+impl<'a> KeyLines<'a> {
+    pub fn new(text: &'a str) -> KeyLines<'a> {
+        let line_starts = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
+        KeyLines { root: DeTable::parse(text).ok(), line_starts }
     }
-    span.map(|s| line_column(text, s.start).0)
+
+    /// `key_line` of `dotted`.
+    pub fn line(&self, dotted: &str) -> Option<usize> {
+        let root = self.root.as_ref()?;
+        let mut span: Option<Range<usize>> = None;
+        let mut value: Option<&DeValue> = None;
+        for segment in dotted.split('.') {
+            let (key_span, item) = match value {
+                None => {
+                    root.get_ref().iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?
+                }
+                Some(DeValue::Table(t)) if segment == "0" && !t.iter().any(|(k, _)| k.get_ref().as_ref() == "0") => {
+                    // `pattern.0` when `pattern` is a single table: the table is layer 0.
+                    continue;
+                }
+                Some(DeValue::Table(t)) => {
+                    t.iter().find(|(k, _)| k.get_ref().as_ref() == segment).map(|(k, v)| (k.span(), v))?
+                }
+                Some(DeValue::Array(items)) => {
+                    let item = items.get(segment.parse::<usize>().ok()?)?;
+                    (item.span(), item)
+                }
+                Some(_) => break,
+            };
+            span = Some(key_span);
+            value = Some(item.get_ref());
+        }
+        // Lines are counted from 1: the number of lines that start at or before the key.
+        span.map(|s| self.line_starts.partition_point(|start| *start <= s.start))
+    }
 }
 
 /// The dotted key (`scales.rows`, `pattern.1.colors.0`) whose value is written over byte
@@ -264,8 +288,17 @@ mod key_line_tests {
         assert_eq!(key_line(jobs, "job.1.preset"), Some(6));
         assert_eq!(key_line(jobs, "job.1.set"), Some(7));
         assert_eq!(key_line(jobs, "job.0.set"), None);
-        let preset = "seed = 1\n[pattern]\nkind = \"spots\"\nsize = 9.0\n";
+        let preset = "seed = 1\n[pattern]\nkind = \"spots\"\nsize = 9.0";
         assert_eq!(key_line(preset, "pattern.0.size"), Some(4));
         assert_eq!(key_line(preset, "seed"), Some(1));
+        // A `set` written as a sub-table (its key is on the header line), as dotted keys, and
+        // jobs as an inline array.
+        let sub_table = "[[job]]\npreset = \"a\"\n[job.set]\n\"scales.rows\" = 3\n";
+        assert_eq!(key_line(sub_table, "job.0.set"), Some(3));
+        let dotted = "[[job]]\npreset = \"a\"\nset.seed = 3\n";
+        assert_eq!(key_line(dotted, "job.0.set"), Some(3));
+        let inline = "job = [\n  { preset = \"a\" },\n  { preset = \"b\", set = { seed = 1 } },\n]\n";
+        assert_eq!(key_line(inline, "job.1.set"), Some(3));
+        assert_eq!(key_line(inline, "job.2.preset"), None);
     }
 }

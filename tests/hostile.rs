@@ -1037,3 +1037,33 @@ fn a_gltf_export_is_checked_for_folders_in_the_way_before_the_work() {
         assert!(report.files.iter().any(|f| f.ends_with(in_the_way)), "{:?}", report.files);
     }
 }
+
+/// A jobs file of many jobs is read in one pass: the lines that its messages name were
+/// looked up by parsing the whole file again for each job's keys, so 20,001 `[[job]]`
+/// tables (660 KB, within the 1 MiB bound) took over two minutes to be refused for the
+/// last one's layout (seen: killed at 120 s; 0.07 s with one parse). A hang guard, not a
+/// speed goal: 60 s. The message names the line of the key at fault.
+#[test]
+fn a_long_jobs_file_is_read_in_one_pass() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    let mut text = "[[job]]\npreset = \"natrix-natrix\"\n".repeat(20_000);
+    text.push_str("[[job]]\npreset = \"natrix-natrix\"\nlayout = \"x\"\n");
+    std::fs::write(&jobs, text).unwrap();
+    let mut child = Command::new(BIN)
+        .args(["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while child.try_wait().unwrap().is_none() {
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("a jobs file of 20,001 jobs took over 60 s to read");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:40003: job 20001 (natrix-natrix): layout \"x\""), "{}", stderr(&out));
+}
