@@ -200,20 +200,12 @@ fn devices_fifos_and_huge_files_are_not_read() {
     let c_path = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
     assert_eq!(unsafe { libc::mkfifo(c_path.as_ptr(), 0o600) }, 0);
     // Without the fix this blocks forever waiting for a writer: give it 60 s, then fail.
-    let mut child = Command::new(BIN)
+    let child = Command::new(BIN)
         .args(["generate", fifo.to_str().unwrap(), "-o", dir.path().to_str().unwrap()])
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
-    while child.try_wait().unwrap().is_none() {
-        if std::time::Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("generate blocked on a FIFO preset");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    let out = child.wait_with_output().unwrap();
+    let out = finished_within(child, 60, "generate blocked on a FIFO preset");
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("it is a FIFO"), "{}", stderr(&out));
 
@@ -277,6 +269,20 @@ fn earlier_set_with_fault_hooks() -> Option<tempfile::TempDir> {
     let dir = tempfile::tempdir().unwrap();
     assert!(generate_into(dir.path(), "1", &[]).status.success());
     Some(dir)
+}
+
+/// The output of `child` once it exits; killed, and the test failed with `hang`, if it
+/// runs past `seconds` (a guard against a hang, not a speed goal).
+fn finished_within(mut child: std::process::Child, seconds: u64, hang: &str) -> std::process::Output {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(seconds);
+    while child.try_wait().unwrap().is_none() {
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("{hang}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
 }
 
 fn manifest_of(dir: &Path) -> std::path::PathBuf {
@@ -1050,20 +1056,12 @@ fn a_long_jobs_file_is_read_in_one_pass() {
     let mut text = "[[job]]\npreset = \"natrix-natrix\"\n".repeat(20_000);
     text.push_str("[[job]]\npreset = \"natrix-natrix\"\nlayout = \"x\"\n");
     std::fs::write(&jobs, text).unwrap();
-    let mut child = Command::new(BIN)
+    let child = Command::new(BIN)
         .args(["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()])
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
-    while child.try_wait().unwrap().is_none() {
-        if std::time::Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("a jobs file of 20,001 jobs took over 60 s to read");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    let out = child.wait_with_output().unwrap();
+    let out = finished_within(child, 60, "a jobs file of 20,001 jobs took over 60 s to read");
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("jobs.toml:40003: job 20001 (natrix-natrix): layout \"x\""), "{}", stderr(&out));
 }
