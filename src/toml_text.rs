@@ -130,7 +130,7 @@ fn plain_type_names(message: &str) -> String {
     let whole_number = out.starts_with("invalid value: integer");
     let expected = &out[at + ", expected ".len()..];
     let plain = match expected {
-        "u8" | "u16" | "u32" | "u64" | "usize" if !whole_number => "a whole number",
+        unsigned if UNSIGNED.contains(&unsigned) && !whole_number => "a whole number",
         "u8" => "a whole number from 0 to 255",
         "u16" => "a whole number from 0 to 65535",
         "u32" => "a whole number from 0 to 4294967295",
@@ -273,11 +273,6 @@ mod tests {
             assert_eq!(plain_type_names(serde), plain);
         }
     }
-}
-
-#[cfg(test)]
-mod key_line_tests {
-    use super::key_line;
 
     /// Keys in tables, in arrays of tables, and a single table read as item 0. Negative
     /// control: a key that is not written has no line.

@@ -61,11 +61,8 @@ impl GltfTextures {
     /// The images by role, in the order the material's texture indices count them (0 base
     /// colour, 1 normal, 2 ORM, 3 thickness when there is one).
     fn images(&self) -> Vec<(&'static str, &[u8])> {
-        let mut images: Vec<(&'static str, &[u8])> = vec![&self.base_color, &self.normal, &self.orm]
-            .into_iter()
-            .zip(IMAGE_ROLES)
-            .map(|(bytes, role)| (role, bytes.as_slice()))
-            .collect();
+        let mut images: Vec<(&'static str, &[u8])> =
+            vec![(IMAGE_ROLES[0], &self.base_color), (IMAGE_ROLES[1], &self.normal), (IMAGE_ROLES[2], &self.orm)];
         if let Some(thickness) = &self.thickness {
             images.push((IMAGE_ROLES[3], thickness));
         }
