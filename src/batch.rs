@@ -66,6 +66,11 @@ pub enum BatchError {
          the preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)"
     )]
     SameFolder { path: PathBuf, first: usize, second: usize, preset: String, folder: PathBuf },
+    /// The job refused when the run was planned, before any job ran: its size (a body atlas
+    /// too tall, more memory than the machine has) or its output (a folder, file or link
+    /// in the way); `line`: the job's `sizes` key, else its `preset` key.
+    #[error("{path}{}: job {job} ({preset}): {source}", at_line(*.line))]
+    Planned { path: PathBuf, line: Option<usize>, job: usize, preset: String, source: Box<Error> },
 }
 
 /// One `[[job]]` table as written.
@@ -166,6 +171,7 @@ fn at_line(line: Option<usize>) -> String {
 pub struct JobLines {
     pub preset: Option<usize>,
     pub set: Option<usize>,
+    pub sizes: Option<usize>,
 }
 
 /// Reads and expands a jobs file; every value is checked before any job runs.
@@ -208,12 +214,14 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
             preset: table.preset.clone(),
             message,
         };
-        let lines = JobLines { preset: line("preset"), set: line("set") };
-        // A preset path is relative to the jobs file; a bare name is a built-in preset.
-        let preset = if table.preset.ends_with(".toml") && Path::new(&table.preset).is_relative() {
-            base.join(&table.preset).to_string_lossy().into_owned()
-        } else {
-            table.preset.clone()
+        let lines = JobLines { preset: line("preset"), set: line("set"), sizes: line("sizes") };
+        // A preset path is relative to the jobs file, by the rule `generate` applies to its
+        // argument relative to the working folder (`preset::read_source`): a name ending in
+        // `.toml`, or a file that exists, is a file; anything else, a built-in preset.
+        let relative = Path::new(&table.preset).is_relative().then(|| base.join(&table.preset));
+        let preset = match relative {
+            Some(path) if table.preset.ends_with(".toml") || path.exists() => path.to_string_lossy().into_owned(),
+            _ => table.preset.clone(),
         };
         let maps = match &table.maps {
             Some(list) => parse_map_list(list).map_err(|e| invalid("maps", format!("maps: {e}")))?,
@@ -528,7 +536,31 @@ pub fn run(
     let mut estimates = Vec::new();
     for (job, r) in mine.iter().zip(&resolved) {
         if !r.done && r.outcome.duplicate_of.is_none() {
-            estimates.push(Plan::new(&request(job, out, &r.outcome))?.memory().estimate_bytes);
+            let planned = |source: Error| BatchError::Planned {
+                path: jobs_file.into(),
+                line: job.lines.sizes.or(job.lines.preset),
+                job: job.table,
+                preset: job.preset.clone(),
+                // A job has a size, not the `--size` that `generate`'s message names.
+                source: Box::new(match source {
+                    Error::Memory { what, needed_mib, available_mib } => Error::Memory {
+                        what: what.strip_prefix("--").map(str::to_string).unwrap_or(what),
+                        needed_mib,
+                        available_mib,
+                    },
+                    other => other,
+                }),
+            };
+            let plan = Plan::new(&request(job, out, &r.outcome)).map_err(planned)?;
+            // Its folder and files, as `Plan::run` checks them, but before any job has
+            // written its set: a folder in a later job's way stopped the run after the
+            // earlier jobs' sets were written.
+            let dir = out.join(&r.outcome.folder);
+            crate::export::check_folder(&dir).map_err(|e| planned(e.into()))?;
+            for file in plan.file_names() {
+                crate::export::check_target(&dir.join(file)).map_err(|e| planned(e.into()))?;
+            }
+            estimates.push(plan.memory().estimate_bytes);
         }
     }
     let concurrency =
@@ -666,6 +698,25 @@ mod tests {
         for job in &list {
             assert_eq!(shards.iter().filter(|s| s.contains(job)).count(), 1);
         }
+    }
+
+    /// A preset path is read from the jobs file's folder by `generate`'s rule: `boa.TOML`
+    /// (not `.toml`) beside the jobs file was looked for in the working folder instead.
+    #[test]
+    fn preset_paths_are_relative_to_the_jobs_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("jobs.toml");
+        std::fs::write(dir.path().join("boa.TOML"), "").unwrap();
+        std::fs::write(dir.path().join("plain"), "").unwrap();
+        let presets = ["boa.TOML", "plain", "sub/x.toml", "natrix-natrix", "missing"];
+        let text: String = presets.iter().map(|p| format!("[[job]]\npreset = {p:?}\n")).collect();
+        std::fs::write(&path, text).unwrap();
+        let found: Vec<String> = load_jobs(&path).unwrap().into_iter().map(|j| j.preset).collect();
+        let beside = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+        assert_eq!(
+            found,
+            [beside("boa.TOML"), beside("plain"), beside("sub/x.toml"), "natrix-natrix".into(), "missing".into()]
+        );
     }
 
     #[test]

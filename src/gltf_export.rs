@@ -53,10 +53,23 @@ pub struct ExportReport {
     pub stats: EvalStats,
     pub encode_time: Duration,
     pub total_time: Duration,
+    /// Whether the export created the file's folder.
+    pub created_folder: bool,
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
 fn is_binary(path: &Path) -> Result<bool, Error> {
+    let text = path.to_string_lossy();
+    if text.ends_with('/') || text.ends_with(std::path::MAIN_SEPARATOR) {
+        return Err(Error::Unsupported(format!(
+            "--gltf {text}: names a folder (it ends in a slash); give a file name"
+        )));
+    }
+    // `.glb` alone: a name that is all extension (`Path::extension` sees none).
+    let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    if name == ".glb" || name == ".gltf" {
+        return Err(Error::Unsupported(format!("--gltf {text}: give a name before {name}, as in snake{name}")));
+    }
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("glb") => Ok(true),
         Some("gltf") => Ok(false),
@@ -135,14 +148,16 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         thickness: texture("thickness"),
         occlusion: request.ao,
     };
+    let created_folder;
     let files = if binary {
         let bytes = glb(&name, &mesh, material, &textures)?;
-        crate::export::create_folder(&dir)?;
+        created_folder = crate::export::create_folder(&dir)?;
         vec![write_file_atomically(&request.out, bytes)?]
     } else {
         let mut files = gltf_files(&name, &mesh, material, &textures)?;
         let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
         let lock = SetLock::acquire(&dir, &name)?;
+        created_folder = lock.created_folder;
         let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
         // An earlier export of this name with a film left its thickness image, which no
         // file references now: under the lock, after the commit, it goes. Whatever stands
@@ -156,5 +171,5 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         }
         written
     };
-    Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed() })
+    Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed(), created_folder })
 }

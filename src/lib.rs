@@ -41,7 +41,7 @@ pub enum Error {
     Size { size: u64 },
     #[error(
         "a body atlas {width} wide is {height} tall (body.length widths), over the {max} rows a map may have; use a \
-         smaller --size"
+         smaller size"
     )]
     Height { width: usize, height: usize, max: usize },
     /// A combination of options the tool does not support (yet).
@@ -78,6 +78,7 @@ impl Error {
     pub fn is_invalid_input(&self) -> bool {
         match self {
             Error::Export(e) => e.is_invalid_input(),
+            Error::Batch(batch::BatchError::Planned { source, .. }) => source.is_invalid_input(),
             Error::Gpu(_) | Error::Internal(_) => false,
             _ => true,
         }

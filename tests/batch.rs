@@ -214,6 +214,13 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
         ),
         ("sizes = []", "jobs.toml:7: job 2 (natrix-natrix): sizes = []: list at least one"),
         ("seeds = []", "jobs.toml:7: job 2 (natrix-natrix): seeds = []: list at least one"),
+        // Refused when the job is planned (they said `error: a body atlas ...`, with no file,
+        // line or job, and named a `--size` that a jobs file does not have).
+        (
+            "layout = \"body\"\nsizes = [5500]",
+            "jobs.toml:8: job 2 (natrix-natrix): a body atlas 5500 wide is 66000 tall (body.length widths), over \
+             the 65535 rows a map may have; use a smaller size",
+        ),
     ] {
         let text = format!(
             "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n[[job]]\npreset = \"natrix-natrix\"\n{table}\n"
@@ -224,6 +231,27 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
         assert!(stderr(&out).contains(says), "{table}: {}", stderr(&out));
         assert!(manifests(&empty).is_empty(), "{table}: a set was written before the bad job was found");
     }
+    // More memory than there is: the job's size, not `--size`.
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n[[job]]\npreset = \"boa-constrictor\"\nsizes = [4096]\nformat = \"exr\"\n").unwrap();
+    let out = common::snakeskin_env(
+        &["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()],
+        &[("SNAKESKIN_MEMORY_LIMIT_MIB", "300")],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:7: job 2 (boa-constrictor): size 4096 needs about"), "{}", stderr(&out));
+    assert!(manifests(&empty).is_empty(), "a set was written before the job too large was found");
+
+    // A folder in a later job's way stops the batch before the first job's set is written
+    // (it was found when that job ran, after the earlier sets), naming the job and its line.
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1, 2]\nsizes = [32]\n").unwrap();
+    let in_the_way = empty.join("natrix-natrix/tile-32-seed2-png/natrix-natrix_color.png");
+    std::fs::create_dir_all(&in_the_way).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--concurrent", "1"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:4: job 1 (natrix-natrix): cannot write"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a folder is in the way"), "{}", stderr(&out));
+    assert!(manifests(&empty).is_empty(), "the first job's set was written before the folder was found");
+    assert!(in_the_way.is_dir() && std::fs::read_dir(&in_the_way).unwrap().next().is_none());
 }
 
 #[test]

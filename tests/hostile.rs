@@ -744,6 +744,47 @@ fn missing_output_folders_are_created_with_a_note() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("note: created folder"), "{}", stderr(&out));
     assert!(chart.exists());
+    // `export` and `batch` said nothing when they created theirs.
+    let glb = dir.path().join("e/f/snake.glb");
+    let out = snakeskin(&["export", PRESET, "--gltf", glb.to_str().unwrap(), "--size", "16"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains(&format!("note: created folder {}", dir.path().join("e/f").display())),
+        "{}",
+        stderr(&out)
+    );
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, format!("[[job]]\npreset = \"{PRESET}\"\nsizes = [16]\n")).unwrap();
+    let batch = dir.path().join("g/h");
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", batch.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains(&format!("note: created folder {}", batch.display())), "{}", stderr(&out));
+    // Negative control: into folders that exist, no note.
+    for out in [
+        snakeskin(&["export", PRESET, "--gltf", glb.to_str().unwrap(), "--size", "16"]),
+        snakeskin(&["batch", jobs.to_str().unwrap(), "-o", batch.to_str().unwrap()]),
+    ] {
+        assert!(out.status.success() && !stderr(&out).contains("note: created folder"), "{}", stderr(&out));
+    }
+}
+
+/// `--ao` belongs to `--pack`; given with a flag that conflicts with `--pack` (`--format`,
+/// `--maps`, `--normal-convention`) it was silently ignored (exit 0, no occlusion anywhere:
+/// clap does not check `requires` then), where alone it was refused.
+#[test]
+fn ao_without_a_pack_is_refused_whatever_comes_with_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = dir.path().join("set");
+    for with in [&["--format", "png"][..], &["--maps", "color"], &["--normal-convention", "directx"], &[]] {
+        let args = [&["generate", PRESET, "--size", "16", "-o", set.to_str().unwrap(), "--ao"][..], with].concat();
+        let out = snakeskin(&args);
+        assert_eq!(out.status.code(), Some(2), "{with:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("--ao"), "{with:?}: {}", stderr(&out));
+        assert!(!set.exists(), "{with:?}: a set was written");
+    }
+    // Negative control: with a pack it runs.
+    let out = snakeskin(&["generate", PRESET, "--size", "16", "-o", set.to_str().unwrap(), "--ao", "--pack", "gltf"]);
+    assert!(out.status.success(), "{}", stderr(&out));
 }
 
 #[test]
@@ -836,6 +877,42 @@ fn outputs_that_are_not_regular_files_are_refused() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("a-file exists and is not a folder"), "{}", stderr(&out));
     assert!(!gallery.exists(), "the gallery was drawn before the check");
+
+    // A link to nothing where an output folder goes, or above it (a loop alike): it was
+    // "cannot write ...: File exists (os error 17)", exit 1, once the work was done (for
+    // `batch`, blaming a job's folder).
+    let dangling = dir.path().join("dangling");
+    std::os::unix::fs::symlink(dir.path().join("nowhere"), &dangling).unwrap();
+    let looped = dir.path().join("looped");
+    std::os::unix::fs::symlink(&looped, &looped).unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, format!("[[job]]\npreset = \"{PRESET}\"\nsizes = [16]\n")).unwrap();
+    for link in [&dangling, &looped] {
+        let (folder, below) = (link.to_str().unwrap().to_string(), link.join("sub").to_string_lossy().into_owned());
+        let glb = link.join("x.glb").to_string_lossy().into_owned();
+        for args in [
+            vec!["generate", PRESET, "--size", "16", "-o", &folder],
+            vec!["generate", PRESET, "--size", "16", "-o", &below],
+            vec!["export", PRESET, "--size", "16", "--gltf", &glb],
+            vec!["batch", jobs.to_str().unwrap(), "-o", &folder],
+        ] {
+            let out = snakeskin(&args);
+            assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+            let says = format!("{} is a symbolic link to nothing", link.display());
+            assert!(stderr(&out).contains(&says), "{args:?}: {}", stderr(&out));
+        }
+        assert!(std::fs::symlink_metadata(link).unwrap().file_type().is_symlink());
+    }
+    assert!(!dir.path().join("nowhere").exists());
+
+    // glTF file names: all extension, or a folder's (a trailing slash: "Not a directory",
+    // exit 1, after the work).
+    for (name, says) in [(".glb", "give a name before .glb"), ("x.glb/", "names a folder")] {
+        let path = format!("{}/{name}", dir.path().display());
+        let out = snakeskin(&["export", PRESET, "--size", "16", "--gltf", &path]);
+        assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{name}: {}", stderr(&out));
+    }
 }
 
 /// A preset whose noise lattice outgrows its image does not allocate the lattice: within

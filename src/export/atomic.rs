@@ -192,12 +192,17 @@ pub fn create_folder(dir: &Path) -> Result<bool, ExportError> {
 
 /// An output folder's path, checked without creating anything: a path that exists and is
 /// not a folder is `ExportError::NotAFolder`, and so is a missing folder under a file
-/// (`-o a-file/sub` names `a-file`); a missing one under folders is fine.
+/// (`-o a-file/sub` names `a-file`); a link to nothing on the way is
+/// `ExportError::BrokenLink` (creating the folder would fail with "File exists"); a missing
+/// one under folders is fine.
 pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
     for path in dir.ancestors().filter(|p| !p.as_os_str().is_empty()) {
         match fs::metadata(path) {
             Ok(meta) if meta.is_dir() => return Ok(()),
             Ok(_) => return Err(ExportError::NotAFolder { path: path.into() }),
+            Err(e) if e.kind() != std::io::ErrorKind::PermissionDenied && fs::symlink_metadata(path).is_ok() => {
+                return Err(ExportError::BrokenLink { path: path.into() });
+            }
             Err(_) => continue,
         }
     }

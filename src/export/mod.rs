@@ -47,6 +47,11 @@ pub enum ExportError {
         "cannot write {path}: a folder is in the way of this output file; move or rename the folder, or write elsewhere"
     )]
     FolderInTheWay { path: PathBuf },
+    #[error(
+        "{path} is a symbolic link to nothing (its target is missing, or a loop of links); make its target, remove \
+         the link, or write elsewhere"
+    )]
+    BrokenLink { path: PathBuf },
     #[error("set {manifest}: {problem}")]
     Verify { manifest: PathBuf, problem: String },
     #[error("cannot encode the packed {texture} texture: {message}")]
@@ -58,11 +63,14 @@ pub enum ExportError {
 impl ExportError {
     /// True when the user's input is at fault: an output folder that is not a folder, an
     /// output file that is something other than a file (a folder in its way included, as a
-    /// link there is).
+    /// link there is, and a link to nothing where a folder goes).
     pub fn is_invalid_input(&self) -> bool {
         matches!(
             self,
-            ExportError::NotAFolder { .. } | ExportError::NotAFile { .. } | ExportError::FolderInTheWay { .. }
+            ExportError::NotAFolder { .. }
+                | ExportError::NotAFile { .. }
+                | ExportError::FolderInTheWay { .. }
+                | ExportError::BrokenLink { .. }
         )
     }
 }

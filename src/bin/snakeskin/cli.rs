@@ -181,8 +181,12 @@ pub struct GenerateArgs {
     #[arg(long, value_enum, value_name = "ENGINE", conflicts_with_all = ["normal_convention", "format", "maps"])]
     pub pack: Option<PackArg>,
     /// With --pack: compute the ambient occlusion map (horizon-based, from the height map)
-    /// into the pack's occlusion channel instead of 1 everywhere.
-    #[arg(long, requires = "pack")]
+    /// into the pack's occlusion channel instead of 1 everywhere. Without a pack, name the
+    /// map instead: --maps all,ao.
+    // `requires` alone is not checked when an argument that conflicts with --pack is given
+    // (clap), so `--ao --format png` was silently a set without occlusion: the conflicts
+    // are --pack's own.
+    #[arg(long, requires = "pack", conflicts_with_all = ["normal_convention", "format", "maps"])]
     pub ao: bool,
     /// Print per-node evaluations, time and buffer size after the run.
     #[arg(long)]

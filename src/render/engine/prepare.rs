@@ -75,7 +75,7 @@ fn packed(
     loaded: &LoadedPreset,
     layout: Layout,
 ) -> Result<MaterialMaps, Error> {
-    let mut packed = MaterialMaps::from_maps(maps).map_err(|e| Error::Preview(e.to_string()))?;
+    let mut packed = MaterialMaps::from_maps(maps).map_err(|e| Error::Internal(e.to_string()))?;
     packed.atlas = (layout == Layout::Body).then(|| body_plan(&loaded.preset));
     Ok(packed)
 }

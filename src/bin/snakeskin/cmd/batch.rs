@@ -17,6 +17,7 @@ pub fn run(args: BatchArgs) -> Result<()> {
         }
         return Ok(());
     }
+    let had_folder = args.out.is_dir();
     let bar = Progress::counting("{spinner} batch [{bar:30}] {pos}/{len} jobs {elapsed} {msg}");
     let concurrency = args.concurrent.map_or_else(batch::default_concurrency, usize::from);
     let index = batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut |done, total, outcome| {
@@ -24,6 +25,9 @@ pub fn run(args: BatchArgs) -> Result<()> {
         bar.message(&format!("{} {}", outcome.status, outcome.folder.display()));
     })?;
     bar.finish();
+    if !had_folder && args.out.is_dir() {
+        eprintln!("note: created folder {}", path_line(&args.out));
+    }
     let ran = index.jobs.iter().filter(|j| j.status == "done").count();
     let duplicates = index.jobs.iter().filter(|j| j.status == "duplicate").count();
     let skipped = index.jobs.len() - ran - duplicates;

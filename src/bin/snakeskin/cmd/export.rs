@@ -25,6 +25,11 @@ pub fn run(args: ExportArgs) -> Result<()> {
     let bar = Progress::counting("{spinner} exporting [{bar:30}] {pos}/{len} nodes {elapsed}");
     let report = export(&request, &|done, total| bar.update(done, total))?;
     bar.finish();
+    if report.created_folder
+        && let Some(folder) = args.gltf.parent()
+    {
+        eprintln!("note: created folder {}", path_line(folder));
+    }
     let (width, height) = report.dimensions;
     if width.max(height) > WEBGL_TEXTURE_LIMIT {
         eprintln!(
