@@ -93,6 +93,23 @@ fn unknown_enum_value_lists_what_is_accepted() {
     assert!(err.contains("leaf") && err.contains("diamond") && err.contains("hexagon"), "{err}");
 }
 
+/// A long list is counted, not echoed back whole (100,000 `rows` made one 500 KB line),
+/// and a kind is named as a preset writes it (`not Spots` was Rust's name).
+#[test]
+fn messages_count_long_lists_and_name_kinds_as_written() {
+    let rows = vec!["1"; 100_000].join(",");
+    let text = format!("[[pattern]]\nkind = \"stripes\"\ncolor = \"#000000\"\nrows = [{rows}]\n");
+    let err = refused("rows.toml", &text, &[]);
+    assert!(err.contains("rows.toml:4: key `pattern.0.rows`") && err.contains("got 100000 entries"), "{err}");
+    assert!(err.len() < 2000, "{} bytes of message", err.len());
+    // Negative control: a short list is shown as written.
+    let err = refused("rows.toml", "[[pattern]]\nkind = \"stripes\"\ncolor = \"#000000\"\nrows = [3, 1]\n", &[]);
+    assert!(err.contains("got [3.0, 1.0]"), "{err}");
+    let text = "[[pattern]]\nkind = \"spots\"\ncolor = \"#000000\"\ncount = 3\n";
+    let err = refused("count.toml", text, &[]);
+    assert!(err.contains("\"blotches\" or \"rings\" only, not \"spots\""), "{err}");
+}
+
 #[test]
 fn out_of_range_value_names_key_and_range() {
     let err = refused("range.toml", "seed = 1\n[optics]\nfilm_ior = 7.5\n", &[]);

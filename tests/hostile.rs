@@ -1142,3 +1142,27 @@ fn a_long_jobs_file_is_read_in_one_pass() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("jobs.toml:40003: job 20001 (natrix-natrix): layout \"x\""), "{}", stderr(&out));
 }
+
+/// A preset of many bad head marks (20,000: 720 KB, within the 1 MiB bound) is refused at
+/// once: every mark's size was checked and each problem's line looked up by parsing the
+/// file again, so it took minutes (seen: 512 s; 8,000 marks 82 s) to say "at most 16 head
+/// marks". A hang guard, not a speed goal: 60 s.
+#[test]
+fn a_preset_of_thousands_of_bad_marks_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let marks = vec!["{kind = \"cap\", color = \"#000000\", size = 9}"; 20_000].join(", ");
+    let preset = write_preset(dir.path(), "marks.toml", &format!("[body]\nhead_mark = [{marks}]\n"));
+    let child = Command::new(BIN)
+        .args(["generate", &preset, "-o", dir.path().join("out").to_str().unwrap(), "--size", "16"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = finished_within(child, 60, "20,000 bad head marks took over 60 s to refuse");
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("marks.toml:2: key `body.head_mark` at most 16 head marks, got 20000"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(stderr(&out).lines().count() < 5, "{}", stderr(&out));
+}

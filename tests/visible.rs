@@ -125,6 +125,27 @@ fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limi
     let map = image::open(out_dir.join("ink_color.png")).unwrap().to_rgb8();
     assert!(map.pixels().all(|p| (0..3).all(|c| p.0[c] <= bound[c])), "map brighter than {bound:?}");
 
+    // A colour an override wrote has no line in the file (it named line 3, `#e0c0a0`),
+    // whether the override names the key or the table around it.
+    for set in ["color.base=\"#f0f0f0\"", "color={base=\"#f0f0f0\"}"] {
+        let out = snakeskin(&[
+            "generate",
+            &preset,
+            "-o",
+            out_dir.to_str().unwrap(),
+            "--size",
+            "32",
+            "--maps",
+            "color",
+            "--set",
+            set,
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let err = stderr(&out);
+        assert!(err.contains("ink.toml: color.base = \"#f0f0f0\" is brighter"), "{set}: {err}");
+        assert!(err.contains("ink.toml:8: belly.color"), "{set}: {err}");
+    }
+
     // Negative control: the same colours over a clear pigment layer are shown as written.
     let clear = write_preset(dir.path(), "clear.toml", &WHITE_UNDER_INK.replace("absorption = 0.3", ""));
     let out = snakeskin(&["generate", &clear, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);

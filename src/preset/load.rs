@@ -139,12 +139,15 @@ pub fn parse_with_seed(
     let mut preset = preset;
     preset.seed = seed.unwrap_or(file_seed);
     let problems = validate(&preset);
+    // A key an override wrote (or a table it replaced) has no line in the file; the file is
+    // parsed for lines once, not once per problem (thousands of them took minutes).
+    let overridden = |key: &str| overrides.iter().any(|(k, _)| key == k || key.starts_with(&format!("{k}.")));
+    let key_lines = std::cell::LazyCell::new(|| toml_text::KeyLines::new(&source.text));
     if !problems.is_empty() {
-        let overridden = |key: &str| overrides.iter().any(|(k, _)| key == k || key.starts_with(&format!("{k}.")));
         let located = problems
             .into_iter()
             .map(|p| {
-                let line = if overridden(&p.key) { None } else { toml_text::key_line(&source.text, &p.key) };
+                let line = if overridden(&p.key) { None } else { key_lines.line(&p.key) };
                 LocatedProblem { line, key: p.key, message: p.message }
             })
             .collect();
@@ -152,7 +155,7 @@ pub fn parse_with_seed(
     }
     let mut clamped_colours = super::visible::clamp_to_visible(&mut preset);
     for c in &mut clamped_colours {
-        c.line = toml_text::key_line(&source.text, &c.key).filter(|_| !overrides.iter().any(|(k, _)| *k == c.key));
+        c.line = if overridden(&c.key) { None } else { key_lines.line(&c.key) };
     }
     let canonical = canonical_text(&preset);
     Ok(LoadedPreset {

@@ -197,8 +197,10 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
                     key: key("rows"),
                     message: format!(
                         "must be [first, last] dorsal rows with 0.5 ≤ first ≤ last ≤ {top} (the vertebral row of \
-                         {} rows), for kind \"stripes\" only; got {:?}",
-                        preset.scales.rows, p.rows
+                         {} rows), for kind \"stripes\" only; got {}",
+                        preset.scales.rows,
+                        // A long list is counted, not echoed back whole.
+                        if p.rows.len() <= 4 { format!("{:?}", p.rows) } else { format!("{} entries", p.rows.len()) }
                     ),
                 });
             }
@@ -215,7 +217,10 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
             if !matches!(p.kind, PatternKind::Blotches | PatternKind::Rings) {
                 c.problems.push(Problem {
                     key: key("count"),
-                    message: format!("counts marks of kind \"blotches\" or \"rings\" only, not {:?}", p.kind),
+                    message: format!(
+                        "counts marks of kind \"blotches\" or \"rings\" only, not \"{}\"",
+                        format!("{:?}", p.kind).to_lowercase()
+                    ),
                 });
             }
         }
@@ -268,9 +273,12 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
             key: "body.head_mark".into(),
             message: format!("at most {MAX_HEAD_MARKS} head marks, got {}", b.head_mark.len()),
         });
-    }
-    for (i, m) in b.head_mark.iter().enumerate() {
-        c.range(format!("body.head_mark.{i}.size"), m.size, HEAD_MARK_SIZE);
+    } else {
+        // Not one by one past the limit: thousands of marks buried the message (and took
+        // minutes to locate, one line each).
+        for (i, m) in b.head_mark.iter().enumerate() {
+            c.range(format!("body.head_mark.{i}.size"), m.size, HEAD_MARK_SIZE);
+        }
     }
 
     let o = &preset.optics;
