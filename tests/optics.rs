@@ -223,6 +223,61 @@ mod cli {
         assert_eq!(code, 2, "{err}");
         assert_eq!(snakeskin(&["brdf", "film", "--batch", "-"], line).0, 0);
     }
+
+    /// A batch line's messages, as the sweep found them: a refused value said "invalid
+    /// query:" twice; serde's "at line 1 column N" is the column of the line named; an
+    /// array of the fields was answered (and, of the wrong length, named a Rust type); a
+    /// comment or a byte-order mark got "expected value at line 1 column 1". Answers before
+    /// the bad line are printed (the output streams, as `--help` says).
+    #[test]
+    fn batch_lines_are_refused_once_each_with_their_line() {
+        let good = "{\"thickness_nm\":400,\"wavelength_nm\":550,\"angle_deg\":30}\n";
+        for (bad, says) in [
+            ("{\"thickness_nm\":-1,\"wavelength_nm\":550,\"angle_deg\":30}", "-:2: thickness_nm must be"),
+            ("{\"thickness_nm\":400,\"wavelength_nm\":550}", "-:2: missing field `angle_deg` (column 40)"),
+            ("[1, 1.55, 2, 400, 550, 30]", "-:2: expected a JSON object, one query per line"),
+            ("# a comment", "-:2: expected a JSON object"),
+        ] {
+            let (code, out, err) = snakeskin(&["brdf", "film", "--batch", "-"], &format!("{good}{bad}\n"));
+            assert_eq!(code, 2, "{bad}: {err}");
+            assert!(err.contains(&format!("error: invalid query: {says}")), "{bad}: {err}");
+            assert_eq!(err.matches("invalid query").count(), 1, "{bad}: {err}");
+            assert!(!err.contains("at line"), "{bad}: {err}");
+            assert_eq!(out.lines().count(), 1, "{bad}: the answer to the good line first: {out}");
+        }
+        // A byte-order mark before the first query is not part of it.
+        let (code, out, err) = snakeskin(&["brdf", "film", "--batch", "-"], &format!("\u{feff}{good}{good}"));
+        assert_eq!(code, 0, "{err}");
+        assert_eq!(out.lines().count(), 2, "{out}");
+    }
+
+    /// Command-line values the sweep found misread: `-0` taken for a flag, `--seed -1`
+    /// answered with clap's tip `-- -1` (which makes it the preset), `--photons` ignored
+    /// without the stochastic model, a short direction called zero, and `presets show FILE`
+    /// told "not a .toml file".
+    #[test]
+    fn values_are_read_as_written_and_refused_for_what_they_are() {
+        let film = ["brdf", "film", "--wavelength-nm", "550", "--thickness-nm", "-0"];
+        let (code, _, err) = snakeskin(&[&film[..], &["--angle-deg", "-0"]].concat(), "");
+        assert_eq!(code, 0, "{err}");
+        let (code, _, err) = snakeskin(&[&film[..], &["--angle-deg", "-30"]].concat(), "");
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("angle_deg must be in [0, 90], got -30"), "{err}");
+        let (code, _, err) = snakeskin(&["graph", "natrix-natrix", "--seed", "-1"], "");
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("invalid value '-1' for '--seed") && !err.contains("-- -1"), "{err}");
+        let (code, _, err) =
+            snakeskin(&["brdf", "albedo", "--angle-deg", "30", "--model", "reference", "--photons", "5000"], "");
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("invalid --photons: photons are counted by --model stochastic only"), "{err}");
+        let (code, _, err) = snakeskin(&["brdf", "eval", "--wi", "1e-7,0,1e-7", "--wo", "0,0,1"], "");
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("at least 1e-6 long") && !err.contains("zero vector"), "{err}");
+        let (code, _, err) = snakeskin(&["presets", "show", "presets/natrix-natrix.toml"], "");
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("is not a built-in preset") && err.contains("did you mean natrix-natrix?"), "{err}");
+        assert!(!err.contains("not a .toml file"), "{err}");
+    }
 }
 
 mod series {

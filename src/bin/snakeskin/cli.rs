@@ -41,7 +41,8 @@ pub enum Command {
     Batch(BatchArgs),
     /// Print the node graph the requested maps need.
     Graph(GraphArgs),
-    /// Query the optics: exact thin-film reflectance and film colour (JSON output).
+    /// Query the optics: the exact thin film, film colour, the BRDF and its albedo (JSON), a
+    /// film colour chart (PNG) and a numerical stress test.
     Brdf {
         #[command(subcommand)]
         command: BrdfCommand,
@@ -135,7 +136,9 @@ pub struct PresetSource {
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_key_value)]
     pub overrides: Vec<(String, String)>,
     /// Override the preset's seed (any 64-bit unsigned integer).
-    #[arg(long)]
+    // Negative numbers are read as the value (and refused as one): clap took `--seed -1`'s
+    // `-1` for a flag and suggested `-- -1`, which makes it the preset argument.
+    #[arg(long, allow_negative_numbers = true)]
     pub seed: Option<u64>,
 }
 
@@ -395,8 +398,11 @@ pub enum Convention {
 pub enum PresetsCommand {
     /// One preset per line under a header: name, species (scientific name), common name, category.
     List,
-    /// Print a preset's TOML.
-    Show { name: String },
+    /// Print a built-in preset's TOML (a start for one of your own).
+    Show {
+        /// A built-in preset's name (`presets list`).
+        name: String,
+    },
 }
 
 fn parse_key_value(arg: &str) -> Result<(String, String), String> {
@@ -414,14 +420,14 @@ fn parse_key_value(arg: &str) -> Result<(String, String), String> {
 
 #[derive(Debug, Args)]
 pub struct StackArgs {
-    /// Refractive index of the ambient medium (thesis n0).
-    #[arg(long, default_value_t = thesis::AMBIENT_IOR)]
+    /// Refractive index of the ambient medium (thesis n0), 1 to 3.
+    #[arg(long, default_value_t = thesis::AMBIENT_IOR, allow_negative_numbers = true)]
     pub n0: f64,
-    /// Refractive index of the iridescent film (thesis n1).
-    #[arg(long, default_value_t = thesis::FILM_IOR)]
+    /// Refractive index of the iridescent film (thesis n1), 1 to 3.
+    #[arg(long, default_value_t = thesis::FILM_IOR, allow_negative_numbers = true)]
     pub n1: f64,
-    /// Refractive index of the pigment layer under the film (thesis n2).
-    #[arg(long, default_value_t = thesis::PIGMENT_IOR)]
+    /// Refractive index of the pigment layer under the film (thesis n2), 1 to 3.
+    #[arg(long, default_value_t = thesis::PIGMENT_IOR, allow_negative_numbers = true)]
     pub n2: f64,
 }
 
@@ -431,18 +437,20 @@ pub enum BrdfCommand {
     Film {
         #[command(flatten)]
         stack: StackArgs,
-        /// Film thickness in nm (thesis δ0).
-        #[arg(long, required_unless_present = "batch")]
+        /// Film thickness in nm (thesis δ0), 0 to 10^7.
+        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
         thickness_nm: Option<f64>,
-        /// Vacuum wavelength in nm.
-        #[arg(long, required_unless_present = "batch")]
+        /// Vacuum wavelength in nm, 1 to 10^6.
+        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
         wavelength_nm: Option<f64>,
-        /// Incidence angle in the ambient medium, degrees (0 = normal).
-        #[arg(long, required_unless_present = "batch")]
+        /// Incidence angle in the ambient medium, degrees, 0 (normal) to 90.
+        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
         angle_deg: Option<f64>,
-        /// Read JSON lines {n0, n1, n2, thickness_nm, wavelength_nm, angle_deg} from FILE
-        /// (or - for stdin); print one JSON line per query, in order. Each line carries its
-        /// own values (n0, n1 and n2 default to the thesis'), so the flags above are refused.
+        /// Read JSON objects {n0, n1, n2, thickness_nm, wavelength_nm, angle_deg}, one per
+        /// line, from FILE (or - for stdin); print one JSON line per query, in order, as each
+        /// is answered (blank lines are skipped). Each line carries its own values (n0, n1
+        /// and n2 default to the thesis'), so the flags above are refused. A bad line stops
+        /// the run with its line number (exit 2), after the answers to the lines before it.
         #[arg(long, value_name = "FILE", conflicts_with_all = ["n0", "n1", "n2", "thickness_nm", "wavelength_nm", "angle_deg"])]
         batch: Option<String>,
     },
@@ -450,18 +458,22 @@ pub enum BrdfCommand {
     Color {
         #[command(flatten)]
         stack: StackArgs,
-        #[arg(long, required_unless_present = "batch")]
+        /// Film thickness in nm (thesis δ0), 0 to 10^7.
+        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
         thickness_nm: Option<f64>,
-        #[arg(long, required_unless_present = "batch")]
+        /// Angle of light and view from the normal in the ambient medium, degrees, 0 to 90.
+        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
         angle_deg: Option<f64>,
-        /// Colour method: spectral (the 1 nm reference of PHYSICS.md), rgb3, spectral-N
-        /// (e.g. spectral-16), gaussian-fit, lut.
+        /// Colour method: spectral (the reference: the exact film summed at 1 nm over CIE
+        /// 1931 2° under D65), rgb3, spectral-N (e.g. spectral-16), gaussian-fit, lut.
         #[arg(long, default_value = "spectral", value_parser = parse_method)]
         method: Method,
-        /// Read JSON lines {n0, n1, n2, thickness_nm, angle_deg, method} from FILE (or - for
-        /// stdin); print one JSON line per query, in order. Each line carries its own values
-        /// (n0, n1 and n2 default to the thesis', method to spectral), so the flags above are
-        /// refused.
+        /// Read JSON objects {n0, n1, n2, thickness_nm, angle_deg, method}, one per line, from
+        /// FILE (or - for stdin); print one JSON line per query, in order, as each is answered
+        /// (blank lines are skipped). Each line carries its own values (n0, n1 and n2 default
+        /// to the thesis', method to spectral), so the flags above are refused. A bad line
+        /// stops the run with its line number (exit 2), after the answers to the lines before
+        /// it.
         #[arg(long, value_name = "FILE", conflicts_with_all = ["n0", "n1", "n2", "thickness_nm", "angle_deg", "method"])]
         batch: Option<String>,
     },
@@ -508,10 +520,10 @@ pub enum BrdfCommand {
 pub struct EvalArgs {
     #[command(flatten)]
     pub stack: StackArgs,
-    /// Direction towards the light, x,y,z (need not be normalised; not zero).
+    /// Direction towards the light, x,y,z (need not be normalised; at least 1e-6 long).
     #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     pub wi: [f64; 3],
-    /// Direction towards the viewer, x,y,z (not zero).
+    /// Direction towards the viewer, x,y,z (at least 1e-6 long).
     #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     pub wo: [f64; 3],
     /// Shading normal, x,y,z (a zero vector falls back to 0,0,1, as a blank normal map does).
@@ -520,7 +532,7 @@ pub struct EvalArgs {
     #[command(flatten)]
     pub layer: LayerArgs,
     /// Layer model under the top interface: layered (default; the stack's transport) or
-    /// thesis (PHYSICS.md's eq. 4.21 diffuse lobe).
+    /// thesis (the thesis' eq. 4.21 diffuse lobe; README, "Which layer model").
     #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
     /// Film colour method (as for `brdf color`; spectral = the exact 1 nm sum).
@@ -532,22 +544,22 @@ pub struct EvalArgs {
 #[derive(Debug, Args)]
 pub struct LayerArgs {
     /// Film thickness in nm (thesis δ0), 0 to 10^7 (10 mm).
-    #[arg(long, default_value_t = thesis::FILM_THICKNESS_NM, value_parser = parse_thickness_nm)]
+    #[arg(long, default_value_t = thesis::FILM_THICKNESS_NM, value_parser = parse_thickness_nm, allow_negative_numbers = true)]
     pub thickness_nm: f64,
     /// Perceptual roughness (GGX α = roughness²), 0 to 1.
-    #[arg(long, default_value_t = 0.35, value_parser = parse_unit)]
+    #[arg(long, default_value_t = 0.35, value_parser = parse_unit, allow_negative_numbers = true)]
     pub roughness: f64,
     /// Absorption coefficient σ0 (one value, or r,g,b), each 0 to 100.
     // The default is thesis::ABSORPTION written out (clap needs text for an array); the
     // test `brdf_eval_defaults_are_the_thesis_values` ties the two.
-    #[arg(long, value_parser = parse_absorption, default_value = "0.6")]
+    #[arg(long, value_parser = parse_absorption, default_value = "0.6", allow_hyphen_values = true)]
     pub absorption: [f64; 3],
     /// Pigment layer thickness δ1 (optical depth τ = σ0 δ1), 0 to 100.
-    #[arg(long, default_value_t = thesis::PIGMENT_THICKNESS, value_parser = parse_pigment_thickness)]
+    #[arg(long, default_value_t = thesis::PIGMENT_THICKNESS, value_parser = parse_pigment_thickness, allow_negative_numbers = true)]
     pub pigment_thickness: f64,
     /// Base albedo k_d, linear r,g,b (or one value), each 0 to 1: the Lambertian base
     /// itself, not the visible colour a colour map holds.
-    #[arg(long, value_parser = parse_albedo, default_value = "1")]
+    #[arg(long, value_parser = parse_albedo, default_value = "1", allow_hyphen_values = true)]
     pub albedo: [f64; 3],
 }
 
@@ -557,7 +569,7 @@ pub struct AlbedoArgs {
     pub stack: StackArgs,
     /// Angle of the light from the normal in degrees, 0 to 90 (by reciprocity also the
     /// view angle of the albedo seen under a uniform sky).
-    #[arg(long, value_parser = parse_angle_deg)]
+    #[arg(long, value_parser = parse_angle_deg, allow_negative_numbers = true)]
     pub angle_deg: f64,
     #[command(flatten)]
     pub layer: LayerArgs,
@@ -570,15 +582,16 @@ pub struct AlbedoArgs {
     /// thesis | layered: the model's BRDF integrated over the hemisphere (64 × 64
     /// stratified half vectors for the specular lobe, 4096 midpoints in cos θ for the
     /// diffuse lobe; within 2e-3 of the exact albedo on known cases). reference: the
-    /// smooth-top closed form of PHYSICS.md (roughness ignored; Gauss–Legendre, ~1e-9).
+    /// smooth-top stack in closed form (roughness ignored; Gauss–Legendre, ~1e-9).
     /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
     /// standard error per channel. The references read the exact 1 nm film (--method is
     /// for the models).
     #[arg(long, default_value = "layered", value_parser = parse_albedo_model)]
     pub model: AlbedoModel,
-    /// Photons per channel for --model stochastic, 1000 to 100,000,000 (σ ∝ 1/√N).
-    #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1000..=100_000_000))]
-    pub photons: u64,
+    /// Photons per channel for --model stochastic (only), 1000 to 100,000,000 (σ ∝ 1/√N);
+    /// default 200,000.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1000..=100_000_000))]
+    pub photons: Option<u64>,
 }
 
 /// What `brdf albedo` integrates: a real-time model or one of the references.
@@ -641,7 +654,9 @@ pub enum BenchCommand {
         #[arg(long)]
         json: bool,
     },
-    /// Time against error of every film colour method on PHYSICS.md's grid.
+    /// Time against error of every film colour method on a grid of film thickness × angle
+    /// over four materials, (n0, n1, n2) = (1, 1.55, 2), (1, 1.33, 1.56), (1, 1.56, 1.33)
+    /// and (1.33, 1.55, 2), against the 1 nm spectral reference.
     Irid {
         /// Print JSON {"default", "methods": [{"name","mean_de","p95_de","max_de","ns_per_eval"}]}.
         #[arg(long)]
@@ -649,7 +664,7 @@ pub enum BenchCommand {
         /// Write an SVG plot of error against cost, one point per method.
         #[arg(long, value_name = "FILE")]
         plot: Option<PathBuf>,
-        /// Thickness step of the grid in nm (PHYSICS.md grid: 0..2000 nm), 0.1 to 2000.
+        /// Thickness step of the grid in nm (the grid spans 0..2000 nm), 0.1 to 2000.
         #[arg(long, default_value_t = 10.0, value_parser = parse_d_step_nm)]
         d_step_nm: f64,
         /// Angle step of the grid in degrees (0..89°), 0.1 to 89.
@@ -660,7 +675,7 @@ pub enum BenchCommand {
         lut_sweep: bool,
     },
     /// Every layer model against the stochastic reference (photons through the stack with a
-    /// rough GGX top) on a fixed grid: the four PHYSICS.md materials, τ ∈ {0, 0.4, 1}, films
+    /// rough GGX top) on a fixed grid: the four materials of `bench irid`, τ ∈ {0, 0.4, 1}, films
     /// of 250 and 650 nm, light at 0–85°, roughness 0.05–0.9, every species' base colours.
     /// Reports the reflected colour's ΔE00 (mean, p95, max), the white-furnace error and the
     /// CPU cost per evaluation (inputs at random thicknesses, and the same sorted by
@@ -806,8 +821,9 @@ fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
 /// A direction: three finite numbers, not all zero (it is normalised before use).
 fn parse_direction(text: &str) -> Result<[f64; 3], String> {
     let v = parse_vec3(text)?;
-    if v.iter().map(|c| c * c).sum::<f64>() < 1e-12 {
-        return Err("a direction must not be the zero vector".into());
+    let length = v.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if length < 1e-6 {
+        return Err(format!("a direction must be at least 1e-6 long (it is normalised), got length {length:e}"));
     }
     Ok(v)
 }

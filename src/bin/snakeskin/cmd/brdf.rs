@@ -106,7 +106,15 @@ fn layers_of(stack: &StackArgs, l: &LayerArgs) -> Result<Layers> {
     Ok(Layers::of_stack(stack, l.thickness_nm, l.roughness, optical_depth, l.albedo))
 }
 
+/// Photons per channel of `brdf albedo --model stochastic` unless told (`--photons`).
+const DEFAULT_PHOTONS: u64 = 200_000;
+
 fn albedo_json(args: &AlbedoArgs) -> Result<String> {
+    if args.photons.is_some() && args.model != AlbedoModel::Stochastic {
+        // It was silently ignored.
+        let reason = "photons are counted by --model stochastic only; leave --photons out, or use that model".into();
+        return Err(Error::InvalidOption { option: "--photons", reason }.into());
+    }
     let stack = stack_of(&args.stack);
     let (layers, l) = (layers_of(&args.stack, &args.layer)?, &args.layer);
     let cos = args.angle_deg.to_radians().cos();
@@ -122,7 +130,7 @@ fn albedo_json(args: &AlbedoArgs) -> Result<String> {
         AlbedoModel::Stochastic => {
             let tables = FilmTables::new(stack, l.thickness_nm);
             let wi = [(1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos];
-            let walked = walk(&layers, &tables, wi, args.photons, 1, 1);
+            let walked = walk(&layers, &tables, wi, args.photons.unwrap_or(DEFAULT_PHOTONS), 1, 1);
             let value = BrdfValue { specular: walked.specular, diffuse: walked.diffuse };
             ("stochastic", value, Some(walked.total_sigma()))
         }
@@ -168,11 +176,34 @@ fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> 
             return Err(Error::Query(format!("{shown}:{}: line longer than {MAX_LINE_BYTES} bytes", i + 1)).into());
         }
         let line = String::from_utf8(bytes).map_err(|_| Error::Query(format!("{shown}:{}: not UTF-8", i + 1)))?;
+        // A byte-order mark (an editor's UTF-8 file) is not part of the first query.
+        let line = if i == 0 { line.trim_start_matches('\u{feff}') } else { &line };
         if line.trim().is_empty() {
             continue;
         }
-        let query: Q = serde_json::from_str(&line).map_err(|e| Error::Query(format!("{shown}:{}: {e}", i + 1)))?;
-        let json = per_line(&query).map_err(|e| Error::Query(format!("{shown}:{}: {e}", i + 1)))?;
+        let at = |message: String| Error::Query(format!("{shown}:{}: {message}", i + 1));
+        // One object per line: serde would also take an array of the fields in order (with
+        // a Rust type in its message when the count is wrong), and a comment got "expected
+        // value at line 1 column 1".
+        if !line.trim_start().starts_with('{') {
+            return Err(
+                at("expected a JSON object, one query per line, e.g. {\"thickness_nm\": 400, ...}".into()).into()
+            );
+        }
+        let query: Q = serde_json::from_str(line).map_err(|e| {
+            // The line is its own document: serde's "at line 1 column N" is the column.
+            let message = e.to_string();
+            let message =
+                message.strip_suffix(&format!(" at line {} column {}", e.line(), e.column())).unwrap_or(&message);
+            at(format!("{message} (column {})", e.column()))
+        })?;
+        // The query's own refusal is already `Error::Query`: the line is added, not a second
+        // "invalid query:".
+        let json = per_line(&query).map_err(|e| match e.downcast::<Error>() {
+            Ok(Error::Query(message)) => at(message).into(),
+            Ok(other) => anyhow::Error::from(other).context(format!("{shown}:{}", i + 1)),
+            Err(other) => other.context(format!("{shown}:{}", i + 1)),
+        })?;
         writeln!(out, "{json}")?;
     }
     Ok(())
