@@ -91,6 +91,33 @@ fn unknown_enum_value_lists_what_is_accepted() {
     let err = refused("shape.toml", "[scales]\nshape = \"round\"\n", &[]);
     assert!(err.contains("shape.toml:2:"), "{err}");
     assert!(err.contains("leaf") && err.contains("diamond") && err.contains("hexagon"), "{err}");
+    let err = refused("kind.toml", "[[pattern]]\nkind = \"spot\"\ncolor = \"#000000\"\n", &[]);
+    assert!(
+        err.contains("kind.toml:2:8: key `pattern.0.kind`: unknown value \"spot\"; did you mean \"spots\"?"),
+        "{err}"
+    );
+}
+
+/// A name is a string: serde's TOML enums also took a table (`[scales.shape.hexagon]` made
+/// hexagons; `kind = {spots = {}}` spots) and answered anything else in their own words
+/// ("wanted string or table", "invalid type: unit variant, expected string only").
+#[test]
+fn enum_values_are_names_in_quotes_only() {
+    for (text, key) in [
+        ("[scales.shape.hexagon]\n", "scales.shape"),
+        ("[scales]\nshape = {hexagon = {}}\n", "scales.shape"),
+        ("[scales]\nshape = 5\n", "scales.shape"),
+        ("[[pattern]]\nkind = {spots = {}}\ncolor = \"#000000\"\n", "pattern.0.kind"),
+        ("category = true\n", "category"),
+    ] {
+        let err = refused("name.toml", text, &[]);
+        assert!(err.contains(&format!("key `{key}")) && err.contains("expected a string"), "{text}: {err}");
+        assert!(!err.contains("wanted") && !err.contains("variant"), "{text}: {err}");
+    }
+    for set in ["scales.shape=5", "scales.shape={}", "scales.shape={hexagon={}}"] {
+        let err = refused("ok.toml", "seed = 1\n", &["--set", set]);
+        assert!(err.contains("expected a string") && !err.contains("variant"), "{set}: {err}");
+    }
 }
 
 /// A long list is counted, not echoed back whole (100,000 `rows` made one 500 KB line),

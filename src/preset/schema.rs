@@ -6,6 +6,54 @@
 
 use serde::{Deserialize, Deserializer, Serialize, de};
 
+/// Preset enums are read from their names alone, `shape = "leaf"`. serde's derive reads an
+/// enum the TOML way, a name or a table (`[scales.shape.hexagon]` was taken for "hexagon"),
+/// and its messages for anything else were its own ("wanted string or table", "invalid
+/// type: unit variant"): `try_from = "String"` reads a string, and `by_name` finds the
+/// variant whose serialised name it is, or names the nearest and lists them all. The
+/// macro's `match` makes leaving a variant out of the list a compile error.
+macro_rules! named_enum {
+    ($t:ident { $($v:ident),+ $(,)? }) => {
+        impl TryFrom<String> for $t {
+            type Error = String;
+            fn try_from(name: String) -> Result<Self, String> {
+                // Every variant is in the list: this match is exhaustive.
+                const _: fn($t) = |x| match x {
+                    $($t::$v)|+ => {}
+                };
+                by_name(&[$($t::$v),+], &name)
+            }
+        }
+    };
+}
+
+/// The variant of `all` serialised as `name` (the preset's spelling), or a message.
+fn by_name<T: Serialize + Copy>(all: &[T], name: &str) -> Result<T, String> {
+    let spelled = |v: &T| serde_json::to_value(v).ok().and_then(|j| j.as_str().map(str::to_string)).unwrap_or_default();
+    let names: Vec<String> = all.iter().map(spelled).collect();
+    match names.iter().position(|n| n == name) {
+        Some(i) => Ok(all[i]),
+        None => {
+            let hint = crate::toml_text::nearest(name, names.iter().map(String::as_str))
+                .map(|n| format!("; did you mean \"{n}\"?"))
+                .unwrap_or_default();
+            Err(format!("unknown value {name:?}{hint} (accepted: {})", names.join(", ")))
+        }
+    }
+}
+
+named_enum!(Category { Solid, VerticalStripe, HorizontalStripe, Spot, Simple, Complex });
+named_enum!(ScaleShape { Leaf, Diamond, Hexagon });
+named_enum!(PatternKind { Solid, Stripes, Rings, Spots, Blotches, Irregular });
+named_enum!(StripePosition { Vertebral, Dorsolateral, Lateral });
+named_enum!(PatternShape { Round, Ring, Diamond, Saddle, Chevron, Hourglass, Zigzag });
+named_enum!(Arrangement { Aligned, Alternating, Checkered });
+named_enum!(NoiseChoice { Perlin, Cellular });
+named_enum!(BellyPattern { None, Checkered, Spots, HalfMoons, MedianStripe });
+named_enum!(IridescenceGradient { Vertical, Radial });
+named_enum!(HeadScales { Shields, Small });
+named_enum!(HeadMarkKind { Cap, Snout, V, X, Spearhead, PostocularStripe, Collar, Lips });
+
 /// A colour written as `"#rrggbb"` (sRGB, 8 bits per channel).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Srgb8(pub [u8; 3]);
@@ -59,7 +107,7 @@ impl Srgb8 {
 
 /// Pinheiro & Walter's pattern categories, used to group the species library.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum Category {
     Solid,
     VerticalStripe,
@@ -122,7 +170,7 @@ pub struct Preset {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum ScaleShape {
     Leaf,
     Diamond,
@@ -180,7 +228,7 @@ impl Default for Scales {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum PatternKind {
     /// A uniform colour over the whole body, with fractal variation (P&W "solid").
     Solid,
@@ -198,7 +246,7 @@ pub enum PatternKind {
 
 /// Named stripe positions, measured from the dorsal midline.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum StripePosition {
     /// On the spine.
     Vertebral,
@@ -221,7 +269,7 @@ impl StripePosition {
 
 /// Shape of spots (`round`, `ring`) or blotches (`round`, `diamond`, `saddle`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum PatternShape {
     Round,
     Ring,
@@ -234,7 +282,7 @@ pub enum PatternShape {
 
 /// How spots are laid out in rows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum Arrangement {
     /// Rows one above the other.
     Aligned,
@@ -245,7 +293,7 @@ pub enum Arrangement {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum NoiseChoice {
     Perlin,
     Cellular,
@@ -420,7 +468,7 @@ pub struct Belly {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum BellyPattern {
     None,
     Checkered,
@@ -525,7 +573,7 @@ impl Default for RoughnessParams {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum IridescenceGradient {
     /// Thicker towards each scale's posterior edge (thesis Fig. 5.4a).
     Vertical,
@@ -553,7 +601,7 @@ pub use crate::material::{Absorption, Optics};
 
 /// Small head scales or large head shields (`body.head_scales`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum HeadScales {
     /// Large symmetrical plates on top of the head (rostral, internasals, prefrontals,
     /// frontal, supraoculars, parietals): most colubrids and elapids.
@@ -564,7 +612,7 @@ pub enum HeadScales {
 
 /// A mark on the head or neck (`[[body.head_mark]]`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum HeadMarkKind {
     /// The whole top and sides of the head, down to the lips.
     Cap,
