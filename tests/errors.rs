@@ -137,6 +137,51 @@ fn messages_count_long_lists_and_name_kinds_as_written() {
     assert!(err.contains("\"blotches\" or \"rings\" only, not \"spots\""), "{err}");
 }
 
+/// An index in a `--set` key reaches into a list the preset has: into a missing key it made
+/// a table ("invalid type: table, expected an array"), and `pattern = []` with
+/// `pattern.0.KEY`, which starts a layer, said "index 0 is out of range".
+#[test]
+fn set_indices_reach_into_lists_the_preset_has() {
+    for (set, says) in [
+        (
+            "body.head_mark.0.kind=cap",
+            "`body.head_mark` is not written in the preset, so `body.head_mark.0` has no list",
+        ),
+        ("optics.absorption.1=5", "`optics.absorption` is not written in the preset"),
+        ("pattern.0.colors.1=#000000", "`pattern.0.colors` is not written in the preset"),
+        ("scales.rows.0=3", "`scales.rows` is not written in the preset"),
+    ] {
+        let err = refused("plain.toml", "seed = 1\n", &["--set", set]);
+        assert!(err.contains(says), "{set}: {err}");
+        assert!(!err.contains("invalid type: table"), "{set}: {err}");
+    }
+    let err = refused("one.toml", "[scales]\nrows = 21\n", &["--set", "scales.rows.0=3"]);
+    assert!(err.contains("`scales.rows` is one value, not a list, so `scales.rows.0` names nothing"), "{err}");
+    let marks = "[body]\nhead_mark = [{kind = \"cap\", color = \"#000000\"}]\n";
+    let err = refused("marks.toml", marks, &["--set", "body.head_mark.3.kind=v"]);
+    assert!(err.contains("`body.head_mark` has 1 entry: body.head_mark.0; there is no `body.head_mark.3`"), "{err}");
+    // Negative controls: `pattern.0.KEY` starts a layer under `pattern = []` too, and an
+    // index into a list the preset has is set.
+    let dir = tempfile::tempdir().unwrap();
+    let preset = write_preset(dir.path(), "empty.toml", "pattern = []\n");
+    let start = ["--set", "pattern.0.kind=stripes", "--set", "pattern.0.color=#000000"];
+    let out =
+        snakeskin(&[&["generate", &preset, "-o", dir.path().to_str().unwrap(), "--size", "16"][..], &start].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let preset = write_preset(dir.path(), "marks.toml", marks);
+    let out = snakeskin(&[
+        "generate",
+        &preset,
+        "-o",
+        dir.path().to_str().unwrap(),
+        "--size",
+        "16",
+        "--set",
+        "body.head_mark.0.kind=v",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 #[test]
 fn out_of_range_value_names_key_and_range() {
     let err = refused("range.toml", "seed = 1\n[optics]\nfilm_ior = 7.5\n", &[]);

@@ -235,7 +235,7 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
     let segments: Vec<&str> = key.split('.').collect();
     let result = if segments.iter().any(|s| s.is_empty()) {
         Err("the key must be a dotted path like scales.rows or pattern.0.kind".to_string())
-    } else if let Err(message) = check_layer_index(root, &segments) {
+    } else if let Err(message) = check_indices(root, &segments) {
         Err(message)
     } else {
         let mut tree = toml::Value::Table(std::mem::take(root));
@@ -248,15 +248,93 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
     result.map_err(|message| PresetError::Override { argument: format!("{key}={value}"), message })
 }
 
-/// `pattern.N...` must name an existing layer (or layer 0 of a preset without layers, which
-/// `--set` creates); otherwise the message says how many layers there are.
-fn check_layer_index(root: &toml::Table, segments: &[&str]) -> Result<(), String> {
-    let [first, index, ..] = segments else { return Ok(()) };
-    let Ok(index) = index.parse::<usize>() else { return Ok(()) };
-    if *first != "pattern" {
-        return Ok(());
+/// An index in a `--set` key must reach into a list the preset has. `pattern.N` must name
+/// an existing layer (or layer 0 of a preset without layers, which `--set` creates), and the
+/// message says how many there are. Any other list must be written in the file (or whole,
+/// by `--set`): an index into a missing key made a table where the schema wants a list
+/// (`body.head_mark.0.kind=cap`: "invalid type: table, expected an array"), and one into
+/// a single value (`optics.absorption.1=5`) the same.
+fn check_indices(root: &toml::Table, segments: &[&str]) -> Result<(), String> {
+    check_indices_in(root, segments, "")
+}
+
+/// `check_indices` in `root`, the table at `prefix` (empty at the preset's root).
+fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Result<(), String> {
+    // A table the file does not have reads as an empty one: what lies below it is missing.
+    let missing = toml::Value::Table(toml::Table::new());
+    let mut here: Option<&toml::Value> = None;
+    for (i, segment) in segments.iter().enumerate() {
+        let path = format!("{prefix}{}", segments[..=i].join("."));
+        let Some(index) = segments.get(i + 1).and_then(|s| s.parse::<usize>().ok()) else {
+            here = Some(step(here, root, segment).unwrap_or(&missing));
+            continue;
+        };
+        let value = step(here, root, segment);
+        if path == "pattern" {
+            check_layer_index(value, index)?;
+            // The layer's own keys: the array's item, or a single `[pattern]` table.
+            let layer = match value {
+                Some(toml::Value::Array(items)) => items.get(index),
+                table => table,
+            };
+            return check_indices_below(layer, &segments[i + 2..], &format!("pattern.{index}."));
+        }
+        let len = match value {
+            None => {
+                return Err(format!(
+                    "`{path}` is not written in the preset, so `{path}.{index}` has no list to reach into (a key that \
+                     takes a list is set whole: --set '{path}=[...]', or written in the preset file)"
+                ));
+            }
+            Some(toml::Value::Array(items)) => items.len(),
+            Some(toml::Value::Table(_)) => return Ok(()),
+            Some(_) => {
+                return Err(format!(
+                    "`{path}` is one value, not a list, so `{path}.{index}` names nothing (a key that takes a list is \
+                     set whole: --set '{path}=[...]')"
+                ));
+            }
+        };
+        if index >= len {
+            return Err(format!("`{path}` has {}; there is no `{path}.{index}`", entries(len, &path)));
+        }
+        let item = value.and_then(|v| v.as_array()).and_then(|items| items.get(index));
+        return check_indices_below(item, &segments[i + 2..], &format!("{path}.{index}."));
     }
-    let layers = match root.get("pattern") {
+    Ok(())
+}
+
+/// `check_indices` below a list's item at `prefix` (a layer's `colors.N`).
+fn check_indices_below(item: Option<&toml::Value>, rest: &[&str], prefix: &str) -> Result<(), String> {
+    match item {
+        Some(toml::Value::Table(t)) if !rest.is_empty() => check_indices_in(t, rest, prefix),
+        // A layer `--set` starts: nothing below it is written yet.
+        None if !rest.is_empty() => check_indices_in(&toml::Table::new(), rest, prefix),
+        _ => Ok(()),
+    }
+}
+
+/// One key down from `here` (the root table when None).
+fn step<'a>(here: Option<&'a toml::Value>, root: &'a toml::Table, key: &str) -> Option<&'a toml::Value> {
+    match here {
+        None => root.get(key),
+        Some(toml::Value::Table(t)) => t.get(key),
+        Some(_) => None,
+    }
+}
+
+/// "1 entry: a.0", "3 entries: a.0 to a.2".
+fn entries(len: usize, path: &str) -> String {
+    match len {
+        0 => "no entries".to_string(),
+        1 => format!("1 entry: {path}.0"),
+        n => format!("{n} entries: {path}.0 to {path}.{}", n - 1),
+    }
+}
+
+/// `pattern.N`: an existing layer, or layer 0 of a preset without layers (`--set` starts it).
+fn check_layer_index(pattern: Option<&toml::Value>, index: usize) -> Result<(), String> {
+    let layers = match pattern {
         None => 0,
         Some(toml::Value::Array(items)) => items.len(),
         Some(_) => 1,
@@ -287,9 +365,12 @@ fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> 
         toml::Value::Array(items) => {
             let len = items.len();
             let index: usize = first.parse().map_err(|_| format!("`{first}` must be an array index"))?;
-            let item = items
-                .get_mut(index)
-                .ok_or_else(|| format!("index {index} is out of range: there are {len} entries"))?;
+            // `pattern = []` and `pattern.0.KEY`: the first layer starts (`check_indices`
+            // lets only that index past the end through).
+            if index == 0 && len == 0 {
+                items.push(toml::Value::Table(Default::default()));
+            }
+            let item = items.get_mut(index).ok_or_else(|| format!("there is no entry {index}: the list has {len}"))?;
             set_path(item, rest, value)
         }
         _ => Err(format!("`{first}` is inside a value that is not a table")),
