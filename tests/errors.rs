@@ -182,6 +182,30 @@ fn set_indices_reach_into_lists_the_preset_has() {
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
+/// A key one kind reads, on a layer of another kind, is refused with its line (`colors` and
+/// `widths` on spots, `phase` on stripes were silently ignored), unless it holds its default.
+#[test]
+fn keys_of_another_kind_are_refused_not_ignored() {
+    let layer = "[[pattern]]\nkind = \"spots\"\ncolor = \"#000000\"\n";
+    for (extra, says) in [
+        ("colors = [\"#ffffff\"]", "key `pattern.0.colors` is read by kind \"rings\" only, not \"spots\""),
+        ("phase = 0.5", "key `pattern.0.phase` is read by kind \"blotches\" only"),
+        ("noise = \"cellular\"", "key `pattern.0.noise` is read by kind \"irregular\" only"),
+        ("position = \"lateral\"", "key `pattern.0.position` is read by kind \"stripes\" only"),
+        ("offset = 0.1", "key `pattern.0.offset` is read by kind \"stripes\" and \"blotches\" only"),
+    ] {
+        let err = refused("kinds.toml", &format!("{layer}{extra}\n"), &[]);
+        assert!(err.contains(&format!("kinds.toml:4: {says}")), "{extra}: {err}");
+    }
+    // Negative controls: a default value, and the key on its own kind.
+    let dir = tempfile::tempdir().unwrap();
+    for text in [format!("{layer}length = 0.6\n"), layer.replace("spots", "rings") + "colors = [\"#ffffff\"]\n"] {
+        let preset = write_preset(dir.path(), "fine.toml", &text);
+        let out = snakeskin(&["generate", &preset, "-o", dir.path().to_str().unwrap(), "--size", "16"]);
+        assert!(out.status.success(), "{text}: {}", stderr(&out));
+    }
+}
+
 #[test]
 fn out_of_range_value_names_key_and_range() {
     let err = refused("range.toml", "seed = 1\n[optics]\nfilm_ior = 7.5\n", &[]);

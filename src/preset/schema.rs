@@ -405,7 +405,7 @@ impl PatternLayer {
     fn default_opacity() -> f64 {
         1.0
     }
-    fn default_noise() -> NoiseChoice {
+    pub(crate) fn default_noise() -> NoiseChoice {
         NoiseChoice::Perlin
     }
     fn default_center_size() -> f64 {
@@ -414,16 +414,16 @@ impl PatternLayer {
     fn default_border_size() -> f64 {
         0.01
     }
-    fn default_widen_to_tail() -> f64 {
+    pub(crate) fn default_widen_to_tail() -> f64 {
         1.0
     }
-    fn default_length() -> f64 {
+    pub(crate) fn default_length() -> f64 {
         0.6
     }
     fn default_shape() -> PatternShape {
         PatternShape::Round
     }
-    fn default_arrangement() -> Arrangement {
+    pub(crate) fn default_arrangement() -> Arrangement {
         Arrangement::Alternating
     }
 }

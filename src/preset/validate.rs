@@ -1,7 +1,7 @@
 //! Range checks on a parsed preset, all before any pixel is computed ("parse first, then
 //! run"). Each problem names the dotted key and the accepted range; `load` adds the line.
 
-use super::schema::{PatternKind, PatternShape, Preset};
+use super::schema::{PatternKind, PatternLayer, PatternShape, Preset};
 
 /// One value outside what the generator accepts.
 #[derive(Debug, Clone, PartialEq)]
@@ -163,6 +163,37 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
                     format!("{:?}", p.kind).to_lowercase()
                 ),
             });
+        }
+        // Keys one kind or two read, set away from their defaults on a kind that ignores
+        // them (`colors` on spots, `phase` on stripes were silently dropped; `shape`,
+        // `count` and `rows` were refused already). A default value changes nothing.
+        let k = p.kind;
+        use PatternKind::{Blotches, Irregular, Rings, Spots, Stripes};
+        let kinds_only: [(&str, bool, &[PatternKind]); 10] = [
+            ("colors", !p.colors.is_empty(), &[Rings]),
+            ("widths", !p.widths.is_empty(), &[Rings]),
+            ("noise", p.noise != PatternLayer::default_noise(), &[Irregular]),
+            ("position", p.position.is_some(), &[Stripes]),
+            ("offset", p.offset != 0.0, &[Stripes, Blotches]),
+            ("arrangement", p.arrangement != PatternLayer::default_arrangement(), &[Spots, Blotches]),
+            ("phase", p.phase != 0.0, &[Blotches]),
+            ("length", p.length != PatternLayer::default_length(), &[Blotches]),
+            ("center_color", p.center_color.is_some(), &[Spots, Blotches]),
+            ("widen_to_tail", p.widen_to_tail != PatternLayer::default_widen_to_tail(), &[Blotches]),
+        ];
+        for (field, set, kinds) in kinds_only {
+            if set && !kinds.contains(&k) {
+                let names: Vec<String> =
+                    kinds.iter().map(|k| format!("\"{}\"", format!("{k:?}").to_lowercase())).collect();
+                c.problems.push(Problem {
+                    key: key(field),
+                    message: format!(
+                        "is read by kind {} only, not \"{}\"; leave it out of this layer",
+                        names.join(" and "),
+                        format!("{k:?}").to_lowercase()
+                    ),
+                });
+            }
         }
         for (j, w) in p.widths.iter().enumerate() {
             c.range(format!("pattern.{i}.widths.{j}"), *w, RING_WIDTH);
