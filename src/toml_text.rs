@@ -60,7 +60,8 @@ pub fn in_plain_words(message: &str) -> String {
 pub fn line_column(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |s| s.chars().count()) + 1;
+    // A byte-order mark (an editor's UTF-8 file) is not a column of the first line.
+    let column = before.rsplit('\n').next().map_or(0, |s| s.trim_start_matches('\u{feff}').chars().count()) + 1;
     (line, column)
 }
 
@@ -235,6 +236,15 @@ fn joined(key: &str, rest: String) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A byte-order mark is not a column: `seed` after one was reported a column late.
+    #[test]
+    fn a_byte_order_mark_is_not_a_column() {
+        let text = "\u{feff}seed = \"x\"\nrows = 1\n";
+        assert_eq!(line_column(text, text.find('"').unwrap()), (1, 8));
+        assert_eq!(line_column(text, text.find("rows").unwrap()), (2, 1));
+        assert_eq!(line_column("seed = \"x\"", 7), (1, 8), "negative control: the same without the mark");
+    }
 
     /// serde's parts only, whole names only: the value a message quotes is left as written.
     #[test]

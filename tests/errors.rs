@@ -206,6 +206,14 @@ fn keys_of_another_kind_are_refused_not_ignored() {
     }
 }
 
+/// A set's files are named after its preset file: a newline there made `new\nline_color.png`.
+#[cfg(unix)]
+#[test]
+fn a_preset_file_name_with_control_characters_is_refused() {
+    let err = refused("new\nline.toml", "seed = 1\n", &[]);
+    assert!(err.contains("its file name has control characters") && err.contains("rename the file"), "{err}");
+}
+
 #[test]
 fn out_of_range_value_names_key_and_range() {
     let err = refused("range.toml", "seed = 1\n[optics]\nfilm_ior = 7.5\n", &[]);

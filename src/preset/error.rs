@@ -15,6 +15,11 @@ pub enum PresetError {
     #[error("cannot read preset {path}: it is {bytes} bytes; presets are limited to {limit} bytes")]
     TooLarge { path: PathBuf, bytes: u64, limit: u64 },
 
+    /// A preset file whose name the set's files cannot carry.
+    #[error(
+        "preset {path:?}: its file name has control characters, and a set's files are named after it; rename the file"
+    )]
+    FileName { path: PathBuf },
     #[error("unknown preset {name:?}: not a .toml file and not a built-in preset (built-in: {available})")]
     UnknownPreset { name: String, available: String },
 

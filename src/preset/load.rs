@@ -47,6 +47,11 @@ pub const MAX_PRESET_BYTES: u64 = 1 << 20;
 pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
     if spec.ends_with(".toml") || path.exists() {
+        // The set's files are named after it: a newline or an escape in their names would
+        // break every listing and script that reads them (`--set` refuses the same).
+        if path.file_stem().is_some_and(|s| s.to_string_lossy().chars().any(char::is_control)) {
+            return Err(PresetError::FileName { path: path.into() });
+        }
         let text = read_bounded(path)?;
         // The set's files are named after it: a hidden name (`.toml`) would hide them.
         let name = path
