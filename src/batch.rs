@@ -216,11 +216,11 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         };
         let lines = JobLines { preset: line("preset"), set: line("set"), sizes: line("sizes") };
         // A preset path is relative to the jobs file, by the rule `generate` applies to its
-        // argument relative to the working folder (`preset::read_source`): a name ending in
-        // `.toml`, or a file that exists, is a file; anything else, a built-in preset.
+        // argument relative to the working folder (`preset::names_a_file`); anything else
+        // is a built-in preset.
         let relative = Path::new(&table.preset).is_relative().then(|| base.join(&table.preset));
         let preset = match relative {
-            Some(path) if table.preset.ends_with(".toml") || path.exists() => path.to_string_lossy().into_owned(),
+            Some(path) if crate::preset::names_a_file(&path) => path.to_string_lossy().into_owned(),
             _ => table.preset.clone(),
         };
         let maps = match &table.maps {
@@ -536,30 +536,20 @@ pub fn run(
     let mut estimates = Vec::new();
     for (job, r) in mine.iter().zip(&resolved) {
         if !r.done && r.outcome.duplicate_of.is_none() {
-            let planned = |source: Error| BatchError::Planned {
+            // A size refused (too tall, too large for memory) at the job's `sizes`; its output
+            // at the job (the folder's name comes from all its keys).
+            let planned = |line: Option<usize>, source: Error| BatchError::Planned {
                 path: jobs_file.into(),
-                line: job.lines.sizes.or(job.lines.preset),
+                line: line.or(job.lines.preset),
                 job: job.table,
                 preset: job.preset.clone(),
-                // A job has a size, not the `--size` that `generate`'s message names.
-                source: Box::new(match source {
-                    Error::Memory { what, needed_mib, available_mib } => Error::Memory {
-                        what: what.strip_prefix("--").map(str::to_string).unwrap_or(what),
-                        needed_mib,
-                        available_mib,
-                    },
-                    other => other,
-                }),
+                source: Box::new(source),
             };
-            let plan = Plan::new(&request(job, out, &r.outcome)).map_err(planned)?;
+            let plan = Plan::new(&request(job, out, &r.outcome)).map_err(|e| planned(job.lines.sizes, e))?;
             // Its folder and files, as `Plan::run` checks them, but before any job has
             // written its set: a folder in a later job's way stopped the run after the
             // earlier jobs' sets were written.
-            let dir = out.join(&r.outcome.folder);
-            crate::export::check_folder(&dir).map_err(|e| planned(e.into()))?;
-            for file in plan.file_names() {
-                crate::export::check_target(&dir.join(file)).map_err(|e| planned(e.into()))?;
-            }
+            plan.check_outputs().map_err(|e| planned(job.lines.preset, e.into()))?;
             estimates.push(plan.memory().estimate_bytes);
         }
     }

@@ -83,6 +83,12 @@ pub struct Plan {
     start: Instant,
 }
 
+/// How messages name a request's size: `generate`'s and `export`'s option, or a batch job's
+/// size (a jobs file's `sizes`).
+fn size_option(request: &GenerateRequest) -> &'static str {
+    if request.job.is_some() { "size" } else { "--size" }
+}
+
 impl Plan {
     /// The preset as loaded (overrides applied, colours clamped to what the stack shows).
     pub fn loaded(&self) -> &LoadedPreset {
@@ -112,10 +118,11 @@ impl Plan {
     /// exceeds the memory available (`Error::Memory`, before any allocation).
     pub fn new(request: &GenerateRequest) -> Result<Plan, Error> {
         let plan = Plan::within_checked_budget(request)?;
+        let size_option = size_option(request);
         let what = if plan.height == plan.size {
-            format!("--size {}", plan.size)
+            format!("{size_option} {}", plan.size)
         } else {
-            format!("--size {} ({} x {})", plan.size, plan.size, plan.height)
+            format!("{size_option} {} ({} x {})", plan.size, plan.size, plan.height)
         };
         plan.memory.refuse_if_over(&what)?;
         Ok(plan)
@@ -137,7 +144,7 @@ impl Plan {
             ));
         }
         if height > MAX_HEIGHT {
-            return Err(Error::Height { width: size, height, max: MAX_HEIGHT });
+            return Err(Error::Height { width: size, height, max: MAX_HEIGHT, size_option: size_option(request) });
         }
         let maps = match request.pack {
             Some(pack) => pack.maps(has_film(&loaded.preset), request.ao),
@@ -176,14 +183,21 @@ impl Plan {
         (self.size, self.height)
     }
 
-    /// Runs the plan. `progress(done, total)` reports node evaluations.
-    pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
-        // Every file of the set is checked before the work, not only when the set is
-        // committed: a folder or a link where the last map goes failed after the whole set
-        // had been evaluated and encoded (the commit checks again: the folder may change).
+    /// The set's folder and every file of it, checked before the work, not only when the
+    /// set is committed: a folder or a link where the last map goes failed after the whole
+    /// set had been evaluated and encoded (the commit checks again: the folder may change).
+    /// `run` calls it, and a batch for every job before the first runs.
+    pub fn check_outputs(&self) -> Result<(), export::ExportError> {
+        export::check_folder(&self.request.out_dir)?;
         for file in self.file_names() {
             export::check_target(&self.request.out_dir.join(file))?;
         }
+        Ok(())
+    }
+
+    /// Runs the plan. `progress(done, total)` reports node evaluations.
+    pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
+        self.check_outputs()?;
         if let Some(pack) = self.request.pack {
             return self.run_pack(pack, progress);
         }

@@ -133,6 +133,7 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
     // The files it will write, checked before the work (a folder or a link where one goes
     // was found only when they were written): the `.glb`, or the `.gltf` and its side files.
     let side_files = if binary { Vec::new() } else { gltf_side_file_names(&name, film.is_some()) };
+    crate::export::check_folder(&dir)?;
     crate::export::check_target(&request.out)?;
     for file in side_files {
         crate::export::check_target(&dir.join(file))?;

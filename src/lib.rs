@@ -41,9 +41,9 @@ pub enum Error {
     Size { size: u64 },
     #[error(
         "a body atlas {width} wide is {height} tall (body.length widths), over the {max} rows a map may have; use a \
-         smaller size"
+         smaller {size_option}"
     )]
-    Height { width: usize, height: usize, max: usize },
+    Height { width: usize, height: usize, max: usize, size_option: &'static str },
     /// A combination of options the tool does not support (yet).
     #[error("{0}")]
     Unsupported(String),

@@ -35,6 +35,12 @@ impl Described {
 pub fn describe(text: &str, error: &toml::de::Error) -> Described {
     let span = error.span();
     let mut message = in_plain_words(error.message().trim_end());
+    // toml hands a date or time over as a table of its own: say what was written.
+    let written = span.clone().and_then(|s| text.get(s)).map(str::trim);
+    if message.starts_with("invalid type: table") && written.is_some_and(|v| v.parse::<toml::value::Datetime>().is_ok())
+    {
+        message = message.replacen("invalid type: table", "invalid type: a date or time", 1);
+    }
     let mut key = None;
     if message.contains("duplicate key") {
         if !message.contains('`') {
@@ -61,7 +67,8 @@ pub fn line_column(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
     // A byte-order mark (an editor's UTF-8 file) is not a column of the first line.
-    let column = before.rsplit('\n').next().map_or(0, |s| s.trim_start_matches('\u{feff}').chars().count()) + 1;
+    let last = before.rsplit('\n').next().unwrap_or("");
+    let column = if line == 1 { last.trim_start_matches('\u{feff}') } else { last }.chars().count() + 1;
     (line, column)
 }
 
@@ -236,6 +243,25 @@ fn joined(key: &str, rest: String) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A date where a number goes was called a table (toml's form of a date).
+    #[test]
+    fn a_date_is_named_a_date() {
+        #[derive(Debug, serde::Deserialize)]
+        struct Seeded {
+            #[allow(dead_code)]
+            seed: u64,
+        }
+        for (text, says) in [("seed = 1979-05-27\n", "a date or time"), ("seed = { a = 1 }\n", "invalid type: table")] {
+            let error = toml::from_str::<Seeded>(text).unwrap_err();
+            let described = describe(text, &error);
+            assert!(
+                described.message.starts_with(&format!("invalid type: {}", says.trim_start_matches("invalid type: "))),
+                "{text}: {}",
+                described.message
+            );
+        }
+    }
 
     /// A byte-order mark is not a column: `seed` after one was reported a column late.
     #[test]

@@ -248,10 +248,32 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     std::fs::create_dir_all(&in_the_way).unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--concurrent", "1"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:4: job 1 (natrix-natrix): cannot write"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:2: job 1 (natrix-natrix): cannot write"), "{}", stderr(&out));
     assert!(stderr(&out).contains("a folder is in the way"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "the first job's set was written before the folder was found");
     assert!(in_the_way.is_dir() && std::fs::read_dir(&in_the_way).unwrap().next().is_none());
+}
+
+/// A jobs file in its own output folder, run again, resumes: the second run read the set's
+/// folder `natrix-natrix/` beside the jobs file as the preset `natrix-natrix` ("it is a
+/// folder; a preset must be a regular file"). And `generate NAME -o NAME`, twice, the same.
+#[test]
+fn a_folder_named_like_a_preset_is_not_read_as_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[1]", 16);
+    for run in 0..2 {
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().to_str().unwrap()]);
+        assert!(out.status.success(), "run {run}: {}", stderr(&out));
+        assert_eq!(summary_counts(&out), if run == 0 { (1, 0) } else { (0, 1) }, "{}", stdout(&out));
+    }
+    for run in 0..2 {
+        let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["generate", "natrix-natrix", "-o", "natrix-natrix", "--size", "16"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "run {run}: {}", stderr(&out));
+    }
 }
 
 #[test]

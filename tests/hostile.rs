@@ -1119,6 +1119,22 @@ fn a_gltf_export_is_checked_for_folders_in_the_way_before_the_work() {
         assert!(calls > 0);
         assert!(report.files.iter().any(|f| f.ends_with(in_the_way)), "{:?}", report.files);
     }
+    // The file's folder too: a file in its place, or a link to nothing, was found when the
+    // export was written (after the work).
+    std::fs::write(dir.path().join("a-file"), b"x").unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(dir.path().join("nowhere"), dir.path().join("dangling")).unwrap();
+    for (out, says) in
+        [("a-file/s.glb", "exists and is not a folder"), ("dangling/s.glb", "a symbolic link to nothing")]
+    {
+        if cfg!(not(unix)) && out.starts_with("dangling") {
+            continue;
+        }
+        let (result, calls) = run(out);
+        let err = result.unwrap_err();
+        assert!(err.contains(says), "{out}: {err}");
+        assert_eq!(calls, 0, "{out}: evaluated before the check");
+    }
 }
 
 /// A jobs file of many jobs is read in one pass: the lines that its messages name were

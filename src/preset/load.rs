@@ -44,9 +44,17 @@ pub const MAX_PRESET_BYTES: u64 = 1 << 20;
 
 /// Resolves a PRESET argument: an existing path or anything ending in `.toml` is a file,
 /// anything else a built-in preset name.
+/// Whether a preset argument names a file rather than a built-in preset: a name ending in
+/// `.toml`, or anything but a folder that exists there. A folder never is: a set's folder
+/// is named after its preset, so `generate natrix-natrix -o natrix-natrix` run twice (and a
+/// batch whose jobs file lies in its output folder) read the folder as the preset.
+pub fn names_a_file(path: &Path) -> bool {
+    path.to_string_lossy().ends_with(".toml") || std::fs::metadata(path).is_ok_and(|m| !m.is_dir())
+}
+
 pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
-    if spec.ends_with(".toml") || path.exists() {
+    if names_a_file(path) {
         // The set's files are named after it: a newline or an escape in their names would
         // break every listing and script that reads them (`--set` refuses the same).
         if path.file_stem().is_some_and(|s| s.to_string_lossy().chars().any(char::is_control)) {
@@ -143,10 +151,16 @@ pub fn parse_with_seed(
 
     let mut preset = preset;
     preset.seed = seed.unwrap_or(file_seed);
-    let problems = validate(&preset);
-    // A key an override wrote (or a table it replaced) has no line in the file; the file is
-    // parsed for lines once, not once per problem (thousands of them took minutes).
-    let overridden = |key: &str| overrides.iter().any(|(k, _)| key == k || key.starts_with(&format!("{k}.")));
+    // A key an override wrote (or a value it replaced whole) has no line in the file; the
+    // file is parsed for lines once, not once per problem (thousands of them took minutes).
+    let written = written_keys(overrides);
+    let overridden = |key: &str| written.iter().any(|k| key == k || key.starts_with(&format!("{k}.")));
+    // Layer 0 may be written as a single `[pattern]` table, and `--set pattern.kind=` sets it.
+    let in_layer = |i: usize, key: &str| {
+        overridden(&format!("pattern.{i}.{key}")) || (i == 0 && overridden(&format!("pattern.{key}")))
+    };
+    let from_file_for_old_kind = |i: usize, key: &str| in_layer(i, "kind") && !in_layer(i, key);
+    let problems = validate(&preset, &from_file_for_old_kind);
     let key_lines = std::cell::LazyCell::new(|| toml_text::KeyLines::new(&source.text));
     if !problems.is_empty() {
         let located = problems
@@ -231,12 +245,7 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
     if key.chars().chain(value.chars()).any(char::is_control) {
         return Err(refuse("the key and value must be one line without control characters".into()));
     }
-    // One TOML value, nothing else: the table must hold exactly the key `v`.
-    let parsed: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
-        Ok(mut t) if t.len() == 1 => t.remove("v").unwrap_or(toml::Value::String(value.into())),
-        Ok(_) => return Err(refuse("the value must be a single TOML value".into())),
-        Err(_) => toml::Value::String(value.into()),
-    };
+    let parsed = override_value(value).map_err(refuse)?;
     let segments: Vec<&str> = key.split('.').collect();
     let result = if segments.iter().any(|s| s.is_empty()) {
         Err("the key must be a dotted path like scales.rows or pattern.0.kind".to_string())
@@ -395,6 +404,40 @@ fn merge(target: &mut toml::Value, value: toml::Value) {
         }
         (target, value) => *target = value,
     }
+}
+
+/// An override's value: one TOML value, or a bare word that is not TOML as a string.
+fn override_value(value: &str) -> Result<toml::Value, String> {
+    // One TOML value, nothing else: the table must hold exactly the key `v`.
+    match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+        Ok(mut t) if t.len() == 1 => Ok(t.remove("v").unwrap_or(toml::Value::String(value.into()))),
+        Ok(_) => Err("the value must be a single TOML value".into()),
+        Err(_) => Ok(toml::Value::String(value.into())),
+    }
+}
+
+/// The keys the overrides write: each override's own, or for an inline table the keys in
+/// it (`merge` fills a table key by key: `--set 'color={base="#fff"}'` writes `color.base`,
+/// and the file's other `color` keys keep their values and their lines).
+fn written_keys(overrides: &[(String, String)]) -> Vec<String> {
+    fn leaves(key: String, value: &toml::Value, out: &mut Vec<String>) {
+        match value {
+            toml::Value::Table(t) if !t.is_empty() => {
+                for (k, v) in t {
+                    leaves(format!("{key}.{k}"), v, out);
+                }
+            }
+            _ => out.push(key),
+        }
+    }
+    let mut out = Vec::new();
+    for (key, value) in overrides {
+        match override_value(value) {
+            Ok(parsed) => leaves(key.clone(), &parsed, &mut out),
+            Err(_) => out.push(key.clone()),
+        }
+    }
+    out
 }
 
 fn fnv1a64(bytes: &[u8]) -> u64 {

@@ -27,9 +27,13 @@ macro_rules! named_enum {
     };
 }
 
+/// A preset enum's value as a preset writes it (`"half_moons"`): its serialised name.
+pub fn spelled<T: Serialize>(value: &T) -> String {
+    serde_json::to_value(value).ok().and_then(|j| j.as_str().map(str::to_string)).unwrap_or_default()
+}
+
 /// The variant of `all` serialised as `name` (the preset's spelling), or a message.
 fn by_name<T: Serialize + Copy>(all: &[T], name: &str) -> Result<T, String> {
-    let spelled = |v: &T| serde_json::to_value(v).ok().and_then(|j| j.as_str().map(str::to_string)).unwrap_or_default();
     let names: Vec<String> = all.iter().map(spelled).collect();
     match names.iter().position(|n| n == name) {
         Some(i) => Ok(all[i]),

@@ -1,7 +1,7 @@
 //! Range checks on a parsed preset, all before any pixel is computed ("parse first, then
 //! run"). Each problem names the dotted key and the accepted range; `load` adds the line.
 
-use super::schema::{PatternKind, PatternLayer, PatternShape, Preset};
+use super::schema::{PatternKind, PatternLayer, PatternShape, Preset, spelled};
 
 /// One value outside what the generator accepts.
 #[derive(Debug, Clone, PartialEq)]
@@ -95,8 +95,12 @@ impl Checker {
     }
 }
 
-/// Every out-of-range value in the preset (empty when it is valid).
-pub fn validate(preset: &Preset) -> Vec<Problem> {
+/// Every out-of-range value in the preset (empty when it is valid). `from_file_for_old_kind
+/// (i, key)`: whether layer i's `key` is the file's while its kind came from `--set`; such a
+/// key, written for the file's kind, is passed over rather than refused as another kind's
+/// (`--set pattern.0.kind=spots` on a preset of blotches keeps their `length`, `shape` and
+/// `count`, which spots do not read), where the same key written by an override is refused.
+pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) -> bool) -> Vec<Problem> {
     use ranges::*;
     let mut c = Checker::default();
     let s = &preset.scales;
@@ -153,15 +157,11 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
             ],
             _ => &[PatternShape::Round],
         };
-        if !shapes.contains(&p.shape) {
-            let names: Vec<String> = shapes.iter().map(|s| format!("{s:?}").to_lowercase()).collect();
+        if !shapes.contains(&p.shape) && !from_file_for_old_kind(i, "shape") {
+            let names: Vec<String> = shapes.iter().map(spelled).collect();
             c.problems.push(Problem {
                 key: key("shape"),
-                message: format!(
-                    "must be one of {} for kind {:?}",
-                    names.join(", "),
-                    format!("{:?}", p.kind).to_lowercase()
-                ),
+                message: format!("must be one of {} for kind \"{}\"", names.join(", "), spelled(&p.kind)),
             });
         }
         // Keys one kind or two read, set away from their defaults on a kind that ignores
@@ -182,15 +182,14 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
             ("widen_to_tail", p.widen_to_tail != PatternLayer::default_widen_to_tail(), &[Blotches]),
         ];
         for (field, set, kinds) in kinds_only {
-            if set && !kinds.contains(&k) {
-                let names: Vec<String> =
-                    kinds.iter().map(|k| format!("\"{}\"", format!("{k:?}").to_lowercase())).collect();
+            if set && !kinds.contains(&k) && !from_file_for_old_kind(i, field) {
+                let names: Vec<String> = kinds.iter().map(|k| format!("\"{}\"", spelled(k))).collect();
                 c.problems.push(Problem {
                     key: key(field),
                     message: format!(
                         "is read by kind {} only, not \"{}\"; leave it out of this layer",
                         names.join(" and "),
-                        format!("{k:?}").to_lowercase()
+                        spelled(&k)
                     ),
                 });
             }
@@ -217,7 +216,7 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
         if !p.rows.is_empty() {
             let top = (preset.scales.rows as f64 + 1.0) / 2.0;
-            let ok = p.kind == PatternKind::Stripes
+            let ok = (p.kind == PatternKind::Stripes || from_file_for_old_kind(i, "rows"))
                 && p.rows.len() == 2
                 && p.rows.iter().all(|r| r.is_finite())
                 && 0.5 <= p.rows[0]
@@ -245,12 +244,12 @@ pub fn validate(preset: &Preset) -> Vec<Problem> {
         c.range(key("widen_to_tail"), p.widen_to_tail, WIDEN_TO_TAIL);
         if let Some(count) = p.count {
             c.int_range(&key("count"), count, MARK_COUNT);
-            if !matches!(p.kind, PatternKind::Blotches | PatternKind::Rings) {
+            if !matches!(p.kind, PatternKind::Blotches | PatternKind::Rings) && !from_file_for_old_kind(i, "count") {
                 c.problems.push(Problem {
                     key: key("count"),
                     message: format!(
                         "counts marks of kind \"blotches\" or \"rings\" only, not \"{}\"",
-                        format!("{:?}", p.kind).to_lowercase()
+                        spelled(&p.kind)
                     ),
                 });
             }
