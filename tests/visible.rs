@@ -126,41 +126,22 @@ fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limi
     assert!(map.pixels().all(|p| (0..3).all(|c| p.0[c] <= bound[c])), "map brighter than {bound:?}");
 
     // A colour an override wrote has no line in the file (it named line 3, `#e0c0a0`),
-    // whether the override names the key or the table around it.
+    // whether the override names the key or the table around it; an inline table writes its
+    // own keys only, so the file's `color.base` keeps its line when the override sets
+    // another key of `color` (the whole table lost its lines).
+    let colour_with = |set: &str| {
+        let dir = out_dir.to_str().unwrap();
+        let out = snakeskin(&["generate", &preset, "-o", dir, "--size", "32", "--maps", "color", "--set", set]);
+        assert!(out.status.success(), "{set}: {}", stderr(&out));
+        stderr(&out)
+    };
     for set in ["color.base=\"#f0f0f0\"", "color={base=\"#f0f0f0\"}", "color={base=\"#f0f0f0\", scale_tone=0.1}"] {
-        let out = snakeskin(&[
-            "generate",
-            &preset,
-            "-o",
-            out_dir.to_str().unwrap(),
-            "--size",
-            "32",
-            "--maps",
-            "color",
-            "--set",
-            set,
-        ]);
-        assert!(out.status.success(), "{}", stderr(&out));
-        let err = stderr(&out);
+        let err = colour_with(set);
         assert!(err.contains("ink.toml: color.base = \"#f0f0f0\" is brighter"), "{set}: {err}");
         assert!(err.contains("ink.toml:8: belly.color"), "{set}: {err}");
     }
-    // An inline table writes its own keys only: the file's `color.base` keeps its line when
-    // the override sets another key of `color` (the whole table lost its lines).
-    let out = snakeskin(&[
-        "generate",
-        &preset,
-        "-o",
-        out_dir.to_str().unwrap(),
-        "--size",
-        "32",
-        "--maps",
-        "color",
-        "--set",
-        "color={scale_tone=0.05}",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stderr(&out).contains("ink.toml:3: color.base = \"#e0c0a0\" is brighter"), "{}", stderr(&out));
+    let err = colour_with("color={scale_tone=0.05}");
+    assert!(err.contains("ink.toml:3: color.base = \"#e0c0a0\" is brighter"), "{err}");
 
     // Negative control: the same colours over a clear pigment layer are shown as written.
     let clear = write_preset(dir.path(), "clear.toml", &WHITE_UNDER_INK.replace("absorption = 0.3", ""));
