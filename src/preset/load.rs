@@ -42,8 +42,6 @@ pub struct LoadedPreset {
 /// far beyond any real preset and bounds what `generate /dev/zero`-like input can cost.
 pub const MAX_PRESET_BYTES: u64 = 1 << 20;
 
-/// Resolves a PRESET argument: an existing path or anything ending in `.toml` is a file,
-/// anything else a built-in preset name.
 /// Whether a preset argument names a file rather than a built-in preset: a name ending in
 /// `.toml`, or anything but a folder that exists there. A folder never is: a set's folder
 /// is named after its preset, so `generate natrix-natrix -o natrix-natrix` run twice (and a
@@ -52,11 +50,12 @@ pub fn names_a_file(path: &Path) -> bool {
     path.to_string_lossy().ends_with(".toml") || std::fs::metadata(path).is_ok_and(|m| !m.is_dir())
 }
 
+/// Resolves a PRESET argument: a file (`names_a_file`), or else a built-in preset name.
 pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
     if names_a_file(path) {
-        // The set's files are named after it: a newline or an escape in their names would
-        // break every listing and script that reads them (`--set` refuses the same).
+        // A newline or an escape in the name would go into the set's file names and break
+        // every listing and script that reads them (`--set` refuses the same).
         if path.file_stem().is_some_and(|s| s.to_string_lossy().chars().any(char::is_control)) {
             return Err(PresetError::FileName { path: path.into() });
         }
