@@ -159,16 +159,9 @@ fn plain_type_names(message: &str) -> String {
     out
 }
 
-/// The line of a dotted key (`pattern.1.size`, `job.0.set`) in `text`, if it is written
-/// there; an index into an array counts its items (`job.2` is the third `[[job]]`), and
-/// `NAME.0` of a single `[NAME]` table is that table (a preset's one `[pattern]` is layer 0).
-/// One key: it parses `text`; for many, `KeyLines`.
-pub fn key_line(text: &str, dotted: &str) -> Option<usize> {
-    KeyLines::new(text).line(dotted)
-}
-
-/// The lines of dotted keys in one text (`key_line`), parsed once: a jobs file asks for
-/// two keys per job, and parsing the file for each made loading it quadratic in its size.
+/// The lines of dotted keys in one text, parsed once: a jobs file asks for two keys per
+/// job, and parsing the file for each made loading it quadratic in its size (and a preset's
+/// thousands of problems took minutes).
 pub struct KeyLines<'a> {
     root: Option<toml::Spanned<DeTable<'a>>>,
     /// The byte offset where each line starts.
@@ -181,7 +174,9 @@ impl<'a> KeyLines<'a> {
         KeyLines { root: DeTable::parse(text).ok(), line_starts }
     }
 
-    /// `key_line` of `dotted`.
+    /// The line of a dotted key (`pattern.1.size`, `job.0.set`), if it is written there; an
+    /// index into an array counts its items (`job.2` is the third `[[job]]`), and `NAME.0` of
+    /// a single `[NAME]` table is that table (a preset's one `[pattern]` is layer 0).
     pub fn line(&self, dotted: &str) -> Option<usize> {
         let root = self.root.as_ref()?;
         let mut span: Option<Range<usize>> = None;
@@ -314,6 +309,7 @@ mod tests {
     /// control: a key that is not written has no line.
     #[test]
     fn a_dotted_key_has_the_line_it_is_written_on() {
+        let key_line = |text: &str, dotted: &str| KeyLines::new(text).line(dotted);
         let jobs = "# jobs\n[[job]]\npreset = \"a\"\n\n[[job]]\npreset = \"b\"\nset = { \"scales.rows\" = 3 }\n";
         assert_eq!(key_line(jobs, "job.0.preset"), Some(3));
         assert_eq!(key_line(jobs, "job.1.preset"), Some(6));
