@@ -450,13 +450,14 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
 }
 
 /// The shard's jobs with their folders and whether each is already done (`done` or
-/// `to do`); nothing is run or written.
+/// `to do`), after the checks `run` makes before it writes anything (a batch that `run`
+/// would refuse is refused here with the same error, not listed "to do"); nothing is run or
+/// written.
 pub fn list(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Result<Vec<JobOutcome>, Error> {
-    Ok(resolve_all(jobs_file, jobs, out, shard)?
+    Ok(plan(jobs_file, jobs, out, shard)?
+        .resolved
         .into_iter()
-        .zip(jobs)
-        .filter(|(_, j)| shard.contains(j))
-        .map(|(Resolved { mut outcome, done }, _)| {
+        .map(|Resolved { mut outcome, done }| {
             if outcome.duplicate_of.is_none() {
                 outcome.status = if done { "done" } else { "to do" };
             }
@@ -526,33 +527,7 @@ pub fn run(
     concurrency: usize,
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
-    // The output folder (a file there is the user's mistake, as for `generate -o`) and the
-    // index's place, before any job runs (a folder in the index's way would otherwise fail
-    // the run after every job), and nothing created yet: a refused batch leaves no folder.
-    crate::export::check_folder(out)?;
-    crate::export::check_target(&out.join(index_file_name(shard)))?;
-    let (mine, resolved): (Vec<&Job>, Vec<Resolved>) =
-        jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
-    let mut estimates = Vec::new();
-    for (job, r) in mine.iter().zip(&resolved) {
-        if !r.done && r.outcome.duplicate_of.is_none() {
-            // A size refused (too tall, too large for memory) at the job's `sizes`; its output
-            // at the job (the folder's name comes from all its keys).
-            let planned = |line: Option<usize>, source: Error| BatchError::Planned {
-                path: jobs_file.into(),
-                line: line.or(job.lines.preset),
-                job: job.table,
-                preset: job.preset.clone(),
-                source: Box::new(source),
-            };
-            let plan = Plan::new(&request(job, out, &r.outcome)).map_err(|e| planned(job.lines.sizes, e))?;
-            // Its folder and files, as `Plan::run` checks them, but before any job has
-            // written its set: a folder in a later job's way stopped the run after the
-            // earlier jobs' sets were written.
-            plan.check_outputs().map_err(|e| planned(job.lines.preset, e.into()))?;
-            estimates.push(plan.memory().estimate_bytes);
-        }
-    }
+    let Planned { mine, resolved, estimates } = plan(jobs_file, jobs, out, shard)?;
     let concurrency =
         fitting_concurrency(concurrency.clamp(1, MAX_CONCURRENCY), estimates, crate::memory::available_bytes());
     let total = mine.len();
@@ -617,6 +592,47 @@ pub fn run(
     crate::export::create_folder(out)?;
     write_file_atomically(&out.join(index_file_name(shard)), json)?;
     Ok(index)
+}
+
+/// The shard's jobs, resolved and planned: what `run` runs and `list` shows.
+struct Planned<'a> {
+    mine: Vec<&'a Job>,
+    resolved: Vec<Resolved>,
+    /// The memory estimate of each job that will generate a set.
+    estimates: Vec<u64>,
+}
+
+/// Every check a run makes before it writes anything: the output folder, the index's place,
+/// every job's preset, size, memory and output files.
+fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard) -> Result<Planned<'a>, Error> {
+    // The output folder (a file there is the user's mistake, as for `generate -o`) and the
+    // index's place, before any job runs (a folder in the index's way would otherwise fail
+    // the run after every job), and nothing created yet: a refused batch leaves no folder.
+    crate::export::check_folder(out)?;
+    crate::export::check_target(&out.join(index_file_name(shard)))?;
+    let (mine, resolved): (Vec<&'a Job>, Vec<Resolved>) =
+        jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
+    let mut estimates = Vec::new();
+    for (job, r) in mine.iter().zip(&resolved) {
+        if !r.done && r.outcome.duplicate_of.is_none() {
+            // A size refused (too tall, too large for memory) at the job's `sizes`; its output
+            // at the job (the folder's name comes from all its keys).
+            let planned = |line: Option<usize>, source: Error| BatchError::Planned {
+                path: jobs_file.into(),
+                line: line.or(job.lines.preset),
+                job: job.table,
+                preset: job.preset.clone(),
+                source: Box::new(source),
+            };
+            let plan = Plan::new(&request(job, out, &r.outcome)).map_err(|e| planned(job.lines.sizes, e))?;
+            // Its folder and files, as `Plan::run` checks them, but before any job has
+            // written its set: a folder in a later job's way stopped the run after the
+            // earlier jobs' sets were written.
+            plan.check_outputs().map_err(|e| planned(job.lines.preset, e.into()))?;
+            estimates.push(plan.memory().estimate_bytes);
+        }
+    }
+    Ok(Planned { mine, resolved, estimates })
 }
 
 /// Sets the flag when the thread unwinds (`run`'s workers).

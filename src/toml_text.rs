@@ -41,6 +41,15 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
     {
         message = message.replacen("invalid type: table", "invalid type: a date or time", 1);
     }
+    let mut at = span.as_ref().map(|s| s.start);
+    if message == "recursion limit" || message.starts_with("cannot recurse further") {
+        message = format!(
+            "keys, tables or arrays nested more than {TOML_NESTING_LIMIT} levels deep (no key of a preset or jobs file \
+             is nested more than a few)"
+        );
+        // The parser gives a dotted key's depth no span: find the line that is that deep.
+        at = at.or_else(|| too_deep_line(text));
+    }
     let mut key = None;
     if message.contains("duplicate key") {
         if !message.contains('`') {
@@ -53,7 +62,25 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
     } else if !message.starts_with("unknown key") {
         key = span.clone().and_then(|s| key_at(text, s.start));
     }
-    Described { line_column: span.map(|s| line_column(text, s.start)), key, message }
+    Described { line_column: at.map(|offset| line_column(text, offset)), key, message }
+}
+
+/// How deep the TOML reader nests keys, tables and arrays before it refuses a file: the
+/// `LIMIT` of toml 0.9's parser (`de/parser/mod.rs`).
+const TOML_NESTING_LIMIT: usize = 80;
+
+/// The offset of the first line whose key has at least `TOML_NESTING_LIMIT` dotted parts
+/// (quoted dots counted too: a close enough guess for a line the reader gave none).
+fn too_deep_line(text: &str) -> Option<usize> {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let key = line.split('=').next().unwrap_or(line);
+        if key.matches('.').count() + 1 >= TOML_NESTING_LIMIT {
+            return Some(offset);
+        }
+        offset += line.len();
+    }
+    None
 }
 
 /// serde's message in a reader's words: "unknown field" with the nearest accepted key, and
@@ -256,6 +283,31 @@ mod tests {
                 described.message
             );
         }
+    }
+
+    /// Nesting past the reader's limit was "recursion limit" with no line for a dotted key,
+    /// and "cannot recurse further" for arrays. Negative control: just under the limit.
+    #[test]
+    fn nesting_too_deep_is_named_with_its_line() {
+        let dotted = |depth: usize| vec!["a"; depth].join(".");
+        let arrays = |depth: usize| format!("{}{}", "[".repeat(depth), "]".repeat(depth));
+        let cases = [
+            (format!("seed = 1\n[{}]\n", dotted(200)), 2),
+            (format!("seed = 1\n\n{} = 1\n", dotted(100)), 3),
+            (format!("seed = 1\na = {}\n", arrays(200)), 2),
+        ];
+        for (text, line) in &cases {
+            let error = toml::from_str::<toml::Table>(text).unwrap_err();
+            let described = describe(text, &error);
+            assert!(
+                described.message.starts_with("keys, tables or arrays nested more than 80"),
+                "{}",
+                described.message
+            );
+            assert_eq!(described.line_column.map(|(l, _)| l), Some(*line), "{}", described.message);
+        }
+        let shallow = format!("[{}]\n", dotted(TOML_NESTING_LIMIT - 1));
+        assert!(toml::from_str::<toml::Table>(&shallow).is_ok());
     }
 
     /// A byte-order mark is not a column: `seed` after one was reported a column late.

@@ -230,6 +230,11 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
         assert_eq!(out.status.code(), Some(2), "{table}: {}", stderr(&out));
         assert!(stderr(&out).contains(says), "{table}: {}", stderr(&out));
         assert!(manifests(&empty).is_empty(), "{table}: a set was written before the bad job was found");
+        // `--list` refuses what a run would refuse (a job refused when planned was listed
+        // "to do").
+        let listed = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--list"]);
+        assert_eq!(listed.status.code(), Some(2), "{table}: {}", stdout(&listed));
+        assert!(stderr(&listed).contains(says), "{table}: {}", stderr(&listed));
     }
     // More memory than there is: the job's size, not `--size`.
     std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n[[job]]\npreset = \"boa-constrictor\"\nsizes = [4096]\nformat = \"exr\"\n").unwrap();
@@ -251,6 +256,9 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert!(stderr(&out).contains("jobs.toml:2: job 1 (natrix-natrix): cannot write"), "{}", stderr(&out));
     assert!(stderr(&out).contains("a folder is in the way"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "the first job's set was written before the folder was found");
+    let listed = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--list"]);
+    assert_eq!(listed.status.code(), Some(2), "{}", stdout(&listed));
+    assert!(stderr(&listed).contains("a folder is in the way"), "{}", stderr(&listed));
     assert!(in_the_way.is_dir() && std::fs::read_dir(&in_the_way).unwrap().next().is_none());
 }
 
@@ -291,9 +299,18 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     )
     .unwrap();
     let out_dir = dir.path().join("out");
+    // `--list` names each job's state and writes nothing; after the run the three are done.
+    let list = |jobs: &Path, out_dir: &Path| {
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--list"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out).lines().map(|l| l.split_whitespace().nth(1).unwrap_or("").to_string()).collect::<Vec<_>>()
+    };
+    assert_eq!(list(&jobs, &out_dir), ["to", "to", "to", "duplicate"]);
+    assert!(!out_dir.exists(), "--list wrote its output folder");
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stdout(&out).contains("3 run, 0 already done, 1 duplicates"), "{}", stdout(&out));
+    assert_eq!(list(&jobs, &out_dir), ["done", "done", "done", "duplicate"]);
     let sets = manifests(&out_dir);
     assert_eq!(sets.len(), 3, "{sets:?}");
     // Each set is complete and is its own job's (a set overwritten by another job's maps

@@ -126,6 +126,41 @@ pub enum Command {
     },
 }
 
+impl Cli {
+    /// The command line parsed, or clap's error (exit code 2): `Cli::try_parse_from` after
+    /// one check of ours. A flag whose value may start with `-` (`--wi -1,0,1`) takes the
+    /// next word whatever it is, so `--absorption --wo 0,0,1` read `--wo` as the absorption
+    /// and then called `0,0,1` an unexpected argument: one of the command's flags right
+    /// after such a flag is refused as its missing value.
+    pub fn try_parse_checked_from(args: Vec<std::ffi::OsString>) -> Result<Cli, clap::Error> {
+        use clap::CommandFactory;
+        let mut command = Cli::command();
+        let mut takes_hyphen_values = std::collections::HashSet::new();
+        let mut flags = std::collections::HashSet::new();
+        let mut commands = vec![&command];
+        while let Some(c) = commands.pop() {
+            for arg in c.get_arguments() {
+                if let Some(long) = arg.get_long() {
+                    flags.insert(format!("--{long}"));
+                    if arg.is_allow_hyphen_values_set() {
+                        takes_hyphen_values.insert(format!("--{long}"));
+                    }
+                }
+            }
+            commands.extend(c.get_subcommands());
+        }
+        let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
+        for pair in words.windows(2) {
+            let next_flag = pair[1].split('=').next().unwrap_or("");
+            if takes_hyphen_values.contains(pair[0]) && flags.contains(next_flag) {
+                let message = format!("`{}` needs a value, and the next word is the flag `{}`\n", pair[0], pair[1]);
+                return Err(clap::Error::raw(clap::error::ErrorKind::InvalidValue, message).format(&mut command));
+            }
+        }
+        Cli::try_parse_from(args)
+    }
+}
+
 /// Which preset, with which edits: shared by every command that reads one.
 #[derive(Debug, Args)]
 pub struct PresetSource {
@@ -851,5 +886,26 @@ mod tests {
             Cli::try_parse_from(["snakeskin", "brdf", "eval", "--wi", "0,0,1", "--wo", "0,0,1", "--absorption", "0.5"]);
         let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.unwrap().command else { panic!() };
         assert_ne!(args.layer.absorption, [thesis::ABSORPTION; 3]);
+    }
+
+    /// A flag with a missing value took the next flag for it: `--absorption --wo 0,0,1` was
+    /// "unexpected argument '0,0,1'". Negative control: a vector that starts with `-`.
+    #[test]
+    fn a_flag_is_not_taken_for_a_missing_value() {
+        let eval = |args: &[&str]| {
+            let words = ["snakeskin", "brdf", "eval"].iter().chain(args).map(|w| w.into()).collect();
+            Cli::try_parse_checked_from(words)
+        };
+        for (args, flag) in [
+            (&["--wi", "0,0,1", "--absorption", "--wo", "0,0,1"][..], "--wo"),
+            (&["--wo", "0,0,1", "--wi", "--albedo", "0.5"][..], "--albedo"),
+            (&["--wi", "0,0,1", "--wo", "0,0,1", "--normal", "--model", "thesis"][..], "--model"),
+        ] {
+            let message = eval(args).unwrap_err().to_string();
+            assert!(message.contains(&format!("needs a value, and the next word is the flag `{flag}")), "{message}");
+        }
+        let cli = eval(&["--wi", "-0.5,0,1", "--wo", "0,-1,1", "--normal", "-0,0,1"]).unwrap();
+        let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.command else { panic!("parsed as brdf eval") };
+        assert_eq!((args.wi, args.wo), ([-0.5, 0.0, 1.0], [0.0, -1.0, 1.0]));
     }
 }

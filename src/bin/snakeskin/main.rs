@@ -10,15 +10,13 @@ mod progress;
 
 use std::process::ExitCode;
 
-use clap::Parser;
-
 fn main() -> ExitCode {
     output::restore_default_sigpipe();
     output::stdout_failure_is_an_error();
     output::quiet_vulkan_device_select();
     // Spawns a thread: after the calls above, which need the process single-threaded.
     output::clean_up_on_interrupt();
-    let cli = cli::Cli::parse();
+    let cli = cli::Cli::try_parse_checked_from(std::env::args_os().collect()).unwrap_or_else(|e| e.exit());
     match cmd::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
