@@ -39,6 +39,11 @@ fn generate_writes_five_maps_in_their_formats_and_a_manifest() {
         let image = ImageReader::open(&path).unwrap().decode().unwrap();
         assert_eq!(image.color(), color_type, "{map}");
         assert_eq!((image.width(), image.height()), (256, 256), "{map}");
+        // Colour is tagged sRGB (the colour map was untagged while the packs' base colour
+        // was tagged); data maps carry no colour-space chunk.
+        let chunks = png_chunk_types(&std::fs::read(&path).unwrap());
+        assert_eq!(chunks.iter().any(|c| c == "sRGB"), map == "color", "{map}: {chunks:?}");
+        assert!(!chunks.iter().any(|c| ["gAMA", "iCCP", "cICP", "cHRM"].contains(&c.as_str())), "{map}: {chunks:?}");
     }
     let files = snapshot(dir.path());
     assert_eq!(files.len(), 6, "five maps and a manifest: {:?}", files.keys());
@@ -59,6 +64,19 @@ fn generate_writes_five_maps_in_their_formats_and_a_manifest() {
     // No source reports iridescence for this species: no film, an empty range.
     assert_eq!((min_nm, max_nm), (0.0, 0.0));
     assert_eq!(manifest["optics"]["film_ior"], 1.55);
+}
+
+/// The chunk types of a PNG file in order, read from its bytes (length, type, data, CRC).
+fn png_chunk_types(bytes: &[u8]) -> Vec<String> {
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "a PNG signature");
+    let mut types = Vec::new();
+    let mut at = 8;
+    while at + 8 <= bytes.len() {
+        let length = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        types.push(String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned());
+        at += 12 + length;
+    }
+    types
 }
 
 #[test]

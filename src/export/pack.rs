@@ -13,7 +13,7 @@ use std::ops::Range;
 use crate::material::MapKind;
 use crate::ops::Image;
 
-use super::{ExportError, SharedBuffer, linear_to_srgb8, unit_to_u8, unit_to_u16};
+use super::{ExportError, SharedBuffer, linear_to_srgb8, png_file_encoder, unit_to_u8, unit_to_u16};
 
 /// How one channel of a packed texture is made from a map's linear sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -257,19 +257,7 @@ impl TextureEncoder {
     pub fn new(spec: TextureSpec, width: usize, height: usize) -> Result<TextureEncoder, ExportError> {
         let error = |e: png::EncodingError| ExportError::Pack { texture: spec.suffix, message: e.to_string() };
         let buffer = SharedBuffer::default();
-        let mut encoder = png::Encoder::new(buffer.clone(), width as u32, height as u32);
-        encoder.set_color(match spec.channels.len() {
-            1 => png::ColorType::Grayscale,
-            3 => png::ColorType::Rgb,
-            4 => png::ColorType::Rgba,
-            n => unreachable!("a packed texture has 1, 3 or 4 channels, not {n}"),
-        });
-        encoder.set_depth(if spec.bit_depth == 16 { png::BitDepth::Sixteen } else { png::BitDepth::Eight });
-        if spec.srgb {
-            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        }
-        encoder.set_compression(png::Compression::Fast);
-        encoder.set_filter(png::Filter::Adaptive);
+        let encoder = png_file_encoder(buffer.clone(), width, height, spec.channels.len(), spec.bit_depth, spec.srgb);
         let writer = encoder.write_header().map_err(error)?.into_stream_writer().map_err(error)?;
         Ok(TextureEncoder { spec, writer, buffer })
     }
