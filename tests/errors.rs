@@ -192,6 +192,24 @@ fn keys_of_another_kind_are_refused_not_ignored() {
         let err = refused("kinds.toml", &format!("{layer}{extra}\n"), &[]);
         assert!(err.contains(&format!("kinds.toml:4: {says}")), "{extra}: {err}");
     }
+    // A solid tint has no size and no edges; a stripe has no centre, nor a shape.
+    let marked = "\"stripes\", \"rings\", \"spots\", \"blotches\" and \"irregular\"";
+    for (kind, extra, says) in [
+        ("solid", "size = 0.4", format!("`pattern.0.size` is read by kind {marked} only, not \"solid\"")),
+        ("solid", "edge_distortion = 0.9", format!("`pattern.0.edge_distortion` is read by kind {marked} only")),
+        (
+            "stripes",
+            "center_size = 0.2",
+            "`pattern.0.center_size` is read by kind \"spots\" and \"blotches\" only".into(),
+        ),
+        // These two said "must be one of round for kind ..." and "must be [first, last] ...
+        // for kind "stripes" only; got [2.0, 3.0]", as if the value were wrong.
+        ("stripes", "shape = \"ring\"", "`pattern.0.shape` is read by kind \"spots\" and \"blotches\" only".into()),
+        ("spots", "rows = [2, 3]", "`pattern.0.rows` is read by kind \"stripes\" only, not \"spots\"".into()),
+    ] {
+        let err = refused("kinds.toml", &format!("{}{extra}\n", layer.replace("spots", kind)), &[]);
+        assert!(err.contains(&format!("kinds.toml:4: key {says}")), "{extra}: {err}");
+    }
     // Negative controls: a default value, and the key on its own kind; and a kind changed
     // by `--set` (README's example), where the file's keys for its old kind are passed over
     // (built-ins were refused: bitis-arietans's blotch `length`, `shape` and `count` on spots).

@@ -1176,7 +1176,7 @@ fn a_preset_of_thousands_of_bad_marks_is_refused_at_once() {
     let out = finished_within(child, 60, "20,000 bad head marks took over 60 s to refuse");
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(
-        stderr(&out).contains("marks.toml:2: key `body.head_mark` at most 16 head marks, got 20000"),
+        stderr(&out).contains("marks.toml:2: key `body.head_mark` may list at most 16 head marks, got 20000"),
         "{}",
         stderr(&out)
     );

@@ -397,13 +397,13 @@ impl PatternLayer {
     fn default_amount() -> f64 {
         1.0
     }
-    fn default_size() -> f64 {
+    pub(crate) fn default_size() -> f64 {
         0.05
     }
     fn default_outline_color() -> Srgb8 {
         Srgb8([0x14, 0x12, 0x10])
     }
-    fn default_edge_distortion() -> f64 {
+    pub(crate) fn default_edge_distortion() -> f64 {
         0.2
     }
     fn default_opacity() -> f64 {
@@ -412,7 +412,7 @@ impl PatternLayer {
     pub(crate) fn default_noise() -> NoiseChoice {
         NoiseChoice::Perlin
     }
-    fn default_center_size() -> f64 {
+    pub(crate) fn default_center_size() -> f64 {
         0.5
     }
     fn default_border_size() -> f64 {
@@ -424,7 +424,7 @@ impl PatternLayer {
     pub(crate) fn default_length() -> f64 {
         0.6
     }
-    fn default_shape() -> PatternShape {
+    pub(crate) fn default_shape() -> PatternShape {
         PatternShape::Round
     }
     pub(crate) fn default_arrangement() -> Arrangement {

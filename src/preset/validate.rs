@@ -155,7 +155,8 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                 PatternShape::Hourglass,
                 PatternShape::Zigzag,
             ],
-            _ => &[PatternShape::Round],
+            // Another kind reads no shape: `kinds_only` below says so.
+            _ => &[PatternShape::Round, p.shape],
         };
         if !shapes.contains(&p.shape) && !from_file_for_old_kind(i, "shape") {
             let names: Vec<String> = shapes.iter().map(spelled).collect();
@@ -164,12 +165,19 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                 message: format!("must be one of {} for kind \"{}\"", names.join(", "), spelled(&p.kind)),
             });
         }
-        // Keys one kind or two read, set away from their defaults on a kind that ignores
-        // them (`colors` on spots, `phase` on stripes were silently dropped; `shape`,
-        // `count` and `rows` were refused already). A default value changes nothing.
+        // Keys some kinds read, set away from their defaults on a kind that ignores them
+        // (`colors` on spots, `phase` on stripes, `size` on solid, `center_size` on stripes
+        // were silently dropped; `shape`, `count` and `rows` were refused already). A
+        // default value changes nothing.
         let k = p.kind;
         use PatternKind::{Blotches, Irregular, Rings, Spots, Stripes};
-        let kinds_only: [(&str, bool, &[PatternKind]); 10] = [
+        let marked = &[Stripes, Rings, Spots, Blotches, Irregular][..];
+        let kinds_only: [(&str, bool, &[PatternKind]); 15] = [
+            ("shape", p.shape != PatternLayer::default_shape(), &[Spots, Blotches]),
+            ("rows", !p.rows.is_empty(), &[Stripes]),
+            ("size", p.size != PatternLayer::default_size(), marked),
+            ("edge_distortion", p.edge_distortion != PatternLayer::default_edge_distortion(), marked),
+            ("center_size", p.center_size != PatternLayer::default_center_size(), &[Spots, Blotches]),
             ("colors", !p.colors.is_empty(), &[Rings]),
             ("widths", !p.widths.is_empty(), &[Rings]),
             ("noise", p.noise != PatternLayer::default_noise(), &[Irregular]),
@@ -184,11 +192,12 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         for (field, set, kinds) in kinds_only {
             if set && !kinds.contains(&k) && !from_file_for_old_kind(i, field) {
                 let names: Vec<String> = kinds.iter().map(|k| format!("\"{}\"", spelled(k))).collect();
+                let (last, rest) = names.split_last().expect("a key some kind reads");
+                let names = if rest.is_empty() { last.clone() } else { format!("{} and {last}", rest.join(", ")) };
                 c.problems.push(Problem {
                     key: key(field),
                     message: format!(
-                        "is read by kind {} only, not \"{}\"; leave it out of this layer",
-                        names.join(" and "),
+                        "is read by kind {names} only, not \"{}\"; leave it out of this layer",
                         spelled(&k)
                     ),
                 });
@@ -214,10 +223,9 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         c.range(key("phase"), p.phase, UNIT);
         c.range(key("center_size"), p.center_size, CENTER_SIZE);
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
-        if !p.rows.is_empty() {
+        if !p.rows.is_empty() && p.kind == PatternKind::Stripes {
             let top = (preset.scales.rows as f64 + 1.0) / 2.0;
-            let ok = (p.kind == PatternKind::Stripes || from_file_for_old_kind(i, "rows"))
-                && p.rows.len() == 2
+            let ok = p.rows.len() == 2
                 && p.rows.iter().all(|r| r.is_finite())
                 && 0.5 <= p.rows[0]
                 && p.rows[0] <= p.rows[1]
@@ -227,7 +235,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                     key: key("rows"),
                     message: format!(
                         "must be [first, last] dorsal rows with 0.5 ≤ first ≤ last ≤ {top} (the vertebral row of \
-                         {} rows), for kind \"stripes\" only; got {}",
+                         {} rows); got {}",
                         preset.scales.rows,
                         // A long list is counted, not echoed back whole.
                         if p.rows.len() <= 4 { format!("{:?}", p.rows) } else { format!("{} entries", p.rows.len()) }
@@ -301,7 +309,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
     if b.head_mark.len() > MAX_HEAD_MARKS {
         c.problems.push(Problem {
             key: "body.head_mark".into(),
-            message: format!("at most {MAX_HEAD_MARKS} head marks, got {}", b.head_mark.len()),
+            message: format!("may list at most {MAX_HEAD_MARKS} head marks, got {}", b.head_mark.len()),
         });
     } else {
         // Not one by one past the limit: thousands of marks buried the message (and took

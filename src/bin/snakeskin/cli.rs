@@ -584,7 +584,9 @@ pub struct LayerArgs {
     /// Perceptual roughness (GGX α = roughness²), 0 to 1.
     #[arg(long, default_value_t = 0.35, value_parser = parse_unit, allow_negative_numbers = true)]
     pub roughness: f64,
-    /// Absorption coefficient σ0 (one value, or r,g,b), each 0 to 100.
+    /// Absorption coefficient σ0 (one value, or r,g,b), each 0 to 100. The default is the
+    /// thesis' 0.6, as every default here is the thesis' value; a preset's
+    /// `optics.absorption` defaults to 0 (give --absorption 0 to match it).
     // The default is thesis::ABSORPTION written out (clap needs text for an array); the
     // test `brdf_eval_defaults_are_the_thesis_values` ties the two.
     #[arg(long, value_parser = parse_absorption, default_value = "0.6", allow_hyphen_values = true)]
