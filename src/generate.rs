@@ -580,7 +580,8 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
         let rows = STRIP_WIDTHS * width;
         return Some(Strips { count: height.div_ceil(rows), rows, margin });
     }
-    let set_budget = std::env::var("SNAKESKIN_TILE_BUDGET_MIB").ok().and_then(|v| v.trim().parse::<u64>().ok());
+    // A malformed value is refused at the command line's start.
+    let set_budget = crate::memory::tile_budget_from_env().ok().flatten();
     let buffers = |rows: usize| crate::graph::estimate_peak_bytes(graph, maps, width, rows);
     // With the normal node, though a tile evaluated whole goes without it (`whole_tile_maps`):
     // the budget was measured with it, and without it the two species in strips at 4096²

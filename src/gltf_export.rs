@@ -60,9 +60,9 @@ pub struct ExportReport {
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
 fn is_binary(path: &Path) -> Result<bool, Error> {
     let text = path.to_string_lossy();
-    if text.ends_with('/') || text.ends_with(std::path::MAIN_SEPARATOR) {
+    if crate::export::ends_as_a_folder(path) {
         return Err(Error::Unsupported(format!(
-            "--gltf {text}: names a folder (it ends in a slash); give a file name"
+            "--gltf {text}: names a folder (it ends in a slash or a dot); give a file name"
         )));
     }
     // `.glb` alone: a name that is all extension (`Path::extension` sees none).

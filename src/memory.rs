@@ -93,12 +93,22 @@ pub const LIMIT_VARIABLE: &str = "SNAKESKIN_MEMORY_LIMIT_MIB";
 /// The user's cap (`LIMIT_VARIABLE`) in MiB, None when unset; a value that is not a whole
 /// number of MiB is an error, not a silently disabled check.
 pub fn limit_from_env() -> Result<Option<u64>, Error> {
-    let invalid = |value: String| Error::Environment {
-        variable: LIMIT_VARIABLE,
-        value,
-        accepted: "a whole number of MiB, e.g. 4096",
-    };
-    match std::env::var(LIMIT_VARIABLE) {
+    mib_from_env(LIMIT_VARIABLE)
+}
+
+/// The environment variable that replaces `generate`'s strip budgets, in MiB (how tests
+/// send small tiles through strips; `generate::strips_of`).
+pub const TILE_BUDGET_VARIABLE: &str = "SNAKESKIN_TILE_BUDGET_MIB";
+
+/// `TILE_BUDGET_VARIABLE` in MiB, None when unset; a malformed value is an error (it was
+/// silently ignored, while the memory limit's was refused).
+pub fn tile_budget_from_env() -> Result<Option<u64>, Error> {
+    mib_from_env(TILE_BUDGET_VARIABLE)
+}
+
+fn mib_from_env(variable: &'static str) -> Result<Option<u64>, Error> {
+    let invalid = |value: String| Error::Environment { variable, value, accepted: "a whole number of MiB, e.g. 4096" };
+    match std::env::var(variable) {
         Err(std::env::VarError::NotPresent) => Ok(None),
         Err(std::env::VarError::NotUnicode(v)) => Err(invalid(v.to_string_lossy().into_owned())),
         Ok(v) => v.trim().parse::<u64>().map(Some).map_err(|_| invalid(v)),

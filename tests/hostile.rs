@@ -100,19 +100,20 @@ fn an_oversized_benchmark_grid_is_refused() {
 
 /// The memory cap's variable is read as a whole number of MiB or refused: a typo must not
 /// switch the check off. Negative control: a valid cap still refuses the oversized set.
+/// The strip budget's variable too (it was silently ignored).
 #[test]
 fn a_malformed_memory_cap_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let o = dir.path().join("out");
-    for value in ["1M", "1.5", "-5", "abc", ""] {
-        let out = snakeskin_env(
-            &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "32"],
-            &[("SNAKESKIN_MEMORY_LIMIT_MIB", value)],
-        );
-        assert_eq!(out.status.code(), Some(2), "{value:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains("invalid SNAKESKIN_MEMORY_LIMIT_MIB="), "{}", stderr(&out));
-        assert!(stderr(&out).contains("a whole number of MiB"), "{}", stderr(&out));
-        assert!(!o.exists(), "{value:?}: nothing may be written");
+    for variable in ["SNAKESKIN_MEMORY_LIMIT_MIB", "SNAKESKIN_TILE_BUDGET_MIB"] {
+        for value in ["1M", "1.5", "-5", "abc", ""] {
+            let out =
+                snakeskin_env(&["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "32"], &[(variable, value)]);
+            assert_eq!(out.status.code(), Some(2), "{value:?}: {}", stderr(&out));
+            assert!(stderr(&out).contains(&format!("invalid {variable}=")), "{}", stderr(&out));
+            assert!(stderr(&out).contains("a whole number of MiB"), "{}", stderr(&out));
+            assert!(!o.exists(), "{value:?}: nothing may be written");
+        }
     }
     let out = snakeskin_env(
         &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "8192"],
@@ -947,10 +948,76 @@ fn a_preview_memory_cannot_hold_is_refused() {
     let args = ["preview", PRESET, "--out", image.to_str().unwrap(), "--size", "64x64", "--layout", "body"];
     let out = snakeskin_env(&[&args[..], &["--map-size", "4096"]].concat(), &limit);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("the preview's set of maps (682×8184) needs about"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the preview's frame and its maps (682×8184 maps) needs about"), "{}", stderr(&out));
     assert!(!image.exists());
     let out = snakeskin_env(&[&args[..], &["--map-size", "64"]].concat(), &limit);
     assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
+    // The frame counts too: an 8192² frame of 64² maps took 4.9 GB under this limit (and,
+    // under `ulimit -v`, ended in wgpu's panic). Refused before its folder is made.
+    let image = dir.path().join("new/p.png");
+    let out = snakeskin_env(
+        &["preview", PRESET, "--out", image.to_str().unwrap(), "--size", "8192x8192", "--map-size", "64"],
+        &limit,
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the preview's frame and its maps (64×64 maps) needs about"), "{}", stderr(&out));
+    assert!(!dir.path().join("new").exists(), "a folder was made for a refused preview");
+}
+
+/// `gallery` had no memory check (a 64-column gallery of 2048-pixel tiles took 4.8 GB, or
+/// aborted under `ulimit -v`), and `-o g.png --closeups g.png` made a folder `g.png`, then
+/// refused it as a folder in the gallery's way. Both refused first, nothing made; the
+/// columns past the last variant are not drawn. Negative control: a small gallery is
+/// refused only for the tiny limit, after its names.
+#[test]
+fn gallery_sizes_and_names_are_checked_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("new/g.png");
+    let f = file.to_str().unwrap();
+    let limit = [("SNAKESKIN_MEMORY_LIMIT_MIB", "100")];
+    let out = snakeskin_env(&["gallery", "-o", f, "--tile", "2048", "--columns", "64"], &limit);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    // 31 variants on one row: 31 tiles and 32 gaps wide, not 64 tiles.
+    assert!(stderr(&out).contains("a gallery of 63616×2056 pixels"), "{}", stderr(&out));
+    let out = snakeskin(&["gallery", "-o", f, "--closeups", f, "--tile", "16"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("-o and --closeups name one path"), "{}", stderr(&out));
+    assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was made");
+    let out = snakeskin_env(&["gallery", "-o", f, "--tile", "16"], &[("SNAKESKIN_MEMORY_LIMIT_MIB", "0")]);
+    assert!(
+        stderr(&out).contains("a gallery of 124×124 pixels") && stderr(&out).contains("needs about"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// Output file names `preview` refuses before any work (neither needs a GPU): the same file
+/// for the render and the heat map (the heat map replaced the render, printed as written),
+/// and a name that ends as a folder's (the render failed after the work with "Not a
+/// directory", exit 1). Negative control: the same options with a file name get past both.
+#[test]
+fn preview_output_names_are_checked_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let preview = |extra: &[&str]| {
+        let args = ["preview", PRESET, "--size", "64x40", "--map-size", "64", "--close-up"];
+        snakeskin_env(&[&args[..], extra].concat(), &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1")])
+    };
+    let same = at("same.png");
+    for (extra, says) in [
+        (vec!["--out", &same, "--reference", &same], "--out and --reference name one file".to_string()),
+        (vec!["--out", &format!("{}/", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
+        (vec!["--out", &format!("{}/.", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
+        (vec!["--out", &same, "--reference", &format!("{}/", at("heat"))], "names a folder".into()),
+    ] {
+        let out = preview(&extra);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(&says), "{extra:?}: {}", stderr(&out));
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "{extra:?}: something was written");
+    }
+    // Past the names, the (tiny) memory limit refuses it: nothing about the names.
+    let out = preview(&["--out", &same, "--reference", &at("heat.png")]);
+    assert!(stderr(&out).contains("needs about"), "{}", stderr(&out));
 }
 
 /// `sheet` checks its options, species and memory before it makes a renderer (parse, then

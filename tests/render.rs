@@ -299,6 +299,18 @@ fn preview_writes_a_png_and_rejects_bad_options() {
         assert!(common::stderr(&run).contains(needle), "{full:?}: {}", common::stderr(&run));
     }
     assert_eq!(std::fs::read(&out).unwrap(), before, "a failed run touched the earlier output");
+    // The reference check's G-buffer is read back in one buffer: past the device's largest
+    // (256 MiB) wgpu panicked (exit 101), after the render was written. Refused before it.
+    let heat = dir.path().join("heat.png");
+    let (h, size) = (heat.to_str().unwrap(), "4112x4096");
+    let run = snakeskin(&["preview", PRESET, "--out", o, "--map-size", "64", "--size", size, "--reference", h]);
+    assert_eq!(run.status.code(), Some(1), "{}", common::stderr(&run));
+    assert!(
+        common::stderr(&run).contains("needs 257 MiB in one buffer, over the device's"),
+        "{}",
+        common::stderr(&run)
+    );
+    assert_eq!(std::fs::read(&out).unwrap(), before, "the render was written before the refusal");
 }
 
 #[test]

@@ -167,6 +167,9 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
 /// (`ExportError::NotAFile`).
 /// Public so that a command can check an output file before the work that makes it.
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
+    if ends_as_a_folder(target) {
+        return Err(ExportError::FolderName { path: target.into() });
+    }
     let Ok(meta) = fs::symlink_metadata(target) else {
         return Ok(());
     };
@@ -178,6 +181,15 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
         return Ok(());
     }
     Err(ExportError::NotAFile { path: target.into(), kind: crate::text_file::file_kind(&file_type) })
+}
+
+/// Whether a path's text ends as only a folder's can: in a separator, `.` or `..` (or is
+/// empty). `Path` drops a trailing separator and `.` (`out/` and `out/.` have the file name
+/// `out`), so this reads the text.
+pub fn ends_as_a_folder(path: &Path) -> bool {
+    let text = path.as_os_str().as_encoded_bytes();
+    let last = text.rsplit(|&b| b == b'/' || std::path::is_separator(b as char)).next().unwrap_or(b"");
+    matches!(last, b"" | b"." | b"..")
 }
 
 /// Creates an output folder if needed (true when it was created); a path that exists and is

@@ -11,7 +11,8 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder, sha256_hex, write_file_atomically,
+    SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder, ends_as_a_folder, sha256_hex,
+    write_file_atomically,
 };
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
@@ -36,8 +37,12 @@ pub enum ExportError {
          finished, or write to another folder"
     )]
     Busy { dir: PathBuf, name: String },
-    #[error("{path} exists and is not a folder; the output option takes the folder to write into")]
+    #[error("{path} exists and is not a folder, so nothing can be written into it; give a folder (or a file in one)")]
     NotAFolder { path: PathBuf },
+    /// An output file's path that ends as a folder's does (`out/`, `out/.`): it was written
+    /// to after the work and failed with "Not a directory".
+    #[error("{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.png")]
+    FolderName { path: PathBuf },
     #[error(
         "{path} is {kind}, not a regular file: snakeskin writes an output whole and renames it over the old one, \
          which would replace it; give the path of a regular file (or of none)"
@@ -70,6 +75,7 @@ impl ExportError {
             ExportError::NotAFolder { .. }
                 | ExportError::NotAFile { .. }
                 | ExportError::FolderInTheWay { .. }
+                | ExportError::FolderName { .. }
                 | ExportError::BrokenLink { .. }
         )
     }

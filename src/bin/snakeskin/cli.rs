@@ -335,7 +335,8 @@ pub struct PreviewArgs {
     pub out: Option<PathBuf>,
     /// Open a window: drag to orbit, wheel to zoom, sliders for the optics; the preset file
     /// is watched and reloaded on save.
-    #[arg(long)]
+    // Not with --out or --reference: the window wrote neither, silently.
+    #[arg(long, conflicts_with_all = ["out", "reference"])]
     pub window: bool,
     /// Image or window size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_image_size)]
@@ -362,10 +363,12 @@ pub struct PreviewArgs {
     #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
     pub layout: LayoutArg,
     /// With --window: render N frames, print the mean frame time and exit.
-    #[arg(long, value_name = "N")]
+    // (`requires = "window"` is met by a bool flag's default: refused with the headless
+    // outputs instead, the one way to run without a window.)
+    #[arg(long, value_name = "N", conflicts_with_all = ["out", "reference"])]
     pub frames: Option<u32>,
-    /// Exposure multiplier before tone mapping (Khronos PBR Neutral), > 0 and at most 1000.
-    #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
+    /// Exposure multiplier before tone mapping (Khronos PBR Neutral), 1e-6 to 1000.
+    #[arg(long, default_value_t = 1.0, value_parser = parse_exposure, allow_negative_numbers = true)]
     pub exposure: f32,
     /// Number of snakes (instanced in a grid).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=400))]
@@ -683,8 +686,11 @@ pub enum BenchCommand {
     /// The BRDF (LUT film) per million evaluations: WGSL compute shader on the GPU and the
     /// Rust f32 twin on one CPU core, side by side in one run.
     Gpu {
-        /// Evaluations per dispatch.
-        #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1000..=16_000_000))]
+        /// Evaluations per dispatch, 1000 to 1,000,000.
+        // The bound is the GPU's, not the bench's: the samples (112 bytes each) are one
+        // storage binding, at most 128 MiB under the limits the device is opened with
+        // (1,198,372 samples); above it wgpu panicked with a validation error.
+        #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1000..=1_000_000))]
         samples: u64,
         /// Layer model to evaluate: layered (default) or thesis.
         #[arg(long, default_value = "layered", value_parser = parse_model)]
@@ -756,7 +762,13 @@ pub struct ImageSize {
 
 fn parse_image_size(text: &str) -> Result<ImageSize, String> {
     let range = snakeskin::render::engine::prepare::IMAGE_RANGE;
-    let bad = || format!("expected WIDTHxHEIGHT (e.g. 1280x720), each {} to {} pixels", range.start(), range.end());
+    let bad = || {
+        format!(
+            "expected WIDTHxHEIGHT (e.g. 1280x720) or one number for a square, each {} to {} pixels",
+            range.start(),
+            range.end()
+        )
+    };
     let (w, h) = match text.split_once(['x', 'X']) {
         Some((w, h)) => (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?),
         None => {
@@ -806,11 +818,9 @@ fn parse_pigment_thickness(text: &str) -> Result<f64, String> {
     bounded(text, ranges::PIGMENT_THICKNESS)
 }
 
+/// Above 0 in f32 too: 1e-50 passed a check of "> 0" and became 0 (a black frame).
 fn parse_exposure(text: &str) -> Result<f32, String> {
-    match bounded(text, (0.0, 1000.0)) {
-        Ok(v) if v > 0.0 => Ok(v as f32),
-        _ => Err("must be a finite number above 0 and at most 1000".into()),
-    }
+    bounded(text, (1e-6, 1000.0)).map(|v| v as f32).map_err(|_| "must be a finite number from 1e-6 to 1000".into())
 }
 
 fn parse_d_step_nm(text: &str) -> Result<f64, String> {
@@ -888,6 +898,30 @@ mod tests {
             Cli::try_parse_from(["snakeskin", "brdf", "eval", "--wi", "0,0,1", "--wo", "0,0,1", "--absorption", "0.5"]);
         let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.unwrap().command else { panic!() };
         assert_ne!(args.layer.absorption, [thesis::ABSORPTION; 3]);
+    }
+
+    /// Preview flags that did nothing were accepted: --frames without --window, --out and
+    /// --reference with it; --exposure -1 got clap's tip `-- -1` (which makes it the
+    /// preset) and 1e-50 became 0 in f32. Negative control: each flag where it acts.
+    #[test]
+    fn preview_flags_that_would_do_nothing_are_refused() {
+        let preview = |args: &[&str]| {
+            let words = ["snakeskin", "preview", "natrix-natrix"].iter().chain(args).map(|w| w.into()).collect();
+            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
+        };
+        for (args, says) in [
+            (&["--out", "a.png", "--frames", "5"][..], "cannot be used with"),
+            (&["--window", "--out", "a.png"], "cannot be used with"),
+            (&["--window", "--reference", "h.png"], "cannot be used with"),
+            (&["--out", "a.png", "--exposure", "-1"], "from 1e-6 to 1000"),
+            (&["--out", "a.png", "--exposure", "1e-50"], "from 1e-6 to 1000"),
+        ] {
+            let error = preview(args).expect_err(&format!("{args:?} was accepted"));
+            assert!(error.contains(says), "{args:?}: {error}");
+        }
+        for args in [&["--window", "--frames", "5"][..], &["--out", "a.png", "--exposure", "1e-6"]] {
+            preview(args).unwrap();
+        }
     }
 
     /// A flag with a missing value took the next flag for it: `--absorption --wo 0,0,1` was

@@ -159,10 +159,12 @@ pub fn path_line(path: &Path) -> String {
 /// Every command treats output paths alike: `generate -o DIR`, `preview --out`, `preview
 /// --reference`, `sheet -o` and the rest create missing folders with this note.
 pub fn ensure_parent_folder(file: &Path) -> anyhow::Result<()> {
+    // The file first: a refused name leaves no folder made for it.
+    snakeskin::export::check_target(file)?;
     if let Some(folder) = file.parent().filter(|p| !p.as_os_str().is_empty()) {
         ensure_folder(folder)?;
     }
-    Ok(snakeskin::export::check_target(file)?)
+    Ok(())
 }
 
 /// Creates an output folder when it is missing (`export::create_folder`), with a note on

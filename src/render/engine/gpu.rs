@@ -16,6 +16,12 @@ pub enum GpuError {
     Limits(String),
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    /// The device could not allocate what a frame or a dispatch needs.
+    #[error("the GPU ran out of memory {0}; use a smaller size")]
+    OutOfMemory(String),
+    /// A device error wgpu would otherwise have panicked on (its default handler).
+    #[error("the GPU refused {0}")]
+    Refused(String),
     /// A GPU timing that came out meaningless (not positive): noise swamped the work.
     #[error("GPU timing failed: {0}")]
     Timing(String),
@@ -67,6 +73,25 @@ impl Gpu {
         }))
         .map_err(|e| GpuError::Device(e.to_string()))?;
         Ok(Gpu { device, queue, info })
+    }
+
+    /// Runs `work` with the device's out-of-memory and validation errors caught as
+    /// `GpuError`s (`what` names the work in the message). Outside such a scope wgpu hands
+    /// them to its default handler, which panics: an 8192² frame under a memory limit
+    /// ended the process with exit code 101.
+    pub fn checked<T>(&self, what: &str, work: impl FnOnce() -> Result<T, GpuError>) -> Result<T, GpuError> {
+        let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let invalid = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let result = work();
+        // Popped in reverse order of their pushing.
+        let invalid = pollster::block_on(invalid.pop());
+        if let Some(e) = pollster::block_on(out_of_memory.pop()) {
+            return Err(GpuError::OutOfMemory(format!("{what} ({e})")));
+        }
+        if let Some(e) = invalid {
+            return Err(GpuError::Refused(format!("{what}: {e}")));
+        }
+        result
     }
 
     /// A short description of the adapter, for reports.

@@ -44,7 +44,7 @@ pub fn material_maps_in(loaded: &LoadedPreset, map_size: usize, layout: Layout) 
 pub fn check_memory(graph: &Graph, size: (usize, usize), extra_bytes: u64, what: &str) -> Result<(), Error> {
     let (width, height) = size;
     let estimate = estimate_generate_bytes(graph, &MapKind::ALL, width, height).saturating_add(extra_bytes);
-    MemoryCheck::against_available(estimate).refuse_if_over(&format!("{what} ({width}×{height})"))
+    MemoryCheck::against_available(estimate).refuse_if_over(&format!("{what} ({width}×{height} maps)"))
 }
 
 /// What `check_memory` calls the preview's maps.
@@ -52,9 +52,17 @@ const PREVIEW_MAPS: &str = "the preview's set of maps";
 
 /// `material_maps_in`'s memory check alone, for a command to run before it makes its
 /// renderer (so that a machine without a GPU hears about the memory first).
-pub fn check_preview_memory(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> Result<(), Error> {
+/// `frame_bytes` are the frame's own (`renderer::frame_bytes`), which an 8192² frame made
+/// 4.9 GB of when only the maps were counted.
+pub fn check_preview_memory(
+    loaded: &LoadedPreset,
+    map_size: usize,
+    layout: Layout,
+    frame_bytes: u64,
+) -> Result<(), Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
-    check_memory(&graph, map_dimensions(loaded, map_size, layout), 0, PREVIEW_MAPS)
+    let what = if frame_bytes > 0 { "the preview's frame and its maps" } else { PREVIEW_MAPS };
+    check_memory(&graph, map_dimensions(loaded, map_size, layout), frame_bytes, what)
 }
 
 /// Width and height of the preview's maps (`material_maps_in`): `map_size` wide, or the

@@ -24,6 +24,21 @@ pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSr
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const MSAA_SAMPLES: u32 = 4;
+
+/// Bytes a headless frame of `width`×`height` holds at once, for the memory check before it
+/// is rendered: the multisampled HDR target and depth (`MSAA_SAMPLES` texels of 8 and 4
+/// bytes), the resolved HDR target (8), the 8-bit output, its readback and the image read
+/// back (4 each). On a software adapter (lavapipe) all of it is host memory.
+pub fn frame_bytes(width: u32, height: u32) -> u64 {
+    let per_pixel = MSAA_SAMPLES as u64 * (8 + 4) + 8 + 3 * 4;
+    width as u64 * height as u64 * per_pixel
+}
+
+/// Bytes the CPU reference check adds to a frame (`render_gbuffer`): two passes of two
+/// 16-byte targets, each read back into a buffer and copied into a vector.
+pub fn gbuffer_bytes(width: u32, height: u32) -> u64 {
+    width as u64 * height as u64 * 4 * 16 * 3
+}
 /// `tonemap.wgsl`'s modes: the PBR Neutral curve, or none (the map viewer shows values).
 pub const TONE_MAP_CURVE: u32 = 0;
 pub const TONE_MAP_NONE: u32 = 1;
@@ -278,6 +293,23 @@ impl Renderer {
     pub fn retexture(&self, material: &mut Material, maps: &MaterialMaps) {
         material.textures = MaterialTextures::new(&self.gpu.device, &self.gpu.queue, &self.material_layout, maps);
         material.mesh = maps.atlas.map(|plan| GpuMesh::new(&self.gpu.device, &BodyShape::for_atlas(&plan).mesh()));
+    }
+
+    /// Refuses a readback of `width`×`height` texels of `texel_bytes` that the device
+    /// cannot hold in one buffer (a 4112×4096 G-buffer of 16-byte texels is over the 256
+    /// MiB it is opened with): a validation error panicked inside wgpu.
+    pub fn check_readback(&self, width: u32, height: u32, texel_bytes: u32) -> Result<(), GpuError> {
+        let padded = (width as u64 * texel_bytes as u64).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64);
+        let largest = self.gpu.device.limits().max_buffer_size;
+        if padded * height as u64 > largest {
+            return Err(GpuError::Limits(format!(
+                "reading back {width}×{height} texels of {texel_bytes} bytes needs {} MiB in one buffer, over the \
+                 device's {} MiB; use a smaller size",
+                (padded * height as u64) >> 20,
+                largest >> 20
+            )));
+        }
+        Ok(())
     }
 
     pub fn targets(&self, width: u32, height: u32, samples: u32) -> Targets {
@@ -573,19 +605,21 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<image::RgbaImage, GpuError> {
-        let targets = self.targets(width, height, settings.samples);
-        let output = self.output_texture(width, height);
-        let view = output.create_view(&wgpu::TextureViewDescriptor::default());
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        self.encode_frame(
-            &mut encoder,
-            &targets,
-            settings,
-            material,
-            FrameOutput { view: &view, format: OUTPUT_FORMAT },
-            None,
-        );
-        let bytes = self.read_texture(encoder, &output, width, height, 4)?;
+        let bytes = self.gpu.checked(&format!("rendering a {width}×{height} frame"), || {
+            let targets = self.targets(width, height, settings.samples);
+            let output = self.output_texture(width, height);
+            let view = output.create_view(&wgpu::TextureViewDescriptor::default());
+            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+            self.encode_frame(
+                &mut encoder,
+                &targets,
+                settings,
+                material,
+                FrameOutput { view: &view, format: OUTPUT_FORMAT },
+                None,
+            );
+            self.read_texture(encoder, &output, width, height, 4)
+        })?;
         image::RgbaImage::from_raw(width, height, bytes).ok_or_else(|| GpuError::Readback("image size".into()))
     }
 
@@ -612,6 +646,18 @@ impl Renderer {
     /// position, film thickness, shading and geometric normals, roughness and albedo, and
     /// whether the snake covers it.
     pub fn render_gbuffer(
+        &self,
+        settings: &FrameSettings,
+        material: &Material,
+        width: u32,
+        height: u32,
+    ) -> Result<GBuffer, GpuError> {
+        self.gpu.checked(&format!("rendering a {width}×{height} G-buffer"), || {
+            self.render_gbuffer_unchecked(settings, material, width, height)
+        })
+    }
+
+    fn render_gbuffer_unchecked(
         &self,
         settings: &FrameSettings,
         material: &Material,
@@ -677,6 +723,7 @@ impl Renderer {
         height: u32,
         texel_bytes: u32,
     ) -> Result<Vec<u8>, GpuError> {
+        self.check_readback(width, height, texel_bytes)?;
         let device = &self.gpu.device;
         let row = width * texel_bytes;
         let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;

@@ -168,8 +168,12 @@ pub const VARIANTS: &[(&str, MapKind, &str)] = &[
     ),
 ];
 
-/// Renders every variant at `tile` pixels and tiles them `columns` wide into one PNG.
+/// Renders every variant at `tile` pixels and tiles them `columns` wide (at most one row of
+/// every variant) into one PNG, after a memory check: a 64-column gallery of 2048-pixel
+/// tiles took 4.8 GB and was not checked at all.
 pub fn render(tile: usize, columns: usize) -> Result<Image, Error> {
+    let columns = fitted_columns(columns);
+    check_memory(tile, columns)?;
     let tiles: Vec<Image> = VARIANTS
         .par_iter()
         .map(|(label, map, overrides)| {
@@ -189,19 +193,58 @@ pub fn render(tile: usize, columns: usize) -> Result<Image, Error> {
             Ok(if image.channels == 1 { gray_to_display(&image) } else { image })
         })
         .collect::<Result<_, Error>>()?;
-    let gap = 4;
-    let rows = tiles.len().div_ceil(columns);
-    let (w, h) = (columns * tile + (columns + 1) * gap, rows * tile + (rows + 1) * gap);
+    let (w, h) = canvas_size(tile, columns);
     // White background; colour tiles are linear, so white is 1.0.
     let mut sheet = Image { width: w, height: h, channels: 3, data: vec![1.0; w * h * 3] };
     for (i, t) in tiles.iter().enumerate() {
-        let (x0, y0) = (gap + (i % columns) * (tile + gap), gap + (i / columns) * (tile + gap));
+        let (x0, y0) = (GAP + (i % columns) * (tile + GAP), GAP + (i / columns) * (tile + GAP));
         for y in 0..tile {
             let dst = ((y0 + y) * w + x0) * 3;
             sheet.data[dst..dst + tile * 3].copy_from_slice(&t.data[y * tile * 3..(y + 1) * tile * 3]);
         }
     }
     Ok(sheet)
+}
+
+/// No more columns than variants: the rest were empty canvas.
+fn fitted_columns(columns: usize) -> usize {
+    columns.clamp(1, VARIANTS.len())
+}
+
+/// Pixels between the gallery's tiles and round its edge.
+const GAP: usize = 4;
+
+/// The gallery's width and height in pixels: `columns` tiles with `GAP`s.
+fn canvas_size(tile: usize, columns: usize) -> (usize, usize) {
+    let (gap, columns) = (GAP, fitted_columns(columns));
+    let rows = VARIANTS.len().div_ceil(columns);
+    (columns * tile + (columns + 1) * gap, rows * tile + (rows + 1) * gap)
+}
+
+/// The gallery's peak against the available memory: every variant's finished tile (three
+/// f32 channels), the canvas (f32, then its 8-bit copy and PNG), and the heaviest variant's
+/// graph once per thread evaluating at a time.
+pub fn check_memory(tile: usize, columns: usize) -> Result<(), Error> {
+    let (w, h) = canvas_size(tile, columns);
+    let tiles = (VARIANTS.len() * tile * tile * 12) as u64;
+    let canvas = (w * h * (12 + 3 + 3)) as u64;
+    let graphs = VARIANTS
+        .iter()
+        .filter_map(|(label, map, overrides)| {
+            let source = PresetSource {
+                name: "gallery".into(),
+                display: format!("gallery variant {label:?}"),
+                text: format!("{BASE}{BASE_COLOR}{BASE_BELLY}{overrides}"),
+            };
+            let loaded = parse(&source, &[]).ok()?;
+            let graph = build_graph(&loaded.preset, BuildOptions::default());
+            Some(crate::memory::estimate_generate_bytes(&graph, &[*map], tile, tile))
+        })
+        .max()
+        .unwrap_or(0)
+        .saturating_mul(rayon::current_num_threads().min(VARIANTS.len()) as u64);
+    let check = crate::memory::MemoryCheck::against_available(tiles + canvas + graphs);
+    check.refuse_if_over(&format!("a gallery of {w}×{h} pixels ({} tiles of {tile}²)", VARIANTS.len()))
 }
 
 /// A height map shown as linear gray, gamma-adjusted so sRGB encoding shows it as stored.

@@ -69,7 +69,8 @@ pub fn plan_sheet(options: SheetOptions, layout: Layout, species: &[String]) -> 
         .into_iter()
         .map(|(name, _)| Ok((name, crate::preset::load(name, &[], None)?)))
         .collect::<Result<_, Error>>()?;
-    let columns = options.columns.max(1);
+    // No more columns than species: the rest were empty cells of canvas.
+    let columns = options.columns.clamp(1, (species.len() as u32).max(1));
     let rows = (species.len() as u32).div_ceil(columns);
     let tile = options.tile;
     let (cell, label_h, strip_w, render) = match layout {
@@ -378,5 +379,15 @@ mod tests {
         }
         // A label longer than the image is clipped, not a panic.
         draw_text(&mut image, 30, 10, "overflowing", INK);
+    }
+
+    /// One species on eight columns made a canvas of eight cells, seven empty.
+    #[test]
+    fn a_sheet_has_no_more_columns_than_species() {
+        let options = SheetOptions { tile: 64, columns: 8, map_size: 64, closeups: false };
+        for (species, columns) in [(vec!["natrix-natrix".to_string()], 1), (vec![], 8)] {
+            let plan = plan_sheet(options, Layout::Tile, &species).unwrap();
+            assert_eq!(plan.canvas.0, columns * plan.cell.0, "{species:?}");
+        }
     }
 }

@@ -148,6 +148,9 @@ pub fn bench_render(
     options: &BenchOptions,
     progress: &dyn Fn(&str),
 ) -> Result<RenderBench, Error> {
+    // The reference check at the end reads its G-buffer back in one buffer: refused now,
+    // not after every timing run.
+    renderer.check_readback(options.reference_size.0, options.reference_size.1, 16)?;
     let maps = material_maps(loaded, options.map_size)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);

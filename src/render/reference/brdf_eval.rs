@@ -62,6 +62,20 @@ pub fn eval_timed(
     samples: &[GpuSample],
     repeats: u32,
 ) -> Result<(Vec<[f32; 3]>, std::time::Duration), GpuError> {
+    gpu.checked(&format!("evaluating {} samples", samples.len()), || {
+        eval_timed_unchecked(gpu, model, stack, lut, method, samples, repeats)
+    })
+}
+
+fn eval_timed_unchecked(
+    gpu: &Gpu,
+    model: Model,
+    stack: Stack,
+    lut: &Lut,
+    method: GpuFilmMethod,
+    samples: &[GpuSample],
+    repeats: u32,
+) -> Result<(Vec<[f32; 3]>, std::time::Duration), GpuError> {
     let device = &gpu.device;
     let (_, source, _) = shader_programs().into_iter().find(|(name, _, _)| *name == "brdf_eval").expect("program");
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -180,7 +194,7 @@ pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBen
     if !(gpu_ms.is_finite() && gpu_ms > 0.0) {
         return Err(GpuError::Timing(format!(
             "10 extra dispatches took {gpu_ms:.4} ms per million evaluations (median of 5): the timing is \
-             dominated by noise; use more --samples"
+             dominated by noise; run it again on a quieter machine"
         )));
     }
 

@@ -20,6 +20,7 @@ use crate::cli::{Cli, Command};
 pub fn run(cli: Cli) -> Result<()> {
     // Checked before any command runs, so a typo cannot switch the memory check off.
     snakeskin::memory::limit_from_env()?;
+    snakeskin::memory::tile_budget_from_env()?;
     match cli.command {
         Command::Generate(args) => generate::run(args),
         Command::Export(args) => export::run(args),

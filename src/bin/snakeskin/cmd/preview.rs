@@ -8,7 +8,7 @@ use crate::progress::Progress;
 use snakeskin::Error;
 use snakeskin::render::Renderer;
 use snakeskin::render::engine::prepare::upload_material_in;
-use snakeskin::render::engine::renderer::FrameSettings;
+use snakeskin::render::engine::renderer::{FrameSettings, frame_bytes, gbuffer_bytes};
 use snakeskin::render::engine::scene::Camera;
 use snakeskin::render::figures::write_png;
 use snakeskin::render::reference::frame::reference_check;
@@ -35,16 +35,36 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         return window(&args, settings);
     }
     let out = args.out.as_deref().expect("checked above");
+    let (width, height) = (args.size.width, args.size.height);
+    if let Some(heat_path) = &args.reference
+        && std::path::absolute(heat_path).ok() == std::path::absolute(out).ok()
+    {
+        // The heat map replaced the render, which was printed as written.
+        return Err(Error::Preview(format!(
+            "--out and --reference name one file ({}); give the heat map a name of its own",
+            path_line(out)
+        ))
+        .into());
+    }
+    // Names, then memory, then folders: a refused run makes none.
+    for file in std::iter::once(out).chain(args.reference.as_deref()) {
+        snakeskin::export::check_target(file)?;
+    }
+    let frame_bytes = frame_bytes(width, height) + args.reference.as_ref().map_or(0, |_| gbuffer_bytes(width, height));
+    let layout = args.layout.layout();
+    snakeskin::render::engine::prepare::check_preview_memory(&loaded, args.map_size as usize, layout, frame_bytes)?;
     ensure_parent_folder(out)?;
     if let Some(heat_path) = &args.reference {
         ensure_parent_folder(heat_path)?;
     }
-    snakeskin::render::engine::prepare::check_preview_memory(&loaded, args.map_size as usize, args.layout.layout())?;
     let bar = Progress::spinner("generating maps and baking the film LUT");
     let renderer = Renderer::headless()?;
+    if args.reference.is_some() {
+        // Before the render is written: the check's G-buffer is read back in one buffer.
+        renderer.check_readback(width, height, 16)?;
+    }
     let material = upload_material_in(&renderer, &loaded, args.map_size as usize, args.method, args.layout.layout())?;
     bar.message("rendering");
-    let (width, height) = (args.size.width, args.size.height);
     let image = renderer.render_image(&settings, &material, width, height)?;
     let written = write_png(out, &image)?;
     bar.finish();
