@@ -285,3 +285,28 @@ fn unwritable_output_leaves_no_partial_files() {
     assert!(stderr(&out).contains("blocked exists and is not a folder"), "{}", stderr(&out));
     assert_eq!(snapshot(dir.path()).len(), 1);
 }
+
+/// A built-in name mistyped gets a suggestion: `natrix_natrix`, `Natrix-Natrix` and the
+/// genus alone (`natrix`) had none, only the list of all 34. Negative control: a name near
+/// none of them gets no suggestion.
+#[test]
+fn a_mistyped_built_in_name_gets_a_suggestion() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().to_str().unwrap();
+    for (name, suggestion) in [
+        ("natrix_natrix", Some("natrix-natrix")),
+        ("Natrix-Natrix", Some("natrix-natrix")),
+        ("natrix", Some("natrix-natrix")),
+        ("vipera-beru", Some("vipera-berus")),
+        ("no-such-snake", None),
+    ] {
+        let out = snakeskin(&["generate", name, "-o", out_dir, "--size", "16"]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        let err = stderr(&out);
+        assert!(err.contains(&format!("unknown preset {name:?}")), "{err}");
+        match suggestion {
+            Some(s) => assert!(err.contains(&format!("; did you mean {s}? (built-in: ")), "{err}"),
+            None => assert!(!err.contains("did you mean"), "{err}"),
+        }
+    }
+}

@@ -1249,3 +1249,16 @@ fn a_preset_of_thousands_of_bad_marks_is_refused_at_once() {
     );
     assert!(stderr(&out).lines().count() < 5, "{}", stderr(&out));
 }
+
+/// With WGPU_BACKEND set to no backend there is, the message said only to install a Vulkan
+/// driver; it names the variable now. (No GPU needed: no adapter is the point.)
+#[test]
+fn a_backend_variable_that_finds_no_adapter_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p.png");
+    let args = ["preview", PRESET, "--out", out.to_str().unwrap(), "--size", "64x40", "--map-size", "64"];
+    let run = snakeskin_env(&args, &[("WGPU_BACKEND", "bogus")]);
+    assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+    assert!(stderr(&run).contains("WGPU_BACKEND=\"bogus\" chose the backends tried"), "{}", stderr(&run));
+    assert!(!out.exists());
+}

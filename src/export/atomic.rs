@@ -157,7 +157,14 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
     // `File::create` makes them), readable by whoever reads the user's other files.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    builder.tempfile_in(dir)
+    // tempfile's error names the hidden temporary (`... at path "/out/.t.png.RZ4prK.
+    // snakeskin-tmp"`), a file the user never sees; the folder is named by the caller.
+    // Its error type is private and exposes no source, so the OS's words are its message's
+    // part before " at path " (tempfile 3's `PathError` display).
+    builder.tempfile_in(dir).map_err(|e| match e.to_string().split_once(" at path ") {
+        Some((reason, _)) => std::io::Error::new(e.kind(), reason.to_string()),
+        None => e,
+    })
 }
 
 /// Refuses a target that is a folder (a rename over it would fail half-way through a set),
@@ -468,4 +475,19 @@ pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, Exp
     tmp.persist(path).map_err(|e| ExportError::Io { path: path.into(), source: e.error })?;
     forget_temporary(&temporary);
     Ok(path.into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A folder no file can be made in (sysfs refuses new files, root or not): the error
+    /// named tempfile's hidden temporary (`at path "/sys/.x.png.RZ4prK.snakeskin-tmp"`).
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_temporary_that_cannot_be_made_is_not_named() {
+        let error = temporary(Path::new("/sys"), "x.png").unwrap_err().to_string();
+        assert!(!error.contains(TMP_SUFFIX) && !error.contains("at path"), "{error}");
+        assert!(error.contains("(os error"), "the OS's reason is kept: {error}");
+    }
 }

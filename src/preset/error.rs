@@ -20,8 +20,8 @@ pub enum PresetError {
         "preset {path:?}: its file name has control characters, and a set's files are named after it; rename the file"
     )]
     FileName { path: PathBuf },
-    #[error("unknown preset {name:?}: not a .toml file and not a built-in preset (built-in: {available})")]
-    UnknownPreset { name: String, available: String },
+    #[error("unknown preset {name:?}: not a .toml file and not a built-in preset{suggestion} (built-in: {available})")]
+    UnknownPreset { name: String, suggestion: String, available: String },
 
     /// TOML syntax, a wrong type, an unknown key or a bad enum value.
     #[error("{location}: {message}")]

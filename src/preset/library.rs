@@ -43,6 +43,23 @@ pub fn names() -> Vec<&'static str> {
     PRESETS.iter().map(|(n, _)| *n).collect()
 }
 
+/// The built-in name a mistyped one most likely means, for "did you mean": the same name in
+/// another case or with `_` or spaces for `-` (`Natrix_natrix`), a file's stem
+/// (`presets/natrix-natrix.toml`), the one species of a genus (`natrix`), or the nearest by
+/// edits. `natrix_natrix` and `natrix` had no suggestion.
+pub fn suggest(name: &str) -> Option<&'static str> {
+    let stem = std::path::Path::new(name).file_stem().map_or(name.into(), |s| s.to_string_lossy());
+    let normal = stem.trim().to_ascii_lowercase().replace(['_', ' '], "-");
+    if let Some(same) = names().into_iter().find(|n| *n == normal) {
+        return Some(same);
+    }
+    let genus: Vec<&str> = names().into_iter().filter(|n| n.starts_with(&format!("{normal}-"))).collect();
+    if let [only] = genus[..] {
+        return Some(only);
+    }
+    crate::toml_text::nearest(&normal, names())
+}
+
 pub fn get(name: &str) -> Option<&'static str> {
     PRESETS.iter().find(|(n, _)| *n == name).map(|(_, text)| *text)
 }

@@ -72,7 +72,11 @@ pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
         Some(text) => {
             Ok(PresetSource { name: spec.into(), display: format!("built-in preset {spec}"), text: text.into() })
         }
-        None => Err(PresetError::UnknownPreset { name: spec.into(), available: library::names().join(", ") }),
+        None => Err(PresetError::UnknownPreset {
+            name: spec.into(),
+            suggestion: library::suggest(spec).map(|n| format!("; did you mean {n}?")).unwrap_or_default(),
+            available: library::names().join(", "),
+        }),
     }
 }
 

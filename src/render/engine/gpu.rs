@@ -55,7 +55,14 @@ impl Gpu {
             compatible_surface: None,
             ..Default::default()
         }))
-        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        .map_err(|e| {
+            // `with_env` lets WGPU_BACKEND choose the backends: a typo there, not a driver,
+            // may be why there is none.
+            let chosen = std::env::var("WGPU_BACKEND")
+                .map(|v| format!("; WGPU_BACKEND={v:?} chose the backends tried (unset it, or set it to vulkan)"))
+                .unwrap_or_default();
+            GpuError::NoAdapter(format!("{e}{chosen}"))
+        })?;
         Gpu::open(&adapter)
     }
 

@@ -335,9 +335,16 @@ fn chosen_species(species: &[String]) -> Result<Vec<(&'static str, &'static str)
     species
         .iter()
         .map(|name| {
-            library::all().iter().find(|(n, _)| n == name).copied().ok_or_else(|| {
-                let nearest = crate::toml_text::nearest(name, library::names());
-                let hint = nearest.map(|n| format!("did you mean {n}? ")).unwrap_or_default();
+            // `a, b` is two names: the space is the list's, not the name's.
+            let name = name.trim();
+            if name.is_empty() {
+                return Err(Error::InvalidOption {
+                    option: "--species",
+                    reason: "an empty name in the list (a comma too many?)".into(),
+                });
+            }
+            library::all().iter().find(|(n, _)| *n == name).copied().ok_or_else(|| {
+                let hint = library::suggest(name).map(|n| format!("did you mean {n}? ")).unwrap_or_default();
                 Error::InvalidOption {
                     option: "--species",
                     reason: format!("no built-in species {name:?}; {hint}`snakeskin presets list` shows them all"),
@@ -379,6 +386,19 @@ mod tests {
         }
         // A label longer than the image is clipped, not a panic.
         draw_text(&mut image, 30, 10, "overflowing", INK);
+    }
+
+    /// `--species "a, b"` kept the space in the second name, and `a,` or `,` asked for a
+    /// species named "".
+    #[test]
+    fn species_names_are_trimmed_and_an_empty_one_is_named() {
+        let names = |list: &[&str]| chosen_species(&list.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+        let chosen = names(&["natrix-natrix", " vipera-berus"]).unwrap();
+        assert_eq!(chosen.iter().map(|(n, _)| *n).collect::<Vec<_>>(), ["natrix-natrix", "vipera-berus"]);
+        let error = names(&["natrix-natrix", ""]).unwrap_err().to_string();
+        assert!(error.contains("an empty name in the list"), "{error}");
+        let error = names(&["natrix"]).unwrap_err().to_string();
+        assert!(error.contains("did you mean natrix-natrix?"), "{error}");
     }
 
     /// One species on eight columns made a canvas of eight cells, seven empty.

@@ -28,13 +28,7 @@ pub fn run(command: PresetsCommand) -> Result<()> {
             // Only built-in presets: "not a .toml file" was untrue for a file's path.
             None => {
                 let names = library::names();
-                let stem = std::path::Path::new(&name).file_stem().map(|s| s.to_string_lossy().into_owned());
-                let hint = match stem.as_deref().filter(|s| names.contains(s)) {
-                    Some(built_in) => format!("; did you mean {built_in}?"),
-                    None => snakeskin::toml_text::nearest(&name, names.iter().copied())
-                        .map(|n| format!("; did you mean {n}?"))
-                        .unwrap_or_default(),
-                };
+                let hint = library::suggest(&name).map(|n| format!("; did you mean {n}?")).unwrap_or_default();
                 let file = if name.ends_with(".toml") { " (a preset file is its own TOML: open it)" } else { "" };
                 let reason = format!("{name:?} is not a built-in preset{file}{hint} (built-in: {})", names.join(", "));
                 Err(snakeskin::Error::InvalidOption { option: "preset name", reason }.into())
