@@ -450,11 +450,11 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
 }
 
 /// The shard's jobs with their folders and whether each is already done (`done` or
-/// `to do`), after the checks `run` makes before it writes anything (a batch that `run`
-/// would refuse is refused here with the same error, not listed "to do"); nothing is run or
-/// written.
+/// `to do`), after the checks `run` makes before it writes anything but the memory (a batch
+/// that `run` would refuse for its input is refused here with the same error, not listed
+/// "to do"); nothing is run or written.
 pub fn list(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Result<Vec<JobOutcome>, Error> {
-    Ok(plan(jobs_file, jobs, out, shard)?
+    Ok(plan(jobs_file, jobs, out, shard, false)?
         .resolved
         .into_iter()
         .map(|Resolved { mut outcome, done }| {
@@ -527,7 +527,7 @@ pub fn run(
     concurrency: usize,
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
-    let Planned { mine, resolved, estimates } = plan(jobs_file, jobs, out, shard)?;
+    let Planned { mine, resolved, estimates } = plan(jobs_file, jobs, out, shard, true)?;
     let concurrency =
         fitting_concurrency(concurrency.clamp(1, MAX_CONCURRENCY), estimates, crate::memory::available_bytes());
     let total = mine.len();
@@ -603,8 +603,16 @@ struct Planned<'a> {
 }
 
 /// Every check a run makes before it writes anything: the output folder, the index's place,
-/// every job's preset, size, memory and output files.
-fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard) -> Result<Planned<'a>, Error> {
+/// every job's preset, size and output files, and (with `check_memory`) its memory against
+/// what this machine has available: not for `list`, which a login node runs for a
+/// cluster's jobs (a job too large for it was refused there).
+fn plan<'a>(
+    jobs_file: &Path,
+    jobs: &'a [Job],
+    out: &Path,
+    shard: Shard,
+    check_memory: bool,
+) -> Result<Planned<'a>, Error> {
     // The output folder (a file there is the user's mistake, as for `generate -o`) and the
     // index's place, before any job runs (a folder in the index's way would otherwise fail
     // the run after every job), and nothing created yet: a refused batch leaves no folder.
@@ -624,7 +632,9 @@ fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard) -> Resu
                 preset: job.preset.clone(),
                 source: Box::new(source),
             };
-            let plan = Plan::new(&request(job, out, &r.outcome)).map_err(|e| planned(job.lines.sizes, e))?;
+            let request = request(job, out, &r.outcome);
+            let plan = if check_memory { Plan::new(&request) } else { Plan::within_checked_budget(&request) }
+                .map_err(|e| planned(job.lines.sizes, e))?;
             // Its folder and files, as `Plan::run` checks them, but before any job has
             // written its set: a folder in a later job's way stopped the run after the
             // earlier jobs' sets were written.

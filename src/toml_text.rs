@@ -69,13 +69,14 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
 /// `LIMIT` of toml 0.9's parser (`de/parser/mod.rs`).
 const TOML_NESTING_LIMIT: usize = 80;
 
-/// The offset of the first line whose key has at least `TOML_NESTING_LIMIT` dotted parts
-/// (quoted dots counted too: a close enough guess for a line the reader gave none).
+/// The offset of the first line whose key has more than `TOML_NESTING_LIMIT` dotted parts
+/// (the reader takes 80 and refuses 81; quoted dots counted too, comments skipped: a close
+/// enough guess for a line the reader gave none).
 fn too_deep_line(text: &str) -> Option<usize> {
     let mut offset = 0;
     for line in text.split_inclusive('\n') {
         let key = line.split('=').next().unwrap_or(line);
-        if key.matches('.').count() + 1 >= TOML_NESTING_LIMIT {
+        if !line.trim_start().starts_with('#') && key.matches('.').count() + 1 > TOML_NESTING_LIMIT {
             return Some(offset);
         }
         offset += line.len();
@@ -293,6 +294,9 @@ mod tests {
         let arrays = |depth: usize| format!("{}{}", "[".repeat(depth), "]".repeat(depth));
         let cases = [
             (format!("seed = 1\n[{}]\n", dotted(200)), 2),
+            // The deepest the reader takes, a comment, then one more (the review: the line
+            // before was named).
+            (format!("seed = 1\n{} = 1\n# {}\n\n{} = 2\n", dotted(80), dotted(90), dotted(81).replace('a', "b")), 5),
             (format!("seed = 1\n\n{} = 1\n", dotted(100)), 3),
             (format!("seed = 1\na = {}\n", arrays(200)), 2),
         ];

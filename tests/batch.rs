@@ -245,6 +245,14 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("jobs.toml:7: job 2 (boa-constrictor): size 4096 needs about"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "a set was written before the job too large was found");
+    // `--list` does not hold the jobs to this machine's memory: a login node lists a
+    // cluster's jobs (the review found them refused there).
+    let listed = common::snakeskin_env(
+        &["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--list"],
+        &[("SNAKESKIN_MEMORY_LIMIT_MIB", "300")],
+    );
+    assert!(listed.status.success(), "{}", stderr(&listed));
+    assert_eq!(stdout(&listed).lines().count(), 2, "{}", stdout(&listed));
 
     // A folder in a later job's way stops the batch before the first job's set is written
     // (it was found when that job ran, after the earlier sets), naming the job and its line.

@@ -206,6 +206,9 @@ fn keys_of_another_kind_are_refused_not_ignored() {
         // for kind "stripes" only; got [2.0, 3.0]", as if the value were wrong.
         ("stripes", "shape = \"ring\"", "`pattern.0.shape` is read by kind \"spots\" and \"blotches\" only".into()),
         ("spots", "rows = [2, 3]", "`pattern.0.rows` is read by kind \"stripes\" only, not \"spots\"".into()),
+        // A size without the colour that would draw it (the review).
+        ("spots", "center_size = 0.3", "`pattern.0.center_size` sizes what `center_color` draws".into()),
+        ("stripes", "border_size = 0.02", "`pattern.0.border_size` sizes what `border_color` draws".into()),
     ] {
         let err = refused("kinds.toml", &format!("{}{extra}\n", layer.replace("spots", kind)), &[]);
         assert!(err.contains(&format!("kinds.toml:4: key {says}")), "{extra}: {err}");

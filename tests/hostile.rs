@@ -1006,6 +1006,8 @@ fn preview_output_names_are_checked_before_the_work() {
     let same = at("same.png");
     for (extra, says) in [
         (vec!["--out", &same, "--reference", &same], "--out and --reference name one file".to_string()),
+        // ... however it is written (the review: `sub/../same.png` replaced the render).
+        (vec!["--out", &at("sub/../same.png"), "--reference", &same], "--out and --reference name one file".into()),
         (vec!["--out", &format!("{}/", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
         (vec!["--out", &format!("{}/.", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
         (vec!["--out", &same, "--reference", &format!("{}/", at("heat"))], "names a folder".into()),

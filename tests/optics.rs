@@ -403,11 +403,14 @@ mod commands {
         assert_eq!(v["inf"], 0);
         assert!(v["min_r"].as_f64().unwrap() >= 0.0 && v["max_r"].as_f64().unwrap() <= 1.0);
         assert!(v["max_albedo"].as_f64().unwrap() <= 1.0 + 2e-3);
-        // The layered model creates no energy on the stress films (0 to 10 mm, ambient
-        // denser than the pigment) beyond its grazing bound: at 100,000 samples 0.857 to
-        // 1.069, every value outside 1 ± 0.02 at the stress' view of 89.94°.
+        // The layered model's furnace on the stress films, each integration with its own
+        // film's K and E: 0.998 to 1.001 in these samples' two integrations (0.293 to 1.008
+        // with the 400 nm film's K and E for every film, the mismatch of two films). Over
+        // more samples it leaves 1 ± 0.02 only at the stress' view of 89.94° (up to 1.069)
+        // and with the ambient denser than the pigment (down to 0.44): BENCHMARKS, "Stress".
         let layered = v["furnace_by_model"].as_array().unwrap().iter().find(|m| m["model"] == "layered").unwrap();
-        assert!(layered["max_albedo"].as_f64().unwrap() <= 1.05, "{layered}");
+        let (min, max) = (layered["min_albedo"].as_f64().unwrap(), layered["max_albedo"].as_f64().unwrap());
+        assert!((0.98..=1.02).contains(&min) && (0.98..=1.02).contains(&max), "{layered}");
         assert!(v["max_f32_dev"].as_f64().unwrap() < 1e-2);
     }
 

@@ -301,7 +301,7 @@ fn preview_writes_a_png_and_rejects_bad_options() {
     assert_eq!(std::fs::read(&out).unwrap(), before, "a failed run touched the earlier output");
     // The reference check's G-buffer is read back in one buffer: past the device's largest
     // (256 MiB) wgpu panicked (exit 101), after the render was written. Refused before it.
-    let heat = dir.path().join("heat.png");
+    let heat = dir.path().join("new/heat.png");
     let (h, size) = (heat.to_str().unwrap(), "4112x4096");
     let run = snakeskin(&["preview", PRESET, "--out", o, "--map-size", "64", "--size", size, "--reference", h]);
     assert_eq!(run.status.code(), Some(1), "{}", common::stderr(&run));
@@ -311,6 +311,7 @@ fn preview_writes_a_png_and_rejects_bad_options() {
         common::stderr(&run)
     );
     assert_eq!(std::fs::read(&out).unwrap(), before, "the render was written before the refusal");
+    assert!(!dir.path().join("new").exists(), "a folder was made for the refused heat map");
 }
 
 #[test]
@@ -441,10 +442,11 @@ fn the_contact_sheet_renders_every_preset() {
         assert!(hi - lo > 60, "cell {i} ({}): render looks blank ({lo}..{hi})", library::names()[i as usize]);
     }
     // `--species` picks cells in the tile layout too (it was ignored there): two species
-    // fill one row of the same cells (a name that is not built in: tests/hostile.rs).
+    // fill one row of the same cells, two columns wide, not four with two empty (a name
+    // that is not built in: tests/hostile.rs).
     let two = ["python-regius".to_string(), "natrix-natrix".to_string()];
     let small = render_sheet(&renderer, &plan_sheet(options, Layout::Tile, &two).unwrap(), &|_, _| {}).unwrap();
-    assert_eq!((small.width(), small.height()), (sheet.width(), cell_h));
+    assert_eq!((small.width(), small.height()), (2 * 3 * tile, cell_h));
 }
 
 #[test]

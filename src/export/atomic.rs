@@ -199,6 +199,30 @@ pub fn ends_as_a_folder(path: &Path) -> bool {
     matches!(last, b"" | b"." | b"..")
 }
 
+/// Whether two output paths name one file: through links and `..` (the longest existing
+/// part of each resolved, the rest read lexically), so `sub/../a.png` is `a.png` whether or
+/// not `sub` exists. A path that cannot be made absolute names no file here. (Comparing
+/// `std::path::absolute`s missed `..` and links: a heat map replaced the render.)
+pub fn same_path(a: &Path, b: &Path) -> bool {
+    matches!((resolved(a), resolved(b)), (Some(a), Some(b)) if a == b)
+}
+
+fn resolved(path: &Path) -> Option<PathBuf> {
+    let absolute = std::path::absolute(path).ok()?;
+    let existing = absolute.ancestors().find(|p| p.exists())?;
+    let mut out = existing.canonicalize().ok()?;
+    for part in absolute.strip_prefix(existing).ok()?.components() {
+        match part {
+            std::path::Component::ParentDir => {
+                out.pop();
+            }
+            std::path::Component::CurDir => {}
+            other => out.push(other),
+        }
+    }
+    Some(out)
+}
+
 /// Creates an output folder if needed (true when it was created); a path that exists and is
 /// not a folder is `ExportError::NotAFolder`. Every output path goes through here.
 pub fn create_folder(dir: &Path) -> Result<bool, ExportError> {
@@ -480,6 +504,22 @@ pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, Exp
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One file named two ways: through `..` (its folder missing or not) and a link.
+    /// Negative controls: two different files, and a file beside its folder's name.
+    #[cfg(unix)]
+    #[test]
+    fn two_names_of_one_file_are_the_same_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let at = |p: &str| dir.path().join(p);
+        fs::create_dir(at("real")).unwrap();
+        std::os::unix::fs::symlink(at("real"), at("link")).unwrap();
+        assert!(same_path(&at("sub/../a.png"), &at("a.png")));
+        assert!(same_path(&at("real/../a.png"), &at("./a.png")));
+        assert!(same_path(&at("link/h.png"), &at("real/h.png")));
+        assert!(!same_path(&at("a.png"), &at("b.png")));
+        assert!(!same_path(&at("real/a.png"), &at("a.png")));
+    }
 
     /// A folder no file can be made in (sysfs refuses new files, root or not): the error
     /// named tempfile's hidden temporary (`at path "/sys/.x.png.RZ4prK.snakeskin-tmp"`).

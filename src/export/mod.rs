@@ -11,8 +11,8 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder, ends_as_a_folder, sha256_hex,
-    write_file_atomically,
+    SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder, ends_as_a_folder, same_path,
+    sha256_hex, write_file_atomically,
 };
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
@@ -285,7 +285,8 @@ fn png_encoder<W: std::io::Write>(out: W, map: MapKind, width: usize, height: us
     png_file_encoder(out, width, height, format.channels as usize, format.bit_depth, format.encoding == Encoding::Srgb)
 }
 
-/// The PNG encoder of every file snakeskin writes, maps and packed textures alike. Colour
+/// The PNG encoder of every map and packed texture (the renderer's images, figures and
+/// sheets are written by the `image` crate, untagged, as screenshots are). Colour
 /// is tagged sRGB (the `sRGB` chunk), so a reader that honours tags shows it as written;
 /// data (height, normal, roughness, thickness, masks) carries no tag, as engines expect of
 /// non-colour textures (PNG has no "data" tag: a `gAMA` of 1.0 would make a viewer that

@@ -203,7 +203,7 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
 
     if draw.index.is_multiple_of(FURNACE_EVERY) {
         // K and E of the film drawn: with the 400 nm film's above, the furnace measured the
-        // mismatch between two films (albedo 0.24 to 1.76), not the model.
+        // mismatch between two films (albedo 0.23 to 1.76), not the model.
         let white = Layers::of_stack(stack, thickness, roughness, [0.0; 3], [1.0; 3]);
         let cos_o = draw.pick(&[1.0, 1e-3, -1.0]);
         let cos_o = if cos_o < 0.0 { draw.unit() } else { cos_o };

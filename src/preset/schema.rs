@@ -415,7 +415,7 @@ impl PatternLayer {
     pub(crate) fn default_center_size() -> f64 {
         0.5
     }
-    fn default_border_size() -> f64 {
+    pub(crate) fn default_border_size() -> f64 {
         0.01
     }
     pub(crate) fn default_widen_to_tail() -> f64 {

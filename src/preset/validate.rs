@@ -203,6 +203,33 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                 });
             }
         }
+        // A size of something only its colour draws, without the colour (the review found
+        // `center_size` alone silently ignored); on a kind that draws no centre the kind's
+        // problem above says enough.
+        let draws_centre = matches!(k, Spots | Blotches);
+        for (field, set, colour, coloured) in [
+            (
+                "center_size",
+                draws_centre && p.center_size != PatternLayer::default_center_size(),
+                "center_color",
+                p.center_color.is_some(),
+            ),
+            (
+                "border_size",
+                p.border_size != PatternLayer::default_border_size(),
+                "border_color",
+                p.border_color.is_some(),
+            ),
+        ] {
+            if set && !coloured && !from_file_for_old_kind(i, field) {
+                c.problems.push(Problem {
+                    key: key(field),
+                    message: format!(
+                        "sizes what `{colour}` draws, which this layer does not set; set it, or leave this out"
+                    ),
+                });
+            }
+        }
         for (j, w) in p.widths.iter().enumerate() {
             c.range(format!("pattern.{i}.widths.{j}"), *w, RING_WIDTH);
         }

@@ -38,7 +38,7 @@ impl ClampedColour {
         let [r, g, b] = self.limit_linear;
         format!(
             "warning: {preset}{line}: {} = \"{}\" is brighter than this layer stack can show (colours mean the \
-             visible colour; with its absorption, and the headroom this key keeps for the map's per-scale tone and \
+             visible colour; with its absorption, and any headroom this key keeps for the map's per-scale tone and \
              colour variation, it may be at most linear [{r:.3}, {g:.3}, {b:.3}]); clamped \
              to \"{}\". Lower optics.absorption or the colour to keep it.",
             self.key, self.requested, self.clamped_to

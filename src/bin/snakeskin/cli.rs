@@ -134,27 +134,34 @@ impl Cli {
     /// after such a flag is refused as its missing value.
     pub fn try_parse_checked_from(args: Vec<std::ffi::OsString>) -> Result<Cli, clap::Error> {
         use clap::CommandFactory;
-        let mut command = Cli::command();
-        let mut takes_hyphen_values = std::collections::HashSet::new();
-        let mut flags = std::collections::HashSet::new();
-        let mut commands = vec![&command];
-        while let Some(c) = commands.pop() {
-            for arg in c.get_arguments() {
-                if let Some(long) = arg.get_long() {
-                    flags.insert(format!("--{long}"));
-                    if arg.is_allow_hyphen_values_set() {
-                        takes_hyphen_values.insert(format!("--{long}"));
-                    }
-                }
-            }
-            commands.extend(c.get_subcommands());
-        }
         let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
+        let mut command = Cli::command();
+        command.build();
+        // The subcommands the words name (`brdf`, `eval`): their flags are the ones that
+        // count, and the error shows the last one's usage.
+        let mut path = vec![&command];
+        for word in words.iter().skip(1) {
+            if let Some(sub) = path.last().and_then(|c| c.find_subcommand(word)) {
+                path.push(sub);
+            }
+        }
+        let flags = |c: &clap::Command| {
+            c.get_arguments()
+                .filter_map(|a| a.get_long().map(|l| (format!("--{l}"), a.is_allow_hyphen_values_set())))
+                .collect::<Vec<_>>()
+        };
+        let flags: Vec<(String, bool)> = path.iter().flat_map(|c| flags(c)).collect();
+        let names: Vec<String> = path.iter().skip(1).map(|c| c.get_name().to_string()).collect();
         for pair in words.windows(2) {
             let next_flag = pair[1].split('=').next().unwrap_or("");
-            if takes_hyphen_values.contains(pair[0]) && flags.contains(next_flag) {
-                let message = format!("`{}` needs a value, and the next word is the flag `{}`\n", pair[0], pair[1]);
-                return Err(clap::Error::raw(clap::error::ErrorKind::InvalidValue, message).format(&mut command));
+            let takes_hyphen_values = flags.iter().any(|(f, hyphen)| f == pair[0] && *hyphen);
+            if takes_hyphen_values && flags.iter().any(|(f, _)| f == next_flag) {
+                let message = format!("`{}` needs a value, and the next word is the flag `{}`", pair[0], pair[1]);
+                let mut chosen = &mut command;
+                for name in &names {
+                    chosen = chosen.find_subcommand_mut(name).expect("a subcommand found above");
+                }
+                return Err(clap::Error::raw(clap::error::ErrorKind::InvalidValue, message).format(chosen));
             }
         }
         Cli::try_parse_from(args)
@@ -380,9 +387,12 @@ pub struct PreviewArgs {
     #[arg(long)]
     pub close_up: bool,
     /// Also shade the frame on the CPU with the f64 spectral reference, print mean and p99
-    /// CIEDE2000 against the GPU image, and write the error heat map to this PNG. The
-    /// reference costs about 3 ms per covered pixel on two cores: 3.5 minutes at
-    /// --size 480x300 with --close-up, 20 minutes or more at the default size.
+    /// CIEDE2000 against the GPU image, and write the error heat map to this PNG. The check
+    /// renders a frame of its own with the same preset, size, camera, method and model, but
+    /// always the whole stack (--layers all), one sample per pixel and no ground, so its
+    /// figures are the shading model's, not the PNG's anti-aliasing. The reference costs
+    /// about 3 ms per covered pixel on two cores: 3.5 minutes at --size 480x300 with
+    /// --close-up, 20 minutes or more at the default size.
     #[arg(long, value_name = "HEATMAP.png")]
     pub reference: Option<PathBuf>,
 }
@@ -938,7 +948,8 @@ mod tests {
             (&["--wi", "0,0,1", "--wo", "0,0,1", "--normal", "--model", "thesis"][..], "--model"),
         ] {
             let message = eval(args).unwrap_err().to_string();
-            assert!(message.contains(&format!("needs a value, and the next word is the flag `{flag}")), "{message}");
+            assert!(message.contains(&format!("needs a value, and the next word is the flag `{flag}`")), "{message}");
+            assert!(message.contains("Usage: snakeskin brdf eval"), "the command's own usage: {message}");
         }
         let cli = eval(&["--wi", "-0.5,0,1", "--wo", "0,-1,1", "--normal", "-0,0,1"]).unwrap();
         let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.command else { panic!("parsed as brdf eval") };

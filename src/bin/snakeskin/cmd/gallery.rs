@@ -13,7 +13,7 @@ pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> 
     snakeskin::render::figures::gallery::check_memory(tile, columns)?;
     snakeskin::export::check_target(out)?;
     if let Some(dir) = closeups
-        && std::path::absolute(dir).ok() == std::path::absolute(out).ok()
+        && snakeskin::export::same_path(dir, out)
     {
         return Err(snakeskin::Error::Unsupported(format!(
             "-o and --closeups name one path ({}): the gallery is a file, the close-ups a folder",

@@ -37,7 +37,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     let out = args.out.as_deref().expect("checked above");
     let (width, height) = (args.size.width, args.size.height);
     if let Some(heat_path) = &args.reference
-        && std::path::absolute(heat_path).ok() == std::path::absolute(out).ok()
+        && snakeskin::export::same_path(heat_path, out)
     {
         // The heat map replaced the render, which was printed as written.
         return Err(Error::Preview(format!(
@@ -46,22 +46,22 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         ))
         .into());
     }
-    // Names, then memory, then folders: a refused run makes none.
+    // Names, then memory, then the GPU's limits, then folders: a refused run makes none.
     for file in std::iter::once(out).chain(args.reference.as_deref()) {
         snakeskin::export::check_target(file)?;
     }
     let frame_bytes = frame_bytes(width, height) + args.reference.as_ref().map_or(0, |_| gbuffer_bytes(width, height));
     let layout = args.layout.layout();
     snakeskin::render::engine::prepare::check_preview_memory(&loaded, args.map_size as usize, layout, frame_bytes)?;
-    ensure_parent_folder(out)?;
-    if let Some(heat_path) = &args.reference {
-        ensure_parent_folder(heat_path)?;
-    }
     let bar = Progress::spinner("generating maps and baking the film LUT");
     let renderer = Renderer::headless()?;
     if args.reference.is_some() {
         // Before the render is written: the check's G-buffer is read back in one buffer.
         renderer.check_readback(width, height, 16)?;
+    }
+    ensure_parent_folder(out)?;
+    if let Some(heat_path) = &args.reference {
+        ensure_parent_folder(heat_path)?;
     }
     let material = upload_material_in(&renderer, &loaded, args.map_size as usize, args.method, args.layout.layout())?;
     bar.message("rendering");
