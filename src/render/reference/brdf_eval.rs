@@ -63,16 +63,16 @@ pub fn eval_timed(
     repeats: u32,
 ) -> Result<(Vec<[f32; 3]>, std::time::Duration), GpuError> {
     gpu.checked(&format!("evaluating {} samples", samples.len()), || {
-        eval_timed_unchecked(gpu, model, stack, lut, method, samples, repeats)
+        dispatch(gpu, model, (stack, lut, method), samples, repeats)
     })
 }
 
-fn eval_timed_unchecked(
+/// `eval_timed`'s work, inside its error scope (the film as one argument: the material's
+/// stack, its LUT and the colour method).
+fn dispatch(
     gpu: &Gpu,
     model: Model,
-    stack: Stack,
-    lut: &Lut,
-    method: GpuFilmMethod,
+    (stack, lut, method): (Stack, &Lut, GpuFilmMethod),
     samples: &[GpuSample],
     repeats: u32,
 ) -> Result<(Vec<[f32; 3]>, std::time::Duration), GpuError> {
