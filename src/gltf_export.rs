@@ -61,9 +61,8 @@ pub struct ExportReport {
 fn is_binary(path: &Path) -> Result<bool, Error> {
     let text = path.to_string_lossy();
     if crate::export::ends_as_a_folder(path) {
-        return Err(Error::Unsupported(format!(
-            "--gltf {text}: names a folder (it ends in a slash or a dot); give a file name"
-        )));
+        // The one message every output file gets (`export::check_target`).
+        return Err(crate::export::ExportError::FolderName { path: path.into() }.into());
     }
     // `.glb` alone: a name that is all extension (`Path::extension` sees none).
     let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();

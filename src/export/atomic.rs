@@ -195,7 +195,7 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
 /// `out`), so this reads the text.
 pub fn ends_as_a_folder(path: &Path) -> bool {
     let text = path.as_os_str().as_encoded_bytes();
-    let last = text.rsplit(|&b| b == b'/' || std::path::is_separator(b as char)).next().unwrap_or(b"");
+    let last = text.rsplit(|&b| std::path::is_separator(b as char)).next().unwrap_or(b"");
     matches!(last, b"" | b"." | b"..")
 }
 

@@ -156,9 +156,9 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                 PatternShape::Zigzag,
             ],
             // Another kind reads no shape: `kinds_only` below says so.
-            _ => &[PatternShape::Round, p.shape],
+            _ => &[],
         };
-        if !shapes.contains(&p.shape) && !from_file_for_old_kind(i, "shape") {
+        if !shapes.is_empty() && !shapes.contains(&p.shape) && !from_file_for_old_kind(i, "shape") {
             let names: Vec<String> = shapes.iter().map(spelled).collect();
             c.problems.push(Problem {
                 key: key("shape"),

@@ -145,12 +145,12 @@ impl Cli {
                 path.push(sub);
             }
         }
-        let flags = |c: &clap::Command| {
+        let long_flags = |c: &clap::Command| {
             c.get_arguments()
                 .filter_map(|a| a.get_long().map(|l| (format!("--{l}"), a.is_allow_hyphen_values_set())))
                 .collect::<Vec<_>>()
         };
-        let flags: Vec<(String, bool)> = path.iter().flat_map(|c| flags(c)).collect();
+        let flags: Vec<(String, bool)> = path.iter().flat_map(|c| long_flags(c)).collect();
         let names: Vec<String> = path.iter().skip(1).map(|c| c.get_name().to_string()).collect();
         for pair in words.windows(2) {
             let next_flag = pair[1].split('=').next().unwrap_or("");

@@ -39,6 +39,11 @@ pub fn frame_bytes(width: u32, height: u32) -> u64 {
 pub fn gbuffer_bytes(width: u32, height: u32) -> u64 {
     width as u64 * height as u64 * 4 * 16 * 3
 }
+/// A readback row's bytes: a texture's row padded to the copy alignment wgpu requires.
+fn padded_row_bytes(width: u32, texel_bytes: u32) -> u32 {
+    (width * texel_bytes).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+}
+
 /// `tonemap.wgsl`'s modes: the PBR Neutral curve, or none (the map viewer shows values).
 pub const TONE_MAP_CURVE: u32 = 0;
 pub const TONE_MAP_NONE: u32 = 1;
@@ -299,7 +304,7 @@ impl Renderer {
     /// cannot hold in one buffer (a 4112×4096 G-buffer of 16-byte texels is over the 256
     /// MiB it is opened with): a validation error panicked inside wgpu.
     pub fn check_readback(&self, width: u32, height: u32, texel_bytes: u32) -> Result<(), GpuError> {
-        let padded = (width as u64 * texel_bytes as u64).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64);
+        let padded = padded_row_bytes(width, texel_bytes) as u64;
         let largest = self.gpu.device.limits().max_buffer_size;
         if padded * height as u64 > largest {
             return Err(GpuError::Limits(format!(
@@ -726,7 +731,7 @@ impl Renderer {
         self.check_readback(width, height, texel_bytes)?;
         let device = &self.gpu.device;
         let row = width * texel_bytes;
-        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded = padded_row_bytes(width, texel_bytes);
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size: (padded * height) as u64,

@@ -177,17 +177,7 @@ pub fn render(tile: usize, columns: usize) -> Result<Image, Error> {
     let tiles: Vec<Image> = VARIANTS
         .par_iter()
         .map(|(label, map, overrides)| {
-            let source = PresetSource {
-                name: label.replace([' ', ':', ',', '+'], "_"),
-                display: format!("gallery variant {label:?}"),
-                text: format!(
-                    "{BASE}{}{}{overrides}",
-                    if overrides.contains("[color]") { "" } else { BASE_COLOR },
-                    if overrides.contains("[belly]") { "" } else { BASE_BELLY },
-                ),
-            };
-            let loaded = parse(&source, &[])?;
-            let graph = build_graph(&loaded.preset, BuildOptions::default());
+            let graph = variant_graph(label, overrides)?;
             let mut maps = evaluate(&graph, &[*map], tile, tile, &|_, _| {}).maps;
             let image = maps.remove(map).expect("requested map");
             Ok(if image.channels == 1 { gray_to_display(&image) } else { image })
@@ -204,6 +194,22 @@ pub fn render(tile: usize, columns: usize) -> Result<Image, Error> {
         }
     }
     Ok(sheet)
+}
+
+/// A variant's graph: `BASE` with the variant's overrides, and the base's colour and belly
+/// tables where the variant writes none of its own (the memory check's copy of this
+/// wrote both always, so the variants with their own failed to parse and were left out).
+fn variant_graph(label: &str, overrides: &str) -> Result<crate::graph::Graph, Error> {
+    let source = PresetSource {
+        name: label.replace([' ', ':', ',', '+'], "_"),
+        display: format!("gallery variant {label:?}"),
+        text: format!(
+            "{BASE}{}{}{overrides}",
+            if overrides.contains("[color]") { "" } else { BASE_COLOR },
+            if overrides.contains("[belly]") { "" } else { BASE_BELLY },
+        ),
+    };
+    Ok(build_graph(&parse(&source, &[])?.preset, BuildOptions::default()))
 }
 
 /// No more columns than variants: the rest were empty canvas.
@@ -228,21 +234,12 @@ pub fn check_memory(tile: usize, columns: usize) -> Result<(), Error> {
     let (w, h) = canvas_size(tile, columns);
     let tiles = (VARIANTS.len() * tile * tile * 12) as u64;
     let canvas = (w * h * (12 + 3 + 3)) as u64;
-    let graphs = VARIANTS
-        .iter()
-        .filter_map(|(label, map, overrides)| {
-            let source = PresetSource {
-                name: "gallery".into(),
-                display: format!("gallery variant {label:?}"),
-                text: format!("{BASE}{BASE_COLOR}{BASE_BELLY}{overrides}"),
-            };
-            let loaded = parse(&source, &[]).ok()?;
-            let graph = build_graph(&loaded.preset, BuildOptions::default());
-            Some(crate::memory::estimate_generate_bytes(&graph, &[*map], tile, tile))
-        })
-        .max()
-        .unwrap_or(0)
-        .saturating_mul(rayon::current_num_threads().min(VARIANTS.len()) as u64);
+    let mut heaviest = 0;
+    for (label, map, overrides) in VARIANTS {
+        let graph = variant_graph(label, overrides)?;
+        heaviest = heaviest.max(crate::memory::estimate_generate_bytes(&graph, &[*map], tile, tile));
+    }
+    let graphs = heaviest.saturating_mul(rayon::current_num_threads().min(VARIANTS.len()) as u64);
     let check = crate::memory::MemoryCheck::against_available(tiles + canvas + graphs);
     check.refuse_if_over(&format!("a gallery of {w}×{h} pixels ({} tiles of {tile}²)", VARIANTS.len()))
 }

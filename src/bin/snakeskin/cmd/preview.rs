@@ -46,7 +46,8 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         ))
         .into());
     }
-    // Names, then memory, then the GPU's limits, then folders: a refused run makes none.
+    // Names, then memory, then the GPU's limits, then folders: a refused run makes none
+    // (`ensure_parent_folder` checks the names again, where other commands rely on it).
     for file in std::iter::once(out).chain(args.reference.as_deref()) {
         snakeskin::export::check_target(file)?;
     }
@@ -63,7 +64,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     if let Some(heat_path) = &args.reference {
         ensure_parent_folder(heat_path)?;
     }
-    let material = upload_material_in(&renderer, &loaded, args.map_size as usize, args.method, args.layout.layout())?;
+    let material = upload_material_in(&renderer, &loaded, args.map_size as usize, args.method, layout)?;
     bar.message("rendering");
     let image = renderer.render_image(&settings, &material, width, height)?;
     let written = write_png(out, &image)?;
