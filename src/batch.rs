@@ -346,6 +346,10 @@ pub struct BatchIndex {
     /// bytes do not depend on it.
     #[serde(skip)]
     pub concurrency: usize,
+    /// The warnings of the shard's presets, each once (a preset's clamped colours are listed in
+    /// its sets' manifests too); not written to the index.
+    #[serde(skip)]
+    pub warnings: Vec<String>,
 }
 
 /// The index file's name for a shard (`index.json` for an unsharded run).
@@ -369,6 +373,8 @@ struct Resolved {
     outcome: JobOutcome,
     /// Whether its set is complete with its key.
     done: bool,
+    /// The preset's warnings (`LoadedPreset::warnings`: clamped colours, the model's limit).
+    warnings: Vec<String>,
 }
 
 /// `check`: whether to look for its finished set (reading and hashing its files).
@@ -398,6 +404,7 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
             source: Box::new(source),
         },
     })?;
+    let warnings = loaded.warnings(&job.preset);
     let seed = loaded.preset.seed;
     let key = job.key(&loaded.content_hash, seed);
     let folder = job.folder(&loaded.name, seed);
@@ -415,7 +422,7 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         status,
         duplicate_of: None,
     };
-    Ok(Resolved { outcome, done })
+    Ok(Resolved { outcome, done, warnings })
 }
 
 /// Resolves every job of the file (not only the shard's, so that every shard finds the same
@@ -457,7 +464,7 @@ pub fn list(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Result<
     Ok(plan(jobs_file, jobs, out, shard, false)?
         .resolved
         .into_iter()
-        .map(|Resolved { mut outcome, done }| {
+        .map(|Resolved { mut outcome, done, .. }| {
             if outcome.duplicate_of.is_none() {
                 outcome.status = if done { "done" } else { "to do" };
             }
@@ -533,6 +540,12 @@ pub fn run(
     let total = mine.len();
     let next = std::sync::atomic::AtomicUsize::new(0);
     let stop = std::sync::atomic::AtomicBool::new(false);
+    let mut warnings: Vec<String> = Vec::new();
+    for warning in resolved.iter().flat_map(|r| &r.warnings) {
+        if !warnings.contains(warning) {
+            warnings.push(warning.clone());
+        }
+    }
     let work: Vec<(&Job, Resolved)> = mine.into_iter().zip(resolved).collect();
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut first_error = None;
@@ -587,6 +600,7 @@ pub fn run(
         shard: format!("{}/{}", shard.index, shard.count),
         jobs: outcomes,
         concurrency,
+        warnings,
     };
     let json = serde_json::to_vec_pretty(&index).map_err(|e| Error::Internal(format!("index: {e}")))?;
     crate::export::create_folder(out)?;

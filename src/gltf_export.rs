@@ -55,6 +55,8 @@ pub struct ExportReport {
     pub total_time: Duration,
     /// Whether the export created the file's folder.
     pub created_folder: bool,
+    /// The preset's warnings (`LoadedPreset::warnings`), for the caller to print.
+    pub warnings: Vec<String>,
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
@@ -171,5 +173,13 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         }
         written
     };
-    Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed(), created_folder })
+    Ok(ExportReport {
+        files,
+        dimensions,
+        stats,
+        encode_time,
+        total_time: start.elapsed(),
+        created_folder,
+        warnings: plan.loaded().warnings(&request.preset),
+    })
 }

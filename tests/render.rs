@@ -39,7 +39,7 @@ fn material_of(renderer: &Renderer, preset: &str, overrides: &[(&str, &str)], me
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = snakeskin::optics::lut::Lut::bake(optics.stack, 32, 128, 32);
     let bands = if let GpuFilmMethod::SpectralN(n) = method { n } else { 1 };
-    renderer.material(&maps, optics, &lut, bands)
+    renderer.material(&maps, optics, &lut, bands).unwrap()
 }
 
 fn close_up() -> FrameSettings {
@@ -74,6 +74,29 @@ fn a_headless_render_shows_the_snake() {
     // The close-up is mostly snake.
     let near = renderer.render_image(&close_up(), &material, 320, 200).unwrap();
     assert!(coverage(&near) > 0.3, "close-up covers {}", coverage(&near));
+}
+
+/// Maps the device cannot hold are an error, not wgpu's panic (the upload ran outside an
+/// error scope: maps past the device's memory ended the process with exit code 101).
+/// Negative control: the same maps one texel narrower are uploaded.
+#[test]
+fn maps_the_device_cannot_hold_are_an_error() {
+    let Some(gpu) = gpu_or_skip("maps_the_device_cannot_hold_are_an_error") else { return };
+    let renderer = Renderer::new(gpu);
+    let widest = renderer.gpu.device.limits().max_texture_dimension_2d as usize;
+    let maps = |width: usize| snakeskin::render::engine::material::MaterialMaps {
+        width,
+        height: 1,
+        atlas: None,
+        albedo_roughness: vec![vec![[0.5; 4]; width]],
+        normal_height: vec![vec![[0.0, 0.0, 1.0, 0.5]; width]],
+        thickness: vec![vec![0.5; width]],
+    };
+    let optics = LayerOptics::from_preset(&load(PRESET, &[]).preset);
+    let lut = snakeskin::optics::lut::Lut::bake(optics.stack, 8, 16, 4);
+    let error = renderer.material(&maps(widest + 1), optics, &lut, 1).err().expect("a texture past the limit");
+    assert!(error.to_string().contains(&format!("uploading {}×1 maps", widest + 1)), "{error}");
+    renderer.material(&maps(widest), optics, &lut, 1).unwrap();
 }
 
 #[test]

@@ -222,3 +222,65 @@ fn the_colour_limit_follows_the_roughness_the_preset_can_reach() {
         assert!(smooth[c] > 1.05 * rough[c], "channel {c}: smooth {smooth:?}, rough {rough:?}");
     }
 }
+
+/// `export` and `batch` report clamped colours too (they were silent: only the manifest
+/// listed them). Negative control: a colour the stack can show is not reported.
+#[test]
+fn export_and_batch_report_clamped_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let preset = write_preset(dir.path(), "ink.toml", WHITE_UNDER_INK);
+    let glb = dir.path().join("ink.glb");
+    let out = snakeskin(&["export", &preset, "--gltf", glb.to_str().unwrap(), "--size", "32"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("ink.toml:3: color.base = \"#e0c0a0\" is brighter"), "{}", stderr(&out));
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"ink.toml\"\nsizes = [32, 64]\nmaps = \"color\"\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("sets").to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    // Once per preset, not once per job.
+    assert_eq!(err.matches("color.base = \"#e0c0a0\" is brighter").count(), 1, "{err}");
+    let dim = write_preset(dir.path(), "dim.toml", &WHITE_UNDER_INK.replace("#e0c0a0", "#101010"));
+    let out = snakeskin(&["export", &dim, "--gltf", dir.path().join("dim.glb").to_str().unwrap(), "--size", "32"]);
+    assert!(out.status.success() && !stderr(&out).contains("color.base"), "{}", stderr(&out));
+}
+
+/// An ambient denser than the pigment layer is warned of with its key and line, because the
+/// layered model loses light there (which the first assertion measures, so that the
+/// warning goes when the model stops losing it). Negative control: equal indices, no
+/// warning.
+#[test]
+fn an_ambient_denser_than_the_pigment_is_warned_of() {
+    let albedo = |n0: &str, n2: &str| {
+        let args = ["brdf", "albedo", "--n0", n0, "--n2", n2, "--absorption", "0", "--roughness", "0.5"];
+        let out = snakeskin(&[&args[..], &["--angle-deg", "75"]].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+        json["albedo"][1].as_f64().unwrap()
+    };
+    let (denser, equal) = (albedo("1.4", "1.33"), albedo("1.33", "1.33"));
+    assert!(denser < 0.8 && (equal - 1.0).abs() < 0.01, "white furnace {denser} (n0 > n2), {equal} (n0 = n2)");
+
+    let dir = tempfile::tempdir().unwrap();
+    let text = "species = \"oily\"\n\n[optics]\nambient_ior = 1.4\npigment_ior = 1.33\n";
+    let preset = write_preset(dir.path(), "oily.toml", text);
+    let out_dir = dir.path().join("out");
+    let out = snakeskin(&["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("oily.toml:4: optics.ambient_ior = 1.4 is above optics.pigment_ior = 1.33"), "{err}");
+    assert!(err.contains("critical angle (72°"), "{err}");
+    let out = snakeskin(&[
+        "generate",
+        &preset,
+        "--set",
+        "optics.ambient_ior=1.33",
+        "-o",
+        out_dir.to_str().unwrap(),
+        "--size",
+        "32",
+        "--maps",
+        "color",
+    ]);
+    assert!(out.status.success() && !stderr(&out).contains("ambient_ior"), "{}", stderr(&out));
+}

@@ -95,6 +95,28 @@ impl Checker {
     }
 }
 
+/// A stack the layered model shows darker than the physics: the ambient denser than the
+/// pigment layer. Beyond the critical angle asin(n2 / n0) the rough top's lobe loses light
+/// the stack reflects (a white lossless stack, `brdf albedo --absorption 0 --n1 1.55`:
+/// 0.50 at 75° for n0 = 1.4 over n2 = 1.33 and roughness 0.5; 0.48 at 50° for 1.5 over 1.0
+/// and roughness 0.9; BENCHMARKS.md "Stress"). The physics is fine (an oil film over a
+/// lighter layer), so it is a warning, not a refusal.
+pub fn model_limit(preset: &Preset) -> Option<Problem> {
+    let o = &preset.optics;
+    (o.ambient_ior > o.pigment_ior).then(|| Problem {
+        key: "optics.ambient_ior".into(),
+        message: format!(
+            "{} is above optics.pigment_ior = {}: the layered model loses light beyond the critical angle \
+             ({:.0}° from the normal), where the rough top's reflection has nowhere to go (a white stack without \
+             absorption reflects as little as half the light), so renders and the albedo are darker than the \
+             physics there. Keep ambient_ior at most pigment_ior for an energy-conserving render.",
+            o.ambient_ior,
+            o.pigment_ior,
+            (o.pigment_ior / o.ambient_ior).asin().to_degrees()
+        ),
+    })
+}
+
 /// Every out-of-range value in the preset (empty when it is valid). `from_file_for_old_kind
 /// (i, key)`: whether layer i's `key` is the file's while its kind came from `--set`; such a
 /// key, written for the file's kind, is passed over rather than refused as another kind's

@@ -176,10 +176,11 @@ pub fn ensure_folder(folder: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Warns, once per key, about preset colours the layer stack cannot show and what they
-/// were clamped to (`snakeskin::preset::visible`).
-pub fn report_clamped_colours(preset: &str, loaded: &snakeskin::preset::LoadedPreset) {
-    for c in &loaded.clamped_colours {
-        eprintln!("{}", c.message(preset));
+/// Prints the preset's warnings (`LoadedPreset::warnings`): colours the layer stack cannot
+/// show and what they were clamped to, once per key, and where the model is darker than
+/// the physics.
+pub fn report_warnings(preset: &str, loaded: &snakeskin::preset::LoadedPreset) {
+    for warning in loaded.warnings(preset) {
+        eprintln!("{warning}");
     }
 }

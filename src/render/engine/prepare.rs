@@ -122,7 +122,7 @@ pub fn upload_material_in(
     let maps = material_maps_in(loaded, map_size, layout)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);
-    Ok(renderer.material(&maps, optics, &lut, bands_for(method)))
+    Ok(renderer.material(&maps, optics, &lut, bands_for(method))?)
 }
 
 pub fn bands_for(method: GpuFilmMethod) -> usize {

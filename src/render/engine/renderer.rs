@@ -277,14 +277,24 @@ impl Renderer {
     }
 
     /// Uploads a material: maps, optics and the film LUT baked for its indices.
-    pub fn material(&self, maps: &MaterialMaps, optics: LayerOptics, lut: &Lut, n_bands: usize) -> Material {
+    /// The upload runs in `Gpu::checked`: 8192² maps are five textures of 256 MiB and more,
+    /// which a device short of memory refuses (a panic of wgpu's default handler otherwise).
+    pub fn material(
+        &self,
+        maps: &MaterialMaps,
+        optics: LayerOptics,
+        lut: &Lut,
+        n_bands: usize,
+    ) -> Result<Material, GpuError> {
         let device = &self.gpu.device;
-        Material {
-            optics,
-            film: FilmBinding::new(device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands),
-            textures: MaterialTextures::new(device, &self.gpu.queue, &self.material_layout, maps),
-            mesh: maps.atlas.map(|plan| GpuMesh::new(device, &BodyShape::for_atlas(&plan).mesh())),
-        }
+        self.gpu.checked(&format!("uploading {}×{} maps", maps.width, maps.height), || {
+            Ok(Material {
+                optics,
+                film: FilmBinding::new(device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands),
+                textures: MaterialTextures::new(device, &self.gpu.queue, &self.material_layout, maps),
+                mesh: maps.atlas.map(|plan| GpuMesh::new(device, &BodyShape::for_atlas(&plan).mesh())),
+            })
+        })
     }
 
     /// Replaces the film tables of a material (after its indices or band count changed).

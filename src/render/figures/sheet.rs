@@ -192,7 +192,7 @@ fn render_tile_sheet(
         let maps =
             MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Internal(format!("the sheet's maps: {e}")))?;
         let optics = LayerOptics::from_preset(&loaded.preset);
-        let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1);
+        let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
         let settings = FrameSettings {
             camera: sheet_camera(),
             method: GpuFilmMethod::Lut,
@@ -246,7 +246,7 @@ fn render_body_sheet(
             MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Internal(format!("the sheet's maps: {e}")))?;
         maps.atlas = Some(body_plan(preset));
         let optics = LayerOptics::from_preset(preset);
-        let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1);
+        let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
         let settings = FrameSettings {
             camera: Camera::framing(1),
             method: GpuFilmMethod::Lut,

@@ -182,7 +182,7 @@ pub fn bench_render(
             if snakes == 20 && !matches!(name.as_str(), "plain-pbr" | "skin-lut") {
                 continue;
             }
-            let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method));
+            let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method))?;
             let camera = crate::render::engine::scene::Camera::framing(snakes);
             let settings = FrameSettings { method: *method, plain: *plain, model: *model, snakes, camera, ..base };
             runs.push((name.clone(), snakes, material, settings, Vec::with_capacity(options.frames)));
@@ -216,7 +216,7 @@ pub fn bench_render(
         timings.iter().find(|t| t.name == name && t.snakes == snakes).map(|t| t.median_ms).unwrap_or(f64::NAN)
     };
     progress("reference comparison");
-    let material = renderer.material(&maps, optics, &lut, 1);
+    let material = renderer.material(&maps, optics, &lut, 1)?;
     let (w, h) = options.reference_size;
     let (report, _) = reference_check(renderer, &material, &base, w, h, &|_, _| {})?;
     Ok(RenderBench {

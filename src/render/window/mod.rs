@@ -191,7 +191,7 @@ impl App {
         let renderer = Renderer::new(gpu);
         let (maps, optics) = self.initial_maps.take().expect("initial maps");
         let lut = self.lut.take().expect("initial LUT");
-        let material = renderer.material(&maps, optics, &lut, self.baked_bands);
+        let material = renderer.material(&maps, optics, &lut, self.baked_bands)?;
         let targets = renderer.targets(config.width, config.height, self.settings.samples);
         self.gfx = Some(Gfx { window, surface, config, renderer, targets, material, egui_state, egui_renderer });
         Ok(())

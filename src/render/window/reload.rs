@@ -70,8 +70,8 @@ pub fn spawn_map_worker(
             while changed_rx.try_recv().is_ok() {}
             let start = Instant::now();
             let result = crate::preset::load(&spec, &overrides, seed).map_err(Error::from).and_then(|loaded| {
-                for c in &loaded.clamped_colours {
-                    eprintln!("{}", c.message(&spec));
+                for warning in loaded.warnings(&spec) {
+                    eprintln!("{warning}");
                 }
                 let (maps, stats) = material_maps_cached(&loaded, map_size, layout, &mut cache)?;
                 Ok(Reloaded { maps, sliders: Sliders::from_preset(&loaded.preset), stats, took: start.elapsed() })

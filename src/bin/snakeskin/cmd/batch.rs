@@ -25,6 +25,9 @@ pub fn run(args: BatchArgs) -> Result<()> {
         bar.message(&format!("{} {}", outcome.status, outcome.folder.display()));
     })?;
     bar.finish();
+    for warning in &index.warnings {
+        eprintln!("{warning}");
+    }
     if !had_folder && args.out.is_dir() {
         eprintln!("note: created folder {}", path_line(&args.out));
     }

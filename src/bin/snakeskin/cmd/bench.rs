@@ -178,7 +178,7 @@ fn gpu(count: usize, model: snakeskin::optics::brdf::Model, json: bool) -> Resul
 
 fn render(preset: &str, size: ImageSize, frames: u64, map_size: u64, reference: ImageSize, json: bool) -> Result<()> {
     let loaded = snakeskin::preset::load(preset, &[], None)?;
-    crate::output::report_clamped_colours(preset, &loaded);
+    crate::output::report_warnings(preset, &loaded);
     let renderer = Renderer::headless()?;
     let options = BenchOptions {
         width: size.width,

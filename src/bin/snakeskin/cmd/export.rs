@@ -25,6 +25,9 @@ pub fn run(args: ExportArgs) -> Result<()> {
     let bar = Progress::counting("{spinner} exporting [{bar:30}] {pos}/{len} nodes {elapsed}");
     let report = export(&request, &|done, total| bar.update(done, total))?;
     bar.finish();
+    for warning in &report.warnings {
+        eprintln!("{warning}");
+    }
     if report.created_folder
         && let Some(folder) = args.gltf.parent()
     {

@@ -33,7 +33,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         job: None,
     };
     let plan = Plan::new(&request)?;
-    crate::output::report_clamped_colours(&source.preset, plan.loaded());
+    crate::output::report_warnings(&source.preset, plan.loaded());
     let memory = plan.memory();
     if memory.is_tight() {
         eprintln!(

@@ -10,7 +10,7 @@ pub fn run(args: GraphArgs) -> Result<()> {
     let maps = &args.preset.maps.0;
     let source = &args.preset.source;
     let loaded = snakeskin::preset::load(&source.preset, &source.overrides, source.seed)?;
-    crate::output::report_clamped_colours(&source.preset, &loaded);
+    crate::output::report_warnings(&source.preset, &loaded);
     let graph = build_graph(&loaded.preset, BuildOptions::default());
     if args.dot {
         print!("{}", to_dot(&graph, maps));

@@ -17,7 +17,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     // Validate everything before touching the GPU or any file.
     let source = &args.source;
     let loaded = snakeskin::preset::load(&source.preset, &source.overrides, source.seed)?;
-    crate::output::report_clamped_colours(&source.preset, &loaded);
+    crate::output::report_warnings(&source.preset, &loaded);
     if args.out.is_none() && !args.window {
         return Err(Error::Preview("nothing to do: give --out FILE.png (headless) or --window".into()).into());
     }
