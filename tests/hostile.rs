@@ -346,6 +346,66 @@ fn a_failed_rename_leaves_the_earlier_set_whole() {
     assert_ne!(snapshot(dir.path()), before);
 }
 
+/// A set written over another with fewer maps, a pack or another format replaces the whole
+/// earlier set: its maps the new one does not write go too (they stayed, of another seed and
+/// size, beside the new set under no manifest: a mixed set). A map changed by hand since is
+/// no longer the set's and stays. Negative control: the same run into a folder whose earlier
+/// set has a different name keeps that set.
+#[test]
+fn a_set_written_over_another_leaves_none_of_its_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    let names = |dir: &Path| -> Vec<String> {
+        let mut names: Vec<String> =
+            std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        names.sort();
+        names
+    };
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let edited = dir.path().join(format!("{PRESET}_height.png"));
+    std::fs::write(&edited, b"painted over by hand").unwrap();
+    let run = |args: &[&str]| {
+        let base = ["generate", PRESET, "-o", dir.path().to_str().unwrap(), "--size", "32", "--seed", "2"];
+        let out = snakeskin(&[&base[..], args].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+    };
+    run(&["--maps", "color"]);
+    let set = |maps: &[&str]| -> Vec<String> {
+        let mut files: Vec<String> = maps.iter().map(|m| format!("{PRESET}_{m}")).collect();
+        files.push(format!("{PRESET}.material.json"));
+        files.sort();
+        files
+    };
+    assert_eq!(names(dir.path()), set(&["color.png", "height.png"]), "the edited height map stays");
+    assert_eq!(std::fs::read(&edited).unwrap(), b"painted over by hand");
+    std::fs::remove_file(&edited).unwrap();
+    run(&["--pack", "unreal"]);
+    assert_eq!(names(dir.path()), set(&["basecolor.png", "height.png", "normal.png", "orm.png"]));
+    run(&["--format", "exr", "--maps", "color,normal"]);
+    assert_eq!(names(dir.path()), set(&["color.exr", "normal.exr"]));
+    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
+    // Another preset's set in the same folder is another set.
+    let out = snakeskin(&["generate", "natrix-natrix", "-o", dir.path().to_str().unwrap(), "--size", "32"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(names(dir.path()).contains(&format!("{PRESET}_color.exr")));
+}
+
+/// The undo of a failed commit puts back the earlier set's maps that the new set does not
+/// write, at every rename (the old manifest, the old colour map and the four others aside;
+/// the colour map and the manifest in).
+#[test]
+fn a_failed_rename_of_a_smaller_set_leaves_the_earlier_set_whole() {
+    let Some(dir) = earlier_set_with_fault_hooks() else { return };
+    let before = snapshot(dir.path());
+    for at in 0..8 {
+        let n = at.to_string();
+        let env = [("SNAKESKIN_TEST_FAIL_AT_RENAME", n.as_str())];
+        let args = ["generate", PRESET, "-o", dir.path().to_str().unwrap(), "--size", "48", "--seed", "2"];
+        let out = snakeskin_env(&[&args[..], &["--maps", "color"]].concat(), &env);
+        assert_eq!(out.status.code(), Some(1), "rename {at}: {}", stderr(&out));
+        assert_eq!(snapshot(dir.path()), before, "rename {at}: the earlier set changed");
+    }
+}
+
 /// A `.gltf` export of a species without a film removes the thickness image an earlier
 /// export with a film left; whatever else stands at that name (here a folder) stays, and
 /// the export, already committed, succeeds. Before, it failed after replacing the other

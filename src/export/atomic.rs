@@ -22,7 +22,8 @@
 //!    file name once: a second stage of a name would remove the first's temporary.
 //! 3. Before any rename, every target is checked: a folder where a file must go is an
 //!    error, and nothing has changed yet.
-//! 4. The old files are moved aside to temporaries, the old manifest first; then the maps
+//! 4. The old files are moved aside to temporaries, the old manifest first, and with them
+//!    the old set's maps that the new one does not write (`left_over_files`); then the maps
 //!    are renamed into place, and the new manifest, which records the SHA-256 of every map,
 //!    is renamed in last; then the old files are removed.
 //!
@@ -326,8 +327,11 @@ impl SetLock {
         // before anything new is in place.
         let mut renames = 0;
         let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
-        let old_first =
-            std::iter::once(&manifest_target).chain(staged.iter().map(|(_, t)| t).filter(|t| **t != manifest_target));
+        let targets: Vec<&PathBuf> = staged.iter().map(|(_, t)| t).collect();
+        let left_over = left_over_files(&manifest_target, &targets);
+        let old_first = std::iter::once(&manifest_target)
+            .chain(targets.iter().copied().filter(|t| **t != manifest_target))
+            .chain(&left_over);
         for target in old_first {
             if fs::symlink_metadata(target).is_err() {
                 continue;
@@ -364,6 +368,36 @@ impl SetLock {
         drop(aside);
         Ok(written)
     }
+}
+
+/// The files the old manifest at `manifest` lists that the new set does not write (`targets`)
+/// and that are still what the old set wrote (their SHA-256 as recorded): they go with the
+/// old set's other files, or a set written over another with fewer maps, a pack or another
+/// format (`--maps color` after a full set, `--pack unreal` after PNGs) left the old set's
+/// other maps beside the new ones, of another size or seed, under no manifest. A file
+/// changed since (by hand: no longer the set's) is left where it is, as is anything the
+/// manifest names that is not a plain file name in the set's folder.
+fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> Vec<PathBuf> {
+    let Ok(text) = fs::read(manifest) else { return Vec::new() };
+    let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return Vec::new() };
+    let Some(entries) = json["maps"].as_array() else { return Vec::new() };
+    let dir = manifest.parent().unwrap_or(Path::new("."));
+    let mut files: Vec<PathBuf> = Vec::new();
+    for entry in entries {
+        let (Some(file), Some(recorded)) = (entry["file"].as_str(), entry["sha256"].as_str()) else { continue };
+        let path = dir.join(file);
+        let plain = !file.is_empty() && !file.contains(['/', '\\']) && !file.starts_with('.');
+        if !plain || targets.contains(&&path) || files.contains(&path) {
+            continue;
+        }
+        // A regular file, not a link (never followed) or a folder.
+        if fs::symlink_metadata(&path).is_ok_and(|m| m.is_file())
+            && fs::read(&path).is_ok_and(|bytes| sha256_hex(&bytes) == recorded)
+        {
+            files.push(path);
+        }
+    }
+    files
 }
 
 /// Undoes a commit that failed: removes the new files already in place and renames the old
