@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::export::pack::Pack;
 use crate::export::{sha256_hex, verify_set, write_file_atomically};
-use crate::generate::{GenerateRequest, Plan};
+use crate::generate::{GenerateRequest, Plan, check_set_outputs, set_file_names};
 use crate::maps::{BuildOptions, Layout};
 use crate::material::{FileFormat, MapKind, parse_map_list};
 use crate::{Error, SIZE_RANGE};
@@ -71,6 +71,18 @@ pub enum BatchError {
     /// in the way); `line`: the job's `sizes` key, else its `preset` key.
     #[error("{path}{}: job {job} ({preset}): {source}", at_line(*.line))]
     Planned { path: PathBuf, line: Option<usize>, job: usize, preset: String, source: Box<Error> },
+    /// The job failed while it ran (a full disk, a file that may not be replaced): its set
+    /// was not written; `line`: the job's `preset` key.
+    #[error("{path}{}: job {job} ({preset}, seed {seed}, size {size}): {source}", at_line(*.line))]
+    Failed { path: PathBuf, line: Option<usize>, job: usize, preset: String, seed: u64, size: u64, source: Box<Error> },
+    /// The job's preset (its file, or a file it reads) changed after the run was planned:
+    /// the set would not be what the job's key records, so it is not written.
+    #[error(
+        "{path}{}: job {job} ({preset}, seed {seed}, size {size}): the preset changed while the batch ran; its set \
+         was not written (the sets written before it are as their jobs asked). Run the batch again",
+        at_line(*.line)
+    )]
+    Changed { path: PathBuf, line: Option<usize>, job: usize, preset: String, seed: u64, size: u64 },
 }
 
 /// One `[[job]]` table as written.
@@ -361,11 +373,24 @@ pub fn index_file_name(shard: Shard) -> String {
     }
 }
 
-/// True when `folder` holds a complete set whose manifest records `key`.
-fn is_done(manifest: &Path, key: &str) -> bool {
+/// True when `manifest` records `key` and its set is complete: every file it lists has the
+/// SHA-256 it records, and it lists exactly the files the job writes (`expected`, which
+/// holds the manifest's own name too). A manifest that lost a map's entry along with the map
+/// passed as done, and the job was never run again.
+fn is_done(manifest: &Path, key: &str, expected: &[String]) -> bool {
     let Ok(text) = std::fs::read(manifest) else { return false };
     let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return false };
-    json["job"].as_str() == Some(key) && verify_set(manifest).is_ok()
+    if json["job"].as_str() != Some(key) {
+        return false;
+    }
+    let Ok(set) = verify_set(manifest) else { return false };
+    let name = |path: &Path| path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let mut listed: Vec<String> = set.files.iter().map(|(_, path)| name(path)).collect();
+    listed.push(name(manifest));
+    listed.sort();
+    let mut expected = expected.to_vec();
+    expected.sort();
+    listed == expected
 }
 
 /// A job resolved against its preset and the output folder.
@@ -375,6 +400,8 @@ struct Resolved {
     done: bool,
     /// The preset's warnings (`LoadedPreset::warnings`: clamped colours, the model's limit).
     warnings: Vec<String>,
+    /// The files its set writes (`generate::set_file_names`).
+    files: Vec<String>,
 }
 
 /// `check`: whether to look for its finished set (reading and hashing its files).
@@ -409,20 +436,23 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
     let key = job.key(&loaded.content_hash, seed);
     let folder = job.folder(&loaded.name, seed);
     let manifest = folder.join(crate::export::manifest_file_name(&loaded.name));
-    let done = check && is_done(&out.join(&manifest), &key);
-    let status = if done { "skipped" } else { "to do" };
-    let outcome = JobOutcome {
+    let mut outcome = JobOutcome {
         index: job.index,
-        preset: loaded.name,
+        preset: loaded.name.clone(),
         seed,
         size: job.size,
         folder,
         manifest,
         key,
-        status,
+        status: "to do",
         duplicate_of: None,
     };
-    Ok(Resolved { outcome, done, warnings })
+    let files = set_file_names(&loaded, &request(job, out, &outcome));
+    let done = check && is_done(&out.join(&outcome.manifest), &outcome.key, &files);
+    if done {
+        outcome.status = "skipped";
+    }
+    Ok(Resolved { outcome, done, warnings, files })
 }
 
 /// Resolves every job of the file (not only the shard's, so that every shard finds the same
@@ -535,8 +565,14 @@ pub fn run(
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
     let Planned { mine, resolved, estimates } = plan(jobs_file, jobs, out, shard, true)?;
-    let concurrency =
-        fitting_concurrency(concurrency.clamp(1, MAX_CONCURRENCY), estimates, crate::memory::available_bytes());
+    let requested = concurrency.clamp(1, MAX_CONCURRENCY);
+    // With nothing to run, the summary says what was asked (one, from an empty list, read as
+    // if memory had limited it).
+    let concurrency = if estimates.is_empty() {
+        requested
+    } else {
+        fitting_concurrency(requested, estimates, crate::memory::available_bytes())
+    };
     let total = mine.len();
     let next = std::sync::atomic::AtomicUsize::new(0);
     let stop = std::sync::atomic::AtomicBool::new(false);
@@ -561,7 +597,7 @@ pub fn run(
                 while !stop.load(std::sync::atomic::Ordering::SeqCst) {
                     let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
                     let Some((job, resolved)) = work.get(k) else { break };
-                    let result = run_one(job, resolved, out);
+                    let result = run_one(jobs_file, job, resolved, out);
                     if result.is_err() {
                         stop.store(true, std::sync::atomic::Ordering::SeqCst);
                     }
@@ -635,6 +671,11 @@ fn plan<'a>(
     let (mine, resolved): (Vec<&'a Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
     let mut estimates = Vec::new();
+    // A plan (the preset's graph, its memory estimate) is the same for every seed: jobs that
+    // differ only in their seed share one (`Job::key` at seed 0 names the rest). Planned one
+    // by one, a table of 100,000 seeds took minutes before anything ran or was listed,
+    // most of it in the allocator.
+    let mut planned_for: std::collections::HashMap<String, u64> = std::collections::HashMap::new();
     for (job, r) in mine.iter().zip(&resolved) {
         if !r.done && r.outcome.duplicate_of.is_none() {
             // A size refused (too tall, too large for memory) at the job's `sizes`; its output
@@ -647,13 +688,21 @@ fn plan<'a>(
                 source: Box::new(source),
             };
             let request = request(job, out, &r.outcome);
-            let plan = if check_memory { Plan::new(&request) } else { Plan::within_checked_budget(&request) }
-                .map_err(|e| planned(job.lines.sizes, e))?;
+            let shape = job.key(&job.preset, 0);
+            let estimate = match planned_for.get(&shape) {
+                Some(estimate) => *estimate,
+                None => {
+                    let plan = if check_memory { Plan::new(&request) } else { Plan::within_checked_budget(&request) }
+                        .map_err(|e| planned(job.lines.sizes, e))?;
+                    planned_for.insert(shape, plan.memory().estimate_bytes);
+                    plan.memory().estimate_bytes
+                }
+            };
             // Its folder and files, as `Plan::run` checks them, but before any job has
             // written its set: a folder in a later job's way stopped the run after the
             // earlier jobs' sets were written.
-            plan.check_outputs().map_err(|e| planned(job.lines.preset, e.into()))?;
-            estimates.push(plan.memory().estimate_bytes);
+            check_set_outputs(&request.out_dir, &r.files).map_err(|e| planned(job.lines.preset, e.into()))?;
+            estimates.push(estimate);
         }
     }
     Ok(Planned { mine, resolved, estimates })
@@ -672,14 +721,39 @@ impl Drop for StopOnPanic<'_> {
 
 /// One job: a duplicate's set is the earlier job's, a done job is left as it is, any other
 /// is generated.
-fn run_one(job: &Job, resolved: &Resolved, out: &Path) -> Result<JobOutcome, Error> {
+fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Result<JobOutcome, Error> {
     let mut outcome = resolved.outcome.clone();
     if outcome.duplicate_of.is_some() {
         // Its set is the earlier job's (in this shard or another).
     } else if !resolved.done {
+        let failed = |source: Error| BatchError::Failed {
+            path: jobs_file.into(),
+            line: job.lines.preset,
+            job: job.table,
+            preset: job.preset.clone(),
+            seed: outcome.seed,
+            size: job.size,
+            source: Box::new(source),
+        };
         // Checked against the available memory with the other jobs when the run was planned
         // (`fitting_concurrency`); the jobs running beside this one hold part of it now.
-        Plan::within_checked_budget(&request(job, out, &outcome))?.run(&|_, _| {})?;
+        let plan = Plan::within_checked_budget(&request(job, out, &outcome)).map_err(failed)?;
+        // The preset is read again here: an edit since the plan would write a set of the
+        // edited preset under the planned key, which a later run, the edit undone, took as
+        // done.
+        let loaded = plan.loaded();
+        if job.key(&loaded.content_hash, loaded.preset.seed) != outcome.key {
+            return Err(BatchError::Changed {
+                path: jobs_file.into(),
+                line: job.lines.preset,
+                job: job.table,
+                preset: job.preset.clone(),
+                seed: outcome.seed,
+                size: job.size,
+            }
+            .into());
+        }
+        plan.run(&|_, _| {}).map_err(failed)?;
         outcome.status = "done";
     } else {
         // A run killed after committing this set but before removing its lock file left an

@@ -4,7 +4,7 @@
 //! and writes them with the manifest as one set (`export::SetLock`). Nothing touches the
 //! output folder until every input has been validated.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::export::pack::{Pack, TextureEncoder, TextureSpec, texture_file_name};
@@ -89,6 +89,32 @@ fn size_option(request: &GenerateRequest) -> &'static str {
     if request.job.is_some() { "size" } else { "--size" }
 }
 
+/// The names of the files a request's set writes for its loaded preset: its maps (or its
+/// pack's textures), then its manifest.
+pub fn set_file_names(loaded: &LoadedPreset, request: &GenerateRequest) -> Vec<String> {
+    let name = &loaded.name;
+    let mut files: Vec<String> = match request.pack {
+        Some(pack) => pack
+            .textures(has_film(&loaded.preset), request.ao)
+            .iter()
+            .map(|spec| texture_file_name(name, spec))
+            .collect(),
+        None => request.maps.iter().map(|map| export::map_file_name_in(name, *map, request.format)).collect(),
+    };
+    files.push(export::manifest_file_name(name));
+    files
+}
+
+/// A set's folder and its files (`set_file_names`) checked before the work
+/// (`Plan::check_outputs`).
+pub fn check_set_outputs(out_dir: &Path, files: &[String]) -> Result<(), export::ExportError> {
+    export::check_folder(out_dir)?;
+    for file in files {
+        export::check_target(&out_dir.join(file))?;
+    }
+    Ok(())
+}
+
 impl Plan {
     /// The preset as loaded (overrides applied, colours clamped to what the stack shows).
     pub fn loaded(&self) -> &LoadedPreset {
@@ -99,19 +125,7 @@ impl Plan {
     /// manifest (`run` checks them before the work; tests/hostile.rs checks that they are
     /// the files written).
     pub fn file_names(&self) -> Vec<String> {
-        let name = &self.loaded.name;
-        let mut files: Vec<String> = match self.request.pack {
-            Some(pack) => pack
-                .textures(has_film(&self.loaded.preset), self.request.ao)
-                .iter()
-                .map(|spec| texture_file_name(name, spec))
-                .collect(),
-            None => {
-                self.request.maps.iter().map(|map| export::map_file_name_in(name, *map, self.request.format)).collect()
-            }
-        };
-        files.push(export::manifest_file_name(name));
-        files
+        set_file_names(&self.loaded, &self.request)
     }
 
     /// Validates the request and estimates its peak memory; refuses a set whose estimate
@@ -188,11 +202,7 @@ impl Plan {
     /// set had been evaluated and encoded (the commit checks again: the folder may change).
     /// `run` calls it, and a batch for every job before the first runs.
     pub fn check_outputs(&self) -> Result<(), export::ExportError> {
-        export::check_folder(&self.request.out_dir)?;
-        for file in self.file_names() {
-            export::check_target(&self.request.out_dir.join(file))?;
-        }
-        Ok(())
+        check_set_outputs(&self.request.out_dir, &self.file_names())
     }
 
     /// Runs the plan. `progress(done, total)` reports node evaluations.

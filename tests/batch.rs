@@ -390,3 +390,100 @@ fn jobs_run_at_once_write_the_files_and_the_index_of_jobs_run_one_at_a_time() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("1..=16"), "{}", stderr(&out));
 }
+
+/// A set is done only when its manifest lists the files the job writes: a manifest that
+/// lost a map's entry with the map was taken as done and never run again. Negative control:
+/// the whole set is still taken as done.
+#[test]
+fn a_set_missing_a_map_is_not_done() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[31]", 32);
+    let out_dir = dir.path().join("out");
+    let run = || snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert_eq!(summary_counts(&run()), (1, 0));
+    assert_eq!(summary_counts(&run()), (0, 1), "the whole set is done");
+    let set = out_dir.join("natrix-natrix/tile-32-seed31-png");
+    let manifest = set.join("natrix-natrix.material.json");
+    let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&manifest).unwrap()).unwrap();
+    json["maps"].as_array_mut().unwrap().retain(|m| m["map"] != "height");
+    std::fs::write(&manifest, serde_json::to_vec(&json).unwrap()).unwrap();
+    std::fs::remove_file(set.join("natrix-natrix_height.png")).unwrap();
+    snakeskin::export::verify_set(&manifest).expect("what the manifest lists is whole");
+    let listed = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--list"]);
+    assert!(stdout(&listed).contains("to do"), "{}", stdout(&listed));
+    assert_eq!(summary_counts(&run()), (1, 0));
+    assert!(set.join("natrix-natrix_height.png").is_file());
+}
+
+/// A preset edited while its batch runs: the job that reads the edited preset is not
+/// written under the key of the planned one (a later run, the edit undone, took that set as
+/// done), and the batch stops with exit 1 and says why; the sets before it stand. The
+/// first job pauses at its commit (`SNAKESKIN_TEST_PAUSE_AT`, debug builds) while the
+/// preset is edited.
+#[test]
+fn a_preset_edited_while_its_batch_runs_is_not_written_under_the_old_key() {
+    if !cfg!(debug_assertions) {
+        eprintln!("SKIPPED: the pause hook exists in debug builds only (cargo test without --release)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let preset = dir.path().join("snake.toml");
+    let original = "species = \"snake\"\n\n[scales]\nrows = 19\n";
+    std::fs::write(&preset, original).unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"snake.toml\"\nseeds = [1, 2]\nsizes = [32]\n").unwrap();
+    let out_dir = dir.path().join("out");
+    let args = ["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--concurrent", "1"];
+    let child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(args)
+        .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The first job's staged maps appear as it reaches its commit, where it pauses.
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let staged = |dir: &Path| {
+        std::fs::read_dir(dir.join("snake/tile-32-seed1-png"))
+            .is_ok_and(|e| e.flatten().any(|f| f.file_name().to_string_lossy().ends_with(".snakeskin-tmp")))
+    };
+    while !staged(&out_dir) {
+        assert!(Instant::now() < deadline, "the first job never reached its commit");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::fs::write(&preset, original.replace("rows = 19", "rows = 41")).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("jobs.toml:2: job 1 (") && err.contains("snake.toml, seed 2, size 32): the preset changed"),
+        "{err}"
+    );
+    snakeskin::export::verify_set(&out_dir.join("snake/tile-32-seed1-png/snake.material.json")).unwrap();
+    assert!(!out_dir.join("snake/tile-32-seed2-png/snake.material.json").exists());
+    // The edit undone, the second job runs and the first is done.
+    std::fs::write(&preset, original).unwrap();
+    let out = snakeskin(&args);
+    assert_eq!(summary_counts(&out), (1, 1), "{}", stderr(&out));
+}
+
+/// A job that fails while it runs (here a rename of its commit, the fault hook of debug
+/// builds) is named with its jobs file, line, seed and size; it named only a file. Exit 1:
+/// not the input's fault.
+#[test]
+fn a_job_that_fails_while_it_runs_is_named() {
+    if !cfg!(debug_assertions) {
+        eprintln!("SKIPPED: the fault hook exists in debug builds only (cargo test without --release)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[5]", 32);
+    let out_dir = dir.path().join("out");
+    let out = common::snakeskin_env(
+        &["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()],
+        &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "0")],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("jobs.toml:2: job 1 (natrix-natrix, seed 5, size 32): ") && err.contains("injected"), "{err}");
+}

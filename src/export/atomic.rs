@@ -144,7 +144,12 @@ fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedT
         live.push(tmp.path().to_path_buf());
         tmp
     };
-    tmp.write_all(bytes).and_then(|_| tmp.as_file().sync_all()).map_err(io_error(tmp.path()))?;
+    // Named as the file it will become (the temporary is hidden from the user), a full disk
+    // said "cannot write /out/.x.png.JWK6WF.snakeskin-tmp: No space left on device (os
+    // error 28) at path "/out/.x.png.JWK6WF.snakeskin-tmp"".
+    tmp.write_all(bytes)
+        .and_then(|_| tmp.as_file().sync_all())
+        .map_err(|e| io_error(&dir.join(target_name))(without_temporary_path(e)))?;
     Ok(tmp)
 }
 
@@ -158,14 +163,18 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
     // `File::create` makes them), readable by whoever reads the user's other files.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    // tempfile's error names the hidden temporary (`... at path "/out/.t.png.RZ4prK.
-    // snakeskin-tmp"`), a file the user never sees; the folder is named by the caller.
-    // Its error type is private and exposes no source, so the OS's words are its message's
-    // part before " at path " (tempfile 3's `PathError` display).
-    builder.tempfile_in(dir).map_err(|e| match e.to_string().split_once(" at path ") {
+    builder.tempfile_in(dir).map_err(without_temporary_path)
+}
+
+/// tempfile's errors name the hidden temporary (`... at path "/out/.t.png.RZ4prK.
+/// snakeskin-tmp"`), a file the user never sees; the caller names the folder or the target.
+/// Its error type is private and exposes no source, so the OS's words are its message's part
+/// before " at path " (tempfile 3's `PathError` display).
+fn without_temporary_path(e: std::io::Error) -> std::io::Error {
+    match e.to_string().split_once(" at path ") {
         Some((reason, _)) => std::io::Error::new(e.kind(), reason.to_string()),
         None => e,
-    })
+    }
 }
 
 /// Refuses a target that is a folder (a rename over it would fail half-way through a set),
