@@ -401,3 +401,42 @@ fn a_tile_written_in_strips_equals_the_whole_tile() {
         }
     }
 }
+
+/// A `count` that the layer's kind does not read (the file's blotches turned to spots by
+/// `--set`, which passes the blotches' keys over) does not count, clip or go into the
+/// manifest: it cut the spots to the counted series' stretch of the body (from the end of
+/// the neck, not the head). Negative control: the same spots without the count are the
+/// same map, and the blotches with it are not.
+#[test]
+fn a_count_the_layer_does_not_read_changes_nothing() {
+    let spots = preset("crotalus-atrox", &[("pattern.0.kind", "spots")]);
+    assert_eq!(spots.pattern[0].count, Some(25), "the file's count is kept, passed over");
+    let mut uncounted = spots.clone();
+    uncounted.pattern[0].count = None;
+    let map = |p: &Preset| body_map(p, MapKind::Color).data.clone();
+    assert!(map(&spots) == map(&uncounted), "a passed-over count changed the spots");
+    let blotches = preset("crotalus-atrox", &[]);
+    let mut blotches_uncounted = blotches.clone();
+    blotches_uncounted.pattern[0].count = None;
+    assert!(map(&blotches) != map(&blotches_uncounted), "the blotches' count counts");
+
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::snakeskin(&[
+        "generate",
+        "crotalus-atrox",
+        "--set",
+        "pattern.0.kind=spots",
+        "--layout",
+        "body",
+        "--size",
+        "32",
+        "--maps",
+        "color",
+        "-o",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("crotalus-atrox.material.json")).unwrap()).unwrap();
+    assert!(manifest["counts"].get("dorsal_marks").is_none(), "{}", manifest["counts"]);
+}

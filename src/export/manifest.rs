@@ -166,7 +166,7 @@ pub fn manifest(
     let counts = body.map(|b| Counts {
         ventrals: plates.then_some(b.ventrals),
         subcaudals: plates.then_some(b.subcaudals),
-        dorsal_marks: p.pattern.iter().find_map(|l| l.count),
+        dorsal_marks: p.pattern.iter().find_map(|l| l.series_count()),
         tail_bands: (p.body.tail_bands > 0).then_some(p.body.tail_bands),
     });
     let regions = body.map(|b| {

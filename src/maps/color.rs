@@ -301,7 +301,7 @@ fn blotches(s: &Shared, layer: &PatternLayer, seed: u32, scale: f32) -> Blotches
     };
     let (count, span) = series(s, layer);
     // Widening along a counted body series only: the tile has no tail to widen toward.
-    let widen = if s.body().is_some() && layer.count.is_some() { layer.widen_to_tail as f32 } else { 1.0 };
+    let widen = if s.body().is_some() && layer.series_count().is_some() { layer.widen_to_tail as f32 } else { 1.0 };
     Blotches {
         shape,
         count,
@@ -355,7 +355,7 @@ fn centre_shape(s: &Shared, layer: &PatternLayer, seed: u32) -> Option<Op> {
 /// (`body.tail_bands`) — else `amount` per circumference over the whole length.
 fn series(s: &Shared, layer: &PatternLayer) -> (u32, (f32, f32)) {
     let amount = layer.amount.round().max(1.0) as u32;
-    match (s.body(), layer.count) {
+    match (s.body(), layer.series_count()) {
         (Some(plan), Some(count)) => {
             let count = count.max(1);
             if s.tail_bands > 0 {
@@ -445,7 +445,7 @@ fn pattern_layer(
     // region clips what is painted — the mark, its border, outline and centre — not the
     // shapes they are derived from, so a mark cut by a region edge gets no outline along it.
     let region = s.body().map(|plan| {
-        let profile = super::body::layer_region(&plan, layer.count.is_some(), s.tail_bands > 0);
+        let profile = super::body::layer_region(&plan, layer.series_count().is_some(), s.tail_bands > 0);
         g.add(format!("{prefix}.region"), Op::Along(profile), &[])
     });
     let clip = |g: &mut GraphBuilder, name: String, mask: NodeId| super::masked(g, name, mask, region);

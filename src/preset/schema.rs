@@ -394,6 +394,13 @@ pub struct PatternLayer {
 }
 
 impl PatternLayer {
+    /// The layer's `count` where its kind reads one (blotches and rings): a `count` the file
+    /// wrote for blotches, passed over after `--set pattern.N.kind=spots`, still cut the spots
+    /// to the counted series' stretch of the body and went into the manifest.
+    pub fn series_count(&self) -> Option<u32> {
+        matches!(self.kind, PatternKind::Blotches | PatternKind::Rings).then_some(self.count).flatten()
+    }
+
     fn default_amount() -> f64 {
         1.0
     }
