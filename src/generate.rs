@@ -242,7 +242,7 @@ impl Plan {
             }
             finished.sort_by_key(|(m, _)| *m);
             let encode_start = Instant::now();
-            let range = crate::maps::thickness_range_nm(&loaded.preset);
+            let range = crate::maps::map_thickness_range_nm(&loaded.preset);
             use rayon::prelude::*;
             let files = finished
                 .par_iter()

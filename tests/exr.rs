@@ -93,3 +93,31 @@ fn check_exr(name: &str, layout: Layout) {
     assert_eq!(irid["bit_depth"], 32);
     assert!(snakeskin::export::verify_set(&dir.path().join(format!("{name}.material.json"))).is_ok());
 }
+
+/// A film switched off by an index equal to the ambient's has no thickness: its map is the
+/// constant 0, and the manifest's range and the OpenEXR map say 0 nm (they said 290–550 nm
+/// and 290 nm, the range of a film that does not show). Negative control: the film on.
+#[test]
+fn a_film_that_does_not_show_has_no_thickness_in_the_files() {
+    let generate = |overrides: &[&str]| {
+        let dir = tempfile::tempdir().unwrap();
+        let args = ["generate", "xenopeltis-unicolor", "-o", dir.path().to_str().unwrap(), "--size", "32"];
+        let rest = ["--format", "exr", "--maps", "iridescence"];
+        let out = common::snakeskin(&[&args[..], &rest, overrides].concat());
+        assert!(out.status.success(), "{}", common::stderr(&out));
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("xenopeltis-unicolor.material.json")).unwrap())
+                .unwrap();
+        let samples = read_channels(&dir.path().join("xenopeltis-unicolor_iridescence.exr")).remove(0).1;
+        (manifest["iridescence"].clone(), samples.iter().cloned().fold(f32::MIN, f32::max))
+    };
+    let (range, thickest) = generate(&["--set", "optics.film_ior=1.0"]);
+    assert_eq!(
+        (range["film"].as_bool(), range["min_nm"].as_f64(), range["max_nm"].as_f64()),
+        (Some(false), Some(0.0), Some(0.0))
+    );
+    assert_eq!(thickest, 0.0);
+    let (range, thickest) = generate(&[]);
+    assert_eq!(range["film"].as_bool(), Some(true));
+    assert!(range["min_nm"].as_f64().unwrap() > 0.0 && thickest > 0.0, "{range} {thickest}");
+}

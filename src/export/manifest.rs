@@ -11,7 +11,7 @@ use serde::Serialize;
 use super::ExportError;
 use super::atomic::sha256_hex;
 use super::pack::TextureSpec;
-use crate::maps::{BuildOptions, Layout, body_plan, thickness_range_nm};
+use crate::maps::{BuildOptions, Layout, body_plan};
 use crate::material::{FileFormat, MapKind, NormalConvention, Optics};
 use crate::preset::LoadedPreset;
 
@@ -179,7 +179,7 @@ pub fn manifest(
             tail: [b.vent, 1.0],
         }
     });
-    let (min_nm, max_nm) = thickness_range_nm(p);
+    let (min_nm, max_nm) = crate::maps::map_thickness_range_nm(p);
     Manifest {
         generator: "snakeskin".into(),
         generator_version: env!("CARGO_PKG_VERSION").into(),

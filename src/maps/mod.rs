@@ -76,6 +76,14 @@ pub fn thickness_range_nm(preset: &Preset) -> (f64, f64) {
     crate::material::thickness_range_nm(preset.optics.film_thickness_nm, preset.iridescence.spread_nm)
 }
 
+/// The thickness range the iridescence map's values stand for in the files (the manifest's
+/// `iridescence` range, the OpenEXR map's nanometres): the film's, or 0 to 0 nm where the
+/// film does not show (its map is the constant 0). A film switched off by `film_ior` equal
+/// to `ambient_ior` kept its range: the manifest said 290–550 nm and the OpenEXR map 290 nm.
+pub fn map_thickness_range_nm(preset: &Preset) -> (f64, f64) {
+    if has_film(preset) { thickness_range_nm(preset) } else { (0.0, 0.0) }
+}
+
 /// Whether the preset's film shows at all (`material::film_is_inert`).
 pub fn has_film(preset: &Preset) -> bool {
     let o = &preset.optics;
