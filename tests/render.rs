@@ -483,6 +483,9 @@ fn sheet_command_writes_a_png() {
     assert_eq!(image.width(), 5 * 3 * 64);
 }
 
+/// The preset is given by a link in another folder (a dotfiles set-up): edits of the file
+/// it names reload too (only the link's own folder was watched, so edits through the link
+/// were never seen).
 #[test]
 fn the_window_reloads_the_preset_file_on_save() {
     use std::io::{BufRead, BufReader};
@@ -499,12 +502,15 @@ fn the_window_reloads_the_preset_file_on_save() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let preset = dir.path().join("snake.toml");
+    std::fs::create_dir(dir.path().join("real")).unwrap();
+    let preset = dir.path().join("real/snake.toml");
+    let link = dir.path().join("snake-link.toml");
     let original = snakeskin::preset::library::get(PLAIN_PRESET).unwrap();
     std::fs::write(&preset, original).unwrap();
+    std::os::unix::fs::symlink(&preset, &link).unwrap();
     let mut child = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
-        .args(["preview", preset.to_str().unwrap(), "--window", "--frames", "1000000", "--size", "320x200"])
+        .args(["preview", link.to_str().unwrap(), "--window", "--frames", "1000000", "--size", "320x200"])
         .args(["--map-size", "128"])
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -536,8 +542,8 @@ fn the_window_reloads_the_preset_file_on_save() {
     assert_ne!(edited, original, "the edit applies");
     std::fs::write(&preset, &edited).unwrap();
     let reloaded = wait_for("reloaded in");
-    // A broken edit keeps the window running with the last good maps.
-    std::fs::write(&preset, "[scales]\nrwos = 3\n").unwrap();
+    // A broken edit (through the link) keeps the window running with the last good maps.
+    std::fs::write(&link, "[scales]\nrwos = 3\n").unwrap();
     let failed = wait_for("reload failed");
     let group = format!("-{}", child.id());
     let _ = Command::new("kill").args(["-TERM", "--", &group]).status();

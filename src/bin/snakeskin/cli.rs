@@ -58,10 +58,10 @@ pub enum Command {
         #[arg(short, long)]
         out: PathBuf,
         /// Tile size in pixels.
-        #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(16..=2048))]
+        #[arg(long, default_value_t = 256, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(16..=2048))]
         tile: u64,
         /// Tiles per row.
-        #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u64).range(1..=64))]
+        #[arg(long, default_value_t = 6, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1..=64))]
         columns: u64,
         /// Also write one close-up per capability of the skin vocabulary into this folder: a
         /// 512 × 512 crop of the colour map beside the same crop of the normal map, both
@@ -87,7 +87,7 @@ pub enum Command {
         #[arg(long, default_value = "640x400", value_parser = parse_image_size)]
         size: ImageSize,
         /// Map resolution for the preview (pixels per side).
-        #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
+        #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(64..=4096))]
         map_size: u64,
     },
     /// A contact sheet of the species library: per species its colour map and a preview
@@ -105,7 +105,7 @@ pub enum Command {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
         columns: u32,
         /// Map resolution per species (pixels per side; a body atlas's width).
-        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u64).range(64..=4096))]
+        #[arg(long, default_value_t = 512, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(64..=4096))]
         map_size: u64,
         /// tile: each species' tile and a render; body: each species' whole body atlas on
         /// its side (snout left) with its counts, and a render of the whole snake (--tile
@@ -127,15 +127,17 @@ pub enum Command {
 }
 
 impl Cli {
-    /// The command line parsed, or clap's error (exit code 2): `Cli::try_parse_from` after
-    /// one check of ours. A flag whose value may start with `-` (`--wi -1,0,1`) takes the
-    /// next word whatever it is, so `--absorption --wo 0,0,1` read `--wo` as the absorption
-    /// and then called `0,0,1` an unexpected argument: one of the command's flags right
-    /// after such a flag is refused as its missing value.
+    /// The command line parsed, or clap's error (exit code 2), with two rules of ours.
+    /// A flag whose value may start with `-` (`--wi -1,0,1`) takes the next word whatever it
+    /// is, so `--absorption --wo 0,0,1` read `--wo` as the absorption and then called
+    /// `0,0,1` an unexpected argument: one of the command's flags right after such a flag is
+    /// refused as its missing value. And every flag that takes a value takes a negative
+    /// number as one, to refuse it with its range: `--size -16` said "unexpected argument
+    /// '-1'" with the tip `-- -1`, which did not help either.
     pub fn try_parse_checked_from(args: Vec<std::ffi::OsString>) -> Result<Cli, clap::Error> {
-        use clap::CommandFactory;
+        use clap::{CommandFactory, FromArgMatches};
         let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
-        let mut command = Cli::command();
+        let mut command = negative_numbers_as_values(Cli::command());
         command.build();
         // The subcommands the words name (`brdf`, `eval`): their flags are the ones that
         // count, and the error shows the last one's usage.
@@ -164,8 +166,19 @@ impl Cli {
                 return Err(clap::Error::raw(clap::error::ErrorKind::InvalidValue, message).format(chosen));
             }
         }
-        Cli::try_parse_from(args)
+        let mut matches = command.try_get_matches_from_mut(args)?;
+        Cli::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut command))
     }
+}
+
+/// `command` and its subcommands with every flag that takes a value taking a negative
+/// number as one (`Cli::try_parse_checked_from`).
+fn negative_numbers_as_values(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|arg| {
+            if !arg.is_positional() && arg.get_action().takes_values() { arg.allow_negative_numbers(true) } else { arg }
+        })
+        .mut_subcommands(negative_numbers_as_values)
 }
 
 /// Which preset, with which edits: shared by every command that reads one.
@@ -203,7 +216,7 @@ pub struct GenerateArgs {
     pub out: PathBuf,
     /// Width of every map in pixels (16 to 16384); the tile is square, a body atlas is
     /// `body.length` widths tall (at most 65535 rows: 5461 wide at the default length 12).
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(16..=16384))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(16..=16384))]
     pub size: u64,
     /// Normal map convention: opengl (+Y up, glTF/Blender) or directx (+Y down, Unreal).
     #[arg(long, value_enum, default_value_t = Convention::Opengl)]
@@ -249,7 +262,7 @@ pub struct ExportArgs {
     pub gltf: PathBuf,
     /// Texture width in pixels (a body atlas is `body.length` widths tall; WebGL viewers
     /// commonly load textures up to 16384 texels a side).
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(16..=16384))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(16..=16384))]
     pub size: u64,
     /// snake (the preview's body), sphere (the material alone, tile layout) or plane.
     #[arg(long, value_enum, default_value_t = MeshArg::Snake)]
@@ -363,16 +376,21 @@ pub struct PreviewArgs {
     pub model: Model,
     /// Map resolution for the preview (pixels per side; a body atlas's width, narrowed
     /// if it would be more than 8192 rows long).
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(64..=4096))]
     pub map_size: u64,
     /// tile (the default: the tile repeated along the body) or body (a body atlas on the
     /// whole snake: head marks on the head, the tail's pattern on the tail).
     #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
     pub layout: LayoutArg,
-    /// With --window: render N frames, print the mean frame time and exit.
+    /// With --window: render N frames (1 to 1,000,000), print the mean frame time and exit.
     // (`requires = "window"` is met by a bool flag's default: refused with the headless
     // outputs instead, the one way to run without a window.)
-    #[arg(long, value_name = "N", conflicts_with_all = ["out", "reference"])]
+    #[arg(
+        long,
+        value_name = "N",
+        conflicts_with_all = ["out", "reference"],
+        value_parser = clap::value_parser!(u32).range(1..=1_000_000)
+    )]
     pub frames: Option<u32>,
     /// Exposure multiplier before tone mapping (Khronos PBR Neutral), 1e-6 to 1000.
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure, allow_negative_numbers = true)]
@@ -553,7 +571,7 @@ pub enum BrdfCommand {
     Stress {
         /// Number of random samples, 1 to 10,000,000 (the default takes about half a minute
         /// on two cores).
-        #[arg(long, default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
+        #[arg(long, default_value_t = 100_000, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1..=10_000_000))]
         samples: u64,
         /// Seed of the sample generator.
         #[arg(long, default_value_t = 1)]
@@ -640,7 +658,7 @@ pub struct AlbedoArgs {
     pub model: AlbedoModel,
     /// Photons per channel for --model stochastic (only), 1000 to 100,000,000 (σ ∝ 1/√N);
     /// default 200,000.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1000..=100_000_000))]
+    #[arg(long, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1000..=100_000_000))]
     pub photons: Option<u64>,
 }
 
@@ -679,10 +697,10 @@ pub enum BenchCommand {
         #[arg(long, default_value = "1280x720", value_parser = parse_image_size)]
         size: ImageSize,
         /// Timed frames per variant (after 3 warm-up frames); the median is reported.
-        #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(3..=10_000))]
+        #[arg(long, default_value_t = 30, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(3..=10_000))]
         frames: u64,
         /// Map resolution (pixels per side).
-        #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(64..=4096))]
+        #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(64..=4096))]
         map_size: u64,
         /// Frame size of the CPU reference comparison (the CPU shades each pixel spectrally,
         /// about 3 ms per covered pixel on two cores: minutes at the default, hours at a
@@ -700,7 +718,7 @@ pub enum BenchCommand {
         // The bound is the GPU's, not the bench's: the samples (112 bytes each) are one
         // storage binding, at most 128 MiB under the limits the device is opened with
         // (1,198,372 samples); above it wgpu panicked with a validation error.
-        #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1000..=1_000_000))]
+        #[arg(long, default_value_t = 1_000_000, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1000..=1_000_000))]
         samples: u64,
         /// Layer model to evaluate: layered (default) or thesis.
         #[arg(long, default_value = "layered", value_parser = parse_model)]
@@ -746,7 +764,7 @@ pub enum BenchCommand {
         /// report says what it makes in ΔE: up to about 1.7 ΔE00 at the default, 1 at
         /// 100,000, 0.25 at 1,600,000, which BENCHMARKS.md uses and which takes about 7
         /// minutes on two cores).
-        #[arg(long, default_value_t = 40_000, value_parser = clap::value_parser!(u64).range(1000..=10_000_000))]
+        #[arg(long, default_value_t = 40_000, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1000..=10_000_000))]
         photons: u64,
         /// Write an SVG plot of error (mean, p95, max ΔE00) against CPU cost, one point per
         /// model.
@@ -925,6 +943,8 @@ mod tests {
             (&["--window", "--reference", "h.png"], "cannot be used with"),
             (&["--out", "a.png", "--exposure", "-1"], "from 1e-6 to 1000"),
             (&["--out", "a.png", "--exposure", "1e-50"], "from 1e-6 to 1000"),
+            // No frame drawn, or none counted: "0 frames, mean frame time NaN ms".
+            (&["--window", "--frames", "0"], "0 is not in 1..=1000000"),
         ] {
             let error = preview(args).expect_err(&format!("{args:?} was accepted"));
             assert!(error.contains(says), "{args:?}: {error}");
@@ -932,6 +952,28 @@ mod tests {
         for args in [&["--window", "--frames", "5"][..], &["--out", "a.png", "--exposure", "1e-6"]] {
             preview(args).unwrap();
         }
+    }
+
+    /// A negative number is a flag's value, refused with the flag's range: `--size -16` said
+    /// "unexpected argument '-1'" with clap's tip `-- -1`, which made it another error.
+    /// Negative controls: a value in range, and a flag after a flag is still a missing value.
+    #[test]
+    fn a_negative_number_is_refused_with_the_flags_range() {
+        let parse = |args: &[&str]| {
+            let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
+            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
+        };
+        for (args, says) in [
+            (&["generate", "natrix-natrix", "--size", "-16"][..], "-16 is not in 16..=16384"),
+            (&["export", "natrix-natrix", "--gltf", "a.glb", "--size", "-1"], "-1 is not in 16..=16384"),
+            (&["preview", "natrix-natrix", "--out", "a.png", "--snakes", "-3"], "-3 is not in 1..=400"),
+            (&["bench", "render", "--frames", "-5"], "-5 is not in 3..=10000"),
+            (&["generate", "natrix-natrix", "--size", "--maps", "color"], "a value is required for '--size"),
+        ] {
+            let error = parse(args).expect_err(&format!("{args:?} was accepted"));
+            assert!(error.contains(says), "{args:?}: {error}");
+        }
+        parse(&["generate", "natrix-natrix", "--size", "16"]).unwrap();
     }
 
     /// A flag with a missing value took the next flag for it: `--absorption --wo 0,0,1` was

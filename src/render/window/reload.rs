@@ -84,25 +84,35 @@ pub fn spawn_map_worker(
     (reloads, watcher)
 }
 
-/// Watches the preset file (when the preset is a file) and signals every change.
+/// Watches the preset file (when the preset is a file) and signals every change: the name
+/// given and, when it is a link, the file it names (an edit of that file changes nothing
+/// at the link's name, so only the link's folder watched saw none of them).
 fn watch_preset(spec: &str, changed: Sender<()>) -> Option<notify::RecommendedWatcher> {
     use notify::Watcher;
     let path = PathBuf::from(spec);
     if !path.is_file() {
         return None;
     }
-    let file_name = path.file_name()?.to_owned();
+    let mut watched: Vec<PathBuf> = vec![path.clone()];
+    if let Ok(target) = std::fs::canonicalize(&path)
+        && std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_symlink())
+    {
+        watched.push(target);
+    }
+    let file_names: Vec<std::ffi::OsString> = watched.iter().filter_map(|p| p.file_name()).map(Into::into).collect();
     let mut watcher = notify::recommended_watcher(move |event: notify::Result<notify::Event>| {
         if let Ok(event) = event
-            && event.paths.iter().any(|p| p.file_name() == Some(file_name.as_os_str()))
+            && event.paths.iter().any(|p| p.file_name().is_some_and(|n| file_names.iter().any(|f| f == n)))
             && !matches!(event.kind, notify::EventKind::Access(_))
         {
             let _ = changed.send(());
         }
     })
     .ok()?;
-    // Watch the folder: editors often replace the file by renaming a new one over it.
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    watcher.watch(dir, notify::RecursiveMode::NonRecursive).ok()?;
+    // Watch the folders: editors often replace the file by renaming a new one over it.
+    for file in &watched {
+        let dir = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        watcher.watch(dir, notify::RecursiveMode::NonRecursive).ok()?;
+    }
     Some(watcher)
 }

@@ -98,13 +98,14 @@ fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
         report: Box::new(|status| eprintln!("preview: {}", crate::output::printable(status))),
     };
     let report = snakeskin::render::window::run(options)?;
-    if let Some(frames) = args.frames {
-        println!(
-            "{frames} frames, mean frame time {:.2} ms ({:.1} fps), adapter {}",
-            report.mean_frame_ms,
-            1000.0 / report.mean_frame_ms,
-            report.adapter
-        );
+    if args.frames.is_some() {
+        // The frames drawn (a closed window ends the run early); a frame time needs two.
+        let timing = if report.mean_frame_ms.is_finite() {
+            format!("mean frame time {:.2} ms ({:.1} fps)", report.mean_frame_ms, 1000.0 / report.mean_frame_ms)
+        } else {
+            "no frame time (it needs two frames)".to_string()
+        };
+        println!("{} frames, {timing}, adapter {}", report.frames, report.adapter);
     }
     Ok(())
 }
