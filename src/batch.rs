@@ -173,6 +173,11 @@ impl Job {
     }
 }
 
+/// A job's size outside `SIZE_RANGE`, in words.
+fn size_refused(size: impl std::fmt::Display) -> String {
+    format!("size {size}: accepted sizes are {} to {} pixels", SIZE_RANGE.start(), SIZE_RANGE.end())
+}
+
 /// `:LINE` after a jobs file's path, where the line is known.
 fn at_line(line: Option<usize>) -> String {
     line.map(|l| format!(":{l}")).unwrap_or_default()
@@ -201,6 +206,14 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         // count jobs.
         let in_job = described.key.as_deref().and_then(|k| k.strip_prefix("job.")).and_then(|k| k.split_once('.'));
         let message = match in_job.and_then(|(index, key)| Some((index.parse::<usize>().ok()? + 1, key))) {
+            // A size the type cannot hold (`-64`) said "a whole number from 0 to
+            // 18446744073709551615": the size's own range, as for a size in the type's.
+            Some((job, key))
+                if key.starts_with("sizes.") && described.message.starts_with("invalid value: integer `") =>
+            {
+                let value = described.message.split('`').nth(1).unwrap_or_default();
+                format!("job {job}: key `sizes`: {}", size_refused(value))
+            }
             Some((job, key)) => format!("job {job}: key `{key}`: {}", described.message),
             None => described.keyed_message(),
         };
@@ -269,7 +282,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         }
         let (lo, hi) = (*SIZE_RANGE.start() as u64, *SIZE_RANGE.end() as u64);
         if let Some(bad) = table.sizes.iter().flatten().find(|s| !(lo..=hi).contains(*s)) {
-            return Err(invalid("sizes", format!("size {bad}: accepted sizes are {lo} to {hi} pixels")));
+            return Err(invalid("sizes", size_refused(bad)));
         }
         let overrides: Vec<(String, String)> = table.set.iter().map(|(k, v)| (k.clone(), v.to_string())).collect();
         let seeds: Vec<Option<u64>> = match &table.seeds {

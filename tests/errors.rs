@@ -87,6 +87,48 @@ fn type_error_names_line_and_key() {
     assert!(err.trim_end().ends_with("expected a whole number"), "{err}");
 }
 
+/// A whole number the key's type cannot hold (negative, or past 2³²) is refused with the
+/// key's range, the one the range check gives a whole number in the type's (it said "from 0
+/// to 4294967295", the type's range). Each key is checked both ways, so the two ranges are
+/// the same by test, not only by construction.
+#[test]
+fn a_whole_number_beyond_its_type_gets_the_keys_range() {
+    let range =
+        |err: &str| err.split("must be an integer in ").nth(1).map(|r| r.split(']').next().unwrap().to_string());
+    for (key, inside_the_type) in [
+        ("scales.rows", "200"),
+        ("scales.smooth_rows", "100"),
+        ("belly.up_rows", "100"),
+        ("body.ventrals", "9000"),
+        ("body.subcaudals", "9000"),
+        ("body.tail_bands", "9000"),
+        ("pattern.0.count", "9000"),
+    ] {
+        let preset = "seed = 1\n\n[[pattern]]\nkind = \"blotches\"\ncolor = \"#202020\"\n";
+        let checked = refused("r.toml", preset, &["--set", &format!("{key}={inside_the_type}")]);
+        for beyond in ["-3", "5000000000", "99999999999999999999"] {
+            let err = refused("r.toml", preset, &["--set", &format!("{key}={beyond}")]);
+            assert!(err.contains(&format!("got {beyond}")) && !err.contains("4294967295"), "{key}={beyond}: {err}");
+            let (beyond_range, checked_range) = (range(&err), range(&checked));
+            assert!(beyond_range.is_some(), "{key}={beyond}: {err}");
+            if key.ends_with("_rows") {
+                assert_eq!(beyond_range.as_deref(), Some("[0, scales.rows / 2"), "{err}");
+            } else {
+                assert_eq!(beyond_range, checked_range, "{key}: {err} / {checked}");
+            }
+        }
+    }
+    // In a file, with its line; a jobs file's size too.
+    let err = refused("w.toml", "seed = 1\n[scales]\nrows = -3\n", &[]);
+    assert!(err.contains("w.toml:3:8: key `scales.rows`: must be an integer in [4, 128], got -3"), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = [-64]\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("key `sizes`: size -64: accepted sizes are 16 to 16384 pixels"), "{}", stderr(&out));
+}
+
 #[test]
 fn unknown_key_is_named_with_a_suggestion() {
     let err = refused("typo.toml", "seed = 1\n[optics]\nfilm_iro = 1.4\n", &[]);

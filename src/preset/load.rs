@@ -162,9 +162,14 @@ pub fn parse_with_seed(
                 Some(culprit) => vec![culprit],
                 None => overrides.iter().collect(),
             };
+            let message = toml_text::in_plain_words(e.message());
+            let message = match named.as_slice() {
+                [(key, _)] => in_key_range(key, &message).unwrap_or(message),
+                _ => message,
+            };
             PresetError::Override {
                 argument: named.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" "),
-                message: toml_text::in_plain_words(e.message()),
+                message,
             }
         })?
     };
@@ -255,6 +260,9 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
     {
         described.key = Some(format!("pattern.0.{rest}"));
     }
+    if let Some(in_range_words) = described.key.as_deref().and_then(|key| in_key_range(key, &described.message)) {
+        described.message = in_range_words;
+    }
     PresetError::Parse {
         location: Location {
             file: source.display.clone(),
@@ -263,6 +271,23 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
         },
         message: described.keyed_message(),
     }
+}
+
+/// A whole number its key's type cannot hold (`-3`, `5000000000`: the reader's "invalid
+/// value: integer `-3`, expected a whole number from 0 to 4294967295", in plain words) in
+/// the range check's words, with the key's range (`validate::whole_number_problem`). A
+/// `--set` value past TOML's integers is read as a word ("invalid type: string
+/// \"99999999999999999999\"") and is a whole number too.
+fn in_key_range(key: &str, message: &str) -> Option<String> {
+    let value = match message.strip_prefix("invalid value: integer `") {
+        Some(rest) => rest.split('`').next()?,
+        None => {
+            let word = message.strip_prefix("invalid type: string \"")?.split('"').next()?;
+            let digits = word.strip_prefix('-').unwrap_or(word);
+            (!digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit())).then_some(word)?
+        }
+    };
+    super::validate::whole_number_problem(key, value)
 }
 
 /// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).

@@ -87,6 +87,17 @@ impl Checker {
         }
     }
 
+    /// A whole-number key against its range (`whole_number_range`; `rows`: the preset's
+    /// `scales.rows`, which bounds the keys counted in half its rows).
+    fn whole_number(&mut self, key: &str, value: u32, rows: u32) {
+        let range = match whole_number_range(key) {
+            Some(WholeRange::Fixed(range)) => range,
+            Some(WholeRange::HalfTheRows) => (0, rows / 2),
+            None => unreachable!("{key} is not in whole_number_range's table"),
+        };
+        self.int_range(key, value, range);
+    }
+
     fn int_range(&mut self, key: &str, value: u32, (lo, hi): (u32, u32)) {
         if !(lo..=hi).contains(&value) {
             self.problems
@@ -117,6 +128,40 @@ pub fn model_limit(preset: &Preset) -> Option<Problem> {
     })
 }
 
+/// The range of a whole-number key.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WholeRange {
+    Fixed((u32, u32)),
+    /// 0 to half of `scales.rows` (rows that change, counted from the spine or the belly).
+    HalfTheRows,
+}
+
+/// The range of every whole-number key, one table for the range checks and for a value the
+/// key's type cannot hold (`-3`, `5000000000`), which the reader refuses before any check:
+/// it said "expected a whole number from 0 to 4294967295", the type's range, not the key's.
+pub fn whole_number_range(key: &str) -> Option<WholeRange> {
+    use ranges::*;
+    Some(match key {
+        "scales.rows" => WholeRange::Fixed(ROWS),
+        "scales.smooth_rows" | "belly.up_rows" => WholeRange::HalfTheRows,
+        "body.ventrals" => WholeRange::Fixed(VENTRALS),
+        "body.subcaudals" => WholeRange::Fixed(SUBCAUDALS),
+        "body.tail_bands" => WholeRange::Fixed(TAIL_BANDS),
+        layer if layer.starts_with("pattern.") && layer.ends_with(".count") => WholeRange::Fixed(MARK_COUNT),
+        _ => return None,
+    })
+}
+
+/// The range check's words for a whole number the key's type cannot hold (`value`: as
+/// written), or None for a key that is not a whole number's.
+pub fn whole_number_problem(key: &str, value: &str) -> Option<String> {
+    let range = match whole_number_range(key)? {
+        WholeRange::Fixed((lo, hi)) => format!("[{lo}, {hi}]"),
+        WholeRange::HalfTheRows => "[0, scales.rows / 2]".to_string(),
+    };
+    Some(format!("must be an integer in {range}, got {value}"))
+}
+
 /// Every out-of-range value in the preset (empty when it is valid). `from_file_for_old_kind
 /// (i, key)`: whether layer i's `key` is the file's while its kind came from `--set`; such a
 /// key, written for the file's kind, is passed over rather than refused as another kind's
@@ -126,7 +171,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
     use ranges::*;
     let mut c = Checker::default();
     let s = &preset.scales;
-    c.int_range("scales.rows", s.rows, ROWS);
+    c.whole_number("scales.rows", s.rows, s.rows);
     c.range("scales.size", s.size, SCALE_SIZE);
     c.range("scales.aspect", s.aspect, SCALE_ASPECT);
     c.range("scales.keel_height", s.keel_height, UNIT);
@@ -137,7 +182,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
     c.range("scales.vertebral_width", s.vertebral_width, ROW_WIDTH);
     c.range("scales.lowest_row_width", s.lowest_row_width, ROW_WIDTH);
     // At most half the rows each side: the rows from one side's plates to the spine.
-    c.int_range("scales.smooth_rows", s.smooth_rows, (0, s.rows / 2));
+    c.whole_number("scales.smooth_rows", s.smooth_rows, s.rows);
 
     if preset.pattern.len() > MAX_PATTERN_LAYERS {
         c.problems.push(Problem {
@@ -300,7 +345,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         c.range(key("opacity"), p.opacity, UNIT);
         c.range(key("widen_to_tail"), p.widen_to_tail, WIDEN_TO_TAIL);
         if let Some(count) = p.count {
-            c.int_range(&key("count"), count, MARK_COUNT);
+            c.whole_number(&key("count"), count, s.rows);
             if !matches!(p.kind, PatternKind::Blotches | PatternKind::Rings) && !from_file_for_old_kind(i, "count") {
                 c.problems.push(Problem {
                     key: key("count"),
@@ -316,7 +361,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
     c.range("belly.width", preset.belly.width, BELLY_WIDTH);
     c.range("belly.blend", preset.belly.blend, BELLY_BLEND);
     c.range("belly.pattern_amount", preset.belly.pattern_amount, UNIT);
-    c.int_range("belly.up_rows", preset.belly.up_rows, (0, s.rows / 2));
+    c.whole_number("belly.up_rows", preset.belly.up_rows, s.rows);
     c.range("color.variation", preset.color.variation, UNIT);
     c.range("color.between_scales", preset.color.between_scales, UNIT);
     c.range("color.scale_tone", preset.color.scale_tone, SCALE_JITTER);
@@ -349,10 +394,10 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
             ),
         });
     }
-    c.int_range("body.ventrals", b.ventrals, VENTRALS);
-    c.int_range("body.subcaudals", b.subcaudals, SUBCAUDALS);
+    c.whole_number("body.ventrals", b.ventrals, s.rows);
+    c.whole_number("body.subcaudals", b.subcaudals, s.rows);
     c.range("body.tail_shift_start", b.tail_shift_start, UNIT);
-    c.int_range("body.tail_bands", b.tail_bands, TAIL_BANDS);
+    c.whole_number("body.tail_bands", b.tail_bands, s.rows);
     c.range("body.tail_band_width", b.tail_band_width, (0.05, 0.95));
     c.range("body.tip_fraction", b.tip_fraction, UNIT);
     if b.head_mark.len() > MAX_HEAD_MARKS {
