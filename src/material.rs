@@ -168,11 +168,17 @@ impl FromStr for MapKind {
     }
 }
 
-/// Parses a comma-separated map list ("color,height"); "all" or empty means the five of
-/// every set (`MapKind::ALL`), and "all,ao" adds ambient occlusion. The result is in
-/// `MapKind` order, each map once.
+/// Parses a comma-separated map list ("color,height"); "all" means the five of every set
+/// (`MapKind::ALL`), and "all,ao" adds ambient occlusion. The result is in `MapKind` order,
+/// each map once. An empty list is refused: it had meant all five, so `--maps "$MAPS"`
+/// with the variable unset wrote every map without a word.
 pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
-    if list.trim().is_empty() || list.trim() == "all" {
+    if list.trim().is_empty() {
+        return Err("an empty list; name the maps (color, height, normal, roughness, iridescence, ao), or all \
+                    (leave the list out for all five)"
+            .into());
+    }
+    if list.trim() == "all" {
         return Ok(MapKind::ALL.to_vec());
     }
     let mut out = Vec::new();

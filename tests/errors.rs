@@ -355,3 +355,18 @@ fn a_mistyped_built_in_name_gets_a_suggestion() {
         }
     }
 }
+
+/// An empty map list is refused (it meant all five: `--maps "$MAPS"` with the variable unset
+/// wrote every map without a word), in a jobs file too. Negative control: `all`.
+#[test]
+fn an_empty_map_list_is_refused() {
+    let err = refused("m.toml", "seed = 1\n", &["--maps", ""]);
+    assert!(err.contains("an empty list; name the maps"), "{err}");
+    accepted("natrix-natrix", &["--maps", "all"]);
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nmaps = \" \"\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("jobs.toml:3: job 1 (natrix-natrix): maps: an empty list"), "{}", stderr(&out));
+}
