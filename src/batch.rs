@@ -371,10 +371,6 @@ pub struct BatchIndex {
     /// bytes do not depend on it.
     #[serde(skip)]
     pub concurrency: usize,
-    /// The warnings of the shard's presets, each once (a preset's clamped colours are listed in
-    /// its sets' manifests too); not written to the index.
-    #[serde(skip)]
-    pub warnings: Vec<String>,
 }
 
 /// The index file's name for a shard (`index.json` for an unsharded run).
@@ -575,6 +571,7 @@ pub fn run(
     out: &Path,
     shard: Shard,
     concurrency: usize,
+    warn: &mut dyn FnMut(&str),
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
     let Planned { mine, resolved, estimates } = plan(jobs_file, jobs, out, shard, true)?;
@@ -589,10 +586,13 @@ pub fn run(
     let total = mine.len();
     let next = std::sync::atomic::AtomicUsize::new(0);
     let stop = std::sync::atomic::AtomicBool::new(false);
-    let mut warnings: Vec<String> = Vec::new();
+    // The shard's presets' warnings, each once, before any job runs (a preset's clamped
+    // colours are listed in its sets' manifests too).
+    let mut warned: Vec<&String> = Vec::new();
     for warning in resolved.iter().flat_map(|r| &r.warnings) {
-        if !warnings.contains(warning) {
-            warnings.push(warning.clone());
+        if !warned.contains(&warning) {
+            warn(warning);
+            warned.push(warning);
         }
     }
     let work: Vec<(&Job, Resolved)> = mine.into_iter().zip(resolved).collect();
@@ -649,7 +649,6 @@ pub fn run(
         shard: format!("{}/{}", shard.index, shard.count),
         jobs: outcomes,
         concurrency,
-        warnings,
     };
     let json = serde_json::to_vec_pretty(&index).map_err(|e| Error::Internal(format!("index: {e}")))?;
     crate::export::create_folder(out)?;

@@ -118,6 +118,9 @@ fn a_whole_number_beyond_its_type_gets_the_keys_range() {
             }
         }
     }
+    // A quoted number is a string, and said so (not "got 21" for a value in range).
+    let err = refused("q.toml", "seed = 1\n", &["--set", "scales.rows=\"21\""]);
+    assert!(err.contains("invalid type: string \"21\"") && !err.contains("must be an integer"), "{err}");
     // In a file, with its line; a jobs file's size too.
     let err = refused("w.toml", "seed = 1\n[scales]\nrows = -3\n", &[]);
     assert!(err.contains("w.toml:3:8: key `scales.rows`: must be an integer in [4, 128], got -3"), "{err}");

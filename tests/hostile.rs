@@ -363,6 +363,16 @@ fn a_set_written_over_another_leaves_none_of_its_maps() {
     assert!(generate_into(dir.path(), "1", &[]).status.success());
     let edited = dir.path().join(format!("{PRESET}_height.png"));
     std::fs::write(&edited, b"painted over by hand").unwrap();
+    // A manifest edited to name files that are not the set's own names (another set's,
+    // `NAME_b`'s, or anything else): they stay.
+    let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(manifest_of(dir.path())).unwrap()).unwrap();
+    let others = ["notes.txt".to_string(), format!("{PRESET}_b_color.png")];
+    for other in &others {
+        std::fs::write(dir.path().join(other), b"mine").unwrap();
+        let sha = snakeskin::export::sha256_hex(b"mine");
+        json["maps"].as_array_mut().unwrap().push(serde_json::json!({"map": other, "file": other, "sha256": sha}));
+    }
+    std::fs::write(manifest_of(dir.path()), serde_json::to_vec(&json).unwrap()).unwrap();
     let run = |args: &[&str]| {
         let base = ["generate", PRESET, "-o", dir.path().to_str().unwrap(), "--size", "32", "--seed", "2"];
         let out = snakeskin(&[&base[..], args].concat());
@@ -375,9 +385,15 @@ fn a_set_written_over_another_leaves_none_of_its_maps() {
         files.sort();
         files
     };
-    assert_eq!(names(dir.path()), set(&["color.png", "height.png"]), "the edited height map stays");
+    let mut kept = set(&["color.png", "height.png"]);
+    kept.extend(others.iter().cloned());
+    kept.sort();
+    assert_eq!(names(dir.path()), kept, "the edited height map and the other files stay");
     assert_eq!(std::fs::read(&edited).unwrap(), b"painted over by hand");
     std::fs::remove_file(&edited).unwrap();
+    for other in &others {
+        std::fs::remove_file(dir.path().join(other)).unwrap();
+    }
     run(&["--pack", "unreal"]);
     assert_eq!(names(dir.path()), set(&["basecolor.png", "height.png", "normal.png", "orm.png"]));
     run(&["--format", "exr", "--maps", "color,normal"]);
@@ -389,21 +405,48 @@ fn a_set_written_over_another_leaves_none_of_its_maps() {
     assert!(names(dir.path()).contains(&format!("{PRESET}_color.exr")));
 }
 
-/// The undo of a failed commit puts back the earlier set's maps that the new set does not
-/// write, at every rename (the old manifest, the old colour map and the four others aside;
-/// the colour map and the manifest in).
+/// A smaller set over a whole one (the old manifest and colour map aside, renames 0 and 1;
+/// the four other old maps, 2-5; the colour map and the manifest in, 6 and 7). A failed
+/// rename of the new set's own undoes the commit, the earlier set's other maps put back
+/// too. The other maps go at best: one that will not move (an immutable file) stays, and
+/// the new set is written (it failed the whole set, naming a file the user had not asked
+/// for). A kill while they are aside leaves temporaries the next run removes (it removed
+/// only those of the names it writes, so these stayed for good).
 #[test]
-fn a_failed_rename_of_a_smaller_set_leaves_the_earlier_set_whole() {
-    let Some(dir) = earlier_set_with_fault_hooks() else { return };
-    let before = snapshot(dir.path());
-    for at in 0..8 {
-        let n = at.to_string();
-        let env = [("SNAKESKIN_TEST_FAIL_AT_RENAME", n.as_str())];
-        let args = ["generate", PRESET, "-o", dir.path().to_str().unwrap(), "--size", "48", "--seed", "2"];
-        let out = snakeskin_env(&[&args[..], &["--maps", "color"]].concat(), &env);
-        assert_eq!(out.status.code(), Some(1), "rename {at}: {}", stderr(&out));
-        assert_eq!(snapshot(dir.path()), before, "rename {at}: the earlier set changed");
+fn a_failed_rename_or_a_kill_in_a_smaller_set_leaves_no_mixed_set_and_no_temporary() {
+    if !fault_hooks_exist() {
+        return;
     }
+    let colour_only = |dir: &Path, seed: &str, env: &[(&str, &str)]| {
+        let args = ["generate", PRESET, "-o", dir.to_str().unwrap(), "--size", "48", "--seed", seed];
+        snakeskin_env(&[&args[..], &["--maps", "color"]].concat(), env)
+    };
+    for at in 0..8 {
+        let dir = earlier_set_with_fault_hooks().unwrap();
+        let before = snapshot(dir.path());
+        let n = at.to_string();
+        let out = colour_only(dir.path(), "2", &[("SNAKESKIN_TEST_FAIL_AT_RENAME", n.as_str())]);
+        if (2..6).contains(&at) {
+            assert!(out.status.success(), "rename {at}: {}", stderr(&out));
+            snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
+            let new_set = |p: &std::path::PathBuf| {
+                let name = p.to_string_lossy();
+                name.ends_with("_color.png") || name.ends_with(".material.json")
+            };
+            let stayed: Vec<_> = before.keys().filter(|p| p.exists() && !new_set(p)).collect();
+            assert_eq!(stayed.len(), 1, "rename {at}: the one old map that would not move stays: {stayed:?}");
+        } else {
+            assert_eq!(out.status.code(), Some(1), "rename {at}: {}", stderr(&out));
+            assert_eq!(snapshot(dir.path()), before, "rename {at}: the earlier set changed");
+        }
+    }
+    let dir = earlier_set_with_fault_hooks().unwrap();
+    let out = colour_only(dir.path(), "2", &[("SNAKESKIN_TEST_KILL_AT_RENAME", "4")]);
+    assert_eq!(out.status.code(), Some(137), "the hook did not fire: {}", stderr(&out));
+    assert!(colour_only(dir.path(), "3", &[]).status.success());
+    let names: Vec<String> =
+        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(names.iter().all(|n| !n.ends_with(".snakeskin-tmp")), "{names:?}");
 }
 
 /// A `.gltf` export of a species without a film removes the thickness image an earlier

@@ -104,6 +104,9 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
     Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// Every temporary of a name, whatever its age (under the set's lock).
+const ZERO_AGE: std::time::Duration = std::time::Duration::ZERO;
+
 /// Removes temporaries that a killed run left for `file_names` in `dir`
 /// (`.FILE.*.snakeskin-tmp`) and that are at least `min_age` old.
 fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time::Duration) {
@@ -288,6 +291,11 @@ impl SetLock {
             let file = options.open(&path).map_err(io_error(&path))?;
             match file.try_lock() {
                 Ok(()) if same_file(&file, &path) => {
+                    // Under the lock every temporary of the set's names is stale: a run killed
+                    // while it committed left the earlier set's files it moved aside, of names
+                    // the next run may not write (`--maps color` after a full set).
+                    let names = super::every_set_file_name(name);
+                    remove_stale_temporaries(dir, &names.iter().map(String::as_str).collect::<Vec<_>>(), ZERO_AGE);
                     return Ok(SetLock { dir: dir.into(), path, _file: file, created_folder });
                 }
                 Ok(()) => continue,
@@ -314,7 +322,7 @@ impl SetLock {
     /// removal of stale temporaries before it takes every temporary of that name).
     pub fn stage(&self, name: &str, bytes: &[u8]) -> Result<Staged, ExportError> {
         // Under the lock no other run can be writing this set: every temporary of it is stale.
-        remove_stale_temporaries(&self.dir, &[name], std::time::Duration::ZERO);
+        remove_stale_temporaries(&self.dir, &[name], ZERO_AGE);
         Ok(Staged { file: stage(&self.dir, name, bytes)?, name: name.into(), sha256: sha256_hex(bytes) })
     }
 
@@ -332,7 +340,8 @@ impl SetLock {
         pause_hook(|| "commit".into());
         let _commit = locked(&COMMIT);
         // Step 4a: the old files out of the way, the manifest first (so that from here on no
-        // old manifest names a map that may change). A file that cannot be moved fails here,
+        // old manifest names a map that may change), then the earlier set's files the new one
+        // does not write. A file in the new set's way that cannot be moved fails here,
         // before anything new is in place.
         let mut renames = 0;
         let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
@@ -353,6 +362,9 @@ impl SetLock {
             });
             match moved {
                 Ok(backup) => aside.push((backup, target.clone())),
+                // An earlier set's map that the new set does not write stays if it will not
+                // move (`left_over_files`): the new set does not need its place.
+                Err(_) if left_over.contains(target) => continue,
                 Err(e) => {
                     put_back(aside, &[], &manifest_target, &mut renames);
                     return Err(e);
@@ -385,8 +397,15 @@ impl SetLock {
 /// format (`--maps color` after a full set, `--pack unreal` after PNGs) left the old set's
 /// other maps beside the new ones, of another size or seed, under no manifest. A file
 /// changed since (by hand: no longer the set's) is left where it is, as is anything the
-/// manifest names that is not a plain file name in the set's folder.
+/// manifest names that is not one of the set's own file names (`every_set_file_name`, in
+/// its folder): an edited manifest cannot make a commit remove another set's files or
+/// anything else. Best effort: a file that will not move aside (immutable, held open
+/// elsewhere) stays, as before such files went at all.
 fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> Vec<PathBuf> {
+    let Some(set_name) = file_name(manifest).strip_suffix(super::manifest::MANIFEST_SUFFIX).map(String::from) else {
+        return Vec::new();
+    };
+    let set_files = super::every_set_file_name(&set_name);
     let Ok(text) = fs::read(manifest) else { return Vec::new() };
     let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return Vec::new() };
     let Some(entries) = json["maps"].as_array() else { return Vec::new() };
@@ -395,8 +414,7 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> Vec<PathBuf> {
     for entry in entries {
         let (Some(file), Some(recorded)) = (entry["file"].as_str(), entry["sha256"].as_str()) else { continue };
         let path = dir.join(file);
-        let plain = !file.is_empty() && !file.contains(['/', '\\']) && !file.starts_with('.');
-        if !plain || targets.contains(&&path) || files.contains(&path) {
+        if !set_files.iter().any(|name| name == file) || targets.contains(&&path) || files.contains(&path) {
             continue;
         }
         // A regular file, not a link (never followed) or a folder.

@@ -147,8 +147,11 @@ pub struct IridescenceRange {
 
 /// The manifest's file name for a set name.
 pub fn manifest_file_name(set_name: &str) -> String {
-    format!("{set_name}.material.json")
+    format!("{set_name}{MANIFEST_SUFFIX}")
 }
+
+/// What a set's name is followed by in its manifest's file name.
+pub const MANIFEST_SUFFIX: &str = ".material.json";
 
 /// The manifest of a set: `entries` its files, `format` their file format's name, `pack`
 /// the engine they are packed for.

@@ -91,6 +91,25 @@ pub fn map_file_name_in(preset_name: &str, map: MapKind, format: FileFormat) -> 
     format!("{preset_name}_{}.{}", map.name(), format.name())
 }
 
+/// Every file name a set named `set_name` can have: each map in each format, each pack's
+/// textures, and the manifest. A commit removes no file of an earlier set but these, and a
+/// run sweeps the stale temporaries of these only: set `a`'s names are never set `a_b`'s.
+pub fn every_set_file_name(set_name: &str) -> Vec<String> {
+    let mut names: Vec<String> = MapKind::EVERY
+        .iter()
+        .flat_map(|map| [FileFormat::Png, FileFormat::Exr].map(|format| map_file_name_in(set_name, *map, format)))
+        .collect();
+    for pack in pack::Pack::ALL {
+        for (film, ao) in [(true, true), (false, false)] {
+            names.extend(pack.textures(film, ao).iter().map(|spec| pack::texture_file_name(set_name, spec)));
+        }
+    }
+    names.push(manifest_file_name(set_name));
+    names.sort();
+    names.dedup();
+    names
+}
+
 /// Encodes one map as OpenEXR (`MapKind::exr_channels`): linear floats in physical units —
 /// the colour map's linear values, the normal's xyz in [-1, 1], the film thickness in nm
 /// (`thickness_nm` = the manifest's range the map's [0, 1] spans).

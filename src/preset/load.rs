@@ -164,7 +164,7 @@ pub fn parse_with_seed(
             };
             let message = toml_text::in_plain_words(e.message());
             let message = match named.as_slice() {
-                [(key, _)] => in_key_range(key, &message).unwrap_or(message),
+                [(key, _)] => in_key_range(key, &message, true).unwrap_or(message),
                 _ => message,
             };
             PresetError::Override {
@@ -260,7 +260,8 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
     {
         described.key = Some(format!("pattern.0.{rest}"));
     }
-    if let Some(in_range_words) = described.key.as_deref().and_then(|key| in_key_range(key, &described.message)) {
+    if let Some(in_range_words) = described.key.as_deref().and_then(|key| in_key_range(key, &described.message, false))
+    {
         described.message = in_range_words;
     }
     PresetError::Parse {
@@ -275,17 +276,20 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
 
 /// A whole number its key's type cannot hold (`-3`, `5000000000`: the reader's "invalid
 /// value: integer `-3`, expected a whole number from 0 to 4294967295", in plain words) in
-/// the range check's words, with the key's range (`validate::whole_number_problem`). A
-/// `--set` value past TOML's integers is read as a word ("invalid type: string
-/// \"99999999999999999999\"") and is a whole number too.
-fn in_key_range(key: &str, message: &str) -> Option<String> {
+/// the range check's words, with the key's range (`validate::whole_number_problem`).
+/// `from_set`: a `--set` value, where a whole number past TOML's integers is read as a word
+/// ("invalid type: string \"99999999999999999999\"") and is a whole number too; a quoted
+/// number (`"21"`, in a file or `--set`) is a string, and said so.
+fn in_key_range(key: &str, message: &str, from_set: bool) -> Option<String> {
     let value = match message.strip_prefix("invalid value: integer `") {
         Some(rest) => rest.split('`').next()?,
-        None => {
+        None if from_set => {
             let word = message.strip_prefix("invalid type: string \"")?.split('"').next()?;
             let digits = word.strip_prefix('-').unwrap_or(word);
-            (!digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit())).then_some(word)?
+            let past_toml = word.parse::<i64>().is_err();
+            (past_toml && !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit())).then_some(word)?
         }
+        None => return None,
     };
     super::validate::whole_number_problem(key, value)
 }

@@ -58,10 +58,10 @@ pub enum Command {
         #[arg(short, long)]
         out: PathBuf,
         /// Tile size in pixels.
-        #[arg(long, default_value_t = 256, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(16..=2048))]
+        #[arg(long, default_value_t = 256, value_parser = ranged_u64(16, 2048))]
         tile: u64,
         /// Tiles per row.
-        #[arg(long, default_value_t = 6, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1..=64))]
+        #[arg(long, default_value_t = 6, value_parser = ranged_u64(1, 64))]
         columns: u64,
         /// Also write one close-up per capability of the skin vocabulary into this folder: a
         /// 512 × 512 crop of the colour map beside the same crop of the normal map, both
@@ -87,7 +87,7 @@ pub enum Command {
         #[arg(long, default_value = "640x400", value_parser = parse_image_size)]
         size: ImageSize,
         /// Map resolution for the preview (pixels per side).
-        #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(64..=4096))]
+        #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
         map_size: u64,
     },
     /// A contact sheet of the species library: per species its colour map and a preview
@@ -105,7 +105,7 @@ pub enum Command {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
         columns: u32,
         /// Map resolution per species (pixels per side; a body atlas's width).
-        #[arg(long, default_value_t = 512, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(64..=4096))]
+        #[arg(long, default_value_t = 512, value_parser = ranged_u64(64, 4096))]
         map_size: u64,
         /// tile: each species' tile and a render; body: each species' whole body atlas on
         /// its side (snout left) with its counts, and a render of the whole snake (--tile
@@ -171,6 +171,17 @@ impl Cli {
     }
 }
 
+/// A whole number in `lo..=hi`, refused with its range whatever it is: negative, or past
+/// u64 (`--samples 18446744073709551616` and `--size -16` were "number too large to fit in
+/// target type" and "invalid digit found in string" under clap's parsers).
+fn ranged_u64(lo: u64, hi: u64) -> impl Fn(&str) -> Result<u64, String> + Clone + Send + Sync + 'static {
+    move |text| match text.trim().parse::<i128>() {
+        Ok(n) if (i128::from(lo)..=i128::from(hi)).contains(&n) => Ok(n as u64),
+        Ok(n) => Err(format!("{n} is not in {lo}..={hi}")),
+        Err(_) => Err(format!("not a whole number; accepted: {lo}..={hi}")),
+    }
+}
+
 /// `command` and its subcommands with every flag that takes a value taking a negative
 /// number as one (`Cli::try_parse_checked_from`).
 fn negative_numbers_as_values(command: clap::Command) -> clap::Command {
@@ -193,7 +204,7 @@ pub struct PresetSource {
     /// Override the preset's seed (any 64-bit unsigned integer).
     // Negative numbers are read as the value (and refused as one): clap took `--seed -1`'s
     // `-1` for a flag and suggested `-- -1`, which makes it the preset argument.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = ranged_u64(0, u64::MAX))]
     pub seed: Option<u64>,
 }
 
@@ -216,7 +227,7 @@ pub struct GenerateArgs {
     pub out: PathBuf,
     /// Width of every map in pixels (16 to 16384); the tile is square, a body atlas is
     /// `body.length` widths tall (at most 65535 rows: 5461 wide at the default length 12).
-    #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(16..=16384))]
+    #[arg(long, default_value_t = 1024, value_parser = ranged_u64(16, 16384))]
     pub size: u64,
     /// Normal map convention: opengl (+Y up, glTF/Blender) or directx (+Y down, Unreal).
     #[arg(long, value_enum, default_value_t = Convention::Opengl)]
@@ -262,7 +273,7 @@ pub struct ExportArgs {
     pub gltf: PathBuf,
     /// Texture width in pixels (a body atlas is `body.length` widths tall; WebGL viewers
     /// commonly load textures up to 16384 texels a side).
-    #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(16..=16384))]
+    #[arg(long, default_value_t = 1024, value_parser = ranged_u64(16, 16384))]
     pub size: u64,
     /// snake (the preview's body), sphere (the material alone, tile layout) or plane.
     #[arg(long, value_enum, default_value_t = MeshArg::Snake)]
@@ -376,7 +387,7 @@ pub struct PreviewArgs {
     pub model: Model,
     /// Map resolution for the preview (pixels per side; a body atlas's width, narrowed
     /// if it would be more than 8192 rows long).
-    #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(64..=4096))]
+    #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
     pub map_size: u64,
     /// tile (the default: the tile repeated along the body) or body (a body atlas on the
     /// whole snake: head marks on the head, the tail's pattern on the tail).
@@ -571,7 +582,7 @@ pub enum BrdfCommand {
     Stress {
         /// Number of random samples, 1 to 10,000,000 (the default takes about half a minute
         /// on two cores).
-        #[arg(long, default_value_t = 100_000, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1..=10_000_000))]
+        #[arg(long, default_value_t = 100_000, value_parser = ranged_u64(1, 10_000_000))]
         samples: u64,
         /// Seed of the sample generator.
         #[arg(long, default_value_t = 1)]
@@ -658,7 +669,7 @@ pub struct AlbedoArgs {
     pub model: AlbedoModel,
     /// Photons per channel for --model stochastic (only), 1000 to 100,000,000 (σ ∝ 1/√N);
     /// default 200,000.
-    #[arg(long, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1000..=100_000_000))]
+    #[arg(long, value_parser = ranged_u64(1000, 100_000_000))]
     pub photons: Option<u64>,
 }
 
@@ -697,10 +708,10 @@ pub enum BenchCommand {
         #[arg(long, default_value = "1280x720", value_parser = parse_image_size)]
         size: ImageSize,
         /// Timed frames per variant (after 3 warm-up frames); the median is reported.
-        #[arg(long, default_value_t = 30, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(3..=10_000))]
+        #[arg(long, default_value_t = 30, value_parser = ranged_u64(3, 10_000))]
         frames: u64,
         /// Map resolution (pixels per side).
-        #[arg(long, default_value_t = 1024, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(64..=4096))]
+        #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
         map_size: u64,
         /// Frame size of the CPU reference comparison (the CPU shades each pixel spectrally,
         /// about 3 ms per covered pixel on two cores: minutes at the default, hours at a
@@ -718,7 +729,7 @@ pub enum BenchCommand {
         // The bound is the GPU's, not the bench's: the samples (112 bytes each) are one
         // storage binding, at most 128 MiB under the limits the device is opened with
         // (1,198,372 samples); above it wgpu panicked with a validation error.
-        #[arg(long, default_value_t = 1_000_000, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1000..=1_000_000))]
+        #[arg(long, default_value_t = 1_000_000, value_parser = ranged_u64(1000, 1_000_000))]
         samples: u64,
         /// Layer model to evaluate: layered (default) or thesis.
         #[arg(long, default_value = "layered", value_parser = parse_model)]
@@ -764,7 +775,7 @@ pub enum BenchCommand {
         /// report says what it makes in ΔE: up to about 1.7 ΔE00 at the default, 1 at
         /// 100,000, 0.25 at 1,600,000, which BENCHMARKS.md uses and which takes about 7
         /// minutes on two cores).
-        #[arg(long, default_value_t = 40_000, value_parser = clap::builder::RangedI64ValueParser::<u64>::new().range(1000..=10_000_000))]
+        #[arg(long, default_value_t = 40_000, value_parser = ranged_u64(1000, 10_000_000))]
         photons: u64,
         /// Write an SVG plot of error (mean, p95, max ΔE00) against CPU cost, one point per
         /// model.
@@ -965,6 +976,8 @@ mod tests {
         };
         for (args, says) in [
             (&["generate", "natrix-natrix", "--size", "-16"][..], "-16 is not in 16..=16384"),
+            (&["generate", "natrix-natrix", "--seed", "-1"], "-1 is not in 0..=18446744073709551615"),
+            (&["brdf", "stress", "--samples", "18446744073709551616"], "18446744073709551616 is not in 1..=10000000"),
             (&["export", "natrix-natrix", "--gltf", "a.glb", "--size", "-1"], "-1 is not in 16..=16384"),
             (&["preview", "natrix-natrix", "--out", "a.png", "--snakes", "-3"], "-3 is not in 1..=400"),
             (&["bench", "render", "--frames", "-5"], "-5 is not in 3..=10000"),

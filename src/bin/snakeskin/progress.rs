@@ -45,6 +45,14 @@ impl Progress {
         }
     }
 
+    /// A line on stderr above the bar (a warning while it runs).
+    pub fn println(&self, line: &str) {
+        match &self.0 {
+            Some(bar) => bar.println(line),
+            None => eprintln!("{line}"),
+        }
+    }
+
     pub fn finish(self) {
         if let Some(bar) = self.0 {
             bar.finish_and_clear();

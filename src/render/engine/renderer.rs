@@ -298,16 +298,30 @@ impl Renderer {
     }
 
     /// Replaces the film tables of a material (after its indices or band count changed).
-    pub fn refilm(&self, material: &mut Material, optics: LayerOptics, lut: &Lut, n_bands: usize) {
-        material.film =
-            FilmBinding::new(&self.gpu.device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands);
+    pub fn refilm(
+        &self,
+        material: &mut Material,
+        optics: LayerOptics,
+        lut: &Lut,
+        n_bands: usize,
+    ) -> Result<(), GpuError> {
+        material.film = self.gpu.checked("uploading the film tables", || {
+            Ok(FilmBinding::new(&self.gpu.device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands))
+        })?;
         material.optics = optics;
+        Ok(())
     }
 
     /// Replaces the maps of a material (live reload).
-    pub fn retexture(&self, material: &mut Material, maps: &MaterialMaps) {
-        material.textures = MaterialTextures::new(&self.gpu.device, &self.gpu.queue, &self.material_layout, maps);
-        material.mesh = maps.atlas.map(|plan| GpuMesh::new(&self.gpu.device, &BodyShape::for_atlas(&plan).mesh()));
+    pub fn retexture(&self, material: &mut Material, maps: &MaterialMaps) -> Result<(), GpuError> {
+        let (textures, mesh) = self.gpu.checked(&format!("uploading {}×{} maps", maps.width, maps.height), || {
+            Ok((
+                MaterialTextures::new(&self.gpu.device, &self.gpu.queue, &self.material_layout, maps),
+                maps.atlas.map(|plan| GpuMesh::new(&self.gpu.device, &BodyShape::for_atlas(&plan).mesh())),
+            ))
+        })?;
+        (material.textures, material.mesh) = (textures, mesh);
+        Ok(())
     }
 
     /// Refuses a readback of `width`×`height` texels of `texel_bytes` that the device

@@ -269,8 +269,12 @@ fn render_body_sheet(
         let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
         let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
         let b = &preset.body;
-        let marks =
-            preset.pattern.iter().find_map(|l| l.count).map(|n| format!(", {n} dorsal marks")).unwrap_or_default();
+        let marks = preset
+            .pattern
+            .iter()
+            .find_map(|l| l.series_count())
+            .map(|n| format!(", {n} dorsal marks"))
+            .unwrap_or_default();
         let bands = if b.tail_bands > 0 { format!(", {} tail bands", b.tail_bands) } else { String::new() };
         let third = clip(format!("{} ventrals, {} subcaudals{marks}{bands}", b.ventrals, b.subcaudals));
         draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);

@@ -202,17 +202,19 @@ impl App {
         let Some(gfx) = self.gfx.as_mut() else { return };
         while let Ok(result) = self.reloads.try_recv() {
             match result {
-                Ok(reloaded) => {
-                    gfx.renderer.retexture(&mut gfx.material, &reloaded.maps);
-                    self.status = format!(
-                        "reloaded in {:.0} ms: {} nodes re-evaluated, {} reused",
-                        reloaded.took.as_secs_f64() * 1e3,
-                        reloaded.stats.evaluated,
-                        reloaded.stats.reused
-                    );
-                    // The file is the source of truth for the optics too.
-                    self.sliders = reloaded.sliders;
-                }
+                Ok(reloaded) => match gfx.renderer.retexture(&mut gfx.material, &reloaded.maps) {
+                    Ok(()) => {
+                        self.status = format!(
+                            "reloaded in {:.0} ms: {} nodes re-evaluated, {} reused",
+                            reloaded.took.as_secs_f64() * 1e3,
+                            reloaded.stats.evaluated,
+                            reloaded.stats.reused
+                        );
+                        // The file is the source of truth for the optics too.
+                        self.sliders = reloaded.sliders;
+                    }
+                    Err(error) => self.status = format!("reload failed, keeping the last good maps: {error}"),
+                },
                 Err(error) => self.status = format!("reload failed, keeping the last good maps: {error}"),
             }
             // Also to the caller: the window may be behind others, and tests read it.
@@ -220,7 +222,11 @@ impl App {
         }
         while let Ok((stack, bands, lut)) = self.lut_results.try_recv() {
             let optics = LayerOptics { stack, ..gfx.material.optics };
-            gfx.renderer.refilm(&mut gfx.material, optics, &lut, bands);
+            if let Err(error) = gfx.renderer.refilm(&mut gfx.material, optics, &lut, bands) {
+                self.status = format!("the film tables were not uploaded, keeping the last: {error}");
+                (self.options.report)(&self.status);
+                continue;
+            }
             self.baked_stack = stack;
             self.baked_bands = bands;
         }

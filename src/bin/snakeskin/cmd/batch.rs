@@ -20,14 +20,13 @@ pub fn run(args: BatchArgs) -> Result<()> {
     let had_folder = args.out.is_dir();
     let bar = Progress::counting("{spinner} batch [{bar:30}] {pos}/{len} jobs {elapsed} {msg}");
     let concurrency = args.concurrent.map_or_else(batch::default_concurrency, usize::from);
-    let index = batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut |done, total, outcome| {
-        bar.update(done, total);
-        bar.message(&format!("{} {}", outcome.status, outcome.folder.display()));
-    })?;
+    let mut warn = |warning: &str| bar.println(warning);
+    let index =
+        batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut warn, &mut |done, total, outcome| {
+            bar.update(done, total);
+            bar.message(&format!("{} {}", outcome.status, outcome.folder.display()));
+        })?;
     bar.finish();
-    for warning in &index.warnings {
-        eprintln!("{warning}");
-    }
     if !had_folder && args.out.is_dir() {
         eprintln!("note: created folder {}", path_line(&args.out));
     }
