@@ -72,17 +72,35 @@ pub enum BatchError {
     #[error("{path}{}: job {job} ({preset}): {source}", at_line(*.line))]
     Planned { path: PathBuf, line: Option<usize>, job: usize, preset: String, source: Box<Error> },
     /// The job failed while it ran (a full disk, a file that may not be replaced): its set
-    /// was not written; `line`: the job's `preset` key.
-    #[error("{path}{}: job {job} ({preset}, seed {seed}, size {size}): {source}", at_line(*.line))]
-    Failed { path: PathBuf, line: Option<usize>, job: usize, preset: String, seed: u64, size: u64, source: Box<Error> },
+    /// was not written.
+    #[error("{job}: {source}")]
+    Failed { job: RunningJob, source: Box<Error> },
     /// The job's preset (its file, or a file it reads) changed after the run was planned:
     /// the set would not be what the job's key records, so it is not written.
     #[error(
-        "{path}{}: job {job} ({preset}, seed {seed}, size {size}): the preset changed while the batch ran; its set \
-         was not written (the sets written before it are as their jobs asked). Run the batch again",
-        at_line(*.line)
+        "{job}: the preset changed while the batch ran; its set was not written (the sets written before it are as \
+         their jobs asked). Run the batch again"
     )]
-    Changed { path: PathBuf, line: Option<usize>, job: usize, preset: String, seed: u64, size: u64 },
+    Changed { job: RunningJob },
+}
+
+/// A job as its messages at run time name it: `jobs.toml:LINE: job N (PRESET, seed S, size
+/// Z)`, the line of its `preset` key.
+#[derive(Debug, Clone)]
+pub struct RunningJob {
+    pub path: PathBuf,
+    pub line: Option<usize>,
+    pub table: usize,
+    pub preset: String,
+    pub seed: u64,
+    pub size: u64,
+}
+
+impl std::fmt::Display for RunningJob {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let RunningJob { path, line, table, preset, seed, size } = self;
+        write!(f, "{}{}: job {table} ({preset}, seed {seed}, size {size})", path.display(), at_line(*line))
+    }
 }
 
 /// One `[[job]]` table as written.
@@ -738,15 +756,15 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
     if outcome.duplicate_of.is_some() {
         // Its set is the earlier job's (in this shard or another).
     } else if !resolved.done {
-        let failed = |source: Error| BatchError::Failed {
+        let running = RunningJob {
             path: jobs_file.into(),
             line: job.lines.preset,
-            job: job.table,
+            table: job.table,
             preset: job.preset.clone(),
             seed: outcome.seed,
             size: job.size,
-            source: Box::new(source),
         };
+        let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
         // Checked against the available memory with the other jobs when the run was planned
         // (`fitting_concurrency`); the jobs running beside this one hold part of it now.
         let plan = Plan::within_checked_budget(&request(job, out, &outcome)).map_err(failed)?;
@@ -755,15 +773,7 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
         // done.
         let loaded = plan.loaded();
         if job.key(&loaded.content_hash, loaded.preset.seed) != outcome.key {
-            return Err(BatchError::Changed {
-                path: jobs_file.into(),
-                line: job.lines.preset,
-                job: job.table,
-                preset: job.preset.clone(),
-                seed: outcome.seed,
-                size: job.size,
-            }
-            .into());
+            return Err(BatchError::Changed { job: running.clone() }.into());
         }
         plan.run(&|_, _| {}).map_err(failed)?;
         outcome.status = "done";

@@ -55,6 +55,8 @@ pub struct GenerateReport {
     /// Maps quantised from their constant value, their node's image not read (a species
     /// without a film: its thickness map), with the value.
     pub constant_maps: Vec<(MapKind, f32)>,
+    /// The earlier set's files that went with it because this set does not write them.
+    pub removed: Vec<PathBuf>,
 }
 
 /// The tallest map written (a body atlas is `body.length` widths tall): PNG readers and GPU
@@ -375,6 +377,7 @@ impl Plan {
             created_folder: lock.created_folder,
             strips: strip_layout.map(|s| (s.count, s.rows, s.margin)),
             constant_maps,
+            removed: lock.removed(),
         })
     }
 }
@@ -440,6 +443,7 @@ impl Plan {
             created_folder: lock.created_folder,
             strips: strips.map(|s| (s.count, s.rows, s.margin)),
             constant_maps: Vec::new(),
+            removed: lock.removed(),
         })
     }
 }

@@ -377,8 +377,15 @@ fn a_set_written_over_another_leaves_none_of_its_maps() {
         let base = ["generate", PRESET, "-o", dir.path().to_str().unwrap(), "--size", "32", "--seed", "2"];
         let out = snakeskin(&[&base[..], args].concat());
         assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out)
     };
-    run(&["--maps", "color"]);
+    // Said, one note per file.
+    let err = run(&["--maps", "color"]);
+    assert!(
+        err.contains(&format!("note: removed {}", dir.path().join(format!("{PRESET}_normal.png")).display())),
+        "{err}"
+    );
+    assert_eq!(err.matches("note: removed").count(), 3, "normal, roughness, iridescence: {err}");
     let set = |maps: &[&str]| -> Vec<String> {
         let mut files: Vec<String> = maps.iter().map(|m| format!("{PRESET}_{m}")).collect();
         files.push(format!("{PRESET}.material.json"));

@@ -274,6 +274,8 @@ pub struct SetLock {
     _file: File,
     /// Whether acquiring created the output folder.
     pub created_folder: bool,
+    /// The earlier set's files a commit removed (`left_over_files`), for the caller to say.
+    removed: Mutex<Vec<PathBuf>>,
 }
 
 impl SetLock {
@@ -296,7 +298,13 @@ impl SetLock {
                     // the next run may not write (`--maps color` after a full set).
                     let names = super::every_set_file_name(name);
                     remove_stale_temporaries(dir, &names.iter().map(String::as_str).collect::<Vec<_>>(), ZERO_AGE);
-                    return Ok(SetLock { dir: dir.into(), path, _file: file, created_folder });
+                    return Ok(SetLock {
+                        dir: dir.into(),
+                        path,
+                        _file: file,
+                        created_folder,
+                        removed: Mutex::new(Vec::new()),
+                    });
                 }
                 Ok(()) => continue,
                 Err(fs::TryLockError::WouldBlock) => {
@@ -313,6 +321,12 @@ impl SetLock {
     pub fn write(&self, maps: &[(String, Vec<u8>)], manifest: (&str, &[u8])) -> Result<Vec<PathBuf>, ExportError> {
         let staged = maps.iter().map(|(name, bytes)| self.stage(name, bytes)).collect::<Result<Vec<_>, _>>()?;
         self.commit(staged, manifest)
+    }
+
+    /// The earlier set's files that commits removed because the new set does not write them
+    /// (`--maps color` after a full set).
+    pub fn removed(&self) -> Vec<PathBuf> {
+        self.removed.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
 
     /// Writes one map of the set to its temporary now (step 2), so its bytes need not be
@@ -386,7 +400,10 @@ impl SetLock {
         }
         sync_folder(dir);
         // The old files go (each `TempPath` removes its file when dropped).
+        let removed: Vec<PathBuf> =
+            aside.iter().map(|(_, target)| target.clone()).filter(|t| left_over.contains(t)).collect();
         drop(aside);
+        self.removed.lock().unwrap_or_else(|e| e.into_inner()).extend(removed);
         Ok(written)
     }
 }

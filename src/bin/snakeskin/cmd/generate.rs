@@ -48,6 +48,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     if report.created_folder {
         eprintln!("note: created folder {}", path_line(&args.out));
     }
+    for file in &report.removed {
+        eprintln!("note: removed {}, the earlier set's (this set does not write it)", path_line(file));
+    }
     for file in &report.files {
         println!("{}", path_line(file));
     }
