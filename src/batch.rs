@@ -227,9 +227,9 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
             // A size the type cannot hold (`-64`) said "a whole number from 0 to
             // 18446744073709551615": the size's own range, as for a size in the type's.
             Some((job, key))
-                if key.starts_with("sizes.") && described.message.starts_with("invalid value: integer `") =>
+                if let Some(value) = crate::toml_text::integer_out_of_type(&described.message)
+                    && key.starts_with("sizes.") =>
             {
-                let value = described.message.split('`').nth(1).unwrap_or_default();
                 format!("job {job}: key `sizes`: {}", size_refused(value))
             }
             Some((job, key)) => format!("job {job}: key `{key}`: {}", described.message),

@@ -139,6 +139,13 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
+/// The value of a whole number its key's type cannot hold (`-3`, `5000000000`), from a
+/// message in plain words (`in_plain_words`: "invalid value: integer `-3`, expected a whole
+/// number from 0 to 4294967295"), for the caller to refuse with the key's own range.
+pub fn integer_out_of_type(message: &str) -> Option<&str> {
+    message.strip_prefix("invalid value: integer `")?.split('`').next()
+}
+
 /// serde's words for types in a reader's: what the value is (`invalid type: sequence`) and
 /// what is accepted (`expected u32`, `expected struct Scales`). Only serde's own parts are
 /// rewritten, never the value the message quotes: the value's type after "invalid type: "

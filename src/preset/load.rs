@@ -281,8 +281,8 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
 /// ("invalid type: string \"99999999999999999999\"") and is a whole number too; a quoted
 /// number (`"21"`, in a file or `--set`) is a string, and said so.
 fn in_key_range(key: &str, message: &str, from_set: bool) -> Option<String> {
-    let value = match message.strip_prefix("invalid value: integer `") {
-        Some(rest) => rest.split('`').next()?,
+    let value = match toml_text::integer_out_of_type(message) {
+        Some(value) => value,
         None if from_set => {
             let word = message.strip_prefix("invalid type: string \"")?.split('"').next()?;
             let digits = word.strip_prefix('-').unwrap_or(word);

@@ -346,7 +346,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         c.range(key("widen_to_tail"), p.widen_to_tail, WIDEN_TO_TAIL);
         if let Some(count) = p.count {
             c.whole_number(&key("count"), count, s.rows);
-            if !matches!(p.kind, PatternKind::Blotches | PatternKind::Rings) && !from_file_for_old_kind(i, "count") {
+            if p.series_count().is_none() && !from_file_for_old_kind(i, "count") {
                 c.problems.push(Problem {
                     key: key("count"),
                     message: format!(

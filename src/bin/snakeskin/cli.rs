@@ -202,9 +202,7 @@ pub struct PresetSource {
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_key_value)]
     pub overrides: Vec<(String, String)>,
     /// Override the preset's seed (any 64-bit unsigned integer).
-    // Negative numbers are read as the value (and refused as one): clap took `--seed -1`'s
-    // `-1` for a flag and suggested `-- -1`, which makes it the preset argument.
-    #[arg(long, allow_negative_numbers = true, value_parser = ranged_u64(0, u64::MAX))]
+    #[arg(long, value_parser = ranged_u64(0, u64::MAX))]
     pub seed: Option<u64>,
 }
 
@@ -404,7 +402,7 @@ pub struct PreviewArgs {
     )]
     pub frames: Option<u32>,
     /// Exposure multiplier before tone mapping (Khronos PBR Neutral), 1e-6 to 1000.
-    #[arg(long, default_value_t = 1.0, value_parser = parse_exposure, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     pub exposure: f32,
     /// Number of snakes (instanced in a grid).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=400))]
@@ -498,13 +496,13 @@ fn parse_key_value(arg: &str) -> Result<(String, String), String> {
 #[derive(Debug, Args)]
 pub struct StackArgs {
     /// Refractive index of the ambient medium (thesis n0), 1 to 3.
-    #[arg(long, default_value_t = thesis::AMBIENT_IOR, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = thesis::AMBIENT_IOR)]
     pub n0: f64,
     /// Refractive index of the iridescent film (thesis n1), 1 to 3.
-    #[arg(long, default_value_t = thesis::FILM_IOR, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = thesis::FILM_IOR)]
     pub n1: f64,
     /// Refractive index of the pigment layer under the film (thesis n2), 1 to 3.
-    #[arg(long, default_value_t = thesis::PIGMENT_IOR, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = thesis::PIGMENT_IOR)]
     pub n2: f64,
 }
 
@@ -515,13 +513,13 @@ pub enum BrdfCommand {
         #[command(flatten)]
         stack: StackArgs,
         /// Film thickness in nm (thesis δ0), 0 to 10^7.
-        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
+        #[arg(long, required_unless_present = "batch")]
         thickness_nm: Option<f64>,
         /// Vacuum wavelength in nm, 1 to 10^6.
-        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
+        #[arg(long, required_unless_present = "batch")]
         wavelength_nm: Option<f64>,
         /// Incidence angle in the ambient medium, degrees, 0 (normal) to 90.
-        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
+        #[arg(long, required_unless_present = "batch")]
         angle_deg: Option<f64>,
         /// Read JSON objects {n0, n1, n2, thickness_nm, wavelength_nm, angle_deg}, one per
         /// line, from FILE (or - for stdin); print one JSON line per query, in order, as each
@@ -536,10 +534,10 @@ pub enum BrdfCommand {
         #[command(flatten)]
         stack: StackArgs,
         /// Film thickness in nm (thesis δ0), 0 to 10^7.
-        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
+        #[arg(long, required_unless_present = "batch")]
         thickness_nm: Option<f64>,
         /// Angle of light and view from the normal in the ambient medium, degrees, 0 to 90.
-        #[arg(long, required_unless_present = "batch", allow_negative_numbers = true)]
+        #[arg(long, required_unless_present = "batch")]
         angle_deg: Option<f64>,
         /// Colour method: spectral (the reference: the exact film summed at 1 nm over CIE
         /// 1931 2° under D65), rgb3, spectral-N (e.g. spectral-16), gaussian-fit, lut.
@@ -621,10 +619,10 @@ pub struct EvalArgs {
 #[derive(Debug, Args)]
 pub struct LayerArgs {
     /// Film thickness in nm (thesis δ0), 0 to 10^7 (10 mm).
-    #[arg(long, default_value_t = thesis::FILM_THICKNESS_NM, value_parser = parse_thickness_nm, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = thesis::FILM_THICKNESS_NM, value_parser = parse_thickness_nm)]
     pub thickness_nm: f64,
     /// Perceptual roughness (GGX α = roughness²), 0 to 1.
-    #[arg(long, default_value_t = 0.35, value_parser = parse_unit, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.35, value_parser = parse_unit)]
     pub roughness: f64,
     /// Absorption coefficient σ0 (one value, or r,g,b), each 0 to 100. The default is the
     /// thesis' 0.6, as every default here is the thesis' value; a preset's
@@ -634,7 +632,7 @@ pub struct LayerArgs {
     #[arg(long, value_parser = parse_absorption, default_value = "0.6", allow_hyphen_values = true)]
     pub absorption: [f64; 3],
     /// Pigment layer thickness δ1 (optical depth τ = σ0 δ1), 0 to 100.
-    #[arg(long, default_value_t = thesis::PIGMENT_THICKNESS, value_parser = parse_pigment_thickness, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = thesis::PIGMENT_THICKNESS, value_parser = parse_pigment_thickness)]
     pub pigment_thickness: f64,
     /// Base albedo k_d, linear r,g,b (or one value), each 0 to 1: the Lambertian base
     /// itself, not the visible colour a colour map holds.
@@ -648,7 +646,7 @@ pub struct AlbedoArgs {
     pub stack: StackArgs,
     /// Angle of the light from the normal in degrees, 0 to 90 (by reciprocity also the
     /// view angle of the albedo seen under a uniform sky).
-    #[arg(long, value_parser = parse_angle_deg, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_angle_deg)]
     pub angle_deg: f64,
     #[command(flatten)]
     pub layer: LayerArgs,

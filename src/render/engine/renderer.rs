@@ -286,14 +286,25 @@ impl Renderer {
         lut: &Lut,
         n_bands: usize,
     ) -> Result<Material, GpuError> {
+        let (textures, mesh) = self.upload_maps(maps)?;
+        Ok(Material { optics, film: self.upload_film(optics, lut, n_bands)?, textures, mesh })
+    }
+
+    /// The maps as textures, and a body atlas's own body (`Gpu::checked`).
+    fn upload_maps(&self, maps: &MaterialMaps) -> Result<(MaterialTextures, Option<GpuMesh>), GpuError> {
         let device = &self.gpu.device;
         self.gpu.checked(&format!("uploading {}×{} maps", maps.width, maps.height), || {
-            Ok(Material {
-                optics,
-                film: FilmBinding::new(device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands),
-                textures: MaterialTextures::new(device, &self.gpu.queue, &self.material_layout, maps),
-                mesh: maps.atlas.map(|plan| GpuMesh::new(device, &BodyShape::for_atlas(&plan).mesh())),
-            })
+            Ok((
+                MaterialTextures::new(device, &self.gpu.queue, &self.material_layout, maps),
+                maps.atlas.map(|plan| GpuMesh::new(device, &BodyShape::for_atlas(&plan).mesh())),
+            ))
+        })
+    }
+
+    /// The film tables for `optics`' stack (`Gpu::checked`).
+    fn upload_film(&self, optics: LayerOptics, lut: &Lut, n_bands: usize) -> Result<FilmBinding, GpuError> {
+        self.gpu.checked("uploading the film tables", || {
+            Ok(FilmBinding::new(&self.gpu.device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands))
         })
     }
 
@@ -305,22 +316,14 @@ impl Renderer {
         lut: &Lut,
         n_bands: usize,
     ) -> Result<(), GpuError> {
-        material.film = self.gpu.checked("uploading the film tables", || {
-            Ok(FilmBinding::new(&self.gpu.device, &self.gpu.queue, &self.film_layout, optics.stack, lut, n_bands))
-        })?;
+        material.film = self.upload_film(optics, lut, n_bands)?;
         material.optics = optics;
         Ok(())
     }
 
     /// Replaces the maps of a material (live reload).
     pub fn retexture(&self, material: &mut Material, maps: &MaterialMaps) -> Result<(), GpuError> {
-        let (textures, mesh) = self.gpu.checked(&format!("uploading {}×{} maps", maps.width, maps.height), || {
-            Ok((
-                MaterialTextures::new(&self.gpu.device, &self.gpu.queue, &self.material_layout, maps),
-                maps.atlas.map(|plan| GpuMesh::new(&self.gpu.device, &BodyShape::for_atlas(&plan).mesh())),
-            ))
-        })?;
-        (material.textures, material.mesh) = (textures, mesh);
+        (material.textures, material.mesh) = self.upload_maps(maps)?;
         Ok(())
     }
 
