@@ -254,6 +254,12 @@ fn keys_of_another_kind_are_refused_not_ignored() {
         // A size without the colour that would draw it (the review).
         ("spots", "center_size = 0.3", "`pattern.0.center_size` sizes what `center_color` draws".into()),
         ("stripes", "border_size = 0.02", "`pattern.0.border_size` sizes what `border_color` draws".into()),
+        // The spots' `checkered` on blotches was silently `aligned` (the docs walkthrough).
+        (
+            "blotches",
+            "arrangement = \"checkered\"",
+            "`pattern.0.arrangement` must be one of aligned, alternating for kind \"blotches\"".into(),
+        ),
     ] {
         let err = refused("kinds.toml", &format!("{}{extra}\n", layer.replace("spots", kind)), &[]);
         assert!(err.contains(&format!("kinds.toml:4: key {says}")), "{extra}: {err}");
@@ -268,7 +274,11 @@ fn keys_of_another_kind_are_refused_not_ignored() {
     let err = refused("kinds.toml", layer, &["--set", "pattern.0.kind=stripes", "--set", "pattern.0.phase=0.5"]);
     assert!(err.contains("key `pattern.0.phase` is read by kind \"blotches\" only, not \"stripes\""), "{err}");
     let dir = tempfile::tempdir().unwrap();
-    for text in [format!("{layer}length = 0.6\n"), layer.replace("spots", "rings") + "colors = [\"#ffffff\"]\n"] {
+    for text in [
+        format!("{layer}length = 0.6\n"),
+        layer.replace("spots", "rings") + "colors = [\"#ffffff\"]\n",
+        format!("{layer}arrangement = \"checkered\"\n"),
+    ] {
         accepted(&write_preset(dir.path(), "fine.toml", &text), &[]);
     }
 }

@@ -1374,3 +1374,144 @@ fn a_backend_variable_that_finds_no_adapter_is_named() {
     assert!(stderr(&run).contains("WGPU_BACKEND=\"bogus\" chose the backends tried"), "{}", stderr(&run));
     assert!(!out.exists());
 }
+
+/// A gallery and its close-ups appear together or not at all (`FileGroup`): a folder in the
+/// way of one close-up was found after the gallery and some close-ups were written (which
+/// ones depended on the threads' order), and a failed rename left new files among old ones.
+/// Renames of the commit (moving the old files aside, putting the new ones in, the last
+/// one) are failed by the debug build's hook: the earlier gallery and close-ups stay byte
+/// for byte, with no temporary left. Negative control: the same run without the hook
+/// replaces the gallery.
+#[test]
+fn a_gallery_and_its_closeups_appear_together_or_not_at_all() {
+    let dir = tempfile::tempdir().unwrap();
+    let (gallery, closeups) = (dir.path().join("g.png"), dir.path().join("c"));
+    let (g, c) = (gallery.to_str().unwrap(), closeups.to_str().unwrap());
+    let blocked = dir.path().join("blocked");
+    std::fs::create_dir_all(blocked.join("rows.png")).unwrap();
+    let out = snakeskin(&["gallery", "-o", g, "--tile", "16", "--closeups", blocked.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("rows.png: a folder is in the way"), "{}", stderr(&out));
+    assert!(!gallery.exists(), "the gallery was written before the close-ups' names were checked");
+    assert_eq!(std::fs::read_dir(&blocked).unwrap().count(), 1, "a close-up was written");
+
+    let out = snakeskin(&["gallery", "-o", g, "--tile", "16", "--closeups", c]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // Every file of the gallery and its close-ups, hidden ones (temporaries) included.
+    let files = || {
+        let mut all = snapshot(&closeups);
+        all.insert(gallery.clone(), std::fs::read(&gallery).unwrap());
+        let hidden = std::fs::read_dir(dir.path())
+            .unwrap()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().starts_with('.'));
+        all.extend(hidden.map(|e| (e.path(), Vec::new())));
+        all
+    };
+    let before = files();
+    assert_eq!(before.len(), 1 + 6, "{:?}", before.keys());
+    // Seven files moved aside (those that exist), then seven renamed in: 14 renames.
+    for rename in [0, 6, 7, 10, 13] {
+        let at = rename.to_string();
+        let out = snakeskin_env(
+            &["gallery", "-o", g, "--tile", "20", "--closeups", c],
+            &[("SNAKESKIN_TEST_FAIL_AT_RENAME", &at)],
+        );
+        assert_eq!(out.status.code(), Some(1), "rename {rename}: {}", stderr(&out));
+        assert_eq!(files(), before, "rename {rename}: the earlier files changed, or a temporary stayed");
+    }
+    let out = snakeskin(&["gallery", "-o", g, "--tile", "20", "--closeups", c]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let after = files();
+    assert_eq!(after.len(), before.len());
+    // The close-ups do not depend on the tile; the gallery does.
+    assert_ne!(after[&gallery], before[&gallery], "the gallery is new");
+}
+
+/// `figures` checks its eleven names and its memory (the maps and a frame) before it makes
+/// a folder or a renderer: a folder in the way of the last figure was found after ten were
+/// written, and an 8192-wide run reached 4.9 GB under a 300 MiB limit. Neither needs a GPU.
+#[test]
+fn figures_are_checked_before_any_is_drawn() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("figs");
+    std::fs::create_dir_all(out_dir.join("absorption_0.7.png")).unwrap();
+    let f = out_dir.to_str().unwrap();
+    let out = snakeskin(&["figures", PRESET, "-o", f, "--size", "16x16", "--map-size", "64"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("absorption_0.7.png: a folder is in the way"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 1, "a figure was written");
+
+    let fresh = dir.path().join("new");
+    let limit = [("SNAKESKIN_MEMORY_LIMIT_MIB", "300")];
+    let args = ["figures", PRESET, "-o", fresh.to_str().unwrap(), "--map-size", "64", "--size"];
+    let out = snakeskin_env(&[&args[..], &["8192x8192"]].concat(), &limit);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("needs about"), "{}", stderr(&out));
+    assert!(!fresh.exists(), "the folder was made before the memory check");
+    // Negative control: a small frame under the same limit passes the check (and then needs
+    // a GPU, which this test does not ask for: it stops at the renderer or draws).
+    let out = snakeskin_env(&[&args[..], &["16x16"]].concat(), &[("SNAKESKIN_MEMORY_LIMIT_MIB", "300")]);
+    assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
+}
+
+/// A legal file name near the 255-byte limit was refused after the work ("cannot write .:
+/// File name too long": its temporary's name is 22 bytes longer); one past the limit is
+/// refused before the work, with the name's length, exit 2. Negative control: 250 bytes is
+/// written.
+#[test]
+fn a_long_file_name_is_written_and_one_past_the_limit_refused_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = |bytes: usize| dir.path().join(format!("{}.png", "z".repeat(bytes - 4)));
+    let ok = name(250);
+    let out = snakeskin(&["brdf", "chart", "--width", "4", "--height", "4", "-o", ok.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(ok.is_file());
+    let too_long = name(256);
+    let out = snakeskin(&["brdf", "chart", "--width", "4", "--height", "4", "-o", too_long.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("its file name is 256 bytes long"), "{}", stderr(&out));
+    let hidden = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().file_name() != ok.file_name().unwrap())
+        .count();
+    assert_eq!(hidden, 0, "a temporary or a file was left");
+}
+
+/// Outputs that failed other commands' way: a standard error that cannot be written
+/// (`2> /dev/full`) panicked, exit 101; a chart past the memory limit ran (500 MB at 4096²
+/// under 64 MiB); a `--batch` answer that could not be written said only the OS's words.
+#[test]
+fn stderr_charts_and_batch_answers_fail_as_other_outputs_do() {
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["presets", "show", "no-such-snake"])
+        .stderr(full)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "a failed stderr is exit 1, not a panic's 101");
+
+    let dir = tempfile::tempdir().unwrap();
+    let chart = dir.path().join("c.png");
+    let args = ["brdf", "chart", "--width", "4096", "--height", "4096", "-o", chart.to_str().unwrap()];
+    let out = snakeskin_env(&args, &[("SNAKESKIN_MEMORY_LIMIT_MIB", "64")]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a film colour chart of 4096×4096 pixels needs about"), "{}", stderr(&out));
+    assert!(!chart.exists());
+
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["brdf", "color", "--batch", "-"])
+        .stdin(Stdio::piped())
+        .stdout(full)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    {
+        use std::io::Write;
+        child.stdin.take().unwrap().write_all(b"{\"thickness_nm\": 1, \"angle_deg\": 0}\n").unwrap();
+    }
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("cannot write to standard output"), "{}", stderr(&out));
+}

@@ -5,6 +5,11 @@
 //! unpredictable name, so a symlink planted at a guessable name cannot redirect the write —
 //! then renamed over the target. A reader sees the old file or the new one, never a part.
 //!
+//! **Groups of files** (`FileGroup`: the documentation figures, a gallery with its close-ups)
+//! are staged the same way, each as soon as it is made, and renamed into place together at
+//! the end, the old files moved aside first and put back if a rename fails: an interrupt or
+//! a failure while they are made leaves the earlier files as they were, never some new.
+//!
 //! **Texture sets** (`SetLock`: `stage` each map, then `commit`; `write` does both) are
 //! several files, and a rename is atomic only per file, so the set's manifest is its commit
 //! record:
@@ -60,6 +65,23 @@ const TMP_SUFFIX: &str = ".snakeskin-tmp";
 
 /// Random characters in a temporary's name (between `.FILE.` and the suffix).
 const RANDOM_CHARS: usize = 6;
+
+/// The longest file name, in bytes, that Linux's file systems take (ext4, XFS, Btrfs, tmpfs:
+/// `NAME_MAX`, limits.h) and macOS's APFS (255 UTF-8 bytes).
+const NAME_MAX_BYTES: usize = 255;
+
+/// The part of a file's name its temporaries carry: `.STEM.RANDOM.snakeskin-tmp` must itself
+/// be a legal name, so a name near the limit is cut (at a character boundary). Without the
+/// cut, a legal 234-byte output name failed after the work with "cannot write .: File name
+/// too long".
+fn temporary_stem(target_name: &str) -> &str {
+    let room = NAME_MAX_BYTES - 2 - RANDOM_CHARS - TMP_SUFFIX.len();
+    let mut end = target_name.len().min(room);
+    while !target_name.is_char_boundary(end) {
+        end -= 1;
+    }
+    &target_name[..end]
+}
 
 /// This process's temporaries of new files (staged, not yet renamed into place): what
 /// `clean_up_before_exit` removes.
@@ -118,7 +140,7 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
         let ours = file_names.iter().any(|f| {
             let random = name
                 .strip_prefix('.')
-                .and_then(|r| r.strip_prefix(*f))
+                .and_then(|r| r.strip_prefix(temporary_stem(f)))
                 .and_then(|r| r.strip_prefix('.'))
                 .and_then(|r| r.strip_suffix(TMP_SUFFIX));
             random.is_some_and(|r| r.len() == RANDOM_CHARS && r.chars().all(|c| c.is_ascii_alphanumeric()))
@@ -159,7 +181,7 @@ fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedT
 /// A new, empty temporary for `target_name` in `dir` (`.NAME.RANDOM.snakeskin-tmp`, created
 /// exclusively): a map being staged, or the place an old file is moved aside to.
 fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTempFile> {
-    let prefix = format!(".{target_name}.");
+    let prefix = format!(".{}.", temporary_stem(target_name));
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(TMP_SUFFIX).rand_bytes(RANDOM_CHARS);
     // tempfile creates 0600 files; outputs are ordinary files (0666 less the umask, as
@@ -189,6 +211,10 @@ fn without_temporary_path(e: std::io::Error) -> std::io::Error {
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
     if ends_as_a_folder(target) {
         return Err(ExportError::FolderName { path: target.into() });
+    }
+    let name_bytes = target.file_name().map_or(0, |n| n.len());
+    if name_bytes > NAME_MAX_BYTES {
+        return Err(ExportError::NameTooLong { path: target.into(), bytes: name_bytes, limit: NAME_MAX_BYTES });
     }
     let Ok(meta) = fs::symlink_metadata(target) else {
         return Ok(());
@@ -352,59 +378,124 @@ impl SetLock {
             check_target(target)?;
         }
         pause_hook(|| "commit".into());
-        let _commit = locked(&COMMIT);
-        // Step 4a: the old files out of the way, the manifest first (so that from here on no
-        // old manifest names a map that may change), then the earlier set's files the new one
-        // does not write. A file in the new set's way that cannot be moved fails here,
-        // before anything new is in place.
-        let mut renames = 0;
-        let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
         let targets: Vec<&PathBuf> = staged.iter().map(|(_, t)| t).collect();
         let left_over = left_over_files(&manifest_target, &targets);
-        let old_first = std::iter::once(&manifest_target)
+        // The old manifest first (so that from here on no old manifest names a map that may
+        // change), then the old maps, then the earlier set's files the new one does not write.
+        let old_first: Vec<PathBuf> = std::iter::once(&manifest_target)
             .chain(targets.iter().copied().filter(|t| **t != manifest_target))
-            .chain(&left_over);
-        for target in old_first {
-            if fs::symlink_metadata(target).is_err() {
-                continue;
-            }
-            let moved = temporary(dir, &file_name(target)).map_err(io_error(dir)).and_then(|backup| {
-                let backup = backup.into_temp_path();
-                forget_temporary(&backup);
-                before_rename(&mut renames).and_then(|()| fs::rename(target, &backup)).map_err(io_error(target))?;
-                Ok(backup)
-            });
-            match moved {
-                Ok(backup) => aside.push((backup, target.clone())),
-                // An earlier set's map that the new set does not write stays if it will not
-                // move (`left_over_files`): the new set does not need its place.
-                Err(_) if left_over.contains(target) => continue,
-                Err(e) => {
-                    put_back(aside, &[], &manifest_target, &mut renames);
-                    return Err(e);
-                }
-            }
-        }
-        // Step 4b: the new files in, the manifest last.
-        let mut written = Vec::new();
-        for (tmp, target) in staged {
-            let temporary = tmp.path().to_path_buf();
-            if let Err(e) =
-                before_rename(&mut renames).and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error))
-            {
-                put_back(aside, &written, &manifest_target, &mut renames);
-                return Err(ExportError::Io { path: target, source: e });
-            }
-            forget_temporary(&temporary);
-            written.push(target);
-        }
-        sync_folder(dir);
-        // The old files go (each `TempPath` removes its file when dropped).
-        let removed: Vec<PathBuf> =
-            aside.iter().map(|(_, target)| target.clone()).filter(|t| left_over.contains(t)).collect();
-        drop(aside);
+            .chain(&left_over)
+            .cloned()
+            .collect();
+        let (written, removed) = swap_in(staged, &old_first, &left_over, Some(&manifest_target))?;
         self.removed.lock().unwrap_or_else(|e| e.into_inner()).extend(removed);
         Ok(written)
+    }
+}
+
+/// Step 4 of a commit, for a set and for a `FileGroup`: under the commit lock (an interrupt
+/// waits for it), moves the existing files of `old` aside, in that order, then renames each
+/// staged file into place, in its order; then removes what it moved aside. A rename that
+/// fails undoes what was done (`put_back`): the new files go, the old ones return. Files of
+/// `may_stay` that will not move aside are left where they are (their place is not needed);
+/// `manifest` is the commit record that goes back only over its own files. Returns the files
+/// written and the files of `may_stay` removed.
+fn swap_in(
+    staged: Vec<(tempfile::NamedTempFile, PathBuf)>,
+    old: &[PathBuf],
+    may_stay: &[PathBuf],
+    manifest: Option<&Path>,
+) -> Result<(Vec<PathBuf>, Vec<PathBuf>), ExportError> {
+    let _commit = locked(&COMMIT);
+    let manifest = manifest.unwrap_or(Path::new(""));
+    let mut renames = 0;
+    let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
+    for target in old {
+        if fs::symlink_metadata(target).is_err() {
+            continue;
+        }
+        let dir = folder_of(target);
+        let moved = temporary(dir, &file_name(target)).map_err(io_error(dir)).and_then(|backup| {
+            let backup = backup.into_temp_path();
+            forget_temporary(&backup);
+            before_rename(&mut renames).and_then(|()| fs::rename(target, &backup)).map_err(io_error(target))?;
+            Ok(backup)
+        });
+        match moved {
+            Ok(backup) => aside.push((backup, target.clone())),
+            Err(_) if may_stay.contains(target) => continue,
+            Err(e) => {
+                put_back(aside, &[], manifest, &mut renames);
+                return Err(e);
+            }
+        }
+    }
+    let mut written = Vec::new();
+    for (tmp, target) in staged {
+        let temporary = tmp.path().to_path_buf();
+        if let Err(e) = before_rename(&mut renames).and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error)) {
+            put_back(aside, &written, manifest, &mut renames);
+            return Err(ExportError::Io { path: target, source: e });
+        }
+        forget_temporary(&temporary);
+        written.push(target);
+    }
+    let mut folders: Vec<&Path> = written.iter().map(|t| folder_of(t)).collect();
+    folders.dedup();
+    for dir in folders {
+        sync_folder(dir);
+    }
+    // The old files go (each `TempPath` removes its file when dropped).
+    let removed: Vec<PathBuf> =
+        aside.iter().map(|(_, target)| target.clone()).filter(|t| may_stay.contains(t)).collect();
+    drop(aside);
+    Ok((written, removed))
+}
+
+/// The folder a target file is in (`.` for a bare file name).
+fn folder_of(path: &Path) -> &Path {
+    path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."))
+}
+
+/// Files that appear together or not at all, without a manifest: the documentation figures,
+/// a gallery and its close-ups. Each is staged when its bytes exist (`stage`: the folder is
+/// made and the target checked), so nothing is visible while the work goes on and an
+/// interrupt leaves the earlier files as they were; `commit` puts them all in place at once
+/// (`swap_in`: the old ones aside first, all back if a rename fails). Unlike a set there is
+/// no lock: two runs on one folder each write a whole group, the last one's stays.
+#[derive(Debug, Default)]
+pub struct FileGroup {
+    staged: Vec<(tempfile::NamedTempFile, PathBuf)>,
+}
+
+impl FileGroup {
+    pub fn new() -> FileGroup {
+        FileGroup::default()
+    }
+
+    /// Writes `bytes` to a temporary beside `target` (creating its folder if needed).
+    pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> Result<(), ExportError> {
+        let (dir, name) = (folder_of(target), file_name(target));
+        if name.is_empty() || ends_as_a_folder(target) {
+            return Err(ExportError::FolderName { path: target.into() });
+        }
+        create_folder(dir)?;
+        check_target(target)?;
+        // Without a lock, a temporary is only taken as stale once it is older than any write.
+        remove_stale_temporaries(dir, &[&name], std::time::Duration::from_secs(600));
+        let tmp = stage(dir, &name, bytes)?;
+        self.staged.push((tmp, target.into()));
+        Ok(())
+    }
+
+    /// Puts every staged file in place, or none (see `swap_in`); returns their paths.
+    pub fn commit(self) -> Result<Vec<PathBuf>, ExportError> {
+        for (_, target) in &self.staged {
+            check_target(target)?;
+        }
+        pause_hook(|| "commit".into());
+        let old: Vec<PathBuf> = self.staged.iter().map(|(_, t)| t.clone()).collect();
+        Ok(swap_in(self.staged, &old, &[], None)?.0)
     }
 }
 

@@ -11,8 +11,8 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder, ends_as_a_folder, same_path,
-    sha256_hex, write_file_atomically,
+    FileGroup, SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder, ends_as_a_folder,
+    same_path, sha256_hex, write_file_atomically,
 };
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
@@ -57,6 +57,10 @@ pub enum ExportError {
          the link, or write elsewhere"
     )]
     BrokenLink { path: PathBuf },
+    #[error(
+        "cannot write {path}: its file name is {bytes} bytes long, and file systems take at most {limit}; give a shorter name"
+    )]
+    NameTooLong { path: PathBuf, bytes: usize, limit: usize },
     #[error("set {manifest}: {problem}")]
     Verify { manifest: PathBuf, problem: String },
     #[error("cannot encode the packed {texture} texture: {message}")]
@@ -77,6 +81,7 @@ impl ExportError {
                 | ExportError::FolderInTheWay { .. }
                 | ExportError::FolderName { .. }
                 | ExportError::BrokenLink { .. }
+                | ExportError::NameTooLong { .. }
         )
     }
 }

@@ -1,7 +1,7 @@
 //! Range checks on a parsed preset, all before any pixel is computed ("parse first, then
 //! run"). Each problem names the dotted key and the accepted range; `load` adds the line.
 
-use super::schema::{PatternKind, PatternLayer, PatternShape, Preset, spelled};
+use super::schema::{Arrangement, PatternKind, PatternLayer, PatternShape, Preset, spelled};
 
 /// One value outside what the generator accepts.
 #[derive(Debug, Clone, PartialEq)]
@@ -110,7 +110,9 @@ impl Checker {
 /// pigment layer. Beyond the critical angle asin(n2 / n0) the rough top's lobe loses light
 /// the stack reflects (a white lossless stack, `brdf albedo --absorption 0 --n1 1.55`:
 /// 0.50 at 75° for n0 = 1.4 over n2 = 1.33 and roughness 0.5; 0.48 at 50° for 1.5 over 1.0
-/// and roughness 0.9; BENCHMARKS.md "Stress"). The physics is fine (an oil film over a
+/// and roughness 0.9; 0.40 at 45° for 2 over 1.33 and roughness 0.9, where the rough-top
+/// walk, `--model stochastic`, reflects 1: the physics review; BENCHMARKS.md "Stress").
+/// The physics is fine (an oil film over a
 /// lighter layer), so it is a warning, not a refusal.
 pub fn model_limit(preset: &Preset) -> Option<Problem> {
     let o = &preset.optics;
@@ -119,7 +121,7 @@ pub fn model_limit(preset: &Preset) -> Option<Problem> {
         message: format!(
             "{} is above optics.pigment_ior = {}: the layered model loses light beyond the critical angle \
              ({:.0}° from the normal), where the rough top's reflection has nowhere to go (a white stack without \
-             absorption reflects as little as half the light), so renders and the albedo are darker than the \
+             absorption reflects as little as 0.4 of the light), so renders and the albedo are darker than the \
              physics there. Keep ambient_ior at most pigment_ior for an energy-conserving render.",
             o.ambient_ior,
             o.pigment_ior,
@@ -230,6 +232,17 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
             c.problems.push(Problem {
                 key: key("shape"),
                 message: format!("must be one of {} for kind \"{}\"", names.join(", "), spelled(&p.kind)),
+            });
+        }
+        // Blotches take the two series' `aligned` and `alternating`; `checkered` (every other
+        // cell of a grid) is the spots' own, and on blotches it was silently `aligned`.
+        if p.kind == PatternKind::Blotches
+            && p.arrangement == Arrangement::Checkered
+            && !from_file_for_old_kind(i, "arrangement")
+        {
+            c.problems.push(Problem {
+                key: key("arrangement"),
+                message: "must be one of aligned, alternating for kind \"blotches\" (checkered is for spots)".into(),
             });
         }
         // Keys some kinds read, set away from their defaults on a kind that ignores them

@@ -99,10 +99,10 @@ pub enum Command {
         /// Tile size in pixels (colour map tile × tile, render 2·tile × tile; with --layout
         /// body: the strip's height, one circumference, the strip length·tile long, the
         /// render 4·tile × 2·tile).
-        #[arg(long, default_value_t = 224, value_parser = clap::value_parser!(u32).range(64..=1024))]
+        #[arg(long, default_value_t = 224, value_parser = ranged_u32(64, 1024))]
         tile: u32,
         /// Cells per row.
-        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
+        #[arg(long, default_value_t = 2, value_parser = ranged_u32(1, 8))]
         columns: u32,
         /// Map resolution per species (pixels per side; a body atlas's width).
         #[arg(long, default_value_t = 512, value_parser = ranged_u64(64, 4096))]
@@ -180,6 +180,14 @@ fn ranged_u64(lo: u64, hi: u64) -> impl Fn(&str) -> Result<u64, String> + Clone 
         Ok(n) => Err(format!("{n} is not in {lo}..={hi}")),
         Err(_) => Err(format!("not a whole number; accepted: {lo}..={hi}")),
     }
+}
+
+/// `ranged_u64` for a flag that holds a u32 (`clap::value_parser!(u32).range` said "number
+/// too large to fit in target type" and "invalid digit found in string" for `--tile 1e30`
+/// and `--tile 1.5`).
+fn ranged_u32(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, String> + Clone + Send + Sync + 'static {
+    let parse = ranged_u64(lo.into(), hi.into());
+    move |text| parse(text).map(|n| n as u32)
 }
 
 /// `command` and its subcommands with every flag that takes a value taking a negative
@@ -312,8 +320,8 @@ pub struct BatchArgs {
     /// still uses every core; running two fills the gaps at each job's start and end. Peak
     /// memory is the sum of the running jobs' (fewer run at once if the largest jobs would
     /// not fit in the available memory together). Files are the same at any value.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=snakeskin::batch::MAX_CONCURRENCY as i64))]
-    pub concurrent: Option<u16>,
+    #[arg(long, value_name = "N", value_parser = ranged_u32(1, snakeskin::batch::MAX_CONCURRENCY as u32))]
+    pub concurrent: Option<u32>,
 }
 
 fn parse_shard(s: &str) -> Result<snakeskin::batch::Shard, String> {
@@ -374,7 +382,8 @@ pub struct PreviewArgs {
     /// unlit on the body (map:color, map:height, map:normal, map:roughness, map:iridescence).
     #[arg(long, default_value = "all", value_name = "STAGE", value_parser = parse_view)]
     pub layers: View,
-    /// Film colour method: lut (default), rgb3, spectral-N (e.g. spectral-16), gaussian-fit.
+    /// Film colour method: lut (default), rgb3, spectral-N (e.g. spectral-16), gaussian-fit,
+    /// or spectral (the 1 nm reference sum in the shader, spectral-421: slow, for checks).
     #[arg(long, default_value = "lut", value_name = "M", value_parser = parse_gpu_method)]
     pub method: GpuFilmMethod,
     /// Layer model: layered (default; the stack's transport: (n0/n2)², internal
@@ -398,14 +407,14 @@ pub struct PreviewArgs {
         long,
         value_name = "N",
         conflicts_with_all = ["out", "reference"],
-        value_parser = clap::value_parser!(u32).range(1..=1_000_000)
+        value_parser = ranged_u32(1, 1_000_000)
     )]
     pub frames: Option<u32>,
     /// Exposure multiplier before tone mapping (Khronos PBR Neutral), 1e-6 to 1000.
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     pub exposure: f32,
     /// Number of snakes (instanced in a grid).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=400))]
+    #[arg(long, default_value_t = 1, value_parser = ranged_u32(1, 400))]
     pub snakes: u32,
     /// Hide the ground plane.
     #[arg(long)]
@@ -570,9 +579,9 @@ pub enum BrdfCommand {
         #[arg(long, default_value = "spectral", value_parser = parse_method)]
         method: Method,
         /// Chart width (thickness samples) and height (angle samples) in pixels, 2 to 4096.
-        #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(2..=4096))]
+        #[arg(long, default_value_t = 800, value_parser = ranged_u32(2, 4096))]
         width: u32,
-        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(2..=4096))]
+        #[arg(long, default_value_t = 300, value_parser = ranged_u32(2, 4096))]
         height: u32,
     },
     /// Random and adversarial inputs: counts NaN and Inf, the range of R and T, the worst
@@ -583,7 +592,7 @@ pub enum BrdfCommand {
         #[arg(long, default_value_t = 100_000, value_parser = ranged_u64(1, 10_000_000))]
         samples: u64,
         /// Seed of the sample generator.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = ranged_u64(0, u64::MAX))]
         seed: u64,
         /// Print one JSON object instead of a table.
         #[arg(long)]
@@ -746,7 +755,9 @@ pub enum BenchCommand {
         /// Write an SVG plot of error against cost, one point per method.
         #[arg(long, value_name = "FILE")]
         plot: Option<PathBuf>,
-        /// Thickness step of the grid in nm (the grid spans 0..2000 nm), 0.1 to 2000.
+        /// Thickness step of the grid in nm (the grid spans 0..2000 nm), 0.1 to 2000; the grid
+        /// takes at most 400,000 points over its four materials, so with 1° angle steps the
+        /// finest is 2 nm (0.1 nm needs angle steps of 25° or more).
         #[arg(long, default_value_t = 10.0, value_parser = parse_d_step_nm)]
         d_step_nm: f64,
         /// Angle step of the grid in degrees (0..89°), 0.1 to 89.
@@ -761,7 +772,9 @@ pub enum BenchCommand {
     /// of 250 and 650 nm, light at 0–85°, roughness 0.05–0.9, every species' base colours.
     /// Reports the reflected colour's ΔE00 (mean, p95, max), the white-furnace error and the
     /// CPU cost per evaluation (inputs at random thicknesses, and the same sorted by
-    /// thickness as a frame reads them). Takes about a minute at the default photon count.
+    /// thickness as a frame reads them). Takes about three minutes on two cores at the default
+    /// photon count, most of it the models' own albedo integration, which fewer photons do not
+    /// shorten (3 min 7 s measured, 5 min 14 s of CPU).
     Layered {
         /// Print JSON {"models": [{"name","mean_de","p95_de","max_de","max_furnace_err",
         /// "max_furnace_err_to_70","ns_per_eval","ns_per_eval_coherent"}], "points",
@@ -861,8 +874,8 @@ fn parse_exposure(text: &str) -> Result<f32, String> {
 }
 
 fn parse_d_step_nm(text: &str) -> Result<f64, String> {
-    // 0.1 nm over 0..2000 nm and 1° steps is 1.8 million reference colours (minutes, ~100
-    // MB); finer steps only repeat the 1 nm spectral reference's own resolution.
+    // Finer than 0.1 nm only repeats the 1 nm spectral reference's own resolution; the grid's
+    // size is bounded with both steps together (`accuracy::MAX_GRID_POINTS`).
     bounded(text, (0.1, 2000.0))
 }
 
@@ -985,6 +998,38 @@ mod tests {
             assert!(error.contains(says), "{args:?}: {error}");
         }
         parse(&["generate", "natrix-natrix", "--size", "16"]).unwrap();
+    }
+
+    /// Every whole-number flag says its range, whatever the word: clap's u32 and u16 range
+    /// parsers said "invalid digit found in string" (`--tile 1.5`, `--seed -1`) and "number
+    /// too large to fit in target type" (`--snakes 99999999999999999999`). Negative control:
+    /// each flag's largest value is taken.
+    #[test]
+    fn every_whole_number_flag_says_its_range() {
+        let parse = |args: &[&str]| {
+            let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
+            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
+        };
+        let huge = "99999999999999999999";
+        for (args, says, largest) in [
+            (&["sheet", "-o", "s.png", "--tile"][..], "is not in 64..=1024", "1024"),
+            (&["sheet", "-o", "s.png", "--columns"], "is not in 1..=8", "8"),
+            (&["brdf", "chart", "-o", "c.png", "--height"], "is not in 2..=4096", "4096"),
+            (&["brdf", "chart", "-o", "c.png", "--width"], "is not in 2..=4096", "4096"),
+            (&["preview", "natrix-natrix", "--out", "a.png", "--snakes"], "is not in 1..=400", "400"),
+            (&["preview", "natrix-natrix", "--window", "--frames"], "is not in 1..=1000000", "1000000"),
+            (&["batch", "jobs.toml", "-o", "out", "--concurrent"], "is not in 1..=16", "16"),
+            (&["brdf", "stress", "--seed"], "is not in 0..=18446744073709551615", "18446744073709551615"),
+        ] {
+            for word in ["1.5", "-1", huge] {
+                let error = parse(&[args, &[word]].concat()).expect_err(&format!("{args:?} {word} was accepted"));
+                let expected = if word == "1.5" { "not a whole number" } else { says };
+                assert!(error.contains(expected), "{args:?} {word}: {error}");
+            }
+            parse(&[args, &[largest]].concat()).unwrap();
+        }
+        let error = parse(&["sheet", "-o", "s.png", "--tile", "1.5"]).unwrap_err();
+        assert!(error.contains("accepted: 64..=1024"), "{error}");
     }
 
     /// A flag with a missing value took the next flag for it: `--absorption --wo 0,0,1` was

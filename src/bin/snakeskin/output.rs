@@ -72,7 +72,9 @@ fn ignored_from_the_start(signal: i32) -> bool {
 /// `> /dev/full`, an I/O error) is an error like any other: one line on stderr and exit
 /// status 1, not a panic (exit 101). `println!` panics with std's message "failed printing to
 /// stdout: REASON"; the hook turns exactly that panic into the error, at every print site
-/// alike, and leaves every other panic to the default hook.
+/// alike, and leaves every other panic to the default hook. A standard error that fails
+/// (`2> /dev/full`) ends the run with status 1 too, saying nothing (there is nowhere to say
+/// it): `eprintln!` panicked and the default hook's message failed as well, exit 101.
 pub fn stdout_failure_is_an_error() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
@@ -81,6 +83,9 @@ pub fn stdout_failure_is_an_error() {
         if let Some(reason) = message.and_then(|m| m.strip_prefix("failed printing to stdout: ")) {
             use std::io::Write;
             let _ = writeln!(std::io::stderr(), "error: cannot write to standard output: {}", printable(reason));
+            std::process::exit(1);
+        }
+        if message.is_some_and(|m| m.starts_with("failed printing to stderr: ")) {
             std::process::exit(1);
         }
         default(info);

@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use crate::Error;
-use crate::export::{encode_png, write_file_atomically};
+use crate::export::{FileGroup, encode_png};
 use crate::graph::evaluate;
 use crate::maps::{BuildOptions, MapKind, build_graph};
 use crate::ops::Image;
@@ -300,9 +300,13 @@ pub const CLOSEUPS: &[(&str, (f32, f32), &str)] = &[
 pub const CLOSEUP_MAP: usize = 1024;
 pub const CLOSEUP_CROP: usize = 512;
 
-/// Writes `<stem>.png` per close-up into `dir` (colour crop left, normal crop right; every
-/// file atomically); returns the paths.
-pub fn write_closeups(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, Error> {
+/// The close-ups' file names (`<stem>.png`), in `CLOSEUPS` order.
+pub fn closeup_file_names() -> impl Iterator<Item = String> {
+    CLOSEUPS.iter().map(|(stem, _, _)| format!("{stem}.png"))
+}
+
+/// Each close-up as (file name, PNG bytes): colour crop left, normal crop right.
+fn closeup_pngs() -> Result<Vec<(String, Vec<u8>)>, Error> {
     CLOSEUPS
         .par_iter()
         .map(|(stem, (u0, v0), text)| {
@@ -329,9 +333,7 @@ pub fn write_closeups(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, 
                     }
                 }
             }
-            let path = dir.join(format!("{stem}.png"));
-            write_file_atomically(&path, encode_png(MapKind::Color, &out)?)?;
-            Ok(path)
+            Ok((format!("{stem}.png"), encode_png(MapKind::Color, &out)?))
         })
         .collect()
 }
@@ -342,10 +344,21 @@ fn srgb_to_linear(encoded: f32) -> f32 {
     if e <= 0.04045 { e / 12.92 } else { ((e + 0.055) / 1.055).powf(2.4) }
 }
 
-/// Renders and writes the gallery PNG atomically.
-pub fn write(path: &std::path::Path, tile: usize, columns: usize) -> Result<(), Error> {
-    let sheet = render(tile, columns)?;
-    let png = encode_png(MapKind::Color, &sheet)?;
-    write_file_atomically(path, png)?;
-    Ok(())
+/// Renders the gallery PNG to `path`, and with `closeups` a folder, the close-ups into it;
+/// they appear together or not at all (`FileGroup`: a close-up that failed left the gallery
+/// and some close-ups written). Returns the paths, the gallery first.
+pub fn write(
+    path: &std::path::Path,
+    tile: usize,
+    columns: usize,
+    closeups: Option<&std::path::Path>,
+) -> Result<Vec<std::path::PathBuf>, Error> {
+    let mut group = FileGroup::new();
+    group.stage(path, &encode_png(MapKind::Color, &render(tile, columns)?)?)?;
+    if let Some(dir) = closeups {
+        for (name, png) in closeup_pngs()? {
+            group.stage(&dir.join(name), &png)?;
+        }
+    }
+    Ok(group.commit()?)
 }

@@ -12,20 +12,25 @@ use super::engine::prepare::upload_material;
 use super::engine::renderer::{FrameSettings, Renderer};
 use super::engine::scene::{Camera, Stage, View};
 use crate::Error;
-use crate::export::write_file_atomically;
+use crate::export::{FileGroup, check_target, write_file_atomically};
 
 /// Encodes and writes a rendered image (atomically).
 pub fn write_png(path: &Path, image: &image::RgbaImage) -> Result<PathBuf, Error> {
     write_rgb_png(path, &image::DynamicImage::ImageRgba8(image.clone()).into_rgb8())
 }
 
-/// Encodes and writes an RGB image (atomically). An encoder failure is ours, not the user's.
+/// Encodes and writes an RGB image (atomically).
 pub fn write_rgb_png(path: &Path, image: &image::RgbImage) -> Result<PathBuf, Error> {
+    Ok(write_file_atomically(path, png_bytes(image)?)?)
+}
+
+/// An RGB image as PNG bytes. An encoder failure is ours, not the user's.
+fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>, Error> {
     let mut bytes = Vec::new();
     image
         .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
         .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
-    Ok(write_file_atomically(path, bytes)?)
+    Ok(bytes)
 }
 
 /// One documentation figure: its file name, what it shows, and the overrides it needs.
@@ -88,7 +93,9 @@ pub fn figure_list() -> Vec<Figure> {
     figures
 }
 
-/// Renders every figure of `figure_list` for `preset` into `out_dir`; returns the files.
+/// Renders every figure of `figure_list` for `preset` into `out_dir`, and puts them in place
+/// together (`FileGroup`: an interrupted or failed run leaves the earlier figures as they
+/// were, not some new ones among them); returns the files.
 pub fn write_figures(
     renderer: &Renderer,
     preset: &str,
@@ -98,7 +105,10 @@ pub fn write_figures(
     progress: &dyn Fn(usize, usize),
 ) -> Result<Vec<PathBuf>, Error> {
     let figures = figure_list();
-    let mut written = Vec::new();
+    for figure in &figures {
+        check_target(&out_dir.join(figure.file))?;
+    }
+    let mut group = FileGroup::new();
     for (i, figure) in figures.iter().enumerate() {
         progress(i, figures.len());
         let overrides: Vec<(String, String)> =
@@ -107,8 +117,10 @@ pub fn write_figures(
         let material = upload_material(renderer, &loaded, map_size, GpuFilmMethod::Lut)?;
         let settings = FrameSettings { view: figure.view, camera: Camera::close_up(), ..FrameSettings::default() };
         let image = renderer.render_image(&settings, &material, size.0, size.1)?;
-        written.push(write_png(&out_dir.join(figure.file), &image)?);
+        let rgb = image::DynamicImage::ImageRgba8(image).into_rgb8();
+        group.stage(&out_dir.join(figure.file), &png_bytes(&rgb)?)?;
     }
+    let written = group.commit()?;
     progress(figures.len(), figures.len());
     Ok(written)
 }

@@ -19,7 +19,7 @@ pub fn run(args: BatchArgs) -> Result<()> {
     }
     let had_folder = args.out.is_dir();
     let bar = Progress::counting("{spinner} batch [{bar:30}] {pos}/{len} jobs {elapsed} {msg}");
-    let concurrency = args.concurrent.map_or_else(batch::default_concurrency, usize::from);
+    let concurrency = args.concurrent.map_or_else(batch::default_concurrency, |n| n as usize);
     let mut warn = |warning: &str| bar.println(warning);
     let index =
         batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut warn, &mut |done, total, outcome| {

@@ -204,7 +204,9 @@ fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> 
             Ok(other) => anyhow::Error::from(other).context(format!("{shown}:{}", i + 1)),
             Err(other) => other.context(format!("{shown}:{}", i + 1)),
         })?;
-        writeln!(out, "{json}")?;
+        // Said as a failed `println!` is (`output::stdout_failure_is_an_error`): the OS's
+        // words alone ("No space left on device") did not say which output failed.
+        writeln!(out, "{json}").map_err(|e| anyhow::anyhow!("cannot write to standard output: {e}"))?;
     }
     Ok(())
 }
@@ -239,6 +241,10 @@ pub fn run(command: BrdfCommand) -> Result<()> {
         BrdfCommand::Chart { stack, out, method, width, height } => {
             let stack = stack_of(&stack);
             check(stack, 0.0, 0.0, None)?;
+            snakeskin::export::check_target(&out)?;
+            let bytes = snakeskin::optics::query::chart_bytes(width as usize, height as usize);
+            snakeskin::memory::MemoryCheck::against_available(bytes)
+                .refuse_if_over(&format!("a film colour chart of {width}×{height} pixels"))?;
             ensure_parent_folder(&out)?;
             let (image, exposure) = chart(stack, method, width as usize, height as usize);
             let png = snakeskin::export::encode_png(snakeskin::material::MapKind::Color, &image)?;

@@ -6,9 +6,10 @@ use anyhow::Result;
 
 use crate::output::{ensure_folder, ensure_parent_folder, path_line};
 
-/// Both outputs are checked before either is drawn: a `--closeups` path that is a file used
-/// to fail after the gallery was written, with the OS's "File exists" and no path. Memory
-/// and the two names are checked before any folder is made.
+/// Every output is checked before any is drawn: a `--closeups` path that is a file used to
+/// fail after the gallery was written, with the OS's "File exists" and no path, and a folder
+/// in the way of one close-up after the gallery and some close-ups were. Memory and the
+/// names are checked before any folder is made; the files appear together (`gallery::write`).
 pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> Result<()> {
     snakeskin::render::figures::gallery::check_memory(tile, columns)?;
     snakeskin::export::check_target(out)?;
@@ -21,16 +22,18 @@ pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> 
         ))
         .into());
     }
+    if let Some(dir) = closeups {
+        snakeskin::export::check_folder(dir)?;
+        for name in snakeskin::render::figures::gallery::closeup_file_names() {
+            snakeskin::export::check_target(&dir.join(name))?;
+        }
+    }
     ensure_parent_folder(out)?;
     if let Some(dir) = closeups {
         ensure_folder(dir)?;
     }
-    snakeskin::render::figures::gallery::write(out, tile, columns)?;
-    println!("{}", path_line(out));
-    if let Some(dir) = closeups {
-        for path in snakeskin::render::figures::gallery::write_closeups(dir)? {
-            println!("{}", path_line(&path));
-        }
+    for path in snakeskin::render::figures::gallery::write(out, tile, columns, closeups)? {
+        println!("{}", path_line(&path));
     }
     Ok(())
 }
