@@ -273,6 +273,14 @@ fn keys_of_another_kind_are_refused_not_ignored() {
     // ... but such a key written by an override with the new kind is refused.
     let err = refused("kinds.toml", layer, &["--set", "pattern.0.kind=stripes", "--set", "pattern.0.phase=0.5"]);
     assert!(err.contains("key `pattern.0.phase` is read by kind \"blotches\" only, not \"stripes\""), "{err}");
+    // A key both kinds read keeps the file's value, so the spots' `checkered` is refused on a
+    // layer made blotches (it was drawn as `aligned`: the review); with an arrangement of
+    // the blotches' own it is taken.
+    let garter =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/presets/thamnophis-sirtalis.toml")).unwrap();
+    let err = refused("garter.toml", &garter, &["--set", "pattern.0.kind=blotches"]);
+    assert!(err.contains("`pattern.0.arrangement` must be one of aligned, alternating"), "{err}");
+    accepted("thamnophis-sirtalis", &["--set", "pattern.0.kind=blotches", "--set", "pattern.0.arrangement=aligned"]);
     let dir = tempfile::tempdir().unwrap();
     for text in [
         format!("{layer}length = 0.6\n"),

@@ -1394,6 +1394,12 @@ fn a_gallery_and_its_closeups_appear_together_or_not_at_all() {
     assert!(stderr(&out).contains("rows.png: a folder is in the way"), "{}", stderr(&out));
     assert!(!gallery.exists(), "the gallery was written before the close-ups' names were checked");
     assert_eq!(std::fs::read_dir(&blocked).unwrap().count(), 1, "a close-up was written");
+    // The gallery named as one of the close-ups (the review: the close-up replaced it).
+    let clash = closeups.join("rows.png");
+    let out = snakeskin(&["gallery", "-o", clash.to_str().unwrap(), "--tile", "16", "--closeups", c]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("-o names the close-up"), "{}", stderr(&out));
+    assert!(!closeups.exists(), "something was made");
 
     let out = snakeskin(&["gallery", "-o", g, "--tile", "16", "--closeups", c]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -1457,8 +1463,10 @@ fn figures_are_checked_before_any_is_drawn() {
 
 /// A legal file name near the 255-byte limit was refused after the work ("cannot write .:
 /// File name too long": its temporary's name is 22 bytes longer); one past the limit is
-/// refused before the work, with the name's length, exit 2. Negative control: 250 bytes is
-/// written.
+/// refused before the work, with the name's length, exit 2. A set whose name is long has
+/// maps whose names share their first 233 bytes, which the first cut of the temporaries'
+/// names made alike, so that staging one map swept the others' temporaries ("No such file or
+/// directory" after the work: the review). Negative control: 250 bytes is written.
 #[test]
 fn a_long_file_name_is_written_and_one_past_the_limit_refused_first() {
     let dir = tempfile::tempdir().unwrap();
@@ -1476,10 +1484,23 @@ fn a_long_file_name_is_written_and_one_past_the_limit_refused_first() {
         .filter(|e| e.as_ref().unwrap().file_name() != ok.file_name().unwrap())
         .count();
     assert_eq!(hidden, 0, "a temporary or a file was left");
+
+    // A set named by a 234-byte preset file: its maps' names are 244 to 253 bytes.
+    let sets = tempfile::tempdir().unwrap();
+    let stem = "s".repeat(234);
+    let preset = write_preset(sets.path(), &format!("{stem}.toml"), "[scales]\nrows = 19\n");
+    let out_dir = sets.path().join("out");
+    let out = snakeskin(&["generate", &preset, "--size", "16", "-o", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let written: Vec<String> =
+        std::fs::read_dir(&out_dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(written.len(), 6, "five maps and the manifest, no temporary: {written:?}");
+    assert!(written.iter().all(|n| n.starts_with(&stem)), "{written:?}");
 }
 
 /// Outputs that failed other commands' way: a standard error that cannot be written
-/// (`2> /dev/full`) panicked, exit 101; a chart past the memory limit ran (500 MB at 4096²
+/// (`2> /dev/full`) panicked, exit 101 (now a run's error keeps its own exit code, and a note
+/// that cannot be written mid-run ends it with 1); a chart past the memory limit ran (500 MB at 4096²
 /// under 64 MiB); a `--batch` answer that could not be written said only the OS's words.
 #[test]
 fn stderr_charts_and_batch_answers_fail_as_other_outputs_do() {
@@ -1489,9 +1510,18 @@ fn stderr_charts_and_batch_answers_fail_as_other_outputs_do() {
         .stderr(full)
         .output()
         .unwrap();
-    assert_eq!(out.status.code(), Some(1), "a failed stderr is exit 1, not a panic's 101");
+    assert_eq!(out.status.code(), Some(2), "invalid input keeps its exit code, not a panic's 101");
 
     let dir = tempfile::tempdir().unwrap();
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let new_folder = dir.path().join("new");
+    let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["generate", PRESET, "--size", "16", "-o", new_folder.to_str().unwrap()])
+        .stderr(full)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "the note 'created folder' could not be written: exit 1, not 101");
+
     let chart = dir.path().join("c.png");
     let args = ["brdf", "chart", "--width", "4096", "--height", "4096", "-o", chart.to_str().unwrap()];
     let out = snakeskin_env(&args, &[("SNAKESKIN_MEMORY_LIMIT_MIB", "64")]);

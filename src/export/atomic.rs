@@ -71,16 +71,23 @@ const RANDOM_CHARS: usize = 6;
 const NAME_MAX_BYTES: usize = 255;
 
 /// The part of a file's name its temporaries carry: `.STEM.RANDOM.snakeskin-tmp` must itself
-/// be a legal name, so a name near the limit is cut (at a character boundary). Without the
-/// cut, a legal 234-byte output name failed after the work with "cannot write .: File name
-/// too long".
-fn temporary_stem(target_name: &str) -> &str {
+/// be a legal name, so a name near the limit is cut (at a character boundary) and ends in
+/// `~` and eight hex digits of its SHA-256, so that two names cut alike keep stems of their
+/// own: the sweep of one name's stale temporaries (`remove_stale_temporaries`) matches its
+/// stem exactly, and a set's maps share their first 233 bytes when the set's name is long
+/// (the first cut, without the digits, swept a set's other staged maps: "No such file or
+/// directory" after the work). Without any cut, a legal 234-byte output name failed after the
+/// work with "cannot write .: File name too long".
+fn temporary_stem(target_name: &str) -> std::borrow::Cow<'_, str> {
     let room = NAME_MAX_BYTES - 2 - RANDOM_CHARS - TMP_SUFFIX.len();
-    let mut end = target_name.len().min(room);
+    if target_name.len() <= room {
+        return target_name.into();
+    }
+    let mut end = room - 9;
     while !target_name.is_char_boundary(end) {
         end -= 1;
     }
-    &target_name[..end]
+    format!("{}~{}", &target_name[..end], &sha256_hex(target_name.as_bytes())[..8]).into()
 }
 
 /// This process's temporaries of new files (staged, not yet renamed into place): what
@@ -140,7 +147,7 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
         let ours = file_names.iter().any(|f| {
             let random = name
                 .strip_prefix('.')
-                .and_then(|r| r.strip_prefix(temporary_stem(f)))
+                .and_then(|r| r.strip_prefix(temporary_stem(f).as_ref()))
                 .and_then(|r| r.strip_prefix('.'))
                 .and_then(|r| r.strip_suffix(TMP_SUFFIX));
             random.is_some_and(|r| r.len() == RANDOM_CHARS && r.chars().all(|c| c.is_ascii_alphanumeric()))

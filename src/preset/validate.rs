@@ -235,14 +235,15 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
             });
         }
         // Blotches take the two series' `aligned` and `alternating`; `checkered` (every other
-        // cell of a grid) is the spots' own, and on blotches it was silently `aligned`.
-        if p.kind == PatternKind::Blotches
-            && p.arrangement == Arrangement::Checkered
-            && !from_file_for_old_kind(i, "arrangement")
-        {
+        // cell of a grid) is the spots' own, and on blotches it was silently `aligned`. Both
+        // kinds read the key, so a file's `checkered` for spots is refused on a layer `--set`
+        // made blotches too (passing it over would have drawn it as `aligned` all the same).
+        if p.kind == PatternKind::Blotches && p.arrangement == Arrangement::Checkered {
             c.problems.push(Problem {
                 key: key("arrangement"),
-                message: "must be one of aligned, alternating for kind \"blotches\" (checkered is for spots)".into(),
+                message: "must be one of aligned, alternating for kind \"blotches\" (checkered is the spots' \
+                          arrangement; with --set pattern.N.kind=blotches, set its arrangement too)"
+                    .into(),
             });
         }
         // Keys some kinds read, set away from their defaults on a kind that ignores them

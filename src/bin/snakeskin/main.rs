@@ -20,7 +20,10 @@ fn main() -> ExitCode {
     match cmd::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {}", output::error_message(&err));
+            // A standard error that cannot be written does not change the run's exit code (an
+            // `eprintln!` there was status 1 from the panic hook, where invalid input is 2).
+            use std::io::Write;
+            let _ = writeln!(std::io::stderr(), "error: {}", output::error_message(&err));
             ExitCode::from(output::exit_code(&err))
         }
     }

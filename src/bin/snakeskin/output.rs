@@ -73,8 +73,10 @@ fn ignored_from_the_start(signal: i32) -> bool {
 /// status 1, not a panic (exit 101). `println!` panics with std's message "failed printing to
 /// stdout: REASON"; the hook turns exactly that panic into the error, at every print site
 /// alike, and leaves every other panic to the default hook. A standard error that fails
-/// (`2> /dev/full`) ends the run with status 1 too, saying nothing (there is nowhere to say
-/// it): `eprintln!` panicked and the default hook's message failed as well, exit 101.
+/// (`2> /dev/full`) while a run goes on (a note, a warning) ends it with status 1 too, saying
+/// nothing (there is nowhere to say it): `eprintln!` panicked and the default hook's message
+/// failed as well, exit 101. A run's final error is written without `eprintln!` (`main`), so
+/// its exit code stays the error's own.
 pub fn stdout_failure_is_an_error() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {

@@ -25,7 +25,16 @@ pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> 
     if let Some(dir) = closeups {
         snakeskin::export::check_folder(dir)?;
         for name in snakeskin::render::figures::gallery::closeup_file_names() {
-            snakeskin::export::check_target(&dir.join(name))?;
+            let closeup = dir.join(name);
+            snakeskin::export::check_target(&closeup)?;
+            // `-o sp/rows.png --closeups sp`: the close-up replaced the gallery (the review).
+            if snakeskin::export::same_path(&closeup, out) {
+                return Err(snakeskin::Error::Unsupported(format!(
+                    "-o names the close-up {} that --closeups writes; give the gallery another name",
+                    path_line(&closeup)
+                ))
+                .into());
+            }
         }
     }
     ensure_parent_folder(out)?;
