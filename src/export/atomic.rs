@@ -430,6 +430,8 @@ fn swap_in(
         });
         match moved {
             Ok(backup) => aside.push((backup, target.clone())),
+            // An earlier set's map that the new set does not write stays if it will not move
+            // (`left_over_files`): the new set does not need its place.
             Err(_) if may_stay.contains(target) => continue,
             Err(e) => {
                 put_back(aside, &[], manifest, &mut renames);
@@ -661,7 +663,7 @@ fn sync_folder(dir: &Path) {
 /// Writes one file atomically (exclusive temporary, then rename) to `path`. The folder must
 /// exist (the binary creates missing folders and says so).
 pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, ExportError> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = folder_of(path);
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).ok_or_else(|| ExportError::Io {
         path: path.into(),
         source: std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path does not name a file"),

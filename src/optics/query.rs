@@ -98,9 +98,6 @@ pub fn film_colour(method: Method, stack: Stack, thickness_nm: f64, cos0: f64) -
     }
 }
 
-/// The film colour chart: thickness 0..2000 nm across, angle 0..89° down, scaled so the
-/// brightest channel is 1. Returns the linear image and the exposure applied (film
-/// reflectances are a few percent to a few tens of percent).
 /// Peak bytes of `chart` and its PNG: the rows in f64 (24 bytes a pixel) and the f32 image
 /// made from them (12) live together, then the 8-bit pixels and the compressed file (at most
 /// about 3 each). A 4096² chart peaked at about 500 MB (maxrss) with no check at all.
@@ -108,6 +105,9 @@ pub fn chart_bytes(width: usize, height: usize) -> u64 {
     width as u64 * height as u64 * (24 + 12 + 3 + 3)
 }
 
+/// The film colour chart: thickness 0..2000 nm across, angle 0..89° down, scaled so the
+/// brightest channel is 1. Returns the linear image and the exposure applied (film
+/// reflectances are a few percent to a few tens of percent).
 pub fn chart(stack: Stack, method: Method, width: usize, height: usize) -> (Image, f64) {
     let rows: Vec<Vec<[f64; 3]>> = (0..height)
         .into_par_iter()
