@@ -289,10 +289,18 @@ pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
         match fs::metadata(path) {
             Ok(meta) if meta.is_dir() => return Ok(()),
             Ok(_) => return Err(ExportError::NotAFolder { path: path.into() }),
-            Err(e) if e.kind() != std::io::ErrorKind::PermissionDenied && fs::symlink_metadata(path).is_ok() => {
-                return Err(ExportError::BrokenLink { path: path.into() });
-            }
-            Err(_) => continue,
+            Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => continue,
+            // Missing when followed: a link to nothing, or missing until a moment ago (a
+            // folder another job of a batch made meanwhile was "a symbolic link to
+            // nothing"), or missing still.
+            Err(_) => match fs::symlink_metadata(path) {
+                Ok(meta) if meta.file_type().is_symlink() => {
+                    return Err(ExportError::BrokenLink { path: path.into() });
+                }
+                Ok(meta) if meta.is_dir() => return Ok(()),
+                Ok(_) => return Err(ExportError::NotAFolder { path: path.into() }),
+                Err(_) => continue,
+            },
         }
     }
     Ok(())
@@ -697,6 +705,31 @@ mod tests {
         assert!(same_path(&at("link/h.png"), &at("real/h.png")));
         assert!(!same_path(&at("a.png"), &at("b.png")));
         assert!(!same_path(&at("real/a.png"), &at("a.png")));
+    }
+
+    /// A folder another thread or process makes while one is checked is a folder, not "a
+    /// symbolic link to nothing": the check read the path missing, then present (CI: two
+    /// jobs of one batch in one new folder, `a_killed_batch_resumes_...`). The race is
+    /// provoked many times over; negative control: a real dangling link is still one.
+    #[cfg(unix)]
+    #[test]
+    fn a_folder_made_meanwhile_is_not_a_broken_link() {
+        let dir = tempfile::tempdir().unwrap();
+        for i in 0..3000 {
+            let path = dir.path().join(format!("f{i}"));
+            let maker = {
+                let path = path.clone();
+                std::thread::spawn(move || fs::create_dir_all(&path).unwrap())
+            };
+            while !path.is_dir() {
+                check_folder(&path).unwrap();
+            }
+            check_folder(&path).unwrap();
+            maker.join().unwrap();
+        }
+        let link = dir.path().join("dangling");
+        std::os::unix::fs::symlink(dir.path().join("nowhere"), &link).unwrap();
+        assert!(matches!(check_folder(&link), Err(ExportError::BrokenLink { .. })));
     }
 
     /// A folder no file can be made in (sysfs refuses new files, root or not): the error
