@@ -422,7 +422,6 @@ fn swap_in(
     manifest: Option<&Path>,
 ) -> Result<(Vec<PathBuf>, Vec<PathBuf>), ExportError> {
     let _commit = locked(&COMMIT);
-    let manifest = manifest.unwrap_or(Path::new(""));
     let mut renames = 0;
     let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
     for target in old {
@@ -557,13 +556,18 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> Vec<PathBuf> {
 /// old manifest returns only over its own maps. An old file that cannot go back stays in
 /// its temporary (never deleted), and then the old manifest stays aside too: the set is
 /// incomplete, not mixed. `renames` counts on from the commit's (`before_rename`).
-fn put_back(aside: Vec<(tempfile::TempPath, PathBuf)>, written: &[PathBuf], manifest: &Path, renames: &mut usize) {
+fn put_back(
+    aside: Vec<(tempfile::TempPath, PathBuf)>,
+    written: &[PathBuf],
+    manifest: Option<&Path>,
+    renames: &mut usize,
+) {
     let mut whole = true;
     for target in written {
         whole &= fs::remove_file(target).is_ok();
     }
     for (backup, target) in aside.into_iter().rev() {
-        if target == manifest && !whole {
+        if Some(target.as_path()) == manifest && !whole {
             let _ = backup.keep();
             continue;
         }

@@ -78,6 +78,25 @@ struct Checker {
 }
 
 impl Checker {
+    /// A value of a key that kinds take different sets of (`shape`, `arrangement`), refused
+    /// with the layer kind's own list; `note` is added to the message.
+    fn one_of<T: PartialEq + serde::Serialize>(
+        &mut self,
+        key: String,
+        kind: PatternKind,
+        value: &T,
+        accepted: &[T],
+        note: &str,
+    ) {
+        if !accepted.contains(value) {
+            let names: Vec<String> = accepted.iter().map(spelled).collect();
+            self.problems.push(Problem {
+                key,
+                message: format!("must be one of {} for kind \"{}\"{note}", names.join(", "), spelled(&kind)),
+            });
+        }
+    }
+
     fn range(&mut self, key: impl Into<String>, value: f64, (lo, hi): (f64, f64)) {
         if !(value.is_finite() && (lo..=hi).contains(&value)) {
             self.problems.push(Problem {
@@ -112,8 +131,7 @@ impl Checker {
 /// 0.50 at 75° for n0 = 1.4 over n2 = 1.33 and roughness 0.5; 0.48 at 50° for 1.5 over 1.0
 /// and roughness 0.9; 0.40 at 45° for 2 over 1.33 and roughness 0.9, where the rough-top
 /// walk, `--model stochastic`, reflects 1: the physics review; BENCHMARKS.md "Stress").
-/// The physics is fine (an oil film over a
-/// lighter layer), so it is a warning, not a refusal.
+/// The physics is fine (an oil film over a lighter layer), so it is a warning, not a refusal.
 pub fn model_limit(preset: &Preset) -> Option<Problem> {
     let o = &preset.optics;
     (o.ambient_ior > o.pigment_ior).then(|| Problem {
@@ -227,24 +245,23 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
             // Another kind reads no shape: `kinds_only` below says so.
             _ => &[],
         };
-        if !shapes.is_empty() && !shapes.contains(&p.shape) && !from_file_for_old_kind(i, "shape") {
-            let names: Vec<String> = shapes.iter().map(spelled).collect();
-            c.problems.push(Problem {
-                key: key("shape"),
-                message: format!("must be one of {} for kind \"{}\"", names.join(", "), spelled(&p.kind)),
-            });
+        if !shapes.is_empty() && !from_file_for_old_kind(i, "shape") {
+            c.one_of(key("shape"), p.kind, &p.shape, shapes, "");
         }
         // Blotches take the two series' `aligned` and `alternating`; `checkered` (every other
         // cell of a grid) is the spots' own, and on blotches it was silently `aligned`. Both
         // kinds read the key, so a file's `checkered` for spots is refused on a layer `--set`
         // made blotches too (passing it over would have drawn it as `aligned` all the same).
-        if p.kind == PatternKind::Blotches && p.arrangement == Arrangement::Checkered {
-            c.problems.push(Problem {
-                key: key("arrangement"),
-                message: "must be one of aligned, alternating for kind \"blotches\" (checkered is the spots' \
-                          arrangement; with --set pattern.N.kind=blotches, set its arrangement too)"
-                    .into(),
-            });
+        if p.kind == PatternKind::Blotches {
+            let note =
+                " (checkered is the spots' arrangement; with --set pattern.N.kind=blotches, set its arrangement too)";
+            c.one_of(
+                key("arrangement"),
+                p.kind,
+                &p.arrangement,
+                &[Arrangement::Aligned, Arrangement::Alternating],
+                note,
+            );
         }
         // Keys some kinds read, set away from their defaults on a kind that ignores them
         // (`colors` on spots, `phase` on stripes, `size` on solid, `center_size` on stripes

@@ -300,9 +300,13 @@ pub const CLOSEUPS: &[(&str, (f32, f32), &str)] = &[
 pub const CLOSEUP_MAP: usize = 1024;
 pub const CLOSEUP_CROP: usize = 512;
 
-/// The close-ups' file names (`<stem>.png`), in `CLOSEUPS` order.
+/// The close-ups' file names, in `CLOSEUPS` order.
 pub fn closeup_file_names() -> impl Iterator<Item = String> {
-    CLOSEUPS.iter().map(|(stem, _, _)| format!("{stem}.png"))
+    CLOSEUPS.iter().map(|(stem, _, _)| closeup_file_name(stem))
+}
+
+fn closeup_file_name(stem: &str) -> String {
+    format!("{stem}.png")
 }
 
 /// Each close-up as (file name, PNG bytes): colour crop left, normal crop right.
@@ -333,7 +337,7 @@ fn closeup_pngs() -> Result<Vec<(String, Vec<u8>)>, Error> {
                     }
                 }
             }
-            Ok((format!("{stem}.png"), encode_png(MapKind::Color, &out)?))
+            Ok((closeup_file_name(stem), encode_png(MapKind::Color, &out)?))
         })
         .collect()
 }

@@ -93,6 +93,14 @@ pub fn figure_list() -> Vec<Figure> {
     figures
 }
 
+/// Checks every figure's file in `out_dir` (`check_target`), before any is rendered.
+pub fn check_figure_files(out_dir: &Path) -> Result<(), Error> {
+    for figure in figure_list() {
+        check_target(&out_dir.join(figure.file))?;
+    }
+    Ok(())
+}
+
 /// Renders every figure of `figure_list` for `preset` into `out_dir`, and puts them in place
 /// together (`FileGroup`: an interrupted or failed run leaves the earlier figures as they
 /// were, not some new ones among them); returns the files.
@@ -104,10 +112,8 @@ pub fn write_figures(
     map_size: usize,
     progress: &dyn Fn(usize, usize),
 ) -> Result<Vec<PathBuf>, Error> {
+    check_figure_files(out_dir)?;
     let figures = figure_list();
-    for figure in &figures {
-        check_target(&out_dir.join(figure.file))?;
-    }
     let mut group = FileGroup::new();
     for (i, figure) in figures.iter().enumerate() {
         progress(i, figures.len());

@@ -201,20 +201,21 @@ impl App {
     fn apply_updates(&mut self) {
         let Some(gfx) = self.gfx.as_mut() else { return };
         while let Ok(result) = self.reloads.try_recv() {
-            match result {
-                Ok(reloaded) => match gfx.renderer.retexture(&mut gfx.material, &reloaded.maps) {
-                    Ok(()) => {
-                        self.status = format!(
-                            "reloaded in {:.0} ms: {} nodes re-evaluated, {} reused",
-                            reloaded.took.as_secs_f64() * 1e3,
-                            reloaded.stats.evaluated,
-                            reloaded.stats.reused
-                        );
-                        // The file is the source of truth for the optics too.
-                        self.sliders = reloaded.sliders;
-                    }
-                    Err(error) => self.status = format!("reload failed, keeping the last good maps: {error}"),
-                },
+            // A reload fails in the generator or in the upload alike: the last good maps stay.
+            let uploaded = result.map_err(|e| e.to_string()).and_then(|reloaded| {
+                gfx.renderer.retexture(&mut gfx.material, &reloaded.maps).map(|()| reloaded).map_err(|e| e.to_string())
+            });
+            match uploaded {
+                Ok(reloaded) => {
+                    self.status = format!(
+                        "reloaded in {:.0} ms: {} nodes re-evaluated, {} reused",
+                        reloaded.took.as_secs_f64() * 1e3,
+                        reloaded.stats.evaluated,
+                        reloaded.stats.reused
+                    );
+                    // The file is the source of truth for the optics too.
+                    self.sliders = reloaded.sliders;
+                }
                 Err(error) => self.status = format!("reload failed, keeping the last good maps: {error}"),
             }
             // Also to the caller: the window may be behind others, and tests read it.
