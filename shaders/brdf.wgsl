@@ -122,7 +122,8 @@ fn lobe_row(roughness: f32) -> u32 {
 }
 
 fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
-    let x = clamp(cos, 0.0, 1.0) * f32(E1_MU - 1u);
+    // sqrt: the nodes are uniform in sqrt(mu) (optics::brdf::energy::node_mu).
+    let x = sqrt(clamp(cos, 0.0, 1.0)) * f32(E1_MU - 1u);
     let y = clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
     let i = min(u32(x), E1_MU - 2u);
     let j = lobe_row(roughness);
@@ -310,7 +311,7 @@ fn ms_norms_from_row(layers: Layers, j: u32) -> array<vec3<f32>, 2> {
     for (var n = 0u; n < 2u * MS_NODES; n++) {
         let node = nodes[n % MS_NODES];
         let row = n / MS_NODES;
-        let x = node.x * f32(E1_MU - 1u);
+        let x = sqrt(node.x) * f32(E1_MU - 1u);
         let i = min(u32(x), E1_MU - 2u);
         norms[row] += node.y * parts_on_row(layers, LOBE_VEC4S * ((j + row) * E1_MU + i), x - f32(i)).beyond;
     }
@@ -347,7 +348,8 @@ fn top_on_row(layers: Layers, k: u32, fx: f32, norm: vec3<f32>) -> Top {
 // thickness).
 fn coupling_table(layers: Layers, cos: f32) -> Top {
     let n_cos = f32(film_info.n_cos);
-    let x = clamp(cos, 0.0, 1.0) * (n_cos - 1.0);
+    // sqrt: the table's cos texels are uniform in sqrt(cos) (optics::lut::coupling_texel_cos).
+    let x = sqrt(clamp(cos, 0.0, 1.0)) * (n_cos - 1.0);
     let rows = f32(E1_ROUGHNESS);
     let v = (clamp(layers.roughness, 0.0, 1.0) * (rows - 1.0) + 0.5) / rows;
     let w = (lut_column(layers.thickness_nm) + 0.5) / f32(film_info.n_fine + film_info.n_coarse);

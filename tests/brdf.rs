@@ -99,6 +99,33 @@ fn layered_model_keeps_the_white_furnace() {
 }
 
 #[test]
+fn a_nearly_smooth_top_keeps_the_furnace_at_grazing_light() {
+    // Between 86° and 89.3° a low-roughness lobe changes within a few α of grazing
+    // (`energy::node_mu`): with the lobe's nodes uniform in μ its rule was read across that
+    // whole boundary layer, and the lossless stack reflected up to 3.3 % more than arrives
+    // here (0.0331; 0.0199 with nodes uniform in √μ; the negative control, nodes uniform in
+    // μ, fails this bound). What is left is the rows' interpolation in roughness, whose
+    // single-scatter albedo bends at grazing light (BENCHMARKS.md, "Beyond the grid's 85°").
+    let mut worst: f64 = 0.0;
+    for stack in GRID_MATERIALS {
+        for thickness in [0.0, 250.0] {
+            let tables = FilmTables::new(stack, thickness);
+            let film = |c: f64| tables.above(c);
+            for roughness in [0.05, 0.08, 0.1, 0.15] {
+                for angle_deg in [86.0f64, 87.0, 88.0, 89.0, 89.3] {
+                    let layers = white_layers(stack, thickness, roughness);
+                    let a = Model::Layered.furnace_albedo(&layers, angle_deg.to_radians().cos(), &film, 64);
+                    let err = a.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
+                    worst = worst.max(err);
+                    assert!(err <= 0.025, "{stack:?} d={thickness} r={roughness} {angle_deg}°: {a:?}");
+                }
+            }
+        }
+    }
+    eprintln!("layered furnace at 86–89.3°, roughness 0.05–0.15: max |albedo − 1| {worst:.4}");
+}
+
+#[test]
 fn furnace_with_the_exact_spectral_film() {
     let stack = Stack::THESIS;
     let film = |c: f64| snakeskin::optics::film_rgb_reference(stack, 400.0, c);
@@ -325,22 +352,27 @@ fn coupling_table_is_the_rule_it_tabulates() {
     // interpolates between roughness rows as the rule does: the same up to f32 rounding, at
     // any roughness. Between texels and columns it interpolates the results where the rule
     // interpolates the lobe and the film (the rule is linear in neither): the reflected
-    // share within 0.005 everywhere (measured ≤ 0.0029 on the four materials, 20,000 points
-    // each), the multiple-scatter amplitude x / √(π X̄) within 0.008 for cos ≥ 0.1 and 0.12
-    // below, where it rises steeply towards grazing (measured ≤ 0.0068 and ≤ 0.090, nearly
-    // all of it between cos texels: between thickness columns ≤ 0.0014; with the earlier
-    // amplitude (1 − E₁) √g, ≤ 0.0045 and ≤ 0.02).
+    // share within 0.005 everywhere (measured ≤ 0.0026 on the four materials, 20,000 points
+    // each), the multiple-scatter amplitude x / √(π X̄) within 0.008 for cos ≥ 0.1 and 0.2
+    // below, where it rises steeply towards grazing (measured ≤ 0.0069 and ≤ 0.150, nearly
+    // all of it between cos texels: between thickness columns ≤ 0.0014). The cos texels are
+    // uniform in √cos (`lut::coupling_texel_cos`), as the lobe's nodes; with both uniform in
+    // cos the amplitude was ≤ 0.090 below 0.1, but the rule itself then missed the boundary
+    // layer of a low-roughness lobe at grazing light, where its amplitude rises several times
+    // higher than it read (texels uniform in cos under nodes uniform in √μ: 4.6 off). With
+    // the earlier amplitude (1 − E₁) √g, ≤ 0.0045 and ≤ 0.02.
     for stack in GRID_MATERIALS {
         let lut = Lut::bake(stack, 64, 256, 64);
         let fine_step = 2000.0 / 255.0;
         let on_column = |u: f32| (u * 255.0).floor() * fine_step;
-        let on_texel = |u: f32| (u * 63.0).floor() / 63.0;
+        let on_texel = |u: f32| snakeskin::optics::lut::coupling_texel_cos((u * 63.0).floor() as usize, 64);
         let (reflected, amplitude) = coupling_table_deviation(&lut, 5_000, on_column, on_texel);
         assert!(reflected < 2e-6 && amplitude < 2e-6, "{stack:?} on texels: {reflected} {amplitude}");
-        let (reflected, amplitude) = coupling_table_deviation(&lut, 20_000, |u| 3000.0 * u, |u| 0.1 + 0.9 * u);
-        assert!(reflected < 0.005 && amplitude < 0.008, "{stack:?}, cos ≥ 0.1: {reflected} {amplitude}");
+        let (r1, a1) = coupling_table_deviation(&lut, 20_000, |u| 3000.0 * u, |u| 0.1 + 0.9 * u);
+        assert!(r1 < 0.005 && a1 < 0.008, "{stack:?}, cos ≥ 0.1: {r1} {a1}");
         let (reflected, amplitude) = coupling_table_deviation(&lut, 20_000, |u| 3000.0 * u, |u| 0.1 * u);
-        assert!(reflected < 0.005 && amplitude < 0.12, "{stack:?}, cos < 0.1: {reflected} {amplitude}");
+        eprintln!("{stack:?}: between texels, cos ≥ 0.1: {r1:.4} {a1:.4}; cos < 0.1: {reflected:.4} {amplitude:.4}");
+        assert!(reflected < 0.005 && amplitude < 0.2, "{stack:?}, cos < 0.1: {reflected} {amplitude}");
     }
     // Negative control: a table whose roughness rows are shifted by one is caught.
     let lut = Lut::bake(Stack::THESIS, 64, 256, 64);

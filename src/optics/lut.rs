@@ -14,7 +14,8 @@
 //! around the roughness, each eighteen film lookups (`energy::ROW_FILM_READS`), and the
 //! multiple-scatter lobe's normalisation on both rows, eight more evaluations of the rule
 //! each, where the thesis model makes one lookup.
-//! Baked with the table on its cos texels, the same rows and its thickness columns, it is
+//! Baked with the table on as many cos texels (uniform in √cos, `coupling_texel_cos`), the
+//! same rows and its thickness columns, it is
 //! one trilinear lookup (`coupling_f32`; in the shader two filtered 3-D texture fetches,
 //! one per RGBA half) that interpolates between rows as the rule does; between cos texels and
 //! thickness columns it interpolates the results where the rule interpolates the lobe and
@@ -36,6 +37,16 @@ pub const FINE_MAX_NM: f64 = 2000.0;
 
 pub const COARSE_MAX_NM: f64 = 20_000.0;
 
+/// The cosine of the coupling table's cos texel `i` of `n`: uniform in √cos, as the rough
+/// lobe's own nodes (`energy::node_mu`), where a low-roughness lobe changes within a few α
+/// of grazing light. Why: once the rule resolved that boundary layer, texels uniform in cos
+/// (the film's, 0.016 apart) read its multiple-scatter amplitude up to 4.6 off below
+/// cos 0.1 and its reflected share 0.0053 off (`coupling_table_is_the_rule_it_tabulates`).
+pub fn coupling_texel_cos(i: usize, n: usize) -> f32 {
+    let t = i as f32 / (n - 1) as f32;
+    t * t
+}
+
 /// The texels one evaluation reads from the coupling table for its two directions
 /// (`Lut::coupling_pair_start`): the four (thickness column, roughness row) corners, each
 /// corner's first entry and its weight, and per direction the cos texel below its cosine
@@ -55,7 +66,7 @@ pub struct Lut {
     pub n_coarse: usize,
     /// Row-major: `texels[i_cos * width + i_d]`, linear sRGB reflectance.
     pub texels: Vec<[f32; 3]>,
-    /// The rough top's coupling at the texels' cos nodes, the rough lobe's roughness rows
+    /// The rough top's coupling at `n_cos` cos nodes (`coupling_texel_cos`), the rough lobe's roughness rows
     /// and the texels' thickness columns (`bake_coupling`): per entry the reflected share
     /// (RGB), the pigment layer's path delta (cos_eff − cos_t, `brdf::path`), the
     /// multiple-scatter amplitude (RGB) and 0 — the two RGBA texels of the shader's
@@ -150,7 +161,7 @@ impl Lut {
                 for i_r in 0..E1_ROUGHNESS {
                     let norm = energy::ms_norm_on_row_f32(i_r, &film, &path.through_f32);
                     for i_cos in 0..n_cos {
-                        let cos = i_cos as f32 / (n_cos - 1) as f32;
+                        let cos = coupling_texel_cos(i_cos, n_cos);
                         let top = energy::top_on_row_with_f32(cos, i_r, &film, &path.through_f32, norm);
                         let (s, m) = (top.reflected, top.ms_amplitude);
                         let r = i_r as f32 / (E1_ROUGHNESS - 1) as f32;
@@ -199,7 +210,7 @@ impl Lut {
     /// `energy::top_f32` interpolates them, and between thickness columns (one trilinear
     /// fetch: `brdf.wgsl`'s `coupling_table`).
     pub fn coupling_f32(&self, thickness_nm: f32, cos: f32, roughness: f32) -> (energy::Top<f32>, f32) {
-        self.coupling_at(self.coupling(), &self.coupling_corners(thickness_nm, roughness), self.cos_texel(cos))
+        self.coupling_at(self.coupling(), &self.coupling_corners(thickness_nm, roughness), self.coupling_texel(cos))
     }
 
     /// `coupling_f32` for the two directions of one evaluation (light and view), which share
@@ -230,7 +241,7 @@ impl Lut {
     pub(crate) fn coupling_pair_start(&self, thickness_nm: f32, cos: [f32; 2], roughness: f32) -> CouplingFetch {
         let fetch = CouplingFetch {
             corners: self.coupling_corners(thickness_nm, roughness),
-            texels: cos.map(|c| self.cos_texel(c)),
+            texels: cos.map(|c| self.coupling_texel(c)),
         };
         #[cfg(target_arch = "x86_64")]
         {
@@ -259,10 +270,21 @@ impl Lut {
         fetch.texels.map(|texel| self.coupling_at(table, &fetch.corners, texel))
     }
 
-    /// The cos texel below `cos` and the weight of the one above it (linear filtering).
+    /// The film's cos texel below `cos` and the weight of the one above it (linear
+    /// filtering; the film's texels are uniform in cos).
     #[inline(always)]
     fn cos_texel(&self, cos: f32) -> (usize, f32) {
         let y = cos.clamp(0.0, 1.0) * (self.n_cos - 1) as f32;
+        let y0 = (y as usize).min(self.n_cos - 2);
+        (y0, y - y0 as f32)
+    }
+
+    /// The coupling table's cos texel below `cos` and the weight of the one above it: its
+    /// texels are uniform in √cos (`coupling_texel_cos`), so the coordinate is √cos
+    /// (n_cos − 1), as `brdf.wgsl`'s `coupling_table` computes it.
+    #[inline(always)]
+    fn coupling_texel(&self, cos: f32) -> (usize, f32) {
+        let y = cos.clamp(0.0, 1.0).sqrt() * (self.n_cos - 1) as f32;
         let y0 = (y as usize).min(self.n_cos - 2);
         (y0, y - y0 as f32)
     }
@@ -286,7 +308,7 @@ impl Lut {
         ]
     }
 
-    /// The coupling at the cos texel `y0` and the weight `fy` of the next (`cos_texel`) from
+    /// The coupling at the cos texel `y0` and the weight `fy` of the next (`coupling_texel`) from
     /// `table` (`coupling`), linear between the two texels, summed over `corners`.
     #[inline(always)]
     fn coupling_at(

@@ -49,7 +49,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::energy::{E1_MU, E1_ROUGHNESS, GridCell};
+use super::energy::{E1_MU, E1_ROUGHNESS, GridCell, node_mu};
 use super::{ALPHA_MIN, COS_MIN, cos_transmitted};
 
 /// The optical depth the effective cosine is matched at (see the module's measurements).
@@ -121,7 +121,7 @@ impl PathTable {
 /// Entry k of the table for (n0, n2): cos_eff − cos_t, walked (see `PathTable`).
 fn entry(n0: f64, n2: f64, k: usize) -> f64 {
     let (i_mu, i_r) = (k % E1_MU, k / E1_MU);
-    let mu = (i_mu as f64 / (E1_MU - 1) as f64).max(MU_MIN);
+    let mu = node_mu(i_mu).max(MU_MIN);
     let Some(cos_t) = cos_transmitted(n0, n2, mu) else {
         return 0.0;
     };
@@ -153,7 +153,7 @@ fn through_walk(n0: f64, n2: f64, k: usize) -> ThroughWalk {
     if i_r == 0 {
         return (0, 0, Vec::new());
     }
-    let mu = (i_mu as f64 / (E1_MU - 1) as f64).max(MU_MIN);
+    let mu = node_mu(i_mu).max(MU_MIN);
     let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
     let alpha = (r * r).max(ALPHA_MIN);
     let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
@@ -346,7 +346,7 @@ mod tests {
                 assert_eq!(table.cos_eff(cos_t, mu, 0.0), cos_t);
             }
             let cos_eff = |i: usize, row: usize| {
-                let mu = i as f64 / (E1_MU - 1) as f64;
+                let mu = node_mu(i);
                 let r = row as f64 / (E1_ROUGHNESS - 1) as f64;
                 table.cos_eff(cos_transmitted(n0, n2, mu).unwrap(), mu, r)
             };
@@ -356,8 +356,8 @@ mod tests {
             // price of one τ_ref for every τ).
             for row in [2, 5] {
                 let r = row as f64 / (E1_ROUGHNESS - 1) as f64;
-                for i in [16, 24, 31] {
-                    let mu = i as f64 / (E1_MU - 1) as f64;
+                for i in [22, 27, 31] {
+                    let mu = node_mu(i);
                     let cos_eff = cos_eff(i, row);
                     for (tau, tolerance) in [(TAU_REF, 0.01), (1.5, 0.03)] {
                         let walked = (-tau / cos_eff).exp();
