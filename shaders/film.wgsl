@@ -35,10 +35,11 @@ struct FilmInfo {
 // the top (optics::brdf::path).
 @group(0) @binding(4) var<storage, read> lobe_table: array<vec4<f32>>;
 // The layered model's coupling baked with the table (optics::lut::Lut::coupling): x = cos
-// texel, the reflected share and the path delta (as in lobe_table's first slot) in the
-// first n_cos texels and the multiple-scatter amplitude in the next n_cos; y = the rough lobe's
-// roughness row (E1_ROUGHNESS); z = thickness texel, as the table's columns. Half floats,
-// read with the same sampler (brdf.wgsl's coupling_table).
+// texel (uniform in sqrt(cos), optics::lut::coupling_texel_cos), the reflected share and the
+// path delta (as in lobe_table's first slot) in the first n_cos texels and the
+// multiple-scatter amplitude in the next n_cos; y = the rough lobe's roughness row
+// (E1_ROUGHNESS); z = thickness texel, as the table's columns. Half floats, read with the
+// same sampler (brdf.wgsl's coupling_table).
 @group(0) @binding(5) var coupling_texture: texture_3d<f32>;
 
 // The table's continuous thickness texel of d (nm), as optics::lut::Lut::column_f32.

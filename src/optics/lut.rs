@@ -206,7 +206,7 @@ impl Lut {
 
     /// What the rough top reflects at cosine `cos` and roughness `roughness` through the
     /// film at `thickness_nm` (`energy::Top`), and the path delta there: the coupling table,
-    /// linear in cos between its texels, in roughness between the rows as
+    /// linear in √cos between its texels (`coupling_texel`), in roughness between the rows as
     /// `energy::top_f32` interpolates them, and between thickness columns (one trilinear
     /// fetch: `brdf.wgsl`'s `coupling_table`).
     pub fn coupling_f32(&self, thickness_nm: f32, cos: f32, roughness: f32) -> (energy::Top<f32>, f32) {

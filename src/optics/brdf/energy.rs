@@ -601,9 +601,11 @@ pub struct Top<T> {
 /// The coupling on one roughness row and between rows, in f64 and f32 (the shader's twin),
 /// written once.
 ///
-/// On a row the lobe's nodes and weights are interpolated in μ and the rule evaluated with
-/// them: on the mirror row that is the film at μ itself, whose curvature near grazing a
-/// linear interpolation of results would miss (the smooth furnace at 89° then loses 0.8 %).
+/// On a row the lobe's nodes and weights are interpolated in √μ (the nodes' own spacing,
+/// `node_mu`) and the rule evaluated with them: on the mirror row that is the film at
+/// nearly μ itself (the chord of μ = t² between two nodes: at most 2.6e-4 above μ, about
+/// 1e-3 of reflectance near grazing light), whose curvature near grazing a linear
+/// interpolation of results would miss (the smooth furnace at 89° then loses 0.8 %).
 /// Between rows the rule's *results* are interpolated, not its nodes and weights: the rows
 /// differ in kind (the mirror row has one node of weight 1 at μ, the next two outer nodes
 /// of weight 0.03 and a centre one), and a rule with interpolated weights puts half its
@@ -620,7 +622,7 @@ macro_rules! top_impl {
         /// through the top, q = (1 − ⟨F⟩) W ⟨F⟩_back with the material's rule `through` (W
         /// and a three-point rule for the last reflection's cosine:
         /// `path::PathTable::through`; empty: none). The lobe and the rule interpolated
-        /// linearly in μ.
+        /// linearly in √μ (`GridCell::at`).
         pub fn $parts(
             cos: $t,
             i_r: usize,
@@ -840,12 +842,13 @@ mod tests {
     /// The rough top by itself, with a black base (nothing comes back from it), against the
     /// photon walk of the whole stack (400,000 photons), in ΔE00 of what the top reflects,
     /// E₁⟨F⟩ + x, at lobe nodes of roughness 14/15: where the film's colour turns quickly
-    /// with the angle (650 nm on (1.33, 1.55, 2.0), at 84° and 59°) and where the two
+    /// with the angle (650 nm on (1.33, 1.55, 2.0), at 84° and 60°) and where the two
     /// cosines of light reflected twice are most correlated (250 nm on (1, 1.55, 2.0) at
-    /// 0°, `bench layered`'s worst cells before this rule). Measured 1.89, 1.07 and 0.30
-    /// (the first is the single scattering's five-point rule at grazing light; with the
-    /// earlier rule for the multiple scattering, 1.82, 1.27 and 1.15); the bounds are a few
-    /// tenths above. Negative control: the same rule without the correlation (M = w vᵀ) is
+    /// 0°, `bench layered`'s worst cells before this rule). Measured 1.10, 0.70 and 0.31
+    /// with the lobe's nodes uniform in √μ (the nodes at μ = 0.104 and 0.504); 1.89, 1.07
+    /// and 0.30 at the nodes of 84.4° and 59° while they were uniform in μ (the first the
+    /// single scattering's five-point rule at grazing light; with the earlier rule for the
+    /// multiple scattering, 1.82, 1.27 and 1.15); the bounds are a few tenths above. Negative control: the same rule without the correlation (M = w vᵀ) is
     /// 1.14 off at 0°, above that angle's bound.
     #[test]
     fn a_rough_top_under_a_colourful_film_reflects_the_walks_colour() {
@@ -857,7 +860,7 @@ mod tests {
         let water = Stack { n0: 1.33, n1: 1.55, n2: 2.0 };
         let air = Stack { n0: 1.0, n1: 1.55, n2: 2.0 };
         for (stack, thickness_nm, i_mu, bound, uncorrelated_above) in
-            [(water, 650.0, 10, 2.2, None), (water, 650.0, 22, 1.4, None), (air, 250.0, E1_MU - 1, 0.6, Some(0.9))]
+            [(water, 650.0, 10, 1.4, None), (water, 650.0, 22, 1.0, None), (air, 250.0, E1_MU - 1, 0.6, Some(0.9))]
         {
             let tables = walk::FilmTables::new(stack, thickness_nm);
             let film = |c: f64| tables.above(c).map(|v| v.clamp(0.0, 1.0));
@@ -1018,8 +1021,10 @@ mod tests {
                         taken[c]
                     );
                 }
-                // Negative control: a normalisation 5 % off is seen.
-                let off = lobe_albedo(mu_o, i_r, 1.05);
+                // Negative control: a normalisation 10 % off is seen.
+                // (10 %: the rule's own error, up to 1.8 % the other way, would leave 5 %
+                // only 3.05 % off, at the edge of the 3 % this asks.)
+                let off = lobe_albedo(mu_o, i_r, 1.10);
                 assert!((0..3).all(|c| (off[c] - taken[c]).abs() > 3e-2 * taken[c]));
             }
         }
