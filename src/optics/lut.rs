@@ -15,8 +15,7 @@
 //! multiple-scatter lobe's normalisation on both rows, eight more evaluations of the rule
 //! each, where the thesis model makes one lookup.
 //! Baked with the table on as many cos texels (uniform in √cos, `coupling_texel_cos`), the
-//! same rows and its thickness columns, it is
-//! one trilinear lookup (`coupling_f32`; in the shader two filtered 3-D texture fetches,
+//! same rows and its thickness columns, it is one trilinear lookup (`coupling_f32`; in the shader two filtered 3-D texture fetches,
 //! one per RGBA half) that interpolates between rows as the rule does; between cos texels and
 //! thickness columns it interpolates the results where the rule interpolates the lobe and
 //! the film (`tests/brdf.rs` bounds the difference). The f32 twin and the shader read it;
@@ -66,13 +65,13 @@ pub struct Lut {
     pub n_coarse: usize,
     /// Row-major: `texels[i_cos * width + i_d]`, linear sRGB reflectance.
     pub texels: Vec<[f32; 3]>,
-    /// The rough top's coupling at `n_cos` cos nodes (`coupling_texel_cos`), the rough lobe's roughness rows
-    /// and the texels' thickness columns (`bake_coupling`): per entry the reflected share
-    /// (RGB), the pigment layer's path delta (cos_eff − cos_t, `brdf::path`), the
-    /// multiple-scatter amplitude (RGB) and 0 — the two RGBA texels of the shader's
-    /// `coupling_texture` — index `(i_d * E1_ROUGHNESS + i_r) * n_cos + i_cos`. Baked on
-    /// first use (`coupling`): it needs the material's path table, a photon walk that a
-    /// film-colour query or a thesis-model render should not pay for.
+    /// The rough top's coupling at `n_cos` cos nodes (`coupling_texel_cos`), the rough lobe's
+    /// roughness rows and the texels' thickness columns (`bake_coupling`): per entry the
+    /// reflected share (RGB), the pigment layer's path delta (cos_eff − cos_t,
+    /// `brdf::path`), the multiple-scatter amplitude (RGB) and 0 — the two RGBA texels of
+    /// the shader's `coupling_texture` — index `(i_d * E1_ROUGHNESS + i_r) * n_cos + i_cos`.
+    /// Baked on first use (`coupling`): it needs the material's path table, a photon walk
+    /// that a film-colour query or a thesis-model render should not pay for.
     coupling: OnceLock<Vec<[f32; 8]>>,
 }
 

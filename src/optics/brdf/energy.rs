@@ -848,8 +848,9 @@ mod tests {
     /// with the lobe's nodes uniform in √μ (the nodes at μ = 0.104 and 0.504); 1.89, 1.07
     /// and 0.30 at the nodes of 84.4° and 59° while they were uniform in μ (the first the
     /// single scattering's five-point rule at grazing light; with the earlier rule for the
-    /// multiple scattering, 1.82, 1.27 and 1.15); the bounds are a few tenths above. Negative control: the same rule without the correlation (M = w vᵀ) is
-    /// 1.14 off at 0°, above that angle's bound.
+    /// multiple scattering, 1.82, 1.27 and 1.15); the bounds are a few tenths above.
+    /// Negative control: the same rule without the correlation (M = w vᵀ) is 1.16 off at
+    /// 0°, above that angle's bound.
     #[test]
     fn a_rough_top_under_a_colourful_film_reflects_the_walks_colour() {
         use crate::optics::brdf::{Layers, path, walk};
