@@ -42,8 +42,7 @@ pub const COARSE_MAX_NM: f64 = 20_000.0;
 /// (the film's, 0.016 apart) read its multiple-scatter amplitude up to 4.6 off below
 /// cos 0.1 and its reflected share 0.0053 off (`coupling_table_is_the_rule_it_tabulates`).
 pub fn coupling_texel_cos(i: usize, n: usize) -> f32 {
-    let t = i as f32 / (n - 1) as f32;
-    t * t
+    energy::GridCell::<f32>::axis_cos(i, n)
 }
 
 /// The texels one evaluation reads from the coupling table for its two directions
@@ -273,9 +272,7 @@ impl Lut {
     /// filtering; the film's texels are uniform in cos).
     #[inline(always)]
     fn cos_texel(&self, cos: f32) -> (usize, f32) {
-        let y = cos.clamp(0.0, 1.0) * (self.n_cos - 1) as f32;
-        let y0 = (y as usize).min(self.n_cos - 2);
-        (y0, y - y0 as f32)
+        self.texel_below(cos.clamp(0.0, 1.0) * (self.n_cos - 1) as f32)
     }
 
     /// The coupling table's cos texel below `cos` and the weight of the one above it: its
@@ -283,7 +280,12 @@ impl Lut {
     /// (n_cos − 1), as `brdf.wgsl`'s `coupling_table` computes it.
     #[inline(always)]
     fn coupling_texel(&self, cos: f32) -> (usize, f32) {
-        let y = cos.clamp(0.0, 1.0).sqrt() * (self.n_cos - 1) as f32;
+        self.texel_below(energy::GridCell::<f32>::axis_coordinate(cos, self.n_cos))
+    }
+
+    /// The cos texel below the continuous coordinate `y` and the weight of the next.
+    #[inline(always)]
+    fn texel_below(&self, y: f32) -> (usize, f32) {
         let y0 = (y as usize).min(self.n_cos - 2);
         (y0, y - y0 as f32)
     }

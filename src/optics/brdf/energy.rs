@@ -84,8 +84,7 @@ pub const E1_ROUGHNESS: usize = 16;
 /// most 0.0004 at any roughness and angle where μ-uniform nodes had 0.0002 (measured over
 /// 0°–90° in 0.1° steps, roughness 0.0667–0.9, against `lobe` evaluated at each angle).
 pub fn node_mu(i_mu: usize) -> f64 {
-    let t = i_mu as f64 / (E1_MU - 1) as f64;
-    t * t
+    GridCell::<f64>::axis_cos(i_mu, E1_MU)
 }
 /// Quadrature strata per axis of the half-vector integral: E₁ to ~1e-4.
 const STRATA: usize = 64;
@@ -561,9 +560,25 @@ pub struct GridCell<T> {
 macro_rules! grid_cell_impl {
     ($t:ty) => {
         impl GridCell<$t> {
+            /// The cosine of node `i` of an axis of `n` nodes uniform in √cos: (i / (n − 1))²
+            /// (the lobe's nodes, `node_mu`, and the film table's coupling texels,
+            /// `lut::coupling_texel_cos`).
+            pub fn axis_cos(i: usize, n: usize) -> $t {
+                let t = i as $t / (n - 1) as $t;
+                t * t
+            }
+
+            /// The continuous node coordinate of `cos` on that axis, √cos (n − 1): the
+            /// inverse of `axis_cos` (`brdf.wgsl`'s `lobe_cell`, `ms_norms_from_row` and
+            /// `coupling_table` compute the same).
+            #[inline(always)]
+            pub fn axis_coordinate(cos: $t, n: usize) -> $t {
+                cos.clamp(0.0, 1.0).sqrt() * (n - 1) as $t
+            }
+
             pub fn at(cos: $t, roughness: $t) -> GridCell<$t> {
-                // √μ: the nodes lie at `node_mu`.
-                let x = cos.clamp(0.0, 1.0).sqrt() * (E1_MU - 1) as $t;
+                // The nodes lie at `node_mu`.
+                let x = Self::axis_coordinate(cos, E1_MU);
                 let y = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as $t;
                 let (i, j) = ((x as usize).min(E1_MU - 2), (y as usize).min(E1_ROUGHNESS - 2));
                 GridCell { i, j, fx: x - i as $t, fy: y - j as $t }
