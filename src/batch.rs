@@ -60,12 +60,23 @@ pub enum BatchError {
     TooMany { path: PathBuf, count: usize, max: usize },
     #[error("invalid --shard {0:?}: expected K/N with 0 <= K < N, e.g. 0/4 (K is the array index)")]
     Shard(String),
-    /// Two different jobs whose sets would go to the same folder and overwrite each other.
+    /// Two different jobs whose sets would go to the same folder and overwrite each other;
+    /// `first_line`, `second_line`: their `preset` keys.
     #[error(
-        "{path}: jobs {first} and {second} ({preset}) would both write {folder} with different output; rename one of \
-         the preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)"
+        "{path}{}: jobs {first}{} and {second} ({preset}) would both write {folder} with different output; rename \
+         one of the preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)",
+        at_line(*.second_line),
+        first_line.map(|l| format!(" (line {l})")).unwrap_or_default()
     )]
-    SameFolder { path: PathBuf, first: usize, second: usize, preset: String, folder: PathBuf },
+    SameFolder {
+        path: PathBuf,
+        first: usize,
+        first_line: Option<usize>,
+        second: usize,
+        second_line: Option<usize>,
+        preset: String,
+        folder: PathBuf,
+    },
     /// The job refused when the run was planned, before any job ran: its size (a body atlas
     /// too tall, more memory than the machine has) or its output (a folder, file or link
     /// in the way); `line`: the job's `sizes` key, else its `preset` key.
@@ -497,7 +508,9 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
                 return Err(BatchError::SameFolder {
                     path: jobs_file.into(),
                     first: jobs[earlier].table,
+                    first_line: jobs[earlier].lines.preset,
                     second: job.table,
+                    second_line: job.lines.preset,
                     preset: r.outcome.preset,
                     folder: r.outcome.folder,
                 }

@@ -356,7 +356,12 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     for shard in ["0/2", "1/2"] {
         let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--shard", shard]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-        assert!(stderr(&out).contains("jobs 1 and 2 (snake) would both write"), "{}", stderr(&out));
+        // Both jobs' `preset` lines: the second where the message starts, the first in it.
+        assert!(
+            stderr(&out).contains("jobs.toml:6: jobs 1 (line 2) and 2 (snake) would both write"),
+            "{}",
+            stderr(&out)
+        );
     }
     assert!(!empty.exists());
 }
