@@ -66,8 +66,9 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
 }
 
 /// How deep the TOML reader nests keys, tables and arrays before it refuses a file: the
-/// `LIMIT` of toml 0.9's parser (`de/parser/mod.rs`).
-const TOML_NESTING_LIMIT: usize = 80;
+/// `LIMIT` of toml 0.9's parser (`de/parser/mod.rs`). A `--set` key is held to it too
+/// (`preset::load`): split at its dots, it never reaches the reader's count.
+pub const TOML_NESTING_LIMIT: usize = 80;
 
 /// The offset of the first line whose key has more than `TOML_NESTING_LIMIT` dotted parts
 /// (the reader takes 80 and refuses 81; quoted dots counted too, comments skipped: a close

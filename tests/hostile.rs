@@ -773,6 +773,30 @@ fn a_set_value_cannot_smuggle_in_more_toml() {
     assert!(err.to_string().contains("one line"), "{err}");
 }
 
+/// A `--set` key of 50,000 dotted parts (a 100 KB jobs file's `set`, or a command line)
+/// overflowed the stack: an abort, exit 134, where a key 80 deep is a plain unknown key.
+#[test]
+fn a_set_key_nested_past_the_readers_limit_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().to_str().unwrap();
+    let dotted = |parts: usize| format!("{}b", "a.".repeat(parts - 1));
+    let deep = format!("{}=1", dotted(50_000));
+    let out = snakeskin(&["generate", PRESET, "-o", o, "--size", "16", "--set", &deep]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the key has 50000 dotted parts; keys nest at most 80 deep"), "{}", stderr(&out));
+    let at_limit = format!("{}=1", dotted(80));
+    let out = snakeskin(&["generate", PRESET, "-o", o, "--size", "16", "--set", &at_limit]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("unknown key"), "{}", stderr(&out));
+    // The same key in a jobs file's `set`, refused with the job's line.
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, format!("[[job]]\npreset = \"{PRESET}\"\nset = {{ \"{}\" = 1 }}\n", dotted(50_000))).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", o]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:3: job 1"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("keys nest at most 80 deep"), "{}", stderr(&out));
+}
+
 #[test]
 fn brdf_eval_refuses_what_it_used_to_clamp() {
     let base = ["brdf", "eval", "--wi", "0,0.3,1", "--wo", "0.2,0,1"];

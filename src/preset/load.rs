@@ -304,6 +304,15 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
     let segments: Vec<&str> = key.split('.').collect();
     let result = if segments.iter().any(|s| s.is_empty()) {
         Err("the key must be a dotted path like scales.rows or pattern.0.kind".to_string())
+    } else if segments.len() > toml_text::TOML_NESTING_LIMIT {
+        // Each part is a level of `set_path`'s recursion and of the reader's when the
+        // preset is read back: 50,000 parts overflowed the stack (an abort, exit 134).
+        Err(format!(
+            "the key has {} dotted parts; keys nest at most {} deep (a preset's keys have a few, like \
+             body.head_mark.0.color)",
+            segments.len(),
+            toml_text::TOML_NESTING_LIMIT
+        ))
     } else if let Err(message) = check_indices(root, &segments) {
         Err(message)
     } else {
