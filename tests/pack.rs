@@ -124,10 +124,22 @@ fn ao_fills_the_occlusion_channel_and_only_when_asked() {
     // fraction of a scale's width): at 256 wide, about 2 % of the pixels below 250/255.
     let occluded = ao.iter().filter(|&&v| v < 250).count() as f64 / ao.len() as f64;
     assert!(occluded > 0.005, "hardly any occlusion: {occluded}");
+    // The manifest says which the channel holds (before, the two manifests differed in a
+    // hash only, and both said "1 everywhere without --ao").
+    let occlusion_meaning = |set: &Path, file: &str| -> String {
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(set.join(format!("{name}.material.json"))).unwrap()).unwrap();
+        let entry = manifest["maps"].as_array().unwrap().iter().find(|m| m["map"] == file).unwrap();
+        entry["meaning"].as_str().unwrap().to_string()
+    };
     for (pack, file, c) in [("gltf", "orm", 0), ("unreal", "orm", 0), ("unity-hdrp", "mask", 1)] {
         let out = dir.path().join(pack);
         generate_at(&out, name, "256", &["--pack", pack, "--ao"]);
         assert_eq!(channel(&read(&out, &format!("{name}_{file}.png")), c), ao, "{pack} occlusion");
+        assert!(occlusion_meaning(&out, file).contains("ambient occlusion from the height map"), "{pack}");
+        let without = dir.path().join(format!("{pack}-without"));
+        generate_at(&without, name, "64", &["--pack", pack]);
+        assert!(occlusion_meaning(&without, file).contains("occlusion, 1 everywhere (not computed"), "{pack}");
     }
     // "all" is the five maps of every set: no ambient occlusion unless named.
     let all = dir.path().join("all");

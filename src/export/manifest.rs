@@ -129,7 +129,7 @@ impl MapEntry {
             color_space: if spec.srgb { "srgb" } else { "linear" }.into(),
             channels: spec.channels.len() as u32,
             bit_depth: spec.bit_depth,
-            meaning: spec.meaning.into(),
+            meaning: spec.meaning.clone(),
             sha256,
         }
     }

@@ -57,7 +57,7 @@ pub struct TextureSpec {
     /// True for colour (sRGB) textures; data textures are linear.
     pub srgb: bool,
     /// What each channel holds, in the engine's own words (the manifest and the README).
-    pub meaning: &'static str,
+    pub meaning: String,
 }
 
 /// The engines a set can be packed for (`generate --pack`).
@@ -111,12 +111,19 @@ impl Pack {
     /// ambient occlusion map (`ops::occlusion`) or 1 everywhere.
     pub fn textures(self, film: bool, ao: bool) -> Vec<TextureSpec> {
         let occlusion = if ao { OCCLUSION } else { NO_OCCLUSION };
+        // Whether the occlusion channel was computed, so that an importer knows whether to
+        // wire it (the two manifests differed only in a hash).
+        let occlusion_words = if ao {
+            "ambient occlusion from the height map (1 = open)"
+        } else {
+            "occlusion, 1 everywhere (not computed: no --ao)"
+        };
         let base_color = TextureSpec {
             suffix: "basecolor",
             channels: RGB_SRGB.to_vec(),
             bit_depth: 8,
             srgb: true,
-            meaning: "RGB: visible diffuse colour (the manifest's color_means), sRGB",
+            meaning: "RGB: visible diffuse colour (the manifest's color_means), sRGB".into(),
         };
         // glTF, Unreal and HDRP all take the thickness as a [0, 1] value remapped to a
         // range in nm given with the material (glTF: iridescenceThicknessMinimum/Maximum,
@@ -126,14 +133,16 @@ impl Pack {
             channels: vec![THICKNESS],
             bit_depth: 8,
             srgb: false,
-            meaning: "grey: film thickness, min_nm + value * (max_nm - min_nm) (the manifest's iridescence range)",
+            meaning: "grey: film thickness, min_nm + value * (max_nm - min_nm) (the manifest's iridescence range)"
+                .into(),
         };
         let height = TextureSpec {
             suffix: "height",
             channels: vec![HEIGHT],
             bit_depth: 16,
             srgb: false,
-            meaning: "grey: relative surface height on the preset's fixed scale, as the height map (displacement or parallax)",
+            meaning: "grey: relative surface height on the preset's fixed scale, as the height map (displacement or parallax)"
+                .into(),
         };
         let mut textures = match self {
             Pack::Gltf => vec![
@@ -143,14 +152,15 @@ impl Pack {
                     channels: NORMAL_OPENGL.to_vec(),
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as glTF requires",
+                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as glTF requires"
+                        .into(),
                 },
                 TextureSpec {
                     suffix: "orm",
                     channels: vec![occlusion, ROUGHNESS, NOT_METALLIC],
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "R: occlusion (1 = open; 1 everywhere without --ao), G: perceptual roughness, B: metallic (0)",
+                    meaning: format!("R: {occlusion_words}, G: perceptual roughness, B: metallic (0)"),
                 },
             ],
             Pack::Unreal => vec![
@@ -160,14 +170,15 @@ impl Pack {
                     channels: NORMAL_DIRECTX.to_vec(),
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, DirectX convention (+Y down, green flipped)",
+                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, DirectX convention (+Y down, green flipped)"
+                        .into(),
                 },
                 TextureSpec {
                     suffix: "orm",
                     channels: vec![occlusion, ROUGHNESS, NOT_METALLIC],
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "R: ambient occlusion (1 = open; 1 everywhere without --ao), G: roughness, B: metallic (0)",
+                    meaning: format!("R: {occlusion_words}, G: roughness, B: metallic (0)"),
                 },
                 height,
             ],
@@ -178,7 +189,8 @@ impl Pack {
                     channels: NORMAL_OPENGL.to_vec(),
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as Unity expects",
+                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as Unity expects"
+                        .into(),
                 },
                 TextureSpec {
                     suffix: "mask",
@@ -190,7 +202,9 @@ impl Pack {
                     ],
                     bit_depth: 8,
                     srgb: false,
-                    meaning: "R: metallic (0), G: ambient occlusion (1 = open; 1 everywhere without --ao), B: detail mask (0), A: smoothness = 1 - roughness",
+                    meaning: format!(
+                        "R: metallic (0), G: {occlusion_words}, B: detail mask (0), A: smoothness = 1 - roughness"
+                    ),
                 },
                 height,
             ],
