@@ -411,6 +411,15 @@ pub fn index_file_name(shard: Shard) -> String {
     }
 }
 
+/// Whether `name` is the name of an index file of some shard (`index_file_name`).
+fn is_index_file_name(name: &str) -> bool {
+    let shard = name.strip_prefix("index.shard-").and_then(|rest| rest.strip_suffix(".json"));
+    name == "index.json"
+        || shard
+            .and_then(|s| s.split_once("-of-"))
+            .is_some_and(|(k, n)| k.parse::<usize>().is_ok() && n.parse::<usize>().is_ok())
+}
+
 /// True when `manifest` records `key` and its set is complete: every file it lists has the
 /// SHA-256 it records, and it lists exactly the files the job writes (`expected`, which
 /// holds the manifest's own name too). A manifest that lost a map's entry along with the map
@@ -502,6 +511,22 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
     let mut resolved: Vec<Resolved> = Vec::with_capacity(jobs.len());
     for job in jobs {
         let mut r = resolve(jobs_file, job, out, shard.contains(job))?;
+        // A preset named like an index (`index.json.toml`) would put its sets in the folder
+        // the run's index is written to: found before any job runs, not after all of them.
+        let top = r.outcome.folder.components().next().map(|c| c.as_os_str().to_string_lossy().into_owned());
+        if let Some(top) = top.filter(|top| is_index_file_name(top)) {
+            return Err(BatchError::Invalid {
+                path: jobs_file.into(),
+                line: job.lines.preset,
+                job: job.table,
+                preset: r.outcome.preset,
+                message: format!(
+                    "its sets would go in the folder {top}, a name the batch keeps for its index \
+                     (index.json, index.shard-K-of-N.json); rename the preset file"
+                ),
+            }
+            .into());
+        }
         if let Some(&earlier) = first_in.get(&r.outcome.folder) {
             let first = &resolved[earlier].outcome;
             if first.key != r.outcome.key {

@@ -364,6 +364,19 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
         );
     }
     assert!(!empty.exists());
+
+    // A preset named like the index would put its sets where the index goes: refused before
+    // any job runs (before, every job ran and the index then failed, "a folder is in the way").
+    for name in ["index.json", "index.shard-0-of-2.json"] {
+        std::fs::write(dir.path().join(format!("{name}.toml")), &preset).unwrap();
+        std::fs::write(&jobs, format!("[[job]]\nsizes = [32]\npreset = \"{name}.toml\"\n")).unwrap();
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        let expected =
+            format!("jobs.toml:3: job 1 ({name}): its sets would go in the folder {name}, a name the batch keeps");
+        assert!(stderr(&out).contains(&expected), "{}", stderr(&out));
+        assert!(!empty.exists());
+    }
 }
 
 #[test]
