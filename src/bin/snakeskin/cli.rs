@@ -57,10 +57,10 @@ pub enum Command {
         /// Output PNG file.
         #[arg(short, long)]
         out: PathBuf,
-        /// Tile size in pixels.
+        /// Tile size in pixels, 16 to 2048.
         #[arg(long, default_value_t = 256, value_parser = ranged_u64(16, 2048))]
         tile: u64,
-        /// Tiles per row.
+        /// Tiles per row, 1 to 64.
         #[arg(long, default_value_t = 6, value_parser = ranged_u64(1, 64))]
         columns: u64,
         /// Also write one close-up per capability of the skin vocabulary into this folder: a
@@ -83,10 +83,10 @@ pub enum Command {
         /// Output folder.
         #[arg(short, long, default_value = "docs/figures", value_name = "DIR")]
         out: PathBuf,
-        /// Image size WIDTHxHEIGHT.
+        /// Image size WIDTHxHEIGHT (or one number for a square), each 16 to 8192 pixels.
         #[arg(long, default_value = "640x400", value_parser = parse_image_size)]
         size: ImageSize,
-        /// Map resolution for the preview (pixels per side).
+        /// Map resolution for the preview (pixels per side), 64 to 4096.
         #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
         map_size: u64,
     },
@@ -98,13 +98,13 @@ pub enum Command {
         out: PathBuf,
         /// Tile size in pixels (colour map tile × tile, render 2·tile × tile; with --layout
         /// body: the strip's height, one circumference, the strip length·tile long, the
-        /// render 4·tile × 2·tile).
+        /// render 4·tile × 2·tile), 64 to 1024.
         #[arg(long, default_value_t = 224, value_parser = ranged_u32(64, 1024))]
         tile: u32,
-        /// Cells per row.
+        /// Cells per row, 1 to 8.
         #[arg(long, default_value_t = 2, value_parser = ranged_u32(1, 8))]
         columns: u32,
-        /// Map resolution per species (pixels per side; a body atlas's width).
+        /// Map resolution per species (pixels per side; a body atlas's width), 64 to 4096.
         #[arg(long, default_value_t = 512, value_parser = ranged_u64(64, 4096))]
         map_size: u64,
         /// tile: each species' tile and a render; body: each species' whole body atlas on
@@ -277,8 +277,8 @@ pub struct ExportArgs {
     /// with a film, NAME.thickness.png beside it).
     #[arg(long, value_name = "FILE")]
     pub gltf: PathBuf,
-    /// Texture width in pixels (a body atlas is `body.length` widths tall; WebGL viewers
-    /// commonly load textures up to 16384 texels a side).
+    /// Texture width in pixels, 16 to 16384 (a body atlas is `body.length` widths tall;
+    /// WebGL viewers commonly load textures up to 16384 texels a side).
     #[arg(long, default_value_t = 1024, value_parser = ranged_u64(16, 16384))]
     pub size: u64,
     /// snake (the preview's body), sphere (the material alone, tile layout) or plane.
@@ -375,7 +375,7 @@ pub struct PreviewArgs {
     // Not with --out or --reference: the window wrote neither, silently.
     #[arg(long, conflicts_with_all = ["out", "reference"])]
     pub window: bool,
-    /// Image or window size WIDTHxHEIGHT.
+    /// Image or window size WIDTHxHEIGHT (or one number for a square), each 16 to 8192 pixels.
     #[arg(long, default_value = "1280x720", value_parser = parse_image_size)]
     pub size: ImageSize,
     /// What to show: a layer stage (diffuse, normal, film, all; thesis Fig. 5.12) or one map
@@ -393,7 +393,7 @@ pub struct PreviewArgs {
     #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
     /// Map resolution for the preview (pixels per side; a body atlas's width, narrowed
-    /// if it would be more than 8192 rows long).
+    /// if it would be more than 8192 rows long), 64 to 4096.
     #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
     pub map_size: u64,
     /// tile (the default: the tile repeated along the body) or body (a body atlas on the
@@ -413,7 +413,7 @@ pub struct PreviewArgs {
     /// Exposure multiplier before tone mapping (Khronos PBR Neutral), 1e-6 to 1000.
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     pub exposure: f32,
-    /// Number of snakes (instanced in a grid).
+    /// Number of snakes (instanced in a grid), 1 to 400.
     #[arg(long, default_value_t = 1, value_parser = ranged_u32(1, 400))]
     pub snakes: u32,
     /// Hide the ground plane.
@@ -521,7 +521,7 @@ pub enum BrdfCommand {
     Film {
         #[command(flatten)]
         stack: StackArgs,
-        /// Film thickness in nm (thesis δ0), 0 to 10^7.
+        /// Film thickness in nm (thesis δ0), 0 to 10,000,000 (10 mm).
         #[arg(long, required_unless_present = "batch")]
         thickness_nm: Option<f64>,
         /// Vacuum wavelength in nm, 1 to 10^6.
@@ -542,7 +542,7 @@ pub enum BrdfCommand {
     Color {
         #[command(flatten)]
         stack: StackArgs,
-        /// Film thickness in nm (thesis δ0), 0 to 10^7.
+        /// Film thickness in nm (thesis δ0), 0 to 10,000,000 (10 mm).
         #[arg(long, required_unless_present = "batch")]
         thickness_nm: Option<f64>,
         /// Angle of light and view from the normal in the ambient medium, degrees, 0 to 90.
@@ -578,9 +578,10 @@ pub enum BrdfCommand {
         /// Colour method (spectral = the 1 nm reference).
         #[arg(long, default_value = "spectral", value_parser = parse_method)]
         method: Method,
-        /// Chart width (thickness samples) and height (angle samples) in pixels, 2 to 4096.
+        /// Chart width in pixels (thickness samples), 2 to 4096.
         #[arg(long, default_value_t = 800, value_parser = ranged_u32(2, 4096))]
         width: u32,
+        /// Chart height in pixels (angle samples), 2 to 4096.
         #[arg(long, default_value_t = 300, value_parser = ranged_u32(2, 4096))]
         height: u32,
     },
@@ -627,7 +628,7 @@ pub struct EvalArgs {
 /// The layer parameters `brdf eval` and `brdf albedo` share.
 #[derive(Debug, Args)]
 pub struct LayerArgs {
-    /// Film thickness in nm (thesis δ0), 0 to 10^7 (10 mm).
+    /// Film thickness in nm (thesis δ0), 0 to 10,000,000 (10 mm).
     #[arg(long, default_value_t = thesis::FILM_THICKNESS_NM, value_parser = parse_thickness_nm)]
     pub thickness_nm: f64,
     /// Perceptual roughness (GGX α = roughness²), 0 to 1.
@@ -711,18 +712,19 @@ pub enum BenchCommand {
         /// Preset to render.
         #[arg(default_value = "xenopeltis-unicolor")]
         preset: String,
-        /// Frame size WIDTHxHEIGHT (use 1920x1080 on a real GPU).
+        /// Frame size WIDTHxHEIGHT (or one number for a square), each 16 to 8192 pixels (use
+        /// 1920x1080 on a real GPU).
         #[arg(long, default_value = "1280x720", value_parser = parse_image_size)]
         size: ImageSize,
-        /// Timed frames per variant (after 3 warm-up frames); the median is reported.
+        /// Timed frames per variant, 3 to 10,000 (after 3 warm-up frames); the median is reported.
         #[arg(long, default_value_t = 30, value_parser = ranged_u64(3, 10_000))]
         frames: u64,
-        /// Map resolution (pixels per side).
+        /// Map resolution (pixels per side), 64 to 4096.
         #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
         map_size: u64,
         /// Frame size of the CPU reference comparison (the CPU shades each pixel spectrally,
         /// about 3 ms per covered pixel on two cores: minutes at the default, hours at a
-        /// full-HD frame).
+        /// full-HD frame); WIDTHxHEIGHT, each 16 to 8192 pixels.
         #[arg(long, default_value = "480x300", value_parser = parse_image_size)]
         reference_size: ImageSize,
         /// Print one JSON object.
@@ -1052,5 +1054,62 @@ mod tests {
         let cli = eval(&["--wi", "-0.5,0,1", "--wo", "0,-1,1", "--normal", "-0,0,1"]).unwrap();
         let Command::Brdf { command: BrdfCommand::Eval(args) } = cli.command else { panic!("parsed as brdf eval") };
         assert_eq!((args.wi, args.wo), ([-0.5, 0.0, 1.0], [0.0, -1.0, 1.0]));
+    }
+
+    /// Whether `parser` takes `value` (on a lone flag, so that the real flag's requirements
+    /// and conflicts do not matter).
+    fn takes(parser: &clap::builder::ValueParser, value: &str) -> bool {
+        let arg = clap::Arg::new("x").long("x").value_parser(parser.clone()).allow_negative_numbers(true);
+        clap::Command::new("t").arg(arg).try_get_matches_from(["t", "--x", value]).is_ok()
+    }
+
+    /// The `LO to HI` pairs a help text names (`16 to 16384`, `1 to 10,000`, `0.5 to 3`).
+    fn named_ranges(help: &str) -> Vec<(f64, f64)> {
+        let number =
+            |w: &str| w.trim_matches(|c: char| !c.is_ascii_digit()).replace([',', '_'], "").parse::<f64>().ok();
+        let words: Vec<&str> = help.split_whitespace().collect();
+        words.windows(3).filter(|w| w[1] == "to").filter_map(|w| Some((number(w[0])?, number(w[2])?))).collect()
+    }
+
+    /// Every flag whose values are bounded numbers says its bounds in `--help`, and they are
+    /// the ones its parser keeps: a user should not learn a range from an error. (Before,
+    /// `sheet --tile`, `gallery --columns`, `preview --snakes`, `bench render --frames` and
+    /// others kept ranges that their help did not name.)
+    #[test]
+    fn every_bounded_number_flag_names_its_range_in_help() {
+        fn check(command: &clap::Command, path: &str, problems: &mut Vec<String>) {
+            for arg in command.get_arguments().filter(|a| a.get_long().is_some() && a.get_action().takes_values()) {
+                let parser = arg.get_value_parser();
+                let numeric = ["0", "1", "2", "3", "16", "64", "1000"].iter().any(|v| takes(parser, v));
+                if !numeric || takes(parser, &u64::MAX.to_string()) {
+                    continue;
+                }
+                let help = format!(
+                    "{} {}",
+                    arg.get_help().map(|h| h.to_string()).unwrap_or_default(),
+                    arg.get_long_help().map(|h| h.to_string()).unwrap_or_default()
+                );
+                let kept = |(lo, hi): (f64, f64)| {
+                    let text = |x: f64| x.to_string();
+                    takes(parser, &text(lo))
+                        && takes(parser, &text(hi))
+                        && !takes(parser, &text(hi + 1.0))
+                        && (lo <= 0.0 || !takes(parser, &text(lo - 1.0)))
+                };
+                if !named_ranges(&help).into_iter().any(kept) {
+                    problems.push(format!("{path} --{}: {help:?}", arg.get_long().unwrap()));
+                }
+            }
+            for sub in command.get_subcommands() {
+                check(sub, &format!("{path} {}", sub.get_name()), problems);
+            }
+        }
+        let mut problems = Vec::new();
+        check(&<Cli as clap::CommandFactory>::command(), "snakeskin", &mut problems);
+        assert!(problems.is_empty(), "flags whose help does not name the range they keep:\n{}", problems.join("\n"));
+        // The check itself: a range its parser does not keep is not taken as named.
+        let tile = clap::builder::ValueParser::new(ranged_u64(16, 2048));
+        assert!(takes(&tile, "2048") && !takes(&tile, "2049") && !takes(&tile, "15"));
+        assert_eq!(named_ranges("Tile size in pixels (16 to 2048)."), [(16.0, 2048.0)]);
     }
 }
