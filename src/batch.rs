@@ -274,7 +274,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         // is a built-in preset.
         let relative = Path::new(&table.preset).is_relative().then(|| base.join(&table.preset));
         let preset = match relative {
-            Some(path) if crate::preset::names_a_file(&path) => path.to_string_lossy().into_owned(),
+            Some(path) if crate::preset::names_a_file(&table.preset, &path) => path.to_string_lossy().into_owned(),
             _ => table.preset.clone(),
         };
         let maps = match &table.maps {

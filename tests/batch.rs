@@ -292,6 +292,27 @@ fn a_folder_named_like_a_preset_is_not_read_as_one() {
     }
 }
 
+/// A file named like a built-in (here a gallery PNG written as `-o natrix-natrix`) does not
+/// replace the built-in, for `generate` in the working folder nor for a jobs file beside it:
+/// before, it was read instead ("not UTF-8 text"; a text file, silently). `./NAME` reads it.
+#[test]
+fn a_file_named_like_a_built_in_preset_does_not_replace_it() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("natrix-natrix"), b"\x89PNG not a preset").unwrap();
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_snakeskin")).args(args).current_dir(dir.path()).output().unwrap()
+    };
+    let out = run(&["generate", "natrix-natrix", "-o", "out", "--size", "16"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.path().join("out/natrix-natrix.material.json").exists());
+    let out = run(&["generate", "./natrix-natrix", "-o", "out", "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2), "./NAME reads the file: {}", stderr(&out));
+    assert!(stderr(&out).contains("./natrix-natrix"), "{}", stderr(&out));
+    std::fs::write(dir.path().join("jobs.toml"), "[[job]]\npreset = \"natrix-natrix\"\nsizes = [16]\n").unwrap();
+    let out = run(&["batch", "jobs.toml", "-o", "batch"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 #[test]
 fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     let dir = tempfile::tempdir().unwrap();

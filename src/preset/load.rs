@@ -59,18 +59,23 @@ impl LoadedPreset {
 /// far beyond any real preset and bounds what `generate /dev/zero`-like input can cost.
 pub const MAX_PRESET_BYTES: u64 = 1 << 20;
 
-/// Whether a preset argument names a file rather than a built-in preset: a name ending in
-/// `.toml`, or anything but a folder that exists there. A folder never is: a set's folder
-/// is named after its preset, so `generate natrix-natrix -o natrix-natrix` run twice (and a
-/// batch whose jobs file lies in its output folder) read the folder as the preset.
-pub fn names_a_file(path: &Path) -> bool {
-    path.to_string_lossy().ends_with(".toml") || std::fs::metadata(path).is_ok_and(|m| !m.is_dir())
+/// Whether a preset argument, as `written`, names the file at `path` (the argument itself,
+/// or a jobs file's entry joined to its folder) rather than a built-in preset: a name ending
+/// in `.toml`, or anything but a folder that exists there — but never a built-in preset's
+/// exact name, which is the built-in wherever it is written (`./NAME` names a file of that
+/// name). A folder never is: a set's folder is named after its preset, so `generate
+/// natrix-natrix -o natrix-natrix` run twice (and a batch whose jobs file lies in its
+/// output folder) read the folder as the preset; and a file named like a built-in (a
+/// gallery written as `-o natrix-natrix`) was read, silently, instead of the built-in.
+pub fn names_a_file(written: &str, path: &Path) -> bool {
+    library::get(written).is_none()
+        && (path.to_string_lossy().ends_with(".toml") || std::fs::metadata(path).is_ok_and(|m| !m.is_dir()))
 }
 
 /// Resolves a PRESET argument: a file (`names_a_file`), or else a built-in preset name.
 pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
-    if names_a_file(path) {
+    if names_a_file(spec, path) {
         // A newline or an escape in the name would go into the set's file names and break
         // every listing and script that reads them (`--set` refuses the same).
         if path.file_stem().is_some_and(|s| s.to_string_lossy().chars().any(char::is_control)) {

@@ -203,7 +203,8 @@ fn negative_numbers_as_values(command: clap::Command) -> clap::Command {
 /// Which preset, with which edits: shared by every command that reads one.
 #[derive(Debug, Args)]
 pub struct PresetSource {
-    /// A preset: a path to a .toml file, or a built-in name (see `snakeskin presets list`).
+    /// A preset: a path to a .toml file, or a built-in name (see `snakeskin presets list`; a
+    /// built-in name is the built-in even beside a file of that name: `./NAME` reads the file).
     pub preset: String,
     /// Override a preset key by dotted path, e.g. `--set scales.rows=23 --set pattern.0.kind=spots`.
     /// VALUE is parsed as TOML; a bare word that is not valid TOML is taken as a string.
