@@ -284,3 +284,28 @@ fn an_ambient_denser_than_the_pigment_is_warned_of() {
     ]);
     assert!(out.status.success() && !stderr(&out).contains("ambient_ior"), "{}", stderr(&out));
 }
+
+/// A film centred below half its spread: the range cannot go below 0 nm, so it starts at 0
+/// and every δ0 up to spread / 2 gives the same maps. Warned of with the key's line (before,
+/// δ0 = 0, 100 and 130 with a 260 nm spread gave identical sets without a word); not for a
+/// film centred at or above half its spread, nor for no film at all.
+#[test]
+fn a_film_centred_below_half_its_spread_is_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let warned = |thickness: &str, spread: &str| {
+        let text = format!(
+            "species = \"thin\"\n\n[optics]\nfilm_thickness_nm = {thickness}\n\n[iridescence]\nspread_nm = {spread}\n"
+        );
+        let preset = write_preset(dir.path(), "thin.toml", &text);
+        let out =
+            snakeskin(&["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "16", "--maps", "iridescence"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let err = stderr(&out);
+        err.contains("thin.toml:4: optics.film_thickness_nm").then_some(err)
+    };
+    let err = warned("100", "260").expect("warned");
+    assert!(err.contains("= 100 is below half of iridescence.spread_nm (260 / 2 = 130)"), "{err}");
+    assert!(err.contains("its range is 0-260 nm"), "{err}");
+    assert!(warned("130", "260").is_none() && warned("0", "0").is_none() && warned("400", "200").is_none());
+}

@@ -36,18 +36,19 @@ pub struct LoadedPreset {
     /// Colour keys the stack cannot show, clamped to its limit (`visible`): callers report
     /// them, the manifest lists them.
     pub clamped_colours: Vec<super::visible::ClampedColour>,
-    /// Where the layered model shows the stack darker than the physics
-    /// (`validate::model_limit`): a warning, with the key's line.
-    pub model_limit: Option<LocatedProblem>,
+    /// Keys that load but do not do what they seem (`validate::warnings`: where the layered
+    /// model shows the stack darker than the physics, a film centred below half its spread),
+    /// each with the key's line.
+    pub warned: Vec<LocatedProblem>,
 }
 
 impl LoadedPreset {
     /// The warnings every command prints for the preset (`preset`: its file or name, as
-    /// given), one line each: colours clamped to what the stack can show, and the model's
-    /// limit.
+    /// given), one line each: colours clamped to what the stack can show, and the keys
+    /// `warned` of.
     pub fn warnings(&self, preset: &str) -> Vec<String> {
         let clamped = self.clamped_colours.iter().map(|c| c.message(preset));
-        let limit = self.model_limit.iter().map(|p| {
+        let limit = self.warned.iter().map(|p| {
             let line = p.line.map(|l| format!(":{l}")).unwrap_or_default();
             format!("warning: {preset}{line}: {} = {}", p.key, p.message)
         });
@@ -206,18 +207,21 @@ pub fn parse_with_seed(
     for c in &mut clamped_colours {
         c.line = if overridden(&c.key) { None } else { key_lines.line(&c.key) };
     }
-    let model_limit = super::validate::model_limit(&preset).map(|p| LocatedProblem {
-        line: if overridden(&p.key) { None } else { key_lines.line(&p.key) },
-        key: p.key,
-        message: p.message,
-    });
+    let warned = super::validate::warnings(&preset)
+        .into_iter()
+        .map(|p| LocatedProblem {
+            line: if overridden(&p.key) { None } else { key_lines.line(&p.key) },
+            key: p.key,
+            message: p.message,
+        })
+        .collect();
     let canonical = canonical_text(&preset);
     Ok(LoadedPreset {
         name: source.name.clone(),
         preset,
         content_hash: format!("{:016x}", fnv1a64(canonical.as_bytes())),
         clamped_colours,
-        model_limit,
+        warned,
     })
 }
 

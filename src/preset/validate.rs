@@ -125,6 +125,29 @@ impl Checker {
     }
 }
 
+/// What a preset that loads does not do as its keys seem to say, one warning each: the
+/// model's limit (`model_limit`) and a film centred too thin for its spread (`film_floor`).
+pub fn warnings(preset: &Preset) -> Vec<Problem> {
+    model_limit(preset).into_iter().chain(film_floor(preset)).collect()
+}
+
+/// A film thickness below half the spread: the range cannot reach below 0 nm, so it starts
+/// at 0 (`material::thickness_range_nm`) and every δ0 up to spread / 2 gives the same maps
+/// (a user sweeping δ0 from 0 saw nothing change, and no word of why).
+fn film_floor(preset: &Preset) -> Option<Problem> {
+    let (thickness, spread) = (preset.optics.film_thickness_nm, preset.iridescence.spread_nm);
+    let (min_nm, max_nm) = crate::material::thickness_range_nm(thickness, spread);
+    (thickness < spread * 0.5).then(|| Problem {
+        key: "optics.film_thickness_nm".into(),
+        message: format!(
+            "{thickness} is below half of iridescence.spread_nm ({spread} / 2 = {}): a film cannot be thinner than \
+             0 nm, so its range is {min_nm}-{max_nm} nm, the same for any film_thickness_nm up to {}",
+            spread * 0.5,
+            spread * 0.5
+        ),
+    })
+}
+
 /// A stack the layered model shows darker than the physics: the ambient denser than the
 /// pigment layer. Beyond the critical angle asin(n2 / n0) the rough top's lobe loses light
 /// the stack reflects (a white lossless stack, `brdf albedo --absorption 0 --n1 1.55`:
@@ -132,7 +155,7 @@ impl Checker {
 /// and roughness 0.9; 0.40 at 45° for 2 over 1.33 and roughness 0.9, where the rough-top
 /// walk, `--model stochastic`, reflects 1: the physics review; BENCHMARKS.md "Stress").
 /// The physics is fine (an oil film over a lighter layer), so it is a warning, not a refusal.
-pub fn model_limit(preset: &Preset) -> Option<Problem> {
+fn model_limit(preset: &Preset) -> Option<Problem> {
     let o = &preset.optics;
     (o.ambient_ior > o.pigment_ior).then(|| Problem {
         key: "optics.ambient_ior".into(),
