@@ -57,6 +57,9 @@ pub struct GenerateReport {
     pub constant_maps: Vec<(MapKind, f32)>,
     /// The earlier set's files that went with it because this set does not write them.
     pub removed: Vec<PathBuf>,
+    /// The earlier set's files that this set does not write and that stayed (changed since,
+    /// or would not move), with why: to warn of.
+    pub kept: Vec<crate::export::KeptFile>,
 }
 
 /// The tallest map written (a body atlas is `body.length` widths tall): PNG readers and GPU
@@ -378,6 +381,7 @@ impl Plan {
             strips: strip_layout.map(|s| (s.count, s.rows, s.margin)),
             constant_maps,
             removed: lock.removed(),
+            kept: lock.kept(),
         })
     }
 }
@@ -444,6 +448,7 @@ impl Plan {
             strips: strips.map(|s| (s.count, s.rows, s.margin)),
             constant_maps: Vec::new(),
             removed: lock.removed(),
+            kept: lock.kept(),
         })
     }
 }

@@ -386,6 +386,11 @@ fn a_set_written_over_another_leaves_none_of_its_maps() {
         "{err}"
     );
     assert_eq!(err.matches("note: removed").count(), 3, "normal, roughness, iridescence: {err}");
+    // The edited map stays, and is said to (before, without a word): a warning naming it.
+    let kept_warning =
+        format!("warning: kept {}, the earlier set's file that this set does not write", edited.display());
+    assert!(err.contains(&kept_warning) && err.contains("it changed since that set wrote it"), "{err}");
+    assert_eq!(err.matches("warning: kept").count(), 1, "only the edited map (not the other sets' files): {err}");
     let set = |maps: &[&str]| -> Vec<String> {
         let mut files: Vec<String> = maps.iter().map(|m| format!("{PRESET}_{m}")).collect();
         files.push(format!("{PRESET}.material.json"));
@@ -442,6 +447,10 @@ fn a_failed_rename_or_a_kill_in_a_smaller_set_leaves_no_mixed_set_and_no_tempora
             };
             let stayed: Vec<_> = before.keys().filter(|p| p.exists() && !new_set(p)).collect();
             assert_eq!(stayed.len(), 1, "rename {at}: the one old map that would not move stays: {stayed:?}");
+            // And is said to stay, with the error (before, the run was silent about it).
+            let warning = format!("warning: kept {}, the earlier set's file", stayed[0].display());
+            assert!(stderr(&out).contains(&warning), "rename {at}: {}", stderr(&out));
+            assert!(stderr(&out).contains("it could not be removed ("), "rename {at}: {}", stderr(&out));
         } else {
             assert_eq!(out.status.code(), Some(1), "rename {at}: {}", stderr(&out));
             assert_eq!(snapshot(dir.path()), before, "rename {at}: the earlier set changed");

@@ -317,6 +317,36 @@ pub struct SetLock {
     pub created_folder: bool,
     /// The earlier set's files a commit removed (`left_over_files`), for the caller to say.
     removed: Mutex<Vec<PathBuf>>,
+    /// The earlier set's files that the new set does not write and that stayed, with why:
+    /// for the caller to warn of (they lie beside the new set under no manifest).
+    kept: Mutex<Vec<KeptFile>>,
+}
+
+/// An earlier set's file that stays beside the new set although the new set does not write
+/// it (`SetLock::kept`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeptFile {
+    pub path: PathBuf,
+    pub why: KeptBecause,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum KeptBecause {
+    /// Its bytes are no longer what the earlier manifest recorded (edited by hand: no longer
+    /// the set's to remove).
+    ChangedSince,
+    /// It would not move aside (immutable, or its folder refuses): the error.
+    WouldNotMove(String),
+}
+
+impl std::fmt::Display for KeptFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let why = match &self.why {
+            KeptBecause::ChangedSince => "it changed since that set wrote it, so it is not the set's to remove".into(),
+            KeptBecause::WouldNotMove(error) => format!("it could not be removed ({error})"),
+        };
+        write!(f, "kept {}, the earlier set's file that this set does not write: {why}", self.path.display())
+    }
 }
 
 impl SetLock {
@@ -345,6 +375,7 @@ impl SetLock {
                         _file: file,
                         created_folder,
                         removed: Mutex::new(Vec::new()),
+                        kept: Mutex::new(Vec::new()),
                     });
                 }
                 Ok(()) => continue,
@@ -368,6 +399,12 @@ impl SetLock {
     /// (`--maps color` after a full set).
     pub fn removed(&self) -> Vec<PathBuf> {
         self.removed.lock().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+
+    /// The earlier set's files that commits left in place although the new set does not
+    /// write them (changed since, or would not move), with why.
+    pub fn kept(&self) -> Vec<KeptFile> {
+        self.kept.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
 
     /// Writes one map of the set to its temporary now (step 2), so its bytes need not be
@@ -394,7 +431,7 @@ impl SetLock {
         }
         pause_hook(|| "commit".into());
         let targets: Vec<&PathBuf> = staged.iter().map(|(_, t)| t).collect();
-        let left_over = left_over_files(&manifest_target, &targets);
+        let (left_over, changed) = left_over_files(&manifest_target, &targets);
         // The old manifest first (so that from here on no old manifest names a map that may
         // change), then the old maps, then the earlier set's files the new one does not write.
         let old_first: Vec<PathBuf> = std::iter::once(&manifest_target)
@@ -402,8 +439,10 @@ impl SetLock {
             .chain(&left_over)
             .cloned()
             .collect();
-        let (written, removed) = swap_in(staged, &old_first, &left_over, Some(&manifest_target))?;
+        let (written, removed, stayed) = swap_in(staged, &old_first, &left_over, Some(&manifest_target))?;
         self.removed.lock().unwrap_or_else(|e| e.into_inner()).extend(removed);
+        let changed = changed.into_iter().map(|path| KeptFile { path, why: KeptBecause::ChangedSince });
+        self.kept.lock().unwrap_or_else(|e| e.into_inner()).extend(changed.chain(stayed));
         Ok(written)
     }
 }
@@ -414,16 +453,17 @@ impl SetLock {
 /// fails undoes what was done (`put_back`): the new files go, the old ones return. Files of
 /// `may_stay` that will not move aside are left where they are (their place is not needed);
 /// `manifest` is the commit record that goes back only over its own files. Returns the files
-/// written and the files of `may_stay` removed.
+/// written, the files of `may_stay` removed and those that stayed (with the error).
 fn swap_in(
     staged: Vec<(tempfile::NamedTempFile, PathBuf)>,
     old: &[PathBuf],
     may_stay: &[PathBuf],
     manifest: Option<&Path>,
-) -> Result<(Vec<PathBuf>, Vec<PathBuf>), ExportError> {
+) -> Result<(Vec<PathBuf>, Vec<PathBuf>, Vec<KeptFile>), ExportError> {
     let _commit = locked(&COMMIT);
     let mut renames = 0;
     let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
+    let mut stayed = Vec::new();
     for target in old {
         if fs::symlink_metadata(target).is_err() {
             continue;
@@ -439,7 +479,13 @@ fn swap_in(
             Ok(backup) => aside.push((backup, target.clone())),
             // An earlier set's map that the new set does not write stays if it will not move
             // (`left_over_files`): the new set does not need its place.
-            Err(_) if may_stay.contains(target) => continue,
+            Err(e) if may_stay.contains(target) => {
+                let error = match e {
+                    ExportError::Io { source, .. } => source.to_string(),
+                    other => other.to_string(),
+                };
+                stayed.push(KeptFile { path: target.clone(), why: KeptBecause::WouldNotMove(error) });
+            }
             Err(e) => {
                 put_back(aside, &[], manifest, &mut renames);
                 return Err(e);
@@ -465,7 +511,7 @@ fn swap_in(
     let removed: Vec<PathBuf> =
         aside.iter().map(|(_, target)| target.clone()).filter(|t| may_stay.contains(t)).collect();
     drop(aside);
-    Ok((written, removed))
+    Ok((written, removed, stayed))
 }
 
 /// The folder a target file is in (`.` for a bare file name).
@@ -524,17 +570,19 @@ impl FileGroup {
 /// manifest names that is not one of the set's own file names (`every_set_file_name`, in
 /// its folder): an edited manifest cannot make a commit remove another set's files or
 /// anything else. Best effort: a file that will not move aside (immutable, held open
-/// elsewhere) stays, as before such files went at all.
-fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> Vec<PathBuf> {
+/// elsewhere) stays, as before such files went at all. Returns the files to remove and the
+/// set's files that changed since (which stay, and are said: `KeptBecause::ChangedSince`).
+fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<PathBuf>) {
+    let nothing = (Vec::new(), Vec::new());
     let Some(set_name) = file_name(manifest).strip_suffix(super::manifest::MANIFEST_SUFFIX).map(String::from) else {
-        return Vec::new();
+        return nothing;
     };
     let set_files = super::every_set_file_name(&set_name);
-    let Ok(text) = fs::read(manifest) else { return Vec::new() };
-    let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return Vec::new() };
-    let Some(entries) = json["maps"].as_array() else { return Vec::new() };
+    let Ok(text) = fs::read(manifest) else { return nothing };
+    let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return nothing };
+    let Some(entries) = json["maps"].as_array() else { return nothing };
     let dir = manifest.parent().unwrap_or(Path::new("."));
-    let mut files: Vec<PathBuf> = Vec::new();
+    let (mut files, mut changed): (Vec<PathBuf>, Vec<PathBuf>) = (Vec::new(), Vec::new());
     for entry in entries {
         let (Some(file), Some(recorded)) = (entry["file"].as_str(), entry["sha256"].as_str()) else { continue };
         let path = dir.join(file);
@@ -542,13 +590,16 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> Vec<PathBuf> {
             continue;
         }
         // A regular file, not a link (never followed) or a folder.
-        if fs::symlink_metadata(&path).is_ok_and(|m| m.is_file())
-            && fs::read(&path).is_ok_and(|bytes| sha256_hex(&bytes) == recorded)
-        {
+        if !fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
+            continue;
+        }
+        if fs::read(&path).is_ok_and(|bytes| sha256_hex(&bytes) == recorded) {
             files.push(path);
+        } else if !changed.contains(&path) {
+            changed.push(path);
         }
     }
-    files
+    (files, changed)
 }
 
 /// Undoes a commit that failed: removes the new files already in place and renames the old

@@ -11,8 +11,8 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    FileGroup, SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder, ends_as_a_folder,
-    same_path, sha256_hex, write_file_atomically,
+    FileGroup, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder,
+    ends_as_a_folder, same_path, sha256_hex, write_file_atomically,
 };
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};

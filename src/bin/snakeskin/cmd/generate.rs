@@ -51,6 +51,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     for file in &report.removed {
         eprintln!("note: removed {}, the earlier set's (this set does not write it)", path_line(file));
     }
+    for kept in &report.kept {
+        eprintln!("warning: {kept}");
+    }
     for file in &report.files {
         println!("{}", path_line(file));
     }
