@@ -1154,15 +1154,32 @@ fn preview_output_names_are_checked_before_the_work() {
         (vec!["--out", &format!("{}/", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
         (vec!["--out", &format!("{}/.", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
         (vec!["--out", &same, "--reference", &format!("{}/", at("heat"))], "names a folder".into()),
+        // A PNG under another format's name (it was written so, without a word).
+        (vec!["--out", &at("render.jpg")], "give it a name ending in .png (it ends in .jpg)".into()),
+        (vec!["--out", &same, "--reference", &at("heat.exr")], "(it ends in .exr)".into()),
     ] {
         let out = preview(&extra);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
         assert!(stderr(&out).contains(&says), "{extra:?}: {}", stderr(&out));
         assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "{extra:?}: something was written");
     }
-    // Past the names, the (tiny) memory limit refuses it: nothing about the names.
-    let out = preview(&["--out", &same, "--reference", &at("heat.png")]);
-    assert!(stderr(&out).contains("needs about"), "{}", stderr(&out));
+    // Past the names, the (tiny) memory limit refuses it: nothing about the names (an
+    // upper-case extension and none at all are PNG names too).
+    for name in ["heat.png", "heat.PNG", "heat"] {
+        let out = preview(&["--out", &same, "--reference", &at(name)]);
+        assert!(stderr(&out).contains("needs about"), "{name}: {}", stderr(&out));
+    }
+    // The other image outputs hold their names to the same rule, before any work.
+    for args in [
+        vec!["brdf", "chart", "-o", &at("chart.jpg")],
+        vec!["gallery", "-o", &at("gallery.jpeg")],
+        vec!["sheet", "-o", &at("sheet.webp"), "--species", PRESET],
+    ] {
+        let out = snakeskin(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("give it a name ending in .png"), "{args:?}: {}", stderr(&out));
+    }
+    assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was written");
 }
 
 /// `sheet` checks its options, species and memory before it makes a renderer (parse, then

@@ -215,6 +215,19 @@ fn without_temporary_path(e: std::io::Error) -> std::io::Error {
 /// or a socket with the output, where the user meant to write through it
 /// (`ExportError::NotAFile`).
 /// Public so that a command can check an output file before the work that makes it.
+/// `check_target` for an output written as a PNG image (a render, a sheet, a gallery, a
+/// chart): a name with another extension (`.jpg`, `.exr`) is refused; one without an
+/// extension is taken as it is.
+pub fn check_png_target(target: &Path) -> Result<(), ExportError> {
+    check_target(target)?;
+    match target.extension().map(|e| e.to_string_lossy()) {
+        Some(extension) if !extension.eq_ignore_ascii_case("png") => {
+            Err(ExportError::NotPngName { path: target.into(), extension: extension.into_owned() })
+        }
+        _ => Ok(()),
+    }
+}
+
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
     if ends_as_a_folder(target) {
         return Err(ExportError::FolderName { path: target.into() });

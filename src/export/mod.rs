@@ -11,8 +11,8 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    FileGroup, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_target, clean_up_before_exit, create_folder,
-    ends_as_a_folder, same_path, sha256_hex, write_file_atomically,
+    FileGroup, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_png_target, check_target,
+    clean_up_before_exit, create_folder, ends_as_a_folder, same_path, sha256_hex, write_file_atomically,
 };
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
@@ -43,6 +43,10 @@ pub enum ExportError {
     /// to after the work and failed with "Not a directory".
     #[error("{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.png")]
     FolderName { path: PathBuf },
+    /// An image output named for another format (`preview --out x.jpg`): it was written as
+    /// a PNG under that name, without a word.
+    #[error("{path}: this output is written as a PNG; give it a name ending in .png (it ends in .{extension})")]
+    NotPngName { path: PathBuf, extension: String },
     #[error(
         "{path} is {kind}, not a regular file: snakeskin writes an output whole and renames it over the old one, \
          which would replace it; give the path of a regular file (or of none)"
@@ -80,6 +84,7 @@ impl ExportError {
                 | ExportError::NotAFile { .. }
                 | ExportError::FolderInTheWay { .. }
                 | ExportError::FolderName { .. }
+                | ExportError::NotPngName { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
         )
@@ -272,6 +277,21 @@ pub fn encode_quantized(q: &Quantized) -> Result<Vec<u8>, ExportError> {
     Ok(out)
 }
 
+/// Encodes an 8-bit RGB image for the eye (a render, a sheet, a figure: `rgb`, rows top
+/// first) as PNG bytes, tagged sRGB as the colour maps are, so that a reader that honours
+/// tags shows every image snakeskin writes alike (the renders were written untagged by
+/// the `image` crate). Balanced compression, the `image` crate's default before: these
+/// files are kept (docs/), so the smaller file is worth the time.
+pub fn encode_srgb_image_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    let mut encoder = png_file_encoder(&mut out, width as usize, height as usize, 3, 8, true);
+    encoder.set_compression(png::Compression::Balanced);
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(rgb).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())?;
+    Ok(out)
+}
+
 /// Encodes one map as PNG bytes.
 pub fn encode_png(map: MapKind, image: &Image) -> Result<Vec<u8>, ExportError> {
     encode_quantized(&quantize(map, image))
@@ -309,9 +329,8 @@ fn png_encoder<W: std::io::Write>(out: W, map: MapKind, width: usize, height: us
     png_file_encoder(out, width, height, format.channels as usize, format.bit_depth, format.encoding == Encoding::Srgb)
 }
 
-/// The PNG encoder of every map and packed texture (the renderer's images, figures and
-/// sheets are written by the `image` crate, untagged, as screenshots are). Colour
-/// is tagged sRGB (the `sRGB` chunk), so a reader that honours tags shows it as written;
+/// The PNG encoder of every map, packed texture and image (`encode_srgb_image_png`: renders,
+/// figures, sheets). Colour is tagged sRGB (the `sRGB` chunk), so a reader that honours tags shows it as written;
 /// data (height, normal, roughness, thickness, masks) carries no tag, as engines expect of
 /// non-colour textures (PNG has no "data" tag: a `gAMA` of 1.0 would make a viewer that
 /// honours it brighten a normal map on screen), and the manifest names its colour space.

@@ -24,13 +24,11 @@ pub fn write_rgb_png(path: &Path, image: &image::RgbImage) -> Result<PathBuf, Er
     Ok(write_file_atomically(path, png_bytes(image)?)?)
 }
 
-/// An RGB image as PNG bytes. An encoder failure is ours, not the user's.
-fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>, Error> {
-    let mut bytes = Vec::new();
-    image
-        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
-    Ok(bytes)
+/// An RGB image as PNG bytes, tagged sRGB (`export::encode_srgb_image_png`). An encoder
+/// failure is ours, not the user's.
+pub(crate) fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>, Error> {
+    crate::export::encode_srgb_image_png(image.width(), image.height(), image.as_raw())
+        .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))
 }
 
 /// One documentation figure: its file name, what it shows, and the overrides it needs.
@@ -129,4 +127,20 @@ pub fn write_figures(
     let written = group.commit()?;
     progress(figures.len(), figures.len());
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    /// Renders, figures and sheets are tagged sRGB like the colour maps (they were untagged),
+    /// and read back as the pixels written.
+    #[test]
+    fn an_image_for_the_eye_is_a_tagged_srgb_png_of_its_pixels() {
+        let image = image::RgbImage::from_fn(5, 3, |x, y| image::Rgb([x as u8 * 50, y as u8 * 80, 7]));
+        let bytes = super::png_bytes(&image).unwrap();
+        let decoder = png::Decoder::new(std::io::Cursor::new(&bytes));
+        let reader = decoder.read_info().unwrap();
+        assert!(reader.info().srgb.is_some(), "no sRGB chunk");
+        let back = image::load_from_memory(&bytes).unwrap().into_rgb8();
+        assert_eq!(back, image);
+    }
 }

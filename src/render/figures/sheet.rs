@@ -366,11 +366,7 @@ pub fn write_sheet(
     progress: &dyn Fn(usize, usize),
 ) -> Result<PathBuf, Error> {
     let sheet = render_sheet(renderer, plan, progress)?;
-    let mut bytes = Vec::new();
-    sheet
-        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
-    Ok(write_file_atomically(path, bytes)?)
+    Ok(write_file_atomically(path, super::png_bytes(&sheet)?)?)
 }
 
 #[cfg(test)]

@@ -241,7 +241,7 @@ pub fn run(command: BrdfCommand) -> Result<()> {
         BrdfCommand::Chart { stack, out, method, width, height } => {
             let stack = stack_of(&stack);
             check(stack, 0.0, 0.0, None)?;
-            snakeskin::export::check_target(&out)?;
+            snakeskin::export::check_png_target(&out)?;
             let bytes = snakeskin::optics::query::chart_bytes(width as usize, height as usize);
             snakeskin::memory::MemoryCheck::against_available(bytes)
                 .refuse_if_over(&format!("a film colour chart of {width}×{height} pixels"))?;

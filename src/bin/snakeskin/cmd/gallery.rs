@@ -12,7 +12,7 @@ use crate::output::{ensure_folder, ensure_parent_folder, path_line};
 /// names are checked before any folder is made; the files appear together (`gallery::write`).
 pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> Result<()> {
     snakeskin::render::figures::gallery::check_memory(tile, columns)?;
-    snakeskin::export::check_target(out)?;
+    snakeskin::export::check_png_target(out)?;
     if let Some(dir) = closeups
         && snakeskin::export::same_path(dir, out)
     {

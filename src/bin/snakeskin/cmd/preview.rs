@@ -49,7 +49,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     // Names, then memory, then the GPU's limits, then folders: a refused run makes none
     // (`ensure_parent_folder` checks the names again, where other commands rely on it).
     for file in std::iter::once(out).chain(args.reference.as_deref()) {
-        snakeskin::export::check_target(file)?;
+        snakeskin::export::check_png_target(file)?;
     }
     let frame_bytes = frame_bytes(width, height) + args.reference.as_ref().map_or(0, |_| gbuffer_bytes(width, height));
     let layout = args.layout.layout();

@@ -12,6 +12,7 @@ use snakeskin::render::figures::sheet::{SheetOptions, plan_sheet, write_sheet};
 pub fn run(out: &Path, options: SheetOptions, layout: snakeskin::maps::Layout, species: &[String]) -> Result<()> {
     // Options, species and memory first: a wrong name is not a GPU's error.
     let plan = plan_sheet(options, layout, species)?;
+    snakeskin::export::check_png_target(out)?;
     ensure_parent_folder(out)?;
     let renderer = Renderer::headless()?;
     let bar = Progress::counting("{spinner} sheet [{bar:30}] {pos}/{len} species {elapsed}");
