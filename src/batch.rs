@@ -124,6 +124,8 @@ struct JobTable {
     maps: Option<String>,
     format: Option<String>,
     pack: Option<String>,
+    /// With `pack`: the ambient occlusion map in the pack's occlusion channel (`--ao`).
+    ao: Option<bool>,
     layout: Option<String>,
     /// `--set` overrides: dotted key to TOML value.
     #[serde(default)]
@@ -155,6 +157,8 @@ pub struct Job {
     pub maps: Vec<MapKind>,
     pub format: FileFormat,
     pub pack: Option<Pack>,
+    /// With a pack: its occlusion channel holds the ambient occlusion map (`generate --ao`).
+    pub ao: bool,
     pub layout: Layout,
 }
 
@@ -168,6 +172,7 @@ impl Job {
     /// their overrides must not share a folder).
     pub fn folder(&self, preset_name: &str, seed: u64) -> PathBuf {
         let what = match self.pack {
+            Some(p) if self.ao => format!("pack-{}-ao", p.name()),
             Some(p) => format!("pack-{}", p.name()),
             None => self.format.name().to_string(),
         };
@@ -187,7 +192,7 @@ impl Job {
     /// The job's key: what its output bytes depend on (the preset's content and seed, the
     /// overrides, the options and the generator's version).
     pub fn key(&self, preset_hash: &str, seed: u64) -> String {
-        let description = serde_json::json!({
+        let mut description = serde_json::json!({
             "generator_version": env!("CARGO_PKG_VERSION"),
             "preset_hash": preset_hash,
             "overrides": self.overrides,
@@ -198,6 +203,10 @@ impl Job {
             "pack": self.pack.map(|p| p.name()),
             "layout": self.layout.name(),
         });
+        // Only when asked for: the keys of jobs written before `ao` existed stay theirs.
+        if self.ao {
+            description["ao"] = true.into();
+        }
         sha256_hex(description.to_string().as_bytes())
     }
 }
@@ -299,6 +308,15 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                 "pack: a pack writes its own textures as PNG; leave out maps and format, or pack".into(),
             ));
         }
+        // `--ao` means the pack's occlusion channel; without a pack the map is named.
+        let ao = table.ao.unwrap_or(false);
+        if ao && pack.is_none() {
+            return Err(invalid(
+                "ao",
+                "ao: the occlusion channel of a pack (with pack = ...); without a pack, name the map: maps = \"all,ao\""
+                    .into(),
+            ));
+        }
         let layout = match table.layout.as_deref() {
             None | Some("tile") => Layout::Tile,
             Some("body") => Layout::Body,
@@ -332,6 +350,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                     maps: maps.clone(),
                     format,
                     pack,
+                    ao,
                     layout,
                 });
             }
@@ -580,7 +599,7 @@ fn request(job: &Job, out: &Path, outcome: &JobOutcome) -> GenerateRequest {
         options: BuildOptions { layout: job.layout, ..BuildOptions::default() },
         format: job.format,
         pack: job.pack,
-        ao: false,
+        ao: job.ao,
         job: Some(outcome.key.clone()),
     }
 }

@@ -313,6 +313,36 @@ fn a_file_named_like_a_built_in_preset_does_not_replace_it() {
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
+/// `ao = true` with a pack puts the ambient occlusion map in the pack's occlusion channel,
+/// in a folder of its own, with the same bytes as `generate --pack gltf --ao` (a batch had
+/// no way to ask for it); without a pack it is refused with the way to name the map.
+#[test]
+fn a_pack_job_can_ask_for_ambient_occlusion() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    let job = |extra: &str| format!("[[job]]\npreset = \"crotalus-atrox\"\nsizes = [64]\nseeds = [3]\n{extra}");
+    std::fs::write(&jobs, format!("{}\n{}", job("pack = \"gltf\"\nao = true\n"), job("pack = \"gltf\"\n"))).unwrap();
+    let out_dir = dir.path().join("out");
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let with = out_dir.join("crotalus-atrox/tile-64-seed3-pack-gltf-ao/crotalus-atrox_orm.png");
+    let without = out_dir.join("crotalus-atrox/tile-64-seed3-pack-gltf/crotalus-atrox_orm.png");
+    let direct = dir.path().join("direct");
+    let args = ["generate", "crotalus-atrox", "--size", "64", "--seed", "3", "--pack", "gltf", "--ao", "-o"];
+    assert!(snakeskin(&[&args[..], &[direct.to_str().unwrap()]].concat()).status.success());
+    let orm = |path: &Path| image::open(path).unwrap().into_rgb8();
+    assert_eq!(orm(&with), orm(&direct.join("crotalus-atrox_orm.png")), "the batch's pack is generate's");
+    assert_ne!(orm(&with), orm(&without), "the occlusion channel holds the map, not 1");
+    std::fs::write(&jobs, job("ao = true\n")).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("jobs.toml:5: job 1 (crotalus-atrox): ao: the occlusion channel of a pack"),
+        "{}",
+        stderr(&out)
+    );
+}
+
 #[test]
 fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     let dir = tempfile::tempdir().unwrap();
