@@ -299,8 +299,9 @@ pub struct ExportArgs {
 pub struct BatchArgs {
     /// The jobs file: [[job]] tables with `preset` (a built-in name or a .toml path relative
     /// to the jobs file) and optional `seeds = [..]`, `sizes = [..]`, `maps = "color,normal"`,
-    /// `format = "png"|"exr"`, `pack = "gltf"|"unreal"|"unity-hdrp"` (with `ao = true`: the pack's occlusion channel computed, as --ao), `layout = "tile"|"body"`
-    /// and `set = { "scales.rows" = 23 }`. Every combination of seeds and sizes is one job.
+    /// `format = "png"|"exr"`, `pack = "gltf"|"unreal"|"unity-hdrp"` (with `ao = true`: the
+    /// pack's occlusion channel computed, as --ao), `layout = "tile"|"body"` and
+    /// `set = { "scales.rows" = 23 }`. Every combination of seeds and sizes is one job.
     #[arg(value_name = "JOBS.toml")]
     pub jobs: PathBuf,
     /// Output folder: each job writes
