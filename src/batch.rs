@@ -405,6 +405,10 @@ pub struct JobOutcome {
     /// The index of the earlier identical job, for a `duplicate`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub duplicate_of: Option<usize>,
+    /// The earlier set's files that stayed beside the job's new set (`GenerateReport::kept`):
+    /// for the caller to warn of, as `generate` does (not in the index).
+    #[serde(skip)]
+    pub kept: Vec<crate::export::KeptFile>,
 }
 
 #[derive(Debug, Serialize)]
@@ -512,6 +516,7 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         key,
         status: "to do",
         duplicate_of: None,
+        kept: Vec::new(),
     };
     let files = set_file_names(&loaded, &request(job, out, &outcome));
     let done = check && is_done(&out.join(&outcome.manifest), &outcome.key, &files);
@@ -832,7 +837,7 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
         if job.key(&loaded.content_hash, loaded.preset.seed) != outcome.key {
             return Err(BatchError::Changed { job: running.clone() }.into());
         }
-        plan.run(&|_, _| {}).map_err(failed)?;
+        outcome.kept = plan.run(&|_, _| {}).map_err(failed)?.kept;
         outcome.status = "done";
     } else {
         // A run killed after committing this set but before removing its lock file left an

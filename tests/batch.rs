@@ -343,6 +343,37 @@ fn a_pack_job_can_ask_for_ambient_occlusion() {
     );
 }
 
+/// A job rerun over its earlier set (the preset edited: its film gone, so no thickness
+/// texture) warns of the earlier set's file that stays because it was edited by hand since,
+/// as `generate` does (before, the batch said nothing and the file stayed under no manifest).
+#[test]
+fn a_batch_warns_of_an_earlier_file_that_stays() {
+    let dir = tempfile::tempdir().unwrap();
+    let preset =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/xenopeltis-unicolor.toml"))
+            .unwrap();
+    std::fs::write(dir.path().join("p.toml"), &preset).unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"p.toml\"\nsizes = [32]\nseeds = [1]\npack = \"gltf\"\n").unwrap();
+    let out_dir = dir.path().join("out");
+    let run = || snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert!(run().status.success());
+    let thickness = out_dir.join("p/tile-32-seed1-pack-gltf/p_thickness.png");
+    let mut bytes = std::fs::read(&thickness).unwrap();
+    bytes.push(0);
+    std::fs::write(&thickness, &bytes).unwrap();
+    assert!(preset.contains("\nspread_nm = 260\n") && preset.contains("\nfilm_thickness_nm = 420\n"));
+    let without_film = preset
+        .replace("\nspread_nm = 260\n", "\nspread_nm = 0\n")
+        .replace("\nfilm_thickness_nm = 420\n", "\nfilm_thickness_nm = 0\n");
+    std::fs::write(dir.path().join("p.toml"), without_film).unwrap();
+    let out = run();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let warning = format!("warning: kept {}, the earlier set's file that this set does not write", thickness.display());
+    assert!(stderr(&out).contains(&warning) && stderr(&out).contains("it changed since"), "{}", stderr(&out));
+    assert!(thickness.exists());
+}
+
 #[test]
 fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     let dir = tempfile::tempdir().unwrap();

@@ -1174,10 +1174,14 @@ fn preview_output_names_are_checked_before_the_work() {
         vec!["brdf", "chart", "-o", &at("chart.jpg")],
         vec!["gallery", "-o", &at("gallery.jpeg")],
         vec!["sheet", "-o", &at("sheet.webp"), "--species", PRESET],
+        // And the plots (SVG), before their benchmark runs.
+        vec!["bench", "layered", "--plot", &at("plot.png")],
+        vec!["bench", "irid", "--plot", &at("plot.pdf")],
     ] {
         let out = snakeskin(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains("give it a name ending in .png"), "{args:?}: {}", stderr(&out));
+        let format = if args[0] == "bench" { "svg" } else { "png" };
+        assert!(stderr(&out).contains(&format!("give it a name ending in .{format}")), "{args:?}: {}", stderr(&out));
     }
     assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was written");
 }

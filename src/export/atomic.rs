@@ -215,17 +215,23 @@ fn without_temporary_path(e: std::io::Error) -> std::io::Error {
 /// or a socket with the output, where the user meant to write through it
 /// (`ExportError::NotAFile`).
 /// Public so that a command can check an output file before the work that makes it.
-/// `check_target` for an output written as a PNG image (a render, a sheet, a gallery, a
-/// chart): a name with another extension (`.jpg`, `.exr`) is refused; one without an
-/// extension is taken as it is.
-pub fn check_png_target(target: &Path) -> Result<(), ExportError> {
+/// `check_target` for an output written in one format, `format` its extension (`png` for a
+/// render, a sheet, a gallery, a chart; `svg` for a plot): a name with another extension
+/// (`.jpg`, `.exr`) is refused (it was written in `format` under that name, without a
+/// word); one without an extension is taken as it is.
+pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), ExportError> {
     check_target(target)?;
     match target.extension().map(|e| e.to_string_lossy()) {
-        Some(extension) if !extension.eq_ignore_ascii_case("png") => {
-            Err(ExportError::NotPngName { path: target.into(), extension: extension.into_owned() })
+        Some(extension) if !extension.eq_ignore_ascii_case(format) => {
+            Err(ExportError::NamedForAnotherFormat { path: target.into(), format, extension: extension.into_owned() })
         }
         _ => Ok(()),
     }
+}
+
+/// `check_target_named` for a PNG image.
+pub fn check_png_target(target: &Path) -> Result<(), ExportError> {
+    check_target_named(target, "png")
 }
 
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
@@ -348,17 +354,24 @@ pub enum KeptBecause {
     /// Its bytes are no longer what the earlier manifest recorded (edited by hand: no longer
     /// the set's to remove).
     ChangedSince,
+    /// It could not be read to compare with the record: the error.
+    Unreadable(String),
     /// It would not move aside (immutable, or its folder refuses): the error.
     WouldNotMove(String),
 }
 
-impl std::fmt::Display for KeptFile {
+/// Why a file stayed, for a warning that names the file (escaped as the caller prints paths).
+impl std::fmt::Display for KeptBecause {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let why = match &self.why {
-            KeptBecause::ChangedSince => "it changed since that set wrote it, so it is not the set's to remove".into(),
-            KeptBecause::WouldNotMove(error) => format!("it could not be removed ({error})"),
-        };
-        write!(f, "kept {}, the earlier set's file that this set does not write: {why}", self.path.display())
+        match self {
+            KeptBecause::ChangedSince => {
+                write!(f, "it changed since that set wrote it, so it is not the set's to remove")
+            }
+            KeptBecause::Unreadable(error) => {
+                write!(f, "it could not be read to compare with that set's record ({error})")
+            }
+            KeptBecause::WouldNotMove(error) => write!(f, "it could not be removed ({error})"),
+        }
     }
 }
 
@@ -454,8 +467,7 @@ impl SetLock {
             .collect();
         let (written, removed, stayed) = swap_in(staged, &old_first, &left_over, Some(&manifest_target))?;
         self.removed.lock().unwrap_or_else(|e| e.into_inner()).extend(removed);
-        let changed = changed.into_iter().map(|path| KeptFile { path, why: KeptBecause::ChangedSince });
-        self.kept.lock().unwrap_or_else(|e| e.into_inner()).extend(changed.chain(stayed));
+        self.kept.lock().unwrap_or_else(|e| e.into_inner()).extend(changed.into_iter().chain(stayed));
         Ok(written)
     }
 }
@@ -584,8 +596,8 @@ impl FileGroup {
 /// its folder): an edited manifest cannot make a commit remove another set's files or
 /// anything else. Best effort: a file that will not move aside (immutable, held open
 /// elsewhere) stays, as before such files went at all. Returns the files to remove and the
-/// set's files that changed since (which stay, and are said: `KeptBecause::ChangedSince`).
-fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<PathBuf>) {
+/// set's files that stay because they changed since or cannot be read (to be said).
+fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<KeptFile>) {
     let nothing = (Vec::new(), Vec::new());
     let Some(set_name) = file_name(manifest).strip_suffix(super::manifest::MANIFEST_SUFFIX).map(String::from) else {
         return nothing;
@@ -595,7 +607,7 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<
     let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return nothing };
     let Some(entries) = json["maps"].as_array() else { return nothing };
     let dir = manifest.parent().unwrap_or(Path::new("."));
-    let (mut files, mut changed): (Vec<PathBuf>, Vec<PathBuf>) = (Vec::new(), Vec::new());
+    let (mut files, mut changed): (Vec<PathBuf>, Vec<KeptFile>) = (Vec::new(), Vec::new());
     for entry in entries {
         let (Some(file), Some(recorded)) = (entry["file"].as_str(), entry["sha256"].as_str()) else { continue };
         let path = dir.join(file);
@@ -606,10 +618,16 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<
         if !fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
             continue;
         }
-        if fs::read(&path).is_ok_and(|bytes| sha256_hex(&bytes) == recorded) {
-            files.push(path);
-        } else if !changed.contains(&path) {
-            changed.push(path);
+        let why = match fs::read(&path) {
+            Ok(bytes) if sha256_hex(&bytes) == recorded => {
+                files.push(path);
+                continue;
+            }
+            Ok(_) => KeptBecause::ChangedSince,
+            Err(e) => KeptBecause::Unreadable(e.to_string()),
+        };
+        if !changed.iter().any(|k| k.path == path) {
+            changed.push(KeptFile { path, why });
         }
     }
     (files, changed)

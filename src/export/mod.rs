@@ -12,7 +12,8 @@ mod srgb;
 
 pub use atomic::{
     FileGroup, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_png_target, check_target,
-    clean_up_before_exit, create_folder, ends_as_a_folder, same_path, sha256_hex, write_file_atomically,
+    check_target_named, clean_up_before_exit, create_folder, ends_as_a_folder, same_path, sha256_hex,
+    write_file_atomically,
 };
 pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
@@ -43,10 +44,10 @@ pub enum ExportError {
     /// to after the work and failed with "Not a directory".
     #[error("{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.png")]
     FolderName { path: PathBuf },
-    /// An image output named for another format (`preview --out x.jpg`): it was written as
-    /// a PNG under that name, without a word.
-    #[error("{path}: this output is written as a PNG; give it a name ending in .png (it ends in .{extension})")]
-    NotPngName { path: PathBuf, extension: String },
+    /// An output named for another format (`preview --out x.jpg`, `--plot x.png`): it was
+    /// written in its own format under that name, without a word.
+    #[error("{path}: this output is a .{format} file; give it a name ending in .{format} (it ends in .{extension})")]
+    NamedForAnotherFormat { path: PathBuf, format: &'static str, extension: String },
     #[error(
         "{path} is {kind}, not a regular file: snakeskin writes an output whole and renames it over the old one, \
          which would replace it; give the path of a regular file (or of none)"
@@ -84,7 +85,7 @@ impl ExportError {
                 | ExportError::NotAFile { .. }
                 | ExportError::FolderInTheWay { .. }
                 | ExportError::FolderName { .. }
-                | ExportError::NotPngName { .. }
+                | ExportError::NamedForAnotherFormat { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
         )

@@ -90,7 +90,9 @@ pub fn spawn_map_worker(
 fn watch_preset(spec: &str, changed: Sender<()>) -> Option<notify::RecommendedWatcher> {
     use notify::Watcher;
     let path = PathBuf::from(spec);
-    if !path.is_file() {
+    // The file the preset was read from (`preset::names_a_file`: a built-in name is the
+    // built-in even beside a file of that name, which is then not watched).
+    if !crate::preset::names_a_file(spec, &path) || !path.is_file() {
         return None;
     }
     let mut watched: Vec<PathBuf> = vec![path.clone()];

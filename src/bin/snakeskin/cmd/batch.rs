@@ -25,6 +25,9 @@ pub fn run(args: BatchArgs) -> Result<()> {
         batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut warn, &mut |done, total, outcome| {
             bar.update(done, total);
             bar.message(&format!("{} {}", outcome.status, outcome.folder.display()));
+            for kept in &outcome.kept {
+                bar.println(&format!("warning: {}", crate::output::kept_words(kept)));
+            }
         })?;
     bar.finish();
     if !had_folder && args.out.is_dir() {

@@ -43,6 +43,7 @@ fn species_colours() -> Result<Vec<[f64; 3]>> {
 
 fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<()> {
     if let Some(path) = plot {
+        snakeskin::export::check_target_named(path, "svg")?;
         ensure_parent_folder(path)?;
     }
     let colours = species_colours()?;
@@ -125,6 +126,7 @@ fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_d
         .into());
     }
     if let Some(path) = plot {
+        snakeskin::export::check_target_named(path, "svg")?;
         ensure_parent_folder(path)?;
     }
     let samples = grid(d_step_nm, angle_step_deg);

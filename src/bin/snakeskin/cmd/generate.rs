@@ -52,7 +52,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         eprintln!("note: removed {}, the earlier set's (this set does not write it)", path_line(file));
     }
     for kept in &report.kept {
-        eprintln!("warning: {kept}");
+        eprintln!("warning: {}", crate::output::kept_words(kept));
     }
     for file in &report.files {
         println!("{}", path_line(file));
