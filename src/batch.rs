@@ -60,23 +60,6 @@ pub enum BatchError {
     TooMany { path: PathBuf, count: usize, max: usize },
     #[error("invalid --shard {0:?}: expected K/N with 0 <= K < N, e.g. 0/4 (K is the array index)")]
     Shard(String),
-    /// Two different jobs whose sets would go to the same folder and overwrite each other;
-    /// `first_line`, `second_line`: their `preset` keys.
-    #[error(
-        "{path}{}: jobs {first}{} and {second} ({preset}) would both write {folder} with different output; rename \
-         one of the preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)",
-        at_line(*.second_line),
-        first_line.map(|l| format!(" (line {l})")).unwrap_or_default()
-    )]
-    SameFolder {
-        path: PathBuf,
-        first: usize,
-        first_line: Option<usize>,
-        second: usize,
-        second_line: Option<usize>,
-        preset: String,
-        folder: PathBuf,
-    },
     /// The job refused when the run was planned, before any job ran: its size (a body atlas
     /// too tall, more memory than the machine has) or its output (a folder, file or link
     /// in the way); `line`: the job's `sizes` key, else its `preset` key.
@@ -554,14 +537,20 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
         if let Some(&earlier) = first_in.get(&r.outcome.folder) {
             let first = &resolved[earlier].outcome;
             if first.key != r.outcome.key {
-                return Err(BatchError::SameFolder {
+                // Two different jobs whose sets would overwrite each other: named with both
+                // jobs' `preset` lines (this job's where the message starts).
+                let first_line = jobs[earlier].lines.preset.map(|l| format!(" (line {l})")).unwrap_or_default();
+                return Err(BatchError::Invalid {
                     path: jobs_file.into(),
-                    first: jobs[earlier].table,
-                    first_line: jobs[earlier].lines.preset,
-                    second: job.table,
-                    second_line: job.lines.preset,
+                    line: job.lines.preset,
+                    job: job.table,
                     preset: r.outcome.preset,
-                    folder: r.outcome.folder,
+                    message: format!(
+                        "would write {}, which job {}{first_line} writes with different output; rename one of the \
+                         preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)",
+                        r.outcome.folder.display(),
+                        jobs[earlier].table,
+                    ),
                 }
                 .into());
             }

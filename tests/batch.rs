@@ -439,11 +439,9 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
         let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--shard", shard]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
         // Both jobs' `preset` lines: the second where the message starts, the first in it.
-        assert!(
-            stderr(&out).contains("jobs.toml:6: jobs 1 (line 2) and 2 (snake) would both write"),
-            "{}",
-            stderr(&out)
-        );
+        let err = stderr(&out);
+        assert!(err.contains("jobs.toml:6: job 2 (snake): would write snake/tile-32-seed"), "{err}");
+        assert!(err.contains("which job 1 (line 2) writes with different output"), "{err}");
     }
     assert!(!empty.exists());
 

@@ -465,7 +465,7 @@ impl SetLock {
             .chain(&left_over)
             .cloned()
             .collect();
-        let (written, removed, stayed) = swap_in(staged, &old_first, &left_over, Some(&manifest_target))?;
+        let Swapped { written, removed, stayed } = swap_in(staged, &old_first, &left_over, Some(&manifest_target))?;
         self.removed.lock().unwrap_or_else(|e| e.into_inner()).extend(removed);
         self.kept.lock().unwrap_or_else(|e| e.into_inner()).extend(changed.into_iter().chain(stayed));
         Ok(written)
@@ -477,14 +477,13 @@ impl SetLock {
 /// staged file into place, in its order; then removes what it moved aside. A rename that
 /// fails undoes what was done (`put_back`): the new files go, the old ones return. Files of
 /// `may_stay` that will not move aside are left where they are (their place is not needed);
-/// `manifest` is the commit record that goes back only over its own files. Returns the files
-/// written, the files of `may_stay` removed and those that stayed (with the error).
+/// `manifest` is the commit record that goes back only over its own files.
 fn swap_in(
     staged: Vec<(tempfile::NamedTempFile, PathBuf)>,
     old: &[PathBuf],
     may_stay: &[PathBuf],
     manifest: Option<&Path>,
-) -> Result<(Vec<PathBuf>, Vec<PathBuf>, Vec<KeptFile>), ExportError> {
+) -> Result<Swapped, ExportError> {
     let _commit = locked(&COMMIT);
     let mut renames = 0;
     let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
@@ -536,7 +535,15 @@ fn swap_in(
     let removed: Vec<PathBuf> =
         aside.iter().map(|(_, target)| target.clone()).filter(|t| may_stay.contains(t)).collect();
     drop(aside);
-    Ok((written, removed, stayed))
+    Ok(Swapped { written, removed, stayed })
+}
+
+/// What a commit did (`swap_in`): the files written, the files of `may_stay` removed, and
+/// those of `may_stay` that stayed (with the error).
+struct Swapped {
+    written: Vec<PathBuf>,
+    removed: Vec<PathBuf>,
+    stayed: Vec<KeptFile>,
 }
 
 /// The folder a target file is in (`.` for a bare file name).
@@ -582,7 +589,7 @@ impl FileGroup {
         }
         pause_hook(|| "commit".into());
         let old: Vec<PathBuf> = self.staged.iter().map(|(_, t)| t.clone()).collect();
-        Ok(swap_in(self.staged, &old, &[], None)?.0)
+        Ok(swap_in(self.staged, &old, &[], None)?.written)
     }
 }
 
