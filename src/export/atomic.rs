@@ -215,25 +215,6 @@ fn without_temporary_path(e: std::io::Error) -> std::io::Error {
 /// or a socket with the output, where the user meant to write through it
 /// (`ExportError::NotAFile`).
 /// Public so that a command can check an output file before the work that makes it.
-/// `check_target` for an output written in one format, `format` its extension (`png` for a
-/// render, a sheet, a gallery, a chart; `svg` for a plot): a name with another extension
-/// (`.jpg`, `.exr`) is refused (it was written in `format` under that name, without a
-/// word); one without an extension is taken as it is.
-pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), ExportError> {
-    check_target(target)?;
-    match target.extension().map(|e| e.to_string_lossy()) {
-        Some(extension) if !extension.eq_ignore_ascii_case(format) => {
-            Err(ExportError::NamedForAnotherFormat { path: target.into(), format, extension: extension.into_owned() })
-        }
-        _ => Ok(()),
-    }
-}
-
-/// `check_target_named` for a PNG image.
-pub fn check_png_target(target: &Path) -> Result<(), ExportError> {
-    check_target_named(target, "png")
-}
-
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
     if ends_as_a_folder(target) {
         return Err(ExportError::FolderName { path: target.into() });
@@ -253,6 +234,25 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
         return Ok(());
     }
     Err(ExportError::NotAFile { path: target.into(), kind: crate::text_file::file_kind(&file_type) })
+}
+
+/// `check_target` for an output written in one format, `format` its extension (`png` for a
+/// render, a sheet, a gallery, a chart; `svg` for a plot): a name with another extension
+/// (`.jpg`, `.exr`) is refused (it was written in `format` under that name, without a
+/// word); one without an extension is taken as it is.
+pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), ExportError> {
+    check_target(target)?;
+    match target.extension().map(|e| e.to_string_lossy()) {
+        Some(extension) if !extension.eq_ignore_ascii_case(format) => {
+            Err(ExportError::NamedForAnotherFormat { path: target.into(), format, extension: extension.into_owned() })
+        }
+        _ => Ok(()),
+    }
+}
+
+/// `check_target_named` for a PNG image.
+pub fn check_png_target(target: &Path) -> Result<(), ExportError> {
+    check_target_named(target, "png")
 }
 
 /// Whether a path's text ends as only a folder's can: in a separator, `.` or `..` (or is

@@ -48,11 +48,11 @@ impl LoadedPreset {
     /// `warned` of.
     pub fn warnings(&self, preset: &str) -> Vec<String> {
         let clamped = self.clamped_colours.iter().map(|c| c.message(preset));
-        let limit = self.warned.iter().map(|p| {
+        let warned = self.warned.iter().map(|p| {
             let line = p.line.map(|l| format!(":{l}")).unwrap_or_default();
             format!("warning: {preset}{line}: {} = {}", p.key, p.message)
         });
-        clamped.chain(limit).collect()
+        clamped.chain(warned).collect()
     }
 }
 
