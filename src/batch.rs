@@ -518,21 +518,20 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
     let mut resolved: Vec<Resolved> = Vec::with_capacity(jobs.len());
     for job in jobs {
         let mut r = resolve(jobs_file, job, out, shard.contains(job))?;
+        // The job's folder refused, at its `preset` line.
+        let refuse = |preset: String, message: String| -> Error {
+            BatchError::Invalid { path: jobs_file.into(), line: job.lines.preset, job: job.table, preset, message }
+                .into()
+        };
         // A preset named like an index (`index.json.toml`) would put its sets in the folder
         // the run's index is written to: found before any job runs, not after all of them.
         let top = r.outcome.folder.components().next().map(|c| c.as_os_str().to_string_lossy().into_owned());
         if let Some(top) = top.filter(|top| is_index_file_name(top)) {
-            return Err(BatchError::Invalid {
-                path: jobs_file.into(),
-                line: job.lines.preset,
-                job: job.table,
-                preset: r.outcome.preset,
-                message: format!(
-                    "its sets would go in the folder {top}, a name the batch keeps for its index \
-                     (index.json, index.shard-K-of-N.json); rename the preset file"
-                ),
-            }
-            .into());
+            let message = format!(
+                "its sets would go in the folder {top}, a name the batch keeps for its index (index.json, \
+                 index.shard-K-of-N.json); rename the preset file"
+            );
+            return Err(refuse(r.outcome.preset, message));
         }
         if let Some(&earlier) = first_in.get(&r.outcome.folder) {
             let first = &resolved[earlier].outcome;
@@ -540,19 +539,13 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
                 // Two different jobs whose sets would overwrite each other: named with both
                 // jobs' `preset` lines (this job's where the message starts).
                 let first_line = jobs[earlier].lines.preset.map(|l| format!(" (line {l})")).unwrap_or_default();
-                return Err(BatchError::Invalid {
-                    path: jobs_file.into(),
-                    line: job.lines.preset,
-                    job: job.table,
-                    preset: r.outcome.preset,
-                    message: format!(
-                        "would write {}, which job {}{first_line} writes with different output; rename one of the \
-                         preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)",
-                        r.outcome.folder.display(),
-                        jobs[earlier].table,
-                    ),
-                }
-                .into());
+                let message = format!(
+                    "would write {}, which job {}{first_line} writes with different output; rename one of the preset \
+                     files (a preset's name is its file name without `.toml`; a built-in preset's, its own)",
+                    r.outcome.folder.display(),
+                    jobs[earlier].table,
+                );
+                return Err(refuse(r.outcome.preset, message));
             }
             r.outcome.status = "duplicate";
             r.outcome.duplicate_of = Some(first.index);
