@@ -271,11 +271,16 @@ pub fn encode_quantized(q: &Quantized) -> Result<Vec<u8>, ExportError> {
     // the pages are resident only as they are written, and a vector grown by doubling
     // leaves its earlier pieces in the encoder thread's allocator arena.
     let mut out = Vec::with_capacity(q.samples.len() + q.samples.len() / 64 + (1 << 16));
-    let error = |e: png::EncodingError| ExportError::Encode { map: q.map, message: e.to_string() };
-    let mut writer = png_encoder(&mut out, q.map, q.width, q.height).write_header().map_err(error)?;
-    writer.write_image_data(&q.samples).map_err(error)?;
-    writer.finish().map_err(error)?;
+    write_whole(png_encoder(&mut out, q.map, q.width, q.height), &q.samples)
+        .map_err(|e| ExportError::Encode { map: q.map, message: e.to_string() })?;
     Ok(out)
+}
+
+/// Writes a whole image's samples through `encoder`: header, data, end.
+fn write_whole<W: std::io::Write>(encoder: png::Encoder<'_, W>, samples: &[u8]) -> Result<(), png::EncodingError> {
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(samples)?;
+    writer.finish()
 }
 
 /// Encodes an 8-bit RGB image for the eye (a render, a sheet, a figure: `rgb`, rows top
@@ -287,9 +292,7 @@ pub fn encode_srgb_image_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<
     let mut out = Vec::new();
     let mut encoder = png_file_encoder(&mut out, width as usize, height as usize, 3, 8, true);
     encoder.set_compression(png::Compression::Balanced);
-    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    writer.write_image_data(rgb).map_err(|e| e.to_string())?;
-    writer.finish().map_err(|e| e.to_string())?;
+    write_whole(encoder, rgb).map_err(|e| e.to_string())?;
     Ok(out)
 }
 
@@ -330,12 +333,12 @@ fn png_encoder<W: std::io::Write>(out: W, map: MapKind, width: usize, height: us
     png_file_encoder(out, width, height, format.channels as usize, format.bit_depth, format.encoding == Encoding::Srgb)
 }
 
-/// The PNG encoder of every map, packed texture and image (`encode_srgb_image_png`: renders,
-/// figures, sheets). Colour is tagged sRGB (the `sRGB` chunk), so a reader that honours tags shows it as written;
-/// data (height, normal, roughness, thickness, masks) carries no tag, as engines expect of
-/// non-colour textures (PNG has no "data" tag: a `gAMA` of 1.0 would make a viewer that
-/// honours it brighten a normal map on screen), and the manifest names its colour space.
-/// Fast compression (fdeflate), adaptive filter. A 16-bit map's low bytes are noise to
+/// The PNG encoder of every map, packed texture and image (`encode_srgb_image_png`:
+/// renders, figures, sheets). Colour is tagged sRGB (the `sRGB` chunk), so a reader that
+/// honours tags shows it as written; data (height, normal, roughness, thickness, masks)
+/// carries no tag, as engines expect of non-colour textures (PNG has no "data" tag: a
+/// `gAMA` of 1.0 would make a viewer that honours it brighten a normal map on screen), and
+/// the manifest names its colour space. Fast compression (fdeflate), adaptive filter. A 16-bit map's low bytes are noise to
 /// deflate, so its file is about its raw size (fdeflate stores a tile's 16-bit height map
 /// uncompressed when that is smaller); zlib at level 6 would save about a tenth (a 512-wide
 /// body atlas's height map: 5.58 MB against 6.30 MB raw, measured with Python's zlib), not

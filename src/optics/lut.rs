@@ -15,8 +15,8 @@
 //! multiple-scatter lobe's normalisation on both rows, eight more evaluations of the rule
 //! each, where the thesis model makes one lookup.
 //! Baked with the table on as many cos texels (uniform in √cos, `coupling_texel_cos`), the
-//! same rows and its thickness columns, it is one trilinear lookup (`coupling_f32`; in the shader two filtered 3-D texture fetches,
-//! one per RGBA half) that interpolates between rows as the rule does; between cos texels and
+//! same rows and its thickness columns, it is one trilinear lookup (`coupling_f32`; in the
+//! shader two filtered 3-D texture fetches, one per RGBA half) that interpolates between rows as the rule does; between cos texels and
 //! thickness columns it interpolates the results where the rule interpolates the lobe and
 //! the film (`tests/brdf.rs` bounds the difference). The f32 twin and the shader read it;
 //! the f64 model evaluates the rule.

@@ -26,7 +26,7 @@ pub fn write_rgb_png(path: &Path, image: &image::RgbImage) -> Result<PathBuf, Er
 
 /// An RGB image as PNG bytes, tagged sRGB (`export::encode_srgb_image_png`). An encoder
 /// failure is ours, not the user's.
-pub(crate) fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>, Error> {
+fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>, Error> {
     crate::export::encode_srgb_image_png(image.width(), image.height(), image.as_raw())
         .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))
 }

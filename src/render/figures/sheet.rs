@@ -9,7 +9,6 @@ use font8x8::UnicodeFonts;
 use image::{Rgb, RgbImage, imageops};
 
 use crate::Error;
-use crate::export::write_file_atomically;
 use crate::graph::evaluate;
 use crate::maps::{BuildOptions, Layout, MapKind, body_plan, build_graph};
 use crate::optics::lut::Lut;
@@ -365,8 +364,7 @@ pub fn write_sheet(
     plan: &SheetPlan,
     progress: &dyn Fn(usize, usize),
 ) -> Result<PathBuf, Error> {
-    let sheet = render_sheet(renderer, plan, progress)?;
-    Ok(write_file_atomically(path, super::png_bytes(&sheet)?)?)
+    super::write_rgb_png(path, &render_sheet(renderer, plan, progress)?)
 }
 
 #[cfg(test)]
