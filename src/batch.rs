@@ -417,13 +417,20 @@ pub fn index_file_name(shard: Shard) -> String {
     }
 }
 
-/// Whether `name` is the name of an index file of some shard (`index_file_name`).
+/// Whether `name` is the name of an index file of some shard: its numbers, put back into
+/// `index_file_name` (the one place that spells the name), give `name` again.
 fn is_index_file_name(name: &str) -> bool {
-    let shard = name.strip_prefix("index.shard-").and_then(|rest| rest.strip_suffix(".json"));
-    name == "index.json"
-        || shard
-            .and_then(|s| s.split_once("-of-"))
-            .is_some_and(|(k, n)| k.parse::<usize>().is_ok() && n.parse::<usize>().is_ok())
+    let numbers: Vec<usize> = name
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|digits| !digits.is_empty())
+        .map_while(|n| n.parse().ok())
+        .collect();
+    let shard = match numbers[..] {
+        [] => Shard::ALL,
+        [index, count] => Shard { index, count },
+        _ => return false,
+    };
+    name == index_file_name(shard)
 }
 
 /// True when `manifest` records `key` and its set is complete: every file it lists has the
@@ -909,5 +916,17 @@ mod tests {
             assert!(bad.parse::<Shard>().is_err(), "{bad}");
         }
         assert_eq!("3/4".parse::<Shard>().unwrap(), Shard { index: 3, count: 4 });
+    }
+
+    #[test]
+    fn index_file_names_are_the_names_index_file_name_writes() {
+        for shard in [Shard::ALL, Shard { index: 0, count: 2 }, Shard { index: 11, count: 12 }] {
+            assert!(is_index_file_name(&index_file_name(shard)), "{shard:?}");
+        }
+        let not_written =
+            ["index.json.toml", "index.shard-1-of-2.json.toml", "index.shard-01-of-2.json", "index2.json"];
+        for name in not_written.into_iter().chain(["index.shard-0-of-1.json", "index.shard-1-2-of-3.json", "x.json"]) {
+            assert!(!is_index_file_name(name), "{name}");
+        }
     }
 }

@@ -24,7 +24,7 @@ pub fn run(args: BatchArgs) -> Result<()> {
     let index =
         batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut warn, &mut |done, total, outcome| {
             bar.update(done, total);
-            bar.message(&format!("{} {}", outcome.status, outcome.folder.display()));
+            bar.message(&format!("{} {}", outcome.status, path_line(&outcome.folder)));
             for kept in &outcome.kept {
                 bar.println(&format!("warning: {}", crate::output::kept_words(kept)));
             }
