@@ -111,7 +111,8 @@ pub fn set_file_names(loaded: &LoadedPreset, request: &GenerateRequest) -> Vec<S
 }
 
 /// A set's folder and its files (`set_file_names`) checked before the work
-/// (`Plan::check_outputs`).
+/// (`Plan::check_outputs`). (None can be the preset's own file: the set's names are its
+/// file stem with a suffix, `NAME_color.png`, `NAME.material.json`.)
 pub fn check_set_outputs(out_dir: &Path, files: &[String]) -> Result<(), export::ExportError> {
     export::check_folder(out_dir)?;
     for file in files {

@@ -135,9 +135,13 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
     // was found only when they were written): the `.glb`, or the `.gltf` and its side files.
     let side_files = if binary { Vec::new() } else { gltf_side_file_names(&name, film.is_some()) };
     crate::export::check_folder(&dir)?;
+    let input = crate::preset::input_file(&request.preset);
     crate::export::check_target(&request.out)?;
+    crate::export::check_not_an_input(&request.out, input)?;
     for file in side_files {
-        crate::export::check_target(&dir.join(file))?;
+        let target = dir.join(file);
+        crate::export::check_target(&target)?;
+        crate::export::check_not_an_input(&target, input)?;
     }
     let (textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
     let dimensions = plan.dimensions();

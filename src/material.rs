@@ -79,8 +79,9 @@ impl MapKind {
         match self {
             MapKind::Color => "visible diffuse colour (the manifest's color_means)".into(),
             MapKind::Height => {
-                "relative surface height on the preset's fixed scale: 0 = below its deepest groove, 1 = the tallest \
-                 scale it can draw (not stretched to the map's own range)"
+                "relative surface height on the preset's fixed scale: 0 = the floor of the deepest groove between \
+                 its scales (for hexagons the skin) less the grain, 1 = the tallest surface it can draw plus the \
+                 grain (not stretched to the map's own range)"
                     .into()
             }
             MapKind::Normal => {

@@ -6,9 +6,14 @@
 //! refuses a set whose estimate exceeds the available memory, and the binary warns when it
 //! takes more than half of it.
 //!
-//! Available memory is the smallest of: `MemAvailable` in /proc/meminfo, the cgroup's
-//! `memory.max` less its `memory.current` (containers), and `SNAKESKIN_MEMORY_LIMIT_MIB`
-//! when set (a cap the user chooses, also how the tests pretend to be a small machine).
+//! Available memory is the smallest of: `MemAvailable` in /proc/meminfo, the headroom of the
+//! process's memory cgroup and of every cgroup above it (limit less usage: `memory.max` and
+//! `memory.current` on cgroup v2, `memory.limit_in_bytes` and `memory.usage_in_bytes` on
+//! v1, the usage less the inactive file cache the kernel reclaims before it kills, as
+//! container runtimes count a working set; a container, a systemd slice, a batch
+//! scheduler's job), and
+//! `SNAKESKIN_MEMORY_LIMIT_MIB` when set (a cap the user chooses, also how the tests pretend
+//! to be a small machine).
 
 use crate::Error;
 use crate::graph::{Graph, estimate_peak_bytes};
@@ -123,8 +128,127 @@ fn meminfo_available() -> Option<u64> {
 }
 
 fn cgroup_headroom() -> Option<u64> {
-    let max: u64 = std::fs::read_to_string("/sys/fs/cgroup/memory.max").ok()?.trim().parse().ok()?;
-    let current: u64 =
-        std::fs::read_to_string("/sys/fs/cgroup/memory.current").ok().and_then(|t| t.trim().parse().ok()).unwrap_or(0);
-    Some(max.saturating_sub(current))
+    let membership = std::fs::read_to_string("/proc/self/cgroup").unwrap_or_default();
+    cgroup_headroom_in(&membership, &|path| std::fs::read_to_string(path).ok())
+}
+
+/// One cgroup hierarchy's memory files: its mount, its limit, its usage, and the key of the
+/// inactive file cache in its `memory.stat`.
+struct Hierarchy {
+    mount: &'static str,
+    limit: &'static str,
+    usage: &'static str,
+    cache: &'static str,
+}
+
+/// A cgroup v1 limit at or above this is "no limit" (the kernel writes the largest page
+/// multiple of i64::MAX, 9223372036854771712).
+const CGROUP_V1_UNLIMITED: u64 = 1 << 62;
+
+/// The least headroom (limit less usage) over the process's memory cgroup and every cgroup
+/// above it, from `/proc/self/cgroup` (`membership`) and the files `read` returns. It read
+/// only the root's v2 files, which hold the limit inside a container's own namespace but not
+/// on a v1 host or in a v2 slice (`systemd-run -p MemoryMax=`): a run there was killed by
+/// the kernel instead of refused.
+fn cgroup_headroom_in(membership: &str, read: &dyn Fn(&std::path::Path) -> Option<String>) -> Option<u64> {
+    use std::path::{Path, PathBuf};
+    let number = |path: PathBuf| read(&path).and_then(|t| t.trim().parse::<u64>().ok());
+    // The page cache counts as usage, but its inactive part is reclaimed before the kernel
+    // kills: left in, a run after a large file copy was refused where it fitted.
+    let inactive_file = |group: &Path, key: &str| {
+        let stat = read(&group.join("memory.stat"))?;
+        stat.lines().find_map(|l| l.strip_prefix(key)?.strip_prefix(' ')?.trim().parse::<u64>().ok())
+    };
+    let v2 =
+        Hierarchy { mount: "/sys/fs/cgroup", limit: "memory.max", usage: "memory.current", cache: "inactive_file" };
+    let v1 = Hierarchy {
+        mount: "/sys/fs/cgroup/memory",
+        limit: "memory.limit_in_bytes",
+        usage: "memory.usage_in_bytes",
+        cache: "total_inactive_file",
+    };
+    // Each hierarchy with the process's path in it.
+    let mut memberships: Vec<(&Hierarchy, &str)> = Vec::new();
+    for line in membership.lines() {
+        let mut fields = line.splitn(3, ':');
+        let (Some(_), Some(controllers), Some(path)) = (fields.next(), fields.next(), fields.next()) else { continue };
+        if controllers.is_empty() {
+            memberships.push((&v2, path));
+        } else if controllers.split(',').any(|c| c == "memory") {
+            memberships.push((&v1, path));
+        }
+    }
+    if memberships.is_empty() {
+        // No membership read: the root's v2 files, as a container shows them.
+        memberships.push((&v2, "/"));
+    }
+    let mut least: Option<u64> = None;
+    for (h, path) in memberships {
+        let mut group = Path::new(h.mount).join(path.trim_start_matches('/'));
+        loop {
+            // "max" (v2) does not parse: no limit at this level.
+            if let Some(limit) = number(group.join(h.limit)).filter(|&l| l < CGROUP_V1_UNLIMITED) {
+                let usage = number(group.join(h.usage)).unwrap_or(0);
+                let usage = usage.saturating_sub(inactive_file(&group, h.cache).unwrap_or(0));
+                let headroom = limit.saturating_sub(usage);
+                least = Some(least.map_or(headroom, |l| l.min(headroom)));
+            }
+            if group == Path::new(h.mount) || !group.pop() || !group.starts_with(h.mount) {
+                break;
+            }
+        }
+    }
+    least
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashMap;
+    use std::path::Path;
+
+    fn headroom(membership: &str, files: &[(&str, &str)]) -> Option<u64> {
+        let files: HashMap<&Path, &str> = files.iter().map(|(p, t)| (Path::new(*p), *t)).collect();
+        cgroup_headroom_in(membership, &|path| files.get(path).map(|t| format!("{t}\n")))
+    }
+
+    #[test]
+    fn the_cgroup_limit_is_found_where_the_process_lives_and_above_it() {
+        // A v2 slice: the limit two levels above the process's own group ("max": none there).
+        let slice = [
+            ("/sys/fs/cgroup/user.slice/job.scope/memory.max", "max"),
+            ("/sys/fs/cgroup/user.slice/job.scope/memory.current", "100"),
+            ("/sys/fs/cgroup/user.slice/memory.max", "1000"),
+            ("/sys/fs/cgroup/user.slice/memory.current", "300"),
+        ];
+        assert_eq!(headroom("0::/user.slice/job.scope\n", &slice), Some(700));
+        // The least headroom of the levels wins.
+        let mut tighter = slice.to_vec();
+        tighter[0].1 = "500";
+        tighter[1].1 = "450";
+        assert_eq!(headroom("0::/user.slice/job.scope\n", &tighter), Some(50));
+        // A v1 host: the memory controller's own hierarchy; the root's "unlimited" is no limit.
+        let v1 = [
+            ("/sys/fs/cgroup/memory/review/memory.limit_in_bytes", "1500"),
+            ("/sys/fs/cgroup/memory/review/memory.usage_in_bytes", "500"),
+            ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "9223372036854771712"),
+            ("/sys/fs/cgroup/memory/memory.usage_in_bytes", "7000"),
+        ];
+        assert_eq!(headroom("11:cpu,cpuacct:/other\n5:memory:/review\n", &v1), Some(1000));
+        // A container's namespace: the root's v2 files, with or without the membership.
+        let container = [("/sys/fs/cgroup/memory.max", "2000"), ("/sys/fs/cgroup/memory.current", "500")];
+        assert_eq!(headroom("0::/\n", &container), Some(1500));
+        assert_eq!(headroom("", &container), Some(1500));
+        // The inactive file cache is reclaimable: not counted as used (v2, and v1's
+        // hierarchical total; v1's own-group `inactive_file` is not the key).
+        let mut cached = container.to_vec();
+        cached.push(("/sys/fs/cgroup/memory.stat", "anon 100\nfile 400\nactive_file 100\ninactive_file 300\n"));
+        assert_eq!(headroom("0::/\n", &cached), Some(1800));
+        let mut cached = v1.to_vec();
+        cached.push(("/sys/fs/cgroup/memory/review/memory.stat", "inactive_file 50\ntotal_inactive_file 400\n"));
+        assert_eq!(headroom("5:memory:/review\n", &cached), Some(1400));
+        // No limit anywhere.
+        assert_eq!(headroom("0::/a/b\n", &[("/sys/fs/cgroup/a/memory.max", "max")]), None);
+        assert_eq!(headroom("4:memory:/\n", &v1[2..]), None);
+    }
 }

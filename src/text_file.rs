@@ -1,7 +1,9 @@
-//! Small text inputs a user names on the command line (presets, jobs files), read with a
-//! bound: a device such as /dev/zero, a FIFO with no writer or a huge file is refused without
-//! reading it, so a mistaken path costs neither memory nor a hang. One reader, so every input
-//! refuses them alike; each caller turns the refusal into its own typed error.
+//! Files read with a bound: the small text inputs a user names on the command line (presets,
+//! jobs files), and the files of an earlier set that a run reads back to see whether it is
+//! complete (its manifest and maps, `batch` and the commit's clean-up). A device such as
+//! /dev/zero, a FIFO with no writer or a huge file is refused without reading it, so a
+//! mistaken path, or a planted one, costs neither memory nor a hang. One reader, so every
+//! input refuses them alike; each caller turns the refusal into its own typed error.
 
 use std::io::Read;
 use std::path::Path;
@@ -17,16 +19,44 @@ pub enum BoundedReadError {
     TooLarge(u64),
 }
 
-/// Reads `path` as UTF-8 text of at most `limit` bytes. The file is opened without blocking
-/// (a FIFO would otherwise wait forever for a writer) and checked through the open handle,
-/// then read with a bound, so neither a device nor a file growing after the check is read
-/// past `limit`.
-pub fn read_bounded(path: &Path, limit: u64) -> Result<String, BoundedReadError> {
+/// Whether opening a path follows a symbolic link at its end: a user's input may be a link;
+/// a file of an earlier set never is one the set wrote (it is never followed).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Links {
+    Follow,
+    Refuse,
+}
+
+impl std::fmt::Display for BoundedReadError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BoundedReadError::Io(e) => write!(f, "{e}"),
+            BoundedReadError::NotAFile(kind) => write!(f, "it is {kind}, not a regular file"),
+            BoundedReadError::TooLarge(bytes) => write!(f, "it is {bytes} bytes, more than such a file can be"),
+        }
+    }
+}
+
+/// Opens `path` for reading, without blocking (a FIFO would otherwise wait forever for a
+/// writer), and checks through the open handle that it is a regular file of at most `limit`
+/// bytes. The caller reads it with `take(limit.saturating_add(1))`, so a file growing after the check is
+/// not read past the bound either (`check_read_length`).
+pub fn open_bounded(path: &Path, limit: u64, links: Links) -> Result<std::fs::File, BoundedReadError> {
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
-    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
-    let file = options.open(path).map_err(BoundedReadError::Io)?;
+    {
+        let no_follow = if links == Links::Refuse { libc::O_NOFOLLOW } else { 0 };
+        std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK | no_follow);
+    }
+    let file = options.open(path).map_err(|e| {
+        // O_NOFOLLOW's refusal of a link is ELOOP: said as what the path is.
+        #[cfg(unix)]
+        if links == Links::Refuse && e.raw_os_error() == Some(libc::ELOOP) {
+            return BoundedReadError::NotAFile("a symbolic link");
+        }
+        BoundedReadError::Io(e)
+    })?;
     let meta = file.metadata().map_err(BoundedReadError::Io)?;
     if !meta.is_file() {
         return Err(BoundedReadError::NotAFile(file_kind(&meta.file_type())));
@@ -34,13 +64,31 @@ pub fn read_bounded(path: &Path, limit: u64) -> Result<String, BoundedReadError>
     if meta.len() > limit {
         return Err(BoundedReadError::TooLarge(meta.len()));
     }
-    let mut bytes = Vec::new();
-    (&file).take(limit + 1).read_to_end(&mut bytes).map_err(BoundedReadError::Io)?;
-    if bytes.len() as u64 > limit {
-        // It grew after the check: its size now, not the limit + 1 bytes that were read.
+    Ok(file)
+}
+
+/// After reading `read` bytes of `file` with `take(limit + 1)`: refuses a file that grew past
+/// `limit` after `open_bounded` checked it, with its size now.
+pub fn check_read_length(file: &std::fs::File, read: u64, limit: u64) -> Result<(), BoundedReadError> {
+    if read > limit {
         let now = file.metadata().map_or(0, |m| m.len());
-        return Err(BoundedReadError::TooLarge(now.max(bytes.len() as u64)));
+        return Err(BoundedReadError::TooLarge(now.max(read)));
     }
+    Ok(())
+}
+
+/// Reads `path`, a regular file of at most `limit` bytes (`open_bounded`).
+pub fn read_bounded_bytes(path: &Path, limit: u64, links: Links) -> Result<Vec<u8>, BoundedReadError> {
+    let file = open_bounded(path, limit, links)?;
+    let mut bytes = Vec::new();
+    (&file).take(limit.saturating_add(1)).read_to_end(&mut bytes).map_err(BoundedReadError::Io)?;
+    check_read_length(&file, bytes.len() as u64, limit)?;
+    Ok(bytes)
+}
+
+/// Reads `path` as UTF-8 text of at most `limit` bytes (`open_bounded`; a link is followed).
+pub fn read_bounded(path: &Path, limit: u64) -> Result<String, BoundedReadError> {
+    let bytes = read_bounded_bytes(path, limit, Links::Follow)?;
     String::from_utf8(bytes).map_err(|e| {
         BoundedReadError::Io(std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 text ({e})")))
     })

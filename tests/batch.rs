@@ -513,6 +513,85 @@ fn a_set_missing_a_map_is_not_done() {
     assert!(set.join("natrix-natrix_height.png").is_file());
 }
 
+/// A set's file replaced by a link to /dev/zero, a FIFO or a huge sparse file: `batch`
+/// read each whole to hash it (memory until the kernel killed it, or a hang on the FIFO);
+/// now it reads regular files within a set's size, never through a link, and such a set is
+/// not done ("to do"), at once.
+#[cfg(unix)]
+#[test]
+fn a_planted_file_in_a_set_is_not_read_through_and_the_set_is_not_done() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[31]", 16);
+    let out_dir = dir.path().join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        snakeskin(&args)
+    };
+    assert_eq!(summary_counts(&run(&[])), (1, 0));
+    let set = out_dir.join("natrix-natrix/tile-16-seed31-png");
+    let colour = set.join("natrix-natrix_color.png");
+    let manifest = set.join("natrix-natrix.material.json");
+    let kept_manifest = std::fs::read(&manifest).unwrap();
+    let fifo = |path: &Path| {
+        let c = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+    };
+    let plants: [(&str, &dyn Fn()); 4] = [
+        ("a map linked to /dev/zero", &|| std::os::unix::fs::symlink("/dev/zero", &colour).unwrap()),
+        ("a map that is a FIFO", &|| fifo(&colour)),
+        ("a sparse 64 GiB map", &|| std::fs::File::create(&colour).unwrap().set_len(64 << 30).unwrap()),
+        ("a manifest that is a FIFO", &|| {
+            std::fs::write(&colour, b"x").unwrap();
+            std::fs::remove_file(&manifest).unwrap();
+            fifo(&manifest);
+        }),
+    ];
+    for (what, plant) in plants {
+        let _ = std::fs::remove_file(&colour);
+        plant();
+        let start = Instant::now();
+        let listed = run(&["--list"]);
+        // A regular file that is not the set's: the job is to do. A link or a FIFO where the
+        // set's file goes: refused as `generate` refuses it (it would be written over).
+        if listed.status.success() {
+            assert!(stdout(&listed).contains("to do"), "{what}: {}", stdout(&listed));
+        } else {
+            assert_eq!(listed.status.code(), Some(2), "{what}: {}", stderr(&listed));
+            assert!(stderr(&listed).contains("not a regular file"), "{what}: {}", stderr(&listed));
+        }
+        assert!(start.elapsed() < Duration::from_secs(20), "{what}: --list took {:?}", start.elapsed());
+        if std::fs::symlink_metadata(&manifest).is_ok_and(|m| !m.is_file()) {
+            std::fs::remove_file(&manifest).unwrap();
+            std::fs::write(&manifest, &kept_manifest).unwrap();
+        }
+    }
+    // `generate` over a set whose manifest is a sparse 64 GiB file: the commit's clean-up
+    // read the old manifest whole (killed for memory in a 1.5 GB cgroup); now the new set
+    // is written and the old "manifest" replaced, at once.
+    std::fs::remove_file(&colour).unwrap();
+    std::fs::File::create(&manifest).unwrap().set_len(64 << 30).unwrap();
+    let start = Instant::now();
+    let out = snakeskin(&["generate", "natrix-natrix", "-o", set.to_str().unwrap(), "--size", "16"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(start.elapsed() < Duration::from_secs(20), "generate took {:?}", start.elapsed());
+    assert!(std::fs::metadata(&manifest).unwrap().len() < 1 << 20);
+}
+
+/// The jobs file named as the batch's own index (`batch out/index.json -o out`): the index
+/// replaced the jobs, and the documented way to resume, running it again, failed.
+#[test]
+fn a_batch_does_not_write_its_index_over_its_jobs_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("index.json");
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = [16]\n").unwrap();
+    let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
+    assert!(stderr(&run).contains("would be written over this command's input"), "{}", stderr(&run));
+    assert!(std::fs::read_to_string(&jobs).unwrap().starts_with("[[job]]"), "the jobs file stays");
+    assert!(!dir.path().join("natrix-natrix").exists(), "refused before any job");
+}
+
 /// A preset edited while its batch runs: the job that reads the edited preset is not
 /// written under the key of the planned one (a later run, the edit undone, took that set as
 /// done), and the batch stops with exit 1 and says why; the sets before it stand. The

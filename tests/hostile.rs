@@ -1091,7 +1091,7 @@ fn a_preview_memory_cannot_hold_is_refused() {
     let args = ["preview", PRESET, "--out", image.to_str().unwrap(), "--size", "64x64", "--layout", "body"];
     let out = snakeskin_env(&[&args[..], &["--map-size", "4096"]].concat(), &limit);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("the preview's frame and its maps (682×8184 maps) needs about"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the preview's frame with its maps (682×8184 maps) needs about"), "{}", stderr(&out));
     assert!(!image.exists());
     let out = snakeskin_env(&[&args[..], &["--map-size", "64"]].concat(), &limit);
     assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
@@ -1103,7 +1103,7 @@ fn a_preview_memory_cannot_hold_is_refused() {
         &limit,
     );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("the preview's frame and its maps (64×64 maps) needs about"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the preview's frame with its maps (64×64 maps) needs about"), "{}", stderr(&out));
     assert!(!dir.path().join("new").exists(), "a folder was made for a refused preview");
 }
 
@@ -1598,4 +1598,49 @@ fn stderr_charts_and_batch_answers_fail_as_other_outputs_do() {
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert!(stderr(&out).contains("cannot write to standard output"), "{}", stderr(&out));
+}
+
+/// An output that names the command's own preset file replaced it (`export ./x.glb --gltf
+/// x.glb`; `preview` does the same check): refused before the work, exit 2, the preset as
+/// it was.
+#[test]
+fn an_output_is_never_written_over_the_preset_it_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let glb = dir.path().join("self.glb");
+    std::fs::write(&glb, "seed = 1\n").unwrap();
+    let out = snakeskin(&["export", glb.to_str().unwrap(), "--gltf", glb.to_str().unwrap(), "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("would be written over this command's input"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&glb).unwrap(), "seed = 1\n");
+    // The same file by another name: through `..`.
+    let other = format!("{}/sub/../self.glb", dir.path().display());
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    let out = snakeskin(&["export", glb.to_str().unwrap(), "--gltf", &other, "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&glb).unwrap(), "seed = 1\n");
+}
+
+/// What the reader said without the key's range or the accepted values: a whole number
+/// written with a fraction, a layer without its kind.
+#[test]
+fn type_errors_name_the_range_and_missing_kinds_the_choices() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("o");
+    let run = |text: &str, set: &[&str]| {
+        let preset = dir.path().join("p.toml");
+        std::fs::write(&preset, text).unwrap();
+        let mut args = vec!["generate", preset.to_str().unwrap(), "-o", o.to_str().unwrap(), "--size", "16"];
+        for s in set {
+            args.extend(["--set", s]);
+        }
+        let out = snakeskin(&args);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let e = run("[scales]\nrows = 20.0\n", &[]);
+    assert!(e.contains("p.toml:2:8: key `scales.rows`") && e.contains("expected a whole number in [4, 128]"), "{e}");
+    let e = run("seed = 1\n", &["scales.rows=nan"]);
+    assert!(e.contains("expected a whole number in [4, 128]"), "{e}");
+    let e = run("[[pattern]]\ncolor = \"#101010\"\n", &[]);
+    assert!(e.contains("missing field `kind`: every layer needs its kind, one of solid, stripes, rings"), "{e}");
 }

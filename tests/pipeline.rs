@@ -518,3 +518,51 @@ fn fused_chains_on_two_threads() {
     };
     assert!(fused_roughness("0.05") != fused_roughness("0.06"), "a changed step went unseen");
 }
+
+#[test]
+fn the_height_maps_range_holds_every_surface_the_field_draws() {
+    // README: the height map's 0 is the floor of the deepest groove between scales and its 1
+    // the tallest surface, so no scale's top clips and no groove does: the field's heights
+    // (before the grain, which widens both ends by its amplitude) must lie at or below the
+    // range's top everywhere, and above its floor but where skin shows, for every shape,
+    // flat and fully imbricate, keeled or not, on the tile and on the body layout (plates,
+    // head shields). The range assumed the leaf's profile for every shape: hexagons reached
+    // 0.7 over a top of 0.6, and a third of a hexagon preset's height map clipped at 1.
+    use snakeskin::maps::{Layout, height_range, scale_field};
+    use snakeskin::ops::scales::channel;
+    for shape in ["leaf", "diamond", "hexagon"] {
+        for imbrication in [0.0, 0.5, 1.0] {
+            for keeled in [false, true] {
+                let text = format!(
+                    "seed = 3\n[scales]\nshape = \"{shape}\"\nimbrication = {imbrication}\nkeeled = {keeled}\n\
+                     keel_height = 1.0\n[height]\ngrain = 0.05\n"
+                );
+                let preset = preset_from(&text);
+                let (low, high) = height_range(&preset);
+                let grain = preset.height.grain as f32;
+                let (floor, top) = (low + grain, high - grain);
+                let mut highest_drawn = 0.0f32;
+                for (layout, width, height) in [(Layout::Tile, 96, 96), (Layout::Body, 48, 48 * 12)] {
+                    let mut field = scale_field(&preset, layout);
+                    field.outputs = vec![channel::HEIGHT];
+                    let heights = field.render(width, height);
+                    let hi = heights.data.iter().cloned().fold(f32::MIN, f32::max);
+                    // (`top` is the range's end less the grain: within a float's rounding.)
+                    assert!(hi <= top + 1e-6, "{layout:?} {text}: heights up to {hi} over the top {top}");
+                    highest_drawn = highest_drawn.max(hi);
+                    // Below the floor only where skin shows: on the tile, where leaves that
+                    // barely overlap (imbrication 0) leave gaps, 1.6 % (a hexagon's floor is
+                    // the skin itself: none).
+                    if layout == Layout::Tile {
+                        let below = heights.data.iter().filter(|&&h| h < floor - 1e-6).count();
+                        let share = below as f32 / heights.data.len() as f32;
+                        assert!(share < 0.03, "{text}: {share} of the tile below the groove floor {floor}");
+                    }
+                }
+                // And the range is no wider than it needs: the tallest surface drawn reaches
+                // near its top, so the 16 bits are spent on the skin's heights.
+                assert!(highest_drawn > 0.9 * top, "{text}: tallest {highest_drawn} of a range to {top}");
+            }
+        }
+    }
+}

@@ -130,7 +130,12 @@ fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
 
 /// SHA-256 of `bytes` as 64 hex digits (the manifest's `sha256` per map).
 pub fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+    hex(&Sha256::digest(bytes))
+}
+
+/// A digest as the manifest writes it: lowercase hex.
+pub(crate) fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// Every temporary of a name, whatever its age (under the set's lock).
@@ -270,6 +275,18 @@ pub fn ends_as_a_folder(path: &Path) -> bool {
 /// `std::path::absolute`s missed `..` and links: a heat map replaced the render.)
 pub fn same_path(a: &Path, b: &Path) -> bool {
     matches!((resolved(a), resolved(b)), (Some(a), Some(b)) if a == b)
+}
+
+/// Refuses an output that names the command's input file (`same_path`, links and `..`
+/// resolved): `preview snake -o snake`, `export ./x.glb --gltf x.glb` and a batch whose jobs
+/// file is its index replaced their input, and could not be run again.
+pub fn check_not_an_input(output: &Path, input: Option<&Path>) -> Result<(), ExportError> {
+    match input {
+        Some(input) if same_path(output, input) => {
+            Err(ExportError::OverwritesInput { output: output.into(), input: input.into() })
+        }
+        _ => Ok(()),
+    }
 }
 
 fn resolved(path: &Path) -> Option<PathBuf> {
@@ -610,9 +627,12 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<
         return nothing;
     };
     let set_files = super::every_set_file_name(&set_name);
-    let Ok(text) = fs::read(manifest) else { return nothing };
+    let Ok(text) = super::manifest::read_set_manifest(manifest, crate::text_file::Links::Refuse) else {
+        return nothing;
+    };
     let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return nothing };
     let Some(entries) = json["maps"].as_array() else { return nothing };
+    let file_limit = super::manifest::set_file_max_bytes(&json);
     let dir = manifest.parent().unwrap_or(Path::new("."));
     let (mut files, mut changed): (Vec<PathBuf>, Vec<KeptFile>) = (Vec::new(), Vec::new());
     for entry in entries {
@@ -625,8 +645,8 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<
         if !fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
             continue;
         }
-        let why = match fs::read(&path) {
-            Ok(bytes) if sha256_hex(&bytes) == recorded => {
+        let why = match super::manifest::set_file_sha256(&path, file_limit, crate::text_file::Links::Refuse) {
+            Ok(actual) if actual == recorded => {
                 files.push(path);
                 continue;
             }

@@ -9,11 +9,11 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::ExportError;
-use super::atomic::sha256_hex;
 use super::pack::TextureSpec;
 use crate::maps::{BuildOptions, Layout, body_plan};
 use crate::material::{FileFormat, MapKind, NormalConvention, Optics};
 use crate::preset::LoadedPreset;
+use crate::text_file::Links;
 
 #[derive(Debug, Serialize)]
 pub struct Manifest {
@@ -72,6 +72,19 @@ pub struct Counts {
     pub dorsal_marks: Option<u32>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tail_bands: Option<u32>,
+}
+
+/// The counts a body atlas of `preset` is drawn with (`plan`, its `body_plan`): the
+/// manifest's `counts` and the body contact sheet's labels, which named ventrals and
+/// subcaudals for the species without plates.
+pub fn body_counts(preset: &crate::preset::Preset, plan: &crate::ops::body::BodyPlan) -> Counts {
+    let plates = preset.belly.plates && preset.belly.width > 0.0;
+    Counts {
+        ventrals: plates.then_some(plan.ventrals),
+        subcaudals: plates.then_some(plan.subcaudals),
+        dorsal_marks: preset.pattern.iter().find_map(|l| l.series_count()),
+        tail_bands: (preset.body.tail_bands > 0).then_some(preset.body.tail_bands),
+    }
 }
 
 /// [start, end] in v of each region of a body atlas.
@@ -165,13 +178,7 @@ pub fn manifest(
 ) -> Manifest {
     let p = &loaded.preset;
     let body = (options.layout == Layout::Body).then(|| body_plan(p));
-    let plates = p.belly.plates && p.belly.width > 0.0;
-    let counts = body.map(|b| Counts {
-        ventrals: plates.then_some(b.ventrals),
-        subcaudals: plates.then_some(b.subcaudals),
-        dorsal_marks: p.pattern.iter().find_map(|l| l.series_count()),
-        tail_bands: (p.body.tail_bands > 0).then_some(p.body.tail_bands),
-    });
+    let counts = body.as_ref().map(|b| body_counts(p, b));
     let regions = body.map(|b| {
         let plate = b.plate_length_v(false);
         Regions {
@@ -206,6 +213,57 @@ pub fn manifest(
     }
 }
 
+/// The most bytes a manifest of an earlier set is read to (a built-in species' body manifest
+/// is under 10 KB): a link to /dev/zero or a huge file in its place is refused unread.
+pub const MANIFEST_MAX_BYTES: u64 = 1 << 20;
+
+/// An earlier set's manifest, read back (`verify_set`, `batch`, a commit's clean-up): a
+/// regular file of at most `MANIFEST_MAX_BYTES`. `links`: whether a link is followed (a
+/// reader's check may meet a set kept as links, as git-annex keeps files; what a run may
+/// remove or replace is never reached through one: the set wrote none).
+pub fn read_set_manifest(path: &Path, links: Links) -> Result<Vec<u8>, crate::text_file::BoundedReadError> {
+    crate::text_file::read_bounded_bytes(path, MANIFEST_MAX_BYTES, links)
+}
+
+/// The most bytes one file of the set a manifest describes can hold: every map of its
+/// `width` × `height` pixels at 16 bytes a pixel (RGBA f32, the widest any format writes),
+/// twice over for a container's overhead (a glTF's base64, a stored PNG), and a MiB for
+/// headers. A file larger than that is not the set's; without the size, or with a size no
+/// run writes (wider than `SIZE_RANGE`, taller than `generate::MAX_HEIGHT`: a forged
+/// manifest's 2³² × 2³² made the bound wrap to nothing), nothing is.
+pub fn set_file_max_bytes(json: &serde_json::Value) -> u64 {
+    let (Some(width), Some(height)) = (json["width"].as_u64(), json["height"].as_u64()) else { return 0 };
+    if width > u64::from(*crate::SIZE_RANGE.end()) || height > crate::generate::MAX_HEIGHT as u64 {
+        return 0;
+    }
+    let maps = MapKind::ALL.len() as u64;
+    width * height * 16 * maps * 2 + (1 << 20)
+}
+
+/// The SHA-256 of an earlier set's file, streamed (the file is not held in memory): a
+/// regular file of at most `limit` bytes (`set_file_max_bytes`); `links` as for
+/// `read_set_manifest`.
+pub fn set_file_sha256(path: &Path, limit: u64, links: Links) -> Result<String, crate::text_file::BoundedReadError> {
+    use crate::text_file::{BoundedReadError, check_read_length, open_bounded};
+    use sha2::Digest;
+    use std::io::Read;
+    let file = open_bounded(path, limit, links)?;
+    let mut reader = (&file).take(limit.saturating_add(1));
+    let mut hasher = sha2::Sha256::new();
+    let mut buffer = vec![0u8; 1 << 16];
+    let mut read = 0u64;
+    loop {
+        let n = reader.read(&mut buffer).map_err(BoundedReadError::Io)?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buffer[..n]);
+        read += n as u64;
+    }
+    check_read_length(&file, read, limit)?;
+    Ok(super::atomic::hex(&hasher.finalize()))
+}
+
 /// A set whose files match its manifest.
 #[derive(Debug, Clone)]
 pub struct VerifiedSet {
@@ -219,16 +277,18 @@ pub struct VerifiedSet {
 /// while renaming); one whose hashes differ is mixed or altered.
 pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
     let problem = |problem: String| ExportError::Verify { manifest: manifest_path.into(), problem };
-    let text = std::fs::read(manifest_path).map_err(|e| {
-        problem(if e.kind() == std::io::ErrorKind::NotFound {
-            "no manifest: the set is incomplete (a run failed or was killed while writing it)".into()
-        } else {
-            format!("cannot read the manifest: {e}")
+    let text = read_set_manifest(manifest_path, Links::Follow).map_err(|e| {
+        problem(match e {
+            crate::text_file::BoundedReadError::Io(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                "no manifest: the set is incomplete (a run failed or was killed while writing it)".into()
+            }
+            e => format!("cannot read the manifest: {e}"),
         })
     })?;
     let json: serde_json::Value =
         serde_json::from_slice(&text).map_err(|e| problem(format!("the manifest is not valid JSON: {e}")))?;
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
+    let file_limit = set_file_max_bytes(&json);
     let maps = json["maps"]
         .as_array()
         .filter(|m| !m.is_empty())
@@ -247,8 +307,8 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
             return Err(problem(format!("the {map} map or its file {file:?} is listed twice")));
         }
         let path = dir.join(file);
-        let bytes = std::fs::read(&path).map_err(|e| problem(format!("{map} map {}: {e}", path.display())))?;
-        let actual = sha256_hex(&bytes);
+        let actual = set_file_sha256(&path, file_limit, Links::Follow)
+            .map_err(|e| problem(format!("{map} map {}: {e}", path.display())))?;
         if actual != expected {
             return Err(problem(format!(
                 "{map} map {} has SHA-256 {actual}, the manifest records {expected}: the set is mixed or altered",

@@ -11,11 +11,13 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    FileGroup, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_png_target, check_target,
-    check_target_named, clean_up_before_exit, create_folder, ends_as_a_folder, same_path, sha256_hex,
+    FileGroup, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_not_an_input, check_png_target,
+    check_target, check_target_named, clean_up_before_exit, create_folder, ends_as_a_folder, same_path, sha256_hex,
     write_file_atomically,
 };
-pub use manifest::{Manifest, MapEntry, VerifiedSet, manifest, manifest_file_name, verify_set};
+pub use manifest::{
+    Counts, Manifest, MapEntry, VerifiedSet, body_counts, manifest, manifest_file_name, read_set_manifest, verify_set,
+};
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
 
 use std::io::Cursor;
@@ -38,12 +40,19 @@ pub enum ExportError {
          finished, or write to another folder"
     )]
     Busy { dir: PathBuf, name: String },
-    #[error("{path} exists and is not a folder, so nothing can be written into it; give a folder (or a file in one)")]
+    #[error(
+        "{path} exists and is not a folder, so nothing can be written into it; give the path of a folder (one that \
+         exists, or one to create)"
+    )]
     NotAFolder { path: PathBuf },
     /// An output file's path that ends as a folder's does (`out/`, `out/.`): it was written
     /// to after the work and failed with "Not a directory".
     #[error("{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.png")]
     FolderName { path: PathBuf },
+    /// An output that names one of the command's inputs (the preset file, the jobs file):
+    /// it replaced the input, and the command could not be run again.
+    #[error("{output} would be written over this command's input {input} (the same file); move or rename one of them")]
+    OverwritesInput { output: PathBuf, input: PathBuf },
     /// An output named for another format (`preview --out x.jpg`, `--plot x.png`): it was
     /// written in its own format under that name, without a word.
     #[error("{path}: this output is a .{format} file; give it a name ending in .{format} (it ends in .{extension})")]
@@ -86,6 +95,7 @@ impl ExportError {
                 | ExportError::FolderInTheWay { .. }
                 | ExportError::FolderName { .. }
                 | ExportError::NamedForAnotherFormat { .. }
+                | ExportError::OverwritesInput { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
         )

@@ -288,15 +288,22 @@ fn build_height(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
     g.add("height.out", Op::Levels { in_low: low, in_high: high, out_low: 0.0, out_high: 1.0 }, &[sum])
 }
 
-/// The scale-field heights the height map stretches over [0, 1] to use its 16 bits. Low:
-/// below the deepest groove between overlapping scales (0.8 × the lowest scale profile,
-/// 0.45, is 0.36); skin showing between scales that do not overlap clamps to 0. High: the
-/// tallest profile (`ScaleField` tops out at 0.6 + 0.3 imbrication, plus 0.2 × keel height)
-/// plus the grain.
+/// The heights the height map stretches over [0, 1]: from the floor of the deepest groove
+/// between the preset's scales (`scales::groove_floor`: 0 for hexagons, whose rims meet at
+/// the skin) to the tallest surface its scales, plates and head shields can make
+/// (`scales::height_top`), each widened by the grain. No scale's top clips, and no groove
+/// between scales; skin showing where leaves or diamonds do not overlap, or round their
+/// head shields, reads 0 (the 16 bits go to the scales). The same for the tile and the body layout (the head's
+/// shields count in both): one scale per preset, as README says. (It assumed the leaf's
+/// profile for every shape, 0.3 to 0.6 + 0.3 imbrication: a third of a hexagon preset's
+/// height map clipped at 1 and a tenth at 0, its normal map flat there.)
 pub fn height_range(preset: &Preset) -> (f32, f32) {
-    let s = &preset.scales;
-    let keel = if s.keeled { 0.2 * s.keel_height } else { 0.0 };
-    (0.3, (0.6 + 0.3 * s.imbrication + keel + preset.height.grain) as f32)
+    use crate::ops::scales::{groove_floor, height_top};
+    let field = scale_field(preset, Layout::Tile);
+    let shields = preset.body.head_scales == schema::HeadScales::Shields;
+    let top = height_top(field.shape, field.imbrication, field.keel_height, preset.belly.plates, shields);
+    let grain = preset.height.grain as f32;
+    (groove_floor(field.shape) - grain, top + grain)
 }
 
 /// The range the roughness map can take (`build_roughness`): the base less its variation and

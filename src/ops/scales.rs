@@ -328,6 +328,71 @@ fn free_edge(profile: f32, t: f32, under_height: f32, imbrication: f32) -> f32 {
     (foot + round * (profile - foot).max(0.0)).max(CREVICE_FLOOR * under_height)
 }
 
+/// A surface's height over a scale, plate or shield: `base` at its rim's top, `dome` more
+/// towards its middle, `rise` × imbrication more towards its free posterior edge. Written
+/// once here for the field's pixels and for the height map's range (`height_top`).
+#[derive(Debug, Clone, Copy)]
+struct Profile {
+    base: f32,
+    dome: f32,
+    rise: f32,
+}
+
+impl Profile {
+    /// `dome` and `along` in [0, 1].
+    #[inline]
+    fn at(&self, dome: f32, imbrication: f32, along: f32) -> f32 {
+        self.base + self.dome * dome + self.rise * imbrication * along
+    }
+
+    fn top(&self, imbrication: f32) -> f32 {
+        self.at(1.0, imbrication, 1.0)
+    }
+}
+
+/// Overlapping dorsal scales (leaf, diamond), domed and rising towards the free edge.
+const SCALE_PROFILE: Profile = Profile { base: 0.45, dome: 0.15, rise: 0.3 };
+/// Hexagons: they do not overlap, so they rise less towards the posterior edge.
+const HEXAGON_PROFILE: Profile = Profile { base: 0.5, dome: 0.2, rise: 0.15 };
+/// Ventral plates: a little above the scales, gently convex across the belly (`dome` at
+/// the midline).
+const PLATE_PROFILE: Profile = Profile { base: 0.55, dome: 0.06, rise: 0.3 };
+/// The body layout's head shields: large domed plates, no overlap.
+const SHIELD_PROFILE: Profile = Profile { base: 0.55, dome: 0.15, rise: 0.0 };
+/// A keel's ridge over the scale, × `keel_height`.
+const KEEL_RISE: f32 = 0.2;
+
+/// The floor of the deepest groove between a shape's scales: where an overlapping scale's
+/// free edge meets the scale underneath (`CREVICE_FLOOR` × the lowest profile, 0.36), or 0
+/// for hexagons, whose rims meet at the skin. Skin showing between scales that do not
+/// overlap, or round a head shield, lies below it (the height map reads 0 there).
+pub fn groove_floor(shape: ScaleShape) -> f32 {
+    match shape {
+        ScaleShape::Hexagon => 0.0,
+        ScaleShape::Leaf | ScaleShape::Diamond => CREVICE_FLOOR * SCALE_PROFILE.base,
+    }
+}
+
+/// The highest surface a field of this shape can write in either layout (a keel's ridge on
+/// the top of a dorsal scale's profile, or a free edge resting `LIP_STEP` above the top of
+/// the scale underneath); `plates` when the belly has plates, `shields` when the body layout
+/// draws head shields. Every surface falls to 0 where nothing lies underneath (a hexagon's
+/// border, a shield's rim, skin between scales), so the field's heights lie in [0, this].
+/// The top of the height map's range (`maps::height_range`): it clipped a third of a
+/// hexagon preset's height map at 1 when it assumed the leaf's profile for every shape.
+pub fn height_top(shape: ScaleShape, imbrication: f32, keel_height: f32, plates: bool, shields: bool) -> f32 {
+    let lip = LIP_STEP * imbrication;
+    // Keels ride on the dorsal scales only (plates and shields have none).
+    let scales = KEEL_RISE * keel_height
+        + match shape {
+            ScaleShape::Hexagon => HEXAGON_PROFILE.top(imbrication),
+            ScaleShape::Leaf | ScaleShape::Diamond => SCALE_PROFILE.top(imbrication) + lip,
+        };
+    let plates = if plates { PLATE_PROFILE.top(imbrication) + lip } else { 0.0 };
+    let shields = if shields { SHIELD_PROFILE.top(imbrication) } else { 0.0 };
+    scales.max(plates).max(shields).min(1.0)
+}
+
 /// Half-width of a diamond in cell widths (see `inside_distance`).
 const DIAMOND_HALF_WIDTH: f32 = 1.0;
 
@@ -611,8 +676,7 @@ impl ScaleField {
         let soft = self.edge_softness.max(1e-4);
         let profile = |inside: f32, y: f32| {
             let along = (y / geo.b * 0.5 + 0.5).clamp(0.0, 1.0);
-            let dome = smoothstep(0.0, 0.35, inside);
-            0.45 + 0.15 * dome + 0.3 * self.imbrication * along
+            SCALE_PROFILE.at(smoothstep(0.0, 0.35, inside), self.imbrication, along)
         };
         let c0 = floor_i32(x);
         // The nine neighbouring cells, columns c0 − 1 ..= c0 + 1 (entries from column −1).
@@ -737,7 +801,7 @@ impl ScaleField {
         let along = (cand.y / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
         let rim = smoothstep(0.0, soft, inside);
         let dome = smoothstep(0.0, 0.35, inside);
-        let h = rim * (0.5 + 0.2 * dome + 0.15 * self.imbrication * along);
+        let h = rim * HEXAGON_PROFILE.at(dome, self.imbrication, along);
         let visible = if inside > 0.0 { Some(cand) } else { None };
         self.write_scale(visible, h, self.keel_height, out);
     }
@@ -771,7 +835,7 @@ impl ScaleField {
                 } else {
                     0.0
                 };
-                out[channel::HEIGHT] = (height + 0.2 * keel_height * keel).clamp(0.0, 1.0);
+                out[channel::HEIGHT] = (height + KEEL_RISE * keel_height * keel).clamp(0.0, 1.0);
                 out[channel::CREVICE] = 1.0 - smoothstep(0.0, soft * 1.5, c.inside);
                 out[channel::ALONG] = along;
                 out[channel::RADIAL] = radial;
@@ -828,7 +892,7 @@ impl ScaleField {
                 aspect,
                 divided,
                 to_end: (half_len - (y - (r as f32 + 0.5)).abs()) * aspect,
-                rise: 0.3 * self.imbrication * along,
+                along,
                 random: [hash::unit(-2, id, 4, self.seed), hash::unit(-3, id, 4, self.seed)],
                 random_undivided: hash::unit(-1, id, 4, self.seed),
                 ly: (y - (r as f32 + 0.5)) / half_len * 0.5 * aspect,
@@ -855,13 +919,13 @@ impl ScaleField {
         let mut under_height = 0.0f32;
         // Plates are gently convex across the belly.
         let across = (dist_belly / half_band).min(1.0);
-        let dome = 0.06 * (1.0 - across * across);
+        let dome = 1.0 - across * across;
         for plate in plates.near.iter().flatten() {
             let inside = if plate.divided { to_side_divided } else { to_side }.min(plate.to_end);
             if inside <= 0.0 {
                 continue;
             }
-            let profile = 0.45 + 0.1 + dome + plate.rise;
+            let profile = PLATE_PROFILE.at(dome, self.imbrication, plate.along);
             match top {
                 Some(_) => under_height = under_height.max(profile),
                 None => top = Some((plate, inside, profile)),
@@ -915,7 +979,7 @@ impl ScaleField {
             centre_v: plate.centre_uv.1,
             row: 0,
         };
-        let h = smoothstep(0.0, soft, inside) * (0.55 + 0.15 * smoothstep(0.0, 1.0, inside));
+        let h = smoothstep(0.0, soft, inside) * SHIELD_PROFILE.at(smoothstep(0.0, 1.0, inside), self.imbrication, 0.0);
         self.write_scale(Some(cand), h, 0.0, out);
         true
     }
@@ -996,9 +1060,9 @@ struct NearPlate {
     divided: bool,
     /// Distance from the row to the plate's nearer end, in dorsal scale widths.
     to_end: f32,
-    /// The plate's rise towards its free posterior edge at this row, 0.3 × imbrication ×
-    /// the position along it.
-    rise: f32,
+    /// The row's position along the plate, 0 at its anterior end to 1 at its free posterior
+    /// edge (`PLATE_PROFILE` rises along it).
+    along: f32,
     /// The random number of each half of a divided plate (u < 1/2, u ≥ 1/2) and of the
     /// whole.
     random: [f32; 2],

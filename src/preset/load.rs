@@ -73,6 +73,13 @@ pub fn names_a_file(written: &str, path: &Path) -> bool {
         && (path.to_string_lossy().ends_with(".toml") || std::fs::metadata(path).is_ok_and(|m| !m.is_dir()))
 }
 
+/// The file a PRESET argument reads (`read_source`), or None for a built-in preset: what no
+/// output of the command may be written over (`export::check_not_an_input`).
+pub fn input_file(spec: &str) -> Option<&Path> {
+    let path = Path::new(spec);
+    names_a_file(spec, path).then_some(path)
+}
+
 /// Resolves a PRESET argument: a file (`names_a_file`), or else a built-in preset name.
 pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
@@ -273,6 +280,9 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
     {
         described.message = in_range_words;
     }
+    if let Some(hint) = described.key.as_deref().and_then(|key| required_key_hint(key, &described.message)) {
+        described.message = format!("{}{hint}", described.message);
+    }
     PresetError::Parse {
         location: Location {
             file: source.display.clone(),
@@ -290,6 +300,11 @@ fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
 /// ("invalid type: string \"99999999999999999999\"") and is a whole number too; a quoted
 /// number (`"21"`, in a file or `--set`) is a string, and said so.
 fn in_key_range(key: &str, message: &str, from_set: bool) -> Option<String> {
+    // A number with a fraction or exponent, `nan` or `inf` where a whole number goes
+    // (`rows = 20.0`): the reader's words, with the key's range they lacked.
+    if message.starts_with("invalid type: floating point") && message.ends_with("expected a whole number") {
+        return Some(format!("{message} in {}", super::validate::whole_number_range_words(key)?));
+    }
     let value = match toml_text::integer_out_of_type(message) {
         Some(value) => value,
         None if from_set => {
@@ -301,6 +316,22 @@ fn in_key_range(key: &str, message: &str, from_set: bool) -> Option<String> {
         None => return None,
     };
     super::validate::whole_number_problem(key, value)
+}
+
+/// What a table missing a required key needs (`[[pattern]]` without `kind`: the reader said
+/// only "missing field `kind`"), or None.
+fn required_key_hint(key: &str, message: &str) -> Option<String> {
+    use super::schema::{HeadMarkKind, PatternKind};
+    let field = message.strip_prefix("missing field `")?.strip_suffix('`')?;
+    let table = key.trim_end_matches(|c: char| c.is_ascii_digit()).trim_end_matches('.');
+    Some(match (table, field) {
+        ("pattern", "kind") => format!(": every layer needs its kind, one of {}", PatternKind::accepted_names()),
+        ("body.head_mark", "kind") => {
+            format!(": every head mark needs its kind, one of {}", HeadMarkKind::accepted_names())
+        }
+        (_, "color") => ": give its colour as \"#rrggbb\"".into(),
+        _ => return None,
+    })
 }
 
 /// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).

@@ -9,5 +9,7 @@ pub mod validate;
 pub mod visible;
 
 pub use error::{LocatedProblem, Location, PresetError, describe_problems};
-pub use load::{LoadedPreset, MAX_PRESET_BYTES, PresetSource, load, names_a_file, parse, parse_with_seed, read_source};
+pub use load::{
+    LoadedPreset, MAX_PRESET_BYTES, PresetSource, input_file, load, names_a_file, parse, parse_with_seed, read_source,
+};
 pub use schema::Preset;

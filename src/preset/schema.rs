@@ -24,6 +24,13 @@ macro_rules! named_enum {
                 by_name(&[$($t::$v),+], &name)
             }
         }
+
+        impl $t {
+            /// Every value as a preset writes it, comma-separated (for messages).
+            pub fn accepted_names() -> String {
+                [$($t::$v),+].iter().map(spelled).collect::<Vec<_>>().join(", ")
+            }
+        }
     };
 }
 

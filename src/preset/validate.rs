@@ -198,11 +198,15 @@ pub fn whole_number_range(key: &str) -> Option<WholeRange> {
 /// The range check's words for a whole number the key's type cannot hold (`value`: as
 /// written), or None for a key that is not a whole number's.
 pub fn whole_number_problem(key: &str, value: &str) -> Option<String> {
-    let range = match whole_number_range(key)? {
+    Some(format!("must be an integer in {}, got {value}", whole_number_range_words(key)?))
+}
+
+/// A whole-number key's range as messages write it (`[4, 128]`), or None for another key.
+pub fn whole_number_range_words(key: &str) -> Option<String> {
+    Some(match whole_number_range(key)? {
         WholeRange::Fixed((lo, hi)) => format!("[{lo}, {hi}]"),
         WholeRange::HalfTheRows => "[0, scales.rows / 2]".to_string(),
-    };
-    Some(format!("must be an integer in {range}, got {value}"))
+    })
 }
 
 /// Every out-of-range value in the preset (empty when it is valid). `from_file_for_old_kind

@@ -47,7 +47,9 @@ pub enum Command {
         #[command(subcommand)]
         command: BrdfCommand,
     },
-    /// Benchmarks: `bench irid` measures every film colour method's error against cost.
+    /// Benchmarks of run time against error: `irid` (the film colour methods), `layered` (the
+    /// layer models against the photon walk), `render` (frame times on the GPU), `gpu` (the
+    /// WGSL BRDF per million evaluations).
     Bench {
         #[command(subcommand)]
         command: BenchCommand,
@@ -563,7 +565,11 @@ pub enum BrdfCommand {
         #[arg(long, value_name = "FILE", conflicts_with_all = ["n0", "n1", "n2", "thickness_nm", "angle_deg", "method"])]
         batch: Option<String>,
     },
-    /// The full multi-layer BRDF for given directions and layer parameters (JSON).
+    /// The full multi-layer BRDF for given directions and layer parameters, as JSON:
+    /// {"model","f":[r,g,b],"specular":[r,g,b],"diffuse":[r,g,b]}, each per steradian and
+    /// without the cosine factor; "f" is the BRDF, the sum of the top's reflection
+    /// ("specular": single and multiple scattering) and what comes back from under it
+    /// ("diffuse").
     Eval(EvalArgs),
     /// The directional albedo for light from one angle, by numerical integration of a
     /// model or by a reference: {"model","albedo":[r,g,b],"specular":[r,g,b],"diffuse":[r,g,b]}
@@ -670,7 +676,10 @@ pub struct AlbedoArgs {
     pub method: Method,
     /// thesis | layered: the model's BRDF integrated over the hemisphere (64 × 64
     /// stratified half vectors for the specular lobe, 4096 midpoints in cos θ for the
-    /// diffuse lobe; within 2e-3 of the exact albedo on known cases). reference: the
+    /// diffuse lobe; within 2e-3 of the exact albedo on known cases to 88.5°: closer to
+    /// grazing a mirror-smooth top's lobe is narrower than the stratification, and at
+    /// roughness 0 the layered model reads 0.903 against the closed form's 0.906 at 89°, 0.878
+    /// against 0.990 at 89.9°). reference: the
     /// smooth-top stack in closed form (roughness ignored; Gauss–Legendre, ~1e-9).
     /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
     /// standard error per channel. The references read the exact 1 nm film (--method is

@@ -194,7 +194,11 @@ fn lambda(w: V3, alpha: f64) -> f64 {
 /// travelling up leaves with probability G1(w, h) = C1(h)^Λ(w); one travelling down always
 /// meets the surface.
 fn next_height(w: V3, h: f64, alpha: f64, u: f64) -> Option<f64> {
-    if w[2] > 0.9999 {
+    // A mirror-smooth top is a plane: whatever leaves it leaves, however grazing (the
+    // near-horizontal shortcut below kept a photon reflected at exactly 90° on the plane,
+    // reflecting until `MAX_EVENTS`, and `brdf albedo --model stochastic --roughness 0
+    // --angle-deg 90` read 0 where the closed form reads 1).
+    if w[2] > 0.9999 || (alpha == 0.0 && w[2] > 0.0) {
         return None;
     }
     if w[2] < -0.9999 {
@@ -612,6 +616,20 @@ mod tests {
             let sigma = (p * (1.0 - p) / photons as f64).sqrt();
             let e1 = smith_lobe_albedo(mu, roughness * roughness);
             assert!((p - e1).abs() <= 4.0 * sigma + 5e-4, "μ={mu} r={roughness}: walk {p:.4} ± {sigma:.4}, E₁ {e1:.4}");
+        }
+    }
+
+    /// Light along a mirror-smooth top, at exactly 90° (cos 6e-17): it meets the plane and
+    /// is reflected back out, every photon (the film here reflects everything).
+    #[test]
+    fn a_mirror_smooth_top_reflects_light_at_exactly_grazing() {
+        let stack = crate::optics::film::Stack::THESIS;
+        let film = FilmTables { stack, above: vec![[1.0; 3]; TABLE_SIZE], below: vec![[1.0; 3]; TABLE_SIZE] };
+        let layers = Layers { roughness: 0.0, ..Layers::of_stack(stack, 400.0, 0.0, [0.0; 3], [1.0; 3]) };
+        let wi = [1.0, 0.0, 90f64.to_radians().cos()];
+        let mut rng = Rng(3);
+        for _ in 0..1000 {
+            assert!(matches!(follow(wi, &layers, &film, walk_alpha(&layers), 0, &mut rng), Fate::Specular(1)));
         }
     }
 

@@ -61,7 +61,7 @@ pub fn check_preview_memory(
     frame_bytes: u64,
 ) -> Result<(), Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
-    check_memory(&graph, map_dimensions(loaded, map_size, layout), frame_bytes, "the preview's frame and its maps")
+    check_memory(&graph, map_dimensions(loaded, map_size, layout), frame_bytes, "the preview's frame with its maps")
 }
 
 /// Width and height of the preview's maps (`material_maps_in`): `map_size` wide, or the

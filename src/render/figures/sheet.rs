@@ -267,15 +267,14 @@ fn render_body_sheet(
         let clip = |text: String| text.chars().take(fits).collect::<String>();
         let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
         let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
-        let b = &preset.body;
-        let marks = preset
-            .pattern
-            .iter()
-            .find_map(|l| l.series_count())
-            .map(|n| format!(", {n} dorsal marks"))
-            .unwrap_or_default();
-        let bands = if b.tail_bands > 0 { format!(", {} tail bands", b.tail_bands) } else { String::new() };
-        let third = clip(format!("{} ventrals, {} subcaudals{marks}{bands}", b.ventrals, b.subcaudals));
+        let counts = crate::export::body_counts(preset, &body_plan(preset));
+        let plates = match (counts.ventrals, counts.subcaudals) {
+            (Some(ventrals), Some(subcaudals)) => format!("{ventrals} ventrals, {subcaudals} subcaudals"),
+            _ => "no ventral plates".into(),
+        };
+        let marks = counts.dorsal_marks.map(|n| format!(", {n} dorsal marks")).unwrap_or_default();
+        let bands = counts.tail_bands.map(|n| format!(", {n} tail bands")).unwrap_or_default();
+        let third = clip(format!("{plates}{marks}{bands}"));
         draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
         draw_text(&mut sheet, x0 + 6, y0 + 8 + 8 * LABEL_SCALE, &second, MUTED);
         draw_text(&mut sheet, x0 + 6, y0 + 12 + 16 * LABEL_SCALE, &third, MUTED);

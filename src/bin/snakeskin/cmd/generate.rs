@@ -80,12 +80,16 @@ pub fn run(args: GenerateArgs) -> Result<()> {
 }
 
 fn print_stats(stats: &EvalStats) {
-    eprintln!("{:<28} {:<36} {:>5} {:>10} {:>10}", "node", "operation", "evals", "ms", "MiB");
+    // Columns as wide as their longest entry (a long operation label pushed its row's
+    // numbers out of line).
+    let name_width = stats.nodes.iter().map(|n| n.name.chars().count()).chain([28]).max().unwrap_or(28);
+    let label_width = stats.nodes.iter().map(|n| n.label.chars().count()).chain([36]).max().unwrap_or(36);
+    eprintln!("{:<name_width$} {:<label_width$} {:>5} {:>10} {:>10}", "node", "operation", "evals", "ms", "MiB");
     let mut nodes = stats.nodes.clone();
     nodes.sort_by_key(|n| std::cmp::Reverse(n.time));
     for n in &nodes {
         eprintln!(
-            "{:<28} {:<36} {:>5} {:>10.2} {:>10.1}",
+            "{:<name_width$} {:<label_width$} {:>5} {:>10.2} {:>10.1}",
             n.name,
             n.label,
             n.evaluations,

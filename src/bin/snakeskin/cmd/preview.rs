@@ -50,6 +50,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     // (`ensure_parent_folder` checks the names again, where other commands rely on it).
     for file in std::iter::once(out).chain(args.reference.as_deref()) {
         snakeskin::export::check_png_target(file)?;
+        snakeskin::export::check_not_an_input(file, snakeskin::preset::input_file(&source.preset))?;
     }
     let frame_bytes = frame_bytes(width, height) + args.reference.as_ref().map_or(0, |_| gbuffer_bytes(width, height));
     let layout = args.layout.layout();
