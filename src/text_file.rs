@@ -19,8 +19,9 @@ pub enum BoundedReadError {
     TooLarge(u64),
 }
 
-/// Whether opening a path follows a symbolic link at its end: a user's input may be a link;
-/// a file of an earlier set never is one the set wrote (it is never followed).
+/// Whether opening a path follows a symbolic link at its end: a user's input may be a link,
+/// and so may a set a reader checks (kept as links, as git-annex keeps files); what a run
+/// may remove or replace is never reached through one (the set wrote none).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Links {
     Follow,
@@ -39,8 +40,8 @@ impl std::fmt::Display for BoundedReadError {
 
 /// Opens `path` for reading, without blocking (a FIFO would otherwise wait forever for a
 /// writer), and checks through the open handle that it is a regular file of at most `limit`
-/// bytes. The caller reads it with `take(limit.saturating_add(1))`, so a file growing after the check is
-/// not read past the bound either (`check_read_length`).
+/// bytes. The caller reads it with `take(limit.saturating_add(1))`, so a file growing after
+/// the check is not read past the bound either (`check_read_length`).
 pub fn open_bounded(path: &Path, limit: u64, links: Links) -> Result<std::fs::File, BoundedReadError> {
     let mut options = std::fs::OpenOptions::new();
     options.read(true);

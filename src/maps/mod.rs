@@ -293,10 +293,10 @@ fn build_height(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId {
 /// the skin) to the tallest surface its scales, plates and head shields can make
 /// (`scales::height_top`), each widened by the grain. No scale's top clips, and no groove
 /// between scales; skin showing where leaves or diamonds do not overlap, or round their
-/// head shields, reads 0 (the 16 bits go to the scales). The same for the tile and the body layout (the head's
-/// shields count in both): one scale per preset, as README says. (It assumed the leaf's
-/// profile for every shape, 0.3 to 0.6 + 0.3 imbrication: a third of a hexagon preset's
-/// height map clipped at 1 and a tenth at 0, its normal map flat there.)
+/// head shields, reads 0 (the 16 bits go to the scales). The same for the tile and the body
+/// layout (the head's shields count in both): one scale per preset, as README says. (It
+/// assumed the leaf's profile for every shape, 0.3 to 0.6 + 0.3 imbrication: a third of a
+/// hexagon preset's height map clipped at 1 and a tenth at 0, its normal map flat there.)
 pub fn height_range(preset: &Preset) -> (f32, f32) {
     use crate::ops::scales::{groove_floor, height_top};
     let field = scale_field(preset, Layout::Tile);
