@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::export::pack::Pack;
-use crate::export::{sha256_hex, verify_set, write_file_atomically};
+use crate::export::{sha256_hex, verify_set_json, write_file_atomically};
 use crate::generate::{GenerateRequest, Plan, check_set_outputs, set_file_names};
 use crate::maps::{BuildOptions, Layout};
 use crate::material::{FileFormat, MapKind, parse_map_list};
@@ -443,7 +443,7 @@ fn is_done(manifest: &Path, key: &str, expected: &[String]) -> bool {
     if json["job"].as_str() != Some(key) {
         return false;
     }
-    let Ok(set) = verify_set(manifest) else { return false };
+    let Ok(set) = verify_set_json(manifest, &json) else { return false };
     let name = |path: &Path| path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let mut listed: Vec<String> = set.files.iter().map(|(_, path)| name(path)).collect();
     listed.push(name(manifest));

@@ -248,18 +248,8 @@ pub fn set_file_sha256(path: &Path, limit: u64, links: Links) -> Result<String, 
     use sha2::Digest;
     use std::io::Read;
     let file = open_bounded(path, limit, links)?;
-    let mut reader = (&file).take(limit.saturating_add(1));
     let mut hasher = sha2::Sha256::new();
-    let mut buffer = vec![0u8; 1 << 16];
-    let mut read = 0u64;
-    loop {
-        let n = reader.read(&mut buffer).map_err(BoundedReadError::Io)?;
-        if n == 0 {
-            break;
-        }
-        hasher.update(&buffer[..n]);
-        read += n as u64;
-    }
+    let read = std::io::copy(&mut (&file).take(limit.saturating_add(1)), &mut hasher).map_err(BoundedReadError::Io)?;
     check_read_length(&file, read, limit)?;
     Ok(super::atomic::hex(&hasher.finalize()))
 }
@@ -287,8 +277,15 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
     })?;
     let json: serde_json::Value =
         serde_json::from_slice(&text).map_err(|e| problem(format!("the manifest is not valid JSON: {e}")))?;
+    verify_set_json(manifest_path, &json)
+}
+
+/// `verify_set` for a manifest already read (`json`, from `manifest_path`): `batch` reads it
+/// once for its job key and the files it lists.
+pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) -> Result<VerifiedSet, ExportError> {
+    let problem = |problem: String| ExportError::Verify { manifest: manifest_path.into(), problem };
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
-    let file_limit = set_file_max_bytes(&json);
+    let file_limit = set_file_max_bytes(json);
     let maps = json["maps"]
         .as_array()
         .filter(|m| !m.is_empty())

@@ -15,6 +15,7 @@ pub use atomic::{
     check_target, check_target_named, clean_up_before_exit, create_folder, ends_as_a_folder, same_path, sha256_hex,
     write_file_atomically,
 };
+pub(crate) use manifest::verify_set_json;
 pub use manifest::{
     Counts, Manifest, MapEntry, VerifiedSet, body_counts, manifest, manifest_file_name, read_set_manifest, verify_set,
 };

@@ -243,7 +243,8 @@ fn render_body_sheet(
         let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
         let mut maps =
             MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Internal(format!("the sheet's maps: {e}")))?;
-        maps.atlas = Some(body_plan(preset));
+        let body = body_plan(preset);
+        maps.atlas = Some(body);
         let optics = LayerOptics::from_preset(preset);
         let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
         let settings = FrameSettings {
@@ -267,7 +268,7 @@ fn render_body_sheet(
         let clip = |text: String| text.chars().take(fits).collect::<String>();
         let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
         let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
-        let counts = crate::export::body_counts(preset, &body_plan(preset));
+        let counts = crate::export::body_counts(preset, &body);
         let plates = match (counts.ventrals, counts.subcaudals) {
             (Some(ventrals), Some(subcaudals)) => format!("{ventrals} ventrals, {subcaudals} subcaudals"),
             _ => "no ventral plates".into(),
@@ -282,7 +283,7 @@ fn render_body_sheet(
         imageops::replace(&mut sheet, &strip, (x0 + 6) as i64, strip_y as i64);
         imageops::replace(&mut sheet, &render, (x0 + strip_w + 12) as i64, (y0 + label_h) as i64);
         if options.closeups {
-            for (k, camera) in head_and_tail_cameras(&body_plan(preset)).into_iter().enumerate() {
+            for (k, camera) in head_and_tail_cameras(&body).into_iter().enumerate() {
                 let settings = FrameSettings { camera, ..settings };
                 let close = renderer.render_image(&settings, &material, render_h, render_h)?;
                 let close = image::DynamicImage::ImageRgba8(close).into_rgb8();

@@ -82,8 +82,8 @@ pub fn run(args: GenerateArgs) -> Result<()> {
 fn print_stats(stats: &EvalStats) {
     // Columns as wide as their longest entry (a long operation label pushed its row's
     // numbers out of line).
-    let name_width = stats.nodes.iter().map(|n| n.name.chars().count()).chain([28]).max().unwrap_or(28);
-    let label_width = stats.nodes.iter().map(|n| n.label.chars().count()).chain([36]).max().unwrap_or(36);
+    let name_width = stats.nodes.iter().map(|n| n.name.chars().count()).fold(28, usize::max);
+    let label_width = stats.nodes.iter().map(|n| n.label.chars().count()).fold(36, usize::max);
     eprintln!("{:<name_width$} {:<label_width$} {:>5} {:>10} {:>10}", "node", "operation", "evals", "ms", "MiB");
     let mut nodes = stats.nodes.clone();
     nodes.sort_by_key(|n| std::cmp::Reverse(n.time));
