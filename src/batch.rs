@@ -388,7 +388,7 @@ pub struct JobOutcome {
     /// The index of the earlier identical job, for a `duplicate`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub duplicate_of: Option<usize>,
-    /// The earlier set's files that stayed beside the job's new set (`GenerateReport::kept`):
+    /// The files of the set's names that stayed beside the job's new set (`GenerateReport::kept`):
     /// for the caller to warn of, as `generate` does (not in the index).
     #[serde(skip)]
     pub kept: Vec<crate::export::KeptFile>,

@@ -57,8 +57,9 @@ pub struct GenerateReport {
     pub constant_maps: Vec<(MapKind, f32)>,
     /// The earlier set's files that went with it because this set does not write them.
     pub removed: Vec<PathBuf>,
-    /// The earlier set's files that this set does not write and that stayed (changed since,
-    /// or would not move), with why: to warn of.
+    /// The files of the set's names that this set does not write and that stayed (changed
+    /// since, would not move, or recorded by no manifest that could be read), with why: to
+    /// warn of.
     pub kept: Vec<crate::export::KeptFile>,
 }
 
@@ -592,8 +593,9 @@ pub const STRIP_BUFFER_BUDGET_BYTES: u64 = 640 << 20;
 /// (2 to 16) whose buffers, margins included, fit `STRIP_BUFFER_BUDGET_BYTES` (the margins
 /// are recomputed rows, so fewer strips cost less time: measured at 4096², three strips
 /// instead of four took Natrix natrix from 5.5–5.7 s to 5.0 s); if none fits, the most
-/// strips whose margins still leave each shorter than the texture (None if even two cannot). `SNAKESKIN_TILE_BUDGET_MIB` replaces both budgets (how the tests send small tiles
-/// through strips).
+/// strips whose margins still leave each shorter than the texture (None if even two
+/// cannot). `SNAKESKIN_TILE_BUDGET_MIB` replaces both budgets (how the tests send small
+/// tiles through strips).
 fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Option<Strips> {
     let margin = graph.row_reach(maps, width);
     if height > width {

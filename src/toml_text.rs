@@ -42,6 +42,14 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
         message = message.replacen("invalid type: table", "invalid type: a date or time", 1);
     }
     let mut at = span.as_ref().map(|s| s.start);
+    // A key that looks right but holds a look-alike (a Cyrillic `а` in `scаles`, a
+    // non-breaking space): the reader's "invalid unquoted key" does not say which character.
+    let refused = span.as_ref().and_then(|s| text.get(s.start..)).and_then(|rest| rest.chars().next());
+    if message.starts_with("invalid unquoted key")
+        && let Some(c) = refused.filter(|c| !c.is_ascii())
+    {
+        message = format!("{message}; `{c}` (U+{:04X}) is not one of them, though it may look like one", c as u32);
+    }
     if message == "recursion limit" || message.starts_with("cannot recurse further") {
         message = format!(
             "keys, tables or arrays nested more than {TOML_NESTING_LIMIT} levels deep (no key of a preset or jobs file \

@@ -369,7 +369,7 @@ fn a_batch_warns_of_an_earlier_file_that_stays() {
     std::fs::write(dir.path().join("p.toml"), without_film).unwrap();
     let out = run();
     assert!(out.status.success(), "{}", stderr(&out));
-    let warning = format!("warning: kept {}, the earlier set's file that this set does not write", thickness.display());
+    let warning = format!("warning: kept {}, which this set does not write: it changed since", thickness.display());
     assert!(stderr(&out).contains(&warning) && stderr(&out).contains("it changed since"), "{}", stderr(&out));
     assert!(thickness.exists());
 }

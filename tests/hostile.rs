@@ -290,6 +290,28 @@ fn manifest_of(dir: &Path) -> std::path::PathBuf {
     dir.join(format!("{PRESET}.material.json"))
 }
 
+/// A run that fails before its commit leaves no folder it made (before: the output folder
+/// and its missing parents stayed, empty). Negative control: a folder that was there stays.
+#[test]
+fn a_failed_run_leaves_no_empty_folder_it_made() {
+    if !fault_hooks_exist() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fail = [("SNAKESKIN_TEST_FAIL_AT_RENAME", "0")];
+    let out = generate_into(&dir.path().join("new/deeper"), "1", &fail);
+    assert!(!out.status.success() && stderr(&out).contains("injected failure"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "new/deeper and new are gone");
+    std::fs::create_dir(dir.path().join("there")).unwrap();
+    let out = generate_into(&dir.path().join("there"), "1", &fail);
+    assert!(!out.status.success(), "{}", stderr(&out));
+    assert!(dir.path().join("there").is_dir(), "a folder the run did not make stays");
+    assert_eq!(std::fs::read_dir(dir.path().join("there")).unwrap().count(), 0);
+    // A run that succeeds keeps the folder it made, with its set.
+    assert!(generate_into(&dir.path().join("made"), "1", &[]).status.success());
+    snakeskin::export::verify_set(&manifest_of(&dir.path().join("made"))).unwrap();
+}
+
 #[test]
 fn a_folder_in_the_way_leaves_the_earlier_set_whole() {
     let dir = tempfile::tempdir().unwrap();
@@ -387,9 +409,8 @@ fn a_set_written_over_another_leaves_none_of_its_maps() {
     );
     assert_eq!(err.matches("note: removed").count(), 3, "normal, roughness, iridescence: {err}");
     // The edited map stays, and is said to (before, without a word): a warning naming it.
-    let kept_warning =
-        format!("warning: kept {}, the earlier set's file that this set does not write", edited.display());
-    assert!(err.contains(&kept_warning) && err.contains("it changed since that set wrote it"), "{err}");
+    let kept_warning = format!("warning: kept {}, which this set does not write", edited.display());
+    assert!(err.contains(&kept_warning) && err.contains("it changed since the earlier set wrote it"), "{err}");
     assert_eq!(err.matches("warning: kept").count(), 1, "only the edited map (not the other sets' files): {err}");
     let set = |maps: &[&str]| -> Vec<String> {
         let mut files: Vec<String> = maps.iter().map(|m| format!("{PRESET}_{m}")).collect();
@@ -415,6 +436,52 @@ fn a_set_written_over_another_leaves_none_of_its_maps() {
     let out = snakeskin(&["generate", "natrix-natrix", "-o", dir.path().to_str().unwrap(), "--size", "32"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(names(dir.path()).contains(&format!("{PRESET}_color.exr")));
+}
+
+/// Files of the set's names that no readable manifest claims (the manifest damaged or
+/// deleted, or a map kept by an earlier run) stay beside a smaller set, and each is said
+/// with why: before, they stayed without a word, a mixed set of two seeds under one name.
+/// Negative control: a set written over a whole earlier set says nothing.
+#[test]
+fn files_no_manifest_claims_are_kept_and_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = |name: &str| dir.path().join(format!("{PRESET}_{name}.png"));
+    let colour_only = |dir: &Path| {
+        let out = snakeskin(&["generate", PRESET, "-o", dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let kept = |err: &str, name: &str, why: &str| {
+        let warning = format!("warning: kept {}, which this set does not write: {why}", map(name).display());
+        assert!(err.contains(&warning), "{name}: {err}");
+    };
+    let out = generate_into(dir.path(), "1", &[]);
+    assert!(out.status.success() && !stderr(&out).contains("warning"), "{}", stderr(&out));
+    let out = generate_into(dir.path(), "1", &[]);
+    assert!(!stderr(&out).contains("warning: kept"), "a whole set over a whole set: {}", stderr(&out));
+    let whole_set = std::fs::read_dir(dir.path()).unwrap().count();
+
+    // A damaged manifest: the earlier maps are not known to be its set's; they stay, said.
+    std::fs::write(manifest_of(dir.path()), b"{damaged").unwrap();
+    let err = colour_only(dir.path());
+    for name in ["height", "normal", "roughness", "iridescence"] {
+        kept(&err, name, "the manifest there could not be read (not JSON");
+    }
+    assert_eq!(err.matches("warning: kept").count(), 4, "{err}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), whole_set, "nothing removed");
+    // The new manifest does not record them: said again on the next run.
+    let err = colour_only(dir.path());
+    kept(&err, "height", "the manifest there does not record it");
+    assert_eq!(err.matches("warning: kept").count(), 4, "{err}");
+    // No manifest at all.
+    std::fs::remove_file(manifest_of(dir.path())).unwrap();
+    let err = colour_only(dir.path());
+    kept(&err, "normal", "no manifest of this set's name is there");
+    assert_eq!(err.matches("warning: kept").count(), 4, "{err}");
+    // A whole set writes them all again: nothing left to say.
+    let out = generate_into(dir.path(), "1", &[]);
+    assert!(!stderr(&out).contains("warning: kept"), "{}", stderr(&out));
+    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
 }
 
 /// A smaller set over a whole one (the old manifest and colour map aside, renames 0 and 1;
@@ -448,9 +515,10 @@ fn a_failed_rename_or_a_kill_in_a_smaller_set_leaves_no_mixed_set_and_no_tempora
             let stayed: Vec<_> = before.keys().filter(|p| p.exists() && !new_set(p)).collect();
             assert_eq!(stayed.len(), 1, "rename {at}: the one old map that would not move stays: {stayed:?}");
             // And is said to stay, with the error (before, the run was silent about it).
-            let warning = format!("warning: kept {}, the earlier set's file", stayed[0].display());
+            let warning = format!("warning: kept {}, which this set does not write", stayed[0].display());
             assert!(stderr(&out).contains(&warning), "rename {at}: {}", stderr(&out));
-            assert!(stderr(&out).contains("it could not be removed ("), "rename {at}: {}", stderr(&out));
+            let why = "it is the earlier set's and could not be removed (";
+            assert!(stderr(&out).contains(why), "rename {at}: {}", stderr(&out));
         } else {
             assert_eq!(out.status.code(), Some(1), "rename {at}: {}", stderr(&out));
             assert_eq!(snapshot(dir.path()), before, "rename {at}: the earlier set changed");
@@ -1641,6 +1709,15 @@ fn type_errors_name_the_range_and_missing_kinds_the_choices() {
     assert!(e.contains("p.toml:2:8: key `scales.rows`") && e.contains("expected a whole number in [4, 128]"), "{e}");
     let e = run("seed = 1\n", &["scales.rows=nan"]);
     assert!(e.contains("expected a whole number in [4, 128]"), "{e}");
+    // The seed too (before: "expected a whole number", no range), and its type's refusal
+    // of a negative in the same words.
+    let e = run("seed = 1.5\n", &[]);
+    assert!(
+        e.contains("p.toml:1:8: key `seed`") && e.contains("expected a whole number in [0, 18446744073709551615]"),
+        "{e}"
+    );
+    let e = run("seed = -3\n", &[]);
+    assert!(e.contains("key `seed`: must be an integer in [0, 18446744073709551615], got -3"), "{e}");
     let e = run("[[pattern]]\ncolor = \"#101010\"\n", &[]);
     assert!(e.contains("missing field `kind`: every layer needs its kind, one of solid, stripes, rings"), "{e}");
 }

@@ -351,15 +351,19 @@ pub struct SetLock {
     _file: File,
     /// Whether acquiring created the output folder.
     pub created_folder: bool,
+    /// The folders acquiring created, the output folder first, then each missing parent:
+    /// those still empty when the lock goes are removed (a run that failed leaves no empty
+    /// folders behind; `remove_dir` removes only an empty one, so a set's folder stays).
+    created: Vec<PathBuf>,
     /// The earlier set's files a commit removed (`left_over_files`), for the caller to say.
     removed: Mutex<Vec<PathBuf>>,
-    /// The earlier set's files that the new set does not write and that stayed, with why:
-    /// for the caller to warn of (they lie beside the new set under no manifest).
+    /// The files of the set's names that the new set does not write and that stayed, with
+    /// why: for the caller to warn of (they lie beside the new set under no manifest).
     kept: Mutex<Vec<KeptFile>>,
 }
 
-/// An earlier set's file that stays beside the new set although the new set does not write
-/// it (`SetLock::kept`).
+/// A file of the set's names (an earlier set's, or one no readable manifest claims) that stays
+/// beside the new set although the new set does not write it (`SetLock::kept`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KeptFile {
     pub path: PathBuf,
@@ -375,6 +379,12 @@ pub enum KeptBecause {
     Unreadable(String),
     /// It would not move aside (immutable, or its folder refuses): the error.
     WouldNotMove(String),
+    /// No manifest of the set's name was there to say whose it is.
+    NoManifest,
+    /// The manifest there could not be read to say whose it is: the error.
+    ManifestUnreadable(String),
+    /// The manifest there does not record it.
+    NotRecorded,
 }
 
 /// Why a file stayed, for a warning that names the file (escaped as the caller prints paths).
@@ -382,12 +392,22 @@ impl std::fmt::Display for KeptBecause {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             KeptBecause::ChangedSince => {
-                write!(f, "it changed since that set wrote it, so it is not the set's to remove")
+                write!(f, "it changed since the earlier set wrote it, so it is not that set's to remove")
             }
             KeptBecause::Unreadable(error) => {
-                write!(f, "it could not be read to compare with that set's record ({error})")
+                write!(f, "it could not be read to compare with the earlier set's record ({error})")
             }
-            KeptBecause::WouldNotMove(error) => write!(f, "it could not be removed ({error})"),
+            KeptBecause::WouldNotMove(error) => write!(f, "it is the earlier set's and could not be removed ({error})"),
+            KeptBecause::NoManifest => {
+                write!(f, "no manifest of this set's name is there, so nothing says it is a set's to remove")
+            }
+            KeptBecause::ManifestUnreadable(error) => write!(
+                f,
+                "the manifest there could not be read ({error}), so nothing says it is the earlier set's to remove"
+            ),
+            KeptBecause::NotRecorded => {
+                write!(f, "the manifest there does not record it, so it is not the earlier set's to remove")
+            }
         }
     }
 }
@@ -395,6 +415,11 @@ impl std::fmt::Display for KeptBecause {
 impl SetLock {
     /// Locks the set `name` in `dir`, creating the folder if it is missing.
     pub fn acquire(dir: &Path, name: &str) -> Result<SetLock, ExportError> {
+        let missing: Vec<PathBuf> = dir
+            .ancestors()
+            .take_while(|p| !p.as_os_str().is_empty() && fs::symlink_metadata(p).is_err())
+            .map(PathBuf::from)
+            .collect();
         let created_folder = create_folder(dir)?;
         let path = dir.join(format!(".{name}.lock"));
         let mut options = fs::OpenOptions::new();
@@ -404,7 +429,16 @@ impl SetLock {
         // A run that ends removes the lock file; if that happened between our open and our
         // lock, we hold a lock on a file nobody else will open: open again.
         for _ in 0..8 {
-            let file = options.open(&path).map_err(io_error(&path))?;
+            let file = match options.open(&path) {
+                Ok(file) => file,
+                // Another run's lock removed the empty folder it had made (`created`) between
+                // our making sure of it and opening the lock: make it again.
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                    create_folder(dir)?;
+                    continue;
+                }
+                Err(e) => return Err(io_error(&path)(e)),
+            };
             match file.try_lock() {
                 Ok(()) if same_file(&file, &path) => {
                     // Under the lock every temporary of the set's names is stale: a run killed
@@ -417,6 +451,7 @@ impl SetLock {
                         path,
                         _file: file,
                         created_folder,
+                        created: if created_folder { missing } else { Vec::new() },
                         removed: Mutex::new(Vec::new()),
                         kept: Mutex::new(Vec::new()),
                     });
@@ -444,8 +479,9 @@ impl SetLock {
         self.removed.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
 
-    /// The earlier set's files that commits left in place although the new set does not
-    /// write them (changed since, or would not move), with why.
+    /// The files of the set's names that commits left in place although the new set does not
+    /// write them (changed since, would not move, or recorded by no readable manifest), with
+    /// why.
     pub fn kept(&self) -> Vec<KeptFile> {
         self.kept.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
@@ -620,20 +656,58 @@ impl FileGroup {
 /// its folder): an edited manifest cannot make a commit remove another set's files or
 /// anything else. Best effort: a file that will not move aside (immutable, held open
 /// elsewhere) stays, as before such files went at all. Returns the files to remove and the
-/// set's files that stay because they changed since or cannot be read (to be said).
+/// files of the set's names that stay beside the new set although it does not write them,
+/// with why (to be said): changed since, unreadable, or recorded by no manifest that could
+/// be read (a manifest deleted or damaged: the files left were silent before).
 fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<KeptFile>) {
-    let nothing = (Vec::new(), Vec::new());
     let Some(set_name) = file_name(manifest).strip_suffix(super::manifest::MANIFEST_SUFFIX).map(String::from) else {
-        return nothing;
+        return (Vec::new(), Vec::new());
     };
-    let set_files = super::every_set_file_name(&set_name);
-    let Ok(text) = super::manifest::read_set_manifest(manifest, crate::text_file::Links::Refuse) else {
-        return nothing;
-    };
-    let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return nothing };
-    let Some(entries) = json["maps"].as_array() else { return nothing };
-    let file_limit = super::manifest::set_file_max_bytes(&json);
     let dir = manifest.parent().unwrap_or(Path::new("."));
+    let set_files = super::every_set_file_name(&set_name);
+    let (files, mut kept, unrecorded_because) = recorded_left_overs(manifest, dir, &set_files, targets);
+    // Every other file of the set's names that the new set does not write stays where it is
+    // (nothing says it is a set's to remove) and is said: it lies beside the new set under no
+    // manifest.
+    for name in &set_files {
+        let path = dir.join(name);
+        let accounted = path == manifest
+            || targets.contains(&&path)
+            || files.contains(&path)
+            || kept.iter().any(|k| k.path == path);
+        if !accounted && fs::symlink_metadata(&path).is_ok() {
+            kept.push(KeptFile { path, why: unrecorded_because.clone() });
+        }
+    }
+    (files, kept)
+}
+
+/// `left_over_files`' reading of the old manifest: the files it records that are still as
+/// recorded (to remove), those it records that changed or cannot be read (to keep), and why
+/// any other file of the set's names is kept (no manifest, a manifest that could not be
+/// read, or one that does not record it).
+fn recorded_left_overs(
+    manifest: &Path,
+    dir: &Path,
+    set_files: &[String],
+    targets: &[&PathBuf],
+) -> (Vec<PathBuf>, Vec<KeptFile>, KeptBecause) {
+    let unreadable = |error: String| (Vec::new(), Vec::new(), KeptBecause::ManifestUnreadable(error));
+    if fs::symlink_metadata(manifest).is_err() {
+        return (Vec::new(), Vec::new(), KeptBecause::NoManifest);
+    }
+    let text = match super::manifest::read_set_manifest(manifest, crate::text_file::Links::Refuse) {
+        Ok(text) => text,
+        Err(e) => return unreadable(e.to_string()),
+    };
+    let json = match serde_json::from_slice::<serde_json::Value>(&text) {
+        Ok(json) => json,
+        Err(e) => return unreadable(format!("not JSON: {e}")),
+    };
+    let Some(entries) = json["maps"].as_array() else {
+        return unreadable("it has no \"maps\" list".into());
+    };
+    let file_limit = super::manifest::set_file_max_bytes(&json);
     let (mut files, mut changed): (Vec<PathBuf>, Vec<KeptFile>) = (Vec::new(), Vec::new());
     for entry in entries {
         let (Some(file), Some(recorded)) = (entry["file"].as_str(), entry["sha256"].as_str()) else { continue };
@@ -657,7 +731,7 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<
             changed.push(KeptFile { path, why });
         }
     }
-    (files, changed)
+    (files, changed, KeptBecause::NotRecorded)
 }
 
 /// Undoes a commit that failed: removes the new files already in place and renames the old
@@ -750,9 +824,15 @@ pub struct Staged {
 }
 
 impl Drop for SetLock {
-    /// Removes the lock file while still holding the lock (see `acquire`).
+    /// Removes the lock file while still holding the lock (see `acquire`), then the folders
+    /// acquiring created if they are still empty (the run failed before its commit).
     fn drop(&mut self) {
         let _ = fs::remove_file(&self.path);
+        for folder in &self.created {
+            if fs::remove_dir(folder).is_err() {
+                break;
+            }
+        }
     }
 }
 

@@ -112,7 +112,7 @@ impl Checker {
         let range = match whole_number_range(key) {
             Some(WholeRange::Fixed(range)) => range,
             Some(WholeRange::HalfTheRows) => (0, rows / 2),
-            None => unreachable!("{key} is not in whole_number_range's table"),
+            Some(WholeRange::EveryU64) | None => unreachable!("{key} is not a u32 key of whole_number_range's table"),
         };
         self.int_range(key, value, range);
     }
@@ -177,6 +177,8 @@ pub enum WholeRange {
     Fixed((u32, u32)),
     /// 0 to half of `scales.rows` (rows that change, counted from the spine or the belly).
     HalfTheRows,
+    /// Every value of its type, a u64 (`seed`): the reader's check is the range check.
+    EveryU64,
 }
 
 /// The range of every whole-number key, one table for the range checks and for a value the
@@ -185,6 +187,7 @@ pub enum WholeRange {
 pub fn whole_number_range(key: &str) -> Option<WholeRange> {
     use ranges::*;
     Some(match key {
+        "seed" => WholeRange::EveryU64,
         "scales.rows" => WholeRange::Fixed(ROWS),
         "scales.smooth_rows" | "belly.up_rows" => WholeRange::HalfTheRows,
         "body.ventrals" => WholeRange::Fixed(VENTRALS),
@@ -206,6 +209,7 @@ pub fn whole_number_range_words(key: &str) -> Option<String> {
     Some(match whole_number_range(key)? {
         WholeRange::Fixed((lo, hi)) => format!("[{lo}, {hi}]"),
         WholeRange::HalfTheRows => "[0, scales.rows / 2]".to_string(),
+        WholeRange::EveryU64 => format!("[0, {}]", u64::MAX),
     })
 }
 

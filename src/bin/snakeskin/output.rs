@@ -161,10 +161,10 @@ pub fn path_line(path: &Path) -> String {
     printable(&path.display().to_string()).replace('\n', "\\n")
 }
 
-/// An earlier set's file that stayed beside the new set (`GenerateReport::kept`), in words:
+/// A file of the set's names that stayed beside the new set (`GenerateReport::kept`), in words:
 /// its path escaped as every listed path is, and why.
 pub fn kept_words(kept: &snakeskin::export::KeptFile) -> String {
-    format!("kept {}, the earlier set's file that this set does not write: {}", path_line(&kept.path), kept.why)
+    format!("kept {}, which this set does not write: {}", path_line(&kept.path), kept.why)
 }
 
 /// Creates the folder a single output file goes into when it is missing, and says so on
