@@ -157,8 +157,9 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
     let created_folder;
     let files = if binary {
         let bytes = glb(&name, &mesh, material, &textures)?;
-        created_folder = crate::export::create_folder(&dir)?;
-        vec![write_file_atomically(&request.out, bytes)?]
+        created_folder = crate::export::create_folder_noted(&dir)?;
+        // A write that fails takes away the folders it made, as a set's lock does.
+        vec![write_file_atomically(&request.out, bytes).inspect_err(|_| crate::export::remove_empty_made_folders())?]
     } else {
         let mut files = gltf_files(&name, &mesh, material, &textures)?;
         let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");

@@ -48,7 +48,10 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
     if message.starts_with("invalid unquoted key")
         && let Some(c) = refused.filter(|c| !c.is_ascii())
     {
-        message = format!("{message}; `{c}` (U+{:04X}) is not one of them, though it may look like one", c as u32);
+        message = format!(
+            "{message} (ASCII only); `{c}` (U+{:04X}) is not ASCII, though it may look like a letter",
+            c as u32
+        );
     }
     if message == "recursion limit" || message.starts_with("cannot recurse further") {
         message = format!(

@@ -465,7 +465,7 @@ fn files_no_manifest_claims_are_kept_and_said() {
     std::fs::write(manifest_of(dir.path()), b"{damaged").unwrap();
     let err = colour_only(dir.path());
     for name in ["height", "normal", "roughness", "iridescence"] {
-        kept(&err, name, "the manifest there could not be read (not JSON");
+        kept(&err, name, "the manifest there could not be used (not JSON");
     }
     assert_eq!(err.matches("warning: kept").count(), 4, "{err}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), whole_set, "nothing removed");
@@ -476,7 +476,7 @@ fn files_no_manifest_claims_are_kept_and_said() {
     // No manifest at all.
     std::fs::remove_file(manifest_of(dir.path())).unwrap();
     let err = colour_only(dir.path());
-    kept(&err, "normal", "no manifest of this set's name is there");
+    kept(&err, "normal", &format!("no {PRESET}.material.json is there to say it is an earlier set's"));
     assert_eq!(err.matches("warning: kept").count(), 4, "{err}");
     // A whole set writes them all again: nothing left to say.
     let out = generate_into(dir.path(), "1", &[]);

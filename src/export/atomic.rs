@@ -305,6 +305,45 @@ fn resolved(path: &Path) -> Option<PathBuf> {
     Some(out)
 }
 
+/// The folders this process made for its outputs (`create_folder_noted`): the output folders
+/// and their missing parents, for `remove_empty_made_folders`. One list for the process,
+/// since a batch's jobs may share a parent that one of them made.
+static MADE_FOLDERS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// `create_folder`, noting each folder it made so that a run that fails can take them away
+/// again (`remove_empty_made_folders`): the parts of the path below its deepest existing
+/// folder, up to the first `..` or `.` (`c/../there/d` with `c` missing notes `c` alone:
+/// `c/../there` is a folder that was there, and `d` under it is left as made).
+pub fn create_folder_noted(dir: &Path) -> Result<bool, ExportError> {
+    let existing = dir.ancestors().find(|p| p.as_os_str().is_empty() || fs::symlink_metadata(p).is_ok());
+    let mut missing = Vec::new();
+    if let Some(existing) = existing
+        && let Ok(below) = dir.strip_prefix(existing)
+    {
+        let mut folder = existing.to_path_buf();
+        for part in below.components() {
+            let std::path::Component::Normal(name) = part else { break };
+            folder.push(name);
+            missing.push(folder.clone());
+        }
+    }
+    let created = create_folder(dir)?;
+    if created {
+        locked(&MADE_FOLDERS).extend(missing);
+    }
+    Ok(created)
+}
+
+/// Removes every folder `create_folder_noted` made that is empty now, deepest first, so a
+/// run that failed before its commit leaves no empty folders behind (its lock's drop calls
+/// this, and so does an export that failed). `remove_dir` removes only an empty folder: a
+/// set's folder, or one another job is writing into (its lock file is there), stays.
+pub fn remove_empty_made_folders() {
+    let mut made = locked(&MADE_FOLDERS);
+    made.sort_by_key(|folder| std::cmp::Reverse(folder.components().count()));
+    made.retain(|folder| fs::remove_dir(folder).is_err());
+}
+
 /// Creates an output folder if needed (true when it was created); a path that exists and is
 /// not a folder is `ExportError::NotAFolder`. Every output path goes through here.
 pub fn create_folder(dir: &Path) -> Result<bool, ExportError> {
@@ -351,10 +390,6 @@ pub struct SetLock {
     _file: File,
     /// Whether acquiring created the output folder.
     pub created_folder: bool,
-    /// The folders acquiring created, the output folder first, then each missing parent:
-    /// those still empty when the lock goes are removed (a run that failed leaves no empty
-    /// folders behind; `remove_dir` removes only an empty one, so a set's folder stays).
-    created: Vec<PathBuf>,
     /// The earlier set's files a commit removed (`left_over_files`), for the caller to say.
     removed: Mutex<Vec<PathBuf>>,
     /// The files of the set's names that the new set does not write and that stayed, with
@@ -379,8 +414,8 @@ pub enum KeptBecause {
     Unreadable(String),
     /// It would not move aside (immutable, or its folder refuses): the error.
     WouldNotMove(String),
-    /// No manifest of the set's name was there to say whose it is.
-    NoManifest,
+    /// No manifest of the set's name (the file name) was there to say whose it is.
+    NoManifest(String),
     /// The manifest there could not be read to say whose it is: the error.
     ManifestUnreadable(String),
     /// The manifest there does not record it.
@@ -398,12 +433,12 @@ impl std::fmt::Display for KeptBecause {
                 write!(f, "it could not be read to compare with the earlier set's record ({error})")
             }
             KeptBecause::WouldNotMove(error) => write!(f, "it is the earlier set's and could not be removed ({error})"),
-            KeptBecause::NoManifest => {
-                write!(f, "no manifest of this set's name is there, so nothing says it is a set's to remove")
+            KeptBecause::NoManifest(manifest) => {
+                write!(f, "no {manifest} is there to say it is an earlier set's to remove")
             }
             KeptBecause::ManifestUnreadable(error) => write!(
                 f,
-                "the manifest there could not be read ({error}), so nothing says it is the earlier set's to remove"
+                "the manifest there could not be used ({error}), so nothing says it is the earlier set's to remove"
             ),
             KeptBecause::NotRecorded => {
                 write!(f, "the manifest there does not record it, so it is not the earlier set's to remove")
@@ -415,12 +450,7 @@ impl std::fmt::Display for KeptBecause {
 impl SetLock {
     /// Locks the set `name` in `dir`, creating the folder if it is missing.
     pub fn acquire(dir: &Path, name: &str) -> Result<SetLock, ExportError> {
-        let missing: Vec<PathBuf> = dir
-            .ancestors()
-            .take_while(|p| !p.as_os_str().is_empty() && fs::symlink_metadata(p).is_err())
-            .map(PathBuf::from)
-            .collect();
-        let created_folder = create_folder(dir)?;
+        let created_folder = create_folder_noted(dir)?;
         let path = dir.join(format!(".{name}.lock"));
         let mut options = fs::OpenOptions::new();
         options.create(true).truncate(false).write(true);
@@ -428,13 +458,18 @@ impl SetLock {
         std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW);
         // A run that ends removes the lock file; if that happened between our open and our
         // lock, we hold a lock on a file nobody else will open: open again.
+        let mut missing = None;
         for _ in 0..8 {
             let file = match options.open(&path) {
                 Ok(file) => file,
-                // Another run's lock removed the empty folder it had made (`created`) between
-                // our making sure of it and opening the lock: make it again.
+                // A failed job of this batch removed the empty folder between our making it
+                // and opening the lock (`remove_empty_made_folders`): make it again.
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                    create_folder(dir)?;
+                    missing = Some(e);
+                    match create_folder_noted(dir) {
+                        Err(ExportError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {}
+                        other => drop(other?),
+                    }
                     continue;
                 }
                 Err(e) => return Err(io_error(&path)(e)),
@@ -451,7 +486,6 @@ impl SetLock {
                         path,
                         _file: file,
                         created_folder,
-                        created: if created_folder { missing } else { Vec::new() },
                         removed: Mutex::new(Vec::new()),
                         kept: Mutex::new(Vec::new()),
                     });
@@ -463,7 +497,11 @@ impl SetLock {
                 Err(fs::TryLockError::Error(source)) => return Err(ExportError::Io { path, source }),
             }
         }
-        Err(ExportError::Busy { dir: dir.into(), name: name.into() })
+        // Eight tries, each lost to a run that ended or to a folder that went: say which.
+        Err(match missing {
+            Some(source) => ExportError::Io { path, source },
+            None => ExportError::Busy { dir: dir.into(), name: name.into() },
+        })
     }
 
     /// Writes the set: `maps` (file name, bytes) first, then `manifest` (file name, bytes)
@@ -694,7 +732,7 @@ fn recorded_left_overs(
 ) -> (Vec<PathBuf>, Vec<KeptFile>, KeptBecause) {
     let unreadable = |error: String| (Vec::new(), Vec::new(), KeptBecause::ManifestUnreadable(error));
     if fs::symlink_metadata(manifest).is_err() {
-        return (Vec::new(), Vec::new(), KeptBecause::NoManifest);
+        return (Vec::new(), Vec::new(), KeptBecause::NoManifest(file_name(manifest)));
     }
     let text = match super::manifest::read_set_manifest(manifest, crate::text_file::Links::Refuse) {
         Ok(text) => text,
@@ -710,26 +748,29 @@ fn recorded_left_overs(
     let file_limit = super::manifest::set_file_max_bytes(&json);
     let (mut files, mut changed): (Vec<PathBuf>, Vec<KeptFile>) = (Vec::new(), Vec::new());
     for entry in entries {
-        let (Some(file), Some(recorded)) = (entry["file"].as_str(), entry["sha256"].as_str()) else { continue };
+        let Some(file) = entry["file"].as_str() else { continue };
         let path = dir.join(file);
-        if !set_files.iter().any(|name| name == file) || targets.contains(&&path) || files.contains(&path) {
+        let seen = files.contains(&path) || changed.iter().any(|k| k.path == path);
+        if !set_files.iter().any(|name| name == file) || targets.contains(&&path) || seen {
             continue;
         }
-        // A regular file, not a link (never followed) or a folder.
-        if !fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
-            continue;
-        }
-        let why = match super::manifest::set_file_sha256(&path, file_limit, crate::text_file::Links::Refuse) {
-            Ok(actual) if actual == recorded => {
-                files.push(path);
-                continue;
+        let Ok(meta) = fs::symlink_metadata(&path) else { continue };
+        // A regular file as its record's digest says goes. A link (never followed), a folder,
+        // or a record without its digest is no longer what the set wrote.
+        let why = match entry["sha256"].as_str() {
+            Some(recorded) if meta.is_file() => {
+                match super::manifest::set_file_sha256(&path, file_limit, crate::text_file::Links::Refuse) {
+                    Ok(actual) if actual == recorded => {
+                        files.push(path);
+                        continue;
+                    }
+                    Ok(_) => KeptBecause::ChangedSince,
+                    Err(e) => KeptBecause::Unreadable(e.to_string()),
+                }
             }
-            Ok(_) => KeptBecause::ChangedSince,
-            Err(e) => KeptBecause::Unreadable(e.to_string()),
+            _ => KeptBecause::ChangedSince,
         };
-        if !changed.iter().any(|k| k.path == path) {
-            changed.push(KeptFile { path, why });
-        }
+        changed.push(KeptFile { path, why });
     }
     (files, changed, KeptBecause::NotRecorded)
 }
@@ -825,14 +866,10 @@ pub struct Staged {
 
 impl Drop for SetLock {
     /// Removes the lock file while still holding the lock (see `acquire`), then the folders
-    /// acquiring created if they are still empty (the run failed before its commit).
+    /// this process made that are empty now (the run failed before its commit).
     fn drop(&mut self) {
         let _ = fs::remove_file(&self.path);
-        for folder in &self.created {
-            if fs::remove_dir(folder).is_err() {
-                break;
-            }
-        }
+        remove_empty_made_folders();
     }
 }
 
@@ -933,5 +970,31 @@ mod tests {
         let error = temporary(Path::new("/sys"), "x.png").unwrap_err().to_string();
         assert!(!error.contains(TMP_SUFFIX) && !error.contains("at path"), "{error}");
         assert!(error.contains("(os error"), "the OS's reason is kept: {error}");
+    }
+
+    /// Folders a failed run made go when its lock goes: a parent another lock made too (a
+    /// batch's jobs share `out/PRESET/`) once the last of them goes, and through a `..` only
+    /// what lies before it (`c/../there`: `there` was there before). A folder that holds a
+    /// file stays. Negative controls: the folders that were there stay.
+    #[test]
+    fn empty_folders_a_run_made_go_with_its_lock() {
+        let dir = tempfile::tempdir().unwrap();
+        let at = |p: &str| dir.path().join(p);
+        fs::create_dir(at("there")).unwrap();
+        let through = SetLock::acquire(&at("c/../there/d"), "boa").unwrap();
+        assert!(at("c").is_dir() && at("there/d").is_dir());
+        drop(through);
+        assert!(!at("c").exists() && at("there").is_dir(), "c goes, the folder that was there stays");
+        let first = SetLock::acquire(&at("out/boa/seed1"), "boa").unwrap();
+        let second = SetLock::acquire(&at("out/boa/seed2"), "boa").unwrap();
+        let written = SetLock::acquire(&at("written"), "boa").unwrap();
+        fs::write(at("written/boa.material.json"), b"{}").unwrap();
+        drop(first);
+        assert!(!at("out/boa/seed1").exists() && at("out/boa/seed2").is_dir(), "the other job's folder stays");
+        drop(second);
+        assert!(!at("out").exists(), "the parent the first lock made goes with the last lock in it");
+        drop(written);
+        assert!(at("written/boa.material.json").is_file());
+        assert!(dir.path().is_dir());
     }
 }

@@ -26,6 +26,7 @@ import os
 import struct
 import sys
 import tempfile
+import urllib.parse
 
 import bpy
 import mathutils
@@ -114,7 +115,7 @@ def wire_film_by_hand(document, binary, material, folder):
         path = os.path.join(tempfile.mkdtemp(), "thickness.png")
         open(path, "wb").write(binary[start : start + view["byteLength"]])
     else:
-        path = os.path.join(folder, image["uri"])
+        path = os.path.join(folder, urllib.parse.unquote(image["uri"]))
     tree = material.node_tree
     bsdf = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
     texture = tree.nodes.new("ShaderNodeTexImage")
