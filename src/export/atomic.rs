@@ -458,14 +458,14 @@ impl SetLock {
         std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW);
         // A run that ends removes the lock file; if that happened between our open and our
         // lock, we hold a lock on a file nobody else will open: open again.
-        let mut missing = None;
+        let mut folder_went = None;
         for _ in 0..8 {
             let file = match options.open(&path) {
                 Ok(file) => file,
                 // A failed job of this batch removed the empty folder between our making it
                 // and opening the lock (`remove_empty_made_folders`): make it again.
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                    missing = Some(e);
+                    folder_went = Some(e);
                     match create_folder_noted(dir) {
                         Err(ExportError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {}
                         other => drop(other?),
@@ -498,7 +498,7 @@ impl SetLock {
             }
         }
         // Eight tries, each lost to a run that ended or to a folder that went: say which.
-        Err(match missing {
+        Err(match folder_went {
             Some(source) => ExportError::Io { path, source },
             None => ExportError::Busy { dir: dir.into(), name: name.into() },
         })
