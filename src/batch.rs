@@ -438,8 +438,7 @@ fn is_index_file_name(name: &str) -> bool {
 /// holds the manifest's own name too). A manifest that lost a map's entry along with the map
 /// passed as done, and the job was never run again.
 fn is_done(manifest: &Path, key: &str, expected: &[String]) -> bool {
-    let Ok(text) = crate::export::read_set_manifest(manifest, crate::text_file::Links::Refuse) else { return false };
-    let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else { return false };
+    let Ok(json) = crate::export::read_set_manifest(manifest, crate::text_file::Links::Refuse) else { return false };
     if json["job"].as_str() != Some(key) {
         return false;
     }
@@ -782,14 +781,9 @@ fn plan<'a>(
             };
             // Its folder and files, as `Plan::run` checks them, but before any job has
             // written its set: a folder in a later job's way stopped the run after the
-            // earlier jobs' sets were written.
-            check_set_outputs(&request.out_dir, &r.files).map_err(|e| planned(job.lines.preset, e.into()))?;
-            // Nor any of its files the jobs file itself (kept among a set's files, it was
-            // replaced by the set's manifest, and the batch could not be run again).
-            for file in &r.files {
-                crate::export::check_not_an_input(&request.out_dir.join(file), Some(jobs_file))
-                    .map_err(|e| planned(job.lines.preset, e.into()))?;
-            }
+            // earlier jobs' sets were written. Nor any of them the jobs file itself.
+            check_set_outputs(&request.out_dir, &r.files, Some(jobs_file))
+                .map_err(|e| planned(job.lines.preset, e.into()))?;
             estimates.push(estimate);
         }
     }

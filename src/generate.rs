@@ -112,12 +112,16 @@ pub fn set_file_names(loaded: &LoadedPreset, request: &GenerateRequest) -> Vec<S
 }
 
 /// A set's folder and its files (`set_file_names`) checked before the work
-/// (`Plan::check_outputs`). (None can be the preset's own file: the set's names are its
-/// file stem with a suffix, `NAME_color.png`, `NAME.material.json`.)
-pub fn check_set_outputs(out_dir: &Path, files: &[String]) -> Result<(), export::ExportError> {
+/// (`Plan::check_outputs`), none of them `input`, the command's input if it has one besides
+/// the preset (a batch's jobs file: kept among a set's files, it was replaced by the set's
+/// manifest, and the batch could not be run again). None can be the preset's own file: the
+/// set's names are its file stem with a suffix, `NAME_color.png`, `NAME.material.json`.
+pub fn check_set_outputs(out_dir: &Path, files: &[String], input: Option<&Path>) -> Result<(), export::ExportError> {
     export::check_folder(out_dir)?;
     for file in files {
-        export::check_target(&out_dir.join(file))?;
+        let target = out_dir.join(file);
+        export::check_target(&target)?;
+        export::check_not_an_input(&target, input)?;
     }
     Ok(())
 }
@@ -209,7 +213,7 @@ impl Plan {
     /// set had been evaluated and encoded (the commit checks again: the folder may change).
     /// `run` calls it, and a batch for every job before the first runs.
     pub fn check_outputs(&self) -> Result<(), export::ExportError> {
-        check_set_outputs(&self.request.out_dir, &self.file_names())
+        check_set_outputs(&self.request.out_dir, &self.file_names(), None)
     }
 
     /// Runs the plan. `progress(done, total)` reports node evaluations.

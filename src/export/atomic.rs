@@ -734,13 +734,10 @@ fn recorded_left_overs(
     if fs::symlink_metadata(manifest).is_err() {
         return (Vec::new(), Vec::new(), KeptBecause::NoManifest(file_name(manifest)));
     }
-    let text = match super::manifest::read_set_manifest(manifest, crate::text_file::Links::Refuse) {
-        Ok(text) => text,
-        Err(e) => return unreadable(e.to_string()),
-    };
-    let json = match serde_json::from_slice::<serde_json::Value>(&text) {
+    let json = match super::manifest::read_set_manifest(manifest, crate::text_file::Links::Refuse) {
         Ok(json) => json,
-        Err(e) => return unreadable(format!("not JSON: {e}")),
+        Err(super::manifest::ManifestReadError::Read(e)) => return unreadable(e.to_string()),
+        Err(super::manifest::ManifestReadError::NotJson(e)) => return unreadable(format!("not JSON: {e}")),
     };
     let Some(entries) = json["maps"].as_array() else {
         return unreadable("it has no \"maps\" list".into());

@@ -217,12 +217,22 @@ pub fn manifest(
 /// is under 10 KB): a link to /dev/zero or a huge file in its place is refused unread.
 pub const MANIFEST_MAX_BYTES: u64 = 1 << 20;
 
-/// An earlier set's manifest, read back (`verify_set`, `batch`, a commit's clean-up): a
-/// regular file of at most `MANIFEST_MAX_BYTES`. `links`: whether a link is followed (a
-/// reader's check may meet a set kept as links, as git-annex keeps files; what a run may
-/// remove or replace is never reached through one: the set wrote none).
-pub fn read_set_manifest(path: &Path, links: Links) -> Result<Vec<u8>, crate::text_file::BoundedReadError> {
-    crate::text_file::read_bounded_bytes(path, MANIFEST_MAX_BYTES, links)
+/// An earlier set's manifest, read back and parsed (`verify_set`, `batch`, a commit's
+/// clean-up): a regular file of at most `MANIFEST_MAX_BYTES`. `links`: whether a link is
+/// followed (a reader's check may meet a set kept as links, as git-annex keeps files; what a
+/// run may remove or replace is never reached through one: the set wrote none).
+pub fn read_set_manifest(path: &Path, links: Links) -> Result<serde_json::Value, ManifestReadError> {
+    let text =
+        crate::text_file::read_bounded_bytes(path, MANIFEST_MAX_BYTES, links).map_err(ManifestReadError::Read)?;
+    serde_json::from_slice(&text).map_err(ManifestReadError::NotJson)
+}
+
+/// Why an earlier set's manifest could not be read back (`read_set_manifest`).
+#[derive(Debug)]
+pub enum ManifestReadError {
+    /// Missing, not a regular file, too large, or the read failed.
+    Read(crate::text_file::BoundedReadError),
+    NotJson(serde_json::Error),
 }
 
 /// The most bytes one file of the set a manifest describes can hold: every map of its
@@ -267,16 +277,17 @@ pub struct VerifiedSet {
 /// while renaming); one whose hashes differ is mixed or altered.
 pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
     let problem = |problem: String| ExportError::Verify { manifest: manifest_path.into(), problem };
-    let text = read_set_manifest(manifest_path, Links::Follow).map_err(|e| {
+    let json = read_set_manifest(manifest_path, Links::Follow).map_err(|e| {
         problem(match e {
-            crate::text_file::BoundedReadError::Io(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            ManifestReadError::Read(crate::text_file::BoundedReadError::Io(e))
+                if e.kind() == std::io::ErrorKind::NotFound =>
+            {
                 "no manifest: the set is incomplete (a run failed or was killed while writing it)".into()
             }
-            e => format!("cannot read the manifest: {e}"),
+            ManifestReadError::Read(e) => format!("cannot read the manifest: {e}"),
+            ManifestReadError::NotJson(e) => format!("the manifest is not valid JSON: {e}"),
         })
     })?;
-    let json: serde_json::Value =
-        serde_json::from_slice(&text).map_err(|e| problem(format!("the manifest is not valid JSON: {e}")))?;
     verify_set_json(manifest_path, &json)
 }
 
