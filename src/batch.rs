@@ -748,7 +748,13 @@ fn plan<'a>(
     // the run after every job), and nothing created yet: a refused batch leaves no folder.
     crate::export::check_folder(out)?;
     crate::export::check_target(&out.join(index_file_name(shard)))?;
-    crate::export::check_not_an_input(&out.join(index_file_name(shard)), Some(jobs_file))?;
+    // The files the run reads: its jobs file and every job's preset file (every shard's:
+    // another shard's job may read a file this one would write), none of them an output.
+    let mut seen = std::collections::HashSet::new();
+    let preset_files =
+        jobs.iter().filter(|j| seen.insert(j.preset.as_str())).filter_map(|j| crate::preset::input_file(&j.preset));
+    let inputs = crate::export::Inputs::new(std::iter::once(jobs_file).chain(preset_files));
+    inputs.check(&out.join(index_file_name(shard)))?;
     let (mine, resolved): (Vec<&'a Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
     let mut estimates = Vec::new();
@@ -781,9 +787,8 @@ fn plan<'a>(
             };
             // Its folder and files, as `Plan::run` checks them, but before any job has
             // written its set: a folder in a later job's way stopped the run after the
-            // earlier jobs' sets were written. Nor any of them the jobs file itself.
-            check_set_outputs(&request.out_dir, &r.files, Some(jobs_file))
-                .map_err(|e| planned(job.lines.preset, e.into()))?;
+            // earlier jobs' sets were written. Nor any of them the jobs file or a preset.
+            check_set_outputs(&request.out_dir, &r.files, &inputs).map_err(|e| planned(job.lines.preset, e.into()))?;
             estimates.push(estimate);
         }
     }

@@ -112,16 +112,17 @@ pub fn set_file_names(loaded: &LoadedPreset, request: &GenerateRequest) -> Vec<S
 }
 
 /// A set's folder and its files (`set_file_names`) checked before the work
-/// (`Plan::check_outputs`), none of them `input`, the command's input if it has one besides
-/// the preset (a batch's jobs file: kept among a set's files, it was replaced by the set's
-/// manifest, and the batch could not be run again). None can be the preset's own file: the
-/// set's names are its file stem with a suffix, `NAME_color.png`, `NAME.material.json`.
-pub fn check_set_outputs(out_dir: &Path, files: &[String], input: Option<&Path>) -> Result<(), export::ExportError> {
+/// (`Plan::check_outputs`), none of them one of `inputs`, the command's inputs besides the
+/// set's own preset (a batch's jobs file and its other jobs' preset files: kept among a
+/// set's files, the jobs file was replaced by the set's manifest, and the batch could not be
+/// run again). None can be the set's own preset file: the set's names are its file stem
+/// with a suffix, `NAME_color.png`, `NAME.material.json`.
+pub fn check_set_outputs(out_dir: &Path, files: &[String], inputs: &export::Inputs) -> Result<(), export::ExportError> {
     export::check_folder(out_dir)?;
     for file in files {
         let target = out_dir.join(file);
         export::check_target(&target)?;
-        export::check_not_an_input(&target, input)?;
+        inputs.check(&target)?;
     }
     Ok(())
 }
@@ -213,7 +214,7 @@ impl Plan {
     /// set had been evaluated and encoded (the commit checks again: the folder may change).
     /// `run` calls it, and a batch for every job before the first runs.
     pub fn check_outputs(&self) -> Result<(), export::ExportError> {
-        check_set_outputs(&self.request.out_dir, &self.file_names(), None)
+        check_set_outputs(&self.request.out_dir, &self.file_names(), &export::Inputs::default())
     }
 
     /// Runs the plan. `progress(done, total)` reports node evaluations.

@@ -592,6 +592,49 @@ fn a_batch_does_not_write_its_index_over_its_jobs_file() {
     assert!(!dir.path().join("natrix-natrix").exists(), "refused before any job");
 }
 
+/// A job's preset saved where the batch writes: as `DIR/index.json` it was replaced by the
+/// index (exit 0), and a job's set files could be written over another job's preset.
+/// Refused before any job runs; the preset stays.
+#[test]
+fn a_batch_writes_over_no_job_preset() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let text = stdout(&snakeskin(&["presets", "show", "natrix-natrix"]));
+    let under_index = out.join("index.json");
+    std::fs::write(&under_index, &text).unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"out/index.json\"\nsizes = [16]\n").unwrap();
+    let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
+    assert!(stderr(&run).contains("would be written over this command's input"), "{}", stderr(&run));
+    assert_eq!(std::fs::read_to_string(&under_index).unwrap(), text, "the preset stays");
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "refused before any job");
+
+    // Job 2's preset saved where job 1's colour map goes.
+    let set = out.join("natrix-natrix/tile-16-seed1-png");
+    std::fs::create_dir_all(&set).unwrap();
+    let in_set = set.join("natrix-natrix_color.png");
+    std::fs::write(&in_set, &text).unwrap();
+    let jobs_text = "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n\n\
+                     [[job]]\npreset = \"out/natrix-natrix/tile-16-seed1-png/natrix-natrix_color.png\"\nsizes = [16]\n";
+    std::fs::write(&jobs, jobs_text).unwrap();
+    let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
+    assert!(stderr(&run).contains("would be written over this command's input"), "{}", stderr(&run));
+    assert_eq!(std::fs::read_to_string(&in_set).unwrap(), text, "the preset stays");
+    // Negative control: the preset moved out of the way, the same jobs run.
+    let moved = dir.path().join("moved.toml");
+    std::fs::rename(&in_set, &moved).unwrap();
+    std::fs::write(
+        &jobs,
+        jobs_text.replace("out/natrix-natrix/tile-16-seed1-png/natrix-natrix_color.png", "moved.toml"),
+    )
+    .unwrap();
+    let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", stderr(&run));
+}
+
 /// A preset edited while its batch runs: the job that reads the edited preset is not
 /// written under the key of the planned one (a later run, the edit undone, took that set as
 /// done), and the batch stops with exit 1 and says why; the sets before it stand. The

@@ -784,14 +784,32 @@ fn a_planted_symlink_at_a_temporary_name_is_not_followed() {
     assert_eq!(std::fs::read(&victim).unwrap(), b"precious");
     assert_eq!(std::fs::read(&target).unwrap(), b"new chart");
     // A symlink planted at the set's lock file is refused, not followed: following it
-    // would create the file it points to.
+    // would create the file it points to. It is named as a link (it said "Too many levels of
+    // symbolic links", of one link), exit 2.
     let sets = tempfile::tempdir().unwrap();
     let elsewhere = dir.path().join("created-through-the-link");
-    std::os::unix::fs::symlink(&elsewhere, sets.path().join(format!(".{PRESET}.lock"))).unwrap();
+    let lock = sets.path().join(format!(".{PRESET}.lock"));
+    std::os::unix::fs::symlink(&elsewhere, &lock).unwrap();
     let out = generate_into(sets.path(), "1", &[]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(!elsewhere.exists(), "the lock followed a planted symlink");
-    assert!(!stderr(&out).contains("another snakeskin run"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("is a symbolic link, not a regular file"), "{}", stderr(&out));
+    // A FIFO there: the run waited for a reader for ever. Now refused at once, by name.
+    std::fs::remove_file(&lock).unwrap();
+    let c_path = std::ffi::CString::new(lock.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c_path.as_ptr(), 0o600) }, 0);
+    let child = Command::new(BIN)
+        .args(["generate", PRESET, "-o", sets.path().to_str().unwrap(), "--size", "16"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = finished_within(child, 60, "generate blocked on a FIFO at its lock");
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("is a FIFO, not a regular file"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_dir(sets.path()).unwrap().count(), 1, "only the FIFO there");
+    // Negative control: with the FIFO gone the same run writes its set.
+    std::fs::remove_file(&lock).unwrap();
+    assert!(generate_into(sets.path(), "1", &[]).status.success());
 }
 
 #[test]
@@ -1569,6 +1587,19 @@ fn figures_are_checked_before_any_is_drawn() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("absorption_0.7.png: a folder is in the way"), "{}", stderr(&out));
     assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 1, "a figure was written");
+
+    // The preset file saved under a figure's name in the figures' folder: it was replaced by
+    // that figure (exit 0).
+    let beside = dir.path().join("beside");
+    std::fs::create_dir_all(&beside).unwrap();
+    let preset_file = beside.join("stage_a_diffuse.png");
+    let text = stdout(&snakeskin(&["presets", "show", PRESET]));
+    std::fs::write(&preset_file, &text).unwrap();
+    let b = beside.to_str().unwrap();
+    let out = snakeskin(&["figures", preset_file.to_str().unwrap(), "-o", b, "--size", "16x16", "--map-size", "64"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("would be written over this command's input"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&preset_file).unwrap(), text, "the preset stays");
 
     let fresh = dir.path().join("new");
     let limit = [("SNAKESKIN_MEMORY_LIMIT_MIB", "300")];

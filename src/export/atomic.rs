@@ -281,11 +281,40 @@ pub fn same_path(a: &Path, b: &Path) -> bool {
 /// resolved): `preview snake -o snake`, `export ./x.glb --gltf x.glb` and a batch whose jobs
 /// file is its index replaced their input, and could not be run again.
 pub fn check_not_an_input(output: &Path, input: Option<&Path>) -> Result<(), ExportError> {
-    match input {
-        Some(input) if same_path(output, input) => {
-            Err(ExportError::OverwritesInput { output: output.into(), input: input.into() })
+    Inputs::new(input).check(output)
+}
+
+/// A command's input files, each resolved once (`same_path`'s rule), for refusing the
+/// outputs that would be written over one of them: a batch checks every job's files against
+/// its jobs file and every job's preset file (a job's preset saved as `DIR/index.json` was
+/// replaced by the batch's index), and resolving both paths per file and input made a
+/// table of 100,000 jobs pay for it on every one.
+#[derive(Debug, Default)]
+pub struct Inputs(Vec<(PathBuf, PathBuf)>);
+
+impl Inputs {
+    /// `paths` as given (the error names them so) and resolved; one entry per file.
+    pub fn new<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Inputs {
+        let mut inputs: Vec<(PathBuf, PathBuf)> = Vec::new();
+        for path in paths {
+            if let Some(real) = resolved(path)
+                && !inputs.iter().any(|(_, seen)| *seen == real)
+            {
+                inputs.push((path.into(), real));
+            }
         }
-        _ => Ok(()),
+        Inputs(inputs)
+    }
+
+    /// Refuses `output` where it names one of the inputs (`ExportError::OverwritesInput`).
+    pub fn check(&self, output: &Path) -> Result<(), ExportError> {
+        if self.0.is_empty() {
+            return Ok(());
+        }
+        match resolved(output).and_then(|out| self.0.iter().find(|(_, real)| *real == out)) {
+            Some((input, _)) => Err(ExportError::OverwritesInput { output: output.into(), input: input.clone() }),
+            None => Ok(()),
+        }
     }
 }
 
@@ -454,8 +483,20 @@ impl SetLock {
         let path = dir.join(format!(".{name}.lock"));
         let mut options = fs::OpenOptions::new();
         options.create(true).truncate(false).write(true);
+        // Not through a link, and without waiting: a FIFO there fails to open (ENXIO), where
+        // a plain open waited for a reader for ever.
         #[cfg(unix)]
-        std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW);
+        std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW | libc::O_NONBLOCK);
+        // The lock file is the run's to make: anything else there is named as such, before
+        // the open and again if the open fails or opens it.
+        let not_a_lock = || {
+            let file_type = fs::symlink_metadata(&path).ok()?.file_type();
+            let kind = crate::text_file::file_kind(&file_type);
+            (!file_type.is_file()).then(|| ExportError::LockNotAFile { path: path.clone(), kind })
+        };
+        if let Some(refused) = not_a_lock() {
+            return Err(refused);
+        }
         // A run that ends removes the lock file; if that happened between our open and our
         // lock, we hold a lock on a file nobody else will open: open again.
         let mut folder_went = None;
@@ -472,8 +513,12 @@ impl SetLock {
                     }
                     continue;
                 }
-                Err(e) => return Err(io_error(&path)(e)),
+                Err(e) => return Err(not_a_lock().unwrap_or_else(|| io_error(&path)(e))),
             };
+            if !file.metadata().is_ok_and(|m| m.is_file()) {
+                return Err(not_a_lock()
+                    .unwrap_or_else(|| ExportError::LockNotAFile { path: path.clone(), kind: "something else" }));
+            }
             match file.try_lock() {
                 Ok(()) if same_file(&file, &path) => {
                     // Under the lock every temporary of the set's names is stale: a run killed

@@ -11,7 +11,7 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    FileGroup, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_not_an_input, check_png_target,
+    FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_not_an_input, check_png_target,
     check_target, check_target_named, clean_up_before_exit, create_folder, create_folder_noted, ends_as_a_folder,
     remove_empty_made_folders, same_path, sha256_hex, write_file_atomically,
 };
@@ -42,6 +42,13 @@ pub enum ExportError {
          finished, or write to another folder"
     )]
     Busy { dir: PathBuf, name: String },
+    /// Something other than a regular file where a set's lock goes: a FIFO made the run wait
+    /// for a reader for ever, a link failed with "Too many levels of symbolic links".
+    #[error(
+        "{path} is {kind}, not a regular file: snakeskin keeps the lock of this set there (an empty file it makes \
+         itself); remove it and run again, or write to another folder"
+    )]
+    LockNotAFile { path: PathBuf, kind: &'static str },
     #[error(
         "{path} exists and is not a folder, so nothing can be written into it; give the path of a folder (one that \
          exists, or one to create)"
@@ -94,6 +101,7 @@ impl ExportError {
             self,
             ExportError::NotAFolder { .. }
                 | ExportError::NotAFile { .. }
+                | ExportError::LockNotAFile { .. }
                 | ExportError::FolderInTheWay { .. }
                 | ExportError::FolderName { .. }
                 | ExportError::NamedForAnotherFormat { .. }

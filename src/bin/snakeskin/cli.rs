@@ -596,7 +596,7 @@ pub enum BrdfCommand {
     /// Random and adversarial inputs: counts NaN and Inf, the range of R and T, the worst
     /// white-furnace albedo and the f32 path's worst deviation from f64 (JSON with --json).
     Stress {
-        /// Number of random samples, 1 to 10,000,000 (the default takes about half a minute
+        /// Number of random samples, 1 to 10,000,000 (the default takes about fifty seconds
         /// on two cores).
         #[arg(long, default_value_t = 100_000, value_parser = ranged_u64(1, 10_000_000))]
         samples: u64,

@@ -91,10 +91,14 @@ pub fn figure_list() -> Vec<Figure> {
     figures
 }
 
-/// Checks every figure's file in `out_dir` (`check_target`), before any is rendered.
-pub fn check_figure_files(out_dir: &Path) -> Result<(), Error> {
+/// Checks every figure's file in `out_dir` (`check_target`), and that none is the file
+/// `preset` reads (a preset saved as `stage_a_diffuse.png` in the figures' folder was
+/// replaced by that figure), before any is rendered.
+pub fn check_figure_files(out_dir: &Path, preset: &str) -> Result<(), Error> {
     for figure in figure_list() {
-        check_target(&out_dir.join(figure.file))?;
+        let target = out_dir.join(figure.file);
+        check_target(&target)?;
+        crate::export::check_not_an_input(&target, crate::preset::input_file(preset))?;
     }
     Ok(())
 }
@@ -110,7 +114,7 @@ pub fn write_figures(
     map_size: usize,
     progress: &dyn Fn(usize, usize),
 ) -> Result<Vec<PathBuf>, Error> {
-    check_figure_files(out_dir)?;
+    check_figure_files(out_dir, preset)?;
     let figures = figure_list();
     let mut group = FileGroup::new();
     for (i, figure) in figures.iter().enumerate() {

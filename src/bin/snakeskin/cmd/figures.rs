@@ -18,7 +18,7 @@ use snakeskin::render::figures::write_figures;
 pub fn run(preset: &str, out: &Path, size: ImageSize, map_size: u64) -> Result<()> {
     let loaded = snakeskin::preset::load(preset, &[], None)?;
     snakeskin::export::check_folder(out)?;
-    snakeskin::render::figures::check_figure_files(out)?;
+    snakeskin::render::figures::check_figure_files(out, preset)?;
     let frame_bytes = snakeskin::render::engine::renderer::frame_bytes(size.width, size.height);
     snakeskin::render::engine::prepare::check_preview_memory(&loaded, map_size as usize, Layout::Tile, frame_bytes)?;
     ensure_folder(out)?;
