@@ -92,6 +92,22 @@ fn type_error_names_line_and_key() {
 /// key's range, the one the range check gives a whole number in the type's (it said "from 0
 /// to 4294967295", the type's range). Each key is checked both ways, so the two ranges are
 /// the same by test, not only by construction.
+/// A refused number far from its range is printed as written, not in full: `film_ior =
+/// 1e300` printed three hundred digits, `--angle-deg=-1e-300` a "-0.000…" as long.
+#[test]
+fn a_number_far_out_of_range_is_printed_short() {
+    let text = "seed = 1\n[optics]\nfilm_ior = 1e300\n";
+    let err = refused("huge.toml", text, &[]);
+    assert!(err.contains("must be a finite number in [1, 3], got 1e300"), "{err}");
+    assert!(err.len() < 400, "{err}");
+    let film = ["brdf", "film", "--n0", "1", "--n1", "1.55", "--n2", "2", "--thickness-nm", "400", "--wavelength-nm"];
+    let out = snakeskin(&[&film[..], &["550", "--angle-deg=-1e-300"]].concat());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("angle_deg must be in [0, 90], got -1e-300"), "{}", stderr(&out));
+    // Negative control: a value near its range is printed plainly.
+    assert!(refused("near.toml", "seed = 1\n[optics]\nfilm_ior = 3.5\n", &[]).contains("got 3.5"));
+}
+
 #[test]
 fn a_whole_number_beyond_its_type_gets_the_keys_range() {
     let range =

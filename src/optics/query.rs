@@ -14,7 +14,7 @@ use super::lut::Lut;
 use super::methods::{Method, gaussian_fit_f64, rgb3_f64, spectral_n_f64};
 use crate::Error;
 use crate::ops::Image;
-use crate::preset::validate::ranges;
+use crate::preset::validate::{ranges, shown};
 
 /// Refuses what the physics does not cover, naming the parameter and the accepted range
 /// (the preset's range table: indices, film thickness).
@@ -22,20 +22,23 @@ pub fn check(stack: Stack, thickness_nm: f64, angle_deg: f64, wavelength_nm: Opt
     let (lo, hi) = ranges::IOR;
     for (name, n) in [("n0", stack.n0), ("n1", stack.n1), ("n2", stack.n2)] {
         if !(n.is_finite() && (lo..=hi).contains(&n)) {
-            return Err(Error::Query(format!("{name} must be a refractive index in [{lo}, {hi}], got {n}")));
+            return Err(Error::Query(format!("{name} must be a refractive index in [{lo}, {hi}], got {}", shown(n))));
         }
     }
     let (lo, hi) = ranges::FILM_THICKNESS_NM;
     if !(thickness_nm.is_finite() && (lo..=hi).contains(&thickness_nm)) {
-        return Err(Error::Query(format!("thickness_nm must be a finite number in [{lo}, {hi}], got {thickness_nm}")));
+        return Err(Error::Query(format!(
+            "thickness_nm must be a finite number in [{lo}, {hi}], got {}",
+            shown(thickness_nm)
+        )));
     }
     if !(angle_deg.is_finite() && (0.0..=90.0).contains(&angle_deg)) {
-        return Err(Error::Query(format!("angle_deg must be in [0, 90], got {angle_deg}")));
+        return Err(Error::Query(format!("angle_deg must be in [0, 90], got {}", shown(angle_deg))));
     }
     if let Some(l) = wavelength_nm
         && !(l.is_finite() && (1.0..=1.0e6).contains(&l))
     {
-        return Err(Error::Query(format!("wavelength_nm must be a finite number in [1, 1000000], got {l}")));
+        return Err(Error::Query(format!("wavelength_nm must be a finite number in [1, 1000000], got {}", shown(l))));
     }
     Ok(())
 }

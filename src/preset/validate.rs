@@ -101,7 +101,7 @@ impl Checker {
         if !(value.is_finite() && (lo..=hi).contains(&value)) {
             self.problems.push(Problem {
                 key: key.into(),
-                message: format!("must be a finite number in [{lo}, {hi}], got {value}"),
+                message: format!("must be a finite number in [{lo}, {hi}], got {}", shown(value)),
             });
         }
     }
@@ -491,4 +491,16 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
     }
     c.problems.dedup();
     c.problems
+}
+
+/// A number refused in an error message, as a reader takes it in: plain where it is
+/// between 1e-4 and 1e15 in size (or 0), in exponent form beyond (`film_ior = 1e300`
+/// printed three hundred digits, `--angle-deg=-1e-300` a "-0.000…" as long).
+pub fn shown(value: f64) -> String {
+    let size = value.abs();
+    if value == 0.0 || !value.is_finite() || (1e-4..1e15).contains(&size) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
 }
