@@ -88,10 +88,6 @@ fn type_error_names_line_and_key() {
     assert!(err.trim_end().ends_with("expected a whole number in [4, 128]"), "{err}");
 }
 
-/// A whole number the key's type cannot hold (negative, or past 2³²) is refused with the
-/// key's range, the one the range check gives a whole number in the type's (it said "from 0
-/// to 4294967295", the type's range). Each key is checked both ways, so the two ranges are
-/// the same by test, not only by construction.
 /// A refused number far from its range is printed as written, not in full: `film_ior =
 /// 1e300` printed three hundred digits, `--angle-deg=-1e-300` a "-0.000…" as long.
 #[test]
@@ -108,6 +104,10 @@ fn a_number_far_out_of_range_is_printed_short() {
     assert!(refused("near.toml", "seed = 1\n[optics]\nfilm_ior = 3.5\n", &[]).contains("got 3.5"));
 }
 
+/// A whole number the key's type cannot hold (negative, or past 2³²) is refused with the
+/// key's range, the one the range check gives a whole number in the type's (it said "from 0
+/// to 4294967295", the type's range). Each key is checked both ways, so the two ranges are
+/// the same by test, not only by construction.
 #[test]
 fn a_whole_number_beyond_its_type_gets_the_keys_range() {
     let range =

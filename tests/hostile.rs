@@ -201,12 +201,11 @@ fn devices_fifos_and_huge_files_are_not_read() {
     let c_path = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
     assert_eq!(unsafe { libc::mkfifo(c_path.as_ptr(), 0o600) }, 0);
     // Without the fix this blocks forever waiting for a writer: give it 60 s, then fail.
-    let child = Command::new(BIN)
-        .args(["generate", fifo.to_str().unwrap(), "-o", dir.path().to_str().unwrap()])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let out = finished_within(child, 60, "generate blocked on a FIFO preset");
+    let out = snakeskin_within(
+        &["generate", fifo.to_str().unwrap(), "-o", dir.path().to_str().unwrap()],
+        60,
+        "generate blocked on a FIFO preset",
+    );
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("it is a FIFO"), "{}", stderr(&out));
 
@@ -274,6 +273,13 @@ fn earlier_set_with_fault_hooks() -> Option<tempfile::TempDir> {
 
 /// The output of `child` once it exits; killed, and the test failed with `hang`, if it
 /// runs past `seconds` (a guard against a hang, not a speed goal).
+/// Runs the binary with `args` (stderr captured), failing with `hang` if it has not finished
+/// within `seconds`: the tests of inputs that once made it wait for ever.
+fn snakeskin_within(args: &[&str], seconds: u64, hang: &str) -> std::process::Output {
+    let child = Command::new(BIN).args(args).stderr(Stdio::piped()).spawn().unwrap();
+    finished_within(child, seconds, hang)
+}
+
 fn finished_within(mut child: std::process::Child, seconds: u64, hang: &str) -> std::process::Output {
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(seconds);
     while child.try_wait().unwrap().is_none() {
@@ -798,12 +804,11 @@ fn a_planted_symlink_at_a_temporary_name_is_not_followed() {
     std::fs::remove_file(&lock).unwrap();
     let c_path = std::ffi::CString::new(lock.to_str().unwrap()).unwrap();
     assert_eq!(unsafe { libc::mkfifo(c_path.as_ptr(), 0o600) }, 0);
-    let child = Command::new(BIN)
-        .args(["generate", PRESET, "-o", sets.path().to_str().unwrap(), "--size", "16"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let out = finished_within(child, 60, "generate blocked on a FIFO at its lock");
+    let out = snakeskin_within(
+        &["generate", PRESET, "-o", sets.path().to_str().unwrap(), "--size", "16"],
+        60,
+        "generate blocked on a FIFO at its lock",
+    );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("is a FIFO, not a regular file"), "{}", stderr(&out));
     assert_eq!(std::fs::read_dir(sets.path()).unwrap().count(), 1, "only the FIFO there");
@@ -1468,12 +1473,11 @@ fn a_long_jobs_file_is_read_in_one_pass() {
     let mut text = "[[job]]\npreset = \"natrix-natrix\"\n".repeat(20_000);
     text.push_str("[[job]]\npreset = \"natrix-natrix\"\nlayout = \"x\"\n");
     std::fs::write(&jobs, text).unwrap();
-    let child = Command::new(BIN)
-        .args(["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let out = finished_within(child, 60, "a jobs file of 20,001 jobs took over 60 s to read");
+    let out = snakeskin_within(
+        &["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()],
+        60,
+        "a jobs file of 20,001 jobs took over 60 s to read",
+    );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("jobs.toml:40003: job 20001 (natrix-natrix): layout \"x\""), "{}", stderr(&out));
 }
@@ -1487,12 +1491,11 @@ fn a_preset_of_thousands_of_bad_marks_is_refused_at_once() {
     let dir = tempfile::tempdir().unwrap();
     let marks = vec!["{kind = \"cap\", color = \"#000000\", size = 9}"; 20_000].join(", ");
     let preset = write_preset(dir.path(), "marks.toml", &format!("[body]\nhead_mark = [{marks}]\n"));
-    let child = Command::new(BIN)
-        .args(["generate", &preset, "-o", dir.path().join("out").to_str().unwrap(), "--size", "16"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let out = finished_within(child, 60, "20,000 bad head marks took over 60 s to refuse");
+    let out = snakeskin_within(
+        &["generate", &preset, "-o", dir.path().join("out").to_str().unwrap(), "--size", "16"],
+        60,
+        "20,000 bad head marks took over 60 s to refuse",
+    );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(
         stderr(&out).contains("marks.toml:2: key `body.head_mark` may list at most 16 head marks, got 20000"),

@@ -95,10 +95,11 @@ pub fn figure_list() -> Vec<Figure> {
 /// `preset` reads (a preset saved as `stage_a_diffuse.png` in the figures' folder was
 /// replaced by that figure), before any is rendered.
 pub fn check_figure_files(out_dir: &Path, preset: &str) -> Result<(), Error> {
+    let input = crate::export::Inputs::new(crate::preset::input_file(preset));
     for figure in figure_list() {
         let target = out_dir.join(figure.file);
         check_target(&target)?;
-        crate::export::check_not_an_input(&target, crate::preset::input_file(preset))?;
+        input.check(&target)?;
     }
     Ok(())
 }
