@@ -23,7 +23,7 @@ const MIB: u64 = 1 << 20;
 
 /// Allocator slack, thread stacks, the binary and its tables: measured resident size of a
 /// 16² run is about 20 MiB; 64 MiB leaves room.
-const FIXED_OVERHEAD_BYTES: u64 = 64 * MIB;
+pub const FIXED_OVERHEAD_BYTES: u64 = 64 * MIB;
 
 /// Estimated peak bytes of `generate` for `maps` at `size`²: the graph's live buffers at
 /// their worst point, plus every quantised map (held until encoding) and its PNG (at most
@@ -46,6 +46,17 @@ pub fn estimate_strips_bytes(graph: &Graph, maps: &[MapKind], width: usize, heig
     let strip_pixels = (width * strip_rows) as u64;
     let strip_quantized: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * strip_pixels).sum();
     estimate_peak_bytes(graph, maps, width, strip_rows) + 2 * strip_quantized + files + FIXED_OVERHEAD_BYTES
+}
+
+/// Hands the memory the allocator keeps from freed blocks back to the system (glibc's
+/// `malloc_trim`; nothing elsewhere), between the species of a sheet or the figures drawn in
+/// turn: the next one's evaluation may run on other threads' arenas, which cannot reuse it.
+pub fn release_freed() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free pages of the allocator's own arenas to the system.
+    unsafe {
+        libc::malloc_trim(0);
+    }
 }
 
 /// An estimate next to the memory available for it.

@@ -483,6 +483,59 @@ fn sheet_command_writes_a_png() {
     assert_eq!(image.width(), 5 * 3 * 64);
 }
 
+/// The peak resident memory (KiB, from `wait4`'s `ru_maxrss`) of `snakeskin args`, which must
+/// succeed; this child's own, whatever else the tests run at the same time.
+#[allow(clippy::zombie_processes, reason = "the child is reaped by wait4, which Child::wait cannot give")]
+fn peak_resident_kib(args: &[&str]) -> u64 {
+    use std::process::{Command, Stdio};
+    let child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("run snakeskin");
+    let pid = child.id() as libc::pid_t;
+    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
+    assert_eq!(unsafe { libc::wait4(pid, &mut status, 0, &mut usage) }, pid, "wait4");
+    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0, "{args:?} failed: status {status}");
+    usage.ru_maxrss as u64
+}
+
+/// The memory check of the commands that draw maps is an upper bound of what they take,
+/// measured (peak resident, lavapipe's textures and frames are host memory), and not a wild
+/// one. It counted the maps' evaluation and the frame alone: a body sheet with `--tile 512
+/// --map-size 512` estimated 325 MiB and peaked at 633, a preview of 2048² maps 313 for 500,
+/// a 2048×1024 frame 204 for 326 (a sheet's frame was not counted at all, nor anywhere the
+/// textures, their mip chains and staging, or the renderer).
+#[test]
+fn the_memory_estimate_of_a_drawing_is_above_its_peak() {
+    let Some(_gpu) = gpu_or_skip("the_memory_estimate_of_a_drawing_is_above_its_peak") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let (sheet, image) = (dir.path().join("s.png"), dir.path().join("p.png"));
+    let (sheet, image) = (sheet.to_str().unwrap(), image.to_str().unwrap());
+    let body = ["--layout", "body", "--tile", "512", "--map-size", "512", "--species", "crotalus-atrox"];
+    let cases: [Vec<&str>; 4] = [
+        [&["sheet", "-o", sheet][..], &body].concat(),
+        vec!["sheet", "-o", sheet, "--tile", "256", "--map-size", "1024", "--species", "natrix-natrix,natrix-natrix"],
+        vec!["preview", PLAIN_PRESET, "--out", image, "--map-size", "2048", "--size", "16x16"],
+        vec!["preview", PLAIN_PRESET, "--out", image, "--map-size", "256", "--size", "2048x1024"],
+    ];
+    for args in cases {
+        // The estimate, as the refusal under a 1 MiB limit prints it.
+        let refused = common::snakeskin_env(&args, &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1")]);
+        let text = common::stderr(&refused);
+        let estimate_mib: u64 = text
+            .split("needs about ")
+            .nth(1)
+            .and_then(|rest| rest.split(' ').next()?.parse().ok())
+            .unwrap_or_else(|| panic!("{args:?}: no estimate in {text}"));
+        let peak_mib = peak_resident_kib(&args) / 1024;
+        eprintln!("{args:?}: estimate {estimate_mib} MiB, peak {peak_mib} MiB");
+        assert!(estimate_mib >= peak_mib, "{args:?}: estimated {estimate_mib} MiB, peaked at {peak_mib} MiB");
+        assert!(estimate_mib <= 2 * peak_mib, "{args:?}: estimated {estimate_mib} MiB for a peak of {peak_mib} MiB");
+    }
+}
+
 /// The preset is given by a link in another folder (a dotfiles set-up): edits of the file
 /// it names reload too (only the link's own folder was watched, so edits through the link
 /// were never seen).

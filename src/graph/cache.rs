@@ -33,6 +33,11 @@ impl NodeCache {
         NodeCache::default()
     }
 
+    /// Bytes of the images the cache holds (for the memory check before it evaluates again).
+    pub fn bytes(&self) -> u64 {
+        self.entries.values().map(|image| image.bytes() as u64).sum()
+    }
+
     pub(crate) fn get(&self, key: u64) -> Option<Arc<Image>> {
         self.entries.get(&key).cloned()
     }

@@ -14,7 +14,10 @@ mod op;
 
 pub use cache::{CacheStats, NodeCache};
 pub use dot::to_dot;
-pub use eval::{EvalStats, Evaluation, NodeStats, estimate_peak_bytes, evaluate, evaluate_into, evaluate_rows};
+pub use eval::{
+    EvalStats, Evaluation, NodeStats, estimate_cached_peak_bytes, estimate_peak_bytes, evaluate, evaluate_into,
+    evaluate_rows,
+};
 pub use fuse::{FusedChain, FusedInput, FusedStep};
 pub use op::Op;
 

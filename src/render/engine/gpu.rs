@@ -155,6 +155,17 @@ impl StorageOutput {
 
 /// Maps a buffer for reading, waits for the GPU, and returns a copy of its bytes.
 pub fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    map_read_with(device, buffer, <[u8]>::to_vec)
+}
+
+/// Maps a buffer for reading, waits for the GPU, and returns what `read` makes of its bytes
+/// (a frame's rows without their padding: a copy of the whole buffer first cost 4 bytes a
+/// pixel more at the frame's peak).
+pub fn map_read_with<T>(
+    device: &wgpu::Device,
+    buffer: &wgpu::Buffer,
+    read: impl FnOnce(&[u8]) -> T,
+) -> Result<T, GpuError> {
     let slice = buffer.slice(..);
     let (sender, receiver) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |result| {
@@ -162,7 +173,7 @@ pub fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>,
     });
     device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
     receiver.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-    let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?.to_vec();
+    let data = read(&slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?);
     buffer.unmap();
     Ok(data)
 }

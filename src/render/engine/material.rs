@@ -61,6 +61,38 @@ impl MaterialMaps {
     }
 }
 
+/// The three textures' formats, in binding order.
+pub const ALBEDO_ROUGHNESS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const NORMAL_HEIGHT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const THICKNESS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
+
+/// Texels in `mip_chain`'s levels for a `width`×`height` level 0 (about 4/3 of level 0).
+pub fn chain_texels(width: usize, height: usize) -> u64 {
+    let (mut w, mut h, mut texels) = (width as u64, height as u64, 0);
+    loop {
+        texels += w * h;
+        if w <= 1 && h <= 1 {
+            return texels;
+        }
+        (w, h) = ((w / 2).max(1), (h / 2).max(1));
+    }
+}
+
+/// Bytes of `MaterialMaps`' packed f32 chains for `width`×`height` maps (16 + 16 + 4 per
+/// texel, every level), for the memory checks before anything is generated.
+pub fn packed_bytes(width: usize, height: usize) -> u64 {
+    let per_texel = 2 * std::mem::size_of::<[f32; 4]>() + std::mem::size_of::<f32>();
+    chain_texels(width, height) * per_texel as u64
+}
+
+/// Bytes of the three textures `MaterialTextures::new` makes for `width`×`height` maps
+/// (8 + 8 + 2 per texel, every level): device memory on a GPU, host memory on lavapipe.
+pub fn texture_bytes(width: usize, height: usize) -> u64 {
+    let texel = |f: wgpu::TextureFormat| f.block_copy_size(None).expect("colour formats have a size") as u64;
+    let per_texel = texel(ALBEDO_ROUGHNESS_FORMAT) + texel(NORMAL_HEIGHT_FORMAT) + texel(THICKNESS_FORMAT);
+    chain_texels(width, height) * per_texel
+}
+
 /// Anything a 2×2 box filter can average.
 pub trait Texel: Copy + Default {
     fn average(a: Self, b: Self, c: Self, d: Self) -> Self;
@@ -187,9 +219,9 @@ impl MaterialTextures {
                 view_formats: &[],
             })
         };
-        let ar = make("albedo_roughness", wgpu::TextureFormat::Rgba16Float);
-        let nh = make("normal_height", wgpu::TextureFormat::Rgba16Float);
-        let th = make("thickness", wgpu::TextureFormat::R16Float);
+        let ar = make("albedo_roughness", ALBEDO_ROUGHNESS_FORMAT);
+        let nh = make("normal_height", NORMAL_HEIGHT_FORMAT);
+        let th = make("thickness", THICKNESS_FORMAT);
         let (mut w, mut h) = (maps.width, maps.height);
         for level in 0..levels as usize {
             let upload = |texture: &wgpu::Texture, data: Vec<u16>, texel_bytes: usize| {
@@ -279,5 +311,17 @@ mod tests {
         assert_eq!(chain.len(), 7);
         assert_eq!(chain.last().unwrap().len(), 1);
         assert!((chain.last().unwrap()[0] - mean0).abs() < 1e-4);
+    }
+
+    /// The memory checks count a chain's texels without building it: the count is the chain's,
+    /// for square, oblong, odd and one-texel sizes (a body atlas is 682×8184 at most).
+    #[test]
+    fn chain_texels_counts_the_levels_mip_chain_makes() {
+        for (w, h) in [(1, 1), (64, 64), (64, 32), (5, 3), (682, 8184), (1, 9), (1024, 1)] {
+            let built: usize = mip_chain(vec![0f32; w * h], w, h).iter().map(Vec::len).sum();
+            assert_eq!(chain_texels(w, h), built as u64, "{w}×{h}");
+        }
+        assert_eq!(packed_bytes(2, 2), (4 + 1) * 36);
+        assert_eq!(texture_bytes(2, 2), (4 + 1) * 18);
     }
 }

@@ -11,7 +11,7 @@ use wgpu::util::DeviceExt;
 
 use super::film::{self, FilmBinding, GpuFilmMethod};
 use super::gpu::{Gpu, GpuError};
-use super::gpu::{map_read, texture_entry, uniform_entry};
+use super::gpu::{map_read_with, texture_entry, uniform_entry};
 use super::material::{self, MaterialMaps, MaterialTextures};
 use super::mesh::{BodyShape, Mesh, Vertex};
 use super::scene::{BounceGrid, Camera, LayerOptics, Lighting, SceneUniform, Stage, View};
@@ -28,11 +28,25 @@ pub const MSAA_SAMPLES: u32 = 4;
 /// Bytes a headless frame of `width`×`height` holds at once, for the memory check before it
 /// is rendered: the multisampled HDR target and depth (`MSAA_SAMPLES` texels of 8 and 4
 /// bytes), the resolved HDR target (8), the 8-bit output, its readback and the image read
-/// back (4 each). On a software adapter (lavapipe) all of it is host memory.
+/// back (4 each), and the RGB image and PNG bytes written from it (at most 3 each). wgpu frees
+/// the targets at its next poll, so they are still there while the image is written.
+/// On a software adapter (lavapipe) all of it is host memory: a 4096×2048 preview with 64²
+/// maps peaked 72.6 bytes a pixel above a 16×16 one's.
 pub fn frame_bytes(width: u32, height: u32) -> u64 {
-    let per_pixel = MSAA_SAMPLES as u64 * (8 + 4) + 8 + 3 * 4;
+    let per_pixel = MSAA_SAMPLES as u64 * (8 + 4) + 8 + 3 * 4 + 2 * 3;
     width as u64 * height as u64 * per_pixel
 }
+
+/// Host memory a renderer holds beyond the process's fixed overhead
+/// (`memory::FIXED_OVERHEAD_BYTES`), whatever it draws: the device, its pipelines and their
+/// compiled shaders, a body's mesh. Measured on lavapipe (Mesa 22.3.6, two cores) with 64²
+/// maps and 16² frames, peak resident: `preview` 189 MiB, `figures` 235 MiB, `sheet --tile
+/// 64 --layout body --closeups --species natrix-natrix` 247 MiB, 183 MiB above the fixed
+/// overhead. On a busy machine (the test suite running beside it) peaks were up to 90 MiB
+/// higher than alone (a 2048×1024 preview of 256² maps: 397 MiB, 324 alone; the allocator
+/// makes more arenas when its threads contend): 256 MiB. A GPU driver's own allocations are
+/// of the same order.
+pub const RENDERER_OVERHEAD_BYTES: u64 = 256 << 20;
 
 /// Bytes the CPU reference check adds to a frame (`render_gbuffer`): two passes of two
 /// 16-byte targets, each read back into a buffer and copied into a vector.
@@ -783,13 +797,14 @@ impl Renderer {
             wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
         );
         self.gpu.queue.submit([encoder.finish()]);
-        let data = map_read(device, &buffer)?;
-        let mut out = Vec::with_capacity((row * height) as usize);
-        for y in 0..height as usize {
-            let start = y * padded as usize;
-            out.extend_from_slice(&data[start..start + row as usize]);
-        }
-        Ok(out)
+        map_read_with(device, &buffer, |data| {
+            let mut out = Vec::with_capacity((row * height) as usize);
+            for y in 0..height as usize {
+                let start = y * padded as usize;
+                out.extend_from_slice(&data[start..start + row as usize]);
+            }
+            out
+        })
     }
 }
 

@@ -14,9 +14,12 @@ use super::engine::scene::{Camera, Stage, View};
 use crate::Error;
 use crate::export::{FileGroup, check_target, write_file_atomically};
 
-/// Encodes and writes a rendered image (atomically).
+/// Encodes and writes a rendered image (atomically), as RGB converted without a copy of the
+/// RGBA image (`renderer::frame_bytes` counts the RGB image and the PNG bytes).
 pub fn write_png(path: &Path, image: &image::RgbaImage) -> Result<PathBuf, Error> {
-    write_rgb_png(path, &image::DynamicImage::ImageRgba8(image.clone()).into_rgb8())
+    use image::buffer::ConvertBuffer;
+    let rgb: image::RgbImage = image.convert();
+    write_rgb_png(path, &rgb)
 }
 
 /// Encodes and writes an RGB image (atomically).
@@ -120,6 +123,7 @@ pub fn write_figures(
     let mut group = FileGroup::new();
     for (i, figure) in figures.iter().enumerate() {
         progress(i, figures.len());
+        crate::memory::release_freed();
         let overrides: Vec<(String, String)> =
             figure.overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
         let loaded = crate::preset::load(preset, &overrides, None)?;

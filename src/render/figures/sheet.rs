@@ -15,7 +15,8 @@ use crate::optics::lut::Lut;
 use crate::preset::{LoadedPreset, library};
 use crate::render::engine::film::GpuFilmMethod;
 use crate::render::engine::material::MaterialMaps;
-use crate::render::engine::renderer::{FrameSettings, Renderer};
+use crate::render::engine::prepare::DrawMemory;
+use crate::render::engine::renderer::{FrameSettings, Renderer, frame_bytes};
 use crate::render::engine::scene::{Camera, LayerOptics};
 
 const LABEL_SCALE: u32 = 2;
@@ -186,12 +187,16 @@ fn render_tile_sheet(
     let mut luts: Vec<(crate::optics::film::Stack, Lut)> = Vec::new();
     for (i, (name, loaded)) in presets.iter().enumerate() {
         progress(i, presets.len());
+        crate::memory::release_freed();
         let graph = build_graph(&loaded.preset, BuildOptions::default());
         let evaluation = evaluate(&graph, &MapKind::ALL, options.map_size, options.map_size, &|_, _| {});
         let maps =
             MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Internal(format!("the sheet's maps: {e}")))?;
         let optics = LayerOptics::from_preset(&loaded.preset);
         let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
+        // The maps are uploaded: only the colour tile is needed from them before the frame.
+        let colour = colour_tile(&evaluation.maps, tile);
+        drop((maps, evaluation));
         let settings = FrameSettings {
             camera: sheet_camera(),
             method: GpuFilmMethod::Lut,
@@ -210,7 +215,7 @@ fn render_tile_sheet(
         let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
         draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
         draw_text(&mut sheet, x0 + 6, y0 + 8 + 8 * LABEL_SCALE, &second, MUTED);
-        imageops::replace(&mut sheet, &colour_tile(&evaluation.maps, tile), (x0) as i64, (y0 + LABEL_HEIGHT) as i64);
+        imageops::replace(&mut sheet, &colour, (x0) as i64, (y0 + LABEL_HEIGHT) as i64);
         imageops::replace(&mut sheet, &render, (x0 + tile) as i64, (y0 + LABEL_HEIGHT) as i64);
     }
     progress(presets.len(), presets.len());
@@ -237,6 +242,7 @@ fn render_body_sheet(
     let options_body = BuildOptions { layout: Layout::Body, ..BuildOptions::default() };
     for (i, (name, loaded)) in presets.iter().enumerate() {
         progress(i, presets.len());
+        crate::memory::release_freed();
         let preset = &loaded.preset;
         let graph = build_graph(preset, options_body);
         let (width, height) = plan.map_size(loaded);
@@ -247,6 +253,15 @@ fn render_body_sheet(
         maps.atlas = Some(body);
         let optics = LayerOptics::from_preset(preset);
         let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
+        // The atlas on its side: rotate so v (snout → tail) runs left to right, scaled to
+        // `circumference` pixels round the body and the body's length along. Made before the
+        // frame, so that the maps are not held beside it.
+        let atlas = colour_image(&evaluation.maps);
+        drop((maps, evaluation));
+        let strip = imageops::rotate270(&atlas);
+        drop(atlas);
+        let length_px = (preset.body.length * circumference as f64).round() as u32;
+        let strip = imageops::resize(&strip, length_px, circumference, imageops::FilterType::Triangle);
         let settings = FrameSettings {
             camera: Camera::framing(1),
             method: GpuFilmMethod::Lut,
@@ -255,12 +270,6 @@ fn render_body_sheet(
         };
         let render = renderer.render_image(&settings, &material, render_w, render_h)?;
         let render = image::DynamicImage::ImageRgba8(render).into_rgb8();
-        // The atlas on its side: rotate so v (snout → tail) runs left to right, scaled to
-        // `circumference` pixels round the body and the body's length along.
-        let atlas = colour_image(&evaluation.maps);
-        let strip = imageops::rotate270(&atlas);
-        let length_px = (preset.body.length * circumference as f64).round() as u32;
-        let strip = imageops::resize(&strip, length_px, circumference, imageops::FilterType::Triangle);
 
         let (x0, y0) = ((i as u32 % columns) * cell_w, (i as u32 / columns) * cell_h);
         let category = preset.category.map(|c| format!(" ({})", c.name())).unwrap_or_default();
@@ -296,28 +305,43 @@ fn render_body_sheet(
     Ok(sheet)
 }
 
-/// Refuses a sheet whose canvas (RGB bytes) and heaviest species' maps (the largest of
-/// generate's estimates over the sheet's presets, each graph weighed, not only its size)
-/// would together need more memory than is available (`prepare::check_memory`), before a
-/// renderer or the canvas is made.
+/// Refuses a sheet whose canvas (RGB bytes) and heaviest species (the largest estimate over
+/// the sheet's presets, each graph weighed, not only its size: its maps, textures, colour
+/// strip and frame, `prepare::DrawMemory`) would together need more memory than is
+/// available, before a renderer or the canvas is made.
 fn check_sheet_memory(plan: &SheetPlan) -> Result<(), Error> {
     let canvas = plan.canvas;
-    let canvas_bytes = canvas.0 as u64 * canvas.1 as u64 * 3;
+    // The canvas, and its PNG bytes at the end (at most its size).
+    let canvas_bytes = canvas.0 as u64 * canvas.1 as u64 * 3 * 2;
     let layout = plan.layout;
+    // The frame and its RGB copy (the close-ups' frames are smaller, and drawn after it).
+    let frame_bytes = frame_bytes(plan.render.0, plan.render.1);
     let heaviest = plan
         .species
         .iter()
         .map(|(_, l)| {
             let graph = build_graph(&l.preset, BuildOptions { layout, ..BuildOptions::default() });
             let (width, height) = plan.map_size(l);
-            (crate::memory::estimate_generate_bytes(&graph, &MapKind::ALL, width, height), graph, (width, height))
+            // The colour image, rotated and scaled to its strip (the tile's square), is made
+            // before the frame.
+            let tile = plan.options.tile as u64;
+            let strip = match layout {
+                Layout::Tile => tile * tile,
+                Layout::Body => (l.preset.body.length * tile as f64).round() as u64 * tile,
+            };
+            let colour_bytes = (width * height) as u64 * 3 * 2 + strip * 3;
+            let memory = DrawMemory {
+                held_bytes: canvas_bytes + colour_bytes,
+                drawn_in_turn: plan.species.len() > 1,
+                ..DrawMemory::new(&graph, (width, height), frame_bytes)
+            };
+            (memory.estimate_bytes(), memory)
         })
-        .max_by_key(|(bytes, _, _)| *bytes);
-    let Some((_, graph, size)) = heaviest else {
+        .max_by_key(|(bytes, _)| *bytes);
+    let Some((_, memory)) = heaviest else {
         return Ok(());
     };
-    let what = format!("a contact sheet of {}×{} pixels, with the maps of its heaviest species", canvas.0, canvas.1);
-    crate::render::engine::prepare::check_memory(&graph, size, canvas_bytes, &what)
+    memory.check(&format!("a contact sheet of {}×{} pixels, with the maps of its heaviest species", canvas.0, canvas.1))
 }
 
 /// The linear colour map as an sRGB image at full size.

@@ -141,6 +141,37 @@ impl<'a> FrameTimer<'a> {
     }
 }
 
+/// Materials the benchmark keeps at once: its eight variants with one snake, and two of them
+/// with twenty (`bench_render`'s runs).
+const TIMED_RUNS: usize = 10;
+
+/// What the benchmark's renderer holds beyond one preview's (`RENDERER_OVERHEAD_BYTES`): the
+/// pipelines of its eight variants, twenty snakes' draws and the timing queries. Measured on
+/// lavapipe (Mesa 22.3.6, two cores), peak resident with 64² maps and a 16² reference:
+/// 505 MiB at a 64² frame, 628 MiB at 640×360, 684 MiB at 1280×720 (a preview with such maps
+/// and frame: under 260 MiB).
+const VARIANTS_OVERHEAD_BYTES: u64 = 384 << 20;
+
+/// Refuses a benchmark whose maps, materials and frames (the timed frame, the reference
+/// check's frame and G-buffer) would need more memory than is available, before a renderer
+/// is made. It had no check: `--size 8192x8192 --map-size 4096` allocated until it failed.
+pub fn check_memory(loaded: &LoadedPreset, options: &BenchOptions) -> Result<(), Error> {
+    use crate::render::engine::prepare::DrawMemory;
+    use crate::render::engine::renderer::{frame_bytes, gbuffer_bytes};
+    let (w, h) = options.reference_size;
+    let frames = frame_bytes(options.width, options.height) + frame_bytes(w, h) + gbuffer_bytes(w, h);
+    let graph = crate::maps::build_graph(&loaded.preset, crate::maps::BuildOptions::default());
+    let size = (options.map_size, options.map_size);
+    // The packed maps are held from the first upload to the last.
+    let packed = crate::render::engine::material::packed_bytes(size.0, size.1);
+    let memory = DrawMemory {
+        held_bytes: packed + VARIANTS_OVERHEAD_BYTES,
+        materials: TIMED_RUNS as u64,
+        ..DrawMemory::new(&graph, size, frames)
+    };
+    memory.check("the render benchmark's materials and frames")
+}
+
 /// Runs the whole benchmark for one preset.
 pub fn bench_render(
     renderer: &Renderer,
@@ -188,6 +219,7 @@ pub fn bench_render(
             runs.push((name.clone(), snakes, material, settings, Vec::with_capacity(options.frames)));
         }
     }
+    debug_assert_eq!(runs.len(), TIMED_RUNS, "check_memory counts the runs' materials");
     let timer = FrameTimer::new(renderer, options, base.samples);
     for round in 0..options.frames + 3 {
         progress(&format!("round {} of {}", round + 1, options.frames + 3));

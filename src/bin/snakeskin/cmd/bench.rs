@@ -181,7 +181,6 @@ fn gpu(count: usize, model: snakeskin::optics::brdf::Model, json: bool) -> Resul
 fn render(preset: &str, size: ImageSize, frames: u64, map_size: u64, reference: ImageSize, json: bool) -> Result<()> {
     let loaded = snakeskin::preset::load(preset, &[], None)?;
     crate::output::report_warnings(preset, &loaded);
-    let renderer = Renderer::headless()?;
     let options = BenchOptions {
         width: size.width,
         height: size.height,
@@ -189,6 +188,8 @@ fn render(preset: &str, size: ImageSize, frames: u64, map_size: u64, reference: 
         map_size: map_size as usize,
         reference_size: (reference.width, reference.height),
     };
+    snakeskin::render::reference::bench::check_memory(&loaded, &options)?;
+    let renderer = Renderer::headless()?;
     let bar = Progress::spinner("bench render");
     let result = bench_render(&renderer, &loaded, &options, &|what| bar.message(what))?;
     bar.finish();

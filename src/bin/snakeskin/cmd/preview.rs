@@ -54,7 +54,13 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     }
     let frame_bytes = frame_bytes(width, height) + args.reference.as_ref().map_or(0, |_| gbuffer_bytes(width, height));
     let layout = args.layout.layout();
-    snakeskin::render::engine::prepare::check_preview_memory(&loaded, args.map_size as usize, layout, frame_bytes)?;
+    snakeskin::render::engine::prepare::check_preview_memory(
+        &loaded,
+        args.map_size as usize,
+        layout,
+        frame_bytes,
+        false,
+    )?;
     let bar = Progress::spinner("generating maps and baking the film LUT");
     let renderer = Renderer::headless()?;
     if args.reference.is_some() {
