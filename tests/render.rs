@@ -483,8 +483,9 @@ fn sheet_command_writes_a_png() {
     assert_eq!(image.width(), 5 * 3 * 64);
 }
 
-/// The peak resident memory (KiB, from `wait4`'s `ru_maxrss`) of `snakeskin args`, which must
-/// succeed; this child's own, whatever else the tests run at the same time.
+/// The peak resident memory (KiB, from `wait4`'s `ru_maxrss`, KiB on Linux) of `snakeskin
+/// args`, which must succeed; this child's own, whatever else the tests run at the same time.
+#[cfg(target_os = "linux")]
 #[allow(clippy::zombie_processes, reason = "the child is reaped by wait4, which Child::wait cannot give")]
 fn peak_resident_kib(args: &[&str]) -> u64 {
     use std::process::{Command, Stdio};
@@ -502,21 +503,26 @@ fn peak_resident_kib(args: &[&str]) -> u64 {
 }
 
 /// The memory check of the commands that draw maps is an upper bound of what they take,
-/// measured (peak resident, lavapipe's textures and frames are host memory), and not a wild
-/// one. It counted the maps' evaluation and the frame alone: a body sheet with `--tile 512
-/// --map-size 512` estimated 325 MiB and peaked at 633, a preview of 2048² maps 313 for 500,
-/// a 2048×1024 frame 204 for 326 (a sheet's frame was not counted at all, nor anywhere the
-/// textures, their mip chains and staging, or the renderer).
+/// measured (peak resident), and on a software adapter, whose textures and frames are host
+/// memory as the estimate counts them, not a wild one (on a GPU they are not resident here).
+/// It counted the maps' evaluation and the frame alone: 325 MiB for a body sheet with `--tile
+/// 512 --map-size 512` that peaks at 631 MiB, 313 for a preview of 2048² maps (497), 204 for
+/// a 2048×1024 frame (324); a sheet's frame was not counted at all, nor anywhere the
+/// textures, their mip chains and staging, or the renderer. The single-species sheet of
+/// large maps holds its maps while they are uploaded (the review: f32 maps beside the upload).
+#[cfg(target_os = "linux")]
 #[test]
 fn the_memory_estimate_of_a_drawing_is_above_its_peak() {
-    let Some(_gpu) = gpu_or_skip("the_memory_estimate_of_a_drawing_is_above_its_peak") else { return };
+    let Some(gpu) = gpu_or_skip("the_memory_estimate_of_a_drawing_is_above_its_peak") else { return };
+    let software = gpu.describe().contains("Cpu");
     let dir = tempfile::tempdir().unwrap();
     let (sheet, image) = (dir.path().join("s.png"), dir.path().join("p.png"));
     let (sheet, image) = (sheet.to_str().unwrap(), image.to_str().unwrap());
     let body = ["--layout", "body", "--tile", "512", "--map-size", "512", "--species", "crotalus-atrox"];
-    let cases: [Vec<&str>; 4] = [
+    let cases: [Vec<&str>; 5] = [
         [&["sheet", "-o", sheet][..], &body].concat(),
         vec!["sheet", "-o", sheet, "--tile", "256", "--map-size", "1024", "--species", "natrix-natrix,natrix-natrix"],
+        vec!["sheet", "-o", sheet, "--tile", "64", "--map-size", "2048", "--species", "natrix-natrix"],
         vec!["preview", PLAIN_PRESET, "--out", image, "--map-size", "2048", "--size", "16x16"],
         vec!["preview", PLAIN_PRESET, "--out", image, "--map-size", "256", "--size", "2048x1024"],
     ];
@@ -532,7 +538,12 @@ fn the_memory_estimate_of_a_drawing_is_above_its_peak() {
         let peak_mib = peak_resident_kib(&args) / 1024;
         eprintln!("{args:?}: estimate {estimate_mib} MiB, peak {peak_mib} MiB");
         assert!(estimate_mib >= peak_mib, "{args:?}: estimated {estimate_mib} MiB, peaked at {peak_mib} MiB");
-        assert!(estimate_mib <= 2 * peak_mib, "{args:?}: estimated {estimate_mib} MiB for a peak of {peak_mib} MiB");
+        if software {
+            assert!(
+                estimate_mib <= 2 * peak_mib,
+                "{args:?}: estimated {estimate_mib} MiB for a peak of {peak_mib} MiB"
+            );
+        }
     }
 }
 

@@ -30,7 +30,9 @@ pub const MAX_TEXTURE_SIDE: usize = 8192;
 pub fn material_maps_in(loaded: &LoadedPreset, map_size: usize, layout: Layout) -> Result<MaterialMaps, Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
     let (width, height) = map_dimensions(loaded, map_size, layout);
-    DrawMemory::new(&graph, (width, height), 0).check(PREVIEW_MAPS)?;
+    // Its callers hold a renderer already, and the commands checked the whole drawing before
+    // they made it (`check_preview_memory`): what the maps add is checked here.
+    DrawMemory::new(&graph, (width, height), 0).check_added(PREVIEW_MAPS)?;
     let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
     packed(&evaluation.maps, loaded, layout)
 }
@@ -38,13 +40,14 @@ pub fn material_maps_in(loaded: &LoadedPreset, map_size: usize, layout: Layout) 
 /// What a command that draws maps holds, phase by phase, for its memory check before anything
 /// is allocated (`estimate_bytes`). The check counted the maps' evaluation (as `generate`'s)
 /// and the frame only: on lavapipe, whose textures are host memory, a body sheet with `--tile
-/// 1024 --map-size 1024` peaked at 1632 MiB resident where it estimated 580 MiB.
+/// 1024 --map-size 1024` peaked at 1635 MiB resident where it estimated 580 MiB.
 #[derive(Debug, Clone, Copy)]
 pub struct DrawMemory {
     /// Width and height of the maps.
     pub maps: (usize, usize),
-    /// The maps' evaluation at its worst (`graph::estimate_peak_bytes`; with a live-reload
-    /// cache, the cache's previous entries and the maps handed over besides).
+    /// The maps' evaluation at its worst: the schedule's buffers (`graph::estimate_peak_bytes`)
+    /// and the maps handed over, which `evaluate` keeps to its end (a live-reload cache: every
+    /// node it keeps).
     pub evaluation_bytes: u64,
     /// Held beside every phase: a contact sheet's canvas, a live-reload cache's entries.
     pub held_bytes: u64,
@@ -52,25 +55,32 @@ pub struct DrawMemory {
     pub frame_bytes: u64,
     /// Materials uploaded from the maps and kept at once (the render benchmark's variants).
     pub materials: u64,
-    /// One of several sets of maps drawn in turn (a sheet's species, the figures): what the
-    /// previous one freed is not all reusable at once (the allocator's other arenas; textures
-    /// wgpu frees at a later poll), counted as one more material's packed chains, textures
-    /// and staging. A second `natrix-natrix` at 2048² raised a sheet's peak by 108 MiB; in a
-    /// busy test run, two at 1024² peaked at 443 MiB where they take 353 alone. Between
-    /// species the sheet hands freed memory back (`memory::release_freed`): 332 MiB then.
-    pub drawn_in_turn: bool,
+    /// The largest maps (width, height) drawn before these, when several are drawn in turn (a
+    /// sheet's species, the figures): what the previous ones freed is not all reusable at once
+    /// (the allocator's other arenas; textures wgpu frees at a later poll), counted as one
+    /// more material of that size: packed chains, textures and staging. A second
+    /// `natrix-natrix` at 2048² raised a sheet's peak by 108 MiB; in a busy test run, two at
+    /// 1024² peaked at 443 MiB where they take 353 alone. Between species the sheet hands
+    /// freed memory back (`memory::release_freed`): 332 MiB then.
+    pub drawn_after: Option<(usize, usize)>,
 }
 
 impl DrawMemory {
     /// One material from `graph`'s maps at `maps` (width, height), drawn into a frame of
     /// `frame_bytes`.
     pub fn new(graph: &Graph, maps: (usize, usize), frame_bytes: u64) -> DrawMemory {
-        let evaluation_bytes = estimate_peak_bytes(graph, &MapKind::ALL, maps.0, maps.1);
-        DrawMemory { maps, evaluation_bytes, held_bytes: 0, frame_bytes, materials: 1, drawn_in_turn: false }
+        let evaluation_bytes = estimate_peak_bytes(graph, &MapKind::ALL, maps.0, maps.1) + maps_bytes(maps.0, maps.1);
+        DrawMemory { maps, evaluation_bytes, held_bytes: 0, frame_bytes, materials: 1, drawn_after: None }
     }
 
-    /// Estimated peak bytes. The phases follow one another, so the peak is the largest of
-    /// them, plus what is held throughout and the fixed overheads:
+    /// Estimated peak bytes of a process that makes its renderer for this drawing:
+    /// `estimate_added_bytes` and the renderer's and the process's own overheads.
+    pub fn estimate_bytes(&self) -> u64 {
+        self.estimate_added_bytes() + RENDERER_OVERHEAD_BYTES + FIXED_OVERHEAD_BYTES
+    }
+
+    /// Estimated bytes the drawing adds to what the process holds. The phases follow one
+    /// another, so the peak is the largest of them, plus what is held throughout:
     /// - evaluation: the graph's buffers at their worst;
     /// - packing: the generator's f32 maps beside their packed mip chains (`packed_bytes`);
     /// - upload: the chains beside every material's textures (`texture_bytes`), wgpu's staging
@@ -79,7 +89,7 @@ impl DrawMemory {
     ///   packed chains: freed memory that the allocator keeps (a 4096² frame with 1024² maps
     ///   peaked 94 MiB above the same frame with 64² maps, where textures and staging are
     ///   48 MiB).
-    pub fn estimate_bytes(&self) -> u64 {
+    pub fn estimate_added_bytes(&self) -> u64 {
         let (width, height) = self.maps;
         let pixels = (width * height) as u64;
         let maps = maps_bytes(width, height);
@@ -93,15 +103,28 @@ impl DrawMemory {
             (packed + textures).saturating_add(self.frame_bytes),
         ];
         let peak = phases.into_iter().max().unwrap_or(0);
-        let one_material = packed + 2 * material::texture_bytes(width, height);
-        let kept_from_before = if self.drawn_in_turn { one_material } else { 0 };
-        peak.saturating_add(self.held_bytes + kept_from_before) + RENDERER_OVERHEAD_BYTES + FIXED_OVERHEAD_BYTES
+        let kept_from_before =
+            self.drawn_after.map_or(0, |(w, h)| material::packed_bytes(w, h) + 2 * material::texture_bytes(w, h));
+        peak.saturating_add(self.held_bytes + kept_from_before)
     }
 
-    /// `Error::Memory` when the estimate exceeds the available memory; `what` names the work.
+    /// `Error::Memory` when the estimate exceeds the available memory, before a renderer is
+    /// made; `what` names the work.
     pub fn check(&self, what: &str) -> Result<(), Error> {
+        self.refuse_over(self.estimate_bytes(), what)
+    }
+
+    /// The same for a process that holds its renderer (and whatever it drew) already: the
+    /// available memory leaves those out, so only what this drawing adds is compared with it.
+    /// Counted again, a 2048² window's reloads (1312 MiB estimated, 891 resident) would be
+    /// refused unless about 2.2 GiB were free.
+    pub fn check_added(&self, what: &str) -> Result<(), Error> {
+        self.refuse_over(self.estimate_added_bytes(), what)
+    }
+
+    fn refuse_over(&self, bytes: u64, what: &str) -> Result<(), Error> {
         let (width, height) = self.maps;
-        MemoryCheck::against_available(self.estimate_bytes()).refuse_if_over(&format!("{what} ({width}×{height} maps)"))
+        MemoryCheck::against_available(bytes).refuse_if_over(&format!("{what} ({width}×{height} maps)"))
     }
 }
 
@@ -117,7 +140,8 @@ const PREVIEW_MAPS: &str = "the preview's set of maps";
 /// `material_maps_in`'s memory check alone, for a command to run before it makes its
 /// renderer (so that a machine without a GPU hears about the memory first).
 /// `frame_bytes` are the frame's own (`renderer::frame_bytes`), which an 8192² frame made
-/// 4.9 GB of when only the maps were counted; `drawn_in_turn` as in `DrawMemory` (figures).
+/// 4.9 GB of when only the maps were counted; `drawn_in_turn`: one of several drawn in turn,
+/// the same size (`DrawMemory::drawn_after`; the figures).
 pub fn check_preview_memory(
     loaded: &LoadedPreset,
     map_size: usize,
@@ -126,8 +150,9 @@ pub fn check_preview_memory(
     drawn_in_turn: bool,
 ) -> Result<(), Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
+    let size = map_dimensions(loaded, map_size, layout);
     let memory =
-        DrawMemory { drawn_in_turn, ..DrawMemory::new(&graph, map_dimensions(loaded, map_size, layout), frame_bytes) };
+        DrawMemory { drawn_after: drawn_in_turn.then_some(size), ..DrawMemory::new(&graph, size, frame_bytes) };
     memory.check("the preview's frame with its maps")
 }
 
@@ -155,24 +180,34 @@ fn packed(
 }
 
 /// The same through a node cache: after an edit only changed nodes run (live reload).
+/// `frame_bytes`: the window's targets, for its first maps (made before its renderer).
 pub fn material_maps_cached(
     loaded: &LoadedPreset,
     map_size: usize,
     layout: Layout,
     cache: &mut NodeCache,
+    frame_bytes: u64,
 ) -> Result<(MaterialMaps, crate::graph::CacheStats), Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
     let (width, height) = map_dimensions(loaded, map_size, layout);
-    // The cache keeps every node, beside its previous entries while it evaluates, and hands
-    // copies of the maps over.
+    // The cache keeps every node, and hands copies of the maps over.
     let kept = estimate_cached_peak_bytes(&graph, &MapKind::ALL, width, height);
     let handed_over = maps_bytes(width, height);
-    let memory = DrawMemory {
-        evaluation_bytes: cache.bytes().saturating_add(handed_over),
-        held_bytes: kept,
-        ..DrawMemory::new(&graph, (width, height), 0)
-    };
-    memory.check(PREVIEW_MAPS)?;
+    if cache.bytes() == 0 {
+        // The window's first maps, before its renderer: the whole process.
+        let memory = DrawMemory {
+            evaluation_bytes: handed_over,
+            held_bytes: kept,
+            ..DrawMemory::new(&graph, (width, height), frame_bytes)
+        };
+        memory.check(PREVIEW_MAPS)?;
+    } else {
+        // A reload, in a window that holds its renderer, targets, cache and textures: what it
+        // adds is the nodes that run (at most every one kept), the maps handed over, their
+        // chains, and the new textures beside the old.
+        let memory = DrawMemory { evaluation_bytes: kept + handed_over, ..DrawMemory::new(&graph, (width, height), 0) };
+        memory.check_added(PREVIEW_MAPS)?;
+    }
     let (maps, stats) = cache.evaluate(&graph, &MapKind::ALL, width, height);
     Ok((packed(&maps, loaded, layout)?, stats))
 }
@@ -205,5 +240,49 @@ pub fn bands_for(method: GpuFilmMethod) -> usize {
     match method {
         GpuFilmMethod::SpectralN(n) => n,
         _ => 1,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 64² maps: 5461 texels in their mip chains (4096 + 1024 + … + 1), packed as 36 bytes
+    /// (two RGBA f32 and one f32) and uploaded as 18 (two RGBA f16 and one f16).
+    const CHAIN: u64 = 5461;
+
+    fn drawing() -> DrawMemory {
+        DrawMemory {
+            maps: (64, 64),
+            evaluation_bytes: 0,
+            held_bytes: 0,
+            frame_bytes: 0,
+            materials: 1,
+            drawn_after: None,
+        }
+    }
+
+    /// Each phase wins when it is the largest; what is held throughout, a material drawn
+    /// before and the overheads add to it.
+    #[test]
+    fn the_estimate_is_the_largest_phase_and_what_is_held() {
+        let (packed, textures) = (CHAIN * 36, CHAIN * 18);
+        let frame = 1 << 30;
+        let drawing_phase = packed + 2 * textures + frame;
+        assert_eq!(DrawMemory { frame_bytes: frame, ..drawing() }.estimate_added_bytes(), drawing_phase);
+        let evaluation = 3 << 30;
+        let heavy = DrawMemory { evaluation_bytes: evaluation, frame_bytes: frame, held_bytes: 7, ..drawing() };
+        assert_eq!(heavy.estimate_added_bytes(), evaluation + 7);
+        // Ten materials: ten textures with their staging in the upload and drawing phases.
+        let ten = DrawMemory { materials: 10, ..drawing() };
+        assert_eq!(ten.estimate_added_bytes(), packed + 20 * textures + 64 * 64 * 8);
+        // A material of 128² maps drawn before: its chains, textures and staging.
+        let after = DrawMemory { frame_bytes: frame, drawn_after: Some((128, 128)), ..drawing() };
+        let before_chain = 21845;
+        assert_eq!(after.estimate_added_bytes(), drawing_phase + before_chain * (36 + 2 * 18));
+        assert_eq!(after.estimate_bytes() - after.estimate_added_bytes(), (256 + 64) << 20);
+        // Without a frame, the upload phase (chains, textures, staging, one level in half
+        // floats) is the largest.
+        assert_eq!(drawing().estimate_added_bytes(), packed + 2 * textures + 64 * 64 * 8);
     }
 }

@@ -192,11 +192,12 @@ fn render_tile_sheet(
         let evaluation = evaluate(&graph, &MapKind::ALL, options.map_size, options.map_size, &|_, _| {});
         let maps =
             MaterialMaps::from_maps(&evaluation.maps).map_err(|e| Error::Internal(format!("the sheet's maps: {e}")))?;
+        // Only the colour tile is needed from the f32 maps: not held through the upload.
+        let colour = colour_tile(&evaluation.maps, tile);
+        drop(evaluation);
         let optics = LayerOptics::from_preset(&loaded.preset);
         let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
-        // The maps are uploaded: only the colour tile is needed from them before the frame.
-        let colour = colour_tile(&evaluation.maps, tile);
-        drop((maps, evaluation));
+        drop(maps);
         let settings = FrameSettings {
             camera: sheet_camera(),
             method: GpuFilmMethod::Lut,
@@ -252,16 +253,17 @@ fn render_body_sheet(
         let body = body_plan(preset);
         maps.atlas = Some(body);
         let optics = LayerOptics::from_preset(preset);
-        let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
         // The atlas on its side: rotate so v (snout → tail) runs left to right, scaled to
         // `circumference` pixels round the body and the body's length along. Made before the
-        // frame, so that the maps are not held beside it.
+        // upload, so that the f32 maps are not held through it nor beside the frame.
         let atlas = colour_image(&evaluation.maps);
-        drop((maps, evaluation));
+        drop(evaluation);
         let strip = imageops::rotate270(&atlas);
         drop(atlas);
         let length_px = (preset.body.length * circumference as f64).round() as u32;
         let strip = imageops::resize(&strip, length_px, circumference, imageops::FilterType::Triangle);
+        let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
+        drop(maps);
         let settings = FrameSettings {
             camera: Camera::framing(1),
             method: GpuFilmMethod::Lut,
@@ -316,23 +318,25 @@ fn check_sheet_memory(plan: &SheetPlan) -> Result<(), Error> {
     let layout = plan.layout;
     // The frame and its RGB copy (the close-ups' frames are smaller, and drawn after it).
     let frame_bytes = frame_bytes(plan.render.0, plan.render.1);
+    // The largest maps of the sheet, which may have been drawn before any species.
+    let largest = plan.species.iter().map(|(_, l)| plan.map_size(l)).max_by_key(|(w, h)| w * h).unwrap_or((0, 0));
     let heaviest = plan
         .species
         .iter()
         .map(|(_, l)| {
             let graph = build_graph(&l.preset, BuildOptions { layout, ..BuildOptions::default() });
             let (width, height) = plan.map_size(l);
-            // The colour image, rotated and scaled to its strip (the tile's square), is made
-            // before the frame.
+            // The colour image (RGB), rotated, and scaled to its strip (the tile's square):
+            // the resize's f32 RGBA pass is the source's width by the new height.
             let tile = plan.options.tile as u64;
-            let strip = match layout {
-                Layout::Tile => tile * tile,
-                Layout::Body => (l.preset.body.length * tile as f64).round() as u64 * tile,
+            let (strip, source_width) = match layout {
+                Layout::Tile => (tile * tile, width as u64),
+                Layout::Body => ((l.preset.body.length * tile as f64).round() as u64 * tile, height as u64),
             };
-            let colour_bytes = (width * height) as u64 * 3 * 2 + strip * 3;
+            let colour_bytes = (width * height) as u64 * 3 * 2 + source_width * tile * 16 + strip * 3;
             let memory = DrawMemory {
                 held_bytes: canvas_bytes + colour_bytes,
-                drawn_in_turn: plan.species.len() > 1,
+                drawn_after: (plan.species.len() > 1).then_some(largest),
                 ..DrawMemory::new(&graph, (width, height), frame_bytes)
             };
             (memory.estimate_bytes(), memory)

@@ -92,7 +92,8 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let loaded = crate::preset::load(&options.preset, &options.overrides, options.seed)?;
     let sliders = Sliders::from_preset(&loaded.preset);
     let mut cache = NodeCache::new();
-    let (maps, _) = material_maps_cached(&loaded, options.map_size, options.layout, &mut cache)?;
+    let targets = super::engine::renderer::frame_bytes(options.size.0, options.size.1);
+    let (maps, _) = material_maps_cached(&loaded, options.map_size, options.layout, &mut cache, targets)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);
 

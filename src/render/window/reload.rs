@@ -73,7 +73,7 @@ pub fn spawn_map_worker(
                 for warning in loaded.warnings(&spec) {
                     eprintln!("{warning}");
                 }
-                let (maps, stats) = material_maps_cached(&loaded, map_size, layout, &mut cache)?;
+                let (maps, stats) = material_maps_cached(&loaded, map_size, layout, &mut cache, 0)?;
                 Ok(Reloaded { maps, sliders: Sliders::from_preset(&loaded.preset), stats, took: start.elapsed() })
             });
             if reload_out.send(result).is_err() {

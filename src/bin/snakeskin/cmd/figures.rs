@@ -11,8 +11,9 @@ use snakeskin::maps::Layout;
 use snakeskin::render::Renderer;
 use snakeskin::render::figures::write_figures;
 
-/// Names, then memory (the maps and one frame: figures are rendered one at a time, each
-/// PNG staged before the next, so drawn in turn), then the GPU, then the folder: a refused run makes none.
+/// Names, then memory (the maps and one frame: figures are rendered one at a time, drawn
+/// in turn, each PNG staged before the next), then the GPU, then the folder: a refused run
+/// makes none.
 /// (The memory check was the maps' alone, after the folder and the renderer were made: an
 /// 8192-wide run reached 4.9 GB under a 300 MiB limit.)
 pub fn run(preset: &str, out: &Path, size: ImageSize, map_size: u64) -> Result<()> {
