@@ -66,16 +66,16 @@ pub const ALBEDO_ROUGHNESS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg
 pub const NORMAL_HEIGHT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const THICKNESS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
 
+/// Width and height of every level of a mip chain, level 0 first: each halves the last
+/// (at least 1) down to 1×1. The one home of the rule that `mip_chain`, the upload and the
+/// memory checks share.
+pub fn mip_levels(width: usize, height: usize) -> impl Iterator<Item = (usize, usize)> {
+    std::iter::successors(Some((width, height)), |&(w, h)| (w > 1 || h > 1).then(|| ((w / 2).max(1), (h / 2).max(1))))
+}
+
 /// Texels in `mip_chain`'s levels for a `width`×`height` level 0 (about 4/3 of level 0).
 pub fn chain_texels(width: usize, height: usize) -> u64 {
-    let (mut w, mut h, mut texels) = (width as u64, height as u64, 0);
-    loop {
-        texels += w * h;
-        if w <= 1 && h <= 1 {
-            return texels;
-        }
-        (w, h) = ((w / 2).max(1), (h / 2).max(1));
-    }
+    mip_levels(width, height).map(|(w, h)| (w * h) as u64).sum()
 }
 
 /// Bytes of `MaterialMaps`' packed f32 chains for `width`×`height` maps (16 + 16 + 4 per
@@ -113,9 +113,9 @@ impl Texel for [f32; 4] {
 /// Level 0 and every halving down to 1×1; odd sizes drop their last row or column.
 pub fn mip_chain<T: Texel>(level0: Vec<T>, width: usize, height: usize) -> Vec<Vec<T>> {
     let mut levels = vec![level0];
-    let (mut w, mut h) = (width, height);
-    while w > 1 || h > 1 {
-        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+    let sizes: Vec<(usize, usize)> = mip_levels(width, height).collect();
+    for pair in sizes.windows(2) {
+        let ((w, h), (nw, nh)) = (pair[0], pair[1]);
         let src = levels.last().expect("level 0");
         let at = |x: usize, y: usize| src[y.min(h - 1) * w + x.min(w - 1)];
         let mut next = Vec::with_capacity(nw * nh);
@@ -130,7 +130,6 @@ pub fn mip_chain<T: Texel>(level0: Vec<T>, width: usize, height: usize) -> Vec<V
             }
         }
         levels.push(next);
-        (w, h) = (nw, nh);
     }
     levels
 }
@@ -222,8 +221,7 @@ impl MaterialTextures {
         let ar = make("albedo_roughness", ALBEDO_ROUGHNESS_FORMAT);
         let nh = make("normal_height", NORMAL_HEIGHT_FORMAT);
         let th = make("thickness", THICKNESS_FORMAT);
-        let (mut w, mut h) = (maps.width, maps.height);
-        for level in 0..levels as usize {
+        for (level, (w, h)) in mip_levels(maps.width, maps.height).enumerate() {
             let upload = |texture: &wgpu::Texture, data: Vec<u16>, texel_bytes: usize| {
                 queue.write_texture(
                     wgpu::TexelCopyTextureInfo {
@@ -244,7 +242,6 @@ impl MaterialTextures {
             upload(&ar, maps.albedo_roughness[level].iter().flat_map(|t| t.map(f32_to_f16)).collect(), 8);
             upload(&nh, maps.normal_height[level].iter().flat_map(|t| t.map(f32_to_f16)).collect(), 8);
             upload(&th, maps.thickness[level].iter().map(|t| f32_to_f16(*t)).collect(), 2);
-            (w, h) = ((w / 2).max(1), (h / 2).max(1));
         }
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("maps"),
