@@ -221,7 +221,7 @@ impl MaterialTextures {
         let ar = make("albedo_roughness", ALBEDO_ROUGHNESS_FORMAT);
         let nh = make("normal_height", NORMAL_HEIGHT_FORMAT);
         let th = make("thickness", THICKNESS_FORMAT);
-        for (level, (w, h)) in mip_levels(maps.width, maps.height).enumerate() {
+        for (level, (w, h)) in mip_levels(maps.width, maps.height).take(levels as usize).enumerate() {
             let upload = |texture: &wgpu::Texture, data: Vec<u16>, texel_bytes: usize| {
                 queue.write_texture(
                     wgpu::TexelCopyTextureInfo {
