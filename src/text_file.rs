@@ -91,8 +91,31 @@ pub fn read_bounded_bytes(path: &Path, limit: u64, links: Links) -> Result<Vec<u
 pub fn read_bounded(path: &Path, limit: u64) -> Result<String, BoundedReadError> {
     let bytes = read_bounded_bytes(path, limit, Links::Follow)?;
     String::from_utf8(bytes).map_err(|e| {
-        BoundedReadError::Io(std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 text ({e})")))
+        let message = not_utf8(e.as_bytes(), &e.utf8_error());
+        BoundedReadError::Io(std::io::Error::new(std::io::ErrorKind::InvalidData, message))
     })
+}
+
+/// Where `bytes` stop being UTF-8, in the words of the TOML errors: the line and column
+/// (counted as `toml_text::line_column` counts them) and the byte, so a stray Latin-1 `é`
+/// can be found in an editor. std's own message gave a byte offset ("invalid utf-8 sequence
+/// of 1 bytes from index 23"). A UTF-16 file (Windows' "Unicode") is named as such: every
+/// other byte of it is zero, and its first line would be all the message could point at.
+fn not_utf8(bytes: &[u8], error: &std::str::Utf8Error) -> String {
+    if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) {
+        return "not UTF-8 text: it begins with a UTF-16 byte-order mark (save it as UTF-8)".into();
+    }
+    let valid = error.valid_up_to();
+    let before = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
+    let (line, column) = crate::toml_text::line_column(before, valid);
+    match error.error_len() {
+        Some(_) => format!(
+            "not UTF-8 text: line {line}, column {column} holds the byte 0x{:02X}, which UTF-8 does not allow there \
+             (save the file as UTF-8)",
+            bytes[valid]
+        ),
+        None => format!("not UTF-8 text: it ends inside a character at line {line}, column {column} (cut short?)"),
+    }
 }
 
 /// What a file that is not a regular file is, in words ("a FIFO", "a device", "a folder",
@@ -118,5 +141,31 @@ pub(crate) fn file_kind(t: &std::fs::FileType) -> &'static str {
         "a symbolic link"
     } else {
         "not a regular file"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::not_utf8;
+
+    fn message(bytes: &[u8]) -> String {
+        not_utf8(bytes, &std::str::from_utf8(bytes).expect_err("the test's bytes are not UTF-8"))
+    }
+
+    /// Line and column of the first byte that is not UTF-8, counted in characters (the `é`
+    /// before it is one column, as in an editor).
+    #[test]
+    fn the_first_byte_that_is_not_utf8_is_placed_by_line_and_column() {
+        assert_eq!(
+            message(b"seed = 1\nname = \"\xC3\xA9t\xE9\"\n"),
+            "not UTF-8 text: line 2, column 11 holds the byte 0xE9, which UTF-8 does not allow there (save the \
+             file as UTF-8)"
+        );
+        assert!(message(b"\xFF").contains("line 1, column 1 holds the byte 0xFF"), "{}", message(b"\xFF"));
+        assert_eq!(message(b"a\nb\xC3"), "not UTF-8 text: it ends inside a character at line 2, column 2 (cut short?)");
+        assert_eq!(
+            message(b"\xFF\xFEs\0e\0"),
+            "not UTF-8 text: it begins with a UTF-16 byte-order mark (save it as UTF-8)"
+        );
     }
 }

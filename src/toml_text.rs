@@ -61,6 +61,18 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
         // The parser gives a dotted key's depth no span: find the line that is that deep.
         at = at.or_else(|| too_deep_line(text));
     }
+    // A raw control character (a NUL, an escape) is allowed nowhere in TOML text, but the
+    // reader says what it expected there: `seed = 1<NUL>` was "string values must be quoted".
+    if let Some(offset) = at
+        && let Some((control_at, c)) = control_on_line(text, offset)
+    {
+        message = format!(
+            "the control character U+{:04X} is not allowed in TOML text (inside a quoted string, write it as the \
+             escape `\\u{:04X}`)",
+            c as u32, c as u32
+        );
+        at = Some(control_at);
+    }
     let mut key = None;
     if message.contains("duplicate key") {
         if !message.contains('`') {
@@ -94,6 +106,16 @@ fn too_deep_line(text: &str) -> Option<usize> {
         offset += line.len();
     }
     None
+}
+
+/// The first control character TOML forbids (U+0000–U+001F but tab, line feed and carriage
+/// return, and U+007F: TOML 1.0, "Comment" and "String") on the line that holds `offset`,
+/// with its offset. A carriage return out of place is left to the reader's own message.
+fn control_on_line(text: &str, offset: usize) -> Option<(usize, char)> {
+    let start = text.get(..offset)?.rfind('\n').map_or(0, |i| i + 1);
+    let end = text[offset..].find('\n').map_or(text.len(), |i| offset + i);
+    let forbidden = |c: char| (c <= '\u{1f}' && !matches!(c, '\t' | '\n' | '\r')) || c == '\u{7f}';
+    text[start..end].char_indices().find(|&(_, c)| forbidden(c)).map(|(i, c)| (start + i, c))
 }
 
 /// serde's message in a reader's words: "unknown field" with the nearest accepted key, and
@@ -303,6 +325,30 @@ mod tests {
                 described.message
             );
         }
+    }
+
+    /// A raw control character is named with its own column: `seed = 1<NUL>` was "string
+    /// values must be quoted" at the value. Negative control: the escape in a quoted string.
+    #[test]
+    fn a_control_character_is_named_where_it_is() {
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct Named {
+            name: Option<String>,
+            seed: Option<u64>,
+        }
+        for (text, line_column, code) in [
+            ("name = \"x\"\nseed = 1\0\n", (2, 9), "U+0000"),
+            ("seed = \u{1b}\n", (1, 8), "U+001B"),
+            ("name = \"a\u{7f}b\"\n", (1, 10), "U+007F"),
+            ("seed = 1 # a\u{1}\n", (1, 13), "U+0001"),
+        ] {
+            let error = toml::from_str::<Named>(text).unwrap_err();
+            let described = describe(text, &error);
+            assert_eq!(described.line_column, Some(line_column), "{text:?}: {}", described.message);
+            assert!(described.message.starts_with(&format!("the control character {code} ")), "{}", described.message);
+        }
+        assert!(toml::from_str::<Named>("name = \"a\\u0000b\"\n").is_ok());
     }
 
     /// Nesting past the reader's limit was "recursion limit" with no line for a dotted key,

@@ -328,6 +328,43 @@ fn out_of_range_value_names_key_and_range() {
     assert!(err.contains("[1, 3]"), "{err}");
 }
 
+/// Spots larger than their spacing: each range alone allowed `size = 0.3` with 64 around, a
+/// radius of 19 spacings that drew each point hundreds of times over (58 s for 16 layers of
+/// them on a body atlas 16 pixels wide). Negative control: the largest size printed as accepted is accepted, at
+/// the size the message names, and by `--set` that lowers the amount.
+#[test]
+fn spots_larger_than_their_spacing_are_refused() {
+    let layer = "[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\namount = 64\nsize = 0.3\n";
+    let err = refused("big_spots.toml", layer, &[]);
+    assert!(err.contains("big_spots.toml:5") && err.contains("pattern.0.size"), "{err}");
+    assert!(err.contains("a radius of 19.2 spacings") && err.contains("size ≤ 0.0312 at this amount"), "{err}");
+    let presets = tempfile::tempdir().unwrap();
+    let path = write_preset(presets.path(), "big_spots.toml", layer);
+    accepted(&path, &["--set", "pattern.0.size=0.0312"]);
+    accepted(&path, &["--set", "pattern.0.amount=3"]);
+    let err = refused("default_size.toml", &layer.replace("size = 0.3\n", ""), &[]);
+    assert!(err.contains("is 0.05 with 64 spots around"), "{err}");
+}
+
+/// A preset that is not UTF-8 is placed by line and column (std's message gave a byte
+/// offset), and a raw control character by its own column with its code (a NUL after a
+/// number was "string values must be quoted").
+#[test]
+fn bytes_a_preset_cannot_hold_are_placed_by_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, bytes, says) in [
+        ("latin1.toml", &b"seed = 1\n[scales]\n# caf\xe9\n"[..], "line 3, column 6 holds the byte 0xE9"),
+        ("nul.toml", b"seed = 1\0\n", "nul.toml:1:9: the control character U+0000 is not allowed in TOML text"),
+    ] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let out = snakeskin(&["generate", path.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{name}: {}", stderr(&out));
+        assert!(!dir.path().join("out").exists(), "{name}: an output folder was made");
+    }
+}
+
 #[test]
 fn non_finite_value_is_refused() {
     let err = refused("nan.toml", "[scales]\nsize = nan\n", &[]);

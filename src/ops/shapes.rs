@@ -105,16 +105,37 @@ pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
                     if x + r_px >= 0.0 && x - r_px <= w && y + r_px >= top && y - r_px <= bottom {
                         pb.push_circle(x, y, r_px.max(0.1));
                         if grid.hole > 0.0 {
-                            // Even-odd filling turns the inner circle into a hole.
-                            pb.push_circle(x, y, (r_px * grid.hole).max(0.05));
+                            push_hole(&mut pb, x, y, (r_px * grid.hole).max(0.05));
                         }
                     }
                 }
             }
         }
     }
-    // Even-odd: ring spots are a circle with its inner circle as a hole.
-    rasterise(frame, drawn, pb, FillRule::EvenOdd)
+    // Non-zero: overlapping spots are their union. Even-odd (before) cut the overlap of two
+    // spots out of both, a lens-shaped hole wherever jitter or size made spots touch.
+    rasterise(frame, drawn, pb, FillRule::Winding)
+}
+
+/// Adds the hole of a ring spot: the circle `push_circle` would add, traced the other way
+/// round (its own points, in reverse order), so under the non-zero rule it cancels its spot
+/// and nothing else. A spot that overlaps the hole still covers it, and coverage where no
+/// spots overlap is the even-odd fill's, to the byte.
+fn push_hole(pb: &mut PathBuilder, x: f32, y: f32, r: f32) {
+    let Some(circle) = PathBuilder::from_circle(x, y, r) else {
+        return;
+    };
+    // tiny-skia traces a circle as a move and quadratic segments (its conics become quads),
+    // then a close: points p0, c1, p1, ..., cn, pn, with pn = p0.
+    let points = circle.points();
+    use tiny_skia::PathSegment::{Close, MoveTo, QuadTo};
+    debug_assert!(circle.segments().all(|s| matches!(s, MoveTo(_) | QuadTo(..) | Close)));
+    let last = points.len() - 1;
+    pb.move_to(points[last].x, points[last].y);
+    for end in (0..last).step_by(2).rev() {
+        pb.quad_to(points[end + 1].x, points[end + 1].y, points[end].x, points[end].y);
+    }
+    pb.close();
 }
 
 /// The rows a shape node draws for `frame`: the whole tile when `frame` is a strip of it,
@@ -439,4 +460,46 @@ pub fn belly_marks(frame: Frame, marks: &BellyMarks) -> Image {
             BellyMarkKind::MedianStripe => ramp(marks.amount * half - d),
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(radius: f32, hole: f32) -> SpotGrid {
+        SpotGrid { across: 4, along: 4, radius, jitter: 0.0, alternate: false, checkered: false, hole, seed: 7 }
+    }
+
+    /// Spots 0.4 of the circumference across, 0.25 apart, cover the whole 64² tile (the
+    /// farthest point from every centre, a cell's corner, is 11.3 px from four of them and
+    /// the radius is 12.8 px). The even-odd fill left their overlaps empty: a lens where
+    /// two met, nothing where four did.
+    #[test]
+    fn overlapping_spots_are_their_union() {
+        let mask = spots(Frame::whole(64, 64), &grid(0.2, 0.0));
+        let uncovered = mask.data.iter().filter(|&&c| c < 1.0).count();
+        assert_eq!(uncovered, 0, "{uncovered} of 4096 pixels not fully covered");
+    }
+
+    /// Ring spots that do not overlap are the even-odd fill of a circle and its inner circle,
+    /// to the byte: the hole is the same circle traced the other way round.
+    #[test]
+    fn ring_spots_apart_are_the_even_odd_fill_of_their_circles() {
+        let (width, radius, hole) = (64usize, 0.1f32, 0.55f32);
+        let mask = spots(Frame::whole(width, width), &grid(radius, hole));
+        let mut pb = PathBuilder::new();
+        for row in 0..4 {
+            for col in 0..4 {
+                let (x, y) = ((col as f32 + 0.5) * 16.0, (row as f32 + 0.5) * 16.0);
+                pb.push_circle(x, y, radius * width as f32);
+                pb.push_circle(x, y, radius * hole * width as f32);
+            }
+        }
+        let frame = Frame::whole(width, width);
+        let even_odd = rasterise(frame, frame, pb, FillRule::EvenOdd);
+        let differ = mask.data.iter().zip(&even_odd.data).filter(|(a, b)| a != b).count();
+        assert_eq!(differ, 0, "{differ} of {} pixels differ from the even-odd fill", width * width);
+        // The hole is there: the centre of the first spot (8, 8) is empty, its ring full.
+        assert_eq!((mask.data[8 * width + 8], mask.data[8 * width + 13]), (0.0, 1.0));
+    }
 }
