@@ -67,8 +67,8 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
         && let Some((control_at, c)) = control_on_line(text, offset)
     {
         message = format!(
-            "the control character U+{:04X} is not allowed in TOML text (inside a quoted string, write it as the \
-             escape `\\u{:04X}`)",
+            "the control character U+{:04X} is not allowed in TOML text (inside a double-quoted string, write it \
+             as the escape `\\u{:04X}`)",
             c as u32, c as u32
         );
         at = Some(control_at);
@@ -109,13 +109,14 @@ fn too_deep_line(text: &str) -> Option<usize> {
 }
 
 /// The first control character TOML forbids (U+0000–U+001F but tab, line feed and carriage
-/// return, and U+007F: TOML 1.0, "Comment" and "String") on the line that holds `offset`,
-/// with its offset. A carriage return out of place is left to the reader's own message.
+/// return, and U+007F: TOML 1.0 and 1.1, "Comment" and "String") from `offset`, where the
+/// reader's error starts, to the end of its line, with its offset. One before the error, or
+/// on another line, is not what the reader refused there. A carriage return out of place is
+/// left to the reader's own message.
 fn control_on_line(text: &str, offset: usize) -> Option<(usize, char)> {
-    let start = text.get(..offset)?.rfind('\n').map_or(0, |i| i + 1);
-    let end = text[offset..].find('\n').map_or(text.len(), |i| offset + i);
+    let end = text.get(offset..)?.find('\n').map_or(text.len(), |i| offset + i);
     let forbidden = |c: char| (c <= '\u{1f}' && !matches!(c, '\t' | '\n' | '\r')) || c == '\u{7f}';
-    text[start..end].char_indices().find(|&(_, c)| forbidden(c)).map(|(i, c)| (start + i, c))
+    text[offset..end].char_indices().find(|&(_, c)| forbidden(c)).map(|(i, c)| (offset + i, c))
 }
 
 /// serde's message in a reader's words: "unknown field" with the nearest accepted key, and
@@ -348,7 +349,13 @@ mod tests {
             assert_eq!(described.line_column, Some(line_column), "{text:?}: {}", described.message);
             assert!(described.message.starts_with(&format!("the control character {code} ")), "{}", described.message);
         }
-        assert!(toml::from_str::<Named>("name = \"a\\u0000b\"\n").is_ok());
+        // The reader's own message where no control character is what it refused: a tab and
+        // a carriage return on the error's line, one on a later line.
+        for text in ["seed = = 1\t\r\n", "seed = = 1\nname = \"a\u{1}\"\n"] {
+            let error = toml::from_str::<Named>(text).unwrap_err();
+            let described = describe(text, &error);
+            assert!(!described.message.contains("control character"), "{text:?}: {}", described.message);
+        }
     }
 
     /// Nesting past the reader's limit was "recursion limit" with no line for a dotted key,

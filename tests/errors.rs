@@ -329,9 +329,11 @@ fn out_of_range_value_names_key_and_range() {
 }
 
 /// Spots larger than their spacing: each range alone allowed `size = 0.3` with 64 around, a
-/// radius of 19 spacings that drew each point hundreds of times over (58 s for 16 layers of
-/// them on a body atlas 16 pixels wide). Negative control: the largest size printed as accepted is accepted, at
-/// the size the message names, and by `--set` that lowers the amount.
+/// radius of 19 spacings that drew each point hundreds of times over (59.9 s for 16 layers
+/// of them on a body atlas 16 pixels wide). Negative controls: the largest size the message
+/// prints is accepted, so is a lower amount, and so is the built-in layer that comes closest
+/// when turned to spots (acanthophis-antarcticus' rings, 1.75 spacings). A size out of its
+/// own range is refused once, by its range.
 #[test]
 fn spots_larger_than_their_spacing_are_refused() {
     let layer = "[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\namount = 64\nsize = 0.3\n";
@@ -344,6 +346,10 @@ fn spots_larger_than_their_spacing_are_refused() {
     accepted(&path, &["--set", "pattern.0.amount=3"]);
     let err = refused("default_size.toml", &layer.replace("size = 0.3\n", ""), &[]);
     assert!(err.contains("is 0.05 with 64 spots around"), "{err}");
+    accepted("acanthophis-antarcticus", &["--set", "pattern.0.kind=spots"]);
+    let err = refused("too_big.toml", &layer.replace("amount = 64", "amount = 2").replace("0.3", "0.9"), &[]);
+    assert!(err.contains("must be a finite number in [0.001, 0.5], got 0.9"), "{err}");
+    assert_eq!(err.matches("pattern.0.size").count(), 1, "{err}");
 }
 
 /// A preset that is not UTF-8 is placed by line and column (std's message gave a byte

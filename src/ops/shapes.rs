@@ -479,6 +479,11 @@ mod tests {
         let mask = spots(Frame::whole(64, 64), &grid(0.2, 0.0));
         let uncovered = mask.data.iter().filter(|&&c| c < 1.0).count();
         assert_eq!(uncovered, 0, "{uncovered} of 4096 pixels not fully covered");
+        // A ring's hole is covered by the rings that overlap it: the first spot's centre
+        // (8, 8) lies 16 px from four neighbours (two of them copies across the edges),
+        // inside their rings (radius 19.2 px, hole 10.6 px); even-odd counted it six times.
+        let rings = spots(Frame::whole(64, 64), &grid(0.3, 0.55));
+        assert_eq!(rings.data[8 * 64 + 8], 1.0);
     }
 
     /// Ring spots that do not overlap are the even-odd fill of a circle and its inner circle,

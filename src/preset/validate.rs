@@ -29,13 +29,14 @@ pub mod ranges {
     pub const RING_WIDTH: (f64, f64) = (0.0, 1.0);
     pub const BLOTCH_LENGTH: (f64, f64) = (0.05, 1.0);
     pub const PATTERN_SIZE: (f64, f64) = (0.001, 0.5);
-    /// A spot's radius in spacings between spots around the body (`size` × `amount`). From
-    /// about 1.2 the jittered round spots cover every point; ring spots still leave gaps up
-    /// to about 2 (a mesh of rings). Past it only the time grows, with the overlap: 16 layers
-    /// of ring spots of radius 19 spacings took 58 s for a body atlas 16 pixels wide, 17 s at
-    /// 2 spacings (BENCHMARKS.md, "Spots that cover each point many times over"). The
-    /// built-in species' spots reach 0.22; a blotch layer turned to spots (`--set
-    /// pattern.0.kind=spots` on bitis-arietans) 1.5.
+    /// A spot's radius in spacings between spots around the body (`size` × the rounded
+    /// `amount`). From about 1.2 the jittered round spots cover every point; ring spots still
+    /// leave gaps up to about 2 (a mesh of rings). Past it only the time grows, with the
+    /// overlap: 16 layers of round spots of radius 19 spacings took 59.9 s for a body atlas
+    /// 16 pixels wide; 16 layers of ring spots at 2 spacings 16.6 s (BENCHMARKS.md, "Spots
+    /// that cover each point many times over"). The built-in species' spots reach 0.22; a
+    /// layer of another kind turned to spots with `--set pattern.N.kind=spots` reaches 1.75
+    /// (acanthophis-antarcticus' rings), 1.5 (bitis-arietans' blotches).
     pub const SPOT_RADIUS_SPACINGS: f64 = 2.0;
     pub const PATTERN_OFFSET: (f64, f64) = (0.0, 0.5);
     pub const OUTLINE_SIZE: (f64, f64) = (0.0, 0.1);
@@ -410,19 +411,22 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         c.range(key("length"), p.length, BLOTCH_LENGTH);
         c.range(key("size"), p.size, PATTERN_SIZE);
         // Spots' radius against their spacing: what the two ranges above allow together
-        // (0.5 with 64 around) covers each point thousands of times.
+        // (0.5 with 64 around) covers each point thousands of times. Checked only where both
+        // are in their ranges (a size already refused is not refused twice).
         let around = p.amount.round();
-        if p.kind == PatternKind::Spots && (1.0..=SPOTS_AROUND.1).contains(&around) && p.size.is_finite() {
+        let in_ranges = (1.0..=SPOTS_AROUND.1).contains(&around) && (PATTERN_SIZE.0..=PATTERN_SIZE.1).contains(&p.size);
+        if p.kind == PatternKind::Spots && in_ranges {
             let most = SPOT_RADIUS_SPACINGS / around;
             if p.size > most {
                 c.problems.push(Problem {
                     key: key("size"),
                     message: format!(
-                        "is {} with {around} spots around (`amount`), a radius of {:.1} spacings between spots; at most \
-                         {SPOT_RADIUS_SPACINGS} spacings are accepted (size ≤ {} at this amount): larger spots cover \
-                         every point several times over (for a layer that covers the skin, use kind \"solid\")",
+                        "is {} with {around} spots around (`amount`), a radius of {} spacings between spots; at most \
+                         {SPOT_RADIUS_SPACINGS} spacings are accepted (size ≤ {} at this amount): larger spots overlap \
+                         each point more than a dozen deep (for a layer that covers the skin, use kind \"solid\")",
                         shown(p.size),
-                        p.size * around,
+                        // Rounded up, so a radius just past the limit does not print as the limit.
+                        shown((p.size * around * 1e3).ceil() / 1e3),
                         // Rounded down, so the number printed is itself accepted.
                         shown((most * 1e4).floor() / 1e4)
                     ),
