@@ -25,6 +25,7 @@ use crate::export::{sha256_hex, verify_set_json, write_file_atomically};
 use crate::generate::{GenerateRequest, Plan, check_set_outputs, set_file_names};
 use crate::maps::{BuildOptions, Layout};
 use crate::material::{FileFormat, MapKind, parse_map_list};
+use crate::preset::validate::ranges::SEED_MAX;
 use crate::{Error, SIZE_RANGE};
 
 /// At most this many jobs per file (after expansion): a typo such as `sizes = [..]` with a
@@ -199,6 +200,12 @@ fn size_refused(size: impl std::fmt::Display) -> String {
     format!("size {size}: accepted sizes are {} to {} pixels", SIZE_RANGE.start(), SIZE_RANGE.end())
 }
 
+/// A seed beyond the preset key's range (`ranges::SEED_MAX`), refused before any job runs:
+/// the batch index and each set's manifest record it as a JSON number.
+fn seed_refused(seed: impl std::fmt::Display) -> String {
+    format!("seed {seed}: accepted seeds are 0 to {SEED_MAX} (2^53 - 1, the largest JSON readers keep exactly)")
+}
+
 /// `:LINE` after a jobs file's path, where the line is known.
 fn at_line(line: Option<usize>) -> String {
     line.map(|l| format!(":{l}")).unwrap_or_default()
@@ -234,6 +241,12 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                     && key.starts_with("sizes.") =>
             {
                 format!("job {job}: key `sizes`: {}", size_refused(value))
+            }
+            Some((job, key))
+                if let Some(value) = crate::toml_text::integer_out_of_type(&described.message)
+                    && key.starts_with("seeds.") =>
+            {
+                format!("job {job}: key `seeds`: {}", seed_refused(value))
             }
             Some((job, key)) => format!("job {job}: key `{key}`: {}", described.message),
             None => described.keyed_message(),
@@ -313,6 +326,9 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         let (lo, hi) = (*SIZE_RANGE.start() as u64, *SIZE_RANGE.end() as u64);
         if let Some(bad) = table.sizes.iter().flatten().find(|s| !(lo..=hi).contains(*s)) {
             return Err(invalid("sizes", size_refused(bad)));
+        }
+        if let Some(bad) = table.seeds.iter().flatten().find(|&&seed| seed > SEED_MAX) {
+            return Err(invalid("seeds", seed_refused(bad)));
         }
         let overrides: Vec<(String, String)> = table.set.iter().map(|(k, v)| (k.clone(), v.to_string())).collect();
         let seeds: Vec<Option<u64>> = match &table.seeds {

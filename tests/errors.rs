@@ -61,7 +61,7 @@ fn type_error_names_line_and_key() {
     // An integer out of the type's range says the range, not "a whole number" alone, in the
     // range check's words (`whole_number_range`).
     let err = refused("negative.toml", "seed = -1\n", &[]);
-    assert!(err.contains("key `seed`: must be an integer in [0, 18446744073709551615], got -1"), "{err}");
+    assert!(err.contains("key `seed`: must be an integer in [0, 9007199254740991], got -1"), "{err}");
     // Beyond i64, the same words (toml said "integer `…` as i128").
     let err = refused(
         "huge.toml",
@@ -69,7 +69,7 @@ fn type_error_names_line_and_key() {
 ",
         &[],
     );
-    assert!(err.contains("must be an integer in [0, 18446744073709551615], got 99999999999999999999"), "{err}");
+    assert!(err.contains("must be an integer in [0, 9007199254740991], got 99999999999999999999"), "{err}");
     assert!(!err.contains("i128"), "{err}");
     // Not a whole number: the key's range (4 to 128), not the type's (0 to 4294967295).
     let err = refused("rows.toml", "[scales]\nrows = 4.0\n", &[]);
@@ -147,6 +147,15 @@ fn a_whole_number_beyond_its_type_gets_the_keys_range() {
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("key `sizes`: size -64: accepted sizes are 16 to 16384 pixels"), "{}", stderr(&out));
+    // A seed its type cannot hold, in the seed's range (before: the type's, 0 to 2^64 - 1).
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1, -1]\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("jobs.toml:3:13: job 1: key `seeds`: seed -1: accepted seeds are 0 to 9007199254740991"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]

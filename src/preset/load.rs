@@ -136,11 +136,13 @@ pub fn parse(source: &PresetSource, overrides: &[(String, String)]) -> Result<Lo
 }
 
 /// `parse`, then the seed replaced by `seed` when given. The seed is set on the parsed
-/// preset, not written into the TOML: TOML integers stop at 2^63 - 1, seeds at 2^64 - 1.
-/// For the same reason a `seed` override is read here as a u64 (`seed_override`; `seed`
-/// wins over it, as `--seed` over `--set seed=`), and the file's seed stays out of the
-/// table the other overrides go into: a file's seed above 2^63 - 1 parses alone, and with
-/// an override made the table's parse fail ("u64 value was too large").
+/// preset, not written into the TOML, and read as a u64 wherever it is written, so that a
+/// seed beyond TOML's integers (2^63 - 1) or the range (`ranges::SEED_MAX`) is refused by
+/// the range check with the key's range, not by the reader in its own words. So a `seed`
+/// override is read here (`seed_override`; `seed` wins over it, as `--seed` over `--set
+/// seed=`), and the file's seed stays out of the table the other overrides go into: a file's
+/// seed above 2^63 - 1 parses alone, and with an override made the table's parse fail ("u64
+/// value was too large").
 pub fn parse_with_seed(
     source: &PresetSource,
     overrides: &[(String, String)],
@@ -192,7 +194,12 @@ pub fn parse_with_seed(
     // A key an override wrote (or a value it replaced whole) has no line in the file; the
     // file is parsed for lines once, not once per problem (thousands of them took minutes).
     let written = written_keys(overrides);
-    let overridden = |key: &str| written.iter().any(|k| key == k || key.starts_with(&format!("{k}.")));
+    // The seed's overrides are not among `overrides` (above): a seed given by `--seed` or
+    // `--set seed=` has no line either.
+    let seed_given = seed.is_some();
+    let overridden = |key: &str| {
+        (seed_given && key == "seed") || written.iter().any(|k| key == k || key.starts_with(&format!("{k}.")))
+    };
     // Layer 0 may be written as a single `[pattern]` table, and `--set pattern.kind=` sets it.
     let in_layer = |i: usize, key: &str| {
         overridden(&format!("pattern.{i}.{key}")) || (i == 0 && overridden(&format!("pattern.{key}")))
@@ -243,7 +250,8 @@ struct WithoutSeed {
 }
 
 /// The value of `--set seed=VALUE`: a whole number from 0 to 2^64 − 1, as one TOML integer
-/// (as `apply_override` reads a value) or, beyond TOML's 2^63 − 1, in decimal digits.
+/// (as `apply_override` reads a value) or, beyond TOML's 2^63 − 1, in decimal digits; the
+/// range check then refuses what lies beyond the seed's range.
 fn seed_override(value: &str) -> Result<u64, PresetError> {
     let parsed = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
         Ok(table) if table.len() == 1 => match table.get("v") {
@@ -255,17 +263,14 @@ fn seed_override(value: &str) -> Result<u64, PresetError> {
     };
     parsed.ok_or_else(|| PresetError::Override {
         argument: format!("seed={value}"),
-        message: format!("the seed must be a whole number from 0 to {}", u64::MAX),
+        message: format!("the seed must be a whole number in [0, {}]", super::validate::ranges::SEED_MAX),
     })
 }
 
-/// The resolved preset as TOML, what `content_hash` hashes. A seed above TOML's integer
-/// range is written as a decimal string after the rest.
+/// The resolved preset as TOML, what `content_hash` hashes. Only a validated preset is
+/// hashed, and its seed (at most 2^53 - 1) is a TOML integer.
 fn canonical_text(preset: &Preset) -> String {
-    toml::to_string(preset).unwrap_or_else(|_| {
-        let rest = Preset { seed: 0, ..preset.clone() };
-        format!("{}\nseed = \"{}\"\n", toml::to_string(&rest).unwrap_or_default(), preset.seed)
-    })
+    toml::to_string(preset).expect("a validated preset is TOML: its seed is within TOML's integers")
 }
 
 fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
@@ -610,31 +615,44 @@ mod tests {
         assert!(err.contains("t.toml:7: key `pattern.1.size`"), "{err}");
     }
 
-    /// Seeds run to 2^64 − 1, TOML's integers to 2^63 − 1. A file's seed above that parsed
-    /// alone but not with any override (the table's parse refused it); `--set seed=` took it
-    /// for a string. Negative controls: values that are not whole numbers from 0 to 2^64 − 1
-    /// are refused with the range, and `--seed` wins over `--set seed=`.
+    /// Seeds run to 2^53 − 1 (`ranges::SEED_MAX`), TOML's integers to 2^63 − 1, a u64 to
+    /// 2^64 − 1. A seed beyond the range is refused by the range check wherever it is written:
+    /// in the file (alone, or with an override, whose table's parse refused a seed beyond
+    /// TOML's integers in its own words), by `--set seed=` or by `--seed`. Negative controls:
+    /// the largest seed is taken everywhere, and a seed given by `--seed` replaces a file's
+    /// seed beyond the range.
     #[test]
-    fn seeds_beyond_toml_integers_survive_overrides() {
-        let big = "seed = 18446744073709551615\n[scales]\nrows = 19\n";
+    fn seeds_are_range_checked_wherever_they_are_written() {
+        use crate::preset::validate::ranges::SEED_MAX;
+        // The file's line where the file's seed is refused, none where a given one is.
+        let refused = |result: Result<LoadedPreset, PresetError>, line: &str| {
+            let err = result.unwrap_err().to_string();
+            assert!(err.contains(&format!("{line}key `seed` must be an integer in [0, 9007199254740991]")), "{err}");
+        };
         let rows = [("scales.rows".to_string(), "23".to_string())];
-        let loaded = parse(&source(big), &rows).unwrap();
-        assert_eq!((loaded.preset.seed, loaded.preset.scales.rows), (u64::MAX, 23));
-        assert_eq!(parse(&source(big), &[]).unwrap().preset.seed, u64::MAX);
+        let file = |seed: u64| format!("seed = {seed}\n[scales]\nrows = 19\n");
         let set_seed = |value: &str| parse(&source("seed = 1\n"), &[("seed".into(), value.into())]);
-        assert_eq!(set_seed("18446744073709551615").unwrap().preset.seed, u64::MAX);
+        for beyond in [SEED_MAX + 1, 1 << 63, u64::MAX] {
+            refused(parse(&source(&file(beyond)), &[]), "t.toml:1: ");
+            refused(parse(&source(&file(beyond)), &rows), "t.toml:1: ");
+            refused(set_seed(&beyond.to_string()), "t.toml (with --set): ");
+            refused(parse_with_seed(&source("seed = 1\n"), &[], Some(beyond)), "t.toml (with --set): ");
+        }
+        let loaded = parse(&source(&file(SEED_MAX)), &rows).unwrap();
+        assert_eq!((loaded.preset.seed, loaded.preset.scales.rows), (SEED_MAX, 23));
+        assert_eq!(set_seed("9007199254740991").unwrap().preset.seed, SEED_MAX);
         assert_eq!(set_seed("9_000").unwrap().preset.seed, 9000);
         assert_eq!(set_seed("0x10").unwrap().preset.seed, 16);
         for bad in ["18446744073709551616", "-1", "1.5", "\"7\"", "seven", "", "007", "1\nscales.rows = 5"] {
             let err = set_seed(bad).unwrap_err().to_string();
             assert!(
-                err.contains(&format!("{:?}", format!("seed={bad}"))) && err.contains("from 0 to 18446744073709551615"),
+                err.contains(&format!("{:?}", format!("seed={bad}"))) && err.contains("in [0, 9007199254740991]"),
                 "{err}"
             );
         }
         // The file's seed, not TOML's default, when an override leaves the seed alone.
         assert_eq!(parse(&source("seed = 7\n"), &rows).unwrap().preset.seed, 7);
-        let both = parse_with_seed(&source(big), &[("seed".into(), "5".into())], Some(6)).unwrap();
+        let both = parse_with_seed(&source(&file(u64::MAX)), &[("seed".into(), "5".into())], Some(6)).unwrap();
         assert_eq!(both.preset.seed, 6);
     }
 

@@ -13,6 +13,12 @@ pub struct Problem {
 
 /// The accepted ranges, one place, so docs/presets.md and the checks agree.
 pub mod ranges {
+    /// 2^53 − 1: the manifest, the batch index and the glTF file record the seed as a JSON
+    /// number, and JSON readers that hold numbers as doubles (JavaScript, whose
+    /// `Number.MAX_SAFE_INTEGER` it is) keep whole numbers exactly only up to there. RFC 7493
+    /// (I-JSON) §2.2 asks the same of integers meant to interoperate. 18446744073709551615
+    /// came back from `JSON.parse` as 18446744073709552000.
+    pub const SEED_MAX: u64 = (1 << 53) - 1;
     pub const ROWS: (u32, u32) = (4, 128);
     pub const SCALE_SIZE: (f64, f64) = (0.5, 2.0);
     pub const SCALE_ASPECT: (f64, f64) = (0.3, 4.0);
@@ -121,7 +127,7 @@ impl Checker {
         let range = match whole_number_range(key) {
             Some(WholeRange::Fixed(range)) => range,
             Some(WholeRange::HalfTheRows) => (0, rows / 2),
-            Some(WholeRange::EveryU64) | None => unreachable!("{key} is not a u32 key of whole_number_range's table"),
+            Some(WholeRange::Seed) | None => unreachable!("{key} is not a u32 key of whole_number_range's table"),
         };
         self.int_range(key, value, range);
     }
@@ -186,8 +192,8 @@ pub enum WholeRange {
     Fixed((u32, u32)),
     /// 0 to half of `scales.rows` (rows that change, counted from the spine or the belly).
     HalfTheRows,
-    /// Every value of its type, a u64 (`seed`): the reader's check is the range check.
-    EveryU64,
+    /// 0 to `ranges::SEED_MAX` (`seed`, a u64).
+    Seed,
 }
 
 /// The range of every whole-number key, one table for the range checks and for a value the
@@ -196,7 +202,7 @@ pub enum WholeRange {
 pub fn whole_number_range(key: &str) -> Option<WholeRange> {
     use ranges::*;
     Some(match key {
-        "seed" => WholeRange::EveryU64,
+        "seed" => WholeRange::Seed,
         "scales.rows" => WholeRange::Fixed(ROWS),
         "scales.smooth_rows" | "belly.up_rows" => WholeRange::HalfTheRows,
         "body.ventrals" => WholeRange::Fixed(VENTRALS),
@@ -218,7 +224,7 @@ pub fn whole_number_range_words(key: &str) -> Option<String> {
     Some(match whole_number_range(key)? {
         WholeRange::Fixed((lo, hi)) => format!("[{lo}, {hi}]"),
         WholeRange::HalfTheRows => "[0, scales.rows / 2]".to_string(),
-        WholeRange::EveryU64 => format!("[0, {}]", u64::MAX),
+        WholeRange::Seed => format!("[0, {}]", ranges::SEED_MAX),
     })
 }
 
@@ -230,6 +236,16 @@ pub fn whole_number_range_words(key: &str) -> Option<String> {
 pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) -> bool) -> Vec<Problem> {
     use ranges::*;
     let mut c = Checker::default();
+    if preset.seed > SEED_MAX {
+        c.problems.push(Problem {
+            key: "seed".into(),
+            message: format!(
+                "must be an integer in [0, {SEED_MAX}], got {} (2^53 - 1: the files record the seed as a JSON \
+                 number, which JavaScript and other readers hold exactly only up to there)",
+                preset.seed
+            ),
+        });
+    }
     let s = &preset.scales;
     c.whole_number("scales.rows", s.rows, s.rows);
     c.range("scales.size", s.size, SCALE_SIZE);

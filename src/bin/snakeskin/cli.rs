@@ -212,8 +212,9 @@ pub struct PresetSource {
     /// VALUE is parsed as TOML; a bare word that is not valid TOML is taken as a string.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_key_value)]
     pub overrides: Vec<(String, String)>,
-    /// Override the preset's seed (any 64-bit unsigned integer).
-    #[arg(long, value_parser = ranged_u64(0, u64::MAX))]
+    /// Override the preset's seed: a whole number from 0 to 9007199254740991 (2^53 - 1, the
+    /// largest that the JSON files recording it keep exactly in every reader).
+    #[arg(long, value_parser = ranged_u64(0, ranges::SEED_MAX))]
     pub seed: Option<u64>,
 }
 
@@ -1000,7 +1001,11 @@ mod tests {
         };
         for (args, says) in [
             (&["generate", "natrix-natrix", "--size", "-16"][..], "-16 is not in 16..=16384"),
-            (&["generate", "natrix-natrix", "--seed", "-1"], "-1 is not in 0..=18446744073709551615"),
+            (&["generate", "natrix-natrix", "--seed", "-1"], "-1 is not in 0..=9007199254740991"),
+            (
+                &["generate", "natrix-natrix", "--seed", "9007199254740992"],
+                "9007199254740992 is not in 0..=9007199254740991",
+            ),
             (&["brdf", "stress", "--samples", "18446744073709551616"], "18446744073709551616 is not in 1..=10000000"),
             (&["export", "natrix-natrix", "--gltf", "a.glb", "--size", "-1"], "-1 is not in 16..=16384"),
             (&["preview", "natrix-natrix", "--out", "a.png", "--snakes", "-3"], "-3 is not in 1..=400"),
@@ -1033,6 +1038,7 @@ mod tests {
             (&["preview", "natrix-natrix", "--window", "--frames"], "is not in 1..=1000000", "1000000"),
             (&["batch", "jobs.toml", "-o", "out", "--concurrent"], "is not in 1..=16", "16"),
             (&["brdf", "stress", "--seed"], "is not in 0..=18446744073709551615", "18446744073709551615"),
+            (&["generate", "natrix-natrix", "--seed"], "is not in 0..=9007199254740991", "9007199254740991"),
         ] {
             for word in ["1.5", "-1", huge] {
                 let error = parse(&[args, &[word]].concat()).expect_err(&format!("{args:?} {word} was accepted"));
