@@ -4,7 +4,8 @@
 //! Colour masks only need 8-bit anti-aliased coverage, which tiny-skia's rasteriser gives
 //! exactly and fast; heights need more precision and come from f32 distances in `scales`.
 //! Wrap-around: a spot that crosses an edge is drawn again shifted by the image size, so
-//! the mask tiles.
+//! the mask tiles; on a body atlas only round the body (u), never from the tail tip to the
+//! snout (`copies_v`).
 
 use tiny_skia::{FillRule, Mask, PathBuilder, Transform};
 
@@ -19,16 +20,29 @@ pub enum Axis {
     V,
 }
 
-/// A smooth periodic band profile over samples `range` of `n`: coverage of bands centred on
-/// `centres` (fractions of the period) with half-width `half_width` and edge width `softness`.
-fn band_profile(n: usize, range: std::ops::Range<usize>, centres: &[f32], half_width: f32, softness: f32) -> Vec<f32> {
+/// A smooth band profile over samples `range` of `n`: coverage of bands centred on
+/// `centres` (fractions of the `n` samples) with half-width `half_width` and edge width
+/// `softness`. `periodic`: the samples wrap round (u, and v on a tile), so a band near one end
+/// reaches past the other; a body atlas' v does not (a ring at the tail tip drew on the snout).
+fn band_profile(
+    n: usize,
+    range: std::ops::Range<usize>,
+    centres: &[f32],
+    half_width: f32,
+    softness: f32,
+    periodic: bool,
+) -> Vec<f32> {
     let soft = softness.max(0.5 / n as f32);
     range
         .map(|i| {
             let t = (i as f32 + 0.5) / n as f32;
             centres.iter().fold(0.0f32, |acc, &c| {
-                let d = (t - c).rem_euclid(1.0);
-                let d = d.min(1.0 - d);
+                let d = if periodic {
+                    let d = (t - c).rem_euclid(1.0);
+                    d.min(1.0 - d)
+                } else {
+                    (t - c).abs()
+                };
                 let k = ((half_width + soft * 0.5 - d) / soft).clamp(0.0, 1.0);
                 acc.max(k * k * (3.0 - 2.0 * k))
             })
@@ -43,14 +57,14 @@ pub fn bands(frame: Frame, axis: Axis, centres: &[f32], half_width: f32, softnes
     let mut image = Image::new(width, height, 1);
     match axis {
         Axis::U => {
-            let profile = band_profile(width, 0..width, centres, half_width, softness);
+            let profile = band_profile(width, 0..width, centres, half_width, softness, true);
             for row in image.data.chunks_exact_mut(width) {
                 row.copy_from_slice(&profile);
             }
         }
         Axis::V => {
             let rows = frame.row0..frame.row0 + height;
-            let profile = band_profile(frame.full_height, rows, centres, half_width, softness);
+            let profile = band_profile(frame.full_height, rows, centres, half_width, softness, frame.wraps_v);
             for (row, value) in image.data.chunks_exact_mut(width).zip(profile) {
                 row.fill(value);
             }
@@ -99,7 +113,7 @@ pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
             let cv = (row as f32 + 0.5 + jy) / along as f32;
             let r_px = grid.radius * jr * w;
             // Draw every periodic copy that can touch the tile.
-            for oy in [-1.0f32, 0.0, 1.0] {
+            for &oy in copies_v(frame) {
                 for ox in [-1.0f32, 0.0, 1.0] {
                     let (x, y) = ((cu + ox) * w, (cv + oy) * h);
                     if x + r_px >= 0.0 && x - r_px <= w && y + r_px >= top && y - r_px <= bottom {
@@ -136,6 +150,13 @@ fn push_hole(pb: &mut PathBuilder, x: f32, y: f32, r: f32) {
         pb.quad_to(points[end + 1].x, points[end + 1].y, points[end].x, points[end].y);
     }
     pb.close();
+}
+
+/// The copies of a shape along v, in textures: a tile repeats, so a shape near one end is
+/// drawn again past the other; a body atlas does not (its ends are the snout and the tail
+/// tip), and a copy of a spot at the tail tip drew on the snout's first rows.
+fn copies_v(frame: Frame) -> &'static [f32] {
+    if frame.wraps_v { &[-1.0, 0.0, 1.0] } else { &[0.0] }
 }
 
 /// The rows a shape node draws for `frame`: the whole tile when `frame` is a strip of it,
@@ -251,7 +272,7 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
         for &(side, shift) in sides {
             // The mirrored series mirrors the jitter too, so a pair is symmetric.
             let cx = (0.5 + side * b.offset + if side < 0.0 { -jx } else { jx }) * w;
-            for copy_v in [-1.0f32, 0.0, 1.0] {
+            for &copy_v in copies_v(frame) {
                 let cy = origin + (i as f32 + 0.5 + jy + b.phase + shift) * spacing + copy_v * h;
                 for copy_u in [-1.0f32, 0.0, 1.0] {
                     let cx = cx + copy_u * w;
@@ -506,5 +527,57 @@ mod tests {
         assert_eq!(differ, 0, "{differ} of {} pixels differ from the even-odd fill", width * width);
         // The hole is there: the centre of the first spot (8, 8) is empty, its ring full.
         assert_eq!((mask.data[8 * width + 8], mask.data[8 * width + 13]), (0.0, 1.0));
+    }
+
+    /// A body atlas of `width` × `height` (its v does not wrap: snout to tail tip), and the
+    /// tile of that size, which does.
+    fn body_and_tile(width: usize, height: usize) -> [Frame; 2] {
+        [Frame { width, height, full_height: height, row0: 0, wraps_v: false }, Frame::whole(width, height)]
+    }
+
+    /// Coverage of the top-left `n` × `n` pixels.
+    fn corner(mask: &Image, n: usize) -> f32 {
+        (0..n).flat_map(|y| (0..n).map(move |x| (x, y))).map(|(x, y)| mask.data[y * mask.width + x]).sum()
+    }
+
+    /// A shape at a body atlas' tail tip stays there: its copy one atlas up drew on the
+    /// snout's first rows. Each case has a shape that crosses the last row and nothing else
+    /// near the first rows' corner; the tile's copy of it covers that corner (the negative
+    /// control: the tile still wraps).
+    #[test]
+    fn shapes_at_the_tail_tip_do_not_reach_the_snout() {
+        // Two alternating rows of spots of radius 38.4 px: the second row's spot centred at
+        // (0, 96) reaches 134.4, past the last row; its copy at (0, -32) covered rows 0-6.
+        let spots_grid = SpotGrid { across: 1, along: 2, alternate: true, ..grid(0.3, 0.0) };
+        // Two blotches centred at rows 64 and 128, 32 rows long each way: the second's copy
+        // covered rows 0-31 about the spine.
+        let blotch = Blotches {
+            shape: BlotchShape::Round,
+            count: 2,
+            half_width: 0.2,
+            length: 1.0,
+            jitter: 0.0,
+            offset: 0.0,
+            staggered: false,
+            phase: 0.5,
+            scale: 1.0,
+            span: (0.0, 1.0),
+            widen: 1.0,
+            seed: 3,
+        };
+        // A ring centred at 0.98 of the length, 0.05 wide each way: it wrapped to v < 0.03.
+        for (i, frame) in body_and_tile(128, 128).into_iter().enumerate() {
+            let spots_corner = corner(&spots(frame, &spots_grid), 4);
+            let blotch_top = (0..8).map(|y| blotches(frame, &blotch).data[y * 128 + 64]).sum::<f32>();
+            let ring_top = bands(frame, Axis::V, &[0.98], 0.05, 0.01).data[0];
+            if i == 0 {
+                assert_eq!((spots_corner, blotch_top, ring_top), (0.0, 0.0, 0.0), "the tail tip drew on the snout");
+            } else {
+                assert!(
+                    spots_corner > 8.0 && blotch_top > 4.0 && ring_top > 0.5,
+                    "{spots_corner} {blotch_top} {ring_top}"
+                );
+            }
+        }
     }
 }
