@@ -57,6 +57,42 @@ fn a_set_larger_than_memory_is_refused_before_it_runs() {
     assert!(stderr(&out).contains("memory estimate before the run:"), "{}", stderr(&out));
 }
 
+/// Under `ulimit -v` (RLIMIT_AS) a set larger than the address space left is refused before
+/// it runs, naming the limit; it aborted with "memory allocation of 203292672 bytes failed",
+/// a backtrace and exit 134. Negative control: a small set runs under the same limit.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_set_larger_than_the_address_space_limit_is_refused_before_it_runs() {
+    use std::os::unix::process::CommandExt;
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("out");
+    let run = |size: &str| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_snakeskin"));
+        cmd.args(["generate", PRESET, "-o", o.to_str().unwrap(), "--size", size])
+            .env_remove("SNAKESKIN_MEMORY_LIMIT_MIB");
+        // 1.5 GB of address space: the 8192² set needs about 5 GB.
+        let limit = libc::rlimit { rlim_cur: 1_500_000_000, rlim_max: libc::RLIM_INFINITY };
+        // SAFETY: setrlimit is async-signal-safe; the child calls it between fork and exec.
+        unsafe {
+            cmd.pre_exec(move || {
+                if libc::setrlimit(libc::RLIMIT_AS, &limit) == 0 {
+                    Ok(())
+                } else {
+                    Err(std::io::Error::last_os_error())
+                }
+            });
+        }
+        cmd.output().expect("run snakeskin")
+    };
+    let out = run("8192");
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("--size 8192 needs about") && err.contains("address-space limit (ulimit -v)"), "{err}");
+    assert!(!o.exists(), "nothing may be written");
+    let out = run("256");
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 #[test]
 fn the_memory_estimate_bounds_the_evaluator_and_knows_every_channel_count() {
     use snakeskin::graph::{estimate_peak_bytes, evaluate};
