@@ -12,9 +12,10 @@
 //! v1, the usage less the inactive file cache the kernel reclaims before it kills, as
 //! container runtimes count a working set; a container, a systemd slice, a batch
 //! scheduler's job), the headroom under the process's own limits (`ulimit -v`, the address
-//! space, less what is mapped already; `ulimit -d`, the data segment, which since Linux 4.7
-//! counts private writable mappings too: without it a run under `ulimit -v` aborted with
-//! "memory allocation of N bytes failed" and a backtrace, exit 134), and
+//! space, less what is mapped already and the malloc arenas its threads may still reserve;
+//! `ulimit -d`, the data segment, which since Linux 4.7 counts private writable mappings too;
+//! without them a run under `ulimit -v` aborted with "memory allocation of N bytes failed"
+//! and a backtrace, exit 134), and
 //! `SNAKESKIN_MEMORY_LIMIT_MIB` when set (a cap the user chooses, also how the tests pretend
 //! to be a small machine). The refusal names the bound that held, so that "only 1100 MiB are
 //! available" on a machine with 20 GiB free says why.
@@ -97,11 +98,11 @@ impl MemoryBound {
                  scheduler's); use a smaller size or raise that limit"
             }
             MemoryBound::AddressSpace => {
-                "under this process's address-space limit (ulimit -v) less what it has mapped already; use a smaller \
-                 size or raise the limit"
+                "under this process's address-space limit (ulimit -v) less what it has mapped and may reserve for its \
+                 threads' allocators; use a smaller size or raise the limit"
             }
             MemoryBound::DataSegment => {
-                "under this process's data-size limit (ulimit -d) less what it has mapped already; use a smaller size \
+                "under this process's data-size limit (ulimit -d) less the data it holds already; use a smaller size \
                  or raise the limit"
             }
             MemoryBound::UserLimit => "under SNAKESKIN_MEMORY_LIMIT_MIB; use a smaller size or raise it",
@@ -175,12 +176,43 @@ fn least_bound(machine: Option<u64>, bounds: [(Option<u64>, MemoryBound); 4]) ->
 /// estimate fitted the headroom by 152 and 217 MiB still aborted.
 const THREAD_ARENA_BYTES: u64 = 64 * MIB;
 
-/// Threads that may allocate in a run: the main thread, the evaluation pool and up to five
-/// map encoders, at most the eight arenas per core glibc creates (M_ARENA_MAX's default).
-fn arena_threads() -> u64 {
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
-    (1 + rayon::current_num_threads() as u64 + 5).min(8 * cores)
+/// Arenas a process under an address-space limit keeps (`bound_arenas_under_address_limit`):
+/// the main one and one more. Glibc's default, eight per core, reserved 64 MiB of address
+/// space per allocating thread: counted for every thread a 64-core host may start, the
+/// allowance alone came to 4.4 GiB and refused every set under `ulimit -v 4G`.
+const ARENAS_UNDER_ADDRESS_LIMIT: u64 = 2;
+
+/// Caps glibc's malloc arenas at `ARENAS_UNDER_ADDRESS_LIMIT` when this process runs under an
+/// address-space limit and the user has not chosen a cap (`MALLOC_ARENA_MAX`); called by the
+/// binary before it starts threads. Threads then share arenas, as glibc does anyway once it
+/// cannot map another, so the headroom need not allow for an arena per thread.
+pub fn bound_arenas_under_address_limit() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    if soft_limits()[0].is_some() && std::env::var_os("MALLOC_ARENA_MAX").is_none() {
+        // SAFETY: mallopt only sets an allocator parameter; called before any thread starts.
+        if unsafe { libc::mallopt(libc::M_ARENA_MAX, ARENAS_UNDER_ADDRESS_LIMIT as libc::c_int) } == 1 {
+            ARENAS_BOUNDED.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+    }
 }
+
+/// Arenas this process may map beyond those in VmSize already: the cap the user set
+/// (`MALLOC_ARENA_MAX`) or the binary's (`bound_arenas_under_address_limit`); else (the library
+/// in another program) one per thread that may allocate (the evaluation pool and up to five map
+/// encoders), at most glibc's eight per core.
+fn arena_threads() -> u64 {
+    if let Some(max) = std::env::var("MALLOC_ARENA_MAX").ok().and_then(|v| v.trim().parse::<u64>().ok()) {
+        return max;
+    }
+    if ARENAS_BOUNDED.load(std::sync::atomic::Ordering::Relaxed) {
+        return ARENAS_UNDER_ADDRESS_LIMIT;
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+    (rayon::current_num_threads() as u64 + 5).min(8 * cores)
+}
+
+/// Whether `bound_arenas_under_address_limit` capped the arenas.
+static ARENAS_BOUNDED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// The headroom under this process's address-space limit (RLIMIT_AS, against `VmSize` in
 /// /proc/self/status, less the arenas its threads may still reserve) and data-size limit

@@ -71,8 +71,13 @@ fn a_set_larger_than_the_address_space_limit_is_refused_before_it_runs() {
         cmd.args(["generate", PRESET, "-o", o.to_str().unwrap(), "--size", size])
             .env_remove("SNAKESKIN_MEMORY_LIMIT_MIB");
         // 1.5 GB of address space: the 8192² set needs about 5 GB.
-        let limit = libc::rlimit { rlim_cur: 1_500_000_000, rlim_max: libc::RLIM_INFINITY };
-        // SAFETY: setrlimit is async-signal-safe; the child calls it between fork and exec.
+        // The hard limit kept: raising it past one already set is not allowed.
+        let mut limit = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+        // SAFETY: getrlimit only writes into `limit`.
+        assert_eq!(unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) }, 0);
+        limit.rlim_cur = limit.rlim_max.min(1_500_000_000);
+        // SAFETY: glibc's setrlimit is a bare system call, neither allocating nor locking, so
+        // the child may make it between fork and exec.
         unsafe {
             cmd.pre_exec(move || {
                 if libc::setrlimit(libc::RLIMIT_AS, &limit) == 0 {

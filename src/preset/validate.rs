@@ -13,7 +13,7 @@ pub struct Problem {
 
 /// The accepted ranges, one place, so docs/presets.md and the checks agree.
 pub mod ranges {
-    /// 2^53 − 1: the manifest, the batch index and the glTF file record the seed as a JSON
+    /// 2^53 − 1: the manifest and the batch index record the seed as a JSON
     /// number, and JSON readers that hold numbers as doubles (JavaScript, whose
     /// `Number.MAX_SAFE_INTEGER` it is) keep whole numbers exactly only up to there. RFC 7493
     /// (I-JSON) §2.2 asks the same of integers meant to interoperate. 18446744073709551615

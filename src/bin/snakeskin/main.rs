@@ -14,6 +14,7 @@ fn main() -> ExitCode {
     output::restore_default_sigpipe();
     output::stdout_failure_is_an_error();
     output::quiet_vulkan_device_select();
+    snakeskin::memory::bound_arenas_under_address_limit();
     // Spawns a thread: after the calls above, which need the process single-threaded.
     output::clean_up_on_interrupt();
     let cli = cli::Cli::try_parse_checked_from(std::env::args_os().collect()).unwrap_or_else(|e| e.exit());
