@@ -906,38 +906,34 @@ fn the_largest_seed_is_the_largest_a_json_reader_keeps() {
 
     let beyond = (largest + 1).to_string();
     let range = "[0, 9007199254740991]";
-    let out = generate_into(dir.path(), &beyond, &[]);
-    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("9007199254740992 is not in 0..=9007199254740991"), "{}", stderr(&out));
-    let o = dir.path().to_str().unwrap();
-    let set = format!("seed={beyond}");
-    let out = snakeskin(&["generate", PRESET, "-o", o, "--size", "48", "--set", &set]);
-    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(
-        stderr(&out).contains(&format!("key `seed` must be an integer in {range}, got {beyond}")),
-        "{}",
+    // Each refusal: exit 2, with `says` in the message.
+    let refused = |args: &[&str], says: &str| {
+        let out = snakeskin(args);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{}", stderr(&out));
         stderr(&out)
+    };
+    let o = dir.path().to_str().unwrap();
+    refused(
+        &["generate", PRESET, "-o", o, "--size", "48", "--seed", &beyond],
+        "9007199254740992 is not in 0..=9007199254740991",
+    );
+    let set = format!("seed={beyond}");
+    refused(
+        &["generate", PRESET, "-o", o, "--size", "48", "--set", &set],
+        &format!("key `seed` must be an integer in {range}, got {beyond}"),
     );
     let file = dir.path().join("big-seed.toml");
     std::fs::write(&file, format!("seed = {}\n", 1u64 << 63)).unwrap();
-    let out = snakeskin(&["generate", file.to_str().unwrap(), "-o", o, "--size", "48"]);
-    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(
-        stderr(&out).contains(&format!("big-seed.toml:1: key `seed` must be an integer in {range}")),
-        "{}",
-        stderr(&out)
+    refused(
+        &["generate", file.to_str().unwrap(), "-o", o, "--size", "48"],
+        &format!("big-seed.toml:1: key `seed` must be an integer in {range}"),
     );
     let jobs = dir.path().join("jobs.toml");
     std::fs::write(&jobs, format!("[[job]]\npreset = \"{PRESET}\"\nseeds = [1, {beyond}]\nsizes = [48]\n")).unwrap();
     let batch_out = dir.path().join("batch");
-    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", batch_out.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(
-        stderr(&out).contains("jobs.toml:3: job 1")
-            && stderr(&out).contains("accepted seeds are 0 to 9007199254740991"),
-        "{}",
-        stderr(&out)
-    );
+    let err = refused(&["batch", jobs.to_str().unwrap(), "-o", batch_out.to_str().unwrap()], "jobs.toml:3: job 1");
+    assert!(err.contains("accepted seeds are 0 to 9007199254740991"), "{err}");
     assert!(!batch_out.exists(), "a refused jobs file wrote {}", batch_out.display());
     assert_eq!(std::fs::read(manifest_of(dir.path())).unwrap(), manifest_bytes, "a refused run touched the set");
 }

@@ -263,7 +263,7 @@ fn seed_override(value: &str) -> Result<u64, PresetError> {
     };
     parsed.ok_or_else(|| PresetError::Override {
         argument: format!("seed={value}"),
-        message: format!("the seed must be a whole number in [0, {}]", super::validate::ranges::SEED_MAX),
+        message: format!("the seed must be a whole number in {}", super::validate::seed_range_words()),
     })
 }
 

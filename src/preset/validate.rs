@@ -224,8 +224,13 @@ pub fn whole_number_range_words(key: &str) -> Option<String> {
     Some(match whole_number_range(key)? {
         WholeRange::Fixed((lo, hi)) => format!("[{lo}, {hi}]"),
         WholeRange::HalfTheRows => "[0, scales.rows / 2]".to_string(),
-        WholeRange::Seed => format!("[0, {}]", ranges::SEED_MAX),
+        WholeRange::Seed => seed_range_words(),
     })
+}
+
+/// The seed's range as messages write it: `[0, 9007199254740991]`.
+pub fn seed_range_words() -> String {
+    format!("[0, {}]", ranges::SEED_MAX)
 }
 
 /// Every out-of-range value in the preset (empty when it is valid). `from_file_for_old_kind
@@ -240,8 +245,9 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         c.problems.push(Problem {
             key: "seed".into(),
             message: format!(
-                "must be an integer in [0, {SEED_MAX}], got {} (2^53 - 1: the files record the seed as a JSON \
-                 number, which JavaScript and other readers hold exactly only up to there)",
+                "must be an integer in {}, got {} (2^53 - 1: the files record the seed as a JSON number, which \
+                 JavaScript and other readers hold exactly only up to there)",
+                seed_range_words(),
                 preset.seed
             ),
         });
