@@ -90,22 +90,37 @@ pub enum MemoryBound {
 
 impl MemoryBound {
     /// Where the limit comes from and how to raise it, as the refusal ends (`Error::Memory`).
-    pub fn words(self) -> &'static str {
+    pub fn words(self) -> String {
+        format!("{}; {}", self.place(), self.remedy())
+    }
+
+    /// Where the limit comes from, as "N MiB are available …" goes on (the refusal, and
+    /// `generate`'s warning when a set needs more than half of it).
+    pub fn place(self) -> &'static str {
         match self {
-            MemoryBound::Machine => "on this machine now; use a smaller size",
+            MemoryBound::Machine => "on this machine now",
             MemoryBound::Cgroup => {
                 "under the memory limit of this process's control group (a container, a systemd slice or a job \
-                 scheduler's); use a smaller size or raise that limit"
+                 scheduler's)"
             }
             MemoryBound::AddressSpace => {
                 "under this process's address-space limit (ulimit -v) less what it has mapped and may reserve for its \
-                 threads' allocators; use a smaller size or raise the limit"
+                 threads' allocators"
             }
             MemoryBound::DataSegment => {
-                "under this process's data-size limit (ulimit -d) less the data it holds already; use a smaller size \
-                 or raise the limit"
+                "under this process's data-size limit (ulimit -d) less the data it holds already"
             }
-            MemoryBound::UserLimit => "under SNAKESKIN_MEMORY_LIMIT_MIB; use a smaller size or raise it",
+            MemoryBound::UserLimit => "under SNAKESKIN_MEMORY_LIMIT_MIB",
+        }
+    }
+
+    /// What to do when a set does not fit.
+    fn remedy(self) -> &'static str {
+        match self {
+            MemoryBound::Machine => "use a smaller size",
+            MemoryBound::Cgroup => "use a smaller size or raise that limit",
+            MemoryBound::AddressSpace | MemoryBound::DataSegment => "use a smaller size or raise the limit",
+            MemoryBound::UserLimit => "use a smaller size or raise it",
         }
     }
 }

@@ -135,7 +135,7 @@ impl ScaleColour {
                 }
                 if self.speckle > 0.0 {
                     let u = (x as f32 + 0.5) / width as f32;
-                    let dot = self.dot(u * cells, v * cells_v, aa) * own;
+                    let dot = self.dot(u * cells, v * cells_v, aa, frame.wraps_v) * own;
                     for (c, s) in px.iter_mut().zip(self.speckle_color) {
                         *c += (s - *c) * dot;
                     }
@@ -145,8 +145,10 @@ impl ScaleColour {
         out
     }
 
-    /// Coverage of the speckle dot near (gx, gy), in grid-cell units.
-    fn dot(&self, gx: f32, gy: f32, aa: f32) -> f32 {
+    /// Coverage of the speckle dot near (gx, gy), in grid-cell units. `wraps_v`: the grid's
+    /// rows wrap round (the tile); on a body atlas there is no cell above the snout or below
+    /// the tail tip (a wrapped row there drew the tail tip's dots on the snout's first row).
+    fn dot(&self, gx: f32, gy: f32, aa: f32, wraps_v: bool) -> f32 {
         let (n, n_v) = (self.speckle_cells.max(1) as i32, self.speckle_cells_v.max(1) as i32);
         let (cx, cy) = (floor_i32(gx), floor_i32(gy));
         let mut coverage = 0.0f32;
@@ -154,6 +156,9 @@ impl ScaleColour {
         for dy in -1..=1 {
             for dx in -1..=1 {
                 let (i, j) = (cx + dx, cy + dy);
+                if !wraps_v && !(0..n_v).contains(&j) {
+                    continue;
+                }
                 let (wi, wj) = (i.rem_euclid(n), j.rem_euclid(n_v));
                 if hash::unit(wi, wj, 0, self.seed) >= self.speckle {
                     continue;
@@ -165,5 +170,58 @@ impl ScaleColour {
             }
         }
         coverage
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ops::image::Frame;
+
+    /// A white map under a dot in every speckle cell (64 × 64 cells, eight pixels each), on a
+    /// field that is all scale surface.
+    fn speckled(frame: Frame) -> Image {
+        let (w, h) = (frame.width, frame.height);
+        let n = w * h;
+        let mut field = vec![0.0f32; 4 * n];
+        field[n..2 * n].fill(0.5);
+        field[2 * n..].fill(1.0);
+        let scales = Image { width: w, height: h, channels: 4, data: field };
+        let colour = Image { width: w, height: h, channels: 3, data: vec![1.0; 3 * n] };
+        let kernel = ScaleColour {
+            tone: 0.0,
+            hue: 0.0,
+            edge: 0.0,
+            tip: 0.0,
+            speckle: 1.0,
+            speckle_color: [0.0; 3],
+            skin: None,
+            speckle_cells: 64,
+            speckle_cells_v: 64,
+            seed: 7,
+            channels: ScaleChannels { crevice: 0, random: 1, inside: 2, along: 3 },
+        };
+        kernel.apply(colour, &scales, frame)
+    }
+
+    #[test]
+    fn speckles_at_the_tail_tip_do_not_reach_the_snout() {
+        let size = 512;
+        let tile = speckled(Frame::whole(size, size));
+        let body = speckled(Frame { wraps_v: false, ..Frame::whole(size, size) });
+        // Past the first and last cell rows the two hold the same dots.
+        for y in 8..size - 8 {
+            assert_eq!(tile.row(y), body.row(y), "row {y}");
+        }
+        // In the end rows the body lacks the dots of the other end's cells: nowhere darker
+        // than the tile, and lighter where a tail-tip dot reached over the tile's seam.
+        let mut lighter = 0;
+        for y in (0..8).chain(size - 8..size) {
+            for (b, t) in body.row(y).iter().zip(tile.row(y)) {
+                assert!(b >= t, "row {y}: a dot the tile lacks");
+                lighter += usize::from(b > t);
+            }
+        }
+        assert!(lighter > 0, "the body's end rows are the tile's: the tail tip's dots drew on the snout");
     }
 }

@@ -37,9 +37,10 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     let memory = plan.memory();
     if memory.is_tight() {
         eprintln!(
-            "warning: this set needs about {:.0} MiB at its peak; {:.0} MiB are available",
+            "warning: this set needs about {:.0} MiB at its peak; {:.0} MiB are available {}",
             memory.estimate_bytes as f64 / MIB,
-            memory.available_bytes as f64 / MIB
+            memory.available_bytes as f64 / MIB,
+            memory.bound.place()
         );
     }
     let bar = Progress::counting("{spinner} generating [{bar:30}] {pos}/{len} nodes {elapsed}");
