@@ -17,8 +17,8 @@
 //! without them a run under `ulimit -v` aborted with "memory allocation of N bytes failed"
 //! and a backtrace, exit 134), and
 //! `SNAKESKIN_MEMORY_LIMIT_MIB` when set (a cap the user chooses, also how the tests pretend
-//! to be a small machine). The refusal names the bound that held, so that "only 1100 MiB are
-//! available" on a machine with 20 GiB free says why.
+//! to be a small machine). The refusal and `generate`'s warning name the bound that held,
+//! so that "only 1100 MiB are available" on a machine with 20 GiB free says why.
 
 use crate::Error;
 use crate::graph::{Graph, estimate_peak_bytes};
@@ -95,7 +95,7 @@ impl MemoryBound {
     }
 
     /// Where the limit comes from, as "N MiB are available …" goes on (the refusal, and
-    /// `generate`'s warning when a set needs more than half of it).
+    /// `generate`'s warning when a set needs more than half the memory available).
     pub fn place(self) -> &'static str {
         match self {
             MemoryBound::Machine => "on this machine now",

@@ -55,6 +55,18 @@ fn a_set_larger_than_memory_is_refused_before_it_runs() {
     let out = snakeskin(&["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "64", "--stats"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("memory estimate before the run:"), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("warning: this set needs"), "{}", stderr(&out));
+
+    // A set that fits in less than twice its estimate runs, with a warning that names the
+    // bound in the refusal's words (about 68 MiB at 256 against 100).
+    let out = snakeskin_env(
+        &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "256"],
+        &[("SNAKESKIN_MEMORY_LIMIT_MIB", "100")],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let warning = err.lines().find(|l| l.starts_with("warning: this set needs about ")).unwrap_or_default();
+    assert!(warning.ends_with("MiB at its peak; 100 MiB are available under SNAKESKIN_MEMORY_LIMIT_MIB"), "{err}");
 }
 
 /// Under `ulimit -v` (RLIMIT_AS) a set larger than the address space left is refused before

@@ -20,7 +20,8 @@
 //! pixel's bytes as they were. The speckle dots lie on a fixed grid of `SPECKLES_PER_SCALE`
 //! cells per scale width in both directions (texture space is isotropic), one dot at most
 //! per cell, present with probability `speckle`: the same dots at every resolution, and the
-//! grid is a whole number of cells per texture, so the map still tiles.
+//! grid is a whole number of cells per texture, so the map still tiles (a body atlas's rows
+//! do not wrap: its two ends take no dots from each other).
 
 use super::hash;
 use super::image::{Image, floor_i32};
@@ -147,7 +148,7 @@ impl ScaleColour {
 
     /// Coverage of the speckle dot near (gx, gy), in grid-cell units. `wraps_v`: the grid's
     /// rows wrap round (the tile); on a body atlas there is no cell above the snout or below
-    /// the tail tip (a wrapped row there drew the tail tip's dots on the snout's first row).
+    /// the tail tip, so neither end takes dots from the other.
     fn dot(&self, gx: f32, gy: f32, aa: f32, wraps_v: bool) -> f32 {
         let (n, n_v) = (self.speckle_cells.max(1) as i32, self.speckle_cells_v.max(1) as i32);
         let (cx, cy) = (floor_i32(gx), floor_i32(gy));
@@ -178,8 +179,8 @@ mod tests {
     use super::*;
     use crate::ops::image::Frame;
 
-    /// A white map under a dot in every speckle cell (64 × 64 cells, eight pixels each), on a
-    /// field that is all scale surface.
+    /// A white map under a dot in every speckle cell (64 × 64 cells: eight pixels each at
+    /// 512²), on a field that is all scale surface.
     fn speckled(frame: Frame) -> Image {
         let (w, h) = (frame.width, frame.height);
         let n = w * h;
@@ -214,14 +215,17 @@ mod tests {
             assert_eq!(tile.row(y), body.row(y), "row {y}");
         }
         // In the end rows the body lacks the dots of the other end's cells: nowhere darker
-        // than the tile, and lighter where a tail-tip dot reached over the tile's seam.
-        let mut lighter = 0;
-        for y in (0..8).chain(size - 8..size) {
-            for (b, t) in body.row(y).iter().zip(tile.row(y)) {
-                assert!(b >= t, "row {y}: a dot the tile lacks");
-                lighter += usize::from(b > t);
+        // than the tile, and lighter where a dot reached over the tile's seam. Each end is
+        // counted apart, so a fix for one end only fails.
+        for (end, rows) in [("snout", 0..8), ("tail tip", size - 8..size)] {
+            let mut lighter = 0;
+            for y in rows {
+                for (b, t) in body.row(y).iter().zip(tile.row(y)) {
+                    assert!(b >= t, "row {y}: a dot the tile lacks");
+                    lighter += usize::from(b > t);
+                }
             }
+            assert!(lighter > 0, "the body's {end} rows are the tile's: the other end's dots drew on them");
         }
-        assert!(lighter > 0, "the body's end rows are the tile's: the tail tip's dots drew on the snout");
     }
 }
