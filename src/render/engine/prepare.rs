@@ -51,7 +51,8 @@ pub struct DrawMemory {
     pub evaluation_bytes: u64,
     /// Held beside every phase: a contact sheet's canvas, a live-reload cache's entries.
     pub held_bytes: u64,
-    /// The frame (`renderer::frame_bytes`) and what is made from it.
+    /// The frame and what is made from it (`renderer::frame_bytes`; a window's,
+    /// `renderer::window_frame_bytes`).
     pub frame_bytes: u64,
     /// Materials uploaded from the maps and kept at once (the render benchmark's variants).
     pub materials: u64,
@@ -180,7 +181,8 @@ fn packed(
 }
 
 /// The same through a node cache: after an edit only changed nodes run (live reload).
-/// `frame_bytes`: the window's targets, for its first maps (made before its renderer).
+/// `frame_bytes`: the window's targets and swap chain (`renderer::window_frame_bytes`), for
+/// its first maps (made before its renderer).
 pub fn material_maps_cached(
     loaded: &LoadedPreset,
     map_size: usize,

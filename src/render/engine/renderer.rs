@@ -37,6 +37,21 @@ pub fn frame_bytes(width: u32, height: u32) -> u64 {
     width as u64 * height as u64 * per_pixel
 }
 
+/// Frames a window's swap chain may queue ahead of the one shown (its
+/// `SurfaceConfiguration::desired_maximum_frame_latency`).
+pub const WINDOW_FRAME_LATENCY: u32 = 2;
+
+/// Bytes a window of `width`×`height` holds for its frames: the multisampled HDR target and
+/// depth and the resolved HDR target (as `frame_bytes`), and the swap chain's 8-bit images,
+/// the one shown and `WINDOW_FRAME_LATENCY` queued (4 bytes each; a driver may keep fewer).
+/// Nothing is read back or written as a PNG. 68 bytes a pixel: a 4096×2048 window (lavapipe
+/// under Xvfb, 64² maps, five frames) peaked 60.7 bytes a pixel above a 16×16 one's.
+pub fn window_frame_bytes(width: u32, height: u32) -> u64 {
+    let swap_chain_images = WINDOW_FRAME_LATENCY as u64 + 1;
+    let per_pixel = MSAA_SAMPLES as u64 * (8 + 4) + 8 + swap_chain_images * 4;
+    width as u64 * height as u64 * per_pixel
+}
+
 /// Host memory a renderer holds beyond the process's fixed overhead
 /// (`memory::FIXED_OVERHEAD_BYTES`), whatever it draws: the device, its pipelines and their
 /// compiled shaders, a body's mesh. Measured on lavapipe (Mesa 22.3.6, two cores) with 64²

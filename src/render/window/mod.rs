@@ -22,7 +22,7 @@ use self::panel::{Sliders, controls};
 use self::reload::Reloaded;
 use super::engine::material::MaterialMaps;
 use super::engine::prepare::{bands_for, material_maps_cached};
-use super::engine::renderer::{FrameOutput, FrameSettings, Material, Renderer, Targets};
+use super::engine::renderer::{FrameOutput, FrameSettings, Material, Renderer, Targets, WINDOW_FRAME_LATENCY};
 use super::engine::scene::LayerOptics;
 use super::{Gpu, GpuError};
 use crate::Error;
@@ -92,7 +92,7 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let loaded = crate::preset::load(&options.preset, &options.overrides, options.seed)?;
     let sliders = Sliders::from_preset(&loaded.preset);
     let mut cache = NodeCache::new();
-    let targets = super::engine::renderer::frame_bytes(options.size.0, options.size.1);
+    let targets = super::engine::renderer::window_frame_bytes(options.size.0, options.size.1);
     let (maps, _) = material_maps_cached(&loaded, options.map_size, options.layout, &mut cache, targets)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);
@@ -174,7 +174,7 @@ impl App {
             width: size.width.max(1),
             height: size.height.max(1),
             present_mode: wgpu::PresentMode::AutoNoVsync,
-            desired_maximum_frame_latency: 2,
+            desired_maximum_frame_latency: WINDOW_FRAME_LATENCY,
             alpha_mode: caps.alpha_modes[0],
             view_formats: vec![],
         };
