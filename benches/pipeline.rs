@@ -42,8 +42,16 @@ fn operations(c: &mut Criterion) {
     let field = scale_field(&loaded.preset, snakeskin::maps::Layout::Tile);
     // The graph's node (planar); `render` adds a copy to interleaved pixels.
     group.bench_function("scales", |b| b.iter(|| field.render_planar(snakeskin::ops::Frame::whole(size, size))));
-    for (name, kind) in [("perlin_4oct", NoiseKind::Perlin), ("cellular_4oct", NoiseKind::Cellular)] {
-        let op = Op::Noise(FractalNoise { kind, cells_u: 8, cells_v: 8, octaves: 4, gain: 0.5, seed: 1 });
+    // Coarse noises (sampled on a grid and upsampled), and a grain noise fine enough to be
+    // sampled at every pixel: `crotalus-atrox`'s at 2048² (105 × 81 cells, three octaves),
+    // as dense in pixels per cell at this size.
+    let noises = [
+        ("perlin_4oct", NoiseKind::Perlin, (8, 8), 4),
+        ("cellular_4oct", NoiseKind::Cellular, (8, 8), 4),
+        ("perlin_grain", NoiseKind::Perlin, (52, 40), 3),
+    ];
+    for (name, kind, (cells_u, cells_v), octaves) in noises {
+        let op = Op::Noise(FractalNoise { kind, cells_u, cells_v, octaves, gain: 0.5, seed: 1 });
         group.bench_function(name, |b| b.iter(|| op.eval(None, &[], snakeskin::ops::Frame::whole(size, size))));
     }
     let noise =
