@@ -131,6 +131,16 @@ impl MemoryCheck {
         MemoryCheck { estimate_bytes, available_bytes, bound }
     }
 
+    /// The estimate in whole MiB, rounded up, as the refusal and the warning give it.
+    pub fn needed_mib(&self) -> u64 {
+        self.estimate_bytes.div_ceil(MIB)
+    }
+
+    /// The available memory in whole MiB, rounded down, as the refusal and the warning give it.
+    pub fn available_mib(&self) -> u64 {
+        self.available_bytes / MIB
+    }
+
     /// More than half of the available memory: worth a warning.
     pub fn is_tight(&self) -> bool {
         self.estimate_bytes > self.available_bytes / 2
@@ -141,8 +151,8 @@ impl MemoryCheck {
         if self.estimate_bytes > self.available_bytes {
             return Err(Error::Memory {
                 what: what.into(),
-                needed_mib: self.estimate_bytes.div_ceil(MIB),
-                available_mib: self.available_bytes / MIB,
+                needed_mib: self.needed_mib(),
+                available_mib: self.available_mib(),
                 bound: self.bound,
             });
         }

@@ -58,7 +58,8 @@ fn a_set_larger_than_memory_is_refused_before_it_runs() {
     assert!(!stderr(&out).contains("warning: this set needs"), "{}", stderr(&out));
 
     // A set that fits in less than twice its estimate runs, with a warning that names the
-    // bound in the refusal's words (about 68 MiB at 256 against 100).
+    // bound in the refusal's words (about 68 MiB at 256 against 100: most of it the fixed
+    // overhead, `memory::FIXED_OVERHEAD_BYTES`).
     let out = snakeskin_env(
         &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "256"],
         &[("SNAKESKIN_MEMORY_LIMIT_MIB", "100")],

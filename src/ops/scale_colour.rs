@@ -206,7 +206,7 @@ mod tests {
     }
 
     #[test]
-    fn speckles_at_the_tail_tip_do_not_reach_the_snout() {
+    fn a_body_atlas_ends_take_no_dots_from_each_other() {
         let size = 512;
         let tile = speckled(Frame::whole(size, size));
         let body = speckled(Frame { wraps_v: false, ..Frame::whole(size, size) });
@@ -216,7 +216,7 @@ mod tests {
         }
         // In the end rows the body lacks the dots of the other end's cells: nowhere darker
         // than the tile, and lighter where a dot reached over the tile's seam. Each end is
-        // counted apart, so a fix for one end only fails.
+        // counted apart, so a fix at one end alone fails it.
         for (end, rows) in [("snout", 0..8), ("tail tip", size - 8..size)] {
             let mut lighter = 0;
             for y in rows {

@@ -41,14 +41,20 @@ pub fn frame_bytes(width: u32, height: u32) -> u64 {
 /// `SurfaceConfiguration::desired_maximum_frame_latency`).
 pub const WINDOW_FRAME_LATENCY: u32 = 2;
 
+/// The most 8-bit images a window's swap chain holds: wgpu asks for one more than
+/// `WINDOW_FRAME_LATENCY` (wgpu-hal 30's Vulkan swap chain), raised to the surface's least
+/// image count, which Mesa's window systems put at 3, 4 or 5 on X11 (by present mode; 5
+/// under Xwayland) and 2 or 4 on Wayland.
+const SWAP_CHAIN_IMAGES_AT_MOST: u64 = 5;
+
 /// Bytes a window of `width`×`height` holds for its frames: the multisampled HDR target and
-/// depth and the resolved HDR target (as `frame_bytes`), and the swap chain's 8-bit images,
-/// the one shown and `WINDOW_FRAME_LATENCY` queued (4 bytes each; a driver may keep fewer).
-/// Nothing is read back or written as a PNG. 68 bytes a pixel: a 4096×2048 window (lavapipe
-/// under Xvfb, 64² maps, five frames) peaked 60.7 bytes a pixel above a 16×16 one's.
+/// depth and the resolved HDR target (as `frame_bytes`), and the swap chain's images (at
+/// most `SWAP_CHAIN_IMAGES_AT_MOST` of 4 bytes); a window has no readback or PNG. 76 bytes a
+/// pixel: a 4096×2048 window (lavapipe under Xvfb, whose swap chain has 3 images; 64² maps,
+/// five frames) peaked 60.7 bytes a pixel above a 16×16 one's. For the window's size when it
+/// opens (`--size`); a window resized later is not checked again.
 pub fn window_frame_bytes(width: u32, height: u32) -> u64 {
-    let swap_chain_images = WINDOW_FRAME_LATENCY as u64 + 1;
-    let per_pixel = MSAA_SAMPLES as u64 * (8 + 4) + 8 + swap_chain_images * 4;
+    let per_pixel = MSAA_SAMPLES as u64 * (8 + 4) + 8 + SWAP_CHAIN_IMAGES_AT_MOST * 4;
     width as u64 * height as u64 * per_pixel
 }
 

@@ -92,8 +92,8 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let loaded = crate::preset::load(&options.preset, &options.overrides, options.seed)?;
     let sliders = Sliders::from_preset(&loaded.preset);
     let mut cache = NodeCache::new();
-    let targets = super::engine::renderer::window_frame_bytes(options.size.0, options.size.1);
-    let (maps, _) = material_maps_cached(&loaded, options.map_size, options.layout, &mut cache, targets)?;
+    let frame_bytes = super::engine::renderer::window_frame_bytes(options.size.0, options.size.1);
+    let (maps, _) = material_maps_cached(&loaded, options.map_size, options.layout, &mut cache, frame_bytes)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);
 
@@ -350,10 +350,14 @@ impl ApplicationHandler for App {
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
-                gfx.config.width = size.width.max(1);
-                gfx.config.height = size.height.max(1);
-                gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
-                gfx.targets = gfx.renderer.targets(gfx.config.width, gfx.config.height, self.settings.samples);
+                // X11 reports the first size even when it is the one configured: nothing to
+                // remake then (a remake holds the old targets beside the new for a moment).
+                let (width, height) = (size.width.max(1), size.height.max(1));
+                if (width, height) != (gfx.config.width, gfx.config.height) {
+                    (gfx.config.width, gfx.config.height) = (width, height);
+                    gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
+                    gfx.targets = gfx.renderer.targets(width, height, self.settings.samples);
+                }
             }
             WindowEvent::RedrawRequested => self.draw(event_loop),
             WindowEvent::MouseInput { state, button: MouseButton::Left, .. } => {

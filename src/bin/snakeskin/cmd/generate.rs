@@ -37,9 +37,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     let memory = plan.memory();
     if memory.is_tight() {
         eprintln!(
-            "warning: this set needs about {:.0} MiB at its peak; {:.0} MiB are available {}",
-            memory.estimate_bytes as f64 / MIB,
-            memory.available_bytes as f64 / MIB,
+            "warning: this set needs about {} MiB at its peak; {} MiB are available {}",
+            memory.needed_mib(),
+            memory.available_mib(),
             memory.bound.place()
         );
     }
