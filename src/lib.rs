@@ -59,7 +59,7 @@ pub enum Error {
     #[error("invalid preview option: {0}")]
     Preview(String),
     /// The work would need more memory than the machine has available.
-    #[error("{what} needs about {needed_mib} MiB at its peak, but only {available_mib} MiB are available {}", .bound.words())]
+    #[error("{what} needs about {needed_mib} MiB at its peak, but only {available_mib} MiB are available {}; {}", .bound.place(), .bound.remedy())]
     Memory { what: String, needed_mib: u64, available_mib: u64, bound: memory::MemoryBound },
     /// An environment variable the tool reads holds a value it does not accept.
     #[error("invalid {variable}={value:?}: expected {accepted}")]

@@ -89,11 +89,6 @@ pub enum MemoryBound {
 }
 
 impl MemoryBound {
-    /// Where the limit comes from and how to raise it, as the refusal ends (`Error::Memory`).
-    pub fn words(self) -> String {
-        format!("{}; {}", self.place(), self.remedy())
-    }
-
     /// Where the limit comes from, as "N MiB are available …" goes on (the refusal, and
     /// `generate`'s warning when a set needs more than half the memory available).
     pub fn place(self) -> &'static str {
@@ -114,8 +109,8 @@ impl MemoryBound {
         }
     }
 
-    /// What to do when a set does not fit.
-    fn remedy(self) -> &'static str {
+    /// What to do when a set does not fit, as the refusal ends (`Error::Memory`).
+    pub fn remedy(self) -> &'static str {
         match self {
             MemoryBound::Machine => "use a smaller size",
             MemoryBound::Cgroup => "use a smaller size or raise that limit",

@@ -25,15 +25,18 @@ const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const MSAA_SAMPLES: u32 = 4;
 
+/// Bytes a pixel of the render targets (`Targets`): the multisampled HDR target and depth
+/// (`MSAA_SAMPLES` texels of 8 and 4 bytes) and the resolved HDR target (8).
+const TARGET_BYTES_PER_PIXEL: u64 = MSAA_SAMPLES as u64 * (8 + 4) + 8;
+
 /// Bytes a headless frame of `width`×`height` holds at once, for the memory check before it
-/// is rendered: the multisampled HDR target and depth (`MSAA_SAMPLES` texels of 8 and 4
-/// bytes), the resolved HDR target (8), the 8-bit output, its readback and the image read
-/// back (4 each), and the RGB image and PNG bytes written from it (at most 3 each). wgpu frees
-/// the targets at its next poll, so they are still there while the image is written.
-/// On a software adapter (lavapipe) all of it is host memory: a 4096×2048 preview with 64²
-/// maps peaked 72.6 bytes a pixel above a 16×16 one's.
+/// is rendered: the render targets (`TARGET_BYTES_PER_PIXEL`), the 8-bit output, its readback
+/// and the image read back (4 each), and the RGB image and PNG bytes written from it (at
+/// most 3 each). wgpu frees the targets at its next poll, so they are still there while the
+/// image is written. On a software adapter (lavapipe) all of it is host memory: a 4096×2048
+/// preview with 64² maps peaked 72.6 bytes a pixel above a 16×16 one's.
 pub fn frame_bytes(width: u32, height: u32) -> u64 {
-    let per_pixel = MSAA_SAMPLES as u64 * (8 + 4) + 8 + 3 * 4 + 2 * 3;
+    let per_pixel = TARGET_BYTES_PER_PIXEL + 3 * 4 + 2 * 3;
     width as u64 * height as u64 * per_pixel
 }
 
@@ -47,14 +50,14 @@ pub const WINDOW_FRAME_LATENCY: u32 = 2;
 /// under Xwayland) and 2 or 4 on Wayland.
 const SWAP_CHAIN_IMAGES_AT_MOST: u64 = 5;
 
-/// Bytes a window of `width`×`height` holds for its frames: the multisampled HDR target and
-/// depth and the resolved HDR target (as `frame_bytes`), and the swap chain's images (at
-/// most `SWAP_CHAIN_IMAGES_AT_MOST` of 4 bytes); a window has no readback or PNG. 76 bytes a
+/// Bytes a window of `width`×`height` holds for its frames: the render targets
+/// (`TARGET_BYTES_PER_PIXEL`) and the swap chain's images (at most
+/// `SWAP_CHAIN_IMAGES_AT_MOST` of 4 bytes); a window has no readback or PNG. 76 bytes a
 /// pixel: a 4096×2048 window (lavapipe under Xvfb, whose swap chain has 3 images; 64² maps,
 /// five frames) peaked 60.7 bytes a pixel above a 16×16 one's. For the window's size when it
 /// opens (`--size`); a window resized later is not checked again.
 pub fn window_frame_bytes(width: u32, height: u32) -> u64 {
-    let per_pixel = MSAA_SAMPLES as u64 * (8 + 4) + 8 + SWAP_CHAIN_IMAGES_AT_MOST * 4;
+    let per_pixel = TARGET_BYTES_PER_PIXEL + SWAP_CHAIN_IMAGES_AT_MOST * 4;
     width as u64 * height as u64 * per_pixel
 }
 
