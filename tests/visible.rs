@@ -5,6 +5,8 @@
 mod common;
 
 use common::*;
+use snakeskin::graph::evaluate;
+use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::optics::brdf::exact::SmoothTop;
 use snakeskin::optics::brdf::walk::Rng;
 use snakeskin::optics::brdf::{Layers, Model, layered};
@@ -143,13 +145,48 @@ fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limi
     let err = colour_with("color={scale_tone=0.05}");
     assert!(err.contains("ink.toml:3: color.base = \"#e0c0a0\" is brighter"), "{err}");
 
-    // Negative control: the same colours over a clear pigment layer are shown as written.
+    // Negative control: over a clear pigment layer the back's colour is shown as written;
+    // only the white belly is clamped, which the per-scale tone and hue would brighten past
+    // a reflectance of 1 (`over_a_lossless_stack_no_key_is_brightened_past_a_reflectance_of_one`).
     let clear = write_preset(dir.path(), "clear.toml", &WHITE_UNDER_INK.replace("absorption = 0.3", ""));
     let out = snakeskin(&["generate", &clear, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
-    assert!(out.status.success() && !stderr(&out).contains("brighter"), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(out.status.success() && !err.contains("color.base"), "{err}");
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out_dir.join("clear.material.json")).unwrap()).unwrap();
-    assert!(manifest["clamped_colors"].as_array().unwrap().is_empty());
+    let clamped = manifest["clamped_colors"].as_array().unwrap();
+    assert_eq!(clamped.len(), 1, "{clamped:?}");
+    assert_eq!(clamped[0]["key"], "belly.color");
+}
+
+/// A lossless stack shows every colour up to a reflectance of 1, and no further: a key that
+/// the map's per-scale tone and colour variation would brighten past 1 is clamped and
+/// reported like one an absorbing stack cannot show. Before, a white back came out of the
+/// map at up to 1.14 (linear) unreported: its EXR held that and its PNG clipped it. The
+/// colour map is checked as the graph evaluates it (f32, before any file's quantisation).
+/// Negative control: a grey belly that the brightening keeps below 1 is shown as written.
+#[test]
+fn over_a_lossless_stack_no_key_is_brightened_past_a_reflectance_of_one() {
+    let text = "[color]\nbase = \"#ffffff\"\nscale_tone = 0.1\n\n[belly]\ncolor = \"#c0c0c0\"\n";
+    let source = PresetSource { name: "white".into(), display: "white.toml".into(), text: text.into() };
+    let loaded = parse(&source, &[]).unwrap();
+    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    let colour = evaluate(&graph, &[MapKind::Color], 128, 128, &|_, _| {}).maps.remove(&MapKind::Color).unwrap();
+    let brightest = colour.data.iter().copied().fold(0.0f32, f32::max);
+    assert!(brightest <= 1.0, "the colour map reaches {brightest}, past a reflectance of 1");
+    // The bound is met, not far off: the brightening takes the clamped key close to it.
+    assert!(brightest > 0.85, "brightest {brightest}");
+    assert_eq!(loaded.clamped_colours.len(), 1, "{:?}", loaded.clamped_colours);
+
+    let dir = tempfile::tempdir().unwrap();
+    let preset = write_preset(dir.path(), "white.toml", text);
+    let out_dir = dir.path().join("out");
+    let out = snakeskin(&["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("white.toml:2: color.base = \"#ffffff\" is brighter than any skin can show"), "{err}");
+    assert!(err.contains("Lower the per-scale tones or the colour"), "{err}");
+    assert!(!err.contains("belly.color"), "{err}");
 }
 
 /// With a rough top and absorption, the colour map is still the layered model's own visible

@@ -5,7 +5,9 @@
 //! absorption cannot show every colour: with k_d = 1 it shows t₁ E / (1 − K) at most
 //! (`layered::normal_transmittance`; 0.07 for the thesis' τ = 0.6 over n2 = 2 and a smooth top). Colours beyond that are clamped to it when
 //! the preset is loaded, and reported with the key, the line and the limit — never
-//! silently — so the maps, the renderer and any tool that reads the colour map agree.
+//! silently — so the maps, the renderer and any tool that reads the colour map agree. A
+//! lossless stack's limit is 1: a key that the map's per-scale tone and colour variation
+//! would brighten past a reflectance of 1 is clamped and reported too.
 //!
 //! The limit is the smallest over the film thicknesses and roughnesses the renderer takes K
 //! and E at (both maps vary per pixel). The colour
@@ -29,6 +31,10 @@ pub struct ClampedColour {
     pub clamped_to: String,
     /// The stack's limit per channel for this key, linear.
     pub limit_linear: [f64; 3],
+    /// Whether the stack absorbs (its limit is below 1); else the key was brighter than a
+    /// reflectance of 1 once brightened by the map.
+    #[serde(skip)]
+    pub absorbing: bool,
 }
 
 impl ClampedColour {
@@ -36,11 +42,15 @@ impl ClampedColour {
     pub fn message(&self, preset: &str) -> String {
         let line = self.line.map(|l| format!(":{l}")).unwrap_or_default();
         let [r, g, b] = self.limit_linear;
+        let (why, remedy) = if self.absorbing {
+            ("this layer stack can show (colours mean the visible colour; with its absorption", "optics.absorption")
+        } else {
+            ("any skin can show (colours mean the visible colour, a reflectance of at most 1", "the per-scale tones")
+        };
         format!(
-            "warning: {preset}{line}: {} = \"{}\" is brighter than this layer stack can show (colours mean the \
-             visible colour; with its absorption, and any headroom this key keeps for the map's per-scale tone and \
-             colour variation, it may be at most linear [{r:.3}, {g:.3}, {b:.3}]); clamped \
-             to \"{}\". Lower optics.absorption or the colour to keep it.",
+            "warning: {preset}{line}: {} = \"{}\" is brighter than {why}, and any headroom this key keeps for the \
+             map's per-scale tone and colour variation, it may be at most linear [{r:.3}, {g:.3}, {b:.3}]); clamped \
+             to \"{}\". Lower {remedy} or the colour to keep it.",
             self.key, self.requested, self.clamped_to
         )
     }
@@ -139,9 +149,12 @@ fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
 /// by up to `per_scale_gain` on every key, and the back's colour variation `color.base` by
 /// up to (1 + `color.variation`) more (`maps::color`).
 pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
-    let Some(limit) = visible_limit(preset) else {
-        return Vec::new();
-    };
+    // A lossless stack shows every colour up to a reflectance of 1 (`layered::visible_limit`),
+    // and the map's brightening must not carry a key past that either: a colour map above 1
+    // is no reflectance, its PNG clips where its EXR does not, and the renderer's inversion
+    // holds k_d at 1 there.
+    let absorbing = visible_limit(preset);
+    let limit = absorbing.unwrap_or([1.0; 3]);
     let per_scale = per_scale_gain(preset);
     let variation = 1.0 + preset.color.variation.max(0.0);
     let mut clamped = Vec::new();
@@ -166,6 +179,7 @@ pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
             requested: colour.to_string(),
             clamped_to: shown.to_string(),
             limit_linear: allowed,
+            absorbing: absorbing.is_some(),
         });
         *colour = shown;
     }
