@@ -119,7 +119,7 @@ struct JobTable {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct JobsFile {
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::preset::schema::tables")]
     job: Vec<JobTable>,
 }
 

@@ -84,6 +84,12 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
         }
     } else if !message.starts_with("unknown key") {
         key = span.clone().and_then(|s| key_at(text, s.start));
+        // An array of tables where one table belongs (`[[scales]]`): the reader points at the
+        // header, whose key is the array's first element (`scales.0`); the array is at fault.
+        if message.starts_with("invalid type: array, expected a table") && written.is_some_and(|w| w.starts_with("[["))
+        {
+            key = key.map(|k| k.rsplit_once('.').map_or(k.clone(), |(array, _)| array.to_string()));
+        }
     }
     Described { line_column: at.map(|offset| line_column(text, offset)), key, message }
 }

@@ -192,6 +192,17 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert!(stderr(&out).contains("jobs.toml:3:9: job 1: key `sizes`: invalid type"), "{}", stderr(&out));
     assert!(stderr(&out).contains("expected an array") && !stderr(&out).contains("sequence"), "{}", stderr(&out));
     assert!(!empty.exists());
+    // A job written as an array is refused as one, not read field by field ("expected
+    // struct JobTable with 9 elements").
+    std::fs::write(&jobs, "job = [[\"natrix-natrix\", [1]]]\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("jobs.toml:1:8: key `job.0`: invalid type: array, expected a table"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!empty.exists());
 
     // A job that cannot run (an unknown preset) stops the batch before any job runs.
     std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n[[job]]\npreset = \"no-such-snake\"\n")

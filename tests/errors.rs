@@ -88,6 +88,82 @@ fn type_error_names_line_and_key() {
     assert!(err.trim_end().ends_with("expected a whole number in [4, 128]"), "{err}");
 }
 
+/// An array where a table belongs is refused with its key and line, not read field by
+/// field: serde's derived structs also read a sequence in field order, so `scales =
+/// ["diamond", 40]` made diamond scales in 40 rows, `optics = [1.33]` set the first index
+/// of refraction and `belly = []` passed as the defaults, all silently; `scales = [19]` was
+/// refused as `scales.0`, and `[[scales]]` too, a key no preset has.
+#[test]
+fn an_array_where_a_table_belongs_is_refused_not_read_in_field_order() {
+    for (text, line, key) in [
+        ("scales = [\"diamond\", 40]\n", 1, "scales"),
+        ("seed = 3\noptics = [1.33]\n", 2, "optics"),
+        ("belly = []\n", 1, "belly"),
+        ("[[scales]]\nrows = 19\n", 1, "scales"),
+        ("pattern = [[\"stripes\", \"#000000\"]]\n", 1, "pattern.0"),
+        ("[body]\nhead_mark = [[\"cap\", \"#000000\"]]\n", 2, "body.head_mark.0"),
+    ] {
+        let err = refused("arrays.toml", text, &[]);
+        assert!(err.contains(&format!("arrays.toml:{line}:")), "{text:?}: {err}");
+        assert!(err.contains(&format!("key `{key}`: invalid type: array, expected a table")), "{text:?}: {err}");
+    }
+    let err = refused("ok.toml", "seed = 1\n", &["--set", "optics=[1.2, 1.5, 1.8]"]);
+    assert!(err.contains("invalid --set \"optics=[1.2, 1.5, 1.8]\": invalid type: array, expected a table"), "{err}");
+    // Negative controls: the same keys as tables, arrays of tables where they belong, and
+    // the jobs file's `[[job]]` tables (its `job = [[…]]` is refused: `tests/batch.rs`).
+    let dir = tempfile::tempdir().unwrap();
+    let tables = "scales = { shape = \"diamond\", rows = 41 }\n[optics]\nambient_ior = 1.33\n[belly]\n\
+                  [[pattern]]\nkind = \"solid\"\ncolor = \"#102030\"\n[[body.head_mark]]\nkind = \"cap\"\n\
+                  color = \"#000000\"\n";
+    accepted(&write_preset(dir.path(), "tables.toml", tables), &[]);
+    accepted("natrix-natrix", &["--set", "optics={ambient_ior = 1.2}"]);
+}
+
+/// A stripe placed twice is refused, not one placement silently dropped: `position` sets the
+/// offset (`position = "lateral"` beside `offset = 0.1` drew the lateral stripe, the same
+/// bytes as with `offset = 0.24`), and `rows` sets the offset, width and count.
+/// Negative controls: each key alone, and `position` with a width and count.
+#[test]
+fn a_stripe_placed_twice_is_refused() {
+    let layer = |extra: &str| format!("[[pattern]]\nkind = \"stripes\"\ncolor = \"#101010\"\n{extra}\n");
+    for (extra, key, by) in [
+        ("position = \"lateral\"\noffset = 0.1", "offset", "position"),
+        ("rows = [9.5, 10]\noffset = 0.1", "offset", "rows"),
+        ("rows = [9.5, 10]\nposition = \"vertebral\"", "position", "rows"),
+        ("rows = [9.5, 10]\nsize = 0.02", "size", "rows"),
+        ("rows = [9.5, 10]\namount = 2", "amount", "rows"),
+    ] {
+        let err = refused("twice.toml", &layer(extra), &[]);
+        let says = format!("twice.toml:5: key `pattern.0.{key}` is replaced by this layer's `{by}`");
+        assert!(err.contains(&says), "{extra}: {err}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for extra in [
+        "position = \"lateral\"",
+        "offset = 0.1",
+        "rows = [9.5, 10]",
+        "position = \"lateral\"\nsize = 0.02\namount = 2",
+    ] {
+        accepted(&write_preset(dir.path(), "once.toml", &layer(extra)), &[]);
+    }
+}
+
+/// One bad value is one problem: a row count out of its range was reported, and then the
+/// keys it bounds as well, against a range made from it (`belly.up_rows` "must be an
+/// integer in [0, 0]", a key the user had not touched). Negative control: with the rows in
+/// range, an `up_rows` past half of them is refused.
+#[test]
+fn a_row_count_out_of_range_is_the_one_problem_reported() {
+    let err = refused("rows.toml", "[scales]\nrows = 1\n[belly]\nup_rows = 1\n", &[]);
+    assert!(err.contains("key `scales.rows` must be an integer in [4, 128], got 1"), "{err}");
+    assert!(!err.contains("belly.up_rows"), "{err}");
+    let stripe = "[scales]\nrows = 1\n[[pattern]]\nkind = \"stripes\"\ncolor = \"#101010\"\nrows = [9.5, 10]\n";
+    let err = refused("rows.toml", stripe, &[]);
+    assert!(err.contains("scales.rows") && !err.contains("pattern.0.rows"), "{err}");
+    let err = refused("rows.toml", "[scales]\nrows = 9\n[belly]\nup_rows = 5\n", &[]);
+    assert!(err.contains("key `belly.up_rows` must be an integer in [0, 4], got 5"), "{err}");
+}
+
 /// A refused number far from its range is printed as written, not in full: `film_ior =
 /// 1e300` printed three hundred digits, `--angle-deg=-1e-300` a "-0.000…" as long.
 #[test]

@@ -158,25 +158,25 @@ pub struct Preset {
     /// Thesis "Seed": fixes every random choice.
     #[serde(default)]
     pub seed: u64,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub scales: Scales,
     /// A `[pattern]` table or `[[pattern]]` layers, composed in order.
     #[serde(default, deserialize_with = "one_or_many")]
     pub pattern: Vec<PatternLayer>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub belly: Belly,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub color: ColorParams,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub height: HeightParams,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub roughness: RoughnessParams,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub iridescence: IridescenceParams,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub optics: Optics,
     /// The whole animal (`generate --layout body`): proportions, counts, head and tail.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub body: Body,
 }
 
@@ -408,7 +408,7 @@ impl PatternLayer {
         matches!(self.kind, PatternKind::Blotches | PatternKind::Rings).then_some(self.count).flatten()
     }
 
-    fn default_amount() -> f64 {
+    pub(crate) fn default_amount() -> f64 {
         1.0
     }
     pub(crate) fn default_size() -> f64 {
@@ -446,6 +446,37 @@ impl PatternLayer {
     }
 }
 
+/// A struct read from a TOML table only. Why: serde's derived structs also read a
+/// sequence, field by field in order, so `scales = ["diamond", 40]` was read as `shape =
+/// "diamond"` and `rows = 40`, `optics = [1.33]` set the first index of refraction, and
+/// `belly = []` passed as the defaults, silently; and `scales = [19]` was refused as
+/// `scales.0`, a key no preset has. An array where a table belongs is refused with the key
+/// and its line: "invalid type: sequence, expected a table".
+pub(crate) fn table<'de, D: Deserializer<'de>, T: Deserialize<'de>>(deserializer: D) -> Result<T, D::Error> {
+    struct Table<T>(std::marker::PhantomData<T>);
+    impl<'de, T: Deserialize<'de>> de::Visitor<'de> for Table<T> {
+        type Value = T;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a table")
+        }
+        fn visit_map<A: de::MapAccess<'de>>(self, map: A) -> Result<T, A::Error> {
+            T::deserialize(de::value::MapAccessDeserializer::new(map))
+        }
+    }
+    deserializer.deserialize_map(Table(std::marker::PhantomData))
+}
+
+/// An array of tables (`[[body.head_mark]]`, `[[pattern]]`), each read by `table`.
+pub(crate) fn tables<'de, D: Deserializer<'de>, T: Deserialize<'de>>(deserializer: D) -> Result<Vec<T>, D::Error> {
+    struct Each<T>(T);
+    impl<'de, T: Deserialize<'de>> Deserialize<'de> for Each<T> {
+        fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+            table(deserializer).map(Each)
+        }
+    }
+    Ok(Vec::<Each<T>>::deserialize(deserializer)?.into_iter().map(|each| each.0).collect())
+}
+
 /// Accepts `[pattern]` (one table) or `[[pattern]]` (an array of tables).
 fn one_or_many<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<PatternLayer>, D::Error> {
     struct Visitor;
@@ -458,7 +489,7 @@ fn one_or_many<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<Pattern
             Ok(vec![PatternLayer::deserialize(de::value::MapAccessDeserializer::new(map))?])
         }
         fn visit_seq<A: de::SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
-            Vec::deserialize(de::value::SeqAccessDeserializer::new(seq))
+            tables(de::value::SeqAccessDeserializer::new(seq))
         }
     }
     deserializer.deserialize_any(Visitor)
@@ -699,6 +730,7 @@ pub struct Body {
     pub tip_color: Option<Srgb8>,
     /// The tip colour's share of the tail's length.
     pub tip_fraction: f64,
+    #[serde(deserialize_with = "tables")]
     pub head_mark: Vec<HeadMark>,
 }
 

@@ -126,6 +126,9 @@ impl Checker {
     fn whole_number(&mut self, key: &str, value: u32, rows: u32) {
         let range = match whole_number_range(key) {
             Some(WholeRange::Fixed(range)) => range,
+            // Bounded by a row count that is itself refused: that one problem says it (with
+            // `rows = 1`, `belly.up_rows = 1` was refused too, a key the user never set).
+            Some(WholeRange::HalfTheRows) if !rows_in_range(rows) => return,
             Some(WholeRange::HalfTheRows) => (0, rows / 2),
             Some(WholeRange::Seed) | None => unreachable!("{key} is not a u32 key of whole_number_range's table"),
         };
@@ -138,6 +141,12 @@ impl Checker {
                 .push(Problem { key: key.into(), message: format!("must be an integer in [{lo}, {hi}], got {value}") });
         }
     }
+}
+
+/// Whether `scales.rows` is within its range: the keys it bounds (`WholeRange::HalfTheRows`,
+/// a stripe's `rows`) are checked against it only then.
+fn rows_in_range(rows: u32) -> bool {
+    (ranges::ROWS.0..=ranges::ROWS.1).contains(&rows)
 }
 
 /// What a preset that loads does not do as its keys seem to say, one warning each: the
@@ -325,6 +334,32 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                 note,
             );
         }
+        // A stripe placed twice: `rows` places it and sets its width and count, and
+        // `position` sets its offset, so the keys they replace were silently ignored beside
+        // them (`position = "lateral"` with `offset = 0.1` drew the lateral stripe).
+        if p.kind == Stripes {
+            // (key, set away from its default, the key that replaces it)
+            let by_rows = !p.rows.is_empty();
+            let replaced = [
+                ("offset", p.offset != 0.0, if by_rows { Some("rows") } else { p.position.map(|_| "position") }),
+                ("position", p.position.is_some(), by_rows.then_some("rows")),
+                ("size", p.size != PatternLayer::default_size(), by_rows.then_some("rows")),
+                ("amount", p.amount != PatternLayer::default_amount(), by_rows.then_some("rows")),
+            ];
+            for (field, set, by) in replaced {
+                if let Some(by) = by.filter(|_| set && !from_file_for_old_kind(i, field)) {
+                    let what = if by == "rows" {
+                        "places the stripe and sets its width and count"
+                    } else {
+                        "places the stripe at a named offset"
+                    };
+                    c.problems.push(Problem {
+                        key: key(field),
+                        message: format!("is replaced by this layer's `{by}`, which {what}; give one of the two"),
+                    });
+                }
+            }
+        }
         // Keys some kinds read, set away from their defaults on a kind that ignores them
         // (`colors` on spots, `phase` on stripes, `size` on solid, `center_size` on stripes
         // were silently dropped; `shape`, `count` and `rows` were refused already). A
@@ -410,7 +445,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         c.range(key("phase"), p.phase, UNIT);
         c.range(key("center_size"), p.center_size, CENTER_SIZE);
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
-        if !p.rows.is_empty() && p.kind == PatternKind::Stripes {
+        if !p.rows.is_empty() && p.kind == PatternKind::Stripes && rows_in_range(preset.scales.rows) {
             let top = (preset.scales.rows as f64 + 1.0) / 2.0;
             let ok = p.rows.len() == 2
                 && p.rows.iter().all(|r| r.is_finite())
