@@ -320,12 +320,26 @@ fn set_indices_reach_into_lists_the_preset_has() {
     let marks = "[body]\nhead_mark = [{kind = \"cap\", color = \"#000000\"}]\n";
     let err = refused("marks.toml", marks, &["--set", "body.head_mark.3.kind=v"]);
     assert!(err.contains("`body.head_mark` has 1 entry: body.head_mark.0; there is no `body.head_mark.3`"), "{err}");
+    // An index is written one way: `pattern.00.kind=spots` reached layer 0 but was not read as
+    // a change of its kind (the old kind's `colors` were refused), and `.+1` reached item 1.
+    for (set, says) in [
+        ("pattern.00.kind=spots", "the index `00` is written `0`"),
+        ("body.head_mark.+0.kind=v", "the index `+0` is written `0`"),
+    ] {
+        let err = refused(
+            "marks.toml",
+            &format!("{marks}[[pattern]]\nkind = \"rings\"\ncolor = \"#ffffff\"\ncolors = [\"#000000\"]\n"),
+            &["--set", set],
+        );
+        assert!(err.contains(says), "{set}: {err}");
+    }
     // Negative controls: `pattern.0.KEY` starts a layer under `pattern = []` too, and an
     // index into a list the preset has is set.
     let dir = tempfile::tempdir().unwrap();
     let preset = write_preset(dir.path(), "empty.toml", "pattern = []\n");
     accepted(&preset, &["--set", "pattern.0.kind=stripes", "--set", "pattern.0.color=#000000"]);
     accepted(&write_preset(dir.path(), "marks.toml", marks), &["--set", "body.head_mark.0.kind=v"]);
+    accepted("micrurus-diastema", &["--set", "pattern.0.kind=spots"]);
 }
 
 /// A key one kind reads, on a layer of another kind, is refused with its line (`colors` and

@@ -358,6 +358,11 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
             segments.len(),
             toml_text::TOML_NESTING_LIMIT
         ))
+    } else if let Some((segment, index)) = non_canonical_index(&segments) {
+        // `pattern.00.kind` reached layer 0 as `pattern.0.kind` does, but the rules that read
+        // the key's words (a kind changed by `--set` passes over the old kind's keys) did not
+        // see it as that key.
+        Err(format!("the index `{segment}` is written `{index}` (a whole number, no sign or leading zeros)"))
     } else if let Err(message) = check_indices(root, &segments) {
         Err(message)
     } else {
@@ -369,6 +374,12 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
         result
     };
     result.map_err(|message| PresetError::Override { argument: format!("{key}={value}"), message })
+}
+
+/// The first part of a `--set` key that reads as an index but is not written the one way an
+/// index is (`00`, `+1`), with that index.
+fn non_canonical_index<'a>(segments: &[&'a str]) -> Option<(&'a str, usize)> {
+    segments.iter().find_map(|s| s.parse::<usize>().ok().filter(|n| n.to_string() != *s).map(|n| (*s, n)))
 }
 
 /// An index in a `--set` key must reach into a list the preset has. `pattern.N` must name
