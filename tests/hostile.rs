@@ -1109,6 +1109,11 @@ fn ao_without_a_pack_is_refused_whatever_comes_with_it() {
         assert_eq!(out.status.code(), Some(2), "{with:?}: {}", stderr(&out));
         assert!(stderr(&out).contains("--ao"), "{with:?}: {}", stderr(&out));
         assert!(!set.exists(), "{with:?}: a set was written");
+        // Alone, the refusal says both ways on: a pack, or the map by name.
+        if with.is_empty() {
+            assert!(stderr(&out).contains("add --pack ENGINE"), "{}", stderr(&out));
+            assert!(stderr(&out).contains("--maps all,ao"), "{}", stderr(&out));
+        }
     }
     // Negative control: with a pack it runs.
     let out = snakeskin(&["generate", PRESET, "--size", "16", "-o", set.to_str().unwrap(), "--ao", "--pack", "gltf"]);

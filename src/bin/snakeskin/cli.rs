@@ -30,7 +30,8 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Generate a texture set: <out>/<name>_<map>.png and <out>/<name>.material.json.
+    /// Generate a texture set: <out>/<name>_<map>.png (.exr with --format exr; an engine's
+    /// textures with --pack) and <out>/<name>.material.json.
     Generate(GenerateArgs),
     /// Export a preset as glTF 2.0 (.glb, or .gltf with its images beside it): the snake (or
     /// a sphere or plane) with the maps as a metallic-roughness material, the film as
@@ -169,7 +170,19 @@ impl Cli {
             }
         }
         let mut matches = command.try_get_matches_from_mut(args)?;
-        Cli::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut command))
+        let cli = Cli::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut command))?;
+        // `--ao` without `--pack`: clap's `requires` said only that `--pack <ENGINE>` was
+        // missing, where the user may have meant the map (`--help` says so).
+        if let Command::Generate(generate) = &cli.command
+            && generate.ao
+            && generate.pack.is_none()
+        {
+            let message = "--ao puts ambient occlusion into a pack's occlusion channel: add --pack ENGINE (gltf, \
+                           unreal or unity-hdrp), or without a pack name the map instead: --maps all,ao";
+            let generate = command.find_subcommand_mut("generate").expect("the generate subcommand");
+            return Err(clap::Error::raw(clap::error::ErrorKind::MissingRequiredArgument, message).format(generate));
+        }
+        Ok(cli)
     }
 }
 
@@ -265,7 +278,8 @@ pub struct GenerateArgs {
     // `requires` alone is not checked when an argument that conflicts with --pack is given
     // (clap), so `--ao --format png` was silently a set without occlusion: the conflicts
     // are --pack's own.
-    #[arg(long, requires = "pack", conflicts_with_all = ["normal_convention", "format", "maps"])]
+    // A missing --pack is refused after parsing, with the hint (`Cli::try_parse_checked_from`).
+    #[arg(long, conflicts_with_all = ["normal_convention", "format", "maps"])]
     pub ao: bool,
     /// Print per-node evaluations, time and buffer size after the run.
     #[arg(long)]
