@@ -86,9 +86,15 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
         key = span.clone().and_then(|s| key_at(text, s.start));
         // An array of tables where one table belongs (`[[scales]]`): the reader points at the
         // header, whose key is the array's first element (`scales.0`); the array is at fault.
-        if message.starts_with("invalid type: array, expected a table") && written.is_some_and(|w| w.starts_with("[["))
+        // Only a header that names that array (an inline `[[1]]` item is the item's fault).
+        if message.starts_with("invalid type: array, expected a table")
+            && let Some((array, index)) = key.as_deref().and_then(|k| k.rsplit_once('.'))
+            && index.bytes().all(|b| b.is_ascii_digit())
+            && written
+                .and_then(|w| w.strip_prefix("[[")?.split_once("]]"))
+                .is_some_and(|(name, _)| name.trim() == array)
         {
-            key = key.map(|k| k.rsplit_once('.').map_or(k.clone(), |(array, _)| array.to_string()));
+            key = Some(array.to_string());
         }
     }
     Described { line_column: at.map(|offset| line_column(text, offset)), key, message }

@@ -102,6 +102,8 @@ fn an_array_where_a_table_belongs_is_refused_not_read_in_field_order() {
         ("[[scales]]\nrows = 19\n", 1, "scales"),
         ("pattern = [[\"stripes\", \"#000000\"]]\n", 1, "pattern.0"),
         ("[body]\nhead_mark = [[\"cap\", \"#000000\"]]\n", 2, "body.head_mark.0"),
+        // An item that is an array inside an inline array is the item's fault, not its list's.
+        ("pattern = [[[\"stripes\"]]]\n", 1, "pattern.0"),
     ] {
         let err = refused("arrays.toml", text, &[]);
         assert!(err.contains(&format!("arrays.toml:{line}:")), "{text:?}: {err}");
@@ -150,16 +152,22 @@ fn a_stripe_placed_twice_is_refused() {
 
 /// One bad value is one problem: a row count out of its range was reported, and then the
 /// keys it bounds as well, against a range made from it (`belly.up_rows` "must be an
-/// integer in [0, 0]", a key the user had not touched). Negative control: with the rows in
-/// range, an `up_rows` past half of them is refused.
+/// integer in [0, 0]", a key the user had not touched); a body fraction out of its range
+/// also failed a check of the fractions' sum, named `body.tail_fraction`. Negative control:
+/// with the rows in range, an `up_rows` past half of them is refused.
 #[test]
-fn a_row_count_out_of_range_is_the_one_problem_reported() {
+fn one_bad_value_is_one_problem() {
+    let err = refused("body.toml", "[body]\nhead_fraction = 0.3\n", &[]);
+    assert!(err.contains("key `body.head_fraction`") && !err.contains("body.tail_fraction"), "{err}");
     let err = refused("rows.toml", "[scales]\nrows = 1\n[belly]\nup_rows = 1\n", &[]);
     assert!(err.contains("key `scales.rows` must be an integer in [4, 128], got 1"), "{err}");
     assert!(!err.contains("belly.up_rows"), "{err}");
     let stripe = "[scales]\nrows = 1\n[[pattern]]\nkind = \"stripes\"\ncolor = \"#101010\"\nrows = [9.5, 10]\n";
     let err = refused("rows.toml", stripe, &[]);
     assert!(err.contains("scales.rows") && !err.contains("pattern.0.rows"), "{err}");
+    // A value no row count allows is still refused beside it, against the most rows allowed.
+    let err = refused("rows.toml", "[scales]\nrows = 1\nsmooth_rows = 5000\n", &[]);
+    assert!(err.contains("key `scales.smooth_rows` must be an integer in [0, 64], got 5000"), "{err}");
     let err = refused("rows.toml", "[scales]\nrows = 9\n[belly]\nup_rows = 5\n", &[]);
     assert!(err.contains("key `belly.up_rows` must be an integer in [0, 4], got 5"), "{err}");
 }

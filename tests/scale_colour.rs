@@ -22,8 +22,11 @@ fn field(text: &str) -> Image {
 }
 
 /// Every per-scale key off: the reference each test changes one key against. Scales a
-/// little smaller than their cells, so the skin shows between them.
-const PLAIN: &str = "seed = 9\n[scales]\njitter = 0.2\nsize = 0.9\n[color]\nbase = \"#806040\"\nvariation = 0.1\n";
+/// little smaller than their cells, so the skin shows between them. A belly darker than the
+/// default, so that no key brightened by a test's tone reaches a reflectance of 1 (then it
+/// would be clamped, `preset::visible`, and change the map everywhere).
+const PLAIN: &str = "seed = 9\n[scales]\njitter = 0.2\nsize = 0.9\n[belly]\ncolor = \"#b0a080\"\n[color]\n\
+                     base = \"#806040\"\nvariation = 0.1\n";
 
 /// `PLAIN` with the per-scale keys off, then `key` (lines of `[color]` keys) set.
 fn with(key: &str) -> String {

@@ -184,9 +184,15 @@ fn over_a_lossless_stack_no_key_is_brightened_past_a_reflectance_of_one() {
     let out = snakeskin(&["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
-    assert!(err.contains("white.toml:2: color.base = \"#ffffff\" is brighter than any skin can show"), "{err}");
-    assert!(err.contains("Lower the per-scale tones or the colour"), "{err}");
+    let says = "white.toml:2: color.base = \"#ffffff\" would be brightened past a reflectance of 1";
+    assert!(err.contains(says), "{err}");
+    assert!(err.contains("Lower color.scale_tone, scale_hue, edge_tone, tip_tone, color.variation or"), "{err}");
     assert!(!err.contains("belly.color"), "{err}");
+    // Absorption in blue alone does not limit a red: the warning says the brightening did.
+    let red = write_preset(dir.path(), "red.toml", "[color]\nbase = \"#ff0000\"\n[optics]\nabsorption = [0, 0, 0.3]\n");
+    let out = snakeskin(&["generate", &red, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
+    let err = stderr(&out);
+    assert!(out.status.success() && err.contains("would be brightened past a reflectance of 1"), "{err}");
 }
 
 /// With a rough top and absorption, the colour map is still the layered model's own visible

@@ -451,7 +451,7 @@ impl PatternLayer {
 /// "diamond"` and `rows = 40`, `optics = [1.33]` set the first index of refraction, and
 /// `belly = []` passed as the defaults, silently; and `scales = [19]` was refused as
 /// `scales.0`, a key no preset has. An array where a table belongs is refused with the key
-/// and its line: "invalid type: sequence, expected a table".
+/// and its line: "invalid type: array, expected a table".
 pub(crate) fn table<'de, D: Deserializer<'de>, T: Deserialize<'de>>(deserializer: D) -> Result<T, D::Error> {
     struct Table<T>(std::marker::PhantomData<T>);
     impl<'de, T: Deserialize<'de>> de::Visitor<'de> for Table<T> {

@@ -74,6 +74,10 @@ pub mod ranges {
     pub const HEAD_FRACTION: (f64, f64) = (0.01, 0.15);
     pub const NECK_FRACTION: (f64, f64) = (0.0, 0.15);
     pub const TAIL_FRACTION: (f64, f64) = (0.02, 0.5);
+    /// What the head, neck and tail ranges leave the trunk at least (the body layout's
+    /// regions need one): checked when compiling, so no preset needs a check of the sum.
+    pub const TRUNK_FRACTION_AT_LEAST: f64 = 0.2;
+    const _: () = assert!(HEAD_FRACTION.1 + NECK_FRACTION.1 + TAIL_FRACTION.1 <= 1.0 - TRUNK_FRACTION_AT_LEAST);
     /// Ventral counts in snakes run from about 100 to over 400.
     pub const VENTRALS: (u32, u32) = (60, 500);
     pub const SUBCAUDALS: (u32, u32) = (5, 250);
@@ -126,10 +130,10 @@ impl Checker {
     fn whole_number(&mut self, key: &str, value: u32, rows: u32) {
         let range = match whole_number_range(key) {
             Some(WholeRange::Fixed(range)) => range,
-            // Bounded by a row count that is itself refused: that one problem says it (with
-            // `rows = 1`, `belly.up_rows = 1` was refused too, a key the user never set).
-            Some(WholeRange::HalfTheRows) if !rows_in_range(rows) => return,
-            Some(WholeRange::HalfTheRows) => (0, rows / 2),
+            // Bounded by a row count that is itself refused: held to what any row count
+            // allows, so that the one problem is the row count's (with `rows = 1`, a file's
+            // `belly.up_rows = 1` was refused too, against [0, 0]).
+            Some(WholeRange::HalfTheRows) => (0, if rows_in_range(rows) { rows } else { ranges::ROWS.1 } / 2),
             Some(WholeRange::Seed) | None => unreachable!("{key} is not a u32 key of whole_number_range's table"),
         };
         self.int_range(key, value, range);
@@ -144,7 +148,7 @@ impl Checker {
 }
 
 /// Whether `scales.rows` is within its range: the keys it bounds (`WholeRange::HalfTheRows`,
-/// a stripe's `rows`) are checked against it only then.
+/// a stripe's `rows`) are checked against it only then, else against the most rows allowed.
 fn rows_in_range(rows: u32) -> bool {
     (ranges::ROWS.0..=ranges::ROWS.1).contains(&rows)
 }
@@ -347,7 +351,10 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                 ("amount", p.amount != PatternLayer::default_amount(), by_rows.then_some("rows")),
             ];
             for (field, set, by) in replaced {
-                if let Some(by) = by.filter(|_| set && !from_file_for_old_kind(i, field)) {
+                // No pass for a file's key under a kind `--set` changed (as `kinds_only` gives):
+                // stripes read every one of these keys, so it would be dropped silently (the
+                // blotches' `arrangement` is refused the same way, above).
+                if let Some(by) = by.filter(|_| set) {
                     let what = if by == "rows" {
                         "places the stripe and sets its width and count"
                     } else {
@@ -438,15 +445,20 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                 ),
             });
         }
-        if p.widths.iter().sum::<f64>() > 1.0 + 1e-9 {
+        // The sum of widths each in range (one out of it is its own problem, not the sum's).
+        let widths_in_range = p.widths.iter().all(|w| (RING_WIDTH.0..=RING_WIDTH.1).contains(w));
+        if widths_in_range && p.widths.iter().sum::<f64>() > 1.0 + 1e-9 {
             c.problems.push(Problem { key: key("widths"), message: "must sum to at most 1 (one repeat)".into() });
         }
         c.range(key("scale_aligned"), p.scale_aligned, UNIT);
         c.range(key("phase"), p.phase, UNIT);
         c.range(key("center_size"), p.center_size, CENTER_SIZE);
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
-        if !p.rows.is_empty() && p.kind == PatternKind::Stripes && rows_in_range(preset.scales.rows) {
-            let top = (preset.scales.rows as f64 + 1.0) / 2.0;
+        if !p.rows.is_empty() && p.kind == PatternKind::Stripes {
+            // Against the preset's row count, or the most rows any count allows where the
+            // count is refused itself (`WholeRange::HalfTheRows` likewise).
+            let rows = if rows_in_range(preset.scales.rows) { preset.scales.rows } else { ranges::ROWS.1 };
+            let top = (rows as f64 + 1.0) / 2.0;
             let ok = p.rows.len() == 2
                 && p.rows.iter().all(|r| r.is_finite())
                 && 0.5 <= p.rows[0]
@@ -458,7 +470,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                     message: format!(
                         "must be [first, last] dorsal rows with 0.5 ≤ first ≤ last ≤ {top} (the vertebral row of \
                          {} rows); got {}",
-                        preset.scales.rows,
+                        rows,
                         // A long list is counted, not echoed back whole.
                         if p.rows.len() <= 4 { format!("{:?}", p.rows) } else { format!("{} entries", p.rows.len()) }
                     ),
@@ -536,15 +548,9 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
     c.range("body.head_fraction", b.head_fraction, HEAD_FRACTION);
     c.range("body.neck_fraction", b.neck_fraction, NECK_FRACTION);
     c.range("body.tail_fraction", b.tail_fraction, TAIL_FRACTION);
-    if b.head_fraction + b.neck_fraction + b.tail_fraction > 0.8 {
-        c.problems.push(Problem {
-            key: "body.tail_fraction".into(),
-            message: format!(
-                "head, neck and tail together must leave at least 0.2 of the length to the trunk, got {} + {} + {}",
-                b.head_fraction, b.neck_fraction, b.tail_fraction
-            ),
-        });
-    }
+    // The ranges leave the trunk at least 0.2 of the length (`TRUNK_FRACTION_AT_LEAST`). A
+    // check of the sum here fired only beside a fraction out of its range, and named
+    // `body.tail_fraction` when the user had set `head_fraction`.
     c.whole_number("body.ventrals", b.ventrals, s.rows);
     c.whole_number("body.subcaudals", b.subcaudals, s.rows);
     c.range("body.tail_shift_start", b.tail_shift_start, UNIT);

@@ -3,11 +3,12 @@
 //! incidence, per unit of light the top lets in), not the base albedo behind the film and
 //! the pigment layer; the renderer recovers the base albedo per pixel. A stack with
 //! absorption cannot show every colour: with k_d = 1 it shows t₁ E / (1 − K) at most
-//! (`layered::normal_transmittance`; 0.07 for the thesis' τ = 0.6 over n2 = 2 and a smooth top). Colours beyond that are clamped to it when
-//! the preset is loaded, and reported with the key, the line and the limit — never
-//! silently — so the maps, the renderer and any tool that reads the colour map agree. A
-//! lossless stack's limit is 1: a key that the map's per-scale tone and colour variation
-//! would brighten past a reflectance of 1 is clamped and reported too.
+//! (`layered::normal_transmittance`; 0.07 for the thesis' τ = 0.6 over n2 = 2 and a smooth
+//! top). Colours beyond that are clamped to it when the preset is loaded, and reported with
+//! the key, the line and the limit — never silently — so the maps, the renderer and any tool
+//! that reads the colour map agree. A lossless stack's limit is 1: a key that the map's
+//! per-scale tone and colour variation would brighten past a reflectance of 1 is clamped
+//! and reported too.
 //!
 //! The limit is the smallest over the film thicknesses and roughnesses the renderer takes K
 //! and E at (both maps vary per pixel). The colour
@@ -31,8 +32,9 @@ pub struct ClampedColour {
     pub clamped_to: String,
     /// The stack's limit per channel for this key, linear.
     pub limit_linear: [f64; 3],
-    /// Whether the stack absorbs (its limit is below 1); else the key was brighter than a
-    /// reflectance of 1 once brightened by the map.
+    /// Whether the stack's absorption set the limit (in the channel that set the clamp);
+    /// else the map's brightening would have carried the key past a reflectance of 1. For
+    /// the warning's words only: the manifest records the limit, which says the same.
     #[serde(skip)]
     pub absorbing: bool,
 }
@@ -42,16 +44,21 @@ impl ClampedColour {
     pub fn message(&self, preset: &str) -> String {
         let line = self.line.map(|l| format!(":{l}")).unwrap_or_default();
         let [r, g, b] = self.limit_linear;
-        let (why, remedy) = if self.absorbing {
-            ("this layer stack can show (colours mean the visible colour; with its absorption", "optics.absorption")
-        } else {
-            ("any skin can show (colours mean the visible colour, a reflectance of at most 1", "the per-scale tones")
-        };
+        let (key, requested, shown) = (&self.key, &self.requested, &self.clamped_to);
+        if self.absorbing {
+            return format!(
+                "warning: {preset}{line}: {key} = \"{requested}\" is brighter than this layer stack can show (colours \
+                 mean the visible colour; with its absorption, and any headroom this key keeps for the map's per-scale \
+                 tone and colour variation, it may be at most linear [{r:.3}, {g:.3}, {b:.3}]); clamped to \"{shown}\". \
+                 Lower optics.absorption or the colour to keep it."
+            );
+        }
+        let variation = if key == "color.base" { ", color.variation" } else { "" };
         format!(
-            "warning: {preset}{line}: {} = \"{}\" is brighter than {why}, and any headroom this key keeps for the \
-             map's per-scale tone and colour variation, it may be at most linear [{r:.3}, {g:.3}, {b:.3}]); clamped \
-             to \"{}\". Lower {remedy} or the colour to keep it.",
-            self.key, self.requested, self.clamped_to
+            "warning: {preset}{line}: {key} = \"{requested}\" would be brightened past a reflectance of 1 by the map's \
+             per-scale tone and colour variation (colours mean the visible colour; with that headroom it may be at \
+             most linear [{r:.3}, {g:.3}, {b:.3}]); clamped to \"{shown}\". Lower color.scale_tone, scale_hue, \
+             edge_tone, tip_tone{variation} or the colour to keep it."
         )
     }
 }
@@ -153,8 +160,7 @@ pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
     // and the map's brightening must not carry a key past that either: a colour map above 1
     // is no reflectance, its PNG clips where its EXR does not, and the renderer's inversion
     // holds k_d at 1 there.
-    let absorbing = visible_limit(preset);
-    let limit = absorbing.unwrap_or([1.0; 3]);
+    let stack_limit = visible_limit(preset).unwrap_or([1.0; 3]);
     let per_scale = per_scale_gain(preset);
     let variation = 1.0 + preset.color.variation.max(0.0);
     let mut clamped = Vec::new();
@@ -166,12 +172,13 @@ pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
             "color.speckle_color" => 1.0,
             _ => per_scale,
         };
-        let allowed = limit.map(|l| l / headroom);
+        let allowed = stack_limit.map(|l| l / headroom);
         let linear = colour.to_linear().map(f64::from);
-        let factor = (0..3).filter(|&c| linear[c] > allowed[c]).map(|c| allowed[c] / linear[c]).fold(1.0, f64::min);
-        if factor >= 1.0 {
+        // The channel furthest over its limit sets the factor (and says whether absorption did).
+        let over = (0..3).filter(|&c| linear[c] > allowed[c]).map(|c| (allowed[c] / linear[c], c));
+        let Some((factor, channel)) = over.min_by(|a, b| a.0.total_cmp(&b.0)) else {
             continue;
-        }
+        };
         let shown = Srgb8([0, 1, 2].map(|c| Srgb8::encode_floor(linear[c] * factor)));
         clamped.push(ClampedColour {
             key,
@@ -179,7 +186,7 @@ pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
             requested: colour.to_string(),
             clamped_to: shown.to_string(),
             limit_linear: allowed,
-            absorbing: absorbing.is_some(),
+            absorbing: stack_limit[channel] < 1.0,
         });
         *colour = shown;
     }

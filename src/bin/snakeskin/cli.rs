@@ -177,8 +177,16 @@ impl Cli {
             && generate.ao
             && generate.pack.is_none()
         {
-            let message = "--ao puts ambient occlusion into a pack's occlusion channel: add --pack ENGINE (gltf, \
-                           unreal or unity-hdrp), or without a pack name the map instead: --maps all,ao";
+            use clap::ValueEnum;
+            let engines: Vec<String> = PackArg::value_variants()
+                .iter()
+                .filter_map(|engine| engine.to_possible_value().map(|v| v.get_name().to_string()))
+                .collect();
+            let message = format!(
+                "--ao puts ambient occlusion into a pack's occlusion channel: add --pack ENGINE ({}), or, without a \
+                 pack, name the map instead: --maps all,ao",
+                engines.join(", ")
+            );
             let generate = command.find_subcommand_mut("generate").expect("the generate subcommand");
             return Err(clap::Error::raw(clap::error::ErrorKind::MissingRequiredArgument, message).format(generate));
         }
@@ -275,10 +283,10 @@ pub struct GenerateArgs {
     /// With --pack: compute the ambient occlusion map (horizon-based, from the height map)
     /// into the pack's occlusion channel instead of 1 everywhere. Without a pack, name the
     /// map instead: --maps all,ao.
-    // `requires` alone is not checked when an argument that conflicts with --pack is given
-    // (clap), so `--ao --format png` was silently a set without occlusion: the conflicts
-    // are --pack's own.
-    // A missing --pack is refused after parsing, with the hint (`Cli::try_parse_checked_from`).
+    // The conflicts are --pack's own: clap's `requires = "pack"` was not checked when an
+    // argument that conflicts with --pack came with it, so `--ao --format png` was silently
+    // a set without occlusion. A missing --pack is refused after parsing, with a hint
+    // (`Cli::try_parse_checked_from`).
     #[arg(long, conflicts_with_all = ["normal_convention", "format", "maps"])]
     pub ao: bool,
     /// Print per-node evaluations, time and buffer size after the run.
