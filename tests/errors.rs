@@ -157,7 +157,7 @@ fn a_stripe_placed_twice_is_refused() {
 /// with the rows in range, an `up_rows` past half of them is refused.
 #[test]
 fn one_bad_value_is_one_problem() {
-    let err = refused("body.toml", "[body]\nhead_fraction = 0.3\n", &[]);
+    let err = refused("body.toml", "[body]\nhead_fraction = 0.7\n", &[]);
     assert!(err.contains("key `body.head_fraction`") && !err.contains("body.tail_fraction"), "{err}");
     let err = refused("rows.toml", "[scales]\nrows = 1\n[belly]\nup_rows = 1\n", &[]);
     assert!(err.contains("key `scales.rows` must be an integer in [4, 128], got 1"), "{err}");
@@ -453,6 +453,11 @@ fn spots_larger_than_their_spacing_are_refused() {
     accepted(&path, &["--set", "pattern.0.amount=3"]);
     let err = refused("default_size.toml", &layer.replace("size = 0.3\n", ""), &[]);
     assert!(err.contains("is 0.05 with 64 spots around"), "{err}");
+    // A key at its default is named as one, not as an override's (it said "(with --set)"
+    // with nothing set); one an override wrote still is.
+    assert!(err.contains("default_size.toml: key `pattern.0.size` (not written: its default)"), "{err}");
+    let err = refused("default_size.toml", &layer.replace("size = 0.3\n", ""), &["--set", "pattern.0.size=0.2"]);
+    assert!(err.contains("default_size.toml (with --set): key `pattern.0.size`"), "{err}");
     accepted("acanthophis-antarcticus", &["--set", "pattern.0.kind=spots"]);
     let err = refused("too_big.toml", &layer.replace("amount = 64", "amount = 2").replace("0.3", "0.9"), &[]);
     assert!(err.contains("must be a finite number in [0.001, 0.5], got 0.9"), "{err}");

@@ -56,19 +56,24 @@ impl fmt::Display for Location {
 #[derive(Debug, Clone, PartialEq)]
 pub struct LocatedProblem {
     pub key: String,
-    /// Line in the file, or None when the value came from `--set`.
+    /// Line in the file, or None when the value came from `--set` or is the key's default.
     pub line: Option<usize>,
+    /// Whether `--set` (or a jobs file's `set`) wrote the key.
+    pub overridden: bool,
     pub message: String,
 }
 
-/// One line per problem: the file and line of a key written in the file, or the file
-/// `(with OVERRIDES)` for one that is not (set by `--set`, or by a jobs file's `set`).
+/// One line per problem: the file and line of a key written in the file, the file `(with
+/// OVERRIDES)` for one an override wrote (`--set`, or a jobs file's `set`), and the file
+/// alone for a key at its default (a check across keys can name one: `pattern.0.size`
+/// against the `amount` written; that said "(with --set)" when nothing was set).
 pub fn describe_problems(file: &str, problems: &[LocatedProblem], overrides: &str) -> String {
     problems
         .iter()
-        .map(|p| match p.line {
-            Some(line) => format!("{file}:{line}: key `{}` {}", p.key, p.message),
-            None => format!("{file} (with {overrides}): key `{}` {}", p.key, p.message),
+        .map(|p| match (p.line, p.overridden) {
+            (Some(line), _) => format!("{file}:{line}: key `{}` {}", p.key, p.message),
+            (None, true) => format!("{file} (with {overrides}): key `{}` {}", p.key, p.message),
+            (None, false) => format!("{file}: key `{}` (not written: its default) {}", p.key, p.message),
         })
         .collect::<Vec<_>>()
         .join("\n")

@@ -211,8 +211,9 @@ pub fn parse_with_seed(
         let located = problems
             .into_iter()
             .map(|p| {
-                let line = if overridden(&p.key) { None } else { key_lines.line(&p.key) };
-                LocatedProblem { line, key: p.key, message: p.message }
+                let set = overridden(&p.key);
+                let line = if set { None } else { key_lines.line(&p.key) };
+                LocatedProblem { line, overridden: set, key: p.key, message: p.message }
             })
             .collect();
         return Err(PresetError::Invalid { file: source.display.clone(), problems: located });
@@ -225,6 +226,7 @@ pub fn parse_with_seed(
         .into_iter()
         .map(|p| LocatedProblem {
             line: if overridden(&p.key) { None } else { key_lines.line(&p.key) },
+            overridden: overridden(&p.key),
             key: p.key,
             message: p.message,
         })
