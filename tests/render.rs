@@ -349,11 +349,9 @@ fn the_window_runs_frames_under_xvfb() {
         eprintln!("the_window_runs_frames_under_xvfb: SKIPPED: xvfb-run not installed");
         return;
     }
-    let out = std::process::Command::new("xvfb-run")
+    let out = on_x11(&mut std::process::Command::new("xvfb-run"))
         .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
         .args(["preview", PRESET, "--window", "--frames", "12", "--size", "480x300", "--map-size", "128"])
-        .env_remove("WAYLAND_DISPLAY")
-        .env_remove("WAYLAND_SOCKET")
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -486,6 +484,13 @@ fn sheet_command_writes_a_png() {
     assert_eq!(image.width(), 5 * 3 * 64);
 }
 
+/// `command` without the desktop's Wayland variables, so that a window opens on the Xvfb
+/// that `xvfb-run` starts, not on the desktop's compositor (which winit prefers).
+#[cfg(any(target_os = "linux", feature = "window"))]
+fn on_x11(command: &mut std::process::Command) -> &mut std::process::Command {
+    command.env_remove("WAYLAND_DISPLAY").env_remove("WAYLAND_SOCKET")
+}
+
 /// The peak resident memory (KiB, from `wait4`'s `ru_maxrss`, KiB on Linux) of `snakeskin
 /// args`, which must succeed; this child's own, whatever else the tests run at the same time.
 /// Under a `wrapper` (e.g. `xvfb-run`) it is the largest peak among the wrapper and the
@@ -498,13 +503,10 @@ fn peak_resident_kib(wrapper: &[&str], args: &[&str]) -> u64 {
     let binary = env!("CARGO_BIN_EXE_snakeskin");
     let (program, first) = wrapper.split_first().map_or((binary, &[][..]), |(p, rest)| (*p, rest));
     let mut errors = tempfile::tempfile().unwrap();
-    let child = Command::new(program)
+    let child = on_x11(&mut Command::new(program))
         .args(first)
         .args((!wrapper.is_empty()).then_some(binary))
         .args(args)
-        // A window opens on Xvfb, not on the desktop's Wayland compositor (which winit prefers).
-        .env_remove("WAYLAND_DISPLAY")
-        .env_remove("WAYLAND_SOCKET")
         .stdout(Stdio::null())
         .stderr(errors.try_clone().unwrap())
         .spawn()
@@ -604,12 +606,10 @@ fn the_window_reloads_the_preset_file_on_save() {
     let original = snakeskin::preset::library::get(PLAIN_PRESET).unwrap();
     std::fs::write(&preset, original).unwrap();
     std::os::unix::fs::symlink(&preset, &link).unwrap();
-    let mut child = Command::new("xvfb-run")
+    let mut child = on_x11(&mut Command::new("xvfb-run"))
         .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
         .args(["preview", link.to_str().unwrap(), "--window", "--frames", "1000000", "--size", "320x200"])
         .args(["--map-size", "128"])
-        .env_remove("WAYLAND_DISPLAY")
-        .env_remove("WAYLAND_SOCKET")
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         // Its own process group, so that stopping it also stops Xvfb and the preview.

@@ -207,30 +207,23 @@ pub fn parse_with_seed(
     let from_file_for_old_kind = |i: usize, key: &str| in_layer(i, "kind") && !in_layer(i, key);
     let problems = validate(&preset, &from_file_for_old_kind);
     let key_lines = std::cell::LazyCell::new(|| toml_text::KeyLines::new(&source.text));
+    // A key's line in the file: none for a key an override wrote (or one not in the file).
+    let line_of = |key: &str| if overridden(key) { None } else { key_lines.line(key) };
+    let locate = |p: super::validate::Problem| LocatedProblem {
+        line: line_of(&p.key),
+        overridden: overridden(&p.key),
+        key: p.key,
+        message: p.message,
+    };
     if !problems.is_empty() {
-        let located = problems
-            .into_iter()
-            .map(|p| {
-                let set = overridden(&p.key);
-                let line = if set { None } else { key_lines.line(&p.key) };
-                LocatedProblem { line, overridden: set, key: p.key, message: p.message }
-            })
-            .collect();
+        let located = problems.into_iter().map(locate).collect();
         return Err(PresetError::Invalid { file: source.display.clone(), problems: located });
     }
     let mut clamped_colours = super::visible::clamp_to_visible(&mut preset);
     for c in &mut clamped_colours {
-        c.line = if overridden(&c.key) { None } else { key_lines.line(&c.key) };
+        c.line = line_of(&c.key);
     }
-    let warned = super::validate::warnings(&preset)
-        .into_iter()
-        .map(|p| LocatedProblem {
-            line: if overridden(&p.key) { None } else { key_lines.line(&p.key) },
-            overridden: overridden(&p.key),
-            key: p.key,
-            message: p.message,
-        })
-        .collect();
+    let warned = super::validate::warnings(&preset).into_iter().map(locate).collect();
     let canonical = canonical_text(&preset);
     Ok(LoadedPreset {
         name: source.name.clone(),

@@ -130,10 +130,8 @@ impl Checker {
     fn whole_number(&mut self, key: &str, value: u32, rows: u32) {
         let range = match whole_number_range(key) {
             Some(WholeRange::Fixed(range)) => range,
-            // Bounded by a row count that is itself refused: held to what any row count
-            // allows, so that the one problem is the row count's (with `rows = 1`, a file's
-            // `belly.up_rows = 1` was refused too, against [0, 0]).
-            Some(WholeRange::HalfTheRows) => (0, if rows_in_range(rows) { rows } else { ranges::ROWS.1 } / 2),
+            // With `rows = 1`, a file's `belly.up_rows = 1` was refused too, against [0, 0].
+            Some(WholeRange::HalfTheRows) => (0, rows_bounding(rows) / 2),
             Some(WholeRange::Seed) | None => unreachable!("{key} is not a u32 key of whole_number_range's table"),
         };
         self.int_range(key, value, range);
@@ -147,10 +145,11 @@ impl Checker {
     }
 }
 
-/// Whether `scales.rows` is within its range: the keys it bounds (`WholeRange::HalfTheRows`,
-/// a stripe's `rows`) are checked against it only then, else against the most rows allowed.
-fn rows_in_range(rows: u32) -> bool {
-    (ranges::ROWS.0..=ranges::ROWS.1).contains(&rows)
+/// The row count the keys `scales.rows` bounds (`WholeRange::HalfTheRows`, a stripe's
+/// `rows`) are checked against: the preset's, or the most rows allowed where its count is
+/// out of range (then that is the one problem, not every key it bounds).
+fn rows_bounding(rows: u32) -> u32 {
+    if (ranges::ROWS.0..=ranges::ROWS.1).contains(&rows) { rows } else { ranges::ROWS.1 }
 }
 
 /// What a preset that loads does not do as its keys seem to say, one warning each: the
@@ -455,9 +454,7 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         c.range(key("center_size"), p.center_size, CENTER_SIZE);
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
         if !p.rows.is_empty() && p.kind == PatternKind::Stripes {
-            // Against the preset's row count, or the most rows any count allows where the
-            // count is refused itself (`WholeRange::HalfTheRows` likewise).
-            let rows = if rows_in_range(preset.scales.rows) { preset.scales.rows } else { ranges::ROWS.1 };
+            let rows = rows_bounding(preset.scales.rows);
             let top = (rows as f64 + 1.0) / 2.0;
             let ok = p.rows.len() == 2
                 && p.rows.iter().all(|r| r.is_finite())
