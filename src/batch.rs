@@ -46,14 +46,14 @@ pub enum BatchError {
     #[error("{path}:{line}:{column}: {message}")]
     Parse { path: PathBuf, line: usize, column: usize, message: String },
     /// A value outside what a job accepts; `line`: where the key is written.
-    #[error("{path}{}: job {job} ({preset}): {message}", at_line(*.line))]
+    #[error("{path}{}: [[job]] {job} ({preset}): {message}", at_line(*.line))]
     Invalid { path: PathBuf, line: Option<usize>, job: usize, preset: String, message: String },
     /// The job's preset refused (the preset's own message); `line`: the job's `preset` key.
-    #[error("{path}{}: job {job} ({preset}): {source}", at_line(*.line))]
+    #[error("{path}{}: [[job]] {job} ({preset}): {source}", at_line(*.line))]
     Preset { path: PathBuf, line: Option<usize>, job: usize, preset: String, source: Box<crate::preset::PresetError> },
     /// The job's `set` table refused: its entries as `key=value`, and why; `line`: the
     /// job's `set` key.
-    #[error("{path}{}: job {job} ({preset}): set `{entries}`: {message}", at_line(*.line))]
+    #[error("{path}{}: [[job]] {job} ({preset}): set `{entries}`: {message}", at_line(*.line))]
     Set { path: PathBuf, line: Option<usize>, job: usize, preset: String, entries: String, message: String },
     #[error("{path}: no [[job]] tables; a jobs file lists jobs as [[job]] tables with at least a preset key")]
     Empty { path: PathBuf },
@@ -64,7 +64,7 @@ pub enum BatchError {
     /// The job refused when the run was planned, before any job ran: its size (a body atlas
     /// too tall, more memory than the machine has) or its output (a folder, file or link
     /// in the way); `line`: the job's `sizes` key, else its `preset` key.
-    #[error("{path}{}: job {job} ({preset}): {source}", at_line(*.line))]
+    #[error("{path}{}: [[job]] {job} ({preset}): {source}", at_line(*.line))]
     Planned { path: PathBuf, line: Option<usize>, job: usize, preset: String, source: Box<Error> },
     /// The job failed while it ran (a full disk, a file that may not be replaced): its set
     /// was not written.
@@ -79,8 +79,10 @@ pub enum BatchError {
     Changed { job: RunningJob },
 }
 
-/// A job as its messages at run time name it: `jobs.toml:LINE: job N (PRESET, seed S, size
-/// Z)`, the line of its `preset` key.
+/// A job as its messages at run time name it: `jobs.toml:LINE: [[job]] N (PRESET, seed S,
+/// size Z)`, N counting the file's `[[job]]` tables from 1 (not the job's index in `--list`
+/// and the index, which counts the jobs the tables' seeds and sizes expand to, from 0), and
+/// LINE that of its `preset` key.
 #[derive(Debug, Clone)]
 pub struct RunningJob {
     pub path: PathBuf,
@@ -94,7 +96,7 @@ pub struct RunningJob {
 impl std::fmt::Display for RunningJob {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let RunningJob { path, line, table, preset, seed, size } = self;
-        write!(f, "{}{}: job {table} ({preset}, seed {seed}, size {size})", path.display(), at_line(*line))
+        write!(f, "{}{}: [[job]] {table} ({preset}, seed {seed}, size {size})", path.display(), at_line(*line))
     }
 }
 
@@ -230,8 +232,8 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     let file: JobsFile = toml::from_str(&text).map_err(|e| {
         let described = crate::toml_text::describe(&text, &e);
         let (line, column) = described.line_column.unwrap_or((1, 1));
-        // `job.0.sizes` is the first [[job]] table's `sizes`: "job 1", as the other messages
-        // count jobs.
+        // `job.0.sizes` is the first [[job]] table's `sizes`: "[[job]] 1", as the other
+        // messages count the tables.
         let in_job = described.key.as_deref().and_then(|k| k.strip_prefix("job.")).and_then(|k| k.split_once('.'));
         let message = match in_job.and_then(|(index, key)| Some((index.parse::<usize>().ok()? + 1, key))) {
             // A size the type cannot hold (`-64`) said "a whole number from 0 to
@@ -240,15 +242,15 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                 if let Some(value) = crate::toml_text::integer_out_of_type(&described.message)
                     && key.starts_with("sizes.") =>
             {
-                format!("job {job}: key `sizes`: {}", size_refused(value))
+                format!("[[job]] {job}: key `sizes`: {}", size_refused(value))
             }
             Some((job, key))
                 if let Some(value) = crate::toml_text::integer_out_of_type(&described.message)
                     && key.starts_with("seeds.") =>
             {
-                format!("job {job}: key `seeds`: {}", seed_refused(value))
+                format!("[[job]] {job}: key `seeds`: {}", seed_refused(value))
             }
-            Some((job, key)) => format!("job {job}: key `{key}`: {}", described.message),
+            Some((job, key)) => format!("[[job]] {job}: key `{key}`: {}", described.message),
             None => described.keyed_message(),
         };
         BatchError::Parse { path: path.into(), line, column, message }
@@ -562,8 +564,8 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
                 // jobs' `preset` lines (this job's where the message starts).
                 let first_line = jobs[earlier].lines.preset.map(|l| format!(" (line {l})")).unwrap_or_default();
                 let message = format!(
-                    "would write {}, which job {}{first_line} writes with different output; rename one of the preset \
-                     files (a preset's name is its file name without `.toml`; a built-in preset's, its own)",
+                    "would write {}, which [[job]] {}{first_line} writes with different output; rename one of the \
+                     preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)",
                     r.outcome.folder.display(),
                     jobs[earlier].table,
                 );

@@ -189,7 +189,7 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nsizes = \"big\"\n").unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:3:9: job 1: key `sizes`: invalid type"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:3:9: [[job]] 1: key `sizes`: invalid type"), "{}", stderr(&out));
     assert!(stderr(&out).contains("expected an array") && !stderr(&out).contains("sequence"), "{}", stderr(&out));
     assert!(!empty.exists());
     // A job written as an array is refused as one, not read field by field ("expected
@@ -211,25 +211,25 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("no-such-snake"), "{}", stderr(&out));
     // ... and the message names the jobs file, the line of the job's preset and the job.
-    assert!(stderr(&out).contains("jobs.toml:6: job 2 (no-such-snake): unknown preset"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:6: [[job]] 2 (no-such-snake): unknown preset"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "a set was written before the bad job was found");
 
     // A bad override names its job and the line of its `set` too (they had no line); an
     // empty list of seeds or sizes is refused, not read as the default, at its line.
     for (table, says) in [
-        ("set = { \"scales.rwos\" = 23 }", "jobs.toml:7: job 2 (natrix-natrix): set `scales.rwos=23`: unknown key"),
+        ("set = { \"scales.rwos\" = 23 }", "jobs.toml:7: [[job]] 2 (natrix-natrix): set `scales.rwos=23`: unknown key"),
         (
             "set = { \"scales.rows\" = 0 }",
-            "jobs.toml:7: job 2 (natrix-natrix): built-in preset natrix-natrix (with its `set` table): key \
+            "jobs.toml:7: [[job]] 2 (natrix-natrix): built-in preset natrix-natrix (with its `set` table): key \
              `scales.rows` must be",
         ),
-        ("sizes = []", "jobs.toml:7: job 2 (natrix-natrix): sizes = []: list at least one"),
-        ("seeds = []", "jobs.toml:7: job 2 (natrix-natrix): seeds = []: list at least one"),
+        ("sizes = []", "jobs.toml:7: [[job]] 2 (natrix-natrix): sizes = []: list at least one"),
+        ("seeds = []", "jobs.toml:7: [[job]] 2 (natrix-natrix): seeds = []: list at least one"),
         // Refused when the job is planned (they said `error: a body atlas ...`, with no file,
         // line or job, and named a `--size` that a jobs file does not have).
         (
             "layout = \"body\"\nsizes = [5500]",
-            "jobs.toml:8: job 2 (natrix-natrix): a body atlas 5500 wide is 66000 tall (body.length widths), over \
+            "jobs.toml:8: [[job]] 2 (natrix-natrix): a body atlas 5500 wide is 66000 tall (body.length widths), over \
              the 65535 rows a map may have; use a smaller size",
         ),
     ] {
@@ -254,7 +254,11 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
         &[("SNAKESKIN_MEMORY_LIMIT_MIB", "300")],
     );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:7: job 2 (boa-constrictor): size 4096 needs about"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("jobs.toml:7: [[job]] 2 (boa-constrictor): size 4096 needs about"),
+        "{}",
+        stderr(&out)
+    );
     assert!(manifests(&empty).is_empty(), "a set was written before the job too large was found");
     // `--list` does not hold the jobs to this machine's memory: a login node lists a
     // cluster's jobs (the review found them refused there).
@@ -272,7 +276,7 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     std::fs::create_dir_all(&in_the_way).unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--concurrent", "1"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:2: job 1 (natrix-natrix): cannot write"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:2: [[job]] 1 (natrix-natrix): cannot write"), "{}", stderr(&out));
     assert!(stderr(&out).contains("a folder is in the way"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "the first job's set was written before the folder was found");
     let listed = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--list"]);
@@ -348,7 +352,7 @@ fn a_pack_job_can_ask_for_ambient_occlusion() {
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(
-        stderr(&out).contains("jobs.toml:5: job 1 (crotalus-atrox): ao: the occlusion channel of a pack"),
+        stderr(&out).contains("jobs.toml:5: [[job]] 1 (crotalus-atrox): ao: the occlusion channel of a pack"),
         "{}",
         stderr(&out)
     );
@@ -451,8 +455,8 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
         // Both jobs' `preset` lines: the second where the message starts, the first in it.
         let err = stderr(&out);
-        assert!(err.contains("jobs.toml:6: job 2 (snake): would write snake/tile-32-seed"), "{err}");
-        assert!(err.contains("which job 1 (line 2) writes with different output"), "{err}");
+        assert!(err.contains("jobs.toml:6: [[job]] 2 (snake): would write snake/tile-32-seed"), "{err}");
+        assert!(err.contains("which [[job]] 1 (line 2) writes with different output"), "{err}");
     }
     assert!(!empty.exists());
 
@@ -464,7 +468,7 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
         let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
         let expected =
-            format!("jobs.toml:3: job 1 ({name}): its sets would go in the folder {name}, a name the batch keeps");
+            format!("jobs.toml:3: [[job]] 1 ({name}): its sets would go in the folder {name}, a name the batch keeps");
         assert!(stderr(&out).contains(&expected), "{}", stderr(&out));
         assert!(!empty.exists());
     }
@@ -687,7 +691,7 @@ fn a_preset_edited_while_its_batch_runs_is_not_written_under_the_old_key() {
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let err = stderr(&out);
     assert!(
-        err.contains("jobs.toml:2: job 1 (") && err.contains("snake.toml, seed 2, size 32): the preset changed"),
+        err.contains("jobs.toml:2: [[job]] 1 (") && err.contains("snake.toml, seed 2, size 32): the preset changed"),
         "{err}"
     );
     snakeskin::export::verify_set(&out_dir.join("snake/tile-32-seed1-png/snake.material.json")).unwrap();
@@ -716,5 +720,8 @@ fn a_job_that_fails_while_it_runs_is_named() {
     );
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let err = stderr(&out);
-    assert!(err.contains("jobs.toml:2: job 1 (natrix-natrix, seed 5, size 32): ") && err.contains("injected"), "{err}");
+    assert!(
+        err.contains("jobs.toml:2: [[job]] 1 (natrix-natrix, seed 5, size 32): ") && err.contains("injected"),
+        "{err}"
+    );
 }

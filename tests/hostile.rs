@@ -945,7 +945,7 @@ fn the_largest_seed_is_the_largest_a_json_reader_keeps() {
     let jobs = dir.path().join("jobs.toml");
     std::fs::write(&jobs, format!("[[job]]\npreset = \"{PRESET}\"\nseeds = [1, {beyond}]\nsizes = [48]\n")).unwrap();
     let batch_out = dir.path().join("batch");
-    let err = refused(&["batch", jobs.to_str().unwrap(), "-o", batch_out.to_str().unwrap()], "jobs.toml:3: job 1");
+    let err = refused(&["batch", jobs.to_str().unwrap(), "-o", batch_out.to_str().unwrap()], "jobs.toml:3: [[job]] 1");
     assert!(err.contains("accepted seeds are 0 to 9007199254740991"), "{err}");
     assert!(!batch_out.exists(), "a refused jobs file wrote {}", batch_out.display());
     assert_eq!(std::fs::read(manifest_of(dir.path())).unwrap(), manifest_bytes, "a refused run touched the set");
@@ -986,7 +986,7 @@ fn a_set_key_nested_past_the_readers_limit_is_refused() {
     std::fs::write(&jobs, format!("[[job]]\npreset = \"{PRESET}\"\nset = {{ \"{}\" = 1 }}\n", dotted(50_000))).unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", o]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:3: job 1"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:3: [[job]] 1"), "{}", stderr(&out));
     assert!(stderr(&out).contains("keys nest at most 80 deep"), "{}", stderr(&out));
 }
 
@@ -1109,12 +1109,24 @@ fn ao_without_a_pack_is_refused_whatever_comes_with_it() {
         assert_eq!(out.status.code(), Some(2), "{with:?}: {}", stderr(&out));
         assert!(stderr(&out).contains("--ao"), "{with:?}: {}", stderr(&out));
         assert!(!set.exists(), "{with:?}: a set was written");
-        // Alone, the refusal says both ways on: a pack, or the map by name.
-        if with.is_empty() {
+        // Alone, the refusal says both ways on: a pack, or the map by name; with maps
+        // named, `ao` added to them (it was clap's bare "cannot be used with '--maps'").
+        if with.is_empty() || with[0] == "--maps" {
             assert!(stderr(&out).contains("add --pack ENGINE"), "{}", stderr(&out));
-            assert!(stderr(&out).contains("--maps all,ao"), "{}", stderr(&out));
+            let maps = if with.is_empty() { "--maps all,ao" } else { "--maps color,ao" };
+            assert!(stderr(&out).contains(maps), "{}", stderr(&out));
         }
     }
+    // The map named already: --ao is only dropped.
+    let out = snakeskin(&["generate", PRESET, "-o", set.to_str().unwrap(), "--ao", "--maps", "height,ao"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("drop --ao: --maps height,ao names the map already"), "{}", stderr(&out));
+    // With a pack as well, --pack's own conflict with --maps.
+    let args = ["generate", PRESET, "-o", set.to_str().unwrap(), "--ao", "--pack", "gltf", "--maps", "color"];
+    let out = snakeskin(&args);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("'--pack <ENGINE>' cannot be used with '--maps <LIST>'"), "{}", stderr(&out));
+    assert!(!set.exists(), "a set was written");
     // Negative control: with a pack it runs.
     let out = snakeskin(&["generate", PRESET, "--size", "16", "-o", set.to_str().unwrap(), "--ao", "--pack", "gltf"]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -1347,6 +1359,9 @@ fn preview_output_names_are_checked_before_the_work() {
         // A PNG under another format's name (it was written so, without a word).
         (vec!["--out", &at("render.jpg")], "give it a name ending in .png (it ends in .jpg)".into()),
         (vec!["--out", &same, "--reference", &at("heat.exr")], "(it ends in .exr)".into()),
+        // The extension alone: it was written as a hidden file named `.png`.
+        (vec!["--out", &at(".png")], "`.png` is an extension without a name".into()),
+        (vec!["--out", &same, "--reference", &at(".PNG")], "`.png` is an extension without a name".into()),
     ] {
         let out = preview(&extra);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
@@ -1354,8 +1369,8 @@ fn preview_output_names_are_checked_before_the_work() {
         assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "{extra:?}: something was written");
     }
     // Past the names, the (tiny) memory limit refuses it: nothing about the names (an
-    // upper-case extension and none at all are PNG names too).
-    for name in ["heat.png", "heat.PNG", "heat"] {
+    // upper-case extension, none at all and a hidden file's name are PNG names too).
+    for name in ["heat.png", "heat.PNG", "heat", ".heat.png"] {
         let out = preview(&["--out", &same, "--reference", &at(name)]);
         assert!(stderr(&out).contains("needs about"), "{name}: {}", stderr(&out));
     }
@@ -1372,6 +1387,11 @@ fn preview_output_names_are_checked_before_the_work() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
         let format = if args[0] == "bench" { "svg" } else { "png" };
         assert!(stderr(&out).contains(&format!("give it a name ending in .{format}")), "{args:?}: {}", stderr(&out));
+    }
+    for args in [vec!["gallery", "-o", &at(".png")], vec!["bench", "layered", "--plot", &at(".svg")]] {
+        let out = snakeskin(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("is an extension without a name"), "{args:?}: {}", stderr(&out));
     }
     assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was written");
 }
@@ -1578,7 +1598,7 @@ fn a_long_jobs_file_is_read_in_one_pass() {
         "a jobs file of 20,001 jobs took over 60 s to read",
     );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:40003: job 20001 (natrix-natrix): layout \"x\""), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:40003: [[job]] 20001 (natrix-natrix): layout \"x\""), "{}", stderr(&out));
 }
 
 /// A preset of many bad head marks (20,000: 720 KB, within the 1 MiB bound) is refused at

@@ -210,7 +210,7 @@ mod cli {
         let (code, _, err) =
             snakeskin(&["brdf", "film", "--thickness-nm", "10", "--wavelength-nm", "500", "--angle-deg", "95"], "");
         assert_eq!(code, 2);
-        assert!(err.contains("angle_deg") && err.contains("[0, 90]"), "{err}");
+        assert!(err.contains("--angle-deg") && err.contains("[0, 90]"), "{err}");
         let (code, _, err) = snakeskin(&["brdf", "film", "--batch", "-"], "{\"thickness_nm\":1}\n");
         assert_eq!(code, 2);
         assert!(err.contains("-:1") && err.contains("wavelength_nm"), "{err}");
@@ -254,6 +254,37 @@ mod cli {
         assert_eq!(out.lines().count(), 2, "{out}");
     }
 
+    /// A flag's value out of range is refused by the flag's name, as written on the command
+    /// line: `--thickness-nm nan` said "thickness_nm must be ...", the name of a batch line's
+    /// field (which a batch line still gets, above).
+    #[test]
+    fn a_flag_out_of_range_is_refused_by_the_flag_s_name() {
+        let film = ["brdf", "film", "--thickness-nm", "400", "--wavelength-nm", "550", "--angle-deg", "30"];
+        for (flag, value, range) in [
+            ("--thickness-nm", "nan", "[0, 10000000]"),
+            ("--wavelength-nm", "0.5", "[1, 1000000]"),
+            ("--angle-deg", "inf", "[0, 90]"),
+            ("--n1", "nan", "[1, 3]"),
+            ("--n0", "0.9", "[1, 3]"),
+        ] {
+            let mut args = film.to_vec();
+            match args.iter().position(|a| *a == flag) {
+                Some(i) => args[i + 1] = value,
+                None => args.extend([flag, value]),
+            }
+            let (code, _, err) = snakeskin(&args, "");
+            assert_eq!(code, 2, "{flag} {value}: {err}");
+            let upper = flag.trim_start_matches('-').replace('-', "_").to_uppercase();
+            let says = format!("invalid value '{value}' for '{flag} <{upper}>': must be a finite number in {range}");
+            assert!(err.contains(&says), "{flag} {value}: {err}");
+        }
+        let (code, _, err) = snakeskin(&["brdf", "color", "--thickness-nm", "-1", "--angle-deg", "0"], "");
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("for '--thickness-nm <THICKNESS_NM>'"), "{err}");
+        // Negative control: the same flags in range are answered.
+        assert_eq!(snakeskin(&[&film[..], &["--n0", "1", "--n1", "3"]].concat(), "").0, 0);
+    }
+
     /// Command-line values the sweep found misread: `-0` taken for a flag, `--seed -1`
     /// answered with clap's tip `-- -1` (which makes it the preset), `--photons` ignored
     /// without the stochastic model, a short direction called zero, and `presets show FILE`
@@ -263,9 +294,17 @@ mod cli {
         let film = ["brdf", "film", "--wavelength-nm", "550", "--thickness-nm", "-0"];
         let (code, _, err) = snakeskin(&[&film[..], &["--angle-deg", "-0"]].concat(), "");
         assert_eq!(code, 0, "{err}");
+        // ... and read as 0: an albedo of -0 answered `"diffuse":[-0.0,-0.0,-0.0]`.
+        let eval = ["brdf", "eval", "--wi", "0,0,1", "--wo", "0,0,1", "--absorption", "0"];
+        let (code, out, err) = snakeskin(&[&eval[..], &["--albedo", "-0"]].concat(), "");
+        assert_eq!(code, 0, "{err}");
+        assert!(out.contains("\"diffuse\":[0.0,0.0,0.0]"), "{out}");
         let (code, _, err) = snakeskin(&[&film[..], &["--angle-deg", "-30"]].concat(), "");
         assert_eq!(code, 2, "{err}");
-        assert!(err.contains("angle_deg must be in [0, 90], got -30"), "{err}");
+        assert!(
+            err.contains("invalid value '-30' for '--angle-deg <ANGLE_DEG>': must be a finite number in [0, 90]"),
+            "{err}"
+        );
         let (code, _, err) = snakeskin(&["graph", "natrix-natrix", "--seed", "-1"], "");
         assert_eq!(code, 2, "{err}");
         assert!(err.contains("invalid value '-1' for '--seed") && !err.contains("-- -1"), "{err}");

@@ -244,9 +244,14 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
 /// `check_target` for an output written in one format, `format` its extension (`png` for a
 /// render, a sheet, a gallery, a chart; `svg` for a plot): a name with another extension
 /// (`.jpg`, `.exr`) is refused (it was written in `format` under that name, without a
-/// word); one without an extension is taken as it is.
+/// word), and so is the extension alone (`.png`, a hidden file); one without an extension is
+/// taken as it is.
 pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), ExportError> {
     check_target(target)?;
+    let name = target.file_name().map(|n| n.to_string_lossy());
+    if name.is_some_and(|n| n.strip_prefix('.').is_some_and(|rest| rest.eq_ignore_ascii_case(format))) {
+        return Err(ExportError::OnlyAnExtension { path: target.into(), format });
+    }
     match target.extension().map(|e| e.to_string_lossy()) {
         Some(extension) if !extension.eq_ignore_ascii_case(format) => {
             Err(ExportError::NamedForAnotherFormat { path: target.into(), format, extension: extension.into_owned() })

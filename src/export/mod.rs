@@ -66,6 +66,10 @@ pub enum ExportError {
     /// written in its own format under that name, without a word.
     #[error("{path}: this output is a .{format} file; give it a name ending in .{format} (it ends in .{extension})")]
     NamedForAnotherFormat { path: PathBuf, format: &'static str, extension: String },
+    /// `-o .png`: Rust reads it as a hidden file named `.png` with no extension, and it was
+    /// written so, out of sight of `ls`.
+    #[error("{path}: `.{format}` is an extension without a name; give the file a name, e.g. snake.{format}")]
+    OnlyAnExtension { path: PathBuf, format: &'static str },
     #[error(
         "{path} is {kind}, not a regular file: snakeskin writes an output whole and renames it over the old one, \
          which would replace it; give the path of a regular file (or of none)"
@@ -105,6 +109,7 @@ impl ExportError {
                 | ExportError::FolderInTheWay { .. }
                 | ExportError::FolderName { .. }
                 | ExportError::NamedForAnotherFormat { .. }
+                | ExportError::OnlyAnExtension { .. }
                 | ExportError::OverwritesInput { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }

@@ -32,13 +32,15 @@ pub fn check(stack: Stack, thickness_nm: f64, angle_deg: f64, wavelength_nm: Opt
             shown(thickness_nm)
         )));
     }
-    if !(angle_deg.is_finite() && (0.0..=90.0).contains(&angle_deg)) {
-        return Err(Error::Query(format!("angle_deg must be in [0, 90], got {}", shown(angle_deg))));
+    let (lo, hi) = ranges::ANGLE_DEG;
+    if !(angle_deg.is_finite() && (lo..=hi).contains(&angle_deg)) {
+        return Err(Error::Query(format!("angle_deg must be in [{lo}, {hi}], got {}", shown(angle_deg))));
     }
+    let (lo, hi) = ranges::QUERY_WAVELENGTH_NM;
     if let Some(l) = wavelength_nm
-        && !(l.is_finite() && (1.0..=1.0e6).contains(&l))
+        && !(l.is_finite() && (lo..=hi).contains(&l))
     {
-        return Err(Error::Query(format!("wavelength_nm must be a finite number in [1, 1000000], got {}", shown(l))));
+        return Err(Error::Query(format!("wavelength_nm must be a finite number in [{lo}, {hi}], got {}", shown(l))));
     }
     Ok(())
 }

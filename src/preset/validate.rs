@@ -63,6 +63,11 @@ pub mod ranges {
     /// Up to 10 mm, the stress-test bound of PHYSICS.md.
     pub const FILM_THICKNESS_NM: (f64, f64) = (0.0, 1.0e7);
     pub const PIGMENT_THICKNESS: (f64, f64) = (0.0, 100.0);
+    /// Angles from the normal of `brdf` queries, degrees.
+    pub const ANGLE_DEG: (f64, f64) = (0.0, 90.0);
+    /// Vacuum wavelengths a `brdf film` query takes: 1 nm to 1 mm, far past the visible, so
+    /// the film can be checked at any wavelength a reference implementation uses.
+    pub const QUERY_WAVELENGTH_NM: (f64, f64) = (1.0, 1.0e6);
     pub const ABSORPTION: (f64, f64) = (0.0, 100.0);
     /// Pattern layers per preset: every built-in species needs at most 3; each layer adds
     /// a few full-size buffers and their time.

@@ -170,9 +170,19 @@ impl Cli {
             }
         }
         let mut matches = command.try_get_matches_from_mut(args)?;
+        // `--maps` as written, for the `--ao` hint below (read before `from_arg_matches_mut`
+        // takes the values out of `matches`).
+        let maps_written = matches
+            .subcommand_matches("generate")
+            .filter(|m| m.value_source("maps") == Some(clap::parser::ValueSource::CommandLine))
+            .and_then(|m| m.get_raw("maps"))
+            .and_then(|mut raw| raw.next())
+            .map(|written| written.to_string_lossy().trim().to_string());
         let cli = Cli::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut command))?;
         // `--ao` without `--pack`: clap's `requires` said only that `--pack <ENGINE>` was
-        // missing, where the user may have meant the map (`--help` says so).
+        // missing, and its conflict with `--maps` only that the two cannot be used together,
+        // where the user may have meant the map (`--help` says so): the hint adds `ao` to
+        // the maps they asked for.
         if let Command::Generate(generate) = &cli.command
             && generate.ao
             && generate.pack.is_none()
@@ -182,9 +192,15 @@ impl Cli {
                 .iter()
                 .filter_map(|engine| engine.to_possible_value().map(|v| v.get_name().to_string()))
                 .collect();
+            let maps = maps_written.unwrap_or_else(|| "all".into());
+            let instead = if generate.preset.maps.0.contains(&MapKind::Ao) {
+                format!("drop --ao: --maps {maps} names the map already")
+            } else {
+                format!("name the map instead: --maps {maps},ao")
+            };
             let message = format!(
                 "--ao puts ambient occlusion into a pack's occlusion channel: add --pack ENGINE ({}), or, without a \
-                 pack, name the map instead: --maps all,ao",
+                 pack, {instead}",
                 engines.join(", ")
             );
             let generate = command.find_subcommand_mut("generate").expect("the generate subcommand");
@@ -286,8 +302,9 @@ pub struct GenerateArgs {
     // The conflicts are --pack's own: clap's `requires = "pack"` was not checked when an
     // argument that conflicts with --pack came with it, so `--ao --format png` was silently
     // a set without occlusion. A missing --pack is refused after parsing, with a hint
-    // (`Cli::try_parse_checked_from`).
-    #[arg(long, conflicts_with_all = ["normal_convention", "format", "maps"])]
+    // (`Cli::try_parse_checked_from`); so is `--maps` without one, where the hint names the
+    // maps given with `ao` added (with --pack, --pack's own conflict refuses it).
+    #[arg(long, conflicts_with_all = ["normal_convention", "format"])]
     pub ao: bool,
     /// Print per-node evaluations, time and buffer size after the run.
     #[arg(long)]
@@ -532,13 +549,13 @@ fn parse_key_value(arg: &str) -> Result<(String, String), String> {
 #[derive(Debug, Args)]
 pub struct StackArgs {
     /// Refractive index of the ambient medium (thesis n0), 1 to 3.
-    #[arg(long, default_value_t = thesis::AMBIENT_IOR)]
+    #[arg(long, default_value_t = thesis::AMBIENT_IOR, value_parser = parse_ior)]
     pub n0: f64,
     /// Refractive index of the iridescent film (thesis n1), 1 to 3.
-    #[arg(long, default_value_t = thesis::FILM_IOR)]
+    #[arg(long, default_value_t = thesis::FILM_IOR, value_parser = parse_ior)]
     pub n1: f64,
     /// Refractive index of the pigment layer under the film (thesis n2), 1 to 3.
-    #[arg(long, default_value_t = thesis::PIGMENT_IOR)]
+    #[arg(long, default_value_t = thesis::PIGMENT_IOR, value_parser = parse_ior)]
     pub n2: f64,
 }
 
@@ -549,13 +566,13 @@ pub enum BrdfCommand {
         #[command(flatten)]
         stack: StackArgs,
         /// Film thickness in nm (thesis δ0), 0 to 10,000,000 (10 mm).
-        #[arg(long, required_unless_present = "batch")]
+        #[arg(long, required_unless_present = "batch", value_parser = parse_thickness_nm)]
         thickness_nm: Option<f64>,
         /// Vacuum wavelength in nm, 1 to 10^6.
-        #[arg(long, required_unless_present = "batch")]
+        #[arg(long, required_unless_present = "batch", value_parser = parse_wavelength_nm)]
         wavelength_nm: Option<f64>,
         /// Incidence angle in the ambient medium, degrees, 0 (normal) to 90.
-        #[arg(long, required_unless_present = "batch")]
+        #[arg(long, required_unless_present = "batch", value_parser = parse_angle_deg)]
         angle_deg: Option<f64>,
         /// Read JSON objects {n0, n1, n2, thickness_nm, wavelength_nm, angle_deg}, one per
         /// line, from FILE (or - for stdin); print one JSON line per query, in order, as each
@@ -570,10 +587,10 @@ pub enum BrdfCommand {
         #[command(flatten)]
         stack: StackArgs,
         /// Film thickness in nm (thesis δ0), 0 to 10,000,000 (10 mm).
-        #[arg(long, required_unless_present = "batch")]
+        #[arg(long, required_unless_present = "batch", value_parser = parse_thickness_nm)]
         thickness_nm: Option<f64>,
         /// Angle of light and view from the normal in the ambient medium, degrees, 0 to 90.
-        #[arg(long, required_unless_present = "batch")]
+        #[arg(long, required_unless_present = "batch", value_parser = parse_angle_deg)]
         angle_deg: Option<f64>,
         /// Colour method: spectral (the reference: the exact film summed at 1 nm over CIE
         /// 1931 2° under D65), rgb3, spectral-N (e.g. spectral-16), gaussian-fit, lut.
@@ -734,7 +751,7 @@ fn parse_albedo_model(text: &str) -> Result<AlbedoModel, String> {
 }
 
 fn parse_angle_deg(text: &str) -> Result<f64, String> {
-    bounded(text, (0.0, 90.0))
+    bounded(text, ranges::ANGLE_DEG)
 }
 
 #[derive(Debug, Subcommand)]
@@ -885,15 +902,25 @@ fn parse_gpu_method(text: &str) -> Result<GpuFilmMethod, String> {
 }
 
 /// A finite number inside `lo..=hi`, for the flags that take one.
+/// A finite number in [lo, hi]; `-0` is read as 0 (an answer computed from it printed `-0.0`).
 fn bounded(text: &str, (lo, hi): (f64, f64)) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && (lo..=hi).contains(&v) => Ok(v),
+        // Adding 0 turns -0 into +0 and leaves every other number as it is (IEEE 754).
+        Ok(v) if v.is_finite() && (lo..=hi).contains(&v) => Ok(v + 0.0),
         _ => Err(format!("must be a finite number in [{lo}, {hi}]")),
     }
 }
 
 fn parse_thickness_nm(text: &str) -> Result<f64, String> {
     bounded(text, ranges::FILM_THICKNESS_NM)
+}
+
+fn parse_ior(text: &str) -> Result<f64, String> {
+    bounded(text, ranges::IOR)
+}
+
+fn parse_wavelength_nm(text: &str) -> Result<f64, String> {
+    bounded(text, ranges::QUERY_WAVELENGTH_NM)
 }
 
 fn parse_unit(text: &str) -> Result<f64, String> {
