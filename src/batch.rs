@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::export::pack::Pack;
 use crate::export::{sha256_hex, verify_set_json, write_file_atomically};
-use crate::generate::{GenerateRequest, Plan, check_set_outputs, set_file_names};
+use crate::generate::{GenerateRequest, Plan, check_set_outputs, pack_size_warning, set_file_names};
 use crate::maps::{BuildOptions, Layout};
 use crate::material::{FileFormat, MapKind, parse_map_list};
 use crate::preset::validate::ranges::SEED_MAX;
@@ -508,7 +508,19 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
             source: Box::new(source),
         },
     })?;
-    let warnings = loaded.warnings(&job.preset);
+    let mut warnings = loaded.warnings(&job.preset);
+    // A pack longer than its engine loads, at the job's `sizes` line (`Pack::size_problem`).
+    if let Some(pack) = job.pack
+        && let Some(problem) = pack_size_warning(pack, job.layout, &loaded.preset, job.size as usize, "a size of")
+    {
+        let at = at_line(job.lines.sizes.or(job.lines.preset));
+        warnings.push(format!(
+            "warning: {}{at}: [[job]] {} ({}): {problem}",
+            jobs_file.display(),
+            job.table,
+            job.preset
+        ));
+    }
     let seed = loaded.preset.seed;
     let key = job.key(&loaded.content_hash, seed);
     let folder = job.folder(&loaded.name, seed);

@@ -10,12 +10,12 @@ use std::time::{Duration, Instant};
 use crate::export::pack::{Pack, TextureEncoder, TextureSpec, texture_file_name};
 use crate::export::{self, MapEntry, SetLock, sha256_hex};
 use crate::graph::{EvalStats, Graph, evaluate_into, evaluate_rows};
-use crate::maps::{BuildOptions, build_graph, has_film};
+use crate::maps::{BuildOptions, Layout, build_graph, has_film};
 use crate::material::{FileFormat, MapKind};
 use crate::memory::MemoryCheck;
 use crate::ops::Frame;
 use crate::ops::filters::NormalSpec;
-use crate::preset::{self, LoadedPreset};
+use crate::preset::{self, LoadedPreset, Preset};
 use crate::{Error, SIZE_RANGE};
 
 #[derive(Debug, Clone)]
@@ -127,6 +127,20 @@ pub fn check_set_outputs(out_dir: &Path, files: &[String], inputs: &export::Inpu
     Ok(())
 }
 
+/// `Pack::size_problem` for a set `size` wide in `layout`, with the largest size whose
+/// textures the engine loads (a body atlas's height is rounded, so it is searched for):
+/// "give {give} N or less". None when the textures fit, or without a pack.
+pub fn pack_size_warning(pack: Pack, layout: Layout, preset: &Preset, size: usize, give: &str) -> Option<String> {
+    let height = layout.height(preset, size);
+    let problem = pack.size_problem((size, height))?;
+    let (limit, _) = pack.longest_side_loaded();
+    // At most the width in proportion, from which the rounding moves it by a texel or so.
+    let start = (limit * size / height).saturating_add(1).min(size).min(limit);
+    let fitting = (1..=start).rev().find(|&width| width.max(layout.height(preset, width)) <= limit).unwrap_or(1);
+    let body = if height == size { "" } else { " (a body atlas is body.length widths tall)" };
+    Some(format!("{problem}: give {give} {fitting} or less{body}"))
+}
+
 impl Plan {
     /// The preset as loaded (overrides applied, colours clamped to what the stack shows).
     pub fn loaded(&self) -> &LoadedPreset {
@@ -202,6 +216,14 @@ impl Plan {
 
     pub fn memory(&self) -> MemoryCheck {
         self.memory
+    }
+
+    /// The pack's warning when its textures are longer than the engine loads
+    /// (`pack_size_warning`), "warning: " first; None when they fit, or without a pack.
+    pub fn size_warning(&self) -> Option<String> {
+        let (layout, preset) = (self.request.options.layout, &self.loaded.preset);
+        let give = size_option(&self.request);
+        pack_size_warning(self.request.pack?, layout, preset, self.size, give).map(|w| format!("warning: {w}"))
     }
 
     /// Width and height of the maps.

@@ -185,6 +185,7 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         encode_time,
         total_time: start.elapsed(),
         created_folder,
-        warnings: plan.loaded().warnings(&request.preset),
+        // The preset's, then the textures' size (`Pack::size_warning`).
+        warnings: plan.loaded().warnings(&request.preset).into_iter().chain(plan.size_warning()).collect(),
     })
 }

@@ -161,3 +161,53 @@ fn pack_refuses_options_that_contradict_it() {
     }
     assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "a refused run wrote files");
 }
+
+/// A pack longer than its engine loads is warned of, with the largest size that fits: a body
+/// atlas is `body.length` widths tall, so `--size 1024` made a 12288-row Unreal texture
+/// without a word (its documentation gives 8192). The size named is checked against the
+/// layout's own height, one texel either side.
+#[test]
+fn a_pack_longer_than_its_engine_loads_is_warned_of_with_a_size_that_fits() {
+    use snakeskin::export::pack::Pack;
+    use snakeskin::generate::pack_size_warning;
+    use snakeskin::maps::Layout;
+    let preset = snakeskin::preset::load("natrix-natrix", &[], None).unwrap().preset;
+    for pack in Pack::ALL {
+        let (limit, _) = pack.longest_side_loaded();
+        // Negative control: a tile at the limit and a body atlas just under it fit.
+        assert_eq!(pack_size_warning(pack, Layout::Tile, &preset, limit, "--size"), None, "{pack:?}");
+        let rows = |width: usize| Layout::Body.height(&preset, width);
+        let under = (1..=limit).rev().find(|&w| rows(w) <= limit).unwrap();
+        assert_eq!(pack_size_warning(pack, Layout::Body, &preset, under, "--size"), None, "{pack:?}");
+        // Past it, both ways.
+        let tile = pack_size_warning(pack, Layout::Tile, &preset, limit + 1, "--size").expect("a tile too wide");
+        assert!(tile.contains(&format!("are {} x {}", limit + 1, limit + 1)), "{tile}");
+        assert!(tile.ends_with(&format!("give --size {limit} or less")), "{tile}");
+        let body = pack_size_warning(pack, Layout::Body, &preset, under + 1, "--size").expect("a body atlas too tall");
+        assert!(
+            body.contains(&format!("{} x {}, longer than the {limit} texels", under + 1, rows(under + 1))),
+            "{body}"
+        );
+        assert!(body.contains(&format!("give --size {under} or less (a body atlas")), "{body}");
+        assert!(body.starts_with(&format!("the {} textures", pack.name())), "{body}");
+    }
+    // The commands print it: a body 40 widths long, 208 wide, is 8320 tall, past Unreal's
+    // 8192 (204 fits: 8160); `export`'s glTF at 410 wide, 16400, past 16384 (409 fits).
+    let dir = tempfile::tempdir().unwrap();
+    let long = ["--layout", "body", "--set", "body.length=40", "-o"];
+    for (size, warned) in [("208", true), ("204", false)] {
+        let out_dir = dir.path().join(size);
+        let args = [&["generate", "natrix-natrix", "--pack", "unreal", "--size", size][..], &long[..]].concat();
+        let out = snakeskin(&[&args[..], &[out_dir.to_str().unwrap()]].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+        let says = "the unreal textures are 208 x 8320, longer than the 8192 texels a side";
+        assert_eq!(stderr(&out).contains(says), warned, "{size}: {}", stderr(&out));
+        assert_eq!(stderr(&out).contains("give --size 204 or less (a body atlas"), warned, "{}", stderr(&out));
+    }
+    let glb = dir.path().join("long.glb");
+    let args = ["export", "natrix-natrix", "--layout", "body", "--set", "body.length=40", "--size", "410", "--gltf"];
+    let out = snakeskin(&[&args[..], &[glb.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the gltf textures are 410 x 16400"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("give --size 409 or less"), "{}", stderr(&out));
+}

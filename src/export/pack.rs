@@ -106,6 +106,39 @@ impl Pack {
         }
     }
 
+    /// The longest texture side the engine is documented to load, and where that is said: past
+    /// it an engine scales the texture down on import or refuses it, so a pack (or a glTF
+    /// file) with a longer side is warned of (`size_warning`). A body atlas is `body.length`
+    /// widths tall, so this is what it meets first.
+    pub fn longest_side_loaded(self) -> (usize, &'static str) {
+        match self {
+            // WebGL's MAX_TEXTURE_SIZE on desktop GPUs is commonly 16384 (many mobile GPUs
+            // stop at 4096 or 8192); glTF viewers in browsers are bound by it.
+            Pack::Gltf => (16384, "that browsers' WebGL commonly loads"),
+            // "Unreal Engine supports texture resolutions from 1x1 up to 8192x8192 with some
+            // slight modifications to .INI files." (Texture Format Support and Settings, UE
+            // 5.0: docs.unrealengine.com/5.0/en-US/texture-format-support-and-settings-in-unreal-engine/)
+            Pack::Unreal => (8192, "that Unreal Engine's documentation supports (with .ini changes)"),
+            // Unity's importing-textures manual: "Maximum 2D and Cubemap texture dimension
+            // size" 16384 for "DX11 Shader Model 5 / GL4" (docs.huihoo.com/unity/5.5/
+            // Documentation/Manual/ImportingTextures.html).
+            Pack::UnityHdrp => (16384, "that Unity's manual lists for DX11 / GL4 GPUs"),
+        }
+    }
+
+    /// What is wrong with a texture of `width` x `height` longer than the engine loads
+    /// (`longest_side_loaded`), in words without a remedy; None when it fits.
+    pub fn size_problem(self, (width, height): (usize, usize)) -> Option<String> {
+        let (limit, documented) = self.longest_side_loaded();
+        (width.max(height) > limit).then(|| {
+            format!(
+                "the {} textures are {width} x {height}, longer than the {limit} texels a side {documented}; a longer \
+                 texture is scaled down or refused",
+                self.name()
+            )
+        })
+    }
+
     /// The packed files, in order. `film`: whether the preset has a film (a thickness
     /// texture is written only then); `ao`: whether the occlusion channel holds the
     /// ambient occlusion map (`ops::occlusion`) or 1 everywhere.

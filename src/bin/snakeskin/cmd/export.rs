@@ -7,10 +7,6 @@ use crate::output::path_line;
 use crate::progress::Progress;
 use snakeskin::gltf_export::{ExportRequest, export};
 
-/// The largest texture side WebGL implementations commonly accept (MAX_TEXTURE_SIZE on
-/// desktop GPUs; many mobile GPUs stop at 4096 or 8192).
-const WEBGL_TEXTURE_LIMIT: usize = 16384;
-
 pub fn run(args: ExportArgs) -> Result<()> {
     let request = ExportRequest {
         preset: args.source.preset.clone(),
@@ -32,13 +28,6 @@ pub fn run(args: ExportArgs) -> Result<()> {
         && let Some(folder) = args.gltf.parent()
     {
         eprintln!("note: created folder {}", path_line(folder));
-    }
-    let (width, height) = report.dimensions;
-    if width.max(height) > WEBGL_TEXTURE_LIMIT {
-        eprintln!(
-            "warning: the textures are {width} x {height}; browsers' WebGL commonly loads at most {WEBGL_TEXTURE_LIMIT} \
-             texels a side (a body atlas is body.length widths tall: use a smaller --size for web viewers)"
-        );
     }
     for file in &report.files {
         println!("{}", path_line(file));

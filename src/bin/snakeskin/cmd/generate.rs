@@ -34,6 +34,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     };
     let plan = Plan::new(&request)?;
     crate::output::report_warnings(&source.preset, plan.loaded());
+    if let Some(warning) = plan.size_warning() {
+        eprintln!("{warning}");
+    }
     let memory = plan.memory();
     if memory.is_tight() {
         eprintln!(
