@@ -133,7 +133,10 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
     let mesh = mesh_for(request.mesh, request.layout, preset);
     // The files it will write, checked before the work (a folder or a link where one goes
     // was found only when they were written): the `.glb`, or the `.gltf` and its side files.
-    let side_files = if binary { Vec::new() } else { gltf_side_file_names(&name, film.is_some()) };
+    // A film of one thickness (no spread) needs no texture: glTF reads the thickness as
+    // the maximum then, which is the minimum (the validator's THICKNESS_TEXTURE_UNUSED).
+    let thickness_varies = film.is_some_and(|(_, min_nm, max_nm)| max_nm > min_nm);
+    let side_files = if binary { Vec::new() } else { gltf_side_file_names(&name, thickness_varies) };
     crate::export::check_folder(&dir)?;
     let input = crate::preset::input_file(&request.preset);
     crate::export::check_target(&request.out)?;
@@ -151,7 +154,7 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
         base_color: texture("basecolor").ok_or_else(|| missing("basecolor"))?,
         normal: texture("normal").ok_or_else(|| missing("normal"))?,
         orm: texture("orm").ok_or_else(|| missing("orm"))?,
-        thickness: texture("thickness"),
+        thickness: texture("thickness").filter(|_| thickness_varies),
         occlusion: request.ao,
     };
     let created_folder;

@@ -90,6 +90,10 @@ fn the_khronos_validator_finds_no_error_and_no_warning() {
     files.push((body, "lampropeltis-triangulum"));
     // A name with a space and a `#`: the file's URIs must be percent-encoded to name their files.
     files.push((export(&gltf_dir, "liasis-mackloti", "liasis #1.gltf", &["--mesh", "sphere"]), "liasis-mackloti"));
+    // A film of one thickness: its texture was embedded though unused (an info of the
+    // validator's, KHR_MATERIALS_IRIDESCENCE_THICKNESS_TEXTURE_UNUSED).
+    let one_thickness = ["--mesh", "plane", "--set", "iridescence.spread_nm=0"];
+    files.push((export(dir.path(), "xenopeltis-unicolor", "one-thickness.glb", &one_thickness), "xenopeltis-unicolor"));
 
     let paths: Vec<&Path> = files.iter().map(|(p, _)| p.as_path()).collect();
     let reports = node("validate.mjs", &paths);
@@ -101,6 +105,8 @@ fn the_khronos_validator_finds_no_error_and_no_warning() {
         );
         assert_eq!(report["errors"], 0, "{report:#}");
         assert_eq!(report["warnings"], 0, "{report:#}");
+        let messages = report["messages"].as_array().unwrap();
+        assert!(!messages.iter().any(|m| m.as_str().unwrap().contains("_UNUSED")), "{report:#}");
         // The iridescence extension is declared exactly where the preset has a film.
         let declared = report["extensions"].as_array().unwrap().iter().any(|e| e == "KHR_materials_iridescence");
         // From the presets' own words (a film of 380–420 nm in the iridescent species, 0 nm
@@ -143,6 +149,31 @@ const FILM_VISIBLE_DELTA_E00: f64 = 3.0;
 /// A `.gltf` exported into a texture set's folder under the set's own name writes its
 /// images beside the set's maps without overwriting one (the set still verifies), and a
 /// later export without a film leaves no thickness image of the earlier one.
+/// A film of one thickness (`iridescence.spread_nm = 0`) is written as glTF reads it without
+/// a texture: minimum = maximum, no thickness texture or image (glTF then takes the maximum).
+/// Its thickness map is one constant node, not the gradient and noise that moved nothing.
+/// Negative control: the same preset with its spread has the texture and its image.
+#[test]
+fn a_film_of_one_thickness_is_written_without_a_thickness_texture() {
+    let dir = tempfile::tempdir().unwrap();
+    for (spread, texture) in [("0", false), ("260", true)] {
+        let name = format!("spread{spread}.gltf");
+        let set = ["--mesh", "plane", "--set", &format!("iridescence.spread_nm={spread}")];
+        let gltf = export(dir.path(), "xenopeltis-unicolor", &name, &set);
+        let json: Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+        let film = &json["materials"][0]["extensions"]["KHR_materials_iridescence"];
+        let (min, max) = (film["iridescenceThicknessMinimum"].as_f64(), film["iridescenceThicknessMaximum"].as_f64());
+        assert_eq!(min == max, !texture, "{spread}: {film}");
+        assert_eq!(film.get("iridescenceThicknessTexture").is_some(), texture, "{spread}: {film}");
+        assert_eq!(json["images"].as_array().unwrap().len(), if texture { 4 } else { 3 }, "{spread}");
+        assert_eq!(dir.path().join(format!("spread{spread}.thickness.png")).is_file(), texture, "{spread}");
+        let overrides = [("iridescence.spread_nm".to_string(), spread.to_string())];
+        let preset = snakeskin::preset::load("xenopeltis-unicolor", &overrides, None).unwrap().preset;
+        let graph = snakeskin::maps::build_graph(&preset, Default::default());
+        assert_eq!(graph.constant_output(snakeskin::material::MapKind::Iridescence).is_some(), !texture, "{spread}");
+    }
+}
+
 #[test]
 fn a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole() {
     let dir = tempfile::tempdir().unwrap();
