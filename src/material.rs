@@ -162,10 +162,13 @@ impl fmt::Display for MapKind {
 impl FromStr for MapKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        MapKind::EVERY
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown map {s:?}; accepted: color, height, normal, roughness, iridescence, ao"))
+        MapKind::EVERY.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            // `colour`, as the documentation's prose spells it, is one letter from the name.
+            let names = MapKind::EVERY.map(MapKind::name);
+            let near = crate::toml_text::nearest(&s.to_ascii_lowercase(), names);
+            let suggestion = near.map(|n| format!("did you mean {n}? ")).unwrap_or_default();
+            format!("unknown map {s:?}; {suggestion}accepted: color, height, normal, roughness, iridescence, ao")
+        })
     }
 }
 

@@ -150,6 +150,19 @@ fn a_stripe_placed_twice_is_refused() {
     }
 }
 
+/// A ring `size` beside `colors` is refused: the sequence's widths replace it (it gave the
+/// same bytes as without it). Negative controls: either alone is accepted.
+#[test]
+fn a_ring_size_beside_its_colours_is_refused() {
+    let layer = |extra: &str| format!("[[pattern]]\nkind = \"rings\"\ncolor = \"#101010\"\n{extra}\n");
+    let err = refused("rings.toml", &layer("colors = [\"#101010\", \"#e0c020\"]\nsize = 0.3"), &[]);
+    assert!(err.contains("rings.toml:5: key `pattern.0.size` is replaced by this layer's `colors`"), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    for extra in ["colors = [\"#101010\", \"#e0c020\"]", "size = 0.3"] {
+        accepted(&write_preset(dir.path(), "once.toml", &layer(extra)), &[]);
+    }
+}
+
 /// One bad value is one problem: a row count out of its range was reported, and then the
 /// keys it bounds as well, against a range made from it (`belly.up_rows` "must be an
 /// integer in [0, 0]", a key the user had not touched); a body fraction out of its range
@@ -527,6 +540,49 @@ fn unwritable_output_leaves_no_partial_files() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("blocked exists and is not a folder"), "{}", stderr(&out));
     assert_eq!(snapshot(dir.path()).len(), 1);
+}
+
+/// A name one `.toml` away from what is there gets the fix: `my-snake` beside my-snake.toml
+/// (as `presets show NAME > my-snake.toml` writes it) listed the built-ins only, and a
+/// missing `natrix-natrix.toml` said only "No such file or directory". Negative controls:
+/// no such file beside the name, and a missing file named after no built-in, get neither.
+#[test]
+fn a_name_one_toml_away_from_a_preset_gets_the_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("my-snake.toml"), "seed = 1\n").unwrap();
+    let run = |name: &str| {
+        let args = ["generate", name, "-o", "out", "--size", "16"];
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
+        stderr(&out)
+    };
+    let err = run("my-snake");
+    assert!(err.contains("unknown preset \"my-snake\": not a .toml file and not a built-in preset; to read the file my-snake.toml, give its name with .toml"), "{err}");
+    assert!(!run("your-snake").contains("give its name with .toml"));
+    let err = run("natrix-natrix.toml");
+    assert!(err.contains("cannot read preset natrix-natrix.toml: No such file or directory (os error 2); to use the built-in preset natrix-natrix, give its name without a path or .toml"), "{err}");
+    assert!(!run("natrix-natrixx.toml").contains("built-in preset"));
+    assert!(!dir.path().join("out").exists(), "a folder was made");
+}
+
+/// A map name mistyped gets a suggestion: `colour` (the documentation's prose spelling)
+/// listed the accepted names only. Negative control: a name near none of them.
+#[test]
+fn a_mistyped_map_name_gets_a_suggestion() {
+    for (maps, says) in [
+        ("colour", "unknown map \"colour\"; did you mean color? accepted: color, height"),
+        ("height,Normal", "unknown map \"Normal\"; did you mean normal? accepted:"),
+        ("iridesence", "did you mean iridescence?"),
+        ("sheen", "unknown map \"sheen\"; accepted:"),
+    ] {
+        let out = snakeskin(&["graph", "natrix-natrix", "--maps", maps]);
+        assert_eq!(out.status.code(), Some(2), "{maps}");
+        assert!(stderr(&out).contains(says), "{maps}: {}", stderr(&out));
+    }
 }
 
 /// A built-in name mistyped gets a suggestion: `natrix_natrix`, `Natrix-Natrix` and the

@@ -1873,4 +1873,15 @@ fn type_errors_name_the_range_and_missing_kinds_the_choices() {
     assert!(e.contains("key `seed`: must be an integer in [0, 9007199254740991], got -3"), "{e}");
     let e = run("[[pattern]]\ncolor = \"#101010\"\n", &[]);
     assert!(e.contains("missing field `kind`: every layer needs its kind, one of solid, stripes, rings"), "{e}");
+    // A layer made by --set, with the --set that adds what it lacks (it said only "missing
+    // field `color`").
+    let e = run("seed = 1\n", &["pattern.0.kind=spots"]);
+    let says = "invalid --set \"pattern.0.kind=spots\": missing field `color`: give its colour as \"#rrggbb\" \
+                (add --set 'pattern.0.color=\"#rrggbb\"')";
+    assert!(e.contains(says), "{e}");
+    let e = run("seed = 1\n", &["pattern.0.color=\"#101010\""]);
+    assert!(
+        e.contains("every layer needs its kind, one of solid, stripes") && e.contains("(add --set pattern.0.kind=...)"),
+        "{e}"
+    );
 }

@@ -6,8 +6,9 @@ use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
-    #[error("cannot read preset {path}: {source}")]
-    Read { path: PathBuf, source: std::io::Error },
+    /// `hint`: empty, or "; ..." naming the built-in preset a missing file's name is close to.
+    #[error("cannot read preset {path}: {source}{hint}")]
+    Read { path: PathBuf, source: std::io::Error, hint: String },
 
     #[error("cannot read preset {path}: it is {kind}; a preset must be a regular file")]
     NotAFile { path: PathBuf, kind: &'static str },

@@ -102,11 +102,17 @@ pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
         Some(text) => {
             Ok(PresetSource { name: spec.into(), display: format!("built-in preset {spec}"), text: text.into() })
         }
-        None => Err(PresetError::UnknownPreset {
-            name: spec.into(),
-            suggestion: library::suggest(spec).map(|n| format!("; did you mean {n}?")).unwrap_or_default(),
-            available: library::names().join(", "),
-        }),
+        None => {
+            // `my-snake` beside my-snake.toml (as `presets show NAME > my-snake.toml` writes
+            // it): a file is read only by a name that says so.
+            let file = format!("{spec}.toml");
+            let suggestion = if !spec.is_empty() && Path::new(&file).is_file() {
+                format!("; to read the file {file}, give its name with .toml")
+            } else {
+                library::suggest(spec).map(|n| format!("; did you mean {n}?")).unwrap_or_default()
+            };
+            Err(PresetError::UnknownPreset { name: spec.into(), suggestion, available: library::names().join(", ") })
+        }
     }
 }
 
@@ -116,7 +122,17 @@ pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
 fn read_bounded(path: &Path) -> Result<String, PresetError> {
     use crate::text_file::{BoundedReadError, read_bounded};
     read_bounded(path, MAX_PRESET_BYTES).map_err(|e| match e {
-        BoundedReadError::Io(source) => PresetError::Read { path: path.into(), source },
+        BoundedReadError::Io(source) => {
+            // `natrix-natrix.toml` where no such file is: the built-in preset was likely meant
+            // (a built-in's name is written without `.toml`).
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            let hint = if source.kind() == std::io::ErrorKind::NotFound && library::get(&stem).is_some() {
+                format!("; to use the built-in preset {stem}, give its name without a path or .toml")
+            } else {
+                String::new()
+            };
+            PresetError::Read { path: path.into(), source, hint }
+        }
         BoundedReadError::NotAFile(kind) => PresetError::NotAFile { path: path.into(), kind },
         BoundedReadError::TooLarge(bytes) => {
             PresetError::TooLarge { path: path.into(), bytes, limit: MAX_PRESET_BYTES }
@@ -182,6 +198,8 @@ pub fn parse_with_seed(
                 [(key, _)] => in_key_range(key, &message, true).unwrap_or(message),
                 _ => message,
             };
+            let hint = named.iter().find_map(|(key, _)| override_required_key_hint(key, &message));
+            let message = format!("{message}{}", hint.unwrap_or_default());
             PresetError::Override {
                 argument: named.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" "),
                 message,
@@ -332,6 +350,21 @@ fn required_key_hint(key: &str, message: &str) -> Option<String> {
         (_, "color") => ": give its colour as \"#rrggbb\"".into(),
         _ => return None,
     })
+}
+
+/// `required_key_hint` for a table an override made, with the `--set` that adds the key:
+/// `--set pattern.0.kind=spots` on a preset without layers said only "missing field
+/// `color`".
+fn override_required_key_hint(key: &str, message: &str) -> Option<String> {
+    let segments: Vec<&str> = key.split('.').collect();
+    let index = segments.iter().position(|s| s.parse::<usize>().is_ok())?;
+    let table = segments[..=index].join(".");
+    let hint = required_key_hint(&table, message)?;
+    let add = match message.strip_prefix("missing field `")?.strip_suffix('`')? {
+        "color" => format!("'{table}.color=\"#rrggbb\"'"),
+        field => format!("{table}.{field}=..."),
+    };
+    Some(format!("{hint} (add --set {add})"))
 }
 
 /// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).

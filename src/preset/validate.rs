@@ -371,6 +371,16 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                 }
             }
         }
+        // A ring sequence's widths are its colours' (`widths`, or equal parts), so a ring
+        // `size` beside `colors` was silently ignored (the same bytes as without it).
+        if p.kind == PatternKind::Rings && !p.colors.is_empty() && p.size != PatternLayer::default_size() {
+            c.problems.push(Problem {
+                key: key("size"),
+                message: "is replaced by this layer's `colors`, whose rings take the repeat in `widths` (or in \
+                          equal parts); give one of the two"
+                    .into(),
+            });
+        }
         // Keys some kinds read, set away from their defaults on a kind that ignores them
         // (`colors` on spots, `phase` on stripes, `size` on solid, `center_size` on stripes
         // were silently dropped; `shape`, `count` and `rows` were refused already). A
