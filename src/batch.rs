@@ -483,31 +483,35 @@ struct Resolved {
 
 /// `check`: whether to look for its finished set (reading and hashing its files).
 fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resolved, Error> {
-    let loaded = crate::preset::load(&job.preset, &job.overrides, job.seed).map_err(|source| match source {
-        // The preset's message says `--set`, which a jobs file's reader did not write.
-        crate::preset::PresetError::Override { argument, message } => BatchError::Set {
-            path: jobs_file.into(),
-            line: job.lines.set,
-            job: job.table,
-            preset: job.preset.clone(),
-            entries: argument,
-            message,
-        },
-        crate::preset::PresetError::Invalid { file, problems } if !job.overrides.is_empty() => BatchError::Invalid {
-            path: jobs_file.into(),
-            line: job.lines.set,
-            job: job.table,
-            preset: job.preset.clone(),
-            message: crate::preset::describe_problems(&file, &problems, "its `set` table"),
-        },
-        source => BatchError::Preset {
-            path: jobs_file.into(),
-            line: job.lines.preset,
-            job: job.table,
-            preset: job.preset.clone(),
-            source: Box::new(source),
-        },
-    })?;
+    let folder = jobs_file.parent().unwrap_or(Path::new(""));
+    let loaded =
+        crate::preset::load_beside(&job.preset, folder, &job.overrides, job.seed).map_err(|source| match source {
+            // The preset's message says `--set`, which a jobs file's reader did not write.
+            crate::preset::PresetError::Override { argument, message } => BatchError::Set {
+                path: jobs_file.into(),
+                line: job.lines.set,
+                job: job.table,
+                preset: job.preset.clone(),
+                entries: argument,
+                message,
+            },
+            crate::preset::PresetError::Invalid { file, problems } if !job.overrides.is_empty() => {
+                BatchError::Invalid {
+                    path: jobs_file.into(),
+                    line: job.lines.set,
+                    job: job.table,
+                    preset: job.preset.clone(),
+                    message: crate::preset::describe_problems(&file, &problems, "its `set` table"),
+                }
+            }
+            source => BatchError::Preset {
+                path: jobs_file.into(),
+                line: job.lines.preset,
+                job: job.table,
+                preset: job.preset.clone(),
+                source: Box::new(source),
+            },
+        })?;
     let mut warnings = loaded.warnings(&job.preset);
     // A pack longer than its engine loads, at the job's `sizes` line (`Pack::size_problem`).
     if let Some(pack) = job.pack
@@ -937,7 +941,7 @@ mod tests {
         let e = jobs("[[job]]\npreset = \"natrix-natrix\"\nsize = [64]\n").unwrap_err().to_string();
         assert!(e.contains(":3:") && e.contains("size"), "{e}");
         let e = jobs("[[job]]\npreset = \"natrix-natrix\"\nsizes = [8]\n").unwrap_err().to_string();
-        assert!(e.contains("jobs.toml:3: job 1") && e.contains("size 8"), "{e}");
+        assert!(e.contains("jobs.toml:3: [[job]] 1") && e.contains("size 8"), "{e}");
         let e = jobs("[[job]]\npreset = \"a\"\npack = \"godot\"\n").unwrap_err().to_string();
         assert!(e.contains("unreal"), "{e}");
         let e = jobs("[[job]]\npreset = \"a\"\npack = \"unreal\"\nformat = \"exr\"\n").unwrap_err().to_string();

@@ -164,8 +164,9 @@ impl FromStr for MapKind {
     fn from_str(s: &str) -> Result<Self, String> {
         MapKind::EVERY.into_iter().find(|m| m.name() == s).ok_or_else(|| {
             // `colour`, as the documentation's prose spells it, is one letter from the name.
+            // (Not for a name of one or two letters: any is within two edits of `ao`.)
             let names = MapKind::EVERY.map(MapKind::name);
-            let near = crate::toml_text::nearest(&s.to_ascii_lowercase(), names);
+            let near = (s.len() > 2).then(|| crate::toml_text::nearest(&s.to_ascii_lowercase(), names)).flatten();
             let suggestion = near.map(|n| format!("did you mean {n}? ")).unwrap_or_default();
             format!("unknown map {s:?}; {suggestion}accepted: color, height, normal, roughness, iridescence, ao")
         })
@@ -187,6 +188,9 @@ pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
     }
     let mut out = Vec::new();
     for item in list.split(',').map(str::trim) {
+        if item.is_empty() {
+            return Err(format!("an empty name in {list:?}; name the maps, one comma between two"));
+        }
         let maps = if item == "all" { MapKind::ALL.to_vec() } else { vec![item.parse()?] };
         for map in maps {
             if !out.contains(&map) {

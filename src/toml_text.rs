@@ -14,7 +14,7 @@ pub struct Described {
     /// 1-based line and column where the error's span starts, when it has one.
     pub line_column: Option<(usize, usize)>,
     /// The dotted key (`scales.rows`, `job.0.sizes`) of a value of the wrong type or
-    /// variant, for the caller to name as its readers count (a jobs file says "job 1").
+    /// variant, for the caller to name as its readers count (a jobs file says "[[job]] 1").
     pub key: Option<String>,
     pub message: String,
 }

@@ -213,6 +213,29 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     // ... and the message names the jobs file, the line of the job's preset and the job.
     assert!(stderr(&out).contains("jobs.toml:6: [[job]] 2 (no-such-snake): unknown preset"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "a set was written before the bad job was found");
+    // A name one `.toml` from a file beside the jobs file (not in the working folder) is
+    // told so; the file's name then runs.
+    std::fs::write(dir.path().join("my-snake.toml"), "seed = 1\n").unwrap();
+    std::fs::write(&jobs, "[[job]]\npreset = \"my-snake\"\nsizes = [16]\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("to read the file my-snake.toml, give its name with .toml"), "{}", stderr(&out));
+    std::fs::write(&jobs, "[[job]]\npreset = \"my-snake.toml\"\nsizes = [16]\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    std::fs::remove_dir_all(&empty).unwrap();
+    // A pack longer than its engine loads is warned of at the job's `sizes` line (208 x 8320
+    // past Unreal's 8192: `Pack::size_problem`), and the set is still made.
+    let long = "[[job]]\npreset = \"natrix-natrix\"\npack = \"unreal\"\nlayout = \"body\"\n\
+                set = { \"body.length\" = 40 }\nsizes = [208]\n";
+    std::fs::write(&jobs, long).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let says = "jobs.toml:6: [[job]] 1 (natrix-natrix): the unreal textures are 208 x 8320, longer than the 8192 \
+                texels a side";
+    assert!(stderr(&out).starts_with("warning: ") && stderr(&out).contains(says), "{}", stderr(&out));
+    assert!(stderr(&out).contains("give a size of 204 or less"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&empty).unwrap();
 
     // A bad override names its job and the line of its `set` too (they had no line); an
     // empty list of seeds or sizes is refused, not read as the default, at its line.

@@ -1360,8 +1360,9 @@ fn preview_output_names_are_checked_before_the_work() {
         (vec!["--out", &at("render.jpg")], "give it a name ending in .png (it ends in .jpg)".into()),
         (vec!["--out", &same, "--reference", &at("heat.exr")], "(it ends in .exr)".into()),
         // The extension alone: it was written as a hidden file named `.png`.
-        (vec!["--out", &at(".png")], "`.png` is an extension without a name".into()),
-        (vec!["--out", &same, "--reference", &at(".PNG")], "`.png` is an extension without a name".into()),
+        (vec!["--out", &at(".png")], "the file's name is only an extension; give it a name, e.g. snake.png".into()),
+        (vec!["--out", &same, "--reference", &at(".PNG")], "the file's name is only an extension".into()),
+        (vec!["--out", &at(".jpg")], "the file's name is only an extension".into()),
     ] {
         let out = preview(&extra);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
@@ -1391,7 +1392,7 @@ fn preview_output_names_are_checked_before_the_work() {
     for args in [vec!["gallery", "-o", &at(".png")], vec!["bench", "layered", "--plot", &at(".svg")]] {
         let out = snakeskin(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains("is an extension without a name"), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("the file's name is only an extension"), "{args:?}: {}", stderr(&out));
     }
     assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was written");
 }
@@ -1877,11 +1878,11 @@ fn type_errors_name_the_range_and_missing_kinds_the_choices() {
     // field `color`").
     let e = run("seed = 1\n", &["pattern.0.kind=spots"]);
     let says = "invalid --set \"pattern.0.kind=spots\": missing field `color`: give its colour as \"#rrggbb\" \
-                (add --set 'pattern.0.color=\"#rrggbb\"')";
+                (set pattern.0.color = \"#rrggbb\" as well)";
     assert!(e.contains(says), "{e}");
     let e = run("seed = 1\n", &["pattern.0.color=\"#101010\""]);
     assert!(
-        e.contains("every layer needs its kind, one of solid, stripes") && e.contains("(add --set pattern.0.kind=...)"),
+        e.contains("every layer needs its kind, one of solid, stripes") && e.contains("(set pattern.0.kind as well)"),
         "{e}"
     );
 }

@@ -248,8 +248,13 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
 /// taken as it is.
 pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), ExportError> {
     check_target(target)?;
+    // `.png`, and another image format's extension alone (`.jpg`: no extension to compare,
+    // so it was written as a hidden PNG).
+    const IMAGE_EXTENSIONS: [&str; 11] =
+        ["png", "jpg", "jpeg", "exr", "webp", "tif", "tiff", "svg", "gif", "bmp", "tga"];
     let name = target.file_name().map(|n| n.to_string_lossy());
-    if name.is_some_and(|n| n.strip_prefix('.').is_some_and(|rest| rest.eq_ignore_ascii_case(format))) {
+    let only_an_extension = |rest: &str| rest.eq_ignore_ascii_case(format) || IMAGE_EXTENSIONS.contains(&rest);
+    if name.is_some_and(|n| n.strip_prefix('.').is_some_and(|rest| only_an_extension(&rest.to_ascii_lowercase()))) {
         return Err(ExportError::OnlyAnExtension { path: target.into(), format });
     }
     match target.extension().map(|e| e.to_string_lossy()) {

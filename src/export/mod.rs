@@ -68,7 +68,7 @@ pub enum ExportError {
     NamedForAnotherFormat { path: PathBuf, format: &'static str, extension: String },
     /// `-o .png`: Rust reads it as a hidden file named `.png` with no extension, and it was
     /// written so, out of sight of `ls`.
-    #[error("{path}: `.{format}` is an extension without a name; give the file a name, e.g. snake.{format}")]
+    #[error("{path}: the file's name is only an extension; give it a name, e.g. snake.{format}")]
     OnlyAnExtension { path: PathBuf, format: &'static str },
     #[error(
         "{path} is {kind}, not a regular file: snakeskin writes an output whole and renames it over the old one, \

@@ -117,11 +117,13 @@ impl Pack {
             Pack::Gltf => (16384, "that browsers' WebGL commonly loads"),
             // "Unreal Engine supports texture resolutions from 1x1 up to 8192x8192 with some
             // slight modifications to .INI files." (Texture Format Support and Settings, UE
-            // 5.0: docs.unrealengine.com/5.0/en-US/texture-format-support-and-settings-in-unreal-engine/)
+            // 5.0: docs.unrealengine.com/5.0/en-US/texture-format-support-and-settings-in-unreal-engine/;
+            // the page's text is UE4's, and later versions may import more: a warning, not
+            // a refusal.)
             Pack::Unreal => (8192, "that Unreal Engine's documentation supports (with .ini changes)"),
             // Unity's importing-textures manual: "Maximum 2D and Cubemap texture dimension
-            // size" 16384 for "DX11 Shader Model 5 / GL4" (docs.huihoo.com/unity/5.5/
-            // Documentation/Manual/ImportingTextures.html).
+            // size" 16384 for "DX11 Shader Model 5 / GL4 (PC GPUs since 2008)"
+            // (docs.unity3d.com/2018.1/Documentation/Manual/ImportingTextures.html).
             Pack::UnityHdrp => (16384, "that Unity's manual lists for DX11 / GL4 GPUs"),
         }
     }
@@ -133,7 +135,7 @@ impl Pack {
         (width.max(height) > limit).then(|| {
             format!(
                 "the {} textures are {width} x {height}, longer than the {limit} texels a side {documented}; a longer \
-                 texture is scaled down or refused",
+                 texture may be scaled down or refused",
                 self.name()
             )
         })

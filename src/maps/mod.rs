@@ -351,12 +351,11 @@ fn build_roughness(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId 
 }
 
 fn build_iridescence(g: &mut GraphBuilder, preset: &Preset, s: &Shared, cols: u32) -> NodeId {
-    if !has_film(preset) || preset.iridescence.spread_nm == 0.0 {
-        // No film shows (`has_film`), or it has one thickness (no spread: the range is one
-        // value, min + t · 0): any map value means the same, so the map is a constant 0 and
-        // none of the gradient and noise nodes below is built or evaluated. (With no spread
-        // the map held the gradient and noise though they moved no thickness, and a glTF
-        // carried it as a texture its viewer could not use.)
+    if !has_film(preset) {
+        // No film shows (`has_film`): any thickness means the same, so the map is a
+        // constant 0 and none of the gradient and noise nodes below is built or evaluated.
+        // A film of one thickness (no spread) keeps them: its map reads as that thickness
+        // everywhere, and the window's spread slider spreads it along the same gradient.
         return g.add("iridescence.out", Op::Constant { value: 0.0 }, &[]);
     }
     let p = &preset.iridescence;

@@ -82,6 +82,12 @@ pub fn input_file(spec: &str) -> Option<&Path> {
 
 /// Resolves a PRESET argument: a file (`names_a_file`), or else a built-in preset name.
 pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
+    read_source_beside(spec, Path::new(""))
+}
+
+/// `read_source` for a name written in a file in `folder` (a jobs file's entries, resolved
+/// against its folder): an unknown name's `NAME.toml` is looked for there.
+pub fn read_source_beside(spec: &str, folder: &Path) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
     if names_a_file(spec, path) {
         // A newline or an escape in the name would go into the set's file names and break
@@ -106,7 +112,7 @@ pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
             // `my-snake` beside my-snake.toml (as `presets show NAME > my-snake.toml` writes
             // it): a file is read only by a name that says so.
             let file = format!("{spec}.toml");
-            let suggestion = if !spec.is_empty() && Path::new(&file).is_file() {
+            let suggestion = if !spec.is_empty() && folder.join(&file).is_file() {
                 format!("; to read the file {file}, give its name with .toml")
             } else {
                 library::suggest(spec).map(|n| format!("; did you mean {n}?")).unwrap_or_default()
@@ -144,6 +150,16 @@ fn read_bounded(path: &Path) -> Result<String, PresetError> {
 /// seed: read, parse, validate.
 pub fn load(spec: &str, overrides: &[(String, String)], seed: Option<u64>) -> Result<LoadedPreset, PresetError> {
     parse_with_seed(&read_source(spec)?, overrides, seed)
+}
+
+/// `load` of a name written in a file in `folder` (`read_source_beside`).
+pub fn load_beside(
+    spec: &str,
+    folder: &Path,
+    overrides: &[(String, String)],
+    seed: Option<u64>,
+) -> Result<LoadedPreset, PresetError> {
+    parse_with_seed(&read_source_beside(spec, folder)?, overrides, seed)
 }
 
 /// Parses and validates; `overrides` are `(dotted.key, toml value text)` pairs.
@@ -352,7 +368,7 @@ fn required_key_hint(key: &str, message: &str) -> Option<String> {
     })
 }
 
-/// `required_key_hint` for a table an override made, with the `--set` that adds the key:
+/// `required_key_hint` for a table an override made, with the key to add:
 /// `--set pattern.0.kind=spots` on a preset without layers said only "missing field
 /// `color`".
 fn override_required_key_hint(key: &str, message: &str) -> Option<String> {
@@ -360,11 +376,12 @@ fn override_required_key_hint(key: &str, message: &str) -> Option<String> {
     let index = segments.iter().position(|s| s.parse::<usize>().is_ok())?;
     let table = segments[..=index].join(".");
     let hint = required_key_hint(&table, message)?;
+    // Worded for `--set` and a jobs file's `set` table alike (both write dotted keys).
     let add = match message.strip_prefix("missing field `")?.strip_suffix('`')? {
-        "color" => format!("'{table}.color=\"#rrggbb\"'"),
-        field => format!("{table}.{field}=..."),
+        "color" => format!("{table}.color = \"#rrggbb\""),
+        field => format!("{table}.{field}"),
     };
-    Some(format!("{hint} (add --set {add})"))
+    Some(format!("{hint} (set {add} as well)"))
 }
 
 /// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).

@@ -376,9 +376,11 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
         if p.kind == PatternKind::Rings && !p.colors.is_empty() && p.size != PatternLayer::default_size() {
             c.problems.push(Problem {
                 key: key("size"),
-                message: "is replaced by this layer's `colors`, whose rings take the repeat in `widths` (or in \
-                          equal parts); give one of the two"
-                    .into(),
+                message: format!(
+                    "is replaced by this layer's `colors`, whose rings take the repeat in `widths` (or in equal \
+                     parts); give one of the two (a size of {}, the default, counts as none)",
+                    PatternLayer::default_size()
+                ),
             });
         }
         // Keys some kinds read, set away from their defaults on a kind that ignores them

@@ -170,14 +170,6 @@ impl Cli {
             }
         }
         let mut matches = command.try_get_matches_from_mut(args)?;
-        // `--maps` as written, for the `--ao` hint below (read before `from_arg_matches_mut`
-        // takes the values out of `matches`).
-        let maps_written = matches
-            .subcommand_matches("generate")
-            .filter(|m| m.value_source("maps") == Some(clap::parser::ValueSource::CommandLine))
-            .and_then(|m| m.get_raw("maps"))
-            .and_then(|mut raw| raw.next())
-            .map(|written| written.to_string_lossy().trim().to_string());
         let cli = Cli::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut command))?;
         // `--ao` without `--pack`: clap's `requires` said only that `--pack <ENGINE>` was
         // missing, and its conflict with `--maps` only that the two cannot be used together,
@@ -192,7 +184,13 @@ impl Cli {
                 .iter()
                 .filter_map(|engine| engine.to_possible_value().map(|v| v.get_name().to_string()))
                 .collect();
-            let maps = maps_written.unwrap_or_else(|| "all".into());
+            // The maps asked for, as `--maps` takes them (`all` for the five).
+            let asked = &generate.preset.maps.0;
+            let maps = if asked[..] == MapKind::ALL[..] {
+                "all".to_string()
+            } else {
+                asked.iter().map(|m| m.name()).collect::<Vec<_>>().join(",")
+            };
             let instead = if generate.preset.maps.0.contains(&MapKind::Ao) {
                 format!("drop --ao: --maps {maps} names the map already")
             } else {
@@ -317,7 +315,7 @@ pub struct ExportArgs {
     pub source: PresetSource,
     /// The file to write: NAME.glb (everything in one binary file) or NAME.gltf (JSON, with
     /// NAME.bin and NAME.basecolor.png, NAME.normal.png, NAME.orm.png and,
-    /// with a film, NAME.thickness.png beside it).
+    /// with a film of more than one thickness, NAME.thickness.png beside it).
     #[arg(long, value_name = "FILE")]
     pub gltf: PathBuf,
     /// Texture width in pixels, 16 to 16384 (a body atlas is `body.length` widths tall;
