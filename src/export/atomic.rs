@@ -253,7 +253,7 @@ pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), Exp
     const IMAGE_EXTENSIONS: [&str; 11] =
         ["png", "jpg", "jpeg", "exr", "webp", "tif", "tiff", "svg", "gif", "bmp", "tga"];
     let name = target.file_name().map(|n| n.to_string_lossy());
-    let only_an_extension = |rest: &str| rest.eq_ignore_ascii_case(format) || IMAGE_EXTENSIONS.contains(&rest);
+    let only_an_extension = |rest: &str| rest == format || IMAGE_EXTENSIONS.contains(&rest);
     if name.is_some_and(|n| n.strip_prefix('.').is_some_and(|rest| only_an_extension(&rest.to_ascii_lowercase()))) {
         return Err(ExportError::OnlyAnExtension { path: target.into(), format });
     }

@@ -108,7 +108,7 @@ impl Pack {
 
     /// The longest texture side the engine is documented to load, and where that is said: past
     /// it an engine scales the texture down on import or refuses it, so a pack (or a glTF
-    /// file) with a longer side is warned of (`size_warning`). A body atlas is `body.length`
+    /// file) with a longer side is warned of (`size_problem`). A body atlas is `body.length`
     /// widths tall, so this is what it meets first.
     pub fn longest_side_loaded(self) -> (usize, &'static str) {
         match self {

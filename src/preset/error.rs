@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
-    /// `hint`: empty, or "; ..." naming the built-in preset a missing file's name is close to.
+    /// `hint`: empty, or "; ..." naming the built-in preset a missing file is named after.
     #[error("cannot read preset {path}: {source}{hint}")]
     Read { path: PathBuf, source: std::io::Error, hint: String },
 

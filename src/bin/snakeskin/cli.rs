@@ -191,7 +191,7 @@ impl Cli {
             } else {
                 asked.iter().map(|m| m.name()).collect::<Vec<_>>().join(",")
             };
-            let instead = if generate.preset.maps.0.contains(&MapKind::Ao) {
+            let instead = if asked.contains(&MapKind::Ao) {
                 format!("drop --ao: --maps {maps} names the map already")
             } else {
                 format!("name the map instead: --maps {maps},ao")
@@ -566,10 +566,10 @@ pub enum BrdfCommand {
         /// Film thickness in nm (thesis δ0), 0 to 10,000,000 (10 mm).
         #[arg(long, required_unless_present = "batch", value_parser = parse_thickness_nm)]
         thickness_nm: Option<f64>,
-        /// Vacuum wavelength in nm, 1 to 10^6.
+        /// Vacuum wavelength in nm, 1 to 1,000,000 (1 mm).
         #[arg(long, required_unless_present = "batch", value_parser = parse_wavelength_nm)]
         wavelength_nm: Option<f64>,
-        /// Incidence angle in the ambient medium, degrees, 0 (normal) to 90.
+        /// Incidence angle in the ambient medium, degrees from the normal, 0 to 90.
         #[arg(long, required_unless_present = "batch", value_parser = parse_angle_deg)]
         angle_deg: Option<f64>,
         /// Read JSON objects {n0, n1, n2, thickness_nm, wavelength_nm, angle_deg}, one per
@@ -899,8 +899,8 @@ fn parse_gpu_method(text: &str) -> Result<GpuFilmMethod, String> {
     parse_method(text).map(GpuFilmMethod::from_method)
 }
 
-/// A finite number inside `lo..=hi`, for the flags that take one.
-/// A finite number in [lo, hi]; `-0` is read as 0 (an answer computed from it printed `-0.0`).
+/// A finite number inside `lo..=hi`, for the flags that take one; `-0` is read as 0 (an
+/// answer computed from it printed `-0.0`).
 fn bounded(text: &str, (lo, hi): (f64, f64)) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         // Adding 0 turns -0 into +0 and leaves every other number as it is (IEEE 754).
