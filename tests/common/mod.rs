@@ -118,3 +118,10 @@ pub fn assert_rows_seamless(img: &snakeskin::ops::Image, what: &str) {
     let limit = 1.5 * beside.max(mean);
     assert!(seam <= limit, "{what}: seam jump {seam:.5} > 1.5 × max(beside {beside:.5}, mean {mean:.5})");
 }
+
+/// `command` without the desktop's Wayland variables, so that a window opens on the Xvfb
+/// that `xvfb-run` starts, not on the desktop's compositor (which winit prefers).
+#[cfg(any(target_os = "linux", feature = "window"))]
+pub fn on_x11(command: &mut std::process::Command) -> &mut std::process::Command {
+    command.env_remove("WAYLAND_DISPLAY").env_remove("WAYLAND_SOCKET")
+}
