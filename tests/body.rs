@@ -116,7 +116,7 @@ fn marks_along_spine(colour: &Image, rows: std::ops::Range<usize>, mark: [f32; 3
 fn other_colours(p: &Preset, mark: Srgb8) -> Vec<[f32; 3]> {
     let mut all = vec![p.color.base];
     for l in &p.pattern {
-        all.push(l.color);
+        all.extend(l.color);
         all.push(l.outline_color);
         all.extend(l.center_color);
         all.extend(l.border_color);
@@ -156,7 +156,7 @@ fn check_marks(name: &str, overrides: &[(&str, &str)]) {
     let p = preset(name, overrides);
     let plan = body_plan(&p);
     let layer = p.pattern.iter().find(|l| l.count.is_some()).expect("a counted layer");
-    let mark = layer.colors.first().copied().unwrap_or(layer.color);
+    let mark = layer.colors.first().copied().unwrap_or(layer.color());
     let colour = body_map(&p, MapKind::Color);
     let trunk = rows_of(colour.height, plan.neck_end, plan.vent);
     let found = marks_along_spine(&colour, trunk, linear(mark), &other_colours(&p, mark));
@@ -294,14 +294,14 @@ fn a_series_can_widen_toward_the_tail() {
         let plan = body_plan(&p);
         let colour = body_map(&p, MapKind::Color);
         let layer = &p.pattern[0];
-        let others = other_colours(&p, layer.color);
+        let others = other_colours(&p, layer.color());
         let h = colour.height;
         let trunk = plan.vent - plan.neck_end;
         let first = rows_of(h, plan.neck_end, plan.neck_end + 0.2 * trunk);
         let last = rows_of(h, plan.vent - 0.2 * trunk, plan.vent);
         let (a, b) = (
-            mark_pixels(&colour, first, linear(layer.color), &others),
-            mark_pixels(&colour, last, linear(layer.color), &others),
+            mark_pixels(&colour, first, linear(layer.color()), &others),
+            mark_pixels(&colour, last, linear(layer.color()), &others),
         );
         b as f64 / a.max(1) as f64
     };

@@ -289,6 +289,51 @@ fn unknown_enum_value_lists_what_is_accepted() {
         err.contains("kind.toml:2:8: key `pattern.0.kind`: unknown value \"spot\"; did you mean \"spots\"?"),
         "{err}"
     );
+    // Spots and blotches take different shapes: the one list offered `ring` to a blotches
+    // layer, which then refused it.
+    let err = refused("blotch.toml", "[[pattern]]\nkind = \"blotches\"\ncolor = \"#000000\"\nshape = \"rnd\"\n", &[]);
+    assert!(
+        err.contains(
+            "(accepted: for spots round, ring; for blotches round, diamond, saddle, chevron, hourglass, zigzag)"
+        ),
+        "{err}"
+    );
+}
+
+/// Every layer needs its colour, named at its table when it is missing; but a rings layer
+/// with a `colors` sequence draws those and needs no `color` (it was required and unread).
+#[test]
+fn a_layer_needs_its_colour_but_a_ring_sequence_draws_its_own() {
+    let err = refused("spots.toml", "seed = 1\n[[pattern]]\nkind = \"spots\"\n", &[]);
+    assert!(
+        err.contains("spots.toml:2: key `pattern.0.color` is missing: give the layer's colour as \"#rrggbb\""),
+        "{err}"
+    );
+    let err = refused("rings.toml", "seed = 1\n[[pattern]]\nkind = \"rings\"\n", &[]);
+    assert!(err.contains("rings.toml:2: key `pattern.0.color` is missing") && err.contains("in `colors`)"), "{err}");
+    // A layer an override made is placed at the override (it said "missing field `color`").
+    let err = refused("plain.toml", "seed = 1\n", &["--set", "pattern.0.kind=spots"]);
+    assert!(err.contains("plain.toml (with --set): key `pattern.0.color` is missing"), "{err}");
+    // A sequence: the same colour map with a `color` beside it or without one, and no
+    // warning about a colour that is not drawn (white is past what the stack shows).
+    let dir = tempfile::tempdir().unwrap();
+    let sequence = "seed = 1\n[[pattern]]\nkind = \"rings\"\ncolors = [\"#101010\", \"#e0c030\"]\n";
+    let colour_map = |name: &str, text: &str| {
+        let path = write_preset(dir.path(), name, text);
+        let out_dir = dir.path().join(name.trim_end_matches(".toml"));
+        let args = ["generate", path.as_str(), "-o", out_dir.to_str().unwrap(), "--size", "64", "--maps", "color"];
+        let out = snakeskin(&args);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        (std::fs::read(out_dir.join(name.replace(".toml", "_color.png"))).unwrap(), stderr(&out))
+    };
+    let (without, said) = colour_map("rings.toml", sequence);
+    assert!(!said.contains("warning"), "{said}");
+    let (beside, said) = colour_map("rings.toml", &sequence.replace("kind", "color = \"#ffffff\"\nkind"));
+    assert!(!said.contains("warning"), "{said}");
+    assert_eq!(without, beside);
+    // Negative control: the same white drawn by a one-ring layer is warned about.
+    let (_, said) = colour_map("ring.toml", "seed = 1\n[[pattern]]\nkind = \"rings\"\ncolor = \"#ffffff\"\n");
+    assert!(said.contains("warning: ") && said.contains("pattern.0.color = \"#ffffff\""), "{said}");
 }
 
 /// A name is a string: serde's TOML enums also took a table (`[scales.shape.hexagon]` made

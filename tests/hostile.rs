@@ -1874,11 +1874,9 @@ fn type_errors_name_the_range_and_missing_kinds_the_choices() {
     assert!(e.contains("key `seed`: must be an integer in [0, 9007199254740991], got -3"), "{e}");
     let e = run("[[pattern]]\ncolor = \"#101010\"\n", &[]);
     assert!(e.contains("missing field `kind`: every layer needs its kind, one of solid, stripes, rings"), "{e}");
-    // A layer made by --set, with the --set that adds what it lacks (it said only "missing
-    // field `color`").
+    // A layer made by --set names the key it lacks (it said only "missing field `color`").
     let e = run("seed = 1\n", &["pattern.0.kind=spots"]);
-    let says = "invalid --set \"pattern.0.kind=spots\": missing field `color`: give its colour as \"#rrggbb\" \
-                (set pattern.0.color = \"#rrggbb\" as well)";
+    let says = "(with --set): key `pattern.0.color` is missing: give the layer's colour as \"#rrggbb\"";
     assert!(e.contains(says), "{e}");
     let e = run("seed = 1\n", &["pattern.0.color=\"#101010\""]);
     assert!(

@@ -208,7 +208,7 @@ fn shapes(
             // Full coverage, modulated by broad noise so the tint is not flat.
             let n = g.add(name("noise"), perlin(3, s.along_count(3), 4, 0.5, seed), &[]);
             let amount = layer.amount as f32;
-            vec![(levels(g, &name("shape"), n, amount * 0.6, amount), layer.color)]
+            vec![(levels(g, &name("shape"), n, amount * 0.6, amount), layer.color())]
         }
         PatternKind::Stripes if layer.rows.len() == 2 => {
             // On named scale rows (`Lattice::row_span_u`), mirrored about the spine.
@@ -216,7 +216,7 @@ fn shapes(
             let half_width = 0.5 * (u1 - u0);
             let centres = vec![0.5 * (u0 + u1), 1.0 - 0.5 * (u0 + u1)];
             let op = Op::Bands { axis: Axis::U, centres, half_width, softness: 0.002 };
-            vec![(g.add(name("shape"), op, &[]), layer.color)]
+            vec![(g.add(name("shape"), op, &[]), layer.color())]
         }
         PatternKind::Stripes => {
             // `amount` stripes each side of the dorsal midline (u = 0.5), centre to centre
@@ -231,7 +231,7 @@ fn shapes(
                 }
             }
             let op = Op::Bands { axis: Axis::U, centres, half_width: size * 0.5, softness: 0.002 };
-            vec![(g.add(name("shape"), op, &[]), layer.color)]
+            vec![(g.add(name("shape"), op, &[]), layer.color())]
         }
         PatternKind::Rings => {
             // A colour sequence repeated `amount` times along the body; widths are
@@ -240,7 +240,7 @@ fn shapes(
             let repeats = repeats as f32;
             let span_len = span.1 - span.0;
             let (colors, mut widths): (Vec<Srgb8>, Vec<f32>) = if layer.colors.is_empty() {
-                (vec![layer.color], vec![size.min(1.0)])
+                (vec![layer.color()], vec![size.min(1.0)])
             } else if layer.widths.is_empty() {
                 let n = layer.colors.len();
                 (layer.colors.clone(), vec![1.0 / n as f32; n])
@@ -267,9 +267,9 @@ fn shapes(
             }
             out
         }
-        PatternKind::Spots => vec![(g.add(name("shape"), Op::Spots(spot_grid(s, layer, seed)), &[]), layer.color)],
+        PatternKind::Spots => vec![(g.add(name("shape"), Op::Spots(spot_grid(s, layer, seed)), &[]), layer.color())],
         PatternKind::Blotches => {
-            vec![(g.add(name("shape"), Op::Blotches(blotches(s, layer, seed, 1.0)), &[]), layer.color)]
+            vec![(g.add(name("shape"), Op::Blotches(blotches(s, layer, seed, 1.0)), &[]), layer.color())]
         }
         PatternKind::Irregular => {
             let kind = match layer.noise {
@@ -283,7 +283,7 @@ fn shapes(
             // Higher amount, lower threshold, more coverage; fBm sits mostly in [0.3, 0.7].
             let level = 0.7 - 0.4 * layer.amount as f32;
             let binary = g.add(name("threshold"), Op::Threshold { level, softness: 0.01 }, &[n]);
-            vec![(g.add(name("shape"), Op::Blur { sigma: size * 0.04 }, &[binary]), layer.color)]
+            vec![(g.add(name("shape"), Op::Blur { sigma: size * 0.04 }, &[binary]), layer.color())]
         }
     }
 }

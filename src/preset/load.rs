@@ -243,11 +243,15 @@ pub fn parse_with_seed(
     let key_lines = std::cell::LazyCell::new(|| toml_text::KeyLines::new(&source.text));
     // A key's line in the file: none for a key an override wrote (or one not in the file).
     let line_of = |key: &str| if overridden(key) { None } else { key_lines.line(key) };
-    let locate = |p: super::validate::Problem| LocatedProblem {
-        line: line_of(&p.key),
-        overridden: overridden(&p.key),
-        key: p.key,
-        message: p.message,
+    let locate = |p: super::validate::Problem| {
+        if p.message.starts_with(super::validate::MISSING) {
+            // An absent key is placed at its table (`[[pattern]]`), or at the override that
+            // made the table (`--set pattern.0.kind=spots` on a preset without layers).
+            let table = p.key.rsplit_once('.').map_or("", |(table, _)| table);
+            let line = line_of(table);
+            return LocatedProblem { line, overridden: line.is_none(), key: p.key, message: p.message };
+        }
+        LocatedProblem { line: line_of(&p.key), overridden: overridden(&p.key), key: p.key, message: p.message }
     };
     if !problems.is_empty() {
         let located = problems.into_iter().map(locate).collect();

@@ -12,8 +12,12 @@ use serde::{Deserialize, Deserializer, Serialize, de};
 /// type: unit variant"): `try_from = "String"` reads a string, and `by_name` finds the
 /// variant whose serialised name it is, or names the nearest and lists them all. The
 /// macro's `match` makes leaving a variant out of the list a compile error.
+/// `accepted:` replaces the message's plain list where not every value goes everywhere.
 macro_rules! named_enum {
     ($t:ident { $($v:ident),+ $(,)? }) => {
+        named_enum!($t { $($v),+ } accepted: None);
+    };
+    ($t:ident { $($v:ident),+ $(,)? } accepted: $accepted:expr) => {
         impl TryFrom<String> for $t {
             type Error = String;
             fn try_from(name: String) -> Result<Self, String> {
@@ -21,7 +25,7 @@ macro_rules! named_enum {
                 const _: fn($t) = |x| match x {
                     $($t::$v)|+ => {}
                 };
-                by_name(&[$($t::$v),+], &name)
+                by_name(&[$($t::$v),+], &name, $accepted)
             }
         }
 
@@ -39,8 +43,9 @@ pub fn spelled<T: Serialize>(value: &T) -> String {
     serde_json::to_value(value).ok().and_then(|j| j.as_str().map(str::to_string)).unwrap_or_default()
 }
 
-/// The variant of `all` serialised as `name` (the preset's spelling), or a message.
-fn by_name<T: Serialize + Copy>(all: &[T], name: &str) -> Result<T, String> {
+/// The variant of `all` serialised as `name` (the preset's spelling), or a message that
+/// lists them (or says `accepted`, where given).
+fn by_name<T: Serialize + Copy>(all: &[T], name: &str, accepted: Option<&str>) -> Result<T, String> {
     let names: Vec<String> = all.iter().map(spelled).collect();
     match names.iter().position(|n| n == name) {
         Some(i) => Ok(all[i]),
@@ -48,7 +53,8 @@ fn by_name<T: Serialize + Copy>(all: &[T], name: &str) -> Result<T, String> {
             let hint = crate::toml_text::nearest(name, names.iter().map(String::as_str))
                 .map(|n| format!("; did you mean \"{n}\"?"))
                 .unwrap_or_default();
-            Err(format!("unknown value {name:?}{hint} (accepted: {})", names.join(", ")))
+            let accepted = accepted.map_or_else(|| names.join(", "), str::to_string);
+            Err(format!("unknown value {name:?}{hint} (accepted: {accepted})"))
         }
     }
 }
@@ -57,7 +63,10 @@ named_enum!(Category { Solid, VerticalStripe, HorizontalStripe, Spot, Simple, Co
 named_enum!(ScaleShape { Leaf, Diamond, Hexagon });
 named_enum!(PatternKind { Solid, Stripes, Rings, Spots, Blotches, Irregular });
 named_enum!(StripePosition { Vertebral, Dorsolateral, Lateral });
-named_enum!(PatternShape { Round, Ring, Diamond, Saddle, Chevron, Hourglass, Zigzag });
+// Spots and blotches take different shapes (`validate.rs` checks which): the plain list put
+// `ring` before a blotches layer, which then refused it.
+named_enum!(PatternShape { Round, Ring, Diamond, Saddle, Chevron, Hourglass, Zigzag }
+    accepted: Some(&PatternShape::accepted_by_kind()));
 named_enum!(Arrangement { Aligned, Alternating, Checkered });
 named_enum!(NoiseChoice { Perlin, Cellular });
 named_enum!(BellyPattern { None, Checkered, Spots, HalfMoons, MedianStripe });
@@ -291,6 +300,26 @@ pub enum PatternShape {
     Zigzag,
 }
 
+impl PatternShape {
+    /// The shapes a spots layer draws.
+    pub const FOR_SPOTS: &[PatternShape] = &[PatternShape::Round, PatternShape::Ring];
+    /// The shapes a blotches layer draws.
+    pub const FOR_BLOTCHES: &[PatternShape] = &[
+        PatternShape::Round,
+        PatternShape::Diamond,
+        PatternShape::Saddle,
+        PatternShape::Chevron,
+        PatternShape::Hourglass,
+        PatternShape::Zigzag,
+    ];
+
+    /// The shapes by the kind that takes them, for messages.
+    fn accepted_by_kind() -> String {
+        let names = |shapes: &[PatternShape]| shapes.iter().map(spelled).collect::<Vec<_>>().join(", ");
+        format!("for spots {}; for blotches {}", names(Self::FOR_SPOTS), names(Self::FOR_BLOTCHES))
+    }
+}
+
 /// How spots are laid out in rows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case", try_from = "String")]
@@ -315,7 +344,10 @@ pub enum NoiseChoice {
 pub struct PatternLayer {
     /// Thesis "PatternType".
     pub kind: PatternKind,
-    pub color: Srgb8,
+    /// The layer's colour: required of every layer but a rings layer with `colors`, which
+    /// draws its sequence instead (`validate.rs`); `PatternLayer::color` reads it.
+    #[serde(default)]
+    pub color: Option<Srgb8>,
     /// Thesis "PatternAmount": stripes per side, spots around the body, or blob coverage.
     #[serde(default = "PatternLayer::default_amount")]
     pub amount: f64,
@@ -343,7 +375,7 @@ pub struct PatternLayer {
     /// Stripes: a named position (overrides `offset`).
     #[serde(default)]
     pub position: Option<StripePosition>,
-    /// Spots: `round` or `ring`; blotches: `round`, `diamond` or `saddle`.
+    /// Spots: one of `PatternShape::FOR_SPOTS`; blotches: one of `FOR_BLOTCHES`.
     #[serde(default = "PatternLayer::default_shape")]
     pub shape: PatternShape,
     /// Spots: `aligned`, `alternating` or `checkered`.
@@ -401,6 +433,17 @@ pub struct PatternLayer {
 }
 
 impl PatternLayer {
+    /// Whether the layer draws `color`: every kind does, but rings with a `colors` sequence.
+    pub fn reads_color(&self) -> bool {
+        self.kind != PatternKind::Rings || self.colors.is_empty()
+    }
+
+    /// The layer's colour. Validation requires it wherever `reads_color` says it is drawn, so
+    /// the fallback (the first colour of `colors`, else black) is never drawn.
+    pub fn color(&self) -> Srgb8 {
+        self.color.or(self.colors.first().copied()).unwrap_or(Srgb8([0; 3]))
+    }
+
     /// The layer's `count` where its kind reads one (blotches and rings): a `count` the file
     /// wrote for blotches, passed over after `--set pattern.N.kind=spots`, still cut the spots
     /// to the counted series' stretch of the body and went into the manifest.

@@ -11,6 +11,10 @@ pub struct Problem {
     pub message: String,
 }
 
+/// How a problem with a required key that is absent begins: such a key has no line of its
+/// own, so the message is placed at its table's.
+pub const MISSING: &str = "is missing";
+
 /// The accepted ranges, one place, so docs/presets.md and the checks agree.
 pub mod ranges {
     /// 2^53 − 1: the manifest and the batch index record the seed as a JSON
@@ -312,15 +316,8 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
             PatternKind::Irregular | PatternKind::Solid => c.range(key("amount"), p.amount, UNIT),
         }
         let shapes: &[PatternShape] = match p.kind {
-            PatternKind::Spots => &[PatternShape::Round, PatternShape::Ring],
-            PatternKind::Blotches => &[
-                PatternShape::Round,
-                PatternShape::Diamond,
-                PatternShape::Saddle,
-                PatternShape::Chevron,
-                PatternShape::Hourglass,
-                PatternShape::Zigzag,
-            ],
+            PatternKind::Spots => PatternShape::FOR_SPOTS,
+            PatternKind::Blotches => PatternShape::FOR_BLOTCHES,
             // Another kind reads no shape: `kinds_only` below says so.
             _ => &[],
         };
@@ -370,6 +367,15 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
                     });
                 }
             }
+        }
+        // Every layer draws its `color` but a rings layer with `colors`, which need not name
+        // one it would not draw.
+        if p.reads_color() && p.color.is_none() {
+            let or_rings = if p.kind == PatternKind::Rings { " (or a sequence of rings in `colors`)" } else { "" };
+            c.problems.push(Problem {
+                key: key("color"),
+                message: format!("{MISSING}: give the layer's colour as \"#rrggbb\"{or_rings}"),
+            });
         }
         // A ring sequence's widths are its colours' (`widths`, or equal parts), so a ring
         // `size` beside `colors` was silently ignored (the same bytes as without it).

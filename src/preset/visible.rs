@@ -122,7 +122,11 @@ fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
         keys.push(("color.skin".into(), skin));
     }
     for (i, layer) in preset.pattern.iter_mut().enumerate() {
-        keys.push((format!("pattern.{i}.color"), &mut layer.color));
+        // A rings layer with `colors` does not draw `color`: no warning for it.
+        let reads_color = layer.reads_color();
+        if let Some(colour) = layer.color.as_mut().filter(|_| reads_color) {
+            keys.push((format!("pattern.{i}.color"), colour));
+        }
         keys.push((format!("pattern.{i}.outline_color"), &mut layer.outline_color));
         if let Some(centre) = layer.center_color.as_mut() {
             keys.push((format!("pattern.{i}.center_color"), centre));

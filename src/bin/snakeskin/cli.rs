@@ -179,7 +179,6 @@ impl Cli {
             && generate.ao
             && generate.pack.is_none()
         {
-            use clap::ValueEnum;
             let engines: Vec<String> = PackArg::value_variants()
                 .iter()
                 .filter_map(|engine| engine.to_possible_value().map(|v| v.get_name().to_string()))
