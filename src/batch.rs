@@ -367,6 +367,13 @@ pub struct Shard {
     pub count: usize,
 }
 
+/// `K/N`, as `--shard` takes it and the index records it.
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
 impl std::str::FromStr for Shard {
     type Err = BatchError;
     fn from_str(s: &str) -> Result<Shard, BatchError> {
@@ -748,7 +755,7 @@ pub fn run(
         generator: "snakeskin".into(),
         generator_version: env!("CARGO_PKG_VERSION").into(),
         jobs_file: jobs_file.into(),
-        shard: format!("{}/{}", shard.index, shard.count),
+        shard: shard.to_string(),
         jobs: outcomes,
         concurrency,
     };

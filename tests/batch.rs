@@ -63,7 +63,8 @@ fn jobs_file(dir: &Path, species: &[&str], seeds: &str, size: u32) -> PathBuf {
 fn summary_counts(out: &std::process::Output) -> (usize, usize) {
     // "40 jobs of 40 in shard 0/1, up to 2 at once: 33 run, 7 already done; index: …"
     let text = stdout(out);
-    let after = text.split(": ").nth(1).unwrap_or_else(|| panic!("no summary in {text:?}"));
+    let summary = text.lines().last().unwrap_or_default();
+    let after = summary.split(": ").nth(1).unwrap_or_else(|| panic!("no summary in {text:?}"));
     let numbers: Vec<usize> =
         after.split(|c: char| !c.is_ascii_digit()).filter_map(|n| n.parse().ok()).take(2).collect();
     (numbers[0], numbers[1])
@@ -92,6 +93,67 @@ const SPECIES: [&str; 20] = [
     "xenopeltis-unicolor",
 ];
 
+/// Every file and folder under `dir`, relative to it.
+fn entries(dir: &Path) -> Vec<PathBuf> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap().flatten() {
+            let path = entry.path();
+            out.push(path.strip_prefix(root).unwrap().into());
+            if path.is_dir() {
+                walk(root, &path, out);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+/// Ctrl-C or SIGTERM: the batch ends with 128 + the signal and leaves its finished sets and
+/// nothing else: no lock file in a set's folder, no folder holding a lock alone (both were
+/// left until a later run took the lock), no temporary; and its log has a line for each set
+/// it finished.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_batch_leaves_its_finished_sets_and_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &SPECIES[..6], "[1, 2]", 256);
+    let out = dir.path().join("out");
+    for signal in [libc::SIGINT, libc::SIGTERM] {
+        let _ = std::fs::remove_dir_all(&out);
+        let child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        while manifests(&out).len() < 2 {
+            assert!(start.elapsed() < Duration::from_secs(300), "the batch made no progress");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        // SAFETY: `kill` with a child's own pid and a valid signal number.
+        assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
+        let ended = child.wait_with_output().unwrap();
+        let finished = manifests(&out);
+        assert!(finished.len() < 12, "the signal came too late to test anything");
+        assert_eq!(ended.status.code(), Some(128 + signal), "{}", stderr(&ended));
+        for path in entries(&out) {
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            assert!(!name.starts_with('.'), "{} was left", path.display());
+            assert!(
+                !out.join(&path).is_dir() || finished.keys().any(|m| m.starts_with(&path)),
+                "{} holds no finished set: {:?}",
+                path.display(),
+                entries(&out)
+            );
+        }
+        let logged = stdout(&ended).lines().filter(|l| l.contains(" done ")).count();
+        assert_eq!(logged, finished.len(), "{}", stdout(&ended));
+    }
+}
+
 #[test]
 fn a_killed_batch_resumes_with_only_the_unfinished_jobs_and_the_same_files() {
     let dir = tempfile::tempdir().unwrap();
@@ -103,6 +165,14 @@ fn a_killed_batch_resumes_with_only_the_unfinished_jobs_and_the_same_files() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(summary_counts(&out), (40, 0), "{}", stdout(&out));
     assert_eq!(manifests(&whole).len(), 40);
+    // Redirected, it still says each job as it ends (it said nothing before its summary):
+    // one line a job, counting up, with the set's folder.
+    let lines: Vec<String> = stdout(&out).lines().map(str::to_string).collect();
+    assert_eq!(lines.len(), 41, "{}", stdout(&out));
+    for (k, line) in lines[..40].iter().enumerate() {
+        let folder = line.strip_prefix(&format!("{}/40 done ", k + 1)).unwrap_or_else(|| panic!("{line}"));
+        assert!(Path::new(folder).is_dir() && folder.starts_with(whole.to_str().unwrap()), "{line}");
+    }
 
     // The same batch, killed with SIGKILL once a few sets are complete.
     let mut child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))

@@ -94,6 +94,11 @@ fn temporary_stem(target_name: &str) -> std::borrow::Cow<'_, str> {
 /// `clean_up_before_exit` removes.
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
+/// This process's set lock files (`SetLock`), for `clean_up_before_exit` to remove: a batch
+/// interrupted by Ctrl-C left `.NAME.lock` in its sets' folders (a folder of a lock alone,
+/// where the job had not begun writing), until a later run took the lock again.
+static HELD_LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
 /// Held by a commit from its first rename to its last (the undo's included), and by
 /// `clean_up_before_exit` from when it begins until the process exits. Taken before `LIVE`.
 static COMMIT: Mutex<()> = Mutex::new(());
@@ -104,9 +109,11 @@ fn locked<T>(mutex: &'static Mutex<T>) -> MutexGuard<'static, T> {
 }
 
 /// For a process that is about to exit on a signal: waits for a commit in progress (and its
-/// undo) to end, then removes this process's temporaries of new files. Returns how many it
-/// removed. Both locks stay held, so no temporary or commit starts before the exit (a
-/// thread that tries waits until then); a second call returns the first one's count.
+/// undo) to end, then removes this process's temporaries of new files, its set lock files
+/// (the locks themselves go with the process) and the folders it made that are empty then.
+/// Returns how many temporaries it removed. The commit and temporaries' locks stay held, so
+/// no temporary or commit starts before the exit (a thread that tries waits until then); a
+/// second call returns the first one's count.
 pub fn clean_up_before_exit() -> usize {
     static REMOVED: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
     *REMOVED.get_or_init(|| {
@@ -114,6 +121,15 @@ pub fn clean_up_before_exit() -> usize {
         let live = locked(&LIVE);
         let removed = live.iter().filter(|path| fs::remove_file(path).is_ok()).count();
         std::mem::forget(live);
+        // Taken in `SetLock::acquire`'s order and kept: no lock file or folder is made after
+        // these are removed (a batch's next job made its folder in between).
+        let held = locked(&HELD_LOCKS);
+        for lock in held.iter() {
+            let _ = fs::remove_file(lock);
+        }
+        let mut made = locked(&MADE_FOLDERS);
+        remove_empty(&mut made);
+        std::mem::forget((held, made));
         removed
     })
 }
@@ -354,6 +370,8 @@ static MADE_FOLDERS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// folder, up to the first `..` or `.` (`c/../there/d` with `c` missing notes `c` alone:
 /// `c/../there` is a folder that was there, and `d` under it is left as made).
 pub fn create_folder_noted(dir: &Path) -> Result<bool, ExportError> {
+    // Held while the folder is made: once `clean_up_before_exit` holds it, none is.
+    let mut made = locked(&MADE_FOLDERS);
     let existing = dir.ancestors().find(|p| p.as_os_str().is_empty() || fs::symlink_metadata(p).is_ok());
     let mut missing = Vec::new();
     if let Some(existing) = existing
@@ -368,7 +386,7 @@ pub fn create_folder_noted(dir: &Path) -> Result<bool, ExportError> {
     }
     let created = create_folder(dir)?;
     if created {
-        locked(&MADE_FOLDERS).extend(missing);
+        made.extend(missing);
     }
     Ok(created)
 }
@@ -378,7 +396,11 @@ pub fn create_folder_noted(dir: &Path) -> Result<bool, ExportError> {
 /// this, and so does an export that failed). `remove_dir` removes only an empty folder: a
 /// set's folder, or one another job is writing into (its lock file is there), stays.
 pub fn remove_empty_made_folders() {
-    let mut made = locked(&MADE_FOLDERS);
+    remove_empty(&mut locked(&MADE_FOLDERS));
+}
+
+/// `remove_empty_made_folders` on the list it holds.
+fn remove_empty(made: &mut Vec<PathBuf>) {
     made.sort_by_key(|folder| std::cmp::Reverse(folder.components().count()));
     made.retain(|folder| fs::remove_dir(folder).is_err());
 }
@@ -489,6 +511,9 @@ impl std::fmt::Display for KeptBecause {
 impl SetLock {
     /// Locks the set `name` in `dir`, creating the folder if it is missing.
     pub fn acquire(dir: &Path, name: &str) -> Result<SetLock, ExportError> {
+        // Held from the lock file's making to its listing: once `clean_up_before_exit` holds
+        // it, no lock file is made that it would not remove.
+        let mut held = locked(&HELD_LOCKS);
         let created_folder = create_folder_noted(dir)?;
         let path = dir.join(format!(".{name}.lock"));
         let mut options = fs::OpenOptions::new();
@@ -536,6 +561,7 @@ impl SetLock {
                     // the next run may not write (`--maps color` after a full set).
                     let names = super::every_set_file_name(name);
                     remove_stale_temporaries(dir, &names.iter().map(String::as_str).collect::<Vec<_>>(), ZERO_AGE);
+                    held.push(path.clone());
                     return Ok(SetLock {
                         dir: dir.into(),
                         path,
@@ -920,7 +946,12 @@ impl Drop for SetLock {
     /// Removes the lock file while still holding the lock (see `acquire`), then the folders
     /// this process made that are empty now (the run failed before its commit).
     fn drop(&mut self) {
+        let mut held = locked(&HELD_LOCKS);
+        if let Some(i) = held.iter().position(|p| *p == self.path) {
+            held.swap_remove(i);
+        }
         let _ = fs::remove_file(&self.path);
+        drop(held);
         remove_empty_made_folders();
     }
 }

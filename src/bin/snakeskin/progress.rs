@@ -53,6 +53,14 @@ impl Progress {
         }
     }
 
+    /// A line on stdout (a written path), the bar kept out of its way.
+    pub fn println_stdout(&self, line: &str) {
+        match &self.0 {
+            Some(bar) => bar.suspend(|| println!("{line}")),
+            None => println!("{line}"),
+        }
+    }
+
     pub fn finish(self) {
         if let Some(bar) = self.0 {
             bar.finish_and_clear();

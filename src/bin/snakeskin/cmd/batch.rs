@@ -12,8 +12,13 @@ pub fn run(args: BatchArgs) -> Result<()> {
     let jobs = batch::load_jobs(&args.jobs).map_err(snakeskin::Error::from)?;
     let shard = args.shard.unwrap_or(Shard::ALL);
     if args.list {
-        for job in batch::list(&args.jobs, &jobs, &args.out, shard)? {
+        let listed = batch::list(&args.jobs, &jobs, &args.out, shard)?;
+        for job in &listed {
             println!("{:>6}  {:<9}  {}", job.index, job.status, path_line(&args.out.join(&job.folder)));
+        }
+        if listed.is_empty() {
+            // It printed nothing at all (a shard past the file's last job).
+            eprintln!("note: no jobs in shard {shard} ({} in the file)", counted(jobs.len(), "job"));
         }
         return Ok(());
     }
@@ -25,6 +30,14 @@ pub fn run(args: BatchArgs) -> Result<()> {
         batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut warn, &mut |done, total, outcome| {
             bar.update(done, total);
             bar.message(&format!("{} {}", outcome.status, path_line(&outcome.folder)));
+            // One line a job on stdout as well, as `generate` prints the paths it wrote: a
+            // redirected run (an array job's log) said nothing until its summary, and nothing
+            // of what it had finished when a signal ended it.
+            bar.println_stdout(&format!(
+                "{done}/{total} {} {}",
+                outcome.status,
+                path_line(&args.out.join(&outcome.folder))
+            ));
             for kept in &outcome.kept {
                 bar.println(&format!("warning: {}", crate::output::kept_words(kept)));
             }
@@ -38,12 +51,17 @@ pub fn run(args: BatchArgs) -> Result<()> {
     let skipped = index.jobs.len() - ran - duplicates;
     let duplicates = if duplicates > 0 { format!(", {duplicates} duplicates of another job") } else { String::new() };
     println!(
-        "{} jobs of {} in shard {}, up to {} at once: {ran} run, {skipped} already done{duplicates}; index: {}",
-        index.jobs.len(),
+        "{} of {} in shard {}, up to {} at once: {ran} run, {skipped} already done{duplicates}; index: {}",
+        counted(index.jobs.len(), "job"),
         jobs.len(),
         index.shard,
         index.concurrency,
         path_line(&args.out.join(batch::index_file_name(shard)))
     );
     Ok(())
+}
+
+/// `1 job`, `2 jobs`.
+fn counted(n: usize, what: &str) -> String {
+    if n == 1 { format!("1 {what}") } else { format!("{n} {what}s") }
 }
