@@ -1133,6 +1133,19 @@ fn ao_without_a_pack_is_refused_whatever_comes_with_it() {
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
+/// Flags that would have done nothing are named, before any GPU work: `--frames` without
+/// `--window` said "nothing to do", and `--close-up` drew the first of `--snakes` alone
+/// (the same bytes as one snake).
+#[test]
+fn preview_flags_that_would_do_nothing_are_named() {
+    let out = snakeskin(&["preview", PRESET, "--frames", "3"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--frames times frames in a window: add --window"), "{}", stderr(&out));
+    let out = snakeskin(&["preview", PRESET, "--close-up", "--snakes", "4", "--out", "x.png"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("'--close-up' cannot be used with '--snakes <SNAKES>'"), "{}", stderr(&out));
+}
+
 #[test]
 fn preview_reference_into_a_missing_folder_and_no_loader_noise() {
     if gpu_or_skip("preview_reference_into_a_missing_folder_and_no_loader_noise").is_none() {

@@ -460,8 +460,8 @@ pub struct PreviewArgs {
     /// Hide the ground plane.
     #[arg(long)]
     pub no_ground: bool,
-    /// Frame the mid-body closely instead of the whole snake.
-    #[arg(long)]
+    /// Frame the mid-body closely instead of the whole snake (of one snake: not with --snakes).
+    #[arg(long, conflicts_with = "snakes")]
     pub close_up: bool,
     /// Also shade the frame on the CPU with the f64 spectral reference, print mean and p99
     /// CIEDE2000 against the GPU image, and write the error heat map to this PNG. The check

@@ -147,6 +147,11 @@ impl BodyShape {
     }
 
     /// The closed tube with UVs and tangents.
+    /// Triangles of `mesh`: two a quad, `segments` quads round each of `rings` bands.
+    pub fn triangles(&self) -> u64 {
+        2 * self.rings.max(4) as u64 * self.segments.max(3) as u64
+    }
+
     pub fn mesh(&self) -> Mesh {
         let (rings, segments) = (self.rings.max(4), self.segments.max(3));
         // Arc length along the centre line at each ring gives v.
@@ -488,6 +493,13 @@ mod tests {
     /// the centre line that one texture height spans there, measured on the mesh's own
     /// positions and v. Negative control: a repeat of one full-girth circumference (the
     /// earlier rule) is off by the girth's ratio, ten times the tolerance at a third.
+    #[test]
+    fn the_triangle_count_is_the_meshes() {
+        for shape in [BodyShape::default(), BodyShape { rings: 3, segments: 2, ..BodyShape::default() }] {
+            assert_eq!(shape.triangles(), shape.mesh().indices.len() as u64 / 3);
+        }
+    }
+
     #[test]
     fn the_tile_stays_square_as_the_girth_changes() {
         let shape = BodyShape { rings: 480, segments: 64, ..BodyShape::default() };

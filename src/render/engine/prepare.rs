@@ -5,6 +5,7 @@
 
 use super::film::GpuFilmMethod;
 use super::material::{self, MaterialMaps};
+use super::mesh::BodyShape;
 use super::renderer::{Material, RENDERER_OVERHEAD_BYTES, Renderer};
 use super::scene::LayerOptics;
 use crate::Error;
@@ -155,6 +156,16 @@ pub fn check_preview_memory(
     let memory =
         DrawMemory { drawn_after: drawn_in_turn.then_some(size), ..DrawMemory::new(&graph, size, frame_bytes) };
     memory.check("the preview's frame with its maps")
+}
+
+/// What `snakes` snakes add to a frame's memory over one (`renderer::more_snakes_bytes`),
+/// drawn with the body mesh of `layout` (an atlas' has more rings).
+pub fn more_snakes_bytes(loaded: &LoadedPreset, layout: Layout, snakes: u32) -> u64 {
+    let shape = match layout {
+        Layout::Tile => BodyShape::default(),
+        Layout::Body => BodyShape::for_atlas(&body_plan(&loaded.preset)),
+    };
+    super::renderer::more_snakes_bytes(shape.triangles(), snakes)
 }
 
 /// Width and height of the preview's maps (`material_maps_in`): `map_size` wide, or the

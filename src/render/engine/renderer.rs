@@ -40,6 +40,23 @@ pub fn frame_bytes(width: u32, height: u32) -> u64 {
     width as u64 * height as u64 * per_pixel
 }
 
+/// Bytes a software rasteriser (lavapipe) holds for each triangle it draws in a frame: it
+/// bins every triangle with its vertices' outputs before it shades. Each snake of `--snakes`
+/// draws the whole body mesh again: 400 tile-layout snakes (61,440 triangles each) at
+/// 320×200 peaked at 2.5 GB where one peaked at 0.19 GB, and the check counted one. From
+/// `preview erythrolamprus-miliaris --map-size 64 --snakes N` (peak resident, `time -f
+/// %M`): 5.4–6.0 MB a further tile snake (1 to 100 snakes, 320×200 and 1280×800: 88–98
+/// bytes a triangle), 4.7 MB at 200; a body atlas' snake (153,600 triangles) 11.4 MB at
+/// 50 snakes, 6.8 at 200 (74 and 44 bytes a triangle): fewer pixels a snake as the grid
+/// grows. 100 bytes a triangle bounds them all.
+pub const BINNED_BYTES_PER_TRIANGLE: u64 = 100;
+
+/// Bytes `snakes` snakes of `triangles` each add to a frame's over one snake's (counted in
+/// the renderer's own overhead): `BINNED_BYTES_PER_TRIANGLE` each.
+pub fn more_snakes_bytes(triangles: u64, snakes: u32) -> u64 {
+    u64::from(snakes.saturating_sub(1)) * triangles * BINNED_BYTES_PER_TRIANGLE
+}
+
 /// Frames a window's swap chain may queue ahead of the one shown (its
 /// `SurfaceConfiguration::desired_maximum_frame_latency`).
 pub const WINDOW_FRAME_LATENCY: u32 = 2;
@@ -191,7 +208,6 @@ pub struct Renderer {
     body: GpuMesh,
     ground: GpuMesh,
     instances: Mutex<(u32, wgpu::Buffer)>,
-    single_instance: wgpu::Buffer,
     /// The last material's K and E (`LayerOptics::bounce_grid`), kept while its optics and
     /// model stay the same: every frame writes them to the scene uniform, and rebuilding
     /// them is eight tables of film-from-below integrals.
@@ -231,6 +247,19 @@ pub fn snake_grid(n: u32) -> Vec<[f32; 4]> {
             [col * spacing_x, -row * spacing_z, 0.0, 0.0]
         })
         .collect()
+}
+
+/// The ground reaches this far either side of its centre (scene units; a body is 2.4 long).
+const GROUND_HALF_SIZE: f32 = 30.0;
+
+/// The instances a frame draws: `snake_grid(n)`, then the ground's placement at the grid's
+/// centre. At the origin, the ground left the far columns of a grid of more than about 100
+/// snakes over the bare background.
+fn placements(n: u32) -> Vec<[f32; 4]> {
+    let (columns, spacing_x, spacing_z) = grid_layout(n);
+    let rows = n.div_ceil(columns);
+    let centre = [(columns - 1) as f32 * spacing_x * 0.5, -((rows - 1) as f32) * spacing_z * 0.5, 0.0, 0.0];
+    snake_grid(n).into_iter().chain(std::iter::once(centre)).collect()
 }
 
 /// Columns of the snake grid and the spacing along x and z (a body is 2.4 long and
@@ -278,7 +307,7 @@ impl Renderer {
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: scene_buffer.as_entire_binding() }],
         });
         let body = GpuMesh::new(device, &BodyShape::default().mesh());
-        let ground = GpuMesh::new(device, &Mesh::ground(30.0));
+        let ground = GpuMesh::new(device, &Mesh::ground(GROUND_HALF_SIZE));
         let instance_buffer = |placements: &[[f32; 4]]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("instances"),
@@ -286,8 +315,7 @@ impl Renderer {
                 usage: wgpu::BufferUsages::VERTEX,
             })
         };
-        let single_instance = instance_buffer(&[[0.0; 4]]);
-        let instances = Mutex::new((1, instance_buffer(&snake_grid(1))));
+        let instances = Mutex::new((1, instance_buffer(&placements(1))));
         Renderer {
             skin_module: module("skin"),
             plain_module: module("plain"),
@@ -304,7 +332,6 @@ impl Renderer {
             body,
             ground,
             instances,
-            single_instance,
             bounce: Mutex::new(None),
             gpu,
         }
@@ -564,7 +591,7 @@ impl Renderer {
         if current.0 != snakes {
             let buffer = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("instances"),
-                contents: bytemuck::cast_slice(&snake_grid(snakes.max(1))),
+                contents: bytemuck::cast_slice(&placements(snakes.max(1))),
                 usage: wgpu::BufferUsages::VERTEX,
             });
             *current = (snakes, buffer);
@@ -643,9 +670,10 @@ impl Renderer {
             if let Some(ground) = ground {
                 pass.set_pipeline(&ground);
                 pass.set_vertex_buffer(0, self.ground.vertices.slice(..));
-                pass.set_vertex_buffer(1, self.single_instance.slice(..));
+                pass.set_vertex_buffer(1, instances.slice(..));
                 pass.set_index_buffer(self.ground.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..self.ground.count, 0, 0..1);
+                let ground_instance = settings.snakes.max(1);
+                pass.draw_indexed(0..self.ground.count, 0, ground_instance..ground_instance + 1);
             }
         }
         let tonemap = self.tonemap_pipeline(output.format);
@@ -860,5 +888,25 @@ pub struct GBuffer {
 impl GBuffer {
     pub fn covered(&self, i: usize) -> bool {
         self.albedo_coverage[i][3] > 0.5
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The ground lies under every snake of every grid `--snakes` draws (1 to 400): each body
+    /// (2.4 long, ±0.35 wide, `grid_layout`) within its reach. Seen failing with the ground at
+    /// the origin, from 122 snakes on.
+    #[test]
+    fn the_ground_lies_under_every_snake_of_the_grid() {
+        for n in 1..=400 {
+            let placed = placements(n);
+            let (snakes, ground) = (&placed[..n as usize], placed[n as usize]);
+            for [x, z, ..] in snakes {
+                let (dx, dz) = ((x - ground[0]).abs() + 1.2, (z - ground[1]).abs() + 0.35);
+                assert!(dx <= GROUND_HALF_SIZE && dz <= GROUND_HALF_SIZE, "{n} snakes: one at ({x}, {z})");
+            }
+        }
     }
 }

@@ -19,7 +19,13 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     let loaded = snakeskin::preset::load(&source.preset, &source.overrides, source.seed)?;
     crate::output::report_warnings(&source.preset, &loaded);
     if args.out.is_none() && !args.window {
-        return Err(Error::Preview("nothing to do: give --out FILE.png (headless) or --window".into()).into());
+        // `--frames` alone said "nothing to do", as if it were not there.
+        let what = if args.frames.is_some() {
+            "--frames times frames in a window: add --window"
+        } else {
+            "nothing to do: give --out FILE.png (headless) or --window"
+        };
+        return Err(Error::Preview(what.into()).into());
     }
     let settings = FrameSettings {
         view: args.layers,
@@ -52,8 +58,10 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         snakeskin::export::check_png_target(file)?;
         snakeskin::export::check_not_an_input(file, snakeskin::preset::input_file(&source.preset))?;
     }
-    let frame_bytes = frame_bytes(width, height) + args.reference.as_ref().map_or(0, |_| gbuffer_bytes(width, height));
     let layout = args.layout.layout();
+    let frame_bytes = frame_bytes(width, height)
+        + args.reference.as_ref().map_or(0, |_| gbuffer_bytes(width, height))
+        + snakeskin::render::engine::prepare::more_snakes_bytes(&loaded, layout, args.snakes);
     snakeskin::render::engine::prepare::check_preview_memory(
         &loaded,
         args.map_size as usize,
