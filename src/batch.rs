@@ -234,7 +234,10 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         let (line, column) = described.line_column.unwrap_or((1, 1));
         // `job.0.sizes` is the first [[job]] table's `sizes`: "[[job]] 1", as the other
         // messages count the tables.
-        let in_job = described.key.as_deref().and_then(|k| k.strip_prefix("job.")).and_then(|k| k.split_once('.'));
+        // A job's own key (`job.2`: a missing field) is the table itself, and an item of a
+        // list (`sizes.0`) is counted from 1 as well.
+        let in_job =
+            described.key.as_deref().and_then(|k| k.strip_prefix("job.")).map(|k| k.split_once('.').unwrap_or((k, "")));
         let message = match in_job.and_then(|(index, key)| Some((index.parse::<usize>().ok()? + 1, key))) {
             // A size the type cannot hold (`-64`) said "a whole number from 0 to
             // 18446744073709551615": the size's own range, as for a size in the type's.
@@ -250,7 +253,21 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
             {
                 format!("[[job]] {job}: key `seeds`: {}", seed_refused(value))
             }
-            Some((job, key)) => format!("[[job]] {job}: key `{key}`: {}", described.message),
+            Some((job, "")) if described.message == "missing field `preset`" => {
+                format!("[[job]] {job}: {}: every job names its preset, built-in or a .toml file", described.message)
+            }
+            Some((job, "")) => format!("[[job]] {job}: {}", described.message),
+            Some((job, key)) => match key
+                .split_once('.')
+                .and_then(|(list, item)| Some((list, item.parse::<usize>().ok()?)))
+            {
+                Some((list, item)) => format!("[[job]] {job}: key `{list}`, item {}: {}", item + 1, described.message),
+                None => format!("[[job]] {job}: key `{key}`: {}", described.message),
+            },
+            // `[job]`: one table where the file needs an array of them.
+            None if described.key.as_deref() == Some("job") && described.message.starts_with("invalid type: table") => {
+                "write each job as a [[job]] table (double brackets: a list of jobs); [job] is a single table".into()
+            }
             None => described.keyed_message(),
         };
         BatchError::Parse { path: path.into(), line, column, message }

@@ -262,13 +262,37 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert!(stderr(&out).contains("jobs.toml:3:9: [[job]] 1: key `sizes`: invalid type"), "{}", stderr(&out));
     assert!(stderr(&out).contains("expected an array") && !stderr(&out).contains("sequence"), "{}", stderr(&out));
     assert!(!empty.exists());
+    // Tables and list items are counted from 1 in every message (a missing preset said
+    // "key `job.2`" of the third table, an item "key `sizes.0`"), and `[job]` is told to
+    // be `[[job]]` (it said "invalid type: table, expected an array").
+    for (text, says) in [
+        (
+            "[[job]]\npreset = \"natrix-natrix\"\n[[job]]\nseeds = [1]\n",
+            "jobs.toml:3:1: [[job]] 2: missing field `preset`: every job names its preset",
+        ),
+        (
+            "[[job]]\npreset = \"natrix-natrix\"\nsizes = [64, \"a\"]\n",
+            "jobs.toml:3:14: [[job]] 1: key `sizes`, item 2: invalid type: string \"a\"",
+        ),
+        ("[job]\npreset = \"natrix-natrix\"\n", "jobs.toml:1:1: write each job as a [[job]] table"),
+        // A value repeated from the file is cut short in the message (400,000 characters of
+        // preset name made 800 KB of it, the name twice).
+        (&format!("[[job]]\npreset = \"{}\"\n", "a".repeat(400_000)), "characters left out ...] aaa"),
+    ] {
+        std::fs::write(&jobs, text).unwrap();
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{text}: {}", stderr(&out));
+        assert!(stderr(&out).len() < 50_000, "{} bytes of message", stderr(&out).len());
+        assert!(!empty.exists());
+    }
     // A job written as an array is refused as one, not read field by field ("expected
     // struct JobTable with 9 elements").
     std::fs::write(&jobs, "job = [[\"natrix-natrix\", [1]]]\n").unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(
-        stderr(&out).contains("jobs.toml:1:8: key `job.0`: invalid type: array, expected a table"),
+        stderr(&out).contains("jobs.toml:1:8: [[job]] 1: invalid type: array, expected a table"),
         "{}",
         stderr(&out)
     );

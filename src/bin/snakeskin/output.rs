@@ -128,7 +128,26 @@ pub fn error_message(err: &anyhow::Error) -> String {
         }
         message.push_str(&text);
     }
-    printable(&message)
+    printable(&message).lines().map(shortened).collect::<Vec<_>>().join("\n")
+}
+
+/// Characters of an error's line kept at its start and at its end when it is longer than
+/// both with `LINE_GAP_AT_LEAST` between: a value repeated from the input can be as long as
+/// the input (a jobs file's 400,000-character preset name made an 800 KB message, the name
+/// twice). A line of two paths at their longest (4096 bytes each on Linux) is whole.
+const LINE_HEAD_CHARS: usize = 8192;
+const LINE_TAIL_CHARS: usize = 1024;
+const LINE_GAP_AT_LEAST: usize = 1024;
+
+/// `line`, or its head and tail with how much was left out between them.
+fn shortened(line: &str) -> String {
+    let count = line.chars().count();
+    if count <= LINE_HEAD_CHARS + LINE_GAP_AT_LEAST + LINE_TAIL_CHARS {
+        return line.to_string();
+    }
+    let head: String = line.chars().take(LINE_HEAD_CHARS).collect();
+    let tail: String = line.chars().skip(count - LINE_TAIL_CHARS).collect();
+    format!("{head} [... {} characters left out ...] {tail}", count - LINE_HEAD_CHARS - LINE_TAIL_CHARS)
 }
 
 /// 2 when the user's input is at fault, 1 for the environment and internal failures: the
