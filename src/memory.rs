@@ -301,7 +301,15 @@ fn mib_from_env(variable: &'static str) -> Result<Option<u64>, Error> {
     match std::env::var(variable) {
         Err(std::env::VarError::NotPresent) => Ok(None),
         Err(std::env::VarError::NotUnicode(v)) => Err(invalid(v.to_string_lossy().into_owned())),
-        Ok(v) => v.trim().parse::<u64>().map(Some).map_err(|_| invalid(v)),
+        // A number past u64 said "expected a whole number of MiB", which it is.
+        Ok(v) => v.trim().parse::<u64>().map(Some).map_err(|e| match e.kind() {
+            std::num::IntErrorKind::PosOverflow => Error::Environment {
+                variable,
+                value: v,
+                accepted: "a whole number of MiB, e.g. 4096, at most 18446744073709551615",
+            },
+            _ => invalid(v),
+        }),
     }
 }
 

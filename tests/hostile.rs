@@ -168,6 +168,11 @@ fn a_malformed_memory_cap_is_refused() {
             assert!(stderr(&out).contains("a whole number of MiB"), "{}", stderr(&out));
             assert!(!o.exists(), "{value:?}: nothing may be written");
         }
+        // A number past u64 is said to be too large (it said "expected a whole number").
+        let args = ["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "32"];
+        let out = snakeskin_env(&args, &[(variable, "99999999999999999999999")]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains("at most 18446744073709551615"), "{}", stderr(&out));
     }
     let out = snakeskin_env(
         &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "8192"],
@@ -1133,9 +1138,9 @@ fn ao_without_a_pack_is_refused_whatever_comes_with_it() {
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
-/// Flags that would have done nothing are named, before any GPU work: `--frames` without
-/// `--window` said "nothing to do", and `--close-up` drew the first of `--snakes` alone
-/// (the same bytes as one snake).
+/// Flags that would have done nothing, or less than asked, are named before any GPU work:
+/// `--frames` without `--window` said "nothing to do", `--close-up` drew the first of
+/// `--snakes` alone (the same bytes as one snake), and a narrowed atlas went unsaid.
 #[test]
 fn preview_flags_that_would_do_nothing_are_named() {
     let out = snakeskin(&["preview", PRESET, "--frames", "3"]);
@@ -1144,6 +1149,16 @@ fn preview_flags_that_would_do_nothing_are_named() {
     let out = snakeskin(&["preview", PRESET, "--close-up", "--snakes", "4", "--out", "x.png"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("'--close-up' cannot be used with '--snakes <SNAKES>'"), "{}", stderr(&out));
+    // A body atlas narrowed to stay within the tallest texture is named (only the memory
+    // refusal named the maps' size); the refusal ends the run before any GPU work.
+    let args = ["preview", "crotalus-atrox", "--layout", "body", "--map-size", "1024", "--out", "x.png"];
+    let out = snakeskin_env(&args, &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1")]);
+    assert_eq!(out.status.code(), Some(2));
+    let says = "note: the body atlas is 682x8184: --map-size 1024 would make it longer than 8192 rows (12 widths)";
+    assert!(stderr(&out).contains(says), "{}", stderr(&out));
+    // Negative control: a width that fits is not named.
+    let out = snakeskin_env(&args.map(|a| if a == "1024" { "512" } else { a }), &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1")]);
+    assert!(!stderr(&out).contains("note: the body atlas"), "{}", stderr(&out));
 }
 
 #[test]
@@ -1166,6 +1181,9 @@ fn preview_reference_into_a_missing_folder_and_no_loader_noise() {
     assert!(image.exists() && heat.exists());
     assert!(err.contains(&format!("note: created folder {}", heat.parent().unwrap().display())), "{err}");
     assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    // Both written paths, as every command prints its outputs (the heat map's was not).
+    let written: Vec<String> = stdout(&out).lines().map(str::to_string).collect();
+    assert_eq!(written, [image.display().to_string(), heat.display().to_string()]);
 }
 
 /// An output path that names something other than a regular file is refused before

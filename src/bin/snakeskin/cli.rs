@@ -107,7 +107,8 @@ pub enum Command {
         /// Cells per row, 1 to 8.
         #[arg(long, default_value_t = 2, value_parser = ranged_u32(1, 8))]
         columns: u32,
-        /// Map resolution per species (pixels per side; a body atlas's width), 64 to 4096.
+        /// Map resolution per species (pixels per side; a body atlas's width, narrowed for a
+        /// species whose atlas would be more than 8192 rows long), 64 to 4096.
         #[arg(long, default_value_t = 512, value_parser = ranged_u64(64, 4096))]
         map_size: u64,
         /// tile: each species' tile and a render; body: each species' whole body atlas on

@@ -37,6 +37,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         camera: if args.close_up { Camera::close_up() } else { Camera::framing(args.snakes) },
         ..FrameSettings::default()
     };
+    narrowed_note(&loaded, args.map_size as usize, args.layout.layout());
     if args.window {
         return window(&args, settings);
     }
@@ -96,6 +97,10 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         );
     }
     println!("{}", path_line(&written));
+    // Every written path is printed (the heat map was not).
+    if let Some(heat_path) = &args.reference {
+        println!("{}", path_line(heat_path));
+    }
     Ok(())
 }
 
@@ -129,4 +134,19 @@ fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
 fn window(_: &PreviewArgs, _: FrameSettings) -> Result<()> {
     Err(Error::Preview("this build has no window (built without the `window` feature); use --out FILE.png".into())
         .into())
+}
+
+/// A body atlas `--map-size` wide that would pass the preview's tallest texture is drawn
+/// narrower (`prepare::map_dimensions`): say so, where the refusal of a run too large for
+/// memory was the only place that named the maps' size.
+fn narrowed_note(loaded: &snakeskin::preset::LoadedPreset, map_size: usize, layout: snakeskin::maps::Layout) {
+    use snakeskin::render::engine::prepare::{MAX_TEXTURE_SIDE, map_dimensions};
+    let (width, height) = map_dimensions(loaded, map_size, layout);
+    if width < map_size {
+        eprintln!(
+            "note: the body atlas is {width}x{height}: --map-size {map_size} would make it longer than {MAX_TEXTURE_SIDE} \
+             rows ({} widths)",
+            loaded.preset.body.length
+        );
+    }
 }
