@@ -122,6 +122,17 @@ pub fn sheet_camera() -> Camera {
 }
 
 /// Draws `text` with its top-left corner at (x, y); characters outside the font are skipped.
+/// `text` as a label line of a cell `cell_w` wide holds it: whole, or cut with ".." where
+/// it was cut mid-word without a sign ("Crotalus at", "Western dia" at `--tile 64`).
+fn clipped(text: &str, cell_w: u32) -> String {
+    let fits = (cell_w as usize).saturating_sub(12) / (8 * LABEL_SCALE as usize);
+    if text.chars().count() <= fits || fits < 3 {
+        return text.chars().take(fits).collect();
+    }
+    let kept: String = text.chars().take(fits.saturating_sub(2)).collect();
+    format!("{}..", kept.trim_end())
+}
+
 pub fn draw_text(image: &mut RgbImage, x: u32, y: u32, text: &str, color: Rgb<u8>) {
     let mut pen = x;
     for ch in text.chars() {
@@ -210,8 +221,7 @@ fn render_tile_sheet(
         let (x0, y0) = ((i as u32 % columns) * cell_w, (i as u32 / columns) * cell_h);
         let preset = &loaded.preset;
         let category = preset.category.map(|c| format!(" ({})", c.name())).unwrap_or_default();
-        let fits = (cell_w as usize - 12) / (8 * LABEL_SCALE as usize);
-        let clip = |text: String| text.chars().take(fits).collect::<String>();
+        let clip = |text: String| clipped(&text, cell_w);
         let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
         let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
         draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
@@ -275,8 +285,7 @@ fn render_body_sheet(
 
         let (x0, y0) = ((i as u32 % columns) * cell_w, (i as u32 / columns) * cell_h);
         let category = preset.category.map(|c| format!(" ({})", c.name())).unwrap_or_default();
-        let fits = (cell_w as usize - 12) / (8 * LABEL_SCALE as usize);
-        let clip = |text: String| text.chars().take(fits).collect::<String>();
+        let clip = |text: String| clipped(&text, cell_w);
         let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
         let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
         let counts = crate::export::body_counts(preset, &body);
@@ -398,6 +407,19 @@ pub fn write_sheet(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A label that does not fit its cell ends in "..", within the cell; one that fits is
+    /// whole. A tile of 64 (a cell 192 wide) holds 11 characters of 16 pixels.
+    #[test]
+    fn a_label_too_long_for_its_cell_says_it_was_cut() {
+        assert_eq!(clipped("Crotalus atrox", 192), "Crotalus..");
+        assert_eq!(clipped("Natrix", 192), "Natrix");
+        assert_eq!(clipped("Natrix natri", 192), "Natrix na..");
+        assert_eq!(clipped("Boa", 12 + 2 * 16), "Bo");
+        for text in ["Crotalus atrox", "Western diamond-backed rattlesnake (complex)"] {
+            assert!(clipped(text, 192).chars().count() <= 11, "{text}");
+        }
+    }
 
     #[test]
     fn text_is_drawn_where_asked_and_clipped_at_the_edge() {
