@@ -626,6 +626,9 @@ fn a_name_one_toml_away_from_a_preset_gets_the_fix() {
                 built-in preset natrix-natrix, give its name without a path or .toml";
     assert!(err.contains(says), "{err}");
     assert!(!run("natrix-natrixx.toml").contains("built-in preset"));
+    // A folder is called one (it was only "not a .toml file and not a built-in preset").
+    std::fs::create_dir(dir.path().join("snakes")).unwrap();
+    assert!(run("snakes").contains("; snakes is a folder: name a .toml file in it"), "{}", run("snakes"));
     assert!(!dir.path().join("out").exists(), "a folder was made");
 }
 

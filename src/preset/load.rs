@@ -114,6 +114,10 @@ pub fn read_source_beside(spec: &str, folder: &Path) -> Result<PresetSource, Pre
             let file = format!("{spec}.toml");
             let suggestion = if !spec.is_empty() && folder.join(&file).is_file() {
                 format!("; to read the file {file}, give its name with .toml")
+            } else if !spec.is_empty() && folder.join(spec).is_dir() {
+                // `graph /tmp` said only that it was no preset, where `graph d.toml` (a
+                // folder) said it was a folder.
+                format!("; {spec} is a folder: name a .toml file in it")
             } else {
                 library::suggest(spec).map(|n| format!("; did you mean {n}?")).unwrap_or_default()
             };
