@@ -297,7 +297,12 @@ pub fn tile_budget_from_env() -> Result<Option<u64>, Error> {
 }
 
 fn mib_from_env(variable: &'static str) -> Result<Option<u64>, Error> {
-    let invalid = |value: String| Error::Environment { variable, value, accepted: "a whole number of MiB, e.g. 4096" };
+    macro_rules! accepted {
+        () => {
+            "a whole number of MiB, e.g. 4096"
+        };
+    }
+    let invalid = |value: String| Error::Environment { variable, value, accepted: accepted!() };
     match std::env::var(variable) {
         Err(std::env::VarError::NotPresent) => Ok(None),
         Err(std::env::VarError::NotUnicode(v)) => Err(invalid(v.to_string_lossy().into_owned())),
@@ -306,7 +311,8 @@ fn mib_from_env(variable: &'static str) -> Result<Option<u64>, Error> {
             std::num::IntErrorKind::PosOverflow => Error::Environment {
                 variable,
                 value: v,
-                accepted: "a whole number of MiB, e.g. 4096, at most 18446744073709551615",
+                // u64::MAX
+                accepted: concat!(accepted!(), ", at most 18446744073709551615"),
             },
             _ => invalid(v),
         }),

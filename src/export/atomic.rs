@@ -47,9 +47,11 @@
 //! its temporaries of new files, and no new temporary or commit starts after that. Without
 //! it, a Ctrl-C left hidden temporaries (up to a set's size) until the next run in that
 //! folder. The old files a commit moved aside are the commit's to put back or remove, never
-//! the handler's. The lock file stays, empty, as after a kill, for the next run to reuse:
-//! removed while the process still ran, it would let another run take the set before this
-//! one's threads have stopped.
+//! the handler's. Its set lock files and the empty folders it made go too (a batch left a
+//! lock in every set folder it had begun): the commit and temporaries' locks stay held
+//! until the exit, so another run that takes a set meanwhile meets no write of this one's
+//! but an export's removal of a thickness image its just-committed set no longer writes.
+//! The locks are taken in one order: `COMMIT`, `LIVE`, `HELD_LOCKS`, `MADE_FOLDERS`.
 
 use std::fs::{self, File};
 use std::io::Write;

@@ -17,9 +17,21 @@ pub fn restore_default_sigpipe() {
     }
 }
 
+/// SIGPIPE ignored from here on: a write to a closed pipe fails with `BrokenPipe`, for a
+/// command that writes while it works (`batch`'s job lines) to stop writing and go on.
+pub fn ignore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: SIG_IGN is a valid disposition for SIGPIPE; `signal` is process-wide and may
+    // be called from any thread.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_IGN);
+    }
+}
+
 /// Ctrl-C, SIGTERM or SIGHUP end the run without leaving its unfinished files: a commit in
-/// progress ends first (a set is never left mixed), the run's temporaries are removed
-/// (`export::clean_up_before_exit`), one line says so, and the exit status is 128 + the
+/// progress ends first (a set is never left mixed), the run's temporaries, its set lock
+/// files and the empty folders it made are removed (`export::clean_up_before_exit`), one
+/// line says so, and the exit status is 128 + the
 /// signal's number, as a shell reports a process that a signal ended (or the run's own, if
 /// it finished meanwhile). Before, the hidden temporaries (up to a set's size) stayed until
 /// the next run in that folder. A second signal exits at once. A signal that was ignored

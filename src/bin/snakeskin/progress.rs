@@ -53,11 +53,11 @@ impl Progress {
         }
     }
 
-    /// A line on stdout (a written path), the bar kept out of its way.
-    pub fn println_stdout(&self, line: &str) {
+    /// Runs `f` (a line on stdout) with the bar kept out of its way.
+    pub fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
         match &self.0 {
-            Some(bar) => bar.suspend(|| println!("{line}")),
-            None => println!("{line}"),
+            Some(bar) => bar.suspend(f),
+            None => f(),
         }
     }
 

@@ -146,14 +146,20 @@ impl BodyShape {
         (c + lift + offset, c + lift)
     }
 
-    /// The closed tube with UVs and tangents.
-    /// Triangles of `mesh`: two a quad, `segments` quads round each of `rings` bands.
-    pub fn triangles(&self) -> u64 {
-        2 * self.rings.max(4) as u64 * self.segments.max(3) as u64
+    /// Rings and segments as the mesh is made: at least 4 and 3.
+    fn rings_segments(&self) -> (usize, usize) {
+        (self.rings.max(4), self.segments.max(3))
     }
 
+    /// Triangles of `mesh`: two a quad, `segments` quads round each of `rings` bands.
+    pub fn triangles(&self) -> u64 {
+        let (rings, segments) = self.rings_segments();
+        2 * rings as u64 * segments as u64
+    }
+
+    /// The closed tube with UVs and tangents.
     pub fn mesh(&self) -> Mesh {
-        let (rings, segments) = (self.rings.max(4), self.segments.max(3));
+        let (rings, segments) = self.rings_segments();
         // Arc length along the centre line at each ring gives v.
         let arc = self.arc_table(rings);
         // An atlas places its regions by length along the body (its v), so the body's shape
@@ -488,11 +494,6 @@ mod tests {
         }
     }
 
-    /// The tile stays square on the body: for every ring behind the snout's dome and wider
-    /// than a third of the full girth, the ring's length round the body (one texture width) against the length along
-    /// the centre line that one texture height spans there, measured on the mesh's own
-    /// positions and v. Negative control: a repeat of one full-girth circumference (the
-    /// earlier rule) is off by the girth's ratio, ten times the tolerance at a third.
     #[test]
     fn the_triangle_count_is_the_meshes() {
         for shape in [BodyShape::default(), BodyShape { rings: 3, segments: 2, ..BodyShape::default() }] {
@@ -500,6 +501,11 @@ mod tests {
         }
     }
 
+    /// The tile stays square on the body: for every ring behind the snout's dome and wider
+    /// than a third of the full girth, the ring's length round the body (one texture width) against the length along
+    /// the centre line that one texture height spans there, measured on the mesh's own
+    /// positions and v. Negative control: a repeat of one full-girth circumference (the
+    /// earlier rule) is off by the girth's ratio, ten times the tolerance at a third.
     #[test]
     fn the_tile_stays_square_as_the_girth_changes() {
         let shape = BodyShape { rings: 480, segments: 64, ..BodyShape::default() };

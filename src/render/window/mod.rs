@@ -92,7 +92,10 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let loaded = crate::preset::load(&options.preset, &options.overrides, options.seed)?;
     let sliders = Sliders::from_preset(&loaded.preset);
     let mut cache = NodeCache::new();
-    let frame_bytes = super::engine::renderer::window_frame_bytes(options.size.0, options.size.1);
+    // The snakes' triangles too: `--snakes`, or as many as the panel's slider draws.
+    let snakes = options.settings.snakes.max(panel::SNAKES_SLIDER_MAX);
+    let frame_bytes = super::engine::renderer::window_frame_bytes(options.size.0, options.size.1)
+        + super::engine::prepare::more_snakes_bytes(&loaded, options.layout, snakes);
     let (maps, _) = material_maps_cached(&loaded, options.map_size, options.layout, &mut cache, frame_bytes)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);

@@ -8,6 +8,9 @@ use crate::render::engine::film::GpuFilmMethod;
 use crate::render::engine::renderer::FrameSettings;
 use crate::render::engine::scene::{LayerOptics, Light, Stage, View};
 
+/// The most snakes the panel's slider draws (the window's memory check counts as many).
+pub const SNAKES_SLIDER_MAX: u32 = 20;
+
 /// Optics as the sliders edit them (σ0 as one number; an RGB σ0 shows its mean).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sliders {
@@ -98,7 +101,7 @@ pub fn controls(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Sliders
         }
         ui.checkbox(&mut settings.lighting.fill.enabled, "fill light");
         ui.checkbox(&mut settings.ground, "ground");
-        ui.add(egui::Slider::new(&mut settings.snakes, 1..=20).text("snakes"));
+        ui.add(egui::Slider::new(&mut settings.snakes, 1..=SNAKES_SLIDER_MAX).text("snakes"));
         ui.separator();
         ui.label("drag: orbit · wheel: zoom");
         if !status.is_empty() {

@@ -22,6 +22,10 @@ pub fn run(args: BatchArgs) -> Result<()> {
         }
         return Ok(());
     }
+    // The job lines below are written while jobs run: a reader that goes away (`| head`)
+    // must not end the batch by SIGPIPE mid-commit, with its locks and temporaries left.
+    crate::output::ignore_sigpipe();
+    let mut log = JobLog::default();
     let had_folder = args.out.is_dir();
     let bar = Progress::counting("{spinner} batch [{bar:30}] {pos}/{len} jobs {elapsed} {msg}");
     let concurrency = args.concurrent.map_or_else(batch::default_concurrency, |n| n as usize);
@@ -33,11 +37,9 @@ pub fn run(args: BatchArgs) -> Result<()> {
             // One line a job on stdout as well, as `generate` prints the paths it wrote: a
             // redirected run (an array job's log) said nothing until its summary, and nothing
             // of what it had finished when a signal ended it.
-            bar.println_stdout(&format!(
-                "{done}/{total} {} {}",
-                outcome.status,
-                path_line(&args.out.join(&outcome.folder))
-            ));
+            bar.suspend(|| {
+                log.line(&format!("{done}/{total} {} {}", outcome.status, path_line(&args.out.join(&outcome.folder))))
+            });
             for kept in &outcome.kept {
                 bar.println(&format!("warning: {}", crate::output::kept_words(kept)));
             }
@@ -50,15 +52,43 @@ pub fn run(args: BatchArgs) -> Result<()> {
     let duplicates = index.jobs.iter().filter(|j| j.status == "duplicate").count();
     let skipped = index.jobs.len() - ran - duplicates;
     let duplicates = if duplicates > 0 { format!(", {duplicates} duplicates of another job") } else { String::new() };
-    println!(
+    log.line(&format!(
         "{} of {} in shard {}, up to {} at once: {ran} run, {skipped} already done{duplicates}; index: {}",
         counted(index.jobs.len(), "job"),
         jobs.len(),
         index.shard,
         index.concurrency,
         path_line(&args.out.join(batch::index_file_name(shard)))
-    );
-    Ok(())
+    ));
+    log.finish()
+}
+
+/// The batch's lines on stdout. A write that fails stops the lines, not the batch (its jobs
+/// run on); afterwards a closed pipe ends the run quietly, and another failure (a full
+/// disk, `> /dev/full`) is the run's error, as for every command.
+#[derive(Default)]
+struct JobLog {
+    failed: Option<std::io::Error>,
+}
+
+impl JobLog {
+    fn line(&mut self, line: &str) {
+        use std::io::Write;
+        if self.failed.is_none()
+            && let Err(e) = writeln!(std::io::stdout(), "{line}")
+        {
+            self.failed = Some(e);
+        }
+    }
+
+    fn finish(self) -> Result<()> {
+        match self.failed {
+            Some(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                Err(anyhow::anyhow!("cannot write to standard output: {e}"))
+            }
+            _ => Ok(()),
+        }
+    }
 }
 
 /// `1 job`, `2 jobs`.
