@@ -12,7 +12,8 @@ use serde::{Deserialize, Deserializer, Serialize, de};
 /// type: unit variant"): `try_from = "String"` reads a string, and `by_name` finds the
 /// variant whose serialised name it is, or names the nearest and lists them all. The
 /// macro's `match` makes leaving a variant out of the list a compile error.
-/// `accepted:` replaces the message's plain list where not every value goes everywhere.
+/// `accepted:` words the message's list where not every value goes everywhere (called only
+/// for a message).
 macro_rules! named_enum {
     ($t:ident { $($v:ident),+ $(,)? }) => {
         named_enum!($t { $($v),+ } accepted: None);
@@ -44,8 +45,8 @@ pub fn spelled<T: Serialize>(value: &T) -> String {
 }
 
 /// The variant of `all` serialised as `name` (the preset's spelling), or a message that
-/// lists them (or says `accepted`, where given).
-fn by_name<T: Serialize + Copy>(all: &[T], name: &str, accepted: Option<&str>) -> Result<T, String> {
+/// lists them (or says what `accepted` words, where given).
+fn by_name<T: Serialize + Copy>(all: &[T], name: &str, accepted: Option<fn() -> String>) -> Result<T, String> {
     let names: Vec<String> = all.iter().map(spelled).collect();
     match names.iter().position(|n| n == name) {
         Some(i) => Ok(all[i]),
@@ -53,7 +54,7 @@ fn by_name<T: Serialize + Copy>(all: &[T], name: &str, accepted: Option<&str>) -
             let hint = crate::toml_text::nearest(name, names.iter().map(String::as_str))
                 .map(|n| format!("; did you mean \"{n}\"?"))
                 .unwrap_or_default();
-            let accepted = accepted.map_or_else(|| names.join(", "), str::to_string);
+            let accepted = accepted.map_or_else(|| names.join(", "), |words| words());
             Err(format!("unknown value {name:?}{hint} (accepted: {accepted})"))
         }
     }
@@ -66,7 +67,7 @@ named_enum!(StripePosition { Vertebral, Dorsolateral, Lateral });
 // Spots and blotches take different shapes (`validate.rs` checks which): the plain list put
 // `ring` before a blotches layer, which then refused it.
 named_enum!(PatternShape { Round, Ring, Diamond, Saddle, Chevron, Hourglass, Zigzag }
-    accepted: Some(&PatternShape::accepted_by_kind()));
+    accepted: Some(PatternShape::accepted_by_kind));
 named_enum!(Arrangement { Aligned, Alternating, Checkered });
 named_enum!(NoiseChoice { Perlin, Cellular });
 named_enum!(BellyPattern { None, Checkered, Spots, HalfMoons, MedianStripe });

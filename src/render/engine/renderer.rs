@@ -256,10 +256,16 @@ const GROUND_HALF_SIZE: f32 = 30.0;
 /// centre. At the origin, the ground left the far columns of a grid of more than about 100
 /// snakes over the bare background.
 fn placements(n: u32) -> Vec<[f32; 4]> {
+    let (x, z) = grid_centre(n);
+    snake_grid(n).into_iter().chain(std::iter::once([x, z, 0.0, 0.0])).collect()
+}
+
+/// The centre (x, z) of the grid of `n` snakes' placements (`snake_grid`): where the ground
+/// lies and the camera of a many-snake frame looks.
+pub fn grid_centre(n: u32) -> (f32, f32) {
     let (columns, spacing_x, spacing_z) = grid_layout(n);
     let rows = n.div_ceil(columns);
-    let centre = [(columns - 1) as f32 * spacing_x * 0.5, -((rows - 1) as f32) * spacing_z * 0.5, 0.0, 0.0];
-    snake_grid(n).into_iter().chain(std::iter::once(centre)).collect()
+    ((columns - 1) as f32 * spacing_x * 0.5, -((rows - 1) as f32) * spacing_z * 0.5)
 }
 
 /// Columns of the snake grid and the spacing along x and z (a body is 2.4 long and

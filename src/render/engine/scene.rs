@@ -50,7 +50,8 @@ impl Camera {
         let rows = snakes.div_ceil(columns);
         let width = (columns - 1) as f32 * spacing_x + 2.6;
         let depth = (rows - 1) as f32 * spacing_z + 1.0;
-        let target = Vec3::new((columns - 1) as f32 * spacing_x * 0.5, 0.05, -((rows - 1) as f32) * spacing_z * 0.5);
+        let (centre_x, centre_z) = crate::render::engine::renderer::grid_centre(snakes);
+        let target = Vec3::new(centre_x, 0.05, centre_z);
         // Fit the grid's width into the horizontal field of view of a 16:9 frame, and its
         // depth (foreshortened by the 40° pitch, about ×1.8 on screen) into the vertical one.
         let tan_v = (35.0f32.to_radians() * 0.5).tan();

@@ -121,7 +121,6 @@ pub fn sheet_camera() -> Camera {
     Camera { target: glam::Vec3::new(-0.3, 0.08, 0.15), yaw_deg: 5.0, pitch_deg: 38.0, distance: 1.25, fov_y_deg: 35.0 }
 }
 
-/// Draws `text` with its top-left corner at (x, y); characters outside the font are skipped.
 /// `text` as a label line of a cell `cell_w` wide holds it: whole, or cut with ".." where
 /// it was cut mid-word without a sign ("Crotalus at", "Western dia" at `--tile 64`).
 fn clipped(text: &str, cell_w: u32) -> String {
@@ -133,6 +132,7 @@ fn clipped(text: &str, cell_w: u32) -> String {
     format!("{}..", kept.trim_end())
 }
 
+/// Draws `text` with its top-left corner at (x, y); characters outside the font are skipped.
 pub fn draw_text(image: &mut RgbImage, x: u32, y: u32, text: &str, color: Rgb<u8>) {
     let mut pen = x;
     for ch in text.chars() {
