@@ -1176,4 +1176,24 @@ mod tests {
         assert!(takes(&tile, "2048") && !takes(&tile, "2049") && !takes(&tile, "15"));
         assert_eq!(named_ranges("Tile size in pixels (16 to 2048)."), [(16.0, 2048.0)]);
     }
+
+    /// The atlas's longest side that `sheet --map-size` and `preview --map-size` name is the
+    /// one they keep (`MAX_TEXTURE_SIDE`): a help text cannot take the constant, so this test
+    /// holds them together. Negative control: a help text with another number of rows.
+    #[test]
+    fn the_atlas_rows_named_in_help_are_the_kept_ones() {
+        use snakeskin::render::engine::prepare::MAX_TEXTURE_SIDE;
+        let rows_named = |help: &str| -> Vec<usize> {
+            let words: Vec<&str> = help.split_whitespace().collect();
+            words.windows(2).filter(|w| w[1].starts_with("rows")).filter_map(|w| w[0].parse().ok()).collect()
+        };
+        let command = <Cli as clap::CommandFactory>::command();
+        for name in ["sheet", "preview"] {
+            let sub = command.find_subcommand(name).unwrap();
+            let arg = sub.get_arguments().find(|a| a.get_long() == Some("map-size")).unwrap();
+            let help = arg.get_long_help().or(arg.get_help()).map(|h| h.to_string()).unwrap_or_default();
+            assert_eq!(rows_named(&help), [MAX_TEXTURE_SIDE], "{name} --map-size: {help:?}");
+        }
+        assert_ne!(rows_named("more than 4096 rows long"), [MAX_TEXTURE_SIDE]);
+    }
 }
