@@ -186,6 +186,46 @@ fn an_interrupted_batch_leaves_its_finished_sets_and_nothing_else() {
     }
 }
 
+/// A standard error that fails while jobs run (`2> /dev/full`, a warning of a file kept
+/// beside a finished set) ends the batch with status 1 and leaves its finished sets and
+/// nothing else, as a signal does: the running job's lock file and the folder made for it
+/// stayed (the panic hook exited without the clean-up).
+#[cfg(target_os = "linux")]
+#[test]
+fn a_failing_standard_error_mid_batch_leaves_nothing_unfinished() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    // The first job finishes long before the second (a larger set), which is running when
+    // the first one's warning is written.
+    let text = "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n\n\
+                [[job]]\npreset = \"python-regius\"\nseeds = [1]\nsizes = [1024]\n";
+    std::fs::write(&jobs, text).unwrap();
+    let out = dir.path().join("out");
+    let first = out.join("natrix-natrix/tile-16-seed1-png");
+    std::fs::create_dir_all(&first).unwrap();
+    std::fs::write(first.join("natrix-natrix_color.exr"), b"not this set's").unwrap();
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let ended = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "2"])
+        .stdout(Stdio::piped())
+        .stderr(full)
+        .output()
+        .unwrap();
+    assert_eq!(ended.status.code(), Some(1), "{}", stdout(&ended));
+    let finished = manifests(&out);
+    assert!(!finished.keys().any(|m| m.starts_with("python-regius")), "the second job ended first: {finished:?}");
+    for path in entries(&out) {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(!name.starts_with('.'), "{} was left", path.display());
+        assert!(
+            !out.join(&path).is_dir() || finished.keys().any(|m| m.starts_with(&path)),
+            "{} holds no finished set: {:?}",
+            path.display(),
+            entries(&out)
+        );
+    }
+}
+
 #[test]
 fn a_killed_batch_resumes_with_only_the_unfinished_jobs_and_the_same_files() {
     let dir = tempfile::tempdir().unwrap();

@@ -87,19 +87,25 @@ fn ignored_from_the_start(signal: i32) -> bool {
 /// alike, and leaves every other panic to the default hook. A standard error that fails
 /// (`2> /dev/full`) while a run goes on (a note, a warning) ends it with status 1 too, saying
 /// nothing (there is nowhere to say it): `eprintln!` panicked and the default hook's message
-/// failed as well, exit 101. A run's final error is written without `eprintln!` (`main`), so
+/// failed as well, exit 101. Either way its unfinished files are removed first, as on a
+/// signal. A run's final error is written without `eprintln!` (`main`), so
 /// its exit code stays the error's own.
 pub fn stdout_failure_is_an_error() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         let payload = info.payload();
         let message = payload.downcast_ref::<String>().map(String::as_str).or(payload.downcast_ref::<&str>().copied());
+        // Both exits leave what a signal's leaves (`clean_up_before_exit`): a batch whose
+        // warning failed mid-run left its running jobs' lock files and the folders made for
+        // them. No print happens under the clean-up's locks (the library prints nothing).
         if let Some(reason) = message.and_then(|m| m.strip_prefix("failed printing to stdout: ")) {
+            snakeskin::export::clean_up_before_exit();
             use std::io::Write;
             let _ = writeln!(std::io::stderr(), "error: cannot write to standard output: {}", printable(reason));
             std::process::exit(1);
         }
         if message.is_some_and(|m| m.starts_with("failed printing to stderr: ")) {
+            snakeskin::export::clean_up_before_exit();
             std::process::exit(1);
         }
         default(info);
