@@ -55,8 +55,6 @@ pub struct ExportReport {
     pub total_time: Duration,
     /// Whether the export created the file's folder.
     pub created_folder: bool,
-    /// The preset's warnings (`LoadedPreset::warnings`), for the caller to print.
-    pub warnings: Vec<String>,
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
@@ -94,101 +92,146 @@ pub fn mesh_for(kind: MeshKind, layout: Layout, preset: &crate::preset::Preset) 
     .without_degenerate_triangles()
 }
 
-/// Plans, evaluates and writes one glTF export.
+/// Plans, evaluates and writes one glTF export (`ExportPlan::new`, then `ExportPlan::run`).
 pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<ExportReport, Error> {
-    let start = Instant::now();
-    let binary = is_binary(&request.out)?;
-    if request.mesh == MeshKind::Sphere && request.layout == Layout::Body {
-        return Err(Error::Unsupported(
-            "--mesh sphere with --layout body: a body atlas spans a whole snake; put it on --mesh snake or plane"
-                .into(),
-        ));
+    ExportPlan::new(request)?.run(progress)
+}
+
+/// An export checked before any pixel is computed: the preset loaded and validated, the
+/// files it will write checked, its warnings and memory known, so that a caller can say them
+/// before the work (the pack's size warning came after the textures were made).
+pub struct ExportPlan {
+    start: Instant,
+    out: PathBuf,
+    binary: bool,
+    name: String,
+    dir: PathBuf,
+    plan: Plan,
+    material: GltfMaterial,
+    mesh: Mesh,
+    thickness_varies: bool,
+    ao: bool,
+    warnings: Vec<String>,
+}
+
+impl ExportPlan {
+    /// The preset's warnings (`LoadedPreset::warnings`), then the textures' size
+    /// (`Plan::size_warning`).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
-    let dir = request.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
-    let name = request
-        .out
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .filter(|s| !s.is_empty())
-        .ok_or_else(|| Error::Unsupported(format!("--gltf {}: no file name", request.out.display())))?;
-    let plan = Plan::new(&GenerateRequest {
-        preset: request.preset.clone(),
-        overrides: request.overrides.clone(),
-        seed: request.seed,
-        size: request.size,
-        maps: vec![MapKind::Color, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence],
-        out_dir: dir.clone(),
-        options: BuildOptions { layout: request.layout, ..BuildOptions::default() },
-        format: FileFormat::Png,
-        pack: Some(Pack::Gltf),
-        ao: request.ao,
-        job: None,
-    })?;
-    let preset = &plan.loaded().preset;
-    let film = has_film(preset).then(|| {
-        let (min_nm, max_nm) = thickness_range_nm(preset);
-        (preset.optics.film_ior, min_nm, max_nm)
-    });
-    let material = GltfMaterial { base_ior: preset.optics.pigment_ior, film, repeat_v: request.layout == Layout::Tile };
-    let mesh = mesh_for(request.mesh, request.layout, preset);
-    // The files it will write, checked before the work (a folder or a link where one goes
-    // was found only when they were written): the `.glb`, or the `.gltf` and its side files.
-    // A film of one thickness (no spread) needs no texture: glTF reads the thickness as
-    // the maximum then, which is the minimum (the validator's THICKNESS_TEXTURE_UNUSED).
-    let thickness_varies = film.is_some_and(|(_, min_nm, max_nm)| max_nm > min_nm);
-    let side_files = if binary { Vec::new() } else { gltf_side_file_names(&name, thickness_varies) };
-    crate::export::check_folder(&dir)?;
-    let input = crate::preset::input_file(&request.preset);
-    crate::export::check_target(&request.out)?;
-    crate::export::check_not_an_input(&request.out, input)?;
-    for file in side_files {
-        let target = dir.join(file);
-        crate::export::check_target(&target)?;
-        crate::export::check_not_an_input(&target, input)?;
+
+    /// The textures' evaluation memory (`Plan::memory`).
+    pub fn memory(&self) -> crate::memory::MemoryCheck {
+        self.plan.memory()
     }
-    let (textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
-    let dimensions = plan.dimensions();
-    let texture = |suffix: &str| textures.iter().find(|(s, _)| s.suffix == suffix).map(|(_, b)| b.clone());
-    let missing = |suffix: &str| Error::Internal(format!("the glTF pack has no {suffix} texture"));
-    let textures = GltfTextures {
-        base_color: texture("basecolor").ok_or_else(|| missing("basecolor"))?,
-        normal: texture("normal").ok_or_else(|| missing("normal"))?,
-        orm: texture("orm").ok_or_else(|| missing("orm"))?,
-        thickness: texture("thickness").filter(|_| thickness_varies),
-        occlusion: request.ao,
-    };
-    let created_folder;
-    let files = if binary {
-        let bytes = glb(&name, &mesh, material, &textures)?;
-        created_folder = crate::export::create_folder_noted(&dir)?;
-        // A write that fails takes away the folders it made, as a set's lock does.
-        vec![write_file_atomically(&request.out, bytes).inspect_err(|_| crate::export::remove_empty_made_folders())?]
-    } else {
-        let mut files = gltf_files(&name, &mesh, material, &textures)?;
-        let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
-        let lock = SetLock::acquire(&dir, &name)?;
-        created_folder = lock.created_folder;
-        let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
-        // An earlier export of this name with a film left its thickness image, which no
-        // file references now: under the lock, after the commit, it goes. Whatever stands
-        // there is harmless once the commit is done, so an export that succeeded does not
-        // fail for it (a folder of that name stays, and so does a file that may not go).
-        if textures.thickness.is_none() {
-            let stale = dir.join(gltf_image_file_name(&name, "thickness"));
-            if std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir()) {
-                let _ = std::fs::remove_file(&stale);
-            }
+
+    pub fn new(request: &ExportRequest) -> Result<ExportPlan, Error> {
+        let start = Instant::now();
+        let binary = is_binary(&request.out)?;
+        if request.mesh == MeshKind::Sphere && request.layout == Layout::Body {
+            return Err(Error::Unsupported(
+                "--mesh sphere with --layout body: a body atlas spans a whole snake; put it on --mesh snake or plane"
+                    .into(),
+            ));
         }
-        written
-    };
-    Ok(ExportReport {
-        files,
-        dimensions,
-        stats,
-        encode_time,
-        total_time: start.elapsed(),
-        created_folder,
-        // The preset's, then the textures' size (`Pack::size_warning`).
-        warnings: plan.loaded().warnings(&request.preset).into_iter().chain(plan.size_warning()).collect(),
-    })
+        let dir = request.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
+        let name = request
+            .out
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| !s.is_empty())
+            .ok_or_else(|| Error::Unsupported(format!("--gltf {}: no file name", request.out.display())))?;
+        let plan = Plan::new(&GenerateRequest {
+            preset: request.preset.clone(),
+            overrides: request.overrides.clone(),
+            seed: request.seed,
+            size: request.size,
+            maps: vec![MapKind::Color, MapKind::Normal, MapKind::Roughness, MapKind::Iridescence],
+            out_dir: dir.clone(),
+            options: BuildOptions { layout: request.layout, ..BuildOptions::default() },
+            format: FileFormat::Png,
+            pack: Some(Pack::Gltf),
+            ao: request.ao,
+            job: None,
+        })?;
+        let preset = &plan.loaded().preset;
+        let film = has_film(preset).then(|| {
+            let (min_nm, max_nm) = thickness_range_nm(preset);
+            (preset.optics.film_ior, min_nm, max_nm)
+        });
+        let material =
+            GltfMaterial { base_ior: preset.optics.pigment_ior, film, repeat_v: request.layout == Layout::Tile };
+        let mesh = mesh_for(request.mesh, request.layout, preset);
+        // The files it will write, checked before the work (a folder or a link where one goes
+        // was found only when they were written): the `.glb`, or the `.gltf` and its side files.
+        // A film of one thickness (no spread) needs no texture: glTF reads the thickness as
+        // the maximum then, which is the minimum (the validator's THICKNESS_TEXTURE_UNUSED).
+        let thickness_varies = film.is_some_and(|(_, min_nm, max_nm)| max_nm > min_nm);
+        let side_files = if binary { Vec::new() } else { gltf_side_file_names(&name, thickness_varies) };
+        crate::export::check_folder(&dir)?;
+        let input = crate::preset::input_file(&request.preset);
+        crate::export::check_target(&request.out)?;
+        crate::export::check_not_an_input(&request.out, input)?;
+        for file in side_files {
+            let target = dir.join(file);
+            crate::export::check_target(&target)?;
+            crate::export::check_not_an_input(&target, input)?;
+        }
+        let warnings = plan.loaded().warnings(&request.preset).into_iter().chain(plan.size_warning()).collect();
+        Ok(ExportPlan {
+            start,
+            out: request.out.clone(),
+            binary,
+            name,
+            dir,
+            plan,
+            material,
+            mesh,
+            thickness_varies,
+            ao: request.ao,
+            warnings,
+        })
+    }
+
+    /// Evaluates the textures and writes the file (and, for `.gltf`, its side files).
+    pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<ExportReport, Error> {
+        let ExportPlan { start, out, binary, name, dir, plan, material, mesh, thickness_varies, ao, .. } = self;
+        let (textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
+        let dimensions = plan.dimensions();
+        let texture = |suffix: &str| textures.iter().find(|(s, _)| s.suffix == suffix).map(|(_, b)| b.clone());
+        let missing = |suffix: &str| Error::Internal(format!("the glTF pack has no {suffix} texture"));
+        let textures = GltfTextures {
+            base_color: texture("basecolor").ok_or_else(|| missing("basecolor"))?,
+            normal: texture("normal").ok_or_else(|| missing("normal"))?,
+            orm: texture("orm").ok_or_else(|| missing("orm"))?,
+            thickness: texture("thickness").filter(|_| thickness_varies),
+            occlusion: ao,
+        };
+        let created_folder;
+        let files = if binary {
+            let bytes = glb(&name, &mesh, material, &textures)?;
+            created_folder = crate::export::create_folder_noted(&dir)?;
+            // A write that fails takes away the folders it made, as a set's lock does.
+            vec![write_file_atomically(&out, bytes).inspect_err(|_| crate::export::remove_empty_made_folders())?]
+        } else {
+            let mut files = gltf_files(&name, &mesh, material, &textures)?;
+            let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
+            let lock = SetLock::acquire(&dir, &name)?;
+            created_folder = lock.created_folder;
+            let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
+            // An earlier export of this name with a film left its thickness image, which no
+            // file references now: under the lock, after the commit, it goes. Whatever stands
+            // there is harmless once the commit is done, so an export that succeeded does not
+            // fail for it (a folder of that name stays, and so does a file that may not go).
+            if textures.thickness.is_none() {
+                let stale = dir.join(gltf_image_file_name(&name, "thickness"));
+                if std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir()) {
+                    let _ = std::fs::remove_file(&stale);
+                }
+            }
+            written
+        };
+        Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed(), created_folder })
+    }
 }

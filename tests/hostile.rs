@@ -68,6 +68,14 @@ fn a_set_larger_than_memory_is_refused_before_it_runs() {
     let err = stderr(&out);
     let warning = err.lines().find(|l| l.starts_with("warning: this set needs about ")).unwrap_or_default();
     assert!(warning.ends_with("MiB at its peak; 100 MiB are available under SNAKESKIN_MEMORY_LIMIT_MIB"), "{err}");
+    // `export` says it as well (it said nothing of its memory).
+    let glb = dir.path().join("tight.glb");
+    let args = ["export", PRESET, "--gltf", glb.to_str().unwrap(), "--size", "256", "--mesh", "plane"];
+    let out = snakeskin_env(&args, &[("SNAKESKIN_MEMORY_LIMIT_MIB", "100")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let warning = err.lines().find(|l| l.starts_with("warning: this export needs about ")).unwrap_or_default();
+    assert!(warning.ends_with("MiB at its peak; 100 MiB are available under SNAKESKIN_MEMORY_LIMIT_MIB"), "{err}");
 }
 
 /// Under `ulimit -v` (RLIMIT_AS) a set larger than the address space left is refused before

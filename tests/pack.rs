@@ -210,4 +210,19 @@ fn a_pack_longer_than_its_engine_loads_is_warned_of_with_a_size_that_fits() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("the gltf textures are 410 x 16400"), "{}", stderr(&out));
     assert!(stderr(&out).contains("give --size 409 or less"), "{}", stderr(&out));
+    // The export knows it before the work (it was said after the textures were made): the
+    // plan has it, and no texel is computed until it runs.
+    use snakeskin::gltf_export::{ExportPlan, ExportRequest, MeshKind};
+    let request = |size: u64| ExportRequest {
+        preset: "natrix-natrix".into(),
+        overrides: vec![("body.length".into(), "40".into())],
+        seed: None,
+        size,
+        layout: Layout::Body,
+        mesh: MeshKind::Snake,
+        out: dir.path().join("planned.glb"),
+        ao: false,
+    };
+    let warned = |size| ExportPlan::new(&request(size)).unwrap().warnings().iter().any(|w| w.contains("16384 texels"));
+    assert!(warned(410) && !warned(409));
 }

@@ -234,3 +234,16 @@ pub fn report_warnings(preset: &str, loaded: &snakeskin::preset::LoadedPreset) {
         eprintln!("{warning}");
     }
 }
+
+/// A warning when `memory` is close to what is available (`MemoryCheck::is_tight`): `what`
+/// ("this set") needs about N MiB at its peak, and where the limit comes from.
+pub fn report_tight_memory(memory: &snakeskin::memory::MemoryCheck, what: &str) {
+    if memory.is_tight() {
+        eprintln!(
+            "warning: {what} needs about {} MiB at its peak; {} MiB are available {}",
+            memory.needed_mib(),
+            memory.available_mib(),
+            memory.bound.place()
+        );
+    }
+}

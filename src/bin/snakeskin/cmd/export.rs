@@ -5,7 +5,7 @@ use anyhow::Result;
 use crate::cli::ExportArgs;
 use crate::output::path_line;
 use crate::progress::Progress;
-use snakeskin::gltf_export::{ExportRequest, export};
+use snakeskin::gltf_export::{ExportPlan, ExportRequest};
 
 pub fn run(args: ExportArgs) -> Result<()> {
     let request = ExportRequest {
@@ -18,12 +18,16 @@ pub fn run(args: ExportArgs) -> Result<()> {
         out: args.gltf.clone(),
         ao: args.ao,
     };
-    let bar = Progress::counting("{spinner} exporting [{bar:30}] {pos}/{len} nodes {elapsed}");
-    let report = export(&request, &|done, total| bar.update(done, total))?;
-    bar.finish();
-    for warning in &report.warnings {
+    // Checked and said before the work, as `generate` does: the preset's warnings, the
+    // textures' size for glTF viewers, and a memory estimate close to what is available.
+    let plan = ExportPlan::new(&request)?;
+    for warning in plan.warnings() {
         eprintln!("{warning}");
     }
+    crate::output::report_tight_memory(&plan.memory(), "this export");
+    let bar = Progress::counting("{spinner} exporting [{bar:30}] {pos}/{len} nodes {elapsed}");
+    let report = plan.run(&|done, total| bar.update(done, total))?;
+    bar.finish();
     if report.created_folder
         && let Some(folder) = args.gltf.parent()
     {

@@ -38,14 +38,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         eprintln!("{warning}");
     }
     let memory = plan.memory();
-    if memory.is_tight() {
-        eprintln!(
-            "warning: this set needs about {} MiB at its peak; {} MiB are available {}",
-            memory.needed_mib(),
-            memory.available_mib(),
-            memory.bound.place()
-        );
-    }
+    crate::output::report_tight_memory(&memory, "this set");
     let bar = Progress::counting("{spinner} generating [{bar:30}] {pos}/{len} nodes {elapsed}");
     let report = plan.run(&|done, total| bar.update(done, total))?;
     bar.finish();
