@@ -14,7 +14,7 @@ use crate::export::pack::Pack;
 use crate::export::{SetLock, write_file_atomically};
 use crate::generate::{GenerateRequest, Plan};
 use crate::graph::EvalStats;
-use crate::maps::{Layout, body_plan, has_film, thickness_range_nm};
+use crate::maps::{Layout, has_film, thickness_range_nm};
 use crate::material::{FileFormat, MapKind};
 use crate::render::engine::mesh::{BodyShape, Mesh};
 use crate::{Error, maps::BuildOptions};
@@ -83,8 +83,7 @@ fn is_binary(path: &Path) -> Result<bool, Error> {
 /// The mesh for a request (the snake's mesh without its closed ends' zero-area triangles).
 pub fn mesh_for(kind: MeshKind, layout: Layout, preset: &crate::preset::Preset) -> Mesh {
     match (kind, layout) {
-        (MeshKind::Snake, Layout::Tile) => BodyShape::default().mesh(),
-        (MeshKind::Snake, Layout::Body) => BodyShape::for_atlas(&body_plan(preset)).mesh(),
+        (MeshKind::Snake, _) => BodyShape::for_layout(layout, preset).mesh(),
         (MeshKind::Sphere, _) => Mesh::sphere(0.5, 2.0, 64, 128),
         (MeshKind::Plane, Layout::Tile) => Mesh::plane(1.0, 1.0),
         (MeshKind::Plane, Layout::Body) => Mesh::plane(1.0, preset.body.length as f32),

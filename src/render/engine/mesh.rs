@@ -69,6 +69,16 @@ impl Default for BodyShape {
 }
 
 impl BodyShape {
+    /// The snake a layout's maps go on: the default body with the tile repeated along it, or
+    /// a body atlas once over `for_atlas` of the preset's plan. The preview, its memory check
+    /// and the glTF export all take it from here.
+    pub fn for_layout(layout: crate::maps::Layout, preset: &crate::preset::Preset) -> BodyShape {
+        match layout {
+            crate::maps::Layout::Tile => BodyShape::default(),
+            crate::maps::Layout::Body => BodyShape::for_atlas(&crate::maps::body_plan(preset)),
+        }
+    }
+
     /// The body for a body atlas: the centre line of the default, a radius that makes the
     /// body `plan.length` circumferences long (so a texel covers the same skin both ways),
     /// and the atlas' head, neck and tail. More rings than the default, so that the short

@@ -161,11 +161,7 @@ pub fn check_preview_memory(
 /// What `snakes` snakes add to a frame's memory over one (`renderer::more_snakes_bytes`),
 /// drawn with the body mesh of `layout` (an atlas' has more rings).
 pub fn more_snakes_bytes(loaded: &LoadedPreset, layout: Layout, snakes: u32) -> u64 {
-    let shape = match layout {
-        Layout::Tile => BodyShape::default(),
-        Layout::Body => BodyShape::for_atlas(&body_plan(&loaded.preset)),
-    };
-    super::renderer::more_snakes_bytes(shape.triangles(), snakes)
+    super::renderer::more_snakes_bytes(BodyShape::for_layout(layout, &loaded.preset).triangles(), snakes)
 }
 
 /// Width and height of the preview's maps (`material_maps_in`): `map_size` wide, or the
