@@ -138,9 +138,17 @@ impl ExportPlan {
         let name = request
             .out
             .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
             .filter(|s| !s.is_empty())
             .ok_or_else(|| Error::Unsupported(format!("--gltf {}: no file name", request.out.display())))?;
+        // The name is written into the file (the mesh's, the material's, a `.gltf`'s URIs of
+        // its side files): one that is not UTF-8 came out as U+FFFD there and in the side
+        // files' names, which then were not the names asked for.
+        let name = name.to_str().map(String::from).ok_or_else(|| {
+            Error::Unsupported(format!(
+                "--gltf {}: the file name is not UTF-8 text; glTF names its mesh, material and side files with it",
+                request.out.display()
+            ))
+        })?;
         let plan = Plan::new(&GenerateRequest {
             preset: request.preset.clone(),
             overrides: request.overrides.clone(),

@@ -1924,3 +1924,29 @@ fn type_errors_name_the_range_and_missing_kinds_the_choices() {
         "{e}"
     );
 }
+
+/// A `--gltf` file name that is not UTF-8 is refused before the work (exit 2), naming why:
+/// it was written as U+FFFD into the file, and a `.gltf`'s side files took that name, not
+/// the one asked for. Negative control: the same name in UTF-8 is written as given.
+#[cfg(unix)]
+#[test]
+fn a_gltf_file_name_that_is_not_utf8_is_refused() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    for extension in ["glb", "gltf"] {
+        let name = [&b"bad\xff."[..], extension.as_bytes()].concat();
+        let out = dir.path().join(std::ffi::OsStr::from_bytes(&name));
+        let ended = Command::new(BIN)
+            .args(["export", PRESET, "--size", "16", "--mesh", "plane", "--gltf"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(ended.status.code(), Some(2), "{}", stderr(&ended));
+        assert!(stderr(&ended).contains("the file name is not UTF-8 text"), "{}", stderr(&ended));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "{extension}: something was written");
+    }
+    let out = dir.path().join("bad\u{ff}.gltf");
+    let ended = snakeskin(&["export", PRESET, "--size", "16", "--mesh", "plane", "--gltf", out.to_str().unwrap()]);
+    assert!(ended.status.success(), "{}", stderr(&ended));
+    assert!(out.is_file() && dir.path().join("bad\u{ff}.bin").is_file());
+}
