@@ -530,18 +530,35 @@ pub fn tables() -> &'static Tables {
 
 /// `f(k)` for k in 0..count, in order, computed on the machine's cores by plain threads
 /// (not the rayon pool: the tables are built under locks that callers on the pool wait for).
-/// The lobe tables' walks and `path::PathTable`'s use it.
+/// The lobe tables' walks and `path::PathTable`'s use it. Each thread takes the next k as
+/// it finishes one: the entries' costs differ by far (the mirror row costs nothing, rough
+/// grazing entries the most), and with each thread given a contiguous half the smooth half
+/// finished early and one core worked alone. The result depends on k alone, so it is the
+/// same on any number of threads.
 pub(super) fn split_over_threads<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, count.max(1));
-    let chunk = count.div_ceil(threads).max(1);
-    let f = &f;
-    std::thread::scope(|scope| {
-        let parts: Vec<_> = (0..count)
-            .step_by(chunk)
-            .map(|start| scope.spawn(move || (start..(start + chunk).min(count)).map(f).collect::<Vec<T>>()))
+    let next = AtomicUsize::new(0);
+    let (f, next) = (&f, &next);
+    let mut done: Vec<(usize, T)> = std::thread::scope(|scope| {
+        let parts: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(move || {
+                    let mut part = Vec::new();
+                    loop {
+                        let k = next.fetch_add(1, Ordering::Relaxed);
+                        if k >= count {
+                            return part;
+                        }
+                        part.push((k, f(k)));
+                    }
+                })
+            })
             .collect();
         parts.into_iter().flat_map(|part| part.join().expect("table thread")).collect()
-    })
+    });
+    done.sort_unstable_by_key(|(k, _)| *k);
+    done.into_iter().map(|(_, value)| value).collect()
 }
 
 /// A cell of the (μ, r) grid that the lobe tables and the path table (`path::PathTable`)
