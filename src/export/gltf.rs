@@ -206,10 +206,12 @@ fn document(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfText
         let mut film = json!({
             "iridescenceFactor": 1.0,
             "iridescenceIor": film_ior,
-            "iridescenceThicknessMinimum": min_nm,
             "iridescenceThicknessMaximum": max_nm,
         });
+        // Without a texture the thickness is the maximum, and a minimum says nothing (the
+        // validator's KHR_MATERIALS_IRIDESCENCE_THICKNESS_RANGE_WITHOUT_TEXTURE).
         if textures.thickness.is_some() {
+            film["iridescenceThicknessMinimum"] = json!(min_nm);
             film["iridescenceThicknessTexture"] = json!({ "index": 3, "texCoord": 0 });
         }
         extensions.insert("KHR_materials_iridescence".into(), film);
@@ -346,6 +348,28 @@ mod tests {
         let bin_len = word(bin_start);
         assert_eq!(word(bin_start + 4) as u32, CHUNK_BIN);
         (json, bytes[bin_start + 8..bin_start + 8 + bin_len].to_vec())
+    }
+
+    /// A film of one thickness has no texture and no minimum: glTF reads the maximum then
+    /// (the validator's note on a minimum without a texture). Negative control: with the
+    /// texture, both.
+    #[test]
+    fn a_film_without_a_thickness_texture_has_no_minimum() {
+        let mesh = Mesh::plane(1.0, 1.0);
+        let material = GltfMaterial { base_ior: 1.56, film: Some((1.33, 420.0, 420.0)), repeat_v: true };
+        for thickness in [None, Some(vec![7, 8])] {
+            let textures = GltfTextures {
+                base_color: vec![1],
+                normal: vec![2],
+                orm: vec![3],
+                thickness: thickness.clone(),
+                occlusion: false,
+            };
+            let (json, _) = parse_glb(&glb("snake", &mesh, material, &textures).unwrap());
+            let film = &json["materials"][0]["extensions"]["KHR_materials_iridescence"];
+            assert_eq!(film["iridescenceThicknessMaximum"], 420.0);
+            assert_eq!(film.get("iridescenceThicknessMinimum").is_some(), thickness.is_some(), "{film}");
+        }
     }
 
     #[test]
