@@ -579,13 +579,42 @@ fn merge(target: &mut toml::Value, value: toml::Value) {
     }
 }
 
-/// An override's value: one TOML value, or a bare word that is not TOML as a string.
+/// An override's value: one TOML value, or a bare word that is not TOML as a string. A
+/// value written as TOML that does not parse is refused with TOML's reason: one that opens
+/// an array, a table or a quoted string, or starts as a number does (`[1, 2`, `"#fff`,
+/// `1e400`), as do `True` and `False` (TOML's are lower case). They were taken as strings,
+/// and the key then said "invalid type: string \"[1, 2\", expected an array".
 fn override_value(value: &str) -> Result<toml::Value, String> {
     // One TOML value, nothing else: the table must hold exactly the key `v`.
     match toml::from_str::<toml::Table>(&format!("v = {value}")) {
         Ok(mut t) if t.len() == 1 => Ok(t.remove("v").unwrap_or(toml::Value::String(value.into()))),
         Ok(_) => Err("the value must be a single TOML value".into()),
-        Err(_) => Ok(toml::Value::String(value.into())),
+        Err(e) => {
+            let word = value.trim();
+            let mut chars = word.chars();
+            let first = chars.next();
+            let numeric = |c: Option<char>| c.is_some_and(|c| c.is_ascii_digit());
+            // A whole number past TOML's integers stays a word: the key's range check names
+            // it (`in_key_range`).
+            let digits = word.strip_prefix('-').unwrap_or(word);
+            let whole = !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit());
+            let number =
+                !whole && (numeric(first) || (matches!(first, Some('+' | '-' | '.')) && numeric(chars.next())));
+            let reason = || e.message().trim().replace('\n', "; ");
+            if word.eq_ignore_ascii_case("true") || word.eq_ignore_ascii_case("false") {
+                Err(format!("{word} is not a TOML boolean: write {}", word.to_ascii_lowercase()))
+            } else if matches!(first, Some('[' | '{' | '"' | '\'')) {
+                Err(format!("not a TOML value ({})", reason()))
+            } else if number {
+                Err(format!(
+                    "not a TOML value ({}); a string that starts like a number is written in quotes, as in \
+                     'KEY=\"{word}\"'",
+                    reason()
+                ))
+            } else {
+                Ok(toml::Value::String(value.into()))
+            }
+        }
     }
 }
 
@@ -623,6 +652,36 @@ mod tests {
 
     fn source(text: &str) -> PresetSource {
         PresetSource { name: "t".into(), display: "t.toml".into(), text: text.into() }
+    }
+
+    /// A value written as TOML that does not parse is refused with TOML's reason (it was
+    /// taken as a string, and the key said "invalid type: string"); a bare word still is a
+    /// string. Negative control: the same values written right parse.
+    #[test]
+    fn a_malformed_toml_value_is_refused_with_its_reason() {
+        for (value, reason) in [
+            ("[\"a\",", "not a TOML value (unclosed array"),
+            ("\"#ffffff", "not a TOML value (invalid basic string"),
+            ("{rows = 3", "not a TOML value ("),
+            ("1e400", "not a TOML value (floating-point number overflowed); a string that starts like a number"),
+            ("True", "True is not a TOML boolean: write true"),
+            ("FALSE", "FALSE is not a TOML boolean: write false"),
+        ] {
+            let err = override_value(value).unwrap_err();
+            assert!(err.starts_with(reason), "{value}: {err}");
+        }
+        for (value, parsed) in [
+            ("[\"a\"]", toml::Value::Array(vec!["a".into()])),
+            ("\"#ffffff\"", "#ffffff".into()),
+            ("1e300", 1e300.into()),
+            ("true", true.into()),
+            ("#ffffff", "#ffffff".into()),
+            ("Vipera berus", "Vipera berus".into()),
+            ("-x", "-x".into()),
+            ("99999999999999999999", "99999999999999999999".into()),
+        ] {
+            assert_eq!(override_value(value), Ok(parsed), "{value}");
+        }
     }
 
     /// An inline table given to `--set` merges into the table it names, key by key, as the
