@@ -432,6 +432,33 @@ mod commands {
         }
     }
 
+    /// `--method` chooses a real-time model's film: with a reference, which reads the exact
+    /// film, it is refused (it was silently ignored, as `--photons` had been). A denser
+    /// ambient than pigment layer draws the layered model's warning (its known loss beyond
+    /// the critical angle); the thesis model and a lighter ambient do not.
+    #[test]
+    fn brdf_albedo_refuses_a_method_it_would_ignore_and_warns_of_the_model_limit() {
+        for model in ["reference", "stochastic"] {
+            let (code, _, err) = run(&["brdf", "albedo", "--angle-deg", "40", "--method", "rgb3", "--model", model]);
+            assert_eq!(code, 2, "{model}: {err}");
+            assert!(err.contains("invalid --method: the references read the exact film"), "{err}");
+        }
+        let (code, _, err) = run(&["brdf", "albedo", "--angle-deg", "40", "--method", "rgb3", "--model", "thesis"]);
+        assert_eq!(code, 0, "{err}");
+        let eval = ["brdf", "eval", "--wi", "0,0,1", "--wo", "0,0,1", "--n1", "1.3"];
+        for (indices, model, warned) in [
+            (["--n0", "1.5", "--n2", "1"], "layered", true),
+            (["--n0", "1.5", "--n2", "1"], "thesis", false),
+            (["--n0", "1", "--n2", "1.5"], "layered", false),
+        ] {
+            let (code, _, err) = run(&[&eval[..], &indices[..], &["--model", model]].concat());
+            assert_eq!(code, 0, "{err}");
+            let says =
+                "warning: --n0 1.5 is above --n2 1: the layered model loses light beyond the critical angle (42°";
+            assert_eq!(err.contains(says), warned, "{indices:?} {model}: {err}");
+        }
+    }
+
     #[test]
     fn brdf_stress_reports_every_key_and_no_nan() {
         let (code, out, err) = run(&["brdf", "stress", "--samples", "4000", "--json"]);

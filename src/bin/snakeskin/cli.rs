@@ -612,9 +612,12 @@ pub enum BrdfCommand {
     /// The directional albedo for light from one angle, by numerical integration of a
     /// model or by a reference: {"model","albedo":[r,g,b],"specular":[r,g,b],"diffuse":[r,g,b]}
     /// (and "sigma" for the stochastic reference). With --albedo 1 and no absorption the
-    /// stack loses nothing: the answer should be 1 (see --model).
+    /// stack loses nothing: the answer should be 1 (see --model; with --n0 above --n2 the
+    /// layered model is darker beyond the critical angle, and says so).
     Albedo(AlbedoArgs),
-    /// A thin-film colour chart PNG: thickness 0..2000 nm across, angle 0..89° down.
+    /// A thin-film colour chart PNG: thickness 0..2000 nm across, angle 0..89° down, its
+    /// brightest channel scaled to 1 (the scale is printed: a dim film's chart is as
+    /// readable as a bright one's; a stack that reflects nothing, n0 = n1 = n2, is black).
     Chart {
         #[command(flatten)]
         stack: StackArgs,
@@ -632,7 +635,10 @@ pub enum BrdfCommand {
         height: u32,
     },
     /// Random and adversarial inputs: counts NaN and Inf, the range of R and T, the worst
-    /// white-furnace albedo and the f32 path's worst deviation from f64 (JSON with --json).
+    /// white-furnace albedo of the thesis model, which must never pass 1 (`max_albedo`),
+    /// every model's furnace range (`furnace_by_model`: the layered model's is about 1, off
+    /// at the grazing and n0 > n2 draws) and the f32 path's worst deviation from f64 (JSON
+    /// with --json).
     Stress {
         /// Number of random samples, 1 to 10,000,000 (the default takes about fifty seconds
         /// on two cores).
@@ -663,7 +669,9 @@ pub struct EvalArgs {
     #[command(flatten)]
     pub layer: LayerArgs,
     /// Layer model under the top interface: layered (default; the stack's transport) or
-    /// thesis (the thesis' eq. 4.21 diffuse lobe; README, "Which layer model").
+    /// thesis (the thesis' eq. 4.21 diffuse lobe; README, "Which layer model"). The
+    /// layered model's tables are built first, once per run: a query takes a few seconds
+    /// (the evaluation itself well under a microsecond); `--batch` shares them.
     #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
     /// Film colour method (as for `brdf color`; spectral = the exact 1 nm sum).
@@ -706,12 +714,13 @@ pub struct AlbedoArgs {
     pub angle_deg: f64,
     #[command(flatten)]
     pub layer: LayerArgs,
-    /// Film colour method for --model thesis | layered (as for `brdf color`). lut, the
-    /// default here, is the renderer's table: the integration reads the film thousands of
-    /// times: at the defaults and 45°, 3.1 s with lut and 78 s with spectral (the exact 1 nm
-    /// sum) on two cores, agreeing within 2e-4, under the integration's own 2e-3.
-    #[arg(long, default_value = "lut", value_parser = parse_method)]
-    pub method: Method,
+    /// Film colour method for --model thesis | layered (as for `brdf color`; refused with
+    /// the references, which read the exact film). lut, the default here, is the
+    /// renderer's table: the integration reads the film thousands of times: at the defaults
+    /// and 45°, 3.1 s with lut and 78 s with spectral (the exact 1 nm sum) on two cores,
+    /// agreeing within 2e-4, under the integration's own 2e-3.
+    #[arg(long, value_parser = parse_method)]
+    pub method: Option<Method>,
     /// thesis | layered: the model's BRDF integrated over the hemisphere (64 × 64
     /// stratified half vectors for the specular lobe, 4096 midpoints in cos θ for the
     /// diffuse lobe; within 2e-3 of the exact albedo on known cases to 88.5°: closer to

@@ -11,7 +11,7 @@ use crate::output::{ensure_parent_folder, path_line, printable};
 use snakeskin::Error;
 use snakeskin::optics::brdf::exact::SmoothTop;
 use snakeskin::optics::brdf::walk::{FilmTables, walk};
-use snakeskin::optics::brdf::{BrdfValue, Layers};
+use snakeskin::optics::brdf::{BrdfValue, Layers, Model};
 use snakeskin::optics::film::{Stack, airy};
 use snakeskin::optics::methods::Method;
 use snakeskin::optics::query::{chart, check, film_colour};
@@ -84,8 +84,26 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
     Ok(serde_json::json!({ "rgb": rgb }).to_string())
 }
 
+/// The layered model's one known loss (`validate::model_limit` warns of it in a preset):
+/// with the ambient denser than the pigment layer, light beyond the critical angle that
+/// the rough top reflects has nowhere to go (a white stack reflects as little as 0.4 of
+/// it), so the model's values are darker than the physics there. Said once, on stderr.
+fn warn_of_model_limit(model: Model, stack: Stack) {
+    if model == Model::Layered && stack.n0 > stack.n2 {
+        eprintln!(
+            "warning: --n0 {} is above --n2 {}: the layered model loses light beyond the critical angle ({:.0}° \
+             from the normal), so its values are darker than the physics there (`brdf albedo --model stochastic` walks the \
+             stack itself)",
+            stack.n0,
+            stack.n2,
+            (stack.n2 / stack.n0).asin().to_degrees()
+        );
+    }
+}
+
 fn eval_json(args: &EvalArgs) -> Result<String> {
     let stack = stack_of(&args.stack);
+    warn_of_model_limit(args.model, stack);
     let (layers, l) = (layers_of(&args.stack, &args.layer)?, &args.layer);
     let film = |c: f64| film_colour(args.method, stack, l.thickness_nm, c);
     let value = args.model.eval(&layers, args.normal, args.wi, args.wo, &film);
@@ -115,12 +133,21 @@ fn albedo_json(args: &AlbedoArgs) -> Result<String> {
         let reason = "photons are counted by --model stochastic only; leave --photons out, or use that model".into();
         return Err(Error::InvalidOption { option: "--photons", reason }.into());
     }
+    if args.method.is_some() && !matches!(args.model, AlbedoModel::Model(_)) {
+        // It was silently ignored: the references read the exact 1 nm film.
+        let reason = "the references read the exact film; --method chooses the film of --model thesis or layered \
+                      only"
+            .into();
+        return Err(Error::InvalidOption { option: "--method", reason }.into());
+    }
     let stack = stack_of(&args.stack);
     let (layers, l) = (layers_of(&args.stack, &args.layer)?, &args.layer);
     let cos = args.angle_deg.to_radians().cos();
     let (name, value, sigma) = match args.model {
         AlbedoModel::Model(model) => {
-            let film = |c: f64| film_colour(args.method, stack, l.thickness_nm, c);
+            warn_of_model_limit(model, stack);
+            let method = args.method.unwrap_or(Method::Lut);
+            let film = |c: f64| film_colour(method, stack, l.thickness_nm, c);
             let total = model.furnace_albedo(&layers, cos, &film, 64);
             let specular = model.furnace_albedo(&Layers { albedo: [0.0; 3], ..layers }, cos, &film, 64);
             let diffuse = [0, 1, 2].map(|c| total[c] - specular[c]);
