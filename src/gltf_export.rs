@@ -55,6 +55,9 @@ pub struct ExportReport {
     pub total_time: Duration,
     /// Whether the export created the file's folder.
     pub created_folder: bool,
+    /// Files of an earlier export of this name that this one removed (a `.gltf`'s thickness
+    /// image, which a film of one thickness no longer references), for the caller to say.
+    pub removed: Vec<PathBuf>,
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
@@ -110,6 +113,7 @@ pub struct ExportPlan {
     mesh: Mesh,
     thickness_varies: bool,
     ao: bool,
+    layout: Layout,
     warnings: Vec<String>,
 }
 
@@ -197,13 +201,14 @@ impl ExportPlan {
             mesh,
             thickness_varies,
             ao: request.ao,
+            layout: request.layout,
             warnings,
         })
     }
 
     /// Evaluates the textures and writes the file (and, for `.gltf`, its side files).
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<ExportReport, Error> {
-        let ExportPlan { start, out, binary, name, dir, plan, material, mesh, thickness_varies, ao, .. } = self;
+        let ExportPlan { start, out, binary, name, dir, plan, material, mesh, thickness_varies, ao, layout, .. } = self;
         let (textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
         let dimensions = plan.dimensions();
         let texture = |suffix: &str| textures.iter().find(|(s, _)| s.suffix == suffix).map(|(_, b)| b.clone());
@@ -215,14 +220,26 @@ impl ExportPlan {
             thickness: texture("thickness").filter(|_| thickness_varies),
             occlusion: ao,
         };
+        // The asset's `extras`: the manifest's keys for what made it (`gltf::document`).
+        let loaded = plan.loaded();
+        let source = serde_json::json!({
+            "preset": loaded.name,
+            "preset_hash": loaded.content_hash,
+            "species": loaded.preset.species,
+            "seed": loaded.preset.seed,
+            "layout": layout.name(),
+            "width": dimensions.0,
+            "height": dimensions.1,
+        });
         let created_folder;
+        let mut removed = Vec::new();
         let files = if binary {
-            let bytes = glb(&name, &mesh, material, &textures)?;
+            let bytes = glb(&name, &mesh, material, &textures, &source)?;
             created_folder = crate::export::create_folder_noted(&dir)?;
             // A write that fails takes away the folders it made, as a set's lock does.
             vec![write_file_atomically(&out, bytes).inspect_err(|_| crate::export::remove_empty_made_folders())?]
         } else {
-            let mut files = gltf_files(&name, &mesh, material, &textures)?;
+            let mut files = gltf_files(&name, &mesh, material, &textures, &source)?;
             let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
             let lock = SetLock::acquire(&dir, &name)?;
             created_folder = lock.created_folder;
@@ -233,12 +250,13 @@ impl ExportPlan {
             // fail for it (a folder of that name stays, and so does a file that may not go).
             if textures.thickness.is_none() {
                 let stale = dir.join(gltf_image_file_name(&name, "thickness"));
-                if std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir()) {
-                    let _ = std::fs::remove_file(&stale);
+                if std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir()) && std::fs::remove_file(&stale).is_ok()
+                {
+                    removed.push(stale);
                 }
             }
             written
         };
-        Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed(), created_folder })
+        Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed(), created_folder, removed })
     }
 }

@@ -205,6 +205,10 @@ fn a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole() {
         ]);
         assert!(out.status.success(), "{}", stderr(&out));
         assert!(!folder.join("liasis-mackloti.thickness.png").exists(), "a stale thickness image was left");
+        // And says so, as `generate` says the earlier set's files it removes (it was silent).
+        let note =
+            format!("note: removed {}, the earlier export's", folder.join("liasis-mackloti.thickness.png").display());
+        assert!(stderr(&out).contains(&note), "{}", stderr(&out));
         snakeskin::export::verify_set(&set).unwrap();
     }
 }
@@ -246,4 +250,35 @@ fn three_js_reads_the_film_and_renders_it() {
     assert_eq!(result["material"]["iridescence"], 0.0, "{result:#}");
     let delta = result["delta_e00_mean"].as_f64().unwrap();
     assert!(delta < 0.5, "a snake without a film changed by ΔE00 {delta}");
+}
+
+/// An exported file says what made it, as a texture set's manifest does: the asset's
+/// `extras` hold the manifest's preset, preset_hash, species, seed, layout and size (it held
+/// only the generator, so a file could not be traced to its preset or made again). Checked
+/// against the manifest of `generate` with the same preset, overrides and seed, for a
+/// `.glb` and a `.gltf`.
+#[test]
+fn an_export_records_the_preset_and_seed_it_was_made_from() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = ["--set", "scales.rows=21", "--seed", "7", "--size", "128"];
+    let out =
+        snakeskin(&[&["generate", "natrix-natrix", "-o", dir.path().join("set").to_str().unwrap()][..], &set].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let manifest: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("set/natrix-natrix.material.json")).unwrap()).unwrap();
+    for file in ["n.glb", "n.gltf"] {
+        let path = export(dir.path(), "natrix-natrix", file, &set[..4]);
+        let bytes = std::fs::read(&path).unwrap();
+        let json: Value = if file.ends_with(".glb") {
+            let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+            serde_json::from_slice(&bytes[20..20 + length]).unwrap()
+        } else {
+            serde_json::from_slice(&bytes).unwrap()
+        };
+        let extras = &json["asset"]["extras"];
+        for key in ["preset", "preset_hash", "species", "seed", "layout", "width", "height"] {
+            assert_eq!(extras[key], manifest[key], "{file}: {key}: {extras}");
+        }
+        assert_eq!(extras["seed"], 7, "{file}");
+    }
 }

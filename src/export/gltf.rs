@@ -158,7 +158,18 @@ enum Images<'a> {
     Files(&'a [String]),
 }
 
-fn document(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfTextures, images: Images) -> Document {
+/// `source`: what made the file, written as the asset's `extras` (the texture set
+/// manifest's keys: `preset`, `preset_hash`, `species`, `seed`, `layout`, `width`,
+/// `height`), so that an exported file can be traced to its preset and made again; null
+/// for none.
+fn document(
+    name: &str,
+    mesh: &Mesh,
+    material: GltfMaterial,
+    textures: &GltfTextures,
+    images: Images,
+    source: &Value,
+) -> Document {
     let mut buffer = Buffer::default();
     let v = &mesh.vertices;
     let position = buffer.attribute(&v.iter().flat_map(|v| v.position).collect::<Vec<_>>(), 3, "VEC3", true);
@@ -225,7 +236,7 @@ fn document(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfText
         Images::Embedded => json!({ "byteLength": bin.len() }),
         Images::Files(_) => json!({ "byteLength": bin.len(), "uri": uri_reference(&format!("{name}.bin")) }),
     };
-    let json = json!({
+    let mut json = json!({
         "asset": { "version": "2.0", "generator": format!("snakeskin {}", env!("CARGO_PKG_VERSION")) },
         "extensionsUsed": used,
         "scene": 0,
@@ -254,6 +265,9 @@ fn document(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfText
         "bufferViews": views,
         "buffers": [buffer],
     });
+    if !source.is_null() {
+        json["asset"]["extras"] = source.clone();
+    }
     Document { json, bin }
 }
 
@@ -264,8 +278,14 @@ const CHUNK_BIN: u32 = 0x004E_4942;
 
 /// A binary glTF (.glb): header, JSON chunk (padded with spaces), BIN chunk (padded with
 /// zeros), every chunk 4-byte aligned; at most 4 GiB in all (the header's u32 length).
-pub fn glb(name: &str, mesh: &Mesh, material: GltfMaterial, textures: &GltfTextures) -> Result<Vec<u8>, ExportError> {
-    let Document { json, mut bin } = document(name, mesh, material, textures, Images::Embedded);
+pub fn glb(
+    name: &str,
+    mesh: &Mesh,
+    material: GltfMaterial,
+    textures: &GltfTextures,
+    source: &Value,
+) -> Result<Vec<u8>, ExportError> {
+    let Document { json, mut bin } = document(name, mesh, material, textures, Images::Embedded, source);
     let mut text = serde_json::to_vec(&json).map_err(|e| ExportError::Gltf(e.to_string()))?;
     while !text.len().is_multiple_of(4) {
         text.push(b' ');
@@ -295,10 +315,11 @@ pub fn gltf_files(
     mesh: &Mesh,
     material: GltfMaterial,
     textures: &GltfTextures,
+    source: &Value,
 ) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
     let images = textures.images();
     let names: Vec<String> = images.iter().map(|(role, _)| gltf_image_file_name(name, role)).collect();
-    let Document { json, bin } = document(name, mesh, material, textures, Images::Files(&names));
+    let Document { json, bin } = document(name, mesh, material, textures, Images::Files(&names), source);
     let text = serde_json::to_vec_pretty(&json).map_err(|e| ExportError::Gltf(e.to_string()))?;
     let mut files = vec![(format!("{name}.bin"), bin)];
     for (file, (_, bytes)) in names.iter().zip(images) {
@@ -365,7 +386,7 @@ mod tests {
                 thickness: thickness.clone(),
                 occlusion: false,
             };
-            let (json, _) = parse_glb(&glb("snake", &mesh, material, &textures).unwrap());
+            let (json, _) = parse_glb(&glb("snake", &mesh, material, &textures, &Value::Null).unwrap());
             let film = &json["materials"][0]["extensions"]["KHR_materials_iridescence"];
             assert_eq!(film["iridescenceThicknessMaximum"], 420.0);
             assert_eq!(film.get("iridescenceThicknessMinimum").is_some(), thickness.is_some(), "{film}");
@@ -383,7 +404,7 @@ mod tests {
             occlusion: false,
         };
         let material = GltfMaterial { base_ior: 1.56, film: Some((1.33, 250.0, 450.0)), repeat_v: true };
-        let (json, bin) = parse_glb(&glb("snake", &mesh, material, &textures).unwrap());
+        let (json, bin) = parse_glb(&glb("snake", &mesh, material, &textures, &Value::Null).unwrap());
         let film = &json["materials"][0]["extensions"]["KHR_materials_iridescence"];
         assert_eq!(film["iridescenceIor"], 1.33);
         assert_eq!(film["iridescenceThicknessMinimum"], 250.0);
@@ -412,7 +433,7 @@ mod tests {
         let textures =
             GltfTextures { base_color: vec![1], normal: vec![2], orm: vec![3], thickness: None, occlusion: false };
         let material = GltfMaterial { base_ior: 2.0, film: None, repeat_v: false };
-        let (json, _) = parse_glb(&glb("s", &mesh, material, &textures).unwrap());
+        let (json, _) = parse_glb(&glb("s", &mesh, material, &textures, &Value::Null).unwrap());
         assert_eq!(json["extensionsUsed"], json!(["KHR_materials_ior"]));
         assert!(json["materials"][0]["extensions"].get("KHR_materials_iridescence").is_none());
         assert_eq!(json["samplers"][0]["wrapT"], gl::CLAMP_TO_EDGE);
