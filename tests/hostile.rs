@@ -157,7 +157,11 @@ fn an_oversized_benchmark_grid_is_refused() {
     assert!(stderr(&out).contains("--d-step-nm"), "{}", stderr(&out));
     let out = snakeskin(&["bench", "irid", "--d-step-nm", "0.5", "--angle-step-deg", "0.5"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("grid points"), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("error: invalid --d-step-nm: 0.5 with --angle-step-deg 0.5 makes") && err.contains("grid points"),
+        "{err}"
+    );
 }
 
 /// The memory cap's variable is read as a whole number of MiB or refused: a typo must not

@@ -119,11 +119,12 @@ fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<(
 fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_deg: f64, sweep: bool) -> Result<()> {
     let points = grid_points(d_step_nm, angle_step_deg);
     if points > MAX_GRID_POINTS {
-        return Err(Error::Query(format!(
-            "--d-step-nm {d_step_nm} with --angle-step-deg {angle_step_deg} makes {points} grid points; at most \
+        // An option pair, not a query: it said "invalid query".
+        let reason = format!(
+            "{d_step_nm} with --angle-step-deg {angle_step_deg} makes {points} grid points; at most \
              {MAX_GRID_POINTS} are accepted (each needs a 421-wavelength reference sum): use larger steps"
-        ))
-        .into());
+        );
+        return Err(Error::InvalidOption { option: "--d-step-nm", reason }.into());
     }
     if let Some(path) = plot {
         snakeskin::export::check_target_named(path, "svg")?;
