@@ -207,7 +207,7 @@ fn a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole() {
         assert!(!folder.join("liasis-mackloti.thickness.png").exists(), "a stale thickness image was left");
         // And says so, as `generate` says the earlier set's files it removes (it was silent).
         let note =
-            format!("note: removed {}, the earlier export's", folder.join("liasis-mackloti.thickness.png").display());
+            format!("note: removed {}, which this export", folder.join("liasis-mackloti.thickness.png").display());
         assert!(stderr(&out).contains(&note), "{}", stderr(&out));
         snakeskin::export::verify_set(&set).unwrap();
     }

@@ -351,7 +351,7 @@ fn in_key_range(key: &str, message: &str, from_set: bool) -> Option<String> {
         Some(value) => value,
         None if from_set => {
             let word = message.strip_prefix("invalid type: string \"")?.split('"').next()?;
-            let digits = word.strip_prefix('-').unwrap_or(word);
+            let digits = word.strip_prefix(['-', '+']).unwrap_or(word);
             let past_toml = word.parse::<i64>().is_err();
             (past_toml && !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit())).then_some(word)?
         }
@@ -596,10 +596,11 @@ fn override_value(value: &str) -> Result<toml::Value, String> {
             let numeric = |c: Option<char>| c.is_some_and(|c| c.is_ascii_digit());
             // A whole number past TOML's integers stays a word: the key's range check names
             // it (`in_key_range`).
-            let digits = word.strip_prefix('-').unwrap_or(word);
+            let digits = word.strip_prefix(['-', '+']).unwrap_or(word);
             let whole = !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit());
-            let number =
-                !whole && (numeric(first) || (matches!(first, Some('+' | '-' | '.')) && numeric(chars.next())));
+            let second = chars.next();
+            let signed_number = matches!(first, Some('+' | '-')) && (numeric(second) || second == Some('.'));
+            let number = !whole && (numeric(first) || signed_number || (first == Some('.') && numeric(second)));
             let reason = || e.message().trim().replace('\n', "; ");
             if word.eq_ignore_ascii_case("true") || word.eq_ignore_ascii_case("false") {
                 Err(format!("{word} is not a TOML boolean: write {}", word.to_ascii_lowercase()))
@@ -607,8 +608,8 @@ fn override_value(value: &str) -> Result<toml::Value, String> {
                 Err(format!("not a TOML value ({})", reason()))
             } else if number {
                 Err(format!(
-                    "not a TOML value ({}); a string that starts like a number is written in quotes, as in \
-                     'KEY=\"{word}\"'",
+                    "not a TOML value ({}); write a TOML number (0.5, 1e3), or a string that starts like a \
+                     number in quotes, as in 'KEY=\"{word}\"'",
                     reason()
                 ))
             } else {
@@ -663,7 +664,8 @@ mod tests {
             ("[\"a\",", "not a TOML value (unclosed array"),
             ("\"#ffffff", "not a TOML value (invalid basic string"),
             ("{rows = 3", "not a TOML value ("),
-            ("1e400", "not a TOML value (floating-point number overflowed); a string that starts like a number"),
+            ("1e400", "not a TOML value (floating-point number overflowed); write a TOML number"),
+            ("-.5", "not a TOML value ("),
             ("True", "True is not a TOML boolean: write true"),
             ("FALSE", "FALSE is not a TOML boolean: write false"),
         ] {
@@ -679,6 +681,7 @@ mod tests {
             ("Vipera berus", "Vipera berus".into()),
             ("-x", "-x".into()),
             ("99999999999999999999", "99999999999999999999".into()),
+            ("+99999999999999999999", "+99999999999999999999".into()),
         ] {
             assert_eq!(override_value(value), Ok(parsed), "{value}");
         }

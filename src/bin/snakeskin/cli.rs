@@ -244,7 +244,8 @@ pub struct PresetSource {
     /// built-in name is the built-in even beside a file of that name: `./NAME` reads the file).
     pub preset: String,
     /// Override a preset key by dotted path, e.g. `--set scales.rows=23 --set pattern.0.kind=spots`.
-    /// VALUE is parsed as TOML; a bare word that is not valid TOML is taken as a string.
+    /// VALUE is parsed as TOML; a bare word that is not valid TOML is taken as a string, but
+    /// one that starts as an array, table, quoted string or number must parse.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_key_value)]
     pub overrides: Vec<(String, String)>,
     /// Override the preset's seed: a whole number from 0 to 9007199254740991 (2^53 - 1, the
@@ -671,7 +672,7 @@ pub struct EvalArgs {
     /// Layer model under the top interface: layered (default; the stack's transport) or
     /// thesis (the thesis' eq. 4.21 diffuse lobe; README, "Which layer model"). The
     /// layered model's tables are built first, once per run: a query takes a few seconds
-    /// (the evaluation itself well under a microsecond); `--batch` shares them.
+    /// (the evaluation itself well under a microsecond).
     #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
     /// Film colour method (as for `brdf color`; spectral = the exact 1 nm sum).

@@ -70,8 +70,9 @@ impl Default for BodyShape {
 
 impl BodyShape {
     /// The snake a layout's maps go on: the default body with the tile repeated along it, or
-    /// a body atlas once over `for_atlas` of the preset's plan. The preview, its memory check
-    /// and the glTF export all take it from here.
+    /// a body atlas once over `for_atlas` of the preset's plan: the preview's memory check
+    /// and the glTF export take it from here (the renderer makes both meshes from the maps
+    /// it is given).
     pub fn for_layout(layout: crate::maps::Layout, preset: &crate::preset::Preset) -> BodyShape {
         match layout {
             crate::maps::Layout::Tile => BodyShape::default(),

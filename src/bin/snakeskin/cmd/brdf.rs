@@ -103,8 +103,8 @@ fn warn_of_model_limit(model: Model, stack: Stack) {
 
 fn eval_json(args: &EvalArgs) -> Result<String> {
     let stack = stack_of(&args.stack);
-    warn_of_model_limit(args.model, stack);
     let (layers, l) = (layers_of(&args.stack, &args.layer)?, &args.layer);
+    warn_of_model_limit(args.model, stack);
     let film = |c: f64| film_colour(args.method, stack, l.thickness_nm, c);
     let value = args.model.eval(&layers, args.normal, args.wi, args.wo, &film);
     let json = serde_json::json!({

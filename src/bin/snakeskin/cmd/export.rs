@@ -34,7 +34,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
         eprintln!("note: created folder {}", path_line(folder));
     }
     for file in &report.removed {
-        eprintln!("note: removed {}, the earlier export's (this export does not write it)", path_line(file));
+        eprintln!("note: removed {}, which this export does not reference (an earlier one's)", path_line(file));
     }
     for file in &report.files {
         println!("{}", path_line(file));
