@@ -110,6 +110,22 @@ fn entries(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
+/// Under `out`, nothing hidden (a lock file, a temporary) and no folder that holds no
+/// finished set: what an ended batch may leave.
+fn only_finished_sets_in(out: &Path) {
+    let finished = manifests(out);
+    for path in entries(out) {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(!name.starts_with('.'), "{} was left", path.display());
+        assert!(
+            !out.join(&path).is_dir() || finished.keys().any(|m| m.starts_with(&path)),
+            "{} holds no finished set: {:?}",
+            path.display(),
+            entries(out)
+        );
+    }
+}
+
 /// A log reader that goes away (`batch ... | head -1`) does not end the batch: the job lines
 /// stop and every job still runs (by SIGPIPE, the batch ended at its second line with its
 /// running jobs' locks and temporaries left; the review).
@@ -165,16 +181,7 @@ fn an_interrupted_batch_leaves_its_finished_sets_and_nothing_else() {
         let finished = manifests(&out);
         assert!(finished.len() < 12, "the signal came too late to test anything");
         assert_eq!(ended.status.code(), Some(128 + signal), "{}", stderr(&ended));
-        for path in entries(&out) {
-            let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            assert!(!name.starts_with('.'), "{} was left", path.display());
-            assert!(
-                !out.join(&path).is_dir() || finished.keys().any(|m| m.starts_with(&path)),
-                "{} holds no finished set: {:?}",
-                path.display(),
-                entries(&out)
-            );
-        }
+        only_finished_sets_in(&out);
         // Every set logged is there; a set whose commit the signal waited for is whole but
         // may go unlogged (its job ends after the clean-up), one a job at most.
         let log = stdout(&ended);
@@ -214,16 +221,7 @@ fn a_failing_standard_error_mid_batch_leaves_nothing_unfinished() {
     assert_eq!(ended.status.code(), Some(1), "{}", stdout(&ended));
     let finished = manifests(&out);
     assert!(!finished.keys().any(|m| m.starts_with("python-regius")), "the second job ended first: {finished:?}");
-    for path in entries(&out) {
-        let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        assert!(!name.starts_with('.'), "{} was left", path.display());
-        assert!(
-            !out.join(&path).is_dir() || finished.keys().any(|m| m.starts_with(&path)),
-            "{} holds no finished set: {:?}",
-            path.display(),
-            entries(&out)
-        );
-    }
+    only_finished_sets_in(&out);
 }
 
 #[test]
