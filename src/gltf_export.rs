@@ -209,9 +209,13 @@ impl ExportPlan {
     /// Evaluates the textures and writes the file (and, for `.gltf`, its side files).
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<ExportReport, Error> {
         let ExportPlan { start, out, binary, name, dir, plan, material, mesh, thickness_varies, ao, layout, .. } = self;
-        let (textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
+        let (mut textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
         let dimensions = plan.dimensions();
-        let texture = |suffix: &str| textures.iter().find(|(s, _)| s.suffix == suffix).map(|(_, b)| b.clone());
+        // Moved out, not copied: the encoded textures were held twice until the file was made.
+        let mut texture = |suffix: &str| {
+            let at = textures.iter().position(|(s, _)| s.suffix == suffix)?;
+            Some(textures.swap_remove(at).1)
+        };
         let missing = |suffix: &str| Error::Internal(format!("the glTF pack has no {suffix} texture"));
         let textures = GltfTextures {
             base_color: texture("basecolor").ok_or_else(|| missing("basecolor"))?,
