@@ -193,16 +193,13 @@ fn film_floor(preset: &Preset) -> Option<Problem> {
 /// The physics is fine (an oil film over a lighter layer), so it is a warning, not a refusal.
 fn model_limit(preset: &Preset) -> Option<Problem> {
     let o = &preset.optics;
-    (o.ambient_ior > o.pigment_ior).then(|| Problem {
+    let limit = crate::optics::brdf::layered::ModelLimit::of(o.ambient_ior, o.pigment_ior)?;
+    Some(Problem {
         key: "optics.ambient_ior".into(),
         message: format!(
-            "{} is above optics.pigment_ior = {}: the layered model loses light beyond the critical angle \
-             ({:.0}° from the normal), where the rough top's reflection has nowhere to go (a white stack without \
-             absorption reflects as little as 0.4 of the light), so renders and the albedo are darker than the \
-             physics there. Keep ambient_ior at most pigment_ior for an energy-conserving render.",
-            o.ambient_ior,
-            o.pigment_ior,
-            (o.pigment_ior / o.ambient_ior).asin().to_degrees()
+            "{} is above optics.pigment_ior = {}: {limit}. Keep ambient_ior at most pigment_ior for an \
+             energy-conserving render.",
+            o.ambient_ior, o.pigment_ior
         ),
     })
 }

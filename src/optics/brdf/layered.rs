@@ -25,6 +25,35 @@ use std::f64::consts::PI;
 
 use super::{COS_MIN, Layers, Layers32, cos_transmitted};
 
+/// The layered model's one known loss, where the medium above is denser than the pigment
+/// layer (n0 > n2): light the rough top sends beyond the critical angle asin(n2 / n0) has
+/// nowhere to go in the model (the physics reflects it back up), so a white stack without
+/// absorption reflects as little as 0.4 of the light there. `None` where n0 ≤ n2. One home
+/// for the condition and its wording: a preset's check (`validate`) and `brdf eval`/`albedo`
+/// warn with it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModelLimit {
+    pub critical_angle_deg: f64,
+}
+
+impl ModelLimit {
+    pub fn of(n0: f64, n2: f64) -> Option<ModelLimit> {
+        (n0 > n2).then(|| ModelLimit { critical_angle_deg: (n2 / n0).asin().to_degrees() })
+    }
+}
+
+impl std::fmt::Display for ModelLimit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the layered model loses light beyond the critical angle ({:.0}° from the normal), where the rough \
+             top's reflection has nowhere to go (a white stack without absorption reflects as little as 0.4 of the \
+             light), so its values are darker than the physics there",
+            self.critical_angle_deg
+        )
+    }
+}
+
 /// a(μ) per channel: the light from a direction at cosine `cos` that reaches the base,
 /// `s` what the rough lobe reflects there.
 fn entering(layers: &Layers, cos: f64, s: [f64; 3]) -> [f64; 3] {

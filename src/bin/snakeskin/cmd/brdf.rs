@@ -10,6 +10,7 @@ use crate::cli::{AlbedoArgs, AlbedoModel, BrdfCommand, EvalArgs, LayerArgs, Stac
 use crate::output::{ensure_parent_folder, path_line, printable};
 use snakeskin::Error;
 use snakeskin::optics::brdf::exact::SmoothTop;
+use snakeskin::optics::brdf::layered::ModelLimit;
 use snakeskin::optics::brdf::walk::{FilmTables, walk};
 use snakeskin::optics::brdf::{BrdfValue, Layers, Model};
 use snakeskin::optics::film::{Stack, airy};
@@ -84,19 +85,16 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
     Ok(serde_json::json!({ "rgb": rgb }).to_string())
 }
 
-/// The layered model's one known loss (`validate::model_limit` warns of it in a preset):
-/// with the ambient denser than the pigment layer, light beyond the critical angle that
-/// the rough top reflects has nowhere to go (a white stack reflects as little as 0.4 of
-/// it), so the model's values are darker than the physics there. Said once, on stderr.
+/// The layered model's one known loss (`ModelLimit`, which a preset's check warns of too),
+/// said once, on stderr.
 fn warn_of_model_limit(model: Model, stack: Stack) {
-    if model == Model::Layered && stack.n0 > stack.n2 {
+    if model != Model::Layered {
+        return;
+    }
+    if let Some(limit) = ModelLimit::of(stack.n0, stack.n2) {
         eprintln!(
-            "warning: --n0 {} is above --n2 {}: the layered model loses light beyond the critical angle ({:.0}° \
-             from the normal), so its values are darker than the physics there (`brdf albedo --model stochastic` walks the \
-             stack itself)",
-            stack.n0,
-            stack.n2,
-            (stack.n2 / stack.n0).asin().to_degrees()
+            "warning: --n0 {} is above --n2 {}: {limit} (`brdf albedo --model stochastic` walks the stack itself)",
+            stack.n0, stack.n2
         );
     }
 }
