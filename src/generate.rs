@@ -158,14 +158,34 @@ impl Plan {
     /// exceeds the memory available (`Error::Memory`, before any allocation).
     pub fn new(request: &GenerateRequest) -> Result<Plan, Error> {
         let plan = Plan::within_checked_budget(request)?;
-        let size_option = size_option(request);
-        let what = if plan.height == plan.size {
-            format!("{size_option} {}", plan.size)
-        } else {
-            format!("{size_option} {} ({} x {})", plan.size, plan.size, plan.height)
-        };
-        plan.memory.refuse_if_over(&what)?;
+        plan.memory.refuse_if_over(&plan.size_words())?;
         Ok(plan)
+    }
+
+    /// The request's size as a memory refusal names it: `--size 1024`, or `--size 1024
+    /// (1024 x 12288)` for a body atlas.
+    pub fn size_words(&self) -> String {
+        let size_option = size_option(&self.request);
+        if self.height == self.size {
+            format!("{size_option} {}", self.size)
+        } else {
+            format!("{size_option} {} ({} x {})", self.size, self.size, self.height)
+        }
+    }
+
+    /// The pack's encoded textures, at most (`pack_textures`' result; 0 without a pack): their
+    /// samples, PNG's filter byte a row, and 1/1024 and 4 KiB for the PNG's chunks and
+    /// deflate's stored blocks (5 bytes in 65,535 where nothing compresses).
+    pub fn texture_bytes_bound(&self) -> u64 {
+        let Some(pack) = self.request.pack else { return 0 };
+        let (width, height) = (self.size as u64, self.height as u64);
+        pack.textures(has_film(&self.loaded.preset), self.request.ao)
+            .iter()
+            .map(|spec| {
+                let samples = width * height * spec.channels.len() as u64 * u64::from(spec.bit_depth / 8);
+                samples + height + samples / 1024 + 4096
+            })
+            .sum()
     }
 
     /// `new` without refusing a set whose estimate exceeds the memory available now: for a
@@ -224,6 +244,11 @@ impl Plan {
         let (layout, preset) = (self.request.options.layout, &self.loaded.preset);
         let give = size_option(&self.request);
         pack_size_warning(self.request.pack?, layout, preset, self.size, give).map(|w| format!("warning: {w}"))
+    }
+
+    /// The layout the maps are drawn in.
+    pub fn layout(&self) -> Layout {
+        self.request.options.layout
     }
 
     /// Width and height of the maps.
@@ -454,13 +479,13 @@ impl Plan {
         let lock = SetLock::acquire(&self.request.out_dir, &self.loaded.name)?;
         let (textures, stats, encode_time) = self.pack_textures(pack, progress)?;
         let name = &self.loaded.name;
-        let files: Vec<(String, Vec<u8>)> =
-            textures.iter().map(|(spec, bytes)| (texture_file_name(name, spec), bytes.clone())).collect();
         let entries: Vec<MapEntry> = textures
             .iter()
-            .zip(&files)
-            .map(|((spec, _), (file, bytes))| MapEntry::for_texture(spec, file, sha256_hex(bytes)))
+            .map(|(spec, bytes)| MapEntry::for_texture(spec, &texture_file_name(name, spec), sha256_hex(bytes)))
             .collect();
+        // Moved, not copied: the encoded textures were held twice while they were written.
+        let files: Vec<(String, Vec<u8>)> =
+            textures.into_iter().map(|(spec, bytes)| (texture_file_name(name, &spec), bytes)).collect();
         let options = self.request.options;
         let mut manifest =
             export::manifest(&self.loaded, (self.size, self.height), entries, options, "png", Some(pack.name()));

@@ -16,6 +16,7 @@ use crate::generate::{GenerateRequest, Plan};
 use crate::graph::EvalStats;
 use crate::maps::{Layout, has_film, thickness_range_nm};
 use crate::material::{FileFormat, MapKind};
+use crate::memory::MemoryCheck;
 use crate::render::engine::mesh::{BodyShape, Mesh};
 use crate::{Error, maps::BuildOptions};
 
@@ -113,8 +114,19 @@ pub struct ExportPlan {
     mesh: Mesh,
     thickness_varies: bool,
     ao: bool,
-    layout: Layout,
+    memory: MemoryCheck,
     warnings: Vec<String>,
+}
+
+/// The most memory the file's making holds once the textures are encoded (`ExportPlan::run`),
+/// from `textures` (their bound, `Plan::texture_bytes_bound`): the textures; a `.glb`'s bytes,
+/// which hold them again with the mesh's buffer; the mesh and its buffer; the fixed overhead.
+/// A `.gltf`'s images are the textures moved, and its buffer is the mesh's alone.
+fn file_bytes_estimate(textures: u64, mesh: &Mesh, binary: bool) -> u64 {
+    // Per vertex: position, normal, tangent, uv (12 f32) in the mesh and in its buffer.
+    let mesh_bytes = (mesh.vertices.len() * 12 * 4 + mesh.indices.len() * 4) as u64;
+    let file = if binary { textures + mesh_bytes } else { 0 };
+    crate::memory::FIXED_OVERHEAD_BYTES + textures + 2 * mesh_bytes + file
 }
 
 impl ExportPlan {
@@ -124,9 +136,10 @@ impl ExportPlan {
         &self.warnings
     }
 
-    /// The textures' evaluation memory (`Plan::memory`).
-    pub fn memory(&self) -> crate::memory::MemoryCheck {
-        self.plan.memory()
+    /// The export's peak memory, estimated: the textures' evaluation (`Plan::memory`) or the
+    /// file's making after it (`file_bytes_estimate`), whichever is more.
+    pub fn memory(&self) -> MemoryCheck {
+        self.memory
     }
 
     pub fn new(request: &ExportRequest) -> Result<ExportPlan, Error> {
@@ -153,7 +166,7 @@ impl ExportPlan {
                 request.out.display()
             ))
         })?;
-        let plan = Plan::new(&GenerateRequest {
+        let plan = Plan::within_checked_budget(&GenerateRequest {
             preset: request.preset.clone(),
             overrides: request.overrides.clone(),
             seed: request.seed,
@@ -174,6 +187,9 @@ impl ExportPlan {
         let material =
             GltfMaterial { base_ior: preset.optics.pigment_ior, film, repeat_v: request.layout == Layout::Tile };
         let mesh = mesh_for(request.mesh, request.layout, preset);
+        let file_bytes = file_bytes_estimate(plan.texture_bytes_bound(), &mesh, binary);
+        let memory = MemoryCheck::against_available(plan.memory().estimate_bytes.max(file_bytes));
+        memory.refuse_if_over(&plan.size_words())?;
         // The files it will write, checked before the work (a folder or a link where one goes
         // was found only when they were written): the `.glb`, or the `.gltf` and its side files.
         // A film of one thickness (no spread) needs no texture: glTF reads the thickness as
@@ -201,15 +217,18 @@ impl ExportPlan {
             mesh,
             thickness_varies,
             ao: request.ao,
-            layout: request.layout,
+            memory,
             warnings,
         })
     }
 
     /// Evaluates the textures and writes the file (and, for `.gltf`, its side files).
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<ExportReport, Error> {
-        let ExportPlan { start, out, binary, name, dir, plan, material, mesh, thickness_varies, ao, layout, .. } = self;
+        let ExportPlan { start, out, binary, name, dir, plan, material, mesh, thickness_varies, ao, .. } = self;
         let (mut textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
+        // The evaluation's buffers, freed on the pool's threads, go back before the file is
+        // made (python-regius's body atlas at 1024 kept 225 MB resident for 47 MB of textures).
+        crate::memory::release_freed();
         let dimensions = plan.dimensions();
         // Moved out, not copied: the encoded textures were held twice until the file was made.
         let mut texture = |suffix: &str| {
@@ -225,16 +244,8 @@ impl ExportPlan {
             occlusion: ao,
         };
         // The asset's `extras`: the manifest's keys for what made it (`gltf::document`).
-        let loaded = plan.loaded();
-        let source = serde_json::json!({
-            "preset": loaded.name,
-            "preset_hash": loaded.content_hash,
-            "species": loaded.preset.species,
-            "seed": loaded.preset.seed,
-            "layout": layout.name(),
-            "width": dimensions.0,
-            "height": dimensions.1,
-        });
+        let source = serde_json::to_value(crate::export::Source::of(plan.loaded(), dimensions, plan.layout()))
+            .expect("a Source is plain data");
         let created_folder;
         let mut removed = Vec::new();
         let files = if binary {
@@ -243,7 +254,8 @@ impl ExportPlan {
             // A write that fails takes away the folders it made, as a set's lock does.
             vec![write_file_atomically(&out, bytes).inspect_err(|_| crate::export::remove_empty_made_folders())?]
         } else {
-            let mut files = gltf_files(&name, &mesh, material, &textures, &source)?;
+            let has_thickness = textures.thickness.is_some();
+            let mut files = gltf_files(&name, &mesh, material, textures, &source)?;
             let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
             let lock = SetLock::acquire(&dir, &name)?;
             created_folder = lock.created_folder;
@@ -252,7 +264,7 @@ impl ExportPlan {
             // file references now: under the lock, after the commit, it goes. Whatever stands
             // there is harmless once the commit is done, so an export that succeeded does not
             // fail for it (a folder of that name stays, and so does a file that may not go).
-            if textures.thickness.is_none() {
+            if !has_thickness {
                 let stale = dir.join(gltf_image_file_name(&name, "thickness"));
                 if std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir()) && std::fs::remove_file(&stale).is_ok()
                 {

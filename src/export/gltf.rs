@@ -68,6 +68,16 @@ impl GltfTextures {
         }
         images
     }
+
+    /// `images`, moved out (a `.gltf`'s image files take them without a copy).
+    fn into_images(self) -> Vec<(&'static str, Vec<u8>)> {
+        let mut images =
+            vec![(IMAGE_ROLES[0], self.base_color), (IMAGE_ROLES[1], self.normal), (IMAGE_ROLES[2], self.orm)];
+        if let Some(thickness) = self.thickness {
+            images.push((IMAGE_ROLES[3], thickness));
+        }
+        images
+    }
 }
 
 /// The roles of a glTF material's images, in its texture indices' order; the last only
@@ -82,35 +92,57 @@ pub fn gltf_side_file_names(name: &str, film: bool) -> Vec<String> {
     std::iter::once(format!("{name}.bin")).chain(roles.iter().map(|role| gltf_image_file_name(name, role))).collect()
 }
 
-/// A glTF document before it is written: the JSON and the binary buffer; images are in the
-/// buffer (GLB) or in their own files (`.gltf`).
+/// A glTF document before it is written: the JSON and the binary buffer's mesh data;
+/// images are in the buffer (GLB, at `image_offsets`, after the mesh data, `length` bytes in
+/// all) or in their own files (`.gltf`).
 struct Document {
     json: Value,
-    bin: Vec<u8>,
+    mesh_bin: Vec<u8>,
+    image_offsets: Vec<usize>,
+    length: usize,
 }
 
-/// The binary buffer being filled, with its buffer views and accessors.
+/// The binary buffer being filled, with its buffer views and accessors. The mesh's bytes are
+/// copied in; a GLB's images are only given their places (`place`), and `glb` writes them from
+/// the textures straight into the file's bytes: with the images copied into the buffer and the
+/// buffer into the file, every image was held three times (a body atlas of python-regius at
+/// 1024: the encoded textures 47 MB, the buffer and the file 53 MB each).
 #[derive(Default)]
 struct Buffer {
     bin: Vec<u8>,
+    /// The buffer's length with the placed images, which follow the mesh data.
+    length: usize,
     views: Vec<Value>,
     accessors: Vec<Value>,
 }
 
 impl Buffer {
-    /// Appends `bytes` as a buffer view at a 4-byte-aligned offset (accessors of floats
-    /// must be aligned); returns the view's index.
-    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        let mut view = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
+    /// A buffer view of `length` bytes at the next 4-byte-aligned offset (accessors of floats
+    /// must be aligned): (the view's index, its offset).
+    fn next_view(&mut self, length: usize, target: Option<u32>) -> (usize, usize) {
+        let offset = self.length.next_multiple_of(4);
+        let mut view = json!({ "buffer": 0, "byteOffset": offset, "byteLength": length });
         if let Some(t) = target {
             view["target"] = json!(t);
         }
-        self.bin.extend_from_slice(bytes);
+        self.length = offset + length;
         self.views.push(view);
-        self.views.len() - 1
+        (self.views.len() - 1, offset)
+    }
+
+    /// Appends `bytes` as a buffer view; returns the view's index. Mesh data only, before any
+    /// `place`d image.
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        debug_assert_eq!(self.length, self.bin.len(), "mesh data after a placed image");
+        let (index, offset) = self.next_view(bytes.len(), target);
+        self.bin.resize(offset, 0);
+        self.bin.extend_from_slice(bytes);
+        index
+    }
+
+    /// A view of `length` bytes whose bytes the GLB writer fills in: (its index, its offset).
+    fn place(&mut self, length: usize) -> (usize, usize) {
+        self.next_view(length, None)
     }
 
     /// A vertex attribute of `components` floats per vertex; returns the accessor's index.
@@ -158,10 +190,9 @@ enum Images<'a> {
     Files(&'a [String]),
 }
 
-/// `source`: what made the file, written as the asset's `extras` (the texture set
-/// manifest's keys: `preset`, `preset_hash`, `species`, `seed`, `layout`, `width`,
-/// `height`), so that an exported file can be traced to its preset and made again; null
-/// for none.
+/// `source`: what made the file, written as the asset's `extras` (`export::Source`, the
+/// texture set manifest's first keys), so that an exported file can be traced to its preset
+/// and made again; null for none.
 fn document(
     name: &str,
     mesh: &Mesh,
@@ -179,12 +210,14 @@ fn document(
     let indices = buffer.indices(&mesh.indices);
 
     let pngs = textures.images();
+    let mut image_offsets = Vec::new();
     let image_list: Vec<Value> = pngs
         .iter()
         .enumerate()
         .map(|(k, (role, bytes))| match &images {
             Images::Embedded => {
-                let index = buffer.view(bytes, None);
+                let (index, offset) = buffer.place(bytes.len());
+                image_offsets.push(offset);
                 json!({ "name": format!("{name}_{role}"), "bufferView": index, "mimeType": "image/png" })
             }
             Images::Files(names) => json!({ "name": format!("{name}_{role}"), "uri": uri_reference(&names[k]) }),
@@ -231,10 +264,10 @@ fn document(
     mat["pbrMetallicRoughness"] = pbr;
     used.sort();
 
-    let Buffer { bin, views, accessors } = buffer;
+    let Buffer { bin, length, views, accessors } = buffer;
     let buffer = match &images {
-        Images::Embedded => json!({ "byteLength": bin.len() }),
-        Images::Files(_) => json!({ "byteLength": bin.len(), "uri": uri_reference(&format!("{name}.bin")) }),
+        Images::Embedded => json!({ "byteLength": length }),
+        Images::Files(_) => json!({ "byteLength": length, "uri": uri_reference(&format!("{name}.bin")) }),
     };
     let mut json = json!({
         "asset": { "version": "2.0", "generator": format!("snakeskin {}", env!("CARGO_PKG_VERSION")) },
@@ -268,7 +301,7 @@ fn document(
     if !source.is_null() {
         json["asset"]["extras"] = source.clone();
     }
-    Document { json, bin }
+    Document { json, mesh_bin: bin, image_offsets, length }
 }
 
 /// GLB chunk types (glTF 2.0, 4.4.3): "JSON" and "BIN\0" as little-endian u32.
@@ -285,15 +318,14 @@ pub fn glb(
     textures: &GltfTextures,
     source: &Value,
 ) -> Result<Vec<u8>, ExportError> {
-    let Document { json, mut bin } = document(name, mesh, material, textures, Images::Embedded, source);
+    let Document { json, mesh_bin, image_offsets, length } =
+        document(name, mesh, material, textures, Images::Embedded, source);
     let mut text = serde_json::to_vec(&json).map_err(|e| ExportError::Gltf(e.to_string()))?;
     while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
-    let total = 12 + 8 + text.len() + 8 + bin.len();
+    let bin_length = length.next_multiple_of(4);
+    let total = 12 + 8 + text.len() + 8 + bin_length;
     let total32 = u32::try_from(total)
         .map_err(|_| ExportError::Gltf(format!("{total} bytes is over GLB's 4 GiB; use a smaller --size")))?;
     let mut out = Vec::with_capacity(total);
@@ -301,10 +333,16 @@ pub fn glb(
         out.extend_from_slice(&word.to_le_bytes());
     }
     out.extend_from_slice(&text);
-    for word in [bin.len() as u32, CHUNK_BIN] {
+    for word in [bin_length as u32, CHUNK_BIN] {
         out.extend_from_slice(&word.to_le_bytes());
     }
-    out.extend_from_slice(&bin);
+    let bin_start = out.len();
+    out.extend_from_slice(&mesh_bin);
+    for (offset, (_, bytes)) in image_offsets.into_iter().zip(textures.images()) {
+        out.resize(bin_start + offset, 0);
+        out.extend_from_slice(bytes);
+    }
+    out.resize(total, 0);
     Ok(out)
 }
 
@@ -314,16 +352,15 @@ pub fn gltf_files(
     name: &str,
     mesh: &Mesh,
     material: GltfMaterial,
-    textures: &GltfTextures,
+    textures: GltfTextures,
     source: &Value,
 ) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
-    let images = textures.images();
-    let names: Vec<String> = images.iter().map(|(role, _)| gltf_image_file_name(name, role)).collect();
-    let Document { json, bin } = document(name, mesh, material, textures, Images::Files(&names), source);
+    let names: Vec<String> = textures.images().iter().map(|(role, _)| gltf_image_file_name(name, role)).collect();
+    let Document { json, mesh_bin, .. } = document(name, mesh, material, &textures, Images::Files(&names), source);
     let text = serde_json::to_vec_pretty(&json).map_err(|e| ExportError::Gltf(e.to_string()))?;
-    let mut files = vec![(format!("{name}.bin"), bin)];
-    for (file, (_, bytes)) in names.iter().zip(images) {
-        files.push((file.clone(), bytes.to_vec()));
+    let mut files = vec![(format!("{name}.bin"), mesh_bin)];
+    for (file, (_, bytes)) in names.into_iter().zip(textures.into_images()) {
+        files.push((file, bytes));
     }
     files.push((format!("{name}.gltf"), text));
     Ok(files)
@@ -420,11 +457,17 @@ mod tests {
         let first: Vec<f32> =
             (0..3).map(|k| f32::from_le_bytes(bin[offset + 4 * k..offset + 4 * k + 4].try_into().unwrap())).collect();
         assert_eq!(first, mesh.vertices[0].position.to_vec());
-        // The thickness image is the fourth and its bytes are in the buffer.
-        let image = &json["images"][3];
-        let view = &json["bufferViews"][image["bufferView"].as_u64().unwrap() as usize];
-        let (o, n) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
-        assert_eq!(&bin[o..o + n], &[7, 8, 9, 10, 11]);
+        // Every image's bytes are in the buffer where its view says (the thickness image the
+        // fourth), each at a 4-byte-aligned offset after the mesh data, and the BIN chunk is
+        // the buffer's length padded to 4 bytes.
+        let images: [&[u8]; 4] = [&[1, 2, 3], &[4, 5], &[6], &[7, 8, 9, 10, 11]];
+        for (k, expected) in images.into_iter().enumerate() {
+            let view = &json["bufferViews"][json["images"][k]["bufferView"].as_u64().unwrap() as usize];
+            let (o, n) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+            assert_eq!((o % 4, &bin[o..o + n]), (0, expected), "image {k}");
+        }
+        let length = json["buffers"][0]["byteLength"].as_u64().unwrap() as usize;
+        assert_eq!(bin.len(), length.next_multiple_of(4));
     }
 
     #[test]

@@ -17,16 +17,9 @@ use crate::text_file::Links;
 
 #[derive(Debug, Serialize)]
 pub struct Manifest {
-    pub generator: String,
-    pub generator_version: String,
-    pub preset: String,
-    pub preset_hash: String,
-    pub species: Option<String>,
-    pub seed: u64,
-    pub width: usize,
-    pub height: usize,
-    /// `tile` (a square that tiles both ways) or `body` (the whole snake, snout at v = 0).
-    pub layout: String,
+    /// What made the set (written in place, the manifest's first keys).
+    #[serde(flatten)]
+    pub source: Source,
     /// `png` or `exr` (the maps' file format; each entry gives its samples).
     pub format: String,
     /// The engine the textures are packed for (`generate --pack`), if any: `maps` then
@@ -49,6 +42,39 @@ pub struct Manifest {
     /// The batch job that wrote the set (`batch::Job::key`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub job: Option<String>,
+}
+
+/// What made a set or a model: the manifest's first keys, and a glTF asset's `extras`
+/// (`gltf_export`), so a file is traced to its preset, its content and its seed the same
+/// way wherever it went.
+#[derive(Debug, Clone, Serialize)]
+pub struct Source {
+    pub generator: String,
+    pub generator_version: String,
+    pub preset: String,
+    pub preset_hash: String,
+    pub species: Option<String>,
+    pub seed: u64,
+    pub width: usize,
+    pub height: usize,
+    /// `tile` (a square that tiles both ways) or `body` (the whole snake, snout at v = 0).
+    pub layout: String,
+}
+
+impl Source {
+    pub fn of(loaded: &LoadedPreset, (width, height): (usize, usize), layout: Layout) -> Source {
+        Source {
+            generator: "snakeskin".into(),
+            generator_version: env!("CARGO_PKG_VERSION").into(),
+            preset: loaded.name.clone(),
+            preset_hash: loaded.content_hash.clone(),
+            species: loaded.preset.species.clone(),
+            seed: loaded.preset.seed,
+            width,
+            height,
+            layout: layout.name().into(),
+        }
+    }
 }
 
 /// The colour map's convention, for the manifest: the visible colour, which the renderer
@@ -170,7 +196,7 @@ pub const MANIFEST_SUFFIX: &str = ".material.json";
 /// the engine they are packed for.
 pub fn manifest(
     loaded: &LoadedPreset,
-    (width, height): (usize, usize),
+    dimensions: (usize, usize),
     entries: Vec<MapEntry>,
     options: BuildOptions,
     format: &str,
@@ -191,15 +217,7 @@ pub fn manifest(
     });
     let (min_nm, max_nm) = crate::maps::map_thickness_range_nm(p);
     Manifest {
-        generator: "snakeskin".into(),
-        generator_version: env!("CARGO_PKG_VERSION").into(),
-        preset: loaded.name.clone(),
-        preset_hash: loaded.content_hash.clone(),
-        species: p.species.clone(),
-        seed: p.seed,
-        width,
-        height,
-        layout: options.layout.name().into(),
+        source: Source::of(loaded, dimensions, options.layout),
         format: format.into(),
         pack: pack.map(String::from),
         counts,
