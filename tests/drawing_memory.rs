@@ -1,5 +1,5 @@
-//! The memory check of the drawing commands (and of `export`) against their measured peaks, in a test
-//! binary of its own: cargo runs test binaries one after another, so nothing else runs
+//! The memory check of the drawing commands (and of `export`) against their measured peaks,
+//! in a test binary of its own: cargo runs test binaries one after another, so nothing else runs
 //! beside the measured children. In tests/render.rs, beside its other GPU tests, the same
 //! 2048×1024 preview peaked at 481 MiB against 323 MiB alone (lavapipe queues more of its
 //! rasteriser's work when the cores are busy), past its estimate of 474 (a CI run of

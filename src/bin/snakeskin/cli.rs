@@ -671,8 +671,9 @@ pub struct EvalArgs {
     pub layer: LayerArgs,
     /// Layer model under the top interface: layered (default; the stack's transport) or
     /// thesis (the thesis' eq. 4.21 diffuse lobe; README, "Which layer model"). The
-    /// layered model's tables are built first, once per run: a query takes a few seconds
-    /// (the evaluation itself well under a microsecond).
+    /// layered model's tables ship built for the default indices (--n0 1, --n2 2): a query
+    /// takes well under a second; other indices walk their path table first, once per run
+    /// (about 2 s; the evaluation itself well under a microsecond).
     #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
     /// Film colour method (as for `brdf color`; spectral = the exact 1 nm sum).

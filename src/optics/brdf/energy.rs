@@ -57,9 +57,10 @@
 //!
 //! The tables (per node of μ and r: E₁ and the lobe's rule, by stratified half-vector
 //! quadrature, as `Model::furnace_albedo`; the multiple scattering's rule, walked with a
-//! fixed seed per node) are computed once, deterministically (0.95 s on this machine's two
-//! cores, the walks split over them), and reach the shader in a storage buffer, so the CPU
-//! and the GPU read the same numbers.
+//! fixed seed per node) are computed deterministically (1.2 s on this machine's two cores, the
+//! walks split over them: `build_lobe_nodes`), once, when they are baked into the binary
+//! (`baked`), and reach the shader in a storage buffer, so the CPU and the GPU read the same
+//! numbers.
 
 use std::sync::OnceLock;
 
@@ -493,39 +494,43 @@ pub fn ms_rule() -> &'static [(f64, f64); MS_NODES] {
     })
 }
 
+/// The lobe's tables: baked into the binary (`baked`), or built where the baked file does
+/// not fit their shape.
 pub fn tables() -> &'static Tables {
     static TABLES: OnceLock<Tables> = OnceLock::new();
-    TABLES.get_or_init(|| {
-        let mut lobes = Vec::with_capacity(E1_MU * E1_ROUGHNESS);
-        for i_r in 0..E1_ROUGHNESS {
-            let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
-            // r = 0 is a mirror: everything the film reflects leaves by the lobe, at μ.
-            let row: Vec<Lobe> = (0..E1_MU)
-                .map(|i_mu| {
-                    let mu = node_mu(i_mu);
-                    if i_r == 0 { Lobe::point(1.0, mu) } else { lobe(mu, r) }
-                })
-                .collect();
-            lobes.extend(row);
-        }
-        // The walks of the multiple scattering's rule, split over the machine's cores by
-        // plain threads (callers on the rayon pool may wait for this table); each node has
-        // its own seed, so the table is the same on any number of threads.
-        let multiples = split_over_threads(lobes.len(), |k| multiple_scattering(k % E1_MU, k / E1_MU, &lobes[k]));
-        let nodes = lobes
-            .iter()
-            .zip(&multiples)
-            .map(|(l, m)| {
-                let slots = std::iter::once(l.albedo)
-                    .chain(l.rule.slots())
-                    .chain(m.slots())
-                    .map(|v| v as f32)
-                    .collect::<Vec<f32>>();
-                <[f32; NODE_LEN]>::try_from(slots).expect("a lobe node's slots")
+    TABLES.get_or_init(|| Tables { nodes: super::baked::lobe_nodes().unwrap_or_else(build_lobe_nodes) })
+}
+
+/// The lobe's tables, built (1.2 s on this machine's two cores; `baked` holds them).
+pub(super) fn build_lobe_nodes() -> Vec<[f32; NODE_LEN]> {
+    let mut lobes = Vec::with_capacity(E1_MU * E1_ROUGHNESS);
+    for i_r in 0..E1_ROUGHNESS {
+        let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
+        // r = 0 is a mirror: everything the film reflects leaves by the lobe, at μ.
+        let row: Vec<Lobe> = (0..E1_MU)
+            .map(|i_mu| {
+                let mu = node_mu(i_mu);
+                if i_r == 0 { Lobe::point(1.0, mu) } else { lobe(mu, r) }
             })
             .collect();
-        Tables { nodes }
-    })
+        lobes.extend(row);
+    }
+    // The walks of the multiple scattering's rule, split over the machine's cores by
+    // plain threads (callers on the rayon pool may wait for this table); each node has
+    // its own seed, so the table is the same on any number of threads.
+    let multiples = split_over_threads(lobes.len(), |k| multiple_scattering(k % E1_MU, k / E1_MU, &lobes[k]));
+    lobes
+        .iter()
+        .zip(&multiples)
+        .map(|(l, m)| {
+            let slots = std::iter::once(l.albedo)
+                .chain(l.rule.slots())
+                .chain(m.slots())
+                .map(|v| v as f32)
+                .collect::<Vec<f32>>();
+            <[f32; NODE_LEN]>::try_from(slots).expect("a lobe node's slots")
+        })
+        .collect()
 }
 
 /// `f(k)` for k in 0..count, in order, computed on the machine's cores by plain threads

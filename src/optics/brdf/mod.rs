@@ -23,6 +23,7 @@
 //! (`render::engine::shaders::generated_constants`), never by copy.
 
 pub mod accuracy;
+mod baked;
 pub mod energy;
 pub mod exact;
 pub mod ggx;

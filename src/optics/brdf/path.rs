@@ -16,8 +16,9 @@
 //! and refraction followed, the plain Fresnel reflectance of n0 | n2). One τ_ref serves
 //! every τ: matched at τ_ref = 0.5, the same grid (τ = 0.4 and 1) measured 0.61 / 1.38 /
 //! 3.73 against 0.60 / 1.33 / 3.66 with the exact mean at each τ. Row r = 0 is Snell's
-//! cos_t exactly. The table depends on n0 and n2 only, and is kept per material
-//! (`cached`); the renderer sends it to the shader in the rough lobe table's spare slot.
+//! cos_t exactly. The table depends on n0 and n2 only, and is kept per material (`cached`;
+//! the thesis' indices, every built-in species', ship built: `baked`); the renderer sends it
+//! to the shader in the rough lobe table's spare slot.
 //!
 //! **Light that comes straight back through the top.** The table also holds, per entry, a
 //! rule for the light that a rough top lets in and sends straight back out without it
@@ -101,7 +102,13 @@ impl PathTable {
     /// split_over_threads`: not the rayon pool, since `cached` builds under a lock that
     /// callers on the pool wait for). Each entry has its own seed, so the table is the same
     /// on any number of threads.
+    /// The baked table of the thesis' indices (`baked`) is taken as it is.
     pub fn new(n0: f64, n2: f64) -> PathTable {
+        super::baked::path_table(n0, n2).unwrap_or_else(|| PathTable::walked(n0, n2))
+    }
+
+    /// `new`, always walked (`baked`'s test compares the two).
+    pub fn walked(n0: f64, n2: f64) -> PathTable {
         if n0 == n2 {
             return PathTable::index_matched(n0);
         }
@@ -109,6 +116,11 @@ impl PathTable {
             super::energy::split_over_threads(E1_ROUGHNESS * E1_MU, |k| (entry(n0, n2, k), through_walk(n0, n2, k)));
         let (delta, walks): (Vec<f64>, Vec<ThroughWalk>) = walked.into_iter().unzip();
         let through = through_rule(n0, n2, &walks);
+        PathTable::from_parts(n0, n2, delta, through)
+    }
+
+    /// The table of these entries, with their f32 copies.
+    pub fn from_parts(n0: f64, n2: f64, delta: Vec<f64>, through: Vec<[f64; THROUGH_LEN]>) -> PathTable {
         let delta_f32 = delta.iter().map(|d| *d as f32).collect();
         let through_f32 = through.iter().map(|t| t.map(|v| v as f32)).collect();
         PathTable { n0, n2, delta, delta_f32, through, through_f32 }
@@ -123,15 +135,7 @@ impl PathTable {
     /// 4.9 s for 1.001; `brdf albedo --n0 1 --n2 1` took 74 s).
     fn index_matched(n: f64) -> PathTable {
         let entries = E1_ROUGHNESS * E1_MU;
-        let through = vec![NO_THROUGH_RULE; entries];
-        PathTable {
-            n0: n,
-            n2: n,
-            delta: vec![0.0; entries],
-            delta_f32: vec![0.0; entries],
-            through_f32: through.iter().map(|t| t.map(|v| v as f32)).collect(),
-            through,
-        }
+        PathTable::from_parts(n, n, vec![0.0; entries], vec![NO_THROUGH_RULE; entries])
     }
 
     /// cos_eff at (μ, r) for light whose Snell cosine in the pigment layer is `cos_t`
