@@ -9,7 +9,9 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use crate::export::gltf::{GltfMaterial, GltfTextures, glb, gltf_files, gltf_image_file_name, gltf_side_file_names};
+use crate::export::gltf::{
+    GltfMaterial, GltfTextures, glb, gltf_files, gltf_image_file_name, gltf_side_file_names, references_image,
+};
 use crate::export::pack::Pack;
 use crate::export::{SetLock, write_file_atomically};
 use crate::generate::{GenerateRequest, Plan};
@@ -259,17 +261,21 @@ impl ExportPlan {
             let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
             let lock = SetLock::acquire(&dir, &name)?;
             created_folder = lock.created_folder;
-            let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
             // An earlier export of this name with a film left its thickness image, which no
-            // file references now: under the lock, after the commit, it goes. Whatever stands
+            // file references once this one is committed: it goes, under the lock, after the
+            // commit, where the `.gltf` it replaces named it (a file of that name that the
+            // earlier `.gltf` did not name is someone else's, and stays). Whatever stands
             // there is harmless once the commit is done, so an export that succeeded does not
             // fail for it (a folder of that name stays, and so does a file that may not go).
-            if !has_thickness {
-                let stale = dir.join(gltf_image_file_name(&name, "thickness"));
-                if std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir()) && std::fs::remove_file(&stale).is_ok()
-                {
-                    removed.push(stale);
-                }
+            let thickness_file = gltf_image_file_name(&name, "thickness");
+            let stale = (!has_thickness && references_image(&dir.join(&gltf_name), &thickness_file))
+                .then(|| dir.join(&thickness_file));
+            let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
+            if let Some(stale) = stale
+                && std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir())
+                && std::fs::remove_file(&stale).is_ok()
+            {
+                removed.push(stale);
             }
             written
         };

@@ -213,6 +213,23 @@ fn a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole() {
     }
 }
 
+/// A `NAME.thickness.png` beside a `.gltf` that does not name it is not the earlier export's,
+/// and an export without a film leaves it as it was (it was removed as stale whoever's it was).
+#[test]
+fn an_export_without_a_film_keeps_a_thickness_image_it_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let no_film = ["--mesh", "plane", "--set", "optics.film_thickness_nm=0", "--set", "iridescence.spread_nm=0"];
+    let gltf = export(dir.path(), "liasis-mackloti", "x.gltf", &no_film);
+    let mine = dir.path().join("x.thickness.png");
+    std::fs::write(&mine, b"someone else's").unwrap();
+    let out = snakeskin(
+        &[&["export", "liasis-mackloti", "--gltf", gltf.to_str().unwrap(), "--size", "64"][..], &no_film].concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read(&mine).unwrap(), b"someone else's", "{}", stderr(&out));
+    assert!(!stderr(&out).contains("removed"), "{}", stderr(&out));
+}
+
 #[test]
 fn three_js_reads_the_film_and_renders_it() {
     if !tools_or_skip("three.js", true) {

@@ -373,6 +373,24 @@ pub fn gltf_image_file_name(name: &str, role: &str) -> String {
     format!("{name}.{role}.png")
 }
 
+/// The most bytes of an earlier `.gltf` read to see which images it names (`references_image`;
+/// one this tool writes is a few KB): a link to /dev/zero or a huge file is not read.
+const EARLIER_GLTF_MAX_BYTES: u64 = 16 << 20;
+
+/// Whether the `.gltf` at `gltf` names `image_file` (a file beside it) as one of its images:
+/// a regular file (no link followed) of at most `EARLIER_GLTF_MAX_BYTES`, JSON with an
+/// `images[].uri` that is `image_file`'s URI reference. False for anything else, so that a
+/// file is taken for an earlier export's only where that export's `.gltf` says it is.
+pub fn references_image(gltf: &std::path::Path, image_file: &str) -> bool {
+    let Ok(bytes) = crate::text_file::read_bounded_bytes(gltf, EARLIER_GLTF_MAX_BYTES, crate::text_file::Links::Refuse)
+    else {
+        return false;
+    };
+    let Ok(json) = serde_json::from_slice::<Value>(&bytes) else { return false };
+    let uri = uri_reference(image_file);
+    json["images"].as_array().is_some_and(|images| images.iter().any(|image| image["uri"].as_str() == Some(&uri)))
+}
+
 /// A file name as a relative URI reference (RFC 3986 §2): every byte but the unreserved
 /// characters percent-encoded, so that a name with a space, `#`, `%` or `?` still names
 /// its file (glTF 2.0 §3.3: `uri` is a URI reference, relative to the `.gltf`).
