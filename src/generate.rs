@@ -174,8 +174,11 @@ impl Plan {
     }
 
     /// The pack's encoded textures, at most (`pack_textures`' result; 0 without a pack): their
-    /// samples, PNG's filter byte a row, and 1/1024 and 4 KiB for the PNG's chunks and
-    /// deflate's stored blocks (5 bytes in 65,535 where nothing compresses).
+    /// samples, PNG's filter byte a row, 1/256 for the stream writer's chunks (12 bytes in each
+    /// 4 KiB IDAT) and 4 KiB. A bound for maps as these are, as the set's estimate assumes
+    /// (`memory::estimate_generate_bytes`): the fast compressor takes them to a third or less
+    /// (python-regius's body atlas at 1024: 47 MB for 126 MB of samples); its fixed codes could
+    /// make incompressible noise up to 1.5× its samples, which neither counts.
     pub fn texture_bytes_bound(&self) -> u64 {
         let Some(pack) = self.request.pack else { return 0 };
         let (width, height) = (self.size as u64, self.height as u64);
@@ -183,7 +186,7 @@ impl Plan {
             .iter()
             .map(|spec| {
                 let samples = width * height * spec.channels.len() as u64 * u64::from(spec.bit_depth / 8);
-                samples + height + samples / 1024 + 4096
+                samples + height + samples / 256 + 4096
             })
             .sum()
     }
@@ -479,13 +482,15 @@ impl Plan {
         let lock = SetLock::acquire(&self.request.out_dir, &self.loaded.name)?;
         let (textures, stats, encode_time) = self.pack_textures(pack, progress)?;
         let name = &self.loaded.name;
+        let names: Vec<String> = textures.iter().map(|(spec, _)| texture_file_name(name, spec)).collect();
         let entries: Vec<MapEntry> = textures
             .iter()
-            .map(|(spec, bytes)| MapEntry::for_texture(spec, &texture_file_name(name, spec), sha256_hex(bytes)))
+            .zip(&names)
+            .map(|((spec, bytes), file)| MapEntry::for_texture(spec, file, sha256_hex(bytes)))
             .collect();
         // Moved, not copied: the encoded textures were held twice while they were written.
         let files: Vec<(String, Vec<u8>)> =
-            textures.into_iter().map(|(spec, bytes)| (texture_file_name(name, &spec), bytes)).collect();
+            names.into_iter().zip(textures).map(|(file, (_, bytes))| (file, bytes)).collect();
         let options = self.request.options;
         let mut manifest =
             export::manifest(&self.loaded, (self.size, self.height), entries, options, "png", Some(pack.name()));

@@ -125,8 +125,9 @@ pub struct ExportPlan {
 /// which hold them again with the mesh's buffer; the mesh and its buffer; the fixed overhead.
 /// A `.gltf`'s images are the textures moved, and its buffer is the mesh's alone.
 fn file_bytes_estimate(textures: u64, mesh: &Mesh, binary: bool) -> u64 {
-    // Per vertex: position, normal, tangent, uv (12 f32) in the mesh and in its buffer.
-    let mesh_bytes = (mesh.vertices.len() * 12 * 4 + mesh.indices.len() * 4) as u64;
+    // The vertices and indices, in the mesh and again in its buffer (the same floats).
+    let mesh_bytes = std::mem::size_of_val(mesh.vertices.as_slice()) + std::mem::size_of_val(mesh.indices.as_slice());
+    let mesh_bytes = mesh_bytes as u64;
     let file = if binary { textures + mesh_bytes } else { 0 };
     crate::memory::FIXED_OVERHEAD_BYTES + textures + 2 * mesh_bytes + file
 }

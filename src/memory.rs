@@ -45,11 +45,11 @@ pub fn estimate_generate_bytes(graph: &Graph, maps: &[MapKind], width: usize, he
 /// one strip's live buffers at their worst (`strip_rows` rows, margins included) and what the
 /// allocator keeps of the strip before, half as much, at most 64 MiB (its buffers, freed on the
 /// pool's threads, stay in their threads' arenas, and the next strip may ask on another
-/// thread: the body atlas of python-regius at 1024 packed for glTF peaked at 295–312 MiB where
-/// one strip's 101 MiB and the files counted 280; at 2048, strips of about 400 MiB, the peaks
-/// of three species stayed 170–280 MiB under the estimate without it), plus the PNG files
-/// growing as rows are encoded (at most the quantised size of the whole set with the fast
-/// filter), plus the fixed overhead.
+/// thread: the body atlas of python-regius at 1024 packed for glTF peaked at 274–312 MiB, ten
+/// runs, where one strip's 101 MiB and the files counted 280; at 2048, strips of about 400 MiB,
+/// the peaks of three species stayed 170–280 MiB under the estimate without it; BENCHMARKS.md,
+/// "Export's memory"), plus the PNG files growing as rows are encoded (at most the quantised
+/// size of the whole set with the fast filter), plus the fixed overhead.
 pub fn estimate_strips_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize, strip_rows: usize) -> u64 {
     let pixels = (width * height) as u64;
     let files: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * pixels).sum();

@@ -3,7 +3,8 @@
 //! beside the measured children. In tests/render.rs, beside its other GPU tests, the same
 //! 2048×1024 preview peaked at 481 MiB against 323 MiB alone (lavapipe queues more of its
 //! rasteriser's work when the cores are busy), past its estimate of 474 (a CI run of
-//! 69a99b0); what the estimate bounds is the command's own peak.
+//! 69a99b0); what the estimate bounds is the command's own peak. The binary's two tests
+//! measure one at a time (`MEASURING`): cargo runs a binary's tests on threads of their own.
 
 mod common;
 
@@ -42,6 +43,9 @@ fn peak_resident_kib(wrapper: &[&str], args: &[&str]) -> u64 {
     usage.ru_maxrss as u64
 }
 
+/// Held by each test while it measures, so that no test's children run beside another's.
+static MEASURING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// A command's memory estimate, as the refusal under a 1 MiB limit prints it.
 fn estimate_mib(args: &[&str]) -> u64 {
     let refused = common::snakeskin_env(args, &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1")]);
@@ -60,6 +64,7 @@ fn estimate_mib(args: &[&str]) -> u64 {
 #[cfg(target_os = "linux")]
 #[test]
 fn the_memory_estimate_of_an_export_is_above_its_peak() {
+    let _alone = MEASURING.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let dir = tempfile::tempdir().unwrap();
     let (glb, gltf, set) = (dir.path().join("s.glb"), dir.path().join("s.gltf"), dir.path().join("set"));
     let body = ["python-regius", "--layout", "body", "--size", "1024"];
@@ -90,6 +95,7 @@ fn the_memory_estimate_of_an_export_is_above_its_peak() {
 #[test]
 fn the_memory_estimate_of_a_drawing_is_above_its_peak() {
     let Some(gpu) = gpu_or_skip("the_memory_estimate_of_a_drawing_is_above_its_peak") else { return };
+    let _alone = MEASURING.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let software = gpu.describe().contains("Cpu");
     let dir = tempfile::tempdir().unwrap();
     let (sheet, image) = (dir.path().join("s.png"), dir.path().join("p.png"));

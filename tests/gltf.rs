@@ -270,8 +270,8 @@ fn three_js_reads_the_film_and_renders_it() {
 }
 
 /// An exported file says what made it, as a texture set's manifest does: the asset's
-/// `extras` hold the manifest's preset, preset_hash, species, seed, layout and size (it held
-/// only the generator, so a file could not be traced to its preset or made again). Checked
+/// `extras` hold the manifest's generator, preset, preset_hash, species, seed, layout and size
+/// (it held only the generator, so a file could not be traced to its preset or made again). Checked
 /// against the manifest of `generate` with the same preset, overrides and seed, for a
 /// `.glb` and a `.gltf`: every key of `extras` is the manifest's, with the same value.
 #[test]

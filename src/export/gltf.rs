@@ -61,22 +61,14 @@ impl GltfTextures {
     /// The images by role, in the order the material's texture indices count them (0 base
     /// colour, 1 normal, 2 ORM, 3 thickness when there is one).
     fn images(&self) -> Vec<(&'static str, &[u8])> {
-        let mut images: Vec<(&'static str, &[u8])> =
-            vec![(IMAGE_ROLES[0], &self.base_color), (IMAGE_ROLES[1], &self.normal), (IMAGE_ROLES[2], &self.orm)];
-        if let Some(thickness) = &self.thickness {
-            images.push((IMAGE_ROLES[3], thickness));
-        }
-        images
+        let images = [Some(&self.base_color), Some(&self.normal), Some(&self.orm), self.thickness.as_ref()];
+        IMAGE_ROLES.into_iter().zip(images).filter_map(|(role, image)| Some((role, image?.as_slice()))).collect()
     }
 
     /// `images`, moved out (a `.gltf`'s image files take them without a copy).
     fn into_images(self) -> Vec<(&'static str, Vec<u8>)> {
-        let mut images =
-            vec![(IMAGE_ROLES[0], self.base_color), (IMAGE_ROLES[1], self.normal), (IMAGE_ROLES[2], self.orm)];
-        if let Some(thickness) = self.thickness {
-            images.push((IMAGE_ROLES[3], thickness));
-        }
-        images
+        let images = [Some(self.base_color), Some(self.normal), Some(self.orm), self.thickness];
+        IMAGE_ROLES.into_iter().zip(images).filter_map(|(role, image)| Some((role, image?))).collect()
     }
 }
 
@@ -133,7 +125,7 @@ impl Buffer {
     /// Appends `bytes` as a buffer view; returns the view's index. Mesh data only, before any
     /// `place`d image.
     fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        debug_assert_eq!(self.length, self.bin.len(), "mesh data after a placed image");
+        assert_eq!(self.length, self.bin.len(), "mesh data after a placed image");
         let (index, offset) = self.next_view(bytes.len(), target);
         self.bin.resize(offset, 0);
         self.bin.extend_from_slice(bytes);
@@ -338,7 +330,9 @@ pub fn glb(
     }
     let bin_start = out.len();
     out.extend_from_slice(&mesh_bin);
-    for (offset, (_, bytes)) in image_offsets.into_iter().zip(textures.images()) {
+    let images = textures.images();
+    assert_eq!(image_offsets.len(), images.len(), "a place for every image");
+    for (offset, (_, bytes)) in image_offsets.into_iter().zip(images) {
         out.resize(bin_start + offset, 0);
         out.extend_from_slice(bytes);
     }
@@ -486,6 +480,31 @@ mod tests {
         }
         let length = json["buffers"][0]["byteLength"].as_u64().unwrap() as usize;
         assert_eq!(bin.len(), length.next_multiple_of(4));
+    }
+
+    /// A `.gltf`'s buffer file is the mesh data alone, exactly `byteLength` long, and its
+    /// images are the textures' bytes under the names the document gives them.
+    #[test]
+    fn a_gltf_buffer_file_is_as_long_as_its_buffer_and_its_images_are_the_textures() {
+        let mesh = Mesh::plane(1.0, 1.0);
+        let textures = || GltfTextures {
+            base_color: vec![1, 2, 3],
+            normal: vec![4, 5],
+            orm: vec![6],
+            thickness: Some(vec![7, 8, 9, 10, 11]),
+            occlusion: false,
+        };
+        let material = GltfMaterial { base_ior: 1.56, film: Some((1.33, 250.0, 450.0)), repeat_v: true };
+        let files = gltf_files("s", &mesh, material, textures(), &Value::Null).unwrap();
+        let json: Value = serde_json::from_slice(&files.last().unwrap().1).unwrap();
+        let file = |name: &str| &files.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("no {name}")).1;
+        let bin = file(json["buffers"][0]["uri"].as_str().unwrap());
+        assert_eq!(bin.len() as u64, json["buffers"][0]["byteLength"].as_u64().unwrap());
+        let expected = textures();
+        for (k, (role, bytes)) in expected.images().into_iter().enumerate() {
+            assert_eq!(json["images"][k]["uri"], format!("s.{role}.png"));
+            assert_eq!(file(&format!("s.{role}.png")).as_slice(), bytes, "{role}");
+        }
     }
 
     #[test]

@@ -96,18 +96,17 @@ pub struct PathTable {
 }
 
 impl PathTable {
-    /// The table for indices (n0, n2), walked entry by entry (about 10⁷ photon walks: 2·10⁶
-    /// for the path, 8·10⁶ for light straight back; 1.05 s on this machine's two cores),
-    /// the entries split over the machine's cores by plain threads (`energy::
-    /// split_over_threads`: not the rayon pool, since `cached` builds under a lock that
-    /// callers on the pool wait for). Each entry has its own seed, so the table is the same
-    /// on any number of threads.
-    /// The baked table of the thesis' indices (`baked`) is taken as it is.
+    /// The table for indices (n0, n2): the baked one for the thesis' indices (`baked`), else
+    /// `walked`.
     pub fn new(n0: f64, n2: f64) -> PathTable {
         super::baked::path_table(n0, n2).unwrap_or_else(|| PathTable::walked(n0, n2))
     }
 
-    /// `new`, always walked (`baked`'s test compares the two).
+    /// The table for indices (n0, n2), walked entry by entry (about 10⁷ photon walks: 2·10⁶
+    /// for the path, 8·10⁶ for light straight back; 1.4 s on this machine's two cores), the
+    /// entries split over the machine's cores by plain threads (`energy::split_over_threads`:
+    /// not the rayon pool, since `cached` builds under a lock that callers on the pool wait
+    /// for). Each entry has its own seed, so the table is the same on any number of threads.
     pub fn walked(n0: f64, n2: f64) -> PathTable {
         if n0 == n2 {
             return PathTable::index_matched(n0);
@@ -397,7 +396,7 @@ mod tests {
     #[test]
     fn the_walked_path_meets_snell_at_r_0_and_single_scattering_where_it_dominates() {
         for (n0, n2) in [(1.0, 2.0), (1.0, 1.33), (1.33, 2.0)] {
-            let table = PathTable::new(n0, n2);
+            let table = PathTable::walked(n0, n2);
             // Row 0 is Snell's law exactly, between the nodes too.
             for i in 0..=100 {
                 let mu = 0.005 + 0.99 * i as f64 / 100.0;
