@@ -641,8 +641,11 @@ fn a_mistyped_map_name_gets_a_suggestion() {
         ("height,Normal", "unknown map \"Normal\"; did you mean normal? accepted:"),
         ("iridesence", "did you mean iridescence?"),
         ("sheen", "unknown map \"sheen\"; accepted:"),
-        // Not `ao` for any word of two letters, nor for a comma too many.
+        // Not `ao` for any word of two letters, nor for a comma too many, nor for one of
+        // three two edits away (every letter of `ao`); one edit still is.
         ("xy", "unknown map \"xy\"; accepted:"),
+        ("foo", "unknown map \"foo\"; accepted:"),
+        ("aoo", "unknown map \"aoo\"; did you mean ao?"),
         ("color,", "an empty name in \"color,\"; name the maps, one comma between two"),
     ] {
         let out = snakeskin(&["graph", "natrix-natrix", "--maps", maps]);

@@ -603,7 +603,11 @@ fn override_value(value: &str) -> Result<toml::Value, String> {
             let number = !whole && (numeric(first) || signed_number || (first == Some('.') && numeric(second)));
             let reason = || e.message().trim().replace('\n', "; ");
             if word.eq_ignore_ascii_case("true") || word.eq_ignore_ascii_case("false") {
-                Err(format!("{word} is not a TOML boolean: write {}", word.to_ascii_lowercase()))
+                // The key may want the word itself (a name, a species): say how to write either.
+                Err(format!(
+                    "{word} is not a TOML boolean: write {}, or 'KEY=\"{word}\"' for the text",
+                    word.to_ascii_lowercase()
+                ))
             } else if matches!(first, Some('[' | '{' | '"' | '\'')) {
                 Err(format!("not a TOML value ({})", reason()))
             } else if number {
@@ -666,8 +670,8 @@ mod tests {
             ("{rows = 3", "not a TOML value ("),
             ("1e400", "not a TOML value (floating-point number overflowed); write a TOML number"),
             ("-.5", "not a TOML value ("),
-            ("True", "True is not a TOML boolean: write true"),
-            ("FALSE", "FALSE is not a TOML boolean: write false"),
+            ("True", "True is not a TOML boolean: write true, or 'KEY=\"True\"' for the text"),
+            ("FALSE", "FALSE is not a TOML boolean: write false, or 'KEY=\"FALSE\"' for the text"),
         ] {
             let err = override_value(value).unwrap_err();
             assert!(err.starts_with(reason), "{value}: {err}");
