@@ -442,18 +442,25 @@ mod tests {
         }
     }
 
-    #[test]
-    fn glb_round_trips_the_mesh_and_writes_every_film_value() {
-        let mesh = Mesh::plane(1.0, 1.0);
-        let textures = GltfTextures {
+    /// Four textures of a few bytes each, the thickness the fourth (the tests below).
+    fn four_textures() -> GltfTextures {
+        GltfTextures {
             base_color: vec![1, 2, 3],
             normal: vec![4, 5],
             orm: vec![6],
             thickness: Some(vec![7, 8, 9, 10, 11]),
             occlusion: false,
-        };
-        let material = GltfMaterial { base_ior: 1.56, film: Some((1.33, 250.0, 450.0)), repeat_v: true };
-        let (json, bin) = parse_glb(&glb("snake", &mesh, material, &textures, &Value::Null).unwrap());
+        }
+    }
+
+    /// A material with a film of 250–450 nm (the tests below).
+    const FILM_MATERIAL: GltfMaterial =
+        GltfMaterial { base_ior: 1.56, film: Some((1.33, 250.0, 450.0)), repeat_v: true };
+
+    #[test]
+    fn glb_round_trips_the_mesh_and_writes_every_film_value() {
+        let mesh = Mesh::plane(1.0, 1.0);
+        let (json, bin) = parse_glb(&glb("snake", &mesh, FILM_MATERIAL, &four_textures(), &Value::Null).unwrap());
         let film = &json["materials"][0]["extensions"]["KHR_materials_iridescence"];
         assert_eq!(film["iridescenceIor"], 1.33);
         assert_eq!(film["iridescenceThicknessMinimum"], 250.0);
@@ -487,20 +494,12 @@ mod tests {
     #[test]
     fn a_gltf_buffer_file_is_as_long_as_its_buffer_and_its_images_are_the_textures() {
         let mesh = Mesh::plane(1.0, 1.0);
-        let textures = || GltfTextures {
-            base_color: vec![1, 2, 3],
-            normal: vec![4, 5],
-            orm: vec![6],
-            thickness: Some(vec![7, 8, 9, 10, 11]),
-            occlusion: false,
-        };
-        let material = GltfMaterial { base_ior: 1.56, film: Some((1.33, 250.0, 450.0)), repeat_v: true };
-        let files = gltf_files("s", &mesh, material, textures(), &Value::Null).unwrap();
+        let files = gltf_files("s", &mesh, FILM_MATERIAL, four_textures(), &Value::Null).unwrap();
         let json: Value = serde_json::from_slice(&files.last().unwrap().1).unwrap();
         let file = |name: &str| &files.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("no {name}")).1;
         let bin = file(json["buffers"][0]["uri"].as_str().unwrap());
         assert_eq!(bin.len() as u64, json["buffers"][0]["byteLength"].as_u64().unwrap());
-        let expected = textures();
+        let expected = four_textures();
         for (k, (role, bytes)) in expected.images().into_iter().enumerate() {
             assert_eq!(json["images"][k]["uri"], format!("s.{role}.png"));
             assert_eq!(file(&format!("s.{role}.png")).as_slice(), bytes, "{role}");
