@@ -351,9 +351,8 @@ fn in_key_range(key: &str, message: &str, from_set: bool) -> Option<String> {
         Some(value) => value,
         None if from_set => {
             let word = message.strip_prefix("invalid type: string \"")?.split('"').next()?;
-            let digits = word.strip_prefix(['-', '+']).unwrap_or(word);
             let past_toml = word.parse::<i64>().is_err();
-            (past_toml && !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit())).then_some(word)?
+            (past_toml && is_whole_number_word(word)).then_some(word)?
         }
         None => return None,
     };
@@ -579,6 +578,14 @@ fn merge(target: &mut toml::Value, value: toml::Value) {
     }
 }
 
+/// Whether `word` is a whole number in digits, signed or not (`-3`, `+99999999999999999999`):
+/// one past TOML's integers stays a word in an override (`override_value`), and the key's
+/// range check names it (`in_key_range`).
+fn is_whole_number_word(word: &str) -> bool {
+    let digits = word.strip_prefix(['-', '+']).unwrap_or(word);
+    !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit())
+}
+
 /// An override's value: one TOML value, or a bare word that is not TOML as a string. A
 /// value written as TOML that does not parse is refused with TOML's reason: one that opens
 /// an array, a table or a quoted string, or starts as a number does (`[1, 2`, `"#fff`,
@@ -596,8 +603,7 @@ fn override_value(value: &str) -> Result<toml::Value, String> {
             let numeric = |c: Option<char>| c.is_some_and(|c| c.is_ascii_digit());
             // A whole number past TOML's integers stays a word: the key's range check names
             // it (`in_key_range`).
-            let digits = word.strip_prefix(['-', '+']).unwrap_or(word);
-            let whole = !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit());
+            let whole = is_whole_number_word(word);
             let second = chars.next();
             let signed_number = matches!(first, Some('+' | '-')) && (numeric(second) || second == Some('.'));
             let number = !whole && (numeric(first) || signed_number || (first == Some('.') && numeric(second)));

@@ -128,8 +128,8 @@ impl PathTable {
     /// The table of a top between equal indices, whose bare interface is no interface at
     /// all: light goes straight through, at cosine μ = cos_t (every δ 0), and the bare
     /// interface reflects none, so none comes straight back (every W 0; a film between
-    /// them is the film's own, which the rule's reweighting cannot add to W = 0). Its walk finds exactly that (`tests`), photon by
-    /// photon, but slowly: index-matched, each photon crosses the microsurface back and
+    /// them is the film's own, which the rule's reweighting cannot add to W = 0). Its walk
+    /// finds exactly that (`tests`), photon by photon, but slowly: index-matched, each photon crosses the microsurface back and
     /// forth many times before it leaves (27 s for the table, against 1.4 s for n2 = 1.2 and
     /// 4.9 s for 1.001; `brdf albedo --n0 1 --n2 1` took 74 s).
     fn index_matched(n: f64) -> PathTable {
