@@ -77,39 +77,96 @@ pub fn fresnel(n0: f64, n: f64, cos0: f64) -> (f64, f64) {
 /// The exact coherent film at one vacuum wavelength: `cos0` is the cosine of the incidence
 /// angle in the ambient medium (clamped to [0, 1]).
 pub fn airy(stack: Stack, thickness_nm: f64, wavelength_nm: f64, cos0: f64) -> FilmRT {
-    let cos0 = cos0.clamp(0.0, 1.0);
-    let Stack { n0, n1, n2 } = stack;
-    let c0 = C64::real(cos0);
-    let c1 = cos_in(n0, n1, cos0);
-    let c2 = cos_in(n0, n2, cos0);
-    let (r01s, r01p, t01s, t01p) = fresnel_amplitudes(n0, c0, n1, c1);
-    let (r12s, r12p, t12s, t12p) = fresnel_amplitudes(n1, c1, n2, c2);
+    FilmAtAngle::new(stack, thickness_nm, cos0).at(wavelength_nm)
+}
 
-    // β = 2π n1 d cos θ1 / λ; complex when the film is evanescent (frustrated TIR).
-    let beta = c1 * (2.0 * std::f64::consts::PI * n1 * thickness_nm / wavelength_nm);
-    let e1 = C64::exp_i(beta);
-    let e2 = C64::exp_i(beta * 2.0);
-    let airy_r = |r01: C64, r12: C64| (r01 + r12 * e2) / (C64::ONE + r01 * r12 * e2);
-    let airy_t = |r01: C64, r12: C64, t01: C64, t12: C64| (t01 * t12 * e1) / (C64::ONE + r01 * r12 * e2);
+/// The exact coherent film at one angle of incidence, with what does not depend on the
+/// wavelength (the cosines in each medium, the two interfaces' Fresnel amplitudes, the flux
+/// ratios) computed once: a spectral sum evaluates 471 wavelengths at one angle, and per
+/// wavelength only the phase changes. `reflectance` is `at(λ).r` bit for bit without the
+/// transmitted wave (one complex exponential instead of two): the reference film colour
+/// (`optics::film_rgb_reference`) costs a third of what it did through `airy`.
+#[derive(Debug, Clone, Copy)]
+pub struct FilmAtAngle {
+    cos0: f64,
+    /// cos θ1, complex when the film is evanescent (frustrated TIR).
+    c1: C64,
+    /// 2π n1 d: the phase β = c1 · (this / λ).
+    phase_nm: f64,
+    /// Amplitudes (s, p) at the 0|1 and 1|2 interfaces.
+    r01: [C64; 2],
+    r12: [C64; 2],
+    t01: [C64; 2],
+    t12: [C64; 2],
+    /// The ratio of normal energy flux behind and in front of the film: Re(n cos) for s and
+    /// Re(n conj(cos)) for p (PHYSICS.md); zero when the substrate wave is evanescent.
+    flux: [f64; 2],
+}
 
-    let rs = airy_r(r01s, r12s).norm_sqr();
-    let rp = airy_r(r01p, r12p).norm_sqr();
-    // Power transmittance: the ratio of normal energy flux, Re(n cos) for s and
-    // Re(n conj(cos)) for p (PHYSICS.md); zero when the substrate wave is evanescent.
-    let flux_s = (c2 * n2).re / (c0 * n0).re;
-    let flux_p = (c2.conj() * n2).re / (c0.conj() * n0).re;
-    let (ts, tp) = if cos0 > 0.0 {
-        (flux_s * airy_t(r01s, r12s, t01s, t12s).norm_sqr(), flux_p * airy_t(r01p, r12p, t01p, t12p).norm_sqr())
-    } else {
-        // Exactly grazing incidence carries no flux: everything is reflected.
-        (0.0, 0.0)
-    };
-    let (rs, rp) = if cos0 > 0.0 { (rs, rp) } else { (1.0, 1.0) };
-    if ![rs, rp, ts, tp].iter().all(|v| v.is_finite()) {
-        // Only |r01 r12| = 1 makes the Airy denominator vanish: the grazing limit, R = 1.
-        return FilmRT::from_sp(1.0, 1.0, 0.0, 0.0);
+impl FilmAtAngle {
+    pub fn new(stack: Stack, thickness_nm: f64, cos0: f64) -> FilmAtAngle {
+        let cos0 = cos0.clamp(0.0, 1.0);
+        let Stack { n0, n1, n2 } = stack;
+        let c0 = C64::real(cos0);
+        let c1 = cos_in(n0, n1, cos0);
+        let c2 = cos_in(n0, n2, cos0);
+        let (r01s, r01p, t01s, t01p) = fresnel_amplitudes(n0, c0, n1, c1);
+        let (r12s, r12p, t12s, t12p) = fresnel_amplitudes(n1, c1, n2, c2);
+        FilmAtAngle {
+            cos0,
+            c1,
+            phase_nm: 2.0 * std::f64::consts::PI * n1 * thickness_nm,
+            r01: [r01s, r01p],
+            r12: [r12s, r12p],
+            t01: [t01s, t01p],
+            t12: [t12s, t12p],
+            flux: [(c2 * n2).re / (c0 * n0).re, (c2.conj() * n2).re / (c0.conj() * n0).re],
+        }
     }
-    FilmRT::from_sp(rs.clamp(0.0, 1.0), rp.clamp(0.0, 1.0), ts.clamp(0.0, 1.0), tp.clamp(0.0, 1.0))
+
+    /// e^{iβ k} for the phase β = 2π n1 d cos θ1 / λ (k = 2: the round trip).
+    fn phase_factor(&self, wavelength_nm: f64, k: f64) -> C64 {
+        C64::exp_i(self.c1 * (self.phase_nm / wavelength_nm) * k)
+    }
+
+    /// The Airy reflection amplitude of polarisation `p` (0: s, 1: p) with round trip `e2`.
+    fn airy_r(&self, p: usize, e2: C64) -> C64 {
+        (self.r01[p] + self.r12[p] * e2) / (C64::ONE + self.r01[p] * self.r12[p] * e2)
+    }
+
+    /// Reflectance and transmittance at one vacuum wavelength.
+    pub fn at(&self, wavelength_nm: f64) -> FilmRT {
+        let (e1, e2) = (self.phase_factor(wavelength_nm, 1.0), self.phase_factor(wavelength_nm, 2.0));
+        let airy_t = |p: usize| (self.t01[p] * self.t12[p] * e1) / (C64::ONE + self.r01[p] * self.r12[p] * e2);
+        let rs = self.airy_r(0, e2).norm_sqr();
+        let rp = self.airy_r(1, e2).norm_sqr();
+        let (ts, tp) = if self.cos0 > 0.0 {
+            (self.flux[0] * airy_t(0).norm_sqr(), self.flux[1] * airy_t(1).norm_sqr())
+        } else {
+            // Exactly grazing incidence carries no flux: everything is reflected.
+            (0.0, 0.0)
+        };
+        let (rs, rp) = if self.cos0 > 0.0 { (rs, rp) } else { (1.0, 1.0) };
+        if ![rs, rp, ts, tp].iter().all(|v| v.is_finite()) {
+            // Only |r01 r12| = 1 makes the Airy denominator vanish: the grazing limit, R = 1.
+            return FilmRT::from_sp(1.0, 1.0, 0.0, 0.0);
+        }
+        FilmRT::from_sp(rs.clamp(0.0, 1.0), rp.clamp(0.0, 1.0), ts.clamp(0.0, 1.0), tp.clamp(0.0, 1.0))
+    }
+
+    /// `at(wavelength_nm).r`, bit for bit (the transmitted wave shares the reflected one's
+    /// denominator, so it is non-finite only where the reflected one is).
+    pub fn reflectance(&self, wavelength_nm: f64) -> f64 {
+        if self.cos0 <= 0.0 {
+            return 1.0;
+        }
+        let e2 = self.phase_factor(wavelength_nm, 2.0);
+        let (rs, rp) = (self.airy_r(0, e2).norm_sqr(), self.airy_r(1, e2).norm_sqr());
+        if !(rs.is_finite() && rp.is_finite()) {
+            return 1.0;
+        }
+        0.5 * (rs.clamp(0.0, 1.0) + rp.clamp(0.0, 1.0))
+    }
 }
 
 /// The incoherent (thick-film) limit: intensities add, phases average out.
@@ -131,4 +188,49 @@ pub fn incoherent(stack: Stack, cos0: f64) -> FilmRT {
     };
     let (rs, rp) = (sum(r01s, r12s), sum(r01p, r12p));
     FilmRT::from_sp(rs, rp, 1.0 - rs, 1.0 - rp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `FilmAtAngle::reflectance` (what the spectral sums call) is `at(λ).r` bit for bit:
+    /// over films that vanish (n1 = n0), stacks with total internal reflection in the film
+    /// and in the substrate (n1 or n2 below n0), zero and thick films, and angles at 0, 1,
+    /// just inside and at the critical angles.
+    #[test]
+    fn the_reflectance_alone_is_the_full_films_bit_for_bit() {
+        let stacks = [
+            Stack::THESIS,
+            Stack { n0: 1.0, n1: 1.0, n2: 1.5 },
+            Stack { n0: 1.33, n1: 1.56, n2: 1.33 },
+            Stack { n0: 2.0, n1: 1.55, n2: 1.0 },
+            Stack { n0: 1.5, n1: 1.2, n2: 1.5 },
+        ];
+        let mut checked = 0;
+        for stack in stacks {
+            let critical = [stack.n1, stack.n2]
+                .map(|n| if n < stack.n0 { (1.0 - (n / stack.n0) * (n / stack.n0)).sqrt() } else { 0.5 });
+            let mut cosines = vec![0.0, 1e-12, 1e-3, 0.3, 0.77, 1.0, -0.5, 1.5];
+            for c in critical {
+                cosines.extend([c, c - 1e-9, c + 1e-9, f64::from_bits(c.to_bits() + 1)]);
+            }
+            for thickness_nm in [0.0, 1.0, 250.0, 812.5, 9000.0] {
+                for &cos0 in &cosines {
+                    let film = FilmAtAngle::new(stack, thickness_nm, cos0);
+                    for lambda in (360..=830).step_by(7) {
+                        let lambda = lambda as f64 + 0.25;
+                        let (alone, full) = (film.reflectance(lambda), film.at(lambda).r);
+                        assert_eq!(
+                            alone.to_bits(),
+                            full.to_bits(),
+                            "{stack:?} {thickness_nm} nm cos {cos0} λ {lambda}"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 10_000);
+    }
 }

@@ -16,7 +16,7 @@ pub mod series;
 pub mod spectrum;
 pub mod stress;
 
-use film::{Stack, airy, incoherent};
+use film::{FilmAtAngle, Stack, incoherent};
 use spectrum::{Observer, xyz_to_linear_srgb};
 
 /// Above this thickness the 1 nm spectral sum aliases (2β changes by more than ~1 rad per nm
@@ -32,7 +32,8 @@ pub fn film_rgb_reference(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3
         let r = incoherent(stack, cos0).r;
         obs.xyz(|_| r)
     } else {
-        obs.xyz(|lambda| airy(stack, thickness_nm, lambda, cos0).r)
+        let film = FilmAtAngle::new(stack, thickness_nm, cos0);
+        obs.xyz(|lambda| film.reflectance(lambda))
     };
     xyz_to_linear_srgb(xyz)
 }

@@ -17,8 +17,9 @@
 
 use super::schema::{Preset, Srgb8};
 use crate::optics::brdf::energy::E1_ROUGHNESS;
-use crate::optics::brdf::{Model, layered};
+use crate::optics::brdf::{exact, layered};
 use crate::render::engine::scene::LayerOptics;
+use rayon::prelude::*;
 
 /// A colour key the stack cannot show, and what it was clamped to.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -73,7 +74,6 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
     if !optics.has_absorption() {
         return None;
     }
-    let bounce = optics.bounce_grid(Model::Layered);
     // Row j of every thickness's table is at roughness j / (E1_ROUGHNESS − 1); the rows that
     // bracket the roughness map's range are the ones a pixel's values come from (a rougher
     // top shows less: its light crosses the pigment layer more obliquely, so the rows of
@@ -87,17 +87,25 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
             (j, layered::normal_transmittance(optics.stack.n0, optics.stack.n2, roughness, optics.optical_depth))
         })
         .collect();
-    Some([0, 1, 2].map(|c| {
-        if optics.optical_depth[c] <= 0.0 {
-            return 1.0;
-        }
-        bounce
-            .tables
-            .iter()
-            .flat_map(|table| t1.iter().map(move |(j, t1)| (t1[c], table.rows[*j])))
-            .map(|(t1, (k, e))| layered::visible_limit(t1, k[c], e[c]))
-            .fold(1.0, f64::min)
-    }))
+    // The K and E rows of `bounce_grid(Model::Layered)` that those roughnesses read, and
+    // only those: a row of one thickness is a few hundred spectral film sums (432 for the
+    // thesis stack), and the whole grid took about 1 s of a preset's load.
+    let limits: Vec<[f64; 3]> = optics
+        .bounce_thicknesses_nm()
+        .par_iter()
+        .flat_map_iter(|&d| {
+            let top = exact::cached(optics.stack, d);
+            let limit = move |&(j, t1): &(usize, [f64; 3])| {
+                let (k, e) = top.k_e_row(optics.optical_depth, j);
+                [0, 1, 2].map(|c| match optics.optical_depth[c] > 0.0 {
+                    true => layered::visible_limit(t1[c], k[c], e[c]),
+                    false => 1.0,
+                })
+            };
+            t1.iter().map(limit).collect::<Vec<_>>()
+        })
+        .collect();
+    Some([0, 1, 2].map(|c| limits.iter().map(|l| l[c]).fold(1.0, f64::min)))
 }
 
 /// The most the per-scale colour brightens a pixel (`ops::scale_colour`): tone and hue

@@ -20,7 +20,7 @@
 
 use std::f64::consts::PI;
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use super::energy;
 use super::{BrdfValue, Layers, cos_transmitted};
@@ -112,8 +112,10 @@ pub struct SmoothTop {
     /// beyond it (totally reflected).
     outside: Vec<Option<f64>>,
     /// Per roughness row, per node: the probability of being sent back down under the
-    /// layered model's coupling (`k_e_row`).
-    coupled: Vec<Vec<[f64; 3]>>,
+    /// layered model's coupling (`k_e_row`), each row computed when first read
+    /// (`coupled_row`): a row costs 24 × 18 spectral film sums, and a preset's colour limit
+    /// reads only the rows its roughness map reaches, `brdf stress` two per sample.
+    coupled: Vec<OnceLock<Vec<[f64; 3]>>>,
 }
 
 impl SmoothTop {
@@ -132,29 +134,34 @@ impl SmoothTop {
                 (sin2_out < 1.0).then(|| (1.0 - sin2_out).sqrt())
             })
             .collect();
-        let through = &super::path::cached(n0, n2).through;
-        let coupled = (0..energy::E1_ROUGHNESS)
-            .map(|row| {
-                below
-                    .iter()
-                    .zip(&outside)
-                    .map(|(&(_, _, rb), mu_out)| {
-                        let Some(mu_out) = *mu_out else {
-                            return [1.0; 3];
-                        };
-                        if row == 0 {
-                            // A mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
-                            return rb;
-                        }
-                        // What the top reflects on this row (its single scattering and x).
-                        let film = |c: f64| reflectance(stack, thickness_nm, c);
-                        let (single, beyond) = energy::parts_on_row(mu_out, row, &film, through);
-                        [0, 1, 2].map(|c| single[c] + beyond[c])
-                    })
-                    .collect()
-            })
-            .collect();
+        let coupled = (0..energy::E1_ROUGHNESS).map(|_| OnceLock::new()).collect();
         SmoothTop { stack, thickness_nm, below, outside, coupled }
+    }
+
+    /// Row `row` of `coupled`, computed on first use (the same values whichever row is
+    /// asked for first: each row reads only the film and the material's path table).
+    fn coupled_row(&self, row: usize) -> &[[f64; 3]] {
+        self.coupled[row].get_or_init(|| {
+            let (stack, thickness_nm) = (self.stack, self.thickness_nm);
+            let through = &super::path::cached(stack.n0, stack.n2).through;
+            self.below
+                .iter()
+                .zip(&self.outside)
+                .map(|(&(_, _, rb), mu_out)| {
+                    let Some(mu_out) = *mu_out else {
+                        return [1.0; 3];
+                    };
+                    if row == 0 {
+                        // A mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
+                        return rb;
+                    }
+                    // What the top reflects on this row (its single scattering and x).
+                    let film = |c: f64| reflectance(stack, thickness_nm, c);
+                    let (single, beyond) = energy::parts_on_row(mu_out, row, &film, through);
+                    [0, 1, 2].map(|c| single[c] + beyond[c])
+                })
+                .collect()
+        })
     }
 
     /// K (sent back to the base per bounce) and E (escaping per bounce) per channel for
@@ -199,7 +206,8 @@ impl SmoothTop {
     /// exp(−τ / cos_eff(μo, r)) (`path`) where the smooth top has exp(−τ / μ), so that E is
     /// the hemispherical escape of the model's own diffuse lobe. K keeps the smooth path.
     pub fn k_e_row(&self, tau: [f64; 3], row: usize) -> ([f64; 3], [f64; 3]) {
-        let sent_back = |node: usize, _| self.coupled[row][node];
+        let coupled = self.coupled_row(row);
+        let sent_back = |node: usize, _| coupled[node];
         if row == 0 || tau.iter().all(|t| *t <= 0.0) {
             return self.integrate(tau, sent_back, |_, mu| mu);
         }
