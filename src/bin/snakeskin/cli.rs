@@ -641,7 +641,7 @@ pub enum BrdfCommand {
     /// at the grazing and n0 > n2 draws) and the f32 path's worst deviation from f64 (JSON
     /// with --json).
     Stress {
-        /// Number of random samples, 1 to 10,000,000 (the default takes about fifty seconds
+        /// Number of random samples, 1 to 10,000,000 (the default takes about ten seconds
         /// on two cores).
         #[arg(long, default_value_t = 100_000, value_parser = ranged_u64(1, 10_000_000))]
         samples: u64,
