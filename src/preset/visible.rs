@@ -97,12 +97,11 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
             let top = exact::cached(optics.stack, d);
             let limit = move |&(j, t1): &(usize, [f64; 3])| {
                 let (k, e) = top.k_e_row(optics.optical_depth, j);
-                [0, 1, 2].map(|c| match optics.optical_depth[c] > 0.0 {
-                    true => layered::visible_limit(t1[c], k[c], e[c]),
-                    false => 1.0,
+                [0, 1, 2].map(|c| {
+                    if optics.optical_depth[c] <= 0.0 { 1.0 } else { layered::visible_limit(t1[c], k[c], e[c]) }
                 })
             };
-            t1.iter().map(limit).collect::<Vec<_>>()
+            t1.iter().map(limit)
         })
         .collect();
     Some([0, 1, 2].map(|c| limits.iter().map(|l| l[c]).fold(1.0, f64::min)))

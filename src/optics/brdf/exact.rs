@@ -113,8 +113,9 @@ pub struct SmoothTop {
     outside: Vec<Option<f64>>,
     /// Per roughness row, per node: the probability of being sent back down under the
     /// layered model's coupling (`k_e_row`), each row computed when first read
-    /// (`coupled_row`): a row costs 24 × 18 spectral film sums, and a preset's colour limit
-    /// reads only the rows its roughness map reaches, `brdf stress` two per sample.
+    /// (`coupled_row`): a row costs 18 spectral film sums per node inside the escape cone
+    /// (24 × 18 for the thesis stack), and a preset's colour limit reads only the rows its
+    /// roughness map reaches, `brdf stress` two per sample.
     coupled: Vec<OnceLock<Vec<[f64; 3]>>>,
 }
 
@@ -139,11 +140,14 @@ impl SmoothTop {
     }
 
     /// Row `row` of `coupled`, computed on first use (the same values whichever row is
-    /// asked for first: each row reads only the film and the material's path table).
+    /// asked for first: each row reads only the film and the material's path table, which
+    /// the mirror row does not need). The initialiser must not wait on the rayon pool: a
+    /// pool thread blocked on this row's `OnceLock` could not take the work it waits for
+    /// (`path::cached` builds on threads of its own).
     fn coupled_row(&self, row: usize) -> &[[f64; 3]] {
         self.coupled[row].get_or_init(|| {
             let (stack, thickness_nm) = (self.stack, self.thickness_nm);
-            let through = &super::path::cached(stack.n0, stack.n2).through;
+            let path = (row > 0).then(|| super::path::cached(stack.n0, stack.n2));
             self.below
                 .iter()
                 .zip(&self.outside)
@@ -151,13 +155,13 @@ impl SmoothTop {
                     let Some(mu_out) = *mu_out else {
                         return [1.0; 3];
                     };
-                    if row == 0 {
-                        // A mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
+                    let Some(path) = &path else {
+                        // Row 0, a mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
                         return rb;
-                    }
+                    };
                     // What the top reflects on this row (its single scattering and x).
                     let film = |c: f64| reflectance(stack, thickness_nm, c);
-                    let (single, beyond) = energy::parts_on_row(mu_out, row, &film, through);
+                    let (single, beyond) = energy::parts_on_row(mu_out, row, &film, &path.through);
                     [0, 1, 2].map(|c| single[c] + beyond[c])
                 })
                 .collect()
