@@ -247,18 +247,17 @@ impl ExportPlan {
             occlusion: ao,
         };
         // The asset's `extras`: the manifest's keys for what made it (`gltf::document`).
-        let source = serde_json::to_value(crate::export::Source::of(plan.loaded(), dimensions, plan.layout()))
-            .expect("a Source is plain data");
+        let source = crate::export::Source::of(plan.loaded(), dimensions, plan.layout());
         let created_folder;
         let mut removed = Vec::new();
         let files = if binary {
-            let bytes = glb(&name, &mesh, material, &textures, &source)?;
+            let bytes = glb(&name, &mesh, material, &textures, Some(&source))?;
             created_folder = crate::export::create_folder_noted(&dir)?;
             // A write that fails takes away the folders it made, as a set's lock does.
             vec![write_file_atomically(&out, bytes).inspect_err(|_| crate::export::remove_empty_made_folders())?]
         } else {
             let has_thickness = textures.thickness.is_some();
-            let mut files = gltf_files(&name, &mesh, material, textures, &source)?;
+            let mut files = gltf_files(&name, &mesh, material, textures, Some(&source))?;
             let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
             let lock = SetLock::acquire(&dir, &name)?;
             created_folder = lock.created_folder;

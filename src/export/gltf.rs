@@ -17,7 +17,7 @@
 
 use serde_json::{Value, json};
 
-use super::ExportError;
+use super::{ExportError, Source};
 use crate::render::engine::mesh::Mesh;
 
 /// glTF's numeric constants (glTF 2.0 spec, 5.1 accessors, 5.11 buffer views, 5.26 samplers).
@@ -182,16 +182,16 @@ enum Images<'a> {
     Files(&'a [String]),
 }
 
-/// `source`: what made the file, written as the asset's `extras` (`export::Source`, the
-/// texture set manifest's first keys), so that an exported file can be traced to its preset
-/// and made again; null for none.
+/// `source`: what made the file, written as the asset's `extras` (the texture set
+/// manifest's first keys), so that an exported file can be traced to its preset and made
+/// again.
 fn document(
     name: &str,
     mesh: &Mesh,
     material: GltfMaterial,
     textures: &GltfTextures,
     images: Images,
-    source: &Value,
+    source: Option<&Source>,
 ) -> Document {
     let mut buffer = Buffer::default();
     let v = &mesh.vertices;
@@ -290,8 +290,8 @@ fn document(
         "bufferViews": views,
         "buffers": [buffer],
     });
-    if !source.is_null() {
-        json["asset"]["extras"] = source.clone();
+    if let Some(source) = source {
+        json["asset"]["extras"] = serde_json::to_value(source).expect("a Source is plain data");
     }
     Document { json, mesh_bin: bin, image_offsets, length }
 }
@@ -308,7 +308,7 @@ pub fn glb(
     mesh: &Mesh,
     material: GltfMaterial,
     textures: &GltfTextures,
-    source: &Value,
+    source: Option<&Source>,
 ) -> Result<Vec<u8>, ExportError> {
     let Document { json, mesh_bin, image_offsets, length } =
         document(name, mesh, material, textures, Images::Embedded, source);
@@ -347,7 +347,7 @@ pub fn gltf_files(
     mesh: &Mesh,
     material: GltfMaterial,
     textures: GltfTextures,
-    source: &Value,
+    source: Option<&Source>,
 ) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
     let names: Vec<String> = textures.images().iter().map(|(role, _)| gltf_image_file_name(name, role)).collect();
     let Document { json, mesh_bin, .. } = document(name, mesh, material, &textures, Images::Files(&names), source);
@@ -435,7 +435,7 @@ mod tests {
                 thickness: thickness.clone(),
                 occlusion: false,
             };
-            let (json, _) = parse_glb(&glb("snake", &mesh, material, &textures, &Value::Null).unwrap());
+            let (json, _) = parse_glb(&glb("snake", &mesh, material, &textures, None).unwrap());
             let film = &json["materials"][0]["extensions"]["KHR_materials_iridescence"];
             assert_eq!(film["iridescenceThicknessMaximum"], 420.0);
             assert_eq!(film.get("iridescenceThicknessMinimum").is_some(), thickness.is_some(), "{film}");
@@ -460,7 +460,7 @@ mod tests {
     #[test]
     fn glb_round_trips_the_mesh_and_writes_every_film_value() {
         let mesh = Mesh::plane(1.0, 1.0);
-        let (json, bin) = parse_glb(&glb("snake", &mesh, FILM_MATERIAL, &four_textures(), &Value::Null).unwrap());
+        let (json, bin) = parse_glb(&glb("snake", &mesh, FILM_MATERIAL, &four_textures(), None).unwrap());
         let film = &json["materials"][0]["extensions"]["KHR_materials_iridescence"];
         assert_eq!(film["iridescenceIor"], 1.33);
         assert_eq!(film["iridescenceThicknessMinimum"], 250.0);
@@ -494,7 +494,7 @@ mod tests {
     #[test]
     fn a_gltf_buffer_file_is_as_long_as_its_buffer_and_its_images_are_the_textures() {
         let mesh = Mesh::plane(1.0, 1.0);
-        let files = gltf_files("s", &mesh, FILM_MATERIAL, four_textures(), &Value::Null).unwrap();
+        let files = gltf_files("s", &mesh, FILM_MATERIAL, four_textures(), None).unwrap();
         let json: Value = serde_json::from_slice(&files.last().unwrap().1).unwrap();
         let file = |name: &str| &files.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("no {name}")).1;
         let bin = file(json["buffers"][0]["uri"].as_str().unwrap());
@@ -512,7 +512,7 @@ mod tests {
         let textures =
             GltfTextures { base_color: vec![1], normal: vec![2], orm: vec![3], thickness: None, occlusion: false };
         let material = GltfMaterial { base_ior: 2.0, film: None, repeat_v: false };
-        let (json, _) = parse_glb(&glb("s", &mesh, material, &textures, &Value::Null).unwrap());
+        let (json, _) = parse_glb(&glb("s", &mesh, material, &textures, None).unwrap());
         assert_eq!(json["extensionsUsed"], json!(["KHR_materials_ior"]));
         assert!(json["materials"][0]["extensions"].get("KHR_materials_iridescence").is_none());
         assert_eq!(json["samplers"][0]["wrapT"], gl::CLAMP_TO_EDGE);
