@@ -28,7 +28,7 @@ use std::sync::OnceLock;
 use crate::optics::brdf::energy::{self, E1_ROUGHNESS};
 use crate::optics::brdf::path;
 
-use super::film::{Stack, airy};
+use super::film::{FilmAtAngle, Stack};
 use super::series::FilmSeries;
 use super::spectrum::{Observer, xyz_to_linear_srgb};
 
@@ -386,11 +386,13 @@ impl Lut {
 /// The spectral colour averaged over thicknesses [d − w/2, d + w/2] (w = 0: at d).
 pub fn box_colour(stack: Stack, film: &FilmSeries, d: f64, w: f64, cos0: f64) -> [f64; 3] {
     let obs = Observer::get();
-    let usable = film.usable();
+    // Where the series does not converge (an evanescent film, near grazing light), the
+    // exact film at this angle, its wavelength-free parts computed once.
+    let exact = (!film.usable()).then(|| FilmAtAngle::new(stack, d, cos0));
     let cos1 = film.cos1.unwrap_or(0.0);
     let xyz = obs.xyz(|lambda| {
-        if !usable {
-            return airy(stack, d, lambda, cos0).r;
+        if let Some(exact) = &exact {
+            return exact.reflectance(lambda);
         }
         let k = 4.0 * std::f64::consts::PI * stack.n1 * cos1 / lambda;
         film.reflectance(k * d, k * w)
