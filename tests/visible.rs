@@ -205,6 +205,7 @@ fn over_a_lossless_stack_no_key_is_brightened_past_a_reflectance_of_one() {
 #[test]
 fn the_visible_colour_is_the_rough_models_own_diffuse_reflectance_at_normal_incidence() {
     use snakeskin::optics::brdf::energy::E1_ROUGHNESS;
+    use snakeskin::optics::brdf::exact::reflectance;
     use snakeskin::optics::brdf::walk::FilmTables;
     let mut worst: f64 = 0.0;
     for stack in [Stack::THESIS, Stack { n0: 1.0, n1: 1.56, n2: 1.33 }] {
@@ -214,6 +215,10 @@ fn the_visible_colour_is_the_rough_models_own_diffuse_reflectance_at_normal_inci
         // millions of times, 80 s of this test with the 1 nm sum at every read.
         let tables = FilmTables::new(stack, thickness_nm);
         let film = |c: f64| tables.above(c);
+        for c in [0.0123, 0.3071, 0.77777, 0.99951] {
+            let (tabulated, exact) = (film(c), reflectance(stack, thickness_nm, c));
+            assert!((0..3).all(|k| (tabulated[k] - exact[k]).abs() < 1e-5), "{c}: {tabulated:?} {exact:?}");
+        }
         for tau in [0.4, 1.0] {
             // On the roughness rows, where K and E are the rows themselves.
             for row in [4, 9, 13] {

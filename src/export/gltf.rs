@@ -184,7 +184,7 @@ enum Images<'a> {
 
 /// `source`: what made the file, written as the asset's `extras` (the texture set
 /// manifest's first keys), so that an exported file can be traced to its preset and made
-/// again.
+/// again; None: no `extras`.
 fn document(
     name: &str,
     mesh: &Mesh,

@@ -834,9 +834,9 @@ pub enum BenchCommand {
     /// of 250 and 650 nm, light at 0–85°, roughness 0.05–0.9, every species' base colours.
     /// Reports the reflected colour's ΔE00 (mean, p95, max), the white-furnace error and the
     /// CPU cost per evaluation (inputs at random thicknesses, and the same sorted by
-    /// thickness as a frame reads them). Takes about three minutes on two cores at the default
+    /// thickness as a frame reads them). Takes about a minute on two cores at the default
     /// photon count, most of it the models' own albedo integration, which fewer photons do not
-    /// shorten (3 min 7 s measured, 5 min 14 s of CPU).
+    /// shorten (58 s measured, 1 min 54 s of CPU; 51 s at 1000 photons).
     Layered {
         /// Print JSON {"models": [{"name","mean_de","p95_de","max_de","max_furnace_err",
         /// "max_furnace_err_to_70","ns_per_eval","ns_per_eval_coherent"}], "points",
@@ -846,7 +846,7 @@ pub enum BenchCommand {
         json: bool,
         /// Photons per channel per reference walk, 1000 to 10,000,000 (noise ∝ 1/√N; the
         /// report says what it makes in ΔE: up to about 1.7 ΔE00 at the default, 1 at
-        /// 100,000, 0.25 at 1,600,000, which BENCHMARKS.md uses and which takes about 7
+        /// 100,000, 0.25 at 1,600,000, which BENCHMARKS.md uses and which takes about eight
         /// minutes on two cores).
         #[arg(long, default_value_t = 40_000, value_parser = ranged_u64(1000, 10_000_000))]
         photons: u64,

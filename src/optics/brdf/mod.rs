@@ -126,12 +126,33 @@ impl Model {
     }
 
     /// `coupling` for the light's and the view's cosines, which share the rough lobe's
-    /// normalisation (`energy::top_pair`).
-    fn coupling_pair(self, cos: [f64; 2], layers: &Layers, film: &dyn Fn(f64) -> [f64; 3]) -> [energy::Top<f64>; 2] {
+    /// normalisation (`energy::top_pair`; `norms` from `ms_norms` where the caller has it).
+    fn coupling_pair(
+        self,
+        cos: [f64; 2],
+        layers: &Layers,
+        film: &dyn Fn(f64) -> [f64; 3],
+        norms: Option<MsNorms>,
+    ) -> [energy::Top<f64>; 2] {
         match self {
             Model::Thesis => cos.map(|c| self.coupling(c, layers, film)),
             Model::Layered => {
-                path::with(layers.n0, layers.n2, |p| energy::top_pair(cos, layers.roughness, film, &p.through))
+                path::with(layers.n0, layers.n2, |p| energy::top_pair(cos, layers.roughness, film, &p.through, norms))
+            }
+        }
+    }
+
+    /// The rough top's multiple-scatter normalisation X̄ on the two roughness rows around
+    /// `layers.roughness`, with `film` as the coupling reads it (`coupling_film`): the same
+    /// for every pair of directions, so an integral over directions computes it once
+    /// (`furnace_albedo`: it was four fifths of each evaluation's rule there). None for the
+    /// thesis model, which has no such lobe.
+    fn ms_norms(self, layers: &Layers, film: &dyn Fn(f64) -> [f64; 3]) -> Option<MsNorms> {
+        match self {
+            Model::Thesis => None,
+            Model::Layered => {
+                let film = coupling_film(film);
+                Some(path::with(layers.n0, layers.n2, |p| energy::ms_norms(layers.roughness, &film, &p.through)))
             }
         }
     }
@@ -289,6 +310,15 @@ pub fn cos_transmitted(n0: f64, n2: f64, cos: f64) -> Option<f64> {
     (k > 0.0).then(|| k.sqrt())
 }
 
+/// X̄ per channel on the two roughness rows around a roughness (`energy::ms_norms`).
+type MsNorms = [[f64; 3]; 2];
+
+/// The film as the f64 coupling reads it: at the cosine clamped to [0, 1], its colour
+/// clamped to [0, 1] (`film_clamped`).
+fn coupling_film(film: &dyn Fn(f64) -> [f64; 3]) -> impl Fn(f64) -> [f64; 3] + '_ {
+    move |c| film_clamped(film(c.clamp(0.0, 1.0)))
+}
+
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
@@ -305,14 +335,15 @@ impl Model {
         wo: [f64; 3],
         film: &dyn Fn(f64) -> [f64; 3],
     ) -> BrdfValue {
-        let Some(lobes) = self.eval_lobes(layers, normal, wi, wo, film) else {
+        let Some(lobes) = self.eval_lobes(layers, normal, wi, wo, film, None) else {
             return BrdfValue::ZERO;
         };
         let specular = [0, 1, 2].map(|c| lobes.single[c] + lobes.multiple[c]);
         BrdfValue { specular, diffuse: lobes.diffuse }
     }
 
-    /// The BRDF's three lobes, or None where it is zero (below the horizon, no direction).
+    /// The BRDF's three lobes, or None where it is zero (below the horizon, no direction);
+    /// `norms`: the model's `ms_norms` for this film, where the caller has computed it.
     fn eval_lobes(
         self,
         layers: &Layers,
@@ -320,10 +351,10 @@ impl Model {
         wi: [f64; 3],
         wo: [f64; 3],
         film: &dyn Fn(f64) -> [f64; 3],
+        norms: Option<MsNorms>,
     ) -> Option<Lobes> {
         let (single, cos_i, cos_o) = single_lobe(layers, normal, wi, wo, film)?;
-        let film_clamped = |c: f64| film_clamped(film(c.clamp(0.0, 1.0)));
-        let [top_i, top_o] = self.coupling_pair([cos_i, cos_o], layers, &film_clamped);
+        let [top_i, top_o] = self.coupling_pair([cos_i, cos_o], layers, &coupling_film(film), norms);
         Some(Lobes {
             single,
             multiple: [0, 1, 2].map(|c| top_i.ms_amplitude[c] * top_o.ms_amplitude[c]),
@@ -390,12 +421,13 @@ impl Model {
             }
         }
         let spec = spec.map(|s| s / (n * n) as f64);
+        let norms = self.ms_norms(layers, film);
         let mut diffuse = [0.0; 3];
         for a in 0..n * n {
             // ∫ over the hemisphere of g(θi) cos θi dω = 2π ∫ g(μ) μ dμ.
             let mu = (a as f64 + 0.5) / (n * n) as f64;
             let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
-            let Some(value) = self.eval_lobes(layers, [0.0, 0.0, 1.0], wi, wo, film) else {
+            let Some(value) = self.eval_lobes(layers, [0.0, 0.0, 1.0], wi, wo, film, norms) else {
                 continue;
             };
             for (c, d) in diffuse.iter_mut().enumerate() {
