@@ -83,12 +83,12 @@ pub fn airy(stack: Stack, thickness_nm: f64, wavelength_nm: f64, cos0: f64) -> F
 /// The exact coherent film at one angle of incidence, with what does not depend on the
 /// wavelength (the cosines in each medium, the two interfaces' Fresnel amplitudes, the flux
 /// ratios) computed once: a spectral sum evaluates 421 wavelengths (360–780 nm) at one
-/// angle, and per wavelength only the phase changes. `reflectance` is `at(λ).r` bit for bit without the
-/// transmitted wave (one complex exponential instead of two): the reference film colour
-/// (`optics::film_rgb_reference`) costs about a third of what it did through `airy`.
+/// angle, and per wavelength only the phase changes. `reflectance` is `at(λ).r` bit for bit
+/// without the transmitted wave (one complex exponential instead of two): the reference
+/// film colour (`optics::film_rgb_reference`) costs about a third of what it did through
+/// `airy`.
 #[derive(Debug, Clone, Copy)]
 pub struct FilmAtAngle {
-    cos0: f64,
     /// cos θ1, complex when the film is evanescent (frustrated TIR).
     c1: C64,
     /// 2π n1 d: the phase β = c1 · (this / λ).
@@ -101,9 +101,10 @@ pub struct FilmAtAngle {
     /// The ratio of normal energy flux behind and in front of the film: Re(n cos) for s and
     /// Re(n conj(cos)) for p (PHYSICS.md); zero when the substrate wave is evanescent.
     flux: [f64; 2],
-    /// True where `at` reflects everything at every wavelength: exactly grazing light
-    /// (cos0 = 0) and a flux ratio that overflows (cos0 below about 1e-308: its transmittance
-    /// is then inf · 0, and `at` takes a non-finite value as the grazing limit).
+    /// True where the film reflects everything at every wavelength: exactly grazing light
+    /// (cos0 = 0: it carries no flux) and a flux ratio that overflows (cos0 below about
+    /// 1e-308: the transmittance would be inf · 0, a non-finite value, which is taken as the
+    /// grazing limit).
     reflects_all: bool,
 }
 
@@ -120,7 +121,6 @@ impl FilmAtAngle {
         let (r12s, r12p, t12s, t12p) = fresnel_amplitudes(n1, c1, n2, c2);
         let flux = [(c2 * n2).re / (c0 * n0).re, (c2.conj() * n2).re / (c0.conj() * n0).re];
         FilmAtAngle {
-            cos0,
             c1,
             phase_nm: 2.0 * std::f64::consts::PI * n1 * thickness_nm,
             r01: [r01s, r01p],
@@ -146,19 +146,16 @@ impl FilmAtAngle {
 
     /// Reflectance and transmittance at one vacuum wavelength.
     pub fn at(&self, wavelength_nm: f64) -> FilmRT {
+        if self.reflects_all {
+            return FilmRT::from_sp(1.0, 1.0, 0.0, 0.0);
+        }
         let beta = self.beta(wavelength_nm);
         let (e1, e2) = (C64::exp_i(beta), C64::exp_i(beta * 2.0));
         let airy_t =
             |pol: usize| (self.t01[pol] * self.t12[pol] * e1) / (C64::ONE + self.r01[pol] * self.r12[pol] * e2);
         let rs = self.airy_r(0, e2).norm_sqr();
         let rp = self.airy_r(1, e2).norm_sqr();
-        let (ts, tp) = if self.cos0 > 0.0 {
-            (self.flux[0] * airy_t(0).norm_sqr(), self.flux[1] * airy_t(1).norm_sqr())
-        } else {
-            // Exactly grazing incidence carries no flux: everything is reflected.
-            (0.0, 0.0)
-        };
-        let (rs, rp) = if self.cos0 > 0.0 { (rs, rp) } else { (1.0, 1.0) };
+        let (ts, tp) = (self.flux[0] * airy_t(0).norm_sqr(), self.flux[1] * airy_t(1).norm_sqr());
         if ![rs, rp, ts, tp].iter().all(|v| v.is_finite()) {
             // Only |r01 r12| = 1 makes the Airy denominator vanish: the grazing limit, R = 1.
             return FilmRT::from_sp(1.0, 1.0, 0.0, 0.0);
@@ -167,7 +164,7 @@ impl FilmAtAngle {
     }
 
     /// `at(wavelength_nm).r`, bit for bit. `at` takes R = 1 where any of R_s, R_p, T_s, T_p
-    /// is not finite; with `reflects_all` false the flux ratios are finite, and T is then
+    /// is not finite; past `reflects_all` the flux ratios are finite, and T is then
     /// non-finite only where its Airy fraction is: the reflected one's denominator vanishes
     /// (R is not finite either) or e^{iβ} overflows (e^{2iβ} has overflowed first, and R
     /// is inf / inf).

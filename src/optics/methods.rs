@@ -200,8 +200,7 @@ fn bb_sensitivity(c_re: f64, c_im: f64, opd_nm: f64) -> [f64; 3] {
 
 /// D65 white XYZ relative to illuminant E's (1, 1, 1), for the von Kries scaling.
 pub fn d65_white() -> [f64; 3] {
-    static WHITE: OnceLock<[f64; 3]> = OnceLock::new();
-    *WHITE.get_or_init(|| Observer::get().white_xyz())
+    Observer::get().white_xyz()
 }
 
 pub fn gaussian_fit_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {

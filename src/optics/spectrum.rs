@@ -22,6 +22,9 @@ pub const XYZ_TO_SRGB: [[f64; 3]; 3] =
 /// Per-wavelength weights k S(λ) (x̄, ȳ, z̄)(λ) for λ = 360..=780 nm.
 pub struct Observer {
     pub weights: Vec<[f64; 3]>,
+    /// `xyz` of the perfect reflector, summed once: every reference film colour is divided
+    /// by it (`brdf::exact::reflectance`).
+    white_xyz: [f64; 3],
 }
 
 fn parse_csv(text: &str) -> Vec<Vec<f64>> {
@@ -50,7 +53,9 @@ impl Observer {
             .collect();
         let k = 1.0 / weights.iter().map(|w| w[1]).sum::<f64>();
         weights.iter_mut().for_each(|w| w.iter_mut().for_each(|c| *c *= k));
-        Observer { weights }
+        let mut observer = Observer { weights, white_xyz: [0.0; 3] };
+        observer.white_xyz = observer.xyz(|_| 1.0);
+        observer
     }
 
     /// The shared table (parsed once).
@@ -73,7 +78,7 @@ impl Observer {
 
     /// XYZ of the perfect reflector (the D65 white with Y = 1).
     pub fn white_xyz(&self) -> [f64; 3] {
-        self.xyz(|_| 1.0)
+        self.white_xyz
     }
 }
 

@@ -783,6 +783,9 @@ macro_rules! top_impl {
 top_impl!(f64, parts_on_row, ms_norm_on_row, ms_norms, top_on_row_with, top_with, top);
 top_impl!(f32, parts_on_row_f32, ms_norm_on_row_f32, ms_norms_f32, top_on_row_with_f32, top_with_f32, top_f32);
 
+/// X̄ per channel on the two roughness rows around a roughness (`ms_norms`).
+pub type MsNorms = [[f64; 3]; 2];
+
 /// `top` for the two directions of one evaluation (the f64 model's), which share the rows'
 /// X̄ (`ms_norms` of this film and roughness): `norms` where the caller has it (an integral
 /// over directions computes it once), else computed here, once, not once per direction.
@@ -791,7 +794,7 @@ pub fn top_pair(
     roughness: f64,
     film: &dyn Fn(f64) -> [f64; 3],
     through: &[[f64; THROUGH_LEN]],
-    norms: Option<[[f64; 3]; 2]>,
+    norms: Option<MsNorms>,
 ) -> [Top<f64>; 2] {
     let norms = norms.unwrap_or_else(|| ms_norms(roughness, film, through));
     cos.map(|c| top_with(c, roughness, film, through, norms))

@@ -114,8 +114,8 @@ pub struct SmoothTop {
     /// Per roughness row, per node: the probability of being sent back down under the
     /// layered model's coupling (`k_e_row`), each row computed when first read
     /// (`coupled_row`): a row costs 18 spectral film sums per node inside the escape cone
-    /// (24 × 18 for the thesis stack; the mirror row, none), and a preset's colour limit reads only the rows its
-    /// roughness map reaches, `brdf stress` two per sample.
+    /// (24 × 18 for the thesis stack; the mirror row, none), and a preset's colour limit
+    /// reads only the rows its roughness map reaches, `brdf stress` two per sample.
     coupled: Vec<OnceLock<Vec<[f64; 3]>>>,
 }
 

@@ -132,7 +132,7 @@ impl Model {
         cos: [f64; 2],
         layers: &Layers,
         film: &dyn Fn(f64) -> [f64; 3],
-        norms: Option<MsNorms>,
+        norms: Option<energy::MsNorms>,
     ) -> [energy::Top<f64>; 2] {
         match self {
             Model::Thesis => cos.map(|c| self.coupling(c, layers, film)),
@@ -147,7 +147,7 @@ impl Model {
     /// for every pair of directions, so an integral over directions computes it once
     /// (`furnace_albedo`: it was four fifths of each evaluation's rule there). None for the
     /// thesis model, which has no such lobe.
-    fn ms_norms(self, layers: &Layers, film: &dyn Fn(f64) -> [f64; 3]) -> Option<MsNorms> {
+    fn ms_norms(self, layers: &Layers, film: &dyn Fn(f64) -> [f64; 3]) -> Option<energy::MsNorms> {
         match self {
             Model::Thesis => None,
             Model::Layered => {
@@ -310,9 +310,6 @@ pub fn cos_transmitted(n0: f64, n2: f64, cos: f64) -> Option<f64> {
     (k > 0.0).then(|| k.sqrt())
 }
 
-/// X̄ per channel on the two roughness rows around a roughness (`energy::ms_norms`).
-type MsNorms = [[f64; 3]; 2];
-
 /// The film as the f64 coupling reads it: at the cosine clamped to [0, 1], its colour
 /// clamped to [0, 1] (`film_clamped`).
 fn coupling_film(film: &dyn Fn(f64) -> [f64; 3]) -> impl Fn(f64) -> [f64; 3] + '_ {
@@ -351,7 +348,7 @@ impl Model {
         wi: [f64; 3],
         wo: [f64; 3],
         film: &dyn Fn(f64) -> [f64; 3],
-        norms: Option<MsNorms>,
+        norms: Option<energy::MsNorms>,
     ) -> Option<Lobes> {
         let (single, cos_i, cos_o) = single_lobe(layers, normal, wi, wo, film)?;
         let [top_i, top_o] = self.coupling_pair([cos_i, cos_o], layers, &coupling_film(film), norms);
