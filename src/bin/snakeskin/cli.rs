@@ -834,9 +834,9 @@ pub enum BenchCommand {
     /// of 250 and 650 nm, light at 0–85°, roughness 0.05–0.9, every species' base colours.
     /// Reports the reflected colour's ΔE00 (mean, p95, max), the white-furnace error and the
     /// CPU cost per evaluation (inputs at random thicknesses, and the same sorted by
-    /// thickness as a frame reads them). Takes about a minute on two cores at the default
-    /// photon count, most of it the models' own albedo integration, which fewer photons do not
-    /// shorten (58 s measured, 1 min 54 s of CPU; 51 s at 1000 photons).
+    /// thickness as a frame reads them). Takes under a minute on two cores at the default
+    /// photon count (41 s measured, 79 s of CPU); the models' own albedo integration, which
+    /// fewer photons do not shorten, is most of it (34 s at 1000 photons).
     Layered {
         /// Print JSON {"models": [{"name","mean_de","p95_de","max_de","max_furnace_err",
         /// "max_furnace_err_to_70","ns_per_eval","ns_per_eval_coherent"}], "points",

@@ -761,7 +761,7 @@ macro_rules! top_impl {
         }
 
         /// `$top` with the two rows' X̄ given.
-        fn $top_with(
+        pub fn $top_with(
             cos: $t,
             roughness: $t,
             film: &dyn Fn($t) -> [$t; 3],
@@ -786,16 +786,17 @@ top_impl!(f32, parts_on_row_f32, ms_norm_on_row_f32, ms_norms_f32, top_on_row_wi
 /// X̄ per channel on the two roughness rows around a roughness (`ms_norms`).
 pub type MsNorms = [[f64; 3]; 2];
 
-/// `top` for the two directions of one evaluation (the f64 model's), which share the rows'
-/// X̄ (`ms_norms` of this film and roughness): `norms` where the caller has it (an integral
-/// over directions computes it once), else computed here, once, not once per direction.
-pub fn top_pair(
-    cos: [f64; 2],
+/// `top` at several cosines (the f64 model's: an evaluation's two directions), which share
+/// the rows' X̄ (`ms_norms` of this film and roughness): `norms` where the caller has it (an
+/// integral over directions computes it once), else computed here, once, not once per
+/// direction.
+pub fn tops<const N: usize>(
+    cos: [f64; N],
     roughness: f64,
     film: &dyn Fn(f64) -> [f64; 3],
     through: &[[f64; THROUGH_LEN]],
     norms: Option<MsNorms>,
-) -> [Top<f64>; 2] {
+) -> [Top<f64>; N] {
     let norms = norms.unwrap_or_else(|| ms_norms(roughness, film, through));
     cos.map(|c| top_with(c, roughness, film, through, norms))
 }

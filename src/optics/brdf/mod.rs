@@ -125,19 +125,20 @@ impl Model {
         }
     }
 
-    /// `coupling` for the light's and the view's cosines, which share the rough lobe's
-    /// normalisation (`energy::top_pair`; `norms` from `ms_norms` where the caller has it).
-    fn coupling_pair(
+    /// `coupling` at several cosines (an evaluation's light and view), which share the
+    /// rough lobe's normalisation (`energy::tops`; `norms` from `ms_norms` where the caller
+    /// has it).
+    fn couplings<const N: usize>(
         self,
-        cos: [f64; 2],
+        cos: [f64; N],
         layers: &Layers,
         film: &dyn Fn(f64) -> [f64; 3],
         norms: Option<energy::MsNorms>,
-    ) -> [energy::Top<f64>; 2] {
+    ) -> [energy::Top<f64>; N] {
         match self {
             Model::Thesis => cos.map(|c| self.coupling(c, layers, film)),
             Model::Layered => {
-                path::with(layers.n0, layers.n2, |p| energy::top_pair(cos, layers.roughness, film, &p.through, norms))
+                path::with(layers.n0, layers.n2, |p| energy::tops(cos, layers.roughness, film, &p.through, norms))
             }
         }
     }
@@ -351,12 +352,19 @@ impl Model {
         norms: Option<energy::MsNorms>,
     ) -> Option<Lobes> {
         let (single, cos_i, cos_o) = single_lobe(layers, normal, wi, wo, film)?;
-        let [top_i, top_o] = self.coupling_pair([cos_i, cos_o], layers, &coupling_film(film), norms);
-        Some(Lobes {
-            single,
-            multiple: [0, 1, 2].map(|c| top_i.ms_amplitude[c] * top_o.ms_amplitude[c]),
-            diffuse: self.diffuse(layers, cos_i, cos_o, top_i.reflected, top_o.reflected),
-        })
+        let [top_i, top_o] = self.couplings([cos_i, cos_o], layers, &coupling_film(film), norms);
+        let (multiple, diffuse) = self.under_lobes(layers, [cos_i, cos_o], [&top_i, &top_o]);
+        Some(Lobes { single, multiple, diffuse })
+    }
+
+    /// The multiple-scatter and diffuse lobes at the light's and the view's floored
+    /// cosines, from the top's coupling there.
+    fn under_lobes(self, layers: &Layers, cos: [f64; 2], top: [&energy::Top<f64>; 2]) -> ([f64; 3], [f64; 3]) {
+        let [top_i, top_o] = top;
+        (
+            [0, 1, 2].map(|c| top_i.ms_amplitude[c] * top_o.ms_amplitude[c]),
+            self.diffuse(layers, cos[0], cos[1], top_i.reflected, top_o.reflected),
+        )
     }
 
     /// The f32 fast path, film colour from the material's LUT: the CPU twin of the shader.
@@ -410,7 +418,7 @@ impl Model {
         let mut spec = [0.0; 3];
         for hv in ggx::stratified_half_vectors(wo, alpha, n) {
             // f cos θi / pdf(wi).
-            let Some((single, _, _)) = single_lobe(layers, [0.0, 0.0, 1.0], hv.wi, wo, film) else {
+            let Some((single, _, _)) = single_lobe(layers, NORMAL, hv.wi, wo, film) else {
                 continue;
             };
             for (s, v) in spec.iter_mut().zip(single) {
@@ -418,21 +426,39 @@ impl Model {
             }
         }
         let spec = spec.map(|s| s / (n * n) as f64);
-        let norms = self.ms_norms(layers, film);
+        // The lobes under the specular one, as `eval_lobes` gives them, with what does not
+        // depend on wi computed once: the rough lobe's normalisation and the view's coupling.
         let mut diffuse = [0.0; 3];
-        for a in 0..n * n {
-            // ∫ over the hemisphere of g(θi) cos θi dω = 2π ∫ g(μ) μ dμ.
-            let mu = (a as f64 + 0.5) / (n * n) as f64;
-            let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
-            let Some(value) = self.eval_lobes(layers, [0.0, 0.0, 1.0], wi, wo, film, norms) else {
-                continue;
-            };
-            for (c, d) in diffuse.iter_mut().enumerate() {
-                *d += (value.multiple[c] + value.diffuse[c]) * mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
+        if let Some(cos_o) = normalize(wo).and_then(|wo| floored_cos(NORMAL, wo)) {
+            let norms = self.ms_norms(layers, film);
+            let film = coupling_film(film);
+            let [top_o] = self.couplings([cos_o], layers, &film, norms);
+            for a in 0..n * n {
+                // ∫ over the hemisphere of g(θi) cos θi dω = 2π ∫ g(μ) μ dμ.
+                let mu = (a as f64 + 0.5) / (n * n) as f64;
+                let Some(cos_i) = normalize([(1.0 - mu * mu).sqrt(), 0.0, mu]).and_then(|wi| floored_cos(NORMAL, wi))
+                else {
+                    continue;
+                };
+                let [top_i] = self.couplings([cos_i], layers, &film, norms);
+                let (multiple, under) = self.under_lobes(layers, [cos_i, cos_o], [&top_i, &top_o]);
+                for (c, d) in diffuse.iter_mut().enumerate() {
+                    *d += (multiple[c] + under[c]) * mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
+                }
             }
         }
         [0, 1, 2].map(|c| spec[c] + diffuse[c])
     }
+}
+
+/// The normal of the integrals' frame (and where a normal has no direction).
+const NORMAL: [f64; 3] = [0.0, 0.0, 1.0];
+
+/// The cosine between the unit normal `n` and the unit direction `w`, floored at `COS_MIN`
+/// as every lobe reads it; None at or below the horizon (where the BRDF is zero).
+fn floored_cos(n: [f64; 3], w: [f64; 3]) -> Option<f64> {
+    let cos = dot(n, w);
+    (cos > 0.0).then(|| cos.max(COS_MIN))
 }
 
 /// The single-scatter specular lobe every model shares, with the floored cosines of wi
@@ -444,13 +470,9 @@ fn single_lobe(
     wo: [f64; 3],
     film: &dyn Fn(f64) -> [f64; 3],
 ) -> Option<([f64; 3], f64, f64)> {
-    let n = normalize(normal).unwrap_or([0.0, 0.0, 1.0]);
+    let n = normalize(normal).unwrap_or(NORMAL);
     let (wi, wo) = (normalize(wi)?, normalize(wo)?);
-    let (cos_i, cos_o) = (dot(n, wi), dot(n, wo));
-    if !(cos_i > 0.0 && cos_o > 0.0) {
-        return None;
-    }
-    let (cos_i, cos_o) = (cos_i.max(COS_MIN), cos_o.max(COS_MIN));
+    let (cos_i, cos_o) = (floored_cos(n, wi)?, floored_cos(n, wo)?);
     let h = normalize([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]])?;
     let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
     let nxh = cross(n, h);
@@ -502,5 +524,48 @@ mod tests {
             assert_eq!(Model::ALL.iter().filter(|o| o.code() == m.code()).count(), 1);
         }
         assert_eq!(Model::parse("lambert"), None);
+    }
+
+    /// `furnace_albedo` computes the lobe's normalisation and the view's coupling once per
+    /// integral; it is still the sum, by its rules, of the lobes each evaluation gives.
+    #[test]
+    fn the_furnace_integral_sums_the_lobes_each_evaluation_gives() {
+        let film = |c: f64| [0.04 + 0.5 * (1.0 - c).powi(5), 0.08 * c, 0.3 - 0.2 * c];
+        let n = 5;
+        let cases: [(f64, f64, f64, f64); 4] =
+            [(0.07, 0.97, 1.0, 1.55), (0.45, 0.5, 1.33, 1.33), (0.9, 0.08, 1.0, 2.0), (0.3, 0.0, 1.0, 1.5)];
+        for model in Model::ALL {
+            for (roughness, cos_o, n0, n2) in cases {
+                let layers = Layers {
+                    n0,
+                    n2,
+                    roughness,
+                    optical_depth: [0.0; 3],
+                    albedo: [1.0, 0.6, 0.2],
+                    k: [0.3, 0.35, 0.45],
+                    e: [0.6, 0.5, 0.4],
+                };
+                let c = cos_o.max(COS_MIN);
+                let wo = [(1.0 - c * c).sqrt(), 0.0, c];
+                let alpha = (roughness * roughness).clamp(ALPHA_MIN, 1.0);
+                let mut sum = [0.0; 3];
+                for hv in ggx::stratified_half_vectors(wo, alpha, n) {
+                    let (single, _, _) = single_lobe(&layers, NORMAL, hv.wi, wo, &film).unwrap_or_default();
+                    (0..3).for_each(|k| sum[k] += single[k] * hv.wi[2] / hv.pdf_wi / (n * n) as f64);
+                }
+                for a in 0..n * n {
+                    let mu = (a as f64 + 0.5) / (n * n) as f64;
+                    let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+                    // Each evaluation on its own: its own normalisation and both couplings.
+                    let lobes = model.eval_lobes(&layers, NORMAL, wi, wo, &film, None).expect("above the horizon");
+                    let weight = mu * 2.0 * std::f64::consts::PI / (n * n) as f64;
+                    (0..3).for_each(|k| sum[k] += (lobes.multiple[k] + lobes.diffuse[k]) * weight);
+                }
+                let integral = model.furnace_albedo(&layers, cos_o, &film, n);
+                let case = format!("{model:?} roughness {roughness} cos_o {cos_o} n0 {n0} n2 {n2}");
+                assert!((0..3).all(|k| (integral[k] - sum[k]).abs() <= 1e-12), "{case}: {integral:?} {sum:?}");
+                assert!(sum.iter().all(|v| *v > 0.01), "{case}: {sum:?}");
+            }
+        }
     }
 }
