@@ -45,16 +45,15 @@ pub enum BatchError {
     /// TOML syntax, an unknown key or a wrong type, at a line and column.
     #[error("{path}:{line}:{column}: {message}")]
     Parse { path: PathBuf, line: usize, column: usize, message: String },
-    /// A value outside what a job accepts; `line`: where the key is written.
-    #[error("{path}{}: [[job]] {job} ({preset}): {message}", at_line(*.line))]
-    Invalid { path: PathBuf, line: Option<usize>, job: usize, preset: String, message: String },
-    /// The job's preset refused (the preset's own message); `line`: the job's `preset` key.
-    #[error("{path}{}: [[job]] {job} ({preset}): {source}", at_line(*.line))]
-    Preset { path: PathBuf, line: Option<usize>, job: usize, preset: String, source: Box<crate::preset::PresetError> },
-    /// The job's `set` table refused: its entries as `key=value`, and why; `line`: the
-    /// job's `set` key.
-    #[error("{path}{}: [[job]] {job} ({preset}): set `{entries}`: {message}", at_line(*.line))]
-    Set { path: PathBuf, line: Option<usize>, job: usize, preset: String, entries: String, message: String },
+    /// A value outside what a job accepts; the place's line: where the key is written.
+    #[error("{place}: {message}")]
+    Invalid { place: JobPlace, message: String },
+    /// The job's preset refused (the preset's own message), at the job's `preset` key.
+    #[error("{place}: {source}")]
+    Preset { place: JobPlace, source: Box<crate::preset::PresetError> },
+    /// The job's `set` table refused, at its `set` key: its entries as `key=value`, and why.
+    #[error("{place}: set `{entries}`: {message}")]
+    Set { place: JobPlace, entries: String, message: String },
     #[error("{path}: no [[job]] tables; a jobs file lists jobs as [[job]] tables with at least a preset key")]
     Empty { path: PathBuf },
     #[error("{path}: {count} jobs after expanding seeds and sizes; at most {max} per file")]
@@ -63,9 +62,9 @@ pub enum BatchError {
     Shard(String),
     /// The job refused when the run was planned, before any job ran: its size (a body atlas
     /// too tall, more memory than the machine has) or its output (a folder, file or link
-    /// in the way); `line`: the job's `sizes` key, else its `preset` key.
-    #[error("{path}{}: [[job]] {job} ({preset}): {source}", at_line(*.line))]
-    Planned { path: PathBuf, line: Option<usize>, job: usize, preset: String, source: Box<Error> },
+    /// in the way); the place's line: the job's `sizes` key, else its `preset` key.
+    #[error("{place}: {source}")]
+    Planned { place: JobPlace, source: Box<Error> },
     /// The job failed while it ran (a full disk, a file that may not be replaced): its set
     /// was not written.
     #[error("{job}: {source}")]
@@ -79,24 +78,44 @@ pub enum BatchError {
     Changed { job: RunningJob },
 }
 
-/// A job as its messages at run time name it: `jobs.toml:LINE: [[job]] N (PRESET, seed S,
-/// size Z)`, N counting the file's `[[job]]` tables from 1 (not the job's index in `--list`
-/// and the index, which counts the jobs the tables' seeds and sizes expand to, from 0), and
-/// LINE that of its `preset` key.
+/// A job's table as every message about it begins: `jobs.toml:LINE: [[job]] N (PRESET)`,
+/// N counting the file's `[[job]]` tables from 1 (not the job's index in `--list` and the
+/// index, which counts the jobs the tables' seeds and sizes expand to, from 0), LINE that of
+/// the key the message is about, where it is written (`Job::place`).
 #[derive(Debug, Clone)]
-pub struct RunningJob {
+pub struct JobPlace {
     pub path: PathBuf,
     pub line: Option<usize>,
     pub table: usize,
     pub preset: String,
+}
+
+impl JobPlace {
+    /// The place with `detail` after the preset, inside its parentheses.
+    fn fmt_with(&self, f: &mut std::fmt::Formatter<'_>, detail: std::fmt::Arguments<'_>) -> std::fmt::Result {
+        let JobPlace { path, line, table, preset } = self;
+        write!(f, "{}{}: [[job]] {table} ({preset}{detail})", path.display(), at_line(*line))
+    }
+}
+
+impl std::fmt::Display for JobPlace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.fmt_with(f, format_args!(""))
+    }
+}
+
+/// A job as its messages at run time name it: its place at its `preset` key, with the seed
+/// and size it runs at: `jobs.toml:LINE: [[job]] N (PRESET, seed S, size Z)`.
+#[derive(Debug, Clone)]
+pub struct RunningJob {
+    pub place: JobPlace,
     pub seed: u64,
     pub size: u64,
 }
 
 impl std::fmt::Display for RunningJob {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let RunningJob { path, line, table, preset, seed, size } = self;
-        write!(f, "{}{}: [[job]] {table} ({preset}, seed {seed}, size {size})", path.display(), at_line(*line))
+        self.place.fmt_with(f, format_args!(", seed {}, size {}", self.seed, self.size))
     }
 }
 
@@ -152,6 +171,11 @@ pub struct Job {
 pub const DEFAULT_SIZE: u64 = 1024;
 
 impl Job {
+    /// Where the job's table is written, at `line` (a key's), for a message about it.
+    fn place(&self, jobs_file: &Path, line: Option<usize>) -> JobPlace {
+        JobPlace { path: jobs_file.into(), line, table: self.table, preset: self.preset.clone() }
+    }
+
     /// The job's folder under the output folder:
     /// `<preset>/<layout>-<size>-seed<seed>-<format or pack>[-<maps>][-set<hash>]`, where
     /// `<hash>` is the first 8 hex digits of the overrides' SHA-256 (jobs that differ only in
@@ -286,10 +310,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     for (k, table) in file.job.iter().enumerate() {
         let line = |key: &str| key_lines.line(&format!("job.{k}.{key}"));
         let invalid = |key: &str, message: String| BatchError::Invalid {
-            path: path.into(),
-            line: line(key),
-            job: k + 1,
-            preset: table.preset.clone(),
+            place: JobPlace { path: path.into(), line: line(key), table: k + 1, preset: table.preset.clone() },
             message,
         };
         let lines = JobLines { preset: line("preset"), set: line("set"), sizes: line("sizes") };
@@ -511,43 +532,23 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
     let loaded =
         crate::preset::load_beside(&job.preset, folder, &job.overrides, job.seed).map_err(|source| match source {
             // The preset's message says `--set`, which a jobs file's reader did not write.
-            crate::preset::PresetError::Override { argument, message } => BatchError::Set {
-                path: jobs_file.into(),
-                line: job.lines.set,
-                job: job.table,
-                preset: job.preset.clone(),
-                entries: argument,
-                message,
-            },
+            crate::preset::PresetError::Override { argument, message } => {
+                BatchError::Set { place: job.place(jobs_file, job.lines.set), entries: argument, message }
+            }
             crate::preset::PresetError::Invalid { file, problems } if !job.overrides.is_empty() => {
                 BatchError::Invalid {
-                    path: jobs_file.into(),
-                    line: job.lines.set,
-                    job: job.table,
-                    preset: job.preset.clone(),
+                    place: job.place(jobs_file, job.lines.set),
                     message: crate::preset::describe_problems(&file, &problems, "its `set` table"),
                 }
             }
-            source => BatchError::Preset {
-                path: jobs_file.into(),
-                line: job.lines.preset,
-                job: job.table,
-                preset: job.preset.clone(),
-                source: Box::new(source),
-            },
+            source => BatchError::Preset { place: job.place(jobs_file, job.lines.preset), source: Box::new(source) },
         })?;
     let mut warnings = loaded.warnings(&job.preset);
     // A pack longer than its engine loads, at the job's `sizes` line (`Pack::size_problem`).
     if let Some(pack) = job.pack
         && let Some(problem) = pack_size_warning(pack, job.layout, &loaded.preset, job.size as usize, "a size of")
     {
-        let at = at_line(job.lines.sizes.or(job.lines.preset));
-        warnings.push(format!(
-            "warning: {}{at}: [[job]] {} ({}): {problem}",
-            jobs_file.display(),
-            job.table,
-            job.preset
-        ));
+        warnings.push(format!("warning: {}: {problem}", job.place(jobs_file, job.lines.sizes.or(job.lines.preset))));
     }
     let seed = loaded.preset.seed;
     let key = job.key(&loaded.content_hash, seed);
@@ -584,8 +585,7 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
         let mut r = resolve(jobs_file, job, out, shard.contains(job))?;
         // The job's folder refused, at its `preset` line.
         let refuse = |preset: String, message: String| -> Error {
-            BatchError::Invalid { path: jobs_file.into(), line: job.lines.preset, job: job.table, preset, message }
-                .into()
+            BatchError::Invalid { place: JobPlace { preset, ..job.place(jobs_file, job.lines.preset) }, message }.into()
         };
         // A preset named like an index (`index.json.toml`) would put its sets in the folder
         // the run's index is written to: found before any job runs, not after all of them.
@@ -826,10 +826,7 @@ fn plan<'a>(
             // A size refused (too tall, too large for memory) at the job's `sizes`; its output
             // at the job (the folder's name comes from all its keys).
             let planned = |line: Option<usize>, source: Error| BatchError::Planned {
-                path: jobs_file.into(),
-                line: line.or(job.lines.preset),
-                job: job.table,
-                preset: job.preset.clone(),
+                place: job.place(jobs_file, line.or(job.lines.preset)),
                 source: Box::new(source),
             };
             let request = request(job, out, &r.outcome);
@@ -871,14 +868,7 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
     if outcome.duplicate_of.is_some() {
         // Its set is the earlier job's (in this shard or another).
     } else if !resolved.done {
-        let running = RunningJob {
-            path: jobs_file.into(),
-            line: job.lines.preset,
-            table: job.table,
-            preset: job.preset.clone(),
-            seed: outcome.seed,
-            size: job.size,
-        };
+        let running = RunningJob { place: job.place(jobs_file, job.lines.preset), seed: outcome.seed, size: job.size };
         let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
         // Checked against the available memory with the other jobs when the run was planned
         // (`fitting_concurrency`); the jobs running beside this one hold part of it now.
