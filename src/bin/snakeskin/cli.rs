@@ -841,7 +841,9 @@ pub enum BenchCommand {
         /// Print JSON {"models": [{"name","mean_de","p95_de","max_de","max_furnace_err",
         /// "max_furnace_err_to_70","ns_per_eval","ns_per_eval_coherent"}], "points",
         /// "photons_per_channel", "reference_noise_mean_de", "reference_noise_max_de",
-        /// "furnace"}.
+        /// "furnace": [[model, roughness, angle_deg, max |albedo − 1|]],
+        /// "error_by_roughness_angle": [[model, roughness, angle_deg, mean ΔE00, max ΔE00]],
+        /// "error_by_optical_depth": [[model, τ, mean ΔE00, max ΔE00]]}.
         #[arg(long)]
         json: bool,
         /// Photons per channel per reference walk, 1000 to 10,000,000 (noise ∝ 1/√N; the

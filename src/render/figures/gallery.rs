@@ -93,7 +93,10 @@ pub const VARIANTS: &[(&str, MapKind, &str)] = &[
     (
         "light tips, pale skin between scales",
         MapKind::Color,
-        "[scales]\nsize = 0.9\n[color]\nbase = \"#4a5a2a\"\ntip_tone = 0.6\nskin = \"#e8e0c8\"\n",
+        // Skin and belly as pale as this stack shows them under the tips' 1.6× brightening
+        // (`no_figure_asks_for_a_colour_it_cannot_show`).
+        "[scales]\nsize = 0.9\n[color]\nbase = \"#4a5a2a\"\ntip_tone = 0.6\nskin = \"#c8c1ac\"\n[belly]\nwidth = 0.2\n\
+         color = \"#c8bd9e\"\n",
     ),
     (
         "composite: centre, dark edge, pale border",
@@ -200,7 +203,12 @@ pub fn render(tile: usize, columns: usize) -> Result<Image, Error> {
 /// tables where the variant writes none of its own (the memory check's copy of this
 /// wrote both always, so the variants with their own failed to parse and were left out).
 fn variant_graph(label: &str, overrides: &str) -> Result<crate::graph::Graph, Error> {
-    let source = PresetSource {
+    Ok(build_graph(&parse(&variant_source(label, overrides), &[])?.preset, BuildOptions::default()))
+}
+
+/// A variant's preset text (`variant_graph`).
+fn variant_source(label: &str, overrides: &str) -> PresetSource {
+    PresetSource {
         name: label.replace([' ', ':', ',', '+'], "_"),
         display: format!("gallery variant {label:?}"),
         text: format!(
@@ -208,8 +216,7 @@ fn variant_graph(label: &str, overrides: &str) -> Result<crate::graph::Graph, Er
             if overrides.contains("[color]") { "" } else { BASE_COLOR },
             if overrides.contains("[belly]") { "" } else { BASE_BELLY },
         ),
-    };
-    Ok(build_graph(&parse(&source, &[])?.preset, BuildOptions::default()))
+    }
 }
 
 /// No more columns than variants: the rest were empty canvas.
@@ -258,7 +265,7 @@ pub const CLOSEUPS: &[(&str, (f32, f32), &str)] = &[
         "per-scale-colour",
         (0.25, 0.0),
         "seed = 4\n[scales]\nsize = 0.95\n[color]\nbase = \"#8a7a50\"\nscale_tone = 0.12\nscale_hue = 0.04\n\
-         edge_tone = -0.5\ntip_tone = 0.35\nspeckle = 0.2\nskin = \"#e0d8c0\"\n",
+         edge_tone = -0.5\ntip_tone = 0.35\nspeckle = 0.2\nskin = \"#d0c9b2\"\n[belly]\ncolor = \"#d0c7ae\"\n",
     ),
     (
         "composite-marks",
@@ -305,6 +312,11 @@ pub fn closeup_file_names() -> impl Iterator<Item = String> {
     CLOSEUPS.iter().map(|(stem, _, _)| closeup_file_name(stem))
 }
 
+/// A close-up's preset (`closeup_pngs`).
+fn closeup_source(stem: &str, text: &str) -> PresetSource {
+    PresetSource { name: stem.to_string(), display: format!("close-up {stem:?}"), text: text.to_string() }
+}
+
 fn closeup_file_name(stem: &str) -> String {
     format!("{stem}.png")
 }
@@ -314,9 +326,7 @@ fn closeup_pngs() -> Result<Vec<(String, Vec<u8>)>, Error> {
     CLOSEUPS
         .par_iter()
         .map(|(stem, (u0, v0), text)| {
-            let source =
-                PresetSource { name: stem.to_string(), display: format!("close-up {stem:?}"), text: text.to_string() };
-            let loaded = parse(&source, &[])?;
+            let loaded = parse(&closeup_source(stem, text), &[])?;
             let graph = build_graph(&loaded.preset, BuildOptions::default());
             let maps = evaluate(&graph, &[MapKind::Color, MapKind::Normal], CLOSEUP_MAP, CLOSEUP_MAP, &|_, _| {}).maps;
             let (n, c) = (CLOSEUP_MAP, CLOSEUP_CROP);
@@ -365,4 +375,26 @@ pub fn write(
         }
     }
     Ok(group.commit()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The figures show what their presets say: no colour key of a variant or a close-up is
+    /// brighter than the stack shows with the map's headroom (`preset::visible`), where it
+    /// would be clamped without a word (the figures print no warnings).
+    #[test]
+    fn no_figure_asks_for_a_colour_it_cannot_show() {
+        let sources = VARIANTS.iter().map(|(label, _, overrides)| variant_source(label, overrides));
+        let sources = sources.chain(CLOSEUPS.iter().map(|(stem, _, text)| closeup_source(stem, text)));
+        let mut clamped = Vec::new();
+        for source in sources {
+            let loaded = parse(&source, &[]).expect("the figures' presets parse");
+            for c in &loaded.clamped_colours {
+                clamped.push(format!("{}: {} = {} shown as {}", source.display, c.key, c.requested, c.clamped_to));
+            }
+        }
+        assert!(clamped.is_empty(), "{}", clamped.join("\n"));
+    }
 }
