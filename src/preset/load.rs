@@ -193,20 +193,22 @@ pub fn parse_with_seed(
     };
     let seed = seed.or(overridden_seed);
     let overrides = overrides.as_slice();
+    // The keys the overrides wrote, each where it put a value whole (`merge`).
+    let mut written = Vec::new();
     let preset = if overrides.is_empty() {
         file_preset
     } else {
         let file_table = toml::from_str::<WithoutSeed>(&source.text).map_err(|e| parse_error(source, &e))?.rest;
         let mut table = file_table.clone();
         for (key, value) in overrides {
-            apply_override(&mut table, key, value)?;
+            apply_override(&mut table, key, value, &mut written)?;
         }
         Preset::deserialize(toml::Value::Table(table)).map_err(|e| {
             // Name the one override that makes this error on its own, where one does (a
             // wrong type); otherwise (a new layer missing a key) all of them.
             let alone = |(key, value): &&(String, String)| {
                 let mut table = file_table.clone();
-                apply_override(&mut table, key, value).is_ok()
+                apply_override(&mut table, key, value, &mut Vec::new()).is_ok()
                     && Preset::deserialize(toml::Value::Table(table)).is_err_and(|a| a.message() == e.message())
             };
             let named: Vec<&(String, String)> = match overrides.iter().find(alone) {
@@ -229,19 +231,21 @@ pub fn parse_with_seed(
 
     let mut preset = preset;
     preset.seed = seed.unwrap_or(file_seed);
-    // A key an override wrote (or a value it replaced whole) has no line in the file; the
-    // file is parsed for lines once, not once per problem (thousands of them took minutes).
-    let written = written_keys(overrides);
+    // A key an override wrote, or one inside a value it put whole (an inline table in place
+    // of the file's layers), has no line in the file; the file is parsed for lines once, not
+    // once per problem (thousands of them took minutes).
+    let under_written = |key: &str| written.iter().any(|k: &String| key == k || key.starts_with(&format!("{k}.")));
     // The seed's overrides are not among `overrides` (above): a seed given by `--seed` or
     // `--set seed=` has no line either.
     let seed_given = seed.is_some();
     let overridden = |key: &str| {
-        (seed_given && key == "seed") || written.iter().any(|k| key == k || key.starts_with(&format!("{k}.")))
+        (seed_given && key == "seed")
+            || under_written(key)
+            // Layer 0 may be written as a single `[pattern]` table, which `--set pattern.kind=`
+            // and `--set 'pattern={..}'` write: problems name its keys `pattern.0.KEY`.
+            || key.strip_prefix("pattern.0.").is_some_and(|rest| under_written(&format!("pattern.{rest}")))
     };
-    // Layer 0 may be written as a single `[pattern]` table, and `--set pattern.kind=` sets it.
-    let in_layer = |i: usize, key: &str| {
-        overridden(&format!("pattern.{i}.{key}")) || (i == 0 && overridden(&format!("pattern.{key}")))
-    };
+    let in_layer = |i: usize, key: &str| overridden(&format!("pattern.{i}.{key}"));
     let from_file_for_old_kind = |i: usize, key: &str| in_layer(i, "kind") && !in_layer(i, key);
     let problems = validate(&preset, &from_file_for_old_kind);
     let key_lines = std::cell::LazyCell::new(|| toml_text::KeyLines::new(&source.text));
@@ -392,7 +396,13 @@ fn override_required_key_hint(key: &str, message: &str) -> Option<String> {
 }
 
 /// Sets `dotted.key` to `value` (parsed as TOML; a bare word that is not TOML is a string).
-fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), PresetError> {
+/// `written`: where the override put values whole (`merge`), added to.
+fn apply_override(
+    root: &mut toml::Table,
+    key: &str,
+    value: &str,
+    written: &mut Vec<String>,
+) -> Result<(), PresetError> {
     let refuse = |message: String| PresetError::Override { argument: format!("{key}={value}"), message };
     if key.chars().chain(value.chars()).any(char::is_control) {
         return Err(refuse("the key and value must be one line without control characters".into()));
@@ -419,7 +429,7 @@ fn apply_override(root: &mut toml::Table, key: &str, value: &str) -> Result<(), 
         Err(message)
     } else {
         let mut tree = toml::Value::Table(std::mem::take(root));
-        let result = set_path(&mut tree, &segments, parsed);
+        let result = set_path(&mut tree, &segments, parsed, key, written);
         if let toml::Value::Table(t) = tree {
             *root = t;
         }
@@ -536,17 +546,23 @@ fn check_layer_index(pattern: Option<&toml::Value>, index: usize) -> Result<(), 
     Err(format!("there is no pattern layer {index}; {have} (add layers in the preset file)"))
 }
 
-fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> Result<(), String> {
+fn set_path(
+    target: &mut toml::Value,
+    segments: &[&str],
+    value: toml::Value,
+    key: &str,
+    written: &mut Vec<String>,
+) -> Result<(), String> {
     let Some((first, rest)) = segments.split_first() else {
-        merge(target, value);
+        merge(target, value, key, written);
         return Ok(());
     };
     match target {
         // `pattern.0` addresses a single `[pattern]` table as layer 0.
-        toml::Value::Table(t) if *first == "0" && !t.contains_key("0") => set_path(target, rest, value),
+        toml::Value::Table(t) if *first == "0" && !t.contains_key("0") => set_path(target, rest, value, key, written),
         toml::Value::Table(t) => {
             let child = t.entry(first.to_string()).or_insert_with(|| toml::Value::Table(Default::default()));
-            set_path(child, rest, value)
+            set_path(child, rest, value, key, written)
         }
         toml::Value::Array(items) => {
             let len = items.len();
@@ -557,7 +573,7 @@ fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> 
                 items.push(toml::Value::Table(Default::default()));
             }
             let item = items.get_mut(index).ok_or_else(|| format!("there is no entry {index}: the list has {len}"))?;
-            set_path(item, rest, value)
+            set_path(item, rest, value, key, written)
         }
         _ => Err(format!("`{first}` is inside a value that is not a table")),
     }
@@ -565,16 +581,23 @@ fn set_path(target: &mut toml::Value, segments: &[&str], value: toml::Value) -> 
 
 /// Puts `value` where `target` is: a table into a table key by key (`--set
 /// 'scales={rows=23}'` changes `rows` and keeps the other scale keys, as `--set
-/// scales.rows=23` does), anything else in place of what was there.
-fn merge(target: &mut toml::Value, value: toml::Value) {
+/// scales.rows=23` does), anything else in place of what was there (`--set
+/// 'pattern={kind="spots"}'` in place of the file's layers). `path`: the key `target` is
+/// at, as the override wrote it; each key where a value went whole is added to `written`
+/// (what lies under it is the override's, not the file's).
+fn merge(target: &mut toml::Value, value: toml::Value, path: &str, written: &mut Vec<String>) {
     match (target, value) {
         (toml::Value::Table(existing), toml::Value::Table(new)) => {
             for (key, v) in new {
                 // A key not there yet starts as an empty table, which `v` then replaces or fills.
-                merge(existing.entry(key).or_insert_with(|| toml::Value::Table(Default::default())), v);
+                let child = existing.entry(key.clone()).or_insert_with(|| toml::Value::Table(Default::default()));
+                merge(child, v, &format!("{path}.{key}"), written);
             }
         }
-        (target, value) => *target = value,
+        (target, value) => {
+            *target = value;
+            written.push(path.to_string());
+        }
     }
 }
 
@@ -627,30 +650,6 @@ fn override_value(value: &str) -> Result<toml::Value, String> {
             }
         }
     }
-}
-
-/// The keys the overrides write: each override's own, or for an inline table the keys in
-/// it (`merge` fills a table key by key: `--set 'color={base="#fff"}'` writes `color.base`,
-/// and the file's other `color` keys keep their values and their lines).
-fn written_keys(overrides: &[(String, String)]) -> Vec<String> {
-    fn leaves(key: String, value: &toml::Value, out: &mut Vec<String>) {
-        match value {
-            toml::Value::Table(t) if !t.is_empty() => {
-                for (k, v) in t {
-                    leaves(format!("{key}.{k}"), v, out);
-                }
-            }
-            _ => out.push(key),
-        }
-    }
-    let mut out = Vec::new();
-    for (key, value) in overrides {
-        match override_value(value) {
-            Ok(parsed) => leaves(key.clone(), &parsed, &mut out),
-            Err(_) => out.push(key.clone()),
-        }
-    }
-    out
 }
 
 fn fnv1a64(bytes: &[u8]) -> u64 {
@@ -790,6 +789,44 @@ mod tests {
         assert_eq!(parse(&source("seed = 7\n"), &rows).unwrap().preset.seed, 7);
         let both = parse_with_seed(&source(&file(u64::MAX)), &[("seed".into(), "5".into())], Some(6)).unwrap();
         assert_eq!(both.preset.seed, 6);
+    }
+
+    /// A problem in a value an override put whole (an inline table in place of the file's
+    /// layers, or a single `[pattern]` table's key set as `pattern.KEY`) is the override's:
+    /// it was placed at the file's old line for that key or its layer's table, or called
+    /// the key's default. Negative controls: keys the override merged around keep the
+    /// file's lines, and an indexed key was already the override's.
+    #[test]
+    fn a_problem_in_what_an_override_wrote_whole_is_the_overrides() {
+        let two_layers = "seed = 1\n[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\namount = 3\n\
+                          [[pattern]]\nkind = \"spots\"\ncolor = \"#202020\"\namount = 4\n";
+        let single = "seed = 1\n[pattern]\nkind = \"rings\"\ncolors = [\"#101010\", \"#202020\"]\n";
+        let problem = |text: &str, set: (&str, &str)| match parse(&source(text), &[(set.0.into(), set.1.into())]) {
+            Err(PresetError::Invalid { problems, .. }) => problems.into_iter().next().expect("one problem"),
+            other => panic!("{set:?}: not refused as invalid: {:?}", other.map(|l| l.name)),
+        };
+        let by_override = |text: &str, set: (&str, &str), key: &str| {
+            let p = problem(text, set);
+            assert_eq!((p.key.as_str(), p.line, p.overridden), (key, None, true), "{set:?}: {p:?}");
+        };
+        by_override(two_layers, ("pattern", "{kind = \"irregular\"}"), "pattern.0.color");
+        by_override(
+            two_layers,
+            ("pattern", "{kind = \"spots\", color = \"#101010\", amount = 99}"),
+            "pattern.0.amount",
+        );
+        by_override(single, ("pattern.amount", "99"), "pattern.0.amount");
+        by_override(
+            "seed = 1\n",
+            ("pattern", "{kind = \"spots\", color = \"#101010\", amount = 99}"),
+            "pattern.0.amount",
+        );
+        by_override(two_layers, ("pattern.1.amount", "99"), "pattern.1.amount");
+        // The file's own: a value the override merged around, in the file's line.
+        let p = problem(&two_layers.replace("amount = 4", "amount = 99"), ("pattern.0", "{amount = 5}"));
+        assert_eq!((p.key.as_str(), p.line, p.overridden), ("pattern.1.amount", Some(9), false), "{p:?}");
+        let p = problem(&single.replace("seed = 1\n", "seed = 1\n[scales]\nrows = 999\n"), ("pattern.amount", "2"));
+        assert_eq!((p.key.as_str(), p.line, p.overridden), ("scales.rows", Some(3), false), "{p:?}");
     }
 
     #[test]

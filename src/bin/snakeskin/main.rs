@@ -12,6 +12,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     output::restore_default_sigpipe();
+    output::file_size_limit_is_an_error();
     output::stdout_failure_is_an_error();
     output::quiet_vulkan_device_select();
     snakeskin::memory::bound_arenas_under_address_limit();

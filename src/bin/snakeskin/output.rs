@@ -28,6 +28,20 @@ pub fn ignore_sigpipe() {
     }
 }
 
+/// A file that outgrows the file-size limit (`ulimit -f`) fails its write with "File too
+/// large" (EFBIG), an error like a full disk's: the run removes its unfinished files and
+/// says which file, and the earlier set stays. By default the kernel's SIGXFSZ ended the
+/// process there instead (exit 153, nothing said), leaving the temporaries and the set's
+/// lock file until the next run in that folder.
+pub fn file_size_limit_is_an_error() {
+    #[cfg(unix)]
+    // SAFETY: called in `main` before any other thread exists; SIG_IGN is a valid
+    // disposition for SIGXFSZ, under which write(2) returns EFBIG at the limit.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
+}
+
 /// Ctrl-C, SIGTERM or SIGHUP end the run without leaving its unfinished files: a commit in
 /// progress ends first (a set is never left mixed), the run's temporaries, its set lock
 /// files and the empty folders it made are removed (`export::clean_up_before_exit`), one
