@@ -217,6 +217,16 @@ fn plain_type_names(message: &str) -> String {
     {
         out = format!("invalid value: integer `{digits}`,{tail}");
     }
+    // A float where a whole number belongs is written out in full (`rows = 1e300`: three
+    // hundred digits); beyond the plain range, in exponent form, as every refused number is.
+    if let Some(rest) = out.strip_prefix("invalid type: floating point `")
+        && let Some((number, tail)) = rest.split_once('`')
+        && let Ok(value) = number.parse::<f64>()
+        && let shown = crate::preset::validate::shown(value)
+        && shown.contains('e')
+    {
+        out = format!("invalid type: floating point `{shown}`{tail}");
+    }
     let Some(at) = out.rfind(", expected ") else { return out };
     let whole_number = out.starts_with("invalid value: integer");
     let expected = &out[at + ", expected ".len()..];
@@ -440,6 +450,19 @@ mod tests {
             ("invalid type: sequence, expected a string", "invalid type: array, expected a string"),
             ("invalid type: integer `5`, expected struct Scales", "invalid type: integer `5`, expected a table"),
             ("invalid type: string \"x\", expected u320", "invalid type: string \"x\", expected u320"),
+            // A float in exponent form beyond the plain range; within it, as serde wrote it.
+            (
+                &format!("invalid type: floating point `1{}.0`, expected u32", "0".repeat(300)),
+                "invalid type: floating point `1e300`, expected a whole number",
+            ),
+            (
+                "invalid type: floating point `23.0`, expected u32",
+                "invalid type: floating point `23.0`, expected a whole number",
+            ),
+            (
+                "invalid type: floating point `0.00001`, expected u8",
+                "invalid type: floating point `1e-5`, expected a whole number",
+            ),
         ];
         for (serde, plain) in cases {
             assert_eq!(plain_type_names(serde), plain);

@@ -1098,6 +1098,21 @@ fn messages_say_each_thing_once_and_name_what_is_wrong() {
     assert!(stderr(&out).contains("\\u{1b}"), "{}", stderr(&out));
 }
 
+/// A chart of a stack that reflects nothing (every index the same) says it is black; it
+/// said "scaled by 1000000.000", its exposure's floor. Negative control: a film's chart
+/// says its scale.
+#[test]
+fn a_chart_of_a_stack_that_reflects_nothing_says_it_is_black() {
+    let dir = tempfile::tempdir().unwrap();
+    let chart = dir.path().join("chart.png");
+    let args = ["brdf", "chart", "-o", chart.to_str().unwrap(), "--width", "8", "--height", "4"];
+    let out = snakeskin(&[&args[..], &["--n0", "2", "--n1", "2", "--n2", "2"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("(black: this stack reflects nothing"), "{}", stderr(&out));
+    let out = snakeskin(&args);
+    assert!(stderr(&out).contains("(linear reflectance scaled by "), "{}", stderr(&out));
+}
+
 #[test]
 fn missing_output_folders_are_created_with_a_note() {
     let dir = tempfile::tempdir().unwrap();

@@ -274,7 +274,15 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             let (image, exposure) = chart(stack, method, width as usize, height as usize);
             let png = snakeskin::export::encode_png(snakeskin::material::MapKind::Color, &image)?;
             snakeskin::export::write_file_atomically(&out, png)?;
-            eprintln!("wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)", path_line(&out));
+            if image.data.iter().all(|v| *v == 0.0) {
+                // Matched indices: nothing to scale (the exposure would read a million).
+                eprintln!("wrote {} (black: this stack reflects nothing at any thickness and angle)", path_line(&out));
+            } else {
+                eprintln!(
+                    "wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)",
+                    path_line(&out)
+                );
+            }
             Ok(())
         }
         BrdfCommand::Eval(args) => {
