@@ -752,10 +752,10 @@ fn a_map_past_the_file_size_limit_is_an_error_that_keeps_the_earlier_set() {
     let dir = tempfile::tempdir().unwrap();
     assert!(generate_into(dir.path(), "1", &[]).status.success());
     let before = snapshot(dir.path());
-    // 16 blocks (8 or 16 KiB, as the shell counts them): a 512² colour map is larger.
-    let command =
-        format!("ulimit -f 16; exec '{BIN}' generate {PRESET} -o '{}' --size 512 --seed 2", dir.path().display());
-    let out = Command::new("sh").arg("-c").arg(&command).output().unwrap();
+    // 16 blocks (8 or 16 KiB, as the shell counts them): a 512² colour map is larger. The
+    // paths go in as the script's arguments, whatever characters they hold.
+    let script = "ulimit -f 16; exec \"$0\" generate \"$1\" -o \"$2\" --size 512 --seed 2";
+    let out = Command::new("sh").args(["-c", script, BIN, PRESET]).arg(dir.path()).output().unwrap();
     assert_eq!(out.status.code(), Some(1), "{:?}: {}", out.status, stderr(&out));
     assert!(stderr(&out).contains("File too large"), "{}", stderr(&out));
     assert_eq!(snapshot(dir.path()), before, "hidden files left: {:?}", hidden_files(dir.path()));

@@ -761,7 +761,7 @@ macro_rules! top_impl {
         }
 
         /// `$top` with the two rows' X̄ given.
-        pub fn $top_with(
+        fn $top_with(
             cos: $t,
             roughness: $t,
             film: &dyn Fn($t) -> [$t; 3],
@@ -786,8 +786,8 @@ top_impl!(f32, parts_on_row_f32, ms_norm_on_row_f32, ms_norms_f32, top_on_row_wi
 /// X̄ per channel on the two roughness rows around a roughness (`ms_norms`).
 pub type MsNorms = [[f64; 3]; 2];
 
-/// `top` at several cosines (the f64 model's: an evaluation's two directions), which share
-/// the rows' X̄ (`ms_norms` of this film and roughness): `norms` where the caller has it (an
+/// `top` at several cosines (the f64 model's: an evaluation's two directions, or one where
+/// an integral holds the other's fixed), which share the rows' X̄ (`ms_norms` of this film and roughness): `norms` where the caller has it (an
 /// integral over directions computes it once), else computed here, once, not once per
 /// direction.
 pub fn tops<const N: usize>(

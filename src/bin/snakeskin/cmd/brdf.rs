@@ -275,7 +275,7 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             let png = snakeskin::export::encode_png(snakeskin::material::MapKind::Color, &image)?;
             snakeskin::export::write_file_atomically(&out, png)?;
             if image.data.iter().all(|v| *v == 0.0) {
-                // Matched indices: nothing to scale (the exposure would read a million).
+                // Matched indices: nothing to scale, so no scale to report.
                 eprintln!("wrote {} (black: this stack reflects nothing at any thickness and angle)", path_line(&out));
             } else {
                 eprintln!(
