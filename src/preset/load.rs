@@ -546,6 +546,8 @@ fn check_layer_index(pattern: Option<&toml::Value>, index: usize) -> Result<(), 
     Err(format!("there is no pattern layer {index}; {have} (add layers in the preset file)"))
 }
 
+/// Puts `value` at `segments` below `target` (`merge`, which records in `written` under the
+/// override's `key` as written).
 fn set_path(
     target: &mut toml::Value,
     segments: &[&str],

@@ -451,7 +451,7 @@ impl Model {
     }
 }
 
-/// The normal of the integrals' frame (and where a normal has no direction).
+/// The normal of the integrals' frame, and the one taken where a normal given has no direction.
 const NORMAL: [f64; 3] = [0.0, 0.0, 1.0];
 
 /// The cosine between the unit normal `n` and the unit direction `w`, floored at `COS_MIN`

@@ -93,8 +93,9 @@ pub const VARIANTS: &[(&str, MapKind, &str)] = &[
     (
         "light tips, pale skin between scales",
         MapKind::Color,
-        // Skin and belly as pale as this stack shows them under the tips' 1.6× brightening
-        // (`no_figure_asks_for_a_colour_it_cannot_show`); its `[belly]` replaces `BASE_BELLY`,
+        // Skin and belly as pale as this stack shows them under the map's per-scale
+        // brightening (`visible::per_scale_gain`, the tips' 0.6 in it;
+        // `no_figure_asks_for_a_colour_it_cannot_show`); its `[belly]` replaces `BASE_BELLY`,
         // whose width it repeats.
         "[scales]\nsize = 0.9\n[color]\nbase = \"#4a5a2a\"\ntip_tone = 0.6\nskin = \"#c8c1ac\"\n[belly]\nwidth = 0.2\n\
          color = \"#c8bd9e\"\n",
