@@ -568,7 +568,12 @@ fn set_path(
         }
         toml::Value::Array(items) => {
             let len = items.len();
-            let index: usize = first.parse().map_err(|_| format!("`{first}` must be an array index"))?;
+            let index: usize = first.parse().map_err(|_| {
+                // The list's own key, and what follows it: `pattern.amount` on `[[pattern]]`.
+                let parts: Vec<&str> = key.split('.').collect();
+                let list = parts[..parts.len() - segments.len()].join(".");
+                format!("`{list}` is a list ({}): write {list}.N.{}", entries(len, &list), segments.join("."))
+            })?;
             // `pattern = []` and `pattern.0.KEY`: the first layer starts (`check_indices`
             // lets only that index past the end through).
             if index == 0 && len == 0 {
@@ -829,6 +834,26 @@ mod tests {
         assert_eq!((p.key.as_str(), p.line, p.overridden), ("pattern.1.amount", Some(9), false), "{p:?}");
         let p = problem(&single.replace("seed = 1\n", "seed = 1\n[scales]\nrows = 999\n"), ("pattern.amount", "2"));
         assert_eq!((p.key.as_str(), p.line, p.overridden), ("scales.rows", Some(3), false), "{p:?}");
+    }
+
+    /// A key into a list without its index names the list and its entries (it said "`amount`
+    /// must be an array index"); a single `[pattern]` table takes the key as layer 0's.
+    #[test]
+    fn a_key_into_a_list_without_an_index_names_the_list() {
+        let two_layers = "seed = 1\n[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\n\
+                          [[pattern]]\nkind = \"spots\"\ncolor = \"#202020\"\n";
+        let err = parse(&source(two_layers), &[("pattern.amount".into(), "3".into())]).unwrap_err().to_string();
+        let says = "`pattern` is a list (2 entries: pattern.0 to pattern.1): write pattern.N.amount";
+        assert!(err.contains(says), "{err}");
+        let marks = "seed = 1\n[[body.head_mark]]\nkind = \"collar\"\ncolor = \"#101010\"\n";
+        let err = parse(&source(marks), &[("body.head_mark.color".into(), "\"#fff\"".into())]).unwrap_err();
+        let says = "`body.head_mark` is a list (1 entry: body.head_mark.0): write body.head_mark.N.color";
+        assert!(err.to_string().contains(says), "{err}");
+        let single = "seed = 1\n[pattern]\nkind = \"spots\"\ncolor = \"#101010\"\n";
+        assert_eq!(
+            parse(&source(single), &[("pattern.amount".into(), "3".into())]).unwrap().preset.pattern[0].amount,
+            3.0
+        );
     }
 
     #[test]
