@@ -787,9 +787,9 @@ top_impl!(f32, parts_on_row_f32, ms_norm_on_row_f32, ms_norms_f32, top_on_row_wi
 pub type MsNorms = [[f64; 3]; 2];
 
 /// `top` at several cosines (the f64 model's: an evaluation's two directions, or one where
-/// an integral holds the other's fixed), which share the rows' X̄ (`ms_norms` of this film and roughness): `norms` where the caller has it (an
-/// integral over directions computes it once), else computed here, once, not once per
-/// direction.
+/// an integral holds the other's fixed), which share the rows' X̄ (`ms_norms` of this film
+/// and roughness): `norms` where the caller has it (an integral over directions computes
+/// it once), else computed here, once, not once per direction.
 pub fn tops<const N: usize>(
     cos: [f64; N],
     roughness: f64,

@@ -125,9 +125,9 @@ impl Model {
         }
     }
 
-    /// `coupling` at several cosines (an evaluation's light and view), which share the
-    /// rough lobe's normalisation (`energy::tops`; `norms` from `ms_norms` where the caller
-    /// has it).
+    /// `coupling` at several cosines (an evaluation's light and view, or one of them), which
+    /// share the rough lobe's normalisation (`energy::tops`; `norms` from `ms_norms` where
+    /// the caller has it). `film` as the coupling reads it (`coupling_film`).
     fn couplings<const N: usize>(
         self,
         cos: [f64; N],
@@ -144,7 +144,7 @@ impl Model {
     }
 
     /// The rough top's multiple-scatter normalisation X̄ on the two roughness rows around
-    /// `layers.roughness`, with `film` as the coupling reads it (`coupling_film`): the same
+    /// `layers.roughness`, `film` as the coupling reads it (`coupling_film`): the same
     /// for every pair of directions, so an integral over directions computes it once
     /// (`furnace_albedo`: it was four fifths of each evaluation's rule there). None for the
     /// thesis model, which has no such lobe.
@@ -152,8 +152,7 @@ impl Model {
         match self {
             Model::Thesis => None,
             Model::Layered => {
-                let film = coupling_film(film);
-                Some(path::with(layers.n0, layers.n2, |p| energy::ms_norms(layers.roughness, &film, &p.through)))
+                Some(path::with(layers.n0, layers.n2, |p| energy::ms_norms(layers.roughness, film, &p.through)))
             }
         }
     }
@@ -430,8 +429,8 @@ impl Model {
         // depend on wi computed once: the rough lobe's normalisation and the view's coupling.
         let mut diffuse = [0.0; 3];
         if let Some(cos_o) = normalize(wo).and_then(|wo| floored_cos(NORMAL, wo)) {
-            let norms = self.ms_norms(layers, film);
             let film = coupling_film(film);
+            let norms = self.ms_norms(layers, &film);
             let [top_o] = self.couplings([cos_o], layers, &film, norms);
             for a in 0..n * n {
                 // ∫ over the hemisphere of g(θi) cos θi dω = 2π ∫ g(μ) μ dμ.
