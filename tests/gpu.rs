@@ -257,6 +257,9 @@ fn bench_gpu_reports_both_costs() {
         let ms = v[key].as_f64().unwrap();
         assert!(ms.is_finite() && ms > 0.0, "{key} = {ms}");
     }
+    // The work the GPU time was taken over: ten extra dispatches, or a tenfold step beyond.
+    let extra = v["gpu_extra_dispatches"].as_u64();
+    assert!(matches!(extra, Some(10 | 100 | 1000 | 10_000 | 100_000)), "gpu_extra_dispatches = {extra:?}");
 }
 
 /// A device error inside `Gpu::checked` is an error, not wgpu's panic (an 8192² frame

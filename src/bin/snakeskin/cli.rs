@@ -792,7 +792,9 @@ pub enum BenchCommand {
         json: bool,
     },
     /// The BRDF (LUT film) per million evaluations: WGSL compute shader on the GPU and the
-    /// Rust f32 twin on one CPU core, side by side in one run.
+    /// Rust f32 twin on one CPU core, side by side in one run. The GPU time is the difference
+    /// between one dispatch and 1 + N in one submission (N = 10, or tenfold more until the
+    /// difference spans 20 ms: a fast GPU is timed over more work), median of five.
     Gpu {
         /// Evaluations per dispatch, 1000 to 1,000,000.
         // The bound is the GPU's, not the bench's: the samples (112 bytes each) are one

@@ -153,14 +153,57 @@ pub struct GpuBench {
     pub model: &'static str,
     pub samples: usize,
     pub gpu_ms_per_million: f64,
+    /// Dispatches beyond the first that the GPU time was measured over
+    /// (`seconds_per_dispatch`): 10 where they take 20 ms or more, tenfold steps beyond.
+    pub gpu_extra_dispatches: u32,
     pub cpu_f32_ms_per_million: f64,
     pub cpu_threads: usize,
 }
 
+/// The shortest span of extra dispatches the GPU timing trusts. Submitting and reading back
+/// jitter by up to a millisecond; on an NVIDIA H200 ten extra dispatches of the thesis
+/// model (one million evaluations each, 0.04 ms) once read as -0.015 ms per million, and
+/// the benchmark gave up.
+const MIN_EXTRA_SPAN_S: f64 = 0.020;
+
+/// The most extra dispatches in one submission: each step is tenfold, taken only after the
+/// last spanned under `MIN_EXTRA_SPAN_S`, so a step's submissions span under 0.2 s each.
+const MAX_EXTRA_DISPATCHES: u32 = 100_000;
+
+/// Seconds per dispatch, and the extra dispatches that measured it, from `time(n)`: the wall
+/// time of n dispatches in one submission. Fixed costs (submit, read-back) cancel in the
+/// difference of 1 + extra and 1 dispatches, median of five pairs; extra starts at 10 and
+/// grows tenfold until that median spans `MIN_EXTRA_SPAN_S`, so a fast GPU is timed over
+/// enough work to rise above the jitter. Never reaching it is an error, not a zero.
+pub fn seconds_per_dispatch(
+    mut time: impl FnMut(u32) -> Result<std::time::Duration, GpuError>,
+) -> Result<(f64, u32), GpuError> {
+    let mut extra = 10;
+    loop {
+        let mut spans = Vec::with_capacity(5);
+        for _ in 0..5 {
+            let one = time(1)?.as_secs_f64();
+            spans.push(time(1 + extra)?.as_secs_f64() - one);
+        }
+        spans.sort_by(f64::total_cmp);
+        let span = spans[2];
+        if span >= MIN_EXTRA_SPAN_S {
+            return Ok((span / f64::from(extra), extra));
+        }
+        if extra >= MAX_EXTRA_DISPATCHES {
+            return Err(GpuError::Timing(format!(
+                "{extra} extra dispatches took {:.4} ms (median of 5), under the {} ms the timing needs to \
+                 rise above its noise; run it again on a quieter machine, or with more --samples",
+                span * 1e3,
+                MIN_EXTRA_SPAN_S * 1e3
+            )));
+        }
+        extra *= 10;
+    }
+}
+
 /// Measures `GpuBench` over `count` deterministic inputs (upper hemisphere, a spread of
-/// roughness and thickness). GPU: fixed costs (submit, readback) cancel in the difference of
-/// 11 and 1 dispatches, median of five pairs; a difference that is not positive means the
-/// timing is meaningless and is an error, not a zero. CPU: median of five passes.
+/// roughness and thickness). GPU: `seconds_per_dispatch`. CPU: median of five passes.
 pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBench, GpuError> {
     let lut = Lut::bake_default(Stack::THESIS);
     let tau = [0.6, 0.4, 0.2];
@@ -183,20 +226,10 @@ pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBen
     let samples: Vec<GpuSample> =
         inputs.iter().map(|(l, wi, wo)| GpuSample::new(l, [0.0, 0.0, 1.0], *wi, *wo)).collect();
 
-    let mut per_million = Vec::new();
-    for _ in 0..5 {
-        let (_, one) = eval_timed(gpu, model, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 1)?;
-        let (_, eleven) = eval_timed(gpu, model, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, 11)?;
-        per_million.push((eleven.as_secs_f64() - one.as_secs_f64()) / 10.0 * 1e3 * 1e6 / count as f64);
-    }
-    per_million.sort_by(f64::total_cmp);
-    let gpu_ms = per_million[2];
-    if !(gpu_ms.is_finite() && gpu_ms > 0.0) {
-        return Err(GpuError::Timing(format!(
-            "10 extra dispatches took {gpu_ms:.4} ms per million evaluations (median of 5): the timing is \
-             dominated by noise; run it again on a quieter machine"
-        )));
-    }
+    let (seconds, extra_dispatches) = seconds_per_dispatch(|repeats| {
+        eval_timed(gpu, model, Stack::THESIS, &lut, GpuFilmMethod::Lut, &samples, repeats).map(|(_, t)| t)
+    })?;
+    let gpu_ms = seconds * 1e3 * 1e6 / count as f64;
 
     // ns per evaluation is ms per million evaluations.
     let cpu_ms = crate::optics::brdf::accuracy::median_ns_per_eval(model, &inputs, &lut);
@@ -205,7 +238,47 @@ pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBen
         model: model.name(),
         samples: count,
         gpu_ms_per_million: gpu_ms,
+        gpu_extra_dispatches: extra_dispatches,
         cpu_f32_ms_per_million: cpu_ms,
         cpu_threads: 1,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    /// A clock for `seconds_per_dispatch`: `fixed_s` per submission, `per_dispatch_s` per
+    /// dispatch, and up to ±0.5 ms of deterministic jitter per call.
+    fn clock(fixed_s: f64, per_dispatch_s: f64) -> impl FnMut(u32) -> Result<Duration, GpuError> {
+        let mut call = 0u32;
+        move |n| {
+            call += 1;
+            let jitter_s = (f64::from(crate::ops::hash::unit(call as i32, 0, 3, 11)) - 0.5) * 1e-3;
+            Ok(Duration::from_secs_f64(fixed_s + f64::from(n) * per_dispatch_s + jitter_s))
+        }
+    }
+
+    #[test]
+    fn a_fast_gpu_is_timed_over_more_dispatches() {
+        // 4 µs a dispatch: ten extra span 40 µs, under the jitter (ten such, read as a
+        // difference of two noisy calls, gave the H200's negative time).
+        let (seconds, extra) = seconds_per_dispatch(clock(0.005, 4e-6)).unwrap();
+        assert_eq!(extra, 10_000, "the first tenfold step whose span reaches 20 ms");
+        assert!((seconds / 4e-6 - 1.0).abs() < 0.05, "{seconds} s a dispatch against 4e-6");
+    }
+
+    #[test]
+    fn a_slow_gpu_keeps_ten_extra_dispatches() {
+        let (seconds, extra) = seconds_per_dispatch(clock(0.005, 0.01)).unwrap();
+        assert_eq!(extra, 10);
+        assert!((seconds / 0.01 - 1.0).abs() < 0.01, "{seconds}");
+    }
+
+    #[test]
+    fn work_that_never_rises_above_the_jitter_is_an_error() {
+        let error = seconds_per_dispatch(clock(0.005, 0.0)).unwrap_err().to_string();
+        assert!(error.contains("100000 extra dispatches took") && error.contains("quieter machine"), "{error}");
+    }
 }

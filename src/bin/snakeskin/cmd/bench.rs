@@ -173,7 +173,10 @@ fn gpu(count: usize, model: snakeskin::optics::brdf::Model, json: bool) -> Resul
         println!("{}", serde_json::to_string(&result)?);
     } else {
         println!("adapter: {}, model: {}", result.adapter, result.model);
-        println!("WGSL BRDF (compute):  {:.3} ms per million evaluations", result.gpu_ms_per_million);
+        println!(
+            "WGSL BRDF (compute):  {:.3} ms per million evaluations ({} extra dispatches timed)",
+            result.gpu_ms_per_million, result.gpu_extra_dispatches
+        );
         println!("Rust f32 twin (1 core): {:.3} ms per million evaluations", result.cpu_f32_ms_per_million);
     }
     Ok(())
