@@ -462,7 +462,19 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
     for (i, segment) in segments.iter().enumerate() {
         let path = format!("{prefix}{}", segments[..=i].join("."));
         let Some(index) = segments.get(i + 1).and_then(|s| s.parse::<usize>().ok()) else {
-            here = Some(step(here, root, segment).unwrap_or(&missing));
+            let value = step(here, root, segment);
+            // A key below a list the preset does not have (`body.head_mark.color` without
+            // head marks) made a table where the schema wants a list: "invalid type: table,
+            // expected an array". A single `[pattern]` table is layer 0, so `pattern.KEY`
+            // may start one.
+            if value.is_none() && i + 1 < segments.len() && path != "pattern" && schema_lists().contains(&path) {
+                return Err(format!(
+                    "`{path}` is a list, and the preset has none, so `{prefix}{}` has nothing to reach into (set \
+                     the list whole: --set '{path}=[...]', or write it in the preset file)",
+                    segments.join(".")
+                ));
+            }
+            here = Some(value.unwrap_or(&missing));
             continue;
         };
         let value = step(here, root, segment);
@@ -498,6 +510,30 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
         return check_indices_below(item, &segments[i + 2..], &format!("{path}.{index}."));
     }
     Ok(())
+}
+
+/// The dotted keys the schema holds as lists (`pattern`, `body.head_mark`, `sources`): the
+/// lists of a preset with nothing written but its seed, as the schema writes them.
+fn schema_lists() -> &'static [String] {
+    static LISTS: std::sync::LazyLock<Vec<String>> = std::sync::LazyLock::new(|| {
+        let preset: Preset = toml::from_str("seed = 0").expect("a seed alone is a preset");
+        let value = toml::Value::try_from(&preset).expect("a preset is TOML");
+        let mut lists = Vec::new();
+        let mut tables = vec![(String::new(), value)];
+        while let Some((path, value)) = tables.pop() {
+            let toml::Value::Table(table) = value else { continue };
+            for (key, value) in table {
+                let key = if path.is_empty() { key } else { format!("{path}.{key}") };
+                match value {
+                    toml::Value::Array(_) => lists.push(key),
+                    value @ toml::Value::Table(_) => tables.push((key, value)),
+                    _ => {}
+                }
+            }
+        }
+        lists
+    });
+    &LISTS
 }
 
 /// `check_indices` below a list's item at `prefix` (a layer's `colors.N`).
@@ -854,6 +890,26 @@ mod tests {
             parse(&source(single), &[("pattern.amount".into(), "3".into())]).unwrap().preset.pattern[0].amount,
             3.0
         );
+        // A preset without head marks: the list, not the reader's "invalid type: table".
+        let err = parse(&source("seed = 1\n"), &[("body.head_mark.color".into(), "\"#fff\"".into())]).unwrap_err();
+        let says = "`body.head_mark` is a list, and the preset has none, so `body.head_mark.color` has nothing \
+                    to reach into (set the list whole: --set 'body.head_mark=[...]'";
+        assert!(err.to_string().contains(says), "{err}");
+        // Negative control: set whole, the list is accepted.
+        let whole = [("body.head_mark".into(), "[{kind=\"collar\", color=\"#ffffff\"}]".into())];
+        assert_eq!(parse(&source("seed = 1\n"), &whole).unwrap().preset.body.head_mark.len(), 1);
+        // And a preset without layers still takes `pattern.KEY` as layer 0's.
+        let layer = [("pattern.kind".into(), "spots".into()), ("pattern.color".into(), "\"#101010\"".into())];
+        assert_eq!(parse(&source("seed = 1\n"), &layer).unwrap().preset.pattern.len(), 1);
+    }
+
+    #[test]
+    fn the_schema_lists_are_the_lists_a_preset_can_hold() {
+        let lists = schema_lists();
+        for list in ["pattern", "body.head_mark", "sources"] {
+            assert!(lists.iter().any(|l| l == list), "{list} in {lists:?}");
+        }
+        assert!(!lists.iter().any(|l| l == "body" || l == "optics.absorption"), "{lists:?}");
     }
 
     #[test]
