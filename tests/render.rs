@@ -473,6 +473,37 @@ fn the_contact_sheet_renders_every_preset() {
     assert_eq!((small.width(), small.height()), (2 * 3 * tile, cell_h));
 }
 
+/// `bench render --lut-only` times the variants that read the film table, each with a
+/// positive median, and leaves out the direct film methods (seconds a frame on lavapipe).
+#[test]
+fn bench_render_lut_only_times_the_table_variants() {
+    let Some(_gpu) = gpu_or_skip("bench_render_lut_only_times_the_table_variants") else { return };
+    let sizes = ["--size", "64x40", "--map-size", "64", "--frames", "3", "--reference-size", "16x16"];
+    let run = snakeskin(&[&["bench", "render", "--lut-only", "--json"][..], &sizes].concat());
+    assert!(run.status.success(), "{}", common::stderr(&run));
+    let v: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let variants = v["variants"].as_array().unwrap();
+    let names: Vec<(&str, u64)> =
+        variants.iter().map(|v| (v["name"].as_str().unwrap(), v["snakes"].as_u64().unwrap())).collect();
+    let expected = [
+        ("plain-pbr", 1),
+        ("skin-lut", 1),
+        ("skin-thesis", 1),
+        ("skin-no-film", 1),
+        ("skin-absorption", 1),
+        ("plain-pbr", 20),
+        ("skin-lut", 20),
+    ];
+    assert_eq!(names, expected);
+    for variant in variants {
+        let ms = variant["median_ms"].as_f64().unwrap();
+        assert!(ms.is_finite() && ms > 0.0, "{variant}");
+    }
+    for key in ["ratio", "thesis_ratio", "reference_mean_de"] {
+        assert!(v[key].as_f64().is_some_and(f64::is_finite), "{key} = {}", v[key]);
+    }
+}
+
 #[test]
 fn sheet_command_writes_a_png() {
     let Some(_gpu) = gpu_or_skip("sheet_command_writes_a_png") else { return };

@@ -787,6 +787,12 @@ pub enum BenchCommand {
         /// full-HD frame); WIDTHxHEIGHT, each 16 to 8192 pixels.
         #[arg(long, default_value = "480x300", value_parser = parse_image_size)]
         reference_size: ImageSize,
+        /// Time only the variants that read the film table (plain, skin, thesis, no film,
+        /// absorption, twenty snakes): skip skin-rgb3, skin-spectral-8 and skin-gaussian-fit,
+        /// which evaluate the film at every pixel and take most of a run (on a hardware GPU
+        /// about 1 s a round of the 1.1 s, on lavapipe seconds a frame).
+        #[arg(long)]
+        lut_only: bool,
         /// Print one JSON object.
         #[arg(long)]
         json: bool,

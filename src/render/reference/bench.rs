@@ -60,6 +60,8 @@ pub struct BenchOptions {
     pub frames: usize,
     pub map_size: usize,
     pub reference_size: (u32, u32),
+    /// Time only the variants that read the LUT film (`DIRECT_FILM_VARIANTS` skipped).
+    pub lut_only: bool,
 }
 
 fn percentile(sorted: &[f64], p: f64) -> f64 {
@@ -145,6 +147,17 @@ impl<'a> FrameTimer<'a> {
 /// with twenty (`bench_render`'s runs).
 const TIMED_RUNS: usize = 10;
 
+/// The variants that evaluate the layered rule with their own film at every pixel instead
+/// of reading the coupling texture (README, "The preview renderer"): on an NVIDIA H200 at
+/// 1920×1080 they took 1.10 s of each 1.12 s round (258, 609 and 229 ms against 3 ms for the
+/// LUT's skin), and seconds a frame on lavapipe. `--lut-only` leaves them out.
+const DIRECT_FILM_VARIANTS: [&str; 3] = ["skin-rgb3", "skin-spectral-8", "skin-gaussian-fit"];
+
+/// The runs `bench_render` times under `options`.
+fn timed_runs(options: &BenchOptions) -> usize {
+    TIMED_RUNS - if options.lut_only { DIRECT_FILM_VARIANTS.len() } else { 0 }
+}
+
 /// What the benchmark's renderer holds beyond one preview's (`RENDERER_OVERHEAD_BYTES`): the
 /// pipelines of its eight variants, twenty snakes' draws and the timing queries. Measured on
 /// lavapipe (Mesa 22.3.6, two cores), peak resident with 64² maps and a 16² reference:
@@ -167,7 +180,7 @@ pub fn check_memory(loaded: &LoadedPreset, options: &BenchOptions) -> Result<(),
     // phases already.
     let memory = DrawMemory {
         held_bytes: VARIANTS_OVERHEAD_BYTES,
-        materials: TIMED_RUNS as u64,
+        materials: timed_runs(options) as u64,
         ..DrawMemory::new(&graph, size, frames)
     };
     memory.check("the render benchmark's materials and frames")
@@ -214,13 +227,16 @@ pub fn bench_render(
             if snakes == 20 && !matches!(name.as_str(), "plain-pbr" | "skin-lut") {
                 continue;
             }
+            if options.lut_only && DIRECT_FILM_VARIANTS.contains(&name.as_str()) {
+                continue;
+            }
             let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method))?;
             let camera = crate::render::engine::scene::Camera::framing(snakes);
             let settings = FrameSettings { method: *method, plain: *plain, model: *model, snakes, camera, ..base };
             runs.push((name.clone(), snakes, material, settings, Vec::with_capacity(options.frames)));
         }
     }
-    debug_assert_eq!(runs.len(), TIMED_RUNS, "check_memory counts the runs' materials");
+    debug_assert_eq!(runs.len(), timed_runs(options), "check_memory counts the runs' materials");
     let timer = FrameTimer::new(renderer, options, base.samples);
     for round in 0..options.frames + 3 {
         progress(&format!("round {} of {}", round + 1, options.frames + 3));

@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 
-use crate::cli::{BenchCommand, ImageSize};
+use crate::cli::BenchCommand;
 use crate::output::ensure_parent_folder;
 use crate::progress::Progress;
 use snakeskin::Error;
@@ -16,8 +16,16 @@ use snakeskin::render::reference::bench::{BenchOptions, bench_render};
 pub fn run(command: BenchCommand) -> Result<()> {
     match command {
         BenchCommand::Gpu { samples, model, json } => gpu(samples as usize, model, json),
-        BenchCommand::Render { preset, size, frames, map_size, reference_size, json } => {
-            render(&preset, size, frames, map_size, reference_size, json)
+        BenchCommand::Render { preset, size, frames, map_size, reference_size, lut_only, json } => {
+            let options = BenchOptions {
+                width: size.width,
+                height: size.height,
+                frames: frames as usize,
+                map_size: map_size as usize,
+                reference_size: (reference_size.width, reference_size.height),
+                lut_only,
+            };
+            render(&preset, &options, json)
         }
         BenchCommand::Irid { json, plot, d_step_nm, angle_step_deg, lut_sweep } => {
             irid(json, plot.as_deref(), d_step_nm, angle_step_deg, lut_sweep)
@@ -182,20 +190,13 @@ fn gpu(count: usize, model: snakeskin::optics::brdf::Model, json: bool) -> Resul
     Ok(())
 }
 
-fn render(preset: &str, size: ImageSize, frames: u64, map_size: u64, reference: ImageSize, json: bool) -> Result<()> {
+fn render(preset: &str, options: &BenchOptions, json: bool) -> Result<()> {
     let loaded = snakeskin::preset::load(preset, &[], None)?;
     crate::output::report_warnings(preset, &loaded);
-    let options = BenchOptions {
-        width: size.width,
-        height: size.height,
-        frames: frames as usize,
-        map_size: map_size as usize,
-        reference_size: (reference.width, reference.height),
-    };
-    snakeskin::render::reference::bench::check_memory(&loaded, &options)?;
+    snakeskin::render::reference::bench::check_memory(&loaded, options)?;
     let renderer = Renderer::headless()?;
     let bar = Progress::spinner("bench render");
-    let result = bench_render(&renderer, &loaded, &options, &|what| bar.message(what))?;
+    let result = bench_render(&renderer, &loaded, options, &|what| bar.message(what))?;
     bar.finish();
     if json {
         println!("{}", serde_json::to_string_pretty(&result)?);
