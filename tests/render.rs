@@ -337,6 +337,81 @@ fn preview_writes_a_png_and_rejects_bad_options() {
     assert!(!dir.path().join("new").exists(), "a folder was made for the refused heat map");
 }
 
+/// The render and its heat map appear together or not at all: a heat map that could not be
+/// put in place (the commit's last rename fails: the fault hook of debug builds) leaves the
+/// earlier render as it was (it had already been replaced when the reference ran).
+/// Negative control: the same run without the fault writes both.
+#[test]
+fn preview_writes_its_render_and_heat_map_together() {
+    let Some(_gpu) = gpu_or_skip("preview_writes_its_render_and_heat_map_together") else { return };
+    if !cfg!(debug_assertions) {
+        eprintln!("SKIPPED: the fault hook exists in debug builds only (cargo test without --release)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (out, heat) = (dir.path().join("snake.png"), dir.path().join("heat.png"));
+    std::fs::write(&out, "the earlier render").unwrap();
+    let (o, h) = (out.to_str().unwrap(), heat.to_str().unwrap());
+    let args = ["preview", PRESET, "--out", o, "--reference", h, "--size", "48x32", "--map-size", "64", "--close-up"];
+    // Renames: the earlier render aside (0), the render in (1), the heat map in (2).
+    let run = common::snakeskin_env(&args, &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "2")]);
+    assert_eq!(run.status.code(), Some(1), "{}", common::stderr(&run));
+    assert_eq!(std::fs::read(&out).unwrap(), b"the earlier render", "the render was replaced alone");
+    assert!(!heat.exists());
+    let run = snakeskin(&args);
+    assert!(run.status.success(), "{}", common::stderr(&run));
+    assert_eq!(common::stdout(&run).lines().count(), 2, "both files are printed");
+    assert!(image::open(&out).is_ok() && image::open(&heat).is_ok());
+}
+
+/// A preview interrupted before its files are in place (paused at the commit, the pause hook
+/// of debug builds) leaves the earlier render, no temporaries, and none of the folders it
+/// made. A folder that takes no new file is refused before the render, naming the file.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_preview_leaves_the_earlier_render_and_no_folder() {
+    let Some(_gpu) = gpu_or_skip("an_interrupted_preview_leaves_the_earlier_render_and_no_folder") else { return };
+    if !cfg!(debug_assertions) {
+        eprintln!("SKIPPED: the pause hook exists in debug builds only (cargo test without --release)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("snake.png");
+    std::fs::write(&out, "the earlier render").unwrap();
+    let heat = dir.path().join("new/deeper/heat.png");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["preview", PRESET, "--out", out.to_str().unwrap(), "--reference", heat.to_str().unwrap()])
+        .args(["--size", "48x32", "--map-size", "64", "--close-up"])
+        .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Both files are staged when the heat map's temporary appears; the run pauses there.
+    let staged = || {
+        std::fs::read_dir(heat.parent().unwrap())
+            .is_ok_and(|e| e.flatten().any(|f| f.file_name().to_string_lossy().ends_with(".snakeskin-tmp")))
+    };
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while !staged() {
+        assert!(std::time::Instant::now() < deadline, "the preview never reached its commit");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+    let run = child.wait_with_output().unwrap();
+    assert_eq!(run.status.code(), Some(128 + libc::SIGTERM), "{}", common::stderr(&run));
+    assert_eq!(std::fs::read(&out).unwrap(), b"the earlier render");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().flatten().map(|e| e.file_name()).collect();
+    assert_eq!(left, ["snake.png"], "temporaries or made folders left");
+
+    // A file where the heat map's folder would be: refused before any rendering.
+    std::fs::write(dir.path().join("blocker"), "").unwrap();
+    let blocked = dir.path().join("blocker/heat.png");
+    let run = snakeskin(&["preview", PRESET, "--out", out.to_str().unwrap(), "--reference", blocked.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(2), "{}", common::stderr(&run));
+    assert_eq!(std::fs::read(&out).unwrap(), b"the earlier render");
+}
+
 #[cfg(feature = "window")]
 #[test]
 fn the_window_runs_frames_under_xvfb() {

@@ -983,6 +983,21 @@ fn sync_folder(dir: &Path) {
     }
 }
 
+/// Checks, before the work, that a new file can be made where `target` goes (its folder must
+/// exist): a temporary for it is made and removed. `preview --out ro/x.png` rendered for
+/// seconds (minutes with its CPU reference) and only then said "cannot write ro:
+/// Permission denied"; now it says so at once, naming the file.
+pub fn check_writable(target: &Path) -> Result<(), ExportError> {
+    let probe = stage(folder_of(target), &file_name(target), &[]).map_err(|e| match e {
+        ExportError::Io { source, .. } => ExportError::Io { path: target.into(), source },
+        other => other,
+    })?;
+    let path = probe.path().to_path_buf();
+    drop(probe);
+    forget_temporary(&path);
+    Ok(())
+}
+
 /// Writes one file atomically (exclusive temporary, then rename) to `path`. The folder must
 /// exist (the binary creates missing folders and says so).
 pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, ExportError> {

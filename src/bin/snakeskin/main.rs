@@ -22,6 +22,9 @@ fn main() -> ExitCode {
     match cmd::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
+            // A failed run leaves no empty folder it made for its outputs (`preview --out
+            // new/x.png` that failed left `new`).
+            snakeskin::export::remove_empty_made_folders();
             // A standard error that cannot be written does not change the run's exit code (an
             // `eprintln!` there was status 1 from the panic hook, where invalid input is 2).
             use std::io::Write;

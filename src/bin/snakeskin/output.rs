@@ -231,10 +231,12 @@ pub fn ensure_parent_folder(file: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Creates an output folder when it is missing (`export::create_folder`), with a note on
-/// stderr; a path that exists but is not a folder is refused, naming it.
+/// Creates an output folder when it is missing, with a note on stderr; a path that exists
+/// but is not a folder is refused, naming it. The folders made are noted
+/// (`export::create_folder_noted`): a run that fails or is interrupted takes them away again
+/// when they are still empty (`main`, `clean_up_before_exit`).
 pub fn ensure_folder(folder: &Path) -> anyhow::Result<()> {
-    if snakeskin::export::create_folder(folder)? {
+    if snakeskin::export::create_folder_noted(folder)? {
         eprintln!("note: created folder {}", path_line(folder));
     }
     Ok(())

@@ -14,12 +14,17 @@ use super::engine::scene::{Camera, Stage, View};
 use crate::Error;
 use crate::export::{FileGroup, check_target, write_file_atomically};
 
-/// Encodes and writes a rendered image (atomically), as RGB converted without a copy of the
-/// RGBA image (`renderer::frame_bytes` counts the RGB image and the PNG bytes).
+/// Encodes and writes a rendered image (atomically).
 pub fn write_png(path: &Path, image: &image::RgbaImage) -> Result<PathBuf, Error> {
+    Ok(write_file_atomically(path, rendered_png_bytes(image)?)?)
+}
+
+/// A rendered image as PNG bytes, as RGB converted without a copy of the RGBA image
+/// (`renderer::frame_bytes` counts the RGB image and the PNG bytes).
+pub fn rendered_png_bytes(image: &image::RgbaImage) -> Result<Vec<u8>, Error> {
     use image::buffer::ConvertBuffer;
     let rgb: image::RgbImage = image.convert();
-    write_rgb_png(path, &rgb)
+    png_bytes(&rgb)
 }
 
 /// Encodes and writes an RGB image (atomically).
@@ -29,7 +34,7 @@ pub fn write_rgb_png(path: &Path, image: &image::RgbImage) -> Result<PathBuf, Er
 
 /// An RGB image as PNG bytes, tagged sRGB (`export::encode_srgb_image_png`). An encoder
 /// failure is ours, not the user's.
-fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>, Error> {
+pub fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>, Error> {
     crate::export::encode_srgb_image_png(image.width(), image.height(), image.as_raw())
         .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))
 }

@@ -6,11 +6,12 @@ use crate::cli::PreviewArgs;
 use crate::output::{ensure_parent_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::Error;
+use snakeskin::export::FileGroup;
 use snakeskin::render::Renderer;
 use snakeskin::render::engine::prepare::upload_material_in;
 use snakeskin::render::engine::renderer::{FrameSettings, frame_bytes, gbuffer_bytes};
 use snakeskin::render::engine::scene::Camera;
-use snakeskin::render::figures::write_png;
+use snakeskin::render::figures::{png_bytes, rendered_png_bytes};
 use snakeskin::render::reference::frame::reference_check;
 
 pub fn run(args: PreviewArgs) -> Result<()> {
@@ -76,30 +77,34 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         // Before the render is written: the check's G-buffer is read back in one buffer.
         renderer.check_readback(width, height, 16)?;
     }
-    ensure_parent_folder(out)?;
-    if let Some(heat_path) = &args.reference {
-        ensure_parent_folder(heat_path)?;
+    // Before the work: a folder that takes no new file is said at once, naming the file.
+    for file in std::iter::once(out).chain(args.reference.as_deref()) {
+        ensure_parent_folder(file)?;
+        snakeskin::export::check_writable(file)?;
     }
     let material = upload_material_in(&renderer, &loaded, args.map_size as usize, args.method, layout)?;
     bar.message("rendering");
     let image = renderer.render_image(&settings, &material, width, height)?;
-    let written = write_png(out, &image)?;
+    // The render and its heat map appear together or not at all: a reference check that
+    // failed (or was interrupted) had already replaced the earlier render.
+    let mut files = FileGroup::new();
+    files.stage(out, &rendered_png_bytes(&image)?)?;
+    drop(image);
     bar.finish();
     if let Some(heat_path) = &args.reference {
         let bar = Progress::counting("{spinner} CPU reference [{bar:30}] {pos}/{len} pixels {elapsed} (ETA {eta})");
         let (report, _) =
             reference_check(&renderer, &material, &settings, width, height, &|done, total| bar.update(done, total))?;
         bar.finish();
-        snakeskin::render::figures::write_rgb_png(heat_path, &report.heat_map(5.0))?;
+        files.stage(heat_path, &png_bytes(&report.heat_map(5.0))?)?;
         eprintln!(
             "reference: {} pixels, CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3} (heat map: black 0 .. yellow >= 5)",
             report.pixels, report.mean_de, report.p99_de, report.max_de
         );
     }
-    println!("{}", path_line(&written));
-    // Every written path is printed (the heat map was not).
-    if let Some(heat_path) = &args.reference {
-        println!("{}", path_line(heat_path));
+    // Every written path is printed: the render, then the heat map.
+    for written in files.commit()? {
+        println!("{}", path_line(&written));
     }
     Ok(())
 }
