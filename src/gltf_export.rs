@@ -9,11 +9,11 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use crate::export::SetLock;
 use crate::export::gltf::{
     GltfMaterial, GltfTextures, glb, gltf_files, gltf_image_file_name, gltf_side_file_names, references_image,
 };
 use crate::export::pack::Pack;
-use crate::export::{SetLock, write_file_atomically};
 use crate::generate::{GenerateRequest, Plan};
 use crate::graph::EvalStats;
 use crate::maps::{Layout, has_film, thickness_range_nm};
@@ -61,6 +61,9 @@ pub struct ExportReport {
     /// Files of an earlier export of this name that this one removed (a `.gltf`'s thickness
     /// image, which a film of one thickness no longer references), for the caller to say.
     pub removed: Vec<PathBuf>,
+    /// Such files that would not go (immutable, or their folder refuses), with why, for the
+    /// caller to say: the export stands, and the file beside it is no longer referenced.
+    pub kept: Vec<crate::export::KeptFile>,
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
@@ -228,6 +231,12 @@ impl ExportPlan {
     /// Evaluates the textures and writes the file (and, for `.gltf`, its side files).
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<ExportReport, Error> {
         let ExportPlan { start, out, binary, name, dir, plan, material, mesh, thickness_varies, ao, .. } = self;
+        // Before the work, as `generate` does: a second export of this name into this folder
+        // stops at once (it did all its work, then a `.gltf` was refused at its commit and a
+        // `.glb` replaced the other's), and under the lock the temporaries a killed export
+        // left (a `.glb`'s whole file) are stale whatever their age. Its drop takes away the
+        // folder it made if the export fails.
+        let lock = SetLock::acquire(&dir, &name)?;
         let (mut textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
         // The evaluation's buffers, freed on the pool's threads, go back before the file is
         // made (python-regius's body atlas at 1024 kept 225 MB resident for 47 MB of textures).
@@ -248,37 +257,47 @@ impl ExportPlan {
         };
         // The asset's `extras`: the manifest's keys for what made it (`gltf::document`).
         let source = crate::export::Source::of(plan.loaded(), dimensions, plan.layout());
-        let created_folder;
+        let created_folder = lock.created_folder;
         let mut removed = Vec::new();
+        let mut kept = Vec::new();
         let files = if binary {
             let bytes = glb(&name, &mesh, material, &textures, Some(&source))?;
-            created_folder = crate::export::create_folder_noted(&dir)?;
-            // A write that fails takes away the folders it made, as a set's lock does.
-            vec![write_file_atomically(&out, bytes).inspect_err(|_| crate::export::remove_empty_made_folders())?]
+            let glb_name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            lock.remove_stale_temporaries_of(&[&glb_name]);
+            lock.write(&[], (&glb_name, &bytes))?
         } else {
             let has_thickness = textures.thickness.is_some();
             let mut files = gltf_files(&name, &mesh, material, textures, Some(&source))?;
             let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
-            let lock = SetLock::acquire(&dir, &name)?;
-            created_folder = lock.created_folder;
+            let thickness_file = gltf_image_file_name(&name, "thickness");
+            let names: Vec<&str> =
+                files.iter().map(|(n, _)| n.as_str()).chain([gltf_name.as_str(), &thickness_file]).collect();
+            lock.remove_stale_temporaries_of(&names);
             // An earlier export of this name with a film left its thickness image, which no
             // file references once this one is committed: it goes, under the lock, after the
             // commit, where the `.gltf` it replaces named it (a file of that name that the
             // earlier `.gltf` did not name is someone else's, and stays). Whatever stands
             // there is harmless once the commit is done, so an export that succeeded does not
             // fail for it (a folder of that name stays, and so does a file that may not go).
-            let thickness_file = gltf_image_file_name(&name, "thickness");
             let stale = (!has_thickness && references_image(&dir.join(&gltf_name), &thickness_file))
                 .then(|| dir.join(&thickness_file));
             let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
             if let Some(stale) = stale
                 && std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir())
-                && std::fs::remove_file(&stale).is_ok()
             {
-                removed.push(stale);
+                // One that will not go is said, as `generate` says the earlier set's maps
+                // that stay (it stayed without a word).
+                match std::fs::remove_file(&stale) {
+                    Ok(()) => removed.push(stale),
+                    Err(e) => kept.push(crate::export::KeptFile {
+                        path: stale,
+                        why: crate::export::KeptBecause::WouldNotMove(e.to_string()),
+                    }),
+                }
             }
             written
         };
-        Ok(ExportReport { files, dimensions, stats, encode_time, total_time: start.elapsed(), created_folder, removed })
+        let total_time = start.elapsed();
+        Ok(ExportReport { files, dimensions, stats, encode_time, total_time, created_folder, removed, kept })
     }
 }

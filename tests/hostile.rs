@@ -610,6 +610,74 @@ fn a_failed_rename_or_a_kill_in_a_smaller_set_leaves_no_mixed_set_and_no_tempora
     assert!(names.iter().all(|n| !n.ends_with(".snakeskin-tmp")), "{names:?}");
 }
 
+/// A killed `.glb` export leaves its whole file in a temporary; the next export of that name
+/// removes it (a `.glb` took no lock, so only temporaries older than ten minutes went, and
+/// one from a minute before stayed beside the file for good).
+#[test]
+fn a_killed_glb_export_leaves_a_temporary_the_next_one_removes() {
+    if !fault_hooks_exist() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let glb = dir.path().join("s.glb");
+    let export = |env: &[(&str, &str)]| {
+        let args = ["export", PRESET, "--gltf", glb.to_str().unwrap(), "--size", "32", "--mesh", "sphere"];
+        snakeskin_env(&args, env)
+    };
+    assert!(export(&[]).status.success());
+    // Rename 0 moves the earlier file aside: killed before it, the new file is staged.
+    let out = export(&[("SNAKESKIN_TEST_KILL_AT_RENAME", "0")]);
+    assert_eq!(out.status.code(), Some(137), "the hook did not fire: {}", stderr(&out));
+    let hidden = || -> Vec<String> {
+        let names = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name());
+        names.map(|n| n.to_string_lossy().into_owned()).filter(|n| n.starts_with('.')).collect()
+    };
+    assert!(hidden().iter().any(|n| n.ends_with(".snakeskin-tmp")), "{:?}", hidden());
+    let out = export(&[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(hidden(), Vec::<String>::new(), "temporaries or the lock left");
+}
+
+/// A second export of one name into one folder stops at once, as a second `generate` of a
+/// set does: the first holds the name from before its work (paused at its commit, the
+/// pause hook of debug builds). It did all its work first: a `.gltf` was then refused at
+/// its commit, and a `.glb` replaced the other's file.
+#[test]
+fn a_second_export_of_one_name_stops_at_once() {
+    if !fault_hooks_exist() {
+        return;
+    }
+    for file in ["s.glb", "s.gltf"] {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join(file);
+        let args = ["export", PRESET, "--gltf", target.to_str().unwrap(), "--size", "32", "--mesh", "sphere"];
+        let first = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(args)
+            .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let staged = || {
+            std::fs::read_dir(dir.path())
+                .unwrap()
+                .flatten()
+                .any(|e| e.file_name().to_string_lossy().ends_with(".snakeskin-tmp"))
+        };
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        while !staged() {
+            assert!(std::time::Instant::now() < deadline, "{file}: the first export never reached its commit");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let second = snakeskin(&args);
+        assert_eq!(second.status.code(), Some(1), "{file}: {}", stderr(&second));
+        assert!(stderr(&second).contains("another snakeskin run is writing the set s in"), "{}", stderr(&second));
+        let first = first.wait_with_output().unwrap();
+        assert!(first.status.success(), "{file}: {}", stderr(&first));
+        assert!(target.is_file());
+    }
+}
+
 /// A `.gltf` export of a species without a film removes the thickness image an earlier
 /// export with a film left; whatever else stands at that name (here a folder) stays, and
 /// the export, already committed, succeeds. Before, it failed after replacing the other

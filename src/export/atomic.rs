@@ -587,6 +587,13 @@ impl SetLock {
         })
     }
 
+    /// Removes every temporary of `file_names` in the set's folder, whatever its age: under
+    /// the lock none is another run's. For files beyond a set's own names (an export's
+    /// `.glb`, `.gltf`, `.bin` and images), which `acquire` does not sweep.
+    pub fn remove_stale_temporaries_of(&self, file_names: &[&str]) {
+        remove_stale_temporaries(&self.dir, file_names, ZERO_AGE);
+    }
+
     /// Writes the set: `maps` (file name, bytes) first, then `manifest` (file name, bytes)
     /// as the commit record. See the module documentation for the guarantee.
     pub fn write(&self, maps: &[(String, Vec<u8>)], manifest: (&str, &[u8])) -> Result<Vec<PathBuf>, ExportError> {
