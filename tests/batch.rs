@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 
-use common::{snakeskin, stderr, stdout};
+use common::{snakeskin, spawn_paused_at_commit, stderr, stdout, test_hooks_exist};
 
 /// Every file under `dir` (relative path → bytes), index files left out (they record what
 /// each run did, which differs between the runs compared).
@@ -844,8 +844,7 @@ fn a_batch_writes_over_no_job_preset() {
 /// preset is edited.
 #[test]
 fn a_preset_edited_while_its_batch_runs_is_not_written_under_the_old_key() {
-    if !cfg!(debug_assertions) {
-        eprintln!("SKIPPED: the pause hook exists in debug builds only (cargo test without --release)");
+    if !test_hooks_exist() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -856,23 +855,8 @@ fn a_preset_edited_while_its_batch_runs_is_not_written_under_the_old_key() {
     std::fs::write(&jobs, "[[job]]\npreset = \"snake.toml\"\nseeds = [1, 2]\nsizes = [32]\n").unwrap();
     let out_dir = dir.path().join("out");
     let args = ["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--concurrent", "1"];
-    let child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(args)
-        .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
     // The first job's staged maps appear as it reaches its commit, where it pauses.
-    let deadline = Instant::now() + Duration::from_secs(60);
-    let staged = |dir: &Path| {
-        std::fs::read_dir(dir.join("snake/tile-32-seed1-png"))
-            .is_ok_and(|e| e.flatten().any(|f| f.file_name().to_string_lossy().ends_with(".snakeskin-tmp")))
-    };
-    while !staged(&out_dir) {
-        assert!(Instant::now() < deadline, "the first job never reached its commit");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    let child = spawn_paused_at_commit(&args, &out_dir.join("snake/tile-32-seed1-png"));
     std::fs::write(&preset, original.replace("rows = 19", "rows = 41")).unwrap();
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
@@ -894,8 +878,7 @@ fn a_preset_edited_while_its_batch_runs_is_not_written_under_the_old_key() {
 /// not the input's fault.
 #[test]
 fn a_job_that_fails_while_it_runs_is_named() {
-    if !cfg!(debug_assertions) {
-        eprintln!("SKIPPED: the fault hook exists in debug builds only (cargo test without --release)");
+    if !test_hooks_exist() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -322,19 +322,10 @@ fn generate_into(dir: &Path, seed: &str, env: &[(&str, &str)]) -> std::process::
     snakeskin_env(&["generate", PRESET, "-o", dir.to_str().unwrap(), "--size", "48", "--seed", seed], env)
 }
 
-/// The commit's fault hooks exist in debug builds only (`cargo test`, the README's command);
-/// under `--release` the tests that need them say so and pass.
-fn fault_hooks_exist() -> bool {
-    if !cfg!(debug_assertions) {
-        eprintln!("SKIPPED: the fault hook exists in debug builds only (cargo test without --release)");
-    }
-    cfg!(debug_assertions)
-}
-
 /// A folder holding a whole set (seed 1) for a test that needs the fault hooks; `None`
-/// where they do not exist (`fault_hooks_exist`).
+/// where they do not exist (`test_hooks_exist`).
 fn earlier_set_with_fault_hooks() -> Option<tempfile::TempDir> {
-    if !fault_hooks_exist() {
+    if !test_hooks_exist() {
         return None;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -371,7 +362,7 @@ fn manifest_of(dir: &Path) -> std::path::PathBuf {
 /// and its missing parents stayed, empty). Negative control: a folder that was there stays.
 #[test]
 fn a_failed_run_leaves_no_empty_folder_it_made() {
-    if !fault_hooks_exist() {
+    if !test_hooks_exist() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -570,7 +561,7 @@ fn files_no_manifest_claims_are_kept_and_said() {
 /// only those of the names it writes, so these stayed for good).
 #[test]
 fn a_failed_rename_or_a_kill_in_a_smaller_set_leaves_no_mixed_set_and_no_temporary() {
-    if !fault_hooks_exist() {
+    if !test_hooks_exist() {
         return;
     }
     let colour_only = |dir: &Path, seed: &str, env: &[(&str, &str)]| {
@@ -615,7 +606,7 @@ fn a_failed_rename_or_a_kill_in_a_smaller_set_leaves_no_mixed_set_and_no_tempora
 /// one from a minute before stayed beside the file for good).
 #[test]
 fn a_killed_glb_export_leaves_a_temporary_the_next_one_removes() {
-    if !fault_hooks_exist() {
+    if !test_hooks_exist() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -644,31 +635,14 @@ fn a_killed_glb_export_leaves_a_temporary_the_next_one_removes() {
 /// its commit, and a `.glb` replaced the other's file.
 #[test]
 fn a_second_export_of_one_name_stops_at_once() {
-    if !fault_hooks_exist() {
+    if !test_hooks_exist() {
         return;
     }
     for file in ["s.glb", "s.gltf"] {
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join(file);
         let args = ["export", PRESET, "--gltf", target.to_str().unwrap(), "--size", "32", "--mesh", "sphere"];
-        let first = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-            .args(args)
-            .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        let staged = || {
-            std::fs::read_dir(dir.path())
-                .unwrap()
-                .flatten()
-                .any(|e| e.file_name().to_string_lossy().ends_with(".snakeskin-tmp"))
-        };
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
-        while !staged() {
-            assert!(std::time::Instant::now() < deadline, "{file}: the first export never reached its commit");
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
+        let first = spawn_paused_at_commit(&args, dir.path());
         let second = snakeskin(&args);
         assert_eq!(second.status.code(), Some(1), "{file}: {}", stderr(&second));
         assert!(stderr(&second).contains("another snakeskin run is writing the set s in"), "{}", stderr(&second));
@@ -718,7 +692,7 @@ fn an_export_is_not_failed_by_what_stands_at_a_stale_image_name() {
 /// before its maps fails at the kill before rename 10.
 #[test]
 fn a_kill_at_any_rename_or_during_the_undo_never_leaves_a_manifest_over_other_maps() {
-    if !fault_hooks_exist() {
+    if !test_hooks_exist() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -344,8 +344,7 @@ fn preview_writes_a_png_and_rejects_bad_options() {
 #[test]
 fn preview_writes_its_render_and_heat_map_together() {
     let Some(_gpu) = gpu_or_skip("preview_writes_its_render_and_heat_map_together") else { return };
-    if !cfg!(debug_assertions) {
-        eprintln!("SKIPPED: the fault hook exists in debug builds only (cargo test without --release)");
+    if !common::test_hooks_exist() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -371,32 +370,17 @@ fn preview_writes_its_render_and_heat_map_together() {
 #[test]
 fn an_interrupted_preview_leaves_the_earlier_render_and_no_folder() {
     let Some(_gpu) = gpu_or_skip("an_interrupted_preview_leaves_the_earlier_render_and_no_folder") else { return };
-    if !cfg!(debug_assertions) {
-        eprintln!("SKIPPED: the pause hook exists in debug builds only (cargo test without --release)");
+    if !common::test_hooks_exist() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("snake.png");
     std::fs::write(&out, "the earlier render").unwrap();
     let heat = dir.path().join("new/deeper/heat.png");
-    let child = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(["preview", PRESET, "--out", out.to_str().unwrap(), "--reference", heat.to_str().unwrap()])
-        .args(["--size", "48x32", "--map-size", "64", "--close-up"])
-        .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let (o, h) = (out.to_str().unwrap(), heat.to_str().unwrap());
+    let args = ["preview", PRESET, "--out", o, "--reference", h, "--size", "48x32", "--map-size", "64", "--close-up"];
     // Both files are staged when the heat map's temporary appears; the run pauses there.
-    let staged = || {
-        std::fs::read_dir(heat.parent().unwrap())
-            .is_ok_and(|e| e.flatten().any(|f| f.file_name().to_string_lossy().ends_with(".snakeskin-tmp")))
-    };
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
-    while !staged() {
-        assert!(std::time::Instant::now() < deadline, "the preview never reached its commit");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    let child = common::spawn_paused_at_commit(&args, heat.parent().unwrap());
     assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
     let run = child.wait_with_output().unwrap();
     assert_eq!(run.status.code(), Some(128 + libc::SIGTERM), "{}", common::stderr(&run));

@@ -21,6 +21,39 @@ pub fn snakeskin_env(args: &[&str], env: &[(&str, &str)]) -> Output {
     cmd.output().expect("run snakeskin")
 }
 
+/// The test hooks (`SNAKESKIN_TEST_PAUSE_AT`, `_FAIL_AT_RENAME`, `_KILL_AT_RENAME`) exist in
+/// debug builds only (`cargo test`, the README's command); under `--release` the tests that
+/// need them say so and pass.
+pub fn test_hooks_exist() -> bool {
+    if !cfg!(debug_assertions) {
+        eprintln!("SKIPPED: the test hooks exist in debug builds only (cargo test without --release)");
+    }
+    cfg!(debug_assertions)
+}
+
+/// Starts `snakeskin args` paused at its commit (`SNAKESKIN_TEST_PAUSE_AT=commit`, three
+/// seconds: debug builds) and returns once it has staged a file in `folder` (a temporary
+/// there), so that the test can act while the run waits; output piped.
+pub fn spawn_paused_at_commit(args: &[&str], folder: &Path) -> std::process::Child {
+    let child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(args)
+        .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run snakeskin");
+    let staged = || {
+        std::fs::read_dir(folder)
+            .is_ok_and(|e| e.flatten().any(|f| f.file_name().to_string_lossy().ends_with(".snakeskin-tmp")))
+    };
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while !staged() {
+        assert!(std::time::Instant::now() < deadline, "{args:?} never staged a file in {folder:?}");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child
+}
+
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
