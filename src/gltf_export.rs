@@ -262,17 +262,18 @@ impl ExportPlan {
         let mut kept = Vec::new();
         let files = if binary {
             let bytes = glb(&name, &mesh, material, &textures, Some(&source))?;
+            // Staged under the lock, which sweeps the name's stale temporaries first.
             let glb_name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            lock.remove_stale_temporaries_of(&[&glb_name]);
             lock.write(&[], (&glb_name, &bytes))?
         } else {
             let has_thickness = textures.thickness.is_some();
             let mut files = gltf_files(&name, &mesh, material, textures, Some(&source))?;
             let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
+            // The files written are staged under the lock, which sweeps their names' stale
+            // temporaries; the thickness image may not be written, and a killed run's
+            // temporary of it would stay.
             let thickness_file = gltf_image_file_name(&name, "thickness");
-            let names: Vec<&str> =
-                files.iter().map(|(n, _)| n.as_str()).chain([gltf_name.as_str(), &thickness_file]).collect();
-            lock.remove_stale_temporaries_of(&names);
+            lock.remove_stale_temporaries_of(&[&thickness_file]);
             // An earlier export of this name with a film left its thickness image, which no
             // file references once this one is committed: it goes, under the lock, after the
             // commit, where the `.gltf` it replaces named it (a file of that name that the

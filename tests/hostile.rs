@@ -627,12 +627,20 @@ fn a_killed_glb_export_leaves_a_temporary_the_next_one_removes() {
     let out = export(&[]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(hidden(), Vec::<String>::new(), "temporaries or the lock left");
+    // One file over its earlier self is one rename: there is no moment without a `.glb` (the
+    // earlier one moved aside first, a kill before the next rename left none, and the next
+    // run's sweep took the earlier one from its temporary).
+    for kill in ["0", "1"] {
+        export(&[("SNAKESKIN_TEST_KILL_AT_RENAME", kill)]);
+        assert!(glb.is_file(), "killed before rename {kill}: no .glb");
+    }
 }
 
-/// A second export of one name into one folder stops at once, as a second `generate` of a
-/// set does: the first holds the name from before its work (paused at its commit, the
-/// pause hook of debug builds). It did all its work first: a `.gltf` was then refused at
-/// its commit, and a `.glb` replaced the other's file.
+/// A second export of one name into one folder is refused while the first runs, as a second
+/// `generate` of a set is: the first holds the name from before its work (paused at its
+/// commit, the pause hook of debug builds). A `.glb` took no lock and replaced the other's
+/// file; a `.gltf` was refused too, but at its commit, after its work (which these small
+/// exports do not make long enough to tell apart).
 #[test]
 fn a_second_export_of_one_name_stops_at_once() {
     if !test_hooks_exist() {
@@ -1893,6 +1901,13 @@ fn a_long_file_name_is_written_and_one_past_the_limit_refused_first() {
         std::fs::read_dir(&out_dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert_eq!(written.len(), 6, "five maps and the manifest, no temporary: {written:?}");
     assert!(written.iter().all(|n| n.starts_with(&stem)), "{written:?}");
+
+    // A 255-byte `.glb`: its export's lock file, `.NAME.lock`, is cut as a temporary's name
+    // is (the review: a legal name failed for its lock's, "File name too long").
+    let glb = dir.path().join(format!("{}.glb", "g".repeat(251)));
+    let out = snakeskin(&["export", "erythrolamprus-miliaris", "--gltf", glb.to_str().unwrap(), "--size", "16"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(glb.is_file());
 }
 
 /// Outputs that failed other commands' way: a standard error that cannot be written

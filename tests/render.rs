@@ -339,8 +339,9 @@ fn preview_writes_a_png_and_rejects_bad_options() {
 
 /// The render and its heat map appear together or not at all: a heat map that could not be
 /// put in place (the commit's last rename fails: the fault hook of debug builds) leaves the
-/// earlier render as it was (it had already been replaced when the reference ran).
-/// Negative control: the same run without the fault writes both.
+/// earlier render as it was (it had already been replaced when the reference ran), and no
+/// folder made for the heat map. Negative control: the same run without the fault writes
+/// both.
 #[test]
 fn preview_writes_its_render_and_heat_map_together() {
     let Some(_gpu) = gpu_or_skip("preview_writes_its_render_and_heat_map_together") else { return };
@@ -348,7 +349,7 @@ fn preview_writes_its_render_and_heat_map_together() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let (out, heat) = (dir.path().join("snake.png"), dir.path().join("heat.png"));
+    let (out, heat) = (dir.path().join("snake.png"), dir.path().join("new/heat.png"));
     std::fs::write(&out, "the earlier render").unwrap();
     let (o, h) = (out.to_str().unwrap(), heat.to_str().unwrap());
     let args = ["preview", PRESET, "--out", o, "--reference", h, "--size", "48x32", "--map-size", "64", "--close-up"];
@@ -356,7 +357,7 @@ fn preview_writes_its_render_and_heat_map_together() {
     let run = common::snakeskin_env(&args, &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "2")]);
     assert_eq!(run.status.code(), Some(1), "{}", common::stderr(&run));
     assert_eq!(std::fs::read(&out).unwrap(), b"the earlier render", "the render was replaced alone");
-    assert!(!heat.exists());
+    assert!(!dir.path().join("new").exists(), "the folder made for the heat map stayed");
     let run = snakeskin(&args);
     assert!(run.status.success(), "{}", common::stderr(&run));
     assert_eq!(common::stdout(&run).lines().count(), 2, "both files are printed");

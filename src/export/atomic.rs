@@ -1,14 +1,15 @@
 //! Output that is never half-written, never mixed, and never follows a planted link.
 //!
-//! **Single files** (`write_file_atomically`: charts, plots, previews, sheets) are written
+//! **Single files** (`write_file_atomically`: charts, plots, sheets) are written
 //! to a fresh temporary in the target folder — created exclusively (`O_EXCL`), with an
 //! unpredictable name, so a symlink planted at a guessable name cannot redirect the write —
 //! then renamed over the target. A reader sees the old file or the new one, never a part.
 //!
-//! **Groups of files** (`FileGroup`: the documentation figures, a gallery with its close-ups)
-//! are staged the same way, each as soon as it is made, and renamed into place together at
-//! the end, the old files moved aside first and put back if a rename fails: an interrupt or
-//! a failure while they are made leaves the earlier files as they were, never some new.
+//! **Groups of files** (`FileGroup`: the documentation figures, a gallery with its close-ups,
+//! a preview with its heat map) are staged the same way, each as soon as it is made, and
+//! renamed into place together at the end, the old files moved aside first and put back if a
+//! rename fails: an interrupt or a failure while they are made leaves the earlier files as
+//! they were, never some new. A group (or commit) of one file is one rename over the old.
 //!
 //! **Texture sets** (`SetLock`: `stage` each map, then `commit`; `write` does both) are
 //! several files, and a rename is atomic only per file, so the set's manifest is its commit
@@ -31,6 +32,9 @@
 //!    the old set's maps that the new one does not write (`left_over_files`); then the maps
 //!    are renamed into place, and the new manifest, which records the SHA-256 of every map,
 //!    is renamed in last; then the old files are removed.
+//!
+//! A glTF export takes the same lock and commit, its `.glb` or `.gltf` the record file (the
+//! `.gltf`'s side files staged before it); the manifest's guarantee below is a set's.
 //!
 //! The guarantee: **whenever `NAME.material.json` exists, the maps it names are exactly the
 //! ones it was written with** — `verify_set` checks the hashes. An earlier set survives every
@@ -81,15 +85,27 @@ const NAME_MAX_BYTES: usize = 255;
 /// directory" after the work). Without any cut, a legal 234-byte output name failed after the
 /// work with "cannot write .: File name too long".
 fn temporary_stem(target_name: &str) -> std::borrow::Cow<'_, str> {
-    let room = NAME_MAX_BYTES - 2 - RANDOM_CHARS - TMP_SUFFIX.len();
-    if target_name.len() <= room {
-        return target_name.into();
+    cut_to(target_name, NAME_MAX_BYTES - 2 - RANDOM_CHARS - TMP_SUFFIX.len())
+}
+
+/// `name` if it has at most `room` bytes, else its first bytes, `~` and eight hex digits of
+/// its SHA-256 in `room` bytes (`temporary_stem`, `lock_file_name`).
+fn cut_to(name: &str, room: usize) -> std::borrow::Cow<'_, str> {
+    if name.len() <= room {
+        return name.into();
     }
     let mut end = room - 9;
-    while !target_name.is_char_boundary(end) {
+    while !name.is_char_boundary(end) {
         end -= 1;
     }
-    format!("{}~{}", &target_name[..end], &sha256_hex(target_name.as_bytes())[..8]).into()
+    format!("{}~{}", &name[..end], &sha256_hex(name.as_bytes())[..8]).into()
+}
+
+/// The lock file of the set (or export) `name`: `.NAME.lock`, the name cut as a temporary's
+/// is where that would pass `NAME_MAX_BYTES` (a legal 255-byte `NAME.glb` failed for its
+/// lock's name, "File name too long").
+fn lock_file_name(name: &str) -> String {
+    format!(".{}.lock", cut_to(name, NAME_MAX_BYTES - ".".len() - ".lock".len()))
 }
 
 /// This process's temporaries of new files (staged, not yet renamed into place): what
@@ -395,7 +411,7 @@ pub fn create_folder_noted(dir: &Path) -> Result<bool, ExportError> {
 
 /// Removes every folder `create_folder_noted` made that is empty now, deepest first, so a
 /// run that failed before its commit leaves no empty folders behind (its lock's drop calls
-/// this, and so does an export that failed). `remove_dir` removes only an empty folder: a
+/// this, and so does `main` for a run that failed). `remove_dir` removes only an empty folder: a
 /// set's folder, or one another job is writing into (its lock file is there), stays.
 pub fn remove_empty_made_folders() {
     remove_empty(&mut locked(&MADE_FOLDERS));
@@ -517,7 +533,7 @@ impl SetLock {
         // it, no lock file is made that it would not remove.
         let mut held = locked(&HELD_LOCKS);
         let created_folder = create_folder_noted(dir)?;
-        let path = dir.join(format!(".{name}.lock"));
+        let path = dir.join(lock_file_name(name));
         let mut options = fs::OpenOptions::new();
         options.create(true).truncate(false).write(true);
         // Not through a link, and without waiting: a FIFO there fails to open (ENXIO), where
@@ -588,8 +604,8 @@ impl SetLock {
     }
 
     /// Removes every temporary of `file_names` in the set's folder, whatever its age: under
-    /// the lock none is another run's. For files beyond a set's own names (an export's
-    /// `.glb`, `.gltf`, `.bin` and images), which `acquire` does not sweep.
+    /// the lock none is another run's. For a file beyond a set's own names that this run
+    /// does not stage (`stage` sweeps the names it writes): an export's thickness image.
     pub fn remove_stale_temporaries_of(&self, file_names: &[&str]) {
         remove_stale_temporaries(&self.dir, file_names, ZERO_AGE);
     }
@@ -667,6 +683,23 @@ fn swap_in(
 ) -> Result<Swapped, ExportError> {
     let _commit = locked(&COMMIT);
     let mut renames = 0;
+    // One file over (at most) its own old one: a single rename replaces it atomically, and
+    // one that fails leaves it. Moved aside first, a reader found no file in between, and a
+    // kill there left the old one only in a temporary, which the next run removed.
+    if let [(_, target)] = staged.as_slice()
+        && old.iter().all(|o| o == target)
+        && may_stay.is_empty()
+    {
+        let target = target.clone();
+        let (tmp, _) = staged.into_iter().next().expect("one staged file");
+        let temporary = tmp.path().to_path_buf();
+        before_rename(&mut renames)
+            .and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error))
+            .map_err(io_error(&target))?;
+        forget_temporary(&temporary);
+        sync_folder(folder_of(&target));
+        return Ok(Swapped { written: vec![target], removed: Vec::new(), stayed: Vec::new() });
+    }
     let mut aside: Vec<(tempfile::TempPath, PathBuf)> = Vec::new();
     let mut stayed = Vec::new();
     for target in old {
@@ -991,9 +1024,10 @@ fn sync_folder(dir: &Path) {
 }
 
 /// Checks, before the work, that a new file can be made where `target` goes (its folder must
-/// exist): a temporary for it is made and removed. `preview --out ro/x.png` rendered for
-/// seconds (minutes with its CPU reference) and only then said "cannot write ro:
-/// Permission denied"; now it says so at once, naming the file.
+/// exist): a temporary for it is made and removed (an empty one, that a watcher of the
+/// folder may see). `preview --out ro/x.png` rendered for seconds (minutes with its CPU
+/// reference) and only then said "cannot write ro: Permission denied"; now it says so at
+/// once, naming the file.
 pub fn check_writable(target: &Path) -> Result<(), ExportError> {
     let probe = stage(folder_of(target), &file_name(target), &[]).map_err(|e| match e {
         ExportError::Io { source, .. } => ExportError::Io { path: target.into(), source },

@@ -513,7 +513,9 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
 }
 
 /// The dotted keys the schema holds as lists (`pattern`, `body.head_mark`, `sources`): the
-/// lists of a preset with nothing written but its seed, as the schema writes them.
+/// lists of a preset with nothing written but its seed, as the schema writes them. Lists in
+/// tables only: not those inside a list's items (a layer's `colors`), which such a preset
+/// has none of.
 fn schema_lists() -> &'static [String] {
     static LISTS: std::sync::LazyLock<Vec<String>> = std::sync::LazyLock::new(|| {
         let preset: Preset = toml::from_str("seed = 0").expect("a seed alone is a preset");

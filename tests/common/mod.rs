@@ -33,7 +33,9 @@ pub fn test_hooks_exist() -> bool {
 
 /// Starts `snakeskin args` paused at its commit (`SNAKESKIN_TEST_PAUSE_AT=commit`, three
 /// seconds: debug builds) and returns once it has staged a file in `folder` (a temporary
-/// there), so that the test can act while the run waits; output piped.
+/// there with bytes: `check_writable`'s probe is an empty one, made before the work), so
+/// that the test can act while the run waits; output piped. A run that never gets there is
+/// killed before the test fails.
 pub fn spawn_paused_at_commit(args: &[&str], folder: &Path) -> std::process::Child {
     let child = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
         .args(args)
@@ -43,12 +45,20 @@ pub fn spawn_paused_at_commit(args: &[&str], folder: &Path) -> std::process::Chi
         .spawn()
         .expect("run snakeskin");
     let staged = || {
-        std::fs::read_dir(folder)
-            .is_ok_and(|e| e.flatten().any(|f| f.file_name().to_string_lossy().ends_with(".snakeskin-tmp")))
+        std::fs::read_dir(folder).is_ok_and(|e| {
+            e.flatten().any(|f| {
+                f.file_name().to_string_lossy().ends_with(".snakeskin-tmp") && f.metadata().is_ok_and(|m| m.len() > 0)
+            })
+        })
     };
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
     while !staged() {
-        assert!(std::time::Instant::now() < deadline, "{args:?} never staged a file in {folder:?}");
+        if std::time::Instant::now() > deadline {
+            let mut child = child;
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{args:?} never staged a file in {folder:?}");
+        }
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     child

@@ -219,15 +219,19 @@ pub fn kept_words(kept: &snakeskin::export::KeptFile) -> String {
 }
 
 /// Creates the folder a single output file goes into when it is missing, and says so on
-/// stderr; refuses a folder standing where the file goes, before any work is done for it.
-/// Every command treats output paths alike: `generate -o DIR`, `preview --out`, `preview
-/// --reference`, `sheet -o` and the rest create missing folders with this note.
+/// stderr; refuses a folder standing where the file goes, and one that takes no new file
+/// (`export::check_writable`), before any work is done for it. Every command treats output
+/// paths alike: `generate -o DIR`, `preview --out`, `preview --reference`, `sheet -o` and the
+/// rest create missing folders with this note.
 pub fn ensure_parent_folder(file: &Path) -> anyhow::Result<()> {
     // The file first: a refused name leaves no folder made for it.
     snakeskin::export::check_target(file)?;
     if let Some(folder) = file.parent().filter(|p| !p.as_os_str().is_empty()) {
         ensure_folder(folder)?;
     }
+    // A read-only folder was found after the work: seconds of rendering (minutes with a
+    // preview's CPU reference), then "cannot write ro: Permission denied".
+    snakeskin::export::check_writable(file)?;
     Ok(())
 }
 

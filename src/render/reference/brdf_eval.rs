@@ -273,7 +273,7 @@ mod tests {
     fn a_slow_gpu_keeps_ten_extra_dispatches() {
         let (seconds, extra) = seconds_per_dispatch(clock(0.005, 0.01)).unwrap();
         assert_eq!(extra, 10);
-        assert!((seconds / 0.01 - 1.0).abs() < 0.01, "{seconds}");
+        assert!((seconds / 0.01 - 1.0).abs() < 0.02, "{seconds}");
     }
 
     #[test]

@@ -37,7 +37,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
         eprintln!("note: removed {}, which this export does not reference (an earlier one's)", path_line(file));
     }
     for kept in &report.kept {
-        eprintln!("warning: {}", crate::output::kept_words(kept));
+        eprintln!("warning: kept {}, which this export does not reference: {}", path_line(&kept.path), kept.why);
     }
     for file in &report.files {
         println!("{}", path_line(file));

@@ -80,7 +80,6 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     // Before the work: a folder that takes no new file is said at once, naming the file.
     for file in std::iter::once(out).chain(args.reference.as_deref()) {
         ensure_parent_folder(file)?;
-        snakeskin::export::check_writable(file)?;
     }
     let material = upload_material_in(&renderer, &loaded, args.map_size as usize, args.method, layout)?;
     bar.message("rendering");
