@@ -11,7 +11,8 @@ use std::time::{Duration, Instant};
 
 use crate::export::SetLock;
 use crate::export::gltf::{
-    GltfMaterial, GltfTextures, glb, gltf_files, gltf_image_file_name, gltf_side_file_names, references_image,
+    EarlierImage, GltfMaterial, GltfTextures, earlier_image, glb, gltf_files, gltf_image_file_name,
+    gltf_side_file_names,
 };
 use crate::export::pack::Pack;
 use crate::generate::{GenerateRequest, Plan};
@@ -61,9 +62,35 @@ pub struct ExportReport {
     /// Files of an earlier export of this name that this one removed (a `.gltf`'s thickness
     /// image, which a film of one thickness no longer references), for the caller to say.
     pub removed: Vec<PathBuf>,
-    /// Such files that would not go (immutable, or their folder refuses), with why, for the
-    /// caller to say: the export stands, and the file beside it is no longer referenced.
-    pub kept: Vec<crate::export::KeptFile>,
+    /// Such files that stay, with why (changed since the earlier export wrote them, or they
+    /// would not go), for the caller to say: the export stands, and the file beside it is no
+    /// longer referenced.
+    pub kept: Vec<(PathBuf, String)>,
+}
+
+/// The most bytes of an earlier export's image hashed to compare with its record: a PNG of
+/// the largest texture an export writes (16384 × 65535 texels, 8 bytes each, stored
+/// uncompressed) and then some. The hash is streamed; the bound stops a file that grows
+/// without end.
+const EARLIER_IMAGE_MAX_BYTES: u64 = 16384 * 65535 * 8 + (1 << 20);
+
+/// Removes an earlier export's image that this one no longer references, unless it changed
+/// since that export wrote it (`recorded`: its SHA-256 there, None where none was
+/// recorded). None when it went; else why it stays, in words.
+fn stale_image_stays(path: &Path, recorded: Option<&str>) -> Option<String> {
+    if let Some(recorded) = recorded {
+        let links = crate::text_file::Links::Refuse;
+        match crate::export::set_file_sha256(path, EARLIER_IMAGE_MAX_BYTES, links) {
+            Ok(now) if now == recorded => {}
+            Ok(_) => {
+                return Some(
+                    "it changed since the earlier export wrote it, so it is not that export's to remove".into(),
+                );
+            }
+            Err(e) => return Some(format!("it could not be read to compare with the earlier export's record ({e})")),
+        }
+    }
+    std::fs::remove_file(path).err().map(|e| format!("it is the earlier export's and could not be removed ({e})"))
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
@@ -276,24 +303,26 @@ impl ExportPlan {
             lock.remove_stale_temporaries_of(&[&thickness_file]);
             // An earlier export of this name with a film left its thickness image, which no
             // file references once this one is committed: it goes, under the lock, after the
-            // commit, where the `.gltf` it replaces named it (a file of that name that the
-            // earlier `.gltf` did not name is someone else's, and stays). Whatever stands
-            // there is harmless once the commit is done, so an export that succeeded does not
-            // fail for it (a folder of that name stays, and so does a file that may not go).
-            let stale = (!has_thickness && references_image(&dir.join(&gltf_name), &thickness_file))
-                .then(|| dir.join(&thickness_file));
+            // commit, where the `.gltf` it replaces named it and it is as that export wrote
+            // it (the SHA-256 in the image's `extras`; an export from before they were
+            // recorded is taken at its word). A file of that name that the earlier `.gltf`
+            // did not name is someone else's, and stays; one edited since stays and is said,
+            // as `generate` keeps a map changed since. Whatever stands there is harmless once
+            // the commit is done, so an export that succeeded does not fail for it (a folder
+            // of that name stays, and so does a file that may not go).
+            let earlier = if has_thickness {
+                EarlierImage::NotNamed
+            } else {
+                earlier_image(&dir.join(&gltf_name), &thickness_file)
+            };
             let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
-            if let Some(stale) = stale
+            let stale = dir.join(&thickness_file);
+            if let EarlierImage::Named { sha256 } = earlier
                 && std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir())
             {
-                // One that will not go is said, as `generate` says the earlier set's maps
-                // that stay (it stayed without a word).
-                match std::fs::remove_file(&stale) {
-                    Ok(()) => removed.push(stale),
-                    Err(e) => kept.push(crate::export::KeptFile {
-                        path: stale,
-                        why: crate::export::KeptBecause::WouldNotMove(e.to_string()),
-                    }),
+                match stale_image_stays(&stale, sha256.as_deref()) {
+                    Some(why) => kept.push((stale, why)),
+                    None => removed.push(stale),
                 }
             }
             written

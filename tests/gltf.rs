@@ -215,6 +215,33 @@ fn a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole() {
 
 /// A `NAME.thickness.png` beside a `.gltf` that does not name it is not the earlier export's,
 /// and an export without a film leaves it as it was (it was removed as stale whoever's it was).
+/// An earlier export's thickness image edited since stays when a re-export no longer writes
+/// it, and is said, as `generate` keeps a map changed since: each image of a `.gltf` carries
+/// its file's SHA-256 in its `extras`. It was removed, edits and all. Negative control: left
+/// as written, it goes (`a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole`).
+#[test]
+fn an_export_keeps_a_thickness_image_edited_since() {
+    let dir = tempfile::tempdir().unwrap();
+    let gltf = export(dir.path(), "liasis-mackloti", "x.gltf", &["--mesh", "plane"]);
+    let json: Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+    for image in json["images"].as_array().unwrap() {
+        let bytes = std::fs::read(dir.path().join(image["uri"].as_str().unwrap())).unwrap();
+        assert_eq!(image["extras"]["sha256"].as_str(), Some(snakeskin::export::sha256_hex(&bytes).as_str()));
+    }
+    let thickness = dir.path().join("x.thickness.png");
+    let mut edited = std::fs::read(&thickness).unwrap();
+    edited.extend_from_slice(b"an edit");
+    std::fs::write(&thickness, &edited).unwrap();
+    let no_film = ["--mesh", "plane", "--set", "optics.film_thickness_nm=0", "--set", "iridescence.spread_nm=0"];
+    let out = snakeskin(
+        &[&["export", "liasis-mackloti", "--gltf", gltf.to_str().unwrap(), "--size", "64"][..], &no_film].concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read(&thickness).unwrap(), edited, "{}", stderr(&out));
+    let warning = "which this export does not reference: it changed since the earlier export wrote it";
+    assert!(stderr(&out).contains(warning), "{}", stderr(&out));
+}
+
 #[test]
 fn an_export_without_a_film_keeps_a_thickness_image_it_did_not_write() {
     let dir = tempfile::tempdir().unwrap();

@@ -212,7 +212,13 @@ fn document(
                 image_offsets.push(offset);
                 json!({ "name": format!("{name}_{role}"), "bufferView": index, "mimeType": "image/png" })
             }
-            Images::Files(names) => json!({ "name": format!("{name}_{role}"), "uri": uri_reference(&names[k]) }),
+            // Each file's SHA-256, so that a later export can tell the image it wrote from one
+            // edited since (`earlier_image`), as a set's manifest does for its maps.
+            Images::Files(names) => json!({
+                "name": format!("{name}_{role}"),
+                "uri": uri_reference(&names[k]),
+                "extras": { "sha256": super::sha256_hex(bytes) },
+            }),
         })
         .collect();
     let texture_list: Vec<Value> = (0..pngs.len()).map(|k| json!({ "sampler": 0, "source": k })).collect();
@@ -371,18 +377,33 @@ pub fn gltf_image_file_name(name: &str, role: &str) -> String {
 /// one this tool writes is a few KB): a link to /dev/zero or a huge file is not read.
 const EARLIER_GLTF_MAX_BYTES: u64 = 16 << 20;
 
-/// Whether the `.gltf` at `gltf` names `image_file` (a file beside it) as one of its images:
-/// a regular file (no link followed) of at most `EARLIER_GLTF_MAX_BYTES`, JSON with an
-/// `images[].uri` that is `image_file`'s URI reference. False for anything else, so that a
-/// file is taken for an earlier export's only where that export's `.gltf` says it is.
-pub fn references_image(gltf: &std::path::Path, image_file: &str) -> bool {
+/// What an earlier `.gltf` says of an image file beside it (`earlier_image`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum EarlierImage {
+    /// Not one of its images: someone else's file.
+    NotNamed,
+    /// One of its images, with the SHA-256 it recorded (None: written before images carried
+    /// one).
+    Named { sha256: Option<String> },
+}
+
+/// What the `.gltf` at `gltf` says of `image_file` (a file beside it): named as one of its
+/// images where it is a regular file (no link followed) of at most `EARLIER_GLTF_MAX_BYTES`,
+/// JSON with an `images[].uri` that is `image_file`'s URI reference, with the image's
+/// `extras.sha256` where it has one. Not named for anything else, so that a file is taken
+/// for an earlier export's only where that export's `.gltf` says it is.
+pub fn earlier_image(gltf: &std::path::Path, image_file: &str) -> EarlierImage {
     let Ok(bytes) = crate::text_file::read_bounded_bytes(gltf, EARLIER_GLTF_MAX_BYTES, crate::text_file::Links::Refuse)
     else {
-        return false;
+        return EarlierImage::NotNamed;
     };
-    let Ok(json) = serde_json::from_slice::<Value>(&bytes) else { return false };
+    let Ok(json) = serde_json::from_slice::<Value>(&bytes) else { return EarlierImage::NotNamed };
     let uri = uri_reference(image_file);
-    json["images"].as_array().is_some_and(|images| images.iter().any(|image| image["uri"].as_str() == Some(&uri)))
+    let images = json["images"].as_array().into_iter().flatten();
+    match images.into_iter().find(|image| image["uri"].as_str() == Some(&uri)) {
+        Some(image) => EarlierImage::Named { sha256: image["extras"]["sha256"].as_str().map(String::from) },
+        None => EarlierImage::NotNamed,
+    }
 }
 
 /// A file name as a relative URI reference (RFC 3986 §2): every byte but the unreserved
