@@ -69,16 +69,21 @@ pub struct ExportReport {
 }
 
 /// The most bytes of an earlier export's image hashed to compare with its record: a PNG of
-/// the largest texture an export writes (16384 × 65535 texels, 8 bytes each, stored
-/// uncompressed) and then some. The hash is streamed; the bound stops a file that grows
-/// without end.
-const EARLIER_IMAGE_MAX_BYTES: u64 = 16384 * 65535 * 8 + (1 << 20);
+/// the largest texture an export writes (the widest size by the tallest atlas, 8 bytes a
+/// texel, stored uncompressed) and 1 MiB for its filter bytes and headers. The hash is
+/// streamed; the bound stops a file that grows without end.
+const EARLIER_IMAGE_MAX_BYTES: u64 =
+    *crate::SIZE_RANGE.end() as u64 * crate::generate::MAX_HEIGHT as u64 * 8 + (1 << 20);
 
 /// Removes an earlier export's image that this one no longer references, unless it changed
-/// since that export wrote it (`recorded`: its SHA-256 there, None where none was
-/// recorded). None when it went; else why it stays, in words.
-fn stale_image_stays(path: &Path, recorded: Option<&str>) -> Option<String> {
+/// since that export wrote it (`recorded`: its SHA-256 there, None where none was recorded;
+/// `regular`: a regular file, which an export writes, where anything else is not opened).
+/// None when it went; else why it stays, in words.
+fn stale_image_stays(path: &Path, regular: bool, recorded: Option<&str>) -> Option<String> {
     if let Some(recorded) = recorded {
+        if !regular {
+            return Some("it is not a regular file, so it is not the earlier export's to remove".into());
+        }
         let links = crate::text_file::Links::Refuse;
         match crate::export::set_file_sha256(path, EARLIER_IMAGE_MAX_BYTES, links) {
             Ok(now) if now == recorded => {}
@@ -318,9 +323,10 @@ impl ExportPlan {
             let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
             let stale = dir.join(&thickness_file);
             if let EarlierImage::Named { sha256 } = earlier
-                && std::fs::symlink_metadata(&stale).is_ok_and(|m| !m.is_dir())
+                && let Ok(meta) = std::fs::symlink_metadata(&stale)
+                && !meta.is_dir()
             {
-                match stale_image_stays(&stale, sha256.as_deref()) {
+                match stale_image_stays(&stale, meta.is_file(), sha256.as_deref()) {
                     Some(why) => kept.push((stale, why)),
                     None => removed.push(stale),
                 }

@@ -213,8 +213,6 @@ fn a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole() {
     }
 }
 
-/// A `NAME.thickness.png` beside a `.gltf` that does not name it is not the earlier export's,
-/// and an export without a film leaves it as it was (it was removed as stale whoever's it was).
 /// An earlier export's thickness image edited since stays when a re-export no longer writes
 /// it, and is said, as `generate` keeps a map changed since: each image of a `.gltf` carries
 /// its file's SHA-256 in its `extras`. It was removed, edits and all. Negative control: left
@@ -240,8 +238,23 @@ fn an_export_keeps_a_thickness_image_edited_since() {
     assert_eq!(std::fs::read(&thickness).unwrap(), edited, "{}", stderr(&out));
     let warning = "which this export does not reference: it changed since the earlier export wrote it";
     assert!(stderr(&out).contains(warning), "{}", stderr(&out));
+
+    // A `.gltf` written before images carried their hash is taken at its word: its image goes.
+    let gltf = export(dir.path(), "liasis-mackloti", "y.gltf", &["--mesh", "plane"]);
+    let mut json: Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+    for image in json["images"].as_array_mut().unwrap() {
+        image.as_object_mut().unwrap().remove("extras");
+    }
+    std::fs::write(&gltf, serde_json::to_vec(&json).unwrap()).unwrap();
+    let out = snakeskin(
+        &[&["export", "liasis-mackloti", "--gltf", gltf.to_str().unwrap(), "--size", "64"][..], &no_film].concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!dir.path().join("y.thickness.png").exists(), "{}", stderr(&out));
 }
 
+/// A `NAME.thickness.png` beside a `.gltf` that does not name it is not the earlier export's,
+/// and an export without a film leaves it as it was (it was removed as stale whoever's it was).
 #[test]
 fn an_export_without_a_film_keeps_a_thickness_image_it_did_not_write() {
     let dir = tempfile::tempdir().unwrap();

@@ -373,7 +373,7 @@ pub fn gltf_image_file_name(name: &str, role: &str) -> String {
     format!("{name}.{role}.png")
 }
 
-/// The most bytes of an earlier `.gltf` read to see which images it names (`references_image`;
+/// The most bytes of an earlier `.gltf` read to see which images it names (`earlier_image`;
 /// one this tool writes is a few KB): a link to /dev/zero or a huge file is not read.
 const EARLIER_GLTF_MAX_BYTES: u64 = 16 << 20;
 
@@ -399,8 +399,7 @@ pub fn earlier_image(gltf: &std::path::Path, image_file: &str) -> EarlierImage {
     };
     let Ok(json) = serde_json::from_slice::<Value>(&bytes) else { return EarlierImage::NotNamed };
     let uri = uri_reference(image_file);
-    let images = json["images"].as_array().into_iter().flatten();
-    match images.into_iter().find(|image| image["uri"].as_str() == Some(&uri)) {
+    match json["images"].as_array().into_iter().flatten().find(|image| image["uri"].as_str() == Some(&uri)) {
         Some(image) => EarlierImage::Named { sha256: image["extras"]["sha256"].as_str().map(String::from) },
         None => EarlierImage::NotNamed,
     }

@@ -268,9 +268,9 @@ pub fn set_file_max_bytes(json: &serde_json::Value) -> u64 {
     width * height * 16 * maps * 2 + (1 << 20)
 }
 
-/// The SHA-256 of an earlier set's file, streamed (the file is not held in memory): a
-/// regular file of at most `limit` bytes (`set_file_max_bytes`); `links` as for
-/// `read_set_manifest`.
+/// The SHA-256 of an earlier set's file (or an earlier export's image), streamed (the file is
+/// not held in memory): a regular file of at most `limit` bytes (`set_file_max_bytes`);
+/// `links` as for `read_set_manifest`.
 pub fn set_file_sha256(path: &Path, limit: u64, links: Links) -> Result<String, crate::text_file::BoundedReadError> {
     use crate::text_file::{BoundedReadError, check_read_length, open_bounded};
     use sha2::Digest;
