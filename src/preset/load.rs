@@ -463,16 +463,30 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
         let path = format!("{prefix}{}", segments[..=i].join("."));
         let Some(index) = segments.get(i + 1).and_then(|s| s.parse::<usize>().ok()) else {
             let value = step(here, root, segment);
-            // A key below a list the preset does not have (`body.head_mark.color` without
-            // head marks) made a table where the schema wants a list: "invalid type: table,
-            // expected an array". A single `[pattern]` table is layer 0, so `pattern.KEY`
-            // may start one.
-            if value.is_none() && i + 1 < segments.len() && path != "pattern" && schema_lists().contains(&path) {
-                return Err(format!(
-                    "`{path}` is a list, and the preset has none, so `{prefix}{}` has nothing to reach into (set \
-                     the list whole: --set '{path}=[...]', or write it in the preset file)",
-                    segments.join(".")
-                ));
+            if i + 1 < segments.len() {
+                match value {
+                    // A key into a list without its index (`pattern.amount` on `[[pattern]]`
+                    // said "`amount` must be an array index"): the list and its entries.
+                    Some(toml::Value::Array(items)) => {
+                        return Err(format!(
+                            "`{path}` is a list ({}): write {path}.N.{}",
+                            entries(items.len(), &path),
+                            segments[i + 1..].join(".")
+                        ));
+                    }
+                    // A key below a list the preset does not have (`body.head_mark.color`
+                    // without head marks) made a table where the schema wants a list:
+                    // "invalid type: table, expected an array". A single `[pattern]` table is
+                    // layer 0, so `pattern.KEY` may start one.
+                    None if path != "pattern" && schema_lists().contains(&path) => {
+                        return Err(format!(
+                            "`{path}` is a list, and the preset has none, so `{prefix}{}` has nothing to reach into \
+                             (set the list whole: --set '{path}=[...]', or write it in the preset file)",
+                            segments.join(".")
+                        ));
+                    }
+                    _ => {}
+                }
             }
             here = Some(value.unwrap_or(&missing));
             continue;
@@ -606,12 +620,8 @@ fn set_path(
         }
         toml::Value::Array(items) => {
             let len = items.len();
-            let index: usize = first.parse().map_err(|_| {
-                // The list's own key, and what follows it: `pattern.amount` on `[[pattern]]`.
-                let parts: Vec<&str> = key.split('.').collect();
-                let list = parts[..parts.len() - segments.len()].join(".");
-                format!("`{list}` is a list ({}): write {list}.N.{}", entries(len, &list), segments.join("."))
-            })?;
+            // `check_indices` has refused a key into a list without its index.
+            let index: usize = first.parse().map_err(|_| format!("`{first}` must be an array index"))?;
             // `pattern = []` and `pattern.0.KEY`: the first layer starts (`check_indices`
             // lets only that index past the end through).
             if index == 0 && len == 0 {
