@@ -461,6 +461,15 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
     let mut here: Option<&toml::Value> = None;
     for (i, segment) in segments.iter().enumerate() {
         let path = format!("{prefix}{}", segments[..=i].join("."));
+        // An index no list has (`pattern.-1`, one past usize): it was taken as a key into
+        // the list, and the message said to write `pattern.N.-1.kind`.
+        if let Some(next) = segments.get(i + 1).filter(|s| is_whole_number_word(s) && s.parse::<usize>().is_err()) {
+            let have = match step(here, root, segment) {
+                Some(toml::Value::Array(items)) => format!(" (`{path}` has {})", entries(items.len(), &path)),
+                _ => String::new(),
+            };
+            return Err(format!("there is no `{path}.{next}`: a list's entries are numbered from 0{have}"));
+        }
         let Some(index) = segments.get(i + 1).and_then(|s| s.parse::<usize>().ok()) else {
             let value = step(here, root, segment);
             if i + 1 < segments.len() {
@@ -670,6 +679,10 @@ fn is_whole_number_word(word: &str) -> bool {
 /// `1e400`), as do `True` and `False` (TOML's are lower case). They were taken as strings,
 /// and the key then said "invalid type: string \"[1, 2\", expected an array".
 fn override_value(value: &str) -> Result<toml::Value, String> {
+    if value.trim().is_empty() {
+        // It was the text "" for every key: "invalid type: string \"\", expected a whole number".
+        return Err("the value is empty: write one after `=` (empty text is written 'KEY=\"\"')".into());
+    }
     // One TOML value, nothing else: the table must hold exactly the key `v`.
     match toml::from_str::<toml::Table>(&format!("v = {value}")) {
         Ok(mut t) if t.len() == 1 => Ok(t.remove("v").unwrap_or(toml::Value::String(value.into()))),
@@ -680,8 +693,10 @@ fn override_value(value: &str) -> Result<toml::Value, String> {
             let first = chars.next();
             let numeric = |c: Option<char>| c.is_some_and(|c| c.is_ascii_digit());
             // A whole number past TOML's integers stays a word: the key's range check names
-            // it (`in_key_range`).
-            let whole = is_whole_number_word(word);
+            // it (`in_key_range`). One TOML refuses otherwise (`023`: leading zeros) is a
+            // number, refused with TOML's reason: it was taken as text ("invalid type:
+            // string").
+            let whole = is_whole_number_word(word) && word.parse::<i64>().is_err();
             let second = chars.next();
             let signed_number = matches!(first, Some('+' | '-')) && (numeric(second) || second == Some('.'));
             let number = !whole && (numeric(first) || signed_number || (first == Some('.') && numeric(second)));
@@ -882,6 +897,61 @@ mod tests {
         assert_eq!((p.key.as_str(), p.line, p.overridden), ("pattern.1.amount", Some(9), false), "{p:?}");
         let p = problem(&single.replace("seed = 1\n", "seed = 1\n[scales]\nrows = 999\n"), ("pattern.amount", "2"));
         assert_eq!((p.key.as_str(), p.line, p.overridden), ("scales.rows", Some(3), false), "{p:?}");
+    }
+
+    /// An index no list can have (`pattern.-1`, one past usize) is said to be one; it was
+    /// taken as a key into the list ("write pattern.N.-1.kind").
+    #[test]
+    fn an_index_no_list_has_is_named() {
+        let one_layer = "seed = 1\n[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\n";
+        for index in ["-1", "99999999999999999999", "-0"] {
+            let set = [(format!("pattern.{index}.kind"), "spots".to_string())];
+            let err = parse(&source(one_layer), &set).unwrap_err().to_string();
+            let says = format!(
+                "there is no `pattern.{index}`: a list's entries are numbered from 0 (`pattern` has 1 entry: pattern.0)"
+            );
+            assert!(err.contains(&says), "{err}");
+        }
+        let set = [("sources.-2".to_string(), "x".to_string())];
+        let err = parse(&source("seed = 1\nsources = [\"a\"]\n"), &set).unwrap_err().to_string();
+        assert!(
+            err.contains("there is no `sources.-2`: a list's entries are numbered from 0 (`sources` has 1"),
+            "{err}"
+        );
+        // Without layers there are no entries to name.
+        let err = parse(&source("seed = 1\n"), &[("pattern.-1.kind".into(), "spots".into())]).unwrap_err();
+        assert!(err.to_string().ends_with("there is no `pattern.-1`: a list's entries are numbered from 0"), "{err}");
+        // Negative control: an index the list has.
+        assert_eq!(
+            parse(&source(one_layer), &[("pattern.0.amount".into(), "3".into())]).unwrap().preset.pattern[0].amount,
+            3.0
+        );
+    }
+
+    /// A value that starts as a number TOML refuses (`023`) gets TOML's reason; it was text,
+    /// and the key said "invalid type: string". An empty value is said to be empty.
+    #[test]
+    fn a_number_toml_refuses_and_an_empty_value_are_said() {
+        for (value, says) in [
+            ("023", "not a TOML value (unexpected leading zero"),
+            ("", "the value is empty"),
+            (" ", "the value is empty"),
+        ] {
+            let err = parse(&source("seed = 1\n"), &[("scales.rows".into(), value.into())]).unwrap_err().to_string();
+            assert!(err.contains(says) && !err.contains("invalid type"), "{value:?}: {err}");
+        }
+        // A whole number past TOML's integers is still the key's range problem.
+        let err = parse(&source("seed = 1\n"), &[("scales.rows".into(), "99999999999999999999".into())]).unwrap_err();
+        assert!(
+            !err.to_string().contains("not a TOML value") && err.to_string().contains("99999999999999999999"),
+            "{err}"
+        );
+        // Negative controls: TOML's number and empty text.
+        assert_eq!(
+            parse(&source("seed = 1\n"), &[("scales.rows".into(), "23".into())]).unwrap().preset.scales.rows,
+            23
+        );
+        assert!(parse(&source("seed = 1\n"), &[("sources".into(), "[\"\"]".into())]).is_ok());
     }
 
     /// A key into a list without its index names the list and its entries (it said "`amount`

@@ -289,10 +289,11 @@ pub struct GenerateArgs {
     /// thickness in nm; a body atlas's float maps are held whole until written).
     #[arg(long, value_enum, default_value_t = FormatArg::Png)]
     pub format: FormatArg,
-    /// Write the textures an engine reads instead of the maps: gltf (base colour, OpenGL
-    /// normal, occlusion-roughness-metallic, film thickness), unreal (ORM, DirectX normal,
-    /// height) or unity-hdrp (mask map with smoothness in alpha, OpenGL normal, height);
-    /// see the README's packing table. Sets the normal convention the engine expects.
+    /// Write the textures an engine reads instead of the maps: every pack has the base colour
+    /// and the film thickness, and besides them gltf an OpenGL normal and
+    /// occlusion-roughness-metallic, unreal ORM, a DirectX normal and the height, unity-hdrp
+    /// the mask map (smoothness in alpha), an OpenGL normal and the height; see the README's
+    /// packing table. Sets the normal convention the engine expects.
     #[arg(long, value_enum, value_name = "ENGINE", conflicts_with_all = ["normal_convention", "format", "maps"])]
     pub pack: Option<PackArg>,
     /// With --pack: compute the ambient occlusion map (horizon-based, from the height map)
