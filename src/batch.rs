@@ -13,8 +13,9 @@
 //! still share a folder (two preset files with the same name) are refused before anything
 //! runs, in every shard alike.
 //! `--shard K/N` runs the jobs whose index is K modulo N (K from 0), the same split on every
-//! machine, for array jobs (Slurm, Kubernetes Indexed Jobs). At the end an index of the
-//! run's jobs, their folders and manifests is written next to them.
+//! machine, for array jobs (Slurm, Kubernetes Indexed Jobs). An index of the run's jobs,
+//! their folders, manifests and status is written next to them as the run starts (the jobs as
+//! planned) and again as it ends, a run a job stopped too (which jobs failed, which never ran).
 
 use std::path::{Path, PathBuf};
 
@@ -76,6 +77,11 @@ pub enum BatchError {
          their jobs asked). Run the batch again"
     )]
     Changed { job: RunningJob },
+    /// A job failed (`Failed`, `Changed`) and the run stopped: `source` is the earliest
+    /// failed job's error (its words are this error's), `index` the run's index as written,
+    /// every job `done`, `skipped`, `duplicate`, `failed` or `not run`, for the caller's summary.
+    #[error("{source}")]
+    Stopped { index: Box<BatchIndex>, source: Box<Error> },
 }
 
 /// A job's table as every message about it begins: `jobs.toml:LINE: [[job]] N (PRESET)`,
@@ -446,7 +452,9 @@ pub struct JobOutcome {
     pub manifest: PathBuf,
     pub key: String,
     /// `done` (run now), `skipped` (already complete with this key), `duplicate` (the same
-    /// job as `duplicate_of`, which makes its set) or, from `list`, `to do`.
+    /// job as `duplicate_of`, which makes its set); in a run that stopped, `failed` (its set
+    /// was not written) or `not run`; from `list`, and in the index a run writes as it starts,
+    /// `to do`.
     pub status: &'static str,
     /// The index of the earlier identical job, for a `duplicate`.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -688,8 +696,9 @@ pub fn fitting_concurrency(requested: usize, mut estimates: Vec<u64>, available_
 /// job finishes, in the order they finish. Every job of the shard is planned first (preset
 /// loaded and validated, memory checked), so a bad job stops the run before any set is
 /// written, not in the middle of it. A job that fails at run time stops the run: no new job
-/// starts, the running ones finish (each set is written atomically), and the first error is
-/// returned. The index lists the jobs in their order, whatever order they finished in, and
+/// starts, the running ones finish (each set is written atomically), the index is written
+/// with the failed jobs and those never started, and `BatchError::Stopped` returned with it
+/// and the earliest failed job's error. The index lists the jobs in their order, whatever order they finished in, and
 /// the files are the same at any concurrency (every set's bytes are).
 pub fn run(
     jobs_file: &Path,
@@ -722,8 +731,15 @@ pub fn run(
         }
     }
     let work: Vec<(&Job, Resolved)> = mine.into_iter().zip(resolved).collect();
+    // The index as the run starts, every job as planned (`to do`, `skipped`, `duplicate`):
+    // an index left from another jobs file (a run stopped by a signal writes none at its
+    // end) described sets this run is not about.
+    if work.iter().any(|(_, r)| r.outcome.status == "to do") {
+        let planned = work.iter().map(|(_, r)| r.outcome.clone()).collect();
+        BatchIndex::new(jobs_file, shard, planned, concurrency).write(out, shard)?;
+    }
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
-    let mut first_error = None;
+    let mut failures: Vec<(usize, Error)> = Vec::new();
     std::thread::scope(|scope| {
         let (sender, receiver) = std::sync::mpsc::channel::<(usize, Result<JobOutcome, Error>)>();
         for _ in 0..concurrency.min(total) {
@@ -755,31 +771,53 @@ pub fn run(
                     progress(done, total, &outcome);
                     finished[k] = Some(outcome);
                 }
-                Err(e) => {
-                    // The error of the earliest job, whichever failed first.
-                    if first_error.as_ref().is_none_or(|(j, _)| k < *j) {
-                        first_error = Some((k, e));
-                    }
-                }
+                Err(e) => failures.push((k, e)),
             }
         }
     });
-    if let Some((_, e)) = first_error {
-        return Err(e);
+    // Every job as it ended; one that never ended failed (its error is in `failures`) or
+    // never started.
+    let outcomes: Vec<JobOutcome> = finished
+        .into_iter()
+        .zip(&work)
+        .enumerate()
+        .map(|(k, (outcome, (_, resolved)))| {
+            outcome.unwrap_or_else(|| {
+                let mut outcome = resolved.outcome.clone();
+                outcome.status = if failures.iter().any(|(j, _)| *j == k) { "failed" } else { "not run" };
+                outcome
+            })
+        })
+        .collect();
+    let index = BatchIndex::new(jobs_file, shard, outcomes, concurrency);
+    let written = index.write(out, shard);
+    // The earliest job's error, whichever failed first; the index's own failure after it.
+    if let Some((_, e)) = failures.into_iter().min_by_key(|(k, _)| *k) {
+        return Err(BatchError::Stopped { index: Box::new(index), source: Box::new(e) }.into());
     }
-    let outcomes: Vec<JobOutcome> = finished.into_iter().flatten().collect();
-    let index = BatchIndex {
-        generator: "snakeskin".into(),
-        generator_version: env!("CARGO_PKG_VERSION").into(),
-        jobs_file: jobs_file.into(),
-        shard: shard.to_string(),
-        jobs: outcomes,
-        concurrency,
-    };
-    let json = serde_json::to_vec_pretty(&index).map_err(|e| Error::Internal(format!("index: {e}")))?;
-    crate::export::create_folder(out)?;
-    write_file_atomically(&out.join(index_file_name(shard)), json)?;
+    written?;
     Ok(index)
+}
+
+impl BatchIndex {
+    fn new(jobs_file: &Path, shard: Shard, jobs: Vec<JobOutcome>, concurrency: usize) -> BatchIndex {
+        BatchIndex {
+            generator: "snakeskin".into(),
+            generator_version: env!("CARGO_PKG_VERSION").into(),
+            jobs_file: jobs_file.into(),
+            shard: shard.to_string(),
+            jobs,
+            concurrency,
+        }
+    }
+
+    /// Writes the index to `out` (created if missing), replacing the one there.
+    fn write(&self, out: &Path, shard: Shard) -> Result<(), Error> {
+        let json = serde_json::to_vec_pretty(self).map_err(|e| Error::Internal(format!("index: {e}")))?;
+        crate::export::create_folder(out)?;
+        write_file_atomically(&out.join(index_file_name(shard)), json)?;
+        Ok(())
+    }
 }
 
 /// The shard's jobs, resolved and planned: what `run` runs and `list` shows.

@@ -75,9 +75,11 @@ impl Error {
     pub fn is_invalid_input(&self) -> bool {
         match self {
             Error::Export(e) => e.is_invalid_input(),
-            Error::Batch(batch::BatchError::Planned { source, .. } | batch::BatchError::Failed { source, .. }) => {
-                source.is_invalid_input()
-            }
+            Error::Batch(
+                batch::BatchError::Planned { source, .. }
+                | batch::BatchError::Failed { source, .. }
+                | batch::BatchError::Stopped { source, .. },
+            ) => source.is_invalid_input(),
             Error::Batch(batch::BatchError::Changed { .. }) => false,
             Error::Gpu(_) | Error::Internal(_) => false,
             _ => true,

@@ -182,6 +182,9 @@ fn an_interrupted_batch_leaves_its_finished_sets_and_nothing_else() {
         assert!(finished.len() < 12, "the signal came too late to test anything");
         assert_eq!(ended.status.code(), Some(128 + signal), "{}", stderr(&ended));
         only_finished_sets_in(&out);
+        // The index written as the run started: this jobs file's twelve jobs.
+        let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("index.json")).unwrap()).unwrap();
+        assert_eq!((index["jobs_file"].as_str(), index["jobs"].as_array().map(Vec::len)), (jobs.to_str(), Some(12)));
         // Every set logged is there; a set whose commit the signal waited for is whole but
         // may go unlogged (its job ends after the clean-up), one a job at most.
         let log = stdout(&ended);
@@ -894,4 +897,43 @@ fn a_job_that_fails_while_it_runs_is_named() {
         err.contains("jobs.toml:2: [[job]] 1 (natrix-natrix, seed 5, size 32): ") && err.contains("injected"),
         "{err}"
     );
+}
+
+/// A batch a job stopped still says what happened, on stdout and in its index: each job done,
+/// failed or not run. It wrote no index and printed no summary, and an index left by an
+/// earlier run of another jobs file stood, describing sets this run was not about (the QA
+/// review). The index of a run as it starts lists this run's jobs.
+#[test]
+fn a_stopped_batch_writes_its_index_with_what_failed_and_what_never_ran() {
+    if !test_hooks_exist() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let earlier = dir.path().join("earlier.toml");
+    std::fs::write(&earlier, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    assert!(snakeskin(&["batch", earlier.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]).status.success());
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[5, 6, 7]", 16);
+    let out = common::snakeskin_env(
+        &["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--concurrent", "1"],
+        &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "0")],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("seed 5, size 16): "), "{}", stderr(&out));
+    let summary = stdout(&out);
+    assert!(
+        summary
+            .contains("3 jobs of 3 in shard 0/1, up to 1 at once: 0 run, 0 already done, 1 failed, 2 not run; index: "),
+        "{summary}"
+    );
+    let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out_dir.join("index.json")).unwrap()).unwrap();
+    assert_eq!(index["jobs_file"].as_str(), jobs.to_str(), "{index}");
+    let statuses: Vec<&str> = index["jobs"].as_array().unwrap().iter().map(|j| j["status"].as_str().unwrap()).collect();
+    assert_eq!(statuses, ["failed", "not run", "not run"], "{index}");
+    // Negative control: run again without the fault, every job is done and said so.
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out_dir.join("index.json")).unwrap()).unwrap();
+    let statuses: Vec<&str> = index["jobs"].as_array().unwrap().iter().map(|j| j["status"].as_str().unwrap()).collect();
+    assert_eq!(statuses, ["done", "done", "done"], "{index}");
 }

@@ -30,7 +30,7 @@ pub fn run(args: BatchArgs) -> Result<()> {
     let bar = Progress::counting("{spinner} batch [{bar:30}] {pos}/{len} jobs {elapsed} {msg}");
     let concurrency = args.concurrent.map_or_else(batch::default_concurrency, |n| n as usize);
     let mut warn = |warning: &str| bar.println(warning);
-    let index =
+    let result =
         batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut warn, &mut |done, total, outcome| {
             bar.update(done, total);
             bar.message(&format!("{} {}", outcome.status, path_line(&outcome.folder)));
@@ -43,23 +43,36 @@ pub fn run(args: BatchArgs) -> Result<()> {
             for kept in &outcome.kept {
                 bar.println(&format!("warning: {}", crate::output::kept_words(kept)));
             }
-        })?;
+        });
+    // A run a job stopped still ends with its summary (what ran, what failed, what never
+    // started: the index says which), then the job's error.
+    let (index, failure) = match result {
+        Ok(index) => (index, None),
+        Err(snakeskin::Error::Batch(batch::BatchError::Stopped { index, source })) => (*index, Some(*source)),
+        Err(e) => return Err(e.into()),
+    };
     bar.finish();
     if !had_folder && args.out.is_dir() {
         eprintln!("note: created folder {}", path_line(&args.out));
     }
-    let ran = index.jobs.iter().filter(|j| j.status == "done").count();
-    let duplicates = index.jobs.iter().filter(|j| j.status == "duplicate").count();
-    let skipped = index.jobs.len() - ran - duplicates;
-    let duplicates = if duplicates > 0 { format!(", {duplicates} duplicates of another job") } else { String::new() };
+    let count = |status: &str| index.jobs.iter().filter(|j| j.status == status).count();
+    let mut counts = format!("{} run, {} already done", count("done"), count("skipped"));
+    for (status, words) in [("duplicate", "duplicates of another job"), ("failed", "failed"), ("not run", "not run")] {
+        if count(status) > 0 {
+            counts.push_str(&format!(", {} {words}", count(status)));
+        }
+    }
     log.line(&format!(
-        "{} of {} in shard {}, up to {} at once: {ran} run, {skipped} already done{duplicates}; index: {}",
+        "{} of {} in shard {}, up to {} at once: {counts}; index: {}",
         counted(index.jobs.len(), "job"),
         jobs.len(),
         index.shard,
         index.concurrency,
         path_line(&args.out.join(batch::index_file_name(shard)))
     ));
+    if let Some(failure) = failure {
+        return Err(failure.into());
+    }
     log.finish()
 }
 
