@@ -158,8 +158,23 @@ fn forget_temporary(path: &Path) {
     locked(&LIVE).retain(|p| p != path);
 }
 
+/// The error of an operation on `path`: the folder's, when it refused to make a file that is
+/// not there (`ExportError::FolderNotWritable`).
 fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
-    move |source| ExportError::Io { path: path.into(), source }
+    move |source| {
+        let refused = source.kind() == std::io::ErrorKind::PermissionDenied;
+        let folder = path.parent().map(|f| if f.as_os_str().is_empty() { Path::new(".") } else { f });
+        match (folder, path.file_name()) {
+            (Some(folder), Some(name)) if refused && fs::symlink_metadata(path).is_err() && folder.is_dir() => {
+                ExportError::FolderNotWritable {
+                    folder: folder.into(),
+                    name: name.to_string_lossy().into_owned(),
+                    source,
+                }
+            }
+            _ => ExportError::Io { path: path.into(), source },
+        }
+    }
 }
 
 /// SHA-256 of `bytes` as 64 hex digits (the manifest's `sha256` per map).
@@ -430,7 +445,16 @@ pub fn create_folder(dir: &Path) -> Result<bool, ExportError> {
     if dir.is_dir() {
         return Ok(false);
     }
-    fs::create_dir_all(dir).map(|_| true).map_err(io_error(dir))
+    fs::create_dir_all(dir)
+        .map(|_| true)
+        .map_err(|source| ExportError::CreateFolder { path: first_missing_folder(dir).into(), source })
+}
+
+/// The first folder of `dir` that is missing (the one a failed `create_dir_all` could not
+/// make, in one that exists); `dir` itself when none is.
+fn first_missing_folder(dir: &Path) -> &Path {
+    let missing = dir.ancestors().take_while(|p| !p.as_os_str().is_empty() && fs::symlink_metadata(p).is_err());
+    missing.last().unwrap_or(dir)
 }
 
 /// An output folder's path, checked without creating anything: a path that exists and is
@@ -1061,6 +1085,37 @@ pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, Exp
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A file a folder refused names the folder (it said "cannot write ro/.NAME.lock"); a
+    /// folder that could not be made is the first one missing (it named the deepest, three
+    /// levels below the one that refused). Tests run as root, where no folder refuses: the
+    /// refusal is the error itself.
+    #[test]
+    fn a_refusal_names_the_folder_that_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let denied = || std::io::Error::from(std::io::ErrorKind::PermissionDenied);
+        let lock = dir.path().join(".x.lock");
+        match io_error(&lock)(denied()) {
+            ExportError::FolderNotWritable { folder, name, .. } => {
+                assert_eq!((folder.as_path(), name.as_str()), (dir.path(), ".x.lock"));
+            }
+            other => panic!("{other}"),
+        }
+        // In the working folder, named as `.`.
+        let here = Path::new(".snakeskin-no-such-file.lock");
+        assert!(
+            matches!(io_error(here)(denied()), ExportError::FolderNotWritable { folder, .. } if folder == Path::new("."))
+        );
+        // Negative controls: a file that is there (it may refuse itself), another error.
+        fs::write(&lock, b"").unwrap();
+        assert!(matches!(io_error(&lock)(denied()), ExportError::Io { .. }));
+        let missing = dir.path().join("y");
+        let full = std::io::Error::from(std::io::ErrorKind::StorageFull);
+        assert!(matches!(io_error(&missing)(full), ExportError::Io { .. }));
+        assert_eq!(first_missing_folder(&dir.path().join("a/b/c")), dir.path().join("a"));
+        assert_eq!(first_missing_folder(&dir.path().join("a/..")), dir.path().join("a"));
+        assert_eq!(first_missing_folder(dir.path()), dir.path());
+    }
 
     /// One file named two ways: through `..` (its folder missing or not) and a link.
     /// Negative controls: two different files, and a file beside its folder's name.

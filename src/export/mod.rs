@@ -35,6 +35,14 @@ use crate::ops::Image;
 pub enum ExportError {
     #[error("cannot write {path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
+    /// A file that could not be made in a folder that exists because the folder refused it:
+    /// the folder is what the user has to change (it said "cannot write ro/.NAME.lock").
+    #[error("cannot write in folder {folder} (making {name} there): {source}")]
+    FolderNotWritable { folder: PathBuf, name: String, source: std::io::Error },
+    /// A missing output folder that could not be made: the first one missing, in the folder
+    /// that refused it (it said "cannot write ro/a/b/c", three levels below `ro`).
+    #[error("cannot create folder {path}: {source}")]
+    CreateFolder { path: PathBuf, source: std::io::Error },
     #[error("cannot encode the {map} map: {message}")]
     Encode { map: MapKind, message: String },
     #[error(
