@@ -29,6 +29,45 @@ use crate::material::{FileFormat, MapKind, parse_map_list};
 use crate::preset::validate::ranges::SEED_MAX;
 use crate::{Error, SIZE_RANGE};
 
+/// Whether two entries of a `set` table reach the same key (`"scales.rows" = 23` and
+/// `scales = { rows = 25 }`, or `scales = 5` beside `"scales.rows" = 3`), and which: the
+/// entries are applied in the table's key order, so one of the two values was silently lost.
+fn set_twice(set: &std::collections::BTreeMap<String, toml::Value>) -> Option<String> {
+    // Every key an entry writes: a table's own keys (an override merges a table key by key),
+    // anything else its key.
+    fn leaves(key: String, value: &toml::Value, into: &mut Vec<String>) {
+        match value {
+            toml::Value::Table(t) if !t.is_empty() => {
+                for (k, v) in t {
+                    leaves(format!("{key}.{k}"), v, into);
+                }
+            }
+            _ => into.push(key),
+        }
+    }
+    let written: Vec<(&String, Vec<String>)> = set
+        .iter()
+        .map(|(key, value)| {
+            let mut into = Vec::new();
+            leaves(key.clone(), value, &mut into);
+            (key, into)
+        })
+        .collect();
+    let within =
+        |inner: &str, outer: &str| inner == outer || inner.strip_prefix(outer).is_some_and(|r| r.starts_with('.'));
+    for (i, (a, a_leaves)) in written.iter().enumerate() {
+        for (b, b_leaves) in &written[i + 1..] {
+            for x in a_leaves {
+                if let Some(y) = b_leaves.iter().find(|y| within(x, y) || within(y, x)) {
+                    let key = if x.len() >= y.len() { x } else { y };
+                    return Some(format!("`{key}` is set by two entries, `{a}` and `{b}`; give it once"));
+                }
+            }
+        }
+    }
+    None
+}
+
 /// At most this many jobs per file (after expansion): a typo such as `sizes = [..]` with a
 /// thousand entries is refused before anything runs.
 pub const MAX_JOBS: usize = 100_000;
@@ -375,6 +414,9 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         }
         if let Some(bad) = table.seeds.iter().flatten().find(|&&seed| seed > SEED_MAX) {
             return Err(invalid("seeds", seed_refused(bad)));
+        }
+        if let Some(message) = set_twice(&table.set) {
+            return Err(invalid("set", message));
         }
         let overrides: Vec<(String, String)> = table.set.iter().map(|(k, v)| (k.clone(), v.to_string())).collect();
         let seeds: Vec<Option<u64>> = match &table.seeds {
@@ -1008,6 +1050,31 @@ mod tests {
             assert!(bad.parse::<Shard>().is_err(), "{bad}");
         }
         assert_eq!("3/4".parse::<Shard>().unwrap(), Shard { index: 3, count: 4 });
+    }
+
+    /// Two entries of a `set` table that reach one key are refused, naming both; one of the
+    /// two values was lost without a word (the QA review). Negative controls: entries that
+    /// write different keys of one table.
+    #[test]
+    fn a_key_set_twice_in_a_set_table_is_refused() {
+        let job = |set: &str| jobs(&format!("[[job]]\npreset = \"a\"\nseeds = [1]\nset = {set}\n"));
+        for (set, says) in [
+            (
+                r#"{ "scales.rows" = 23, scales = { rows = 25 } }"#,
+                "`scales.rows` is set by two entries, `scales` and `scales.rows`",
+            ),
+            (r#"{ scales = 5, "scales.rows" = 3 }"#, "`scales.rows` is set by two entries, `scales` and `scales.rows`"),
+            (r#"{ "pattern.0" = { kind = "spots" }, "pattern.0.kind" = "bands" }"#, "`pattern.0.kind` is set by two"),
+        ] {
+            let e = job(set).unwrap_err().to_string();
+            assert!(e.contains("jobs.toml:4: [[job]] 1 (a): ") && e.contains(says), "{set}: {e}");
+        }
+        for set in [
+            r#"{ "scales.rows" = 23, scales = { keel = 0.5 } }"#,
+            r#"{ "pattern.0.kind" = "spots", "pattern.1.kind" = "bands", "pattern.10.kind" = "x" }"#,
+        ] {
+            assert!(job(set).is_ok(), "{set}: {:?}", job(set).err());
+        }
     }
 
     #[test]
