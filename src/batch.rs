@@ -871,16 +871,11 @@ struct Planned<'a> {
 }
 
 /// Every check a run makes before it writes anything: the output folder, the index's place,
-/// every job's preset, size and output files, and (with `check_memory`) its memory against
-/// what this machine has available: not for `list`, which a login node runs for a
-/// cluster's jobs (a job too large for it was refused there).
-fn plan<'a>(
-    jobs_file: &Path,
-    jobs: &'a [Job],
-    out: &Path,
-    shard: Shard,
-    check_memory: bool,
-) -> Result<Planned<'a>, Error> {
+/// every job's preset, size and output files, and (with `for_run`) its memory against
+/// what this machine has available and its folder's writing (a probe file made and removed):
+/// not for `list`, which writes nothing, and which a login node runs for a cluster's jobs (a
+/// job too large for it was refused there).
+fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard, for_run: bool) -> Result<Planned<'a>, Error> {
     // The output folder (a file there is the user's mistake, as for `generate -o`) and the
     // index's place, before any job runs (a folder in the index's way would otherwise fail
     // the run after every job), and nothing created yet: a refused batch leaves no folder.
@@ -901,6 +896,7 @@ fn plan<'a>(
     // by one, a table of 100,000 seeds took minutes before anything ran or was listed,
     // most of it in the allocator.
     let mut planned_for: std::collections::HashMap<String, u64> = std::collections::HashMap::new();
+    let mut probed = std::collections::HashSet::new();
     for (job, r) in mine.iter().zip(&resolved) {
         if !r.done && r.outcome.duplicate_of.is_none() {
             // A size refused (too tall, too large for memory) at the job's `sizes`; its output
@@ -914,7 +910,7 @@ fn plan<'a>(
             let estimate = match planned_for.get(&shape) {
                 Some(estimate) => *estimate,
                 None => {
-                    let plan = if check_memory { Plan::new(&request) } else { Plan::within_checked_budget(&request) }
+                    let plan = if for_run { Plan::new(&request) } else { Plan::within_checked_budget(&request) }
                         .map_err(|e| planned(job.lines.sizes, e))?;
                     planned_for.insert(shape, plan.memory().estimate_bytes);
                     plan.memory().estimate_bytes
@@ -924,6 +920,12 @@ fn plan<'a>(
             // written its set: a folder in a later job's way stopped the run after the
             // earlier jobs' sets were written. Nor any of them the jobs file or a preset.
             check_set_outputs(&request.out_dir, &r.files, &inputs).map_err(|e| planned(job.lines.preset, e.into()))?;
+            // And that its folder can be written (or made), each folder once: a read-only one
+            // stopped the run when its job came, after the jobs before it.
+            if for_run && let Some(file) = r.files.last() {
+                crate::export::check_folder_writable(&request.out_dir, file, &mut probed)
+                    .map_err(|e| planned(job.lines.preset, e.into()))?;
+            }
             estimates.push(estimate);
         }
     }

@@ -1054,13 +1054,36 @@ fn sync_folder(dir: &Path) {
 /// once, naming the file.
 pub fn check_writable(target: &Path) -> Result<(), ExportError> {
     let probe = stage(folder_of(target), &file_name(target), &[]).map_err(|e| match e {
-        ExportError::Io { source, .. } => ExportError::Io { path: target.into(), source },
+        // Named as the target's: the folder's when it refused a file not there yet.
+        ExportError::Io { source, .. } | ExportError::FolderNotWritable { source, .. } => io_error(target)(source),
         other => other,
     })?;
     let path = probe.path().to_path_buf();
     drop(probe);
     forget_temporary(&path);
     Ok(())
+}
+
+/// Checks, before the work, that a run can write `file` in `dir`, or where `dir` is missing,
+/// make its first missing folder (a probe of that name in the folder that exists:
+/// `check_writable`). Each folder once: `probed` holds those probed. A batch whose job's
+/// preset folder was read-only found it when that job ran, after the jobs before it.
+pub fn check_folder_writable(
+    dir: &Path,
+    file: &str,
+    probed: &mut std::collections::HashSet<PathBuf>,
+) -> Result<(), ExportError> {
+    let target = probe_target(dir, file);
+    if !probed.insert(folder_of(&target).to_path_buf()) {
+        return Ok(());
+    }
+    check_writable(&target)
+}
+
+/// What `check_folder_writable` makes a probe of: `file` in `dir`, or `dir`'s first missing
+/// folder (in the folder that exists).
+fn probe_target(dir: &Path, file: &str) -> PathBuf {
+    if fs::symlink_metadata(dir).is_ok() { dir.join(file) } else { first_missing_folder(dir).into() }
 }
 
 /// Writes one file atomically (exclusive temporary, then rename) to `path`. The folder must
@@ -1115,6 +1138,24 @@ mod tests {
         assert_eq!(first_missing_folder(&dir.path().join("a/b/c")), dir.path().join("a"));
         assert_eq!(first_missing_folder(&dir.path().join("a/..")), dir.path().join("a"));
         assert_eq!(first_missing_folder(dir.path()), dir.path());
+    }
+
+    /// A batch's folders are probed before any job runs where its sets go: a file in a folder
+    /// that exists, else the first folder missing in the one that does; each folder once.
+    #[test]
+    fn a_folder_is_probed_where_the_set_goes_and_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let set = dir.path().join("natrix/tile-16-seed1-png");
+        assert_eq!(probe_target(&set, "n.material.json"), dir.path().join("natrix"));
+        fs::create_dir_all(&set).unwrap();
+        assert_eq!(probe_target(&set, "n.material.json"), set.join("n.material.json"));
+        let mut probed = std::collections::HashSet::new();
+        check_folder_writable(&set, "n.material.json", &mut probed).unwrap();
+        check_folder_writable(&set, "m.material.json", &mut probed).unwrap();
+        check_folder_writable(&dir.path().join("natrix/other"), "n.material.json", &mut probed).unwrap();
+        assert_eq!(probed, [set.clone(), dir.path().join("natrix")].into_iter().collect());
+        // The probe leaves nothing.
+        assert_eq!(fs::read_dir(&set).unwrap().count(), 0);
     }
 
     /// One file named two ways: through `..` (its folder missing or not) and a link.

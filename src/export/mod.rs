@@ -11,9 +11,9 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_not_an_input, check_png_target,
-    check_target, check_target_named, check_writable, clean_up_before_exit, create_folder, create_folder_noted,
-    ends_as_a_folder, remove_empty_made_folders, same_path, sha256_hex, write_file_atomically,
+    FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_folder_writable, check_not_an_input,
+    check_png_target, check_target, check_target_named, check_writable, clean_up_before_exit, create_folder,
+    create_folder_noted, ends_as_a_folder, remove_empty_made_folders, same_path, sha256_hex, write_file_atomically,
 };
 pub(crate) use manifest::verify_set_json;
 pub use manifest::{
