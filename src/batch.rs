@@ -34,12 +34,18 @@ use crate::{Error, SIZE_RANGE};
 /// entries are applied in the table's key order, so one of the two values was silently lost.
 fn set_twice(set: &std::collections::BTreeMap<String, toml::Value>) -> Option<String> {
     // Every key an entry writes: a table's own keys (an override merges a table key by key),
-    // anything else its key.
+    // a list's entries as `key.N` (`pattern = [{ color = .. }]` beside `"pattern.0.kind"`
+    // loses nothing), anything else its key. An empty table or list writes no key of its own.
     fn leaves(key: String, value: &toml::Value, into: &mut Vec<String>) {
         match value {
-            toml::Value::Table(t) if !t.is_empty() => {
+            toml::Value::Table(t) => {
                 for (k, v) in t {
                     leaves(format!("{key}.{k}"), v, into);
+                }
+            }
+            toml::Value::Array(items) => {
+                for (i, v) in items.iter().enumerate() {
+                    leaves(format!("{key}.{i}"), v, into);
                 }
             }
             _ => into.push(key),
@@ -117,10 +123,12 @@ pub enum BatchError {
     )]
     Changed { job: RunningJob },
     /// A job failed (`Failed`, `Changed`) and the run stopped: `source` is the earliest
-    /// failed job's error (its words are this error's), `index` the run's index as written,
-    /// every job `done`, `skipped`, `duplicate`, `failed` or `not run`, for the caller's summary.
+    /// failed job's error (its words are this error's), `index` the run's index, every job
+    /// `done`, `skipped`, `duplicate`, `failed` or `not run`, for the caller's summary, and
+    /// `index_error` why it could not be written, if it could not (the file holds the index
+    /// the run started with).
     #[error("{source}")]
-    Stopped { index: Box<BatchIndex>, source: Box<Error> },
+    Stopped { index: Box<BatchIndex>, index_error: Option<Box<Error>>, source: Box<Error> },
 }
 
 /// A job's table as every message about it begins: `jobs.toml:LINE: [[job]] N (PRESET)`,
@@ -776,10 +784,8 @@ pub fn run(
     // The index as the run starts, every job as planned (`to do`, `skipped`, `duplicate`):
     // an index left from another jobs file (a run stopped by a signal writes none at its
     // end) described sets this run is not about.
-    if work.iter().any(|(_, r)| r.outcome.status == "to do") {
-        let planned = work.iter().map(|(_, r)| r.outcome.clone()).collect();
-        BatchIndex::new(jobs_file, shard, planned, concurrency).write(out, shard)?;
-    }
+    let planned = work.iter().map(|(_, r)| r.outcome.clone()).collect();
+    BatchIndex::new(jobs_file, shard, planned, concurrency).write(out, shard)?;
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut failures: Vec<(usize, Error)> = Vec::new();
     std::thread::scope(|scope| {
@@ -817,8 +823,8 @@ pub fn run(
             }
         }
     });
-    // Every job as it ended; one that never ended failed (its error is in `failures`) or
-    // never started.
+    // Every job as it ended; one that never ended failed (its error is in `failures`),
+    // never started, or was not the run's to make (skipped, a duplicate).
     let outcomes: Vec<JobOutcome> = finished
         .into_iter()
         .zip(&work)
@@ -826,16 +832,23 @@ pub fn run(
         .map(|(k, (outcome, (_, resolved)))| {
             outcome.unwrap_or_else(|| {
                 let mut outcome = resolved.outcome.clone();
-                outcome.status = if failures.iter().any(|(j, _)| *j == k) { "failed" } else { "not run" };
+                // A set already done (`skipped`) or another job's (`duplicate`) stays as
+                // planned: it was marked `not run` though it was there.
+                if failures.iter().any(|(j, _)| *j == k) {
+                    outcome.status = "failed";
+                } else if outcome.status == "to do" {
+                    outcome.status = "not run";
+                }
                 outcome
             })
         })
         .collect();
     let index = BatchIndex::new(jobs_file, shard, outcomes, concurrency);
     let written = index.write(out, shard);
-    // The earliest job's error, whichever failed first; the index's own failure after it.
+    // The earliest job's error, whichever failed first; the index's own failure with it.
     if let Some((_, e)) = failures.into_iter().min_by_key(|(k, _)| *k) {
-        return Err(BatchError::Stopped { index: Box::new(index), source: Box::new(e) }.into());
+        let index_error = written.err().map(Box::new);
+        return Err(BatchError::Stopped { index: Box::new(index), index_error, source: Box::new(e) }.into());
     }
     written?;
     Ok(index)
@@ -1067,6 +1080,8 @@ mod tests {
             ),
             (r#"{ scales = 5, "scales.rows" = 3 }"#, "`scales.rows` is set by two entries, `scales` and `scales.rows`"),
             (r#"{ "pattern.0" = { kind = "spots" }, "pattern.0.kind" = "bands" }"#, "`pattern.0.kind` is set by two"),
+            (r#"{ pattern = [{ kind = "spots" }], "pattern.0.kind" = "bands" }"#, "`pattern.0.kind` is set by two"),
+            (r#"{ sources = ["a", "b"], "sources.1" = "c" }"#, "`sources.1` is set by two"),
         ] {
             let e = job(set).unwrap_err().to_string();
             assert!(e.contains("jobs.toml:4: [[job]] 1 (a): ") && e.contains(says), "{set}: {e}");
@@ -1074,6 +1089,8 @@ mod tests {
         for set in [
             r#"{ "scales.rows" = 23, scales = { keel = 0.5 } }"#,
             r#"{ "pattern.0.kind" = "spots", "pattern.1.kind" = "bands", "pattern.10.kind" = "x" }"#,
+            r##"{ pattern = [{ color = "#101010" }], "pattern.0.kind" = "spots" }"##,
+            r#"{ scales = {}, "scales.rows" = 3 }"#,
         ] {
             assert!(job(set).is_ok(), "{set}: {:?}", job(set).err());
         }

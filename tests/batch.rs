@@ -913,7 +913,9 @@ fn a_stopped_batch_writes_its_index_with_what_failed_and_what_never_ran() {
     let earlier = dir.path().join("earlier.toml");
     std::fs::write(&earlier, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n").unwrap();
     assert!(snakeskin(&["batch", earlier.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]).status.success());
-    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[5, 6, 7]", 16);
+    // Seed 1 is the earlier run's set (skipped), the last job a duplicate of it: both stay
+    // as planned when the run stops (they were `not run`).
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[5, 1, 7, 1]", 16);
     let out = common::snakeskin_env(
         &["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--concurrent", "1"],
         &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "0")],
@@ -922,18 +924,20 @@ fn a_stopped_batch_writes_its_index_with_what_failed_and_what_never_ran() {
     assert!(stderr(&out).contains("seed 5, size 16): "), "{}", stderr(&out));
     let summary = stdout(&out);
     assert!(
-        summary
-            .contains("3 jobs of 3 in shard 0/1, up to 1 at once: 0 run, 0 already done, 1 failed, 2 not run; index: "),
+        summary.contains(
+            "4 jobs of 4 in shard 0/1, up to 1 at once: 0 run, 1 already done, 1 duplicates of another job, 1 failed, \
+             1 not run; index: "
+        ),
         "{summary}"
     );
     let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out_dir.join("index.json")).unwrap()).unwrap();
     assert_eq!(index["jobs_file"].as_str(), jobs.to_str(), "{index}");
     let statuses: Vec<&str> = index["jobs"].as_array().unwrap().iter().map(|j| j["status"].as_str().unwrap()).collect();
-    assert_eq!(statuses, ["failed", "not run", "not run"], "{index}");
+    assert_eq!(statuses, ["failed", "skipped", "not run", "duplicate"], "{index}");
     // Negative control: run again without the fault, every job is done and said so.
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
     let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out_dir.join("index.json")).unwrap()).unwrap();
     let statuses: Vec<&str> = index["jobs"].as_array().unwrap().iter().map(|j| j["status"].as_str().unwrap()).collect();
-    assert_eq!(statuses, ["done", "done", "done"], "{index}");
+    assert_eq!(statuses, ["done", "skipped", "done", "duplicate"], "{index}");
 }

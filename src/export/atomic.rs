@@ -585,7 +585,8 @@ impl SetLock {
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                     folder_went = Some(e);
                     match create_folder_noted(dir) {
-                        Err(ExportError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {}
+                        Err(ExportError::CreateFolder { source, .. } | ExportError::Io { source, .. })
+                            if source.kind() == std::io::ErrorKind::NotFound => {}
                         other => drop(other?),
                     }
                     continue;
@@ -1053,11 +1054,23 @@ fn sync_folder(dir: &Path) {
 /// reference) and only then said "cannot write ro: Permission denied"; now it says so at
 /// once, naming the file.
 pub fn check_writable(target: &Path) -> Result<(), ExportError> {
-    let probe = stage(folder_of(target), &file_name(target), &[]).map_err(|e| match e {
-        // Named as the target's: the folder's when it refused a file not there yet.
-        ExportError::Io { source, .. } | ExportError::FolderNotWritable { source, .. } => io_error(target)(source),
-        other => other,
-    })?;
+    let folder = folder_of(target);
+    let probe = {
+        // Listed while it exists, as a staged file is (`stage`), for an interrupt's clean-up;
+        // empty, so neither written nor synced (a batch probes a folder per set).
+        let mut live = locked(&LIVE);
+        let probe = temporary(folder, &file_name(target)).map_err(|source| {
+            // The probe is always a new file: a refusal is the folder's, whatever stands at
+            // the target (an earlier set's writable manifest was named as the culprit).
+            if source.kind() == std::io::ErrorKind::PermissionDenied && folder.is_dir() {
+                ExportError::FolderNotWritable { folder: folder.into(), name: file_name(target), source }
+            } else {
+                ExportError::Io { path: target.into(), source }
+            }
+        })?;
+        live.push(probe.path().to_path_buf());
+        probe
+    };
     let path = probe.path().to_path_buf();
     drop(probe);
     forget_temporary(&path);

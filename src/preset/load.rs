@@ -463,12 +463,17 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
         let path = format!("{prefix}{}", segments[..=i].join("."));
         // An index no list has (`pattern.-1`, one past usize): it was taken as a key into
         // the list, and the message said to write `pattern.N.-1.kind`.
+        // Only at a list (one the preset has, or one of the schema's): below a table or a value
+        // the key is an unknown one, as `scales.x1` is.
         if let Some(next) = segments.get(i + 1).filter(|s| is_whole_number_word(s) && s.parse::<usize>().is_err()) {
             let have = match step(here, root, segment) {
-                Some(toml::Value::Array(items)) => format!(" (`{path}` has {})", entries(items.len(), &path)),
-                _ => String::new(),
+                Some(toml::Value::Array(items)) => Some(format!(" (`{path}` has {})", entries(items.len(), &path))),
+                None if path == "pattern" || schema_lists().contains(&path) => Some(String::new()),
+                _ => None,
             };
-            return Err(format!("there is no `{path}.{next}`: a list's entries are numbered from 0{have}"));
+            if let Some(have) = have {
+                return Err(format!("there is no `{path}.{next}`: a list's entries are numbered from 0{have}"));
+            }
         }
         let Some(index) = segments.get(i + 1).and_then(|s| s.parse::<usize>().ok()) else {
             let value = step(here, root, segment);
@@ -921,11 +926,13 @@ mod tests {
         // Without layers there are no entries to name.
         let err = parse(&source("seed = 1\n"), &[("pattern.-1.kind".into(), "spots".into())]).unwrap_err();
         assert!(err.to_string().ends_with("there is no `pattern.-1`: a list's entries are numbered from 0"), "{err}");
-        // Negative control: an index the list has.
+        // Negative controls: an index the list has; a number below a table is an unknown key.
         assert_eq!(
             parse(&source(one_layer), &[("pattern.0.amount".into(), "3".into())]).unwrap().preset.pattern[0].amount,
             3.0
         );
+        let err = parse(&source("seed = 1\n"), &[("scales.-1".into(), "5".into())]).unwrap_err().to_string();
+        assert!(!err.contains("a list's entries") && err.contains("-1"), "{err}");
     }
 
     /// A value that starts as a number TOML refuses (`023`) gets TOML's reason; it was text,

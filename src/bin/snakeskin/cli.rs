@@ -290,7 +290,8 @@ pub struct GenerateArgs {
     #[arg(long, value_enum, default_value_t = FormatArg::Png)]
     pub format: FormatArg,
     /// Write the textures an engine reads instead of the maps: every pack has the base colour
-    /// and the film thickness, and besides them gltf an OpenGL normal and
+    /// and (for a species with a film) the film thickness, and besides them gltf an OpenGL
+    /// normal and
     /// occlusion-roughness-metallic, unreal ORM, a DirectX normal and the height, unity-hdrp
     /// the mask map (smoothness in alpha), an OpenGL normal and the height; see the README's
     /// packing table. Sets the normal convention the engine expects.

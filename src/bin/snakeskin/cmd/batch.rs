@@ -46,9 +46,11 @@ pub fn run(args: BatchArgs) -> Result<()> {
         });
     // A run a job stopped still ends with its summary (what ran, what failed, what never
     // started: the index says which), then the job's error.
-    let (index, failure) = match result {
-        Ok(index) => (index, None),
-        Err(snakeskin::Error::Batch(batch::BatchError::Stopped { index, source })) => (*index, Some(*source)),
+    let (index, index_error, failure) = match result {
+        Ok(index) => (index, None, None),
+        Err(snakeskin::Error::Batch(batch::BatchError::Stopped { index, index_error, source })) => {
+            (*index, index_error, Some(*source))
+        }
         Err(e) => return Err(e.into()),
     };
     bar.finish();
@@ -62,13 +64,18 @@ pub fn run(args: BatchArgs) -> Result<()> {
             counts.push_str(&format!(", {} {words}", count(status)));
         }
     }
+    let index_file = path_line(&args.out.join(batch::index_file_name(shard)));
+    let index_said = match index_error {
+        // The file there is the index the run started with (its jobs `to do`).
+        Some(e) => format!("the index was not written ({e}): {index_file} lists the jobs as the run started"),
+        None => format!("index: {index_file}"),
+    };
     log.line(&format!(
-        "{} of {} in shard {}, up to {} at once: {counts}; index: {}",
+        "{} of {} in shard {}, up to {} at once: {counts}; {index_said}",
         counted(index.jobs.len(), "job"),
         jobs.len(),
         index.shard,
         index.concurrency,
-        path_line(&args.out.join(batch::index_file_name(shard)))
     ));
     if let Some(failure) = failure {
         return Err(failure.into());
