@@ -577,7 +577,7 @@ fn sheet_command_writes_a_png() {
 
 /// The preset is given by a link in another folder (a dotfiles set-up): edits of the file
 /// it names reload too (only the link's own folder was watched, so edits through the link
-/// were never seen).
+/// were never seen), and so do edits after that file's folder was deleted and made again.
 #[cfg(feature = "window")]
 #[test]
 fn the_window_reloads_the_preset_file_on_save() {
@@ -638,6 +638,13 @@ fn the_window_reloads_the_preset_file_on_save() {
     // A broken edit (through the link) keeps the window running with the last good maps.
     std::fs::write(&link, "[scales]\nrwos = 3\n").unwrap();
     let failed = wait_for("reload failed");
+    // The file's folder deleted and made again (a `git checkout`): its old watch sees nothing
+    // of the new folder, and every edit after it went unseen.
+    std::fs::remove_dir_all(dir.path().join("real")).unwrap();
+    let gone = wait_for("reload failed");
+    std::fs::create_dir(dir.path().join("real")).unwrap();
+    std::fs::write(&preset, original).unwrap();
+    let back = wait_for("reloaded in");
     let group = format!("-{}", child.id());
     let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
     let _ = child.wait();
@@ -649,6 +656,8 @@ fn the_window_reloads_the_preset_file_on_save() {
     assert!(numbers.len() >= 3 && numbers[1] < numbers[2], "{reloaded}");
     let failed = failed.expect("a broken preset was not reported");
     assert!(failed.contains("rwos"), "{failed}");
+    assert!(gone.is_some_and(|l| l.contains("No such file")), "the deleted folder's preset was not reported");
+    assert!(back.is_some(), "no reload after the preset's folder was made again");
 }
 
 #[test]

@@ -84,7 +84,6 @@ struct App {
     lut_results: Receiver<(Stack, usize, Lut)>,
     reloads: Receiver<Result<Reloaded, Error>>,
     status: String,
-    _watcher: Option<notify::RecommendedWatcher>,
 }
 
 /// Opens the window and runs until it is closed (or `frames` frames were drawn).
@@ -101,11 +100,12 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let lut = Lut::bake_default(optics.stack);
 
     let (lut_jobs, lut_results) = reload::spawn_lut_worker();
-    let (reloads, watcher) = reload::spawn_map_worker(&options, cache);
+    let (reloads, watching) = reload::spawn_map_worker(&options, cache);
 
     let event_loop = EventLoop::new().map_err(|e| {
         Error::Gpu(GpuError::Window(format!(
-            "cannot open a window: {e} (no display? run under `xvfb-run -a`, or use --out)"
+            "cannot open a window: {} (no display? run under `xvfb-run -a`, or use --out)",
+            without_source_location(&e.to_string())
         )))
     })?;
     event_loop.set_control_flow(ControlFlow::Poll);
@@ -127,8 +127,7 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
         lut_jobs,
         lut_results,
         reloads,
-        status: watcher.as_ref().map(|_| "watching the preset file".to_string()).unwrap_or_default(),
-        _watcher: watcher,
+        status: if watching { "watching the preset file".to_string() } else { String::new() },
         options,
     };
     event_loop.run_app(&mut app).map_err(|e| Error::Gpu(GpuError::Window(format!("window event loop failed: {e}"))))?;
@@ -391,5 +390,26 @@ impl ApplicationHandler for App {
         if let Some(gfx) = &self.gfx {
             gfx.window.request_redraw();
         }
+    }
+}
+
+/// winit's error without the source location it opens with ("os error at /root/.cargo/
+/// registry/src/.../winit-0.30.13/src/platform_impl/linux/mod.rs:765: neither WAYLAND_DISPLAY
+/// nor ..."): a path of the machine that built the binary, of no use to its user.
+fn without_source_location(message: &str) -> &str {
+    message.strip_prefix("os error at ").and_then(|rest| rest.split_once(": ")).map_or(message, |(_, words)| words)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Negative control: a message without a location is kept whole.
+    #[test]
+    fn a_window_error_loses_the_build_machine_path() {
+        let said = "os error at /root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/winit-0.30.13/src/\
+                    platform_impl/linux/mod.rs:765: neither WAYLAND_DISPLAY nor WAYLAND_SOCKET nor DISPLAY is set.";
+        assert_eq!(without_source_location(said), "neither WAYLAND_DISPLAY nor WAYLAND_SOCKET nor DISPLAY is set.");
+        assert_eq!(without_source_location("the event loop can't be re-created"), "the event loop can't be re-created");
     }
 }

@@ -4,8 +4,8 @@
 //! moves (only the newest request while a slider is dragged). The render thread swaps their
 //! results in between frames.
 
-use std::path::PathBuf;
-use std::sync::mpsc::{Receiver, Sender, channel};
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
 use std::time::{Duration, Instant};
 
 use super::WindowOptions;
@@ -52,19 +52,29 @@ pub fn spawn_lut_worker() -> (Sender<LutJob>, Receiver<LutResult>) {
     (lut_jobs, lut_results)
 }
 
+/// How often the map worker looks whether a folder whose watch was lost is back
+/// (`PresetWatch::refresh`): a `stat` a second while one is missing.
+const FOLDER_CHECK_INTERVAL: Duration = Duration::from_secs(1);
+
 /// Starts the map worker and the file watcher (when the preset is a file): every save
-/// regenerates the maps through `cache`.
-pub fn spawn_map_worker(
-    options: &WindowOptions,
-    mut cache: NodeCache,
-) -> (Receiver<Result<Reloaded, Error>>, Option<notify::RecommendedWatcher>) {
+/// regenerates the maps through `cache`. True with the receiver when the preset is watched.
+pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache) -> (Receiver<Result<Reloaded, Error>>, bool) {
     let (reload_out, reloads) = channel();
     let (changed_tx, changed_rx) = channel::<()>();
-    let watcher = watch_preset(&options.preset, changed_tx);
+    let mut watch = watch_preset(&options.preset, changed_tx);
+    let watching = watch.is_some();
     let (spec, overrides, seed, map_size, layout) =
         (options.preset.clone(), options.overrides.clone(), options.seed, options.map_size, options.layout);
     std::thread::spawn(move || {
-        while changed_rx.recv().is_ok() {
+        loop {
+            match changed_rx.recv_timeout(FOLDER_CHECK_INTERVAL) {
+                Ok(()) => {}
+                // A folder watched again may hold a file changed while it was not watched.
+                Err(RecvTimeoutError::Timeout) if watch.as_mut().is_some_and(PresetWatch::refresh) => {}
+                Err(RecvTimeoutError::Timeout) => continue,
+                // No watcher (a built-in preset): nothing will change.
+                Err(RecvTimeoutError::Disconnected) => break,
+            }
             // Editors save in bursts (truncate, write, rename): let the file settle.
             std::thread::sleep(Duration::from_millis(150));
             while changed_rx.try_recv().is_ok() {}
@@ -81,13 +91,42 @@ pub fn spawn_map_worker(
             }
         }
     });
-    (reloads, watcher)
+    (reloads, watching)
+}
+
+/// The preset file's watch: the watcher, the folders it watches, and those whose watch was
+/// lost: a folder deleted (or renamed away) and made again (a `git checkout`, a sync tool)
+/// is a new folder that the old watch does not see: every edit after it went unseen, for
+/// good, while the panel still said "watching" (the window review). The watcher marks a
+/// folder lost when the folder itself goes; `refresh` watches it again once it is back.
+pub struct PresetWatch {
+    watcher: notify::RecommendedWatcher,
+    lost: std::sync::Arc<std::sync::Mutex<Vec<PathBuf>>>,
+}
+
+impl PresetWatch {
+    /// Watches again each lost folder that is there now; true when one was (its file may
+    /// have changed while it was not watched).
+    fn refresh(&mut self) -> bool {
+        use notify::Watcher;
+        let mut lost = self.lost.lock().unwrap_or_else(|e| e.into_inner());
+        let before = lost.len();
+        lost.retain(|dir| {
+            if !dir.is_dir() {
+                return true;
+            }
+            // A folder renamed away keeps its watch (on the folder, not the name): gone first.
+            let _ = self.watcher.unwatch(dir);
+            self.watcher.watch(dir, notify::RecursiveMode::NonRecursive).is_err()
+        });
+        lost.len() < before
+    }
 }
 
 /// Watches the preset file (when the preset is a file) and signals every change: the name
 /// given and, when it is a link, the file it names (an edit of that file changes nothing
 /// at the link's name, so only the link's folder watched saw none of them).
-fn watch_preset(spec: &str, changed: Sender<()>) -> Option<notify::RecommendedWatcher> {
+fn watch_preset(spec: &str, changed: Sender<()>) -> Option<PresetWatch> {
     use notify::Watcher;
     let path = PathBuf::from(spec);
     // The file the preset was read from (`preset::names_a_file`: a built-in name is the
@@ -102,19 +141,38 @@ fn watch_preset(spec: &str, changed: Sender<()>) -> Option<notify::RecommendedWa
         watched.push(target);
     }
     let file_names: Vec<std::ffi::OsString> = watched.iter().filter_map(|p| p.file_name()).map(Into::into).collect();
+    // Watch the folders: editors often replace the file by renaming a new one over it. Named
+    // as the watcher names them in its events: absolute.
+    let folders: Vec<PathBuf> = watched
+        .iter()
+        .map(|file| file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")))
+        .map(|dir| std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf()))
+        .collect();
+    let watched_folders = folders.clone();
+    let lost = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let marks = lost.clone();
     let mut watcher = notify::recommended_watcher(move |event: notify::Result<notify::Event>| {
-        if let Ok(event) = event
-            && event.paths.iter().any(|p| p.file_name().is_some_and(|n| file_names.iter().any(|f| f == n)))
+        let Ok(event) = event else { return };
+        // A watched folder itself deleted or renamed: its watch no longer sees that name.
+        let own = matches!(
+            event.kind,
+            notify::EventKind::Remove(_) | notify::EventKind::Modify(notify::event::ModifyKind::Name(_))
+        );
+        for dir in event.paths.iter().filter(|p| own && folders.contains(p)) {
+            let mut lost = marks.lock().unwrap_or_else(|e| e.into_inner());
+            if !lost.contains(dir) {
+                lost.push(dir.clone());
+            }
+        }
+        if event.paths.iter().any(|p| p.file_name().is_some_and(|n| file_names.iter().any(|f| f == n)))
             && !matches!(event.kind, notify::EventKind::Access(_))
         {
             let _ = changed.send(());
         }
     })
     .ok()?;
-    // Watch the folders: editors often replace the file by renaming a new one over it.
-    for file in &watched {
-        let dir = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    for dir in &watched_folders {
         watcher.watch(dir, notify::RecursiveMode::NonRecursive).ok()?;
     }
-    Some(watcher)
+    Some(PresetWatch { watcher, lost })
 }

@@ -125,11 +125,15 @@ fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
     if args.frames.is_some() {
         // The frames drawn (a closed window ends the run early); a frame time needs two.
         let timing = if report.mean_frame_ms.is_finite() {
-            format!("mean frame time {:.2} ms ({:.1} fps)", report.mean_frame_ms, 1000.0 / report.mean_frame_ms)
+            // fps to two significant figures: a 25 s frame read "0.0 fps".
+            let fps = 1000.0 / report.mean_frame_ms;
+            let decimals = if fps >= 10.0 { 1 } else { (1.0 - fps.log10().floor()).clamp(1.0, 6.0) as usize };
+            format!("mean frame time {:.2} ms ({fps:.decimals$} fps)", report.mean_frame_ms)
         } else {
             "no frame time (it needs two frames)".to_string()
         };
-        println!("{} frames, {timing}, adapter {}", report.frames, report.adapter);
+        let frames = if report.frames == 1 { "1 frame".to_string() } else { format!("{} frames", report.frames) };
+        println!("{frames}, {timing}, adapter {}", report.adapter);
     }
     Ok(())
 }
