@@ -645,6 +645,11 @@ fn the_window_reloads_the_preset_file_on_save() {
     std::fs::create_dir(dir.path().join("real")).unwrap();
     std::fs::write(&preset, original).unwrap();
     let back = wait_for("reloaded in");
+    // And an edit after it: the new folder is watched (that reload may have come from the
+    // look that found the folder back).
+    std::thread::sleep(Duration::from_millis(500));
+    std::fs::write(&preset, &edited).unwrap();
+    let edited_after = wait_for("reloaded in");
     let group = format!("-{}", child.id());
     let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
     let _ = child.wait();
@@ -658,6 +663,7 @@ fn the_window_reloads_the_preset_file_on_save() {
     assert!(failed.contains("rwos"), "{failed}");
     assert!(gone.is_some_and(|l| l.contains("No such file")), "the deleted folder's preset was not reported");
     assert!(back.is_some(), "no reload after the preset's folder was made again");
+    assert!(edited_after.is_some(), "no reload of an edit in the folder made again");
 }
 
 #[test]

@@ -19,7 +19,6 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
 use self::panel::{Sliders, controls};
-use self::reload::Reloaded;
 use super::engine::material::MaterialMaps;
 use super::engine::prepare::{bands_for, material_maps_cached};
 use super::engine::renderer::{FrameOutput, FrameSettings, Material, Renderer, Targets, WINDOW_FRAME_LATENCY};
@@ -82,7 +81,7 @@ struct App {
     frames_done: u32,
     lut_jobs: Sender<(Stack, usize)>,
     lut_results: Receiver<(Stack, usize, Lut)>,
-    reloads: Receiver<Result<Reloaded, Error>>,
+    map_worker: reload::MapWorker,
     status: String,
 }
 
@@ -100,7 +99,7 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let lut = Lut::bake_default(optics.stack);
 
     let (lut_jobs, lut_results) = reload::spawn_lut_worker();
-    let (reloads, watching) = reload::spawn_map_worker(&options, cache);
+    let map_worker = reload::spawn_map_worker(&options, cache);
 
     let event_loop = EventLoop::new().map_err(|e| {
         Error::Gpu(GpuError::Window(format!(
@@ -126,8 +125,8 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
         frames_done: 0,
         lut_jobs,
         lut_results,
-        reloads,
-        status: if watching { "watching the preset file".to_string() } else { String::new() },
+        status: if map_worker.watching { "watching the preset file".to_string() } else { String::new() },
+        map_worker,
         options,
     };
     event_loop.run_app(&mut app).map_err(|e| Error::Gpu(GpuError::Window(format!("window event loop failed: {e}"))))?;
@@ -203,7 +202,7 @@ impl App {
     /// Swaps in finished background work and pushes slider changes to the GPU.
     fn apply_updates(&mut self) {
         let Some(gfx) = self.gfx.as_mut() else { return };
-        while let Ok(result) = self.reloads.try_recv() {
+        while let Ok(result) = self.map_worker.reloads.try_recv() {
             // A reload fails in the generator or in the upload alike: the last good maps stay.
             let uploaded = result.map_err(|e| e.to_string()).and_then(|reloaded| {
                 gfx.renderer.retexture(&mut gfx.material, &reloaded.maps).map(|()| reloaded).map_err(|e| e.to_string())
@@ -404,7 +403,7 @@ fn without_source_location(message: &str) -> &str {
 mod tests {
     use super::*;
 
-    /// Negative control: a message without a location is kept whole.
+    /// winit's location goes; a message without one is kept whole (the negative control).
     #[test]
     fn a_window_error_loses_the_build_machine_path() {
         let said = "os error at /root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/winit-0.30.13/src/\

@@ -52,32 +52,69 @@ pub fn spawn_lut_worker() -> (Sender<LutJob>, Receiver<LutResult>) {
     (lut_jobs, lut_results)
 }
 
-/// How often the map worker looks whether a folder whose watch was lost is back
-/// (`PresetWatch::refresh`): a `stat` a second while one is missing.
-const FOLDER_CHECK_INTERVAL: Duration = Duration::from_secs(1);
+/// How often the map worker wakes without news: to look whether a folder whose watch was
+/// lost is back (`PresetWatch::refresh`: a `stat` a lost folder) and whether the window is
+/// gone.
+const WAKE_INTERVAL: Duration = Duration::from_secs(1);
+
+/// What the watcher tells the map worker.
+enum Watched {
+    /// The preset file changed.
+    Changed,
+    /// A watched folder itself went (deleted, renamed away) or the watcher lost events: that
+    /// folder's watch sees no longer what lies at its name.
+    Lost(PathBuf),
+}
+
+/// The map worker, as the window holds it.
+pub struct MapWorker {
+    pub reloads: Receiver<Result<Reloaded, Error>>,
+    /// Whether the preset file is watched.
+    pub watching: bool,
+    /// Dropped with the window: the worker (its cache, the watcher) ends within a second.
+    _stop: Sender<()>,
+}
 
 /// Starts the map worker and the file watcher (when the preset is a file): every save
-/// regenerates the maps through `cache`. True with the receiver when the preset is watched.
-pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache) -> (Receiver<Result<Reloaded, Error>>, bool) {
+/// regenerates the maps through `cache`.
+pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache) -> MapWorker {
     let (reload_out, reloads) = channel();
-    let (changed_tx, changed_rx) = channel::<()>();
-    let mut watch = watch_preset(&options.preset, changed_tx);
+    let (watched_tx, watched_rx) = channel::<Watched>();
+    let (stop, stopped) = channel::<()>();
+    let mut watch = watch_preset(&options.preset, watched_tx);
     let watching = watch.is_some();
     let (spec, overrides, seed, map_size, layout) =
         (options.preset.clone(), options.overrides.clone(), options.seed, options.map_size, options.layout);
     std::thread::spawn(move || {
         loop {
-            match changed_rx.recv_timeout(FOLDER_CHECK_INTERVAL) {
-                Ok(()) => {}
-                // A folder watched again may hold a file changed while it was not watched.
-                Err(RecvTimeoutError::Timeout) if watch.as_mut().is_some_and(PresetWatch::refresh) => {}
-                Err(RecvTimeoutError::Timeout) => continue,
+            if matches!(stopped.try_recv(), Err(std::sync::mpsc::TryRecvError::Disconnected)) {
+                break;
+            }
+            let mut reload = match watched_rx.recv_timeout(WAKE_INTERVAL) {
+                Ok(Watched::Changed) => true,
+                Ok(Watched::Lost(dir)) => {
+                    if let Some(w) = watch.as_mut() {
+                        w.lose(dir);
+                    }
+                    false
+                }
+                Err(RecvTimeoutError::Timeout) => false,
                 // No watcher (a built-in preset): nothing will change.
                 Err(RecvTimeoutError::Disconnected) => break,
+            };
+            // On every wake (a steady stream of edits must not keep it from running): a folder
+            // watched again may hold a file changed while it was not watched.
+            reload |= watch.as_mut().is_some_and(PresetWatch::refresh);
+            if !reload {
+                continue;
             }
             // Editors save in bursts (truncate, write, rename): let the file settle.
             std::thread::sleep(Duration::from_millis(150));
-            while changed_rx.try_recv().is_ok() {}
+            while let Ok(news) = watched_rx.try_recv() {
+                if let (Watched::Lost(dir), Some(w)) = (news, watch.as_mut()) {
+                    w.lose(dir);
+                }
+            }
             let start = Instant::now();
             let result = crate::preset::load(&spec, &overrides, seed).map_err(Error::from).and_then(|loaded| {
                 for warning in loaded.warnings(&spec) {
@@ -91,42 +128,50 @@ pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache) -> (Recei
             }
         }
     });
-    (reloads, watching)
+    MapWorker { reloads, watching, _stop: stop }
 }
 
-/// The preset file's watch: the watcher, the folders it watches, and those whose watch was
-/// lost: a folder deleted (or renamed away) and made again (a `git checkout`, a sync tool)
-/// is a new folder that the old watch does not see: every edit after it went unseen, for
-/// good, while the panel still said "watching" (the window review). The watcher marks a
-/// folder lost when the folder itself goes; `refresh` watches it again once it is back.
+/// The preset file's watch: the watcher and the folders whose watch was lost. A folder
+/// deleted (or renamed away) and made again (a `git checkout`, a sync tool) is a new folder
+/// that the old watch does not see: every edit after it went unseen, for good, while the
+/// panel still said "watching" (the window review). The watcher reports a folder lost when
+/// the folder itself goes (`Watched::Lost`); `refresh` watches it again once it is back.
+/// The list is the map worker's alone: the watcher's `watch` and `unwatch` wait for its event
+/// thread, which runs the callback, so a lock shared with the callback could deadlock.
 pub struct PresetWatch {
     watcher: notify::RecommendedWatcher,
-    lost: std::sync::Arc<std::sync::Mutex<Vec<PathBuf>>>,
+    lost: Vec<PathBuf>,
 }
 
 impl PresetWatch {
+    fn lose(&mut self, dir: PathBuf) {
+        if !self.lost.contains(&dir) {
+            self.lost.push(dir);
+        }
+    }
+
     /// Watches again each lost folder that is there now; true when one was (its file may
     /// have changed while it was not watched).
     fn refresh(&mut self) -> bool {
         use notify::Watcher;
-        let mut lost = self.lost.lock().unwrap_or_else(|e| e.into_inner());
-        let before = lost.len();
-        lost.retain(|dir| {
+        let before = self.lost.len();
+        let watcher = &mut self.watcher;
+        self.lost.retain(|dir| {
             if !dir.is_dir() {
                 return true;
             }
             // A folder renamed away keeps its watch (on the folder, not the name): gone first.
-            let _ = self.watcher.unwatch(dir);
-            self.watcher.watch(dir, notify::RecursiveMode::NonRecursive).is_err()
+            let _ = watcher.unwatch(dir);
+            watcher.watch(dir, notify::RecursiveMode::NonRecursive).is_err()
         });
-        lost.len() < before
+        self.lost.len() < before
     }
 }
 
 /// Watches the preset file (when the preset is a file) and signals every change: the name
 /// given and, when it is a link, the file it names (an edit of that file changes nothing
 /// at the link's name, so only the link's folder watched saw none of them).
-fn watch_preset(spec: &str, changed: Sender<()>) -> Option<PresetWatch> {
+fn watch_preset(spec: &str, news: Sender<Watched>) -> Option<PresetWatch> {
     use notify::Watcher;
     let path = PathBuf::from(spec);
     // The file the preset was read from (`preset::names_a_file`: a built-in name is the
@@ -141,38 +186,35 @@ fn watch_preset(spec: &str, changed: Sender<()>) -> Option<PresetWatch> {
         watched.push(target);
     }
     let file_names: Vec<std::ffi::OsString> = watched.iter().filter_map(|p| p.file_name()).map(Into::into).collect();
-    // Watch the folders: editors often replace the file by renaming a new one over it. Named
-    // as the watcher names them in its events: absolute.
+    // Watch the folders: editors often replace the file by renaming a new one over it. Each
+    // as the watcher names it in its events: its real path (as FSEvents reports paths),
+    // watched as such.
     let folders: Vec<PathBuf> = watched
         .iter()
         .map(|file| file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")))
-        .map(|dir| std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf()))
+        .map(|dir| std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf()))
         .collect();
     let watched_folders = folders.clone();
-    let lost = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
-    let marks = lost.clone();
     let mut watcher = notify::recommended_watcher(move |event: notify::Result<notify::Event>| {
         let Ok(event) = event else { return };
-        // A watched folder itself deleted or renamed: its watch no longer sees that name.
+        // A watched folder itself deleted or renamed: its watch no longer sees that name. Events
+        // the watcher lost (a queue overflow) may have said so: every folder is taken as lost.
         let own = matches!(
             event.kind,
             notify::EventKind::Remove(_) | notify::EventKind::Modify(notify::event::ModifyKind::Name(_))
         );
-        for dir in event.paths.iter().filter(|p| own && folders.contains(p)) {
-            let mut lost = marks.lock().unwrap_or_else(|e| e.into_inner());
-            if !lost.contains(dir) {
-                lost.push(dir.clone());
-            }
+        for dir in folders.iter().filter(|dir| event.need_rescan() || (own && event.paths.contains(dir))) {
+            let _ = news.send(Watched::Lost(dir.clone()));
         }
         if event.paths.iter().any(|p| p.file_name().is_some_and(|n| file_names.iter().any(|f| f == n)))
             && !matches!(event.kind, notify::EventKind::Access(_))
         {
-            let _ = changed.send(());
+            let _ = news.send(Watched::Changed);
         }
     })
     .ok()?;
     for dir in &watched_folders {
         watcher.watch(dir, notify::RecursiveMode::NonRecursive).ok()?;
     }
-    Some(PresetWatch { watcher, lost })
+    Some(PresetWatch { watcher, lost: Vec::new() })
 }

@@ -125,10 +125,7 @@ fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
     if args.frames.is_some() {
         // The frames drawn (a closed window ends the run early); a frame time needs two.
         let timing = if report.mean_frame_ms.is_finite() {
-            // fps to two significant figures: a 25 s frame read "0.0 fps".
-            let fps = 1000.0 / report.mean_frame_ms;
-            let decimals = if fps >= 10.0 { 1 } else { (1.0 - fps.log10().floor()).clamp(1.0, 6.0) as usize };
-            format!("mean frame time {:.2} ms ({fps:.decimals$} fps)", report.mean_frame_ms)
+            format!("mean frame time {:.2} ms ({} fps)", report.mean_frame_ms, fps_text(report.mean_frame_ms))
         } else {
             "no frame time (it needs two frames)".to_string()
         };
@@ -156,5 +153,25 @@ fn narrowed_note(loaded: &snakeskin::preset::LoadedPreset, map_size: usize, layo
              rows ({} widths)",
             loaded.preset.body.length
         );
+    }
+}
+
+/// Frames a second from a mean frame time: one decimal, or below 10 fps two significant
+/// figures (a 25 s frame read "0.0 fps").
+fn fps_text(mean_frame_ms: f64) -> String {
+    let fps = 1000.0 / mean_frame_ms;
+    let decimals = if fps >= 10.0 { 1 } else { (1.0 - fps.log10().floor()).clamp(1.0, 6.0) as usize };
+    format!("{fps:.decimals$}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fps_text;
+
+    #[test]
+    fn slow_frames_keep_two_figures_of_their_rate() {
+        for (ms, says) in [(25_000.0, "0.040"), (1000.0, "1.0"), (200.0, "5.0"), (16.667, "60.0"), (2000.0, "0.50")] {
+            assert_eq!(fps_text(ms), says, "{ms} ms");
+        }
     }
 }
