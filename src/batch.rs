@@ -748,8 +748,9 @@ pub fn fitting_concurrency(requested: usize, mut estimates: Vec<u64>, available_
 /// written, not in the middle of it. A job that fails at run time stops the run: no new job
 /// starts, the running ones finish (each set is written atomically), the index is written
 /// with the failed jobs and those never started, and `BatchError::Stopped` returned with it
-/// and the earliest failed job's error. The index lists the jobs in their order, whatever order they finished in, and
-/// the files are the same at any concurrency (every set's bytes are).
+/// and the earliest failed job's error. The index lists the jobs in their order, whatever
+/// order they finished in, and the files are the same at any concurrency (every set's bytes
+/// are).
 pub fn run(
     jobs_file: &Path,
     jobs: &[Job],
