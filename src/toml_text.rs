@@ -194,15 +194,15 @@ pub fn integer_out_of_type(message: &str) -> Option<&str> {
     message.strip_prefix("invalid value: integer `")?.split('`').next()
 }
 
-/// serde's words for types in a reader's: what the value is (`invalid type: sequence`) and what is
-/// accepted (`expected u32`, `expected struct Scales`). Only serde's own parts are rewritten: the
-/// value's type after "invalid type: " and the final ", expected ..."; the value the message quotes
-/// only where a float lies beyond the plain range (written out in all its digits), as
-/// `validate::shown` shows every refused number. An integer's type range is named only where the
-/// value is a whole number outside it (`-1`, `5000000000`): for `rows = 4.0` it read "expected a
-/// whole number from 0 to 4294967295", which is not the key's range (4 to 128, checked once the
-/// value is a whole number). A whole number beyond i64 is "an integer `…` as i128" in toml's words:
-/// said as the value it is.
+/// serde's words for types in a reader's: what the value is (`invalid type: sequence`) and
+/// what is accepted (`expected u32`, `expected struct Scales`). Only serde's own parts are
+/// rewritten: the value's type after "invalid type: " and the final ", expected ..."; the value
+/// the message quotes only where a float lies beyond the plain range (written out in all its
+/// digits), as `validate::shown` shows every refused number. An integer's type range is named
+/// only where the value is a whole number outside it (`-1`, `5000000000`): for `rows = 4.0` it
+/// read "expected a whole number from 0 to 4294967295", which is not the key's range (4 to
+/// 128, checked once the value is a whole number). A whole number beyond i64 is "an integer
+/// `…` as i128" in toml's words: said as the value it is.
 fn plain_type_names(message: &str) -> String {
     let mut out = message.to_string();
     for (serde, plain) in [("sequence", "array"), ("map", "table")] {

@@ -60,6 +60,16 @@ fn jobs_file(dir: &Path, species: &[&str], seeds: &str, size: u32) -> PathBuf {
     path
 }
 
+/// The index a run wrote into `out` (`index.json`).
+fn read_index(out: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(out.join("index.json")).unwrap()).unwrap()
+}
+
+/// Each job's status in an index, in its order.
+fn statuses(index: &serde_json::Value) -> Vec<&str> {
+    index["jobs"].as_array().unwrap().iter().map(|j| j["status"].as_str().unwrap()).collect()
+}
+
 fn summary_counts(out: &std::process::Output) -> (usize, usize) {
     // "40 jobs of 40 in shard 0/1, up to 2 at once: 33 run, 7 already done; index: …"
     let text = stdout(out);
@@ -183,7 +193,7 @@ fn an_interrupted_batch_leaves_its_finished_sets_and_nothing_else() {
         assert_eq!(ended.status.code(), Some(128 + signal), "{}", stderr(&ended));
         only_finished_sets_in(&out);
         // The index written as the run started: this jobs file's twelve jobs.
-        let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("index.json")).unwrap()).unwrap();
+        let index = read_index(&out);
         assert_eq!((index["jobs_file"].as_str(), index["jobs"].as_array().map(Vec::len)), (jobs.to_str(), Some(12)));
         // Every set logged is there; a set whose commit the signal waited for is whole but
         // may go unlogged (its job ends after the clean-up), one a job at most.
@@ -291,7 +301,7 @@ fn a_killed_batch_resumes_with_only_the_unfinished_jobs_and_the_same_files() {
     // A third run has nothing to do; the index lists all 40 jobs.
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", resumed.to_str().unwrap()]);
     assert_eq!(summary_counts(&out), (0, 40), "{}", stdout(&out));
-    let index: serde_json::Value = serde_json::from_slice(&std::fs::read(resumed.join("index.json")).unwrap()).unwrap();
+    let index = read_index(&resumed);
     assert_eq!(index["jobs"].as_array().unwrap().len(), 40);
 }
 
@@ -610,7 +620,7 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     assert_eq!(sets.len(), 3, "{sets:?}");
     // Each set is complete and is its own job's (a set overwritten by another job's maps
     // would fail its hashes or carry the other job's key).
-    let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out_dir.join("index.json")).unwrap()).unwrap();
+    let index = read_index(&out_dir);
     let index = index["jobs"].as_array().unwrap();
     assert_eq!(index[3]["status"], "duplicate");
     assert_eq!(index[3]["duplicate_of"], 0);
@@ -930,14 +940,12 @@ fn a_stopped_batch_writes_its_index_with_what_failed_and_what_never_ran() {
         ),
         "{summary}"
     );
-    let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out_dir.join("index.json")).unwrap()).unwrap();
+    let index = read_index(&out_dir);
     assert_eq!(index["jobs_file"].as_str(), jobs.to_str(), "{index}");
-    let statuses: Vec<&str> = index["jobs"].as_array().unwrap().iter().map(|j| j["status"].as_str().unwrap()).collect();
-    assert_eq!(statuses, ["failed", "skipped", "not run", "duplicate"], "{index}");
+    assert_eq!(statuses(&index), ["failed", "skipped", "not run", "duplicate"], "{index}");
     // Negative control: run again without the fault, every job is done and said so.
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let index: serde_json::Value = serde_json::from_slice(&std::fs::read(out_dir.join("index.json")).unwrap()).unwrap();
-    let statuses: Vec<&str> = index["jobs"].as_array().unwrap().iter().map(|j| j["status"].as_str().unwrap()).collect();
-    assert_eq!(statuses, ["done", "skipped", "done", "duplicate"], "{index}");
+    let index = read_index(&out_dir);
+    assert_eq!(statuses(&index), ["done", "skipped", "done", "duplicate"], "{index}");
 }

@@ -159,21 +159,25 @@ fn forget_temporary(path: &Path) {
 }
 
 /// The error of an operation on `path`: the folder's, when it refused to make a file that is
-/// not there (`ExportError::FolderNotWritable`).
+/// not there (`folder_refused`).
 fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
     move |source| {
-        let refused = source.kind() == std::io::ErrorKind::PermissionDenied;
-        let folder = path.parent().map(|f| if f.as_os_str().is_empty() { Path::new(".") } else { f });
-        match (folder, path.file_name()) {
-            (Some(folder), Some(name)) if refused && fs::symlink_metadata(path).is_err() && folder.is_dir() => {
-                ExportError::FolderNotWritable {
-                    folder: folder.into(),
-                    name: name.to_string_lossy().into_owned(),
-                    source,
-                }
-            }
-            _ => ExportError::Io { path: path.into(), source },
+        if path.file_name().is_some() && fs::symlink_metadata(path).is_err() {
+            folder_refused(path, source)
+        } else {
+            ExportError::Io { path: path.into(), source }
         }
+    }
+}
+
+/// The error of making the new file `path`: `ExportError::FolderNotWritable` where its folder
+/// (one that exists) refused it, the file's otherwise.
+fn folder_refused(path: &Path, source: std::io::Error) -> ExportError {
+    let folder = folder_of(path);
+    if source.kind() == std::io::ErrorKind::PermissionDenied && folder.is_dir() {
+        ExportError::FolderNotWritable { folder: folder.into(), name: file_name(path), source }
+    } else {
+        ExportError::Io { path: path.into(), source }
     }
 }
 
@@ -222,20 +226,23 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
 /// Writes `bytes` to a new exclusive temporary beside `target` and returns it (deleted on
 /// drop unless persisted).
 fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedTempFile, ExportError> {
-    let mut tmp = {
-        // Created and listed under one lock: once `clean_up_before_exit` has begun, none is
-        // created that it would not remove.
-        let mut live = locked(&LIVE);
-        let tmp = temporary(dir, target_name).map_err(io_error(dir))?;
-        live.push(tmp.path().to_path_buf());
-        tmp
-    };
+    let mut tmp = listed_temporary(dir, target_name).map_err(io_error(dir))?;
     // Named as the file it will become (the temporary is hidden from the user), a full disk
     // said "cannot write /out/.x.png.JWK6WF.snakeskin-tmp: No space left on device (os
     // error 28) at path "/out/.x.png.JWK6WF.snakeskin-tmp"".
     tmp.write_all(bytes)
         .and_then(|_| tmp.as_file().sync_all())
         .map_err(|e| io_error(&dir.join(target_name))(without_temporary_path(e)))?;
+    Ok(tmp)
+}
+
+/// `temporary`, listed in `LIVE` for an interrupt's clean-up: created and listed under one
+/// lock, so that once `clean_up_before_exit` has begun none is created that it would not
+/// remove.
+fn listed_temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut live = locked(&LIVE);
+    let tmp = temporary(dir, target_name)?;
+    live.push(tmp.path().to_path_buf());
     Ok(tmp)
 }
 
@@ -1054,23 +1061,10 @@ fn sync_folder(dir: &Path) {
 /// reference) and only then said "cannot write ro: Permission denied"; now it says so at
 /// once, naming the file.
 pub fn check_writable(target: &Path) -> Result<(), ExportError> {
-    let folder = folder_of(target);
-    let probe = {
-        // Listed while it exists, as a staged file is (`stage`), for an interrupt's clean-up;
-        // empty, so neither written nor synced (a batch probes a folder per set).
-        let mut live = locked(&LIVE);
-        let probe = temporary(folder, &file_name(target)).map_err(|source| {
-            // The probe is always a new file: a refusal is the folder's, whatever stands at
-            // the target (an earlier set's writable manifest was named as the culprit).
-            if source.kind() == std::io::ErrorKind::PermissionDenied && folder.is_dir() {
-                ExportError::FolderNotWritable { folder: folder.into(), name: file_name(target), source }
-            } else {
-                ExportError::Io { path: target.into(), source }
-            }
-        })?;
-        live.push(probe.path().to_path_buf());
-        probe
-    };
+    // Empty, so neither written nor synced (a batch probes a folder per set). The probe is
+    // always a new file: a refusal is the folder's, whatever stands at the target (an earlier
+    // set's writable manifest was named as the culprit).
+    let probe = listed_temporary(folder_of(target), &file_name(target)).map_err(|e| folder_refused(target, e))?;
     let path = probe.path().to_path_buf();
     drop(probe);
     forget_temporary(&path);

@@ -461,12 +461,13 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
     let mut here: Option<&toml::Value> = None;
     for (i, segment) in segments.iter().enumerate() {
         let path = format!("{prefix}{}", segments[..=i].join("."));
-        // An index no list has (`pattern.-1`, one past usize): it was taken as a key into
-        // the list, and the message said to write `pattern.N.-1.kind`.
-        // Only at a list (one the preset has, or one of the schema's): below a table or a value
-        // the key is an unknown one, as `scales.x1` is.
+        let value = step(here, root, segment);
+        // An index no list has (`pattern.-1`, one past usize), at a list (one the preset has,
+        // or one of the schema's): it was taken as a key into the list, and the message said
+        // to write `pattern.N.-1.kind`. Below a table or a value it is an unknown key, as
+        // `scales.x1` is.
         if let Some(next) = segments.get(i + 1).filter(|s| is_whole_number_word(s) && s.parse::<usize>().is_err()) {
-            let have = match step(here, root, segment) {
+            let have = match value {
                 Some(toml::Value::Array(items)) => Some(format!(" (`{path}` has {})", entries(items.len(), &path))),
                 None if path == "pattern" || schema_lists().contains(&path) => Some(String::new()),
                 _ => None,
@@ -476,7 +477,6 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
             }
         }
         let Some(index) = segments.get(i + 1).and_then(|s| s.parse::<usize>().ok()) else {
-            let value = step(here, root, segment);
             if i + 1 < segments.len() {
                 match value {
                     // A key into a list without its index (`pattern.amount` on `[[pattern]]`
@@ -505,7 +505,6 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
             here = Some(value.unwrap_or(&missing));
             continue;
         };
-        let value = step(here, root, segment);
         if path == "pattern" {
             check_layer_index(value, index)?;
             // The layer's own keys: the array's item, or a single `[pattern]` table.
