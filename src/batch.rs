@@ -490,6 +490,50 @@ impl Shard {
     }
 }
 
+/// Where one job stands: the word the index, `--list`, the job lines and the summary use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JobStatus {
+    /// Planned, not yet run: in `list`, and in the index a run writes as it starts.
+    ToDo,
+    /// Run now; from `list`, already complete with this key.
+    Done,
+    /// Already complete with this key: not run again.
+    Skipped,
+    /// The same job as `duplicate_of`, which makes its set.
+    Duplicate,
+    /// In a run that stopped: its set was not written.
+    Failed,
+    /// In a run that stopped: never started.
+    NotRun,
+}
+
+impl JobStatus {
+    pub fn word(self) -> &'static str {
+        match self {
+            JobStatus::ToDo => "to do",
+            JobStatus::Done => "done",
+            JobStatus::Skipped => "skipped",
+            JobStatus::Duplicate => "duplicate",
+            JobStatus::Failed => "failed",
+            JobStatus::NotRun => "not run",
+        }
+    }
+}
+
+/// The index holds the word (`"status": "to do"`).
+impl Serialize for JobStatus {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.word())
+    }
+}
+
+impl std::fmt::Display for JobStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // `pad`, not `write_str`: `--list` aligns the words in a column (`{:<9}`).
+        f.pad(self.word())
+    }
+}
+
 /// What happened to one job.
 #[derive(Debug, Clone, Serialize)]
 pub struct JobOutcome {
@@ -501,11 +545,7 @@ pub struct JobOutcome {
     pub folder: PathBuf,
     pub manifest: PathBuf,
     pub key: String,
-    /// `done` (run now), `skipped` (already complete with this key), `duplicate` (the same
-    /// job as `duplicate_of`, which makes its set); in a run that stopped, `failed` (its set
-    /// was not written) or `not run`; from `list`, and in the index a run writes as it starts,
-    /// `to do`.
-    pub status: &'static str,
+    pub status: JobStatus,
     /// The index of the earlier identical job, for a `duplicate`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub duplicate_of: Option<usize>,
@@ -620,14 +660,14 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         folder,
         manifest,
         key,
-        status: "to do",
+        status: JobStatus::ToDo,
         duplicate_of: None,
         kept: Vec::new(),
     };
     let files = set_file_names(&loaded, &request(job, out, &outcome));
     let done = check && is_done(&out.join(&outcome.manifest), &outcome.key, &files);
     if done {
-        outcome.status = "skipped";
+        outcome.status = JobStatus::Skipped;
     }
     Ok(Resolved { outcome, done, warnings, files })
 }
@@ -669,7 +709,7 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
                 );
                 return Err(refuse(r.outcome.preset, message));
             }
-            r.outcome.status = "duplicate";
+            r.outcome.status = JobStatus::Duplicate;
             r.outcome.duplicate_of = Some(first.index);
         } else {
             first_in.insert(r.outcome.folder.clone(), resolved.len());
@@ -689,7 +729,7 @@ pub fn list(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Result<
         .into_iter()
         .map(|Resolved { mut outcome, done, .. }| {
             if outcome.duplicate_of.is_none() {
-                outcome.status = if done { "done" } else { "to do" };
+                outcome.status = if done { JobStatus::Done } else { JobStatus::ToDo };
             }
             outcome
         })
@@ -836,9 +876,9 @@ pub fn run(
                 // A set already done (`skipped`) or another job's (`duplicate`) stays as
                 // planned: it was marked `not run` though it was there.
                 if failures.iter().any(|(j, _)| *j == k) {
-                    outcome.status = "failed";
-                } else if outcome.status == "to do" {
-                    outcome.status = "not run";
+                    outcome.status = JobStatus::Failed;
+                } else if outcome.status == JobStatus::ToDo {
+                    outcome.status = JobStatus::NotRun;
                 }
                 outcome
             })
@@ -977,7 +1017,7 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
             return Err(BatchError::Changed { job: running.clone() }.into());
         }
         outcome.kept = plan.run(&|_, _| {}).map_err(failed)?.kept;
-        outcome.status = "done";
+        outcome.status = JobStatus::Done;
     } else {
         // A run killed after committing this set but before removing its lock file left an
         // empty `.NAME.lock` behind: taking the lock and letting it go removes it (and leaves

@@ -6,7 +6,7 @@ use anyhow::Result;
 use crate::cli::BatchArgs;
 use crate::output::path_line;
 use crate::progress::Progress;
-use snakeskin::batch::{self, Shard};
+use snakeskin::batch::{self, JobStatus, Shard};
 
 pub fn run(args: BatchArgs) -> Result<()> {
     let jobs = batch::load_jobs(&args.jobs).map_err(snakeskin::Error::from)?;
@@ -57,9 +57,14 @@ pub fn run(args: BatchArgs) -> Result<()> {
     if !had_folder && args.out.is_dir() {
         eprintln!("note: created folder {}", path_line(&args.out));
     }
-    let count = |status: &str| index.jobs.iter().filter(|j| j.status == status).count();
-    let mut counts = format!("{} run, {} already done", count("done"), count("skipped"));
-    for (status, words) in [("duplicate", "duplicates of another job"), ("failed", "failed"), ("not run", "not run")] {
+    let count = |status: JobStatus| index.jobs.iter().filter(|j| j.status == status).count();
+    let mut counts = format!("{} run, {} already done", count(JobStatus::Done), count(JobStatus::Skipped));
+    let others = [
+        (JobStatus::Duplicate, "duplicates of another job"),
+        (JobStatus::Failed, "failed"),
+        (JobStatus::NotRun, "not run"),
+    ];
+    for (status, words) in others {
         if count(status) > 0 {
             counts.push_str(&format!(", {} {words}", count(status)));
         }
