@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::film::Stack;
 use super::film_rgb_reference;
-use super::lut::Lut;
+use super::lut::LazyLut;
 use super::methods::{Method, gaussian_fit_f64, rgb3_f64, spectral_n_f64};
 use crate::Error;
 use crate::ops::Image;
@@ -48,19 +48,21 @@ pub fn check(stack: Stack, thickness_nm: f64, angle_deg: f64, wavelength_nm: Opt
 /// Baked tables kept at once by `film_colour`'s LUT cache.
 const MAX_CACHED_LUTS: usize = 8;
 
-/// LUTs baked so far, per material (a batch of queries on one material bakes once).
-fn lut_for(stack: Stack) -> Arc<Lut> {
-    static CACHE: Mutex<BakedCache<[u64; 3], Lut>> = Mutex::new(BakedCache::new(MAX_CACHED_LUTS));
+/// LUTs read so far, per material (the queries of a batch on one material share its texels).
+fn lut_for(stack: Stack) -> Arc<LazyLut> {
+    static CACHE: Mutex<BakedCache<[u64; 3], LazyLut>> = Mutex::new(BakedCache::new(MAX_CACHED_LUTS));
     let key = [stack.n0.to_bits(), stack.n1.to_bits(), stack.n2.to_bits()];
     let mut cache = CACHE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    cache.get_or_bake(key, || Lut::bake_default(stack))
+    cache.get_or_bake(key, || LazyLut::new(stack))
 }
 
-/// A few baked values by key. A table is about 12 MiB, so a batch over many materials keeps
-/// a few. When the cache is full, a value chosen at random makes room. Emptying the whole
-/// cache (as before) or dropping the least recently used value misses on every query of a
-/// batch that cycles through more materials than the cache holds (9 materials in turn:
-/// every query baked, 2 s each); always replacing the value baked last misses on every
+/// A few baked values by key. A table grows to about 0.3 MiB as its texels are read, and
+/// each line of a batch may name its own material, so a batch keeps a few. When the cache
+/// is full, a value chosen at random makes room. Emptying the whole cache (as before) or
+/// dropping the least recently used value misses on every query of a batch that cycles
+/// through more materials than the cache holds (9 materials in turn: every query's texels
+/// computed again, 2 s each when a query baked its whole table); always replacing the
+/// value baked last misses on every
 /// query of two new materials taken in turn. A random choice keeps most of either: the
 /// test below counts the bakes of both. (The choice changes only what is baked again, never
 /// a value.)
