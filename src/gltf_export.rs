@@ -103,7 +103,7 @@ fn is_binary(path: &Path) -> Result<bool, Error> {
     let text = path.to_string_lossy();
     if crate::export::ends_as_a_folder(path) {
         // The one message every output file gets (`export::check_target`).
-        return Err(crate::export::ExportError::FolderName { path: path.into() }.into());
+        return Err(crate::export::ExportError::FolderName { path: path.into(), default_extension: "glb" }.into());
     }
     // `.glb` alone: a name that is all extension (`Path::extension` sees none).
     let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
@@ -292,15 +292,18 @@ impl ExportPlan {
         let created_folder = lock.created_folder;
         let mut removed = Vec::new();
         let mut kept = Vec::new();
+        // The file under the name given, its extension's case kept (`--gltf FOO.GLTF` wrote
+        // FOO.gltf, a file other than the one named and checked).
+        let out_name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let files = if binary {
             let bytes = glb(&name, &mesh, material, &textures, Some(&source))?;
             // Staged under the lock, which sweeps the name's stale temporaries first.
-            let glb_name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            lock.write(&[], (&glb_name, &bytes))?
+            lock.write(&[], (&out_name, &bytes))?
         } else {
             let has_thickness = textures.thickness.is_some();
             let mut files = gltf_files(&name, &mesh, material, textures, Some(&source))?;
-            let (gltf_name, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
+            let (_, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
+            let gltf_name = out_name;
             // The files written are staged under the lock, which sweeps their names' stale
             // temporaries; the thickness image may not be written, and a killed run's
             // temporary of it would stay.
@@ -311,22 +314,23 @@ impl ExportPlan {
             // commit, where the `.gltf` it replaces named it and it is as that export wrote
             // it (the SHA-256 in the image's `extras`; an export from before they were
             // recorded is taken at its word). A file of that name that the earlier `.gltf`
-            // did not name is someone else's, and stays; one edited since stays and is said,
-            // as `generate` keeps a map changed since. Whatever stands there is harmless once
-            // the commit is done, so an export that succeeded does not fail for it (a folder
-            // of that name stays, and so does a file that may not go).
-            let earlier = if has_thickness {
-                EarlierImage::NotNamed
-            } else {
-                earlier_image(&dir.join(&gltf_name), &thickness_file)
-            };
+            // did not name, or with no readable `.gltf` there (a killed commit's), may be
+            // someone else's, and stays; one edited since stays. Each is said, as `generate`
+            // says of the maps it keeps. Whatever stands there is harmless once the commit is
+            // done, so an export that succeeded does not fail for it (a folder of that name
+            // stays, and so does a file that may not go).
+            let earlier = (!has_thickness).then(|| earlier_image(&dir.join(&gltf_name), &thickness_file));
             let written = lock.write(&files, (&gltf_name, &gltf_bytes))?;
             let stale = dir.join(&thickness_file);
-            if let EarlierImage::Named { sha256 } = earlier
+            if let Some(earlier) = earlier
                 && let Ok(meta) = std::fs::symlink_metadata(&stale)
                 && !meta.is_dir()
             {
-                match stale_image_stays(&stale, meta.is_file(), sha256.as_deref()) {
+                let stays = match &earlier {
+                    EarlierImage::Named { sha256 } => stale_image_stays(&stale, meta.is_file(), sha256.as_deref()),
+                    other => other.why_it_stays(&gltf_name),
+                };
+                match stays {
                     Some(why) => kept.push((stale, why)),
                     None => removed.push(stale),
                 }

@@ -213,6 +213,28 @@ fn a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole() {
     }
 }
 
+/// `--gltf NAME.GLTF` writes the file named, its extension's case kept, as `.GLB` did (it
+/// wrote NAME.gltf, a file other than the one named and checked).
+#[test]
+fn an_upper_case_extension_names_the_file_written() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, lower) in [("UP.GLTF", "UP.gltf"), ("Up.Glb", "Up.glb")] {
+        let written = export(dir.path(), "xenopeltis-unicolor", name, &["--mesh", "plane"]);
+        assert!(written.is_file(), "{name}");
+        assert!(!dir.path().join(lower).exists(), "{name}");
+    }
+    assert!(dir.path().join("UP.bin").is_file());
+    // A name that ends as a folder's is refused with an example of its own kind (it said
+    // "as in out/snake.png", a name `--gltf` refuses).
+    for (given, example) in
+        [("x.glb/", "as in out/snake.glb"), ("x.gltf/.", "as in out/snake.gltf"), ("x/", "as in out/snake.glb")]
+    {
+        let out = snakeskin(&["export", "xenopeltis-unicolor", "--gltf", &format!("{}/{given}", dir.path().display())]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains(example), "{given}: {}", stderr(&out));
+    }
+}
+
 /// An earlier export's thickness image edited since stays when a re-export no longer writes
 /// it, and is said, as `generate` keeps a map changed since: each image of a `.gltf` carries
 /// its file's SHA-256 in its `extras`. It was removed, edits and all. Negative control: left
@@ -254,7 +276,9 @@ fn an_export_keeps_a_thickness_image_edited_since() {
 }
 
 /// A `NAME.thickness.png` beside a `.gltf` that does not name it is not the earlier export's,
-/// and an export without a film leaves it as it was (it was removed as stale whoever's it was).
+/// and an export without a film leaves it as it was (it was removed as stale whoever's it was),
+/// and says so; so it does where no `.gltf` is there to say whose it is (a killed commit's
+/// images without their `.gltf`, which stayed without a word), or one that cannot be read.
 #[test]
 fn an_export_without_a_film_keeps_a_thickness_image_it_did_not_write() {
     let dir = tempfile::tempdir().unwrap();
@@ -268,6 +292,32 @@ fn an_export_without_a_film_keeps_a_thickness_image_it_did_not_write() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(std::fs::read(&mine).unwrap(), b"someone else's", "{}", stderr(&out));
     assert!(!stderr(&out).contains("removed"), "{}", stderr(&out));
+    let kept = format!("warning: kept {}, which this export does not reference: ", mine.display());
+    assert!(stderr(&out).contains(&format!("{kept}the x.gltf there did not name it")), "{}", stderr(&out));
+
+    // An export with a film, then its `.gltf` gone or broken: its image stays, said.
+    for (broken, why) in
+        [(None, "no x.gltf is there to say"), (Some(&b"{broken"[..]), "the x.gltf there could not be read (not JSON")]
+    {
+        let gltf = export(dir.path(), "liasis-mackloti", "x.gltf", &["--mesh", "plane"]);
+        let image = std::fs::read(&mine).unwrap();
+        match broken {
+            None => std::fs::remove_file(&gltf).unwrap(),
+            Some(bytes) => std::fs::write(&gltf, bytes).unwrap(),
+        }
+        let out = snakeskin(
+            &[&["export", "liasis-mackloti", "--gltf", gltf.to_str().unwrap(), "--size", "64"][..], &no_film].concat(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert_eq!(std::fs::read(&mine).unwrap(), image, "{why}: {}", stderr(&out));
+        assert!(stderr(&out).contains(&format!("{kept}{why}")), "{why}: {}", stderr(&out));
+    }
+    // Negative control: beside the `.gltf` that named it, it goes without a warning.
+    let gltf = export(dir.path(), "liasis-mackloti", "x.gltf", &["--mesh", "plane"]);
+    let out = snakeskin(
+        &[&["export", "liasis-mackloti", "--gltf", gltf.to_str().unwrap(), "--size", "64"][..], &no_film].concat(),
+    );
+    assert!(out.status.success() && !mine.exists() && !stderr(&out).contains("warning"), "{}", stderr(&out));
 }
 
 #[test]

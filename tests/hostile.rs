@@ -954,9 +954,25 @@ fn a_planted_symlink_at_a_temporary_name_is_not_followed() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("is a FIFO, not a regular file"), "{}", stderr(&out));
     assert_eq!(std::fs::read_dir(sets.path()).unwrap().count(), 1, "only the FIFO there");
-    // Negative control: with the FIFO gone the same run writes its set.
+    // A file with content there is not a lock (the run's are empty): refused and kept. It was
+    // taken and removed at the end, even where it was the preset being exported.
     std::fs::remove_file(&lock).unwrap();
+    let preset = snakeskin(&["presets", "show", PRESET]).stdout;
+    std::fs::write(&lock, &preset).unwrap();
+    let out = generate_into(sets.path(), "1", &[]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let said = format!("{} holds {} bytes, so it is not a lock of snakeskin's", lock.display(), preset.len());
+    assert!(stderr(&out).contains(&said), "{}", stderr(&out));
+    let glb = sets.path().join(format!("{PRESET}.glb"));
+    let out = snakeskin(&["export", lock.to_str().unwrap(), "--gltf", glb.to_str().unwrap(), "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert_eq!(std::fs::read(&lock).unwrap(), preset, "the file at the lock changed");
+    assert_eq!(std::fs::read_dir(sets.path()).unwrap().count(), 1, "only the file there");
+    // Negative control: with it gone (or empty, as a killed run leaves its lock) the same
+    // run writes its set.
+    std::fs::write(&lock, b"").unwrap();
     assert!(generate_into(sets.path(), "1", &[]).status.success());
+    assert!(!lock.exists(), "the lock file stayed");
 }
 
 #[test]

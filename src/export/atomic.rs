@@ -278,7 +278,7 @@ fn without_temporary_path(e: std::io::Error) -> std::io::Error {
 /// Public so that a command can check an output file before the work that makes it.
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
     if ends_as_a_folder(target) {
-        return Err(ExportError::FolderName { path: target.into() });
+        return Err(ExportError::FolderName { path: target.into(), default_extension: "png" });
     }
     let name_bytes = target.file_name().map_or(0, |n| n.len());
     if name_bytes > NAME_MAX_BYTES {
@@ -571,12 +571,16 @@ impl SetLock {
         // a plain open waited for a reader for ever.
         #[cfg(unix)]
         std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW | libc::O_NONBLOCK);
-        // The lock file is the run's to make: anything else there is named as such, before
-        // the open and again if the open fails or opens it.
+        // The lock file is the run's to make, empty: anything else there is named as such,
+        // before the open and again if the open fails or opens it.
         let not_a_lock = || {
-            let file_type = fs::symlink_metadata(&path).ok()?.file_type();
+            let meta = fs::symlink_metadata(&path).ok()?;
+            let file_type = meta.file_type();
             let kind = crate::text_file::file_kind(&file_type);
-            (!file_type.is_file()).then(|| ExportError::LockNotAFile { path: path.clone(), kind })
+            match file_type.is_file() {
+                true => (meta.len() > 0).then(|| ExportError::LockHoldsData { path: path.clone(), bytes: meta.len() }),
+                false => Some(ExportError::LockNotAFile { path: path.clone(), kind }),
+            }
         };
         if let Some(refused) = not_a_lock() {
             return Err(refused);
@@ -600,7 +604,7 @@ impl SetLock {
                 }
                 Err(e) => return Err(not_a_lock().unwrap_or_else(|| io_error(&path)(e))),
             };
-            if !file.metadata().is_ok_and(|m| m.is_file()) {
+            if !file.metadata().is_ok_and(|m| m.is_file() && m.len() == 0) {
                 return Err(not_a_lock()
                     .unwrap_or_else(|| ExportError::LockNotAFile { path: path.clone(), kind: "something else" }));
             }
@@ -817,7 +821,7 @@ impl FileGroup {
     pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> Result<(), ExportError> {
         let (dir, name) = (folder_of(target), file_name(target));
         if name.is_empty() || ends_as_a_folder(target) {
-            return Err(ExportError::FolderName { path: target.into() });
+            return Err(ExportError::FolderName { path: target.into(), default_extension: "png" });
         }
         create_folder(dir)?;
         check_target(target)?;

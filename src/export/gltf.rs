@@ -385,19 +385,52 @@ pub enum EarlierImage {
     /// One of its images, with the SHA-256 it recorded (None: written before images carried
     /// one).
     Named { sha256: Option<String> },
+    /// No `.gltf` there (a killed commit can leave its images without it), or one that could
+    /// not be read: why, to say of a file that stays (as `generate` says of a map no
+    /// manifest records).
+    Unknown(String),
+}
+
+impl EarlierImage {
+    /// Why an image file that an export no longer writes stays beside it, unless the earlier
+    /// `.gltf` named it.
+    pub fn why_it_stays(&self, gltf_name: &str) -> Option<String> {
+        match self {
+            EarlierImage::Named { .. } => None,
+            EarlierImage::NotNamed => {
+                Some(format!("the {gltf_name} there did not name it, so it is not the earlier export's to remove"))
+            }
+            EarlierImage::Unknown(why) => Some(why.clone()),
+        }
+    }
 }
 
 /// What the `.gltf` at `gltf` says of `image_file` (a file beside it): named as one of its
 /// images where it is a regular file (no link followed) of at most `EARLIER_GLTF_MAX_BYTES`,
 /// JSON with an `images[].uri` that is `image_file`'s URI reference, with the image's
-/// `extras.sha256` where it has one. Not named for anything else, so that a file is taken
-/// for an earlier export's only where that export's `.gltf` says it is.
+/// `extras.sha256` where it has one. Never named otherwise, so that a file is taken for an
+/// earlier export's only where that export's `.gltf` says it is.
 pub fn earlier_image(gltf: &std::path::Path, image_file: &str) -> EarlierImage {
-    let Ok(bytes) = crate::text_file::read_bounded_bytes(gltf, EARLIER_GLTF_MAX_BYTES, crate::text_file::Links::Refuse)
-    else {
-        return EarlierImage::NotNamed;
+    use crate::text_file::{BoundedReadError, Links, read_bounded_bytes};
+    let gltf_name = gltf.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let unreadable = |why: &dyn std::fmt::Display| {
+        EarlierImage::Unknown(format!(
+            "the {gltf_name} there could not be read ({why}), so nothing says it is the earlier export's to remove"
+        ))
     };
-    let Ok(json) = serde_json::from_slice::<Value>(&bytes) else { return EarlierImage::NotNamed };
+    let bytes = match read_bounded_bytes(gltf, EARLIER_GLTF_MAX_BYTES, Links::Refuse) {
+        Ok(bytes) => bytes,
+        Err(BoundedReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
+            return EarlierImage::Unknown(format!(
+                "no {gltf_name} is there to say it is an earlier export's to remove"
+            ));
+        }
+        Err(e) => return unreadable(&e),
+    };
+    let json = match serde_json::from_slice::<Value>(&bytes) {
+        Ok(json) => json,
+        Err(e) => return unreadable(&format_args!("not JSON: {e}")),
+    };
     let uri = uri_reference(image_file);
     match json["images"].as_array().into_iter().flatten().find(|image| image["uri"].as_str() == Some(&uri)) {
         Some(image) => EarlierImage::Named { sha256: image["extras"]["sha256"].as_str().map(String::from) },

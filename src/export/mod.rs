@@ -57,6 +57,14 @@ pub enum ExportError {
          itself); remove it and run again, or write to another folder"
     )]
     LockNotAFile { path: PathBuf, kind: &'static str },
+    /// A file with content where a set's lock goes: not a lock (snakeskin's are empty), so
+    /// not the run's to take and remove (a preset named `.NAME.lock` was removed by its own
+    /// export).
+    #[error(
+        "{path} holds {bytes} bytes, so it is not a lock of snakeskin's (an empty file it makes itself, named after \
+         the set, and removes when the run ends); move it away and run again, or write to another folder"
+    )]
+    LockHoldsData { path: PathBuf, bytes: u64 },
     #[error(
         "{path} exists and is not a folder, so nothing can be written into it; give the path of a folder (one that \
          exists, or one to create)"
@@ -64,8 +72,12 @@ pub enum ExportError {
     NotAFolder { path: PathBuf },
     /// An output file's path that ends as a folder's does (`out/`, `out/.`): it was written
     /// to after the work and failed with "Not a directory".
-    #[error("{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.png")]
-    FolderName { path: PathBuf },
+    /// The example's extension is the path's (`snake.glb/`), else `default_extension`.
+    #[error(
+        "{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.{}",
+        extension_or(.path, .default_extension)
+    )]
+    FolderName { path: PathBuf, default_extension: &'static str },
     /// An output that names one of the command's inputs (the preset file, the jobs file):
     /// it replaced the input, and the command could not be run again.
     #[error("{output} would be written over this command's input {input} (the same file); move or rename one of them")]
@@ -104,6 +116,14 @@ pub enum ExportError {
     Gltf(String),
 }
 
+/// The extension of the name `path` ends in (`snake.glb` of `snake.glb/`), else `default`.
+fn extension_or(path: &std::path::Path, default: &str) -> String {
+    match path.extension() {
+        Some(extension) if !extension.is_empty() => extension.to_string_lossy().into_owned(),
+        _ => default.into(),
+    }
+}
+
 impl ExportError {
     /// True when the user's input is at fault: an output folder that is not a folder, an
     /// output file that is something other than a file (a folder in its way included, as a
@@ -114,6 +134,7 @@ impl ExportError {
             ExportError::NotAFolder { .. }
                 | ExportError::NotAFile { .. }
                 | ExportError::LockNotAFile { .. }
+                | ExportError::LockHoldsData { .. }
                 | ExportError::FolderInTheWay { .. }
                 | ExportError::FolderName { .. }
                 | ExportError::NamedForAnotherFormat { .. }
