@@ -321,8 +321,9 @@ pub struct ExportArgs {
     /// with a film of more than one thickness, NAME.thickness.png beside it).
     #[arg(long, value_name = "FILE")]
     pub gltf: PathBuf,
-    /// Texture width in pixels, 16 to 16384 (a body atlas is `body.length` widths tall;
-    /// WebGL viewers commonly load textures up to 16384 texels a side).
+    /// Texture width in pixels, 16 to 16384 (a body atlas is `body.length` widths tall, at
+    /// most 65535 rows: 5461 wide at the default length 12; WebGL viewers commonly load
+    /// textures up to 16384 texels a side).
     #[arg(long, default_value_t = 1024, value_parser = ranged_u64(16, 16384))]
     pub size: u64,
     /// snake (the preview's body), sphere (the material alone, tile layout) or plane.
@@ -900,10 +901,24 @@ fn parse_image_size(text: &str) -> Result<ImageSize, String> {
             (s, s)
         }
     };
-    if !range.contains(&w) || !range.contains(&h) {
-        return Err(bad());
-    }
-    Ok(ImageSize { width: w, height: h })
+    // The side out of range named, as a number outside the range cannot be seen from the
+    // range alone in a long `--size 10240x720`.
+    let side = |name: &str, pixels: u32| -> Result<u32, String> {
+        match range.contains(&pixels) {
+            true => Ok(pixels),
+            false => Err(format!(
+                "the {name} {pixels} is out of range: each side {} to {} pixels",
+                range.start(),
+                range.end()
+            )),
+        }
+    };
+    let square = !text.contains(['x', 'X']);
+    let (width, height) = match square {
+        true => (side("size", w)?, h),
+        false => (side("width", w)?, side("height", h)?),
+    };
+    Ok(ImageSize { width, height })
 }
 
 fn parse_view(text: &str) -> Result<View, String> {
@@ -1218,5 +1233,16 @@ mod tests {
             assert_eq!(rows_named(&help), [MAX_TEXTURE_SIDE], "{name} --map-size: {help:?}");
         }
         assert_ne!(rows_named("more than 4096 rows long"), [MAX_TEXTURE_SIDE]);
+    }
+
+    #[test]
+    fn an_image_size_out_of_range_names_its_side() {
+        assert_eq!(parse_image_size("640x400"), Ok(ImageSize { width: 640, height: 400 }));
+        assert_eq!(parse_image_size("16"), Ok(ImageSize { width: 16, height: 16 }));
+        let said = |text: &str| parse_image_size(text).unwrap_err();
+        assert!(said("100000x300").starts_with("the width 100000 is out of range: "), "{}", said("100000x300"));
+        assert!(said("300x0").starts_with("the height 0 is out of range: "), "{}", said("300x0"));
+        assert!(said("9000").starts_with("the size 9000 is out of range: "), "{}", said("9000"));
+        assert!(said("300xten").starts_with("expected WIDTHxHEIGHT"), "{}", said("300xten"));
     }
 }
