@@ -626,6 +626,12 @@ fn a_name_one_toml_away_from_a_preset_gets_the_fix() {
                 built-in preset natrix-natrix, give its name without a path or .toml";
     assert!(err.contains(says), "{err}");
     assert!(!run("natrix-natrixx.toml").contains("built-in preset"));
+    // A path that is no file is the file's error (it was "not a .toml file and not a
+    // built-in preset", where the README says `./NAME` reads the file).
+    let err = run("./your-snake");
+    assert!(err.contains("cannot read preset ./your-snake: No such file or directory"), "{err}");
+    let err = run("./natrix-natrix");
+    assert!(err.contains("; to use the built-in preset natrix-natrix, give its name without a path"), "{err}");
     // A folder is called one (it was only "not a .toml file and not a built-in preset").
     std::fs::create_dir(dir.path().join("snakes")).unwrap();
     assert!(run("snakes").contains("; snakes is a folder: name a .toml file in it"), "{}", run("snakes"));

@@ -150,6 +150,15 @@ pub fn bench_irid(d_step_nm: f64, angle_step_deg: f64, methods: &[Method]) -> Ve
 mod tests {
     use super::*;
 
+    /// The finest grids `bench irid --d-step-nm`'s help names: about 1.8 nm at 1° angle
+    /// steps, 0.1 nm over 22.25° (it said 2 nm and 25°, which were not the limits).
+    #[test]
+    fn the_finest_grids_the_help_names_are_the_limits() {
+        let fits = |d: f64, a: f64| grid_points(d, a) <= MAX_GRID_POINTS;
+        assert!(fits(1.802, 1.0) && !fits(1.80, 1.0));
+        assert!(fits(0.1, 22.26) && !fits(0.1, 22.25));
+    }
+
     #[test]
     fn grid_points_counts_the_grid_without_building_it() {
         for (d, a) in [(10.0, 1.0), (50.0, 11.0), (7.0, 3.0), (0.5, 89.0), (2000.0, 0.7), (3.3, 2.9)] {

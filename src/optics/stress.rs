@@ -89,13 +89,12 @@ impl Draw {
     }
 }
 
-pub fn run(samples: u64, seed: u64) -> StressReport {
+pub fn run(samples: u64, seed: u32) -> StressReport {
     let luts: Vec<Lut> = STRESS_MATERIALS.iter().map(|s| Lut::bake_default(*s)).collect();
-    let seed32 = (seed ^ (seed >> 32)) as u32;
     let partials: Vec<StressReport> = (0..samples)
         .into_par_iter()
         .fold(empty, |mut acc, index| {
-            sample(&mut acc, &luts, Draw { seed: seed32, index, stream: 0 });
+            sample(&mut acc, &luts, Draw { seed, index, stream: 0 });
             acc
         })
         .collect();

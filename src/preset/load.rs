@@ -62,7 +62,9 @@ pub const MAX_PRESET_BYTES: u64 = 1 << 20;
 
 /// Whether a preset argument, as `written`, names the file at `path` (the argument itself,
 /// or a jobs file's entry joined to its folder) rather than a built-in preset: a name ending
-/// in `.toml`, or anything but a folder that exists there — but never a built-in preset's
+/// in `.toml`, anything but a folder that exists there, or a path with a `/` that is no
+/// folder (no built-in's name has one: `./my-snake` missing said "not a .toml file and not a
+/// built-in preset", where the file's error was meant) — but never a built-in preset's
 /// exact name, which is the built-in wherever it is written (`./NAME` names a file of that
 /// name). A folder never is: a set's folder is named after its preset, so `generate
 /// natrix-natrix -o natrix-natrix` run twice (and a batch whose jobs file lies in its
@@ -70,7 +72,9 @@ pub const MAX_PRESET_BYTES: u64 = 1 << 20;
 /// gallery written as `-o natrix-natrix`) was read, silently, instead of the built-in.
 pub fn names_a_file(written: &str, path: &Path) -> bool {
     library::get(written).is_none()
-        && (path.to_string_lossy().ends_with(".toml") || std::fs::metadata(path).is_ok_and(|m| !m.is_dir()))
+        && (path.to_string_lossy().ends_with(".toml")
+            || std::fs::metadata(path).is_ok_and(|m| !m.is_dir())
+            || (written.contains('/') && !path.is_dir()))
 }
 
 /// The file a PRESET argument reads (`read_source`), or None for a built-in preset: what no

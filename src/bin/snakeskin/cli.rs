@@ -428,8 +428,9 @@ pub struct PreviewArgs {
     /// unlit on the body (map:color, map:height, map:normal, map:roughness, map:iridescence).
     #[arg(long, default_value = "all", value_name = "STAGE", value_parser = parse_view)]
     pub layers: View,
-    /// Film colour method: lut (default), rgb3, spectral-N (e.g. spectral-16), gaussian-fit,
-    /// or spectral (the 1 nm reference sum in the shader, spectral-421: slow, for checks).
+    /// Film colour method: lut (default), rgb3, spectral-N (N = 1 to 421, e.g. spectral-16),
+    /// gaussian-fit, or spectral (the 1 nm reference sum in the shader, spectral-421: slow,
+    /// for checks).
     #[arg(long, default_value = "lut", value_name = "M", value_parser = parse_gpu_method)]
     pub method: GpuFilmMethod,
     /// Layer model: layered (default; the stack's transport: (n0/n2)², internal
@@ -595,7 +596,8 @@ pub enum BrdfCommand {
         #[arg(long, required_unless_present = "batch", value_parser = parse_angle_deg)]
         angle_deg: Option<f64>,
         /// Colour method: spectral (the reference: the exact film summed at 1 nm over CIE
-        /// 1931 2° under D65), rgb3, spectral-N (e.g. spectral-16), gaussian-fit, lut.
+        /// 1931 2° under D65), rgb3, spectral-N (N = 1 to 421, e.g. spectral-16), gaussian-fit,
+        /// lut.
         #[arg(long, default_value = "spectral", value_parser = parse_method)]
         method: Method,
         /// Read JSON objects {n0, n1, n2, thickness_nm, angle_deg, method}, one per line, from
@@ -628,7 +630,8 @@ pub enum BrdfCommand {
         /// Output PNG file.
         #[arg(short, long)]
         out: PathBuf,
-        /// Colour method (spectral = the 1 nm reference).
+        /// Colour method: spectral (the 1 nm reference), rgb3, spectral-N (N = 1 to 421),
+        /// gaussian-fit, lut.
         #[arg(long, default_value = "spectral", value_parser = parse_method)]
         method: Method,
         /// Chart width in pixels (thickness samples), 2 to 4096.
@@ -648,8 +651,9 @@ pub enum BrdfCommand {
         /// on two cores).
         #[arg(long, default_value_t = 100_000, value_parser = ranged_u64(1, 10_000_000))]
         samples: u64,
-        /// Seed of the sample generator.
-        #[arg(long, default_value_t = 1, value_parser = ranged_u64(0, u64::MAX))]
+        /// Seed of the sample generator, 0 to 4294967295 (its hash takes 32 bits: a larger
+        /// seed was folded onto a smaller one's samples).
+        #[arg(long, default_value_t = 1, value_parser = ranged_u64(0, u32::MAX as u64))]
         seed: u64,
         /// Print one JSON object instead of a table.
         #[arg(long)]
@@ -661,14 +665,15 @@ pub enum BrdfCommand {
 pub struct EvalArgs {
     #[command(flatten)]
     pub stack: StackArgs,
-    /// Direction towards the light, x,y,z (need not be normalised; at least 1e-6 long).
+    /// Direction towards the light, x,y,z (need not be normalised; at least 1e-6 long, each
+    /// number at most 1e6 in size).
     #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     pub wi: [f64; 3],
-    /// Direction towards the viewer, x,y,z (at least 1e-6 long).
+    /// Direction towards the viewer, x,y,z (as --wi).
     #[arg(long, value_parser = parse_direction, allow_hyphen_values = true)]
     pub wo: [f64; 3],
-    /// Shading normal, x,y,z (a zero vector falls back to 0,0,1, as a blank normal map does).
-    #[arg(long, value_parser = parse_vec3, default_value = "0,0,1", allow_hyphen_values = true)]
+    /// Shading normal, x,y,z (as --wi; 0,0,0 falls back to 0,0,1, as a blank normal map does).
+    #[arg(long, value_parser = parse_normal, default_value = "0,0,1", allow_hyphen_values = true)]
     pub normal: [f64; 3],
     #[command(flatten)]
     pub layer: LayerArgs,
@@ -690,7 +695,8 @@ pub struct LayerArgs {
     /// Film thickness in nm (thesis δ0), 0 to 10,000,000 (10 mm).
     #[arg(long, default_value_t = thesis::FILM_THICKNESS_NM, value_parser = parse_thickness_nm)]
     pub thickness_nm: f64,
-    /// Perceptual roughness (GGX α = roughness²), 0 to 1.
+    /// Perceptual roughness (GGX α = roughness², floored at α 0.001: below about 0.032 all read
+    /// as 0.032, a mirror to the eye), 0 to 1.
     #[arg(long, default_value_t = 0.35, value_parser = parse_unit)]
     pub roughness: f64,
     /// Absorption coefficient σ0 (one value, or r,g,b), each 0 to 100. The default is the
@@ -830,7 +836,7 @@ pub enum BenchCommand {
         plot: Option<PathBuf>,
         /// Thickness step of the grid in nm (the grid spans 0..2000 nm), 0.1 to 2000; the grid
         /// takes at most 400,000 points over its four materials, so with 1° angle steps the
-        /// finest is 2 nm (0.1 nm needs angle steps of 25° or more).
+        /// finest is about 1.8 nm (0.1 nm needs angle steps over 22.25°).
         #[arg(long, default_value_t = 10.0, value_parser = parse_d_step_nm)]
         d_step_nm: f64,
         /// Angle step of the grid in degrees (0..89°), 0.1 to 89.
@@ -1026,6 +1032,16 @@ fn parse_direction(text: &str) -> Result<[f64; 3], String> {
     Ok(v)
 }
 
+/// A shading normal: a direction, or exactly 0,0,0 (the BRDF's fallback to 0,0,1). A normal
+/// of 1e-9,0,0 was normalised to +x and one of 1e-300,0,0 fell back to +z (its squared length
+/// underflows), while --wi refused both.
+fn parse_normal(text: &str) -> Result<[f64; 3], String> {
+    match parse_vec3(text)? {
+        [0.0, 0.0, 0.0] => Ok([0.0; 3]),
+        _ => parse_direction(text).map_err(|e| format!("{e}; or 0,0,0 for the fallback to 0,0,1")),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1122,7 +1138,7 @@ mod tests {
             (&["preview", "natrix-natrix", "--out", "a.png", "--snakes"], "is not in 1..=400", "400"),
             (&["preview", "natrix-natrix", "--window", "--frames"], "is not in 1..=1000000", "1000000"),
             (&["batch", "jobs.toml", "-o", "out", "--concurrent"], "is not in 1..=16", "16"),
-            (&["brdf", "stress", "--seed"], "is not in 0..=18446744073709551615", "18446744073709551615"),
+            (&["brdf", "stress", "--seed"], "is not in 0..=4294967295", "4294967295"),
             (&["generate", "natrix-natrix", "--seed"], "is not in 0..=9007199254740991", "9007199254740991"),
         ] {
             for word in ["1.5", "-1", huge] {
@@ -1233,6 +1249,17 @@ mod tests {
             assert_eq!(rows_named(&help), [MAX_TEXTURE_SIDE], "{name} --map-size: {help:?}");
         }
         assert_ne!(rows_named("more than 4096 rows long"), [MAX_TEXTURE_SIDE]);
+    }
+
+    #[test]
+    fn a_normal_is_a_direction_or_zero() {
+        assert_eq!(parse_normal("0,0,0"), Ok([0.0; 3]));
+        assert_eq!(parse_normal("-0,0,0"), Ok([0.0; 3]));
+        assert_eq!(parse_normal("0,2,0"), Ok([0.0, 2.0, 0.0]));
+        for tiny in ["1e-9,0,0", "1e-300,0,0"] {
+            let said = parse_normal(tiny).unwrap_err();
+            assert!(said.contains("at least 1e-6 long") && said.contains("or 0,0,0"), "{tiny}: {said}");
+        }
     }
 
     #[test]

@@ -372,7 +372,7 @@ fn chosen_species(species: &[String]) -> Result<Vec<(&'static str, &'static str)
     if species.is_empty() {
         return Ok(library::all().to_vec());
     }
-    species
+    let chosen: Vec<(&'static str, &'static str)> = species
         .iter()
         .map(|name| {
             // `a, b` is two names: the space is the list's, not the name's.
@@ -391,7 +391,17 @@ fn chosen_species(species: &[String]) -> Result<Vec<(&'static str, &'static str)
                 }
             })
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    // A name twice drew two identical cells without a word: likely a slip for another name.
+    for (k, (name, _)) in chosen.iter().enumerate() {
+        if chosen[..k].iter().any(|(earlier, _)| earlier == name) {
+            return Err(Error::InvalidOption {
+                option: "--species",
+                reason: format!("{name} is listed twice (a sheet shows each species once)"),
+            });
+        }
+    }
+    Ok(chosen)
 }
 
 /// Renders the sheet `plan` lays out and writes it as a PNG (atomically).
@@ -447,6 +457,8 @@ mod tests {
         assert!(error.contains("an empty name in the list"), "{error}");
         let error = names(&["natrix"]).unwrap_err().to_string();
         assert!(error.contains("did you mean natrix-natrix?"), "{error}");
+        let error = names(&["natrix-natrix", "vipera-berus", " natrix-natrix"]).unwrap_err().to_string();
+        assert!(error.contains("natrix-natrix is listed twice"), "{error}");
     }
 
     /// One species on eight columns made a canvas of eight cells, seven empty.

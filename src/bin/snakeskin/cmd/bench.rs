@@ -4,7 +4,7 @@
 use anyhow::Result;
 
 use crate::cli::BenchCommand;
-use crate::output::ensure_parent_folder;
+use crate::output::{ensure_parent_folder, path_line};
 use crate::progress::Progress;
 use snakeskin::Error;
 use snakeskin::optics::accuracy::{MAX_GRID_POINTS, Prepared, grid, grid_points, measure, reference_colours};
@@ -73,6 +73,8 @@ fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<(
             .collect();
         let svg = snakeskin::optics::plot::error_vs_cost_svg(&points, snakeskin::optics::brdf::Model::default().name());
         snakeskin::export::write_file_atomically(path, svg.into_bytes())?;
+        // On stderr, as `brdf chart` says its file: stdout may be the JSON.
+        eprintln!("wrote {}", path_line(path));
     }
     if json {
         println!("{}", serde_json::to_string(&report)?);
@@ -169,6 +171,7 @@ fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_d
     if let Some(path) = plot {
         let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default);
         snakeskin::export::write_file_atomically(path, svg.into_bytes())?;
+        eprintln!("wrote {}", path_line(path));
     }
     Ok(())
 }

@@ -15,10 +15,21 @@ pub fn run(args: GraphArgs) -> Result<()> {
     if args.dot {
         print!("{}", to_dot(&graph, maps));
     } else {
-        for id in graph.reachable(maps) {
-            let node = graph.node(id);
-            let inputs: Vec<&str> = node.inputs.iter().map(|i| graph.node(*i).name.as_str()).collect();
-            println!("{:<28} {:<36} <- {}", node.name, node.op.label(), inputs.join(", "));
+        let rows: Vec<[String; 3]> = graph
+            .reachable(maps)
+            .into_iter()
+            .map(|id| {
+                let node = graph.node(id);
+                let inputs: Vec<&str> = node.inputs.iter().map(|i| graph.node(*i).name.as_str()).collect();
+                [node.name.clone(), node.op.label(), inputs.join(", ")]
+            })
+            .collect();
+        // Columns as wide as their longest entry: a label longer than a fixed width pushed
+        // its row's inputs out of line.
+        let width = |k: usize| rows.iter().map(|row| row[k].chars().count()).max().unwrap_or(0);
+        let (name_width, label_width) = (width(0), width(1));
+        for [name, label, inputs] in &rows {
+            println!("{name:<name_width$}  {label:<label_width$}  <- {inputs}");
         }
     }
     Ok(())
