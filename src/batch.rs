@@ -369,10 +369,13 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         let lines = JobLines { preset: line("preset"), set: line("set"), sizes: line("sizes") };
         // A preset path is relative to the jobs file, by the rule `generate` applies to its
         // argument relative to the working folder (`preset::names_a_file`); anything else
-        // is a built-in preset.
+        // is a built-in preset. An entry with a `/` is a path even where it names a folder
+        // there (refused as one): left as written, it was looked for in the working folder.
         let relative = Path::new(&table.preset).is_relative().then(|| base.join(&table.preset));
         let preset = match relative {
-            Some(path) if crate::preset::names_a_file(&table.preset, &path) => path.to_string_lossy().into_owned(),
+            Some(path) if crate::preset::names_a_file(&table.preset, &path) || table.preset.contains('/') => {
+                path.to_string_lossy().into_owned()
+            }
             _ => table.preset.clone(),
         };
         let maps = match &table.maps {
@@ -973,7 +976,8 @@ fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard, for_run
             // Its folder and files, as `Plan::run` checks them, but before any job has
             // written its set: a folder in a later job's way stopped the run after the
             // earlier jobs' sets were written. Nor any of them the jobs file or a preset.
-            check_set_outputs(&request.out_dir, &r.files, &inputs).map_err(|e| planned(job.lines.preset, e.into()))?;
+            check_set_outputs(&request.out_dir, &r.outcome.preset, &r.files, &inputs)
+                .map_err(|e| planned(job.lines.preset, e.into()))?;
             // And that its folder can be written (or made), each folder once: a read-only one
             // stopped the run when its job came, after the jobs before it.
             if for_run && let Some(file) = r.files.last() {

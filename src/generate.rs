@@ -115,16 +115,23 @@ pub fn set_file_names(loaded: &LoadedPreset, request: &GenerateRequest) -> Vec<S
 /// (`Plan::check_outputs`), none of them one of `inputs`, the command's inputs besides the
 /// set's own preset (a batch's jobs file and its other jobs' preset files: kept among a
 /// set's files, the jobs file was replaced by the set's manifest, and the batch could not be
-/// run again). None can be the set's own preset file: the set's names are its file stem
-/// with a suffix, `NAME_color.png`, `NAME.material.json`.
-pub fn check_set_outputs(out_dir: &Path, files: &[String], inputs: &export::Inputs) -> Result<(), export::ExportError> {
+/// run again). None of the files can be the set's own preset file: the set's names are its
+/// file stem with a suffix, `NAME_color.png`, `NAME.material.json`; but the set's lock
+/// (`.NAME.lock`, `name` the set's), which the run removes as it ends, can be, so it is
+/// checked against `inputs` too: `generate ./.preset.lock` removed its own (empty) preset.
+pub fn check_set_outputs(
+    out_dir: &Path,
+    name: &str,
+    files: &[String],
+    inputs: &export::Inputs,
+) -> Result<(), export::ExportError> {
     export::check_folder(out_dir)?;
     for file in files {
         let target = out_dir.join(file);
         export::check_target(&target)?;
         inputs.check(&target)?;
     }
-    Ok(())
+    inputs.check(&out_dir.join(export::lock_file_name(name)))
 }
 
 /// `Pack::size_problem` for a set `size` wide in `layout`, with the largest size whose
@@ -207,7 +214,13 @@ impl Plan {
             ));
         }
         if height > MAX_HEIGHT {
-            return Err(Error::Height { width: size, height, max: MAX_HEIGHT, size_option: size_option(request) });
+            // The widest that fits, named (a body atlas's height is rounded, so it is searched
+            // for down from the width in proportion).
+            let layout = request.options.layout;
+            let start = (MAX_HEIGHT * size / height).saturating_add(1).min(size);
+            let fits = (1..=start).rev().find(|&w| layout.height(&loaded.preset, w) <= MAX_HEIGHT).unwrap_or(1);
+            let size_option = size_option(request);
+            return Err(Error::Height { width: size, height, max: MAX_HEIGHT, size_option, fits });
         }
         let maps = match request.pack {
             Some(pack) => pack.maps(has_film(&loaded.preset), request.ao),
@@ -264,7 +277,8 @@ impl Plan {
     /// set had been evaluated and encoded (the commit checks again: the folder may change).
     /// `run` calls it, and a batch for every job before the first runs.
     pub fn check_outputs(&self) -> Result<(), export::ExportError> {
-        check_set_outputs(&self.request.out_dir, &self.file_names(), &export::Inputs::default())
+        let preset = crate::preset::input_file(&self.request.preset);
+        check_set_outputs(&self.request.out_dir, &self.loaded.name, &self.file_names(), &export::Inputs::new(preset))
     }
 
     /// Runs the plan. `progress(done, total)` reports node evaluations.

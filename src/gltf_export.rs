@@ -9,12 +9,12 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use crate::export::SetLock;
 use crate::export::gltf::{
     EarlierImage, GltfMaterial, GltfTextures, earlier_image, glb, gltf_files, gltf_image_file_name,
     gltf_side_file_names,
 };
 use crate::export::pack::Pack;
+use crate::export::{Earlier, KeptBecause, KeptFile, SetLock};
 use crate::generate::{GenerateRequest, Plan};
 use crate::graph::EvalStats;
 use crate::maps::{Layout, has_film, thickness_range_nm};
@@ -65,7 +65,7 @@ pub struct ExportReport {
     /// Such files that stay, with why (changed since the earlier export wrote them, or they
     /// would not go), for the caller to say: the export stands, and the file beside it is no
     /// longer referenced.
-    pub kept: Vec<(PathBuf, String)>,
+    pub kept: Vec<KeptFile>,
 }
 
 /// The most bytes of an earlier export's image hashed to compare with its record: a PNG of
@@ -78,24 +78,20 @@ const EARLIER_IMAGE_MAX_BYTES: u64 =
 /// Removes an earlier export's image that this one no longer references, unless it changed
 /// since that export wrote it (`recorded`: its SHA-256 there, None where none was recorded;
 /// `regular`: a regular file, which an export writes, where anything else is not opened).
-/// None when it went; else why it stays, in words.
-fn stale_image_stays(path: &Path, regular: bool, recorded: Option<&str>) -> Option<String> {
+/// None when it went; else why it stays.
+fn stale_image_stays(path: &Path, regular: bool, recorded: Option<&str>) -> Option<KeptBecause> {
     if let Some(recorded) = recorded {
         if !regular {
-            return Some("it is not a regular file, so it is not the earlier export's to remove".into());
+            return Some(KeptBecause::NotAFile);
         }
         let links = crate::text_file::Links::Refuse;
         match crate::export::set_file_sha256(path, EARLIER_IMAGE_MAX_BYTES, links) {
             Ok(now) if now == recorded => {}
-            Ok(_) => {
-                return Some(
-                    "it changed since the earlier export wrote it, so it is not that export's to remove".into(),
-                );
-            }
-            Err(e) => return Some(format!("it could not be read to compare with the earlier export's record ({e})")),
+            Ok(_) => return Some(KeptBecause::ChangedSince),
+            Err(e) => return Some(KeptBecause::Unreadable(e.to_string())),
         }
     }
-    std::fs::remove_file(path).err().map(|e| format!("it is the earlier export's and could not be removed ({e})"))
+    std::fs::remove_file(path).err().map(|e| KeptBecause::WouldNotMove(e.to_string()))
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
@@ -103,7 +99,7 @@ fn is_binary(path: &Path) -> Result<bool, Error> {
     let text = path.to_string_lossy();
     if crate::export::ends_as_a_folder(path) {
         // The one message every output file gets (`export::check_target`).
-        return Err(crate::export::ExportError::FolderName { path: path.into(), default_extension: "glb" }.into());
+        return Err(crate::export::ExportError::folder_name(path, &["glb", "gltf"]).into());
     }
     // `.glb` alone: a name that is all extension (`Path::extension` sees none).
     let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
@@ -238,6 +234,9 @@ impl ExportPlan {
         let input = crate::preset::input_file(&request.preset);
         crate::export::check_target(&request.out)?;
         crate::export::check_not_an_input(&request.out, input)?;
+        // The lock the export takes and removes (`.NAME.lock`): a preset file of that name,
+        // an empty one (a valid preset) not refused as a lock with content, was removed.
+        crate::export::check_not_an_input(&dir.join(crate::export::lock_file_name(&name)), input)?;
         for file in side_files {
             let target = dir.join(file);
             crate::export::check_target(&target)?;
@@ -331,7 +330,7 @@ impl ExportPlan {
                     other => other.why_it_stays(&gltf_name),
                 };
                 match stays {
-                    Some(why) => kept.push((stale, why)),
+                    Some(why) => kept.push(KeptFile { path: stale, why, by: Earlier::Export }),
                     None => removed.push(stale),
                 }
             }

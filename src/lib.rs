@@ -40,10 +40,10 @@ pub enum Error {
     #[error("invalid --size {size}: accepted sizes are {lo} to {hi} pixels", lo = SIZE_RANGE.start(), hi = SIZE_RANGE.end())]
     Size { size: u64 },
     #[error(
-        "a body atlas {width} wide is {height} tall (body.length widths), over the {max} rows a map may have; use a \
-         smaller {size_option}"
+        "a body atlas {width} wide is {height} tall (body.length widths), over the {max} rows a map may have; give \
+         {size_option} {fits} or less, or a shorter body.length"
     )]
-    Height { width: usize, height: usize, max: usize, size_option: &'static str },
+    Height { width: usize, height: usize, max: usize, size_option: &'static str, fits: usize },
     /// A combination of options the tool does not support (yet).
     #[error("{0}")]
     Unsupported(String),

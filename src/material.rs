@@ -322,8 +322,13 @@ impl<'de> Deserialize<'de> for Absorption {
                 for (i, slot) in rgb.iter_mut().enumerate() {
                     *slot = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &self))?;
                 }
-                if seq.next_element::<f64>()?.is_some() {
-                    return Err(de::Error::invalid_length(4, &self));
+                // The length said is the list's (it said 4 for any longer list).
+                let mut length = 3;
+                while seq.next_element::<de::IgnoredAny>()?.is_some() {
+                    length += 1;
+                }
+                if length > 3 {
+                    return Err(de::Error::invalid_length(length, &self));
                 }
                 Ok(Absorption(rgb))
             }

@@ -430,7 +430,7 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
         (
             "layout = \"body\"\nsizes = [5500]",
             "jobs.toml:8: [[job]] 2 (natrix-natrix): a body atlas 5500 wide is 66000 tall (body.length widths), over \
-             the 65535 rows a map may have; use a smaller size",
+             the 65535 rows a map may have; give size 5461 or less, or a shorter body.length",
         ),
     ] {
         let text = format!(
@@ -526,6 +526,33 @@ fn a_file_named_like_a_built_in_preset_does_not_replace_it() {
     std::fs::write(dir.path().join("jobs.toml"), "[[job]]\npreset = \"natrix-natrix\"\nsizes = [16]\n").unwrap();
     let out = run(&["batch", "jobs.toml", "-o", "batch"]);
     assert!(out.status.success(), "{}", stderr(&out));
+}
+
+/// A jobs file's entry with a `/` is a path in the jobs file's folder from any working folder,
+/// even where it names a folder there (refused as one): it was looked for in the working
+/// folder, which read a file of that path there, or said it had no such file. Negative
+/// control: the same entry naming a preset file in the jobs file's folder runs.
+#[test]
+fn a_jobs_entry_with_a_slash_is_in_the_jobs_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs_dir = dir.path().join("J");
+    std::fs::create_dir_all(jobs_dir.join("sub/name")).unwrap();
+    std::fs::write(jobs_dir.join("jobs.toml"), "[[job]]\npreset = \"sub/name\"\nsizes = [16]\n").unwrap();
+    // A preset of that path in the working folder, which the batch must not read.
+    std::fs::create_dir_all(dir.path().join("sub")).unwrap();
+    std::fs::write(dir.path().join("sub/name"), "seed = 1\n").unwrap();
+    let run = || {
+        let args = ["batch", "J/jobs.toml", "-o", "out"];
+        Command::new(env!("CARGO_BIN_EXE_snakeskin")).args(args).current_dir(dir.path()).output().unwrap()
+    };
+    let out = run();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("J/sub/name is a folder: name a .toml file in it"), "{}", stderr(&out));
+    std::fs::remove_dir(jobs_dir.join("sub/name")).unwrap();
+    std::fs::write(jobs_dir.join("sub/name"), "seed = 2\n").unwrap();
+    let out = run();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.path().join("out/name/tile-16-seed2-png").is_dir(), "{}", stdout(&out));
 }
 
 /// `ao = true` with a pack puts the ambient occlusion map in the pack's occlusion channel,

@@ -356,6 +356,15 @@ fn a_body_atlas_too_long_or_a_bad_body_key_is_refused_with_its_key() {
     let out = common::snakeskin(&["generate", "crotalus-atrox", "-o", d, "--size", "16384", "--layout", "body"]);
     assert_eq!(out.status.code(), Some(2), "{}", common::stderr(&out));
     assert!(common::stderr(&out).contains("body.length"), "{}", common::stderr(&out));
+    // The widest that fits, named: its atlas is at most 65535 rows, one pixel wider's more.
+    let fits: usize = common::stderr(&out)
+        .split("give --size ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next()?.parse().ok())
+        .unwrap_or_else(|| panic!("no width named: {}", common::stderr(&out)));
+    let preset = snakeskin::preset::load("crotalus-atrox", &[], None).unwrap().preset;
+    let layout = snakeskin::maps::Layout::Body;
+    assert!(layout.height(&preset, fits) <= 65535 && layout.height(&preset, fits + 1) > 65535, "{fits}");
     for (key, value) in [("body.ventrals", "10"), ("body.tail_fraction", "0.9"), ("pattern.0.widen_to_tail", "9")] {
         let set = format!("{key}={value}");
         let out = common::snakeskin(&["generate", "crotalus-atrox", "-o", d, "--layout", "body", "--set", &set]);

@@ -106,7 +106,7 @@ fn the_memory_estimate_of_a_drawing_is_above_its_peak() {
     let xvfb = ["xvfb-run", "-a", "-s", "-screen 0 2100x1100x24"];
     let cases: [Vec<&str>; 7] = [
         [&["sheet", "-o", sheet][..], &body].concat(),
-        vec!["sheet", "-o", sheet, "--tile", "256", "--map-size", "1024", "--species", "natrix-natrix,natrix-natrix"],
+        vec!["sheet", "-o", sheet, "--tile", "256", "--map-size", "1024", "--species", "natrix-natrix,vipera-berus"],
         vec!["sheet", "-o", sheet, "--tile", "64", "--map-size", "2048", "--species", "natrix-natrix"],
         vec!["preview", PLAIN_PRESET, "--out", image, "--map-size", "2048", "--size", "16x16"],
         vec!["preview", PLAIN_PRESET, "--out", image, "--map-size", "256", "--size", "2048x1024"],

@@ -35,6 +35,19 @@ fn accepted(preset: &str, extra: &[&str]) {
     assert!(out.status.success(), "{preset} {extra:?}: {}", stderr(&out));
 }
 
+/// An absorption list of the wrong length says its length (any longer list said 4).
+/// Negative control: three numbers are accepted.
+#[test]
+fn an_absorption_list_of_the_wrong_length_says_its_length() {
+    for (list, length) in [("[1, 2]", 2), ("[1, 2, 3, 4, 5]", 5), ("[1, 2, 3, 4, \"x\"]", 5)] {
+        let err = refused("a.toml", &format!("[optics]\nabsorption = {list}\n"), &[]);
+        let says = format!("invalid length {length}, expected a number or [r, g, b]");
+        assert!(err.contains(&says) && err.contains("optics.absorption"), "{list}: {err}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    accepted(&write_preset(dir.path(), "a.toml", "[optics]\nabsorption = [1, 2, 3]\n"), &[]);
+}
+
 #[test]
 fn toml_syntax_error_names_file_and_line() {
     let err = refused("broken.toml", "seed = 1\n\n[scales]\nrows = = 3\n", &[]);

@@ -226,9 +226,12 @@ fn an_upper_case_extension_names_the_file_written() {
     assert!(dir.path().join("UP.bin").is_file());
     // A name that ends as a folder's is refused with an example of its own kind (it said
     // "as in out/snake.png", a name `--gltf` refuses).
-    for (given, example) in
-        [("x.glb/", "as in out/snake.glb"), ("x.gltf/.", "as in out/snake.gltf"), ("x/", "as in out/snake.glb")]
-    {
+    for (given, example) in [
+        ("x.glb/", "as in out/snake.glb"),
+        ("x.gltf/.", "as in out/snake.gltf"),
+        ("x/", "as in out/snake.glb"),
+        ("x.png/", "as in out/snake.glb"),
+    ] {
         let out = snakeskin(&["export", "xenopeltis-unicolor", "--gltf", &format!("{}/{given}", dir.path().display())]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
         assert!(stderr(&out).contains(example), "{given}: {}", stderr(&out));
@@ -293,11 +296,11 @@ fn an_export_without_a_film_keeps_a_thickness_image_it_did_not_write() {
     assert_eq!(std::fs::read(&mine).unwrap(), b"someone else's", "{}", stderr(&out));
     assert!(!stderr(&out).contains("removed"), "{}", stderr(&out));
     let kept = format!("warning: kept {}, which this export does not reference: ", mine.display());
-    assert!(stderr(&out).contains(&format!("{kept}the x.gltf there did not name it")), "{}", stderr(&out));
+    assert!(stderr(&out).contains(&format!("{kept}the x.gltf there does not record it")), "{}", stderr(&out));
 
     // An export with a film, then its `.gltf` gone or broken: its image stays, said.
     for (broken, why) in
-        [(None, "no x.gltf is there to say"), (Some(&b"{broken"[..]), "the x.gltf there could not be read (not JSON")]
+        [(None, "no x.gltf is there to say"), (Some(&b"{broken"[..]), "the x.gltf there could not be used (not JSON")]
     {
         let gltf = export(dir.path(), "liasis-mackloti", "x.gltf", &["--mesh", "plane"]);
         let image = std::fs::read(&mine).unwrap();

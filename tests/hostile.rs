@@ -966,8 +966,16 @@ fn a_planted_symlink_at_a_temporary_name_is_not_followed() {
     let glb = sets.path().join(format!("{PRESET}.glb"));
     let out = snakeskin(&["export", lock.to_str().unwrap(), "--gltf", glb.to_str().unwrap(), "--size", "16"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("would be written over this command's input"), "{}", stderr(&out));
     assert_eq!(std::fs::read(&lock).unwrap(), preset, "the file at the lock changed");
     assert_eq!(std::fs::read_dir(sets.path()).unwrap().count(), 1, "only the file there");
+    // An empty preset there (all defaults) is the export's input, which its lock would be:
+    // refused as such (it was taken as the lock and removed).
+    std::fs::write(&lock, b"").unwrap();
+    let out = snakeskin(&["export", lock.to_str().unwrap(), "--gltf", glb.to_str().unwrap(), "--size", "16"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("would be written over this command's input"), "{}", stderr(&out));
+    assert!(lock.exists(), "the preset at the lock was removed");
     // Negative control: with it gone (or empty, as a killed run leaves its lock) the same
     // run writes its set.
     std::fs::write(&lock, b"").unwrap();
@@ -1500,6 +1508,8 @@ fn preview_output_names_are_checked_before_the_work() {
         (vec!["--out", &at("sub/../same.png"), "--reference", &same], "--out and --reference name one file".into()),
         (vec!["--out", &format!("{}/", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
         (vec!["--out", &format!("{}/.", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
+        // Its example a PNG's name whatever the folder's (`shots.d/` said "as in out/snake.d").
+        (vec!["--out", &format!("{}/", at("shots.d"))], "give a file name, as in out/snake.png".into()),
         (vec!["--out", &same, "--reference", &format!("{}/", at("heat"))], "names a folder".into()),
         // A PNG under another format's name (it was written so, without a word).
         (vec!["--out", &at("render.jpg")], "give it a name ending in .png (it ends in .jpg)".into()),

@@ -587,3 +587,17 @@ fn a_cached_evaluation_is_estimated_with_every_node_kept() {
         assert!(one_shot < held, "{name}: the one-shot estimate {one_shot} already covers {held}");
     }
 }
+
+/// `graph`'s list keeps its columns for every built-in species: each row's inputs start
+/// where every other row's do (a label longer than a fixed width, `colour per scale tone=…
+/// speckle=…`, pushed its row's inputs out of line).
+#[test]
+fn the_graph_list_keeps_its_columns() {
+    for name in snakeskin::preset::library::names() {
+        let out = snakeskin(&["graph", name]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let text = stdout(&out);
+        let columns: BTreeSet<usize> = text.lines().map(|line| line.find(" <- ").expect("an arrow a row")).collect();
+        assert_eq!(columns.len(), 1, "{name}: the arrows stand in columns {columns:?}\n{text}");
+    }
+}

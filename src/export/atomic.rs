@@ -104,7 +104,7 @@ fn cut_to(name: &str, room: usize) -> std::borrow::Cow<'_, str> {
 /// The lock file of the set (or export) `name`: `.NAME.lock`, the name cut as a temporary's
 /// is where that would pass `NAME_MAX_BYTES` (a legal 255-byte `NAME.glb` failed for its
 /// lock's name, "File name too long").
-fn lock_file_name(name: &str) -> String {
+pub fn lock_file_name(name: &str) -> String {
     format!(".{}.lock", cut_to(name, NAME_MAX_BYTES - ".".len() - ".lock".len()))
 }
 
@@ -278,7 +278,7 @@ fn without_temporary_path(e: std::io::Error) -> std::io::Error {
 /// Public so that a command can check an output file before the work that makes it.
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
     if ends_as_a_folder(target) {
-        return Err(ExportError::FolderName { path: target.into(), default_extension: "png" });
+        return Err(ExportError::folder_name(target, &super::OUTPUT_EXTENSIONS));
     }
     let name_bytes = target.file_name().map_or(0, |n| n.len());
     if name_bytes > NAME_MAX_BYTES {
@@ -303,6 +303,10 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
 /// word), and so is the extension alone (`.png`, a hidden file); one without an extension is
 /// taken as it is.
 pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), ExportError> {
+    // Its example named with the format asked for (`chart.v2/` said "as in out/snake.v2").
+    if ends_as_a_folder(target) {
+        return Err(ExportError::folder_name(target, &[format]));
+    }
     check_target(target)?;
     // `.png`, and another image format's extension alone (`.jpg`: no extension to compare,
     // so it was written as a hidden PNG).
@@ -508,11 +512,38 @@ pub struct SetLock {
 }
 
 /// A file of the set's names (an earlier set's, or one no readable manifest claims) that stays
-/// beside the new set although the new set does not write it (`SetLock::kept`).
+/// beside the new set although the new set does not write it (`SetLock::kept`); or an
+/// export's image its new `.gltf` does not reference (`gltf_export`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KeptFile {
     pub path: PathBuf,
     pub why: KeptBecause,
+    /// What would have written it: the earlier set or export.
+    pub by: Earlier,
+}
+
+/// What writes the files a run may find of an earlier run: a texture set (its manifest
+/// records its maps) or a glTF export (its `.gltf` names its images).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Earlier {
+    Set,
+    Export,
+}
+
+impl Earlier {
+    pub fn word(self) -> &'static str {
+        match self {
+            Earlier::Set => "set",
+            Earlier::Export => "export",
+        }
+    }
+}
+
+impl KeptFile {
+    /// Why it stayed, for a warning that names the file (escaped as the caller prints paths).
+    pub fn reason(&self) -> String {
+        self.why.words(self.by)
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -524,34 +555,36 @@ pub enum KeptBecause {
     Unreadable(String),
     /// It would not move aside (immutable, or its folder refuses): the error.
     WouldNotMove(String),
-    /// No manifest of the set's name (the file name) was there to say whose it is.
-    NoManifest(String),
-    /// The manifest there could not be read to say whose it is: the error.
-    ManifestUnreadable(String),
-    /// The manifest there does not record it.
-    NotRecorded,
+    /// Not a regular file where the record names one (a link, a device).
+    NotAFile,
+    /// No record (the manifest, the `.gltf`: its file name) was there to say whose it is.
+    NoRecord(String),
+    /// The record there could not be used to say whose it is: what it is ("manifest", the
+    /// `.gltf`'s file name) and the error.
+    RecordUnreadable { record: String, error: String },
+    /// The record there ("manifest", the `.gltf`'s file name) does not name it.
+    NotRecorded { record: String },
 }
 
-/// Why a file stayed, for a warning that names the file (escaped as the caller prints paths).
-impl std::fmt::Display for KeptBecause {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl KeptBecause {
+    /// Why a file stayed, the earlier run `by` named: one sentence for sets and exports.
+    pub fn words(&self, by: Earlier) -> String {
+        let by = by.word();
         match self {
             KeptBecause::ChangedSince => {
-                write!(f, "it changed since the earlier set wrote it, so it is not that set's to remove")
+                format!("it changed since the earlier {by} wrote it, so it is not that {by}'s to remove")
             }
             KeptBecause::Unreadable(error) => {
-                write!(f, "it could not be read to compare with the earlier set's record ({error})")
+                format!("it could not be read to compare with the earlier {by}'s record ({error})")
             }
-            KeptBecause::WouldNotMove(error) => write!(f, "it is the earlier set's and could not be removed ({error})"),
-            KeptBecause::NoManifest(manifest) => {
-                write!(f, "no {manifest} is there to say it is an earlier set's to remove")
-            }
-            KeptBecause::ManifestUnreadable(error) => write!(
-                f,
-                "the manifest there could not be used ({error}), so nothing says it is the earlier set's to remove"
+            KeptBecause::WouldNotMove(error) => format!("it is the earlier {by}'s and could not be removed ({error})"),
+            KeptBecause::NotAFile => format!("it is not a regular file, so it is not the earlier {by}'s to remove"),
+            KeptBecause::NoRecord(record) => format!("no {record} is there to say it is an earlier {by}'s to remove"),
+            KeptBecause::RecordUnreadable { record, error } => format!(
+                "the {record} there could not be used ({error}), so nothing says it is the earlier {by}'s to remove"
             ),
-            KeptBecause::NotRecorded => {
-                write!(f, "the manifest there does not record it, so it is not the earlier set's to remove")
+            KeptBecause::NotRecorded { record } => {
+                format!("the {record} there does not record it, so it is not the earlier {by}'s to remove")
             }
         }
     }
@@ -604,9 +637,16 @@ impl SetLock {
                 }
                 Err(e) => return Err(not_a_lock().unwrap_or_else(|| io_error(&path)(e))),
             };
-            if !file.metadata().is_ok_and(|m| m.is_file() && m.len() == 0) {
-                return Err(not_a_lock()
-                    .unwrap_or_else(|| ExportError::LockNotAFile { path: path.clone(), kind: "something else" }));
+            // The file opened, by its own metadata (the path may have changed since).
+            match file.metadata() {
+                Ok(m) if m.is_file() && m.len() > 0 => {
+                    return Err(ExportError::LockHoldsData { path: path.clone(), bytes: m.len() });
+                }
+                Ok(m) if m.is_file() => {}
+                _ => {
+                    return Err(not_a_lock()
+                        .unwrap_or_else(|| ExportError::LockNotAFile { path: path.clone(), kind: "something else" }));
+                }
             }
             match file.try_lock() {
                 Ok(()) if same_file(&file, &path) => {
@@ -758,7 +798,7 @@ fn swap_in(
                     ExportError::Io { source, .. } => source.to_string(),
                     other => other.to_string(),
                 };
-                stayed.push(KeptFile { path: target.clone(), why: KeptBecause::WouldNotMove(error) });
+                stayed.push(KeptFile { path: target.clone(), why: KeptBecause::WouldNotMove(error), by: Earlier::Set });
             }
             Err(e) => {
                 put_back(aside, &[], manifest, &mut renames);
@@ -821,7 +861,7 @@ impl FileGroup {
     pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> Result<(), ExportError> {
         let (dir, name) = (folder_of(target), file_name(target));
         if name.is_empty() || ends_as_a_folder(target) {
-            return Err(ExportError::FolderName { path: target.into(), default_extension: "png" });
+            return Err(ExportError::folder_name(target, &super::OUTPUT_EXTENSIONS));
         }
         create_folder(dir)?;
         check_target(target)?;
@@ -873,7 +913,7 @@ fn left_over_files(manifest: &Path, targets: &[&PathBuf]) -> (Vec<PathBuf>, Vec<
             || files.contains(&path)
             || kept.iter().any(|k| k.path == path);
         if !accounted && fs::symlink_metadata(&path).is_ok() {
-            kept.push(KeptFile { path, why: unrecorded_because.clone() });
+            kept.push(KeptFile { path, why: unrecorded_because.clone(), by: Earlier::Set });
         }
     }
     (files, kept)
@@ -889,9 +929,11 @@ fn recorded_left_overs(
     set_files: &[String],
     targets: &[&PathBuf],
 ) -> (Vec<PathBuf>, Vec<KeptFile>, KeptBecause) {
-    let unreadable = |error: String| (Vec::new(), Vec::new(), KeptBecause::ManifestUnreadable(error));
+    let record = || "manifest".to_string();
+    let unreadable =
+        |error: String| (Vec::new(), Vec::new(), KeptBecause::RecordUnreadable { record: record(), error });
     if fs::symlink_metadata(manifest).is_err() {
-        return (Vec::new(), Vec::new(), KeptBecause::NoManifest(file_name(manifest)));
+        return (Vec::new(), Vec::new(), KeptBecause::NoRecord(file_name(manifest)));
     }
     let json = match super::manifest::read_set_manifest(manifest, crate::text_file::Links::Refuse) {
         Ok(json) => json,
@@ -926,9 +968,9 @@ fn recorded_left_overs(
             }
             _ => KeptBecause::ChangedSince,
         };
-        changed.push(KeptFile { path, why });
+        changed.push(KeptFile { path, why, by: Earlier::Set });
     }
-    (files, changed, KeptBecause::NotRecorded)
+    (files, changed, KeptBecause::NotRecorded { record: record() })
 }
 
 /// Undoes a commit that failed: removes the new files already in place and renames the old

@@ -17,7 +17,7 @@
 
 use serde_json::{Value, json};
 
-use super::{ExportError, Source};
+use super::{ExportError, KeptBecause, Source};
 use crate::render::engine::mesh::Mesh;
 
 /// glTF's numeric constants (glTF 2.0 spec, 5.1 accessors, 5.11 buffer views, 5.26 samplers).
@@ -388,18 +388,16 @@ pub enum EarlierImage {
     /// No `.gltf` there (a killed commit can leave its images without it), or one that could
     /// not be read: why, to say of a file that stays (as `generate` says of a map no
     /// manifest records).
-    Unknown(String),
+    Unknown(KeptBecause),
 }
 
 impl EarlierImage {
     /// Why an image file that an export no longer writes stays beside it, unless the earlier
-    /// `.gltf` named it.
-    pub fn why_it_stays(&self, gltf_name: &str) -> Option<String> {
+    /// `.gltf` (`gltf_name`) named it.
+    pub fn why_it_stays(&self, gltf_name: &str) -> Option<KeptBecause> {
         match self {
             EarlierImage::Named { .. } => None,
-            EarlierImage::NotNamed => {
-                Some(format!("the {gltf_name} there did not name it, so it is not the earlier export's to remove"))
-            }
+            EarlierImage::NotNamed => Some(KeptBecause::NotRecorded { record: gltf_name.into() }),
             EarlierImage::Unknown(why) => Some(why.clone()),
         }
     }
@@ -413,23 +411,18 @@ impl EarlierImage {
 pub fn earlier_image(gltf: &std::path::Path, image_file: &str) -> EarlierImage {
     use crate::text_file::{BoundedReadError, Links, read_bounded_bytes};
     let gltf_name = gltf.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let unreadable = |why: &dyn std::fmt::Display| {
-        EarlierImage::Unknown(format!(
-            "the {gltf_name} there could not be read ({why}), so nothing says it is the earlier export's to remove"
-        ))
-    };
+    let unreadable =
+        |error: String| EarlierImage::Unknown(KeptBecause::RecordUnreadable { record: gltf_name.clone(), error });
     let bytes = match read_bounded_bytes(gltf, EARLIER_GLTF_MAX_BYTES, Links::Refuse) {
         Ok(bytes) => bytes,
         Err(BoundedReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
-            return EarlierImage::Unknown(format!(
-                "no {gltf_name} is there to say it is an earlier export's to remove"
-            ));
+            return EarlierImage::Unknown(KeptBecause::NoRecord(gltf_name));
         }
-        Err(e) => return unreadable(&e),
+        Err(e) => return unreadable(e.to_string()),
     };
     let json = match serde_json::from_slice::<Value>(&bytes) {
         Ok(json) => json,
-        Err(e) => return unreadable(&format_args!("not JSON: {e}")),
+        Err(e) => return unreadable(format!("not JSON: {e}")),
     };
     let uri = uri_reference(image_file);
     match json["images"].as_array().into_iter().flatten().find(|image| image["uri"].as_str() == Some(&uri)) {

@@ -11,9 +11,10 @@ pub mod pack;
 mod srgb;
 
 pub use atomic::{
-    FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_folder_writable, check_not_an_input,
-    check_png_target, check_target, check_target_named, check_writable, clean_up_before_exit, create_folder,
-    create_folder_noted, ends_as_a_folder, remove_empty_made_folders, same_path, sha256_hex, write_file_atomically,
+    Earlier, FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_folder_writable,
+    check_not_an_input, check_png_target, check_target, check_target_named, check_writable, clean_up_before_exit,
+    create_folder, create_folder_noted, ends_as_a_folder, lock_file_name, remove_empty_made_folders, same_path,
+    sha256_hex, write_file_atomically,
 };
 pub(crate) use manifest::verify_set_json;
 pub use manifest::{
@@ -72,12 +73,9 @@ pub enum ExportError {
     NotAFolder { path: PathBuf },
     /// An output file's path that ends as a folder's does (`out/`, `out/.`): it was written
     /// to after the work and failed with "Not a directory".
-    /// The example's extension is the path's (`snake.glb/`), else `default_extension`.
-    #[error(
-        "{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.{}",
-        extension_or(.path, .default_extension)
-    )]
-    FolderName { path: PathBuf, default_extension: &'static str },
+    /// `extension`: the example's, one the command writes (`folder_name`).
+    #[error("{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.{extension}")]
+    FolderName { path: PathBuf, extension: &'static str },
     /// An output that names one of the command's inputs (the preset file, the jobs file):
     /// it replaced the input, and the command could not be run again.
     #[error("{output} would be written over this command's input {input} (the same file); move or rename one of them")]
@@ -116,13 +114,20 @@ pub enum ExportError {
     Gltf(String),
 }
 
-/// The extension of the name `path` ends in (`snake.glb` of `snake.glb/`), else `default`.
-fn extension_or(path: &std::path::Path, default: &str) -> String {
-    match path.extension() {
-        Some(extension) if !extension.is_empty() => extension.to_string_lossy().into_owned(),
-        _ => default.into(),
+impl ExportError {
+    /// `FolderName` for `path`, its example's extension the path's where it is one of
+    /// `accepted` (`snake.glb/` for `--gltf`), else the first: `foo.glb/` said "as in
+    /// out/snake.png" to `--gltf`, which refuses that name.
+    pub fn folder_name(path: &std::path::Path, accepted: &[&'static str]) -> ExportError {
+        let written = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+        let extension = accepted.iter().copied().find(|e| written.as_deref() == Some(*e)).unwrap_or(accepted[0]);
+        ExportError::FolderName { path: path.into(), extension }
     }
 }
+
+/// The extensions of the files the commands write one by one (`check_target`), the first
+/// the most common, for `ExportError::folder_name`.
+pub const OUTPUT_EXTENSIONS: [&str; 3] = ["png", "svg", "exr"];
 
 impl ExportError {
     /// True when the user's input is at fault: an output folder that is not a folder, an

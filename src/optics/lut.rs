@@ -402,8 +402,9 @@ impl Lut {
 /// The default table (`Lut::bake_default`) with each texel computed on first read, for
 /// queries: one film colour reads 4 of its 20,480 texels, where baking the whole table for
 /// it took 2.6 s of CPU here (`brdf color --method lut`); the queries of a batch share
-/// what earlier ones computed, so a batch never computes more than the bake. Its values
-/// are the baked table's, bit for bit (the test below).
+/// what earlier ones computed, so while the table is kept (`query`'s cache) a batch never
+/// computes more than the bake. Its values are the baked table's, bit for bit (the test
+/// below).
 pub struct LazyLut {
     shape: Lut,
     /// Each row's film series, made on the row's first read.

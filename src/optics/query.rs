@@ -45,40 +45,39 @@ pub fn check(stack: Stack, thickness_nm: f64, angle_deg: f64, wavelength_nm: Opt
     Ok(())
 }
 
-/// Baked tables kept at once by `film_colour`'s LUT cache.
+/// Tables kept at once by `film_colour`'s LUT cache.
 const MAX_CACHED_LUTS: usize = 8;
 
 /// LUTs read so far, per material (the queries of a batch on one material share its texels).
 fn lut_for(stack: Stack) -> Arc<LazyLut> {
-    static CACHE: Mutex<BakedCache<[u64; 3], LazyLut>> = Mutex::new(BakedCache::new(MAX_CACHED_LUTS));
+    static CACHE: Mutex<TableCache<[u64; 3], LazyLut>> = Mutex::new(TableCache::new(MAX_CACHED_LUTS));
     let key = [stack.n0.to_bits(), stack.n1.to_bits(), stack.n2.to_bits()];
     let mut cache = CACHE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    cache.get_or_bake(key, || LazyLut::new(stack))
+    cache.get_or_make(key, || LazyLut::new(stack))
 }
 
-/// A few baked values by key. A table grows to about 0.3 MiB as its texels are read, and
-/// each line of a batch may name its own material, so a batch keeps a few. When the cache
-/// is full, a value chosen at random makes room. Emptying the whole cache (as before) or
-/// dropping the least recently used value misses on every query of a batch that cycles
-/// through more materials than the cache holds (9 materials in turn: every query's texels
-/// computed again, 2 s each when a query baked its whole table); always replacing the
-/// value baked last misses on every
-/// query of two new materials taken in turn. A random choice keeps most of either: the
-/// test below counts the bakes of both. (The choice changes only what is baked again, never
-/// a value.)
-struct BakedCache<K, V> {
+/// A few values by key, each made once while it is kept. A table holds about 0.3 MiB (its
+/// 20,480 texel cells), and each line of a batch may name its own material, so a batch
+/// keeps a few. When the cache is full, a value chosen at random makes room. Emptying the
+/// whole cache (as before) or dropping the least recently used value misses on every query
+/// of a batch that cycles through more materials than the cache holds (9 materials in turn:
+/// every query's texels computed again, 2 s each when a query baked its whole table);
+/// always replacing the value made last misses on every query of two new materials taken in
+/// turn. A random choice keeps most of either: the test below counts the makings of both.
+/// (The choice changes only what is made again, never a value.)
+struct TableCache<K, V> {
     entries: Vec<(K, Arc<V>)>,
     max: usize,
     /// xorshift64 state for the choice of the value that makes room.
     state: u64,
 }
 
-impl<K: PartialEq, V> BakedCache<K, V> {
+impl<K: PartialEq, V> TableCache<K, V> {
     const fn new(max: usize) -> Self {
-        BakedCache { entries: Vec::new(), max, state: 0x9e37_79b9_7f4a_7c15 }
+        TableCache { entries: Vec::new(), max, state: 0x9e37_79b9_7f4a_7c15 }
     }
 
-    fn get_or_bake(&mut self, key: K, bake: impl FnOnce() -> V) -> Arc<V> {
+    fn get_or_make(&mut self, key: K, make: impl FnOnce() -> V) -> Arc<V> {
         if let Some((_, value)) = self.entries.iter().find(|(k, _)| *k == key) {
             return value.clone();
         }
@@ -88,7 +87,7 @@ impl<K: PartialEq, V> BakedCache<K, V> {
             self.state ^= self.state << 17;
             self.entries.swap_remove((self.state % self.entries.len() as u64) as usize);
         }
-        let value = Arc::new(bake());
+        let value = Arc::new(make());
         self.entries.push((key, value.clone()));
         value
     }
@@ -116,15 +115,17 @@ pub fn chart_bytes(width: usize, height: usize) -> u64 {
 /// brightest channel is 1. Returns the linear image and the exposure applied (film
 /// reflectances are a few percent to a few tens of percent).
 pub fn chart(stack: Stack, method: Method, width: usize, height: usize) -> (Image, f64) {
+    // The table taken once, not through the cache's lock per pixel (16 million at 4096²).
+    let lut = matches!(method, Method::Lut).then(|| lut_for(stack));
+    let colour = |thickness_nm: f64, cos0: f64| match &lut {
+        Some(lut) => lut.lookup_f64(thickness_nm, cos0),
+        None => film_colour(method, stack, thickness_nm, cos0),
+    };
     let rows: Vec<Vec<[f64; 3]>> = (0..height)
         .into_par_iter()
         .map(|y| {
-            let angle_deg = 89.0 * y as f64 / (height - 1) as f64;
-            (0..width)
-                .map(|x| {
-                    film_colour(method, stack, 2000.0 * x as f64 / (width - 1) as f64, angle_deg.to_radians().cos())
-                })
-                .collect()
+            let cos0 = (89.0 * y as f64 / (height - 1) as f64).to_radians().cos();
+            (0..width).map(|x| colour(2000.0 * x as f64 / (width - 1) as f64, cos0)).collect()
         })
         .collect();
     let brightest = rows.iter().flatten().flat_map(|p| p.iter().copied()).fold(1e-6, f64::max);
@@ -143,30 +144,30 @@ mod tests {
     use super::*;
 
     /// Queries of materials in the two orders that defeat the simpler rules: cycling
-    /// through one more material than the cache holds (every query baked when a full cache
+    /// through one more material than the cache holds (every query made again when a full cache
     /// was emptied, or with least-recently-used), and, once it is full, two new materials in
-    /// turn (every query baked when the value baked last made room). Negative control:
-    /// within its size, each material is baked once.
+    /// turn (every query made again when the value made last made room). Negative control:
+    /// within its size, each material is made once.
     #[test]
     fn a_full_cache_keeps_most_of_a_cycle_and_of_two_materials_in_turn() {
-        let bakes = |queries: &[u32]| {
-            let mut cache = BakedCache::new(MAX_CACHED_LUTS);
-            let mut bakes = 0;
+        let makings = |queries: &[u32]| {
+            let mut cache = TableCache::new(MAX_CACHED_LUTS);
+            let mut makings = 0;
             for &k in queries {
-                cache.get_or_bake(k, || {
-                    bakes += 1;
+                cache.get_or_make(k, || {
+                    makings += 1;
                     k
                 });
             }
-            bakes
+            makings
         };
         let n = MAX_CACHED_LUTS as u32;
         let cycles = |materials: u32| (0..10).flat_map(|_| 0..materials).collect::<Vec<u32>>();
-        assert_eq!(bakes(&cycles(n)), n);
-        let cycle = bakes(&cycles(n + 1));
-        assert!(cycle <= 45, "{cycle} bakes of 90 queries cycling {} materials", n + 1);
+        assert_eq!(makings(&cycles(n)), n);
+        let cycle = makings(&cycles(n + 1));
+        assert!(cycle <= 45, "{cycle} makings of 90 queries cycling {} materials", n + 1);
         let in_turn: Vec<u32> = (0..n).chain((0..90).map(|q| n + q % 2)).collect();
-        let two = bakes(&in_turn);
-        assert!(two <= n + 20, "{two} bakes of {} queries, two new materials in turn", in_turn.len());
+        let two = makings(&in_turn);
+        assert!(two <= n + 20, "{two} makings of {} queries, two new materials in turn", in_turn.len());
     }
 }

@@ -6,7 +6,7 @@
 //! the `--set` argument) → range-check (errors name the key, with its line when it came
 //! from the file).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
@@ -115,10 +115,13 @@ pub fn read_source_beside(spec: &str, folder: &Path) -> Result<PresetSource, Pre
         None => {
             // `my-snake` beside my-snake.toml (as `presets show NAME > my-snake.toml` writes
             // it): a file is read only by a name that says so.
+            // A name with a `/` is a path resolved already (a jobs file's entries are joined
+            // to its folder: `batch::load_jobs`); a bare name is looked for in `folder`.
+            let beside = |name: &str| if spec.contains('/') { PathBuf::from(name) } else { folder.join(name) };
             let file = format!("{spec}.toml");
-            let suggestion = if !spec.is_empty() && folder.join(&file).is_file() {
+            let suggestion = if !spec.is_empty() && beside(&file).is_file() {
                 format!("; to read the file {file}, give its name with .toml")
-            } else if !spec.is_empty() && folder.join(spec).is_dir() {
+            } else if !spec.is_empty() && beside(spec).is_dir() {
                 // `graph /tmp` said only that it was no preset, where `graph d.toml` (a
                 // folder) said it was a folder.
                 format!("; {spec} is a folder: name a .toml file in it")

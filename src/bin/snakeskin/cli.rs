@@ -653,8 +653,8 @@ pub enum BrdfCommand {
         samples: u64,
         /// Seed of the sample generator, 0 to 4294967295 (its hash takes 32 bits: a larger
         /// seed was folded onto a smaller one's samples).
-        #[arg(long, default_value_t = 1, value_parser = ranged_u64(0, u32::MAX as u64))]
-        seed: u64,
+        #[arg(long, default_value_t = 1, value_parser = ranged_u32(0, u32::MAX))]
+        seed: u32,
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
@@ -900,11 +900,11 @@ fn parse_image_size(text: &str) -> Result<ImageSize, String> {
             range.end()
         )
     };
-    let (w, h) = match text.split_once(['x', 'X']) {
-        Some((w, h)) => (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?),
+    let (w, h, square) = match text.split_once(['x', 'X']) {
+        Some((w, h)) => (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?, false),
         None => {
             let s: u32 = text.trim().parse().map_err(|_| bad())?;
-            (s, s)
+            (s, s, true)
         }
     };
     // The side out of range named, as a number outside the range cannot be seen from the
@@ -919,7 +919,6 @@ fn parse_image_size(text: &str) -> Result<ImageSize, String> {
             )),
         }
     };
-    let square = !text.contains(['x', 'X']);
     let (width, height) = match square {
         true => (side("size", w)?, h),
         false => (side("width", w)?, side("height", h)?),
@@ -1024,7 +1023,11 @@ fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
 
 /// A direction: three finite numbers, not all zero (it is normalised before use).
 fn parse_direction(text: &str) -> Result<[f64; 3], String> {
-    let v = parse_vec3(text)?;
+    direction(parse_vec3(text)?)
+}
+
+/// `v` where it is at least 1e-6 long.
+fn direction(v: [f64; 3]) -> Result<[f64; 3], String> {
     let length = v.iter().map(|c| c * c).sum::<f64>().sqrt();
     if length < 1e-6 {
         return Err(format!("a direction must be at least 1e-6 long (it is normalised), got length {length:e}"));
@@ -1038,7 +1041,7 @@ fn parse_direction(text: &str) -> Result<[f64; 3], String> {
 fn parse_normal(text: &str) -> Result<[f64; 3], String> {
     match parse_vec3(text)? {
         [0.0, 0.0, 0.0] => Ok([0.0; 3]),
-        _ => parse_direction(text).map_err(|e| format!("{e}; or 0,0,0 for the fallback to 0,0,1")),
+        v => direction(v).map_err(|e| format!("{e}; or 0,0,0 for the fallback to 0,0,1")),
     }
 }
 
@@ -1249,6 +1252,18 @@ mod tests {
             assert_eq!(rows_named(&help), [MAX_TEXTURE_SIDE], "{name} --map-size: {help:?}");
         }
         assert_ne!(rows_named("more than 4096 rows long"), [MAX_TEXTURE_SIDE]);
+    }
+
+    /// The roughness floor `brdf eval --help` names is `brdf::ALPHA_MIN`'s (a help text
+    /// cannot take the constant). Negative control: another α.
+    #[test]
+    fn the_roughness_floor_named_in_help_is_alpha_min() {
+        let command = <Cli as clap::CommandFactory>::command();
+        let eval = command.find_subcommand("brdf").unwrap().find_subcommand("eval").unwrap();
+        let help = eval.get_arguments().find(|a| a.get_id() == "roughness").unwrap().get_help().unwrap().to_string();
+        let names = |alpha: f64| help.contains(&format!("α {alpha}")) && help.contains(&format!("{:.3}", alpha.sqrt()));
+        assert!(names(snakeskin::optics::brdf::ALPHA_MIN), "{help}");
+        assert!(!names(2e-3), "{help}");
     }
 
     #[test]

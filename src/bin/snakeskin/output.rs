@@ -215,7 +215,11 @@ pub fn path_line(path: &Path) -> String {
 /// A file of the set's names that stayed beside the new set (`GenerateReport::kept`), in words:
 /// its path escaped as every listed path is, and why.
 pub fn kept_words(kept: &snakeskin::export::KeptFile) -> String {
-    format!("kept {}, which this set does not write: {}", path_line(&kept.path), kept.why)
+    let which = match kept.by {
+        snakeskin::export::Earlier::Set => "which this set does not write",
+        snakeskin::export::Earlier::Export => "which this export does not reference",
+    };
+    format!("kept {}, {which}: {}", path_line(&kept.path), kept.reason())
 }
 
 /// Creates the folder a single output file goes into when it is missing, and says so on

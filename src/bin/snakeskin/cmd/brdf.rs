@@ -294,7 +294,6 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             Ok(())
         }
         BrdfCommand::Stress { samples, seed, json } => {
-            let seed = u32::try_from(seed).map_err(|_| anyhow::anyhow!("--seed {seed} is over 4294967295"))?;
             let report = snakeskin::optics::stress::run(samples, seed);
             if json {
                 println!("{}", serde_json::to_string(&report)?);

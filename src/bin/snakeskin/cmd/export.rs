@@ -36,8 +36,8 @@ pub fn run(args: ExportArgs) -> Result<()> {
     for file in &report.removed {
         eprintln!("note: removed {}, which this export does not reference (an earlier one's)", path_line(file));
     }
-    for (file, why) in &report.kept {
-        eprintln!("warning: kept {}, which this export does not reference: {why}", path_line(file));
+    for kept in &report.kept {
+        eprintln!("warning: {}", crate::output::kept_words(kept));
     }
     for file in &report.files {
         println!("{}", path_line(file));
