@@ -86,8 +86,8 @@ pub enum BatchError {
     Read { path: PathBuf, source: std::io::Error },
     #[error("cannot read jobs file {path}: it is {kind}; a jobs file must be a regular file")]
     NotAFile { path: PathBuf, kind: &'static str },
-    #[error("jobs file {path} is {bytes} bytes; jobs files are limited to {limit} bytes")]
-    TooLarge { path: PathBuf, bytes: u64, limit: u64 },
+    #[error("jobs file {path} is {size}; jobs files are limited to {limit} bytes")]
+    TooLarge { path: PathBuf, size: crate::text_file::FileSize, limit: u64 },
     /// TOML syntax, an unknown key or a wrong type, at a line and column.
     #[error("{path}:{line}:{column}: {message}")]
     Parse { path: PathBuf, line: usize, column: usize, message: String },
@@ -304,7 +304,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     let text = crate::text_file::read_bounded(path, MAX_FILE_BYTES).map_err(|e| match e {
         BoundedReadError::Io(source) => BatchError::Read { path: path.into(), source },
         BoundedReadError::NotAFile(kind) => BatchError::NotAFile { path: path.into(), kind },
-        BoundedReadError::TooLarge(bytes) => BatchError::TooLarge { path: path.into(), bytes, limit: MAX_FILE_BYTES },
+        BoundedReadError::TooLarge(size) => BatchError::TooLarge { path: path.into(), size, limit: MAX_FILE_BYTES },
     })?;
     let file: JobsFile = toml::from_str(&text).map_err(|e| {
         let described = crate::toml_text::describe(&text, &e);

@@ -15,8 +15,26 @@ pub enum BoundedReadError {
     Io(std::io::Error),
     /// Not a regular file: what it is ("a FIFO", "a device", "a folder" ...).
     NotAFile(&'static str),
-    /// Larger than the limit: its size in bytes (its size now, if it grew while it was read).
-    TooLarge(u64),
+    /// Larger than the limit: its size (its size now, if it grew while it was read).
+    TooLarge(FileSize),
+}
+
+/// A file's size as far as it is known: its bytes, or only that it holds more than the
+/// limit (a file that reports no size, as /proc's do, read to the limit and a byte more: it
+/// was said to be that many bytes, "1048577", whatever it held).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileSize {
+    Bytes(u64),
+    MoreThan(u64),
+}
+
+impl std::fmt::Display for FileSize {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FileSize::Bytes(bytes) => write!(f, "{bytes} bytes"),
+            FileSize::MoreThan(limit) => write!(f, "more than {limit} bytes"),
+        }
+    }
 }
 
 /// Whether opening a path follows a symbolic link at its end: a user's input may be a link,
@@ -33,7 +51,10 @@ impl std::fmt::Display for BoundedReadError {
         match self {
             BoundedReadError::Io(e) => write!(f, "{e}"),
             BoundedReadError::NotAFile(kind) => write!(f, "it is {kind}, not a regular file"),
-            BoundedReadError::TooLarge(bytes) => write!(f, "it is {bytes} bytes, more than such a file can be"),
+            BoundedReadError::TooLarge(size @ FileSize::Bytes(_)) => {
+                write!(f, "it is {size}, more than such a file can be")
+            }
+            BoundedReadError::TooLarge(size) => write!(f, "it is {size}, larger than such a file can be"),
         }
     }
 }
@@ -63,7 +84,7 @@ pub fn open_bounded(path: &Path, limit: u64, links: Links) -> Result<std::fs::Fi
         return Err(BoundedReadError::NotAFile(file_kind(&meta.file_type())));
     }
     if meta.len() > limit {
-        return Err(BoundedReadError::TooLarge(meta.len()));
+        return Err(BoundedReadError::TooLarge(FileSize::Bytes(meta.len())));
     }
     Ok(file)
 }
@@ -73,7 +94,8 @@ pub fn open_bounded(path: &Path, limit: u64, links: Links) -> Result<std::fs::Fi
 pub fn check_read_length(file: &std::fs::File, read: u64, limit: u64) -> Result<(), BoundedReadError> {
     if read > limit {
         let now = file.metadata().map_or(0, |m| m.len());
-        return Err(BoundedReadError::TooLarge(now.max(read)));
+        let size = if now > limit { FileSize::Bytes(now) } else { FileSize::MoreThan(limit) };
+        return Err(BoundedReadError::TooLarge(size));
     }
     Ok(())
 }
@@ -146,7 +168,23 @@ pub(crate) fn file_kind(t: &std::fs::FileType) -> &'static str {
 
 #[cfg(test)]
 mod tests {
-    use super::not_utf8;
+    use super::{check_read_length, not_utf8};
+
+    /// A file read past its limit whose size says less than was read (a /proc file reports
+    /// 0) is "more than the limit", not the bytes read ("1048577"); one that reports more
+    /// is its size.
+    #[test]
+    fn a_file_past_its_limit_is_its_size_or_more_than_the_limit() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f");
+        std::fs::write(&path, [b'x'; 100]).unwrap();
+        let file = std::fs::File::open(&path).unwrap();
+        let said = |file: &std::fs::File| check_read_length(file, 11, 10).unwrap_err().to_string();
+        assert_eq!(said(&file), "it is 100 bytes, more than such a file can be");
+        std::fs::write(&path, b"12345").unwrap();
+        assert_eq!(said(&file), "it is more than 10 bytes, larger than such a file can be");
+        assert!(check_read_length(&file, 10, 10).is_ok());
+    }
 
     fn message(bytes: &[u8]) -> String {
         not_utf8(bytes, &std::str::from_utf8(bytes).expect_err("the test's bytes are not UTF-8"))

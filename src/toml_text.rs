@@ -164,10 +164,12 @@ fn with_suggestion(message: &str) -> String {
 /// The accepted name nearest to `unknown`, for "did you mean", if one is near enough: at
 /// most 2 edits, or a third of its length for a long one, and at most half its letters for a
 /// short one (`graph --maps foo` asked "did you mean ao?": two edits, every letter of `ao`).
+/// Case is not an edit (`ROWS` had no suggestion).
 pub fn nearest<'a>(unknown: &str, accepted: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let unknown = unknown.to_lowercase();
     accepted
         .into_iter()
-        .map(|a| (edit_distance(unknown, a), a))
+        .map(|a| (edit_distance(&unknown, &a.to_lowercase()), a))
         .filter(|(d, a)| *d <= 2.max(a.len() / 3).min(a.chars().count() / 2))
         .min()
         .map(|(_, a)| a)

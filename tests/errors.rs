@@ -35,6 +35,35 @@ fn accepted(preset: &str, extra: &[&str]) {
     assert!(out.status.success(), "{preset} {extra:?}: {}", stderr(&out));
 }
 
+/// A body or belly key that shapes what another draws is refused without it, with its line
+/// (they passed silently, where a pattern layer refuses a key its kind does not read).
+/// Negative controls: each beside its partner is accepted.
+#[test]
+fn a_key_without_the_key_it_shapes_is_refused() {
+    for (text, says, with) in [
+        (
+            "[body]\ntail_band_width = 0.3\n",
+            "b.toml:2: key `body.tail_band_width` shapes the bands",
+            "tail_bands = 4\n",
+        ),
+        ("[body]\ntail_band_color = \"#ff0000\"\n", "b.toml:2: key `body.tail_band_color` shapes", "tail_bands = 4\n"),
+        ("[body]\ntip_fraction = 0.3\n", "b.toml:2: key `body.tip_fraction` sizes what", "tip_color = \"#ffffff\"\n"),
+        (
+            "[body]\ntail_shift_start = 0.3\n",
+            "b.toml:2: key `body.tail_shift_start` starts",
+            "tail_color = \"#aa2200\"\n",
+        ),
+        ("[belly]\nup_rows = 2\nplates = false\n", "b.toml:2: key `belly.up_rows` runs the belly", ""),
+    ] {
+        let err = refused("b.toml", text, &[]);
+        assert!(err.contains(says), "{text}: {err}");
+        let dir = tempfile::tempdir().unwrap();
+        let partnered =
+            if with.is_empty() { text.replace("plates = false", "plates = true") } else { format!("{text}{with}") };
+        accepted(&write_preset(dir.path(), "b.toml", &partnered), &[]);
+    }
+}
+
 /// An absorption list of the wrong length says its length (any longer list said 4).
 /// Negative control: three numbers are accepted.
 #[test]

@@ -1518,6 +1518,8 @@ fn preview_output_names_are_checked_before_the_work() {
         (vec!["--out", &at(".png")], "the file's name is only an extension; give it a name, e.g. snake.png".into()),
         (vec!["--out", &same, "--reference", &at(".PNG")], "the file's name is only an extension".into()),
         (vec!["--out", &at(".jpg")], "the file's name is only an extension".into()),
+        // `-` is standard output to most tools: it was written as a file named `-`.
+        (vec!["--out", "-"], "-: writing to standard output is not supported".into()),
     ] {
         let out = preview(&extra);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));

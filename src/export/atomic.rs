@@ -277,6 +277,9 @@ fn without_temporary_path(e: std::io::Error) -> std::io::Error {
 /// (`ExportError::NotAFile`).
 /// Public so that a command can check an output file before the work that makes it.
 pub fn check_target(target: &Path) -> Result<(), ExportError> {
+    if target.as_os_str() == "-" {
+        return Err(ExportError::Stdout);
+    }
     if ends_as_a_folder(target) {
         return Err(ExportError::folder_name(target, &super::OUTPUT_EXTENSIONS));
     }

@@ -73,6 +73,10 @@ pub enum ExportError {
     NotAFolder { path: PathBuf },
     /// An output file's path that ends as a folder's does (`out/`, `out/.`): it was written
     /// to after the work and failed with "Not a directory".
+    /// `-` as an output file: read as standard output by most tools, it was written as a file
+    /// named `-`.
+    #[error("-: writing to standard output is not supported; give a file name (./- for a file named -)")]
+    Stdout,
     /// `extension`: the example's, one the command writes (`folder_name`).
     #[error("{path} names a folder (it ends in a slash or a dot); give a file name, as in out/snake.{extension}")]
     FolderName { path: PathBuf, extension: &'static str },
@@ -142,6 +146,7 @@ impl ExportError {
                 | ExportError::LockHoldsData { .. }
                 | ExportError::FolderInTheWay { .. }
                 | ExportError::FolderName { .. }
+                | ExportError::Stdout
                 | ExportError::NamedForAnotherFormat { .. }
                 | ExportError::OnlyAnExtension { .. }
                 | ExportError::OverwritesInput { .. }

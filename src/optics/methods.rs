@@ -38,7 +38,9 @@ impl Method {
             "gaussian-fit" => Method::GaussianFit,
             "lut" => Method::Lut,
             other => {
-                Method::SpectralN(other.strip_prefix("spectral-")?.parse().ok().filter(|n| (1..=421).contains(n))?)
+                // Digits only: `spectral-+5` was read as spectral-5.
+                let digits = other.strip_prefix("spectral-").filter(|d| d.bytes().all(|b| b.is_ascii_digit()))?;
+                Method::SpectralN(digits.parse().ok().filter(|n| (1..=421).contains(n))?)
             }
         })
     }
@@ -249,4 +251,19 @@ pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32)
     let white = d65_white();
     let v = [xyz[0] as f64 * white[0], xyz[1] as f64 * white[1], xyz[2] as f64 * white[2]];
     mat3_mul(&XYZ_TO_SRGB, v).map(|x| x as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `spectral-N` takes N in digits from 1 to 421 (`spectral-+5` was read as spectral-5).
+    #[test]
+    fn spectral_n_is_digits_in_range() {
+        assert_eq!(Method::parse("spectral-8"), Some(Method::SpectralN(8)));
+        assert_eq!(Method::parse("spectral-421"), Some(Method::SpectralN(421)));
+        for refused in ["spectral-+5", "spectral-0", "spectral-422", "spectral- 5", "spectral-", "spectral-5.0"] {
+            assert_eq!(Method::parse(refused), None, "{refused}");
+        }
+    }
 }

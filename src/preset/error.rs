@@ -13,8 +13,8 @@ pub enum PresetError {
     #[error("cannot read preset {path}: it is {kind}; a preset must be a regular file")]
     NotAFile { path: PathBuf, kind: &'static str },
 
-    #[error("cannot read preset {path}: it is {bytes} bytes; presets are limited to {limit} bytes")]
-    TooLarge { path: PathBuf, bytes: u64, limit: u64 },
+    #[error("cannot read preset {path}: it is {size}; presets are limited to {limit} bytes")]
+    TooLarge { path: PathBuf, size: crate::text_file::FileSize, limit: u64 },
 
     /// A preset file whose name the set's files cannot carry.
     #[error(

@@ -151,9 +151,7 @@ fn read_bounded(path: &Path) -> Result<String, PresetError> {
             PresetError::Read { path: path.into(), source, hint }
         }
         BoundedReadError::NotAFile(kind) => PresetError::NotAFile { path: path.into(), kind },
-        BoundedReadError::TooLarge(bytes) => {
-            PresetError::TooLarge { path: path.into(), bytes, limit: MAX_PRESET_BYTES }
-        }
+        BoundedReadError::TooLarge(size) => PresetError::TooLarge { path: path.into(), size, limit: MAX_PRESET_BYTES },
     })
 }
 
@@ -798,6 +796,8 @@ mod tests {
         let err = parse(&source("[scales]\nrwos = 3\n"), &[]).unwrap_err().to_string();
         assert!(err.contains("t.toml:2:1"), "{err}");
         assert!(err.contains("did you mean `rows`"), "{err}");
+        let err = parse(&source("[scales]\nROWS = 3\n"), &[]).unwrap_err().to_string();
+        assert!(err.contains("unknown key `ROWS`; did you mean `rows`"), "{err}");
     }
 
     #[test]

@@ -574,6 +574,38 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
     c.whole_number("body.tail_bands", b.tail_bands, s.rows);
     c.range("body.tail_band_width", b.tail_band_width, (0.05, 0.95));
     c.range("body.tip_fraction", b.tip_fraction, UNIT);
+    // A key that shapes what another draws, without that other (the review found
+    // `tail_band_width` without `tail_bands`, `tip_fraction` without `tip_color` and
+    // `up_rows` without `plates` passing silently, where a pattern layer refuses a key its
+    // kind does not read).
+    let (body, belly) = (crate::preset::schema::Body::default(), crate::preset::schema::Belly::default());
+    let no_bands = "shapes the bands `body.tail_bands` draws, which is 0 here; set it, or leave this out";
+    for (key, set, unread, message) in [
+        (
+            "body.tail_shift_start",
+            b.tail_shift_start != body.tail_shift_start,
+            b.tail_color.is_none(),
+            "starts the shift to `body.tail_color`, which this preset does not set; set it, or leave this out",
+        ),
+        ("body.tail_band_width", b.tail_band_width != body.tail_band_width, b.tail_bands == 0, no_bands),
+        ("body.tail_band_color", b.tail_band_color != body.tail_band_color, b.tail_bands == 0, no_bands),
+        (
+            "body.tip_fraction",
+            b.tip_fraction != body.tip_fraction,
+            b.tip_color.is_none(),
+            "sizes what `body.tip_color` draws, which this preset does not set; set it, or leave this out",
+        ),
+        (
+            "belly.up_rows",
+            preset.belly.up_rows != belly.up_rows,
+            !preset.belly.plates,
+            "runs the belly colour up beside the plates, which `belly.plates = false` leaves out; leave this out",
+        ),
+    ] {
+        if set && unread {
+            c.problems.push(Problem { key: key.into(), message: message.into() });
+        }
+    }
     if b.head_mark.len() > MAX_HEAD_MARKS {
         c.problems.push(Problem {
             key: "body.head_mark".into(),
