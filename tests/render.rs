@@ -638,6 +638,10 @@ fn the_window_reloads_the_preset_file_on_save() {
     // A broken edit (through the link) keeps the window running with the last good maps.
     std::fs::write(&link, "[scales]\nrwos = 3\n").unwrap();
     let failed = wait_for("reload failed");
+    // An empty file (an editor's truncate before its write) keeps them too: it reloaded as
+    // the default snake.
+    std::fs::write(&preset, "").unwrap();
+    let empty = wait_for("reload failed");
     // The file's folder deleted and made again (a `git checkout`): its old watch sees nothing
     // of the new folder, and every edit after it went unseen.
     std::fs::remove_dir_all(dir.path().join("real")).unwrap();
@@ -661,6 +665,7 @@ fn the_window_reloads_the_preset_file_on_save() {
     assert!(numbers.len() >= 3 && numbers[1] < numbers[2], "{reloaded}");
     let failed = failed.expect("a broken preset was not reported");
     assert!(failed.contains("rwos"), "{failed}");
+    assert!(empty.is_some_and(|l| l.contains("is empty (a save in progress?)")), "an empty file was loaded");
     assert!(gone.is_some_and(|l| l.contains("No such file")), "the deleted folder's preset was not reported");
     assert!(back.is_some(), "no reload after the preset's folder was made again");
     assert!(edited_after.is_some(), "no reload of an edit in the folder made again");

@@ -116,6 +116,17 @@ pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache) -> MapWor
                 }
             }
             let start = Instant::now();
+            // An empty file is the default snake to `generate`, but here it is most likely an
+            // editor's save half done (truncate, then write): it reloaded as the default
+            // snake. The last good maps stay, and the file's next write reloads.
+            let input = crate::preset::input_file(&spec);
+            if input.is_some_and(|file| std::fs::metadata(file).is_ok_and(|m| m.len() == 0)) {
+                let empty = format!("{spec} is empty (a save in progress?); its next save reloads");
+                if reload_out.send(Err(Error::Unsupported(empty))).is_err() {
+                    break;
+                }
+                continue;
+            }
             let result = crate::preset::load(&spec, &overrides, seed).map_err(Error::from).and_then(|loaded| {
                 for warning in loaded.warnings(&spec) {
                     eprintln!("{warning}");
