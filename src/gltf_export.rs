@@ -62,9 +62,9 @@ pub struct ExportReport {
     /// Files of an earlier export of this name that this one removed (a `.gltf`'s thickness
     /// image, which a film of one thickness no longer references), for the caller to say.
     pub removed: Vec<PathBuf>,
-    /// Such files that stay, with why (changed since the earlier export wrote them, or they
-    /// would not go), for the caller to say: the export stands, and the file beside it is no
-    /// longer referenced.
+    /// Such files that stay, with why (changed since the earlier export wrote them, no
+    /// readable `.gltf` there says whose they are, or they would not go), for the caller to
+    /// say: the export stands, and the file beside it is no longer referenced.
     pub kept: Vec<KeptFile>,
 }
 
