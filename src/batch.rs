@@ -371,7 +371,10 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         // argument relative to the working folder (`preset::names_a_file`); anything else
         // is a built-in preset. An entry with a `/` is a path even where it names a folder
         // there (refused as one): left as written, it was looked for in the working folder.
-        let relative = Path::new(&table.preset).is_relative().then(|| base.join(&table.preset));
+        // Joined without `.` inside (`J/./sub` named in messages read as a path to write).
+        let relative = Path::new(&table.preset)
+            .is_relative()
+            .then(|| base.join(&table.preset).components().collect::<std::path::PathBuf>());
         let preset = match relative {
             Some(path) if crate::preset::names_a_file(&table.preset, &path) || table.preset.contains('/') => {
                 path.to_string_lossy().into_owned()

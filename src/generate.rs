@@ -131,7 +131,7 @@ pub fn check_set_outputs(
         export::check_target(&target)?;
         inputs.check(&target)?;
     }
-    inputs.check(&out_dir.join(export::lock_file_name(name)))
+    export::check_lock_not_an_input(&out_dir.join(export::lock_file_name(name)), inputs)
 }
 
 /// `Pack::size_problem` for a set `size` wide in `layout`, with the largest size whose

@@ -236,7 +236,8 @@ impl ExportPlan {
         crate::export::check_not_an_input(&request.out, input)?;
         // The lock the export takes and removes (`.NAME.lock`): a preset file of that name,
         // an empty one (a valid preset) not refused as a lock with content, was removed.
-        crate::export::check_not_an_input(&dir.join(crate::export::lock_file_name(&name)), input)?;
+        let lock = dir.join(crate::export::lock_file_name(&name));
+        crate::export::check_lock_not_an_input(&lock, &crate::export::Inputs::new(input))?;
         for file in side_files {
             let target = dir.join(file);
             crate::export::check_target(&target)?;

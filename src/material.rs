@@ -165,8 +165,10 @@ impl FromStr for MapKind {
         MapKind::EVERY.into_iter().find(|m| m.name() == s).ok_or_else(|| {
             // `colour`, as the documentation's prose spells it, is one letter from the name.
             // (Not for a name of one or two letters: any is within two edits of `ao`.)
+            // The same name in another case is suggested at any length (`AO`).
             let names = MapKind::EVERY.map(MapKind::name);
-            let near = (s.len() > 2).then(|| crate::toml_text::nearest(&s.to_ascii_lowercase(), names)).flatten();
+            let same = names.into_iter().find(|n| n.eq_ignore_ascii_case(s));
+            let near = same.or_else(|| (s.len() > 2).then(|| crate::toml_text::nearest(s, names)).flatten());
             let suggestion = near.map(|n| format!("did you mean {n}? ")).unwrap_or_default();
             format!("unknown map {s:?}; {suggestion}accepted: color, height, normal, roughness, iridescence, ao")
         })

@@ -62,6 +62,17 @@ fn a_key_without_the_key_it_shapes_is_refused() {
             if with.is_empty() { text.replace("plates = false", "plates = true") } else { format!("{text}{with}") };
         accepted(&write_preset(dir.path(), "b.toml", &partnered), &[]);
     }
+    // An override that turns a built-in's partner off passes over the keys its file wrote
+    // for it (they were refused, at a line of a file the user cannot edit); one that writes
+    // the key itself without its partner is refused.
+    accepted("crotalus-atrox", &["--set", "body.tail_bands=0"]);
+    accepted("corallus-caninus", &["--set", "belly.plates=false"]);
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().to_str().unwrap();
+    let out =
+        snakeskin(&["generate", "natrix-natrix", "-o", out_dir, "--size", "16", "--set", "body.tip_fraction=0.3"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("(with --set): key `body.tip_fraction` sizes what"), "{}", stderr(&out));
 }
 
 /// An absorption list of the wrong length says its length (any longer list said 4).
@@ -694,6 +705,8 @@ fn a_mistyped_map_name_gets_a_suggestion() {
         ("xy", "unknown map \"xy\"; accepted:"),
         ("foo", "unknown map \"foo\"; accepted:"),
         ("aoo", "unknown map \"aoo\"; did you mean ao?"),
+        // The same name in capitals, at any length (`AO` had none).
+        ("AO", "unknown map \"AO\"; did you mean ao?"),
         ("color,", "an empty name in \"color,\"; name the maps, one comma between two"),
     ] {
         let out = snakeskin(&["graph", "natrix-natrix", "--maps", maps]);

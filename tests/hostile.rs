@@ -966,7 +966,7 @@ fn a_planted_symlink_at_a_temporary_name_is_not_followed() {
     let glb = sets.path().join(format!("{PRESET}.glb"));
     let out = snakeskin(&["export", lock.to_str().unwrap(), "--gltf", glb.to_str().unwrap(), "--size", "16"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("would be written over this command's input"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("is where this run keeps its lock"), "{}", stderr(&out));
     assert_eq!(std::fs::read(&lock).unwrap(), preset, "the file at the lock changed");
     assert_eq!(std::fs::read_dir(sets.path()).unwrap().count(), 1, "only the file there");
     // An empty preset there (all defaults) is the export's input, which its lock would be:
@@ -974,7 +974,8 @@ fn a_planted_symlink_at_a_temporary_name_is_not_followed() {
     std::fs::write(&lock, b"").unwrap();
     let out = snakeskin(&["export", lock.to_str().unwrap(), "--gltf", glb.to_str().unwrap(), "--size", "16"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("would be written over this command's input"), "{}", stderr(&out));
+    let said = format!("the input {} is where this run keeps its lock (.NAME.lock", lock.display());
+    assert!(stderr(&out).contains(&said), "{}", stderr(&out));
     assert!(lock.exists(), "the preset at the lock was removed");
     // Negative control: with it gone (or empty, as a killed run leaves its lock) the same
     // run writes its set.

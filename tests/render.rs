@@ -641,7 +641,7 @@ fn the_window_reloads_the_preset_file_on_save() {
     // An empty file (an editor's truncate before its write) keeps them too: it reloaded as
     // the default snake.
     std::fs::write(&preset, "").unwrap();
-    let empty = wait_for("reload failed");
+    let empty = wait_for("is empty (a save in progress?)");
     // The file's folder deleted and made again (a `git checkout`): its old watch sees nothing
     // of the new folder, and every edit after it went unseen.
     std::fs::remove_dir_all(dir.path().join("real")).unwrap();

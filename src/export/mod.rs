@@ -12,9 +12,9 @@ mod srgb;
 
 pub use atomic::{
     Earlier, FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_folder_writable,
-    check_not_an_input, check_png_target, check_target, check_target_named, check_writable, clean_up_before_exit,
-    create_folder, create_folder_noted, ends_as_a_folder, lock_file_name, remove_empty_made_folders, same_path,
-    sha256_hex, write_file_atomically,
+    check_lock_not_an_input, check_not_an_input, check_png_target, check_target, check_target_named, check_writable,
+    clean_up_before_exit, create_folder, create_folder_noted, ends_as_a_folder, lock_file_name,
+    remove_empty_made_folders, same_path, sha256_hex, write_file_atomically,
 };
 pub(crate) use manifest::verify_set_json;
 pub use manifest::{
@@ -84,6 +84,13 @@ pub enum ExportError {
     /// it replaced the input, and the command could not be run again.
     #[error("{output} would be written over this command's input {input} (the same file); move or rename one of them")]
     OverwritesInput { output: PathBuf, input: PathBuf },
+    /// The command's input file where the set's (or export's) lock goes: the run would take
+    /// it as its lock and remove it as it ends.
+    #[error(
+        "the input {input} is where this run keeps its lock (.NAME.lock, which it takes and removes as it ends); \
+         rename the file"
+    )]
+    InputAtLock { input: PathBuf },
     /// An output named for another format (`preview --out x.jpg`, `--plot x.png`): it was
     /// written in its own format under that name, without a word.
     #[error("{path}: this output is a .{format} file; give it a name ending in .{format} (it ends in .{extension})")]
@@ -150,6 +157,7 @@ impl ExportError {
                 | ExportError::NamedForAnotherFormat { .. }
                 | ExportError::OnlyAnExtension { .. }
                 | ExportError::OverwritesInput { .. }
+                | ExportError::InputAtLock { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
         )

@@ -250,9 +250,7 @@ pub fn parse_with_seed(
             // and `--set 'pattern={..}'` write: problems name its keys `pattern.0.KEY`.
             || key.strip_prefix("pattern.0.").is_some_and(|rest| under_written(&format!("pattern.{rest}")))
     };
-    let in_layer = |i: usize, key: &str| overridden(&format!("pattern.{i}.{key}"));
-    let from_file_for_old_kind = |i: usize, key: &str| in_layer(i, "kind") && !in_layer(i, key);
-    let problems = validate(&preset, &from_file_for_old_kind);
+    let problems = validate(&preset, &overridden);
     let key_lines = std::cell::LazyCell::new(|| toml_text::KeyLines::new(&source.text));
     // A key's line in the file: none for a key an override wrote (or one not in the file).
     let line_of = |key: &str| if overridden(key) { None } else { key_lines.line(key) };

@@ -251,13 +251,19 @@ pub fn seed_range_words() -> String {
     format!("[0, {}]", ranges::SEED_MAX)
 }
 
-/// Every out-of-range value in the preset (empty when it is valid). `from_file_for_old_kind
-/// (i, key)`: whether layer i's `key` is the file's while its kind came from `--set`; such a
-/// key, written for the file's kind, is passed over rather than refused as another kind's
-/// (`--set pattern.0.kind=spots` on a preset of blotches keeps their `length`, `shape` and
-/// `count`, which spots do not read), where the same key written by an override is refused.
-pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) -> bool) -> Vec<Problem> {
+/// Every out-of-range value in the preset (empty when it is valid). `overridden(key)`:
+/// whether an override (`--set`, a jobs file's `set`) wrote the dotted key. A key the file
+/// wrote for what an override then changed is passed over rather than refused: layer i's
+/// key while its kind came from `--set` (`--set pattern.0.kind=spots` on a preset of blotches
+/// keeps their `length`, `shape` and `count`, which spots do not read), a body key while the
+/// key it shapes was overridden (`--set body.tail_bands=0` on a preset with banded tails);
+/// the same key written by an override is refused.
+pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Problem> {
     use ranges::*;
+    // Whether `key` is the file's while `partner`, which it belongs to, was overridden.
+    let from_file_for_overridden = |key: &str, partner: &str| overridden(partner) && !overridden(key);
+    let from_file_for_old_kind =
+        |i: usize, key: &str| from_file_for_overridden(&format!("pattern.{i}.{key}"), &format!("pattern.{i}.kind"));
     let mut c = Checker::default();
     if preset.seed > SEED_MAX {
         c.problems.push(Problem {
@@ -578,31 +584,49 @@ pub fn validate(preset: &Preset, from_file_for_old_kind: &dyn Fn(usize, &str) ->
     // `tail_band_width` without `tail_bands`, `tip_fraction` without `tip_color` and
     // `up_rows` without `plates` passing silently, where a pattern layer refuses a key its
     // kind does not read).
+    // A key at its default is not told apart from one left out. One the file wrote is passed
+    // over where an override turned its partner off (`--set body.tail_bands=0` on a preset
+    // with banded tails, `--set belly.plates=false`).
     let (body, belly) = (crate::preset::schema::Body::default(), crate::preset::schema::Belly::default());
     let no_bands = "shapes the bands `body.tail_bands` draws, which is 0 here; set it, or leave this out";
-    for (key, set, unread, message) in [
+    for (key, set, partner, unread, message) in [
         (
             "body.tail_shift_start",
             b.tail_shift_start != body.tail_shift_start,
+            "body.tail_color",
             b.tail_color.is_none(),
             "starts the shift to `body.tail_color`, which this preset does not set; set it, or leave this out",
         ),
-        ("body.tail_band_width", b.tail_band_width != body.tail_band_width, b.tail_bands == 0, no_bands),
-        ("body.tail_band_color", b.tail_band_color != body.tail_band_color, b.tail_bands == 0, no_bands),
+        (
+            "body.tail_band_width",
+            b.tail_band_width != body.tail_band_width,
+            "body.tail_bands",
+            b.tail_bands == 0,
+            no_bands,
+        ),
+        (
+            "body.tail_band_color",
+            b.tail_band_color != body.tail_band_color,
+            "body.tail_bands",
+            b.tail_bands == 0,
+            no_bands,
+        ),
         (
             "body.tip_fraction",
             b.tip_fraction != body.tip_fraction,
+            "body.tip_color",
             b.tip_color.is_none(),
             "sizes what `body.tip_color` draws, which this preset does not set; set it, or leave this out",
         ),
         (
             "belly.up_rows",
             preset.belly.up_rows != belly.up_rows,
+            "belly.plates",
             !preset.belly.plates,
             "runs the belly colour up beside the plates, which `belly.plates = false` leaves out; leave this out",
         ),
     ] {
-        if set && unread {
+        if set && unread && !from_file_for_overridden(key, partner) {
             c.problems.push(Problem { key: key.into(), message: message.into() });
         }
     }
