@@ -583,10 +583,9 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
     // A key that shapes what another draws, without that other (the review found
     // `tail_band_width` without `tail_bands`, `tip_fraction` without `tip_color` and
     // `up_rows` without `plates` passing silently, where a pattern layer refuses a key its
-    // kind does not read).
-    // A key at its default is not told apart from one left out. One the file wrote is passed
-    // over where an override turned its partner off (`--set body.tail_bands=0` on a preset
-    // with banded tails, `--set belly.plates=false`).
+    // kind does not read). A key at its default is not told apart from one left out; one the
+    // file wrote is passed over where an override turned its partner off (`--set
+    // body.tail_bands=0` on a preset with banded tails, `--set belly.plates=false`).
     let (body, belly) = (crate::preset::schema::Body::default(), crate::preset::schema::Belly::default());
     let no_bands = "shapes the bands `body.tail_bands` draws, which is 0 here; set it, or leave this out";
     for (key, set, partner, unread, message) in [
