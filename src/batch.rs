@@ -59,11 +59,10 @@ fn set_twice(set: &std::collections::BTreeMap<String, toml::Value>) -> Option<St
             (key, into)
         })
         .collect();
-    let within =
-        |inner: &str, outer: &str| inner == outer || inner.strip_prefix(outer).is_some_and(|r| r.starts_with('.'));
     for (i, (a, a_leaves)) in written.iter().enumerate() {
         for (b, b_leaves) in &written[i + 1..] {
             for x in a_leaves {
+                let within = crate::toml_text::key_within;
                 if let Some(y) = b_leaves.iter().find(|y| within(x, y) || within(y, x)) {
                     let key = if x.len() >= y.len() { x } else { y };
                     return Some(format!("`{key}` is set by two entries, `{a}` and `{b}`; give it once"));

@@ -326,9 +326,9 @@ impl ExportPlan {
                 && let Ok(meta) = std::fs::symlink_metadata(&stale)
                 && !meta.is_dir()
             {
-                let stays = match &earlier {
+                let stays = match earlier {
                     EarlierImage::Named { sha256 } => stale_image_stays(&stale, meta.is_file(), sha256.as_deref()),
-                    other => other.why_it_stays(&gltf_name),
+                    EarlierImage::NotShown(why) => Some(why),
                 };
                 match stays {
                     Some(why) => kept.push(KeptFile { path: stale, why, by: Earlier::Export }),

@@ -161,6 +161,12 @@ fn with_suggestion(message: &str) -> String {
     format!("unknown key `{unknown}`{hint} (accepted keys here: {})", accepted.join(", "))
 }
 
+/// Whether the dotted key `key` is `table` or lies inside it (`scales.rows` in `scales`, not
+/// `scales_x`).
+pub fn key_within(key: &str, table: &str) -> bool {
+    key.strip_prefix(table).is_some_and(|rest| rest.is_empty() || rest.starts_with('.'))
+}
+
 /// The accepted name nearest to `unknown`, for "did you mean", if one is near enough: at
 /// most 2 edits, or a third of its length for a long one, and at most half its letters for a
 /// short one (`graph --maps foo` asked "did you mean ao?": two edits, every letter of `ao`).

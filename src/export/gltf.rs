@@ -380,27 +380,13 @@ const EARLIER_GLTF_MAX_BYTES: u64 = 16 << 20;
 /// What an earlier `.gltf` says of an image file beside it (`earlier_image`).
 #[derive(Debug, Clone, PartialEq)]
 pub enum EarlierImage {
-    /// Not one of its images: someone else's file.
-    NotNamed,
     /// One of its images, with the SHA-256 it recorded (None: written before images carried
     /// one).
     Named { sha256: Option<String> },
-    /// No `.gltf` there (a killed commit can leave its images without it), or one that could
-    /// not be read: why, to say of a file that stays (as `generate` says of a map no
-    /// manifest records).
-    Unknown(KeptBecause),
-}
-
-impl EarlierImage {
-    /// Why an image file that an export no longer writes stays beside it, unless the earlier
-    /// `.gltf` (`gltf_name`) named it.
-    pub fn why_it_stays(&self, gltf_name: &str) -> Option<KeptBecause> {
-        match self {
-            EarlierImage::Named { .. } => None,
-            EarlierImage::NotNamed => Some(KeptBecause::NotRecorded { record: gltf_name.into() }),
-            EarlierImage::Unknown(why) => Some(why.clone()),
-        }
-    }
+    /// Not shown to be one: the `.gltf` does not name it (someone else's file), is not there
+    /// (a killed commit can leave its images without it) or could not be read. Why, to say
+    /// of a file that stays (as `generate` says of a map no manifest records).
+    NotShown(KeptBecause),
 }
 
 /// What the `.gltf` at `gltf` says of `image_file` (a file beside it): named as one of its
@@ -412,11 +398,11 @@ pub fn earlier_image(gltf: &std::path::Path, image_file: &str) -> EarlierImage {
     use crate::text_file::{BoundedReadError, Links, read_bounded_bytes};
     let gltf_name = gltf.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let unreadable =
-        |error: String| EarlierImage::Unknown(KeptBecause::RecordUnreadable { record: gltf_name.clone(), error });
+        |error: String| EarlierImage::NotShown(KeptBecause::RecordUnreadable { record: gltf_name.clone(), error });
     let bytes = match read_bounded_bytes(gltf, EARLIER_GLTF_MAX_BYTES, Links::Refuse) {
         Ok(bytes) => bytes,
         Err(BoundedReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
-            return EarlierImage::Unknown(KeptBecause::NoRecord(gltf_name));
+            return EarlierImage::NotShown(KeptBecause::NoRecord(gltf_name));
         }
         Err(e) => return unreadable(e.to_string()),
     };
@@ -427,7 +413,7 @@ pub fn earlier_image(gltf: &std::path::Path, image_file: &str) -> EarlierImage {
     let uri = uri_reference(image_file);
     match json["images"].as_array().into_iter().flatten().find(|image| image["uri"].as_str() == Some(&uri)) {
         Some(image) => EarlierImage::Named { sha256: image["extras"]["sha256"].as_str().map(String::from) },
-        None => EarlierImage::NotNamed,
+        None => EarlierImage::NotShown(KeptBecause::NotRecorded { record: gltf_name }),
     }
 }
 

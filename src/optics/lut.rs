@@ -434,7 +434,8 @@ impl LazyLut {
     }
 
     /// How many texels have been computed.
-    pub fn computed(&self) -> usize {
+    #[cfg(test)]
+    fn computed(&self) -> usize {
         self.texels.iter().filter(|t| t.get().is_some()).count()
     }
 }

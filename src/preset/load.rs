@@ -239,7 +239,7 @@ pub fn parse_with_seed(
     // A key an override wrote, or one inside a value it put whole (an inline table in place
     // of the file's layers), has no line in the file; the file is parsed for lines once, not
     // once per problem (thousands of them took minutes).
-    let under_written = |key: &str| written.iter().any(|k: &String| key == k || key.starts_with(&format!("{k}.")));
+    let under_written = |key: &str| written.iter().any(|k: &String| toml_text::key_within(key, k));
     // The seed's overrides are not among `overrides` (above): a seed given by `--seed` or
     // `--set seed=` has no line either.
     let seed_given = seed.is_some();
