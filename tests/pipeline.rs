@@ -401,8 +401,18 @@ fn a_map_written_alone_computes_only_its_scale_channels_and_the_same_samples() {
             })
             .unwrap()
     };
-    for name in ["crotalus-atrox", "xenopeltis-unicolor", "bitis-gabonica", PATTERNED] {
-        let loaded = parse(&read_source(name).unwrap(), &[]).unwrap();
+    // The last: a per-scale colour of speckles alone, which reads no optional channel
+    // (`ScaleChannels`: a stand-in index had kept the height plane for `--maps color`).
+    let speckles_alone = [("color.scale_tone", "0"), ("color.speckle", "0.3")].map(|(k, v)| (k.into(), v.into()));
+    let cases = [
+        ("crotalus-atrox", &[][..]),
+        ("xenopeltis-unicolor", &[]),
+        ("bitis-gabonica", &[]),
+        (PATTERNED, &[]),
+        ("xenopeltis-unicolor", &speckles_alone[..]),
+    ];
+    for (name, overrides) in cases {
+        let loaded = parse(&read_source(name).unwrap(), overrides).unwrap();
         let whole = build_graph(&loaded.preset, BuildOptions::default());
         let all = evaluate(&whole, &MapKind::ALL, 96, 96, &|_, _| {}).maps;
         assert_eq!(field(&whole.for_maps(&MapKind::ALL)), field(&whole), "{name}: the whole set lost a channel");
@@ -424,6 +434,26 @@ fn a_map_written_alone_computes_only_its_scale_channels_and_the_same_samples() {
         got.sort_unstable();
         assert_eq!(got, wanted, "{name}: the roughness map's scale field");
         assert!(field(&whole).len() > wanted.len(), "{name}: the control: the whole set reads more");
+        // The colour map reads the crevices, the channels of the per-scale colour's keys that
+        // are on (`ops::scale_colour`) and the scale centres of patterns snapped to scales.
+        let c = &loaded.preset.color;
+        let mut wanted = vec![channel::CREVICE];
+        if c.scale_tone > 0.0 || c.scale_hue > 0.0 {
+            wanted.push(channel::CELL_RANDOM);
+        }
+        if c.tip_tone != 0.0 {
+            wanted.push(channel::ALONG);
+        }
+        if c.edge_tone != 0.0 {
+            wanted.push(channel::INSIDE);
+        }
+        if loaded.preset.pattern.iter().any(|p| p.scale_aligned > 0.0) {
+            wanted.extend([channel::CENTRE_U, channel::CENTRE_V]);
+        }
+        wanted.sort_unstable();
+        let mut got = field(&whole.for_maps(&[MapKind::Color]));
+        got.sort_unstable();
+        assert_eq!(got, wanted, "{name} {overrides:?}: the colour map's scale field");
     }
 }
 

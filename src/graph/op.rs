@@ -107,7 +107,8 @@ impl Op {
             (Op::SnapToScales { centre_u, centre_v, .. }, 1) => Some(vec![centre_u, centre_v]),
             (Op::ScaleColour(op), 1) => {
                 let c = &mut op.channels;
-                Some(vec![&mut c.crevice, &mut c.random, &mut c.inside, &mut c.along])
+                let optional = [&mut c.random, &mut c.inside, &mut c.along].into_iter().flat_map(Option::as_mut);
+                Some(std::iter::once(&mut c.crevice).chain(optional).collect())
             }
             _ => None,
         }

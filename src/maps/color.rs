@@ -161,29 +161,29 @@ fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
         speckle_cells: s.lattice.cols as u32 * SPECKLES_PER_SCALE,
         speckle_cells_v: s.along_count(s.lattice.cols as u32 * SPECKLES_PER_SCALE),
         seed: derive_seed(preset.seed, "per_scale"),
-        channels: ScaleChannels {
-            crevice: s.channel_index(channel::CREVICE),
-            random: s.field.output_index(channel::CELL_RANDOM).unwrap_or(0),
-            inside: s.field.output_index(channel::INSIDE).unwrap_or(0),
-            along: s.field.output_index(channel::ALONG).unwrap_or(0),
+        channels: {
+            let [random, inside, along] = per_scale_reads(preset).map(|(ch, read)| read.then(|| s.channel_index(ch)));
+            ScaleChannels { crevice: s.channel_index(channel::CREVICE), random, inside, along }
         },
     })
 }
 
+/// The scale-field channels the per-scale colour reads besides the crevice, each with
+/// whether its keys are on: the cell's random number (`scale_tone`, `scale_hue`), the
+/// distance inside the outline (`edge_tone`) and the position along the scale (`tip_tone`),
+/// in `ScaleChannels`' order.
+fn per_scale_reads(preset: &Preset) -> [(usize, bool); 3] {
+    let c = &preset.color;
+    [
+        (channel::CELL_RANDOM, c.scale_tone > 0.0 || c.scale_hue > 0.0),
+        (channel::INSIDE, c.edge_tone != 0.0),
+        (channel::ALONG, c.tip_tone != 0.0),
+    ]
+}
+
 /// The scale-field channels the per-scale colour reads, for `scale_outputs`.
 pub(super) fn per_scale_channels(preset: &Preset) -> Vec<usize> {
-    let c = &preset.color;
-    let mut channels = Vec::new();
-    if c.scale_tone > 0.0 || c.scale_hue > 0.0 {
-        channels.push(channel::CELL_RANDOM);
-    }
-    if c.edge_tone != 0.0 {
-        channels.push(channel::INSIDE);
-    }
-    if c.tip_tone != 0.0 {
-        channels.push(channel::ALONG);
-    }
-    channels
+    per_scale_reads(preset).into_iter().filter_map(|(ch, read)| read.then_some(ch)).collect()
 }
 
 fn perlin(cells_u: u32, cells_v: u32, octaves: u32, gain: f32, seed: u32) -> Op {

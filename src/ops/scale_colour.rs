@@ -36,13 +36,19 @@ pub const SPECKLES_PER_SCALE: u32 = 6;
 /// Dot radius in speckle cells.
 const DOT_RADIUS: f32 = 0.28;
 
-/// Scale-field channel positions the kernel reads (indices into the scales image).
+/// Scale-field channel positions the kernel reads (indices into the scales image). A
+/// channel only some keys read is None where they are off, so that `Graph::for_maps` keeps
+/// only the field's planes some node reads (a stand-in index 0 kept the height plane, 16 MiB
+/// at 2048², for a `--maps color` run that never read it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct ScaleChannels {
     pub crevice: usize,
-    pub random: usize,
-    pub inside: usize,
-    pub along: usize,
+    /// Read by `tone` and `hue`.
+    pub random: Option<usize>,
+    /// Read by `edge`.
+    pub inside: Option<usize>,
+    /// Read by `tip`.
+    pub along: Option<usize>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -91,8 +97,15 @@ impl ScaleColour {
             let v = (frame.texture_row(y) as f32 + 0.5) / height as f32;
             // The field is planar (`Image::plane`): this row of the four channels read.
             let field_row = |c: usize| scales.plane_rows(c, y..y + 1);
-            let (crevices, randoms, insides, alongs) =
-                (field_row(k.crevice), field_row(k.random), field_row(k.inside), field_row(k.along));
+            // A plane whose keys are off is not read (an empty row: its keys never index it).
+            let read = |on: bool, c: Option<usize>| match on {
+                true => field_row(c.expect("the per-scale colour's channels include what its keys read")),
+                false => &[][..],
+            };
+            let crevices = field_row(k.crevice);
+            let randoms = read(self.tone != 0.0 || self.hue != 0.0, k.random);
+            let insides = read(self.edge != 0.0, k.inside);
+            let alongs = read(self.tip != 0.0, k.along);
             // The scale's second random number, hashed once per run of pixels of one scale
             // (a scale spans many pixels of a row), not once per pixel.
             let mut second_of: (u32, f32) = (u32::MAX, 0.0);
@@ -108,13 +121,13 @@ impl ScaleColour {
                 if own <= 0.0 {
                     continue;
                 }
-                let random = randoms[x];
                 let mut gain = [1.0f32; 3];
                 if self.tone != 0.0 {
-                    let t = 1.0 + self.tone * (2.0 * random - 1.0) * own;
+                    let t = 1.0 + self.tone * (2.0 * randoms[x] - 1.0) * own;
                     gain = gain.map(|g| g * t);
                 }
                 if self.hue != 0.0 {
+                    let random = randoms[x];
                     if second_of.0 != random.to_bits() {
                         second_of = (random.to_bits(), hash::unit(random.to_bits() as i32, 0, 7, self.seed));
                     }
@@ -200,7 +213,7 @@ mod tests {
             speckle_cells: 64,
             speckle_cells_v: 64,
             seed: 7,
-            channels: ScaleChannels { crevice: 0, random: 1, inside: 2, along: 3 },
+            channels: ScaleChannels { crevice: 0, random: Some(1), inside: Some(2), along: Some(3) },
         };
         kernel.apply(colour, &scales, frame)
     }
