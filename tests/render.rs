@@ -7,6 +7,7 @@
 mod common;
 
 use common::{gpu_or_skip, gpu_required, on_x11, snakeskin};
+use snakeskin::export::srgb;
 use snakeskin::graph::{NodeCache, evaluate};
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::optics::brdf::Model;
@@ -16,7 +17,6 @@ use snakeskin::render::engine::prepare::material_maps;
 use snakeskin::render::engine::renderer::{FrameSettings, Material};
 use snakeskin::render::engine::scene::{Camera, LayerOptics, Stage, View};
 use snakeskin::render::reference::frame::reference_check;
-use snakeskin::render::reference::frame::srgb_encode;
 
 /// An iridescent species (its sources report iridescence, so it has a film).
 const PRESET: &str = "xenopeltis-unicolor";
@@ -265,7 +265,7 @@ fn the_map_viewer_shows_the_color_map_and_stages_differ() {
     let mut worst = 0.0f64;
     for i in (0..(w * h) as usize).filter(|i| gbuffer.covered(*i)) {
         for c in 0..3 {
-            let expected = srgb_encode(gbuffer.albedo_coverage[i][c] as f64) * 255.0;
+            let expected = srgb::encode(gbuffer.albedo_coverage[i][c] as f64) * 255.0;
             worst = worst.max((image.as_raw()[4 * i + c] as f64 - expected).abs());
         }
     }

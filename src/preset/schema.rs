@@ -82,10 +82,7 @@ pub struct Srgb8(pub [u8; 3]);
 impl Srgb8 {
     /// Linear RGB by the sRGB transfer function (IEC 61966-2-1).
     pub fn to_linear(self) -> [f32; 3] {
-        self.0.map(|c| {
-            let c = c as f32 / 255.0;
-            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-        })
+        self.0.map(|c| crate::export::srgb::decode_f32(c as f32 / 255.0))
     }
 
     pub fn parse(text: &str) -> Option<Self> {

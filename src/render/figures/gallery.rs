@@ -253,9 +253,11 @@ pub fn check_memory(tile: usize, columns: usize) -> Result<(), Error> {
     check.refuse_if_over(&format!("a gallery of {w}×{h} pixels ({} tiles of {tile}²)", VARIANTS.len()))
 }
 
-/// A height map shown as linear gray, gamma-adjusted so sRGB encoding shows it as stored.
+/// A one-channel map shown as gray: the linear value whose sRGB encoding is the value, so
+/// the figure shows each value as its code (a 2.2 power stood in for the transfer function
+/// and showed dark values up to 9 codes darker).
 fn gray_to_display(image: &Image) -> Image {
-    let data = image.data.iter().flat_map(|v| [v.clamp(0.0, 1.0).powf(2.2); 3]).collect();
+    let data = image.data.iter().flat_map(|v| [crate::export::srgb::decode_f32(*v); 3]).collect();
     Image { width: image.width, height: image.height, channels: 3, data }
 }
 
@@ -343,7 +345,11 @@ fn closeup_pngs() -> Result<Vec<(String, Vec<u8>)>, Error> {
                             // The normal map's [-1, 1] shown as its PNG stores it, (n + 1) / 2,
                             // as the linear value that sRGB encoding turns into that code.
                             let v = img.data[(sy * n + sx) * 3 + ch];
-                            let v = if *map == MapKind::Normal { srgb_to_linear((v + 1.0) * 0.5) } else { v };
+                            let v = if *map == MapKind::Normal {
+                                crate::export::srgb::decode_f32((v + 1.0) * 0.5)
+                            } else {
+                                v
+                            };
                             out.data[(y * 2 * c + k * c + x) * 3 + ch] = v;
                         }
                     }
@@ -352,12 +358,6 @@ fn closeup_pngs() -> Result<Vec<(String, Vec<u8>)>, Error> {
             Ok((closeup_file_name(stem), encode_png(MapKind::Color, &out)?))
         })
         .collect()
-}
-
-/// The sRGB transfer function's inverse (IEC 61966-2-1).
-fn srgb_to_linear(encoded: f32) -> f32 {
-    let e = encoded.clamp(0.0, 1.0);
-    if e <= 0.04045 { e / 12.92 } else { ((e + 0.055) / 1.055).powf(2.4) }
 }
 
 /// Renders the gallery PNG to `path`, and with `closeups` a folder, the close-ups into it;
@@ -382,6 +382,17 @@ pub fn write(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A one-channel tile shows each value as its own code: v / 255 encodes back to v (a 2.2
+    /// power in its place was 9 codes off near black).
+    #[test]
+    fn a_gray_tile_shows_each_value_as_its_code() {
+        let data = (0..=255).map(|v| v as f32 / 255.0).collect();
+        let gray = gray_to_display(&Image { width: 256, height: 1, channels: 1, data });
+        for (v, rgb) in gray.data.chunks(3).enumerate() {
+            assert!(rgb.iter().all(|c| crate::export::linear_to_srgb8(*c) as usize == v), "{v}: {rgb:?}");
+        }
+    }
 
     /// The figures show what their presets say: no colour key of a variant or a close-up is
     /// brighter than the stack shows with the map's headroom (`preset::visible`), where it
