@@ -145,8 +145,9 @@ impl Op {
     /// Temporary buffers a kernel allocates besides its output, in output-sized images, at
     /// `width` pixels wide: the small blur's horizontal pass, and its input, which it still
     /// holds while it writes a new output (`filters::gaussian_blur`; the estimate has
-    /// counted that input as handed over); the coverage pixmap of tiny-skia shapes (RGBA8,
-    /// the size of one f32 channel).
+    /// counted that input as handed over); the coverage mask of tiny-skia shapes (a byte a
+    /// pixel over the frame's rows, on a body atlas rounded out to `shapes::CUT_ROWS`: under
+    /// one f32 channel but for strips under 21 rows).
     pub fn scratch_images(&self, width: usize) -> usize {
         match self {
             Op::Blur { sigma } if filters::blur_is_gaussian(*sigma, width) => 2,
@@ -198,8 +199,7 @@ impl Op {
     /// (`Graph::row_reach` sums them along the graph).
     pub fn row_reach(&self, width: usize) -> usize {
         match self {
-            // Three passes of boxes (or a Gaussian) of about 3 σ together, and a pixel more.
-            Op::Blur { sigma } => (3.5 * sigma * width as f32).ceil() as usize + 2,
+            Op::Blur { sigma } => crate::ops::filters::blur_row_reach(*sigma, width),
             Op::Sobel { .. } | Op::HeightToNormal { .. } => 1,
             Op::SnapToScales { reach, .. } => (reach * width as f32).ceil() as usize + 2,
             // Pixels are square: a texture width is `width` rows.
@@ -267,20 +267,10 @@ impl Op {
         }
     }
 
-    /// Operations without inputs, which compute their pixels from the frame's texture rows.
+    /// Operations without inputs, which compute their pixels from the frame's texture rows
+    /// (`arity`'s list, not a second one a new generator could be left out of).
     fn is_generator(&self) -> bool {
-        matches!(
-            self,
-            Op::Noise(_)
-                | Op::Constant { .. }
-                | Op::Scales(_)
-                | Op::Bands { .. }
-                | Op::Blotches(_)
-                | Op::BellyMarks(_)
-                | Op::Spots(_)
-                | Op::Along(_)
-                | Op::HeadMark(_)
-        )
+        self.arity() == (0..=0)
     }
 
     /// A short description for stats and DOT labels.

@@ -172,8 +172,34 @@ pub fn constant(width: usize, height: usize, value: f32) -> Image {
     image
 }
 
+/// Below this σ in pixels `blur` is the identity (a third of a pixel: the kernel's outer
+/// taps would weigh under 1e-2).
+const IDENTITY_BELOW_PX: f32 = 0.33;
+
+/// Up to this σ in pixels `blur` samples the Gaussian; beyond, three box passes (Kovesi).
+const GAUSSIAN_UP_TO_PX: f32 = 2.0;
+
+/// The sampled Gaussian's radius in pixels: 3 σ, at least one.
+fn gaussian_radius(sigma_px: f32) -> usize {
+    (sigma_px * 3.0).ceil().max(1.0) as usize
+}
+
+/// How many rows above and below a pixel `blur` reads: the sampled Gaussian's radius, or
+/// the three box passes' half-widths summed (each pass reads what the one before wrote),
+/// 0 for the identity. What a strip of a long texture carries as margin for it.
+pub fn blur_row_reach(sigma: f32, width: usize) -> usize {
+    let sigma_px = sigma * width as f32;
+    if sigma_px < IDENTITY_BELOW_PX {
+        0
+    } else if blur_is_gaussian(sigma, width) {
+        gaussian_radius(sigma_px)
+    } else {
+        box_widths(sigma_px).iter().map(|w| w / 2).sum()
+    }
+}
+
 fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
-    let radius = (sigma_px * 3.0).ceil().max(1.0) as isize;
+    let radius = gaussian_radius(sigma_px) as isize;
     let mut kernel: Vec<f32> =
         (-radius..=radius).map(|i| (-(i * i) as f32 / (2.0 * sigma_px * sigma_px)).exp()).collect();
     let sum: f32 = kernel.iter().sum();
@@ -190,7 +216,7 @@ fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
 /// atlas, whose snout and tail tip are not neighbours).
 pub fn blur(input: Cow<'_, Image>, sigma: f32, wraps_v: bool) -> Image {
     let sigma_px = sigma * input.width as f32;
-    if sigma_px < 0.33 {
+    if sigma_px < IDENTITY_BELOW_PX {
         return input.into_owned();
     }
     if blur_is_gaussian(sigma, input.width) {
@@ -210,7 +236,7 @@ pub fn blur(input: Cow<'_, Image>, sigma: f32, wraps_v: bool) -> Image {
 /// its input) rather than running box passes in place: from a third of a pixel up to 2 px.
 pub fn blur_is_gaussian(sigma: f32, width: usize) -> bool {
     let sigma_px = sigma * width as f32;
-    (0.33..=2.0).contains(&sigma_px)
+    (IDENTITY_BELOW_PX..=GAUSSIAN_UP_TO_PX).contains(&sigma_px)
 }
 
 /// The scratch of `blur`'s box passes in image rows of its size (`box_pass`: the ring of a
@@ -221,7 +247,7 @@ pub fn blur_is_gaussian(sigma: f32, width: usize) -> bool {
 /// rows, which the caller counts once per channel: an overestimate for a colour blur.
 pub fn blur_scratch_rows(sigma: f32, width: usize) -> usize {
     let sigma_px = sigma * width as f32;
-    if sigma_px < 0.33 || blur_is_gaussian(sigma, width) {
+    if sigma_px < IDENTITY_BELOW_PX || blur_is_gaussian(sigma, width) {
         return 0;
     }
     let r = box_widths(sigma_px).into_iter().max().unwrap_or(1) / 2;

@@ -95,32 +95,35 @@ pub struct SpotGrid {
 
 /// Rasterises the spot grid into an anti-aliased coverage mask in [0, 1].
 pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
-    let drawn = drawn_rows(frame);
     let (w, h) = (frame.width as f32, frame.full_height as f32);
-    let (top, bottom) = (drawn.row0 as f32, (drawn.row0 + drawn.height) as f32);
-    let mut pb = PathBuilder::new();
     let (across, along) = (grid.across.max(1), grid.along.max(1));
-    for row in 0..along as i32 {
-        for col in 0..across as i32 {
-            if grid.checkered && (row + col) % 2 == 1 {
-                continue;
-            }
-            let shift = if grid.alternate && row % 2 == 1 { 0.5 } else { 0.0 };
-            let jx = hash::signed(col, row, 0, grid.seed) * grid.jitter * 0.5;
-            let jy = hash::signed(col, row, 1, grid.seed) * grid.jitter * 0.5;
-            let jr = 1.0 + hash::signed(col, row, 2, grid.seed) * grid.jitter * 0.5;
-            let cu = (col as f32 + 0.5 + shift + jx) / across as f32;
-            let cv = (row as f32 + 0.5 + jy) / along as f32;
-            let r_px = grid.radius * jr * w;
-            // Draw every periodic copy that can touch the tile.
-            for &oy in copies_v(frame) {
-                for ox in [-1.0f32, 0.0, 1.0] {
-                    let (x, y) = ((cu + ox) * w, (cv + oy) * h);
-                    if x + r_px >= 0.0 && x - r_px <= w && y + r_px >= top && y - r_px <= bottom {
-                        pb.push_circle(x, y, r_px.max(0.1));
-                        if grid.hole > 0.0 {
-                            push_hole(&mut pb, x, y, (r_px * grid.hole).max(0.05));
-                        }
+    // Each spot's centre (texture u, v) and radius in pixels; None for a checkered gap.
+    let spot = |col: i32, row: i32| {
+        if grid.checkered && (row + col) % 2 == 1 {
+            return None;
+        }
+        let shift = if grid.alternate && row % 2 == 1 { 0.5 } else { 0.0 };
+        let jx = hash::signed(col, row, 0, grid.seed) * grid.jitter * 0.5;
+        let jy = hash::signed(col, row, 1, grid.seed) * grid.jitter * 0.5;
+        let jr = 1.0 + hash::signed(col, row, 2, grid.seed) * grid.jitter * 0.5;
+        let cu = (col as f32 + 0.5 + shift + jx) / across as f32;
+        let cv = (row as f32 + 0.5 + jy) / along as f32;
+        Some((cu, cv, grid.radius * jr * w))
+    };
+    let canvas = Canvas::new(frame);
+    let mut pb = PathBuilder::new();
+    for (col, row) in (0..along as i32).flat_map(|row| (0..across as i32).map(move |col| (col, row))) {
+        let Some((cu, cv, r_px)) = spot(col, row) else {
+            continue;
+        };
+        // Draw every periodic copy that can touch the tile.
+        for &oy in copies_v(frame) {
+            for ox in [-1.0f32, 0.0, 1.0] {
+                let (x, y) = ((cu + ox) * w, (cv + oy) * h);
+                if canvas.keeps((x - r_px, x + r_px), (y - r_px, y + r_px)) {
+                    pb.push_circle(x, y, r_px.max(0.1));
+                    if grid.hole > 0.0 {
+                        push_hole(&mut pb, x, y, (r_px * grid.hole).max(0.05));
                     }
                 }
             }
@@ -128,7 +131,7 @@ pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
     }
     // Non-zero: overlapping spots are their union. Even-odd (before) cut the overlap of two
     // spots out of both, a lens-shaped hole wherever jitter or size made spots touch.
-    rasterise(frame, drawn, pb, FillRule::Winding)
+    canvas.rasterise(pb, FillRule::Winding)
 }
 
 /// Adds the hole of a ring spot: the circle `push_circle` would add, traced the other way
@@ -159,37 +162,190 @@ fn copies_v(frame: Frame) -> &'static [f32] {
     if frame.wraps_v { &[-1.0, 0.0, 1.0] } else { &[0.0] }
 }
 
-/// The rows a shape node draws for `frame`: the whole tile when `frame` is a strip of it,
-/// else `frame`'s own. tiny-skia's anti-aliased coverage of a pixel can depend on the
-/// mask's extent and on the other copies in the path (measured: one 8-bit step at one pixel
-/// on the seam of a strip of Crotalus at 256²), so a strip of the tile takes its rows from
-/// a mask of the whole tile (one byte per pixel). A body atlas is drawn strip by strip: it
-/// is not periodic, and its strips are checked against the whole atlas (`tests/body.rs`).
-fn drawn_rows(frame: Frame) -> Frame {
-    if frame.wraps_v && frame.height < frame.full_height { Frame::whole(frame.width, frame.full_height) } else { frame }
+/// Where a shape node draws for `frame`: a coverage mask over the texture's columns and the
+/// rows [top, top + rows), of which `frame`'s rows are kept.
+///
+/// tiny-skia's anti-aliased coverage of a pixel is not a function of the shapes alone. It
+/// cuts an edge that leaves the mask, at the mask's own coordinates in f32, and steps a cut
+/// edge from its cut rather than from its start; it rounds coordinates to its fixed point
+/// after they were moved to the mask's origin; and it splits curves where they turn, again
+/// at the mask's coordinates. So a strip drawn on its own mask differed from the same rows
+/// of the whole texture's (measured: one sixteenth, the 4 × 4 supersampling's step, at
+/// pixels up to 39 rows inside a strip of `bitis-arietans`' chevrons at 96² body, which a
+/// 0.5 threshold turned into a pixel of the other colour; one 8-bit step on the seam of a
+/// strip of Crotalus' tile at 256²).
+/// - A strip of the tile takes its rows from a mask of the whole tile (one byte a pixel).
+/// - A body atlas, which is not periodic, is drawn strip by strip, exactly (`on_grid`):
+///   every curve becomes lines, every edge gets a vertex where it crosses the texture's
+///   left and right edges and every `CUT_ROWS`-th row, all in texture coordinates, and each
+///   vertex is rounded to 1/`SUBPIXELS` pixel; a strip's mask starts and ends on a cut row.
+///   tiny-skia then cuts nothing (an edge lies inside the mask or wholly beside it, and one
+///   beside it it drops or stands up at the side with its own ends), and moving the
+///   vertices by whole rows to the mask's origin is exact, so its fixed point sees the same
+///   fractions wherever the mask starts. The mask is the strip's rows and under two cut
+///   blocks more. Every generator's strips are held to the whole atlas's rows
+///   (`tests/body.rs`).
+#[derive(Debug, Clone, Copy)]
+struct Canvas {
+    frame: Frame,
+    /// The texture row of the mask's first row.
+    top: usize,
+    rows: usize,
 }
 
-/// Fills the path (in texture pixels) into an anti-aliased coverage mask in [0, 1] over the
-/// rows of `frame`, drawing the rows of `drawn` (which hold `frame`'s; all zero if there is
-/// nothing to fill or the size is unusable).
-fn rasterise(frame: Frame, drawn: Frame, pb: PathBuilder, rule: FillRule) -> Image {
-    let (width, height) = (frame.width, frame.height);
-    let mut out = Image::new(width, height, 1);
-    let (Some(mut mask), Some(path)) = (Mask::new(width as u32, drawn.height as u32), pb.finish()) else {
-        return out;
-    };
-    // Written before tiny-skia reads it: the blitter loads a row's coverage before it stores
-    // it, and a fresh page first read maps the shared zero page, so its store then paid a
-    // copy-on-write fault with a TLB shootdown (BENCHMARKS.md, "Copy-on-write faults").
-    mask.data_mut().fill(0);
-    let transform =
-        if drawn.row0 == 0 { Transform::identity() } else { Transform::from_translate(0.0, -(drawn.row0 as f32)) };
-    mask.fill_path(&path, rule, true, transform);
-    let first = (frame.row0 - drawn.row0) * width;
-    for (o, &m) in out.data.iter_mut().zip(&mask.data()[first..first + width * height]) {
-        *o = m as f32 / 255.0;
+/// Rows between the cuts of a body atlas's edges (`Canvas`): a strip's mask is its rows
+/// rounded out to them.
+const CUT_ROWS: usize = 32;
+
+/// A body atlas's vertices are multiples of 1/SUBPIXELS pixel: tiny-skia's fixed point
+/// has 1/4 (supersampling) × 1/64 (FDot6) of a pixel, so they are exact in it, and in f32
+/// up to 2^16 pixels (an atlas has at most 65,535 rows; its copies round the body reach
+/// 3 widths of at most 8,192).
+const SUBPIXELS: f32 = 256.0;
+
+/// How far a flattened curve may lie from the curve, in pixels (`on_grid`).
+const FLATNESS_PX: f32 = 1.0 / 64.0;
+
+impl Canvas {
+    fn new(frame: Frame) -> Canvas {
+        let (top, end) = match frame.wraps_v {
+            true if frame.height < frame.full_height => (0, frame.full_height),
+            true => (frame.row0, frame.row0 + frame.height),
+            false => (frame.row0 / CUT_ROWS * CUT_ROWS, (frame.row0 + frame.height).div_ceil(CUT_ROWS) * CUT_ROWS),
+        };
+        Canvas { frame, top, rows: end - top }
     }
-    out
+
+    /// Whether the shape within columns [x0, x1] and rows [y0, y1] (texture pixels) reaches
+    /// the mask.
+    fn keeps(&self, (x0, x1): (f32, f32), (y0, y1): (f32, f32)) -> bool {
+        let (top, bottom) = (self.top as f32, (self.top + self.rows) as f32);
+        x1 >= 0.0 && x0 <= self.frame.width as f32 && y1 >= top && y0 <= bottom
+    }
+
+    /// Fills the path (in texture pixels) into an anti-aliased coverage mask in [0, 1] over
+    /// the rows of the frame (all zero if there is nothing to fill or the size is unusable).
+    fn rasterise(&self, pb: PathBuilder, rule: FillRule) -> Image {
+        let (width, height) = (self.frame.width, self.frame.height);
+        let mut out = Image::new(width, height, 1);
+        let path = match self.frame.wraps_v {
+            true => pb.finish().and_then(|p| match self.top {
+                0 => Some(p),
+                top => p.transform(Transform::from_translate(0.0, -(top as f32))),
+            }),
+            false => pb.finish().and_then(|p| on_grid(&p, width as f32, self.top)),
+        };
+        let (Some(mut mask), Some(path)) = (Mask::new(width as u32, self.rows as u32), path) else {
+            return out;
+        };
+        // Written before tiny-skia reads it: the blitter loads a row's coverage before it
+        // stores it, and a fresh page first read maps the shared zero page, so its store then
+        // paid a copy-on-write fault with a TLB shootdown (BENCHMARKS.md, "Copy-on-write
+        // faults").
+        mask.data_mut().fill(0);
+        mask.fill_path(&path, rule, true, Transform::identity());
+        let first = (self.frame.row0 - self.top) * width;
+        for (o, &m) in out.data.iter_mut().zip(&mask.data()[first..first + width * height]) {
+            *o = m as f32 / 255.0;
+        }
+        out
+    }
+}
+
+/// A body atlas's path as `Canvas` draws it: its curves as lines (within `FLATNESS_PX`),
+/// a vertex added where an edge crosses column 0 or `width` or a multiple of `CUT_ROWS`
+/// rows, every vertex rounded to 1/`SUBPIXELS` pixel, then moved up by `top` rows (exact).
+/// Everything before the move is computed in texture coordinates, the same for any strip.
+fn on_grid(path: &tiny_skia::Path, width: f32, top: usize) -> Option<tiny_skia::Path> {
+    use tiny_skia::{PathSegment, Point};
+    let grid = |v: f32| (v * SUBPIXELS).round() / SUBPIXELS;
+    let mut pb = PathBuilder::new();
+    let line_to = |pb: &mut PathBuilder, a: Point, b: Point| {
+        // The crossings of the cut columns and rows in order along the edge: (where, the
+        // column's x or the row's y, exactly).
+        let mut cuts: Vec<(f32, Option<f32>, Option<f32>)> = Vec::new();
+        for x in [0.0, width] {
+            if (a.x - x) * (b.x - x) < 0.0 {
+                cuts.push(((x - a.x) / (b.x - a.x), Some(x), None));
+            }
+        }
+        let (lo, hi) = (a.y.min(b.y), a.y.max(b.y));
+        let mut row = ((lo / CUT_ROWS as f32).floor() as i64 + 1) * CUT_ROWS as i64;
+        while (row as f32) < hi {
+            cuts.push(((row as f32 - a.y) / (b.y - a.y), None, Some(row as f32)));
+            row += CUT_ROWS as i64;
+        }
+        cuts.sort_by(|p, q| p.0.total_cmp(&q.0));
+        for (t, x, y) in cuts {
+            let x = x.unwrap_or_else(|| grid(a.x + (b.x - a.x) * t));
+            let y = y.unwrap_or_else(|| grid(a.y + (b.y - a.y) * t));
+            pb.line_to(x, y - top as f32);
+        }
+        pb.line_to(grid(b.x), grid(b.y) - top as f32);
+    };
+    let mut last = Point::zero();
+    let mut start = Point::zero();
+    // A contour left open is closed by the fill with one more edge, which needs its cuts.
+    let mut open = false;
+    for segment in path.segments() {
+        match segment {
+            PathSegment::MoveTo(p) => {
+                if open {
+                    line_to(&mut pb, last, start);
+                }
+                pb.move_to(grid(p.x), grid(p.y) - top as f32);
+                (last, start, open) = (p, p, true);
+            }
+            PathSegment::LineTo(p) => {
+                line_to(&mut pb, last, p);
+                last = p;
+            }
+            PathSegment::QuadTo(c, p) => {
+                let bend = (last.x - 2.0 * c.x + p.x).abs().max((last.y - 2.0 * c.y + p.y).abs());
+                let n = (bend / (8.0 * FLATNESS_PX)).sqrt().ceil().max(1.0) as usize;
+                let p0 = last;
+                for k in 1..=n {
+                    let t = k as f32 / n as f32;
+                    let (s, u) = (1.0 - t, t);
+                    let q = Point::from_xy(
+                        s * s * p0.x + 2.0 * s * u * c.x + u * u * p.x,
+                        s * s * p0.y + 2.0 * s * u * c.y + u * u * p.y,
+                    );
+                    let q = if k == n { p } else { q };
+                    line_to(&mut pb, last, q);
+                    last = q;
+                }
+            }
+            PathSegment::CubicTo(c1, c2, p) => {
+                let bend = [(last, c1, c2), (c1, c2, p)]
+                    .iter()
+                    .map(|(a, b, c)| (a.x - 2.0 * b.x + c.x).abs().max((a.y - 2.0 * b.y + c.y).abs()))
+                    .fold(0.0, f32::max);
+                let n = (3.0 * bend / (4.0 * FLATNESS_PX)).sqrt().ceil().max(1.0) as usize;
+                let p0 = last;
+                for k in 1..=n {
+                    let t = k as f32 / n as f32;
+                    let s = 1.0 - t;
+                    let q = Point::from_xy(
+                        s * s * s * p0.x + 3.0 * s * s * t * c1.x + 3.0 * s * t * t * c2.x + t * t * t * p.x,
+                        s * s * s * p0.y + 3.0 * s * s * t * c1.y + 3.0 * s * t * t * c2.y + t * t * t * p.y,
+                    );
+                    let q = if k == n { p } else { q };
+                    line_to(&mut pb, last, q);
+                    last = q;
+                }
+            }
+            PathSegment::Close => {
+                line_to(&mut pb, last, start);
+                pb.close();
+                (last, open) = (start, false);
+            }
+        }
+    }
+    if open {
+        line_to(&mut pb, last, start);
+    }
+    pb.finish()
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -244,9 +400,7 @@ pub struct Blotches {
 /// Rasterises blotches into an anti-aliased coverage mask (tiny-skia), wrapping along v
 /// and around u.
 pub fn blotches(frame: Frame, b: &Blotches) -> Image {
-    let drawn = drawn_rows(frame);
     let (w, h) = (frame.width as f32, frame.full_height as f32);
-    let (top, bottom) = (drawn.row0 as f32, (drawn.row0 + drawn.height) as f32);
     let count = b.count.max(1);
     let spacing = (b.span.1 - b.span.0) * h / count as f32;
     let origin = b.span.0 * h;
@@ -254,12 +408,15 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
     let sides: &[(f32, f32)] =
         if b.offset > 0.0 { &[(1.0, 0.0), (-1.0, if b.staggered { 0.5 } else { 0.0 })] } else { &[(0.0, 0.0)] };
     if b.shape == BlotchShape::Zigzag {
+        let canvas = Canvas::new(frame);
         for &(side, shift) in sides {
-            zigzag(&mut pb, b, (0.5 + side * b.offset) * w, origin + (b.phase + shift) * spacing, spacing, w, h);
+            let (cx, start) = ((0.5 + side * b.offset) * w, origin + (b.phase + shift) * spacing);
+            zigzag(&mut pb, b, &canvas, cx, start, spacing, h);
         }
-        return rasterise(frame, drawn, pb, FillRule::Winding);
+        return canvas.rasterise(pb, FillRule::Winding);
     }
-    for i in 0..count as i32 {
+    // Blotch i's jitter across and along (u, spacings), half-width and half-length (pixels).
+    let blotch = |i: i32| {
         let jx = hash::signed(i, 0, 0, b.seed) * b.jitter * 0.05;
         let jy = hash::signed(i, 0, 1, b.seed) * b.jitter * 0.2;
         let js = (1.0 + hash::signed(i, 0, 2, b.seed) * b.jitter * 0.3) * b.scale;
@@ -268,7 +425,11 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
             let t = ((i as f32 + 0.5) / count as f32).clamp(0.0, 1.0);
             hw *= 1.0 + (b.widen - 1.0) * t;
         }
-        let hl = 0.5 * b.length * js * spacing;
+        (jx, jy, hw, 0.5 * b.length * js * spacing)
+    };
+    let canvas = Canvas::new(frame);
+    for i in 0..count as i32 {
+        let (jx, jy, hw, hl) = blotch(i);
         for &(side, shift) in sides {
             // The mirrored series mirrors the jitter too, so a pair is symmetric.
             let cx = (0.5 + side * b.offset + if side < 0.0 { -jx } else { jx }) * w;
@@ -276,7 +437,7 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
                 let cy = origin + (i as f32 + 0.5 + jy + b.phase + shift) * spacing + copy_v * h;
                 for copy_u in [-1.0f32, 0.0, 1.0] {
                     let cx = cx + copy_u * w;
-                    if cy + hl < top || cy - hl > bottom || cx + hw < 0.0 || cx - hw > w {
+                    if !canvas.keeps((cx - hw, cx + hw), (cy - hl, cy + hl)) {
                         continue;
                     }
                     push_blotch(&mut pb, b.shape, cx, cy, hw, hl);
@@ -284,7 +445,7 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
             }
         }
     }
-    rasterise(frame, drawn, pb, FillRule::Winding)
+    canvas.rasterise(pb, FillRule::Winding)
 }
 
 /// One blotch centred at (cx, cy) pixels with half-width `hw` and half-length `hl`.
@@ -347,10 +508,11 @@ fn push_blotch(pb: &mut PathBuilder, shape: BlotchShape, cx: f32, cy: f32, hw: f
 /// A continuous zigzag band about x = `cx`: vertices alternate ±`half_width` every half
 /// spacing; the band is `length` spacings thick along the body. Drawn over the
 /// tile plus one spacing each end so it wraps along v without a seam.
-fn zigzag(pb: &mut PathBuilder, b: &Blotches, cx: f32, start: f32, spacing: f32, w: f32, h: f32) {
+fn zigzag(pb: &mut PathBuilder, b: &Blotches, canvas: &Canvas, cx: f32, start: f32, spacing: f32, h: f32) {
+    let w = canvas.frame.width as f32;
     let start = start.rem_euclid(spacing);
-    let amplitude = b.half_width * b.scale * w;
-    let thick = 0.5 * b.length.clamp(0.05, 1.0) * spacing * b.scale;
+    let amplitude = zigzag_amplitude(b, w);
+    let thick = zigzag_half_thickness(b, spacing);
     let count = (h / spacing).round() as i32;
     for copy_u in [-1.0f32, 0.0, 1.0] {
         let x0 = cx + copy_u * w;
@@ -366,6 +528,12 @@ fn zigzag(pb: &mut PathBuilder, b: &Blotches, cx: f32, start: f32, spacing: f32,
             // under the nonzero rule the overlaps at the vertices add instead of cancelling
             // (traced alternately, the band broke at every vertex).
             let (xa, ya, xb, yb) = if xb >= xa { (xa, ya, xb, yb) } else { (xb, yb, xa, ya) };
+            // A body atlas draws only the segments that reach the strip (see `Canvas`); the
+            // tile every one, as its coverage was made with.
+            let (top, bottom) = (ya.min(yb) - thick, ya.max(yb) + thick);
+            if !canvas.frame.wraps_v && !canvas.keeps((xa, xb), (top, bottom)) {
+                continue;
+            }
             pb.move_to(xa, ya - thick);
             pb.line_to(xb, yb - thick);
             pb.line_to(xb, yb + thick);
@@ -373,6 +541,16 @@ fn zigzag(pb: &mut PathBuilder, b: &Blotches, cx: f32, start: f32, spacing: f32,
             pb.close();
         }
     }
+}
+
+/// How far the zigzag's vertices lie either side of its centre line, in pixels.
+fn zigzag_amplitude(b: &Blotches, width: f32) -> f32 {
+    b.half_width * b.scale * width
+}
+
+/// Half the zigzag band's thickness along v, in pixels (`spacing` between its zigs).
+fn zigzag_half_thickness(b: &Blotches, spacing: f32) -> f32 {
+    0.5 * b.length.clamp(0.05, 1.0) * spacing * b.scale
 }
 
 /// What the ventral plates carry (`BellyMarks`).
@@ -521,8 +699,7 @@ mod tests {
                 pb.push_circle(x, y, radius * hole * width as f32);
             }
         }
-        let frame = Frame::whole(width, width);
-        let even_odd = rasterise(frame, frame, pb, FillRule::EvenOdd);
+        let even_odd = Canvas::new(Frame::whole(width, width)).rasterise(pb, FillRule::EvenOdd);
         let differ = mask.data.iter().zip(&even_odd.data).filter(|(a, b)| a != b).count();
         assert_eq!(differ, 0, "{differ} of {} pixels differ from the even-odd fill", width * width);
         // The hole is there: the centre of the first spot (8, 8) is empty, its ring full.
