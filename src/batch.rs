@@ -107,9 +107,11 @@ pub enum BatchError {
     Shard(String),
     /// The job refused when the run was planned, before any job ran: its size (a body atlas
     /// too tall, more memory than the machine has) or its output (a folder, file or link
-    /// in the way); the place's line: the job's `sizes` key, else its `preset` key.
-    #[error("{place}: {source}")]
-    Planned { place: JobPlace, source: Box<Error> },
+    /// in the way); the place's line: the job's `sizes` key, else its `preset` key; with the
+    /// seed and size, as a job's messages at run time (a table of several seeds was named
+    /// without them, and only its folder's path told which one was refused).
+    #[error("{job}: {source}")]
+    Planned { job: RunningJob, source: Box<Error> },
     /// The job failed while it ran (a full disk, a file that may not be replaced): its set
     /// was not written.
     #[error("{job}: {source}")]
@@ -431,6 +433,14 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         if let Some(message) = set_twice(&table.set) {
             return Err(invalid("set", message));
         }
+        // The job's seed replaces a `set` one (as `--seed` replaces `--set seed=`): beside
+        // `seeds` it was lost without a word, in a folder of its own (`-set<hash>`).
+        if table.seeds.is_some() && table.set.contains_key("seed") {
+            return Err(invalid(
+                "set",
+                "set = { seed = .. } beside seeds, which replace it: list the seed in seeds".into(),
+            ));
+        }
         let overrides: Vec<(String, String)> = table.set.iter().map(|(k, v)| (k.clone(), v.to_string())).collect();
         let seeds: Vec<Option<u64>> = match &table.seeds {
             Some(seeds) => seeds.iter().copied().map(Some).collect(),
@@ -686,9 +696,10 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
     let mut resolved: Vec<Resolved> = Vec::with_capacity(jobs.len());
     for job in jobs {
         let mut r = resolve(jobs_file, job, out, shard.contains(job))?;
-        // The job's folder refused, at its `preset` line.
-        let refuse = |preset: String, message: String| -> Error {
-            BatchError::Invalid { place: JobPlace { preset, ..job.place(jobs_file, job.lines.preset) }, message }.into()
+        // The job's folder refused, at its `preset` line, the preset as the job writes it (a
+        // clash of `x.toml` with `sub/x.toml` named both jobs `(x)`).
+        let refuse = |message: String| -> Error {
+            BatchError::Invalid { place: job.place(jobs_file, job.lines.preset), message }.into()
         };
         // A preset named like an index (`index.json.toml`) would put its sets in the folder
         // the run's index is written to: found before any job runs, not after all of them.
@@ -698,21 +709,22 @@ fn resolve_all(jobs_file: &Path, jobs: &[Job], out: &Path, shard: Shard) -> Resu
                 "its sets would go in the folder {top}, a name the batch keeps for its index (index.json, \
                  index.shard-K-of-N.json); rename the preset file"
             );
-            return Err(refuse(r.outcome.preset, message));
+            return Err(refuse(message));
         }
         if let Some(&earlier) = first_in.get(&r.outcome.folder) {
             let first = &resolved[earlier].outcome;
             if first.key != r.outcome.key {
                 // Two different jobs whose sets would overwrite each other: named with both
                 // jobs' `preset` lines (this job's where the message starts).
-                let first_line = jobs[earlier].lines.preset.map(|l| format!(" (line {l})")).unwrap_or_default();
+                let first_line = jobs[earlier].lines.preset.map(|l| format!("line {l}, ")).unwrap_or_default();
                 let message = format!(
-                    "would write {}, which [[job]] {}{first_line} writes with different output; rename one of the \
+                    "would write {}, which [[job]] {} ({first_line}{}) writes with different output; rename one of the \
                      preset files (a preset's name is its file name without `.toml`; a built-in preset's, its own)",
                     r.outcome.folder.display(),
                     jobs[earlier].table,
+                    jobs[earlier].preset,
                 );
-                return Err(refuse(r.outcome.preset, message));
+                return Err(refuse(message));
             }
             r.outcome.status = JobStatus::Duplicate;
             r.outcome.duplicate_of = Some(first.index);
@@ -831,6 +843,13 @@ pub fn run(
     // an index left from another jobs file (a run stopped by a signal writes none at its
     // end) described sets this run is not about.
     let planned = work.iter().map(|(_, r)| r.outcome.clone()).collect();
+    if let Some(earlier) = index_of_other_jobs(out, shard, jobs_file) {
+        warn(&format!(
+            "note: {} listed the jobs of {}; it lists this run's now (their sets stay where they are)",
+            out.join(index_file_name(shard)).display(),
+            earlier.display()
+        ));
+    }
     BatchIndex::new(jobs_file, shard, planned, concurrency).write(out, shard)?;
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut failures: Vec<(usize, Error)> = Vec::new();
@@ -900,6 +919,20 @@ pub fn run(
     Ok(index)
 }
 
+/// The jobs file of the index already in `out` where it is another than `jobs_file` (the
+/// run replaces that index; a second jobs file into one folder replaced the first's without
+/// a word). None where there is none, it cannot be read, or it is this file's.
+fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<PathBuf> {
+    #[derive(serde::Deserialize)]
+    struct JobsFileOf {
+        jobs_file: PathBuf,
+    }
+    let text = std::fs::read(out.join(index_file_name(shard))).ok()?;
+    let earlier = serde_json::from_slice::<JobsFileOf>(&text).ok()?.jobs_file;
+    let same = earlier == jobs_file || crate::export::same_path(&earlier, jobs_file);
+    (!same).then_some(earlier)
+}
+
 impl BatchIndex {
     fn new(jobs_file: &Path, shard: Shard, jobs: Vec<JobOutcome>, concurrency: usize) -> BatchIndex {
         BatchIndex {
@@ -914,7 +947,8 @@ impl BatchIndex {
 
     /// Writes the index to `out` (created if missing), replacing the one there.
     fn write(&self, out: &Path, shard: Shard) -> Result<(), Error> {
-        let json = serde_json::to_vec_pretty(self).map_err(|e| Error::Internal(format!("index: {e}")))?;
+        let mut json = serde_json::to_vec_pretty(self).map_err(|e| Error::Internal(format!("index: {e}")))?;
+        json.push(b'\n');
         crate::export::create_folder(out)?;
         write_file_atomically(&out.join(index_file_name(shard)), json)?;
         Ok(())
@@ -961,7 +995,11 @@ fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard, for_run
             // A size refused (too tall, too large for memory) at the job's `sizes`; its output
             // at the job (the folder's name comes from all its keys).
             let planned = |line: Option<usize>, source: Error| BatchError::Planned {
-                place: job.place(jobs_file, line.or(job.lines.preset)),
+                job: RunningJob {
+                    place: job.place(jobs_file, line.or(job.lines.preset)),
+                    seed: r.outcome.seed,
+                    size: job.size,
+                },
                 source: Box::new(source),
             };
             let request = request(job, out, &r.outcome);
@@ -1010,6 +1048,13 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
     if outcome.duplicate_of.is_some() {
         // Its set is the earlier job's (in this shard or another).
     } else if !resolved.done {
+        // Another run into the same folder may have finished the set since this one was
+        // planned: looked for again (two batches over the same jobs, in turn, each generated
+        // every set the other had not when it started; the QA review).
+        if is_done(&out.join(&outcome.manifest), &outcome.key, &resolved.files) {
+            outcome.status = JobStatus::Skipped;
+            return Ok(outcome);
+        }
         let running = RunningJob { place: job.place(jobs_file, job.lines.preset), seed: outcome.seed, size: job.size };
         let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
         // Checked against the available memory with the other jobs when the run was planned
@@ -1141,6 +1186,16 @@ mod tests {
         ] {
             assert!(job(set).is_ok(), "{set}: {:?}", job(set).err());
         }
+    }
+
+    /// A `set` seed beside `seeds` is refused: the seeds replace it, and it was lost without
+    /// a word. Alone it is the job's seed (negative control).
+    #[test]
+    fn a_set_seed_beside_seeds_is_refused() {
+        let e = jobs("[[job]]\npreset = \"a\"\nseeds = [1]\nset = { seed = 5 }\n").unwrap_err().to_string();
+        assert!(e.contains("jobs.toml:4: [[job]] 1 (a): ") && e.contains("beside seeds"), "{e}");
+        let alone = jobs("[[job]]\npreset = \"a\"\nset = { seed = 5 }\n").unwrap();
+        assert_eq!(alone[0].overrides, [("seed".to_string(), "5".to_string())]);
     }
 
     #[test]

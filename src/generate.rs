@@ -118,7 +118,8 @@ pub fn set_file_names(loaded: &LoadedPreset, request: &GenerateRequest) -> Vec<S
 /// run again). None of the files can be the set's own preset file: the set's names are its
 /// file stem with a suffix, `NAME_color.png`, `NAME.material.json`; but the set's lock
 /// (`.NAME.lock`, `name` the set's), which the run removes as it ends, can be, so it is
-/// checked against `inputs` too: `generate ./.preset.lock` removed its own (empty) preset.
+/// checked against `inputs` too: `generate ./.preset.lock` removed its own (empty) preset;
+/// and for what is there (`check_lock_place`).
 pub fn check_set_outputs(
     out_dir: &Path,
     name: &str,
@@ -131,7 +132,9 @@ pub fn check_set_outputs(
         export::check_target(&target)?;
         inputs.check(&target)?;
     }
-    export::check_lock_not_an_input(&out_dir.join(export::lock_file_name(name)), inputs)
+    let lock = out_dir.join(export::lock_file_name(name));
+    export::check_lock_not_an_input(&lock, inputs)?;
+    export::check_lock_place(&lock)
 }
 
 /// `Pack::size_problem` for a set `size` wide in `layout`, with the largest size whose

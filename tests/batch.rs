@@ -429,7 +429,7 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
         // line or job, and named a `--size` that a jobs file does not have).
         (
             "layout = \"body\"\nsizes = [5500]",
-            "jobs.toml:8: [[job]] 2 (natrix-natrix): a body atlas 5500 wide is 66000 tall (body.length widths), over \
+            "jobs.toml:8: [[job]] 2 (natrix-natrix, seed 31, size 5500): a body atlas 5500 wide is 66000 tall (body.length widths), over \
              the 65535 rows a map may have; give size 5461 or less, or a shorter body.length",
         ),
     ] {
@@ -455,7 +455,7 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(
-        stderr(&out).contains("jobs.toml:7: [[job]] 2 (boa-constrictor): size 4096 needs about"),
+        stderr(&out).contains("jobs.toml:7: [[job]] 2 (boa-constrictor, seed 16, size 4096): size 4096 needs about"),
         "{}",
         stderr(&out)
     );
@@ -470,13 +470,14 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     assert_eq!(stdout(&listed).lines().count(), 2, "{}", stdout(&listed));
 
     // A folder in a later job's way stops the batch before the first job's set is written
-    // (it was found when that job ran, after the earlier sets), naming the job and its line.
+    // (it was found when that job ran, after the earlier sets), naming the job, its line and
+    // the seed (a table of two seeds was named without it).
     std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1, 2]\nsizes = [32]\n").unwrap();
     let in_the_way = empty.join("natrix-natrix/tile-32-seed2-png/natrix-natrix_color.png");
     std::fs::create_dir_all(&in_the_way).unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--concurrent", "1"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:2: [[job]] 1 (natrix-natrix): cannot write"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:2: [[job]] 1 (natrix-natrix, seed 2, size 32): cannot write"), "{}", stderr(&out));
     assert!(stderr(&out).contains("a folder is in the way"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "the first job's set was written before the folder was found");
     let listed = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--list"]);
@@ -505,6 +506,84 @@ fn a_folder_named_like_a_preset_is_not_read_as_one() {
             .unwrap();
         assert!(out.status.success(), "run {run}: {}", stderr(&out));
     }
+}
+
+/// Something other than an empty file at a later job's lock (`.NAME.lock`: a FIFO, a link,
+/// a folder, a file with content) is refused before any job runs, and by `--list`: the run
+/// wrote the earlier jobs' sets and then stopped at it, and `--list` called the job "to do"
+/// (the QA review). Negative control: an empty file there is a lock left by a killed run.
+#[test]
+fn a_non_lock_at_a_later_jobs_lock_is_refused_before_anything_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[1, 2]", 16);
+    let out = dir.path().join("out");
+    let folder = out.join("natrix-natrix/tile-16-seed2-png");
+    let lock = folder.join(".natrix-natrix.lock");
+    let plant: [(&str, &dyn Fn()); 4] = [
+        ("a FIFO", &|| {
+            let c = std::ffi::CString::new(lock.to_str().unwrap()).unwrap();
+            assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+        }),
+        ("a symbolic link", &|| std::os::unix::fs::symlink(dir.path().join("elsewhere"), &lock).unwrap()),
+        ("a folder", &|| std::fs::create_dir(&lock).unwrap()),
+        ("holds 2 bytes", &|| std::fs::write(&lock, "hi").unwrap()),
+    ];
+    let run = |list: bool| {
+        let mut args = vec!["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend(list.then_some("--list"));
+        snakeskin(&args)
+    };
+    for (said, plant) in plant {
+        let _ = std::fs::remove_dir_all(&out);
+        std::fs::create_dir_all(&folder).unwrap();
+        plant();
+        for list in [true, false] {
+            let refused = run(list);
+            assert_eq!(refused.status.code(), Some(2), "{said} (list {list}): {}", stderr(&refused));
+            assert!(stderr(&refused).contains(said), "{said} (list {list}): {}", stderr(&refused));
+        }
+        assert!(!out.join("natrix-natrix/tile-16-seed1-png").exists(), "{said}: the first job ran");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+    std::fs::create_dir_all(&folder).unwrap();
+    std::fs::write(&lock, "").unwrap();
+    let ran = run(false);
+    assert!(ran.status.success(), "an empty lock: {}", stderr(&ran));
+    assert_eq!(summary_counts(&ran), (2, 0), "{}", stdout(&ran));
+}
+
+/// A set another run finished after this one was planned is not generated again: two
+/// batches over the same jobs into one folder each generated every set the other had not
+/// finished when it started (the QA review: 36 generations for 24 sets). Here the second job
+/// of the slow run (each commit paused three seconds, a debug-build hook) is finished by a
+/// quick run meanwhile.
+#[test]
+fn a_set_finished_by_another_run_meanwhile_is_not_generated_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let both = dir.path().join("both.toml");
+    let text = |seed: u32| format!("[[job]]\npreset = \"natrix-natrix\"\nseeds = [{seed}]\nsizes = [16]\n\n");
+    std::fs::write(&both, text(1) + &text(2)).unwrap();
+    let second = dir.path().join("second.toml");
+    std::fs::write(&second, text(2)).unwrap();
+    let slow = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["batch", both.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "1"])
+        .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // While the slow run's first job waits at its commit.
+    std::thread::sleep(std::time::Duration::from_millis(1000));
+    let quick = snakeskin(&["batch", second.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(quick.status.success(), "{}", stderr(&quick));
+    assert_eq!(summary_counts(&quick), (1, 0), "{}", stdout(&quick));
+    let manifest = out.join("natrix-natrix/tile-16-seed2-png/natrix-natrix.material.json");
+    let made = std::fs::metadata(&manifest).unwrap().modified().unwrap();
+    let slow = slow.wait_with_output().unwrap();
+    assert!(slow.status.success(), "{}", stderr(&slow));
+    assert_eq!(summary_counts(&slow), (1, 1), "the slow run generated the quick one's set: {}", stdout(&slow));
+    assert_eq!(std::fs::metadata(&manifest).unwrap().modified().unwrap(), made);
 }
 
 /// A file named like a built-in (here a gallery PNG written as `-o natrix-natrix`) does not
@@ -616,6 +695,25 @@ fn a_batch_warns_of_an_earlier_file_that_stays() {
     assert!(thickness.exists());
 }
 
+/// A second jobs file into the same folder replaces the first's index, and says so; the
+/// same jobs file again (negative control) says nothing. It was replaced without a word.
+#[test]
+fn a_batch_says_when_it_replaces_another_jobs_files_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = jobs_file(dir.path(), &["natrix-natrix"], "[1]", 16);
+    let second = dir.path().join("second.toml");
+    std::fs::write(&second, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [2]\nsizes = [16]\n").unwrap();
+    let out = dir.path().join("out");
+    let run = |jobs: &Path| snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    for (jobs, says) in [(&first, false), (&first, false), (&second, true)] {
+        let ran = run(jobs);
+        assert!(ran.status.success(), "{}", stderr(&ran));
+        let note = format!("listed the jobs of {}; it lists this run's now", first.display());
+        assert_eq!(stderr(&ran).contains(&note), says, "{}: {}", jobs.display(), stderr(&ran));
+    }
+    assert_eq!(read_index(&out)["jobs_file"], second.to_str().unwrap());
+}
+
 #[test]
 fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     let dir = tempfile::tempdir().unwrap();
@@ -680,10 +778,17 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     for shard in ["0/2", "1/2"] {
         let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--shard", shard]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-        // Both jobs' `preset` lines: the second where the message starts, the first in it.
+        // Both jobs' `preset` lines and presets as written: the second where the message
+        // starts, the first in it (both were named `(snake)`).
         let err = stderr(&out);
-        assert!(err.contains("jobs.toml:6: [[job]] 2 (snake): would write snake/tile-32-seed"), "{err}");
-        assert!(err.contains("which [[job]] 1 (line 2) writes with different output"), "{err}");
+        assert!(
+            err.contains("jobs.toml:6: [[job]] 2 (") && err.contains("/b/snake.toml): would write snake/tile-32"),
+            "{err}"
+        );
+        assert!(
+            err.contains("which [[job]] 1 (line 2, ") && err.contains("/a/snake.toml) writes with different"),
+            "{err}"
+        );
     }
     assert!(!empty.exists());
 
@@ -694,8 +799,7 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
         std::fs::write(&jobs, format!("[[job]]\nsizes = [32]\npreset = \"{name}.toml\"\n")).unwrap();
         let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap()]);
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-        let expected =
-            format!("jobs.toml:3: [[job]] 1 ({name}): its sets would go in the folder {name}, a name the batch keeps");
+        let expected = format!("/{name}.toml): its sets would go in the folder {name}, a name the batch keeps");
         assert!(stderr(&out).contains(&expected), "{}", stderr(&out));
         assert!(!empty.exists());
     }

@@ -604,6 +604,22 @@ impl KeptBecause {
     }
 }
 
+/// Refuses what is at a set's lock path unless it is nothing or an empty regular file
+/// (snakeskin's locks are empty): `SetLock::acquire` as it opens the lock, and a batch for
+/// every job before any runs (a FIFO at a later job's lock stopped the run after the earlier
+/// jobs' sets were written, and `--list` said "to do").
+pub fn check_lock_place(path: &Path) -> Result<(), ExportError> {
+    let Ok(meta) = fs::symlink_metadata(path) else {
+        return Ok(());
+    };
+    let file_type = meta.file_type();
+    match file_type.is_file() {
+        true if meta.len() > 0 => Err(ExportError::LockHoldsData { path: path.into(), bytes: meta.len() }),
+        true => Ok(()),
+        false => Err(ExportError::LockNotAFile { path: path.into(), kind: crate::text_file::file_kind(&file_type) }),
+    }
+}
+
 impl SetLock {
     /// Locks the set `name` in `dir`, creating the folder if it is missing.
     pub fn acquire(dir: &Path, name: &str) -> Result<SetLock, ExportError> {
@@ -620,15 +636,7 @@ impl SetLock {
         std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW | libc::O_NONBLOCK);
         // The lock file is the run's to make, empty: anything else there is named as such,
         // before the open and again if the open fails or opens it.
-        let not_a_lock = || {
-            let meta = fs::symlink_metadata(&path).ok()?;
-            let file_type = meta.file_type();
-            let kind = crate::text_file::file_kind(&file_type);
-            match file_type.is_file() {
-                true => (meta.len() > 0).then(|| ExportError::LockHoldsData { path: path.clone(), bytes: meta.len() }),
-                false => Some(ExportError::LockNotAFile { path: path.clone(), kind }),
-            }
-        };
+        let not_a_lock = || check_lock_place(&path).err();
         if let Some(refused) = not_a_lock() {
             return Err(refused);
         }

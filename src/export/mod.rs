@@ -12,8 +12,8 @@ pub mod srgb;
 
 pub use atomic::{
     Earlier, FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_folder_writable,
-    check_lock_not_an_input, check_not_an_input, check_png_target, check_target, check_target_named, check_writable,
-    clean_up_before_exit, create_folder, create_folder_noted, ends_as_a_folder, lock_file_name,
+    check_lock_not_an_input, check_lock_place, check_not_an_input, check_png_target, check_target, check_target_named,
+    check_writable, clean_up_before_exit, create_folder, create_folder_noted, ends_as_a_folder, lock_file_name,
     remove_empty_made_folders, same_path, sha256_hex, write_file_atomically,
 };
 pub(crate) use manifest::verify_set_json;
