@@ -246,6 +246,16 @@ pub enum NormalConvention {
     DirectX,
 }
 
+impl NormalConvention {
+    /// The name the manifest records and `--normal-convention` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            NormalConvention::OpenGl => "opengl",
+            NormalConvention::DirectX => "directx",
+        }
+    }
+}
+
 /// The layer stack's optics (thesis Table 5.2 names in comments; defaults in `thesis`).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]

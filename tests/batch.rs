@@ -477,7 +477,11 @@ fn shards_split_the_jobs_without_overlap_and_a_changed_job_is_redone() {
     std::fs::create_dir_all(&in_the_way).unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--concurrent", "1"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("jobs.toml:2: [[job]] 1 (natrix-natrix, seed 2, size 32): cannot write"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("jobs.toml:2: [[job]] 1 (natrix-natrix, seed 2, size 32): cannot write"),
+        "{}",
+        stderr(&out)
+    );
     assert!(stderr(&out).contains("a folder is in the way"), "{}", stderr(&out));
     assert!(manifests(&empty).is_empty(), "the first job's set was written before the folder was found");
     let listed = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", empty.to_str().unwrap(), "--list"]);

@@ -631,3 +631,57 @@ fn the_graph_list_keeps_its_columns() {
         assert_eq!(columns.len(), 1, "{name}: the arrows stand in columns {columns:?}\n{text}");
     }
 }
+
+#[test]
+fn the_manifest_gives_the_height_maps_rise_and_the_normal_maps_convention_as_the_maps_are() {
+    // `displacement.rise_texture_widths` and `normal_convention`, read back from the written maps
+    // alone: the normal's tilt over the height's slope (both by finite differences of the
+    // PNGs) is the rise, and the sign of its green against the height's slope down the image
+    // is the convention (+Y up: green grows where the height falls towards the bottom). For
+    // a plain set either way and for each pack with a normal texture and a height map or not.
+    let dir = tempfile::tempdir().unwrap();
+    let size = 256;
+    let cases: [(&str, &[&str]); 4] = [
+        ("opengl", &[]),
+        ("directx", &["--normal-convention", "directx"]),
+        ("unreal", &["--pack", "unreal"]),
+        ("unity", &["--pack", "unity-hdrp"]),
+    ];
+    let mut rise_seen = None;
+    for (name, extra) in cases {
+        let out = dir.path().join(name);
+        let mut args = vec!["generate", "crotalus-atrox", "-o", out.to_str().unwrap(), "--size", "256"];
+        args.extend(extra);
+        let run = snakeskin(&args);
+        assert!(run.status.success(), "{}", stderr(&run));
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("crotalus-atrox.material.json")).unwrap()).unwrap();
+        let rise = manifest["displacement"]["rise_texture_widths"].as_f64().unwrap();
+        let normal = image::open(out.join("crotalus-atrox_normal.png")).unwrap().into_rgb8();
+        // The height of the plain sets (the packs' is the same surface: the rise must agree).
+        let height_file = dir.path().join("opengl/crotalus-atrox_height.png");
+        let height = image::open(height_file).unwrap().into_luma16();
+        let h = |x: u32, y: u32| height.get_pixel(x % size, y % size)[0] as f64 / 65535.0;
+        let n = |x: u32, y: u32, c: usize| normal.get_pixel(x, y)[c] as f64 / 255.0 * 2.0 - 1.0;
+        // Least squares of tilt = rise × slope (slopes per texture width), over every pixel.
+        let (mut sx, mut xx, mut sy, mut yy) = (0.0, 0.0, 0.0, 0.0);
+        for y in 0..size {
+            for x in 0..size {
+                let dh_du = (h(x + 1, y) - h(x + size - 1, y)) * size as f64 / 2.0;
+                let dh_dv = (h(x, y + 1) - h(x, y + size - 1)) * size as f64 / 2.0;
+                let (nx, ny, nz) = (n(x, y, 0), n(x, y, 1), n(x, y, 2));
+                sx += -nx / nz * dh_du;
+                xx += dh_du * dh_du;
+                sy += ny / nz * dh_dv;
+                yy += dh_dv * dh_dv;
+            }
+        }
+        let (fitted_u, fitted_v) = (sx / xx, sy / yy);
+        assert!((fitted_u / rise - 1.0).abs() < 0.05, "{name}: rise {rise}, the maps' {fitted_u}");
+        // +Y up: the green is the slope down the image times the rise, +; +Y down: −.
+        let convention = if fitted_v > 0.0 { "opengl" } else { "directx" };
+        assert!((fitted_v.abs() / rise - 1.0).abs() < 0.05, "{name}: rise {rise}, the maps' along v {fitted_v}");
+        assert_eq!(manifest["normal_convention"], convention, "{name}");
+        assert_eq!(*rise_seen.get_or_insert(rise), rise, "{name}: the packs' rise is the set's");
+    }
+}

@@ -361,3 +361,31 @@ fn a_film_centred_below_half_its_spread_is_warned_of() {
     assert!(err.contains("its range is 0-260 nm"), "{err}");
     assert!(warned("130", "260").is_none() && warned("0", "0").is_none() && warned("400", "200").is_none());
 }
+
+#[test]
+fn every_colour_key_is_named_where_docs_say_what_a_colour_means() {
+    // docs/presets.md, "What a colour means", lists the keys whose colours are visible
+    // colours (clamped where the stack cannot show them); every key `colour_keys` treats so,
+    // over every built-in and the test preset, must be there: the list had left out head
+    // marks, tail colours, the skin and the speckles (the README walkthrough).
+    let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/presets.md")).unwrap();
+    let start = docs.find("Every colour key (").unwrap();
+    let paragraph = &docs[start..start + docs[start..].find("is the **visible").unwrap()];
+    let mut seen = std::collections::BTreeSet::new();
+    let names =
+        snakeskin::preset::library::all().iter().map(|(name, _)| name.to_string()).chain([common::PATTERNED.into()]);
+    for name in names {
+        let loaded = snakeskin::preset::load(&name, &[], None).unwrap();
+        for key in snakeskin::preset::visible::colour_key_names(&loaded.preset) {
+            // A layer's or a head mark's key by its last name (`pattern.2.colors.0`:
+            // `colors`); the others whole.
+            let shown = match key.starts_with("pattern.") || key.starts_with("body.head_mark.") {
+                true => key.split('.').rfind(|s| s.parse::<usize>().is_err()).unwrap().to_string(),
+                false => key.clone(),
+            };
+            assert!(paragraph.contains(&format!("`{shown}`")), "{name}: {key} (`{shown}`) is not in: {paragraph}");
+            seen.insert(shown);
+        }
+    }
+    assert!(seen.len() >= 12, "the built-ins reach most kinds of colour key: {seen:?}");
+}

@@ -34,6 +34,11 @@ pub struct Manifest {
     pub regions: Option<Regions>,
     pub maps: Vec<MapEntry>,
     pub iridescence: IridescenceRange,
+    /// The height map's physical scale (not `height`, the image's rows, beside `width`).
+    pub displacement: HeightScale,
+    /// The normal map's convention (`NormalConvention::name`): `opengl`, +Y up (glTF,
+    /// Blender, Unity), or `directx`, +Y down (Unreal).
+    pub normal_convention: String,
     pub optics: Optics,
     /// What the colour map's values are (`COLOR_MEANS`).
     pub color_means: String,
@@ -184,6 +189,16 @@ pub struct IridescenceRange {
     pub max_nm: f64,
 }
 
+/// The physical scale of the height map.
+#[derive(Debug, Serialize)]
+pub struct HeightScale {
+    /// How far above a sample of 0 a sample of 1 stands, in texture widths, as the normal
+    /// map was made (`maps::height_rise_texture_widths`): a displacement's scale is this
+    /// times the texture's width in the scene's units (the body's circumference for the
+    /// body atlas).
+    pub rise_texture_widths: f64,
+}
+
 /// The manifest's file name for a set name.
 pub fn manifest_file_name(set_name: &str) -> String {
     format!("{set_name}{MANIFEST_SUFFIX}")
@@ -224,6 +239,8 @@ pub fn manifest(
         regions,
         maps: entries,
         iridescence: IridescenceRange { film: crate::maps::has_film(p), min_nm, max_nm },
+        displacement: HeightScale { rise_texture_widths: crate::maps::height_rise_texture_widths(p) as f64 },
+        normal_convention: options.normal_convention.name().into(),
         optics: p.optics.clone(),
         color_means: COLOR_MEANS.into(),
         clamped_colors: loaded.clamped_colours.clone(),

@@ -98,6 +98,16 @@ const HEIGHT: Channel = Channel::map(MapKind::Height, 0, Transfer::Unit);
 impl Pack {
     pub const ALL: [Pack; 3] = [Pack::Gltf, Pack::Unreal, Pack::UnityHdrp];
 
+    /// The normal map's convention the engine expects: glTF's and Unity's +Y up (OpenGL),
+    /// Unreal's +Y down (DirectX).
+    pub fn normal_convention(self) -> crate::material::NormalConvention {
+        use crate::material::NormalConvention;
+        match self {
+            Pack::Gltf | Pack::UnityHdrp => NormalConvention::OpenGl,
+            Pack::Unreal => NormalConvention::DirectX,
+        }
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Pack::Gltf => "gltf",
@@ -168,7 +178,7 @@ impl Pack {
             channels: vec![THICKNESS],
             bit_depth: 8,
             srgb: false,
-            meaning: "grey: film thickness, min_nm + value * (max_nm - min_nm) (the manifest's iridescence range)"
+            meaning: "grey: film thickness in nm, min_nm + (sample / 255) * (max_nm - min_nm) (the manifest's iridescence range)"
                 .into(),
         };
         let height = TextureSpec {
@@ -179,12 +189,16 @@ impl Pack {
             meaning: "grey: relative surface height on the preset's fixed scale, as the height map (displacement or parallax)"
                 .into(),
         };
+        let normal_channels = match self.normal_convention() {
+            crate::material::NormalConvention::OpenGl => NORMAL_OPENGL,
+            crate::material::NormalConvention::DirectX => NORMAL_DIRECTX,
+        };
         let mut textures = match self {
             Pack::Gltf => vec![
                 base_color,
                 TextureSpec {
                     suffix: "normal",
-                    channels: NORMAL_OPENGL.to_vec(),
+                    channels: normal_channels.to_vec(),
                     bit_depth: 8,
                     srgb: false,
                     meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as glTF requires"
@@ -202,7 +216,7 @@ impl Pack {
                 base_color,
                 TextureSpec {
                     suffix: "normal",
-                    channels: NORMAL_DIRECTX.to_vec(),
+                    channels: normal_channels.to_vec(),
                     bit_depth: 8,
                     srgb: false,
                     meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, DirectX convention (+Y down, green flipped)"
@@ -221,7 +235,7 @@ impl Pack {
                 base_color,
                 TextureSpec {
                     suffix: "normal",
-                    channels: NORMAL_OPENGL.to_vec(),
+                    channels: normal_channels.to_vec(),
                     bit_depth: 8,
                     srgb: false,
                     meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as Unity expects"

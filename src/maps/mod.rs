@@ -244,8 +244,7 @@ pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     g.set_output(MapKind::Height, height);
 
     // The normal follows the physical surface: undo the height map's stretch.
-    let (low, high) = height_range(preset);
-    let slope = preset.height.normal_strength as f32 / shared.lattice.cols as f32 * (high - low);
+    let slope = height_rise_texture_widths(preset);
     let normal = g.add(
         "normal.out",
         Op::HeightToNormal { slope, convention: options.normal_convention, v_extent: along },
@@ -304,6 +303,17 @@ pub fn height_range(preset: &Preset) -> (f32, f32) {
     let top = height_top(field.shape, field.imbrication, field.keel_height, preset.belly.plates, shields);
     let grain = preset.height.grain as f32;
     (groove_floor(field.shape) - grain, top + grain)
+}
+
+/// How far above a height sample of 0 one of 1 stands, in texture widths: the surface the
+/// normal map shades, whose full height range (`height_range`) rises `height.normal_strength`
+/// scale widths (a scale column is 1 / columns of the texture's width). The same for the
+/// tile and the body atlas; the manifest's `displacement.rise_texture_widths`, for a displacement
+/// that agrees with the normal map.
+pub fn height_rise_texture_widths(preset: &Preset) -> f32 {
+    let (low, high) = height_range(preset);
+    let columns = scale_field(preset, Layout::Tile).lattice().cols;
+    preset.height.normal_strength as f32 / columns as f32 * (high - low)
 }
 
 /// The range the roughness map can take (`build_roughness`): the base less its variation and

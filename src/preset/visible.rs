@@ -117,6 +117,11 @@ pub fn per_scale_gain(preset: &Preset) -> f64 {
         * (1.0 + c.tip_tone.max(0.0))
 }
 
+/// The names of every colour key of the preset (`colour_keys`), e.g. `pattern.1.colors.0`.
+pub fn colour_key_names(preset: &Preset) -> Vec<String> {
+    colour_keys(&mut preset.clone()).into_iter().map(|(key, _)| key).collect()
+}
+
 /// Every colour key of a preset with its value, mutable.
 fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
     let mut keys: Vec<(String, &mut Srgb8)> = vec![
