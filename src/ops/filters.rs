@@ -1,9 +1,11 @@
-//! Per-pixel and neighbourhood filters: levels, threshold, blend, colourise, wrap-around
-//! Gaussian blur, Sobel edges and height → normal.
+//! Per-pixel and neighbourhood filters: levels, threshold, blend, colourise, Gaussian blur,
+//! Sobel edges and height → normal.
 //!
-//! All neighbourhood filters address pixels modulo the image size, so a tileable input stays
-//! tileable. Radii are given in normalised texture units and converted to pixels here, which
-//! keeps `--size 512` and `--size 4096` of one preset the same picture at different detail.
+//! All neighbourhood filters address pixels modulo the image width, and modulo its height on
+//! the tile, so a tileable input stays tileable; on a body atlas (`Frame::wraps_v` false)
+//! rows beyond the snout and the tail tip repeat the end rows. Radii are given in normalised
+//! texture units and converted to pixels here, which keeps `--size 512` and `--size 4096`
+//! of one preset the same picture at different detail.
 
 use std::borrow::Cow;
 
@@ -207,7 +209,7 @@ fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
     kernel
 }
 
-/// Separable Gaussian blur with wrap-around edges. `sigma` is in normalised units (fraction of
+/// Separable Gaussian blur, wrapping round u (and v on the tile: `wraps_v`). `sigma` is in normalised units (fraction of
 /// the image width); below a third of a pixel it is the identity. Up to 2 px the kernel is
 /// sampled exactly; beyond, three successive box filters of Kovesi's widths (P. Kovesi,
 /// "Fast almost-Gaussian filtering", DICTA 2010) match the Gaussian's variance at a cost
@@ -640,9 +642,6 @@ pub fn resample_bilinear_rows(src: &Image, width: usize, frame: Frame, coarse_he
     out
 }
 
-/// Calls `f(centre, left, right, up, here, down, out)` for every pixel: sample offsets of the
-/// pixel and its wrapped left and right neighbours within a row (channel 0), the wrapped
-/// rows above, at and below it, and the pixel's output (no modulo per sample).
 /// Row `y` of an image `h` rows tall, wrapped round (`wraps_v`) or clamped to the nearest
 /// row. For `y` within one image of the range, wrapping matches `rem_euclid`.
 #[inline]
@@ -650,6 +649,9 @@ fn edge_row(y: isize, h: usize, wraps_v: bool) -> usize {
     if wraps_v { y.rem_euclid(h as isize) as usize } else { y.clamp(0, h as isize - 1) as usize }
 }
 
+/// Calls `f(centre, left, right, up, here, down, out)` for every pixel: sample offsets of the
+/// pixel and its wrapped left and right neighbours within a row (channel 0), the rows above,
+/// at and below it (`edge_row`), and the pixel's output (no modulo per sample).
 fn neighbourhood<F>(input: &Image, channels_out: usize, wraps_v: bool, f: F) -> Image
 where
     F: Fn(usize, usize, usize, &[f32], &[f32], &[f32], &mut [f32]) + Sync,

@@ -138,18 +138,6 @@ impl Image {
         Image::from_fn(width, height, 1, |u, v, out| out[0] = value(u, v))
     }
 
-    /// Applies `f` to every pixel of `self` in place (parallel over rows).
-    pub fn map_pixels<F>(mut self, f: F) -> Self
-    where
-        F: Fn(&mut [f32]) + Sync,
-    {
-        let channels = self.channels;
-        self.data.par_chunks_mut(channels * self.width).for_each(|row| {
-            row.chunks_exact_mut(channels).for_each(&f);
-        });
-        self
-    }
-
     pub fn pixel_count(&self) -> usize {
         self.width * self.height
     }

@@ -1,5 +1,6 @@
 //! The film's GPU resources: one bind group (group 0 of every shading program) holding the
-//! material's indices, its baked colour LUT and the spectral-N band table, so that every film
+//! material's indices, its baked colour LUT (with its sampler), the spectral-N band table,
+//! the rough lobe's table and the layered model's coupling texture, so that every film
 //! method in `shaders/film.wgsl` reads the same inputs and a method switch is only a pipeline
 //! switch. The LUT is a half-float texture read with one hardware-filtered fetch at the texel
 //! coordinates `Lut::lookup_f32` computes (its piecewise thickness axis is mapped in the
@@ -35,7 +36,7 @@ impl GpuFilmMethod {
             Method::Lut => GpuFilmMethod::Lut,
             Method::Rgb3 => GpuFilmMethod::Rgb3,
             Method::SpectralN(n) => GpuFilmMethod::SpectralN(n),
-            Method::Spectral => GpuFilmMethod::SpectralN(421),
+            Method::Spectral => GpuFilmMethod::SpectralN(crate::optics::spectrum::SAMPLES),
             Method::GaussianFit => GpuFilmMethod::GaussianFit,
         }
     }

@@ -53,10 +53,10 @@ fn vec4_literal(v: [f64; 4]) -> String {
     format!("vec4<f32>({}, {}, {}, {})", f32_literal(v[0]), f32_literal(v[1]), f32_literal(v[2]), f32_literal(v[3]))
 }
 
-/// The shared numbers as WGSL `const` declarations: (name, WGSL type, value).
-/// `brdf.wgsl`'s `ms_norms_from_row` lists the rule's eight node constants in an array.
+// `brdf.wgsl`'s `ms_norms_from_row` lists the rule's eight node constants in an array.
 const _: () = assert!(MS_NODES == 8, "brdf.wgsl's ms_norms_from_row lists eight nodes");
 
+/// The shared numbers as WGSL `const` declarations: (name, WGSL type, value).
 pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
     let mut c: Vec<(&'static str, &'static str, String)> = vec![
         ("PI", "f32", f32_literal(std::f64::consts::PI)),
@@ -76,8 +76,6 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("BB_POS", "vec4<f32>", vec4_literal(BB_LOBES.map(|l| l.1))),
         ("BB_VAR", "vec4<f32>", vec4_literal(BB_LOBES.map(|l| l.2))),
         ("GAUSSIAN_FIT_HARMONICS", "u32", format!("{GAUSSIAN_FIT_HARMONICS}u")),
-        // The axes of the rough lobe's table (optics::brdf::energy; the table itself is a
-        // storage buffer of the film bind group, render::engine::film).
         ("PBR_NEUTRAL_OFFSET", "f32", f32_literal(PBR_NEUTRAL_OFFSET)),
         ("PBR_NEUTRAL_START_COMPRESSION", "f32", f32_literal(PBR_NEUTRAL_START_COMPRESSION)),
         ("PBR_NEUTRAL_DESATURATION", "f32", f32_literal(PBR_NEUTRAL_DESATURATION)),
@@ -85,6 +83,8 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("TONE_MAP_NONE", "u32", format!("{TONE_MAP_NONE}u")),
         ("GBUFFER_POSITION_NORMAL", "u32", format!("{GBUFFER_POSITION_NORMAL}u")),
         ("GBUFFER_ALBEDO_GEOMETRY", "u32", format!("{GBUFFER_ALBEDO_GEOMETRY}u")),
+        // The axes of the rough lobe's table (optics::brdf::energy; the table itself is a
+        // storage buffer of the film bind group, render::engine::film).
         ("E1_MU", "u32", format!("{E1_MU}u")),
         ("E1_ROUGHNESS", "u32", format!("{E1_ROUGHNESS}u")),
         // The lobe table's entries (render::engine::film::lobe_table) and the slots of a

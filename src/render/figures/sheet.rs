@@ -158,7 +158,8 @@ pub fn draw_text(image: &mut RgbImage, x: u32, y: u32, text: &str, color: Rgb<u8
     }
 }
 
-/// The linear colour map as an sRGB image, box-filtered down to `tile` × `tile`.
+/// The linear colour map as an sRGB image, resized to `tile` × `tile` (a triangle filter on
+/// the sRGB codes).
 fn colour_tile(maps: &std::collections::BTreeMap<MapKind, crate::ops::Image>, tile: u32) -> RgbImage {
     imageops::resize(&colour_image(maps), tile, tile, imageops::FilterType::Triangle)
 }

@@ -165,8 +165,18 @@ impl App {
         .map_err(|e| Error::Gpu(GpuError::NoAdapter(e.to_string())))?;
         let gpu = Gpu::open(&adapter)?;
         let caps = surface.get_capabilities(&adapter);
-        // The tone mapper writes linear values and relies on an sRGB target to encode them.
-        let format = caps.formats.iter().copied().find(|f| f.is_srgb()).unwrap_or(caps.formats[0]);
+        // The tone mapper writes linear values and relies on an sRGB target to encode them:
+        // a surface that offers none would show the picture darker than it is.
+        let (Some(format), Some(&alpha_mode)) =
+            (caps.formats.iter().copied().find(|f| f.is_srgb()), caps.alpha_modes.first())
+        else {
+            return Err(Error::Gpu(GpuError::Window(format!(
+                "the window's surface on {} offers no sRGB format (it offers {:?}), which the preview's tone mapping \
+                 writes to; use the headless preview (preview --out FILE.png)",
+                adapter.get_info().name,
+                caps.formats
+            ))));
+        };
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -176,7 +186,7 @@ impl App {
             height: size.height.max(1),
             present_mode: wgpu::PresentMode::AutoNoVsync,
             desired_maximum_frame_latency: WINDOW_FRAME_LATENCY,
-            alpha_mode: caps.alpha_modes[0],
+            alpha_mode,
             view_formats: vec![],
         };
         surface.configure(&gpu.device, &config);
