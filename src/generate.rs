@@ -333,7 +333,7 @@ impl Plan {
                 })
                 .collect::<Result<Vec<_>, export::ExportError>>()?;
             (finished.iter().map(|(m, _)| *m).collect(), Files::Bytes(files), stats, encode_start.elapsed())
-        } else if let Some(layout) = strip_layout.filter(|_| height == size) {
+        } else if let Some(layout) = strip_layout.filter(|_| graph.wraps_v()) {
             // A tile too large to evaluate whole: strip by strip, each map's rows quantised
             // into the whole map's samples as they come, each map compressed as it completes
             // (the same PNG bytes as a tile evaluated whole).
@@ -547,7 +547,7 @@ fn for_each_band(
     progress: &(dyn Fn(usize, usize) + Sync),
     sink: &mut BandSink,
 ) -> Result<EvalStats, Error> {
-    let frames = strip_frames(width, height, strips);
+    let frames = strip_frames(width, height, graph.wraps_v(), strips);
     let mut stats = EvalStats::default();
     for (k, (frame, kept)) in frames.iter().enumerate() {
         let nodes = &|done: usize, total: usize| progress(k * total + done, frames.len() * total);
@@ -573,7 +573,7 @@ fn for_each_strip_map(
     progress: &(dyn Fn(usize, usize) + Sync),
     sink: &mut dyn FnMut(MapKind, crate::ops::Image, std::ops::Range<usize>) -> Result<(), Error>,
 ) -> Result<EvalStats, Error> {
-    let frames = strip_frames(width, height, strips);
+    let frames = strip_frames(width, height, graph.wraps_v(), strips);
     let mut stats = EvalStats::default();
     for (k, (frame, kept)) in frames.iter().enumerate() {
         let nodes = &|done: usize, total: usize| progress(k * total + done, frames.len() * total);
@@ -594,11 +594,15 @@ fn for_each_strip_map(
 /// The frame of each strip (its rows plus its margins) and the rows of it that belong to the
 /// texture. The tile repeats along v, so its strips' margins run round the seam (the first
 /// strip's margin above is the texture's last rows); a body atlas's stop at its ends.
-fn strip_frames(width: usize, height: usize, strips: Option<Strips>) -> Vec<(Frame, std::ops::Range<usize>)> {
+fn strip_frames(
+    width: usize,
+    height: usize,
+    wraps: bool,
+    strips: Option<Strips>,
+) -> Vec<(Frame, std::ops::Range<usize>)> {
     let Some(Strips { count, rows: step, margin }) = strips else {
         return vec![(Frame::whole(width, height), 0..height)];
     };
-    let wraps = height == width;
     (0..count)
         .map(|k| {
             let (start, end) = (k * step, ((k + 1) * step).min(height));
@@ -674,7 +678,7 @@ pub const STRIP_BUFFER_BUDGET_BYTES: u64 = 640 << 20;
 /// tiles through strips).
 fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Option<Strips> {
     let margin = graph.row_reach(maps, width);
-    if height > width {
+    if !graph.wraps_v() {
         let rows = STRIP_WIDTHS * width;
         return Some(Strips { count: height.div_ceil(rows), rows, margin });
     }
