@@ -248,7 +248,7 @@ fn shapes(
                 (layer.colors.clone(), layer.widths.iter().map(|w| *w as f32).collect())
             };
             if fully_snapped(layer) {
-                let floor_cells = s.field.longest_reach_cells(&s.lattice) + s.field.jitter.clamp(0.0, 0.5);
+                let floor_cells = s.field.apart_cells(&s.lattice);
                 widths = rings_of_whole_scales(&widths, s.lattice.rows_v as f32 * span_len / repeats, floor_cells);
             }
             // Start half way into the first colour, so the texture's v seam falls inside a

@@ -181,7 +181,7 @@ impl Shared {
     /// the scale's longest reach plus its centre jitter, in cell lengths, times a cell's
     /// length (`SnapToScales::reach`).
     pub fn snap_reach(&self) -> f32 {
-        let cells = self.field.longest_reach_cells(&self.lattice) + self.field.jitter.clamp(0.0, 0.5);
+        let cells = self.field.apart_cells(&self.lattice);
         cells * self.field.length / self.lattice.rows_v as f32
     }
 

@@ -252,18 +252,26 @@ struct CellTable {
     cols: i32,
 }
 
+/// What `jitter` (at most `JITTER_MAX`) moves per unit: a cell's centre up to ±`JITTER_OFFSET`
+/// cells each way, its outline's angle up to ±`JITTER_ANGLE_RAD`, its size up to
+/// ±`JITTER_SIZE` of itself (`CellTable`; `longest_reach_cells` bounds what they reach).
+const JITTER_MAX: f32 = 0.5;
+const JITTER_OFFSET: f32 = 0.5;
+const JITTER_ANGLE_RAD: f32 = 0.6;
+const JITTER_SIZE: f32 = 0.4;
+
 impl CellTable {
     fn new(field: &ScaleField, lattice: &Lattice) -> Self {
-        let j = field.jitter.clamp(0.0, 0.5);
+        let j = field.jitter.clamp(0.0, JITTER_MAX);
         let mut cells = Vec::with_capacity((lattice.cols * lattice.rows_v) as usize);
         for r in 0..lattice.rows_v {
             for c in 0..lattice.cols {
                 let s = field.seed;
-                let angle = hash::signed(c, r, 2, s) * j * 0.6;
-                let size = field.size * (1.0 + hash::signed(c, r, 3, s) * j * 0.4);
+                let angle = hash::signed(c, r, 2, s) * j * JITTER_ANGLE_RAD;
+                let size = field.size * (1.0 + hash::signed(c, r, 3, s) * j * JITTER_SIZE);
                 cells.push(CellJitter {
-                    dx: hash::signed(c, r, 0, s) * j * 0.5,
-                    dy: hash::signed(c, r, 1, s) * j * 0.5,
+                    dx: hash::signed(c, r, 0, s) * j * JITTER_OFFSET,
+                    dy: hash::signed(c, r, 1, s) * j * JITTER_OFFSET,
                     cos: angle.cos(),
                     sin: angle.sin(),
                     inv_size: 1.0 / size.max(0.05),
@@ -470,12 +478,12 @@ impl Geometry {
 impl ScaleField {
     /// The longest reach of any one scale along the body, in cell lengths: the outline's
     /// full extent along v at the largest size and rotation the jitter gives (`CellTable`:
-    /// size × (1 ± 0.4 j), angle ± 0.6 j), at least one cell. Scales whose centres lie
+    /// size × (1 ± `JITTER_SIZE` j), angle ± `JITTER_ANGLE_RAD` j), at least one cell. Scales whose centres lie
     /// further apart along the body than this (plus the centre jitter, ± j / 2 each) cannot
     /// touch: what keeps a ring drawn in whole scales from letting its neighbours meet.
     pub fn longest_reach_cells(&self, lattice: &Lattice) -> f32 {
-        let j = self.jitter.clamp(0.0, 0.5);
-        let size = self.size * (1.0 + 0.4 * j);
+        let j = self.jitter.clamp(0.0, JITTER_MAX);
+        let size = self.size * (1.0 + JITTER_SIZE * j);
         let reach = match self.shape {
             // Voronoi cells: one cell along the body, however they are jittered.
             ScaleShape::Hexagon => 1.0,
@@ -483,11 +491,17 @@ impl ScaleField {
                 // Half-length 0.5 cell lengths, half-width in cell widths = 1 / aspect cell
                 // lengths; rotated by θ the outline reaches b cos θ + a sin θ along v.
                 let (b, a) = (0.5 * size, half_width(self.shape) * size / lattice.aspect);
-                let theta = 0.6 * j;
+                let theta = JITTER_ANGLE_RAD * j;
                 2.0 * (b * theta.cos() + a * theta.sin())
             }
         };
         reach.max(1.0)
+    }
+
+    /// How far apart along the body two scales' centres must lie not to touch, in cell
+    /// lengths: `longest_reach_cells` plus both centres' jitter (±`JITTER_OFFSET` j each).
+    pub fn apart_cells(&self, lattice: &Lattice) -> f32 {
+        self.longest_reach_cells(lattice) + 2.0 * JITTER_OFFSET * self.jitter.clamp(0.0, JITTER_MAX)
     }
 
     /// A scale centre's v: wrapped into [0, 1) on the tile; left as it is on a body atlas,
