@@ -938,7 +938,9 @@ impl BatchIndex {
         BatchIndex {
             generator: "snakeskin".into(),
             generator_version: env!("CARGO_PKG_VERSION").into(),
-            jobs_file: jobs_file.into(),
+            // The file itself, wherever a later run is started from (as given, it was relative
+            // to this run's working folder, and a later run's note mistook it for another).
+            jobs_file: std::fs::canonicalize(jobs_file).unwrap_or_else(|_| jobs_file.into()),
             shard: shard.to_string(),
             jobs,
             concurrency,
@@ -1045,16 +1047,16 @@ impl Drop for StopOnPanic<'_> {
 /// is generated.
 fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Result<JobOutcome, Error> {
     let mut outcome = resolved.outcome.clone();
+    // Another run into the same folder may have finished the set since this one was planned:
+    // looked for again (of two batches over the same jobs, the second generated again every
+    // set the first finished after the second was planned; the QA review). Not under the
+    // set's lock: a run that commits the set between this look and the lock is a set
+    // generated twice, the same bytes.
+    let done = resolved.done
+        || (outcome.duplicate_of.is_none() && is_done(&out.join(&outcome.manifest), &outcome.key, &resolved.files));
     if outcome.duplicate_of.is_some() {
         // Its set is the earlier job's (in this shard or another).
-    } else if !resolved.done {
-        // Another run into the same folder may have finished the set since this one was
-        // planned: looked for again (two batches over the same jobs, in turn, each generated
-        // every set the other had not when it started; the QA review).
-        if is_done(&out.join(&outcome.manifest), &outcome.key, &resolved.files) {
-            outcome.status = JobStatus::Skipped;
-            return Ok(outcome);
-        }
+    } else if !done {
         let running = RunningJob { place: job.place(jobs_file, job.lines.preset), seed: outcome.seed, size: job.size };
         let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
         // Checked against the available memory with the other jobs when the run was planned
@@ -1070,6 +1072,7 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
         outcome.kept = plan.run(&|_, _| {}).map_err(failed)?.kept;
         outcome.status = JobStatus::Done;
     } else {
+        outcome.status = JobStatus::Skipped;
         // A run killed after committing this set but before removing its lock file left an
         // empty `.NAME.lock` behind: taking the lock and letting it go removes it (and leaves
         // the set alone; a set some other run holds is left as it is).

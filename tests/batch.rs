@@ -716,6 +716,19 @@ fn a_batch_says_when_it_replaces_another_jobs_files_index() {
         assert_eq!(stderr(&ran).contains(&note), says, "{}: {}", jobs.display(), stderr(&ran));
     }
     assert_eq!(read_index(&out)["jobs_file"], second.to_str().unwrap());
+    // The same file named from another folder is the same jobs file (the index holds its
+    // canonical path; given as typed, `../second.toml` from a folder below was "another").
+    let below = dir.path().join("below");
+    std::fs::create_dir(&below).unwrap();
+    for (folder, jobs, out) in [(dir.path(), "second.toml", "out"), (&below, "../second.toml", "../out")] {
+        let ran = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["batch", jobs, "-o", out])
+            .current_dir(folder)
+            .output()
+            .unwrap();
+        assert!(ran.status.success(), "{}", stderr(&ran));
+        assert!(!stderr(&ran).contains("listed the jobs of"), "{jobs}: {}", stderr(&ran));
+    }
 }
 
 #[test]

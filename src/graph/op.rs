@@ -145,9 +145,10 @@ impl Op {
     /// Temporary buffers a kernel allocates besides its output, in output-sized images, at
     /// `width` pixels wide: the small blur's horizontal pass, and its input, which it still
     /// holds while it writes a new output (`filters::gaussian_blur`; the estimate has
-    /// counted that input as handed over); the coverage mask of tiny-skia shapes (a byte a
-    /// pixel over the frame's rows, on a body atlas rounded out to `shapes::CUT_ROWS`: under
-    /// one f32 channel but for strips under 21 rows).
+    /// counted that input as handed over); the coverage mask of tiny-skia shapes, a byte a
+    /// pixel: under one f32 channel for a body atlas's strip (its rows rounded out to
+    /// `shapes::CUT_ROWS`) and a whole texture, but over the whole tile for a strip of the
+    /// tile (`shapes::Canvas`), which this counts as one channel of the strip.
     pub fn scratch_images(&self, width: usize) -> usize {
         match self {
             Op::Blur { sigma } if filters::blur_is_gaussian(*sigma, width) => 2,

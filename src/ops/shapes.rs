@@ -178,12 +178,16 @@ fn copies_v(frame: Frame) -> &'static [f32] {
 /// - A body atlas, which is not periodic, is drawn strip by strip, exactly (`on_grid`):
 ///   every curve becomes lines, every edge gets a vertex where it crosses the texture's
 ///   left and right edges and every `CUT_ROWS`-th row, all in texture coordinates, and each
-///   vertex is rounded to 1/`SUBPIXELS` pixel; a strip's mask starts and ends on a cut row.
-///   tiny-skia then cuts nothing (an edge lies inside the mask or wholly beside it, and one
-///   beside it it drops or stands up at the side with its own ends), and moving the
-///   vertices by whole rows to the mask's origin is exact, so its fixed point sees the same
-///   fractions wherever the mask starts. The mask is the strip's rows and under two cut
-///   blocks more. Every generator's strips are held to the whole atlas's rows
+///   vertex is rounded to 1/`SUBPIXELS` pixel; a strip's mask starts and ends on a cut row,
+///   and is drawn in blocks of `BLOCK_ROWS` that tiny-skia does not tile (its own tiles'
+///   columns are cut too). tiny-skia then cuts nothing (an edge lies inside the block or
+///   wholly beside it, and one beside it it drops or stands up at the side with its own
+///   ends), and moving the vertices by whole rows to the block's origin is exact, so its
+///   fixed point sees the same fractions wherever the mask starts. The mask is the strip's
+///   rows and under two cut blocks more. Curves as lines cost time where there are many:
+///   ring spots 64 around a body 40 widths long at 1024, 3.4 → 6.1 s for the node; the
+///   built-ins' shapes as before (`pantherophis-guttatus`, `lampropeltis-triangulum` at
+///   2048, 37–55 ms a node either way). Every generator's strips are held to the whole atlas's rows
 ///   (`tests/body.rs`).
 #[derive(Debug, Clone, Copy)]
 struct Canvas {
@@ -197,14 +201,24 @@ struct Canvas {
 /// rounded out to them.
 const CUT_ROWS: usize = 32;
 
+/// tiny-skia draws a mask over 8,191 pixels a side in tiles of 8,191 (`DrawTiler`, 8192 × 4
+/// supersamples overflow its fixed point), cutting the edges at their borders. A body
+/// atlas's mask is drawn in blocks of at most this many rows, a multiple of `CUT_ROWS`, so
+/// that no block is tiled along v; along u its edges are cut at every `TILER_SIDE` columns.
+const BLOCK_ROWS: usize = 255 * CUT_ROWS;
+const TILER_SIDE: usize = 8191;
+const _: () = assert!(BLOCK_ROWS <= TILER_SIDE);
+
 /// A body atlas's vertices are multiples of 1/SUBPIXELS pixel: tiny-skia's fixed point
 /// has 1/4 (supersampling) × 1/64 (FDot6) of a pixel, so they are exact in it, and in f32
 /// up to 2^16 pixels (an atlas has at most 65,535 rows; its copies round the body reach
 /// 3 widths of at most 8,192).
 const SUBPIXELS: f32 = 256.0;
 
-/// How far a flattened curve may lie from the curve, in pixels (`on_grid`).
-const FLATNESS_PX: f32 = 1.0 / 64.0;
+/// How far a flattened curve may lie from the curve, in pixels (`on_grid`): a sixteenth,
+/// under the supersampling's quarter pixel. (1/64 took ring spots 64 around a body 40 widths
+/// long at 1024 from 4.6 s to 11.4 s.)
+const FLATNESS_PX: f32 = 1.0 / 16.0;
 
 impl Canvas {
     fn new(frame: Frame) -> Canvas {
@@ -228,43 +242,60 @@ impl Canvas {
     fn rasterise(&self, pb: PathBuilder, rule: FillRule) -> Image {
         let (width, height) = (self.frame.width, self.frame.height);
         let mut out = Image::new(width, height, 1);
-        let path = match self.frame.wraps_v {
-            true => pb.finish().and_then(|p| match self.top {
-                0 => Some(p),
-                top => p.transform(Transform::from_translate(0.0, -(top as f32))),
-            }),
-            false => pb.finish().and_then(|p| on_grid(&p, width as f32, self.top)),
-        };
-        let (Some(mut mask), Some(path)) = (Mask::new(width as u32, self.rows as u32), path) else {
+        let Some(path) = pb.finish() else {
             return out;
         };
-        // Written before tiny-skia reads it: the blitter loads a row's coverage before it
-        // stores it, and a fresh page first read maps the shared zero page, so its store then
-        // paid a copy-on-write fault with a TLB shootdown (BENCHMARKS.md, "Copy-on-write
-        // faults").
-        mask.data_mut().fill(0);
-        mask.fill_path(&path, rule, true, Transform::identity());
-        let first = (self.frame.row0 - self.top) * width;
-        for (o, &m) in out.data.iter_mut().zip(&mask.data()[first..first + width * height]) {
-            *o = m as f32 / 255.0;
+        // The mask in blocks of at most `BLOCK_ROWS` rows (the tile's in one), each starting
+        // on a cut row on a body atlas.
+        let block_rows = if self.frame.wraps_v { self.rows } else { BLOCK_ROWS };
+        let mut block_top = self.top;
+        while block_top < self.top + self.rows {
+            let rows = block_rows.min(self.top + self.rows - block_top);
+            let block = match self.frame.wraps_v {
+                true if block_top == 0 => Some(path.clone()),
+                true => path.clone().transform(Transform::from_translate(0.0, -(block_top as f32))),
+                false => on_grid(&path, width as f32, block_top),
+            };
+            let (Some(mut mask), Some(block)) = (Mask::new(width as u32, rows as u32), block) else {
+                return out;
+            };
+            // Written before tiny-skia reads it: the blitter loads a row's coverage before it
+            // stores it, and a fresh page first read maps the shared zero page, so its store
+            // then paid a copy-on-write fault with a TLB shootdown (BENCHMARKS.md,
+            // "Copy-on-write faults").
+            mask.data_mut().fill(0);
+            mask.fill_path(&block, rule, true, Transform::identity());
+            // The frame's rows within the block.
+            let (first, last) = (self.frame.row0.max(block_top), (self.frame.row0 + height).min(block_top + rows));
+            for texture_row in first..last {
+                let from = &mask.data()[(texture_row - block_top) * width..][..width];
+                let to = &mut out.data[(texture_row - self.frame.row0) * width..][..width];
+                for (o, &m) in to.iter_mut().zip(from) {
+                    *o = m as f32 / 255.0;
+                }
+            }
+            block_top += rows;
         }
         out
     }
 }
 
 /// A body atlas's path as `Canvas` draws it: its curves as lines (within `FLATNESS_PX`),
-/// a vertex added where an edge crosses column 0 or `width` or a multiple of `CUT_ROWS`
-/// rows, every vertex rounded to 1/`SUBPIXELS` pixel, then moved up by `top` rows (exact).
+/// a vertex added where an edge crosses column 0, `width` or a multiple of `TILER_SIDE` or
+/// a multiple of `CUT_ROWS` rows, every vertex rounded to 1/`SUBPIXELS` pixel, then moved up by `top` rows (exact).
 /// Everything before the move is computed in texture coordinates, the same for any strip.
 fn on_grid(path: &tiny_skia::Path, width: f32, top: usize) -> Option<tiny_skia::Path> {
     use tiny_skia::{PathSegment, Point};
     let grid = |v: f32| (v * SUBPIXELS).round() / SUBPIXELS;
-    let mut pb = PathBuilder::new();
-    let line_to = |pb: &mut PathBuilder, a: Point, b: Point| {
-        // The crossings of the cut columns and rows in order along the edge: (where, the
-        // column's x or the row's y, exactly).
-        let mut cuts: Vec<(f32, Option<f32>, Option<f32>)> = Vec::new();
-        for x in [0.0, width] {
+    // Room for the flattened curves and the cuts (growing the builder's buffers was a tenth
+    // of a body atlas's ring spots' time).
+    let mut pb = PathBuilder::with_capacity(4 * path.len(), 8 * path.points().len());
+    // The crossings of the cut columns and rows of one edge in order along it: (where, the
+    // column's x or the row's y, exactly); one buffer for every edge.
+    let mut cuts: Vec<(f32, Option<f32>, Option<f32>)> = Vec::new();
+    let mut line_to = |pb: &mut PathBuilder, a: Point, b: Point| {
+        cuts.clear();
+        for x in [0.0, width].into_iter().chain((1..).map(|k| (k * TILER_SIDE) as f32).take_while(|x| *x < width)) {
             if (a.x - x) * (b.x - x) < 0.0 {
                 cuts.push(((x - a.x) / (b.x - a.x), Some(x), None));
             }
@@ -276,7 +307,7 @@ fn on_grid(path: &tiny_skia::Path, width: f32, top: usize) -> Option<tiny_skia::
             row += CUT_ROWS as i64;
         }
         cuts.sort_by(|p, q| p.0.total_cmp(&q.0));
-        for (t, x, y) in cuts {
+        for &(t, x, y) in &cuts {
             let x = x.unwrap_or_else(|| grid(a.x + (b.x - a.x) * t));
             let y = y.unwrap_or_else(|| grid(a.y + (b.y - a.y) * t));
             pb.line_to(x, y - top as f32);
@@ -664,6 +695,38 @@ pub fn belly_marks(frame: Frame, marks: &BellyMarks) -> Image {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A body atlas taller than tiny-skia draws untiled (8,191 rows): strips across its
+    /// blocks (`BLOCK_ROWS`) and tiny-skia's tile borders draw the whole atlas's rows, for
+    /// lines (chevrons) and curves (ovals), each crossing the texture's sides. Seen failing
+    /// with the blocks as tall as the mask (tiny-skia then tiled it at row 8,191).
+    #[test]
+    fn a_tall_body_atlas_draws_its_strips_as_the_whole() {
+        let (width, height) = (64, 20_000);
+        for shape in [BlotchShape::Chevron, BlotchShape::Round] {
+            let b = Blotches {
+                shape,
+                count: 300,
+                half_width: 0.3,
+                length: 0.8,
+                jitter: 0.5,
+                offset: 0.45,
+                staggered: true,
+                phase: 0.0,
+                scale: 1.0,
+                span: (0.0, 1.0),
+                widen: 1.0,
+                seed: 5,
+            };
+            let frame = |row0, rows| Frame { width, height: rows, full_height: height, row0, wraps_v: false };
+            let whole = blotches(frame(0, height), &b);
+            for (row0, rows) in [(7_990, 400), (8_150, 100), (11_345, 8_300), (16_300, 3_700)] {
+                let strip = blotches(frame(row0, rows), &b);
+                let differ = (0..rows).filter(|y| strip.row(*y) != whole.row(row0 + y)).count();
+                assert_eq!(differ, 0, "{shape:?}: {differ} rows of a strip from {row0} differ");
+            }
+        }
+    }
 
     fn grid(radius: f32, hole: f32) -> SpotGrid {
         SpotGrid { across: 4, along: 4, radius, jitter: 0.0, alternate: false, checkered: false, hole, seed: 7 }
