@@ -95,35 +95,31 @@ pub struct SpotGrid {
 
 /// Rasterises the spot grid into an anti-aliased coverage mask in [0, 1].
 pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
-    let (w, h) = (frame.width as f32, frame.full_height as f32);
-    let (across, along) = (grid.across.max(1), grid.along.max(1));
-    // Each spot's centre (texture u, v) and radius in pixels; None for a checkered gap.
-    let spot = |col: i32, row: i32| {
-        if grid.checkered && (row + col) % 2 == 1 {
-            return None;
-        }
-        let shift = if grid.alternate && row % 2 == 1 { 0.5 } else { 0.0 };
-        let jx = hash::signed(col, row, 0, grid.seed) * grid.jitter * 0.5;
-        let jy = hash::signed(col, row, 1, grid.seed) * grid.jitter * 0.5;
-        let jr = 1.0 + hash::signed(col, row, 2, grid.seed) * grid.jitter * 0.5;
-        let cu = (col as f32 + 0.5 + shift + jx) / across as f32;
-        let cv = (row as f32 + 0.5 + jy) / along as f32;
-        Some((cu, cv, grid.radius * jr * w))
-    };
     let canvas = Canvas::new(frame);
+    let (w, h) = (frame.width as f32, frame.full_height as f32);
     let mut pb = PathBuilder::new();
-    for (col, row) in (0..along as i32).flat_map(|row| (0..across as i32).map(move |col| (col, row))) {
-        let Some((cu, cv, r_px)) = spot(col, row) else {
-            continue;
-        };
-        // Draw every periodic copy that can touch the tile.
-        for &oy in copies_v(frame) {
-            for ox in [-1.0f32, 0.0, 1.0] {
-                let (x, y) = ((cu + ox) * w, (cv + oy) * h);
-                if canvas.keeps((x - r_px, x + r_px), (y - r_px, y + r_px)) {
-                    pb.push_circle(x, y, r_px.max(0.1));
-                    if grid.hole > 0.0 {
-                        push_hole(&mut pb, x, y, (r_px * grid.hole).max(0.05));
+    let (across, along) = (grid.across.max(1), grid.along.max(1));
+    for row in 0..along as i32 {
+        for col in 0..across as i32 {
+            if grid.checkered && (row + col) % 2 == 1 {
+                continue;
+            }
+            let shift = if grid.alternate && row % 2 == 1 { 0.5 } else { 0.0 };
+            let jx = hash::signed(col, row, 0, grid.seed) * grid.jitter * 0.5;
+            let jy = hash::signed(col, row, 1, grid.seed) * grid.jitter * 0.5;
+            let jr = 1.0 + hash::signed(col, row, 2, grid.seed) * grid.jitter * 0.5;
+            let cu = (col as f32 + 0.5 + shift + jx) / across as f32;
+            let cv = (row as f32 + 0.5 + jy) / along as f32;
+            let r_px = grid.radius * jr * w;
+            // Draw every periodic copy that can touch the tile.
+            for &oy in copies_v(frame) {
+                for ox in [-1.0f32, 0.0, 1.0] {
+                    let (x, y) = ((cu + ox) * w, (cv + oy) * h);
+                    if canvas.keeps((x - r_px, x + r_px), (y - r_px, y + r_px)) {
+                        pb.push_circle(x, y, r_px.max(0.1));
+                        if grid.hole > 0.0 {
+                            push_hole(&mut pb, x, y, (r_px * grid.hole).max(0.05));
+                        }
                     }
                 }
             }
@@ -240,50 +236,61 @@ impl Canvas {
     /// Fills the path (in texture pixels) into an anti-aliased coverage mask in [0, 1] over
     /// the rows of the frame (all zero if there is nothing to fill or the size is unusable).
     fn rasterise(&self, pb: PathBuilder, rule: FillRule) -> Image {
-        let (width, height) = (self.frame.width, self.frame.height);
-        let mut out = Image::new(width, height, 1);
+        let mut out = Image::new(self.frame.width, self.frame.height, 1);
         let Some(path) = pb.finish() else {
             return out;
         };
-        // The mask in blocks of at most `BLOCK_ROWS` rows (the tile's in one), each starting
-        // on a cut row on a body atlas.
-        let block_rows = if self.frame.wraps_v { self.rows } else { BLOCK_ROWS };
+        if self.frame.wraps_v {
+            let path = match self.top {
+                0 => Some(path),
+                top => path.transform(Transform::from_translate(0.0, -(top as f32))),
+            };
+            if let Some(path) = path {
+                self.fill(&mut out, &path, self.top, self.rows, rule);
+            }
+            return out;
+        }
+        // A body atlas's mask in blocks, each starting on a cut row.
         let mut block_top = self.top;
         while block_top < self.top + self.rows {
-            let rows = block_rows.min(self.top + self.rows - block_top);
-            let block = match self.frame.wraps_v {
-                true if block_top == 0 => Some(path.clone()),
-                true => path.clone().transform(Transform::from_translate(0.0, -(block_top as f32))),
-                false => on_grid(&path, width as f32, block_top),
-            };
-            let (Some(mut mask), Some(block)) = (Mask::new(width as u32, rows as u32), block) else {
-                return out;
-            };
-            // Written before tiny-skia reads it: the blitter loads a row's coverage before it
-            // stores it, and a fresh page first read maps the shared zero page, so its store
-            // then paid a copy-on-write fault with a TLB shootdown (BENCHMARKS.md,
-            // "Copy-on-write faults").
-            mask.data_mut().fill(0);
-            mask.fill_path(&block, rule, true, Transform::identity());
-            // The frame's rows within the block.
-            let (first, last) = (self.frame.row0.max(block_top), (self.frame.row0 + height).min(block_top + rows));
-            for texture_row in first..last {
-                let from = &mask.data()[(texture_row - block_top) * width..][..width];
-                let to = &mut out.data[(texture_row - self.frame.row0) * width..][..width];
-                for (o, &m) in to.iter_mut().zip(from) {
-                    *o = m as f32 / 255.0;
-                }
+            let rows = BLOCK_ROWS.min(self.top + self.rows - block_top);
+            if let Some(block) = on_grid(&path, self.frame.width as f32, block_top) {
+                self.fill(&mut out, &block, block_top, rows, rule);
             }
             block_top += rows;
         }
         out
     }
+
+    /// Fills `path` (in the mask's pixels, its first row the texture's `top`) into a mask
+    /// `rows` tall, and its rows that are the frame's into `out`.
+    fn fill(&self, out: &mut Image, path: &tiny_skia::Path, top: usize, rows: usize, rule: FillRule) {
+        let width = self.frame.width;
+        let Some(mut mask) = Mask::new(width as u32, rows as u32) else {
+            return;
+        };
+        // Written before tiny-skia reads it: the blitter loads a row's coverage before it
+        // stores it, and a fresh page first read maps the shared zero page, so its store then
+        // paid a copy-on-write fault with a TLB shootdown (BENCHMARKS.md, "Copy-on-write
+        // faults").
+        mask.data_mut().fill(0);
+        mask.fill_path(path, rule, true, Transform::identity());
+        let frame_rows = self.frame.row0..self.frame.row0 + self.frame.height;
+        for texture_row in frame_rows.start.max(top)..frame_rows.end.min(top + rows) {
+            let from = &mask.data()[(texture_row - top) * width..][..width];
+            let to = &mut out.data[(texture_row - frame_rows.start) * width..][..width];
+            for (o, &m) in to.iter_mut().zip(from) {
+                *o = m as f32 / 255.0;
+            }
+        }
+    }
 }
 
 /// A body atlas's path as `Canvas` draws it: its curves as lines (within `FLATNESS_PX`),
 /// a vertex added where an edge crosses column 0, `width` or a multiple of `TILER_SIDE` or
-/// a multiple of `CUT_ROWS` rows, every vertex rounded to 1/`SUBPIXELS` pixel, then moved up by `top` rows (exact).
-/// Everything before the move is computed in texture coordinates, the same for any strip.
+/// a multiple of `CUT_ROWS` rows, every vertex rounded to 1/`SUBPIXELS` pixel, then moved
+/// up by `top` rows (exact). Everything before the move is computed in texture coordinates,
+/// the same for any strip.
 fn on_grid(path: &tiny_skia::Path, width: f32, top: usize) -> Option<tiny_skia::Path> {
     use tiny_skia::{PathSegment, Point};
     let grid = |v: f32| (v * SUBPIXELS).round() / SUBPIXELS;
@@ -446,8 +453,8 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
         }
         return canvas.rasterise(pb, FillRule::Winding);
     }
-    // Blotch i's jitter across and along (u, spacings), half-width and half-length (pixels).
-    let blotch = |i: i32| {
+    let canvas = Canvas::new(frame);
+    for i in 0..count as i32 {
         let jx = hash::signed(i, 0, 0, b.seed) * b.jitter * 0.05;
         let jy = hash::signed(i, 0, 1, b.seed) * b.jitter * 0.2;
         let js = (1.0 + hash::signed(i, 0, 2, b.seed) * b.jitter * 0.3) * b.scale;
@@ -456,11 +463,7 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
             let t = ((i as f32 + 0.5) / count as f32).clamp(0.0, 1.0);
             hw *= 1.0 + (b.widen - 1.0) * t;
         }
-        (jx, jy, hw, 0.5 * b.length * js * spacing)
-    };
-    let canvas = Canvas::new(frame);
-    for i in 0..count as i32 {
-        let (jx, jy, hw, hl) = blotch(i);
+        let hl = 0.5 * b.length * js * spacing;
         for &(side, shift) in sides {
             // The mirrored series mirrors the jitter too, so a pair is symmetric.
             let cx = (0.5 + side * b.offset + if side < 0.0 { -jx } else { jx }) * w;
@@ -542,8 +545,8 @@ fn push_blotch(pb: &mut PathBuilder, shape: BlotchShape, cx: f32, cy: f32, hw: f
 fn zigzag(pb: &mut PathBuilder, b: &Blotches, canvas: &Canvas, cx: f32, start: f32, spacing: f32, h: f32) {
     let w = canvas.frame.width as f32;
     let start = start.rem_euclid(spacing);
-    let amplitude = zigzag_amplitude(b, w);
-    let thick = zigzag_half_thickness(b, spacing);
+    let amplitude = b.half_width * b.scale * w;
+    let thick = 0.5 * b.length.clamp(0.05, 1.0) * spacing * b.scale;
     let count = (h / spacing).round() as i32;
     for copy_u in [-1.0f32, 0.0, 1.0] {
         let x0 = cx + copy_u * w;
@@ -572,16 +575,6 @@ fn zigzag(pb: &mut PathBuilder, b: &Blotches, canvas: &Canvas, cx: f32, start: f
             pb.close();
         }
     }
-}
-
-/// How far the zigzag's vertices lie either side of its centre line, in pixels.
-fn zigzag_amplitude(b: &Blotches, width: f32) -> f32 {
-    b.half_width * b.scale * width
-}
-
-/// Half the zigzag band's thickness along v, in pixels (`spacing` between its zigs).
-fn zigzag_half_thickness(b: &Blotches, spacing: f32) -> f32 {
-    0.5 * b.length.clamp(0.05, 1.0) * spacing * b.scale
 }
 
 /// What the ventral plates carry (`BellyMarks`).
