@@ -214,6 +214,14 @@ fn segment_distance(p: (f32, f32), a: (f32, f32), b: (f32, f32)) -> f32 {
 
 impl HeadMark {
     /// Signed distance inside the mark at (u, v), in circumferences (positive inside).
+    /// The furthest v any shape of this size reaches: only the head and neck can carry a
+    /// mark, and rows beyond stay 0 (a spearhead's base, a collar's end, a cap of size k, the
+    /// V's arms). A test holds it to `inside` for every shape and size on the built-ins' plans.
+    pub fn reach_v(&self) -> f32 {
+        let (p, k) = (&self.plan, self.size);
+        (p.head_end * (1.3 + 0.6 * k).max(k)).max(p.head_end + 0.7 * k * (p.neck_end - p.head_end).max(0.005))
+    }
+
     pub fn inside(&self, u: f32, v: f32) -> f32 {
         let p = &self.plan;
         let (ux, us) = p.head_units();
@@ -274,12 +282,7 @@ pub fn head_mark(frame: Frame, mark: &HeadMark) -> Image {
     let (width, height) = (frame.width, frame.height);
     // One pixel in circumferences (the texture is isotropic: width = one circumference).
     let pixel = 1.0 / width as f32;
-    // Only the head and neck can carry a mark: rows beyond the furthest any shape reaches
-    // stay 0 (a spearhead's base, a collar's end, a cap of size k, the V's arms).
-    let (p, k) = (&mark.plan, mark.size);
-    let reach_v =
-        (p.head_end * (1.3 + 0.6 * k).max(k)).max(p.head_end + 0.7 * k * (p.neck_end - p.head_end).max(0.005));
-    let last_row = (reach_v * frame.full_height as f32).ceil() as usize + 2;
+    let last_row = (mark.reach_v() * frame.full_height as f32).ceil() as usize + 2;
     let last = last_row.saturating_sub(frame.row0).min(height);
     let mut image = Image::new(width, height, 1);
     use rayon::prelude::*;
@@ -386,6 +389,53 @@ mod tests {
         assert_eq!((first_sub.index, first_sub.subcaudal), (200, true));
         assert_eq!(p.plate_at(0.99999).unwrap().index, 259);
         assert!((p.plate_centre_v(0) - (0.04 + 0.5 * 0.78 / 200.0)).abs() < 1e-6);
+    }
+
+    /// No shape reaches past `reach_v`, beyond which `head_mark` draws nothing: every shape
+    /// at the smallest, default and largest sizes, on every built-in's plan and at the
+    /// shortest and longest head and body, sampled every 1/200 of the circumference over the
+    /// fifth of the body's length past `reach_v` (every 1/2000 of it). Negative control: a
+    /// reach a tenth shorter is passed by some shape.
+    #[test]
+    fn no_head_mark_reaches_past_its_reach() {
+        use crate::preset::validate::ranges::{BODY_LENGTH, HEAD_FRACTION, HEAD_MARK_SIZE};
+        let mut plans: Vec<BodyPlan> = crate::preset::library::all()
+            .iter()
+            .map(|(name, _)| crate::maps::body_plan(&crate::preset::load(name, &[], None).unwrap().preset))
+            .collect();
+        for (head, length) in [(HEAD_FRACTION.0, BODY_LENGTH.0), (HEAD_FRACTION.1, BODY_LENGTH.1)] {
+            let set =
+                [("body.head_fraction".to_string(), head.to_string()), ("body.length".into(), length.to_string())];
+            plans.push(crate::maps::body_plan(&crate::preset::load("natrix-natrix", &set, None).unwrap().preset));
+        }
+        let shapes = [
+            HeadMarkShape::Cap,
+            HeadMarkShape::Snout,
+            HeadMarkShape::V,
+            HeadMarkShape::X,
+            HeadMarkShape::Spearhead,
+            HeadMarkShape::PostocularStripe,
+            HeadMarkShape::Collar,
+            HeadMarkShape::Lips,
+        ];
+        let reached = |scale: f32| {
+            let mut reached = 0;
+            for plan in &plans {
+                for shape in shapes {
+                    for size in [HEAD_MARK_SIZE.0 as f32, 1.0, HEAD_MARK_SIZE.1 as f32] {
+                        let mark = HeadMark { shape, size, plan: *plan };
+                        let from = mark.reach_v() * scale;
+                        let beyond = (0..400).map(|j| (from + 0.2 * j as f32 / 400.0).min(1.0));
+                        reached += beyond
+                            .flat_map(|v| (0..200).map(move |i| (i as f32 / 200.0, v)))
+                            .any(|(u, v)| mark.inside(u, v) > 0.0) as usize;
+                    }
+                }
+            }
+            reached
+        };
+        assert_eq!(reached(1.0), 0, "a shape reaches past reach_v");
+        assert!(reached(0.9) > 0, "the control: a tenth less is passed");
     }
 
     #[test]
