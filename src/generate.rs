@@ -510,10 +510,8 @@ impl Plan {
             names.into_iter().zip(textures).map(|(file, (_, bytes))| (file, bytes)).collect();
         let options = self.request.options;
         let mut manifest =
-            export::manifest(&self.loaded, (self.size, self.height), entries, options, "png", Some(pack.name()));
+            export::manifest(&self.loaded, (self.size, self.height), entries, options, "png", Some(pack));
         manifest.job = self.request.job.clone();
-        // The pack's normal texture is in its engine's convention, whatever the graph's.
-        manifest.normal_convention = pack.normal_convention().name().into();
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
         let written = lock.write(&files, (&export::manifest_file_name(name), &json))?;
         let strips = strips_of(&self.graph, &self.maps, self.size, self.height);

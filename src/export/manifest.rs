@@ -208,14 +208,15 @@ pub fn manifest_file_name(set_name: &str) -> String {
 pub const MANIFEST_SUFFIX: &str = ".material.json";
 
 /// The manifest of a set: `entries` its files, `format` their file format's name, `pack`
-/// the engine they are packed for.
+/// the engine they are packed for (whose normal convention is its own, whatever the
+/// graph's).
 pub fn manifest(
     loaded: &LoadedPreset,
     dimensions: (usize, usize),
     entries: Vec<MapEntry>,
     options: BuildOptions,
     format: &str,
-    pack: Option<&str>,
+    pack: Option<super::pack::Pack>,
 ) -> Manifest {
     let p = &loaded.preset;
     let body = (options.layout == Layout::Body).then(|| body_plan(p));
@@ -234,13 +235,13 @@ pub fn manifest(
     Manifest {
         source: Source::of(loaded, dimensions, options.layout),
         format: format.into(),
-        pack: pack.map(String::from),
+        pack: pack.map(|pack| pack.name().into()),
         counts,
         regions,
         maps: entries,
         iridescence: IridescenceRange { film: crate::maps::has_film(p), min_nm, max_nm },
         displacement: HeightScale { rise_texture_widths: crate::maps::height_rise_texture_widths(p) as f64 },
-        normal_convention: options.normal_convention.name().into(),
+        normal_convention: pack.map_or(options.normal_convention, |pack| pack.normal_convention()).name().into(),
         optics: p.optics.clone(),
         color_means: COLOR_MEANS.into(),
         clamped_colors: loaded.clamped_colours.clone(),

@@ -308,8 +308,8 @@ pub fn height_range(preset: &Preset) -> (f32, f32) {
 /// How far above a height sample of 0 one of 1 stands, in texture widths: the surface the
 /// normal map shades, whose full height range (`height_range`) rises `height.normal_strength`
 /// scale widths (a scale column is 1 / columns of the texture's width). The same for the
-/// tile and the body atlas; the manifest's `displacement.rise_texture_widths`, for a displacement
-/// that agrees with the normal map.
+/// tile and the body atlas; the manifest's `displacement.rise_texture_widths`, for a
+/// displacement that agrees with the normal map.
 pub fn height_rise_texture_widths(preset: &Preset) -> f32 {
     let (low, high) = height_range(preset);
     let columns = scale_field(preset, Layout::Tile).lattice().cols;

@@ -213,7 +213,6 @@ fn segment_distance(p: (f32, f32), a: (f32, f32), b: (f32, f32)) -> f32 {
 }
 
 impl HeadMark {
-    /// Signed distance inside the mark at (u, v), in circumferences (positive inside).
     /// The furthest v any shape of this size reaches: only the head and neck can carry a
     /// mark, and rows beyond stay 0 (a spearhead's base, a collar's end, a cap of size k, the
     /// V's arms). A test holds it to `inside` for every shape and size on the built-ins' plans.
@@ -222,6 +221,7 @@ impl HeadMark {
         (p.head_end * (1.3 + 0.6 * k).max(k)).max(p.head_end + 0.7 * k * (p.neck_end - p.head_end).max(0.005))
     }
 
+    /// Signed distance inside the mark at (u, v), in circumferences (positive inside).
     pub fn inside(&self, u: f32, v: f32) -> f32 {
         let p = &self.plan;
         let (ux, us) = p.head_units();

@@ -209,8 +209,9 @@ fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
     kernel
 }
 
-/// Separable Gaussian blur, wrapping round u (and v on the tile: `wraps_v`). `sigma` is in normalised units (fraction of
-/// the image width); below a third of a pixel it is the identity. Up to 2 px the kernel is
+/// Separable Gaussian blur, wrapping round u (and v on the tile: `wraps_v`). `sigma` is in
+/// normalised units (fraction of the image width); below a third of a pixel it is the
+/// identity. Up to 2 px the kernel is
 /// sampled exactly; beyond, three successive box filters of Kovesi's widths (P. Kovesi,
 /// "Fast almost-Gaussian filtering", DICTA 2010) match the Gaussian's variance at a cost
 /// independent of sigma (running sums), which is what keeps large blurs cheap at 4K.

@@ -478,9 +478,10 @@ impl Geometry {
 impl ScaleField {
     /// The longest reach of any one scale along the body, in cell lengths: the outline's
     /// full extent along v at the largest size and rotation the jitter gives (`CellTable`:
-    /// size × (1 ± `JITTER_SIZE` j), angle ± `JITTER_ANGLE_RAD` j), at least one cell. Scales whose centres lie
-    /// further apart along the body than this (plus the centre jitter, ± j / 2 each) cannot
-    /// touch: what keeps a ring drawn in whole scales from letting its neighbours meet.
+    /// size × (1 ± `JITTER_SIZE` j), angle ± `JITTER_ANGLE_RAD` j), at least one cell.
+    /// Scales whose centres lie further apart along the body than this plus the centres'
+    /// jitter (`apart_cells`) cannot touch: what keeps a ring drawn in whole scales from
+    /// letting its neighbours meet.
     pub fn longest_reach_cells(&self, lattice: &Lattice) -> f32 {
         let j = self.jitter.clamp(0.0, JITTER_MAX);
         let size = self.size * (1.0 + JITTER_SIZE * j);

@@ -183,8 +183,8 @@ fn copies_v(frame: Frame) -> &'static [f32] {
 ///   rows and under two cut blocks more. Curves as lines cost time where there are many:
 ///   ring spots 64 around a body 40 widths long at 1024, 3.4 → 6.1 s for the node; the
 ///   built-ins' shapes as before (`pantherophis-guttatus`, `lampropeltis-triangulum` at
-///   2048, 37–55 ms a node either way). Every generator's strips are held to the whole atlas's rows
-///   (`tests/body.rs`).
+///   2048, 37–55 ms a node either way). Every generator's strips are held to the whole
+///   atlas's rows (`tests/body.rs`).
 #[derive(Debug, Clone, Copy)]
 struct Canvas {
     frame: Frame,
