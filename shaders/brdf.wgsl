@@ -338,7 +338,7 @@ fn with_ms_norms(layers: Layers) -> Layers {
 // x(mu_i) x(mu_o) / (pi X) returns the x it takes in every direction.
 fn top_on_row(layers: Layers, k: u32, fx: f32, norm: vec3<f32>) -> Top {
     let parts = parts_on_row(layers, k, fx);
-    let amplitude = select(vec3<f32>(0.0), parts.beyond / sqrt(PI * norm), norm > vec3<f32>(1e-9));
+    let amplitude = select(vec3<f32>(0.0), parts.beyond / sqrt(PI * norm), norm > vec3<f32>(MS_NORM_MIN));
     return Top(parts.single + parts.beyond, amplitude, 0.0);
 }
 

@@ -205,7 +205,7 @@ fn film_gaussian_fit(thickness_nm: f32, cos0: f32) -> vec3<f32> {
         }
         var c = h.d;
         for (var m = 1u; m <= GAUSSIAN_FIT_HARMONICS; m++) {
-            let phase = 2.0 * PI * (f32(m) * opd) * 1e-9;
+            let phase = 2.0 * PI * (f32(m) * opd) * BB_METRES_PER_NM;
             let mag = length(c);
             let arg = atan2(c.y, c.x);
             let lobes = bb_lobes(phase, arg);

@@ -27,7 +27,7 @@ fn fs_plain(in: VertexOut) -> @location(0) vec4<f32> {
     let m = sample_material(in);
     let wo = normalize(scene.camera.xyz - in.world);
     var radiance = vec3<f32>(0.0);
-    for (var i = 0u; i < 2u; i++) {
+    for (var i = 0u; i < SCENE_LIGHTS; i++) {
         let wi = scene.light_dir[i].xyz;
         radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * plain_brdf(m.albedo, m.roughness, m.normal, wi, wo)
             * max(dot(m.normal, wi), 0.0);

@@ -7,9 +7,9 @@ struct Scene {
     // xyz: camera position; w: unused.
     camera: vec4<f32>,
     // xyz: unit direction towards the light; w: 1 if the light is on.
-    light_dir: array<vec4<f32>, 2>,
+    light_dir: array<vec4<f32>, SCENE_LIGHTS>,
     // Irradiance on a surface facing the light, linear RGB.
-    light_rgb: array<vec4<f32>, 2>,
+    light_rgb: array<vec4<f32>, SCENE_LIGHTS>,
     // Sky radiance straight up and straight down (the gradient's ends).
     sky_top: vec4<f32>,
     sky_bottom: vec4<f32>,

@@ -65,7 +65,7 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
         if (STAGE == STAGE_DIFFUSE) {
             n = m.geometric;
         }
-        for (var i = 0u; i < 2u; i++) {
+        for (var i = 0u; i < SCENE_LIGHTS; i++) {
             let wi = scene.light_dir[i].xyz;
             radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * m.albedo / PI * max(dot(n, wi), 0.0);
         }
@@ -74,7 +74,7 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
     let layers = layers_of(m);
     // What the top does towards the viewer, shared by both lights and the ambient term.
     let top_o = coupling(layers, max(dot(m.normal, wo), COS_MIN));
-    for (var i = 0u; i < 2u; i++) {
+    for (var i = 0u; i < SCENE_LIGHTS; i++) {
         let wi = scene.light_dir[i].xyz;
         let cos_i = max(dot(m.normal, wi), 0.0);
         if (scene.light_dir[i].w > 0.0 && cos_i > 0.0) {
@@ -146,7 +146,7 @@ fn fs_ground(in: VertexOut) -> @location(0) vec4<f32> {
     let i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
     let checker = mix(0.07, 0.09, 0.5 - 0.5 * i.x * i.y);
     var radiance = sky(n) * checker;
-    for (var i = 0u; i < 2u; i++) {
+    for (var i = 0u; i < SCENE_LIGHTS; i++) {
         let wi = scene.light_dir[i].xyz;
         radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * checker / PI * max(dot(n, wi), 0.0);
     }

@@ -179,6 +179,9 @@ pub const BB_LOBES: [(f64, f64, f64); 4] = [
     (9.7470e-14, 2.2399e+06, 4.5282e+09),
 ];
 pub const BB_NORM: f64 = 1.0685e-7;
+/// The lobes' centres and variances are in radians per metre of optical path (Belcour &
+/// Barla's Fourier variable), and our path differences in nanometres.
+pub const BB_METRES_PER_NM: f64 = 1e-9;
 
 /// A lobe's amplitude with its normalisation folded in, val √(2π var) / BB_NORM: what the
 /// f32 paths (Rust and WGSL) multiply by.
@@ -190,7 +193,7 @@ pub const GAUSSIAN_FIT_HARMONICS: usize = 3;
 
 /// Re(C · S(opd)) per XYZ channel, C a harmonic coefficient, `opd_nm` the path difference.
 fn bb_sensitivity(c_re: f64, c_im: f64, opd_nm: f64) -> [f64; 3] {
-    let phase = 2.0 * std::f64::consts::PI * opd_nm * 1e-9;
+    let phase = 2.0 * std::f64::consts::PI * opd_nm * BB_METRES_PER_NM;
     let (mag, arg) = ((c_re * c_re + c_im * c_im).sqrt(), c_im.atan2(c_re));
     let lobe = |(val, pos, var): (f64, f64, f64)| {
         val * (2.0 * std::f64::consts::PI * var).sqrt() * (pos * phase + arg).cos() * (-var * phase * phase).exp()
@@ -237,7 +240,7 @@ pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32)
     for h in [&film.s, &film.p] {
         let mut c = h.d;
         for m in 1..=GAUSSIAN_FIT_HARMONICS {
-            let phase = 2.0 * std::f32::consts::PI * (m as f32 * opd) * 1e-9;
+            let phase = 2.0 * std::f32::consts::PI * (m as f32 * opd) * BB_METRES_PER_NM as f32;
             let (mag, arg) = ((c[0] * c[0] + c[1] * c[1]).sqrt(), c[1].atan2(c[0]));
             let lobe = |l: (f64, f64, f64)| {
                 bb_amplitude(l) as f32 * (l.1 as f32 * phase + arg).cos() * (-(l.2 as f32) * phase * phase).exp()

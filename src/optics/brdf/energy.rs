@@ -477,6 +477,11 @@ fn multiple_scattering(i_mu: usize, i_r: usize, lobe: &Lobe) -> Multiple {
 /// Nodes of the rule for the multiple-scatter lobe's normalisation (`ms_norm_on_row`).
 pub const MS_NODES: usize = 8;
 
+/// X̄ at or below which a row has no multiple-scatter lobe (amplitude 0): a top that
+/// scatters nothing more than once (a black film; X̄ is then 0 or rounding), where x / √(π X̄)
+/// would be 0 / 0.
+pub const MS_NORM_MIN: f64 = 1e-9;
+
 /// The (μ, weight) pairs of that rule: four Gauss–Legendre nodes on [0, 1/4] and four on
 /// [1/4, 1]. (Measured against rules that integrate the tables more exactly, since the
 /// tables' nodes are uniform in √μ: Gauss–Legendre in √μ, four and four, and sixteen nodes
@@ -740,8 +745,9 @@ macro_rules! top_impl {
             let (single, x) = $parts(cos, i_r, film, through);
             Top {
                 reflected: [0, 1, 2].map(|c| single[c] + x[c]),
-                ms_amplitude: [0, 1, 2]
-                    .map(|c| if norm[c] > 1e-9 { x[c] / (std::f64::consts::PI as $t * norm[c]).sqrt() } else { 0.0 }),
+                ms_amplitude: [0, 1, 2].map(|c| {
+                    if norm[c] > MS_NORM_MIN as $t { x[c] / (std::f64::consts::PI as $t * norm[c]).sqrt() } else { 0.0 }
+                }),
             }
         }
 

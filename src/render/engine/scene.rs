@@ -80,6 +80,11 @@ impl Light {
     }
 }
 
+/// How many directional lights a scene has: the key and the fill (`Lighting::lights`); the
+/// scene uniform's light arrays and the shaders' light loops (`SCENE_LIGHTS` in WGSL) hold
+/// this many.
+pub const SCENE_LIGHTS: usize = 2;
+
 #[derive(Debug, Clone, Copy)]
 pub struct Lighting {
     pub key: Light,
@@ -97,6 +102,13 @@ impl Default for Lighting {
             sky_top: [0.30, 0.36, 0.45],
             sky_bottom: [0.08, 0.07, 0.06],
         }
+    }
+}
+
+impl Lighting {
+    /// The directional lights in the order the GPU's scene uniform holds them.
+    pub fn lights(&self) -> [&Light; SCENE_LIGHTS] {
+        [&self.key, &self.fill]
     }
 }
 
@@ -305,8 +317,8 @@ impl BounceGrid {
 pub struct SceneUniform {
     pub view_proj: [[f32; 4]; 4],
     pub camera: [f32; 4],
-    pub light_dir: [[f32; 4]; 2],
-    pub light_rgb: [[f32; 4]; 2],
+    pub light_dir: [[f32; 4]; SCENE_LIGHTS],
+    pub light_rgb: [[f32; 4]; SCENE_LIGHTS],
     pub sky_top: [f32; 4],
     pub sky_bottom: [f32; 4],
     pub film: [f32; 4],
@@ -334,8 +346,7 @@ impl SceneUniform {
                 [l.irradiance[0], l.irradiance[1], l.irradiance[2], 0.0],
             )
         };
-        let (key_dir, key_rgb) = light(&lighting.key);
-        let (fill_dir, fill_rgb) = light(&lighting.fill);
+        let lights = lighting.lights().map(light);
         let p = camera.position();
         let rgb4 = |c: [f32; 3]| [c[0], c[1], c[2], 0.0];
         let tau = optics.optical_depth.map(|t| t as f32);
@@ -343,8 +354,8 @@ impl SceneUniform {
         SceneUniform {
             view_proj: camera.view_proj(aspect).to_cols_array_2d(),
             camera: [p.x, p.y, p.z, 0.0],
-            light_dir: [key_dir, fill_dir],
-            light_rgb: [key_rgb, fill_rgb],
+            light_dir: lights.map(|l| l.0),
+            light_rgb: lights.map(|l| l.1),
             sky_top: rgb4(lighting.sky_top),
             sky_bottom: rgb4(lighting.sky_bottom),
             film: [

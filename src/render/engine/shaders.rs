@@ -10,15 +10,15 @@
 
 use crate::maps::MapKind;
 use crate::optics::brdf::energy::{
-    E1_MU, E1_ROUGHNESS, LOBE_NODES, MS_NODES, PAIR_NODES, PAIR_SLOT, PAIR_WEIGHTS_SLOT, ROW_FILM_READS, SHARE_SLOT,
-    ms_rule,
+    E1_MU, E1_ROUGHNESS, LOBE_NODES, MS_NODES, MS_NORM_MIN, PAIR_NODES, PAIR_SLOT, PAIR_WEIGHTS_SLOT, ROW_FILM_READS,
+    SHARE_SLOT, ms_rule,
 };
 use crate::optics::brdf::path::THROUGH_NODES;
 use crate::optics::brdf::{ALPHA_MIN, COS_MIN, LENGTH_MIN, Model};
 use crate::optics::fast::{BOX_NARROW_RAD, HARMONICS_DENOM_MIN, Q_NEGLIGIBLE, SINC_SMALL};
 use crate::optics::lut::{COARSE_MAX_NM, FINE_MAX_NM};
-use crate::optics::methods::{BB_LOBES, GAUSSIAN_FIT_HARMONICS, RGB3_BAND_NM, RGB3_NM, bb_amplitude};
-use crate::render::engine::scene::BOUNCE_THICKNESSES;
+use crate::optics::methods::{BB_LOBES, BB_METRES_PER_NM, GAUSSIAN_FIT_HARMONICS, RGB3_BAND_NM, RGB3_NM, bb_amplitude};
+use crate::render::engine::scene::{BOUNCE_THICKNESSES, SCENE_LIGHTS};
 
 use super::film::GpuFilmMethod;
 use super::renderer::{GBUFFER_ALBEDO_GEOMETRY, GBUFFER_POSITION_NORMAL, TONE_MAP_CURVE, TONE_MAP_NONE};
@@ -75,6 +75,10 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("BB_AMP", "vec4<f32>", vec4_literal(BB_LOBES.map(bb_amplitude))),
         ("BB_POS", "vec4<f32>", vec4_literal(BB_LOBES.map(|l| l.1))),
         ("BB_VAR", "vec4<f32>", vec4_literal(BB_LOBES.map(|l| l.2))),
+        ("BB_METRES_PER_NM", "f32", f32_literal(BB_METRES_PER_NM)),
+        ("MS_NORM_MIN", "f32", f32_literal(MS_NORM_MIN)),
+        // The scene's directional lights (render::engine::scene::Lighting::lights).
+        ("SCENE_LIGHTS", "u32", format!("{SCENE_LIGHTS}u")),
         ("GAUSSIAN_FIT_HARMONICS", "u32", format!("{GAUSSIAN_FIT_HARMONICS}u")),
         ("PBR_NEUTRAL_OFFSET", "f32", f32_literal(PBR_NEUTRAL_OFFSET)),
         ("PBR_NEUTRAL_START_COMPRESSION", "f32", f32_literal(PBR_NEUTRAL_START_COMPRESSION)),

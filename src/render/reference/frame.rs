@@ -115,7 +115,7 @@ pub fn shade_pixel(
     let layers = optics.layers(settings.model, bounce, thickness, nr[3], [albedo[0], albedo[1], albedo[2]]);
     let lighting = &settings.lighting;
     let mut radiance = [0.0; 3];
-    for light in [&lighting.key, &lighting.fill] {
+    for light in lighting.lights() {
         if !light.enabled {
             continue;
         }
