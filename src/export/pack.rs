@@ -170,9 +170,11 @@ impl Pack {
             srgb: true,
             meaning: "RGB: visible diffuse colour (the manifest's color_means), sRGB".into(),
         };
-        // glTF, Unreal and HDRP all take the thickness as a [0, 1] value remapped to a
-        // range in nm given with the material (glTF: iridescenceThicknessMinimum/Maximum,
-        // read from G; a grey image has it in every channel).
+        // The thickness as a [0, 1] value over the manifest's range in nm: glTF remaps it
+        // the same way (iridescenceThicknessMinimum/Maximum, read from G; a grey image has
+        // it in every channel); Unreal's Substrate thin film (1.0 = 10 µm) and HDRP (R, an
+        // optical path, not a thickness) take it differently, as the README's engine
+        // sections say.
         let thickness = TextureSpec {
             suffix: "thickness",
             channels: vec![THICKNESS],
