@@ -328,7 +328,7 @@ impl Plan {
                 .map(|(map, image)| {
                     Ok((
                         export::map_file_name_in(&loaded.name, *map, FileFormat::Exr),
-                        export::encode_exr(*map, image, range)?,
+                        export::encode_exr(*map, image, range, graph.wraps_v())?,
                     ))
                 })
                 .collect::<Result<Vec<_>, export::ExportError>>()?;

@@ -121,18 +121,46 @@ impl FileFormat {
     }
 }
 
-impl MapKind {
-    /// OpenEXR layout: channel names and bits per sample (16 = half, 32 = float). Colour and
-    /// roughness in half (11 significant bits, finer than the PNG's 8); height, the normal and
-    /// the film thickness (in nm, up to 10 mm: PHYSICS.md's bound) need float.
-    pub fn exr_channels(self) -> (&'static [&'static str], u32) {
+/// An OpenEXR map's sample type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExrSample {
+    /// 16-bit half float: 11 significant bits.
+    Half,
+    /// 32-bit float.
+    Float,
+}
+
+impl ExrSample {
+    pub fn bits(self) -> u32 {
         match self {
-            MapKind::Color => (&["R", "G", "B"], 16),
-            MapKind::Height => (&["Y"], 32),
-            MapKind::Normal => (&["R", "G", "B"], 32),
-            MapKind::Roughness => (&["Y"], 16),
-            MapKind::Iridescence => (&["Y"], 32),
-            MapKind::Ao => (&["Y"], 16),
+            ExrSample::Half => 16,
+            ExrSample::Float => 32,
+        }
+    }
+
+    /// The manifest's `sample_type` (OpenEXR's own names for the pixel types).
+    pub fn name(self) -> &'static str {
+        match self {
+            ExrSample::Half => "half",
+            ExrSample::Float => "float",
+        }
+    }
+}
+
+impl MapKind {
+    /// OpenEXR layout: channel names and sample type. Colour and roughness in half (11
+    /// significant bits, finer than the PNG's 8); height, the normal and the film thickness
+    /// (in nm, up to 10 mm: PHYSICS.md's bound) need float. One-channel maps are `Y`, the
+    /// name OpenEXR's readers take for a grey image (they are data, not luminance: the
+    /// manifest's `meaning` says what).
+    pub fn exr_channels(self) -> (&'static [&'static str], ExrSample) {
+        match self {
+            MapKind::Color => (&["R", "G", "B"], ExrSample::Half),
+            MapKind::Height => (&["Y"], ExrSample::Float),
+            MapKind::Normal => (&["R", "G", "B"], ExrSample::Float),
+            MapKind::Roughness => (&["Y"], ExrSample::Half),
+            MapKind::Iridescence => (&["Y"], ExrSample::Float),
+            MapKind::Ao => (&["Y"], ExrSample::Half),
         }
     }
 

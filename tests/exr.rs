@@ -8,24 +8,31 @@ use snakeskin::graph::evaluate;
 use snakeskin::maps::{BuildOptions, Layout, MapKind, build_graph, thickness_range_nm};
 use snakeskin::preset::load;
 
-/// Channels of the first layer as (name, f32 samples in row-major order).
-fn read_channels(path: &std::path::Path) -> Vec<(String, Vec<f32>)> {
+/// A file's first layer: its channels as (name, OpenEXR sample type, f32 samples in
+/// row-major order), and its `wrapmodes` attribute.
+struct ExrFile {
+    channels: Vec<(String, &'static str, Vec<f32>)>,
+    wrap_modes: Option<String>,
+}
+
+fn read_exr(path: &std::path::Path) -> ExrFile {
     use exr::prelude::*;
     let image = read_all_flat_layers_from_file(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let layer = &image.layer_data[0];
-    layer
+    let channels = layer
         .channel_data
         .list
         .iter()
         .map(|c| {
-            let samples: Vec<f32> = match &c.sample_data {
-                FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
-                FlatSamples::F32(v) => v.clone(),
-                FlatSamples::U32(v) => v.iter().map(|x| *x as f32).collect(),
+            let (sample_type, samples): (&str, Vec<f32>) = match &c.sample_data {
+                FlatSamples::F16(v) => ("half", v.iter().map(|x| x.to_f32()).collect()),
+                FlatSamples::F32(v) => ("float", v.clone()),
+                FlatSamples::U32(v) => ("uint", v.iter().map(|x| *x as f32).collect()),
             };
-            (c.name.to_string(), samples)
+            (c.name.to_string(), sample_type, samples)
         })
-        .collect()
+        .collect();
+    ExrFile { channels, wrap_modes: layer.attributes.wrap_mode_name.as_ref().map(|t| t.to_string()) }
 }
 
 #[test]
@@ -60,10 +67,26 @@ fn check_exr(name: &str, layout: Layout) {
     let graph = build_graph(&preset, BuildOptions { layout, ..BuildOptions::default() });
     let height = layout.height(&preset, 64);
     let maps = evaluate(&graph, &MapKind::ALL, 64, height, &|_, _| {}).maps;
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join(format!("{name}.material.json"))).unwrap())
+            .unwrap();
+    // OpenEXR's standard `wrapmodes` (horizontal, vertical): a tile repeats both ways; a
+    // body atlas repeats around the body only, as the glTF samplers of `tests/gltf.rs` say.
+    let wrap_modes = match layout {
+        Layout::Tile => "periodic",
+        Layout::Body => "periodic,clamp",
+    };
     for (map, image) in &maps {
         let file = dir.path().join(format!("{name}_{}.exr", map.name()));
-        let channels = read_channels(&file);
-        let (names, bits) = map.exr_channels();
+        let exr = read_exr(&file);
+        assert_eq!(exr.wrap_modes.as_deref(), Some(wrap_modes), "{map}");
+        let entry = manifest["maps"].as_array().unwrap().iter().find(|m| m["map"] == map.name()).unwrap();
+        for (channel, sample_type, _) in &exr.channels {
+            assert_eq!(entry["sample_type"], *sample_type, "{map} {channel}: the manifest says the file's type");
+            assert_eq!(entry["bit_depth"], if *sample_type == "half" { 16 } else { 32 }, "{map} {channel}");
+        }
+        let channels: Vec<(String, Vec<f32>)> = exr.channels.into_iter().map(|(n, _, s)| (n, s)).collect();
+        let (names, sample) = map.exr_channels();
         let mut found: Vec<&str> = channels.iter().map(|(n, _)| n.as_str()).collect();
         found.sort();
         let mut wanted = names.to_vec();
@@ -76,7 +99,7 @@ fn check_exr(name: &str, layout: Layout) {
                 let x = image.data[i * image.channels + k.min(image.channels - 1)];
                 let want = if *map == MapKind::Iridescence { (lo + x as f64 * (hi - lo)) as f32 } else { x };
                 // Half floats keep 11 significant bits; floats are exact.
-                let tolerance = if bits == 16 { want.abs() * 1e-3 + 1e-4 } else { 0.0 };
+                let tolerance = if sample.bits() == 16 { want.abs() * 1e-3 + 1e-4 } else { 0.0 };
                 assert!(
                     (got - want).abs() <= tolerance,
                     "{map} {channel} sample {i}: {got} in the file, {want} computed"
@@ -84,9 +107,6 @@ fn check_exr(name: &str, layout: Layout) {
             }
         }
     }
-    let manifest: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join(format!("{name}.material.json"))).unwrap())
-            .unwrap();
     assert_eq!(manifest["format"], "exr");
     let irid = manifest["maps"].as_array().unwrap().iter().find(|m| m["map"] == "iridescence").unwrap();
     assert_eq!(irid["meaning"], "film thickness in nm");
@@ -108,7 +128,7 @@ fn a_film_that_does_not_show_has_no_thickness_in_the_files() {
         let manifest: serde_json::Value =
             serde_json::from_slice(&std::fs::read(dir.path().join("xenopeltis-unicolor.material.json")).unwrap())
                 .unwrap();
-        let samples = read_channels(&dir.path().join("xenopeltis-unicolor_iridescence.exr")).remove(0).1;
+        let samples = read_exr(&dir.path().join("xenopeltis-unicolor_iridescence.exr")).channels.remove(0).2;
         (manifest["iridescence"].clone(), samples.iter().cloned().fold(f32::MIN, f32::max))
     };
     let (range, thickest) = generate(&["--set", "optics.film_ior=1.0"]);

@@ -85,10 +85,13 @@ impl Source {
 /// The colour map's convention, for the manifest: the visible colour, which the renderer
 /// inverts through the stack (`optics::brdf::layered::visible_colour`).
 pub const COLOR_MEANS: &str = "visible diffuse colour: the stack's diffuse reflectance at normal incidence per \
-     unit of light the top lets in, t1 k_d E / (1 - k_d K) with t1 = exp(-tau / cos_eff(1, roughness)) the \
-     pigment layer's transmittance along the rough top's path (exp(-tau) under a smooth top) (a glTF baseColor \
-     under a dielectric top); the layered model recovers the base albedo k_d = c / (t1 E + c K) per pixel, the thesis model \
-     reads the map as k_d itself";
+     unit of light the top lets in, c = t1 k_d E / (1 - k_d K), per linear channel, with k_d the base's Lambertian \
+     albedo, K and E the shares of the base's diffuse light that the top sends back down and lets out per bounce \
+     (the film seen from below), tau = optics.absorption * optics.pigment_thickness the pigment layer's optical \
+     depth (only the product matters: the two are in reciprocal relative units), and t1 = exp(-tau / \
+     cos_eff(1, roughness)) the pigment layer's transmittance along the rough top's path (exp(-tau) under a smooth \
+     top) (a glTF baseColor under a dielectric top); the layered model recovers the base albedo k_d = c / (t1 E + \
+     c K) per pixel, the thesis model reads the map as k_d itself; see docs/presets.md";
 
 #[derive(Debug, Serialize)]
 pub struct Counts {
@@ -129,6 +132,9 @@ pub struct Regions {
     pub tail: [f32; 2],
 }
 
+/// `MapEntry::sample_type` of a PNG (every packed texture is one).
+const PNG_SAMPLES: &str = "uint";
+
 #[derive(Debug, Serialize)]
 pub struct MapEntry {
     pub map: String,
@@ -136,6 +142,9 @@ pub struct MapEntry {
     pub color_space: String,
     pub channels: u32,
     pub bit_depth: u32,
+    /// How a sample is stored: `uint` (PNG's unsigned integers of `bit_depth` bits, 0 to
+    /// the largest value meaning 0 to 1), or OpenEXR's `half` or `float`.
+    pub sample_type: String,
     pub meaning: String,
     /// SHA-256 of the file's bytes, 64 hex digits.
     pub sha256: String,
@@ -144,14 +153,14 @@ pub struct MapEntry {
 impl MapEntry {
     /// The entry of one of the set's maps in a file format.
     pub fn for_map(map: MapKind, file: &str, sha256: String, format: FileFormat, convention: NormalConvention) -> Self {
-        let (color_space, channels, bit_depth, meaning) = match format {
+        let (color_space, channels, bit_depth, sample_type, meaning) = match format {
             FileFormat::Png => {
                 let f = map.format();
-                (f.color_space(), f.channels, f.bit_depth, map.meaning(convention))
+                (f.color_space(), f.channels, f.bit_depth, PNG_SAMPLES, map.meaning(convention))
             }
             FileFormat::Exr => {
-                let (names, bits) = map.exr_channels();
-                ("linear", names.len() as u32, bits, map.exr_meaning(convention))
+                let (names, sample) = map.exr_channels();
+                ("linear", names.len() as u32, sample.bits(), sample.name(), map.exr_meaning(convention))
             }
         };
         MapEntry {
@@ -160,6 +169,7 @@ impl MapEntry {
             color_space: color_space.into(),
             channels,
             bit_depth,
+            sample_type: sample_type.into(),
             meaning,
             sha256,
         }
@@ -173,6 +183,7 @@ impl MapEntry {
             color_space: if spec.srgb { "srgb" } else { "linear" }.into(),
             channels: spec.channels.len() as u32,
             bit_depth: spec.bit_depth,
+            sample_type: PNG_SAMPLES.into(),
             meaning: spec.meaning.clone(),
             sha256,
         }

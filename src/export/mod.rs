@@ -193,12 +193,26 @@ pub fn every_set_file_name(set_name: &str) -> Vec<String> {
     names
 }
 
+/// OpenEXR's `wrapmodes` attribute of a set's maps (horizontal, then vertical: the standard
+/// attribute's keywords, OpenEXR's ImfStandardAttributes.h): a tile repeats both ways; a
+/// body atlas repeats around the body and stops at the snout and the tail tip, as the
+/// glTF export's samplers say.
+pub fn exr_wrap_modes(wraps_v: bool) -> &'static str {
+    if wraps_v { "periodic" } else { "periodic,clamp" }
+}
+
 /// Encodes one map as OpenEXR (`MapKind::exr_channels`): linear floats in physical units —
 /// the colour map's linear values, the normal's xyz in [-1, 1], the film thickness in nm
-/// (`thickness_nm` = the manifest's range the map's [0, 1] spans).
-pub fn encode_exr(map: MapKind, image: &Image, thickness_nm: (f64, f64)) -> Result<Vec<u8>, ExportError> {
+/// (`thickness_nm` = the manifest's range the map's [0, 1] spans) — with the set's wrap
+/// modes (`exr_wrap_modes`).
+pub fn encode_exr(
+    map: MapKind,
+    image: &Image,
+    thickness_nm: (f64, f64),
+    wraps_v: bool,
+) -> Result<Vec<u8>, ExportError> {
     use exr::prelude::*;
-    let (names, bits) = map.exr_channels();
+    let (names, sample) = map.exr_channels();
     let (w, h, ch) = (image.width, image.height, image.channels);
     let value = |x: f32| match map {
         MapKind::Iridescence => (thickness_nm.0 + x as f64 * (thickness_nm.1 - thickness_nm.0)) as f32,
@@ -209,15 +223,15 @@ pub fn encode_exr(map: MapKind, image: &Image, thickness_nm: (f64, f64)) -> Resu
         .enumerate()
         .map(|(c, name)| {
             let samples = image.data.iter().skip(c.min(ch - 1)).step_by(ch).map(|x| value(*x));
-            let data = if bits == 16 {
-                FlatSamples::F16(samples.map(f16::from_f32).collect())
-            } else {
-                FlatSamples::F32(samples.collect())
+            let data = match sample {
+                crate::material::ExrSample::Half => FlatSamples::F16(samples.map(f16::from_f32).collect()),
+                crate::material::ExrSample::Float => FlatSamples::F32(samples.collect()),
             };
             AnyChannel::new(*name, data)
         })
         .collect();
-    let exr_image = exr::image::Image::from_channels((w, h), AnyChannels::sort(channels));
+    let mut exr_image = exr::image::Image::from_channels((w, h), AnyChannels::sort(channels));
+    exr_image.layer_data.attributes.wrap_mode_name = Some(Text::from(exr_wrap_modes(wraps_v)));
     let mut bytes = Cursor::new(Vec::new());
     exr_image.write().to_buffered(&mut bytes).map_err(|e| ExportError::Encode { map, message: e.to_string() })?;
     Ok(bytes.into_inner())
