@@ -381,7 +381,7 @@ fn node_bytes(graph: &Graph, id: NodeId, inputs: &[usize], width: usize, height:
     let op = &graph.node(id).op;
     let channels = op.output_channels(inputs) as u64;
     let bytes = channels * (width as u64) * (height as u64) * 4;
-    let mut scratch = op.scratch_images(width) as u64 * bytes;
+    let mut scratch = op.scratch_images(width) as u64 * bytes + op.mask_bytes(width, height, graph.wraps_v());
     scratch += op.scratch_rows(width) as u64 * channels * width as u64 * 4;
     if let super::Op::Fused(chain) = op {
         scratch += chain.scratch_bytes(width, height, inputs);

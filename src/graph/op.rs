@@ -145,14 +145,20 @@ impl Op {
     /// Temporary buffers a kernel allocates besides its output, in output-sized images, at
     /// `width` pixels wide: the small blur's horizontal pass, and its input, which it still
     /// holds while it writes a new output (`filters::gaussian_blur`; the estimate has
-    /// counted that input as handed over); the coverage mask of tiny-skia shapes, a byte a
-    /// pixel: under one f32 channel for a body atlas's strip (its rows rounded out to
-    /// `shapes::CUT_ROWS`) and a whole texture, but over the whole tile for a strip of the
-    /// tile (`shapes::Canvas`), which this counts as one channel of the strip.
+    /// counted that input as handed over).
     pub fn scratch_images(&self, width: usize) -> usize {
         match self {
             Op::Blur { sigma } if filters::blur_is_gaussian(*sigma, width) => 2,
-            Op::Blotches(_) | Op::Spots(_) => 1,
+            _ => 0,
+        }
+    }
+
+    /// Bytes of the coverage mask a shape kernel draws into besides its output, for an
+    /// output `height` rows of a texture `width` wide (`shapes::coverage_mask_bytes`: the
+    /// whole tile for any strip of a tile).
+    pub fn mask_bytes(&self, width: usize, height: usize, wraps_v: bool) -> u64 {
+        match self {
+            Op::Blotches(_) | Op::Spots(_) => shapes::coverage_mask_bytes(width, height, wraps_v),
             _ => 0,
         }
     }

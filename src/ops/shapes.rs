@@ -216,6 +216,15 @@ const SUBPIXELS: f32 = 256.0;
 /// long at 1024 from 4.6 s to 11.4 s.)
 const FLATNESS_PX: f32 = 1.0 / 16.0;
 
+/// The most bytes of coverage mask `Canvas` holds at once for an output `height` rows of a
+/// texture `width` wide (a byte a pixel): a tile's mask is the whole tile (square) for any
+/// strip of it; a body atlas's covers the strip's rows rounded out to `CUT_ROWS` either
+/// side, one block of at most `BLOCK_ROWS` at a time.
+pub fn coverage_mask_bytes(width: usize, height: usize, wraps_v: bool) -> u64 {
+    let rows = if wraps_v { width.max(height) } else { ((height.div_ceil(CUT_ROWS) + 1) * CUT_ROWS).min(BLOCK_ROWS) };
+    (width * rows) as u64
+}
+
 impl Canvas {
     fn new(frame: Frame) -> Canvas {
         let (top, end) = match frame.wraps_v {
@@ -688,6 +697,29 @@ pub fn belly_marks(frame: Frame, marks: &BellyMarks) -> Image {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The memory estimate's mask (`coverage_mask_bytes`) holds every mask `Canvas` draws:
+    /// strips of a tile (whose masks cover the whole tile) and of body atlases at every
+    /// offset, short and taller than a block. Seen failing with the estimate's former one
+    /// f32 channel of the strip (a 16-row strip of a 256 tile: 16 KiB against 64 KiB).
+    #[test]
+    fn the_estimated_mask_holds_every_mask_drawn() {
+        let width = 256;
+        for (full_height, wraps_v) in [(256, true), (20_000, false)] {
+            for height in [1, 16, 31, 32, 33, 100, 256, 9_000] {
+                for row0 in [0, 1, 31, 32, 47, 1_000, 10_000] {
+                    if height > full_height || (!wraps_v && row0 + height > full_height) {
+                        continue;
+                    }
+                    let frame = Frame { width, height, full_height, row0: row0 % full_height, wraps_v };
+                    let canvas = Canvas::new(frame);
+                    let drawn = if wraps_v { canvas.rows } else { canvas.rows.min(BLOCK_ROWS) };
+                    let estimate = coverage_mask_bytes(width, height, wraps_v);
+                    assert!((width * drawn) as u64 <= estimate, "{frame:?}: {drawn} rows drawn, {estimate} bytes");
+                }
+            }
+        }
+    }
 
     /// A body atlas taller than tiny-skia draws untiled (8,191 rows): strips across its
     /// blocks (`BLOCK_ROWS`) and tiny-skia's tile borders draw the whole atlas's rows, for
