@@ -689,3 +689,30 @@ fn twenty_instanced_snakes_are_all_in_view() {
         assert!(on_body, "snake {k} at {p:?} is not in view");
     }
 }
+
+/// `figures` reads its preset once: a file saved while the figures render changes none of
+/// them (each figure read the file again: a run made a set of two presets' figures). The
+/// file is made invalid when the second figure starts, and every figure is still written:
+/// none read it again. Seen failing with the file read per figure (the invalid file's error
+/// after the first figure's rendering). One run only: each figure builds its material's
+/// film tables (about 2.5 s a figure here).
+#[test]
+fn figures_read_their_preset_once() {
+    let Some(gpu) = gpu_or_skip("figures_read_their_preset_once") else { return };
+    let renderer = Renderer::new(gpu);
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("mine.toml");
+    let first = "[color]\nbase = \"#2040c0\"\n";
+    std::fs::write(&file, first).unwrap();
+    let preset = file.to_str().unwrap();
+    let progress = |i: usize, _: usize| {
+        if i == 1 {
+            std::fs::write(&file, "[color]\nbase = \"not a colour\"\n").unwrap();
+        }
+    };
+    let written = snakeskin::render::figures::write_figures(&renderer, preset, dir.path(), (16, 16), 64, &progress)
+        .unwrap_or_else(|e| panic!("the file saved during the run was read: {e}"));
+    assert_eq!(written.len(), snakeskin::render::figures::figure_list().len());
+    assert!(written.iter().all(|f| f.is_file()), "{written:?}");
+    assert!(snakeskin::preset::load(preset, &[], None).is_err(), "the control: the file is invalid now");
+}

@@ -114,7 +114,10 @@ pub fn check_figure_files(out_dir: &Path, preset: &str) -> Result<(), Error> {
 
 /// Renders every figure of `figure_list` for `preset` into `out_dir`, and puts them in place
 /// together (`FileGroup`: an interrupted or failed run leaves the earlier figures as they
-/// were, not some new ones among them); returns the files.
+/// were, not some new ones among them); returns the files. The preset file is read once and
+/// every figure's variant parsed from that text before any is rendered (each figure read
+/// the file again: one saved during a run made a set of two presets' figures, and an error
+/// in it came after the others' rendering).
 pub fn write_figures(
     renderer: &Renderer,
     preset: &str,
@@ -125,14 +128,20 @@ pub fn write_figures(
 ) -> Result<Vec<PathBuf>, Error> {
     check_figure_files(out_dir, preset)?;
     let figures = figure_list();
+    let source = crate::preset::read_source(preset)?;
+    let presets = figures
+        .iter()
+        .map(|figure| {
+            let overrides: Vec<(String, String)> =
+                figure.overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+            crate::preset::parse(&source, &overrides)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let mut group = FileGroup::new();
-    for (i, figure) in figures.iter().enumerate() {
+    for (i, (figure, loaded)) in figures.iter().zip(&presets).enumerate() {
         progress(i, figures.len());
         crate::memory::release_freed();
-        let overrides: Vec<(String, String)> =
-            figure.overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-        let loaded = crate::preset::load(preset, &overrides, None)?;
-        let material = upload_material(renderer, &loaded, map_size, GpuFilmMethod::Lut)?;
+        let material = upload_material(renderer, loaded, map_size, GpuFilmMethod::Lut)?;
         let settings = FrameSettings { view: figure.view, camera: Camera::close_up(), ..FrameSettings::default() };
         let image = renderer.render_image(&settings, &material, size.0, size.1)?;
         let rgb = image::DynamicImage::ImageRgba8(image).into_rgb8();
