@@ -1939,6 +1939,44 @@ fn a_long_file_name_is_written_and_one_past_the_limit_refused_first() {
     assert!(glb.is_file());
 }
 
+/// An output path with a control character is refused before any work, exit 2, nothing
+/// made: a newline in `-o` was written, and the listing printed `nl\nout/NAME_color.png`, a
+/// path that does not exist (hostile-input review). Every kind of output: a set's folder
+/// (and one below it), a glTF file, a render, a batch's folder. Negative control: the same
+/// names without the character are written.
+#[test]
+fn an_output_path_with_a_control_character_is_refused_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, format!("[[job]]\npreset = \"{PRESET}\"\nsizes = [16]\n")).unwrap();
+    let jobs = jobs.to_str().unwrap().to_string();
+    for (bad, good) in [("nl\nout", "nl_out"), ("tab\tout/inner", "tab_out/inner"), ("esc\u{1b}", "esc")] {
+        let commands: [Vec<String>; 4] = [
+            ["generate", PRESET, "--size", "16", "-o", &at(bad)].map(String::from).to_vec(),
+            ["export", PRESET, "--size", "16", "--gltf", &format!("{}.glb", at(bad))].map(String::from).to_vec(),
+            ["brdf", "chart", "--width", "4", "--height", "4", "-o", &format!("{}.png", at(bad))]
+                .map(String::from)
+                .to_vec(),
+            ["batch", &jobs, "-o", &at(bad)].map(String::from).to_vec(),
+        ];
+        for args in commands {
+            let words: Vec<&str> = args.iter().map(String::as_str).collect();
+            let out = snakeskin(&words);
+            assert_eq!(out.status.code(), Some(2), "{words:?}: {}", stderr(&out));
+            assert!(stderr(&out).contains("the path has a control character"), "{words:?}: {}", stderr(&out));
+            let good_args: Vec<String> = args.iter().map(|a| a.replace(bad, good)).collect();
+            let words: Vec<&str> = good_args.iter().map(String::as_str).collect();
+            let out = snakeskin(&words);
+            assert!(out.status.success(), "{words:?}: {}", stderr(&out));
+        }
+    }
+    let mut left: Vec<String> =
+        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    left.sort();
+    assert!(left.iter().all(|n| !n.chars().any(char::is_control)), "{left:?}");
+}
+
 /// Outputs that failed other commands' way: a standard error that cannot be written
 /// (`2> /dev/full`) panicked, exit 101 (now a run's error keeps its own exit code, and a note
 /// that cannot be written mid-run ends it with 1); a chart past the memory limit ran (500 MB at 4096²

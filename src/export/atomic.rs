@@ -280,6 +280,7 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
     if target.as_os_str() == "-" {
         return Err(ExportError::Stdout);
     }
+    refuse_control_characters(target)?;
     if ends_as_a_folder(target) {
         return Err(ExportError::folder_name(target, &super::OUTPUT_EXTENSIONS));
     }
@@ -298,6 +299,16 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
         return Ok(());
     }
     Err(ExportError::NotAFile { path: target.into(), kind: crate::text_file::file_kind(&file_type) })
+}
+
+/// Refuses an output path with a control character anywhere in it (a newline printed a
+/// listed file as `nl\nout/…`, a path that does not exist; the preset names the files are
+/// named after are refused alike: `PresetError::FileName`).
+fn refuse_control_characters(path: &Path) -> Result<(), ExportError> {
+    match path.to_string_lossy().chars().any(char::is_control) {
+        true => Err(ExportError::ControlCharacter { path: path.into() }),
+        false => Ok(()),
+    }
 }
 
 /// `check_target` for an output written in one format, `format` its extension (`png` for a
@@ -488,6 +499,7 @@ fn first_missing_folder(dir: &Path) -> &Path {
 /// `ExportError::BrokenLink` (creating the folder would fail with "File exists"); a missing
 /// one under folders is fine.
 pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
+    refuse_control_characters(dir)?;
     for path in dir.ancestors().filter(|p| !p.as_os_str().is_empty()) {
         match fs::metadata(path) {
             Ok(meta) if meta.is_dir() => return Ok(()),

@@ -117,6 +117,11 @@ pub enum ExportError {
         "cannot write {path}: its file name is {bytes} bytes long, and file systems take at most {limit}; give a shorter name"
     )]
     NameTooLong { path: PathBuf, bytes: usize, limit: usize },
+    #[error(
+        "cannot write {path:?}: the path has a control character (a newline, a tab, an escape), which would break \
+         the lists of files written and every script that reads them; give a name without one"
+    )]
+    ControlCharacter { path: PathBuf },
     #[error("set {manifest}: {problem}")]
     Verify { manifest: PathBuf, problem: String },
     #[error("cannot encode the packed {texture} texture: {message}")]
@@ -160,6 +165,7 @@ impl ExportError {
                 | ExportError::InputAtLock { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
+                | ExportError::ControlCharacter { .. }
         )
     }
 }
