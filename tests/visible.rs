@@ -337,6 +337,45 @@ fn an_ambient_denser_than_the_pigment_is_warned_of() {
     assert!(out.status.success() && !stderr(&out).contains("ambient_ior"), "{}", stderr(&out));
 }
 
+/// A film less dense than the ambient is warned of with its key and line, because the
+/// layered model's energy is off near the film's critical angle (which the first assertion
+/// measures against the furnace's 1, so that the warning goes when the model is mended).
+/// Negative controls: the film as dense as the ambient, and a film that does not show, draw
+/// no warning; the thin film of the same stack is within 0.02 (the warning's own words).
+#[test]
+fn a_film_less_dense_than_the_ambient_is_warned_of() {
+    let albedo = |n1: &str, thickness: &str| {
+        let args = ["brdf", "albedo", "--n0", "1.5", "--n1", n1, "--n2", "2", "--absorption", "0"];
+        let more = ["--roughness", "0.35", "--thickness-nm", thickness, "--angle-deg", "60"];
+        let out = snakeskin(&[&args[..], &more[..]].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert_eq!(stderr(&out).contains("is below --n0 1.5"), n1 != "1.5", "{}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+        (0..3).map(|c| (json["albedo"][c].as_f64().unwrap() - 1.0).abs()).fold(0.0, f64::max)
+    };
+    let (thick, thin, matched) = (albedo("1.35", "1500"), albedo("1.35", "250"), albedo("1.5", "1500"));
+    assert!(thick > 0.1 && thin < 0.02 && matched < 0.01, "furnace errors {thick} {thin} {matched}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let text = "species = \"oily\"\n\n[optics]\nambient_ior = 1.33\nfilm_ior = 1.25\n";
+    let preset = write_preset(dir.path(), "oily.toml", text);
+    let run = |overrides: &[&str]| {
+        let mut args = vec!["graph", &preset];
+        for o in overrides {
+            args.extend(["--set", o]);
+        }
+        let out = snakeskin(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let err = run(&[]);
+    assert!(err.contains("oily.toml:5: optics.film_ior = 1.25 is below optics.ambient_ior = 1.33"), "{err}");
+    assert!(err.contains("critical angle (70°"), "{err}");
+    assert!(!run(&["optics.film_ior=1.33"]).contains("film_ior"));
+    let no_film = run(&["optics.film_thickness_nm=0", "iridescence.spread_nm=0"]);
+    assert!(!no_film.contains("film_ior"), "{no_film}");
+}
+
 /// A film centred below half its spread: the range cannot go below 0 nm, so it starts at 0
 /// and every δ0 up to spread / 2 gives the same maps. Warned of with the key's line (before,
 /// δ0 = 0, 100 and 130 with a 260 nm spread gave identical sets without a word); not for a

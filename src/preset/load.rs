@@ -37,7 +37,7 @@ pub struct LoadedPreset {
     /// them, the manifest lists them.
     pub clamped_colours: Vec<super::visible::ClampedColour>,
     /// Keys that load but do not do what they seem (`validate::warnings`: where the layered
-    /// model shows the stack darker than the physics, a film centred below half its spread),
+    /// model is off from the physics of the stack, a film centred below half its spread),
     /// each with the key's line.
     pub warned: Vec<LocatedProblem>,
 }

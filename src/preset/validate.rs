@@ -162,9 +162,29 @@ fn rows_bounding(rows: u32) -> u32 {
 }
 
 /// What a preset that loads does not do as its keys seem to say, one warning each: the
-/// model's limit (`model_limit`) and a film centred too thin for its spread (`film_floor`).
+/// model's limits (`model_limit`, `film_below_ambient`) and a film centred too thin for its
+/// spread (`film_floor`).
 pub fn warnings(preset: &Preset) -> Vec<Problem> {
-    model_limit(preset).into_iter().chain(film_floor(preset)).collect()
+    model_limit(preset).into_iter().chain(film_below_ambient(preset)).chain(film_floor(preset)).collect()
+}
+
+/// A film whose index is below the ambient's, where it shows: the layered model's energy is
+/// off near the film's critical angle (`FilmBelowAmbient`). A warning, as `model_limit`: the
+/// physics is fine.
+fn film_below_ambient(preset: &Preset) -> Option<Problem> {
+    let o = &preset.optics;
+    if !crate::maps::has_film(preset) {
+        return None;
+    }
+    let limit = crate::optics::brdf::layered::FilmBelowAmbient::of(o.ambient_ior, o.film_ior)?;
+    Some(Problem {
+        key: "optics.film_ior".into(),
+        message: format!(
+            "{} is below optics.ambient_ior = {}: {limit}. Keep film_ior at least ambient_ior for an \
+             energy-conserving render.",
+            o.film_ior, o.ambient_ior
+        ),
+    })
 }
 
 /// A film thickness below half the spread: the range cannot reach below 0 nm, so it starts
@@ -184,8 +204,8 @@ fn film_floor(preset: &Preset) -> Option<Problem> {
     })
 }
 
-/// A stack the layered model shows darker than the physics: the ambient denser than the
-/// pigment layer. Beyond the critical angle asin(n2 / n0) the rough top's lobe loses light
+/// A stack the layered model shows darker (and at some angles brighter) than the physics:
+/// the ambient denser than the pigment layer. Beyond the critical angle asin(n2 / n0) the rough top's lobe loses light
 /// the stack reflects (a white lossless stack, `brdf albedo --absorption 0 --n1 1.55`:
 /// 0.50 at 75° for n0 = 1.4 over n2 = 1.33 and roughness 0.5; 0.48 at 50° for 1.5 over 1.0
 /// and roughness 0.9; 0.40 at 45° for 2 over 1.33 and roughness 0.9, where the rough-top

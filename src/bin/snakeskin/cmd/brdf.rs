@@ -10,7 +10,7 @@ use crate::cli::{AlbedoArgs, AlbedoModel, BrdfCommand, EvalArgs, LayerArgs, Stac
 use crate::output::{ensure_parent_folder, path_line, printable};
 use snakeskin::Error;
 use snakeskin::optics::brdf::exact::SmoothTop;
-use snakeskin::optics::brdf::layered::ModelLimit;
+use snakeskin::optics::brdf::layered::{FilmBelowAmbient, ModelLimit};
 use snakeskin::optics::brdf::walk::{FilmTables, walk};
 use snakeskin::optics::brdf::{BrdfValue, Layers, Model};
 use snakeskin::optics::film::{Stack, airy};
@@ -85,17 +85,18 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
     Ok(serde_json::json!({ "rgb": rgb }).to_string())
 }
 
-/// The layered model's one known loss (`ModelLimit`, which a preset's check warns of too),
-/// said once, on stderr.
+/// The layered model's known limits (`ModelLimit`, `FilmBelowAmbient`, which a preset's
+/// check warns of too), each said once, on stderr.
 fn warn_of_model_limit(model: Model, stack: Stack) {
     if model != Model::Layered {
         return;
     }
+    let walk = "`brdf albedo --model stochastic` walks the stack itself";
     if let Some(limit) = ModelLimit::of(stack.n0, stack.n2) {
-        eprintln!(
-            "warning: --n0 {} is above --n2 {}: {limit} (`brdf albedo --model stochastic` walks the stack itself)",
-            stack.n0, stack.n2
-        );
+        eprintln!("warning: --n0 {} is above --n2 {}: {limit} ({walk})", stack.n0, stack.n2);
+    }
+    if let Some(limit) = FilmBelowAmbient::of(stack.n0, stack.n1) {
+        eprintln!("warning: --n1 {} is below --n0 {}: {limit} ({walk})", stack.n1, stack.n0);
     }
 }
 
