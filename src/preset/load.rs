@@ -483,13 +483,20 @@ fn check_indices_in(root: &toml::Table, segments: &[&str], prefix: &str) -> Resu
             if i + 1 < segments.len() {
                 match value {
                     // A key into a list without its index (`pattern.amount` on `[[pattern]]`
-                    // said "`amount` must be an array index"): the list and its entries.
+                    // said "`amount` must be an array index"): the list and its entries. A
+                    // word where the index goes (`pattern.x.kind` was told to write
+                    // `pattern.N.x.kind`) is replaced by N; a list of values (`sources`)
+                    // has no keys below its entries.
                     Some(toml::Value::Array(items)) => {
-                        return Err(format!(
-                            "`{path}` is a list ({}): write {path}.N.{}",
-                            entries(items.len(), &path),
-                            segments[i + 1..].join(".")
-                        ));
+                        let rest = &segments[i + 1..];
+                        let write = if !items.iter().all(toml::Value::is_table) {
+                            format!("{path}.N")
+                        } else if rest.len() > 1 {
+                            format!("{path}.N.{} (N in place of `{}`)", rest[1..].join("."), rest[0])
+                        } else {
+                            format!("{path}.N.{}", rest[0])
+                        };
+                        return Err(format!("`{path}` is a list ({}): write {write}", entries(items.len(), &path)));
                     }
                     // A key below a list the preset does not have (`body.head_mark.color`
                     // without head marks) made a table where the schema wants a list:
@@ -978,6 +985,17 @@ mod tests {
         let err = parse(&source(marks), &[("body.head_mark.color".into(), "\"#fff\"".into())]).unwrap_err();
         let says = "`body.head_mark` is a list (1 entry: body.head_mark.0): write body.head_mark.N.color";
         assert!(err.to_string().contains(says), "{err}");
+        // A word where the index goes, and a key below a list of values (the hints were
+        // `pattern.N.x.kind` and `sources.N.x`, both still wrong).
+        let err = parse(&source(two_layers), &[("pattern.x.kind".into(), "\"spots\"".into())]).unwrap_err();
+        assert!(err.to_string().contains("write pattern.N.kind (N in place of `x`)"), "{err}");
+        let sources = "seed = 1\nsources = [\"a\", \"b\"]\n";
+        let err = parse(&source(sources), &[("sources.x".into(), "\"c\"".into())]).unwrap_err();
+        assert!(
+            err.to_string().contains("`sources` is a list (2 entries: sources.0 to sources.1): write sources.N"),
+            "{err}"
+        );
+        assert!(!err.to_string().contains("sources.N."), "{err}");
         let single = "seed = 1\n[pattern]\nkind = \"spots\"\ncolor = \"#101010\"\n";
         assert_eq!(
             parse(&source(single), &[("pattern.amount".into(), "3".into())]).unwrap().preset.pattern[0].amount,
