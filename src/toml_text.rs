@@ -68,7 +68,7 @@ pub fn describe(text: &str, error: &toml::de::Error) -> Described {
     {
         message = format!(
             "the control character U+{:04X} is not allowed in TOML text (inside a double-quoted string, write it \
-             as the escape `\\u{:04X}`)",
+             as the escape `\\u{:04X}`; a comment cannot hold one)",
             c as u32, c as u32
         );
         at = Some(control_at);
@@ -122,13 +122,15 @@ fn too_deep_line(text: &str) -> Option<usize> {
 
 /// The first control character TOML forbids (U+0000–U+001F but tab, line feed and carriage
 /// return, and U+007F: TOML 1.0 and 1.1, "Comment" and "String") from `offset`, where the
-/// reader's error starts, to the end of its line, with its offset. One before the error, or
-/// on another line, is not what the reader refused there. A carriage return out of place is
-/// left to the reader's own message.
+/// reader's error starts, or the character just before it (a line that starts with one:
+/// the reader points past it, "key with no value"), to the end of its line, with its offset.
+/// One further before the error, or on another line, is not what the reader refused there.
+/// A carriage return out of place is left to the reader's own message.
 fn control_on_line(text: &str, offset: usize) -> Option<(usize, char)> {
     let end = text.get(offset..)?.find('\n').map_or(text.len(), |i| offset + i);
     let forbidden = |c: char| (c <= '\u{1f}' && !matches!(c, '\t' | '\n' | '\r')) || c == '\u{7f}';
-    text[offset..end].char_indices().find(|&(_, c)| forbidden(c)).map(|(i, c)| (offset + i, c))
+    let start = text[..offset].chars().next_back().filter(|c| forbidden(*c)).map_or(offset, |c| offset - c.len_utf8());
+    text[start..end].char_indices().find(|&(_, c)| forbidden(c)).map(|(i, c)| (start + i, c))
 }
 
 /// serde's message in a reader's words: "unknown field" with the nearest accepted key, and
@@ -375,6 +377,9 @@ mod tests {
             ("seed = \u{1b}\n", (1, 8), "U+001B"),
             ("name = \"a\u{7f}b\"\n", (1, 10), "U+007F"),
             ("seed = 1 # a\u{1}\n", (1, 13), "U+0001"),
+            // At a line's start the reader points past it ("key with no value" at 2:2).
+            ("seed = 7\n\u{1}\n", (2, 1), "U+0001"),
+            ("\0", (1, 1), "U+0000"),
         ] {
             let error = toml::from_str::<Named>(text).unwrap_err();
             let described = describe(text, &error);
