@@ -1975,6 +1975,16 @@ fn an_output_path_with_a_control_character_is_refused_first() {
         std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     left.sort();
     assert!(left.iter().all(|n| !n.chars().any(char::is_control)), "{left:?}");
+    // Bytes that are not UTF-8 were listed with U+FFFD in their place.
+    use std::os::unix::ffi::OsStrExt;
+    let not_utf8 = dir.path().join(std::ffi::OsStr::from_bytes(b"bad\xffname"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["generate", PRESET, "--size", "16", "-o"])
+        .arg(&not_utf8)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("not UTF-8") && !not_utf8.exists(), "{}", stderr(&out));
 }
 
 /// Outputs that failed other commands' way: a standard error that cannot be written

@@ -710,8 +710,10 @@ fn figures_read_their_preset_once() {
             std::fs::write(&file, "[color]\nbase = \"not a colour\"\n").unwrap();
         }
     };
-    let written = snakeskin::render::figures::write_figures(&renderer, preset, dir.path(), (16, 16), 64, &progress)
-        .unwrap_or_else(|e| panic!("the file saved during the run was read: {e}"));
+    let source = snakeskin::preset::read_source(preset).unwrap();
+    let written =
+        snakeskin::render::figures::write_figures(&renderer, preset, &source, dir.path(), (16, 16), 64, &progress)
+            .unwrap_or_else(|e| panic!("the file saved during the run was read: {e}"));
     assert_eq!(written.len(), snakeskin::render::figures::figure_list().len());
     assert!(written.iter().all(|f| f.is_file()), "{written:?}");
     assert!(snakeskin::preset::load(preset, &[], None).is_err(), "the control: the file is invalid now");

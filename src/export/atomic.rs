@@ -301,13 +301,14 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
     Err(ExportError::NotAFile { path: target.into(), kind: crate::text_file::file_kind(&file_type) })
 }
 
-/// Refuses an output path with a control character anywhere in it (a newline printed a
-/// listed file as `nl\nout/…`, a path that does not exist; the preset names the files are
-/// named after are refused alike: `PresetError::FileName`).
+/// Refuses an output path that a list of the files written cannot show as it is: a
+/// control character anywhere in it (a newline printed a listed file as `nl\nout/…`, a path
+/// that does not exist; the preset names the files are named after are refused alike:
+/// `PresetError::FileName`), or bytes that are not UTF-8 (listed with U+FFFD in their place).
 fn refuse_control_characters(path: &Path) -> Result<(), ExportError> {
-    match path.to_string_lossy().chars().any(char::is_control) {
-        true => Err(ExportError::ControlCharacter { path: path.into() }),
-        false => Ok(()),
+    match path.to_str() {
+        Some(text) if !text.chars().any(char::is_control) => Ok(()),
+        _ => Err(ExportError::NotListable { path: path.into() }),
     }
 }
 

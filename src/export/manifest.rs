@@ -89,8 +89,9 @@ pub const COLOR_MEANS: &str = "visible diffuse colour: the stack's diffuse refle
      albedo, K and E the shares of the base's diffuse light that the top sends back down and lets out per bounce \
      (the film seen from below), tau = optics.absorption * optics.pigment_thickness the pigment layer's optical \
      depth (only the product matters: the two are in reciprocal relative units), and t1 = exp(-tau / \
-     cos_eff(1, roughness)) the pigment layer's transmittance along the rough top's path (exp(-tau) under a smooth \
-     top) (a glTF baseColor under a dielectric top); the layered model recovers the base albedo k_d = c / (t1 E + \
+     cos_eff(1, roughness)) the pigment layer's transmittance along the path of light the rough top lets in at \
+     normal incidence, cos_eff being that path's effective cosine (1 under a smooth top: t1 = exp(-tau)) (a glTF \
+     baseColor under a dielectric top); the layered model recovers the base albedo k_d = c / (t1 E + \
      c K) per pixel, the thesis model reads the map as k_d itself; see docs/presets.md";
 
 #[derive(Debug, Serialize)]

@@ -118,10 +118,11 @@ pub enum ExportError {
     )]
     NameTooLong { path: PathBuf, bytes: usize, limit: usize },
     #[error(
-        "cannot write {path:?}: the path has a control character (a newline, a tab, an escape), which would break \
-         the lists of files written and every script that reads them; give a name without one"
+        "cannot write {path:?}: the path has a control character (a newline, a tab, an escape) or bytes that are \
+         not UTF-8, which the lists of files written cannot show as they are (a script reading them would get \
+         another path); give a path without them, in its folders' names too"
     )]
-    ControlCharacter { path: PathBuf },
+    NotListable { path: PathBuf },
     #[error("set {manifest}: {problem}")]
     Verify { manifest: PathBuf, problem: String },
     #[error("cannot encode the packed {texture} texture: {message}")]
@@ -165,7 +166,7 @@ impl ExportError {
                 | ExportError::InputAtLock { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
-                | ExportError::ControlCharacter { .. }
+                | ExportError::NotListable { .. }
         )
     }
 }

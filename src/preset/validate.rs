@@ -169,14 +169,17 @@ pub fn warnings(preset: &Preset) -> Vec<Problem> {
 }
 
 /// A film whose index is below the ambient's, where it shows: the layered model's energy is
-/// off near the film's critical angle (`FilmBelowAmbient`). A warning, as `model_limit`: the
-/// physics is fine.
+/// off around the film's critical angle (`FilmBelowAmbient`), for the thickest film of the
+/// thickness map's range and the roughest top the roughness map reaches. A warning, as
+/// `model_limit`: the physics is fine.
 fn film_below_ambient(preset: &Preset) -> Option<Problem> {
     let o = &preset.optics;
     if !crate::maps::has_film(preset) {
         return None;
     }
-    let limit = crate::optics::brdf::layered::FilmBelowAmbient::of(o.ambient_ior, o.film_ior)?;
+    let thickest_nm = crate::maps::map_thickness_range_nm(preset).1;
+    let roughest = crate::maps::roughness_range(preset).1;
+    let limit = crate::optics::brdf::layered::FilmBelowAmbient::of(o.ambient_ior, o.film_ior, thickest_nm, roughest)?;
     Some(Problem {
         key: "optics.film_ior".into(),
         message: format!(
@@ -204,8 +207,8 @@ fn film_floor(preset: &Preset) -> Option<Problem> {
     })
 }
 
-/// A stack the layered model shows darker (and at some angles brighter) than the physics:
-/// the ambient denser than the pigment layer. Beyond the critical angle asin(n2 / n0) the rough top's lobe loses light
+/// A stack the layered model shows darker than the physics: the ambient denser than the
+/// pigment layer. Beyond the critical angle asin(n2 / n0) the rough top's lobe loses light
 /// the stack reflects (a white lossless stack, `brdf albedo --absorption 0 --n1 1.55`:
 /// 0.50 at 75° for n0 = 1.4 over n2 = 1.33 and roughness 0.5; 0.48 at 50° for 1.5 over 1.0
 /// and roughness 0.9; 0.40 at 45° for 2 over 1.33 and roughness 0.9, where the rough-top

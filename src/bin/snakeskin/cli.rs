@@ -619,8 +619,9 @@ pub enum BrdfCommand {
     /// model or by a reference: {"model","albedo":[r,g,b],"specular":[r,g,b],"diffuse":[r,g,b]}
     /// (and "sigma" for the stochastic reference). With --albedo 1 and no absorption the
     /// stack loses nothing: the answer should be 1 (see --model; with --n0 above --n2 the
-    /// layered model is darker beyond the critical angle and can be brighter below it, and
-    /// with --n1 below --n0 off either way near the film's critical angle: it says so).
+    /// layered model is darker beyond the critical angle, and with --n1 below --n0, a film over
+    /// 250 nm and roughness over 0.05 it is off either way around the film's critical angle: it
+    /// says so).
     Albedo(AlbedoArgs),
     /// A thin-film colour chart PNG: thickness 0..2000 nm across, angle 0..89° down, its
     /// brightest channel scaled to 1 (the scale is printed: a dim film's chart is as

@@ -114,13 +114,14 @@ pub fn check_figure_files(out_dir: &Path, preset: &str) -> Result<(), Error> {
 
 /// Renders every figure of `figure_list` for `preset` into `out_dir`, and puts them in place
 /// together (`FileGroup`: an interrupted or failed run leaves the earlier figures as they
-/// were, not some new ones among them); returns the files. The preset file is read once and
-/// every figure's variant parsed from that text before any is rendered (each figure read
-/// the file again: one saved during a run made a set of two presets' figures, and an error
-/// in it came after the others' rendering).
+/// were, not some new ones among them); returns the files. `source` is the preset's text as
+/// the command read it once (`preset::read_source`), every figure's variant parsed from it
+/// before any is rendered (each figure read the file again: one saved during a run made a
+/// set of two presets' figures, and an error in it came after the others' rendering).
 pub fn write_figures(
     renderer: &Renderer,
     preset: &str,
+    source: &crate::preset::PresetSource,
     out_dir: &Path,
     size: (u32, u32),
     map_size: usize,
@@ -128,13 +129,12 @@ pub fn write_figures(
 ) -> Result<Vec<PathBuf>, Error> {
     check_figure_files(out_dir, preset)?;
     let figures = figure_list();
-    let source = crate::preset::read_source(preset)?;
     let presets = figures
         .iter()
         .map(|figure| {
             let overrides: Vec<(String, String)> =
                 figure.overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-            crate::preset::parse(&source, &overrides)
+            crate::preset::parse(source, &overrides)
         })
         .collect::<Result<Vec<_>, _>>()?;
     let mut group = FileGroup::new();

@@ -86,8 +86,9 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
 }
 
 /// The layered model's known limits (`ModelLimit`, `FilmBelowAmbient`, which a preset's
-/// check warns of too), each said once, on stderr.
-fn warn_of_model_limit(model: Model, stack: Stack) {
+/// check warns of too) for a film `thickness_nm` thick under a top `roughness` rough, each
+/// said once, on stderr.
+fn warn_of_model_limit(model: Model, stack: Stack, thickness_nm: f64, roughness: f64) {
     if model != Model::Layered {
         return;
     }
@@ -95,7 +96,7 @@ fn warn_of_model_limit(model: Model, stack: Stack) {
     if let Some(limit) = ModelLimit::of(stack.n0, stack.n2) {
         eprintln!("warning: --n0 {} is above --n2 {}: {limit} ({walk})", stack.n0, stack.n2);
     }
-    if let Some(limit) = FilmBelowAmbient::of(stack.n0, stack.n1) {
+    if let Some(limit) = FilmBelowAmbient::of(stack.n0, stack.n1, thickness_nm, roughness) {
         eprintln!("warning: --n1 {} is below --n0 {}: {limit} ({walk})", stack.n1, stack.n0);
     }
 }
@@ -103,7 +104,7 @@ fn warn_of_model_limit(model: Model, stack: Stack) {
 fn eval_json(args: &EvalArgs) -> Result<String> {
     let stack = stack_of(&args.stack);
     let (layers, l) = (layers_of(&args.stack, &args.layer)?, &args.layer);
-    warn_of_model_limit(args.model, stack);
+    warn_of_model_limit(args.model, stack, l.thickness_nm, l.roughness);
     let film = |c: f64| film_colour(args.method, stack, l.thickness_nm, c);
     let value = args.model.eval(&layers, args.normal, args.wi, args.wo, &film);
     let json = serde_json::json!({
@@ -144,7 +145,7 @@ fn albedo_json(args: &AlbedoArgs) -> Result<String> {
     let cos = args.angle_deg.to_radians().cos();
     let (name, value, sigma) = match args.model {
         AlbedoModel::Model(model) => {
-            warn_of_model_limit(model, stack);
+            warn_of_model_limit(model, stack, l.thickness_nm, l.roughness);
             let method = args.method.unwrap_or(Method::Lut);
             let film = |c: f64| film_colour(method, stack, l.thickness_nm, c);
             let total = model.furnace_albedo(&layers, cos, &film, 64);

@@ -17,7 +17,9 @@ use snakeskin::render::figures::write_figures;
 /// (The memory check was the maps' alone, after the folder and the renderer were made: an
 /// 8192-wide run reached 4.9 GB under a 300 MiB limit.)
 pub fn run(preset: &str, out: &Path, size: ImageSize, map_size: u64) -> Result<()> {
-    let loaded = snakeskin::preset::load(preset, &[], None)?;
+    // Read once: the memory check and every figure parse this text (`write_figures`).
+    let source = snakeskin::preset::read_source(preset)?;
+    let loaded = snakeskin::preset::parse(&source, &[])?;
     snakeskin::export::check_folder(out)?;
     snakeskin::render::figures::check_figure_files(out, preset)?;
     let frame_bytes = snakeskin::render::engine::renderer::frame_bytes(size.width, size.height);
@@ -31,9 +33,15 @@ pub fn run(preset: &str, out: &Path, size: ImageSize, map_size: u64) -> Result<(
     ensure_folder(out)?;
     let renderer = Renderer::headless()?;
     let bar = Progress::counting("{spinner} figures [{bar:30}] {pos}/{len} {elapsed}");
-    let files = write_figures(&renderer, preset, out, (size.width, size.height), map_size as usize, &|done, total| {
-        bar.update(done, total)
-    })?;
+    let files = write_figures(
+        &renderer,
+        preset,
+        &source,
+        out,
+        (size.width, size.height),
+        map_size as usize,
+        &|done, total| bar.update(done, total),
+    )?;
     bar.finish();
     for f in files {
         println!("{}", path_line(&f));
