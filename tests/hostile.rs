@@ -1987,6 +1987,17 @@ fn an_output_path_with_a_control_character_is_refused_first() {
     assert!(stderr(&out).contains("not UTF-8") && !not_utf8.exists(), "{}", stderr(&out));
 }
 
+/// A folder that takes no new files is named as the folder to change: `-o /proc/self` said
+/// "cannot write /proc/self/.NAME.lock: No such file or directory", a file the user never
+/// named (hostile-input review). Nothing is made there.
+#[test]
+fn a_folder_that_takes_no_files_is_named() {
+    let out = snakeskin(&["generate", PRESET, "--size", "16", "-o", "/proc/self"]);
+    assert_ne!(out.status.code(), Some(0), "{}", stderr(&out));
+    let says = format!("cannot write in folder /proc/self (making .{PRESET}.lock there)");
+    assert!(stderr(&out).contains(&says), "{}", stderr(&out));
+}
+
 /// Outputs that failed other commands' way: a standard error that cannot be written
 /// (`2> /dev/full`) panicked, exit 101 (now a run's error keeps its own exit code, and a note
 /// that cannot be written mid-run ends it with 1); a chart past the memory limit ran (500 MB at 4096²

@@ -171,10 +171,12 @@ fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
 }
 
 /// The error of making the new file `path`: `ExportError::FolderNotWritable` where its folder
-/// (one that exists) refused it, the file's otherwise.
+/// (one that exists) refused it — no permission, or a read-only file system (which said
+/// "cannot write ro/.NAME.lock": the hostile-input review) — the file's otherwise.
 fn folder_refused(path: &Path, source: std::io::Error) -> ExportError {
+    use std::io::ErrorKind::{PermissionDenied, ReadOnlyFilesystem};
     let folder = folder_of(path);
-    if source.kind() == std::io::ErrorKind::PermissionDenied && folder.is_dir() {
+    if matches!(source.kind(), PermissionDenied | ReadOnlyFilesystem) && folder.is_dir() {
         ExportError::FolderNotWritable { folder: folder.into(), name: file_name(path), source }
     } else {
         ExportError::Io { path: path.into(), source }
@@ -707,8 +709,13 @@ impl SetLock {
                 Err(fs::TryLockError::Error(source)) => return Err(ExportError::Io { path, source }),
             }
         }
-        // Eight tries, each lost to a run that ended or to a folder that went: say which.
+        // Eight tries, each lost to a run that ended or to a folder that went: say which. A
+        // folder that is there still takes no new files (`-o /proc/self` said "cannot write
+        // /proc/self/.NAME.lock: No such file or directory"): the folder is to change.
         Err(match folder_went {
+            Some(source) if dir.is_dir() => {
+                ExportError::FolderNotWritable { folder: dir.into(), name: file_name(&path), source }
+            }
             Some(source) => ExportError::Io { path, source },
             None => ExportError::Busy { dir: dir.into(), name: name.into() },
         })
@@ -1217,6 +1224,9 @@ mod tests {
         assert!(
             matches!(io_error(here)(denied()), ExportError::FolderNotWritable { folder, .. } if folder == Path::new("."))
         );
+        // A read-only file system.
+        let read_only = io_error(&lock)(std::io::Error::from(std::io::ErrorKind::ReadOnlyFilesystem));
+        assert!(matches!(read_only, ExportError::FolderNotWritable { .. }), "{read_only}");
         // Negative controls: a file that is there (it may refuse itself), another error.
         fs::write(&lock, b"").unwrap();
         assert!(matches!(io_error(&lock)(denied()), ExportError::Io { .. }));
