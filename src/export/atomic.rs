@@ -282,7 +282,7 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
     if target.as_os_str() == "-" {
         return Err(ExportError::Stdout);
     }
-    refuse_control_characters(target)?;
+    refuse_unlistable(target)?;
     if ends_as_a_folder(target) {
         return Err(ExportError::folder_name(target, &super::OUTPUT_EXTENSIONS));
     }
@@ -307,7 +307,7 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
 /// control character anywhere in it (a newline printed a listed file as `nl\nout/…`, a path
 /// that does not exist; the preset names the files are named after are refused alike:
 /// `PresetError::FileName`), or bytes that are not UTF-8 (listed with U+FFFD in their place).
-fn refuse_control_characters(path: &Path) -> Result<(), ExportError> {
+fn refuse_unlistable(path: &Path) -> Result<(), ExportError> {
     match path.to_str() {
         Some(text) if !text.chars().any(char::is_control) => Ok(()),
         _ => Err(ExportError::NotListable { path: path.into() }),
@@ -502,7 +502,7 @@ fn first_missing_folder(dir: &Path) -> &Path {
 /// `ExportError::BrokenLink` (creating the folder would fail with "File exists"); a missing
 /// one under folders is fine.
 pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
-    refuse_control_characters(dir)?;
+    refuse_unlistable(dir)?;
     for path in dir.ancestors().filter(|p| !p.as_os_str().is_empty()) {
         match fs::metadata(path) {
             Ok(meta) if meta.is_dir() => return Ok(()),

@@ -191,21 +191,29 @@ impl Pack {
             meaning: "grey: relative surface height on the preset's fixed scale, as the height map (displacement or parallax)"
                 .into(),
         };
-        let normal_channels = match self.normal_convention() {
-            crate::material::NormalConvention::OpenGl => NORMAL_OPENGL,
-            crate::material::NormalConvention::DirectX => NORMAL_DIRECTX,
+        // The engine's normal convention, its channels and words, with why it is that one.
+        let (normal_channels, convention) = match self.normal_convention() {
+            crate::material::NormalConvention::OpenGl => (NORMAL_OPENGL, "OpenGL convention (+Y up)"),
+            crate::material::NormalConvention::DirectX => {
+                (NORMAL_DIRECTX, "DirectX convention (+Y down, green flipped)")
+            }
+        };
+        let why = match self {
+            Pack::Gltf => ", as glTF requires",
+            Pack::Unreal => "",
+            Pack::UnityHdrp => ", as Unity expects",
+        };
+        let normal = TextureSpec {
+            suffix: "normal",
+            channels: normal_channels.to_vec(),
+            bit_depth: 8,
+            srgb: false,
+            meaning: format!("RGB: tangent-space normal xyz * 0.5 + 0.5, {convention}{why}"),
         };
         let mut textures = match self {
             Pack::Gltf => vec![
                 base_color,
-                TextureSpec {
-                    suffix: "normal",
-                    channels: normal_channels.to_vec(),
-                    bit_depth: 8,
-                    srgb: false,
-                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as glTF requires"
-                        .into(),
-                },
+                normal,
                 TextureSpec {
                     suffix: "orm",
                     channels: vec![occlusion, ROUGHNESS, NOT_METALLIC],
@@ -216,14 +224,7 @@ impl Pack {
             ],
             Pack::Unreal => vec![
                 base_color,
-                TextureSpec {
-                    suffix: "normal",
-                    channels: normal_channels.to_vec(),
-                    bit_depth: 8,
-                    srgb: false,
-                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, DirectX convention (+Y down, green flipped)"
-                        .into(),
-                },
+                normal,
                 TextureSpec {
                     suffix: "orm",
                     channels: vec![occlusion, ROUGHNESS, NOT_METALLIC],
@@ -235,14 +236,7 @@ impl Pack {
             ],
             Pack::UnityHdrp => vec![
                 base_color,
-                TextureSpec {
-                    suffix: "normal",
-                    channels: normal_channels.to_vec(),
-                    bit_depth: 8,
-                    srgb: false,
-                    meaning: "RGB: tangent-space normal xyz * 0.5 + 0.5, OpenGL convention (+Y up), as Unity expects"
-                        .into(),
-                },
+                normal,
                 TextureSpec {
                     suffix: "mask",
                     channels: vec![
