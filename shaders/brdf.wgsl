@@ -223,7 +223,8 @@ fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, roughness: f32, k: v
 
 // The rule's two parts on one roughness row (energy::parts_on_row): the lobe's entries k
 // and k + LOBE_VEC4S mixed by fx; the single scattering E1 <F> (the film over the lobe's
-// microfacet angles, five-point Gauss rule) and what the top reflects beyond it, x: the
+// microfacet angles, five-point Gauss rule, or the quantile rule where the table holds it)
+// and what the top reflects beyond it, x: the
 // multiple scattering (1 - E1) g, g = s sum_ij M_ij F(a_i) F(b_j) + (1 - s) <F>_a <F>_b^2
 // (energy::Multiple), plus the light that comes straight back through the top,
 // q = (1 - <F>) W <F>_back (its three-point rule).
@@ -242,18 +243,43 @@ fn parts_on_row(layers: Layers, k: u32, fx: f32) -> RowParts {
     // methods' film is long, and Mesa inlines every call; written out, the rule's eighteen
     // reads at X's sixteen nodes and six couplings made lavapipe compile the rgb3 pipeline
     // for over ten minutes.)
+    // A material whose film is less dense than the medium above reads the lobe by the
+    // quantile rule (energy::LobeRule): the table then holds its nodes after the entries
+    // (render::engine::film::lobe_table), read here in the same loop.
+    let quantile_base = LOBE_ENTRIES * LOBE_VEC4S;
+    let quantiles = arrayLength(&lobe_table) > quantile_base;
+    let quantile_entry = quantile_base + (k / LOBE_VEC4S) * QUANTILE_VEC4S;
+    let reads = ROW_FILM_READS + select(0u, QUANTILES, quantiles);
     var f: array<vec3<f32>, ROW_FILM_READS>;
-    for (var n = 0u; n < ROW_FILM_READS; n++) {
-        var s = LOBE_THROUGH_SLOT + 1u + n - LOBE_NODES - 2u * PAIR_NODES;
-        if (n < LOBE_NODES) {
-            s = LOBE_NODE_SLOT + 1u + n;
-        } else if (n < LOBE_NODES + 2u * PAIR_NODES) {
-            s = LOBE_NODE_SLOT + PAIR_SLOT + n - LOBE_NODES;
+    var quantile_mean = vec3<f32>(0.0);
+    for (var n = 0u; n < reads; n++) {
+        var c: f32;
+        if (n >= ROW_FILM_READS) {
+            let i = n - ROW_FILM_READS;
+            let a = lobe_table[quantile_entry + i / 4u][i % 4u];
+            let b = lobe_table[quantile_entry + QUANTILE_VEC4S + i / 4u][i % 4u];
+            c = mix(a, b, fx);
+        } else {
+            var s = LOBE_THROUGH_SLOT + 1u + n - LOBE_NODES - 2u * PAIR_NODES;
+            if (n < LOBE_NODES) {
+                s = LOBE_NODE_SLOT + 1u + n;
+            } else if (n < LOBE_NODES + 2u * PAIR_NODES) {
+                s = LOBE_NODE_SLOT + PAIR_SLOT + n - LOBE_NODES;
+            }
+            c = lobe_slot(&v, s);
         }
-        f[n] = film_clamped(layers, lobe_slot(&v, s));
+        let film = film_clamped(layers, c);
+        if (n >= ROW_FILM_READS) {
+            quantile_mean += film / f32(QUANTILES);
+        } else {
+            f[n] = film;
+        }
     }
     let e1 = lobe_slot(&v, LOBE_NODE_SLOT);
-    let mean = by_rule(&v, &f, LOBE_NODE_SLOT + 1u, 0u, LOBE_NODES);
+    var mean = by_rule(&v, &f, LOBE_NODE_SLOT + 1u, 0u, LOBE_NODES);
+    if (quantiles) {
+        mean = quantile_mean;
+    }
     // The multiple scattering (energy::Multiple::reflected).
     var both = vec3<f32>(0.0);
     var first = vec3<f32>(0.0);

@@ -304,11 +304,10 @@ impl ExportPlan {
             let mut files = gltf_files(&name, &mesh, material, textures, Some(&source))?;
             let (_, gltf_bytes) = files.pop().expect("gltf_files ends with the .gltf");
             let gltf_name = out_name;
-            // The files written are staged under the lock, which sweeps their names' stale
-            // temporaries; the thickness image may not be written, and a killed run's
-            // temporary of it would stay.
+            // The lock swept every stale temporary of this name's files when it was taken,
+            // the thickness image's too, which this export may not write
+            // (`export::every_file_name_under_lock`).
             let thickness_file = gltf_image_file_name(&name, "thickness");
-            lock.remove_stale_temporaries_of(&[&thickness_file]);
             // An earlier export of this name with a film left its thickness image, which no
             // file references once this one is committed: it goes, under the lock, after the
             // commit, where the `.gltf` it replaces named it and it is as that export wrote

@@ -98,6 +98,60 @@ fn layered_model_keeps_the_white_furnace() {
     );
 }
 
+/// A film less dense than the medium above (n1 < n0) totally reflects beyond its critical
+/// angle and, thick, rings with fringes just inside it: F is not smooth in the microfacet
+/// cosine, and the lobe's five-point Gauss rule read it as 0.89–1.19 of the light around that
+/// angle. The coupling reads such films by the quantile rule (`energy::LobeRule`); the
+/// furnace holds to the bounds over thickness, roughness and angles through the
+/// critical one from roughness `FILM_BELOW_AMBIENT_ROUGH` up; smoother tops within 0.05
+/// (`layered::FilmBelowAmbient`, warned of). Negative control: the same stacks read by the
+/// Gauss rule fail.
+#[test]
+fn a_film_less_dense_than_the_ambient_keeps_the_white_furnace() {
+    use snakeskin::optics::brdf::energy::LobeRule;
+    let stacks = [Stack { n0: 1.5, n1: 1.35, n2: 2.0 }, Stack { n0: 1.33, n1: 1.18, n2: 2.5 }];
+    use snakeskin::optics::brdf::layered::FILM_BELOW_AMBIENT_ROUGH;
+    let (mut worst, mut gauss_worst) = ([0.0f64; 3], 0.0f64);
+    for stack in stacks {
+        for thickness in [250.0, 1500.0, 2400.0] {
+            let tables = FilmTables::new(stack, thickness);
+            let film = |c: f64| tables.above(c);
+            for roughness in [0.0, 0.1, 0.2, 0.35, 0.6, 1.0] {
+                let layers = white_layers(stack, thickness, roughness);
+                assert_eq!(layers.lobe_rule(), LobeRule::Quantiles);
+                for angle_deg in [0.0f64, 30.0, 50.0, 55.0, 60.0, 62.5, 65.0, 70.0, 80.0] {
+                    let cos_o = f64::cos(angle_deg.to_radians());
+                    let a = Model::Layered.furnace_albedo(&layers, cos_o, &film, 64);
+                    let err = a.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
+                    // Tops smoother than `FILM_BELOW_AMBIENT_ROUGH` (warned of): 0.0375 at most
+                    // (2400 nm, roughness 0.1, 62.5°); rougher, the bounds.
+                    let (regime, bound) = if roughness < FILM_BELOW_AMBIENT_ROUGH {
+                        (2, 0.05)
+                    } else if angle_deg <= 70.0 {
+                        (0, 0.02)
+                    } else {
+                        (1, 0.05)
+                    };
+                    worst[regime] = worst[regime].max(err);
+                    assert!(err <= bound, "{stack:?} d={thickness} r={roughness} {angle_deg}°: {a:?}");
+                    if (thickness, roughness, angle_deg) == (1500.0, 0.35, 60.0) {
+                        // As before the quantile rule: a film denser than the ambient gets the
+                        // Gauss rule (`LobeRule::of`), so this is that reading.
+                        let gauss = Layers { n1: stack.n0, ..layers };
+                        let g = Model::Layered.furnace_albedo(&gauss, cos_o, &film, 64);
+                        gauss_worst = gauss_worst.max(g.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max));
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "film below the ambient: max |albedo − 1| {:.4} up to 70°, {:.4} beyond, {:.4} under tops smoother than {}",
+        worst[0], worst[1], worst[2], FILM_BELOW_AMBIENT_ROUGH
+    );
+    assert!(gauss_worst > 0.1, "the Gauss rule's reading is off: {gauss_worst}");
+}
+
 #[test]
 fn a_nearly_smooth_top_keeps_the_furnace_at_grazing_light() {
     // Between 86° and 89.3° a low-roughness lobe changes within a few α of grazing
@@ -165,7 +219,8 @@ proptest! {
         model in proptest::sample::select(Model::ALL.to_vec()),
         k in prop_oneof![Just(0.0), Just(0.999), 0.0f64..1.0], e in 0.0f64..1.0,
     ) {
-        let layers = Layers { n0, n2, roughness, optical_depth: [tau; 3], albedo: [albedo; 3], k: [k; 3], e: [e; 3] };
+        let (optical_depth, albedo, k, e) = ([tau; 3], [albedo; 3], [k; 3], [e; 3]);
+        let layers = Layers { n0, n1: n2, n2, roughness, optical_depth, albedo, k, e };
         let normal = if zero_normal { [0.0; 3] } else { [nx, ny, nz] };
         let value = model.eval(&layers, normal, unit(ti, pi), unit(to, po), &|_| [film_r; 3]);
         for v in value.total() {
@@ -336,7 +391,8 @@ fn coupling_table_deviation(
         let (d, cos, r) = (thickness_nm(u(0)), cos(u(1)), u(2));
         let film = |c: f32| lut.lookup_f32(d, c.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
         let through = &snakeskin::optics::brdf::path::cached(lut.stack.n0, lut.stack.n2).through_f32;
-        let rule = snakeskin::optics::brdf::energy::top_f32(cos, r, &film, through);
+        let lobe_rule = snakeskin::optics::brdf::energy::LobeRule::of(lut.stack.n0, lut.stack.n1);
+        let rule = snakeskin::optics::brdf::energy::top_f32(cos, r, &film, through, lobe_rule);
         let (table, _) = lut.coupling_f32(d, cos, r);
         for c in 0..3 {
             reflected = reflected.max((table.reflected[c] - rule.reflected[c]).abs());
@@ -427,8 +483,9 @@ fn light_straight_back_through_the_rough_top_meets_the_walk() {
     let mu = 85f64.to_radians().cos();
     let layers = Layers::of_stack(stack, 650.0, 0.9, [0.0; 3], [0.0; 3]);
     let walked = walk::walk(&layers, &film, [(1.0 - mu * mu).sqrt(), 0.0, mu], 200_000, 1, 17);
-    let with = energy::top(mu, 0.9, &film_fn, &path::cached(stack.n0, stack.n2).through);
-    let without = energy::top(mu, 0.9, &film_fn, &[]);
+    let rule = energy::LobeRule::of(stack.n0, stack.n1);
+    let with = energy::top(mu, 0.9, &film_fn, &path::cached(stack.n0, stack.n2).through, rule);
+    let without = energy::top(mu, 0.9, &film_fn, &[], rule);
     for c in 0..3 {
         let reference = walked.total()[c];
         assert!(walked.diffuse[c] > 0.01, "the walk finds the light that comes straight back: {:?}", walked.diffuse);

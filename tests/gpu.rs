@@ -281,6 +281,72 @@ fn a_device_error_is_an_error_not_a_panic() {
     buffer(1024).unwrap();
 }
 
+/// A film less dense than the medium above: the coupling reads it by the quantile rule
+/// (`energy::LobeRule`), and so does the shader's direct film method, from the quantile nodes
+/// the lobe table holds for such a material (`render::engine::film::lobe_table`). GPU
+/// against the f64 BRDF around the same f32 film; negative control: the f64 BRDF reading the
+/// film by the Gauss rule is far from the GPU.
+#[test]
+fn a_film_less_dense_than_the_ambient_reads_the_quantile_rule_on_the_gpu() {
+    use snakeskin::optics::brdf::energy::LobeRule;
+    use snakeskin::optics::methods::rgb3_f32;
+    use snakeskin::render::engine::film::GpuFilmMethod;
+    use snakeskin::render::reference::brdf_eval::eval_timed;
+    let Some(gpu) = gpu_or_skip("a_film_less_dense_than_the_ambient_reads_the_quantile_rule_on_the_gpu") else {
+        return;
+    };
+    let stack = Stack { n0: 1.5, n1: 1.35, n2: 2.0 };
+    let film = |d: f32, c: f32| rgb3_f32(1.5, 1.35, 2.0, d, c);
+    let lut = Lut::bake(stack, 16, 32, 8);
+    let mut rng = Rng(11);
+    let (mut inputs, mut samples) = (Vec::new(), Vec::new());
+    for _ in 0..4000 {
+        let roughness = 0.1 + 0.9 * rng.next() as f64;
+        let l =
+            Layers::of_stack(stack, 1500.0, roughness, [0.0; 3], [0.5; 3]).to_f32(1000.0 + 1000.0 * rng.next() as f64);
+        // Up to 72° (cos 0.3), across the film's critical angle, 64°: beyond, the GPU and the
+        // CPU f32 film disagree for such a stack whichever model reads them (noticed here, not
+        // traced: the thesis model by 0.21 at grazing light).
+        let (wi, wo) = (rng.direction(true), rng.direction(true));
+        if wi[2] < 0.3 || wo[2] < 0.3 {
+            continue;
+        }
+        samples.push(GpuSample::new(&l, [0.0, 0.0, 1.0], wi, wo));
+        inputs.push((l, wi, wo));
+    }
+    let (gpu_values, _) =
+        eval_timed(&gpu, Model::Layered, stack, &lut, GpuFilmMethod::Rgb3, &samples, 1).expect("gpu evaluation");
+    let (mut worst, mut gauss_worst) = (0.0f64, 0.0f64);
+    for ((l, wi, wo), g) in inputs.iter().zip(&gpu_values) {
+        let layers = Layers {
+            n0: l.n0 as f64,
+            n1: stack.n1,
+            n2: l.n2 as f64,
+            roughness: l.roughness as f64,
+            optical_depth: l.optical_depth.map(|v| v as f64),
+            albedo: l.albedo.map(|v| v as f64),
+            k: l.k.map(|v| v as f64),
+            e: l.e.map(|v| v as f64),
+        };
+        assert_eq!(layers.lobe_rule(), LobeRule::Quantiles);
+        let d = l.thickness_nm;
+        let eval = |layers: &Layers| {
+            let (wi, wo) = (wi.map(|v| v as f64), wo.map(|v| v as f64));
+            Model::Layered.eval(layers, [0.0, 0.0, 1.0], wi, wo, &|c| film(d, c as f32).map(|v| v as f64)).total()
+        };
+        let (cpu, gauss) = (eval(&layers), eval(&Layers { n1: stack.n0, ..layers }));
+        for c in 0..3 {
+            worst = worst.max((g[c] as f64 - cpu[c]).abs() / (1.0 + cpu[c].abs()));
+            gauss_worst = gauss_worst.max((g[c] as f64 - gauss[c]).abs() / (1.0 + gauss[c].abs()));
+        }
+    }
+    eprintln!(
+        "film below the ambient, rgb3: max |gpu - cpu| / (1 + cpu) = {worst:e}; by the Gauss rule {gauss_worst:e}"
+    );
+    assert!(worst < 5e-3, "GPU and CPU differ by {worst}");
+    assert!(gauss_worst > 2e-2, "the Gauss rule's reading is far from the GPU's: {gauss_worst}");
+}
+
 #[test]
 fn every_gpu_film_method_matches_its_cpu_f32_twin() {
     use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
@@ -315,6 +381,7 @@ fn every_gpu_film_method_matches_its_cpu_f32_twin() {
         for ((l, wi, wo), g) in inputs.iter().zip(&gpu_values) {
             let layers = Layers {
                 n0: l.n0 as f64,
+                n1: stack.n1,
                 n2: l.n2 as f64,
                 roughness: l.roughness as f64,
                 optical_depth: l.optical_depth.map(|v| v as f64),

@@ -60,6 +60,7 @@
 use std::fs::{self, File};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
 use sha2::{Digest, Sha256};
@@ -120,6 +121,43 @@ static HELD_LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Held by a commit from its first rename to its last (the undo's included), and by
 /// `clean_up_before_exit` from when it begins until the process exits. Taken before `LIVE`.
 static COMMIT: Mutex<()> = Mutex::new(());
+
+/// Whether a commit's renames (or its undo) are under way (`swap_in`), for a second signal
+/// that must not end the run in the middle of them (`wait_for_commit`).
+static COMMITTING: AtomicBool = AtomicBool::new(false);
+
+/// Sets `COMMITTING` for as long as it lives (a failed rename's early return included).
+struct Committing;
+
+impl Committing {
+    fn start() -> Committing {
+        COMMITTING.store(true, Ordering::SeqCst);
+        Committing
+    }
+}
+
+impl Drop for Committing {
+    fn drop(&mut self) {
+        COMMITTING.store(false, Ordering::SeqCst);
+    }
+}
+
+/// Waits while a commit's renames are under way, at most `limit`; whether none is (any
+/// more). A second signal waits so (`output::clean_up_on_interrupt` in the binary): it
+/// exited at once, and a Ctrl-C pressed twice during the few milliseconds of a commit left
+/// new maps and old ones under the set's names, no manifest, and the earlier set only in
+/// temporaries, which the next run removed (an interruption review). The limit keeps the
+/// way out of a rename that hangs (a stalled network drive).
+pub fn wait_for_commit(limit: std::time::Duration) -> bool {
+    let start = std::time::Instant::now();
+    while COMMITTING.load(Ordering::SeqCst) {
+        if start.elapsed() >= limit {
+            return false;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    true
+}
 
 /// A poisoned lock still guards valid data here (lists of paths), so it is used as it is.
 fn locked<T>(mutex: &'static Mutex<T>) -> MutexGuard<'static, T> {
@@ -689,8 +727,9 @@ impl SetLock {
                 Ok(()) if same_file(&file, &path) => {
                     // Under the lock every temporary of the set's names is stale: a run killed
                     // while it committed left the earlier set's files it moved aside, of names
-                    // the next run may not write (`--maps color` after a full set).
-                    let names = super::every_set_file_name(name);
+                    // the next run may not write (`--maps color` after a full set), and a
+                    // killed `.gltf` export's, which a `.glb` export does not write.
+                    let names = super::every_file_name_under_lock(name);
                     remove_stale_temporaries(dir, &names.iter().map(String::as_str).collect::<Vec<_>>(), ZERO_AGE);
                     held.push(path.clone());
                     return Ok(SetLock {
@@ -719,13 +758,6 @@ impl SetLock {
             Some(source) => ExportError::Io { path, source },
             None => ExportError::Busy { dir: dir.into(), name: name.into() },
         })
-    }
-
-    /// Removes every temporary of `file_names` in the set's folder, whatever its age: under
-    /// the lock none is another run's. For a file beyond a set's own names that this run
-    /// does not stage (`stage` sweeps the names it writes): an export's thickness image.
-    pub fn remove_stale_temporaries_of(&self, file_names: &[&str]) {
-        remove_stale_temporaries(&self.dir, file_names, ZERO_AGE);
     }
 
     /// Writes the set: `maps` (file name, bytes) first, then `manifest` (file name, bytes)
@@ -800,6 +832,7 @@ fn swap_in(
     manifest: Option<&Path>,
 ) -> Result<Swapped, ExportError> {
     let _commit = locked(&COMMIT);
+    let _committing = Committing::start();
     let mut renames = 0;
     // One file over (at most) its own old one: a single rename replaces it atomically, and
     // one that fails leaves it. Moved aside first, a reader found no file in between, and a

@@ -157,6 +157,7 @@ impl Lut {
     fn bake_coupling(&self) -> Vec<[f32; 8]> {
         let (w, n_cos) = (self.width(), self.n_cos);
         let path = path::cached(self.stack.n0, self.stack.n2);
+        let rule = energy::LobeRule::of(self.stack.n0, self.stack.n1);
         let columns: Vec<Vec<[f32; 8]>> = (0..w)
             .into_par_iter()
             .map(|j| {
@@ -167,10 +168,10 @@ impl Lut {
                 };
                 let mut column = Vec::with_capacity(E1_ROUGHNESS * n_cos);
                 for i_r in 0..E1_ROUGHNESS {
-                    let norm = energy::ms_norm_on_row_f32(i_r, &film, &path.through_f32);
+                    let norm = energy::ms_norm_on_row_f32(i_r, &film, &path.through_f32, rule);
                     for i_cos in 0..n_cos {
                         let cos = coupling_texel_cos(i_cos, n_cos);
-                        let top = energy::top_on_row_with_f32(cos, i_r, &film, &path.through_f32, norm);
+                        let top = energy::top_on_row_with_f32(cos, i_r, &film, &path.through_f32, rule, norm);
                         let (s, m) = (top.reflected, top.ms_amplitude);
                         let r = i_r as f32 / (E1_ROUGHNESS - 1) as f32;
                         let delta = energy::GridCell::<f32>::at(cos, r).bilinear(&path.delta_f32);

@@ -169,8 +169,8 @@ pub fn warnings(preset: &Preset) -> Vec<Problem> {
 }
 
 /// A film whose index is below the ambient's, where it shows: the layered model's energy is
-/// off around the film's critical angle (`FilmBelowAmbient`), for the thickest film of the
-/// thickness map's range and the roughest top the roughness map reaches. A warning, as
+/// off near the film's critical angle (`FilmBelowAmbient`), for the thickest film of the
+/// thickness map's range under a nearly smooth top within the roughness map's range. A warning, as
 /// `model_limit`: the physics is fine.
 fn film_below_ambient(preset: &Preset) -> Option<Problem> {
     let o = &preset.optics;
@@ -178,8 +178,8 @@ fn film_below_ambient(preset: &Preset) -> Option<Problem> {
         return None;
     }
     let thickest_nm = crate::maps::map_thickness_range_nm(preset).1;
-    let roughest = crate::maps::roughness_range(preset).1;
-    let limit = crate::optics::brdf::layered::FilmBelowAmbient::of(o.ambient_ior, o.film_ior, thickest_nm, roughest)?;
+    let roughness = crate::maps::roughness_range(preset);
+    let limit = crate::optics::brdf::layered::FilmBelowAmbient::of(o.ambient_ior, o.film_ior, thickest_nm, roughness)?;
     Some(Problem {
         key: "optics.film_ior".into(),
         message: format!(

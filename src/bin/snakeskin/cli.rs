@@ -620,8 +620,8 @@ pub enum BrdfCommand {
     /// (and "sigma" for the stochastic reference). With --albedo 1 and no absorption the
     /// stack loses nothing: the answer should be 1 (see --model; with --n0 above --n2 the
     /// layered model is darker beyond the critical angle, and with --n1 below --n0, a film over
-    /// 250 nm and roughness over 0.05 it is off either way around the film's critical angle: it
-    /// says so).
+    /// 250 nm and roughness under 0.3 it is off by up to 0.04 within a few degrees of the
+    /// film's critical angle: it says so).
     Albedo(AlbedoArgs),
     /// A thin-film colour chart PNG: thickness 0..2000 nm across, angle 0..89° down, its
     /// brightest channel scaled to 1 (the scale is printed: a dim film's chart is as

@@ -48,7 +48,9 @@ pub fn file_size_limit_is_an_error() {
 /// line says so, and the exit status is 128 + the
 /// signal's number, as a shell reports a process that a signal ended (or the run's own, if
 /// it finished meanwhile). Before, the hidden temporaries (up to a set's size) stayed until
-/// the next run in that folder. A second signal exits at once. A signal that was ignored
+/// the next run in that folder. A second signal exits at once, but not in the middle of a
+/// commit's renames: it waits for them, at most `SECOND_SIGNAL_COMMIT_WAIT` (a commit takes
+/// milliseconds; the limit is the way out of a rename that hangs). A signal that was ignored
 /// when the process started (`nohup` ignores SIGHUP; a non-interactive shell's background
 /// job, SIGINT) stays ignored.
 pub fn clean_up_on_interrupt() {
@@ -65,6 +67,7 @@ pub fn clean_up_on_interrupt() {
                 // that hangs (a rename on a stalled network drive).
                 std::thread::spawn(move || {
                     if let Some(again) = signals.forever().next() {
+                        snakeskin::export::wait_for_commit(SECOND_SIGNAL_COMMIT_WAIT);
                         std::process::exit(128 + again);
                     }
                 });
@@ -82,6 +85,9 @@ pub fn clean_up_on_interrupt() {
         });
     }
 }
+
+/// How long a second signal waits for a commit's renames to end (`clean_up_on_interrupt`).
+const SECOND_SIGNAL_COMMIT_WAIT: std::time::Duration = std::time::Duration::from_secs(10);
 
 /// Whether `signal`'s disposition is "ignore", as the process inherited it (called before
 /// any handler is installed).

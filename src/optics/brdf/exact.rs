@@ -148,6 +148,7 @@ impl SmoothTop {
         self.coupled[row].get_or_init(|| {
             let (stack, thickness_nm) = (self.stack, self.thickness_nm);
             let path = (row > 0).then(|| super::path::cached(stack.n0, stack.n2));
+            let rule = energy::LobeRule::of(stack.n0, stack.n1);
             self.below
                 .iter()
                 .zip(&self.outside)
@@ -161,7 +162,7 @@ impl SmoothTop {
                     };
                     // What the top reflects on this row (its single scattering and x).
                     let film = |c: f64| reflectance(stack, thickness_nm, c);
-                    let (single, beyond) = energy::parts_on_row(mu_out, row, &film, &path.through);
+                    let (single, beyond) = energy::parts_on_row(mu_out, row, &film, &path.through, rule);
                     [0, 1, 2].map(|c| single[c] + beyond[c])
                 })
                 .collect()

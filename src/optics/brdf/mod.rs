@@ -119,9 +119,9 @@ impl Model {
     pub fn coupling(self, cos: f64, layers: &Layers, film: &dyn Fn(f64) -> [f64; 3]) -> energy::Top<f64> {
         match self {
             Model::Thesis => energy::Top { reflected: film(cos), ms_amplitude: [0.0; 3] },
-            Model::Layered => {
-                path::with(layers.n0, layers.n2, |p| energy::top(cos, layers.roughness, film, &p.through))
-            }
+            Model::Layered => path::with(layers.n0, layers.n2, |p| {
+                energy::top(cos, layers.roughness, film, &p.through, layers.lobe_rule())
+            }),
         }
     }
 
@@ -137,9 +137,9 @@ impl Model {
     ) -> [energy::Top<f64>; N] {
         match self {
             Model::Thesis => cos.map(|c| self.coupling(c, layers, film)),
-            Model::Layered => {
-                path::with(layers.n0, layers.n2, |p| energy::tops(cos, layers.roughness, film, &p.through, norms))
-            }
+            Model::Layered => path::with(layers.n0, layers.n2, |p| {
+                energy::tops(cos, layers.roughness, film, &p.through, layers.lobe_rule(), norms)
+            }),
         }
     }
 
@@ -151,9 +151,9 @@ impl Model {
     fn ms_norms(self, layers: &Layers, film: &dyn Fn(f64) -> [f64; 3]) -> Option<energy::MsNorms> {
         match self {
             Model::Thesis => None,
-            Model::Layered => {
-                Some(path::with(layers.n0, layers.n2, |p| energy::ms_norms(layers.roughness, film, &p.through)))
-            }
+            Model::Layered => Some(path::with(layers.n0, layers.n2, |p| {
+                energy::ms_norms(layers.roughness, film, &p.through, layers.lobe_rule())
+            })),
         }
     }
 
@@ -226,6 +226,9 @@ enum PendingCoupling {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Layers {
     pub n0: f64,
+    /// The film's index: where it is below n0 the coupling reads the film by the quantile
+    /// rule (`energy::LobeRule::of`).
+    pub n1: f64,
     pub n2: f64,
     /// Perceptual roughness r (α = r²).
     pub roughness: f64,
@@ -251,7 +254,12 @@ impl Layers {
         albedo: [f64; 3],
     ) -> Layers {
         let (k, e) = exact::cached(stack, thickness_nm).k_e_at(optical_depth, roughness);
-        Layers { n0: stack.n0, n2: stack.n2, roughness, optical_depth, albedo, k, e }
+        Layers { n0: stack.n0, n1: stack.n1, n2: stack.n2, roughness, optical_depth, albedo, k, e }
+    }
+
+    /// How the rough top's coupling reads this material's film (`energy::LobeRule::of`).
+    pub fn lobe_rule(&self) -> energy::LobeRule {
+        energy::LobeRule::of(self.n0, self.n1)
     }
 
     /// The f32 form, with the film thickness the LUT is read at.
@@ -537,6 +545,7 @@ mod tests {
             for (roughness, cos_o, n0, n2) in cases {
                 let layers = Layers {
                     n0,
+                    n1: n2,
                     n2,
                     roughness,
                     optical_depth: [0.0; 3],

@@ -93,20 +93,34 @@ pub const LOBE_VEC4S: usize = LOBE_SLOTS.div_ceil(4);
 /// the lobe's albedo, its five-point rule and the multiple scattering's rule (`energy::node`),
 /// then the rule for light that comes straight back through the top. Filled for every
 /// material, absorbing or not: the window changes the absorption without a new film binding.
+/// For a material whose coupling reads the quantile rule (`energy::LobeRule::of`: a film
+/// less dense than the medium above), the quantile nodes of every entry follow, in the same
+/// order, `QUANTILE_VEC4S` vec4s each; the shader reads the rule the table holds
+/// (`brdf.wgsl`'s `parts_on_row`), so the choice has one home.
 fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
-    use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, node};
+    use crate::optics::brdf::energy::{E1_MU, E1_ROUGHNESS, LobeRule, node, quantile_table};
     let path = crate::optics::brdf::path::cached(stack.n0, stack.n2);
-    (0..E1_MU * E1_ROUGHNESS)
-        .flat_map(|k| {
-            let mut slots = [0.0f32; 4 * LOBE_VEC4S];
-            slots[0] = path.delta_f32[k];
-            slots[LOBE_NODE_SLOT..LOBE_THROUGH_SLOT].copy_from_slice(&node(k % E1_MU, k / E1_MU));
-            slots[LOBE_THROUGH_SLOT..LOBE_SLOTS].copy_from_slice(&path.through_f32[k]);
-            let entry: [[f32; 4]; LOBE_VEC4S] = std::array::from_fn(|v| std::array::from_fn(|c| slots[4 * v + c]));
-            entry
-        })
-        .collect()
+    let entries = (0..E1_MU * E1_ROUGHNESS).flat_map(|k| {
+        let mut slots = [0.0f32; 4 * LOBE_VEC4S];
+        slots[0] = path.delta_f32[k];
+        slots[LOBE_NODE_SLOT..LOBE_THROUGH_SLOT].copy_from_slice(&node(k % E1_MU, k / E1_MU));
+        slots[LOBE_THROUGH_SLOT..LOBE_SLOTS].copy_from_slice(&path.through_f32[k]);
+        let entry: [[f32; 4]; LOBE_VEC4S] = std::array::from_fn(|v| std::array::from_fn(|c| slots[4 * v + c]));
+        entry
+    });
+    let quantiles = (LobeRule::of(stack.n0, stack.n1) == LobeRule::Quantiles).then(quantile_table).unwrap_or(&[]);
+    let quantiles = quantiles.iter().flat_map(|nodes| {
+        let entry: [[f32; 4]; QUANTILE_VEC4S] =
+            std::array::from_fn(|v| std::array::from_fn(|c| nodes[4 * v + c] as f32));
+        entry
+    });
+    entries.chain(quantiles).collect()
 }
+
+/// vec4s per entry of the lobe table's quantile section (the shader's `QUANTILE_VEC4S`).
+pub const QUANTILE_VEC4S: usize = crate::optics::brdf::energy::QUANTILES / 4;
+// The shader reads the quantile nodes four to a vec4: a remainder would be lost.
+const _: () = assert!(crate::optics::brdf::energy::QUANTILES.is_multiple_of(4));
 
 /// The LUT's coupling table (`Lut::coupling`) as `film.wgsl`'s `coupling_texture`: a 3-D
 /// half-float texture of 2 n_cos × E1_ROUGHNESS × the table's thickness columns, the

@@ -256,9 +256,9 @@ impl LayerOptics {
         colour: [f64; 3],
     ) -> crate::optics::brdf::Layers {
         let (k, e) = bounce.at(thickness_nm, roughness);
-        let Stack { n0, n2, .. } = self.stack;
-        let layers =
-            crate::optics::brdf::Layers { n0, n2, roughness, optical_depth: self.optical_depth, albedo: colour, k, e };
+        let Stack { n0, n1, n2 } = self.stack;
+        let optical_depth = self.optical_depth;
+        let layers = crate::optics::brdf::Layers { n0, n1, n2, roughness, optical_depth, albedo: colour, k, e };
         crate::optics::brdf::Layers { albedo: model.base_albedo(colour, &layers), ..layers }
     }
 

@@ -97,6 +97,10 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("LOBE_NODE_SLOT", "u32", format!("{}u", super::film::LOBE_NODE_SLOT)),
         ("LOBE_THROUGH_SLOT", "u32", format!("{}u", super::film::LOBE_THROUGH_SLOT)),
         ("LOBE_NODES", "u32", format!("{LOBE_NODES}u")),
+        // The lobe table's quantile section, where a material has it (film::lobe_table).
+        ("QUANTILES", "u32", format!("{}u", crate::optics::brdf::energy::QUANTILES)),
+        ("QUANTILE_VEC4S", "u32", format!("{}u", super::film::QUANTILE_VEC4S)),
+        ("LOBE_ENTRIES", "u32", format!("{}u", E1_MU * E1_ROUGHNESS)),
         ("PAIR_NODES", "u32", format!("{PAIR_NODES}u")),
         ("PAIR_SLOT", "u32", format!("{PAIR_SLOT}u")),
         ("PAIR_WEIGHTS_SLOT", "u32", format!("{PAIR_WEIGHTS_SLOT}u")),

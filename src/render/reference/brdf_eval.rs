@@ -213,7 +213,16 @@ pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBen
         .map(|i| {
             let roughness = 0.05 + 0.9 * unit(i, 0) as f64;
             let (k, e) = bounce.at(roughness);
-            let layers = Layers { n0: 1.0, n2: 2.0, roughness, optical_depth: tau, albedo: [0.5, 0.4, 0.3], k, e };
+            let layers = Layers {
+                n0: 1.0,
+                n1: Stack::THESIS.n1,
+                n2: 2.0,
+                roughness,
+                optical_depth: tau,
+                albedo: [0.5, 0.4, 0.3],
+                k,
+                e,
+            };
             let layers = layers.to_f32(2000.0 * unit(i, 1) as f64);
             let dir = |a: f32, b: f32| {
                 let phi = b * std::f32::consts::TAU;

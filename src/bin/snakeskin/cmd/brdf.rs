@@ -96,7 +96,7 @@ fn warn_of_model_limit(model: Model, stack: Stack, thickness_nm: f64, roughness:
     if let Some(limit) = ModelLimit::of(stack.n0, stack.n2) {
         eprintln!("warning: --n0 {} is above --n2 {}: {limit} ({walk})", stack.n0, stack.n2);
     }
-    if let Some(limit) = FilmBelowAmbient::of(stack.n0, stack.n1, thickness_nm, roughness) {
+    if let Some(limit) = FilmBelowAmbient::of(stack.n0, stack.n1, thickness_nm, (roughness, roughness)) {
         eprintln!("warning: --n1 {} is below --n0 {}: {limit} ({walk})", stack.n1, stack.n0);
     }
 }
