@@ -152,6 +152,34 @@ fn a_film_less_dense_than_the_ambient_keeps_the_white_furnace() {
     assert!(gauss_worst > 0.1, "the Gauss rule's reading is off: {gauss_worst}");
 }
 
+/// A pigment layer less dense than the medium above (n2 < n0) totally reflects at the
+/// film's lower face beyond asin(n2 / n0), 53.1° here: F has a corner there too, and the
+/// Gauss rule read the white stack as 0.948 at 45° and 1.082 at 53° (roughness 0.35, `brdf
+/// albedo`, an independent review's find). Read by the quantile rule (`energy::LobeRule::of`
+/// takes n2 too), the furnace holds inside that angle; beyond it the model loses light
+/// (`layered::ModelLimit`, warned of). Seen failing with `LobeRule::of` ignoring n2.
+#[test]
+fn a_pigment_less_dense_than_the_ambient_keeps_the_furnace_inside_its_critical_angle() {
+    use snakeskin::optics::brdf::energy::LobeRule;
+    let stack = Stack { n0: 1.5, n1: 1.55, n2: 1.2 };
+    let mut worst = 0.0f64;
+    for thickness in [0.0, 1500.0] {
+        let tables = FilmTables::new(stack, thickness);
+        let film = |c: f64| tables.above(c);
+        for roughness in [0.2, 0.35, 0.6] {
+            let layers = white_layers(stack, thickness, roughness);
+            assert_eq!(layers.lobe_rule(), LobeRule::Quantiles);
+            for angle_deg in [0.0f64, 30.0, 45.0, 50.0, 53.0] {
+                let a = Model::Layered.furnace_albedo(&layers, angle_deg.to_radians().cos(), &film, 64);
+                let err = a.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
+                worst = worst.max(err);
+                assert!(err <= 0.02, "d={thickness} r={roughness} {angle_deg}°: {a:?}");
+            }
+        }
+    }
+    eprintln!("pigment below the ambient, inside its critical angle: max |albedo − 1| {worst:.4}");
+}
+
 #[test]
 fn a_nearly_smooth_top_keeps_the_furnace_at_grazing_light() {
     // Between 86° and 89.3° a low-roughness lobe changes within a few α of grazing
@@ -391,7 +419,7 @@ fn coupling_table_deviation(
         let (d, cos, r) = (thickness_nm(u(0)), cos(u(1)), u(2));
         let film = |c: f32| lut.lookup_f32(d, c.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
         let through = &snakeskin::optics::brdf::path::cached(lut.stack.n0, lut.stack.n2).through_f32;
-        let lobe_rule = snakeskin::optics::brdf::energy::LobeRule::of(lut.stack.n0, lut.stack.n1);
+        let lobe_rule = snakeskin::optics::brdf::energy::LobeRule::of(lut.stack.n0, lut.stack.n1, lut.stack.n2);
         let rule = snakeskin::optics::brdf::energy::top_f32(cos, r, &film, through, lobe_rule);
         let (table, _) = lut.coupling_f32(d, cos, r);
         for c in 0..3 {
@@ -483,7 +511,7 @@ fn light_straight_back_through_the_rough_top_meets_the_walk() {
     let mu = 85f64.to_radians().cos();
     let layers = Layers::of_stack(stack, 650.0, 0.9, [0.0; 3], [0.0; 3]);
     let walked = walk::walk(&layers, &film, [(1.0 - mu * mu).sqrt(), 0.0, mu], 200_000, 1, 17);
-    let rule = energy::LobeRule::of(stack.n0, stack.n1);
+    let rule = energy::LobeRule::of(stack.n0, stack.n1, stack.n2);
     let with = energy::top(mu, 0.9, &film_fn, &path::cached(stack.n0, stack.n2).through, rule);
     let without = energy::top(mu, 0.9, &film_fn, &[], rule);
     for c in 0..3 {

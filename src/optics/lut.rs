@@ -157,7 +157,7 @@ impl Lut {
     fn bake_coupling(&self) -> Vec<[f32; 8]> {
         let (w, n_cos) = (self.width(), self.n_cos);
         let path = path::cached(self.stack.n0, self.stack.n2);
-        let rule = energy::LobeRule::of(self.stack.n0, self.stack.n1);
+        let rule = energy::LobeRule::of(self.stack.n0, self.stack.n1, self.stack.n2);
         let columns: Vec<Vec<[f32; 8]>> = (0..w)
             .into_par_iter()
             .map(|j| {

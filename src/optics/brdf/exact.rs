@@ -148,7 +148,7 @@ impl SmoothTop {
         self.coupled[row].get_or_init(|| {
             let (stack, thickness_nm) = (self.stack, self.thickness_nm);
             let path = (row > 0).then(|| super::path::cached(stack.n0, stack.n2));
-            let rule = energy::LobeRule::of(stack.n0, stack.n1);
+            let rule = energy::LobeRule::of(stack.n0, stack.n1, stack.n2);
             self.below
                 .iter()
                 .zip(&self.outside)

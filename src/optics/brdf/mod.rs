@@ -226,8 +226,8 @@ enum PendingCoupling {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Layers {
     pub n0: f64,
-    /// The film's index: where it is below n0 the coupling reads the film by the quantile
-    /// rule (`energy::LobeRule::of`).
+    /// The film's index: where it (or n2) is below n0 the coupling reads the film by the
+    /// quantile rule (`energy::LobeRule::of`).
     pub n1: f64,
     pub n2: f64,
     /// Perceptual roughness r (α = r²).
@@ -259,7 +259,7 @@ impl Layers {
 
     /// How the rough top's coupling reads this material's film (`energy::LobeRule::of`).
     pub fn lobe_rule(&self) -> energy::LobeRule {
-        energy::LobeRule::of(self.n0, self.n1)
+        energy::LobeRule::of(self.n0, self.n1, self.n2)
     }
 
     /// The f32 form, with the film thickness the LUT is read at.

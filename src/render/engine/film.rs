@@ -108,7 +108,8 @@ fn lobe_table(stack: Stack) -> Vec<[f32; 4]> {
         let entry: [[f32; 4]; LOBE_VEC4S] = std::array::from_fn(|v| std::array::from_fn(|c| slots[4 * v + c]));
         entry
     });
-    let quantiles = (LobeRule::of(stack.n0, stack.n1) == LobeRule::Quantiles).then(quantile_table).unwrap_or(&[]);
+    let quantiles =
+        (LobeRule::of(stack.n0, stack.n1, stack.n2) == LobeRule::Quantiles).then(quantile_table).unwrap_or(&[]);
     let quantiles = quantiles.iter().flat_map(|nodes| {
         let entry: [[f32; 4]; QUANTILE_VEC4S] =
             std::array::from_fn(|v| std::array::from_fn(|c| nodes[4 * v + c] as f32));
