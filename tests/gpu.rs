@@ -281,6 +281,21 @@ fn a_device_error_is_an_error_not_a_panic() {
     buffer(1024).unwrap();
 }
 
+/// The f64 layers of the f32 ones a GPU sample carries, with the film's index `n1` (which
+/// `Layers32` does not hold: the f64 coupling picks its rule by it).
+fn f64_layers(l: &snakeskin::optics::brdf::Layers32, n1: f64) -> Layers {
+    Layers {
+        n0: l.n0 as f64,
+        n1,
+        n2: l.n2 as f64,
+        roughness: l.roughness as f64,
+        optical_depth: l.optical_depth.map(|v| v as f64),
+        albedo: l.albedo.map(|v| v as f64),
+        k: l.k.map(|v| v as f64),
+        e: l.e.map(|v| v as f64),
+    }
+}
+
 /// A film less dense than the medium above: the coupling reads it by the quantile rule
 /// (`energy::LobeRule`), and so does the shader's direct film method, from the quantile nodes
 /// the lobe table holds for such a material (`render::engine::film::lobe_table`). GPU
@@ -318,16 +333,7 @@ fn a_film_less_dense_than_the_ambient_reads_the_quantile_rule_on_the_gpu() {
         eval_timed(&gpu, Model::Layered, stack, &lut, GpuFilmMethod::Rgb3, &samples, 1).expect("gpu evaluation");
     let (mut worst, mut gauss_worst) = (0.0f64, 0.0f64);
     for ((l, wi, wo), g) in inputs.iter().zip(&gpu_values) {
-        let layers = Layers {
-            n0: l.n0 as f64,
-            n1: stack.n1,
-            n2: l.n2 as f64,
-            roughness: l.roughness as f64,
-            optical_depth: l.optical_depth.map(|v| v as f64),
-            albedo: l.albedo.map(|v| v as f64),
-            k: l.k.map(|v| v as f64),
-            e: l.e.map(|v| v as f64),
-        };
+        let layers = f64_layers(l, stack.n1);
         assert_eq!(layers.lobe_rule(), LobeRule::Quantiles);
         let d = l.thickness_nm;
         let eval = |layers: &Layers| {
@@ -379,16 +385,7 @@ fn every_gpu_film_method_matches_its_cpu_f32_twin() {
         let (gpu_values, _) = eval_timed(&gpu, model, stack, &lut, method, &samples, 1).expect("gpu evaluation");
         let mut worst = 0.0f64;
         for ((l, wi, wo), g) in inputs.iter().zip(&gpu_values) {
-            let layers = Layers {
-                n0: l.n0 as f64,
-                n1: stack.n1,
-                n2: l.n2 as f64,
-                roughness: l.roughness as f64,
-                optical_depth: l.optical_depth.map(|v| v as f64),
-                albedo: l.albedo.map(|v| v as f64),
-                k: l.k.map(|v| v as f64),
-                e: l.e.map(|v| v as f64),
-            };
+            let layers = f64_layers(l, stack.n1);
             let d = l.thickness_nm;
             let cpu = model
                 .eval(&layers, [0.0, 0.0, 1.0], wi.map(|v| v as f64), wo.map(|v| v as f64), &|c| {
