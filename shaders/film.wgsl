@@ -94,10 +94,16 @@ struct Harmonics {
     q: vec2<f32>,
 }
 
+// As optics::fast::Film32: kappa1 = Im cos theta1 (> 0 beyond the critical angle of a film
+// less dense than the ambient, where there is no series and band_reflectance reads the exact
+// film), and the Fresnel amplitudes (r01 in xy, r12 in zw) of s and of p.
 struct Film {
     s: Harmonics,
     p: Harmonics,
     cos1: f32,
+    kappa1: f32,
+    amplitudes_s: vec4<f32>,
+    amplitudes_p: vec4<f32>,
 }
 
 fn harmonics(a: vec2<f32>, b: vec2<f32>) -> Harmonics {
@@ -125,13 +131,27 @@ fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
     let c0 = vec2<f32>(cos0, 0.0);
     let c1 = cos_in(n0 / n1, cos0);
     let c2 = cos_in(n0 / n2, cos0);
-    let s = harmonics(r_s(n0, c0, n1, c1), r_s(n1, c1, n2, c2));
-    let p = harmonics(r_p(n0, c0, n1, c1), r_p(n1, c1, n2, c2));
+    let a_s = r_s(n0, c0, n1, c1);
+    let b_s = r_s(n1, c1, n2, c2);
+    let a_p = r_p(n0, c0, n1, c1);
+    let b_p = r_p(n1, c1, n2, c2);
     var cos1 = 0.0;
     if (c1.y == 0.0) {
         cos1 = c1.x;
     }
-    return Film(s, p, cos1);
+    return Film(harmonics(a_s, b_s), harmonics(a_p, b_p), cos1, c1.y, vec4<f32>(a_s, b_s), vec4<f32>(a_p, b_p));
+}
+
+// The exact coherent film at one wavelength (optics::fast::airy_reflectance_f32).
+fn airy_reflectance(f: Film, n1: f32, thickness_nm: f32, wavelength_nm: f32) -> f32 {
+    let k = 4.0 * PI * n1 * thickness_nm / wavelength_nm;
+    let e = vec2<f32>(cos(k * f.cos1), sin(k * f.cos1)) * exp(-k * f.kappa1);
+    let one = vec2<f32>(1.0, 0.0);
+    let ns = f.amplitudes_s.xy + cmul(f.amplitudes_s.zw, e);
+    let ds = one + cmul(cmul(f.amplitudes_s.xy, f.amplitudes_s.zw), e);
+    let np = f.amplitudes_p.xy + cmul(f.amplitudes_p.zw, e);
+    let dp = one + cmul(cmul(f.amplitudes_p.xy, f.amplitudes_p.zw), e);
+    return clamp(0.5 * (dot(ns, ns) / dot(ds, ds) + dot(np, np) / dot(dp, dp)), 0.0, 1.0);
 }
 
 fn sinc(x: f32) -> f32 {
@@ -159,7 +179,12 @@ fn series(h: Harmonics, phase: f32, box_width: f32) -> f32 {
     return clamp(h.c0 + 2.0 * mean.x, 0.0, 1.0);
 }
 
+// optics::fast::band_reflectance_f32: the prefiltered series, or the exact film where the
+// film's wave is evanescent.
 fn band_reflectance(f: Film, n1: f32, thickness_nm: f32, wavelength_nm: f32, band_nm: f32) -> f32 {
+    if (f.kappa1 > 0.0) {
+        return airy_reflectance(f, n1, thickness_nm, wavelength_nm);
+    }
     let phase = 4.0 * PI * n1 * thickness_nm * f.cos1 / wavelength_nm;
     let box_width = phase * band_nm / wavelength_nm;
     return 0.5 * (series(f.s, phase, box_width) + series(f.p, phase, box_width));
@@ -196,6 +221,9 @@ fn bb_lobes(phase: f32, arg: f32) -> vec4<f32> {
 fn film_gaussian_fit(thickness_nm: f32, cos0: f32) -> vec3<f32> {
     let n = film_info.iors_band;
     let f = film_coefficients(n.x, n.y, n.z, cos0);
+    if (f.kappa1 > 0.0) {
+        return vec3<f32>(airy_reflectance(f, n.y, thickness_nm, GAUSSIAN_FIT_EVANESCENT_NM));
+    }
     let opd = 2.0 * n.y * thickness_nm * f.cos1;
     var xyz = vec3<f32>(0.5 * (f.s.c0 + f.p.c0));
     for (var pol = 0u; pol < 2u; pol++) {

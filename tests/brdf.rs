@@ -323,6 +323,75 @@ fn each_method_f32_agrees_with_its_f64_form() {
     }
 }
 
+/// Beyond the critical angle of a film less dense than the ambient (n1 < n0) the wave in the
+/// film is evanescent and the film has no Fourier series (|r01| = 1). Its reflectance then
+/// runs from the bare n0|n2 interface's at zero thickness (Fresnel, computed here) to 1 once
+/// the film is a few decay lengths thick (total internal reflection); every f32 method keeps
+/// both limits and agrees with its f64 form, which reads the exact film (`airy`) there.
+#[test]
+fn every_f32_method_reads_an_evanescent_film_exactly() {
+    let fresnel = |n0: f64, n2: f64, cos0: f64| {
+        let eta2 = (n0 / n2) * (n0 / n2);
+        let c2 = snakeskin::optics::complex::C64::real((1.0 - eta2) + eta2 * cos0 * cos0).sqrt_upper();
+        let c0 = snakeskin::optics::complex::C64::real(cos0);
+        let rs = (c0 * n0 - c2 * n2) / (c0 * n0 + c2 * n2);
+        let rp = (c0 * n2 - c2 * n0) / (c0 * n2 + c2 * n0);
+        0.5 * (rs.norm_sqr() + rp.norm_sqr())
+    };
+    let stacks = [
+        Stack { n0: 1.5, n1: 1.35, n2: 2.0 },
+        Stack { n0: 1.33, n1: 1.2, n2: 1.55 },
+        Stack { n0: 1.5, n1: 1.3, n2: 1.4 },
+    ];
+    let mut evanescent_points = 0;
+    for stack in stacks {
+        let critical = (stack.n1 / stack.n0).asin();
+        let (n0, n1, n2) = (stack.n0 as f32, stack.n1 as f32, stack.n2 as f32);
+        for step in 0..=24 {
+            // From 10° inside the critical angle to 89.5°.
+            let theta = critical - 10f64.to_radians()
+                + step as f64 / 24.0 * (89.5f64.to_radians() - critical + 10f64.to_radians());
+            let cos0 = theta.cos();
+            let beyond = theta > critical + 1e-3;
+            for d in [0.0, 5.0, 20.0, 60.0, 150.0, 400.0, 1000.0, 2000.0] {
+                let (df, c) = (d as f32, cos0 as f32);
+                let pairs: [(&str, [f32; 3], [f64; 3]); 4] = [
+                    ("rgb3", rgb3_f32(n0, n1, n2, df, c), rgb3_f64(stack, d, cos0)),
+                    ("spectral-8", spectral_n_f32(n0, n1, n2, df, c, 8), spectral_n_f64(stack, d, cos0, 8)),
+                    ("spectral-32", spectral_n_f32(n0, n1, n2, df, c, 32), spectral_n_f64(stack, d, cos0, 32)),
+                    ("gaussian-fit", gaussian_fit_f32(n0, n1, n2, df, c), gaussian_fit_f64(stack, d, cos0)),
+                ];
+                for (name, a, b) in pairs {
+                    let de = ciede2000(linear_srgb_to_lab(a.map(|v| v as f64)), linear_srgb_to_lab(b));
+                    assert!(
+                        de < 0.05,
+                        "{name} {stack:?} θ {:.2}° d {d}: f32 {a:?} vs f64 {b:?} (ΔE {de})",
+                        theta.to_degrees()
+                    );
+                    if !beyond {
+                        continue;
+                    }
+                    evanescent_points += 1;
+                    let bare = fresnel(stack.n0, stack.n2, cos0);
+                    // The film's decay length at the longest wavelength read, λ / (4π n1 κ).
+                    let kappa = ((stack.n0 / stack.n1 * theta.sin()).powi(2) - 1.0).sqrt();
+                    let decay_nm = 700.0 / (4.0 * std::f64::consts::PI * stack.n1 * kappa);
+                    for k in 0..3 {
+                        let v = a[k] as f64;
+                        if d == 0.0 {
+                            assert!((v - bare).abs() < 2e-3, "{name} {stack:?} θ {theta}: bare {bare}, f32 {a:?}");
+                        }
+                        if d > 8.0 * decay_nm {
+                            assert!(v > 0.995, "{name} {stack:?} θ {theta} d {d}: not total reflection, {a:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(evanescent_points > 500, "{evanescent_points} points beyond the critical angle");
+}
+
 #[test]
 fn thick_films_converge_to_the_incoherent_limit() {
     // From 20 µm to 10 mm every method's colour stays within ΔE00 1.0 (a just-noticeable

@@ -319,13 +319,8 @@ fn a_film_less_dense_than_the_ambient_reads_the_quantile_rule_on_the_gpu() {
         let roughness = 0.1 + 0.9 * rng.next() as f64;
         let l =
             Layers::of_stack(stack, 1500.0, roughness, [0.0; 3], [0.5; 3]).to_f32(1000.0 + 1000.0 * rng.next() as f64);
-        // Up to 72° (cos 0.3), across the film's critical angle, 64°: beyond, the GPU and the
-        // CPU f32 film disagree for such a stack whichever model reads them (noticed here, not
-        // traced: the thesis model by 0.21 at grazing light).
+        // Every direction, across the film's critical angle (64°).
         let (wi, wo) = (rng.direction(true), rng.direction(true));
-        if wi[2] < 0.3 || wo[2] < 0.3 {
-            continue;
-        }
         samples.push(GpuSample::new(&l, [0.0, 0.0, 1.0], wi, wo));
         inputs.push((l, wi, wo));
     }
@@ -355,11 +350,18 @@ fn a_film_less_dense_than_the_ambient_reads_the_quantile_rule_on_the_gpu() {
 
 #[test]
 fn every_gpu_film_method_matches_its_cpu_f32_twin() {
+    let Some(gpu) = gpu_or_skip("every_gpu_film_method_matches_its_cpu_f32_twin") else { return };
+    // The thesis stack, and a film less dense than the ambient (n1 < n0: beyond 64° the wave in
+    // the film is evanescent and every method reads the exact film, optics::fast::Film32).
+    for stack in [Stack::THESIS, Stack { n0: 1.5, n1: 1.35, n2: 2.0 }] {
+        film_methods_match_on(&gpu, stack);
+    }
+}
+
+fn film_methods_match_on(gpu: &snakeskin::render::Gpu, stack: Stack) {
     use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
     use snakeskin::render::engine::film::GpuFilmMethod;
     use snakeskin::render::reference::brdf_eval::eval_timed;
-    let Some(gpu) = gpu_or_skip("every_gpu_film_method_matches_its_cpu_f32_twin") else { return };
-    let stack = Stack::THESIS;
     let lut = Lut::bake(stack, 16, 32, 8);
     let mut rng = Rng(7);
     let mut inputs = Vec::new();
@@ -374,34 +376,35 @@ fn every_gpu_film_method_matches_its_cpu_f32_twin() {
         samples.push(GpuSample::new(&l, [0.0, 0.0, 1.0], wi, wo));
         inputs.push((l, wi, wo));
     }
-    type Film = fn(f32, f32) -> [f32; 3];
+    type Film = fn([f32; 3], f32, f32) -> [f32; 3];
     let methods: [(GpuFilmMethod, Film); 4] = [
-        (GpuFilmMethod::Rgb3, |d, c| rgb3_f32(1.0, 1.55, 2.0, d, c)),
-        (GpuFilmMethod::SpectralN(8), |d, c| spectral_n_f32(1.0, 1.55, 2.0, d, c, 8)),
-        (GpuFilmMethod::SpectralN(32), |d, c| spectral_n_f32(1.0, 1.55, 2.0, d, c, 32)),
-        (GpuFilmMethod::GaussianFit, |d, c| gaussian_fit_f32(1.0, 1.55, 2.0, d, c)),
+        (GpuFilmMethod::Rgb3, |[n0, n1, n2], d, c| rgb3_f32(n0, n1, n2, d, c)),
+        (GpuFilmMethod::SpectralN(8), |[n0, n1, n2], d, c| spectral_n_f32(n0, n1, n2, d, c, 8)),
+        (GpuFilmMethod::SpectralN(32), |[n0, n1, n2], d, c| spectral_n_f32(n0, n1, n2, d, c, 32)),
+        (GpuFilmMethod::GaussianFit, |[n0, n1, n2], d, c| gaussian_fit_f32(n0, n1, n2, d, c)),
     ];
+    let iors = [stack.n0, stack.n1, stack.n2].map(|n| n as f32);
     for (model, (method, film)) in Model::ALL.into_iter().flat_map(|m| methods.map(|f| (m, f))) {
-        let (gpu_values, _) = eval_timed(&gpu, model, stack, &lut, method, &samples, 1).expect("gpu evaluation");
+        let (gpu_values, _) = eval_timed(gpu, model, stack, &lut, method, &samples, 1).expect("gpu evaluation");
         let mut worst = 0.0f64;
         for ((l, wi, wo), g) in inputs.iter().zip(&gpu_values) {
             let layers = f64_layers(l, stack.n1);
             let d = l.thickness_nm;
             let cpu = model
                 .eval(&layers, [0.0, 0.0, 1.0], wi.map(|v| v as f64), wo.map(|v| v as f64), &|c| {
-                    film(d, c as f32).map(|v| v as f64)
+                    film(iors, d, c as f32).map(|v| v as f64)
                 })
                 .total();
             for c in 0..3 {
-                assert!(g[c].is_finite(), "{model:?} {}: not finite", method.name());
+                assert!(g[c].is_finite(), "{stack:?} {model:?} {}: not finite", method.name());
                 worst = worst.max((g[c] as f64 - cpu[c]).abs() / (1.0 + cpu[c].abs()));
             }
         }
-        eprintln!("{model:?} {}: max |gpu - cpu| / (1 + cpu) = {worst:e}", method.name());
+        eprintln!("{stack:?} {model:?} {}: max |gpu - cpu| / (1 + cpu) = {worst:e}", method.name());
         // The CPU side here is the f64 BRDF around the f32 film method. The f32 BRDF's own
         // rounding grows only at adversarial grazing (`brdf stress`: 0.045 at most, with a
         // shading normal at 90° to the view under a near-mirror top); these inputs are not
         // grazing, and 5e-3 bounds the film twins.
-        assert!(worst < 5e-3, "{model:?} {}: GPU and CPU differ by {worst}", method.name());
+        assert!(worst < 5e-3, "{stack:?} {model:?} {}: GPU and CPU differ by {worst}", method.name());
     }
 }

@@ -55,6 +55,23 @@ pub struct Film32 {
     pub s: Harmonics32,
     pub p: Harmonics32,
     pub cos1: f32,
+    /// Im cos θ1: 0 while the film's wave travels, positive beyond the critical angle of a film
+    /// less dense than the ambient (n1 < n0), where the wave in the film is evanescent. There
+    /// |r01| = 1, so |q| = 1 and the series does not exist: `band_reflectance_f32` reads the
+    /// exact film instead, whose reflectance then climbs from the bare n0|n2 interface's at
+    /// zero thickness to 1 within a fraction of a wavelength (frustrated total reflection).
+    pub kappa1: f32,
+    /// The Fresnel amplitudes [r01, r12] of s and of p (the exact film's, `airy_reflectance_f32`).
+    pub amplitudes_s: [C32; 2],
+    pub amplitudes_p: [C32; 2],
+}
+
+impl Film32 {
+    /// True beyond the film's critical angle (see `kappa1`).
+    #[inline]
+    pub fn evanescent(&self) -> bool {
+        self.kappa1 > 0.0
+    }
 }
 
 /// Floor on 1 − |q|² in the harmonics' normalisation: |q| < 1 for any physical interface
@@ -96,7 +113,14 @@ pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
     };
     let (a_s, a_p) = r(n0, c0, n1, c1);
     let (b_s, b_p) = r(n1, c1, n2, c2);
-    Film32 { s: harmonics(a_s, b_s), p: harmonics(a_p, b_p), cos1: if c1[1] == 0.0 { c1[0] } else { 0.0 } }
+    Film32 {
+        s: harmonics(a_s, b_s),
+        p: harmonics(a_p, b_p),
+        cos1: if c1[1] == 0.0 { c1[0] } else { 0.0 },
+        kappa1: c1[1],
+        amplitudes_s: [a_s, b_s],
+        amplitudes_p: [a_p, b_p],
+    }
 }
 
 #[inline]
@@ -139,4 +163,27 @@ pub fn reflectance_f32(film: &Film32, phase: f32, box_width: f32) -> f32 {
 #[inline]
 pub fn phase_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32) -> f32 {
     4.0 * std::f32::consts::PI * n1 * thickness_nm * film.cos1 / wavelength_nm
+}
+
+/// The exact coherent film at one wavelength (Airy, as `film::airy`'s reflectance), unpolarised:
+/// r = (r01 + r12 e) / (1 + r01 r12 e) per polarisation, e = exp(2iβ), β = 2π n1 d cos θ1 / λ,
+/// which for an evanescent film (cos θ1 = i κ) is the real decay exp(−4π n1 d κ / λ).
+#[inline]
+pub fn airy_reflectance_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32) -> f32 {
+    let k = 4.0 * std::f32::consts::PI * n1 * thickness_nm / wavelength_nm;
+    let e = scale([(k * film.cos1).cos(), (k * film.cos1).sin()], (-k * film.kappa1).exp());
+    let r = |[a, b]: [C32; 2]| norm_sqr(add(a, mul(b, e))) / norm_sqr(add([1.0, 0.0], mul(mul(a, b), e)));
+    (0.5 * (r(film.amplitudes_s) + r(film.amplitudes_p))).clamp(0.0, 1.0)
+}
+
+/// The film's reflectance over a band of `band_nm` around `wavelength_nm`: the prefiltered
+/// series, or beyond the film's critical angle (no series) the exact film at the band's centre,
+/// which varies slowly with the wavelength there. The twin of `methods::band_reflectance_f64`.
+#[inline]
+pub fn band_reflectance_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32, band_nm: f32) -> f32 {
+    if film.evanescent() {
+        return airy_reflectance_f32(film, n1, thickness_nm, wavelength_nm);
+    }
+    let phase = phase_f32(film, n1, thickness_nm, wavelength_nm);
+    reflectance_f32(film, phase, phase * band_nm / wavelength_nm)
 }

@@ -15,7 +15,7 @@
 
 use std::sync::OnceLock;
 
-use super::fast::{film_f32, phase_f32, reflectance_f32};
+use super::fast::{airy_reflectance_f32, band_reflectance_f32, film_f32};
 use super::film::Stack;
 use super::series::FilmSeries;
 use super::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, Observer, XYZ_TO_SRGB, mat3_mul};
@@ -143,9 +143,7 @@ pub fn spectral_n_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32, n
     let width = bands.width_nm as f32;
     let mut rgb = [0.0f32; 3];
     for (lambda, w) in bands.centres_nm.iter().zip(&bands.rgb_weights) {
-        let lambda = *lambda as f32;
-        let phase = phase_f32(&film, n1, thickness_nm, lambda);
-        let r = reflectance_f32(&film, phase, phase * width / lambda);
+        let r = band_reflectance_f32(&film, n1, thickness_nm, *lambda as f32, width);
         for c in 0..3 {
             rgb[c] += r * w[c] as f32;
         }
@@ -160,10 +158,7 @@ pub fn rgb3_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
 
 pub fn rgb3_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32; 3] {
     let film = film_f32(n0, n1, n2, cos0);
-    RGB3_NM.map(|lambda| {
-        let phase = phase_f32(&film, n1, thickness_nm, lambda);
-        reflectance_f32(&film, phase, phase * RGB3_BAND_NM / lambda)
-    })
+    RGB3_NM.map(|lambda| band_reflectance_f32(&film, n1, thickness_nm, lambda, RGB3_BAND_NM))
 }
 
 /// Belcour & Barla (2017) Gaussian fits of the XYZ sensitivity in Fourier space
@@ -208,10 +203,15 @@ pub fn d65_white() -> [f64; 3] {
     Observer::get().white_xyz()
 }
 
+/// The wavelength (nm) at which the Gaussian fit reads the exact film, grey, beyond the film's
+/// critical angle, where its series does not exist: 550 nm, the middle of the visible range
+/// and near the peak of the CIE ȳ function (555 nm).
+pub const GAUSSIAN_FIT_EVANESCENT_NM: f64 = 550.0;
+
 pub fn gaussian_fit_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] {
     let film = FilmSeries::new(stack, cos0);
     let Some(cos1) = film.cos1 else {
-        let r = super::film::airy(stack, thickness_nm, 550.0, cos0).r;
+        let r = super::film::airy(stack, thickness_nm, GAUSSIAN_FIT_EVANESCENT_NM, cos0).r;
         return [r; 3];
     };
     let opd = 2.0 * stack.n1 * thickness_nm * cos1;
@@ -234,6 +234,11 @@ pub fn gaussian_fit_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] 
 pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32; 3] {
     use super::fast::C32;
     let film = film_f32(n0, n1, n2, cos0);
+    if film.evanescent() {
+        // As gaussian_fit_f64: no series beyond the film's critical angle, the exact film at
+        // the fit's centre wavelength instead (grey).
+        return [airy_reflectance_f32(&film, n1, thickness_nm, GAUSSIAN_FIT_EVANESCENT_NM as f32); 3];
+    }
     let opd = 2.0 * n1 * thickness_nm * film.cos1;
     let mut xyz = [0.5 * (film.s.c0 + film.p.c0); 3];
     let mul = |a: C32, b: C32| [a[0] * b[0] - a[1] * b[1], a[0] * b[1] + a[1] * b[0]];

@@ -17,7 +17,9 @@ use crate::optics::brdf::path::THROUGH_NODES;
 use crate::optics::brdf::{ALPHA_MIN, COS_MIN, LENGTH_MIN, Model};
 use crate::optics::fast::{BOX_NARROW_RAD, HARMONICS_DENOM_MIN, Q_NEGLIGIBLE, SINC_SMALL};
 use crate::optics::lut::{COARSE_MAX_NM, FINE_MAX_NM};
-use crate::optics::methods::{BB_LOBES, BB_METRES_PER_NM, GAUSSIAN_FIT_HARMONICS, RGB3_BAND_NM, RGB3_NM, bb_amplitude};
+use crate::optics::methods::{
+    BB_LOBES, BB_METRES_PER_NM, GAUSSIAN_FIT_EVANESCENT_NM, GAUSSIAN_FIT_HARMONICS, RGB3_BAND_NM, RGB3_NM, bb_amplitude,
+};
 use crate::render::engine::scene::{BOUNCE_THICKNESSES, SCENE_LIGHTS};
 
 use super::film::GpuFilmMethod;
@@ -80,6 +82,7 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         // The scene's directional lights (render::engine::scene::Lighting::lights).
         ("SCENE_LIGHTS", "u32", format!("{SCENE_LIGHTS}u")),
         ("GAUSSIAN_FIT_HARMONICS", "u32", format!("{GAUSSIAN_FIT_HARMONICS}u")),
+        ("GAUSSIAN_FIT_EVANESCENT_NM", "f32", f32_literal(GAUSSIAN_FIT_EVANESCENT_NM)),
         ("PBR_NEUTRAL_OFFSET", "f32", f32_literal(PBR_NEUTRAL_OFFSET)),
         ("PBR_NEUTRAL_START_COMPRESSION", "f32", f32_literal(PBR_NEUTRAL_START_COMPRESSION)),
         ("PBR_NEUTRAL_DESATURATION", "f32", f32_literal(PBR_NEUTRAL_DESATURATION)),
