@@ -95,13 +95,15 @@ struct Harmonics {
 }
 
 // As optics::fast::Film32: kappa1 = Im cos theta1 (> 0 beyond the critical angle of a film
-// less dense than the ambient, where there is no series and band_reflectance reads the exact
-// film), and the Fresnel amplitudes (r01 in xy, r12 in zw) of s and of p.
+// less dense than the ambient, where the wave in the film is evanescent), exact (the series is
+// not used and band_reflectance reads the exact film: evanescent, or |q|^2 >= MAX_Q2), and
+// the Fresnel amplitudes (r01 in xy, r12 in zw) of s and of p.
 struct Film {
     s: Harmonics,
     p: Harmonics,
     cos1: f32,
     kappa1: f32,
+    exact: bool,
     amplitudes_s: vec4<f32>,
     amplitudes_p: vec4<f32>,
 }
@@ -135,23 +137,37 @@ fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
     let b_s = r_s(n1, c1, n2, c2);
     let a_p = r_p(n0, c0, n1, c1);
     let b_p = r_p(n1, c1, n2, c2);
+    let s = harmonics(a_s, b_s);
+    let p = harmonics(a_p, b_p);
     var cos1 = 0.0;
     if (c1.y == 0.0) {
         cos1 = c1.x;
     }
-    return Film(harmonics(a_s, b_s), harmonics(a_p, b_p), cos1, c1.y, vec4<f32>(a_s, b_s), vec4<f32>(a_p, b_p));
+    let exact = !(c1.y == 0.0 && dot(s.q, s.q) < MAX_Q2 && dot(p.q, p.q) < MAX_Q2);
+    // Exactly at the film's critical angle the film has no phase: the bare n0|n2 interface
+    // (optics::fast::film_f32).
+    if (c1.x == 0.0 && c1.y == 0.0) {
+        let zero = vec2<f32>(0.0);
+        let bare_s = vec4<f32>(r_s(n0, c0, n2, c2), zero);
+        let bare_p = vec4<f32>(r_p(n0, c0, n2, c2), zero);
+        return Film(s, p, cos1, c1.y, exact, bare_s, bare_p);
+    }
+    return Film(s, p, cos1, c1.y, exact, vec4<f32>(a_s, b_s), vec4<f32>(a_p, b_p));
+}
+
+// One polarisation's exact reflectance |a + b e|^2 / |1 + a b e|^2 (optics::fast::
+// airy_reflectance_f32).
+fn airy_one(ab: vec4<f32>, e: vec2<f32>) -> f32 {
+    let num = ab.xy + cmul(ab.zw, e);
+    let den = vec2<f32>(1.0, 0.0) + cmul(cmul(ab.xy, ab.zw), e);
+    return dot(num, num) / dot(den, den);
 }
 
 // The exact coherent film at one wavelength (optics::fast::airy_reflectance_f32).
 fn airy_reflectance(f: Film, n1: f32, thickness_nm: f32, wavelength_nm: f32) -> f32 {
     let k = 4.0 * PI * n1 * thickness_nm / wavelength_nm;
     let e = vec2<f32>(cos(k * f.cos1), sin(k * f.cos1)) * exp(-k * f.kappa1);
-    let one = vec2<f32>(1.0, 0.0);
-    let ns = f.amplitudes_s.xy + cmul(f.amplitudes_s.zw, e);
-    let ds = one + cmul(cmul(f.amplitudes_s.xy, f.amplitudes_s.zw), e);
-    let np = f.amplitudes_p.xy + cmul(f.amplitudes_p.zw, e);
-    let dp = one + cmul(cmul(f.amplitudes_p.xy, f.amplitudes_p.zw), e);
-    return clamp(0.5 * (dot(ns, ns) / dot(ds, ds) + dot(np, np) / dot(dp, dp)), 0.0, 1.0);
+    return clamp(0.5 * (airy_one(f.amplitudes_s, e) + airy_one(f.amplitudes_p, e)), 0.0, 1.0);
 }
 
 fn sinc(x: f32) -> f32 {
@@ -180,9 +196,9 @@ fn series(h: Harmonics, phase: f32, box_width: f32) -> f32 {
 }
 
 // optics::fast::band_reflectance_f32: the prefiltered series, or the exact film where the
-// film's wave is evanescent.
+// series is not used (f.exact).
 fn band_reflectance(f: Film, n1: f32, thickness_nm: f32, wavelength_nm: f32, band_nm: f32) -> f32 {
-    if (f.kappa1 > 0.0) {
+    if (f.exact) {
         return airy_reflectance(f, n1, thickness_nm, wavelength_nm);
     }
     let phase = 4.0 * PI * n1 * thickness_nm * f.cos1 / wavelength_nm;
@@ -218,11 +234,23 @@ fn bb_lobes(phase: f32, arg: f32) -> vec4<f32> {
     return BB_AMP * cos(BB_POS * phase + vec4<f32>(arg)) * exp(-BB_VAR * phase * phase);
 }
 
+// 16 |D|^2 |q|^(2H) < (GAUSSIAN_FIT_MAX_REST (1 - |q|^2))^2, as optics::methods::gaussian_fit_f32.
+fn gaussian_fit_rest_is_small(h: Harmonics) -> bool {
+    let q2 = dot(h.q, h.q);
+    var q2h = 1.0;
+    for (var m = 0u; m < GAUSSIAN_FIT_HARMONICS; m++) {
+        q2h *= q2;
+    }
+    let allowed = GAUSSIAN_FIT_MAX_REST * (1.0 - q2);
+    return 16.0 * dot(h.d, h.d) * q2h < allowed * allowed;
+}
+
 fn film_gaussian_fit(thickness_nm: f32, cos0: f32) -> vec3<f32> {
     let n = film_info.iors_band;
     let f = film_coefficients(n.x, n.y, n.z, cos0);
-    if (f.kappa1 > 0.0) {
-        return vec3<f32>(airy_reflectance(f, n.y, thickness_nm, GAUSSIAN_FIT_EVANESCENT_NM));
+    // The harmonics left out, compared squared (optics::methods::GAUSSIAN_FIT_MAX_REST).
+    if (f.exact || !(gaussian_fit_rest_is_small(f.s) && gaussian_fit_rest_is_small(f.p))) {
+        return vec3<f32>(airy_reflectance(f, n.y, thickness_nm, GAUSSIAN_FIT_EXACT_NM));
     }
     let opd = 2.0 * n.y * thickness_nm * f.cos1;
     var xyz = vec3<f32>(0.5 * (f.s.c0 + f.p.c0));

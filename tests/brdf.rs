@@ -324,10 +324,14 @@ fn each_method_f32_agrees_with_its_f64_form() {
 }
 
 /// Beyond the critical angle of a film less dense than the ambient (n1 < n0) the wave in the
-/// film is evanescent and the film has no Fourier series (|r01| = 1). Its reflectance then
+/// film is evanescent and the film has no Fourier series in a real phase. Its reflectance then
 /// runs from the bare n0|n2 interface's at zero thickness (Fresnel, computed here) to 1 once
 /// the film is a few decay lengths thick (total internal reflection); every f32 method keeps
-/// both limits and agrees with its f64 form, which reads the exact film (`airy`) there.
+/// both limits and agrees with its f64 form, which reads the exact film (`airy`) there. At
+/// the f32 cosines next to the critical angle's every method stays finite and in [0, 1]
+/// (exactly at it q = 1, and rgb3 gave NaN for one f32 cosine of (1.5, 1.3, 1.4)); there
+/// the film's reflectance changes by 0.5 within 1e-7 of the cosine, which f32's cos θ1,
+/// (1 − η²) + η² cos²θ0 cancelling to nothing, cannot follow, so no agreement is asked.
 #[test]
 fn every_f32_method_reads_an_evanescent_film_exactly() {
     let fresnel = |n0: f64, n2: f64, cos0: f64| {
@@ -368,19 +372,27 @@ fn every_f32_method_reads_an_evanescent_film_exactly() {
                         "{name} {stack:?} θ {:.2}° d {d}: f32 {a:?} vs f64 {b:?} (ΔE {de})",
                         theta.to_degrees()
                     );
+                    // A film of no thickness is the bare interface, at every angle (inside
+                    // the critical angle too, where |q| → 1 as it nears: the Gaussian fit's
+                    // three harmonics read 0.98 for 0.08 there before it took the exact film;
+                    // below GAUSSIAN_FIT_MAX_Q their truncation is within 0.01).
+                    let bare = fresnel(stack.n0, stack.n2, cos0);
+                    let within = if name == "gaussian-fit" { 0.01 } else { 2e-3 };
+                    if d == 0.0 {
+                        for v in a {
+                            assert!((v as f64 - bare).abs() < within, "{name} {stack:?} θ {theta}: bare {bare}, {a:?}");
+                        }
+                    }
                     if !beyond {
                         continue;
                     }
                     evanescent_points += 1;
-                    let bare = fresnel(stack.n0, stack.n2, cos0);
-                    // The film's decay length at the longest wavelength read, λ / (4π n1 κ).
+                    // The film's decay length λ / (4π n1 κ) at the end of the visible range
+                    // (780 nm; spectral-32's last band is centred at 773 nm).
                     let kappa = ((stack.n0 / stack.n1 * theta.sin()).powi(2) - 1.0).sqrt();
-                    let decay_nm = 700.0 / (4.0 * std::f64::consts::PI * stack.n1 * kappa);
+                    let decay_nm = 780.0 / (4.0 * std::f64::consts::PI * stack.n1 * kappa);
                     for k in 0..3 {
                         let v = a[k] as f64;
-                        if d == 0.0 {
-                            assert!((v - bare).abs() < 2e-3, "{name} {stack:?} θ {theta}: bare {bare}, f32 {a:?}");
-                        }
                         if d > 8.0 * decay_nm {
                             assert!(v > 0.995, "{name} {stack:?} θ {theta} d {d}: not total reflection, {a:?}");
                         }
@@ -390,6 +402,23 @@ fn every_f32_method_reads_an_evanescent_film_exactly() {
         }
     }
     assert!(evanescent_points > 500, "{evanescent_points} points beyond the critical angle");
+    for stack in stacks {
+        let (n0, n1, n2) = (stack.n0 as f32, stack.n1 as f32, stack.n2 as f32);
+        let critical_cos = (1.0 - (stack.n1 / stack.n0).powi(2)).sqrt() as f32;
+        for ulps in -300i32..=300 {
+            let c = f32::from_bits((critical_cos.to_bits() as i32 + ulps) as u32);
+            for d in [0.0f32, 300.0, 1500.0] {
+                let methods = [
+                    ("rgb3", rgb3_f32(n0, n1, n2, d, c)),
+                    ("spectral-8", spectral_n_f32(n0, n1, n2, d, c, 8)),
+                    ("gaussian-fit", gaussian_fit_f32(n0, n1, n2, d, c)),
+                ];
+                for (name, a) in methods {
+                    assert!(a.iter().all(|v| (0.0..=1.0).contains(v)), "{name} {stack:?} cos {c} d {d}: {a:?}");
+                }
+            }
+        }
+    }
 }
 
 #[test]

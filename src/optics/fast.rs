@@ -1,8 +1,11 @@
 //! The f32 film kernels the real-time methods share, written as the WGSL twin will be:
-//! complex numbers as `[f32; 2]`, no allocation, no branches on data beyond clamps.
+//! complex numbers as `[f32; 2]`, no allocation, few branches on data (the series' three
+//! regimes, and the exact film where the series is not used).
 //!
 //! `harmonics_f32` computes the same Fourier coefficients as `series::FilmSeries` and
 //! `reflectance_f32` sums the prefiltered series (see `series.rs` for the derivation).
+
+use super::series::MAX_Q;
 
 pub type C32 = [f32; 2];
 
@@ -56,22 +59,19 @@ pub struct Film32 {
     pub p: Harmonics32,
     pub cos1: f32,
     /// Im cos θ1: 0 while the film's wave travels, positive beyond the critical angle of a film
-    /// less dense than the ambient (n1 < n0), where the wave in the film is evanescent. There
-    /// |r01| = 1, so |q| = 1 and the series does not exist: `band_reflectance_f32` reads the
-    /// exact film instead, whose reflectance then climbs from the bare n0|n2 interface's at
-    /// zero thickness to 1 within a fraction of a wavelength (frustrated total reflection).
+    /// less dense than the ambient (n1 < n0), where the wave in the film is evanescent: the
+    /// round-trip phase is imaginary and the series in it does not exist. The exact film there
+    /// climbs from the bare n0|n2 interface's reflectance at zero thickness towards 1 (total
+    /// reflection) over a few decay lengths λ / (4π n1 κ): the further beyond the critical
+    /// angle, the thinner the film that reflects everything.
     pub kappa1: f32,
+    /// True where the series is not used and `band_reflectance_f32` reads the exact film: the
+    /// f64 rule (`series::FilmSeries::usable`), an evanescent film or |q| ≥ `MAX_Q` (the
+    /// film's own critical angle, where |q| → 1, and exactly at it q = 1).
+    pub exact: bool,
     /// The Fresnel amplitudes [r01, r12] of s and of p (the exact film's, `airy_reflectance_f32`).
     pub amplitudes_s: [C32; 2],
     pub amplitudes_p: [C32; 2],
-}
-
-impl Film32 {
-    /// True beyond the film's critical angle (see `kappa1`).
-    #[inline]
-    pub fn evanescent(&self) -> bool {
-        self.kappa1 > 0.0
-    }
 }
 
 /// Floor on 1 − |q|² in the harmonics' normalisation: |q| < 1 for any physical interface
@@ -85,6 +85,8 @@ pub const SINC_SMALL: f32 = 1e-4;
 pub const BOX_NARROW_RAD: f32 = 1e-3;
 /// |q|² below this: the series is a single term (no multiple reflections to sum).
 pub const Q_NEGLIGIBLE: f32 = 1e-12;
+/// |q|² at or above this: the series is not used (`Film32::exact`), `series::MAX_Q` squared.
+pub const MAX_Q2_F32: f32 = (MAX_Q * MAX_Q) as f32;
 
 #[inline]
 fn harmonics(a: C32, b: C32) -> Harmonics32 {
@@ -113,13 +115,25 @@ pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
     };
     let (a_s, a_p) = r(n0, c0, n1, c1);
     let (b_s, b_p) = r(n1, c1, n2, c2);
+    let (s, p) = (harmonics(a_s, b_s), harmonics(a_p, b_p));
+    // Exactly at the film's critical angle (cos θ1 = 0: r01 = 1, r12 = −1, and the exact film
+    // divides 0 by 0) the film has no phase at any thickness, and a film without phase is
+    // the bare n0|n2 interface ((r01 + r12) / (1 + r01 r12) = r02): its amplitudes, with no
+    // second face.
+    let (amplitudes_s, amplitudes_p) = if c1 == [0.0, 0.0] {
+        let (r02_s, r02_p) = r(n0, c0, n2, c2);
+        ([r02_s, [0.0; 2]], [r02_p, [0.0; 2]])
+    } else {
+        ([a_s, b_s], [a_p, b_p])
+    };
     Film32 {
-        s: harmonics(a_s, b_s),
-        p: harmonics(a_p, b_p),
+        s,
+        p,
         cos1: if c1[1] == 0.0 { c1[0] } else { 0.0 },
         kappa1: c1[1],
-        amplitudes_s: [a_s, b_s],
-        amplitudes_p: [a_p, b_p],
+        exact: !(c1[1] == 0.0 && norm_sqr(s.q) < MAX_Q2_F32 && norm_sqr(p.q) < MAX_Q2_F32),
+        amplitudes_s,
+        amplitudes_p,
     }
 }
 
@@ -168,6 +182,9 @@ pub fn phase_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32) 
 /// The exact coherent film at one wavelength (Airy, as `film::airy`'s reflectance), unpolarised:
 /// r = (r01 + r12 e) / (1 + r01 r12 e) per polarisation, e = exp(2iβ), β = 2π n1 d cos θ1 / λ,
 /// which for an evanescent film (cos θ1 = i κ) is the real decay exp(−4π n1 d κ / λ).
+/// 1 + r01 r12 e ≠ 0: it would need |r01| = |r12| = |e| = 1, a travelling wave with both faces
+/// reflecting totally, which only cos θ1 = 0 gives, and there `film_f32` holds the bare
+/// interface's amplitude instead.
 #[inline]
 pub fn airy_reflectance_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32) -> f32 {
     let k = 4.0 * std::f32::consts::PI * n1 * thickness_nm / wavelength_nm;
@@ -177,11 +194,11 @@ pub fn airy_reflectance_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelengt
 }
 
 /// The film's reflectance over a band of `band_nm` around `wavelength_nm`: the prefiltered
-/// series, or beyond the film's critical angle (no series) the exact film at the band's centre,
-/// which varies slowly with the wavelength there. The twin of `methods::band_reflectance_f64`.
+/// series, or where it is not used (`Film32::exact`) the exact film at the band's centre, as
+/// the twin `methods::band_reflectance_f64` does.
 #[inline]
 pub fn band_reflectance_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32, band_nm: f32) -> f32 {
-    if film.evanescent() {
+    if film.exact {
         return airy_reflectance_f32(film, n1, thickness_nm, wavelength_nm);
     }
     let phase = phase_f32(film, n1, thickness_nm, wavelength_nm);

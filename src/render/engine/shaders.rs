@@ -15,10 +15,11 @@ use crate::optics::brdf::energy::{
 };
 use crate::optics::brdf::path::THROUGH_NODES;
 use crate::optics::brdf::{ALPHA_MIN, COS_MIN, LENGTH_MIN, Model};
-use crate::optics::fast::{BOX_NARROW_RAD, HARMONICS_DENOM_MIN, Q_NEGLIGIBLE, SINC_SMALL};
+use crate::optics::fast::{BOX_NARROW_RAD, HARMONICS_DENOM_MIN, MAX_Q2_F32, Q_NEGLIGIBLE, SINC_SMALL};
 use crate::optics::lut::{COARSE_MAX_NM, FINE_MAX_NM};
 use crate::optics::methods::{
-    BB_LOBES, BB_METRES_PER_NM, GAUSSIAN_FIT_EVANESCENT_NM, GAUSSIAN_FIT_HARMONICS, RGB3_BAND_NM, RGB3_NM, bb_amplitude,
+    BB_LOBES, BB_METRES_PER_NM, GAUSSIAN_FIT_EXACT_NM, GAUSSIAN_FIT_HARMONICS, GAUSSIAN_FIT_MAX_REST, RGB3_BAND_NM,
+    RGB3_NM, bb_amplitude,
 };
 use crate::render::engine::scene::{BOUNCE_THICKNESSES, SCENE_LIGHTS};
 
@@ -71,6 +72,7 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("SINC_SMALL", "f32", f32_literal(SINC_SMALL as f64)),
         ("BOX_NARROW_RAD", "f32", f32_literal(BOX_NARROW_RAD as f64)),
         ("Q_NEGLIGIBLE", "f32", f32_literal(Q_NEGLIGIBLE as f64)),
+        ("MAX_Q2", "f32", f32_literal(MAX_Q2_F32 as f64)),
         ("RGB3_NM", "vec3<f32>", vec3_literal(RGB3_NM.map(f64::from))),
         ("RGB3_BAND_NM", "f32", f32_literal(RGB3_BAND_NM as f64)),
         // Belcour–Barla lobes as (X, Y, Z, X's second lobe).
@@ -82,7 +84,8 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         // The scene's directional lights (render::engine::scene::Lighting::lights).
         ("SCENE_LIGHTS", "u32", format!("{SCENE_LIGHTS}u")),
         ("GAUSSIAN_FIT_HARMONICS", "u32", format!("{GAUSSIAN_FIT_HARMONICS}u")),
-        ("GAUSSIAN_FIT_EVANESCENT_NM", "f32", f32_literal(GAUSSIAN_FIT_EVANESCENT_NM)),
+        ("GAUSSIAN_FIT_EXACT_NM", "f32", f32_literal(GAUSSIAN_FIT_EXACT_NM)),
+        ("GAUSSIAN_FIT_MAX_REST", "f32", f32_literal(GAUSSIAN_FIT_MAX_REST)),
         ("PBR_NEUTRAL_OFFSET", "f32", f32_literal(PBR_NEUTRAL_OFFSET)),
         ("PBR_NEUTRAL_START_COMPRESSION", "f32", f32_literal(PBR_NEUTRAL_START_COMPRESSION)),
         ("PBR_NEUTRAL_DESATURATION", "f32", f32_literal(PBR_NEUTRAL_DESATURATION)),
