@@ -299,6 +299,50 @@ pub struct JobLines {
     pub sizes: Option<usize>,
 }
 
+/// A jobs file's error in its reader's words (`toml_text::describe`), its key counted as the
+/// other messages count jobs and items (from 1).
+fn jobs_file_error(path: &Path, described: crate::toml_text::Described) -> BatchError {
+    let (line, column) = described.line_column.unwrap_or((1, 1));
+    // `job.0.sizes` is the first [[job]] table's `sizes`: "[[job]] 1", as the other
+    // messages count the tables.
+    // A job's own key (`job.2`: a missing field) is the table itself, and an item of a
+    // list (`sizes.0`) is counted from 1 as well.
+    let in_job =
+        described.key.as_deref().and_then(|k| k.strip_prefix("job.")).map(|k| k.split_once('.').unwrap_or((k, "")));
+    let message = match in_job.and_then(|(index, key)| Some((index.parse::<usize>().ok()? + 1, key))) {
+        // A size the type cannot hold (`-64`) said "a whole number from 0 to
+        // 18446744073709551615": the size's own range, as for a size in the type's.
+        Some((job, key))
+            if let Some(value) = crate::toml_text::integer_out_of_type(&described.message)
+                && key.starts_with("sizes.") =>
+        {
+            format!("[[job]] {job}: key `sizes`: {}", size_refused(value))
+        }
+        Some((job, key))
+            if let Some(value) = crate::toml_text::integer_out_of_type(&described.message)
+                && key.starts_with("seeds.") =>
+        {
+            format!("[[job]] {job}: key `seeds`: {}", seed_refused(value))
+        }
+        Some((job, "")) if described.message == "missing field `preset`" => {
+            format!("[[job]] {job}: {}: every job names its preset, built-in or a .toml file", described.message)
+        }
+        Some((job, "")) => format!("[[job]] {job}: {}", described.message),
+        Some((job, key)) => {
+            match key.split_once('.').and_then(|(list, item)| Some((list, item.parse::<usize>().ok()?))) {
+                Some((list, item)) => format!("[[job]] {job}: key `{list}`, item {}: {}", item + 1, described.message),
+                None => format!("[[job]] {job}: key `{key}`: {}", described.message),
+            }
+        }
+        // `[job]`: one table where the file needs an array of them.
+        None if described.key.as_deref() == Some("job") && described.message.starts_with("invalid type: table") => {
+            "write each job as a [[job]] table (double brackets: a list of jobs); [job] is a single table".into()
+        }
+        None => described.keyed_message(),
+    };
+    BatchError::Parse { path: path.into(), line, column, message }
+}
+
 /// Reads and expands a jobs file; every value is checked before any job runs.
 pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     use crate::text_file::BoundedReadError;
@@ -307,49 +351,11 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         BoundedReadError::NotAFile(kind) => BatchError::NotAFile { path: path.into(), kind },
         BoundedReadError::TooLarge(size) => BatchError::TooLarge { path: path.into(), size, limit: MAX_FILE_BYTES },
     })?;
-    let file: JobsFile = toml::from_str(&text).map_err(|e| {
-        let described = crate::toml_text::describe(&text, &e);
-        let (line, column) = described.line_column.unwrap_or((1, 1));
-        // `job.0.sizes` is the first [[job]] table's `sizes`: "[[job]] 1", as the other
-        // messages count the tables.
-        // A job's own key (`job.2`: a missing field) is the table itself, and an item of a
-        // list (`sizes.0`) is counted from 1 as well.
-        let in_job =
-            described.key.as_deref().and_then(|k| k.strip_prefix("job.")).map(|k| k.split_once('.').unwrap_or((k, "")));
-        let message = match in_job.and_then(|(index, key)| Some((index.parse::<usize>().ok()? + 1, key))) {
-            // A size the type cannot hold (`-64`) said "a whole number from 0 to
-            // 18446744073709551615": the size's own range, as for a size in the type's.
-            Some((job, key))
-                if let Some(value) = crate::toml_text::integer_out_of_type(&described.message)
-                    && key.starts_with("sizes.") =>
-            {
-                format!("[[job]] {job}: key `sizes`: {}", size_refused(value))
-            }
-            Some((job, key))
-                if let Some(value) = crate::toml_text::integer_out_of_type(&described.message)
-                    && key.starts_with("seeds.") =>
-            {
-                format!("[[job]] {job}: key `seeds`: {}", seed_refused(value))
-            }
-            Some((job, "")) if described.message == "missing field `preset`" => {
-                format!("[[job]] {job}: {}: every job names its preset, built-in or a .toml file", described.message)
-            }
-            Some((job, "")) => format!("[[job]] {job}: {}", described.message),
-            Some((job, key)) => match key
-                .split_once('.')
-                .and_then(|(list, item)| Some((list, item.parse::<usize>().ok()?)))
-            {
-                Some((list, item)) => format!("[[job]] {job}: key `{list}`, item {}: {}", item + 1, described.message),
-                None => format!("[[job]] {job}: key `{key}`: {}", described.message),
-            },
-            // `[job]`: one table where the file needs an array of them.
-            None if described.key.as_deref() == Some("job") && described.message.starts_with("invalid type: table") => {
-                "write each job as a [[job]] table (double brackets: a list of jobs); [job] is a single table".into()
-            }
-            None => described.keyed_message(),
-        };
-        BatchError::Parse { path: path.into(), line, column, message }
-    })?;
+    let file: JobsFile =
+        toml::from_str(&text).map_err(|e| jobs_file_error(path, crate::toml_text::describe(&text, &e)))?;
+    if let Some(underflow) = crate::toml_text::underflowing_float(&text) {
+        return Err(jobs_file_error(path, underflow));
+    }
     if file.job.is_empty() {
         return Err(BatchError::Empty { path: path.into() });
     }

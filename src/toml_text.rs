@@ -311,6 +311,56 @@ impl<'a> KeyLines<'a> {
     }
 }
 
+/// True where `written`, a decimal number as written (a TOML float without its underscores,
+/// a flag's value), is not zero but reads as 0: nearer 0 than a 64-bit float holds (about
+/// 2.5e-324). Such a number was read as 0 without a word (`between_scales = 1e-400`, even
+/// where 0 is out of range: "got 0"), while one too large for a float is refused.
+pub fn underflows(written: &str) -> bool {
+    let mantissa = written.split(['e', 'E']).next().unwrap_or_default();
+    written.trim().parse::<f64>() == Ok(0.0) && mantissa.chars().any(|c| ('1'..='9').contains(&c))
+}
+
+/// What is said of a number that underflows (`underflows`).
+pub fn underflow_message(written: &str) -> String {
+    format!(
+        "`{}` is nearer 0 than a 64-bit float holds (the nearest is about 5e-324) and would be read as 0: write 0, \
+         or a number the key accepts",
+        written.trim()
+    )
+}
+
+/// The first float written in `text` that underflows (`underflows`), located and keyed as the
+/// reader's errors are (`describe`); `None` where there is none or the text does not parse
+/// (the reader's own error then says why).
+pub fn underflowing_float(text: &str) -> Option<Described> {
+    fn in_value(value: &toml::Spanned<DeValue>) -> Option<(String, Range<usize>, String)> {
+        match value.get_ref() {
+            DeValue::Float(f) if underflows(f.as_str()) => Some((String::new(), value.span(), f.as_str().to_string())),
+            DeValue::Table(t) => in_table(t),
+            DeValue::Array(items) => items.iter().enumerate().find_map(|(i, item)| {
+                let (key, span, written) = in_value(item)?;
+                Some((joined(&i.to_string(), key), span, written))
+            }),
+            _ => None,
+        }
+    }
+    fn in_table(table: &DeTable) -> Option<(String, Range<usize>, String)> {
+        table.iter().find_map(|(key, value)| {
+            let (rest, span, written) = in_value(value)?;
+            Some((joined(key.get_ref(), rest), span, written))
+        })
+    }
+    let root = DeTable::parse(text).ok()?;
+    let (key, span, _) = in_table(root.get_ref())?;
+    // The message quotes the number as written, underscores and all.
+    let written = text.get(span.clone()).unwrap_or_default();
+    Some(Described {
+        line_column: Some(line_column(text, span.start)),
+        key: Some(key),
+        message: underflow_message(written),
+    })
+}
+
 /// The dotted key (`scales.rows`, `pattern.1.colors.0`) whose value is written over byte
 /// `offset` of `text`: the key a type error's span points into.
 fn key_at(text: &str, offset: usize) -> Option<String> {
@@ -342,6 +392,23 @@ fn joined(key: &str, rest: String) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// What reads as 0 though it is not 0 underflows; 0 however written, the smallest float,
+    /// numbers too large and words do not.
+    #[test]
+    fn underflow_is_a_nonzero_number_read_as_zero() {
+        for tiny in ["1e-400", "-1e-400", "+2.5E-330", "0.001e-322", "1e-324", " 3e-999 "] {
+            assert!(underflows(tiny), "{tiny}");
+        }
+        for not in ["0", "-0.0", "0e-400", "0.000E-5", "5e-324", "1e-300", "1e400", "inf", "nan", "e", "", "1e-4x00"] {
+            assert!(!underflows(not), "{not}");
+        }
+        let text = "seed = 1\n[optics]\nabsorption = [0.5, 1_0e-401, 0.0]\n";
+        let found = underflowing_float(text).expect("one underflows");
+        assert_eq!((found.line_column, found.key.as_deref()), (Some((3, 20)), Some("optics.absorption.1")));
+        assert!(found.message.starts_with("`1_0e-401` is nearer 0"), "{}", found.message);
+        assert!(underflowing_float("seed = 1\n[optics]\nabsorption = [0.5, 1e-300, 0.0]\n").is_none());
+    }
 
     /// A date where a number goes was called a table (toml's form of a date).
     #[test]

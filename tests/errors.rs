@@ -265,6 +265,52 @@ fn a_number_far_out_of_range_is_printed_short() {
     assert!(refused("near.toml", "seed = 1\n[optics]\nfilm_ior = 3.5\n", &[]).contains("got 3.5"));
 }
 
+/// A number nearer 0 than a 64-bit float holds was read as 0 without a word, where one too
+/// large is refused: `between_scales = 1e-400` drew what 0 draws, `size = 2.4e-400` said "got
+/// 0", a number never written. It is refused with its line and key in a preset, in `--set`,
+/// in a jobs file and on a `brdf --batch` line. Negative controls: 0 written out, and the
+/// smallest float.
+#[test]
+fn a_number_that_underflows_is_refused_not_read_as_zero() {
+    let says = "`1e-400` is nearer 0 than a 64-bit float holds";
+    let err = refused("tiny.toml", "seed = 1\n[color]\nbetween_scales = 1e-400\n", &[]);
+    assert!(
+        err.contains("tiny.toml:3:18") && err.contains("key `color.between_scales`") && err.contains(says),
+        "{err}"
+    );
+    let err = refused("list.toml", "[optics]\nabsorption = [0.1, 1e-400, 0.2]\n", &[]);
+    assert!(err.contains("list.toml:2:") && err.contains("key `optics.absorption.1`") && err.contains(says), "{err}");
+    let err = refused("plain.toml", "seed = 1\n", &["--set", "color.between_scales=1e-400"]);
+    assert!(err.contains("invalid --set \"color.between_scales=1e-400\"") && err.contains(says), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nset = { \"scales.size\" = 1e-400 }\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("out").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("jobs.toml:3:") && stderr(&out).contains(says), "{}", stderr(&out));
+    assert!(!dir.path().join("out").exists());
+    use std::io::Write;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["brdf", "film", "--batch", "-"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let lines = b"{\"thickness_nm\": 5e-324, \"wavelength_nm\": 550, \"angle_deg\": 0}\n\
+                  {\"thickness_nm\": 1e-400, \"wavelength_nm\": 550, \"angle_deg\": 0}\n";
+    child.stdin.take().unwrap().write_all(lines).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("-:2: ") && stderr(&out).contains(says), "{}", stderr(&out));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1, "the first line's answer");
+    // Negative controls: 0 however written, and the smallest float, are numbers.
+    accepted("natrix-natrix", &["--set", "color.between_scales=0e-400", "--set", "optics.absorption=5e-324"]);
+    let presets = tempfile::tempdir().unwrap();
+    let path = write_preset(presets.path(), "zero.toml", "seed = 1\n[color]\nbetween_scales = 0.000e-400\n");
+    accepted(&path, &[]);
+}
+
 /// A whole number the key's type cannot hold (negative, or past 2³²) is refused with the
 /// key's range, the one the range check gives a whole number in the type's (it said "from 0
 /// to 4294967295", the type's range). Each key is checked both ways, so the two ranges are

@@ -190,6 +190,9 @@ pub fn parse_with_seed(
     seed: Option<u64>,
 ) -> Result<LoadedPreset, PresetError> {
     let file_preset: Preset = toml::from_str(&source.text).map_err(|e| parse_error(source, &e))?;
+    if let Some(underflow) = toml_text::underflowing_float(&source.text) {
+        return Err(located_error(source, underflow));
+    }
     let file_seed = file_preset.seed;
     let (seed_overrides, overrides): (Vec<_>, Vec<_>) = overrides.iter().cloned().partition(|(key, _)| key == "seed");
     let overridden_seed = match seed_overrides.last() {
@@ -293,19 +296,29 @@ struct WithoutSeed {
     rest: toml::Table,
 }
 
-/// The value of `--set seed=VALUE`: a whole number from 0 to 2^64 − 1, as one TOML integer
-/// (as `apply_override` reads a value) or, beyond TOML's 2^63 − 1, in decimal digits; the
-/// range check then refuses what lies beyond the seed's range.
-fn seed_override(value: &str) -> Result<u64, PresetError> {
-    let parsed = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+/// A seed as written on the command line, by `--seed` or `--set seed=`, which take the same
+/// spellings: decimal digits (leading zeros and numbers beyond TOML's 2^63 − 1 included, up
+/// to 2^64 − 1) or one TOML integer (`0x10`, `0o20`, `0b10000`, `1_000`, `+16`). `None` for
+/// anything else; the caller checks the seed's range. (`--seed` took decimal digits only and
+/// `--set seed=` TOML only: `0x10` was refused by one and `0016` by the other.)
+pub fn parse_seed_text(text: &str) -> Option<u64> {
+    let word = text.trim();
+    if !word.is_empty() && word.bytes().all(|b| b.is_ascii_digit()) {
+        return word.parse::<u64>().ok();
+    }
+    match toml::from_str::<toml::Table>(&format!("v = {word}")) {
         Ok(table) if table.len() == 1 => match table.get("v") {
             Some(toml::Value::Integer(i)) => u64::try_from(*i).ok(),
             _ => None,
         },
-        Ok(_) => None,
-        Err(_) => value.trim().parse::<u64>().ok().filter(|seed| *seed > i64::MAX as u64),
-    };
-    parsed.ok_or_else(|| PresetError::Override {
+        _ => None,
+    }
+}
+
+/// The value of `--set seed=VALUE` (`parse_seed_text`); the range check then refuses what lies
+/// beyond the seed's range.
+fn seed_override(value: &str) -> Result<u64, PresetError> {
+    parse_seed_text(value).ok_or_else(|| PresetError::Override {
         argument: format!("seed={value}"),
         message: format!("the seed must be a whole number in {}", super::validate::seed_range_words()),
     })
@@ -318,7 +331,12 @@ fn canonical_text(preset: &Preset) -> String {
 }
 
 fn parse_error(source: &PresetSource, error: &toml::de::Error) -> PresetError {
-    let mut described = toml_text::describe(&source.text, error);
+    located_error(source, toml_text::describe(&source.text, error))
+}
+
+/// An error in a preset file's text, at its line and column, under the key the range checks
+/// would name.
+fn located_error(source: &PresetSource, mut described: toml_text::Described) -> PresetError {
     // A single `[pattern]` table is layer 0, as the range checks name it: `pattern.0.amount`.
     if let Some(rest) = described.key.as_deref().and_then(|k| k.strip_prefix("pattern."))
         && rest.split('.').next().is_none_or(|s| s.parse::<usize>().is_err())
@@ -698,7 +716,9 @@ fn override_value(value: &str) -> Result<toml::Value, String> {
         return Err("the value is empty: write one after `=` (empty text is written 'KEY=\"\"')".into());
     }
     // One TOML value, nothing else: the table must hold exactly the key `v`.
-    match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+    let as_toml = format!("v = {value}");
+    match toml::from_str::<toml::Table>(&as_toml) {
+        Ok(_) if let Some(underflow) = crate::toml_text::underflowing_float(&as_toml) => Err(underflow.message),
         Ok(mut t) if t.len() == 1 => Ok(t.remove("v").unwrap_or(toml::Value::String(value.into()))),
         Ok(_) => Err("the value must be a single TOML value".into()),
         Err(e) => {
@@ -864,7 +884,9 @@ mod tests {
         assert_eq!(set_seed("9007199254740991").unwrap().preset.seed, SEED_MAX);
         assert_eq!(set_seed("9_000").unwrap().preset.seed, 9000);
         assert_eq!(set_seed("0x10").unwrap().preset.seed, 16);
-        for bad in ["18446744073709551616", "-1", "1.5", "\"7\"", "seven", "", "007", "1\nscales.rows = 5"] {
+        // Leading zeros, as `--seed` takes them (`parse_seed_text`), though TOML does not.
+        assert_eq!(set_seed("007").unwrap().preset.seed, 7);
+        for bad in ["18446744073709551616", "-1", "1.5", "\"7\"", "seven", "", "1\nscales.rows = 5"] {
             let err = set_seed(bad).unwrap_err().to_string();
             assert!(
                 err.contains(&format!("{:?}", format!("seed={bad}"))) && err.contains("in [0, 9007199254740991]"),

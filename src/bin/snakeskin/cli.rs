@@ -250,8 +250,25 @@ pub struct PresetSource {
     pub overrides: Vec<(String, String)>,
     /// Override the preset's seed: a whole number from 0 to 9007199254740991 (2^53 - 1, the
     /// largest that the JSON files recording it keep exactly in every reader).
-    #[arg(long, value_parser = ranged_u64(0, ranges::SEED_MAX))]
+    #[arg(long, value_parser = parse_seed)]
     pub seed: Option<u64>,
+}
+
+/// `--seed`: the spellings `--set seed=` takes (`preset::parse_seed_text`), inside
+/// `ranges::SEED_MAX`, refused as `ranged_u64` refuses a number (a negative one with itself).
+fn parse_seed(text: &str) -> Result<u64, String> {
+    let decimal = ranged_u64(0, ranges::SEED_MAX)(text);
+    if decimal.is_ok() || text.trim().parse::<i128>().is_ok() {
+        return decimal;
+    }
+    match snakeskin::preset::parse_seed_text(text) {
+        Some(seed) if seed <= ranges::SEED_MAX => Ok(seed),
+        Some(seed) => Err(format!("{seed} is not in 0..={}", ranges::SEED_MAX)),
+        None => Err(format!(
+            "not a whole number; accepted: 0..={} (decimal, or a TOML integer: 0x10, 0o20, 0b10000, 1_000)",
+            ranges::SEED_MAX
+        )),
+    }
 }
 
 #[derive(Debug, Args)]
@@ -948,6 +965,11 @@ fn parse_gpu_method(text: &str) -> Result<GpuFilmMethod, String> {
 /// A finite number inside `lo..=hi`, for the flags that take one; `-0` is read as 0 (an
 /// answer computed from it printed `-0.0`).
 fn bounded(text: &str, (lo, hi): (f64, f64)) -> Result<f64, String> {
+    if snakeskin::toml_text::underflows(text) {
+        return Err(
+            snakeskin::toml_text::underflow_message(text).replace("the key accepts", &format!("in [{lo}, {hi}]"))
+        );
+    }
     match text.trim().parse::<f64>() {
         // Adding 0 turns -0 into +0 and leaves every other number as it is (IEEE 754).
         Ok(v) if v.is_finite() && (lo..=hi).contains(&v) => Ok(v + 0.0),
@@ -1014,6 +1036,9 @@ fn parse_albedo(text: &str) -> Result<[f64; 3], String> {
 }
 
 fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
+    if let Some(tiny) = text.split(',').find(|p| snakeskin::toml_text::underflows(p)) {
+        return Err(snakeskin::toml_text::underflow_message(tiny).replace("a number the key accepts", "a larger one"));
+    }
     let parts: Vec<f64> = text
         .split(',')
         .map(|p| p.trim().parse::<f64>().map_err(|_| format!("expected x,y,z numbers, got {text:?}")))
@@ -1094,6 +1119,47 @@ mod tests {
         }
         for args in [&["--window", "--frames", "5"][..], &["--out", "a.png", "--exposure", "1e-6"]] {
             preview(args).unwrap();
+        }
+    }
+
+    /// `--seed` and `--set seed=` take the same spellings (README: `--set seed=` is `--seed`):
+    /// `0x10` was refused by the flag and `0016` by the override. Negative controls: what is
+    /// not a whole number, or lies beyond the seed's range, is refused by both.
+    #[test]
+    fn the_seed_flag_and_the_seed_override_take_the_same_spellings() {
+        let source = snakeskin::preset::read_source("natrix-natrix").unwrap();
+        let by_override = |text: &str| {
+            snakeskin::preset::parse(&source, &[("seed".into(), text.into())]).map(|loaded| loaded.preset.seed)
+        };
+        for text in ["16", "0016", "0x10", "0o20", "0b10000", "+16", "1_6", " 16 "] {
+            assert_eq!(parse_seed(text), Ok(16), "--seed {text}");
+            assert_eq!(by_override(text).ok(), Some(16), "--set seed={text}");
+        }
+        for text in ["1.6", "0x", "sixteen", "", "-16", "-0x10", "1e3", "9007199254740992", "0x20000000000000"] {
+            assert!(parse_seed(text).is_err(), "--seed {text} was accepted");
+            assert!(by_override(text).is_err(), "--set seed={text} was accepted");
+        }
+    }
+
+    /// A number nearer 0 than a float holds was read as 0 by every flag that takes a number
+    /// (`--thickness-nm 1e-400`: a bare interface, without a word). Negative controls: 0 and the
+    /// smallest float are numbers.
+    #[test]
+    fn a_flags_number_that_underflows_is_refused() {
+        let parse = |args: &[&str]| {
+            let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
+            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
+        };
+        let film = ["brdf", "film", "--wavelength-nm", "550", "--angle-deg", "0", "--thickness-nm"];
+        for tiny in ["1e-400", "2.5E-330", "0.1e-330"] {
+            let error = parse(&[&film[..], &[tiny]].concat()).expect_err(tiny);
+            assert!(error.contains("is nearer 0 than a 64-bit float holds"), "{error}");
+            let eval = ["brdf", "eval", "--wi", "0,0,1", "--wo"];
+            let error = parse(&[&eval[..], &[&format!("1,0,-{tiny}")]].concat()).expect_err(tiny);
+            assert!(error.contains("is nearer 0 than a 64-bit float holds"), "{error}");
+        }
+        for fine in ["0", "0.0", "-0", "0e-400", "5e-324"] {
+            parse(&[&film[..], &[fine]].concat()).unwrap_or_else(|e| panic!("{fine}: {e}"));
         }
     }
 

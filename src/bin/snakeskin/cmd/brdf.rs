@@ -224,6 +224,10 @@ fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> 
                 message.strip_suffix(&format!(" at line {} column {}", e.line(), e.column())).unwrap_or(&message);
             at(format!("{message} (column {})", e.column()))
         })?;
+        // serde_json reads a number nearer 0 than a float holds as 0, without a word.
+        if let Some(tiny) = underflowing_json_number(line) {
+            return Err(at(snakeskin::toml_text::underflow_message(tiny).replace("the key", "the field")).into());
+        }
         // The query's own refusal is already `Error::Query`: the line is added, not a second
         // "invalid query:".
         let json = per_line(&query).map_err(|e| match e.downcast::<Error>() {
@@ -236,6 +240,31 @@ fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> 
         writeln!(out, "{json}").map_err(|e| anyhow::anyhow!("cannot write to standard output: {e}"))?;
     }
     Ok(())
+}
+
+/// The first number outside the strings of a JSON line that underflows to 0
+/// (`toml_text::underflows`).
+fn underflowing_json_number(line: &str) -> Option<&str> {
+    let (mut in_string, mut escaped, mut start) = (false, false, None);
+    for (i, c) in line.char_indices().chain(std::iter::once((line.len(), ' '))) {
+        if in_string {
+            (escaped, in_string) = (!escaped && c == '\\', escaped || c != '"');
+            continue;
+        }
+        let numeric = c.is_ascii_digit() || matches!(c, '-' | '+' | '.' | 'e' | 'E');
+        match (start, numeric) {
+            (None, true) => start = Some(i),
+            (Some(s), false) => {
+                if snakeskin::toml_text::underflows(&line[s..i]) {
+                    return Some(&line[s..i]);
+                }
+                start = None;
+            }
+            _ => {}
+        }
+        in_string = c == '"';
+    }
+    None
 }
 
 pub fn run(command: BrdfCommand) -> Result<()> {
