@@ -130,8 +130,20 @@ fn r_p(ni: f32, ci: vec2<f32>, nj: f32, cj: vec2<f32>) -> vec2<f32> {
 
 fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
     let cos0 = clamp(cos0_in, 0.0, 1.0);
+    if (cos0 * cos0 < F32_MIN_POSITIVE) {
+        // Grazing light is all reflected (optics::fast::film_f32).
+        let none = Harmonics(1.0, vec2<f32>(0.0), vec2<f32>(0.0));
+        let reflects_all = vec4<f32>(1.0, 0.0, 0.0, 0.0);
+        return Film(none, none, 0.0, 0.0, true, reflects_all, reflects_all);
+    }
     let c0 = vec2<f32>(cos0, 0.0);
-    let c1 = cos_in(n0 / n1, cos0);
+    // Off exactly 0 at the film's critical angle (optics::fast::film_f32).
+    let eta1 = n0 / n1;
+    var x1 = (1.0 - eta1 * eta1) + eta1 * eta1 * cos0 * cos0;
+    if (x1 == 0.0) {
+        x1 = F32_EPSILON * abs(1.0 - eta1 * eta1);
+    }
+    let c1 = csqrt_real(x1);
     let c2 = cos_in(n0 / n2, cos0);
     let a_s = r_s(n0, c0, n1, c1);
     let b_s = r_s(n1, c1, n2, c2);
@@ -144,14 +156,6 @@ fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
         cos1 = c1.x;
     }
     let exact = !(c1.y == 0.0 && dot(s.q, s.q) < MAX_Q2 && dot(p.q, p.q) < MAX_Q2);
-    // Exactly at the film's critical angle the film has no phase: the bare n0|n2 interface
-    // (optics::fast::film_f32).
-    if (c1.x == 0.0 && c1.y == 0.0) {
-        let zero = vec2<f32>(0.0);
-        let bare_s = vec4<f32>(r_s(n0, c0, n2, c2), zero);
-        let bare_p = vec4<f32>(r_p(n0, c0, n2, c2), zero);
-        return Film(s, p, cos1, c1.y, exact, bare_s, bare_p);
-    }
     return Film(s, p, cos1, c1.y, exact, vec4<f32>(a_s, b_s), vec4<f32>(a_p, b_p));
 }
 

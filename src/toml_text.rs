@@ -320,18 +320,22 @@ pub fn underflows(written: &str) -> bool {
     written.trim().parse::<f64>() == Ok(0.0) && mantissa.chars().any(|c| ('1'..='9').contains(&c))
 }
 
-/// What is said of a number that underflows (`underflows`).
-pub fn underflow_message(written: &str) -> String {
+/// What is said of a number that underflows (`underflows`), `instead` what to write.
+pub fn underflow_message(written: &str, instead: &str) -> String {
     format!(
-        "`{}` is nearer 0 than a 64-bit float holds (the nearest is about 5e-324) and would be read as 0: write 0, \
-         or a number the key accepts",
+        "`{}` is nearer 0 than a 64-bit float holds (the nearest is about 5e-324) and would be read as 0: write \
+         {instead}",
         written.trim()
     )
 }
 
-/// The first float written in `text` that underflows (`underflows`), located and keyed as the
-/// reader's errors are (`describe`); `None` where there is none or the text does not parse
-/// (the reader's own error then says why).
+/// What a key's underflowing number is to be replaced with (`underflow_message`).
+pub const UNDERFLOW_INSTEAD: &str = "a number the key accepts (0 itself, where it does)";
+
+/// A float written in `text` that underflows (`underflows`; of several, the first in the
+/// order of the keys, which may not be the file's), located and keyed as the reader's errors
+/// are (`describe`); `None` where there is none or the text does not parse (the reader's own
+/// error then says why).
 pub fn underflowing_float(text: &str) -> Option<Described> {
     fn in_value(value: &toml::Spanned<DeValue>) -> Option<(String, Range<usize>, String)> {
         match value.get_ref() {
@@ -357,7 +361,7 @@ pub fn underflowing_float(text: &str) -> Option<Described> {
     Some(Described {
         line_column: Some(line_column(text, span.start)),
         key: Some(key),
-        message: underflow_message(written),
+        message: underflow_message(written, UNDERFLOW_INSTEAD),
     })
 }
 

@@ -238,6 +238,20 @@ fn one_bad_value_is_one_problem() {
     assert!(err.contains("key `belly.up_rows` must be an integer in [0, 4], got 5"), "{err}");
 }
 
+/// `snakeskin brdf film --batch -` with `input` on its standard input.
+fn film_batch(input: &[u8]) -> std::process::Output {
+    use std::io::Write;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["brdf", "film", "--batch", "-"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    child.wait_with_output().unwrap()
+}
+
 /// A refused number far from its range is printed as written, not in full: `film_ior =
 /// 1e300` printed three hundred digits, an angle of -1e-300 (then `--angle-deg`, now a
 /// `brdf film --batch` line: the flag is refused by clap as written) a "-0.000…" as long.
@@ -247,17 +261,7 @@ fn a_number_far_out_of_range_is_printed_short() {
     let err = refused("huge.toml", text, &[]);
     assert!(err.contains("must be a finite number in [1, 3], got 1e300"), "{err}");
     assert!(err.len() < 400, "{err}");
-    use std::io::Write;
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(["brdf", "film", "--batch", "-"])
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let line = b"{\"thickness_nm\": 400, \"wavelength_nm\": 550, \"angle_deg\": -1e-300}\n";
-    child.stdin.take().unwrap().write_all(line).unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = film_batch(b"{\"thickness_nm\": 400, \"wavelength_nm\": 550, \"angle_deg\": -1e-300}\n");
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("-:1: angle_deg must be in [0, 90], got -1e-300"), "{}", stderr(&out));
     assert!(stderr(&out).len() < 200, "{}", stderr(&out));
@@ -289,18 +293,9 @@ fn a_number_that_underflows_is_refused_not_read_as_zero() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("jobs.toml:3:") && stderr(&out).contains(says), "{}", stderr(&out));
     assert!(!dir.path().join("out").exists());
-    use std::io::Write;
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(["brdf", "film", "--batch", "-"])
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
     let lines = b"{\"thickness_nm\": 5e-324, \"wavelength_nm\": 550, \"angle_deg\": 0}\n\
                   {\"thickness_nm\": 1e-400, \"wavelength_nm\": 550, \"angle_deg\": 0}\n";
-    child.stdin.take().unwrap().write_all(lines).unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = film_batch(lines);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("-:2: ") && stderr(&out).contains(says), "{}", stderr(&out));
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1, "the first line's answer");

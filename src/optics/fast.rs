@@ -101,11 +101,34 @@ fn harmonics(a: C32, b: C32) -> Harmonics32 {
 #[inline]
 pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
     let cos0 = cos0.clamp(0.0, 1.0);
+    if cos0 * cos0 < f32::MIN_POSITIVE {
+        // Grazing light carries no flux and is all reflected, as `film::FilmAtAngle` takes it
+        // (r01 was 0 / 0 where n1 = n0): the exact film with r01 = 1 and no second face. So is
+        // light whose cosine squares to less than a normal f32 (below 1.1e-19, where the exact
+        // film reflects 1 to f32's precision): the cosines' squares and the amplitudes'
+        // denominators underflowed there (NaN where n1 = n0).
+        let none = Harmonics32 { c0: 1.0, d: [0.0; 2], q: [0.0; 2] };
+        let reflects_all = [[1.0, 0.0], [0.0; 2]];
+        let amplitudes_s = reflects_all;
+        return Film32 {
+            s: none,
+            p: none,
+            cos1: 0.0,
+            kappa1: 0.0,
+            exact: true,
+            amplitudes_s,
+            amplitudes_p: amplitudes_s,
+        };
+    }
     let c0: C32 = [cos0, 0.0];
     // (1 − η²) + η² cos²θ0: exact for η = 1 at grazing (see film::cos_in).
-    let cos_sq = |eta: f32| sqrt_real((1.0 - eta * eta) + eta * eta * cos0 * cos0);
-    let c1 = cos_sq(n0 / n1);
-    let c2 = cos_sq(n0 / n2);
+    let cos_sq = |eta: f32| (1.0 - eta * eta) + eta * eta * cos0 * cos0;
+    // Where the film's cancels to exactly 0 (light at its critical angle), the size of the
+    // sum's rounding, as `film::film_cos_in` (never 0 where n1 = n0: cos0² is normal here).
+    let eta1 = n0 / n1;
+    let x1 = cos_sq(eta1);
+    let c1 = sqrt_real(if x1 == 0.0 { f32::EPSILON * (1.0 - eta1 * eta1).abs() } else { x1 });
+    let c2 = sqrt_real(cos_sq(n0 / n2));
     let r = |ni: f32, ci: C32, nj: f32, cj: C32| {
         let (a, b) = (scale(ci, ni), scale(cj, nj));
         let rs = div(sub(a, b), add(a, b));
@@ -116,24 +139,14 @@ pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
     let (a_s, a_p) = r(n0, c0, n1, c1);
     let (b_s, b_p) = r(n1, c1, n2, c2);
     let (s, p) = (harmonics(a_s, b_s), harmonics(a_p, b_p));
-    // Exactly at the film's critical angle (cos θ1 = 0: r01 = 1, r12 = −1, and the exact film
-    // divides 0 by 0) the film has no phase at any thickness, and a film without phase is
-    // the bare n0|n2 interface ((r01 + r12) / (1 + r01 r12) = r02): its amplitudes, with no
-    // second face.
-    let (amplitudes_s, amplitudes_p) = if c1 == [0.0, 0.0] {
-        let (r02_s, r02_p) = r(n0, c0, n2, c2);
-        ([r02_s, [0.0; 2]], [r02_p, [0.0; 2]])
-    } else {
-        ([a_s, b_s], [a_p, b_p])
-    };
     Film32 {
         s,
         p,
         cos1: if c1[1] == 0.0 { c1[0] } else { 0.0 },
         kappa1: c1[1],
         exact: !(c1[1] == 0.0 && norm_sqr(s.q) < MAX_Q2_F32 && norm_sqr(p.q) < MAX_Q2_F32),
-        amplitudes_s,
-        amplitudes_p,
+        amplitudes_s: [a_s, b_s],
+        amplitudes_p: [a_p, b_p],
     }
 }
 
@@ -183,8 +196,8 @@ pub fn phase_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32) 
 /// r = (r01 + r12 e) / (1 + r01 r12 e) per polarisation, e = exp(2iβ), β = 2π n1 d cos θ1 / λ,
 /// which for an evanescent film (cos θ1 = i κ) is the real decay exp(−4π n1 d κ / λ).
 /// 1 + r01 r12 e ≠ 0: it would need |r01| = |r12| = |e| = 1, a travelling wave with both faces
-/// reflecting totally, which only cos θ1 = 0 gives, and there `film_f32` holds the bare
-/// interface's amplitude instead.
+/// reflecting totally, which only cos θ1 = 0 gives, and `film_f32` keeps cos θ1 off 0 (or,
+/// for grazing light, holds no second face).
 #[inline]
 pub fn airy_reflectance_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32) -> f32 {
     let k = 4.0 * std::f32::consts::PI * n1 * thickness_nm / wavelength_nm;

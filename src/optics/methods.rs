@@ -216,7 +216,7 @@ pub const GAUSSIAN_FIT_EXACT_NM: f64 = 550.0;
 /// at every angle, so they keep the series; near the critical angle of a film less dense than
 /// the ambient |q| → 1 and the bound grows past 0.7: there the f32 form read a bare film on
 /// (1.5, 1.35, 2) as 0.98 where it reflects 0.08. Below 0.01 its reading of a bare film is
-/// within 0.004 on such stacks (both measured over 0–90° in steps of 0.01°, in Python, for
+/// within 0.004 on the three stacks of `tests/brdf.rs` (0.0052 on (1.5, 1.45, 1.5), a review found) (both measured over 0–90° in steps of 0.01°, in Python, for
 /// this change).
 pub const GAUSSIAN_FIT_MAX_REST: f64 = 0.01;
 

@@ -16,7 +16,7 @@
 //! the same idea as Belcour & Barla (2017) applied to the exact coefficients.
 
 use super::complex::C64;
-use super::film::{Stack, cos_in};
+use super::film::{Stack, cos_in, film_cos_in};
 
 /// Fourier coefficients of one polarisation's reflectance.
 #[derive(Debug, Clone, Copy)]
@@ -50,7 +50,7 @@ impl FilmSeries {
     pub fn new(stack: Stack, cos0: f64) -> Self {
         let cos0 = cos0.clamp(0.0, 1.0);
         let Stack { n0, n1, n2 } = stack;
-        let (c0, c1, c2) = (C64::real(cos0), cos_in(n0, n1, cos0), cos_in(n0, n2, cos0));
+        let (c0, c1, c2) = (C64::real(cos0), film_cos_in(n0, n1, cos0), cos_in(n0, n2, cos0));
         let r = |ni: f64, ci: C64, nj: f64, cj: C64| {
             let rs = (ci * ni - cj * nj) / (ci * ni + cj * nj);
             let rp = (ci * nj - cj * ni) / (ci * nj + cj * ni);

@@ -966,9 +966,7 @@ fn parse_gpu_method(text: &str) -> Result<GpuFilmMethod, String> {
 /// answer computed from it printed `-0.0`).
 fn bounded(text: &str, (lo, hi): (f64, f64)) -> Result<f64, String> {
     if snakeskin::toml_text::underflows(text) {
-        return Err(
-            snakeskin::toml_text::underflow_message(text).replace("the key accepts", &format!("in [{lo}, {hi}]"))
-        );
+        return Err(snakeskin::toml_text::underflow_message(text, &format!("a number in [{lo}, {hi}]")));
     }
     match text.trim().parse::<f64>() {
         // Adding 0 turns -0 into +0 and leaves every other number as it is (IEEE 754).
@@ -1037,7 +1035,7 @@ fn parse_albedo(text: &str) -> Result<[f64; 3], String> {
 
 fn parse_vec3(text: &str) -> Result<[f64; 3], String> {
     if let Some(tiny) = text.split(',').find(|p| snakeskin::toml_text::underflows(p)) {
-        return Err(snakeskin::toml_text::underflow_message(tiny).replace("a number the key accepts", "a larger one"));
+        return Err(snakeskin::toml_text::underflow_message(tiny, "0 or a larger number"));
     }
     let parts: Vec<f64> = text
         .split(',')

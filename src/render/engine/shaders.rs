@@ -73,6 +73,8 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("BOX_NARROW_RAD", "f32", f32_literal(BOX_NARROW_RAD as f64)),
         ("Q_NEGLIGIBLE", "f32", f32_literal(Q_NEGLIGIBLE as f64)),
         ("MAX_Q2", "f32", f32_literal(MAX_Q2_F32 as f64)),
+        ("F32_EPSILON", "f32", f32_literal(f32::EPSILON as f64)),
+        ("F32_MIN_POSITIVE", "f32", f32_literal(f32::MIN_POSITIVE as f64)),
         ("RGB3_NM", "vec3<f32>", vec3_literal(RGB3_NM.map(f64::from))),
         ("RGB3_BAND_NM", "f32", f32_literal(RGB3_BAND_NM as f64)),
         // Belcour–Barla lobes as (X, Y, Z, X's second lobe).

@@ -226,7 +226,7 @@ fn run_batch<Q: for<'de> Deserialize<'de>>(path: &str, per_line: impl Fn(&Q) -> 
         })?;
         // serde_json reads a number nearer 0 than a float holds as 0, without a word.
         if let Some(tiny) = underflowing_json_number(line) {
-            return Err(at(snakeskin::toml_text::underflow_message(tiny).replace("the key", "the field")).into());
+            return Err(at(snakeskin::toml_text::underflow_message(tiny, "a number the field accepts")).into());
         }
         // The query's own refusal is already `Error::Query`: the line is added, not a second
         // "invalid query:".
