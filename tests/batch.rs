@@ -1097,3 +1097,77 @@ fn a_stopped_batch_writes_its_index_with_what_failed_and_what_never_ran() {
     let index = read_index(&out_dir);
     assert_eq!(statuses(&index), ["done", "skipped", "done", "duplicate"], "{index}");
 }
+
+/// `snakeskin verify`: a whole set, a batch's folder of sets and a manifest named alone
+/// pass (exit 0, one `ok` line each); a map altered after the run (one byte appended) and a
+/// set without its manifest (a run killed while renaming) fail with exit 1 and the file
+/// named; a path that is no manifest, a missing one and a folder without sets are the
+/// user's mistake (exit 2). Negative control: the altered set passes again once the byte
+/// is taken off.
+#[test]
+fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let jobs = jobs_file(dir.path(), &["natrix-natrix", "xenopeltis-unicolor"], "[1]", 16);
+    let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let manifests: Vec<PathBuf> = manifests(&out).into_keys().map(|p| out.join(p)).collect();
+    assert_eq!(manifests.len(), 2, "{manifests:?}");
+    let verify = |paths: &[&Path]| {
+        let args: Vec<&str> = ["verify"].into_iter().chain(paths.iter().map(|p| p.to_str().unwrap())).collect();
+        snakeskin(&args)
+    };
+    let whole = verify(&[&out]);
+    assert_eq!(whole.status.code(), Some(0), "{}{}", stdout(&whole), stderr(&whole));
+    assert_eq!(stdout(&whole).lines().filter(|l| l.starts_with("ok ")).count(), 2, "{}", stdout(&whole));
+    let alone = verify(&[&manifests[0]]);
+    assert_eq!(alone.status.code(), Some(0), "{}", stderr(&alone));
+
+    // One byte appended to one map of the first set.
+    let set_folder = manifests[0].parent().unwrap();
+    let map = std::fs::read_dir(set_folder)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| p.extension().is_some_and(|x| x == "png"))
+        .unwrap();
+    let bytes = std::fs::read(&map).unwrap();
+    std::fs::write(&map, [&bytes[..], &[0]].concat()).unwrap();
+    let altered = verify(&[&out]);
+    assert_eq!(altered.status.code(), Some(1), "{}", stderr(&altered));
+    let lines = stdout(&altered);
+    let map_name = map.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        lines.lines().any(|l| l.starts_with("FAILED ") && l.contains(&map_name) && l.contains("mixed or altered")),
+        "{lines}"
+    );
+    assert_eq!(lines.lines().filter(|l| l.starts_with("ok ")).count(), 1, "{lines}");
+    assert!(stderr(&altered).contains("1 of 2 sets failed"), "{}", stderr(&altered));
+    std::fs::write(&map, &bytes).unwrap();
+    assert_eq!(verify(&[&out]).status.code(), Some(0));
+
+    // A set without its manifest, named by the manifest's path: incomplete.
+    let moved = dir.path().join("aside.json");
+    std::fs::rename(&manifests[0], &moved).unwrap();
+    let incomplete = verify(&[&manifests[0]]);
+    assert_eq!(incomplete.status.code(), Some(1), "{}", stderr(&incomplete));
+    assert!(
+        stdout(&incomplete).starts_with("FAILED ") && stdout(&incomplete).contains("incomplete"),
+        "{}",
+        stdout(&incomplete)
+    );
+    std::fs::rename(&moved, &manifests[0]).unwrap();
+
+    // The user's mistakes: a map file, a missing path, a folder without sets.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    for (path, says) in [
+        (map.as_path(), "is not a set's manifest"),
+        (dir.path().join("missing").as_path(), "missing"),
+        (empty.as_path(), "holds no set's manifest"),
+    ] {
+        let refused = verify(&[path]);
+        assert_eq!(refused.status.code(), Some(2), "{path:?}: {}", stderr(&refused));
+        assert!(stderr(&refused).contains(says), "{path:?}: {}", stderr(&refused));
+    }
+}

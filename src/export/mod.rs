@@ -18,8 +18,8 @@ pub use atomic::{
 };
 pub(crate) use manifest::verify_set_json;
 pub use manifest::{
-    Counts, Manifest, ManifestReadError, MapEntry, Source, VerifiedSet, body_counts, manifest, manifest_file_name,
-    read_set_manifest, set_file_sha256, verify_set,
+    Counts, MANIFEST_SUFFIX, Manifest, ManifestReadError, MapEntry, Source, VerifiedSet, body_counts, manifest,
+    manifest_file_name, read_set_manifest, set_file_sha256, verify_set,
 };
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
 

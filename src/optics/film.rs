@@ -63,7 +63,7 @@ pub fn cos_in(n0: f64, n: f64, cos0: f64) -> C64 {
 /// the cosine takes the size of the sum's rounding instead, √(ε |1 − (n0/n1)²|), which its
 /// neighbours' cosines have too (an independent review's find, measured with 50-digit
 /// arithmetic). Where n1 = n0 the cosine is cos0 itself, and 0 only where cos0² underflowed
-/// (cos0 < 1e-154): it is cos0 there.
+/// (cos0 below about 2e-162): it is cos0 there.
 pub fn film_cos_in(n0: f64, n1: f64, cos0: f64) -> C64 {
     let c1 = cos_in(n0, n1, cos0);
     if c1 == C64::ZERO && cos0 > 0.0 {

@@ -40,6 +40,11 @@ pub struct LoadedPreset {
     /// model is off from the physics of the stack, a film centred below half its spread),
     /// each with the key's line.
     pub warned: Vec<LocatedProblem>,
+    /// The file sets no key (empty, or comments only) and nothing was given in its place
+    /// (`--set`, `--seed`): every key takes its default, the same green snake whatever the
+    /// file was meant to say, which a user who saved the wrong file, or one the editor had
+    /// not yet written, should hear of.
+    pub sets_no_key: bool,
 }
 
 impl LoadedPreset {
@@ -47,12 +52,15 @@ impl LoadedPreset {
     /// given), one line each: colours clamped to what the stack can show, and the keys
     /// `warned` of.
     pub fn warnings(&self, preset: &str) -> Vec<String> {
+        let empty = self.sets_no_key.then(|| {
+            format!("warning: {preset}: the file sets no key: every key takes its default (docs/presets.md lists them)")
+        });
         let clamped = self.clamped_colours.iter().map(|c| c.message(preset));
         let warned = self.warned.iter().map(|p| {
             let line = p.line.map(|l| format!(":{l}")).unwrap_or_default();
             format!("warning: {preset}{line}: {} = {}", p.key, p.message)
         });
-        clamped.chain(warned).collect()
+        empty.into_iter().chain(clamped).chain(warned).collect()
     }
 }
 
@@ -277,12 +285,16 @@ pub fn parse_with_seed(
     }
     let warned = super::validate::warnings(&preset).into_iter().map(locate).collect();
     let canonical = canonical_text(&preset);
+    let sets_no_key = overrides.is_empty()
+        && !seed_given
+        && toml::from_str::<toml::Table>(&source.text).is_ok_and(|table| table.is_empty());
     Ok(LoadedPreset {
         name: source.name.clone(),
         preset,
         content_hash: format!("{:016x}", fnv1a64(canonical.as_bytes())),
         clamped_colours,
         warned,
+        sets_no_key,
     })
 }
 
@@ -367,21 +379,26 @@ fn located_error(source: &PresetSource, mut described: toml_text::Described) -> 
 /// ("invalid type: string \"99999999999999999999\"") and is a whole number too; a quoted
 /// number (`"21"`, in a file or `--set`) is a string, and said so.
 fn in_key_range(key: &str, message: &str, from_set: bool) -> Option<String> {
-    // A number with a fraction or exponent, `nan` or `inf` where a whole number goes
-    // (`rows = 20.0`): the reader's words, with the key's range they lacked.
-    if message.starts_with("invalid type: floating point") && message.ends_with("expected a whole number") {
+    let value = match toml_text::integer_out_of_type(message) {
+        Some(value) => Some(value),
+        None if from_set => message.strip_prefix("invalid type: string \"").and_then(|rest| {
+            let word = rest.split('"').next()?;
+            let past_toml = word.parse::<i64>().is_err();
+            (past_toml && is_whole_number_word(word)).then_some(word)
+        }),
+        None => None,
+    };
+    if let Some(value) = value {
+        return super::validate::whole_number_problem(key, value);
+    }
+    // Any other type where a whole number goes — a number with a fraction or exponent,
+    // `nan`, `inf` (`rows = 20.0`), a string (`rows = "many"`), a boolean — the reader's
+    // words, with the key's range they lacked (a string said "expected a whole number" where
+    // 19.5 said "expected a whole number in [4, 128]").
+    if message.starts_with("invalid type: ") && message.ends_with("expected a whole number") {
         return Some(format!("{message} in {}", super::validate::whole_number_range_words(key)?));
     }
-    let value = match toml_text::integer_out_of_type(message) {
-        Some(value) => value,
-        None if from_set => {
-            let word = message.strip_prefix("invalid type: string \"")?.split('"').next()?;
-            let past_toml = word.parse::<i64>().is_err();
-            (past_toml && is_whole_number_word(word)).then_some(word)?
-        }
-        None => return None,
-    };
-    super::validate::whole_number_problem(key, value)
+    None
 }
 
 /// What a table missing a required key needs (`[[pattern]]` without `kind`: the reader said
@@ -766,6 +783,21 @@ mod tests {
 
     fn source(text: &str) -> PresetSource {
         PresetSource { name: "t".into(), display: "t.toml".into(), text: text.into() }
+    }
+
+    /// A file that sets no key is warned of (it loaded silently as the default snake).
+    /// Negative controls: one key, a `--set`, a `--seed`, and a built-in preset.
+    #[test]
+    fn a_file_that_sets_no_key_is_warned_of() {
+        let says = |loaded: &LoadedPreset| loaded.warnings("t.toml").iter().any(|w| w.contains("sets no key"));
+        for text in ["", "\n  \n", "# a comment only\n"] {
+            let loaded = parse(&source(text), &[]).unwrap();
+            assert!(says(&loaded), "{text:?}: {:?}", loaded.warnings("t.toml"));
+        }
+        assert!(!says(&parse(&source("seed = 1"), &[]).unwrap()));
+        assert!(!says(&parse(&source(""), &[("scales.rows".into(), "21".into())]).unwrap()));
+        assert!(!says(&parse_with_seed(&source(""), &[], Some(3)).unwrap()));
+        assert!(!says(&load("natrix-natrix", &[], None).unwrap()));
     }
 
     /// A value written as TOML that does not parse is refused with TOML's reason (it was

@@ -128,6 +128,17 @@ pub enum Command {
         #[command(subcommand)]
         command: PresetsCommand,
     },
+    /// Check sets against their manifests: every file a NAME.material.json lists must lie
+    /// beside it with the SHA-256 it records. One line per set on stdout, `ok` or `FAILED`
+    /// with why (a missing manifest: a run was killed while renaming; a file that differs: the
+    /// set was altered or mixed); exit 0 when every set is whole, 1 when one is not, 2 for a
+    /// path that is no manifest or folder of sets. glTF exports carry no manifest.
+    Verify {
+        /// A set's manifest (NAME.material.json), or a folder: every manifest in it and in its
+        /// subfolders two levels down (a batch's output folder).
+        #[arg(required = true, value_name = "PATH")]
+        paths: Vec<PathBuf>,
+    },
 }
 
 impl Cli {
@@ -168,6 +179,34 @@ impl Cli {
                     chosen = chosen.find_subcommand_mut(name).expect("a subcommand found above");
                 }
                 return Err(clap::Error::raw(clap::error::ErrorKind::InvalidValue, message).format(chosen));
+            }
+        }
+        // A long flag written with one dash (`-out`, `-size 64`) is clap's short flag with its
+        // value attached (`-o ut`): `generate NAME -out` wrote the set into `./ut/`, and
+        // `-size 64` said "unexpected argument '64'". A word that is one of the command's
+        // long flags but for its second dash is refused with the flag it names.
+        for word in words.iter().skip(1).take_while(|w| **w != "--") {
+            let Some(rest) = word.strip_prefix('-').filter(|r| r.len() > 1 && !r.starts_with('-')) else {
+                continue;
+            };
+            let long = format!("--{}", rest.split('=').next().unwrap_or(""));
+            if flags.iter().any(|(f, _)| *f == long) {
+                let first = rest.chars().next().unwrap_or('-');
+                let short_exists = path.iter().flat_map(|c| c.get_arguments()).any(|a| a.get_short() == Some(first));
+                let read_as = if short_exists {
+                    format!(
+                        " (with one, it is read as the short flag `-{first}` with the value `{}`)",
+                        &rest[first.len_utf8()..]
+                    )
+                } else {
+                    String::new()
+                };
+                let message = format!("`{word}` has one dash: write `-{word}`; long flags take two{read_as}");
+                let mut chosen = &mut command;
+                for name in &names {
+                    chosen = chosen.find_subcommand_mut(name).expect("a subcommand found above");
+                }
+                return Err(clap::Error::raw(clap::error::ErrorKind::UnknownArgument, message).format(chosen));
             }
         }
         let mut matches = command.try_get_matches_from_mut(args)?;
@@ -243,8 +282,9 @@ pub struct PresetSource {
     /// A preset: a path to a .toml file, or a built-in name (see `snakeskin presets list`; a
     /// built-in name is the built-in even beside a file of that name: `./NAME` reads the file).
     pub preset: String,
-    /// Override a preset key by dotted path, e.g. `--set scales.rows=23 --set pattern.0.kind=spots`.
-    /// VALUE is parsed as TOML; a bare word that is not valid TOML is taken as a string, but
+    /// Override a preset key by dotted path, e.g. `--set scales.rows=23 --set color.base=#6c6e5c`
+    /// (a preset without pattern layers takes one with its kind and colour: `--set
+    /// pattern.0.kind=spots --set pattern.0.color=#101010`). VALUE is parsed as TOML; a bare word that is not valid TOML is taken as a string, but
     /// one that starts as an array, table, quoted string or number must parse.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_key_value)]
     pub overrides: Vec<(String, String)>,
@@ -335,8 +375,9 @@ pub struct ExportArgs {
     pub source: PresetSource,
     /// The file to write: NAME.glb (everything in one binary file) or NAME.gltf (JSON, with
     /// NAME.bin and NAME.basecolor.png, NAME.normal.png, NAME.orm.png and,
-    /// with a film of more than one thickness, NAME.thickness.png beside it).
-    #[arg(long, value_name = "FILE")]
+    /// with a film of more than one thickness, NAME.thickness.png beside it). `-o FILE`, as
+    /// the other commands write their output, is the same flag.
+    #[arg(short = 'o', long, value_name = "FILE")]
     pub gltf: PathBuf,
     /// Texture width in pixels, 16 to 16384 (a body atlas is `body.length` widths tall, at
     /// most 65535 rows: 5461 wide at the default length 12; WebGL viewers commonly load
@@ -1187,6 +1228,41 @@ mod tests {
             assert!(error.contains(says), "{args:?}: {error}");
         }
         parse(&["generate", "natrix-natrix", "--size", "16"]).unwrap();
+    }
+
+    /// A long flag with one dash is refused with the flag it names: `generate NAME -out`
+    /// wrote into `./ut/` (clap's `-o ut`) and `-size 64` called 64 an unexpected argument.
+    /// Negative controls: the short flag with its value attached where no long flag is
+    /// spelled so (`-oout`), a negative number as a value, and words after `--`.
+    #[test]
+    fn a_long_flag_with_one_dash_is_refused() {
+        let parse = |args: &[&str]| {
+            let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
+            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
+        };
+        for (args, says) in [
+            (
+                &["generate", "natrix-natrix", "-out"][..],
+                "write `--out`; long flags take two (with one, it is read as the short flag `-o` with the value `ut`)",
+            ),
+            (
+                &["export", "natrix-natrix", "-gltf", "a.glb"],
+                "`-gltf` has one dash: write `--gltf`; long flags take two",
+            ),
+            (&["generate", "natrix-natrix", "-size", "64"], "write `--size`"),
+            (&["generate", "natrix-natrix", "-maps=color"], "write `--maps=color`"),
+            (&["brdf", "eval", "-roughness", "0.3"], "write `--roughness`"),
+        ] {
+            let error = parse(args).expect_err(&format!("{args:?} was accepted"));
+            assert!(error.contains(says), "{args:?}: {error}");
+        }
+        // No short flag `-g` in `export`: no "read as" clause.
+        let error = parse(&["export", "natrix-natrix", "-gltf", "a.glb"]).unwrap_err();
+        assert!(!error.contains("read as"), "{error}");
+        parse(&["generate", "natrix-natrix", "-oout"]).unwrap();
+        parse(&["brdf", "eval", "--wi", "-0.3,0,1", "--wo", "0,0,1"]).unwrap();
+        let error = parse(&["generate", "natrix-natrix", "--", "-size"]).expect_err("a second preset");
+        assert!(!error.contains("long flags take two dashes"), "{error}");
     }
 
     /// Every whole-number flag says its range, whatever the word: clap's u32 and u16 range

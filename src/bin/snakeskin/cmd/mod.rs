@@ -12,6 +12,7 @@ mod graph;
 mod presets;
 mod preview;
 mod sheet;
+mod verify;
 
 use anyhow::Result;
 
@@ -43,5 +44,6 @@ pub fn run(cli: Cli) -> Result<()> {
             sheet::run(&out, options, layout.layout(), &species)
         }
         Command::Presets { command } => presets::run(command),
+        Command::Verify { paths } => verify::run(&paths),
     }
 }
