@@ -1161,8 +1161,11 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
     // The user's mistakes: a map file, a missing path, a folder without sets.
     let empty = dir.path().join("empty");
     std::fs::create_dir(&empty).unwrap();
+    let glb = dir.path().join("x.glb");
+    std::fs::write(&glb, b"glTF").unwrap();
     for (path, says) in [
         (map.as_path(), "is not a set's manifest"),
+        (glb.as_path(), "a glTF export carries no manifest"),
         (dir.path().join("missing").as_path(), "missing"),
         (empty.as_path(), "holds no set's manifest"),
     ] {

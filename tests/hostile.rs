@@ -896,11 +896,17 @@ fn an_interrupt_during_the_commit_waits_for_it() {
     let in_commit = |dir: &Path| !manifest_of(dir).exists();
     let (code, err) = interrupted(dir.path(), "rename-3", libc::SIGINT, None, in_commit, None);
     assert!(code == Some(130) || code == Some(0), "{code:?}: {err}");
-    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
-    let manifest: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(manifest_of(dir.path())).unwrap()).unwrap();
-    assert_eq!(manifest["seed"], 7, "{manifest}");
+    assert_the_new_set_is_whole(dir.path());
     assert!(hidden_files(dir.path()).iter().all(|n| !n.ends_with(".snakeskin-tmp")), "{:?}", hidden_files(dir.path()));
+}
+
+/// The set in `dir` is whole (`verify_set`) and the new run's (seed 7, where the earlier
+/// set's is another).
+fn assert_the_new_set_is_whole(dir: &Path) {
+    snakeskin::export::verify_set(&manifest_of(dir)).unwrap();
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(manifest_of(dir)).unwrap()).unwrap();
+    assert_eq!(manifest["seed"], 7, "{manifest}");
 }
 
 /// A second Ctrl-C during the commit's renames waits for them too (at most ten seconds,
@@ -916,10 +922,7 @@ fn a_second_interrupt_during_the_commit_waits_for_it() {
     let twice = Some(std::time::Duration::from_millis(300));
     let (code, err) = interrupted(dir.path(), "rename-3", libc::SIGINT, None, in_commit, twice);
     assert!(code == Some(130) || code == Some(0), "{code:?}: {err}");
-    snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap();
-    let manifest: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(manifest_of(dir.path())).unwrap()).unwrap();
-    assert_eq!(manifest["seed"], 7, "{manifest}");
+    assert_the_new_set_is_whole(dir.path());
 }
 
 #[test]

@@ -332,7 +332,12 @@ pub fn parse_seed_text(text: &str) -> Option<u64> {
 fn seed_override(value: &str) -> Result<u64, PresetError> {
     parse_seed_text(value).ok_or_else(|| PresetError::Override {
         argument: format!("seed={value}"),
-        message: format!("the seed must be a whole number in {}", super::validate::seed_range_words()),
+        // With the value: a whole number past the range was called "not a whole number".
+        message: format!(
+            "the seed must be a whole number in {}, got {}",
+            super::validate::seed_range_words(),
+            value.trim()
+        ),
     })
 }
 

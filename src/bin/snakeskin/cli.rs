@@ -1115,6 +1115,12 @@ fn parse_normal(text: &str) -> Result<[f64; 3], String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `snakeskin ARGS...` parsed as the binary parses it: Ok, or clap's message.
+    fn parse(args: &[&str]) -> Result<(), String> {
+        let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
+        Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
+    }
     use clap::Parser;
 
     #[test]
@@ -1140,10 +1146,7 @@ mod tests {
     /// preset) and 1e-50 became 0 in f32. Negative control: each flag where it acts.
     #[test]
     fn preview_flags_that_would_do_nothing_are_refused() {
-        let preview = |args: &[&str]| {
-            let words = ["snakeskin", "preview", "natrix-natrix"].iter().chain(args).map(|w| w.into()).collect();
-            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
-        };
+        let preview = |args: &[&str]| parse(&[&["preview", "natrix-natrix"][..], args].concat());
         for (args, says) in [
             (&["--out", "a.png", "--frames", "5"][..], "cannot be used with"),
             (&["--window", "--out", "a.png"], "cannot be used with"),
@@ -1178,6 +1181,9 @@ mod tests {
             assert!(parse_seed(text).is_err(), "--seed {text} was accepted");
             assert!(by_override(text).is_err(), "--set seed={text} was accepted");
         }
+        // The value said: a whole number past the range was called "not a whole number".
+        let error = by_override("99999999999999999999999").unwrap_err().to_string();
+        assert!(error.contains("in [0, 9007199254740991], got 99999999999999999999999"), "{error}");
     }
 
     /// A number nearer 0 than a float holds was read as 0 by every flag that takes a number
@@ -1185,10 +1191,6 @@ mod tests {
     /// smallest float are numbers.
     #[test]
     fn a_flags_number_that_underflows_is_refused() {
-        let parse = |args: &[&str]| {
-            let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
-            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
-        };
         let film = ["brdf", "film", "--wavelength-nm", "550", "--angle-deg", "0", "--thickness-nm"];
         for tiny in ["1e-400", "2.5E-330", "0.1e-330"] {
             let error = parse(&[&film[..], &[tiny]].concat()).expect_err(tiny);
@@ -1207,10 +1209,6 @@ mod tests {
     /// Negative controls: a value in range, and a flag after a flag is still a missing value.
     #[test]
     fn a_negative_number_is_refused_with_the_flags_range() {
-        let parse = |args: &[&str]| {
-            let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
-            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
-        };
         for (args, says) in [
             (&["generate", "natrix-natrix", "--size", "-16"][..], "-16 is not in 16..=16384"),
             (&["generate", "natrix-natrix", "--seed", "-1"], "-1 is not in 0..=9007199254740991"),
@@ -1236,10 +1234,6 @@ mod tests {
     /// spelled so (`-oout`), a negative number as a value, and words after `--`.
     #[test]
     fn a_long_flag_with_one_dash_is_refused() {
-        let parse = |args: &[&str]| {
-            let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
-            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
-        };
         for (args, says) in [
             (
                 &["generate", "natrix-natrix", "-out"][..],
@@ -1271,10 +1265,6 @@ mod tests {
     /// each flag's largest value is taken.
     #[test]
     fn every_whole_number_flag_says_its_range() {
-        let parse = |args: &[&str]| {
-            let words = ["snakeskin"].iter().chain(args).map(|w| w.into()).collect();
-            Cli::try_parse_checked_from(words).map(|_| ()).map_err(|e| e.to_string())
-        };
         let huge = "99999999999999999999";
         for (args, says, largest) in [
             (&["sheet", "-o", "s.png", "--tile"][..], "is not in 64..=1024", "1024"),

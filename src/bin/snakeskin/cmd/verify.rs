@@ -66,8 +66,13 @@ fn manifests_at(path: &Path) -> Result<Vec<PathBuf>> {
     };
     if !metadata.is_dir() {
         if !names_a_manifest {
-            let reason =
-                format!("{} is not a set's manifest (NAME{MANIFEST_SUFFIX}) or a folder of sets", path_line(path));
+            let gltf =
+                path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+            let reason = format!(
+                "{} is not a set's manifest (NAME{MANIFEST_SUFFIX}) or a folder of sets{}",
+                path_line(path),
+                if gltf { " (a glTF export carries no manifest)" } else { "" }
+            );
             return Err(invalid(reason).into());
         }
         return Ok(vec![path.to_path_buf()]);
