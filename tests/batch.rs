@@ -1142,23 +1142,36 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         "{lines}"
     );
     assert_eq!(lines.lines().filter(|l| l.starts_with("ok ")).count(), 1, "{lines}");
-    assert!(stderr(&altered).contains("1 of 2 sets failed"), "{}", stderr(&altered));
+    assert!(stderr(&altered).contains("1 of 2 checks failed"), "{}", stderr(&altered));
     std::fs::write(&map, &bytes).unwrap();
     assert_eq!(verify(&[&out]).status.code(), Some(0));
 
-    // A set without its manifest, named by the manifest's path: incomplete.
+    // A set without its manifest (its maps there): incomplete, named by the manifest's
+    // path, by its folder and by the batch's folder (which passed it over before).
     let moved = dir.path().join("aside.json");
     std::fs::rename(&manifests[0], &moved).unwrap();
-    let incomplete = verify(&[&manifests[0]]);
-    assert_eq!(incomplete.status.code(), Some(1), "{}", stderr(&incomplete));
-    assert!(
-        stdout(&incomplete).starts_with("FAILED ") && stdout(&incomplete).contains("incomplete"),
-        "{}",
-        stdout(&incomplete)
-    );
+    for path in [manifests[0].as_path(), set_folder, out.as_path()] {
+        let incomplete = verify(&[path]);
+        assert_eq!(incomplete.status.code(), Some(1), "{path:?}: {}", stderr(&incomplete));
+        let lines = stdout(&incomplete);
+        assert!(lines.lines().any(|l| l.starts_with("FAILED ") && l.contains("incomplete")), "{path:?}: {lines}");
+    }
     std::fs::rename(&moved, &manifests[0]).unwrap();
+    // A set named twice (its manifest, its folder, the batch's folder) is checked once.
+    let twice = verify(&[&manifests[0], set_folder, &out]);
+    assert_eq!(twice.status.code(), Some(0), "{}", stderr(&twice));
+    assert_eq!(stdout(&twice).lines().count(), 2, "{}", stdout(&twice));
+    // A linked set folder is followed.
+    let linked = dir.path().join("linked");
+    std::fs::create_dir(&linked).unwrap();
+    std::os::unix::fs::symlink(set_folder, linked.join("set")).unwrap();
+    let through_link = verify(&[&linked]);
+    assert_eq!(through_link.status.code(), Some(0), "{}", stderr(&through_link));
+    assert!(stdout(&through_link).starts_with("ok "), "{}", stdout(&through_link));
 
-    // The user's mistakes: a map file, a missing path, a folder without sets.
+    // The user's mistakes: a map file, a missing path, a folder without sets, a manifest's
+    // name mistyped (no file of that set beside it: no incomplete set).
+    let typo = set_folder.join("natrix-natrx.material.json");
     let empty = dir.path().join("empty");
     std::fs::create_dir(&empty).unwrap();
     let glb = dir.path().join("x.glb");
@@ -1167,7 +1180,8 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         (map.as_path(), "is not a set's manifest"),
         (glb.as_path(), "a glTF export carries no manifest"),
         (dir.path().join("missing").as_path(), "missing"),
-        (empty.as_path(), "holds no set's manifest"),
+        (empty.as_path(), "holds no set"),
+        (typo.as_path(), "no such manifest, and no file of set \"natrix-natrx\" beside it"),
     ] {
         let refused = verify(&[path]);
         assert_eq!(refused.status.code(), Some(2), "{path:?}: {}", stderr(&refused));

@@ -40,8 +40,8 @@ pub struct LoadedPreset {
     /// model is off from the physics of the stack, a film centred below half its spread),
     /// each with the key's line.
     pub warned: Vec<LocatedProblem>,
-    /// The file sets no key (empty, or comments only) and nothing was given in its place
-    /// (`--set`, `--seed`): every key takes its default, the same green snake whatever the
+    /// The file sets no key (empty, comments or empty tables only) and no `--set` gave one:
+    /// every key takes its default, the same green snake whatever the
     /// file was meant to say, which a user who saved the wrong file, or one the editor had
     /// not yet written, should hear of.
     pub sets_no_key: bool,
@@ -53,7 +53,10 @@ impl LoadedPreset {
     /// `warned` of.
     pub fn warnings(&self, preset: &str) -> Vec<String> {
         let empty = self.sets_no_key.then(|| {
-            format!("warning: {preset}: the file sets no key: every key takes its default (docs/presets.md lists them)")
+            format!(
+                "warning: {preset}: the file sets no key: every key takes its default (`snakeskin presets show NAME` \
+                 prints a whole preset to start from)"
+            )
         });
         let clamped = self.clamped_colours.iter().map(|c| c.message(preset));
         let warned = self.warned.iter().map(|p| {
@@ -285,9 +288,13 @@ pub fn parse_with_seed(
     }
     let warned = super::validate::warnings(&preset).into_iter().map(locate).collect();
     let canonical = canonical_text(&preset);
-    let sets_no_key = overrides.is_empty()
-        && !seed_given
-        && toml::from_str::<toml::Table>(&source.text).is_ok_and(|table| table.is_empty());
+    // Tables without keys (`[scales]` alone) set nothing either; a seed (`--seed`, a jobs
+    // file's `seeds`) still draws the default snake.
+    fn sets_nothing(table: &toml::Table) -> bool {
+        table.values().all(|v| v.as_table().is_some_and(sets_nothing))
+    }
+    let sets_no_key =
+        overrides.is_empty() && toml::from_str::<toml::Table>(&source.text).is_ok_and(|table| sets_nothing(&table));
     Ok(LoadedPreset {
         name: source.name.clone(),
         preset,
@@ -330,6 +337,12 @@ pub fn parse_seed_text(text: &str) -> Option<u64> {
 /// The value of `--set seed=VALUE` (`parse_seed_text`); the range check then refuses what lies
 /// beyond the seed's range.
 fn seed_override(value: &str) -> Result<u64, PresetError> {
+    if value.trim().is_empty() {
+        return Err(PresetError::Override {
+            argument: format!("seed={value}"),
+            message: format!("the value is empty: write a whole number in {}", super::validate::seed_range_words()),
+        });
+    }
     parse_seed_text(value).ok_or_else(|| PresetError::Override {
         argument: format!("seed={value}"),
         // With the value: a whole number past the range was called "not a whole number".
@@ -790,18 +803,19 @@ mod tests {
         PresetSource { name: "t".into(), display: "t.toml".into(), text: text.into() }
     }
 
-    /// A file that sets no key is warned of (it loaded silently as the default snake).
-    /// Negative controls: one key, a `--set`, a `--seed`, and a built-in preset.
+    /// A file that sets no key is warned of (it loaded silently as the default snake), a
+    /// seed given or not. Negative controls: one key, a `--set`, and a built-in preset.
     #[test]
     fn a_file_that_sets_no_key_is_warned_of() {
         let says = |loaded: &LoadedPreset| loaded.warnings("t.toml").iter().any(|w| w.contains("sets no key"));
-        for text in ["", "\n  \n", "# a comment only\n"] {
+        for text in ["", "\n  \n", "# a comment only\n", "[scales]\n[body]\n", "scales = {}"] {
             let loaded = parse(&source(text), &[]).unwrap();
             assert!(says(&loaded), "{text:?}: {:?}", loaded.warnings("t.toml"));
         }
         assert!(!says(&parse(&source("seed = 1"), &[]).unwrap()));
         assert!(!says(&parse(&source(""), &[("scales.rows".into(), "21".into())]).unwrap()));
-        assert!(!says(&parse_with_seed(&source(""), &[], Some(3)).unwrap()));
+        // A seed alone still draws the default snake.
+        assert!(says(&parse_with_seed(&source(""), &[], Some(3)).unwrap()));
         assert!(!says(&load("natrix-natrix", &[], None).unwrap()));
     }
 

@@ -184,16 +184,28 @@ impl Cli {
         // A long flag written with one dash (`-out`, `-size 64`) is clap's short flag with its
         // value attached (`-o ut`): `generate NAME -out` wrote the set into `./ut/`, and
         // `-size 64` said "unexpected argument '64'". A word that is one of the command's
-        // long flags but for its second dash is refused with the flag it names.
+        // long flags (or their aliases) but for its second dash, alone or followed by what
+        // cannot continue a flag's name (`-out/`, `-out.glb`, `-size=16`), is refused with the
+        // flag it names. `-help` and `-version` are left to clap (which shows the help).
+        let last = path.last().expect("the command itself at least");
+        let long_names: Vec<&str> = last
+            .get_arguments()
+            .flat_map(|a| a.get_long().into_iter().chain(a.get_all_aliases().unwrap_or_default()))
+            .filter(|l| *l != "help" && *l != "version")
+            .collect();
         for word in words.iter().skip(1).take_while(|w| **w != "--") {
             let Some(rest) = word.strip_prefix('-').filter(|r| r.len() > 1 && !r.starts_with('-')) else {
                 continue;
             };
-            let long = format!("--{}", rest.split('=').next().unwrap_or(""));
-            if flags.iter().any(|(f, _)| *f == long) {
+            let ends_a_name =
+                |after: &str| after.chars().next().is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_'));
+            let named =
+                long_names.iter().filter(|l| rest.strip_prefix(**l).is_some_and(ends_a_name)).max_by_key(|l| l.len());
+            if let Some(named) = named {
                 let first = rest.chars().next().unwrap_or('-');
-                let short_exists = path.iter().flat_map(|c| c.get_arguments()).any(|a| a.get_short() == Some(first));
-                let read_as = if short_exists {
+                let short_takes_a_value =
+                    last.get_arguments().any(|a| a.get_short() == Some(first) && a.get_action().takes_values());
+                let read_as = if short_takes_a_value {
                     format!(
                         " (with one, it is read as the short flag `-{first}` with the value `{}`)",
                         &rest[first.len_utf8()..]
@@ -201,7 +213,7 @@ impl Cli {
                 } else {
                     String::new()
                 };
-                let message = format!("`{word}` has one dash: write `-{word}`; long flags take two{read_as}");
+                let message = format!("`{word}` has one dash: write `--{named}`; long flags take two{read_as}");
                 let mut chosen = &mut command;
                 for name in &names {
                     chosen = chosen.find_subcommand_mut(name).expect("a subcommand found above");
@@ -376,8 +388,8 @@ pub struct ExportArgs {
     /// The file to write: NAME.glb (everything in one binary file) or NAME.gltf (JSON, with
     /// NAME.bin and NAME.basecolor.png, NAME.normal.png, NAME.orm.png and,
     /// with a film of more than one thickness, NAME.thickness.png beside it). `-o FILE`, as
-    /// the other commands write their output, is the same flag.
-    #[arg(short = 'o', long, value_name = "FILE")]
+    /// the other commands write their output, is the same flag, and so is `--out FILE`.
+    #[arg(short = 'o', long, visible_alias = "out", value_name = "FILE")]
     pub gltf: PathBuf,
     /// Texture width in pixels, 16 to 16384 (a body atlas is `body.length` widths tall, at
     /// most 65535 rows: 5461 wide at the default length 12; WebGL viewers commonly load
@@ -1244,7 +1256,10 @@ mod tests {
                 "`-gltf` has one dash: write `--gltf`; long flags take two",
             ),
             (&["generate", "natrix-natrix", "-size", "64"], "write `--size`"),
-            (&["generate", "natrix-natrix", "-maps=color"], "write `--maps=color`"),
+            (&["generate", "natrix-natrix", "-maps=color"], "write `--maps`"),
+            (&["generate", "natrix-natrix", "-out/"], "write `--out`"),
+            (&["generate", "natrix-natrix", "-out.d"], "write `--out`"),
+            (&["export", "natrix-natrix", "-out.glb"], "write `--out`"),
             (&["brdf", "eval", "-roughness", "0.3"], "write `--roughness`"),
         ] {
             let error = parse(args).expect_err(&format!("{args:?} was accepted"));
@@ -1254,6 +1269,11 @@ mod tests {
         let error = parse(&["export", "natrix-natrix", "-gltf", "a.glb"]).unwrap_err();
         assert!(!error.contains("read as"), "{error}");
         parse(&["generate", "natrix-natrix", "-oout"]).unwrap();
+        parse(&["generate", "natrix-natrix", "-outility"]).unwrap();
+        parse(&["export", "natrix-natrix", "--out", "a.glb"]).unwrap();
+        // `-help` is clap's (it shows the help), not refused as `--help`.
+        let error = parse(&["generate", "natrix-natrix", "-help"]).unwrap_err();
+        assert!(!error.contains("one dash"), "{error}");
         parse(&["brdf", "eval", "--wi", "-0.3,0,1", "--wo", "0,0,1"]).unwrap();
         let error = parse(&["generate", "natrix-natrix", "--", "-size"]).expect_err("a second preset");
         assert!(!error.contains("long flags take two dashes"), "{error}");

@@ -1,10 +1,12 @@
 //! `snakeskin verify PATH...`: checks sets against their manifests, for pipelines that take
 //! a set from a shared folder, a cache or an archive and need to know it is whole. A run
-//! killed while renaming leaves an incomplete set, and a file replaced by hand a mixed one;
-//! both fail here. The check is the library's (`export::verify_set`: every map the manifest
-//! lists exists beside it with the SHA-256 it records), so `batch`, which skips finished
-//! jobs by it, and this command agree on what a finished set is.
+//! killed while renaming leaves an incomplete set (maps without their manifest), and a file
+//! replaced by hand a mixed one; both fail here. The check of a manifest is the library's
+//! (`export::verify_set`: every map it lists exists beside it with the SHA-256 it records),
+//! so `batch`, which skips finished jobs by it, and this command agree on what a finished
+//! set is; a set's files are known by `export::every_set_file_name`, as a commit knows them.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
@@ -12,114 +14,175 @@ use anyhow::Result;
 use crate::output::path_line;
 use snakeskin::export::MANIFEST_SUFFIX;
 
-/// The most manifests one folder argument is searched for: a set folder holds one, a batch
+/// The most sets one folder argument is searched for: a set folder holds one, a batch
 /// folder one per job; a folder with more is not a set folder (`verify /`), and is refused
 /// before any file is hashed.
-const MAX_MANIFESTS: usize = 100_000;
+const MAX_SETS: usize = 100_000;
 
-/// How far below a folder argument manifests are looked for: a batch writes each set two
+/// How far below a folder argument sets are looked for: a batch writes each set two
 /// folders down (`OUT/PRESET/tile-1024-seed1-png/`).
 const SUBFOLDER_LEVELS: usize = 2;
 
+/// What one line of the report checks.
+enum Check {
+    /// A set's manifest (which may be missing, or no regular file: `verify_set` says so).
+    Manifest(PathBuf),
+    /// Files of a set named `name` in `folder` with no manifest beside them.
+    Orphans { folder: PathBuf, name: String, files: usize },
+    /// A subfolder that could not be listed: the sets in it are not checked.
+    Unlistable { folder: PathBuf, error: String },
+}
+
 pub fn run(paths: &[PathBuf]) -> Result<()> {
-    let mut manifests = Vec::new();
+    let mut checks = Vec::new();
     for path in paths {
-        manifests.extend(manifests_at(path)?);
+        checks.extend(checks_at(path)?);
     }
+    // Each set once, however often it is named (a manifest and its folder, `./x` and `x`).
+    let mut seen = std::collections::HashSet::new();
+    checks.retain(|check| match check {
+        Check::Manifest(path) => seen.insert(std::fs::canonicalize(path).unwrap_or_else(|_| path.clone())),
+        _ => true,
+    });
     let mut failed = 0;
-    for manifest in &manifests {
-        match snakeskin::export::verify_set(manifest) {
-            Ok(set) => println!("ok {} ({} files)", path_line(manifest), set.files.len()),
-            Err(e) => {
-                failed += 1;
+    for check in &checks {
+        let failure = match check {
+            Check::Manifest(manifest) => match snakeskin::export::verify_set(manifest) {
+                Ok(set) => {
+                    let count = set.files.len();
+                    println!("ok {} ({count} file{})", path_line(manifest), if count == 1 { "" } else { "s" });
+                    continue;
+                }
                 // The error names the manifest (`set PATH: problem`).
-                println!("FAILED {}", crate::output::printable(&e.to_string()).replace('\n', "\\n"));
+                Err(e) => e.to_string(),
+            },
+            Check::Orphans { folder, name, files } => format!(
+                "set {}: {files} of its files but no manifest ({name}{MANIFEST_SUFFIX}): the set is incomplete (a \
+                 run failed or was killed while writing it)",
+                path_line(&folder.join(name))
+            ),
+            Check::Unlistable { folder, error } => {
+                format!("cannot list {}: {error}: the sets in it are not checked", path_line(folder))
             }
-        }
+        };
+        failed += 1;
+        println!("FAILED {}", crate::output::printable(&failure).replace('\n', "\\n"));
     }
     if failed > 0 {
-        anyhow::bail!("{failed} of {} sets failed: incomplete or altered (listed above)", manifests.len());
+        anyhow::bail!("{failed} of {} checks failed: sets incomplete, altered or unread (listed above)", checks.len());
     }
     Ok(())
 }
 
-/// The manifests `path` names: itself, where it is a file; in a folder, those in it and in
-/// its subfolders down to `SUBFOLDER_LEVELS` (a batch's output), hidden entries and links
-/// passed over. A manifest missing
-/// from its folder is an incomplete set; a path that is missing otherwise, one that is no
-/// manifest, or a folder without a manifest, is the user's mistake.
-fn manifests_at(path: &Path) -> Result<Vec<PathBuf>> {
+/// What `path` names: a manifest, where it is one (or names one in a folder that holds the
+/// set's files: an incomplete set); in a folder, the sets in it and in its subfolders down
+/// to `SUBFOLDER_LEVELS` (a batch's output), links followed, hidden entries passed over. A
+/// path that is missing, one that is no manifest, or a folder without a set, is the user's
+/// mistake.
+fn checks_at(path: &Path) -> Result<Vec<Check>> {
     let invalid = |reason: String| snakeskin::Error::InvalidOption { option: "verify PATH", reason };
-    let names_a_manifest = path.to_string_lossy().ends_with(MANIFEST_SUFFIX);
-    let metadata = match std::fs::metadata(path) {
-        Ok(metadata) => metadata,
-        // A manifest missing from a folder that exists is a set that is incomplete (a run
-        // killed while renaming), which `verify_set` says.
-        Err(e)
-            if e.kind() == std::io::ErrorKind::NotFound
-                && names_a_manifest
-                && path.parent().is_some_and(|p| p.as_os_str().is_empty() || p.is_dir()) =>
-        {
-            return Ok(vec![path.to_path_buf()]);
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let set_name = name.strip_suffix(MANIFEST_SUFFIX).filter(|s| !s.is_empty());
+    let metadata = std::fs::metadata(path);
+    if let Some(set_name) = set_name
+        && !metadata.as_ref().is_ok_and(|m| m.is_dir())
+    {
+        // A manifest that is there is checked; a missing one is an incomplete set where the
+        // set's files lie beside it, and a wrong path otherwise (a typo).
+        let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let present = metadata.is_ok() || path.is_symlink();
+        if present || set_files_in(folder, set_name) > 0 {
+            return Ok(vec![Check::Manifest(path.to_path_buf())]);
         }
-        Err(e) => return Err(invalid(format!("{}: {e}", path_line(path))).into()),
-    };
-    if !metadata.is_dir() {
-        if !names_a_manifest {
-            let gltf =
-                path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
-            let reason = format!(
-                "{} is not a set's manifest (NAME{MANIFEST_SUFFIX}) or a folder of sets{}",
-                path_line(path),
-                if gltf { " (a glTF export carries no manifest)" } else { "" }
-            );
-            return Err(invalid(reason).into());
-        }
-        return Ok(vec![path.to_path_buf()]);
+        let reason = format!("{}: no such manifest, and no file of set {set_name:?} beside it", path_line(path));
+        return Err(invalid(reason).into());
     }
-    let mut found = Vec::new();
+    let metadata = metadata.map_err(|e| invalid(format!("{}: {e}", path_line(path))))?;
+    if !metadata.is_dir() {
+        let gltf = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+        let reason = format!(
+            "{} is not a set's manifest (NAME{MANIFEST_SUFFIX}) or a folder of sets{}",
+            path_line(path),
+            if gltf { " (a glTF export carries no manifest)" } else { "" }
+        );
+        return Err(invalid(reason).into());
+    }
+    let mut checks = Vec::new();
     // Depth first, in name order, so the lines come out in the order `ls -R` lists them.
     let mut folders = vec![(path.to_path_buf(), 0)];
     while let Some((folder, depth)) = folders.pop() {
-        let mut below = Vec::new();
-        for entry in read_sorted(&folder)? {
-            let name = entry.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            if name.starts_with('.') || entry.is_symlink() {
+        let entries = match read_sorted(&folder) {
+            Ok(entries) => entries,
+            Err(e) if depth == 0 => return Err(invalid(format!("cannot list {}: {e}", path_line(&folder))).into()),
+            Err(e) => {
+                checks.push(Check::Unlistable { folder, error: e.to_string() });
                 continue;
             }
-            if entry.is_dir() {
+        };
+        let mut below = Vec::new();
+        // Set name → its files here; which of them have a manifest.
+        let mut sets: BTreeMap<String, usize> = BTreeMap::new();
+        let mut manifests = Vec::new();
+        for entry in entries {
+            let name = entry.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            if name.starts_with('.') {
+                continue;
+            }
+            if let Some(set) = name.strip_suffix(MANIFEST_SUFFIX).filter(|s| !s.is_empty()) {
+                // Whatever it is (a file, a link, a FIFO, a folder): `verify_set` says.
+                manifests.push(set.to_string());
+                checks.push(Check::Manifest(entry));
+            } else if entry.is_dir() {
                 if depth < SUBFOLDER_LEVELS {
                     below.push((entry, depth + 1));
                 }
-            } else if name.ends_with(MANIFEST_SUFFIX) && entry.is_file() {
-                found.push(entry);
-                if found.len() > MAX_MANIFESTS {
-                    let reason =
-                        format!("{} holds more than {MAX_MANIFESTS} manifests: name a set's folder", path_line(path));
-                    return Err(invalid(reason).into());
-                }
+            } else if let Some(set) = set_of(&name) {
+                *sets.entry(set).or_default() += 1;
+            }
+            if checks.len() > MAX_SETS {
+                let reason = format!("{} holds more than {MAX_SETS} sets: name a set's folder", path_line(path));
+                return Err(invalid(reason).into());
+            }
+        }
+        for (name, files) in sets {
+            if !manifests.contains(&name) {
+                checks.push(Check::Orphans { folder: folder.clone(), name, files });
             }
         }
         folders.extend(below.into_iter().rev());
     }
-    if found.is_empty() {
+    if checks.is_empty() {
         let reason = format!(
-            "{} holds no set's manifest (NAME{MANIFEST_SUFFIX}), nor do its subfolders: nothing to verify",
+            "{} holds no set (NAME{MANIFEST_SUFFIX} or a set's files), nor do its subfolders: nothing to verify",
             path_line(path)
         );
         return Err(invalid(reason).into());
     }
-    Ok(found)
+    Ok(checks)
+}
+
+/// The set whose file `file_name` is (`NAME_color.png`, `NAME_orm.png`, …), if it is one of
+/// `every_set_file_name`'s names for the name before one of its underscores.
+fn set_of(file_name: &str) -> Option<String> {
+    file_name.match_indices('_').map(|(i, _)| &file_name[..i]).find_map(|set| {
+        (!set.is_empty() && snakeskin::export::every_set_file_name(set).iter().any(|n| n == file_name))
+            .then(|| set.to_string())
+    })
+}
+
+/// How many files of set `set_name` lie in `folder` (its manifest aside).
+fn set_files_in(folder: &Path, set_name: &str) -> usize {
+    let manifest = snakeskin::export::manifest_file_name(set_name);
+    snakeskin::export::every_set_file_name(set_name)
+        .iter()
+        .filter(|name| **name != manifest && folder.join(name).symlink_metadata().is_ok())
+        .count()
 }
 
 /// The entries of `folder`, sorted by path (the listing's order is the file system's).
-fn read_sorted(folder: &Path) -> Result<Vec<PathBuf>> {
-    let entries = std::fs::read_dir(folder)
-        .map_err(|e| anyhow::anyhow!("cannot list {}: {e}", path_line(folder)))?
-        .map(|entry| entry.map(|e| e.path()))
-        .collect::<std::io::Result<Vec<_>>>()
-        .map_err(|e| anyhow::anyhow!("cannot list {}: {e}", path_line(folder)))?;
-    let mut entries = entries;
+fn read_sorted(folder: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut entries =
+        std::fs::read_dir(folder)?.map(|entry| entry.map(|e| e.path())).collect::<std::io::Result<Vec<_>>>()?;
     entries.sort();
     Ok(entries)
 }
