@@ -141,6 +141,21 @@ pub enum Command {
     },
 }
 
+/// A refusal of the command line in clap's format, with the usage of the subcommand the
+/// words named (`names`: `brdf`, `eval`), as clap's own errors show it.
+fn refusal(
+    command: &mut clap::Command,
+    names: &[String],
+    kind: clap::error::ErrorKind,
+    message: String,
+) -> clap::Error {
+    let mut chosen = command;
+    for name in names {
+        chosen = chosen.find_subcommand_mut(name).expect("a subcommand the words named");
+    }
+    clap::Error::raw(kind, message).format(chosen)
+}
+
 impl Cli {
     /// The command line parsed, or clap's error (exit code 2), with two rules of ours.
     /// A flag whose value may start with `-` (`--wi -1,0,1`) takes the next word whatever it
@@ -174,11 +189,7 @@ impl Cli {
             let takes_hyphen_values = flags.iter().any(|(f, hyphen)| f == pair[0] && *hyphen);
             if takes_hyphen_values && flags.iter().any(|(f, _)| f == next_flag) {
                 let message = format!("`{}` needs a value, and the next word is the flag `{}`", pair[0], pair[1]);
-                let mut chosen = &mut command;
-                for name in &names {
-                    chosen = chosen.find_subcommand_mut(name).expect("a subcommand found above");
-                }
-                return Err(clap::Error::raw(clap::error::ErrorKind::InvalidValue, message).format(chosen));
+                return Err(refusal(&mut command, &names, clap::error::ErrorKind::InvalidValue, message));
             }
         }
         // A long flag written with one dash (`-out`, `-size 64`) is clap's short flag with its
@@ -214,11 +225,7 @@ impl Cli {
                     String::new()
                 };
                 let message = format!("`{word}` has one dash: write `--{named}`; long flags take two{read_as}");
-                let mut chosen = &mut command;
-                for name in &names {
-                    chosen = chosen.find_subcommand_mut(name).expect("a subcommand found above");
-                }
-                return Err(clap::Error::raw(clap::error::ErrorKind::UnknownArgument, message).format(chosen));
+                return Err(refusal(&mut command, &names, clap::error::ErrorKind::UnknownArgument, message));
             }
         }
         let mut matches = command.try_get_matches_from_mut(args)?;

@@ -107,6 +107,8 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
         );
         return Err(invalid(reason).into());
     }
+    let suffixes: Vec<String> =
+        snakeskin::export::every_set_file_name("").into_iter().filter(|n| n != MANIFEST_SUFFIX).collect();
     let mut checks = Vec::new();
     // Depth first, in name order, so the lines come out in the order `ls -R` lists them.
     let mut folders = vec![(path.to_path_buf(), 0)];
@@ -136,7 +138,7 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
                 if depth < SUBFOLDER_LEVELS {
                     below.push((entry, depth + 1));
                 }
-            } else if let Some(set) = set_of(&name) {
+            } else if let Some(set) = set_of(&name, &suffixes) {
                 *sets.entry(set).or_default() += 1;
             }
             if checks.len() > MAX_SETS {
@@ -161,13 +163,16 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
     Ok(checks)
 }
 
-/// The set whose file `file_name` is (`NAME_color.png`, `NAME_orm.png`, …), if it is one of
-/// `every_set_file_name`'s names for the name before one of its underscores.
-fn set_of(file_name: &str) -> Option<String> {
-    file_name.match_indices('_').map(|(i, _)| &file_name[..i]).find_map(|set| {
-        (!set.is_empty() && snakeskin::export::every_set_file_name(set).iter().any(|n| n == file_name))
-            .then(|| set.to_string())
-    })
+/// The set whose file `file_name` is (`NAME_color.png`, `NAME_orm.png`, …), if it ends in one
+/// of the suffixes every set's file names have (`suffixes`: `every_set_file_name` of the
+/// empty name, its manifest's left out).
+fn set_of(file_name: &str, suffixes: &[String]) -> Option<String> {
+    // The longest suffix that fits: a set name may end as a shorter suffix begins.
+    suffixes
+        .iter()
+        .filter(|suffix| file_name.len() > suffix.len() && file_name.ends_with(suffix.as_str()))
+        .max_by_key(|suffix| suffix.len())
+        .map(|suffix| file_name[..file_name.len() - suffix.len()].to_string())
 }
 
 /// How many files of set `set_name` lie in `folder` (its manifest aside).
