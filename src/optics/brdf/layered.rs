@@ -32,7 +32,22 @@ use super::{COS_MIN, Layers, Layers32, cos_transmitted};
 /// (`brdf albedo --model layered --absorption 0 --albedo 1 --thickness-nm 400 --n0 1.5 --n1
 /// 1.55 --n2 1.33 --roughness 1`: 0.995 at 62°, 0.238 at 63°, the critical angle 62.5°;
 /// 0.267 on (1.2, 1.3, 1.0); the walk gives 1; an independent review measured 0.392 at 70°,
-/// past the 0.4 this said). `None` where n0 ≤ n2. One home
+/// past the 0.4 this said). `None` where n0 ≤ n2.
+///
+/// Letting the lobe send light beyond the critical angle (1 − s there, E taking the light it
+/// sends out there and K giving it up) was tried and is not enough (a later session;
+/// BENCHMARKS, "A pigment layer less dense than the ambient: the top reflects too little"):
+/// the rough top's own s is too small there. On the bare interface 1.5 | 1.33 with k_d = 0
+/// (`brdf albedo --model layered` against `--model stochastic`, `--albedo 0 --thickness-nm
+/// 0 --n0 1.5 --n1 1.4 --n2 1.33 --absorption 0`), roughness 1: 0.38 against the walk's
+/// 0.57 at 70°, 0.62 against 0.94 at 80°; roughness 0.6: 0.54 against 0.61 at 70°;
+/// roughness 0.3 within 0.011. The walk's difference is light that enters the microsurface
+/// and comes straight back (its never-entering share is 0.08 at 70°, roughness 1); the
+/// model's straight-back term q counts it only for light entering through the lobe's first
+/// microfacet. With n0 < n2 the two agree within 0.001 (1 | 1.33, roughness 1, 0°–85°). Summed
+/// over the hemisphere that s lets in (n0/n2)² ⟨1 − s⟩ ≈ 1.10 of a Lambertian's light at
+/// roughness 1, where the walk's top keeps the balance n0² ⟨T↓⟩ = n2² ⟨T↑⟩ (1.762 both ways,
+/// α = 1), so E would pass 1 − K and the furnace 1.07. One home
 /// for the condition and its wording: a preset's check (`validate`) and `brdf eval`/`albedo`
 /// warn with it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,7 +67,8 @@ impl std::fmt::Display for ModelLimit {
             f,
             "the layered model loses light beyond the critical angle ({:.0}° from the normal), where the rough \
              top's reflection has nowhere to go (a white stack without absorption reflects as little as a quarter of \
-             the light, dropping there), so its values are darker than the physics there",
+             the light, dropping there), so its values are darker than the physics there; and from roughness 0.6 \
+             its top reflects too little of oblique light (0.38 where the physics gives 0.57 at 70° under roughness 1)",
             self.critical_angle_deg
         )
     }
