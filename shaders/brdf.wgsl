@@ -148,13 +148,12 @@ fn path_delta_at(cos: f32, roughness: f32) -> f32 {
 // the rough lobe reflects and cos_eff - cos_t its path delta (the top at mu: coupling).
 fn layered_entering(layers: Layers, cos: f32, top: Top) -> vec3<f32> {
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    // Snell's cos_t^2, below 0 beyond the critical angle of n0 > n2, where a rough top still
+    // lets 1 - s in and cos_t is taken as 0 (optics::brdf::path::snell_cos).
     let k = (1.0 - eta2) + eta2 * cos * cos;
-    if (k <= 0.0) {
-        return vec3<f32>(0.0);
-    }
     var a = vec3<f32>(1.0) - top.reflected;
     if (HAS_ABSORPTION) {
-        let path_cos = max(sqrt(k) + top.path_delta, COS_MIN);
+        let path_cos = max(sqrt(max(k, 0.0)) + top.path_delta, COS_MIN);
         a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) / path_cos);
     }
     return a;
@@ -175,14 +174,12 @@ fn layered_diffuse(layers: Layers, cos_i: f32, cos_o: f32, top_i: Top, top_o: To
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
     let k_i = (1.0 - eta2) + eta2 * cos_i * cos_i;
     let k_o = (1.0 - eta2) + eta2 * cos_o * cos_o;
-    if (!(k_i > 0.0 && k_o > 0.0)) {
-        return vec3<f32>(0.0);
-    }
     let kd = clamp(layers.albedo, vec3<f32>(0.0), vec3<f32>(1.0));
     var a = (vec3<f32>(1.0) - top_i.reflected) * (vec3<f32>(1.0) - top_o.reflected);
     if (HAS_ABSORPTION) {
-        let inverse_path = 1.0 / max(sqrt(k_i) + top_i.path_delta, COS_MIN)
-            + 1.0 / max(sqrt(k_o) + top_o.path_delta, COS_MIN);
+        // cos_t 0 beyond the critical angle of n0 > n2 (layered_entering).
+        let inverse_path = 1.0 / max(sqrt(max(k_i, 0.0)) + top_i.path_delta, COS_MIN)
+            + 1.0 / max(sqrt(max(k_o, 0.0)) + top_o.path_delta, COS_MIN);
         a *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) * inverse_path);
     }
     return eta2 * kd * a / (PI * (vec3<f32>(1.0) - kd * layers.k));
@@ -295,7 +292,8 @@ fn parts_on_row(layers: Layers, k: u32, fx: f32) -> RowParts {
     let twice = lobe_slot(&v, LOBE_NODE_SLOT + SHARE_SLOT);
     let multiple = twice * both + (1.0 - twice) * first * second * second;
     let back = by_rule(&v, &f, LOBE_THROUGH_SLOT + 1u, LOBE_NODES + 2u * PAIR_NODES, THROUGH_NODES);
-    let q = (1.0 - mean) * lobe_slot(&v, LOBE_THROUGH_SLOT) * back;
+    // Light straight back: a share of all the light the top lets in (energy::parts_on_row).
+    let q = (1.0 - e1 * mean - (1.0 - e1) * multiple) * lobe_slot(&v, LOBE_THROUGH_SLOT) * back;
     // x never more than the light the single scattering leaves (q's reweighting is an
     // estimate).
     let single = e1 * mean;

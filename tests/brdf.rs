@@ -153,31 +153,39 @@ fn a_film_less_dense_than_the_ambient_keeps_the_white_furnace() {
 }
 
 /// A pigment layer less dense than the medium above (n2 < n0) totally reflects at the
-/// film's lower face beyond asin(n2 / n0), 53.1° here: F has a corner there too, and the
-/// Gauss rule read the white stack as 0.948 at 45° and 1.082 at 53° (roughness 0.35, `brdf
-/// albedo`, an independent review's find). Read by the quantile rule (`energy::LobeRule::of`
-/// takes n2 too), the furnace holds inside that angle; beyond it the model loses light
-/// (`layered::ModelLimit`, warned of). Seen failing with `LobeRule::of` ignoring n2.
+/// film's lower face beyond asin(n2 / n0), 53.1° on (1.5, 1.55, 1.2): F has a corner there,
+/// and the Gauss rule read the white stack as 0.948 at 45° and 1.082 at 53° (roughness 0.35,
+/// `brdf albedo`, an independent review's find); it is read by the quantile rule
+/// (`energy::LobeRule::of` takes n2 too). Beyond that angle a rough top still lets light
+/// in, through tilted microfacets, and out (`layered::entering`, `exact::SmoothTop::k_e_row`),
+/// and much of it straight back (`path::through_rule`'s node for total reflections): the
+/// furnace holds to the bounds at every angle. Seen failing with the lobe sending
+/// nothing beyond the critical angle (0.238 at 63° on (1.5, 1.55, 1.33), roughness 1), and
+/// with one Gauss rule over all of light straight back's last reflections (the top then
+/// reflects too little and the lossless E passes 1: 1.07 at 0°).
 #[test]
-fn a_pigment_less_dense_than_the_ambient_keeps_the_furnace_inside_its_critical_angle() {
+fn a_pigment_less_dense_than_the_ambient_keeps_the_furnace_at_every_angle() {
     use snakeskin::optics::brdf::energy::LobeRule;
-    let stack = Stack { n0: 1.5, n1: 1.55, n2: 1.2 };
-    let mut worst = 0.0f64;
-    for thickness in [0.0, 1500.0] {
-        let tables = FilmTables::new(stack, thickness);
-        let film = |c: f64| tables.above(c);
-        for roughness in [0.2, 0.35, 0.6] {
-            let layers = white_layers(stack, thickness, roughness);
-            assert_eq!(layers.lobe_rule(), LobeRule::Quantiles);
-            for angle_deg in [0.0f64, 30.0, 45.0, 50.0, 53.0] {
-                let a = Model::Layered.furnace_albedo(&layers, angle_deg.to_radians().cos(), &film, 64);
-                let err = a.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
-                worst = worst.max(err);
-                assert!(err <= 0.02, "d={thickness} r={roughness} {angle_deg}°: {a:?}");
+    let stacks = [Stack { n0: 1.5, n1: 1.55, n2: 1.2 }, Stack { n0: 1.5, n1: 1.55, n2: 1.33 }];
+    let mut worst = [0.0f64; 2];
+    for stack in stacks {
+        for thickness in [0.0, 400.0, 1500.0] {
+            let tables = FilmTables::new(stack, thickness);
+            let film = |c: f64| tables.above(c);
+            for roughness in [0.05, 0.2, 0.35, 0.6, 1.0] {
+                let layers = white_layers(stack, thickness, roughness);
+                assert_eq!(layers.lobe_rule(), LobeRule::Quantiles);
+                for angle_deg in [0.0f64, 30.0, 45.0, 50.0, 53.0, 55.0, 60.0, 63.0, 70.0, 80.0, 85.0] {
+                    let a = Model::Layered.furnace_albedo(&layers, angle_deg.to_radians().cos(), &film, 64);
+                    let err = a.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
+                    let (regime, bound) = if angle_deg <= 70.0 { (0, 0.02) } else { (1, 0.05) };
+                    worst[regime] = worst[regime].max(err);
+                    assert!(err <= bound, "{stack:?} d={thickness} r={roughness} {angle_deg}°: {a:?}");
+                }
             }
         }
     }
-    eprintln!("pigment below the ambient, inside its critical angle: max |albedo − 1| {worst:.4}");
+    eprintln!("pigment below the ambient: max |albedo − 1| {:.4} up to 70°, {:.4} beyond", worst[0], worst[1]);
 }
 
 #[test]
@@ -694,4 +702,42 @@ fn light_straight_back_through_the_rough_top_meets_the_walk() {
         );
         assert!(reference - without.reflected[c] > 0.009, "channel {c}: without the term {}", without.reflected[c]);
     }
+}
+
+/// Under a pigment layer less dense than the ambient (n0 > n2) most of the light a rough top
+/// lets in at oblique angles comes straight back: in through one microfacet, out through
+/// another (at roughness 1 and 70° on 1.5 | 1.33, 0.49 of the light, against 0.08 that never
+/// enters). Its last reflections from above are total beyond the critical angle, for any
+/// film, and `path::through_rule` gives them a node of their own; the top's reflection then
+/// meets the walk's, with a black base so that nothing comes back from it. Seen failing with
+/// one Gauss rule over all last reflections (off by 0.32; 0.383 against 0.574 at 70° on the
+/// bare interface, roughness 1, with the term below as it was too) and with light straight
+/// back a share of the light in through the lobe's first microfacet only, 1 − ⟨F⟩ (0.066).
+/// Left: up to 0.041 too little at roughness 0.6 (a 400 nm film, 70°; the bare
+/// interface at 50°, 0.133 against 0.157), light the multiple scattering's pair rule
+/// (`energy::Multiple`, read at fixed cosines) misses across the same corner.
+#[test]
+fn light_straight_back_under_a_pigment_less_dense_than_the_ambient_meets_the_walk() {
+    use snakeskin::optics::brdf::{energy, path, walk};
+    let stack = Stack { n0: 1.5, n1: 1.4, n2: 1.33 };
+    let mut worst = 0.0f64;
+    for thickness in [0.0, 400.0] {
+        let film = FilmTables::new(stack, thickness);
+        let film_fn = |c: f64| film.above(c).map(|v| v.clamp(0.0, 1.0));
+        for roughness in [0.6, 1.0] {
+            let layers = Layers::of_stack(stack, thickness, roughness, [0.0; 3], [0.0; 3]);
+            for angle_deg in [0.0f64, 50.0, 70.0, 80.0] {
+                let mu = angle_deg.to_radians().cos();
+                let walked = walk::walk(&layers, &film, [(1.0 - mu * mu).sqrt(), 0.0, mu], 100_000, 1, 29);
+                let rule = energy::LobeRule::of(stack.n0, stack.n1, stack.n2);
+                let top = energy::top(mu, roughness, &film_fn, &path::cached(stack.n0, stack.n2).through, rule);
+                for c in 0..3 {
+                    let (model, reference) = (top.reflected[c], walked.total()[c]);
+                    worst = worst.max((model - reference).abs());
+                }
+            }
+        }
+    }
+    eprintln!("pigment below the ambient: the top's reflection off the walk's by {worst:.4} at most");
+    assert!(worst < 0.05, "{worst}");
 }

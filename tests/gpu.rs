@@ -348,6 +348,57 @@ fn a_film_less_dense_than_the_ambient_reads_the_quantile_rule_on_the_gpu() {
     assert!(gauss_worst > 2e-2, "the Gauss rule's reading is far from the GPU's: {gauss_worst}");
 }
 
+/// A pigment layer less dense than the ambient (n0 > n2): beyond the critical angle (62.5°
+/// here) a rough top lets light into the pigment layer and out of it, and much of it
+/// straight back (`layered::entering`, `path::through_rule`'s node for total reflections).
+/// The shader's twin against the f64 BRDF around the same f32 film, over every direction and
+/// with absorption, so the path table's deltas beyond that angle are read. Seen failing with
+/// the shader's diffuse lobe still zero beyond the angle.
+#[test]
+fn a_pigment_less_dense_than_the_ambient_lets_light_in_beyond_its_critical_angle_on_the_gpu() {
+    use snakeskin::optics::methods::rgb3_f32;
+    use snakeskin::render::engine::film::GpuFilmMethod;
+    use snakeskin::render::reference::brdf_eval::eval_timed;
+    let Some(gpu) =
+        gpu_or_skip("a_pigment_less_dense_than_the_ambient_lets_light_in_beyond_its_critical_angle_on_the_gpu")
+    else {
+        return;
+    };
+    let stack = Stack { n0: 1.5, n1: 1.55, n2: 1.33 };
+    let film = |d: f32, c: f32| rgb3_f32(1.5, 1.55, 1.33, d, c);
+    let lut = Lut::bake(stack, 16, 32, 8);
+    let critical_cos = (1.0f32 - (1.33f32 / 1.5).powi(2)).sqrt();
+    let mut rng = Rng(23);
+    let (mut inputs, mut samples) = (Vec::new(), Vec::new());
+    for _ in 0..4000 {
+        let roughness = 0.1 + 0.9 * rng.next() as f64;
+        let l = Layers::of_stack(stack, 400.0, roughness, [0.3, 0.5, 0.8], [0.6, 0.4, 0.2])
+            .to_f32(200.0 + 400.0 * rng.next() as f64);
+        let (wi, wo) = (rng.direction(true), rng.direction(true));
+        samples.push(GpuSample::new(&l, [0.0, 0.0, 1.0], wi, wo));
+        inputs.push((l, wi, wo));
+    }
+    let (gpu_values, _) =
+        eval_timed(&gpu, Model::Layered, stack, &lut, GpuFilmMethod::Rgb3, &samples, 1).expect("gpu evaluation");
+    let (mut worst, mut beyond) = (0.0f64, 0);
+    for ((l, wi, wo), g) in inputs.iter().zip(&gpu_values) {
+        let layers = f64_layers(l, stack.n1);
+        let d = l.thickness_nm;
+        let (wi64, wo64) = (wi.map(|v| v as f64), wo.map(|v| v as f64));
+        let value = Model::Layered.eval(&layers, [0.0, 0.0, 1.0], wi64, wo64, &|c| film(d, c as f32).map(|v| v as f64));
+        let cpu = value.total();
+        if wi[2] < critical_cos && value.diffuse[0] > 1e-4 {
+            beyond += 1;
+        }
+        for c in 0..3 {
+            worst = worst.max((g[c] as f64 - cpu[c]).abs() / (1.0 + cpu[c].abs()));
+        }
+    }
+    eprintln!("pigment below the ambient: max |gpu - cpu| / (1 + cpu) = {worst:e}; {beyond} lit beyond the angle");
+    assert!(beyond > 500, "light from beyond the critical angle reaches the base: {beyond}");
+    assert!(worst < 5e-3, "GPU and CPU differ by {worst}");
+}
+
 #[test]
 fn every_gpu_film_method_matches_its_cpu_f32_twin() {
     let Some(gpu) = gpu_or_skip("every_gpu_film_method_matches_its_cpu_f32_twin") else { return };

@@ -297,44 +297,44 @@ fn export_and_batch_report_clamped_colours() {
     assert!(out.status.success() && !stderr(&out).contains("color.base"), "{}", stderr(&out));
 }
 
-/// An ambient denser than the pigment layer is warned of with its key and line, because the
-/// layered model loses light there (which the first assertion measures, so that the
-/// warning goes when the model stops losing it). Negative control: equal indices, no
-/// warning.
+/// An ambient denser than the pigment layer: a rough top lets light in and out beyond the
+/// critical angle, and the layered model follows it, so the white furnace holds there and a
+/// preset with such indices loads without a word. Until a later session the model lost the
+/// light there (0.50 at 75° on 1.4 | 1.33, roughness 0.5: this test's first assertion then
+/// failed, as it was written to, once the model was mended) and such presets were warned
+/// of. Control: equal indices.
 #[test]
-fn an_ambient_denser_than_the_pigment_is_warned_of() {
+fn an_ambient_denser_than_the_pigment_keeps_the_furnace_without_a_warning() {
     let albedo = |n0: &str, n2: &str| {
         let args = ["brdf", "albedo", "--n0", n0, "--n2", n2, "--absorption", "0", "--roughness", "0.5"];
         let out = snakeskin(&[&args[..], &["--angle-deg", "75"]].concat());
-        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(out.status.success() && stderr(&out).is_empty(), "{}", stderr(&out));
         let json: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
         json["albedo"][1].as_f64().unwrap()
     };
     let (denser, equal) = (albedo("1.4", "1.33"), albedo("1.33", "1.33"));
-    assert!(denser < 0.8 && (equal - 1.0).abs() < 0.01, "white furnace {denser} (n0 > n2), {equal} (n0 = n2)");
+    assert!(
+        (denser - 1.0).abs() < 0.02 && (equal - 1.0).abs() < 0.01,
+        "white furnace {denser} (n0 > n2), {equal} (n0 = n2)"
+    );
 
     let dir = tempfile::tempdir().unwrap();
     let text = "species = \"oily\"\n\n[optics]\nambient_ior = 1.4\npigment_ior = 1.33\n";
     let preset = write_preset(dir.path(), "oily.toml", text);
     let out_dir = dir.path().join("out");
     let out = snakeskin(&["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
+    assert!(out.status.success() && !stderr(&out).contains("ambient_ior"), "{}", stderr(&out));
+    // Past a contrast of about 1.35 under rough tops the model lets out more light than
+    // arrives (`layered::PigmentBelowAmbient`): warned of with the key and line.
+    let text = "species = \"oily\"\n\n[optics]\nambient_ior = 1.5\npigment_ior = 1.0\n\n[roughness]\nbase = 1.0\n";
+    let preset = write_preset(dir.path(), "contrast.toml", text);
+    let out = snakeskin(&["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let err = stderr(&out);
-    assert!(err.contains("oily.toml:4: optics.ambient_ior = 1.4 is above optics.pigment_ior = 1.33"), "{err}");
-    assert!(err.contains("critical angle (72°"), "{err}");
-    let out = snakeskin(&[
-        "generate",
-        &preset,
-        "--set",
-        "optics.ambient_ior=1.33",
-        "-o",
-        out_dir.to_str().unwrap(),
-        "--size",
-        "32",
-        "--maps",
-        "color",
-    ]);
-    assert!(out.status.success() && !stderr(&out).contains("ambient_ior"), "{}", stderr(&out));
+    assert!(
+        err.contains("contrast.toml:4: optics.ambient_ior = 1.5 is above optics.pigment_ior = 1: from roughness"),
+        "{err}"
+    );
 }
 
 /// A film less dense than the ambient: the coupling reads it by the quantile rule, so the

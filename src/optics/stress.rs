@@ -25,11 +25,11 @@ pub struct StressReport {
     /// models that must never reflect more than arrives (the thesis model).
     pub max_albedo: f64,
     /// Smallest and largest white-furnace albedo of each model, with K and E of the film
-    /// drawn. The layered model holds albedo 1 within its furnace bounds up to 89° where the
-    /// ambient is not denser than the pigment; the stress also views at 89.94° (cos 0.001),
-    /// where it is off by up to 0.15, and draws n0 = 1.5 over n2 = 1, where a rough top
-    /// loses about half (beyond the critical angle the lobe's deficit has nowhere to go; 0.6
-    /// for n0 = 2 over n2 = 1.33 at roughness 0.9).
+    /// drawn. The layered model holds albedo 1 within its furnace bounds up to 89°; the
+    /// stress also views at 89.94° (cos 0.001), where a mirror-smooth top reads 0.79–0.86, and
+    /// draws n0 = 1.5 over n2 = 1, where tops of roughness 0.87 and more reflect up to 1.05
+    /// (`layered::PigmentBelowAmbient`; before the model followed the light beyond the
+    /// critical angle, 0.44 there).
     pub furnace_by_model: Vec<ModelFurnace>,
     /// Largest |f32 − f64| / (1 + |f64|) of the BRDF.
     pub max_f32_dev: f64,

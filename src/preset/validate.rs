@@ -162,16 +162,35 @@ fn rows_bounding(rows: u32) -> u32 {
 }
 
 /// What a preset that loads does not do as its keys seem to say, one warning each: the
-/// model's limits (`model_limit`, `film_below_ambient`) and a film centred too thin for its
-/// spread (`film_floor`).
+/// model's limits (`pigment_below_ambient`, `film_below_ambient`) and a film centred too
+/// thin for its spread (`film_floor`).
 pub fn warnings(preset: &Preset) -> Vec<Problem> {
-    model_limit(preset).into_iter().chain(film_below_ambient(preset)).chain(film_floor(preset)).collect()
+    pigment_below_ambient(preset).into_iter().chain(film_below_ambient(preset)).chain(film_floor(preset)).collect()
+}
+
+/// An ambient so much denser than the pigment layer that the layered model lets out more
+/// light than arrives (`PigmentBelowAmbient`), over the thickness map's films and the
+/// roughness map's range. A warning: the physics is fine (an oil film over a lighter layer).
+fn pigment_below_ambient(preset: &Preset) -> Option<Problem> {
+    let o = &preset.optics;
+    let stack = crate::optics::film::Stack { n0: o.ambient_ior, n1: o.film_ior, n2: o.pigment_ior };
+    let thickness = crate::maps::map_thickness_range_nm(preset);
+    let roughness = crate::maps::roughness_range(preset);
+    let limit = crate::optics::brdf::layered::PigmentBelowAmbient::of(stack, thickness, roughness)?;
+    Some(Problem {
+        key: "optics.ambient_ior".into(),
+        message: format!(
+            "{} is above optics.pigment_ior = {}: {limit}. Keep ambient_ior at most about 1.35 times pigment_ior \
+             for an energy-conserving render.",
+            o.ambient_ior, o.pigment_ior
+        ),
+    })
 }
 
 /// A film whose index is below the ambient's, where it shows: the layered model's energy is
 /// off near the film's critical angle (`FilmBelowAmbient`), for the thickest film of the
-/// thickness map's range under a nearly smooth top within the roughness map's range. A warning, as
-/// `model_limit`: the physics is fine.
+/// thickness map's range under a nearly smooth top within the roughness map's range. A
+/// warning: the physics is fine.
 fn film_below_ambient(preset: &Preset) -> Option<Problem> {
     let o = &preset.optics;
     if !crate::maps::has_film(preset) {
@@ -203,26 +222,6 @@ fn film_floor(preset: &Preset) -> Option<Problem> {
              0 nm, so its range is {min_nm}-{max_nm} nm, the same for any film_thickness_nm up to {}",
             spread * 0.5,
             spread * 0.5
-        ),
-    })
-}
-
-/// A stack the layered model shows darker than the physics: the ambient denser than the
-/// pigment layer. Beyond the critical angle asin(n2 / n0) the rough top's lobe loses light
-/// the stack reflects (a white lossless stack, `brdf albedo --absorption 0 --n1 1.55`:
-/// 0.50 at 75° for n0 = 1.4 over n2 = 1.33 and roughness 0.5; 0.48 at 50° for 1.5 over 1.0
-/// and roughness 0.9; 0.40 at 45° for 2 over 1.33 and roughness 0.9, where the rough-top
-/// walk, `--model stochastic`, reflects 1: the physics review; BENCHMARKS.md "Stress").
-/// The physics is fine (an oil film over a lighter layer), so it is a warning, not a refusal.
-fn model_limit(preset: &Preset) -> Option<Problem> {
-    let o = &preset.optics;
-    let limit = crate::optics::brdf::layered::ModelLimit::of(o.ambient_ior, o.pigment_ior)?;
-    Some(Problem {
-        key: "optics.ambient_ior".into(),
-        message: format!(
-            "{} is above optics.pigment_ior = {}: {limit}. Keep ambient_ior at most pigment_ior for an \
-             energy-conserving render.",
-            o.ambient_ior, o.pigment_ior
         ),
     })
 }

@@ -695,10 +695,10 @@ pub enum BrdfCommand {
     /// The directional albedo for light from one angle, by numerical integration of a
     /// model or by a reference: {"model","albedo":[r,g,b],"specular":[r,g,b],"diffuse":[r,g,b]}
     /// (and "sigma" for the stochastic reference). With --albedo 1 and no absorption the
-    /// stack loses nothing: the answer should be 1 (see --model; with --n0 above --n2 the
-    /// layered model is darker beyond the critical angle, and with --n1 below --n0, a film over
-    /// 250 nm and roughness under 0.3 it is off by up to 0.04 within a few degrees of the
-    /// film's critical angle: it says so).
+    /// stack loses nothing: the answer should be 1 (see --model; with --n1 below --n0, a film
+    /// over 250 nm and roughness under 0.3 the layered model is off by up to 0.04 within a few
+    /// degrees of the film's critical angle, and with --n0 over about 1.35 times --n2 under
+    /// rough tops it reflects up to about 1.07: it says so).
     Albedo(AlbedoArgs),
     /// A thin-film colour chart PNG: thickness 0..2000 nm across, angle 0..89° down, its
     /// brightest channel scaled to 1 (the scale is printed: a dim film's chart is as

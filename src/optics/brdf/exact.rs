@@ -111,6 +111,10 @@ pub struct SmoothTop {
     /// Per node: the cosine outside (in n0) of a direction inside the escape cone, None
     /// beyond it (totally reflected).
     outside: Vec<Option<f64>>,
+    /// Where n0 > n2: (cosine in n0, quadrature weight) over the directions beyond the
+    /// critical angle, which no direction inside reaches through a smooth top and a rough
+    /// top lets light out into (`k_e_row`); empty otherwise.
+    beyond_critical: Vec<(f64, f64)>,
     /// Per roughness row, per node: the probability of being sent back down under the
     /// layered model's coupling (`k_e_row`), each row computed when first read
     /// (`coupled_row`): a row costs 18 spectral film sums per node inside the escape cone
@@ -135,11 +139,17 @@ impl SmoothTop {
                 (sin2_out < 1.0).then(|| (1.0 - sin2_out).sqrt())
             })
             .collect();
+        let beyond_critical = if n0 > n2 {
+            gauss_legendre(NODES_PER_SEGMENT, 0.0, (1.0 - (n2 / n0) * (n2 / n0)).sqrt())
+        } else {
+            Vec::new()
+        };
         let coupled = (0..energy::E1_ROUGHNESS).map(|_| OnceLock::new()).collect();
-        SmoothTop { stack, thickness_nm, below, outside, coupled }
+        SmoothTop { stack, thickness_nm, below, outside, beyond_critical, coupled }
     }
 
-    /// Row `row` of `coupled`, computed on first use (the same values whichever row is
+    /// Row `row` of `coupled` (the nodes of `below`, then those of `beyond_critical`: s
+    /// there, 1 on the mirror row), computed on first use (the same values whichever row is
     /// asked for first: each row reads only the film and the material's path table, which
     /// the mirror row does not need). The initialiser must not wait on the rayon pool: a
     /// pool thread blocked on this row's `OnceLock` could not take the work it waits for
@@ -149,23 +159,28 @@ impl SmoothTop {
             let (stack, thickness_nm) = (self.stack, self.thickness_nm);
             let path = (row > 0).then(|| super::path::cached(stack.n0, stack.n2));
             let rule = energy::LobeRule::of(stack.n0, stack.n1, stack.n2);
-            self.below
-                .iter()
-                .zip(&self.outside)
-                .map(|(&(_, _, rb), mu_out)| {
-                    let Some(mu_out) = *mu_out else {
-                        return [1.0; 3];
-                    };
-                    let Some(path) = &path else {
-                        // Row 0, a mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
-                        return rb;
-                    };
-                    // What the top reflects on this row (its single scattering and x).
-                    let film = |c: f64| reflectance(stack, thickness_nm, c);
-                    let (single, beyond) = energy::parts_on_row(mu_out, row, &film, &path.through, rule);
-                    [0, 1, 2].map(|c| single[c] + beyond[c])
-                })
-                .collect()
+            // What the top reflects on this row (its single scattering and x).
+            let film = |c: f64| reflectance(stack, thickness_nm, c);
+            let reflected = |mu_out: f64, through: &[_]| {
+                let (single, beyond) = energy::parts_on_row(mu_out, row, &film, through, rule);
+                [0, 1, 2].map(|c| single[c] + beyond[c])
+            };
+            let below = self.below.iter().zip(&self.outside).map(|(&(_, _, rb), mu_out)| {
+                let Some(mu_out) = *mu_out else {
+                    return [1.0; 3];
+                };
+                match &path {
+                    Some(path) => reflected(mu_out, &path.through),
+                    // Row 0, a mirror: F(μo) = R_b(μ) by reciprocity of the lossless film.
+                    None => rb,
+                }
+            });
+            let beyond_critical = self.beyond_critical.iter().map(|&(mu_out, _)| match &path {
+                Some(path) => reflected(mu_out, &path.through),
+                // A mirror reflects all of it (no wave propagates in n2 there).
+                None => [1.0; 3],
+            });
+            below.chain(beyond_critical).collect()
         })
     }
 
@@ -210,19 +225,46 @@ impl SmoothTop {
     /// on the way out as the light the top lets in does on the way in (reciprocity): E takes
     /// exp(−τ / cos_eff(μo, r)) (`path`) where the smooth top has exp(−τ / μ), so that E is
     /// the hemispherical escape of the model's own diffuse lobe. K keeps the smooth path.
+    ///
+    /// **Beyond the critical angle of n0 > n2.** Every direction inside reaches, by Snell's
+    /// law, a direction inside the critical cone outside, so the integral over the nodes
+    /// inside leaves out the light a rough top lets out beyond it (the model's diffuse lobe
+    /// sends 1 − s there: `layered::entering`). That light is added to E as the lobe's own
+    /// escape there, (n0/n2)² ∫ 2μo (1 − s(μo)) exp(−τ / cos_eff(μo, r)) dμo over μo below
+    /// the critical cosine (`beyond_critical`), and taken from K with the same weight at
+    /// the round trip's exp(−2τ / cos_eff): the light inside that leaves there would
+    /// otherwise have been counted as sent back. Without absorption both terms are equal, so
+    /// K + E = 1 still. (Before, the lobe sent nothing beyond the critical angle and a
+    /// white stack at roughness 1 reflected a quarter of the light just past it.)
     pub fn k_e_row(&self, tau: [f64; 3], row: usize) -> ([f64; 3], [f64; 3]) {
         let coupled = self.coupled_row(row);
-        let sent_back = |node: usize, _| coupled[node];
-        if row == 0 || tau.iter().all(|t| *t <= 0.0) {
-            return self.integrate(tau, sent_back, |_, mu| mu);
-        }
-        let path = super::path::cached(self.stack.n0, self.stack.n2);
+        let (inside, beyond) = coupled.split_at(self.below.len());
+        let sent_back = |node: usize, _| inside[node];
+        let absorbing = tau.iter().any(|t| *t > 0.0);
+        let path = (row > 0 && absorbing).then(|| super::path::cached(self.stack.n0, self.stack.n2));
         let r = row as f64 / (energy::E1_ROUGHNESS - 1) as f64;
-        self.integrate(tau, sent_back, |node, mu| match self.outside[node] {
-            // The direction inside is Snell's cos_t of the one outside.
-            Some(mu_out) => path.cos_eff(mu, mu_out, r),
-            None => mu,
-        })
+        let (mut k, mut e) = match &path {
+            None => self.integrate(tau, sent_back, |_, mu| mu),
+            Some(path) => self.integrate(tau, sent_back, |node, mu| match self.outside[node] {
+                // The direction inside is Snell's cos_t of the one outside.
+                Some(mu_out) => path.cos_eff(mu, mu_out, r),
+                None => mu,
+            }),
+        };
+        if row == 0 {
+            return (k, e);
+        }
+        let eta2 = (self.stack.n0 / self.stack.n2).powi(2);
+        for (&(mu_out, weight), s) in self.beyond_critical.iter().zip(beyond) {
+            let cos_eff = path.as_ref().map_or(1.0, |p| p.cos_eff(0.0, mu_out, r));
+            for c in 0..3 {
+                let tau = tau[c].max(0.0);
+                let out = eta2 * weight * 2.0 * mu_out * (1.0 - s[c]);
+                e[c] += out * (-tau / cos_eff).exp();
+                k[c] -= out * (-2.0 * tau / cos_eff).exp();
+            }
+        }
+        (k.map(|v| v.max(0.0)), e)
     }
 
     /// `bounce_table(tau).at(roughness)` from the two rows it needs (`Layers::of_stack`, once

@@ -10,7 +10,7 @@ use crate::cli::{AlbedoArgs, AlbedoModel, BrdfCommand, EvalArgs, LayerArgs, Stac
 use crate::output::{ensure_parent_folder, path_line, printable};
 use snakeskin::Error;
 use snakeskin::optics::brdf::exact::SmoothTop;
-use snakeskin::optics::brdf::layered::{FilmBelowAmbient, ModelLimit};
+use snakeskin::optics::brdf::layered::{FilmBelowAmbient, PigmentBelowAmbient};
 use snakeskin::optics::brdf::walk::{FilmTables, walk};
 use snakeskin::optics::brdf::{BrdfValue, Layers, Model};
 use snakeskin::optics::film::{Stack, airy};
@@ -85,15 +85,15 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
     Ok(serde_json::json!({ "rgb": rgb }).to_string())
 }
 
-/// The layered model's known limits (`ModelLimit`, `FilmBelowAmbient`, which a preset's
-/// check warns of too) for a film `thickness_nm` thick under a top `roughness` rough, each
-/// said once, on stderr.
+/// The layered model's known limits (`PigmentBelowAmbient`, `FilmBelowAmbient`, which a
+/// preset's check warns of too) for a film `thickness_nm` thick under a top `roughness`
+/// rough, each said once, on stderr.
 fn warn_of_model_limit(model: Model, stack: Stack, thickness_nm: f64, roughness: f64) {
     if model != Model::Layered {
         return;
     }
     let walk = "`brdf albedo --model stochastic` walks the stack itself";
-    if let Some(limit) = ModelLimit::of(stack.n0, stack.n2) {
+    if let Some(limit) = PigmentBelowAmbient::of(stack, (thickness_nm, thickness_nm), (roughness, roughness)) {
         eprintln!("warning: --n0 {} is above --n2 {}: {limit} ({walk})", stack.n0, stack.n2);
     }
     if let Some(limit) = FilmBelowAmbient::of(stack.n0, stack.n1, thickness_nm, (roughness, roughness)) {
