@@ -1944,8 +1944,18 @@ fn figures_are_checked_before_any_is_drawn() {
     let args = ["figures", PRESET, "-o", fresh.to_str().unwrap(), "--map-size", "64", "--size"];
     let out = snakeskin_env(&[&args[..], &["8192x8192"]].concat(), &limit);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("needs about"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("drawing the figures' frames with their maps (64×64 maps) needs about"),
+        "{}",
+        stderr(&out)
+    );
     assert!(!fresh.exists(), "the folder was made before the memory check");
+    // A folder that takes no files (here one root cannot write in either) is found before
+    // the maps and the first frame, not when the first figure is written seconds later
+    // ("cannot write …: Permission denied", an independent review's find).
+    let out = snakeskin(&["figures", PRESET, "-o", "/proc/self", "--size", "16x16", "--map-size", "64"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("cannot write /proc/self/stage_a_diffuse.png"), "{}", stderr(&out));
     // Negative control: a small frame under the same limit passes the check (and then needs
     // a GPU, which this test does not ask for: it stops at the renderer or draws).
     let out = snakeskin_env(&[&args[..], &["16x16"]].concat(), &[("SNAKESKIN_MEMORY_LIMIT_MIB", "400")]);

@@ -172,6 +172,36 @@ fn set_overrides_change_the_output_like_editing_the_file() {
     assert_eq!(std::fs::read(a.join("edited_height.png")).unwrap(), std::fs::read(b.join("base_height.png")).unwrap());
 }
 
+/// A set says what made it beyond its preset: the manifest lists the `--set` overrides as
+/// given (a set without any has no such key), and a key given twice is warned of, the last
+/// value used. Before, neither: two sets with different overrides had manifests differing
+/// only in `preset_hash`, and `--set a=1 --set a=2` said nothing.
+#[test]
+fn the_manifest_records_the_overrides_and_a_repeated_key_is_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let generate = |out: &str, sets: &[&str]| {
+        let folder = dir.path().join(out);
+        let mut args =
+            vec!["generate", "natrix-natrix", "-o", folder.to_str().unwrap(), "--size", "32", "--maps", "color"];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let run = snakeskin(&args);
+        assert!(run.status.success(), "{}", stderr(&run));
+        let manifest = std::fs::read_to_string(folder.join("natrix-natrix.material.json")).unwrap();
+        (serde_json::from_str::<serde_json::Value>(&manifest).unwrap(), stderr(&run))
+    };
+    let (twice, err) = generate("twice", &["scales.rows=10", "scales.rows=20"]);
+    let (once, quiet) = generate("once", &["scales.rows=20"]);
+    let (none, _) = generate("none", &[]);
+    assert_eq!(twice["overrides"], serde_json::json!(["scales.rows=10", "scales.rows=20"]));
+    assert_eq!(once["overrides"], serde_json::json!(["scales.rows=20"]));
+    assert!(none.get("overrides").is_none(), "{none}");
+    assert_eq!(twice["preset_hash"], once["preset_hash"]);
+    assert!(err.contains("warning: --set scales.rows is given 2 times: the last, scales.rows=20, is used"), "{err}");
+    assert!(!quiet.contains("given"), "{quiet}");
+}
+
 #[test]
 fn docs_presets_md_documents_every_key() {
     // Every key of a fully populated preset must appear in the docs, as `key`.

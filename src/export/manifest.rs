@@ -58,6 +58,10 @@ pub struct Source {
     pub generator_version: String,
     pub preset: String,
     pub preset_hash: String,
+    /// The `--set` overrides (and a jobs file's `set`) as given, `KEY=VALUE` in order; absent
+    /// where there were none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub overrides: Vec<String>,
     pub species: Option<String>,
     pub seed: u64,
     pub width: usize,
@@ -73,6 +77,7 @@ impl Source {
             generator_version: env!("CARGO_PKG_VERSION").into(),
             preset: loaded.name.clone(),
             preset_hash: loaded.content_hash.clone(),
+            overrides: loaded.overrides.clone(),
             species: loaded.preset.species.clone(),
             seed: loaded.preset.seed,
             width,

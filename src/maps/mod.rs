@@ -306,8 +306,9 @@ pub fn height_range(preset: &Preset) -> (f32, f32) {
 }
 
 /// How far above a height sample of 0 one of 1 stands, in texture widths: the surface the
-/// normal map shades, whose full height range (`height_range`) rises `height.normal_strength`
-/// scale widths (a scale column is 1 / columns of the texture's width). The same for the
+/// normal map shades, where a unit of the scale field's height rises `height.normal_strength`
+/// scale widths (a scale column is 1 / columns of the texture's width), so the height map's
+/// full range (`height_range`, high − low of the field's units) rises that many times over. The same for the
 /// tile and the body atlas; the manifest's `displacement.rise_texture_widths`, for a
 /// displacement that agrees with the normal map.
 pub fn height_rise_texture_widths(preset: &Preset) -> f32 {

@@ -45,6 +45,9 @@ pub struct LoadedPreset {
     /// file was meant to say, which a user who saved the wrong file, or one the editor had
     /// not yet written, should hear of.
     pub sets_no_key: bool,
+    /// The overrides as given (`--set`, a jobs file's `set`; `KEY=VALUE`, in order): the
+    /// manifest records them, so a set says what made it beyond its preset.
+    pub overrides: Vec<String>,
 }
 
 impl LoadedPreset {
@@ -63,7 +66,25 @@ impl LoadedPreset {
             let line = p.line.map(|l| format!(":{l}")).unwrap_or_default();
             format!("warning: {preset}{line}: {} = {}", p.key, p.message)
         });
-        empty.into_iter().chain(clamped).chain(warned).collect()
+        empty.into_iter().chain(clamped).chain(warned).chain(self.repeated_overrides()).collect()
+    }
+
+    /// One warning per key given more than once among the overrides (`--set a=1 --set a=2`):
+    /// the last wins, silently before.
+    fn repeated_overrides(&self) -> Vec<String> {
+        let split = |o: &String| -> (String, String) {
+            let (k, v) = o.split_once('=').unwrap_or((o, ""));
+            (k.trim().to_string(), v.to_string())
+        };
+        let given: Vec<(String, String)> = self.overrides.iter().map(split).collect();
+        // Each key at its last override, in the order those come.
+        let lasts = given.iter().enumerate().filter(|(i, (k, _))| !given[i + 1..].iter().any(|(later, _)| later == k));
+        lasts
+            .filter_map(|(_, (k, v))| {
+                let times = given.iter().filter(|(other, _)| other == k).count();
+                (times > 1).then(|| format!("warning: --set {k} is given {times} times: the last, {k}={v}, is used"))
+            })
+            .collect()
     }
 }
 
@@ -205,6 +226,7 @@ pub fn parse_with_seed(
         return Err(located_error(source, underflow));
     }
     let file_seed = file_preset.seed;
+    let overrides_given = overrides;
     let (seed_overrides, overrides): (Vec<_>, Vec<_>) = overrides.iter().cloned().partition(|(key, _)| key == "seed");
     let overridden_seed = match seed_overrides.last() {
         Some((_, value)) => Some(seed_override(value)?),
@@ -302,6 +324,7 @@ pub fn parse_with_seed(
         clamped_colours,
         warned,
         sets_no_key,
+        overrides: overrides_given.iter().map(|(k, v)| format!("{k}={v}")).collect(),
     })
 }
 

@@ -916,7 +916,7 @@ pub enum BenchCommand {
         plot: Option<PathBuf>,
         /// Thickness step of the grid in nm (the grid spans 0..2000 nm), 0.1 to 2000; the grid
         /// takes at most 400,000 points over its four materials, so with 1° angle steps the
-        /// finest is about 1.8 nm (0.1 nm needs angle steps over 22.25°).
+        /// finest is 1.81 nm (0.1 nm needs angle steps over 22.25°).
         #[arg(long, default_value_t = 10.0, value_parser = parse_d_step_nm)]
         d_step_nm: f64,
         /// Angle step of the grid in degrees (0..89°), 0.1 to 89.

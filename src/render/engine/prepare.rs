@@ -155,7 +155,11 @@ pub fn check_preview_memory(
     let size = map_dimensions(loaded, map_size, layout);
     let memory =
         DrawMemory { drawn_after: drawn_in_turn.then_some(size), ..DrawMemory::new(&graph, size, frame_bytes) };
-    memory.check("the preview's frame with its maps")
+    memory.check(if drawn_in_turn {
+        "drawing the figures' frames with their maps"
+    } else {
+        "the preview's frame with its maps"
+    })
 }
 
 /// What `snakes` snakes add to a frame's memory over one (`renderer::more_snakes_bytes`),

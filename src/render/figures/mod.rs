@@ -104,10 +104,14 @@ pub fn figure_list() -> Vec<Figure> {
 /// replaced by that figure), before any is rendered.
 pub fn check_figure_files(out_dir: &Path, preset: &str) -> Result<(), Error> {
     let input = crate::export::Inputs::new(crate::preset::input_file(preset));
+    let mut probed = std::collections::HashSet::new();
     for figure in figure_list() {
         let target = out_dir.join(figure.file);
         check_target(&target)?;
         input.check(&target)?;
+        // The folder takes files (or can be made): a read-only one was found after the
+        // figures' maps and first frame, seconds in (an independent review's find).
+        crate::export::check_folder_writable(out_dir, figure.file, &mut probed)?;
     }
     Ok(())
 }

@@ -183,7 +183,7 @@ pub fn check_memory(loaded: &LoadedPreset, options: &BenchOptions) -> Result<(),
         materials: timed_runs(options) as u64,
         ..DrawMemory::new(&graph, size, frames)
     };
-    memory.check("the render benchmark's materials and frames")
+    memory.check("the render benchmark (its materials and frames)")
 }
 
 /// Runs the whole benchmark for one preset.
