@@ -765,8 +765,9 @@ fn a_mistyped_map_name_gets_a_suggestion() {
 }
 
 /// A built-in name mistyped gets a suggestion: `natrix_natrix`, `Natrix-Natrix` and the
-/// genus alone (`natrix`) had none, only the list of all 34. Negative control: a name near
-/// none of them gets no suggestion.
+/// genus alone (`natrix`) had none, only the list of all 34; nor had a common name, an
+/// artist's first guess (`grass-snake`, `"Corn snake"`, `macklots-python`: an independent
+/// review's find). Negative control: a name near none of them gets no suggestion.
 #[test]
 fn a_mistyped_built_in_name_gets_a_suggestion() {
     let dir = tempfile::tempdir().unwrap();
@@ -776,6 +777,9 @@ fn a_mistyped_built_in_name_gets_a_suggestion() {
         ("Natrix-Natrix", Some("natrix-natrix")),
         ("natrix", Some("natrix-natrix")),
         ("vipera-beru", Some("vipera-berus")),
+        ("grass-snake", Some("natrix-natrix")),
+        ("Corn snake", Some("pantherophis-guttatus")),
+        ("macklots-python", Some("liasis-mackloti")),
         ("no-such-snake", None),
     ] {
         let out = snakeskin(&["generate", name, "-o", out_dir, "--size", "16"]);

@@ -473,6 +473,13 @@ mod commands {
             assert_eq!(err.contains(says), warned, "{indices:?} roughness {roughness}: {err}");
             assert!(warned || err.is_empty(), "{err}");
         }
+        // Within about 3 % of the pigment's index, the critical angle near grazing: warned of
+        // at any roughness (`PigmentBelowAmbient::LowContrast`: 1.21 at 85° here, roughness 1).
+        let near = ["--n0", "1.34", "--n1", "1.55", "--n2", "1.33", "--roughness", "0.3"];
+        let (code, _, err) = run(&[&eval[..6], &near[..]].concat());
+        assert_eq!(code, 0, "{err}");
+        let says = "warning: --n0 1.34 is above --n2 1.33: the critical angle (83° from the normal) lies near grazing";
+        assert!(err.contains(says), "{err}");
     }
 
     #[test]

@@ -45,19 +45,34 @@ pub fn names() -> Vec<&'static str> {
 
 /// The built-in name a mistyped one most likely means, for "did you mean": the same name in
 /// another case or with `_` or spaces for `-` (`Natrix_natrix`), a file's stem
-/// (`presets/natrix-natrix.toml`), the one species of a genus (`natrix`), or the nearest by
-/// edits. `natrix_natrix` and `natrix` had no suggestion.
+/// (`presets/natrix-natrix.toml`), a species' common name written so (`grass-snake`, `"Corn
+/// snake"`, `macklots-python`: an artist's first guess, which had no suggestion), the one
+/// species of a genus (`natrix`), or the nearest by edits. `natrix_natrix` and `natrix` had
+/// no suggestion.
 pub fn suggest(name: &str) -> Option<&'static str> {
     let stem = std::path::Path::new(name).file_stem().map_or(name.into(), |s| s.to_string_lossy());
-    let normal = stem.trim().to_ascii_lowercase().replace(['_', ' '], "-");
+    let normal = normal_name(&stem);
     if let Some(same) = names().into_iter().find(|n| *n == normal) {
         return Some(same);
+    }
+    let common = |text: &str| {
+        let table = toml::from_str::<toml::Table>(text).ok()?;
+        table.get("common_name")?.as_str().map(normal_name)
+    };
+    if let Some((name, _)) = PRESETS.iter().find(|(_, text)| common(text).is_some_and(|c| c == normal)) {
+        return Some(name);
     }
     let genus: Vec<&str> = names().into_iter().filter(|n| n.starts_with(&format!("{normal}-"))).collect();
     if let [only] = genus[..] {
         return Some(only);
     }
     crate::toml_text::nearest(&normal, names())
+}
+
+/// A name as the suggestions compare it: trimmed, lower case, `_` and spaces as `-`,
+/// apostrophes dropped (`Macklot's python` is `macklots-python`).
+fn normal_name(name: &str) -> String {
+    name.trim().to_lowercase().replace(['_', ' '], "-").replace(['\'', '’'], "")
 }
 
 pub fn get(name: &str) -> Option<&'static str> {

@@ -180,8 +180,8 @@ fn pigment_below_ambient(preset: &Preset) -> Option<Problem> {
     Some(Problem {
         key: "optics.ambient_ior".into(),
         message: format!(
-            "{} is above optics.pigment_ior = {}: {limit}. Keep ambient_ior at most about 1.35 times pigment_ior \
-             for an energy-conserving render.",
+            "{} is above optics.pigment_ior = {}: {limit}. Keep ambient_ior at most pigment_ior, or from about \
+             1.03 to 1.35 times it, for an energy-conserving render.",
             o.ambient_ior, o.pigment_ior
         ),
     })

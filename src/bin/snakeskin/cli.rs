@@ -697,8 +697,9 @@ pub enum BrdfCommand {
     /// (and "sigma" for the stochastic reference). With --albedo 1 and no absorption the
     /// stack loses nothing: the answer should be 1 (see --model; with --n1 below --n0, a film
     /// over 250 nm and roughness under 0.3 the layered model is off by up to 0.04 within a few
-    /// degrees of the film's critical angle, and with --n0 over about 1.35 times --n2 under
-    /// rough tops it reflects up to about 1.07: it says so).
+    /// degrees of the film's critical angle; with --n0 over about 1.35 times --n2 under rough
+    /// tops it reflects up to about 1.07, and with --n0 above --n2 by less than about 3 % up to
+    /// 1.6 of grazing light: it says so).
     Albedo(AlbedoArgs),
     /// A thin-film colour chart PNG: thickness 0..2000 nm across, angle 0..89° down, its
     /// brightest channel scaled to 1 (the scale is printed: a dim film's chart is as

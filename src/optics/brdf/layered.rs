@@ -47,56 +47,77 @@ use super::{COS_MIN, Layers, Layers32};
 /// Found from the material's own K and E (`exact::SmoothTop::k_e_row`) on the roughness rows
 /// a preset's roughness spans, at the thinnest and thickest films; warned of where E passes
 /// 1 by more than `PIGMENT_BELOW_AMBIENT_EXCESS`.
+///
+/// At low contrast, too: where n0 < `PIGMENT_BELOW_AMBIENT_LOW_CONTRAST` n2 the critical angle
+/// lies within about 14° of grazing, the light straight back makes a step in what the rough
+/// top reflects there, and the multiple-scatter lobe's normalisation X̄ (`energy::ms_rule`'s
+/// fixed nodes) misses it: grazing light under rough tops is reflected more than arrives (an
+/// independent review's find; white furnace at 85°, n2 = 1.33, roughness 1 / 0.6: n0 = 1.335
+/// 1.63 / 1.17, 1.34 1.21 / 1.12, 1.36 1.06 / 1.04, 1.38 1.03 / 1.01; the model before the
+/// change read 1.52 at 1.335). Warned of at any roughness.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PigmentBelowAmbient {
-    /// The smallest roughness (a row of the energy table) whose lossless E passes the limit.
-    pub roughness_from: f64,
-    /// The largest E − 1 there.
-    pub excess: f64,
+pub enum PigmentBelowAmbient {
+    /// n0 / n2 below `PIGMENT_BELOW_AMBIENT_LOW_CONTRAST`: the critical angle, in degrees.
+    LowContrast { critical_angle_deg: f64 },
+    /// The lossless E passes 1: from the smallest roughness (a row of the energy table)
+    /// where it passes the limit, by at most `excess`.
+    Escapes { roughness_from: f64, excess: f64 },
 }
 
 /// How far the lossless E may pass 1 before `PigmentBelowAmbient` warns: the furnace bound
 /// of the layered-transport issue.
 pub const PIGMENT_BELOW_AMBIENT_EXCESS: f64 = 0.02;
+/// Contrasts n0 / n2 above 1 and below this are warned of (`PigmentBelowAmbient::LowContrast`):
+/// 1.36 / 1.33 = 1.023 read 1.06 at 85°, 1.38 / 1.33 = 1.038 within 0.03.
+pub const PIGMENT_BELOW_AMBIENT_LOW_CONTRAST: f64 = 1.03;
 
 impl PigmentBelowAmbient {
     /// The limit for `stack` with films `thickness_nm` (thinnest, thickest) under tops whose
-    /// roughness spans `roughness` (smoothest, roughest): `None` where n0 ≤ n2 or E stays
-    /// within the limit.
+    /// roughness spans `roughness` (smoothest, roughest): `None` where n0 ≤ n2 or the model
+    /// stays within the limits.
     pub fn of(stack: crate::optics::film::Stack, thickness_nm: (f64, f64), roughness: (f64, f64)) -> Option<Self> {
         if stack.n0 <= stack.n2 {
             return None;
+        }
+        if stack.n0 < PIGMENT_BELOW_AMBIENT_LOW_CONTRAST * stack.n2 {
+            let critical_angle_deg = (stack.n2 / stack.n0).asin().to_degrees();
+            return Some(PigmentBelowAmbient::LowContrast { critical_angle_deg });
         }
         let last = (super::energy::E1_ROUGHNESS - 1) as f64;
         let (smoothest, roughest) = (roughness.0.min(roughness.1), roughness.0.max(roughness.1));
         let rows =
             (smoothest.clamp(0.0, 1.0) * last).floor() as usize..=(roughest.clamp(0.0, 1.0) * last).ceil() as usize;
-        let mut found: Option<PigmentBelowAmbient> = None;
+        let mut found: Option<(f64, f64)> = None;
         for row in rows {
             for film_nm in [thickness_nm.0, thickness_nm.1] {
                 let (k, e) = super::exact::cached(stack, film_nm).k_e_row([0.0; 3], row);
                 let excess = (0..3).map(|c| k[c] + e[c] - 1.0).fold(0.0, f64::max);
                 if excess > PIGMENT_BELOW_AMBIENT_EXCESS {
-                    let roughness_from = found.map_or(row as f64 / last, |f| f.roughness_from);
-                    let excess = found.map_or(excess, |f| f.excess.max(excess));
-                    found = Some(PigmentBelowAmbient { roughness_from, excess });
+                    found = Some(found.map_or((row as f64 / last, excess), |(from, worst)| (from, worst.max(excess))));
                 }
             }
         }
-        found
+        found.map(|(roughness_from, excess)| PigmentBelowAmbient::Escapes { roughness_from, excess })
     }
 }
 
 impl std::fmt::Display for PigmentBelowAmbient {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "from roughness {:.2} the layered model's rough top lets out more light than arrives (it reflects too \
-             little of the light a rough top sends straight back at this contrast), so a white stack without \
-             absorption reflects up to about {:.3} of the light",
-            self.roughness_from,
-            1.0 + self.excess
-        )
+        match self {
+            PigmentBelowAmbient::LowContrast { critical_angle_deg } => write!(
+                f,
+                "the critical angle ({critical_angle_deg:.0}° from the normal) lies near grazing, where the layered \
+                 model's rough top reflects more light than arrives (a white stack under a rough top, up to 1.6 of \
+                 it at 85° for 1.335 over 1.33)"
+            ),
+            PigmentBelowAmbient::Escapes { roughness_from, excess } => write!(
+                f,
+                "from roughness {roughness_from:.2} the layered model's rough top lets out more light than arrives \
+                 (it reflects too little of the light a rough top sends straight back at this contrast), so a white \
+                 stack without absorption reflects up to about {:.3} of the light",
+                1.0 + excess
+            ),
+        }
     }
 }
 
