@@ -77,7 +77,7 @@ impl Source {
             generator_version: env!("CARGO_PKG_VERSION").into(),
             preset: loaded.name.clone(),
             preset_hash: loaded.content_hash.clone(),
-            overrides: loaded.overrides.clone(),
+            overrides: loaded.overrides.iter().map(|(key, value)| format!("{key}={value}")).collect(),
             species: loaded.preset.species.clone(),
             seed: loaded.preset.seed,
             width,

@@ -45,9 +45,9 @@ pub struct LoadedPreset {
     /// file was meant to say, which a user who saved the wrong file, or one the editor had
     /// not yet written, should hear of.
     pub sets_no_key: bool,
-    /// The overrides as given (`--set`, a jobs file's `set`; `KEY=VALUE`, in order): the
+    /// The overrides as given (`--set`, a jobs file's `set`; `(KEY, VALUE)`, in order): the
     /// manifest records them, so a set says what made it beyond its preset.
-    pub overrides: Vec<String>,
+    pub overrides: Vec<(String, String)>,
 }
 
 impl LoadedPreset {
@@ -72,11 +72,7 @@ impl LoadedPreset {
     /// One warning per key given more than once among the overrides (`--set a=1 --set a=2`):
     /// the last wins, silently before.
     fn repeated_overrides(&self) -> Vec<String> {
-        let split = |o: &String| -> (String, String) {
-            let (k, v) = o.split_once('=').unwrap_or((o, ""));
-            (k.trim().to_string(), v.to_string())
-        };
-        let given: Vec<(String, String)> = self.overrides.iter().map(split).collect();
+        let given = &self.overrides;
         // Each key at its last override, in the order those come.
         let lasts = given.iter().enumerate().filter(|(i, (k, _))| !given[i + 1..].iter().any(|(later, _)| later == k));
         lasts
@@ -324,7 +320,7 @@ pub fn parse_with_seed(
         clamped_colours,
         warned,
         sets_no_key,
-        overrides: overrides_given.iter().map(|(k, v)| format!("{k}={v}")).collect(),
+        overrides: overrides_given.to_vec(),
     })
 }
 

@@ -103,7 +103,8 @@ pub struct Rule<const N: usize> {
 }
 
 impl<const N: usize> Rule<N> {
-    fn point(cos: f64) -> Rule<N> {
+    /// All weight on one node.
+    pub(super) fn point(cos: f64) -> Rule<N> {
         Rule { cos: [cos; N], weight: std::array::from_fn(|k| if k == 0 { 1.0 } else { 0.0 }) }
     }
 

@@ -235,13 +235,10 @@ fn through_rule(n0: f64, n2: f64, walks: &[ThroughWalk]) -> Vec<[f64; THROUGH_LE
         // The rule and the mean of 1 / F_bare of a set of last reflections' cosines, each
         // weighted by 1 / F_bare there.
         let rule_of = |cosines: &[f64]| {
-            let weights: Vec<f64> = cosines.iter().map(|c| 1.0 / bare(true, *c).max(1e-9)).collect();
-            let total: f64 = weights.iter().sum();
             let (total_reflections, partial): (Vec<f64>, Vec<f64>) = cosines.iter().partition(|c| **c < total_below);
             if total_reflections.is_empty() {
-                let moment = |p: i32| cosines.iter().zip(&weights).map(|(c, w)| w * c.powi(p)).sum::<f64>() / total;
-                let moments: [f64; 2 * THROUGH_NODES] = std::array::from_fn(|p| moment(p as i32));
-                return (super::energy::Rule::<THROUGH_NODES>::gauss(&moments), total / cosines.len() as f64);
+                let (rule, weight) = weighted_rule::<THROUGH_NODES>(cosines, &bare);
+                return (rule, weight / cosines.len() as f64);
             }
             // Total reflections (weight 1 each, F = 1 for every film) on a node at grazing,
             // where every film reflects all; a Gauss rule of the other nodes for the rest,
@@ -251,8 +248,8 @@ fn through_rule(n0: f64, n2: f64, walks: &[ThroughWalk]) -> Vec<[f64; THROUGH_LE
             // over both misread the corner: on 1.5 | 1.33 at roughness 1 and 70° it read
             // the bare F as 0.170 where the photons' weighted mean is 0.258, and q two
             // thirds of the walk's; the split rule alone read 0.518 of the walk's 0.543.
-            let total_share = total_reflections.len() as f64 / total;
-            let rest = partial_rule(&partial, &bare);
+            let (rest, partial_weight) = weighted_rule::<{ THROUGH_NODES - 1 }>(&partial, &bare);
+            let total_share = total_reflections.len() as f64 / (total_reflections.len() as f64 + partial_weight);
             let mut cos = [0.0; THROUGH_NODES];
             let mut weight = [0.0; THROUGH_NODES];
             weight[0] = total_share;
@@ -277,19 +274,18 @@ fn through_rule(n0: f64, n2: f64, walks: &[ThroughWalk]) -> Vec<[f64; THROUGH_LE
     rule
 }
 
-/// The Gauss rule of `THROUGH_NODES` − 1 points of last reflections' cosines that are not
-/// total, each weighted by 1 / F_bare there (`through_rule`); a point at 1 with weight 1
-/// where there are none (its weight is then 0 in the rule).
-fn partial_rule(cosines: &[f64], bare: &impl Fn(bool, f64) -> f64) -> super::energy::Rule<{ THROUGH_NODES - 1 }> {
+/// The Gauss rule of N points of last reflections' cosines, each weighted by 1 / F_bare
+/// there (`through_rule`), and the weights' sum; a point at 1 and a sum of 0 where there
+/// are none (the caller then gives the rule no weight).
+fn weighted_rule<const N: usize>(cosines: &[f64], bare: &impl Fn(bool, f64) -> f64) -> (super::energy::Rule<N>, f64) {
     if cosines.is_empty() {
-        let weight = std::array::from_fn(|k| if k == 0 { 1.0 } else { 0.0 });
-        return super::energy::Rule { cos: [1.0; THROUGH_NODES - 1], weight };
+        return (super::energy::Rule::point(1.0), 0.0);
     }
     let weights: Vec<f64> = cosines.iter().map(|c| 1.0 / bare(true, *c).max(1e-9)).collect();
     let total: f64 = weights.iter().sum();
     let moment = |p: i32| cosines.iter().zip(&weights).map(|(c, w)| w * c.powi(p)).sum::<f64>() / total;
-    let moments: [f64; 2 * (THROUGH_NODES - 1)] = std::array::from_fn(|p| moment(p as i32));
-    super::energy::Rule::gauss(&moments)
+    let moments: Vec<f64> = (0..2 * N).map(|p| moment(p as i32)).collect();
+    (super::energy::Rule::gauss(&moments), total)
 }
 
 /// The rule of an entry from which no light comes straight back: W = 0 (its nodes and
