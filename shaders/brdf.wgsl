@@ -33,7 +33,8 @@ struct Layers {
 
 fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
     let len = length(v);
-    if (len > LENGTH_MIN && len < 3.0e38) {
+    // Finite and not too short (Rust's is_finite: NaN fails both tests, infinity the second).
+    if (len > LENGTH_MIN && len <= F32_MAX) {
         return v / len;
     }
     return fallback;
@@ -53,13 +54,20 @@ fn specular_scale(cos_h: f32, sin2_h: f32, cos_i: f32, cos_o: f32, a2: f32) -> f
     return d * g2 / (4.0 * cos_i * cos_o);
 }
 
+// Snell's cos^2 in n2 of light at cosine cos in n0, below 0 beyond the critical angle of
+// n0 > n2; (1 - eta^2) + eta^2 cos^2, exact at grazing light where eta = 1
+// (optics::brdf::snell_cos_sq).
+fn snell_cos_sq(n0: f32, n2: f32, cos: f32) -> f32 {
+    let eta2 = (n0 / n2) * (n0 / n2);
+    return (1.0 - eta2) + eta2 * cos * cos;
+}
+
 // ---- The thesis model (optics::brdf::thesis). ----
 
 // (1 - F(n.wi)) (1 - F(n.wo)) exp(-tau (1/cos_t(wi) + 1/cos_t(wo))) k_d / pi.
 fn thesis_diffuse(layers: Layers, cos_i: f32, cos_o: f32, f_i: vec3<f32>, f_o: vec3<f32>) -> vec3<f32> {
-    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
-    let ki = (1.0 - eta2) + eta2 * cos_i * cos_i;
-    let ko = (1.0 - eta2) + eta2 * cos_o * cos_o;
+    let ki = snell_cos_sq(layers.n0, layers.n2, cos_i);
+    let ko = snell_cos_sq(layers.n0, layers.n2, cos_o);
     if (!(ki > 0.0 && ko > 0.0)) {
         return vec3<f32>(0.0);
     }
@@ -76,8 +84,7 @@ fn thesis_diffuse(layers: Layers, cos_i: f32, cos_o: f32, f_i: vec3<f32>, f_o: v
 fn thesis_ambient_diffuse(layers: Layers, cos_o: f32, f_o: vec3<f32>) -> vec3<f32> {
     var base = (vec3<f32>(1.0) - f_o) * layers.albedo;
     if (HAS_ABSORPTION) {
-        let eta = layers.n0 / layers.n2;
-        let k = (1.0 - eta * eta) + eta * eta * cos_o * cos_o;
+        let k = snell_cos_sq(layers.n0, layers.n2, cos_o);
         let path = 1.0 / max(sqrt(max(k, 0.0)), COS_MIN) + 1.0;
         base *= exp(-max(layers.optical_depth, vec3<f32>(0.0)) * path);
     }
@@ -147,10 +154,9 @@ fn path_delta_at(cos: f32, roughness: f32) -> f32 {
 // a(mu) = (1 - s(mu)) exp(-tau / cos_eff(mu, r)): the light that reaches the base, s what
 // the rough lobe reflects and cos_eff - cos_t its path delta (the top at mu: coupling).
 fn layered_entering(layers: Layers, cos: f32, top: Top) -> vec3<f32> {
-    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
-    // Snell's cos_t^2, below 0 beyond the critical angle of n0 > n2, where a rough top still
-    // lets 1 - s in and cos_t is taken as 0 (optics::brdf::path::snell_cos).
-    let k = (1.0 - eta2) + eta2 * cos * cos;
+    // Below 0 beyond the critical angle of n0 > n2, where a rough top still lets 1 - s in
+    // and cos_t is taken as 0 (optics::brdf::path::snell_cos).
+    let k = snell_cos_sq(layers.n0, layers.n2, cos);
     var a = vec3<f32>(1.0) - top.reflected;
     if (HAS_ABSORPTION) {
         let path_cos = max(sqrt(max(k, 0.0)) + top.path_delta, COS_MIN);
@@ -172,8 +178,8 @@ fn normal_transmittance(optical_depth: vec3<f32>, roughness: f32) -> vec3<f32> {
 // in one exponential (layered::diffuse_f32), with the tops at mu_i and mu_o (coupling).
 fn layered_diffuse(layers: Layers, cos_i: f32, cos_o: f32, top_i: Top, top_o: Top) -> vec3<f32> {
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
-    let k_i = (1.0 - eta2) + eta2 * cos_i * cos_i;
-    let k_o = (1.0 - eta2) + eta2 * cos_o * cos_o;
+    let k_i = snell_cos_sq(layers.n0, layers.n2, cos_i);
+    let k_o = snell_cos_sq(layers.n0, layers.n2, cos_o);
     let kd = clamp(layers.albedo, vec3<f32>(0.0), vec3<f32>(1.0));
     var a = (vec3<f32>(1.0) - top_i.reflected) * (vec3<f32>(1.0) - top_o.reflected);
     if (HAS_ABSORPTION) {

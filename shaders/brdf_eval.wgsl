@@ -1,5 +1,6 @@
-// Compute entry point that evaluates skin_brdf (brdf.wgsl, prepended) on a buffer of
-// samples: the GPU side of the CPU/GPU comparison in tests/gpu.rs.
+// Compute entry points that evaluate skin_brdf (brdf.wgsl, prepended), or the film colour
+// alone (film.wgsl's film_rgb, by the pipeline's FILM_METHOD), on a buffer of samples: the
+// GPU side of the CPU/GPU comparisons in tests/gpu.rs.
 
 struct Sample {
     normal_roughness: vec4<f32>,
@@ -14,7 +15,7 @@ struct Sample {
 @group(1) @binding(0) var<storage, read> samples: array<Sample>;
 @group(1) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(EVAL_WORKGROUP_SIZE)
 fn eval_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
     if (i >= arrayLength(&samples)) {
@@ -34,4 +35,16 @@ fn eval_samples(@builtin(global_invocation_id) id: vec3<u32>) {
         vec3<f32>(0.0),
     ));
     results[i] = vec4<f32>(skin_brdf(layers, s.normal_roughness.xyz, s.wi_thickness.xyz, s.wo_n0.xyz), 1.0);
+}
+
+// The film colour of each sample's thickness (wi_thickness.w) at the cosine wi_thickness.z
+// (the light's direction against a normal along z), by the pipeline's FILM_METHOD.
+@compute @workgroup_size(EVAL_WORKGROUP_SIZE)
+fn film_samples(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= arrayLength(&samples)) {
+        return;
+    }
+    let s = samples[i];
+    results[i] = vec4<f32>(film_rgb(s.wi_thickness.w, s.wi_thickness.z), 1.0);
 }

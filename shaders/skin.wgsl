@@ -15,9 +15,8 @@ override GBUFFER_PART: u32 = GBUFFER_POSITION_NORMAL;
 // base albedo recovered from the colour map as the model reads it (base_albedo;
 // LayerOptics::layers is the CPU twin).
 fn layers_of(m: Material) -> Layers {
-    let y = clamp(m.roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
-    let j = min(u32(y), E1_ROUGHNESS - 2u);
-    let f = y - f32(j);
+    let j = lobe_row(m.roughness);
+    let f = clamp(m.roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u) - f32(j);
     var x = 0.0;
     if (scene.film.y > scene.film.x) {
         x = clamp((m.thickness_nm - scene.film.x) / (scene.film.y - scene.film.x), 0.0, 1.0);

@@ -221,8 +221,7 @@ pub struct Job {
     pub layout: Layout,
 }
 
-/// The default size of a job without `sizes`.
-pub const DEFAULT_SIZE: u64 = 1024;
+pub use crate::DEFAULT_SIZE;
 
 impl Job {
     /// Where the job's table is written, at `line` (a key's), for a message about it.

@@ -29,6 +29,9 @@ pub use material::parse_map_list;
 /// by the memory estimate (`memory`), not by this bound: 16384² needs about 17 GiB.
 pub const SIZE_RANGE: std::ops::RangeInclusive<u32> = 16..=16384;
 
+/// The size of a set whose size is not given (`--size`, a jobs file's `sizes`).
+pub const DEFAULT_SIZE: u64 = 1024;
+
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     #[error(transparent)]

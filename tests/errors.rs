@@ -35,7 +35,7 @@ fn accepted(preset: &str, extra: &[&str]) {
     assert!(out.status.success(), "{preset} {extra:?}: {}", stderr(&out));
 }
 
-/// A body or belly key that shapes what another draws is refused without it, with its line
+/// A scales, body or belly key that shapes what another draws is refused without it, with its line
 /// (they passed silently, where a pattern layer refuses a key its kind does not read).
 /// Negative controls: each beside its partner is accepted.
 #[test]
@@ -54,6 +54,9 @@ fn a_key_without_the_key_it_shapes_is_refused() {
             "tail_color = \"#aa2200\"\n",
         ),
         ("[belly]\nup_rows = 2\nplates = false\n", "b.toml:2: key `belly.up_rows` runs the belly", ""),
+        ("[scales]\nkeel_height = 0.7\n", "b.toml:2: key `scales.keel_height` shapes the keels", "keeled = true\n"),
+        ("[scales]\nkeel_width = 0.2\n", "b.toml:2: key `scales.keel_width` shapes the keels", "keeled = true\n"),
+        ("[scales]\nsmooth_rows = 1\n", "b.toml:2: key `scales.smooth_rows` shapes the keels", "keeled = true\n"),
     ] {
         let err = refused("b.toml", text, &[]);
         assert!(err.contains(says), "{text}: {err}");
@@ -67,6 +70,7 @@ fn a_key_without_the_key_it_shapes_is_refused() {
     // the key itself without its partner is refused.
     accepted("crotalus-atrox", &["--set", "body.tail_bands=0"]);
     accepted("corallus-caninus", &["--set", "belly.plates=false"]);
+    accepted("bitis-arietans", &["--set", "scales.keeled=false"]);
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().to_str().unwrap();
     let out =

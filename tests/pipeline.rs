@@ -563,9 +563,11 @@ fn the_height_maps_range_holds_every_surface_the_field_draws() {
     for shape in ["leaf", "diamond", "hexagon"] {
         for imbrication in [0.0, 0.5, 1.0] {
             for keeled in [false, true] {
+                // The tallest keel where there are keels (a keel height without them is refused).
+                let keel = if keeled { "keel_height = 1.0\n" } else { "" };
                 let text = format!(
                     "seed = 3\n[scales]\nshape = \"{shape}\"\nimbrication = {imbrication}\nkeeled = {keeled}\n\
-                     keel_height = 1.0\n[height]\ngrain = 0.05\n"
+                     {keel}[height]\ngrain = 0.05\n"
                 );
                 let preset = preset_from(&text);
                 let (low, high) = height_range(&preset);

@@ -322,7 +322,13 @@ pub fn quantize_rows(map: MapKind, width: usize, height: usize, row: impl Fn(usi
 /// A map's f32 samples to the file's scale, before rounding (`MapKind::format`'s encoding).
 fn sample_encoding(map: MapKind) -> impl Fn(f32) -> f32 + Sync {
     let encoding = map.format().encoding;
-    move |x: f32| match encoding {
+    move |x: f32| encode(encoding, x)
+}
+
+/// The stored value on [0, 1] of a linear sample in `encoding`: the one home of the map
+/// files' encodings (a pack's channels take theirs from here too, `pack::Transfer`).
+pub(crate) fn encode(encoding: Encoding, x: f32) -> f32 {
+    match encoding {
         Encoding::Srgb => linear_to_srgb8(x) as f32 / 255.0,
         Encoding::Linear => x,
         Encoding::SignedUnit => x * 0.5 + 0.5,

@@ -10,10 +10,10 @@
 use std::io::Write;
 use std::ops::Range;
 
-use crate::material::MapKind;
+use crate::material::{Encoding, MapKind};
 use crate::ops::Image;
 
-use super::{ExportError, SharedBuffer, linear_to_srgb8, png_file_encoder, unit_to_u8, unit_to_u16};
+use super::{ExportError, SharedBuffer, encode, png_file_encoder, unit_to_u8, unit_to_u16};
 
 /// How one channel of a packed texture is made from a map's linear sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -296,10 +296,10 @@ impl Transfer {
     /// The stored value on [0, 1] of a linear sample.
     fn apply(self, x: f32) -> f32 {
         match self {
-            Transfer::Srgb => linear_to_srgb8(x) as f32 / 255.0,
-            Transfer::Unit => x,
-            Transfer::SignedUnit => x * 0.5 + 0.5,
-            Transfer::NegatedSignedUnit => -x * 0.5 + 0.5,
+            Transfer::Srgb => encode(Encoding::Srgb, x),
+            Transfer::Unit => encode(Encoding::Linear, x),
+            Transfer::SignedUnit => encode(Encoding::SignedUnit, x),
+            Transfer::NegatedSignedUnit => encode(Encoding::SignedUnit, -x),
             Transfer::Complement => 1.0 - x,
         }
     }
@@ -374,6 +374,7 @@ impl TextureEncoder {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::export::linear_to_srgb8;
 
     #[test]
     fn every_pack_reads_colour_normal_and_roughness_and_the_film_only_when_there_is_one() {

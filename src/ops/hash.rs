@@ -39,12 +39,20 @@ pub fn signed(a: i32, b: i32, stream: u32, seed: u32) -> f32 {
 /// Derives an independent 32-bit seed for a named purpose from the preset seed
 /// (SplitMix64's output function, so nearby seeds give unrelated streams).
 pub fn derive_seed(seed: u64, purpose: &str) -> u32 {
-    let mut z = seed
+    let mut state = seed
         ^ purpose.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3));
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    splitmix64(&mut state) as u32
+}
+
+/// SplitMix64 (Steele, Lea & Flood 2014, with Vigna's constants): advances `state` by the
+/// golden-ratio increment and returns its mix. The one copy every generator of the crate
+/// (and its tests) steps with.
+pub fn splitmix64(state: &mut u64) -> u64 {
+    *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let mut z = *state;
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    (z ^ (z >> 31)) as u32
+    z ^ (z >> 31)
 }
 
 #[cfg(test)]

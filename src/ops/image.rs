@@ -189,6 +189,13 @@ impl Image {
     }
 }
 
+/// Hermite smoothstep: 0 below `e0`, 1 above `e1`, 3t² − 2t³ between.
+#[inline]
+pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
 /// `x.floor() as i32` without a libm call: x86-64's baseline has no SSE4.1 `roundss`, so
 /// `f32::floor` is a function call, and the lattice kernels floor several times per pixel.
 /// Exact for |x| < 2³¹.

@@ -24,7 +24,7 @@
 //! do not wrap: its two ends take no dots from each other).
 
 use super::hash;
-use super::image::{Image, floor_i32};
+use super::image::{Image, floor_i32, smoothstep};
 
 /// Rim band, in scale-cell widths from the outline inward: about an eighth of a scale's
 /// width, the margin that reads as "edged" in photographs of e.g. Natrix or Philodryas.
@@ -72,12 +72,6 @@ pub struct ScaleColour {
     pub speckle_cells_v: u32,
     pub seed: u32,
     pub channels: ScaleChannels,
-}
-
-#[inline]
-fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
 }
 
 impl ScaleColour {

@@ -24,7 +24,7 @@ use super::body::{BodyPlan, HEAD_TOP_HALF_U, Plate};
 use super::hash;
 use rayon::prelude::*;
 
-use super::image::{Image, floor_i32};
+use super::image::{Image, floor_i32, smoothstep};
 
 /// Channel layout of the scale field.
 pub mod channel {
@@ -281,12 +281,6 @@ impl CellTable {
         }
         CellTable { cells, cols: lattice.cols }
     }
-}
-
-#[inline]
-fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
 }
 
 /// One candidate scale evaluated at a pixel, in the scale's own frame (units: scale widths).

@@ -18,7 +18,7 @@ use super::methods::{Method, gaussian_fit_f32, rgb3_f32, spectral_n_f32};
 /// (n0, n1, n2) of PHYSICS.md's error grid: the thesis' default, a water-like film on a
 /// keratin-like base, the same inverted, and the default under water.
 pub const GRID_MATERIALS: [Stack; 4] = [
-    Stack { n0: 1.00, n1: 1.55, n2: 2.00 },
+    Stack::THESIS,
     Stack { n0: 1.00, n1: 1.33, n2: 1.56 },
     Stack { n0: 1.00, n1: 1.56, n2: 1.33 },
     Stack { n0: 1.33, n1: 1.55, n2: 2.00 },
@@ -137,13 +137,6 @@ pub fn measure(prepared: &Prepared, samples: &[Sample], reference_lab: &[[f64; 3
         .collect();
     per_eval.sort_by(f64::total_cmp);
     MethodReport { name: prepared.method.name(), mean_de: mean, p95_de: p95, max_de: max, ns_per_eval: per_eval[2] }
-}
-
-/// The whole table: every real-time method on the grid.
-pub fn bench_irid(d_step_nm: f64, angle_step_deg: f64, methods: &[Method]) -> Vec<MethodReport> {
-    let samples = grid(d_step_nm, angle_step_deg);
-    let reference_lab: Vec<[f64; 3]> = reference_colours(&samples).into_iter().map(linear_srgb_to_lab).collect();
-    methods.iter().map(|m| measure(&Prepared::new(*m), &samples, &reference_lab)).collect()
 }
 
 #[cfg(test)]

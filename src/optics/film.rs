@@ -75,7 +75,7 @@ pub fn film_cos_in(n0: f64, n1: f64, cos0: f64) -> C64 {
 }
 
 /// Fresnel amplitude coefficients (r_s, r_p, t_s, t_p) from medium i into medium j.
-fn fresnel_amplitudes(ni: f64, ci: C64, nj: f64, cj: C64) -> (C64, C64, C64, C64) {
+pub(crate) fn fresnel_amplitudes(ni: f64, ci: C64, nj: f64, cj: C64) -> (C64, C64, C64, C64) {
     let s_den = ci * ni + cj * nj;
     let p_den = ci * nj + cj * ni;
     let rs = (ci * ni - cj * nj) / s_den;

@@ -32,8 +32,11 @@ use super::film::{FilmAtAngle, Stack};
 use super::series::FilmSeries;
 use super::spectrum::{Observer, xyz_to_linear_srgb};
 
+/// The end of the fine thickness columns, uniform over [0, FINE_MAX_NM] (the module's
+/// thickness axis; shared with the shader's prelude).
 pub const FINE_MAX_NM: f64 = 2000.0;
 
+/// The last coarse column, exactly the incoherent limit: thicker films clamp to it.
 pub const COARSE_MAX_NM: f64 = 20_000.0;
 
 /// The cosine of the coupling table's cos texel `i` of `n`: uniform in √cos, as the rough

@@ -18,7 +18,7 @@ use std::sync::OnceLock;
 use super::fast::{airy_reflectance_f32, band_reflectance_f32, film_f32};
 use super::film::Stack;
 use super::series::FilmSeries;
-use super::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, Observer, XYZ_TO_SRGB, mat3_mul};
+use super::spectrum::{LAMBDA_MIN_NM, Observer, SAMPLES, XYZ_TO_SRGB, mat3_mul};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Method {
@@ -40,7 +40,7 @@ impl Method {
             other => {
                 // Digits only: `spectral-+5` was read as spectral-5.
                 let digits = other.strip_prefix("spectral-").filter(|d| d.bytes().all(|b| b.is_ascii_digit()))?;
-                Method::SpectralN(digits.parse().ok().filter(|n| (1..=421).contains(n))?)
+                Method::SpectralN(digits.parse().ok().filter(|n| (1..=SAMPLES).contains(n))?)
             }
         })
     }
@@ -87,7 +87,7 @@ pub struct Bands {
 impl Bands {
     pub fn new(n: usize) -> Bands {
         let obs = Observer::get();
-        let span = (LAMBDA_MAX_NM - LAMBDA_MIN_NM + 1) as f64;
+        let span = SAMPLES as f64;
         let width = span / n as f64;
         let mut xyz = vec![[0.0f64; 3]; n];
         for (i, w) in obs.weights.iter().enumerate() {
@@ -106,7 +106,7 @@ impl Bands {
 
     /// The band table for N (1..=421), built once on first use.
     pub fn cached(n: usize) -> &'static Bands {
-        const MAX_BANDS: usize = (LAMBDA_MAX_NM - LAMBDA_MIN_NM + 1) as usize;
+        const MAX_BANDS: usize = SAMPLES;
         static CACHE: OnceLock<Vec<OnceLock<Bands>>> = OnceLock::new();
         let n = n.clamp(1, MAX_BANDS);
         let all = CACHE.get_or_init(|| (0..MAX_BANDS).map(|_| OnceLock::new()).collect());
@@ -190,12 +190,18 @@ pub const GAUSSIAN_FIT_HARMONICS: usize = 3;
 fn bb_sensitivity(c_re: f64, c_im: f64, opd_nm: f64) -> [f64; 3] {
     let phase = 2.0 * std::f64::consts::PI * opd_nm * BB_METRES_PER_NM;
     let (mag, arg) = ((c_re * c_re + c_im * c_im).sqrt(), c_im.atan2(c_re));
-    let lobe = |(val, pos, var): (f64, f64, f64)| {
-        val * (2.0 * std::f64::consts::PI * var).sqrt() * (pos * phase + arg).cos() * (-var * phase * phase).exp()
-    };
+    let lobe = |l: (f64, f64, f64)| bb_amplitude(l) * (l.1 * phase + arg).cos() * (-l.2 * phase * phase).exp();
     let mut xyz = [0, 1, 2].map(|i| lobe(BB_LOBES[i]));
     xyz[0] += lobe(BB_LOBES[3]);
-    xyz.map(|v| mag * v / BB_NORM)
+    xyz.map(|v| mag * v)
+}
+
+/// The gaussian-fit's XYZ (under illuminant E: the fits are of the bare CMFs) to linear
+/// sRGB under D65: the von Kries scaling by D65's white (`d65_white`), then `XYZ_TO_SRGB`,
+/// in one matrix. The f64 and f32 paths and the shader's `FilmInfo` take it from here.
+pub fn gaussian_fit_xyz_to_rgb() -> [[f64; 3]; 3] {
+    let white = d65_white();
+    XYZ_TO_SRGB.map(|row| [row[0] * white[0], row[1] * white[1], row[2] * white[2]])
 }
 
 /// D65 white XYZ relative to illuminant E's (1, 1, 1), for the von Kries scaling.
@@ -244,8 +250,7 @@ pub fn gaussian_fit_f64(stack: Stack, thickness_nm: f64, cos0: f64) -> [f64; 3] 
             c = c * h.q;
         }
     }
-    let white = d65_white();
-    mat3_mul(&XYZ_TO_SRGB, [xyz[0] * white[0], xyz[1] * white[1], xyz[2] * white[2]])
+    mat3_mul(&gaussian_fit_xyz_to_rgb(), xyz)
 }
 
 pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32) -> [f32; 3] {
@@ -279,9 +284,7 @@ pub fn gaussian_fit_f32(n0: f32, n1: f32, n2: f32, thickness_nm: f32, cos0: f32)
             c = mul(c, h.q);
         }
     }
-    let white = d65_white();
-    let v = [xyz[0] as f64 * white[0], xyz[1] as f64 * white[1], xyz[2] as f64 * white[2]];
-    mat3_mul(&XYZ_TO_SRGB, v).map(|x| x as f32)
+    mat3_mul(&gaussian_fit_xyz_to_rgb(), xyz.map(f64::from)).map(|x| x as f32)
 }
 
 #[cfg(test)]

@@ -52,8 +52,7 @@ impl FilmSeries {
         let Stack { n0, n1, n2 } = stack;
         let (c0, c1, c2) = (C64::real(cos0), film_cos_in(n0, n1, cos0), cos_in(n0, n2, cos0));
         let r = |ni: f64, ci: C64, nj: f64, cj: C64| {
-            let rs = (ci * ni - cj * nj) / (ci * ni + cj * nj);
-            let rp = (ci * nj - cj * ni) / (ci * nj + cj * ni);
+            let (rs, rp, _, _) = super::film::fresnel_amplitudes(ni, ci, nj, cj);
             (rs, rp)
         };
         let (a_s, a_p) = r(n0, c0, n1, c1);

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use super::brdf::{Layers, Model};
 use super::film::{Stack, airy, incoherent};
 use super::lut::Lut;
+use super::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
 use crate::ops::hash;
 
 #[derive(Debug, Clone, serde::Serialize)]
@@ -47,7 +48,7 @@ pub struct ModelFurnace {
 
 /// The materials the stress draws from: the thesis default and its edge cases.
 pub const STRESS_MATERIALS: [Stack; 7] = [
-    Stack { n0: 1.0, n1: 1.55, n2: 2.0 },
+    Stack::THESIS,
     Stack { n0: 1.0, n1: 1.0, n2: 2.0 },
     Stack { n0: 1.0, n1: 1.56, n2: 1.33 },
     Stack { n0: 1.5, n1: 1.55, n2: 1.0 },
@@ -168,7 +169,8 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
     // Film R and T at a random wavelength and angle.
     let cos0 = draw.pick(&[0.0, 1e-9, 1.0, -1.0]);
     let cos0 = if cos0 < 0.0 { draw.unit() } else { cos0 };
-    let film = airy(stack, thickness, 360.0 + draw.unit() * 420.0, cos0);
+    let film =
+        airy(stack, thickness, f64::from(LAMBDA_MIN_NM) + draw.unit() * f64::from(LAMBDA_MAX_NM - LAMBDA_MIN_NM), cos0);
     let inc = incoherent(stack, cos0);
     let rt = [film.rs, film.rp, film.r, film.ts, film.tp, film.t, inc.r, inc.t];
     count(acc, &rt);
@@ -181,7 +183,8 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
     // K and E of a 400 nm film for every sample: these look for non-finite and
     // out-of-range values, not energy (the film from below at every sampled thickness would
     // cost 30,000 Airy sums a sample); the furnace below takes the film drawn.
-    let layers = Layers::of_stack(stack, 400.0, roughness, [tau; 3], [1.0, 0.5, 0.0]);
+    let layers =
+        Layers::of_stack(stack, crate::material::thesis::FILM_THICKNESS_NM, roughness, [tau; 3], [1.0, 0.5, 0.0]);
     let layers32 = layers.to_f32(thickness);
     for model in Model::ALL {
         let value = model.eval(&layers, normal, wi, wo, &|c| lut.lookup_f64(thickness, c)).total();

@@ -609,8 +609,13 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
     // file wrote is passed over where an override turned its partner off (`--set
     // body.tail_bands=0` on a preset with banded tails, `--set belly.plates=false`).
     let (body, belly) = (crate::preset::schema::Body::default(), crate::preset::schema::Belly::default());
+    let scales = crate::preset::schema::Scales::default();
     let no_bands = "shapes the bands `body.tail_bands` draws, which is 0 here; set it, or leave this out";
+    let no_keels = "shapes the keels `scales.keeled` draws, which is false here; set it, or leave this out";
     for (key, set, partner, unread, message) in [
+        ("scales.keel_height", s.keel_height != scales.keel_height, "scales.keeled", !s.keeled, no_keels),
+        ("scales.keel_width", s.keel_width != scales.keel_width, "scales.keeled", !s.keeled, no_keels),
+        ("scales.smooth_rows", s.smooth_rows != scales.smooth_rows, "scales.keeled", !s.keeled, no_keels),
         (
             "body.tail_shift_start",
             b.tail_shift_start != body.tail_shift_start,

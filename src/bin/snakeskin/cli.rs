@@ -90,7 +90,7 @@ pub enum Command {
         #[arg(long, default_value = "640x400", value_parser = parse_image_size)]
         size: ImageSize,
         /// Map resolution for the preview (pixels per side), 64 to 4096.
-        #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
+        #[arg(long, default_value_t = 1024, value_parser = map_size())]
         map_size: u64,
     },
     /// A contact sheet of the species library: per species its colour map and a preview
@@ -109,7 +109,7 @@ pub enum Command {
         columns: u32,
         /// Map resolution per species (pixels per side; a body atlas's width, narrowed for a
         /// species whose atlas would be more than 8192 rows long), 64 to 4096.
-        #[arg(long, default_value_t = 512, value_parser = ranged_u64(64, 4096))]
+        #[arg(long, default_value_t = 512, value_parser = map_size())]
         map_size: u64,
         /// tile: each species' tile and a render; body: each species' whole body atlas on
         /// its side (snout left) with its counts, and a render of the whole snake (--tile
@@ -277,6 +277,17 @@ fn ranged_u64(lo: u64, hi: u64) -> impl Fn(&str) -> Result<u64, String> + Clone 
     }
 }
 
+/// A set's `--size`: `snakeskin::SIZE_RANGE`.
+fn set_size() -> impl Fn(&str) -> Result<u64, String> + Clone + Send + Sync + 'static {
+    ranged_u64((*snakeskin::SIZE_RANGE.start()).into(), (*snakeskin::SIZE_RANGE.end()).into())
+}
+
+/// A drawing command's `--map-size`: `render::engine::prepare::MAP_SIZE_RANGE`.
+fn map_size() -> impl Fn(&str) -> Result<u64, String> + Clone + Send + Sync + 'static {
+    let range = snakeskin::render::engine::prepare::MAP_SIZE_RANGE;
+    ranged_u64((*range.start()).into(), (*range.end()).into())
+}
+
 /// `ranged_u64` for a flag that holds a u32 (`clap::value_parser!(u32).range` said "number
 /// too large to fit in target type" and "invalid digit found in string" for `--tile 1e30`
 /// and `--tile 1.5`).
@@ -349,7 +360,7 @@ pub struct GenerateArgs {
     pub out: PathBuf,
     /// Width of every map in pixels (16 to 16384); the tile is square, a body atlas is
     /// `body.length` widths tall (at most 65535 rows: 5461 wide at the default length 12).
-    #[arg(long, default_value_t = 1024, value_parser = ranged_u64(16, 16384))]
+    #[arg(long, default_value_t = snakeskin::DEFAULT_SIZE, value_parser = set_size())]
     pub size: u64,
     /// Normal map convention: opengl (+Y up, glTF/Blender) or directx (+Y down, Unreal).
     #[arg(long, value_enum, default_value_t = Convention::Opengl)]
@@ -401,7 +412,7 @@ pub struct ExportArgs {
     /// Texture width in pixels, 16 to 16384 (a body atlas is `body.length` widths tall, at
     /// most 65535 rows: 5461 wide at the default length 12; WebGL viewers commonly load
     /// textures up to 16384 texels a side).
-    #[arg(long, default_value_t = 1024, value_parser = ranged_u64(16, 16384))]
+    #[arg(long, default_value_t = snakeskin::DEFAULT_SIZE, value_parser = set_size())]
     pub size: u64,
     /// snake (the preview's body), sphere (the material alone, tile layout) or plane.
     #[arg(long, value_enum, default_value_t = MeshArg::Snake)]
@@ -518,7 +529,7 @@ pub struct PreviewArgs {
     pub model: Model,
     /// Map resolution for the preview (pixels per side; a body atlas's width, narrowed
     /// if it would be more than 8192 rows long), 64 to 4096.
-    #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
+    #[arg(long, default_value_t = 1024, value_parser = map_size())]
     pub map_size: u64,
     /// tile (the default: the tile repeated along the body) or body (a body atlas on the
     /// whole snake: head marks on the head, the tail's pattern on the tail).
@@ -727,8 +738,8 @@ pub enum BrdfCommand {
     /// at the grazing and n0 > n2 draws) and the f32 path's worst deviation from f64 (JSON
     /// with --json).
     Stress {
-        /// Number of random samples, 1 to 10,000,000 (the default takes about ten seconds
-        /// on two cores).
+        /// Number of random samples, 1 to 10,000,000 (the default takes about 13 seconds on
+        /// two cores, 11 of them baking the stacks' film tables, whatever the count).
         #[arg(long, default_value_t = 100_000, value_parser = ranged_u64(1, 10_000_000))]
         samples: u64,
         /// Seed of the sample generator, 0 to 4294967295 (its hash takes 32 bits: a larger
@@ -870,7 +881,7 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 30, value_parser = ranged_u64(3, 10_000))]
         frames: u64,
         /// Map resolution (pixels per side), 64 to 4096.
-        #[arg(long, default_value_t = 1024, value_parser = ranged_u64(64, 4096))]
+        #[arg(long, default_value_t = 1024, value_parser = map_size())]
         map_size: u64,
         /// Frame size of the CPU reference comparison (the CPU shades each pixel spectrally,
         /// about 3 ms per covered pixel on two cores: minutes at the default, hours at a
@@ -933,7 +944,7 @@ pub enum BenchCommand {
     /// Reports the reflected colour's ΔE00 (mean, p95, max), the white-furnace error and the
     /// CPU cost per evaluation (inputs at random thicknesses, and the same sorted by
     /// thickness as a frame reads them). Takes under a minute on two cores at the default
-    /// photon count (41 s measured, 79 s of CPU); the models' own albedo integration, which
+    /// photon count (45 s measured, 87 s of CPU); the models' own albedo integration, which
     /// fewer photons do not shorten, is most of it (34 s at 1000 photons).
     Layered {
         /// Print JSON {"models": [{"name","mean_de","p95_de","max_de","max_furnace_err",

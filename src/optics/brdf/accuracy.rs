@@ -235,7 +235,13 @@ pub fn run(colours: &[[f64; 3]], photons: u64) -> LayeredBench {
 /// 200,000 deterministic inputs on one core; `coherent`: the inputs sorted by thickness.
 pub fn ns_per_eval(model: Model, coherent: bool) -> f64 {
     let lut = Lut::bake_default(Stack::THESIS);
-    let layers = Layers::of_stack(Stack::THESIS, 400.0, 0.35, [0.6, 0.4, 0.2], [0.5, 0.4, 0.3]);
+    let layers = Layers::of_stack(
+        Stack::THESIS,
+        crate::material::thesis::FILM_THICKNESS_NM,
+        0.35,
+        [0.6, 0.4, 0.2],
+        [0.5, 0.4, 0.3],
+    );
     let count = 200_000;
     let mut inputs: Vec<_> = (0..count)
         .map(|i| {

@@ -223,7 +223,8 @@ pub fn diffuse_f32(layers: &Layers32, cos: [f32; 2], reflected: [[f32; 3]; 2], p
     let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
     // Snell's cos_t², below 0 beyond the critical angle of n0 > n2, where cos_t is taken as 0
     // (`path::snell_cos`).
-    let (k_i, k_o) = ((1.0 - eta2) + eta2 * cos_i * cos_i, (1.0 - eta2) + eta2 * cos_o * cos_o);
+    let (k_i, k_o) =
+        (super::snell_cos_sq_f32(layers.n0, layers.n2, cos_i), super::snell_cos_sq_f32(layers.n0, layers.n2, cos_o));
     let absorbing = layers.optical_depth.iter().any(|t| *t > 0.0);
     let inverse_path = if absorbing {
         let cos_min = COS_MIN as f32;

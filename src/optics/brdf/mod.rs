@@ -313,9 +313,23 @@ fn normalize(v: [f64; 3]) -> Option<[f64; 3]> {
 /// n2 sin θ_t; the film's parallel faces do not change it); None under total internal
 /// reflection (no light enters). Every model reads it.
 pub fn cos_transmitted(n0: f64, n2: f64, cos: f64) -> Option<f64> {
-    let eta2 = (n0 / n2) * (n0 / n2);
-    let k = (1.0 - eta2) + eta2 * cos * cos;
+    let k = snell_cos_sq(n0, n2, cos);
     (k > 0.0).then(|| k.sqrt())
+}
+
+/// Snell's cos² of the direction refracted into n2 from a direction at cosine `cos` in n0,
+/// below 0 beyond the critical angle of n0 > n2. Written as (1 − η²) + η² cos² rather than
+/// 1 − η² sin²: at grazing light with η = 1 the latter cancels to 0 (`film::cos_in`). The
+/// f32 twin `snell_cos_sq_f32` and `brdf.wgsl`'s `snell_cos_sq` are the same expression.
+pub fn snell_cos_sq(n0: f64, n2: f64, cos: f64) -> f64 {
+    let eta2 = (n0 / n2) * (n0 / n2);
+    (1.0 - eta2) + eta2 * cos * cos
+}
+
+/// `snell_cos_sq` in f32.
+pub fn snell_cos_sq_f32(n0: f32, n2: f32, cos: f32) -> f32 {
+    let eta2 = (n0 / n2) * (n0 / n2);
+    (1.0 - eta2) + eta2 * cos * cos
 }
 
 /// The film as the f64 coupling reads it: at the cosine clamped to [0, 1], its colour

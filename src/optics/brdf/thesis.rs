@@ -12,7 +12,7 @@
 
 use std::f64::consts::PI;
 
-use super::{COS_MIN, Layers, Layers32, cos_transmitted};
+use super::{COS_MIN, Layers, Layers32, cos_transmitted, snell_cos_sq, snell_cos_sq_f32};
 
 /// The diffuse lobe at cosines `cos_i`, `cos_o` (already floored at COS_MIN) with the film's
 /// reflectance `f_i`, `f_o` at those cosines (clamped to [0, 1]).
@@ -32,8 +32,7 @@ pub fn diffuse(layers: &Layers, cos_i: f64, cos_o: f64, f_i: [f64; 3], f_o: [f64
 /// The f32 diffuse lobe, as `brdf.wgsl`'s `thesis_diffuse`.
 pub fn diffuse_f32(layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o: [f32; 3]) -> [f32; 3] {
     let cos_min = COS_MIN as f32;
-    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
-    let (ki, ko) = (1.0 - eta2 * (1.0 - cos_i * cos_i), 1.0 - eta2 * (1.0 - cos_o * cos_o));
+    let (ki, ko) = (snell_cos_sq_f32(layers.n0, layers.n2, cos_i), snell_cos_sq_f32(layers.n0, layers.n2, cos_o));
     if !(ki > 0.0 && ko > 0.0) {
         return [0.0; 3];
     }
@@ -49,8 +48,7 @@ pub fn diffuse_f32(layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o
 /// and is attenuated along the view path plus one layer thickness. Multiplies the sky
 /// radiance along the normal.
 pub fn ambient_diffuse(layers: &Layers, cos_o: f64, f_o: [f64; 3]) -> [f64; 3] {
-    let eta = layers.n0 / layers.n2;
-    let k = (1.0 - eta * eta) + eta * eta * cos_o * cos_o;
+    let k = snell_cos_sq(layers.n0, layers.n2, cos_o);
     let path = 1.0 / k.max(0.0).sqrt().max(COS_MIN) + 1.0;
     [0, 1, 2].map(|c| (1.0 - f_o[c]) * layers.albedo[c] * (-layers.optical_depth[c].max(0.0) * path).exp())
 }

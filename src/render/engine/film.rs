@@ -15,8 +15,7 @@ use crate::optics::brdf::energy::NODE_LEN;
 use crate::optics::brdf::path::THROUGH_LEN;
 use crate::optics::film::Stack;
 use crate::optics::lut::Lut;
-use crate::optics::methods::{Bands, Method, d65_white};
-use crate::optics::spectrum::XYZ_TO_SRGB;
+use crate::optics::methods::{Bands, Method, gaussian_fit_xyz_to_rgb};
 
 /// How `film.wgsl` computes the film colour (its `FILM_METHOD` override constant).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -202,9 +201,7 @@ impl FilmBinding {
         n_bands: usize,
     ) -> FilmBinding {
         let bands = Bands::cached(n_bands.max(1));
-        let white = d65_white();
-        let xyz_to_rgb =
-            XYZ_TO_SRGB.map(|row| [row[0] * white[0], row[1] * white[1], row[2] * white[2], 0.0].map(|v| v as f32));
+        let xyz_to_rgb = gaussian_fit_xyz_to_rgb().map(|row| [row[0], row[1], row[2], 0.0].map(|v| v as f32));
         let info = FilmInfo {
             n_cos: lut.n_cos as u32,
             n_fine: lut.n_fine as u32,

@@ -134,44 +134,17 @@ pub fn mip_chain<T: Texel>(level0: Vec<T>, width: usize, height: usize) -> Vec<V
     levels
 }
 
-/// IEEE 754 binary16 from f32, round to nearest even; overflow to infinity (maps never get
-/// near 65504).
+/// IEEE 754 binary16 from f32, round to nearest even, overflow to infinity (maps never get
+/// near 65504): the `half` crate's, which the EXR export's halves are too. (A hand-written
+/// conversion here until a later session rounded some subnormals down: it dropped the bits
+/// it shifted out before deciding the tie, so 2^-25 plus a little became 0 for 2^-24.)
 pub fn f32_to_f16(value: f32) -> u16 {
-    let bits = value.to_bits();
-    let sign = ((bits >> 16) & 0x8000) as u16;
-    let exp = ((bits >> 23) & 0xff) as i32;
-    let mantissa = bits & 0x7f_ffff;
-    if exp == 0xff {
-        return sign | 0x7c00 | if mantissa != 0 { 0x200 } else { 0 };
-    }
-    let e = exp - 127 + 15;
-    if e >= 0x1f {
-        return sign | 0x7c00;
-    }
-    if e <= 0 {
-        if e < -10 {
-            return sign;
-        }
-        let m = (mantissa | 0x80_0000) >> (1 - e);
-        let round = ((m & 0x1fff) > 0x1000 || ((m & 0x1fff) == 0x1000 && (m & 0x2000) != 0)) as u32;
-        return sign | ((m >> 13) + round) as u16;
-    }
-    let round = ((mantissa & 0x1fff) > 0x1000 || ((mantissa & 0x1fff) == 0x1000 && (mantissa & 0x2000) != 0)) as u32;
-    let out = ((e as u32) << 10 | (mantissa >> 13)) + round;
-    sign | out as u16
+    half::f16::from_f32(value).to_bits()
 }
 
 /// f32 from IEEE 754 binary16 (exact: every half is an f32).
-pub fn f16_to_f32(half: u16) -> f32 {
-    let sign = if half & 0x8000 != 0 { -1.0 } else { 1.0 };
-    let exp = ((half >> 10) & 0x1f) as i32;
-    let mantissa = (half & 0x3ff) as f32;
-    match exp {
-        0 => sign * mantissa * 2f32.powi(-24),
-        0x1f if mantissa == 0.0 => sign * f32::INFINITY,
-        0x1f => f32::NAN,
-        _ => sign * (1.0 + mantissa / 1024.0) * 2f32.powi(exp - 15),
-    }
+pub fn f16_to_f32(bits: u16) -> f32 {
+    half::f16::from_bits(bits).to_f32()
 }
 
 /// The value a half-float texture stores for `value`.
@@ -289,6 +262,12 @@ mod tests {
         assert_eq!(f32_to_f16(1e6), 0x7c00);
         // Smallest subnormal 2^-24.
         assert_eq!(f32_to_f16(5.960_464_5e-8), 0x0001);
+        // Subnormals round to nearest on all the bits shifted out: just above half the
+        // smallest subnormal (f32 bits 0x3300_0743) is the smallest, not 0, and just above
+        // 2.5 of it (0x3420_013f) is 3, not 2 (both missed by the conversion before `half`).
+        assert_eq!(f32_to_f16(f32::from_bits(0x3300_0743)), 0x0001);
+        assert_eq!(f32_to_f16(f32::from_bits(0x3420_013f)), 0x0003);
+        assert_eq!(f32_to_f16(f32::from_bits(0x3300_0000)), 0x0000, "a tie to even");
         // 1/3 rounds to 0x3555.
         assert_eq!(f32_to_f16(1.0 / 3.0), 0x3555);
         // And back: 0x3555 is 0.333251953125, the nearest half to 1/3.

@@ -18,6 +18,12 @@ use crate::preset::LoadedPreset;
 /// Preview image size limits (pixels per side): lavapipe handles 8K, a window rarely more.
 pub const IMAGE_RANGE: std::ops::RangeInclusive<u32> = 16..=8192;
 
+/// The map sizes (pixels per side) the drawing commands (preview, figures, sheet, bench
+/// render) generate their materials at: the maps are made before the first frame, and a
+/// 4096² set (1.6 s and under 1 GiB for the built-in species, BENCHMARKS "Speed") still
+/// opens a preview in seconds.
+pub const MAP_SIZE_RANGE: std::ops::RangeInclusive<u32> = 64..=4096;
+
 /// Generates the five maps of `preset` at `map_size`² for rendering.
 pub fn material_maps(loaded: &LoadedPreset, map_size: usize) -> Result<MaterialMaps, Error> {
     material_maps_in(loaded, map_size, Layout::Tile)

@@ -75,6 +75,9 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("MAX_Q2", "f32", f32_literal(MAX_Q2_F32 as f64)),
         ("F32_EPSILON", "f32", f32_literal(f32::EPSILON as f64)),
         ("F32_MIN_POSITIVE", "f32", f32_literal(f32::MIN_POSITIVE as f64)),
+        ("F32_MAX", "f32", f32_literal(f32::MAX as f64)),
+        // brdf_eval.wgsl's entry points; the dispatch divides by it (render::reference::brdf_eval).
+        ("EVAL_WORKGROUP_SIZE", "u32", format!("{}u", crate::render::reference::brdf_eval::WORKGROUP_SIZE)),
         ("RGB3_NM", "vec3<f32>", vec3_literal(RGB3_NM.map(f64::from))),
         ("RGB3_BAND_NM", "f32", f32_literal(RGB3_BAND_NM as f64)),
         // Belcour–Barla lobes as (X, Y, Z, X's second lobe).

@@ -14,11 +14,6 @@ use super::engine::scene::{Camera, Stage, View};
 use crate::Error;
 use crate::export::{FileGroup, check_target, write_file_atomically};
 
-/// Encodes and writes a rendered image (atomically).
-pub fn write_png(path: &Path, image: &image::RgbaImage) -> Result<PathBuf, Error> {
-    Ok(write_file_atomically(path, rendered_png_bytes(image)?)?)
-}
-
 /// A rendered image as PNG bytes, as RGB converted without a copy of the RGBA image
 /// (`renderer::frame_bytes` counts the RGB image and the PNG bytes).
 pub fn rendered_png_bytes(image: &image::RgbaImage) -> Result<Vec<u8>, Error> {

@@ -13,6 +13,11 @@ use crate::render::engine::gpu::{StorageOutput, storage_entry};
 use crate::render::engine::shaders::shader_programs;
 use crate::render::{Gpu, GpuError};
 
+/// Invocations per workgroup of `brdf_eval.wgsl`'s entry points (the shader's
+/// `EVAL_WORKGROUP_SIZE`, from the generated prelude): 64, a multiple of every GPU's SIMD
+/// width (32 on NVIDIA, 64 on AMD's GCN).
+pub const WORKGROUP_SIZE: u32 = 64;
+
 /// One BRDF query, laid out as the shader's `Sample` (seven vec4s).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
@@ -48,6 +53,29 @@ pub fn eval_on_gpu(gpu: &Gpu, model: Model, lut: &Lut, samples: &[GpuSample]) ->
     Ok(eval_timed(gpu, model, Stack::THESIS, lut, GpuFilmMethod::Lut, samples, 1)?.0)
 }
 
+/// The film colour by `method` for the material `stack` (whose LUT is `lut`) of each
+/// (thickness in nm, cosine) pair, as the shader's `film_rgb` computes it: the GPU half of
+/// the test of every film method against its Rust f32 twin (`optics::methods`).
+pub fn film_on_gpu(
+    gpu: &Gpu,
+    stack: Stack,
+    lut: &Lut,
+    method: GpuFilmMethod,
+    points: &[(f32, f32)],
+) -> Result<Vec<[f32; 3]>, GpuError> {
+    let samples: Vec<GpuSample> = points
+        .iter()
+        .map(|&(thickness_nm, cos)| {
+            let mut sample = GpuSample::zeroed();
+            sample.wi_thickness = [(1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos, thickness_nm];
+            sample
+        })
+        .collect();
+    gpu.checked(&format!("evaluating the film at {} points", samples.len()), || {
+        Ok(dispatch(gpu, ("film_samples", Model::Thesis), (stack, lut, method), &samples, 1)?.0)
+    })
+}
+
 /// Evaluates the BRDF of `model` for every sample, dispatching the evaluation `repeats` times in one
 /// submission (same inputs and outputs), with film colour by `method` for the material
 /// `stack` (whose LUT is `lut`); also returns the wall time from submit to results on the
@@ -63,15 +91,16 @@ pub fn eval_timed(
     repeats: u32,
 ) -> Result<(Vec<[f32; 3]>, std::time::Duration), GpuError> {
     gpu.checked(&format!("evaluating {} samples", samples.len()), || {
-        dispatch(gpu, model, (stack, lut, method), samples, repeats)
+        dispatch(gpu, ("eval_samples", model), (stack, lut, method), samples, repeats)
     })
 }
 
-/// `eval_timed`'s work, inside its error scope (the film as one argument: the material's
-/// stack, its LUT and the colour method).
+/// `eval_timed`'s and `film_on_gpu`'s work, inside their error scope: the compute entry
+/// point (`eval_samples`, the BRDF of the model; `film_samples`, the film alone), the film
+/// as one argument (the material's stack, its LUT and the colour method).
 fn dispatch(
     gpu: &Gpu,
-    model: Model,
+    (entry_point, model): (&str, Model),
     (stack, lut, method): (Stack, &Lut, GpuFilmMethod),
     samples: &[GpuSample],
     repeats: u32,
@@ -100,7 +129,7 @@ fn dispatch(
         label: Some("brdf_eval"),
         layout: Some(&layout),
         module: &module,
-        entry_point: Some("eval_samples"),
+        entry_point: Some(entry_point),
         compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
         cache: None,
     });
@@ -132,7 +161,7 @@ fn dispatch(
         pass.set_bind_group(0, &film.bind_group, &[]);
         pass.set_bind_group(1, &io_group, &[]);
         for _ in 0..repeats.max(1) {
-            pass.dispatch_workgroups((samples.len() as u32).div_ceil(64), 1, 1);
+            pass.dispatch_workgroups((samples.len() as u32).div_ceil(WORKGROUP_SIZE), 1, 1);
         }
     }
     results.copy_out(&mut encoder);
