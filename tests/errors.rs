@@ -57,6 +57,7 @@ fn a_key_without_the_key_it_shapes_is_refused() {
         ("[scales]\nkeel_height = 0.7\n", "b.toml:2: key `scales.keel_height` shapes the keels", "keeled = true\n"),
         ("[scales]\nkeel_width = 0.2\n", "b.toml:2: key `scales.keel_width` shapes the keels", "keeled = true\n"),
         ("[scales]\nsmooth_rows = 1\n", "b.toml:2: key `scales.smooth_rows` shapes the keels", "keeled = true\n"),
+        ("[roughness]\nkeel = 0.4\n[scales]\n", "b.toml:2: key `roughness.keel` shapes the keels", "keeled = true\n"),
     ] {
         let err = refused("b.toml", text, &[]);
         assert!(err.contains(says), "{text}: {err}");
@@ -554,7 +555,11 @@ fn keys_of_another_kind_are_refused_not_ignored() {
         // These two said "must be one of round for kind ..." and "must be [first, last] ...
         // for kind "stripes" only; got [2.0, 3.0]", as if the value were wrong.
         ("stripes", "shape = \"ring\"", "`pattern.0.shape` is read by kind \"spots\" and \"blotches\" only".into()),
-        ("spots", "rows = [2, 3]", "`pattern.0.rows` is read by kind \"stripes\" only, not \"spots\"".into()),
+        (
+            "blotches",
+            "rows = [2, 3]",
+            "`pattern.0.rows` is read by kind \"stripes\" and \"spots\" only, not \"blotches\"".into(),
+        ),
         // A size without the colour that would draw it (the review).
         ("spots", "center_size = 0.3", "`pattern.0.center_size` sizes what `center_color` draws".into()),
         ("stripes", "border_size = 0.02", "`pattern.0.border_size` sizes what `border_color` draws".into()),

@@ -140,10 +140,10 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
     }
 }
 
-/// How far `filter` is from exact linear interpolation on this adapter: the largest error
-/// of the weight it gives a texel, over 4,096 positions between two texels (0 and 1). Exact
-/// filtering (lavapipe interpolates in f32) gives ~1e-7; hardware that computes its weights
-/// in fixed point with 8 fractional bits gives up to 1/512 (rounding) or 1/256.
+/// Every film method of the shader (rgb3, spectral-N, gaussian-fit, and none: the bare
+/// interface) against its Rust f32 twin (`optics::methods`; none against the f64 film of no
+/// thickness), the film alone (`brdf_eval.wgsl`'s `film_samples`): the BRDF test above reads
+/// the film through the LUT only.
 #[test]
 fn every_film_method_on_the_gpu_matches_its_rust_twin() {
     use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
@@ -226,6 +226,10 @@ fn every_film_method_on_the_gpu_matches_its_rust_twin() {
     }
 }
 
+/// How far `filter` is from exact linear interpolation on this adapter: the largest error
+/// of the weight it gives a texel, over 4,096 positions between two texels (0 and 1). Exact
+/// filtering (lavapipe interpolates in f32) gives ~1e-7; hardware that computes its weights
+/// in fixed point with 8 fractional bits gives up to 1/512 (rounding) or 1/256.
 fn filter_weight_error(gpu: &snakeskin::render::Gpu, filter: wgpu::FilterMode) -> f32 {
     use snakeskin::render::engine::gpu::{StorageOutput, sampler_entry, storage_entry, texture_entry};
     use wgpu::util::DeviceExt;

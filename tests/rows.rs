@@ -133,7 +133,8 @@ fn row_keys_are_checked() {
         ("[scales]\nvertebral_width = 5\n", "scales.vertebral_width"),
         ("[belly]\nup_rows = 30\n", "belly.up_rows"),
         ("[[pattern]]\nkind = \"stripes\"\ncolor = \"#ffffff\"\nrows = [3, 12]\n", "pattern.0.rows"),
-        ("[[pattern]]\nkind = \"spots\"\ncolor = \"#ffffff\"\nrows = [1, 2]\n", "pattern.0.rows"),
+        ("[[pattern]]\nkind = \"spots\"\ncolor = \"#ffffff\"\nrows = [1, 12]\n", "pattern.0.rows"),
+        ("[[pattern]]\nkind = \"blotches\"\ncolor = \"#ffffff\"\nrows = [1, 2]\n", "pattern.0.rows"),
     ] {
         let err = parse(&source(text), &[]).expect_err(key).to_string();
         assert!(err.contains(key), "{key}: {err}");

@@ -447,10 +447,15 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             float(h, *amount);
             float(h, *reach);
         }
-        Op::Spots(SpotGrid { across, along, radius, jitter, alternate, checkered, hole, seed }) => {
+        Op::Spots(SpotGrid { across, along, radius, jitter, alternate, checkered, hole, seed, band }) => {
             (across, along, alternate, checkered, seed).hash(h);
             for x in [radius, jitter, hole] {
                 float(h, *x);
+            }
+            band.is_some().hash(h);
+            if let Some((u0, u1)) = band {
+                float(h, *u0);
+                float(h, *u1);
             }
         }
         Op::Levels { in_low, in_high, out_low, out_high } => {

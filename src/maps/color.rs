@@ -321,15 +321,24 @@ fn blotches(s: &Shared, layer: &PatternLayer, seed: u32, scale: f32) -> Blotches
 /// The spot grid of a `spots` layer.
 fn spot_grid(s: &Shared, layer: &PatternLayer, seed: u32) -> SpotGrid {
     let across = layer.amount.round().max(1.0) as u32;
+    // On named scale rows of each side (`Lattice::row_span_u`), as a stripe's.
+    let band = (layer.rows.len() == 2).then(|| s.lattice.row_span_u(layer.rows[0] as f32, layer.rows[1] as f32));
+    // Rows along the body as far apart as the columns across: `across` round the body, or
+    // `across` over the band's width.
+    let per_circumference = match band {
+        Some((u0, u1)) => ((across as f32 / (u1 - u0).max(1e-3)).round() as u32).clamp(1, 4096),
+        None => across,
+    };
     SpotGrid {
         across,
-        along: s.along_count(across),
+        along: s.along_count(per_circumference),
         radius: layer.size as f32,
         jitter: 0.35,
         alternate: layer.arrangement == Arrangement::Alternating,
         checkered: layer.arrangement == Arrangement::Checkered,
         hole: if layer.shape == PatternShape::Ring { 0.55 } else { 0.0 },
         seed,
+        band,
     }
 }
 
@@ -352,7 +361,12 @@ fn centre_shape(s: &Shared, layer: &PatternLayer, seed: u32) -> Option<Op> {
 /// texture, and the stretch of v (fractions) they are spread over: `amount` per tile over
 /// the tile; on the body, `count` over the trunk (neck to vent) where the preset counts
 /// them — continued down the tail at the same spacing unless the tail has bands of its own
-/// (`body.tail_bands`) — else `amount` per circumference over the whole length.
+/// (`body.tail_bands`) — else `amount` per circumference: blotches from the end of the head,
+/// where the layer's region starts (`body::layer_region`), to the tail's tip, so that the
+/// first is whole (spread over the whole length, the series was cut by the head's edge: a
+/// half blotch with a flat, unoutlined end behind the head of `python-regius`, an independent
+/// review found); rings over the whole length, a band the head's edge cuts being still a
+/// band (started at the head's end, a coral snake's first black ring met its red head).
 fn series(s: &Shared, layer: &PatternLayer) -> (u32, (f32, f32)) {
     let amount = layer.amount.round().max(1.0) as u32;
     match (s.body(), layer.series_count()) {
@@ -366,6 +380,11 @@ fn series(s: &Shared, layer: &PatternLayer) -> (u32, (f32, f32)) {
             let spacing = (plan.vent - plan.neck_end) / count as f32;
             let on_tail = ((1.0 - plan.vent) / spacing).floor() as u32;
             (count + on_tail, (plan.neck_end, plan.neck_end + (count + on_tail) as f32 * spacing))
+        }
+        (Some(plan), None) if layer.kind == PatternKind::Blotches => {
+            let behind_head = 1.0 - plan.head_end;
+            let marks = ((s.along_count(amount) as f32 * behind_head).round() as u32).max(1);
+            (marks, (plan.head_end, 1.0))
         }
         _ => (s.along_count(amount), (0.0, 1.0)),
     }

@@ -91,6 +91,11 @@ pub struct SpotGrid {
     /// Ring spots: the hole's radius as a fraction of the spot's (0 = solid spots).
     pub hole: f32,
     pub seed: u32,
+    /// Spots confined to a band of each side, the u range (u0, u1) on the side u > 0.5
+    /// (`Lattice::row_span_u`) and its mirror 1 − u: `across` columns per side within it,
+    /// an alternating grid's shifted rows one fewer, between them. None: `across` columns
+    /// round the whole body.
+    pub band: Option<(f32, f32)>,
 }
 
 /// Rasterises the spot grid into an anti-aliased coverage mask in [0, 1].
@@ -99,26 +104,44 @@ pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
     let (w, h) = (frame.width as f32, frame.full_height as f32);
     let mut pb = PathBuilder::new();
     let (across, along) = (grid.across.max(1), grid.along.max(1));
+    // (u0, u1, mirrored) of each stretch the columns spread over; each side's spots draw
+    // their own jitter (columns numbered on from the first side's).
+    let sides: &[(f32, f32, bool)] = match grid.band {
+        None => &[(0.0, 1.0, false)],
+        Some((u0, u1)) => &[(u0, u1, false), (u0, u1, true)],
+    };
     for row in 0..along as i32 {
-        for col in 0..across as i32 {
-            if grid.checkered && (row + col) % 2 == 1 {
-                continue;
-            }
-            let shift = if grid.alternate && row % 2 == 1 { 0.5 } else { 0.0 };
-            let jx = hash::signed(col, row, 0, grid.seed) * grid.jitter * 0.5;
-            let jy = hash::signed(col, row, 1, grid.seed) * grid.jitter * 0.5;
-            let jr = 1.0 + hash::signed(col, row, 2, grid.seed) * grid.jitter * 0.5;
-            let cu = (col as f32 + 0.5 + shift + jx) / across as f32;
-            let cv = (row as f32 + 0.5 + jy) / along as f32;
-            let r_px = grid.radius * jr * w;
-            // Draw every periodic copy that can touch the tile.
-            for &oy in copies_v(frame) {
-                for ox in [-1.0f32, 0.0, 1.0] {
-                    let (x, y) = ((cu + ox) * w, (cv + oy) * h);
-                    if canvas.keeps((x - r_px, x + r_px), (y - r_px, y + r_px)) {
-                        pb.push_circle(x, y, r_px.max(0.1));
-                        if grid.hole > 0.0 {
-                            push_hole(&mut pb, x, y, (r_px * grid.hole).max(0.05));
+        for (side, &(u0, u1, mirrored)) in sides.iter().enumerate() {
+            // Round the body an alternating row shifts by half a spacing and wraps; within a
+            // band its spots lie between the others', one fewer, so none leaves the band.
+            let odd = grid.alternate && row % 2 == 1;
+            let (columns, first) = match (grid.band, odd) {
+                (Some(_), true) if across > 1 => (across - 1, 1.0),
+                (Some(_), _) => (across, 0.5),
+                (None, true) => (across, 1.0),
+                (None, false) => (across, 0.5),
+            };
+            for col in 0..columns as i32 {
+                if grid.checkered && (row + col) % 2 == 1 {
+                    continue;
+                }
+                let hashed = col + side as i32 * across as i32;
+                let jx = hash::signed(hashed, row, 0, grid.seed) * grid.jitter * 0.5;
+                let jy = hash::signed(hashed, row, 1, grid.seed) * grid.jitter * 0.5;
+                let jr = 1.0 + hash::signed(hashed, row, 2, grid.seed) * grid.jitter * 0.5;
+                let u = u0 + (u1 - u0) * (col as f32 + first + jx) / across as f32;
+                let cu = if mirrored { 1.0 - u } else { u };
+                let cv = (row as f32 + 0.5 + jy) / along as f32;
+                let r_px = grid.radius * jr * w;
+                // Draw every periodic copy that can touch the tile.
+                for &oy in copies_v(frame) {
+                    for ox in [-1.0f32, 0.0, 1.0] {
+                        let (x, y) = ((cu + ox) * w, (cv + oy) * h);
+                        if canvas.keeps((x - r_px, x + r_px), (y - r_px, y + r_px)) {
+                            pb.push_circle(x, y, r_px.max(0.1));
+                            if grid.hole > 0.0 {
+                                push_hole(&mut pb, x, y, (r_px * grid.hole).max(0.05));
+                            }
                         }
                     }
                 }
@@ -754,7 +777,60 @@ mod tests {
     }
 
     fn grid(radius: f32, hole: f32) -> SpotGrid {
-        SpotGrid { across: 4, along: 4, radius, jitter: 0.0, alternate: false, checkered: false, hole, seed: 7 }
+        SpotGrid {
+            across: 4,
+            along: 4,
+            radius,
+            jitter: 0.0,
+            alternate: false,
+            checkered: false,
+            hole,
+            seed: 7,
+            band: None,
+        }
+    }
+
+    /// Spots on a band of rows lie within it and its mirror, on both sides, every row: the
+    /// alternating rows' one fewer between the others'. Negative control: the same grid
+    /// without the band covers the columns outside it.
+    #[test]
+    fn spots_on_a_band_of_rows_stay_within_it_on_both_sides() {
+        let (width, radius) = (256usize, 0.02f32);
+        let band = (0.62f32, 0.80f32);
+        let banded =
+            SpotGrid { across: 2, along: 8, alternate: true, jitter: 0.35, band: Some(band), ..grid(radius, 0.0) };
+        let mask = spots(Frame::whole(width, width), &banded);
+        let column = |x: usize| (0..width).map(|y| mask.data[y * width + x]).sum::<f32>();
+        let u = |x: usize| (x as f32 + 0.5) / width as f32;
+        // Jitter moves a centre by up to 0.175 of a spacing (0.09 here); a spot reaches its
+        // radius beyond it, the band's edge spots lie half a spacing inside it.
+        let inside = |u: f32| {
+            let reach = radius * 1.175 + 1.0 / width as f32;
+            let near = |(a, b): (f32, f32)| u > a - reach && u < b + reach;
+            near(band) || near((1.0 - band.1, 1.0 - band.0))
+        };
+        let outside: f32 = (0..width).filter(|x| !inside(u(*x))).map(column).sum();
+        assert_eq!(outside, 0.0, "spots outside the band and its mirror");
+        let side = |a: f32, b: f32| (0..width).filter(|x| u(*x) > a && u(*x) < b).map(column).sum::<f32>();
+        assert!(side(band.0, band.1) > 0.0 && side(1.0 - band.1, 1.0 - band.0) > 0.0, "both sides have spots");
+        // Every row of spots is there, the odd (shifted) rows' one spot a side included: a
+        // row's spots lie within 0.175 of its 32 px spacing plus their 6 px of its centre.
+        for row in 0..8 {
+            let y = (row * 32 + 16) as usize;
+            let on_side = |a: f32, b: f32| {
+                (y - 12..y + 12)
+                    .flat_map(|y| (0..width).map(move |x| (x, y)))
+                    .filter(|(x, _)| u(*x) > a && u(*x) < b)
+                    .map(|(x, y)| mask.data[y * width + x])
+                    .sum::<f32>()
+            };
+            let (near, far) = (on_side(0.5, 1.0), on_side(0.0, 0.5));
+            assert!(near > 0.0 && far > 0.0, "row {row}: spots {near} on one side, {far} on the other");
+        }
+        let round = spots(Frame::whole(width, width), &SpotGrid { band: None, ..banded });
+        let column = |x: usize| (0..width).map(|y| round.data[y * width + x]).sum::<f32>();
+        let outside: f32 = (0..width).filter(|x| !inside(u(*x))).map(column).sum();
+        assert!(outside > 0.0, "without the band the spots go round the body");
     }
 
     /// Spots 0.4 of the circumference across, 0.25 apart, cover the whole 64² tile (the

@@ -423,7 +423,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         let marked = &[Stripes, Rings, Spots, Blotches, Irregular][..];
         let kinds_only: [(&str, bool, &[PatternKind]); 15] = [
             ("shape", p.shape != PatternLayer::default_shape(), &[Spots, Blotches]),
-            ("rows", !p.rows.is_empty(), &[Stripes]),
+            ("rows", !p.rows.is_empty(), &[Stripes, Spots]),
             ("size", p.size != PatternLayer::default_size(), marked),
             ("edge_distortion", p.edge_distortion != PatternLayer::default_edge_distortion(), marked),
             ("center_size", p.center_size != PatternLayer::default_center_size(), &[Spots, Blotches]),
@@ -501,7 +501,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         c.range(key("phase"), p.phase, UNIT);
         c.range(key("center_size"), p.center_size, CENTER_SIZE);
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
-        if !p.rows.is_empty() && p.kind == PatternKind::Stripes {
+        if !p.rows.is_empty() && matches!(p.kind, PatternKind::Stripes | PatternKind::Spots) {
             let rows = rows_bounding(preset.scales.rows);
             let top = (rows as f64 + 1.0) / 2.0;
             let ok = p.rows.len() == 2
@@ -609,13 +609,23 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
     // file wrote is passed over where an override turned its partner off (`--set
     // body.tail_bands=0` on a preset with banded tails, `--set belly.plates=false`).
     let (body, belly) = (crate::preset::schema::Body::default(), crate::preset::schema::Belly::default());
-    let scales = crate::preset::schema::Scales::default();
+    let (scales, roughness) =
+        (crate::preset::schema::Scales::default(), crate::preset::schema::RoughnessParams::default());
     let no_bands = "shapes the bands `body.tail_bands` draws, which is 0 here; set it, or leave this out";
     let no_keels = "shapes the keels `scales.keeled` draws, which is false here; set it, or leave this out";
     for (key, set, partner, unread, message) in [
         ("scales.keel_height", s.keel_height != scales.keel_height, "scales.keeled", !s.keeled, no_keels),
         ("scales.keel_width", s.keel_width != scales.keel_width, "scales.keeled", !s.keeled, no_keels),
         ("scales.smooth_rows", s.smooth_rows != scales.smooth_rows, "scales.keeled", !s.keeled, no_keels),
+        // 0, no keel roughness, asks for nothing a smooth scale lacks (a preset that zeroes
+        // every roughness addition need not know which apply).
+        (
+            "roughness.keel",
+            preset.roughness.keel != roughness.keel && preset.roughness.keel != 0.0,
+            "scales.keeled",
+            !s.keeled,
+            no_keels,
+        ),
         (
             "body.tail_shift_start",
             b.tail_shift_start != body.tail_shift_start,

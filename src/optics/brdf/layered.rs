@@ -59,8 +59,9 @@ use super::{COS_MIN, Layers, Layers32};
 pub enum PigmentBelowAmbient {
     /// n0 / n2 below `PIGMENT_BELOW_AMBIENT_LOW_CONTRAST`: the critical angle, in degrees.
     LowContrast { critical_angle_deg: f64 },
-    /// The lossless E passes 1: from the smallest roughness (a row of the energy table)
-    /// where it passes the limit, by at most `excess`.
+    /// The lossless E passes 1: from the smallest roughness where it passes the limit (the
+    /// first row of the energy table that does, or the smoothest top asked about where that
+    /// lies above the row), by at most `excess`.
     Escapes { roughness_from: f64, excess: f64 },
 }
 
@@ -97,7 +98,12 @@ impl PigmentBelowAmbient {
                 }
             }
         }
-        found.map(|(roughness_from, excess)| PigmentBelowAmbient::Escapes { roughness_from, excess })
+        // A row below the preset's smoothest top is read only to interpolate towards it: the
+        // warning names the preset's own roughness there, not the row's.
+        found.map(|(row_from, excess)| PigmentBelowAmbient::Escapes {
+            roughness_from: row_from.max(smoothest.clamp(0.0, 1.0)),
+            excess,
+        })
     }
 }
 
