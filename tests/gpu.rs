@@ -142,8 +142,10 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
 
 /// Every film method of the shader (rgb3, spectral-N, gaussian-fit, and none: the bare
 /// interface) against its Rust f32 twin (`optics::methods`; none against the f64 film of no
-/// thickness), the film alone (`brdf_eval.wgsl`'s `film_samples`): the BRDF test above reads
-/// the film through the LUT only.
+/// thickness), the film alone (`brdf_eval.wgsl`'s `film_samples`): a bound a hundred times
+/// tighter on the film than `every_gpu_film_method_matches_its_cpu_f32_twin` (below), which
+/// reads each method through the BRDF, and the bare interface of a material without a film,
+/// which no other test compares.
 #[test]
 fn every_film_method_on_the_gpu_matches_its_rust_twin() {
     use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};

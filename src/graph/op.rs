@@ -447,9 +447,9 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             float(h, *amount);
             float(h, *reach);
         }
-        Op::Spots(SpotGrid { across, along, radius, jitter, alternate, checkered, hole, seed, band }) => {
+        Op::Spots(SpotGrid { across, along, radius, jitter, alternate, checkered, hole, seed, band, span }) => {
             (across, along, alternate, checkered, seed).hash(h);
-            for x in [radius, jitter, hole] {
+            for x in [radius, jitter, hole, &span.0, &span.1] {
                 float(h, *x);
             }
             band.is_some().hash(h);

@@ -329,9 +329,20 @@ fn spot_grid(s: &Shared, layer: &PatternLayer, seed: u32) -> SpotGrid {
         Some((u0, u1)) => ((across as f32 / (u1 - u0).max(1e-3)).round() as u32).clamp(1, 4096),
         None => across,
     };
+    // On a body atlas, rows from the end of the head, where the layer's region starts
+    // (`body::layer_region`), so that the first row's spots are whole, as a blotch series'
+    // first blotch (`series`; spread over the whole length, the head's edge cut the first
+    // row of `epicrates-cenchria`'s ocelli in half, an independent review found).
+    let (along, span) = match s.body() {
+        Some(plan) => {
+            let behind_head = 1.0 - plan.head_end;
+            (((s.along_count(per_circumference) as f32 * behind_head).round() as u32).max(1), (plan.head_end, 1.0))
+        }
+        None => (s.along_count(per_circumference), (0.0, 1.0)),
+    };
     SpotGrid {
         across,
-        along: s.along_count(per_circumference),
+        along,
         radius: layer.size as f32,
         jitter: 0.35,
         alternate: layer.arrangement == Arrangement::Alternating,
@@ -339,6 +350,7 @@ fn spot_grid(s: &Shared, layer: &PatternLayer, seed: u32) -> SpotGrid {
         hole: if layer.shape == PatternShape::Ring { 0.55 } else { 0.0 },
         seed,
         band,
+        span,
     }
 }
 

@@ -96,6 +96,9 @@ pub struct SpotGrid {
     /// an alternating grid's shifted rows one fewer, between them. None: `across` columns
     /// round the whole body.
     pub band: Option<(f32, f32)>,
+    /// The stretch of v (fractions) the `along` rows spread over: the tile, (0, 1); on a
+    /// body atlas, from the end of the head (`maps::color`'s `spot_grid`).
+    pub span: (f32, f32),
 }
 
 /// Rasterises the spot grid into an anti-aliased coverage mask in [0, 1].
@@ -131,7 +134,7 @@ pub fn spots(frame: Frame, grid: &SpotGrid) -> Image {
                 let jr = 1.0 + hash::signed(hashed, row, 2, grid.seed) * grid.jitter * 0.5;
                 let u = u0 + (u1 - u0) * (col as f32 + first + jx) / across as f32;
                 let cu = if mirrored { 1.0 - u } else { u };
-                let cv = (row as f32 + 0.5 + jy) / along as f32;
+                let cv = grid.span.0 + (grid.span.1 - grid.span.0) * (row as f32 + 0.5 + jy) / along as f32;
                 let r_px = grid.radius * jr * w;
                 // Draw every periodic copy that can touch the tile.
                 for &oy in copies_v(frame) {
@@ -787,6 +790,7 @@ mod tests {
             hole,
             seed: 7,
             band: None,
+            span: (0.0, 1.0),
         }
     }
 
@@ -868,6 +872,27 @@ mod tests {
         assert_eq!(differ, 0, "{differ} of {} pixels differ from the even-odd fill", width * width);
         // The hole is there: the centre of the first spot (8, 8) is empty, its ring full.
         assert_eq!((mask.data[8 * width + 8], mask.data[8 * width + 13]), (0.0, 1.0));
+    }
+
+    /// Spots on a body atlas whose rows start behind the head lie there, every row whole: none
+    /// above the span's start less a spot's reach, none cut by the last row. Negative
+    /// control: over the whole length the first row reaches the top rows.
+    #[test]
+    fn spots_spread_over_a_span_of_the_body_stay_within_it() {
+        let (width, height) = (64usize, 512usize);
+        let frame = Frame { width, height, full_height: height, row0: 0, wraps_v: false };
+        let spanned = SpotGrid { across: 4, along: 16, jitter: 0.35, span: (0.25, 1.0), ..grid(0.05, 0.0) };
+        let mask = spots(frame, &spanned);
+        let row_sum = |m: &Image, y: usize| (0..width).map(|x| m.data[y * width + x]).sum::<f32>();
+        // A spot reaches its radius (3.2 px, up to 1.175 times with jitter) beyond a centre
+        // that jitter moves by up to 0.175 of the 24 px spacing from its row's.
+        let first_centre = 0.25 * height as f32 + 12.0;
+        let top = (first_centre - 0.175 * 24.0 - 0.05 * 1.175 * 64.0 - 1.0) as usize;
+        let above: f32 = (0..top).map(|y| row_sum(&mask, y)).sum();
+        assert_eq!(above, 0.0, "spots above the span's start (row {top})");
+        assert_eq!(row_sum(&mask, height - 1), 0.0, "a spot cut by the last row");
+        let whole = spots(frame, &SpotGrid { span: (0.0, 1.0), along: 21, ..spanned });
+        assert!((0..top).map(|y| row_sum(&whole, y)).sum::<f32>() > 0.0, "over the whole length they start at the top");
     }
 
     /// A body atlas of `width` × `height` (its v does not wrap: snout to tail tip), and the
