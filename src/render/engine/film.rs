@@ -64,7 +64,7 @@ impl GpuFilmMethod {
 
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct FilmInfo {
+pub(crate) struct FilmInfo {
     n_cos: u32,
     n_fine: u32,
     n_coarse: u32,

@@ -218,6 +218,37 @@ pub fn program(name: &str) -> String {
 mod tests {
     use super::*;
 
+    /// The size in bytes WGSL gives struct `name` of `program` (naga's layout rules).
+    fn wgsl_struct_size(program_name: &str, name: &str) -> u32 {
+        let module = naga::front::wgsl::parse_str(&program(program_name)).expect("the program parses");
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).expect("the program's types lay out");
+        let (handle, _) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{program_name} has no struct {name}"));
+        layouter[handle].size
+    }
+
+    /// The structs Rust writes into GPU buffers have the sizes their WGSL twins read, which
+    /// are copied by hand (a field added on one side only shifted every later sample or
+    /// uniform without an error). Negative control: a struct of another size is told apart.
+    #[test]
+    fn buffers_have_the_sizes_their_shaders_read() {
+        use crate::render::engine::film::FilmInfo;
+        use crate::render::engine::scene::SceneUniform;
+        use crate::render::reference::brdf_eval::GpuSample;
+        for (program_name, name, rust) in [
+            ("brdf_eval", "Sample", std::mem::size_of::<GpuSample>()),
+            ("brdf_eval", "FilmInfo", std::mem::size_of::<FilmInfo>()),
+            ("skin", "Scene", std::mem::size_of::<SceneUniform>()),
+        ] {
+            assert_eq!(wgsl_struct_size(program_name, name) as usize, rust, "{program_name}'s {name}");
+        }
+        assert_ne!(wgsl_struct_size("brdf_eval", "Sample") as usize, std::mem::size_of::<FilmInfo>());
+    }
+
     /// Every numeric literal outside comments, with its line (a token starting with a digit,
     /// or a '.' followed by one, not inside an identifier), parsed as f64 (suffix dropped).
     fn literals(source: &str) -> Vec<(f64, String)> {
