@@ -333,13 +333,8 @@ fn spot_grid(s: &Shared, layer: &PatternLayer, seed: u32) -> SpotGrid {
     // (`body::layer_region`), so that the first row's spots are whole, as a blotch series'
     // first blotch (`series`; spread over the whole length, the head's edge cut the first
     // row of `epicrates-cenchria`'s ocelli in half, an independent review found).
-    let (along, span) = match s.body() {
-        Some(plan) => {
-            let behind_head = 1.0 - plan.head_end;
-            (((s.along_count(per_circumference) as f32 * behind_head).round() as u32).max(1), (plan.head_end, 1.0))
-        }
-        None => (s.along_count(per_circumference), (0.0, 1.0)),
-    };
+    let (along, span) =
+        s.behind_head_count(per_circumference).unwrap_or_else(|| (s.along_count(per_circumference), (0.0, 1.0)));
     SpotGrid {
         across,
         along,
@@ -393,10 +388,8 @@ fn series(s: &Shared, layer: &PatternLayer) -> (u32, (f32, f32)) {
             let on_tail = ((1.0 - plan.vent) / spacing).floor() as u32;
             (count + on_tail, (plan.neck_end, plan.neck_end + (count + on_tail) as f32 * spacing))
         }
-        (Some(plan), None) if layer.kind == PatternKind::Blotches => {
-            let behind_head = 1.0 - plan.head_end;
-            let marks = ((s.along_count(amount) as f32 * behind_head).round() as u32).max(1);
-            (marks, (plan.head_end, 1.0))
+        (_, None) if layer.kind == PatternKind::Blotches => {
+            s.behind_head_count(amount).unwrap_or_else(|| (s.along_count(amount), (0.0, 1.0)))
         }
         _ => (s.along_count(amount), (0.0, 1.0)),
     }

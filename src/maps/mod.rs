@@ -210,6 +210,15 @@ impl Shared {
         }
         ((per_circumference as f32 * self.field.length).round() as u32).max(1)
     }
+
+    /// On a body atlas, marks at `per_circumference` from the end of the head (where an
+    /// uncounted layer's region starts, `body::layer_region`) to the tail's tip: how many,
+    /// and that stretch of v. None on the tile.
+    pub fn behind_head_count(&self, per_circumference: u32) -> Option<(u32, (f32, f32))> {
+        let plan = self.body()?;
+        let marks = ((self.along_count(per_circumference) as f32 * (1.0 - plan.head_end)).round() as u32).max(1);
+        Some((marks, (plan.head_end, 1.0)))
+    }
 }
 
 /// Builds the whole graph for a preset; evaluation later picks the part it needs.
