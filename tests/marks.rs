@@ -204,3 +204,67 @@ fn a_composite_centre_lies_inside_the_mark_and_a_border_outside_it() {
         assert!(close, "a border pixel at ({x}, {y}) is more than 9 px from the mark");
     }
 }
+
+/// Snapped part-way to the scales, a mark tints the scales astride its edge part-way on both
+/// sides of that edge; the tint stops under the outline, so that the ground outside the
+/// outline shows no tint of a quarter or more (traced on the snapped mask, the outline ran
+/// through the half-tinted scales, which showed beyond it: `lampropeltis-triangulum`'s
+/// saddles; seen failing so, 584 px, and with the outline on the mark's own shape but the
+/// tint not stopped).
+#[test]
+fn a_mark_snapped_part_way_shows_no_tint_outside_its_outline() {
+    const BIG: usize = 512;
+    let text =
+        MARK.replace("#202020", "#ff0000") + "scale_aligned = 0.5\noutline_size = 0.01\noutline_color = \"#000000\"\n";
+    let img = common::colour_map(&text, BIG);
+    let ground = snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear()[1];
+    // Red over grey, then darkened by the black outline's cover o: r = ((1 − t) ground + t)(1 − o)
+    // and g = b = (1 − t) ground (1 − o), so the tint t follows from r / g whatever o is.
+    let (mut tint, mut cover) = (vec![0.0f32; BIG * BIG], vec![0.0f32; BIG * BIG]);
+    for i in 0..BIG * BIG {
+        let [r, g, _] = pixel(&img, i);
+        let excess = (r / g.max(1e-6) - 1.0) * ground;
+        tint[i] = excess / (1.0 + excess);
+        cover[i] = 1.0 - g / ((1.0 - tint[i]) * ground).max(1e-6);
+    }
+    let half_tinted = tint.iter().filter(|t| (0.3..0.7).contains(*t)).count();
+    assert!(half_tinted > 500, "only {half_tinted} px tinted part-way: the test sees no partial snapping");
+    assert!(cover.iter().filter(|o| **o > 0.5).count() > 1000, "no outline drawn");
+    // The ground: the largest region (seamless, 4-connected) of pixels the outline covers less
+    // than half.
+    let open: Vec<bool> = cover.iter().map(|o| *o < 0.5).collect();
+    let mut region = vec![usize::MAX; BIG * BIG];
+    let mut sizes = Vec::new();
+    for start in 0..BIG * BIG {
+        if !open[start] || region[start] != usize::MAX {
+            continue;
+        }
+        let id = sizes.len();
+        let (mut stack, mut size) = (vec![start], 0usize);
+        region[start] = id;
+        while let Some(i) = stack.pop() {
+            size += 1;
+            let (x, y) = (i % BIG, i / BIG);
+            for (nx, ny) in [((x + 1) % BIG, y), ((x + BIG - 1) % BIG, y), (x, (y + 1) % BIG), (x, (y + BIG - 1) % BIG)]
+            {
+                let n = ny * BIG + nx;
+                if open[n] && region[n] == usize::MAX {
+                    region[n] = id;
+                    stack.push(n);
+                }
+            }
+        }
+        sizes.push(size);
+    }
+    let outside = (0..sizes.len()).max_by_key(|&id| sizes[id]).unwrap();
+    assert!(sizes[outside] > BIG * BIG / 3, "the ground is only {} px", sizes[outside]);
+    let leaked: Vec<usize> = (0..BIG * BIG).filter(|&i| region[i] == outside && tint[i] >= 0.25).collect();
+    assert!(
+        leaked.is_empty(),
+        "{} px outside the outline are tinted a quarter or more, the first at ({}, {}) tint {:.2}",
+        leaked.len(),
+        leaked[0] % BIG,
+        leaked[0] / BIG,
+        tint[leaked[0]]
+    );
+}

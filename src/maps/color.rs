@@ -490,7 +490,27 @@ fn pattern_layer(
             let moved = g.add(name("distorted"), Op::Blend { mode: BlendMode::Add, opacity: 1.0 }, &[soft, offset]);
             mask = g.add(name("mask"), Op::Threshold { level: 0.5, softness: 0.04 }, &[moved]);
         }
+        // Snapped part-way (0 < scale_aligned < 1), a scale astride the mark's own edge is
+        // tinted part-way on both sides of it: by `scale_aligned` outside the mark where the
+        // scale's centre lies inside, by 1 − `scale_aligned` inside where it lies outside. An
+        // outline traced on that mask ran through the half-tinted scales, which showed
+        // beyond it (`lampropeltis-triangulum`'s saddles); one traced round every tinted
+        // scale merged marks that nearly touch (`crotalus-atrox`'s diamonds, tip to tip). So
+        // the outline traces the mark's own shape, and the tint is kept within the outline's
+        // outer edge: the shape blurred as the outline's is and thresholded where a blurred
+        // edge falls to 0.1, 1.28 σ outside it, under the outline (`tests/marks.rs` checks
+        // that no tint shows past it).
+        let outline_sigma = layer.outline_size as f32 * 0.5;
+        let part_way = layer.scale_aligned > 0.0 && layer.scale_aligned < 1.0;
+        let own_outline_blur = (layer.outline_size > 0.0 && part_way).then(|| {
+            let own = off_belly(g, context, layer, name("own_off_belly"), mask);
+            g.add(name("outline_blur"), Op::Blur { sigma: outline_sigma }, &[own])
+        });
         mask = snapped_and_off_belly(g, s, context, layer, &name, mask);
+        if let Some(soft) = own_outline_blur {
+            let within = g.add(name("within_outline"), Op::Threshold { level: 0.1, softness: 0.05 }, &[soft]);
+            mask = super::masked(g, name("tint_within_outline"), mask, Some(within));
+        }
         if let Some(border_color) = layer.border_color.filter(|_| layer.border_size > 0.0) {
             // A pale border round the mark and its outline: the mask dilated by blurring
             // and a low threshold (a blurred edge falls to 0.1 at 1.28 σ outside it).
@@ -511,9 +531,9 @@ fn pattern_layer(
         last_mask = Some(mask);
         if layer.outline_size > 0.0 {
             // Thesis §4.2.1.6: edge detection, blur and binarise, then colour the outline.
-            let sigma = layer.outline_size as f32 * 0.5;
-            let soft = g.add(name("outline_blur"), Op::Blur { sigma }, &[mask]);
-            let edges = g.add(name("outline_edges"), Op::Sobel { edge_sigma: sigma }, &[soft]);
+            let soft = own_outline_blur
+                .unwrap_or_else(|| g.add(name("outline_blur"), Op::Blur { sigma: outline_sigma }, &[mask]));
+            let edges = g.add(name("outline_edges"), Op::Sobel { edge_sigma: outline_sigma }, &[soft]);
             let mut outline = g.add(name("outline"), Op::Threshold { level: 0.35, softness: 0.1 }, &[edges]);
             outline = clip(g, name("outline_in_region"), outline);
             color = g.add(
@@ -557,6 +577,11 @@ fn snapped_and_off_belly(
     if layer.scale_aligned > 0.0 {
         mask = s.snap(g, name("scale_aligned"), mask, layer.scale_aligned as f32);
     }
+    off_belly(g, context, layer, name("off_belly"), mask)
+}
+
+/// `mask` kept off the belly unless the layer lies `over_belly`.
+fn off_belly(g: &mut GraphBuilder, context: &LayerContext, layer: &PatternLayer, name: String, mask: NodeId) -> NodeId {
     let outside = context.outside_belly.filter(|_| !layer.over_belly);
-    super::masked(g, name("off_belly"), mask, outside)
+    super::masked(g, name, mask, outside)
 }
