@@ -268,3 +268,49 @@ fn a_mark_snapped_part_way_shows_no_tint_outside_its_outline() {
         tint[leaked[0]]
     );
 }
+
+/// Snapped to whole scales, a scale is the pattern's or not: every pixel of a scale carries
+/// the same tint, 0 or 1, even where the pattern's soft, distorted edge crosses the scale's
+/// centre (the centre's own value there tinted whole scales part-way: `loxocemus-bicolor`'s
+/// grey "white scales"; seen failing so: 1649 px tinted part-way).
+#[test]
+fn a_mark_snapped_to_whole_scales_tints_each_scale_wholly_or_not_at_all() {
+    const BIG: usize = 512;
+    // Many small patches with ragged edges (as `loxocemus-bicolor`'s), so that many scale
+    // centres lie in an edge's soft band.
+    let text = "seed = 3\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\n\
+                scale_hue = 0\n[[pattern]]\nkind = \"irregular\"\ncolor = \"#ff0000\"\nnoise = \"cellular\"\n\
+                amount = 0.3\nsize = 0.03\nedge_distortion = 0.5\nscale_aligned = 1\n";
+    let img = common::colour_map(text, BIG);
+    let field = common::full_scale_field(text, BIG);
+    // Interleaved (`ScaleField::render`).
+    let centre = |i: usize, c: usize| field.data[i * field.channels + c];
+    let (centre_u, centre_v) = (snakeskin::ops::scales::channel::CENTRE_U, snakeskin::ops::scales::channel::CENTRE_V);
+    let ground = snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear()[1];
+    let (mut whole, mut partial) = (0usize, Vec::new());
+    // Off the belly (its band and blend lie at the texture's sides), on pixels a scale covers.
+    for y in 0..BIG {
+        for x in BIG * 3 / 10..BIG * 7 / 10 {
+            let i = y * BIG + x;
+            if centre(i, centre_u) < 0.0 {
+                continue;
+            }
+            let [r, g, _] = pixel(&img, i);
+            // Red over grey: r / g = 1 + t / ((1 − t) ground).
+            let excess = (r / g.max(1e-6) - 1.0) * ground;
+            let tint = excess / (1.0 + excess);
+            if (0.02..0.98).contains(&tint) {
+                partial.push((x, y, tint, centre(i, centre_u), centre(i, centre_v)));
+            } else if tint >= 0.98 {
+                whole += 1;
+            }
+        }
+    }
+    assert!(whole > 2000, "only {whole} px wholly tinted: the test sees no mark");
+    assert!(
+        partial.is_empty(),
+        "{} px of scales tinted part-way, the first at {:?} (tint, centre u, v)",
+        partial.len(),
+        partial.first()
+    );
+}
