@@ -538,10 +538,17 @@ fn keys_of_another_kind_are_refused_not_ignored() {
         ("noise = \"cellular\"", "key `pattern.0.noise` is read by kind \"irregular\" only"),
         ("position = \"lateral\"", "key `pattern.0.position` is read by kind \"stripes\" only"),
         ("offset = 0.1", "key `pattern.0.offset` is read by kind \"stripes\" and \"blotches\" only"),
+        ("broken = 0.3", "key `pattern.0.broken` is read by kind \"stripes\" only, not \"spots\""),
     ] {
         let err = refused("kinds.toml", &format!("{layer}{extra}\n"), &[]);
         assert!(err.contains(&format!("kinds.toml:4: {says}")), "{extra}: {err}");
     }
+    // On its own kind, `broken` keeps most of the stripe's pieces.
+    let err = refused("kinds.toml", &format!("{}broken = 0.95\n", layer.replace("spots", "stripes")), &[]);
+    assert!(
+        err.contains("kinds.toml:4: key `pattern.0.broken` must be a finite number in [0, 0.6], got 0.95"),
+        "{err}"
+    );
     // A solid tint has no size and no edges; a stripe has no centre, nor a shape.
     let marked = "\"stripes\", \"rings\", \"spots\", \"blotches\" and \"irregular\"";
     for (kind, extra, says) in [

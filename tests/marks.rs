@@ -314,3 +314,67 @@ fn a_mark_snapped_to_whole_scales_tints_each_scale_wholly_or_not_at_all() {
         partial.first()
     );
 }
+
+/// A broken stripe leaves out the share of its length that `broken` says, in gaps about
+/// every three scale lengths; unbroken, it runs the whole length (the negative control).
+/// Exactly so on a free stripe with straight edges; on average on one with ragged edges
+/// snapped to whole scales (`morelia-viridis`' setting, where gaps and pieces end on scale
+/// edges), whose pieces the distortion no longer eats (at 0.9 with edge distortion 0.6,
+/// whole stripes went: the review).
+#[test]
+fn a_broken_stripe_leaves_out_its_share_of_the_length() {
+    for (edges, tolerance) in
+        ["edge_distortion = 0\n", "edge_distortion = 0.6\nscale_aligned = 1\n"].iter().zip([0.04, 0.12])
+    {
+        for seed in 1..=4 {
+            let stripe = format!(
+                "seed = {seed}\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\n\
+                 scale_hue = 0\n[[pattern]]\nkind = \"stripes\"\ncolor = \"#ff0000\"\nposition = \"vertebral\"\n\
+                 size = 0.04\n{edges}"
+            );
+            for broken in [0.0, 0.3, 0.6] {
+                let img = colour(&format!("{stripe}broken = {broken}\n"));
+                // Along the spine (the stripe's centre line): red over grey where it is drawn.
+                let drawn: Vec<bool> = (0..SIZE)
+                    .map(|y| {
+                        let [r, g, _] = pixel(&img, y * SIZE + SIZE / 2);
+                        r > 2.0 * g
+                    })
+                    .collect();
+                let share = drawn.iter().filter(|d| **d).count() as f64 / SIZE as f64;
+                let case = format!("{edges:?} seed {seed} broken {broken}");
+                assert!((share - (1.0 - broken)).abs() < tolerance, "{case}: {share:.3} of the length drawn");
+                let gaps = (0..SIZE).filter(|&y| !drawn[y] && drawn[(y + SIZE - 1) % SIZE]).count();
+                if broken > 0.0 {
+                    // A gap about every three scale lengths: several in a tile.
+                    assert!(gaps >= 3, "{case}: {gaps} gaps in the tile's length");
+                } else {
+                    assert_eq!(gaps, 0, "{case}");
+                }
+            }
+        }
+    }
+}
+
+/// A solid tint snapped to whole scales keeps its shades: each scale takes the broad noise's
+/// value at its centre. (Read as a mark's coverage, 1 from a half up and 0 below, a tint of
+/// amount 0.5, which spans 0.3 to 0.5, vanished: the review of the snapping commit.)
+#[test]
+fn a_solid_tint_snapped_to_scales_keeps_its_shades() {
+    let text = "seed = 3\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\n\
+                scale_hue = 0\n[[pattern]]\nkind = \"solid\"\ncolor = \"#ff0000\"\namount = 0.5\nscale_aligned = 1\n";
+    let img = colour(text);
+    let ground = snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear()[1];
+    let tints: Vec<f32> = (0..SIZE)
+        .flat_map(|y| (SIZE * 3 / 10..SIZE * 7 / 10).map(move |x| y * SIZE + x))
+        .map(|i| {
+            let [r, g, _] = pixel(&img, i);
+            let excess = (r / g.max(1e-6) - 1.0) * ground;
+            excess / (1.0 + excess)
+        })
+        .collect();
+    let mean = tints.iter().sum::<f32>() / tints.len() as f32;
+    let (low, high) = tints.iter().fold((f32::MAX, f32::MIN), |(l, h), t| (l.min(*t), h.max(*t)));
+    assert!((0.25..0.5).contains(&mean), "mean tint {mean}");
+    assert!(high - low > 0.05, "tints from {low} to {high}: the shades are gone");
+}

@@ -35,7 +35,7 @@ pub enum Op {
     /// its scale's centre, by `amount` (colour that follows scale boundaries).
     /// `reach`: how far (texture widths) a pixel may lie from its scale's centre along the
     /// body, for the margin of a strip (`row_reach`).
-    SnapToScales { amount: f32, centre_u: usize, centre_v: usize, reach: f32 },
+    SnapToScales { amount: f32, centre_u: usize, centre_v: usize, reach: f32, whole: bool },
     /// A jittered grid of round spots (tiny-skia coverage). No inputs.
     Spots(SpotGrid),
     /// Linear remap of the input range to the output range.
@@ -247,8 +247,8 @@ impl Op {
             }
             Op::Blotches(b) => shapes::blotches(frame, b),
             Op::BellyMarks(marks) => shapes::belly_marks(frame, marks),
-            Op::SnapToScales { amount, centre_u, centre_v, .. } => {
-                filters::snap_to_scales(input(), rest[0], *amount, *centre_u, *centre_v, frame)
+            Op::SnapToScales { amount, centre_u, centre_v, whole, .. } => {
+                filters::snap_to_scales(input(), rest[0], *amount, *centre_u, *centre_v, *whole, frame)
             }
             Op::Spots(grid) => shapes::spots(frame, grid),
             Op::Blur { sigma } => filters::blur(first.expect("operation has an input"), *sigma, frame.wraps_v),
@@ -442,8 +442,8 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
                 float(h, *x);
             }
         }
-        Op::SnapToScales { amount, centre_u, centre_v, reach } => {
-            (centre_u, centre_v).hash(h);
+        Op::SnapToScales { amount, centre_u, centre_v, reach, whole } => {
+            (centre_u, centre_v, whole).hash(h);
             float(h, *amount);
             float(h, *reach);
         }

@@ -79,7 +79,7 @@ pub(super) fn marks(
         }
         let mut mask = g.add("body.tail_bands", Op::Along(AlongProfile { knots }), &[]);
         if snap > 0.0 {
-            mask = s.snap(g, "body.tail_bands_aligned".into(), mask, snap as f32);
+            mask = s.snap(g, "body.tail_bands_aligned".into(), mask, snap as f32, true);
         }
         mask = super::masked(g, "body.tail_bands_off_belly".into(), mask, outside_belly);
         color = g.add(

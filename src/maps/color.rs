@@ -288,6 +288,36 @@ fn shapes(
     }
 }
 
+/// Scale lengths along the body from one gap of a broken stripe to the next, on average (a
+/// visual choice: no source found gives how often a broken stripe breaks).
+const STRIPE_GAP_EVERY_SCALES: f32 = 3.0;
+
+/// A stripe layer's mask with `broken` of its length left out: one gap about every
+/// `STRIPE_GAP_EVERY_SCALES` scale lengths, each `broken` of the spacing long, the same gaps
+/// in every stripe of the layer (both sides of a pair of stripes break together).
+fn broken_stripes(
+    g: &mut GraphBuilder,
+    s: &Shared,
+    layer: &PatternLayer,
+    name: &dyn Fn(&str) -> String,
+    seed: u32,
+    stripes: NodeId,
+) -> NodeId {
+    let count = ((s.lattice.rows_v as f32 / STRIPE_GAP_EVERY_SCALES).round() as i32).max(1);
+    // Moved by up to a quarter of the stretch between gaps, two neighbours never overlap
+    // (they stay 1 − (1 − broken) / 2 of a spacing apart, more than a gap's length), so
+    // exactly `broken` of the length is left out.
+    let jitter = 0.25 * (1.0 - layer.broken as f32);
+    let centres = (0..count)
+        .map(|k| (k as f32 + 0.5 + jitter * crate::ops::hash::signed(k, 0, 0, seed)) / count as f32)
+        .collect();
+    let half_width = 0.5 * layer.broken as f32 / count as f32;
+    let op = Op::Bands { axis: Axis::V, centres, half_width, softness: 0.002 / s.field.length };
+    let gaps = g.add(name("gaps"), op, &[]);
+    let kept = levels(g, &name("between_gaps"), gaps, 1.0, 0.0);
+    g.add(name("broken"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[stripes, kept])
+}
+
 /// The blotch series of a `blotches` layer, every blotch scaled by `scale` (a composite
 /// mark's centre is the same series drawn smaller).
 fn blotches(s: &Shared, layer: &PatternLayer, seed: u32, scale: f32) -> Blotches {
@@ -490,6 +520,11 @@ fn pattern_layer(
             let moved = g.add(name("distorted"), Op::Blend { mode: BlendMode::Add, opacity: 1.0 }, &[soft, offset]);
             mask = g.add(name("mask"), Op::Threshold { level: 0.5, softness: 0.04 }, &[moved]);
         }
+        if layer.kind == PatternKind::Stripes && layer.broken > 0.0 {
+            // After the edges' distortion, which ate short pieces whole, and before the
+            // snapping, so that the gaps end on scale edges too.
+            mask = broken_stripes(g, s, layer, &name, seed, mask);
+        }
         // Snapped part-way (0 < scale_aligned < 1), a scale astride the mark's own edge is
         // tinted part-way on both sides of it: by `scale_aligned` outside the mark where the
         // scale's centre lies inside, by 1 − `scale_aligned` inside where it lies outside. An
@@ -575,7 +610,9 @@ fn snapped_and_off_belly(
     mut mask: NodeId,
 ) -> NodeId {
     if layer.scale_aligned > 0.0 {
-        mask = s.snap(g, name("scale_aligned"), mask, layer.scale_aligned as f32);
+        // A solid tint's mask is broad noise, not a coverage: each scale takes its value.
+        let whole = layer.kind != PatternKind::Solid;
+        mask = s.snap(g, name("scale_aligned"), mask, layer.scale_aligned as f32, whole);
     }
     off_belly(g, context, layer, name("off_belly"), mask)
 }

@@ -191,10 +191,12 @@ impl Shared {
     }
 
     /// Moves a mask to its value at each pixel's scale centre, by `amount`
-    /// (`Op::SnapToScales`: colour that follows scale boundaries).
-    pub fn snap(&self, g: &mut GraphBuilder, name: String, mask: NodeId, amount: f32) -> NodeId {
+    /// (`Op::SnapToScales`: colour that follows scale boundaries); `whole` for a coverage
+    /// mask, whose scales are the pattern's or not (`filters::snap_to_scales`).
+    pub fn snap(&self, g: &mut GraphBuilder, name: String, mask: NodeId, amount: f32, whole: bool) -> NodeId {
         let op = Op::SnapToScales {
             amount,
+            whole,
             centre_u: self.channel_index(channel::CENTRE_U),
             centre_v: self.channel_index(channel::CENTRE_V),
             reach: self.snap_reach(),

@@ -534,13 +534,14 @@ fn gaussian_blur(input: &Image, sigma_px: f32, wraps_v: bool) -> Image {
     out
 }
 
-/// Moves a mask towards whether its scale is the pattern's: 1 where the mask is half or more
-/// at the pixel's scale centre, 0 where less (channels `centre_u`, `centre_v` of the planar
-/// scale field; negative where no scale covers the pixel, which keeps the mask's own value).
-/// A scale is the pattern's or not: the centre's value itself, read where an edge's
-/// antialiasing or a distorted edge's soft band crossed the centre, tinted whole scales
-/// part-way (`loxocemus-bicolor`'s grey "white scales", a half-tinted scale of
-/// `corallus-caninus` showing past its outline).
+/// Moves a mask towards its value at each pixel's scale centre (channels `centre_u`,
+/// `centre_v` of the planar scale field; negative where no scale covers the pixel, which
+/// keeps the mask's own value). With `whole` (a coverage mask: a pattern's marks) a scale
+/// is the pattern's or not, 1 where the mask is half or more at its centre and 0 where less:
+/// the centre's value itself, read where an edge's antialiasing or a distorted edge's soft
+/// band crossed the centre, tinted whole scales part-way (`loxocemus-bicolor`'s grey "white
+/// scales", a half-tinted scale of `corallus-caninus` showing past its outline). Without it
+/// (a solid tint's broad noise) each scale takes the value at its centre.
 /// In a strip (`frame`), a centre outside the strip's rows reads its nearest row: the strip's
 /// margin (`Op::row_reach`) keeps that out of the rows that are kept.
 pub fn snap_to_scales(
@@ -549,6 +550,7 @@ pub fn snap_to_scales(
     amount: f32,
     centre_u: usize,
     centre_v: usize,
+    whole: bool,
     frame: Frame,
 ) -> Image {
     let full = frame.full_height;
@@ -590,7 +592,11 @@ pub fn snap_to_scales(
                     let relative = if frame.wraps_v && relative < 0 { relative + full as isize } else { relative };
                     relative.clamp(0, frame.height as isize - 1)
                 };
-                let centre = if at(cx, cy) >= 0.5 { 1.0 } else { 0.0 };
+                let centre = match at(cx, cy) {
+                    v if !whole => v,
+                    v if v >= 0.5 => 1.0,
+                    _ => 0.0,
+                };
                 own + (centre - own) * amount
             };
         }

@@ -397,6 +397,10 @@ pub struct PatternLayer {
     /// boundaries); 0 leaves it free, 1 colours each scale by the pattern at its centre.
     #[serde(default)]
     pub scale_aligned: f64,
+    /// Stripes: the fraction of each stripe's length left out, in gaps along the body (0:
+    /// unbroken; a green tree python's "broken vertebral stripe").
+    #[serde(default)]
+    pub broken: f64,
     /// Stripes: the dorsal scale rows the stripe covers, `[first, last]`, counted from the
     /// lowest row (1, next to the ventral plates) to the vertebral row; fractions reach into
     /// a row (9.5 = from the middle of row 9). Mirrored on both sides; overrides `offset`,

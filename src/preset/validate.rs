@@ -38,6 +38,11 @@ pub mod ranges {
     pub const BLOTCHES_PER_TILE: (f64, f64) = (1.0, 32.0);
     pub const RING_WIDTH: (f64, f64) = (0.0, 1.0);
     pub const BLOTCH_LENGTH: (f64, f64) = (0.05, 1.0);
+    /// A stripe's share left out: at most 0.6, so that the pieces kept are 1.2 scale lengths
+    /// long on average (a gap every three: `maps::color`), and a stripe snapped to scales
+    /// keeps most of them (a piece with no scale centre in it is not drawn; at 0.9 whole
+    /// stripes went).
+    pub const STRIPE_BROKEN: (f64, f64) = (0.0, 0.6);
     pub const PATTERN_SIZE: (f64, f64) = (0.001, 0.5);
     /// A spot's radius in spacings between spots around the body (`size` × the rounded
     /// `amount`). From about 1.2 the jittered round spots cover every point; ring spots still
@@ -421,7 +426,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         let k = p.kind;
         use PatternKind::{Blotches, Irregular, Rings, Spots, Stripes};
         let marked = &[Stripes, Rings, Spots, Blotches, Irregular][..];
-        let kinds_only: [(&str, bool, &[PatternKind]); 15] = [
+        let kinds_only: [(&str, bool, &[PatternKind]); 16] = [
             ("shape", p.shape != PatternLayer::default_shape(), &[Spots, Blotches]),
             ("rows", !p.rows.is_empty(), &[Stripes, Spots]),
             ("size", p.size != PatternLayer::default_size(), marked),
@@ -437,6 +442,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
             ("length", p.length != PatternLayer::default_length(), &[Blotches]),
             ("center_color", p.center_color.is_some(), &[Spots, Blotches]),
             ("widen_to_tail", p.widen_to_tail != PatternLayer::default_widen_to_tail(), &[Blotches]),
+            ("broken", p.broken != 0.0, &[Stripes]),
         ];
         for (field, set, kinds) in kinds_only {
             if set && !kinds.contains(&k) && !from_file_for_old_kind(i, field) {
@@ -498,6 +504,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
             c.problems.push(Problem { key: key("widths"), message: "must sum to at most 1 (one repeat)".into() });
         }
         c.range(key("scale_aligned"), p.scale_aligned, UNIT);
+        c.range(key("broken"), p.broken, STRIPE_BROKEN);
         c.range(key("phase"), p.phase, UNIT);
         c.range(key("center_size"), p.center_size, CENTER_SIZE);
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
