@@ -875,23 +875,10 @@ mod tests {
         let (width, height) = (128, 1024);
         for frame in body_and_tile(width, height) {
             for seed in 1..9 {
-                let b = Blotches {
-                    shape: BlotchShape::Diamond,
-                    count: 12,
-                    half_width: 0.05,
-                    length: 1.0,
-                    jitter: 0.5,
-                    offset: 0.0,
-                    staggered: false,
-                    phase: 0.0,
-                    scale: 1.0,
-                    span: (0.0, 1.0),
-                    widen: 1.0,
-                    seed,
-                };
-                let mask = blotches(frame, &b);
-                // Along the spine (the diamonds' centre line is column 64's left edge), a
-                // diamond's coverage falls under a quarter within about two rows of its tips.
+                let mask = blotches(frame, &Blotches { seed, ..series_of(BlotchShape::Diamond) });
+                // Along the spine (the series' centre line is column 64's left edge; a
+                // diamond's own moves sideways by up to 3.2 px), a diamond's coverage falls
+                // under a quarter some rows before its tips.
                 let inside: Vec<bool> = (0..height).map(|y| mask.data[y * width + width / 2] > 0.25).collect();
                 let starts = (0..height).filter(|&y| inside[y] && !inside[(y + height - 1) % height]).count();
                 assert_eq!(starts, 12, "{frame:?} seed {seed}: {starts} runs of marks along the spine for 12 marks");
