@@ -144,12 +144,35 @@ fn a_zigzag_is_one_band_from_head_to_tail() {
     assert!(swing > 0.06 * SIZE as f32, "the zigzag swings only {swing} px");
 }
 
-const MARK: &str = "seed = 3\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\nscale_hue = 0\n\
-                    [[pattern]]\nkind = \"blotches\"\ncolor = \"#202020\"\namount = 3\nsize = 0.12\nlength = 0.7\n\
-                    edge_distortion = 0\n";
+/// A grey ground with no variation of its own, so that a pattern's tint reads exactly.
+macro_rules! grey_ground {
+    () => {
+        "[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\nscale_hue = 0\n"
+    };
+}
+
+const MARK: &str = concat!(
+    "seed = 3\n",
+    grey_ground!(),
+    "[[pattern]]\nkind = \"blotches\"\ncolor = \"#202020\"\namount = 3\nsize = 0.12\nlength = 0.7\nedge_distortion = 0\n"
+);
 
 fn pixel(img: &Image, i: usize) -> [f32; 3] {
     [img.data[i * 3], img.data[i * 3 + 1], img.data[i * 3 + 2]]
+}
+
+/// The `grey_ground!` ground's linear grey.
+fn ground() -> f32 {
+    snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear()[1]
+}
+
+/// How far pixel `i` is tinted by pure red over the grey ground, whatever black darkened it
+/// by a cover o: r = ((1 − t) ground + t)(1 − o) and g = (1 − t) ground (1 − o), so
+/// r / g = 1 + t / ((1 − t) ground).
+fn red_tint(img: &Image, i: usize) -> f32 {
+    let [r, g, _] = pixel(img, i);
+    let excess = (r / g.max(1e-6) - 1.0) * ground();
+    excess / (1.0 + excess)
 }
 
 #[test]
@@ -217,15 +240,11 @@ fn a_mark_snapped_part_way_shows_no_tint_outside_its_outline() {
     let text =
         MARK.replace("#202020", "#ff0000") + "scale_aligned = 0.5\noutline_size = 0.01\noutline_color = \"#000000\"\n";
     let img = common::colour_map(&text, BIG);
-    let ground = snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear()[1];
-    // Red over grey, then darkened by the black outline's cover o: r = ((1 − t) ground + t)(1 − o)
-    // and g = b = (1 − t) ground (1 − o), so the tint t follows from r / g whatever o is.
+    // The black outline's cover o from g = (1 − t) ground (1 − o).
     let (mut tint, mut cover) = (vec![0.0f32; BIG * BIG], vec![0.0f32; BIG * BIG]);
     for i in 0..BIG * BIG {
-        let [r, g, _] = pixel(&img, i);
-        let excess = (r / g.max(1e-6) - 1.0) * ground;
-        tint[i] = excess / (1.0 + excess);
-        cover[i] = 1.0 - g / ((1.0 - tint[i]) * ground).max(1e-6);
+        tint[i] = red_tint(&img, i);
+        cover[i] = 1.0 - pixel(&img, i)[1] / ((1.0 - tint[i]) * ground()).max(1e-6);
     }
     let half_tinted = tint.iter().filter(|t| (0.3..0.7).contains(*t)).count();
     assert!(half_tinted > 500, "only {half_tinted} px tinted part-way: the test sees no partial snapping");
@@ -278,15 +297,17 @@ fn a_mark_snapped_to_whole_scales_tints_each_scale_wholly_or_not_at_all() {
     const BIG: usize = 512;
     // Many small patches with ragged edges (as `loxocemus-bicolor`'s), so that many scale
     // centres lie in an edge's soft band.
-    let text = "seed = 3\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\n\
-                scale_hue = 0\n[[pattern]]\nkind = \"irregular\"\ncolor = \"#ff0000\"\nnoise = \"cellular\"\n\
-                amount = 0.3\nsize = 0.03\nedge_distortion = 0.5\nscale_aligned = 1\n";
+    let text = concat!(
+        "seed = 3\n",
+        grey_ground!(),
+        "[[pattern]]\nkind = \"irregular\"\ncolor = \"#ff0000\"\nnoise = \"cellular\"\namount = 0.3\nsize = 0.03\n\
+         edge_distortion = 0.5\nscale_aligned = 1\n"
+    );
     let img = common::colour_map(text, BIG);
     let field = common::full_scale_field(text, BIG);
     // Interleaved (`ScaleField::render`).
     let centre = |i: usize, c: usize| field.data[i * field.channels + c];
     let (centre_u, centre_v) = (snakeskin::ops::scales::channel::CENTRE_U, snakeskin::ops::scales::channel::CENTRE_V);
-    let ground = snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear()[1];
     let (mut whole, mut partial) = (0usize, Vec::new());
     // Off the belly (its band and blend lie at the texture's sides), on pixels a scale covers.
     for y in 0..BIG {
@@ -295,10 +316,7 @@ fn a_mark_snapped_to_whole_scales_tints_each_scale_wholly_or_not_at_all() {
             if centre(i, centre_u) < 0.0 {
                 continue;
             }
-            let [r, g, _] = pixel(&img, i);
-            // Red over grey: r / g = 1 + t / ((1 − t) ground).
-            let excess = (r / g.max(1e-6) - 1.0) * ground;
-            let tint = excess / (1.0 + excess);
+            let tint = red_tint(&img, i);
             if (0.02..0.98).contains(&tint) {
                 partial.push((x, y, tint, centre(i, centre_u), centre(i, centre_v)));
             } else if tint >= 0.98 {
@@ -328,9 +346,9 @@ fn a_broken_stripe_leaves_out_its_share_of_the_length() {
     {
         for seed in 1..=4 {
             let stripe = format!(
-                "seed = {seed}\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\n\
-                 scale_hue = 0\n[[pattern]]\nkind = \"stripes\"\ncolor = \"#ff0000\"\nposition = \"vertebral\"\n\
-                 size = 0.04\n{edges}"
+                "seed = {seed}\n{}[[pattern]]\nkind = \"stripes\"\ncolor = \"#ff0000\"\nposition = \"vertebral\"\n\
+                 size = 0.04\n{edges}",
+                grey_ground!()
             );
             for broken in [0.0, 0.3, 0.6] {
                 let img = colour(&format!("{stripe}broken = {broken}\n"));
@@ -361,17 +379,15 @@ fn a_broken_stripe_leaves_out_its_share_of_the_length() {
 /// amount 0.5, which spans 0.3 to 0.5, vanished: the review of the snapping commit.)
 #[test]
 fn a_solid_tint_snapped_to_scales_keeps_its_shades() {
-    let text = "seed = 3\n[color]\nbase = \"#808080\"\nvariation = 0\nbetween_scales = 0\nscale_tone = 0\n\
-                scale_hue = 0\n[[pattern]]\nkind = \"solid\"\ncolor = \"#ff0000\"\namount = 0.5\nscale_aligned = 1\n";
+    let text = concat!(
+        "seed = 3\n",
+        grey_ground!(),
+        "[[pattern]]\nkind = \"solid\"\ncolor = \"#ff0000\"\namount = 0.5\nscale_aligned = 1\n"
+    );
     let img = colour(text);
-    let ground = snakeskin::preset::schema::Srgb8([0x80; 3]).to_linear()[1];
     let tints: Vec<f32> = (0..SIZE)
         .flat_map(|y| (SIZE * 3 / 10..SIZE * 7 / 10).map(move |x| y * SIZE + x))
-        .map(|i| {
-            let [r, g, _] = pixel(&img, i);
-            let excess = (r / g.max(1e-6) - 1.0) * ground;
-            excess / (1.0 + excess)
-        })
+        .map(|i| red_tint(&img, i))
         .collect();
     let mean = tints.iter().sum::<f32>() / tints.len() as f32;
     let (low, high) = tints.iter().fold((f32::MAX, f32::MIN), |(l, h), t| (l.min(*t), h.max(*t)));
