@@ -110,3 +110,41 @@ fn the_same_ring_at_its_written_width_breaks_when_scales_are_snapped_by_their_ce
     });
     assert!(broken, "the control ring survived: the test could not see a break");
 }
+
+/// Yellow pixels of each column of the belly band (within 1/16 of the circumference of its
+/// midline, u = 0; the band is 0.22 wide) in the tile's first half and its second: the yellow
+/// ring before the red band and the one after it (the black centred near v = 0, the red near
+/// v = 0.5).
+fn belly_yellow_either_side(class: &[u8], size: usize) -> Vec<(usize, usize)> {
+    let edge = size / 16;
+    (0..edge)
+        .chain(size - edge..size)
+        .map(|x| {
+            let yellow = |rows: std::ops::Range<usize>| rows.filter(|y| class[y * size + x] == 1).count();
+            (yellow(0..size / 2), yellow(size / 2..size))
+        })
+        .collect()
+}
+
+#[test]
+fn the_yellow_rings_either_side_of_a_red_band_cover_as_many_plates() {
+    // The sequence is symmetric about the red band's centre, so each yellow ring must cover
+    // as many ventral plates as the other; the two were one plate and two on the coral
+    // snake's tile when the sequence's centre fell a quarter row off the lattice's mirror
+    // lines (each ring's pixels per column differ by less than a plate; 2 px of rounding).
+    for seed in [1, 2, 3] {
+        for size in [128, 256, 512] {
+            let class = classes(&preset(1.0, seed), size);
+            for (i, (first, second)) in belly_yellow_either_side(&class, size).into_iter().enumerate() {
+                assert!(
+                    first > 0 && second > 0,
+                    "seed {seed}, size {size}, belly column {i}: a yellow ring is missing"
+                );
+                assert!(
+                    first.abs_diff(second) <= 2,
+                    "seed {seed}, size {size}, belly column {i}: the yellow rings cover {first} and {second} px"
+                );
+            }
+        }
+    }
+}

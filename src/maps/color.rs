@@ -255,6 +255,17 @@ fn shapes(
             // ring rather than on the boundary between two (a counted series starts at the
             // start of the trunk).
             let mut start = if span == (0.0, 1.0) { -0.5 * widths.first().copied().unwrap_or(0.0) } else { 0.0 };
+            if fully_snapped(layer) && s.body().is_none() {
+                // In whole scales on the tile, the first colour centred on a row of scales
+                // (`Lattice::row_centre_v`, a mirror line of the lattice), so that a sequence
+                // symmetric about its colours' centres covers as many scales on both sides
+                // (about the centre half a repeat on too, where a repeat is a whole number of
+                // rows): a coral snake's two yellow rings, the first colour centred at v = 0 (a
+                // quarter row from a mirror line), covered one plate and two. (The other
+                // mirror lines, between two rows, gave two plates each where 1.2 rows were asked.)
+                // Not on a body atlas, whose plates are counted along the body, off the lattice.
+                start += s.lattice.row_centre_v(0) * repeats;
+            }
             let mut out = Vec::new();
             for (k, (color, width)) in colors.into_iter().zip(widths).enumerate() {
                 let centres = (0..repeats as usize)

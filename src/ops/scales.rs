@@ -123,6 +123,15 @@ pub struct Lattice {
 }
 
 impl Lattice {
+    /// The v of the centre of row r of column 0 (the tile's ventral plate r), unjittered:
+    /// v · rows_v = r + 0.5 + `ROW_PHASE`. The tile's lattice is mirror-symmetric about it
+    /// (and about every v half a row from it): column c's centres lie at v · rows_v =
+    /// r + 0.5 + ROW_PHASE + c · stagger / cols (`ScaleField::centre`), offsets whose set
+    /// (mod 1) negation maps onto itself. The scales' jitter is not mirrored.
+    pub fn row_centre_v(&self, r: i32) -> f32 {
+        (r as f32 + 0.5 + ROW_PHASE) / self.rows_v as f32
+    }
+
     /// The ventral band's width, fraction of the circumference (whole columns).
     pub fn belly_width(&self) -> f32 {
         2.0 * self.bounds[(self.belly_cols / 2) as usize]
@@ -867,7 +876,7 @@ impl ScaleField {
         let Some(body) = &self.body else {
             let rows = PlateRows {
                 plate: &|_| Some((lattice.aspect, false)),
-                centre_v: &|r| ((r as f32 + 0.5 + ROW_PHASE) / lattice.rows_v as f32).rem_euclid(1.0),
+                centre_v: &|r| lattice.row_centre_v(r).rem_euclid(1.0),
                 identity: &|r| r.rem_euclid(lattice.rows_v),
             };
             return Some(self.plate_row_at(v * lattice.rows_v as f32 - ROW_PHASE, &rows));
