@@ -101,6 +101,7 @@ pub(super) fn marks(
             HeadMarkKind::X => HeadMarkShape::X,
             HeadMarkKind::Spearhead => HeadMarkShape::Spearhead,
             HeadMarkKind::PostocularStripe => HeadMarkShape::PostocularStripe,
+            HeadMarkKind::PostocularSpot => HeadMarkShape::PostocularSpot,
             HeadMarkKind::Collar => HeadMarkShape::Collar,
             HeadMarkKind::Lips => HeadMarkShape::Lips,
         };

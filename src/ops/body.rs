@@ -190,6 +190,7 @@ pub enum HeadMarkShape {
     X,
     Spearhead,
     PostocularStripe,
+    PostocularSpot,
     Collar,
     Lips,
 }
@@ -204,6 +205,11 @@ pub struct HeadMark {
 /// Half-width of the head's sides down to the lips, fraction of the circumference from the
 /// spine: the cap covers this much, the lips lie just below it.
 const HEAD_SIDE_HALF_U: f32 = 0.32;
+
+/// The postocular stripe, from behind the eye (at the supraocular's outer edge, `SHIELDS`)
+/// to the angle of the jaw, in head-local units (x in shield half-widths across,
+/// s in head lengths along); a postocular spot lies on it near the eye.
+const POSTOCULAR: ((f32, f32), (f32, f32)) = ((0.62, 0.45), (1.45, 1.0));
 
 /// Distance from p to the segment a–b.
 fn segment_distance(p: (f32, f32), a: (f32, f32), b: (f32, f32)) -> f32 {
@@ -258,7 +264,14 @@ impl HeadMark {
                 let t = ((s - apex) / (base - apex)).clamp(0.0, 1.0);
                 (half * t - du).min(s - apex).min(base - s)
             }
-            HeadMarkShape::PostocularStripe => arm((0.62, 0.45), (1.45, 1.0), 0.10 * k),
+            HeadMarkShape::PostocularStripe => arm(POSTOCULAR.0, POSTOCULAR.1, 0.10 * k),
+            // A disc 0.3 shield half-widths across at size 1 (the stripe is 0.2 wide), a fifth
+            // of the way down the stripe: just behind the eye.
+            HeadMarkShape::PostocularSpot => {
+                let (a, b) = POSTOCULAR;
+                let centre = (a.0 + 0.2 * (b.0 - a.0), a.1 + 0.2 * (b.1 - a.1));
+                arm(centre, centre, 0.15 * k)
+            }
             HeadMarkShape::Collar => {
                 let neck = (p.neck_end - p.head_end).max(0.005) * p.length;
                 band(head, head + 0.7 * k * neck, s).min(0.42 - du)
@@ -415,6 +428,7 @@ mod tests {
             HeadMarkShape::X,
             HeadMarkShape::Spearhead,
             HeadMarkShape::PostocularStripe,
+            HeadMarkShape::PostocularSpot,
             HeadMarkShape::Collar,
             HeadMarkShape::Lips,
         ];
@@ -436,6 +450,48 @@ mod tests {
         };
         assert_eq!(reached(1.0), 0, "a shape reaches past reach_v");
         assert!(reached(0.9) > 0, "the control: a tenth less is passed");
+    }
+
+    /// Pixels of a head mark on `plan()`'s head, 512 across: each side's count, and each
+    /// side's extent across (u) and along (v · length), in circumferences.
+    fn mark_sides(shape: HeadMarkShape) -> [(usize, f32, f32); 2] {
+        let mark = HeadMark { shape, size: 1.0, plan: plan() };
+        let n = 512;
+        let rows = (mark.reach_v() * n as f32 * mark.plan.length).ceil() as usize;
+        [false, true].map(|right| {
+            let (mut count, mut u_range, mut v_range) = (0, (f32::MAX, f32::MIN), (f32::MAX, f32::MIN));
+            for y in 0..rows {
+                let v = (y as f32 + 0.5) / (n as f32 * mark.plan.length);
+                for x in 0..n {
+                    let u = (x as f32 + 0.5) / n as f32;
+                    if (u > 0.5) == right && mark.inside(u, v) > 0.0 {
+                        count += 1;
+                        u_range = (u_range.0.min(u), u_range.1.max(u));
+                        v_range = (v_range.0.min(v), v_range.1.max(v));
+                    }
+                }
+            }
+            (count, u_range.1 - u_range.0, (v_range.1 - v_range.0) * mark.plan.length)
+        })
+    }
+
+    #[test]
+    fn a_postocular_spot_is_round_and_sits_on_the_stripe_on_each_side() {
+        let spot = mark_sides(HeadMarkShape::PostocularSpot);
+        let [(left, across, along), (right, ..)] = spot;
+        assert!(left > 20 && left == right, "one spot a side, mirrored: {left} and {right} px");
+        assert!((across / along - 1.0).abs() < 0.1, "round: {across} across, {along} along");
+        // On the stripe's line and much smaller than it.
+        let stripe = HeadMark { shape: HeadMarkShape::PostocularStripe, size: 1.0, plan: plan() };
+        let spot_mark = HeadMark { shape: HeadMarkShape::PostocularSpot, size: 1.0, plan: plan() };
+        let (ux, head) = plan().head_units();
+        let (a, b) = POSTOCULAR;
+        let centre = (0.5 + (a.0 + 0.2 * (b.0 - a.0)) * ux, (a.1 + 0.2 * (b.1 - a.1)) * head / plan().length);
+        assert!(spot_mark.inside(centre.0, centre.1) > 0.0 && stripe.inside(centre.0, centre.1) > 0.0);
+        let [(stripe_px, stripe_across, stripe_along), _] = mark_sides(HeadMarkShape::PostocularStripe);
+        assert!(left * 3 < stripe_px, "a spot, not a stripe: {left} px against the stripe's {stripe_px}");
+        // The control: the stripe itself is not round.
+        assert!((stripe_across / stripe_along - 1.0).abs() > 0.1, "{stripe_across} across, {stripe_along} along");
     }
 
     #[test]

@@ -73,7 +73,7 @@ named_enum!(NoiseChoice { Perlin, Cellular });
 named_enum!(BellyPattern { None, Checkered, Spots, HalfMoons, MedianStripe });
 named_enum!(IridescenceGradient { Vertical, Radial });
 named_enum!(HeadScales { Shields, Small });
-named_enum!(HeadMarkKind { Cap, Snout, V, X, Spearhead, PostocularStripe, Collar, Lips });
+named_enum!(HeadMarkKind { Cap, Snout, V, X, Spearhead, PostocularStripe, PostocularSpot, Collar, Lips });
 
 /// A colour written as `"#rrggbb"` (sRGB, 8 bits per channel).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -720,6 +720,8 @@ pub enum HeadMarkKind {
     Spearhead,
     /// A stripe from behind the eye to the angle of the jaw, each side.
     PostocularStripe,
+    /// A round spot just behind the eye, each side (where the stripe would start).
+    PostocularSpot,
     /// A band round the neck just behind the head.
     Collar,
     /// The lip scales along both jaws.
