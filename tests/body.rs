@@ -508,3 +508,55 @@ fn a_count_the_layer_does_not_read_changes_nothing() {
         serde_json::from_slice(&std::fs::read(dir.path().join("crotalus-atrox.material.json")).unwrap()).unwrap();
     assert!(manifest["counts"].get("dorsal_marks").is_none(), "{}", manifest["counts"]);
 }
+
+/// Pixels of `mark`'s colour (nearer it than every other colour of the preset) in each of
+/// `rows`, on the back (the middle half of the width: the belly band is centred on u = 0).
+fn back_pixels_per_row(
+    colour: &Image,
+    rows: std::ops::Range<usize>,
+    mark: [f32; 3],
+    others: &[[f32; 3]],
+) -> Vec<usize> {
+    let w = colour.width;
+    rows.map(|y| {
+        (w / 4..3 * w / 4)
+            .filter(|x| {
+                let px = &colour.data[(y * w + x) * 3..(y * w + x) * 3 + 3];
+                others.iter().all(|o| distance(px, mark) < distance(px, *o))
+            })
+            .count()
+    })
+    .collect()
+}
+
+#[test]
+fn irregular_patches_close_behind_the_head() {
+    // An irregular layer starts where the head ends (the head has its own marks). Its
+    // patches must end there with their own edges, not be cut flat across the neck: the
+    // region's edge alone left as much of the pattern in the first rows behind the head as
+    // two to six noise cells further on.
+    for name in ["morelia-spilota", "python-regius"] {
+        let p = preset(name, &[]);
+        let layer = p.pattern.iter().find(|l| l.kind == snakeskin::preset::schema::PatternKind::Irregular).unwrap();
+        let mark = layer.color.unwrap();
+        let colour = body_map(&p, MapKind::Color);
+        let plan = body_plan(&p);
+        let row = |v: f32| (v * colour.height as f32).ceil() as usize;
+        let cell_v = layer.size as f32 / plan.length;
+        let first = back_pixels_per_row(
+            &colour,
+            row(plan.head_end)..row(plan.head_end) + 2,
+            linear(mark),
+            &other_colours(&p, mark),
+        );
+        let later = back_pixels_per_row(
+            &colour,
+            row(plan.head_end + 2.0 * cell_v)..row(plan.head_end + 6.0 * cell_v),
+            linear(mark),
+            &other_colours(&p, mark),
+        );
+        let later_mean = later.iter().sum::<usize>() as f32 / later.len() as f32;
+        assert!(later_mean > 0.1 * (WIDTH / 2) as f32, "{name}: the control, {later_mean} px a row further on");
+        assert!(first.iter().all(|n| *n == 0), "{name}: {first:?} px of the pattern in the first rows behind the head");
+    }
+}

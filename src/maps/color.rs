@@ -5,6 +5,7 @@
 
 use super::Shared;
 use crate::graph::{GraphBuilder, NodeId, Op};
+use crate::ops::body::AlongProfile;
 use crate::ops::filters::BlendMode;
 use crate::ops::hash::derive_seed;
 use crate::ops::noise::{FractalNoise, NoiseKind};
@@ -290,7 +291,17 @@ fn shapes(
             let cells = (1.0 / size).round().clamp(1.0, 256.0) as u32;
             let noise =
                 FractalNoise { kind, cells_u: cells, cells_v: s.along_count(cells), octaves: 3, gain: 0.45, seed };
-            let n = g.add(name("noise"), Op::Noise(noise), &[]);
+            let mut n = g.add(name("noise"), Op::Noise(noise), &[]);
+            if let Some(plan) = s.body() {
+                // On a body atlas the layer starts at the end of the head (`body::layer_region`):
+                // the noise faded to 0 over one of its cells behind it closes the patches there
+                // with their own edges and outlines, where the region's edge cut them flat
+                // across the neck.
+                let cell_v = 1.0 / cells as f32 / s.field.length;
+                let knots = vec![(plan.head_end, 0.0), (plan.head_end + cell_v, 1.0)];
+                let fade = g.add(name("head_fade"), Op::Along(AlongProfile { knots }), &[]);
+                n = super::masked(g, name("faded"), n, Some(fade));
+            }
             // Higher amount, lower threshold, more coverage; fBm sits mostly in [0.3, 0.7].
             let level = 0.7 - 0.4 * layer.amount as f32;
             let binary = g.add(name("threshold"), Op::Threshold { level, softness: 0.01 }, &[n]);
