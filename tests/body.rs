@@ -531,32 +531,32 @@ fn back_pixels_per_row(
 
 #[test]
 fn irregular_patches_close_behind_the_head() {
-    // An irregular layer starts where the head ends (the head has its own marks). Its
-    // patches must end there with their own edges, not be cut flat across the neck: the
-    // region's edge alone left as much of the pattern in the first rows behind the head as
-    // two to six noise cells further on.
-    for name in ["morelia-spilota", "python-regius"] {
-        let p = preset(name, &[]);
+    // An irregular layer starts where the head ends (the head has its own marks). The
+    // minority's patches must end there with their own edges, not be cut flat across the
+    // neck: none within a third of a noise cell behind the head, where the region's edge
+    // alone left as much of them as two to six cells further on. The minority: the layer's
+    // patches, or the ground's holes in a layer covering most of the body.
+    // python-regius' blotches in blue, which no pixel of the irregular layer is nearer to.
+    let cases: [(&str, &[(&str, &str)]); 4] = [
+        ("morelia-spilota", &[]),
+        ("morelia-spilota", &[("pattern.0.amount", "0.3")]),
+        ("morelia-spilota", &[("pattern.0.amount", "0.9")]),
+        ("python-regius", &[("pattern.1.color", "#2040f0")]),
+    ];
+    for (name, overrides) in cases {
+        let p = preset(name, overrides);
         let layer = p.pattern.iter().find(|l| l.kind == snakeskin::preset::schema::PatternKind::Irregular).unwrap();
-        let mark = layer.color.unwrap();
+        let minority = if layer.amount > 0.5 { p.color.base } else { layer.color.unwrap() };
         let colour = body_map(&p, MapKind::Color);
         let plan = body_plan(&p);
         let row = |v: f32| (v * colour.height as f32).ceil() as usize;
         let cell_v = layer.size as f32 / plan.length;
-        let first = back_pixels_per_row(
-            &colour,
-            row(plan.head_end)..row(plan.head_end) + 2,
-            linear(mark),
-            &other_colours(&p, mark),
-        );
-        let later = back_pixels_per_row(
-            &colour,
-            row(plan.head_end + 2.0 * cell_v)..row(plan.head_end + 6.0 * cell_v),
-            linear(mark),
-            &other_colours(&p, mark),
-        );
+        let count = |rows| back_pixels_per_row(&colour, rows, linear(minority), &other_colours(&p, minority));
+        let first = count(row(plan.head_end)..row(plan.head_end + cell_v / 3.0));
+        let later = count(row(plan.head_end + 2.0 * cell_v)..row(plan.head_end + 6.0 * cell_v));
         let later_mean = later.iter().sum::<usize>() as f32 / later.len() as f32;
-        assert!(later_mean > 0.1 * (WIDTH / 2) as f32, "{name}: the control, {later_mean} px a row further on");
-        assert!(first.iter().all(|n| *n == 0), "{name}: {first:?} px of the pattern in the first rows behind the head");
+        let what = format!("{name}, amount {}", layer.amount);
+        assert!(later_mean > 0.03 * (WIDTH / 2) as f32, "{what}: the control, {later_mean} px a row further on");
+        assert!(first.iter().all(|n| *n == 0), "{what}: {first:?} px in the first rows behind the head");
     }
 }

@@ -8,6 +8,7 @@ use std::collections::BTreeSet;
 
 use snakeskin::ops::Image;
 use snakeskin::ops::scales::channel;
+use snakeskin::preset::schema::PatternKind;
 use snakeskin::preset::{PresetSource, parse};
 
 const SIZE: usize = 384;
@@ -139,4 +140,44 @@ fn row_keys_are_checked() {
         let err = parse(&source(text), &[]).expect_err(key).to_string();
         assert!(err.contains(key), "{key}: {err}");
     }
+}
+
+/// The median of the linear luminance of the scale centres of `rows` (median: the spots and
+/// blotches on them, a minority of the centres, do not move it).
+fn median_luminance(centres: &[(u32, [f32; 3])], rows: std::ops::RangeInclusive<u32>) -> f32 {
+    let mut luminance: Vec<f32> = centres
+        .iter()
+        .filter(|(row, _)| rows.contains(row))
+        .map(|(_, c)| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2])
+        .collect();
+    luminance.sort_by(f32::total_cmp);
+    luminance[luminance.len() / 2]
+}
+
+#[test]
+fn the_corn_snakes_sides_are_lighter_than_its_back() {
+    // 'the sides are lighter with small spots' (American Cyclopaedia, in the preset): the
+    // flanks' rows 1–8 (of 29) against the back's ground, the preset's base colour (the
+    // back's own centres are mostly blotch: their median is one); and the back (rows 10–15)
+    // keeps that ground: none of its centres nearer the sides' colour than the base.
+    let text = snakeskin::preset::library::get("pantherophis-guttatus").unwrap();
+    let preset = parse(&PresetSource { name: "corn".into(), display: "corn".into(), text: text.into() }, &[])
+        .unwrap_or_else(|e| panic!("{e}"))
+        .preset;
+    let c = preset.color.base.to_linear();
+    let ground = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let centres = centres_by_row(text);
+    let sides = median_luminance(&centres, 1..=8);
+    assert!(sides > 1.2 * ground, "sides {sides}, the back's ground {ground}");
+    let side = preset
+        .pattern
+        .iter()
+        .find(|l| !l.rows.is_empty() && l.kind == PatternKind::Stripes)
+        .and_then(|l| l.color)
+        .unwrap()
+        .to_linear();
+    let distance = |a: &[f32; 3], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
+    let back: Vec<_> = centres.iter().filter(|(row, _)| (10..=15).contains(row)).collect();
+    let lighter = back.iter().filter(|(_, colour)| distance(colour, &side) < distance(colour, &c)).count();
+    assert!(back.len() > 1000 && lighter == 0, "{lighter} of the back's {} centres have the sides' colour", back.len());
 }

@@ -254,18 +254,19 @@ fn shapes(
             }
             // Start half way into the first colour, so the texture's v seam falls inside a
             // ring rather than on the boundary between two (a counted series starts at the
-            // start of the trunk).
+            // start of the trunk; in whole scales, a quarter row before it, below).
             let mut start = if span == (0.0, 1.0) { -0.5 * widths.first().copied().unwrap_or(0.0) } else { 0.0 };
             if fully_snapped(layer) && s.body().is_none() {
-                // In whole scales on the tile, the first colour centred on a row of scales
-                // (`Lattice::row_centre_v`, a mirror line of the lattice), so that a sequence
-                // symmetric about its colours' centres covers as many scales on both sides
-                // (about the centre half a repeat on too, where a repeat is a whole number of
-                // rows): a coral snake's two yellow rings, the first colour centred at v = 0 (a
-                // quarter row from a mirror line), covered one plate and two. (The other
-                // mirror lines, between two rows, gave two plates each where 1.2 rows were asked.)
+                // In whole scales on the tile, the first colour centred on the row of scales a
+                // quarter row before v = 0 (`Lattice::row_centre_v`, about which the lattice
+                // is symmetric), so that a sequence symmetric about its colours' centres
+                // covers as many plates on both sides, and as many dorsal scales in all (about
+                // the centre half a repeat on too, where a repeat is a whole number of rows):
+                // a coral snake's two yellow rings, the first colour centred at v = 0 (a
+                // quarter row off), covered one plate and two. (Centred between two rows,
+                // also symmetric, they covered two plates each where 1.2 rows were asked.)
                 // Not on a body atlas, whose plates are counted along the body, off the lattice.
-                start += s.lattice.row_centre_v(0) * repeats;
+                start += s.lattice.row_centre_v(-1) * repeats;
             }
             let mut out = Vec::new();
             for (k, (color, width)) in colors.into_iter().zip(widths).enumerate() {
@@ -294,13 +295,22 @@ fn shapes(
             let mut n = g.add(name("noise"), Op::Noise(noise), &[]);
             if let Some(plan) = s.body() {
                 // On a body atlas the layer starts at the end of the head (`body::layer_region`):
-                // the noise faded to 0 over one of its cells behind it closes the patches there
-                // with their own edges and outlines, where the region's edge cut them flat
-                // across the neck.
+                // the noise faded over one of its cells behind it, to 0 (no patch) or, for a
+                // layer covering more than half, to 1 (no hole), closes the minority's patches
+                // there with their own edges and outlines, where the region's edge cut them
+                // flat across the neck (faded to 0, a layer covering most of the body left a
+                // collar of the ground behind the head).
                 let cell_v = 1.0 / cells as f32 / s.field.length;
-                let knots = vec![(plan.head_end, 0.0), (plan.head_end + cell_v, 1.0)];
+                let covers_most = layer.amount > 0.5;
+                let head = if covers_most { 1.0 } else { 0.0 };
+                let knots = vec![(plan.head_end, head), (plan.head_end + cell_v, 1.0 - head)];
                 let fade = g.add(name("head_fade"), Op::Along(AlongProfile { knots }), &[]);
-                n = super::masked(g, name("faded"), n, Some(fade));
+                n = if covers_most {
+                    // 1 − (1 − n)(1 − fade): 1 at the head, n from a cell behind it.
+                    g.add(name("faded"), Op::Blend { mode: BlendMode::Screen, opacity: 1.0 }, &[n, fade])
+                } else {
+                    super::masked(g, name("faded"), n, Some(fade))
+                };
             }
             // Higher amount, lower threshold, more coverage; fBm sits mostly in [0.3, 0.7].
             let level = 0.7 - 0.4 * layer.amount as f32;

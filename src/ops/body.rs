@@ -211,6 +211,18 @@ const HEAD_SIDE_HALF_U: f32 = 0.32;
 /// s in head lengths along); a postocular spot lies on it near the eye.
 const POSTOCULAR: ((f32, f32), (f32, f32)) = ((0.62, 0.45), (1.45, 1.0));
 
+/// How far down the postocular stripe a postocular spot is centred: behind the eye, clear of
+/// the supraocular shield, which ends 0.60 head lengths back (`SHIELDS`): at size 1 the spot
+/// starts 0.64 head lengths back on the test's plan (0.61 at 0.4; at 0.2 it lay beside the
+/// supraocular, over the eye, an independent review found).
+const POSTOCULAR_SPOT_AT: f32 = 0.45;
+
+/// The postocular spot's centre in head-local units (as `POSTOCULAR`).
+fn postocular_spot_centre() -> (f32, f32) {
+    let ((ax, a_along), (bx, b_along)) = POSTOCULAR;
+    (ax + POSTOCULAR_SPOT_AT * (bx - ax), a_along + POSTOCULAR_SPOT_AT * (b_along - a_along))
+}
+
 /// Distance from p to the segment a–b.
 fn segment_distance(p: (f32, f32), a: (f32, f32), b: (f32, f32)) -> f32 {
     let (dx, dy) = (b.0 - a.0, b.1 - a.1);
@@ -265,11 +277,9 @@ impl HeadMark {
                 (half * t - du).min(s - apex).min(base - s)
             }
             HeadMarkShape::PostocularStripe => arm(POSTOCULAR.0, POSTOCULAR.1, 0.10 * k),
-            // A disc 0.3 shield half-widths across at size 1 (the stripe is 0.2 wide), a fifth
-            // of the way down the stripe: just behind the eye.
+            // A disc 0.3 shield half-widths across at size 1 (the stripe is 0.2 wide).
             HeadMarkShape::PostocularSpot => {
-                let (a, b) = POSTOCULAR;
-                let centre = (a.0 + 0.2 * (b.0 - a.0), a.1 + 0.2 * (b.1 - a.1));
+                let centre = postocular_spot_centre();
                 arm(centre, centre, 0.15 * k)
             }
             HeadMarkShape::Collar => {
@@ -452,9 +462,9 @@ mod tests {
         assert!(reached(0.9) > 0, "the control: a tenth less is passed");
     }
 
-    /// Pixels of a head mark on `plan()`'s head, 512 across: each side's count, and each
-    /// side's extent across (u) and along (v · length), in circumferences.
-    fn mark_sides(shape: HeadMarkShape) -> [(usize, f32, f32); 2] {
+    /// Pixels of a head mark on `plan()`'s head, 512 across: each side's count, each side's
+    /// extent across (u) and along (v · length), in circumferences, and its first v.
+    fn mark_sides(shape: HeadMarkShape) -> [(usize, f32, f32, f32); 2] {
         let mark = HeadMark { shape, size: 1.0, plan: plan() };
         let n = 512;
         let rows = (mark.reach_v() * n as f32 * mark.plan.length).ceil() as usize;
@@ -471,24 +481,32 @@ mod tests {
                     }
                 }
             }
-            (count, u_range.1 - u_range.0, (v_range.1 - v_range.0) * mark.plan.length)
+            (count, u_range.1 - u_range.0, (v_range.1 - v_range.0) * mark.plan.length, v_range.0)
         })
     }
 
     #[test]
     fn a_postocular_spot_is_round_and_sits_on_the_stripe_on_each_side() {
         let spot = mark_sides(HeadMarkShape::PostocularSpot);
-        let [(left, across, along), (right, ..)] = spot;
+        let [(left, across, along, first_v), (right, ..)] = spot;
         assert!(left > 20 && left == right, "one spot a side, mirrored: {left} and {right} px");
         assert!((across / along - 1.0).abs() < 0.1, "round: {across} across, {along} along");
         // On the stripe's line and much smaller than it.
         let stripe = HeadMark { shape: HeadMarkShape::PostocularStripe, size: 1.0, plan: plan() };
         let spot_mark = HeadMark { shape: HeadMarkShape::PostocularSpot, size: 1.0, plan: plan() };
         let (ux, head) = plan().head_units();
-        let (a, b) = POSTOCULAR;
-        let centre = (0.5 + (a.0 + 0.2 * (b.0 - a.0)) * ux, (a.1 + 0.2 * (b.1 - a.1)) * head / plan().length);
+        let (spot_x, spot_along) = postocular_spot_centre();
+        let centre = (0.5 + spot_x * ux, spot_along * head / plan().length);
         assert!(spot_mark.inside(centre.0, centre.1) > 0.0 && stripe.inside(centre.0, centre.1) > 0.0);
-        let [(stripe_px, stripe_across, stripe_along), _] = mark_sides(HeadMarkShape::PostocularStripe);
+        // Behind the eye: no part of it beside the supraocular shield, over the eye.
+        let (_, _, supraocular) = SHIELDS.iter().find(|(name, ..)| *name == "supraocular").unwrap();
+        let supraocular_back = supraocular.iter().map(|p| p.1).fold(0.0, f32::max);
+        let first = first_v * plan().length / head;
+        assert!(
+            first > supraocular_back,
+            "the spot starts {first} head lengths back, the supraocular ends at {supraocular_back}"
+        );
+        let [(stripe_px, stripe_across, stripe_along, _), _] = mark_sides(HeadMarkShape::PostocularStripe);
         assert!(left * 3 < stripe_px, "a spot, not a stripe: {left} px against the stripe's {stripe_px}");
         // The control: the stripe itself is not round.
         assert!((stripe_across / stripe_along - 1.0).abs() > 0.1, "{stripe_across} across, {stripe_along} along");

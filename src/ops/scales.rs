@@ -124,10 +124,13 @@ pub struct Lattice {
 
 impl Lattice {
     /// The v of the centre of row r of column 0 (the tile's ventral plate r), unjittered:
-    /// v · rows_v = r + 0.5 + `ROW_PHASE`. The tile's lattice is mirror-symmetric about it
-    /// (and about every v half a row from it): column c's centres lie at v · rows_v =
-    /// r + 0.5 + ROW_PHASE + c · stagger / cols (`ScaleField::centre`), offsets whose set
-    /// (mod 1) negation maps onto itself. The scales' jitter is not mirrored.
+    /// v · rows_v = r + 0.5 + `ROW_PHASE`. About it (and every v half a row from it) the
+    /// ventral plates, one per row across the belly band, are mirror-symmetric; the dorsal
+    /// columns are symmetric under the mirror in v combined with the one about the belly's
+    /// midline (u ↦ −u, a half turn): column c's centres lie at v · rows_v =
+    /// r + 0.5 + ROW_PHASE + c · stagger / cols (`ScaleField::centre`), and the mirror in v
+    /// maps them onto column −c's. So a band and its mirror image cover as many plates, and
+    /// as many dorsal scales in all (not column by column). The scales' jitter is not mirrored.
     pub fn row_centre_v(&self, r: i32) -> f32 {
         (r as f32 + 0.5 + ROW_PHASE) / self.rows_v as f32
     }

@@ -720,7 +720,7 @@ pub enum HeadMarkKind {
     Spearhead,
     /// A stripe from behind the eye to the angle of the jaw, each side.
     PostocularStripe,
-    /// A round spot just behind the eye, each side (where the stripe would start).
+    /// A round spot just behind the eye, each side, on the postocular stripe's line.
     PostocularSpot,
     /// A band round the neck just behind the head.
     Collar,
