@@ -347,7 +347,7 @@ fn broken_stripes(
     let op = Op::Bands { axis: Axis::V, centres, half_width, softness: 0.002 / s.field.length };
     let gaps = g.add(name("gaps"), op, &[]);
     let kept = levels(g, &name("between_gaps"), gaps, 1.0, 0.0);
-    g.add(name("broken"), Op::Blend { mode: BlendMode::Multiply, opacity: 1.0 }, &[stripes, kept])
+    super::masked(g, name("broken"), stripes, Some(kept))
 }
 
 /// The blotch series of a `blotches` layer, every blotch scaled by `scale` (a composite
