@@ -273,16 +273,30 @@ fn a_body_atlas_written_in_strips_equals_the_whole_atlas() {
     }
 }
 
-/// Pixels nearer `mark` than any of `others` in the rows of `rows`.
-fn mark_pixels(colour: &Image, rows: std::ops::Range<usize>, mark: [f32; 3], others: &[[f32; 3]]) -> usize {
+/// Pixels nearer `mark` than any of `others`, in each row of `rows`, over `columns`.
+fn mark_pixels_per_row(
+    colour: &Image,
+    (rows, columns): (std::ops::Range<usize>, std::ops::Range<usize>),
+    mark: [f32; 3],
+    others: &[[f32; 3]],
+) -> Vec<usize> {
     let w = colour.width;
-    rows.flat_map(|y| (0..w).map(move |x| (y, x)))
-        .filter(|(y, x)| {
-            let px = &colour.data[(y * w + x) * 3..(y * w + x) * 3 + 3];
-            let own = distance(px, mark);
-            others.iter().all(|o| own < distance(px, *o))
-        })
-        .count()
+    rows.map(|y| {
+        columns
+            .clone()
+            .filter(|x| {
+                let px = &colour.data[(y * w + x) * 3..(y * w + x) * 3 + 3];
+                let own = distance(px, mark);
+                others.iter().all(|o| own < distance(px, *o))
+            })
+            .count()
+    })
+    .collect()
+}
+
+/// Pixels nearer `mark` than any of `others` in the rows of `rows`, all columns.
+fn mark_pixels(colour: &Image, rows: std::ops::Range<usize>, mark: [f32; 3], others: &[[f32; 3]]) -> usize {
+    mark_pixels_per_row(colour, (rows, 0..colour.width), mark, others).iter().sum()
 }
 
 #[test]
@@ -518,15 +532,7 @@ fn back_pixels_per_row(
     others: &[[f32; 3]],
 ) -> Vec<usize> {
     let w = colour.width;
-    rows.map(|y| {
-        (w / 4..3 * w / 4)
-            .filter(|x| {
-                let px = &colour.data[(y * w + x) * 3..(y * w + x) * 3 + 3];
-                others.iter().all(|o| distance(px, mark) < distance(px, *o))
-            })
-            .count()
-    })
-    .collect()
+    mark_pixels_per_row(colour, (rows, w / 4..3 * w / 4), mark, others)
 }
 
 #[test]

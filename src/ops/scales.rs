@@ -132,7 +132,13 @@ impl Lattice {
     /// maps them onto column −c's. So a band and its mirror image cover as many plates, and
     /// as many dorsal scales in all (not column by column). The scales' jitter is not mirrored.
     pub fn row_centre_v(&self, r: i32) -> f32 {
-        (r as f32 + 0.5 + ROW_PHASE) / self.rows_v as f32
+        v_of_row_y(r as f32 + 0.5, self.rows_v as f32)
+    }
+
+    /// Lattice y of texture v: row r (the tile's plate r) spans y ∈ [r, r + 1).
+    #[inline]
+    pub fn row_y(&self, v: f32) -> f32 {
+        row_y(v, self.rows_v as f32)
     }
 
     /// The ventral band's width, fraction of the circumference (whole columns).
@@ -314,6 +320,20 @@ struct Candidate {
 /// The lattice is shifted by a quarter row along v so that no row of scale edges lies
 /// exactly on the texture's v seam (a crevice there would be real but would read as a seam).
 pub const ROW_PHASE: f32 = 0.25;
+
+/// Lattice y of texture v on a tile of `rows_v` rows: row r spans y ∈ [r, r + 1), so its
+/// edges lie a quarter row off the v seam (`ROW_PHASE`). The one place the phase is applied;
+/// `v_of_row_y` is its inverse.
+#[inline]
+pub fn row_y(v: f32, rows_v: f32) -> f32 {
+    v * rows_v - ROW_PHASE
+}
+
+/// Texture v of lattice y on a tile of `rows_v` rows (unwrapped), the inverse of `row_y`.
+#[inline]
+pub fn v_of_row_y(y: f32, rows_v: f32) -> f32 {
+    (y + ROW_PHASE) / rows_v
+}
 
 /// Where a scale's rim meets the scale underneath, the surface falls to this fraction of the
 /// lower scale's height: a groove, not a hole.
@@ -573,7 +593,7 @@ impl ScaleField {
         }
         rows.into_par_iter().enumerate().for_each(|(row_index, mut planes)| {
             let v = frame.v(row_index);
-            let y = v * lattice.rows_v as f32 - ROW_PHASE;
+            let y = lattice.row_y(v);
             let candidates = if imbricate { self.row_candidates(&lattice, &table, &geo, y) } else { Vec::new() };
             let hexagons =
                 if self.shape == ScaleShape::Hexagon { self.row_hexagons(&lattice, &table, y) } else { Vec::new() };
@@ -622,7 +642,7 @@ impl ScaleField {
                     inv_size: cell.inv_size,
                     random: cell.random,
                     centre_u: lattice.u_of(cx),
-                    centre_v: self.wrap_v((cy + ROW_PHASE) / lattice.rows_v as f32),
+                    centre_v: self.wrap_v(v_of_row_y(cy, lattice.rows_v as f32)),
                     row: lattice.row_of(c),
                     x_min: cx as f64 + x_min,
                     x_max: cx as f64 + x_max,
@@ -768,7 +788,7 @@ impl ScaleField {
                     y: cy_iso,
                     random: cell.random,
                     centre_u: lattice.u_of(cx),
-                    centre_v: self.wrap_v((cy_iso / lattice.aspect + ROW_PHASE) / lattice.rows_v as f32),
+                    centre_v: self.wrap_v(v_of_row_y(cy_iso / lattice.aspect, lattice.rows_v as f32)),
                     row: lattice.row_of(c),
                 }
             })
@@ -882,7 +902,7 @@ impl ScaleField {
                 centre_v: &|r| lattice.row_centre_v(r).rem_euclid(1.0),
                 identity: &|r| r.rem_euclid(lattice.rows_v),
             };
-            return Some(self.plate_row_at(v * lattice.rows_v as f32 - ROW_PHASE, &rows));
+            return Some(self.plate_row_at(lattice.row_y(v), &rows));
         };
         let y = body.plate_coordinate(v)?.0;
         let total = (body.ventrals + body.subcaudals) as i32;
@@ -1295,7 +1315,7 @@ mod tests {
         let geo = Geometry::new(field.shape, 0.5 * lattice.aspect);
         let mut misses = 0;
         for row in 0..23 {
-            let y = (row as f32 + 0.37) / 23.0 * lattice.rows_v as f32 - ROW_PHASE;
+            let y = lattice.row_y((row as f32 + 0.37) / 23.0);
             let candidates = field.row_candidates(&lattice, &table, &geo, y);
             for (cand, (_, cx, _, cell)) in candidates.iter().zip(field.row_cells(&lattice, &table, y)) {
                 let (lo, hi) = outline_x_range_grown(&geo, cell, cand.py, margin);
@@ -1390,7 +1410,7 @@ mod tests {
             let table = CellTable::new(&field, &lattice);
             let geo = Geometry::new(field.shape, 0.5 * lattice.aspect);
             for row in 0..23 {
-                let y = (row as f32 + 0.37) / 23.0 * lattice.rows_v as f32 - ROW_PHASE;
+                let y = lattice.row_y((row as f32 + 0.37) / 23.0);
                 let candidates = field.row_candidates(&lattice, &table, &geo, y);
                 let mut sweep = Sweep::new(&candidates);
                 for i in 0..997 {

@@ -656,7 +656,7 @@ pub enum BellyMarkKind {
 }
 
 /// Marks on the ventral plates, aligned with the scale field's plates (the same rows and
-/// row phase, `ops::scales::ROW_PHASE`), inside the belly band centred on u = 0.
+/// row phase, `ops::scales::row_y`), inside the belly band centred on u = 0.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BellyMarks {
     pub kind: BellyMarkKind,
@@ -678,8 +678,7 @@ pub fn belly_marks(frame: Frame, marks: &BellyMarks) -> Image {
     let half = marks.belly_width * 0.5;
     let rows = marks.rows_v.max(1) as f32;
     let soft = marks.softness.max(0.5 / width.min(height) as f32);
-    // Plate r spans y = v · rows − ROW_PHASE ∈ [r, r + 1); `along` runs 0 → 1 head to tail.
-    let phase = super::scales::ROW_PHASE;
+    // Plate r spans lattice y ∈ [r, r + 1) (`row_y`); `along` runs 0 → 1 head to tail.
     let ramp = |distance_inside: f32| ((distance_inside - 0.3 * soft) / soft).clamp(0.0, 1.0);
     Image::gray_from_fn_in(frame, |u, v| {
         let (side, d) = if u < 0.5 { (0, u) } else { (1, 1.0 - u) };
@@ -690,7 +689,7 @@ pub fn belly_marks(frame: Frame, marks: &BellyMarks) -> Image {
         // plates are 1 / rows long, written as a division as it always was)
         let (plate, along, plate_len) = match &marks.body {
             None => {
-                let y = v * rows - phase;
+                let y = super::scales::row_y(v, rows);
                 let r = super::image::floor_i32(y);
                 (r.rem_euclid(marks.rows_v.max(1) as i32), y - r as f32, None)
             }

@@ -38,6 +38,9 @@ pub struct FilmSeries {
 fn harmonics(a: C64, b: C64) -> Harmonics {
     let q = -(a * b);
     let k = b * (C64::ONE - a * a);
+    // |q| = |ab| reaches 1 only where both interfaces reflect everything (grazing light and
+    // total internal reflection at once); there `usable` is false and the series unused. The
+    // floor only keeps the constructor finite.
     let denom = (1.0 - q.norm_sqr()).max(1e-300);
     let k2 = k.norm_sqr();
     Harmonics { c0: a.norm_sqr() + k2 / denom, d: k * a.conj() + q * (k2 / denom), q }
@@ -83,6 +86,8 @@ impl FilmSeries {
 }
 
 fn sinc(x: f64) -> f64 {
+    // sin x / x = 1 − x²/6 + …: below |x| = 1e-8 the x² term (< 2e-17) is under f64's
+    // epsilon, so 1 is exact to the last bit and the division by a tiny x is avoided.
     if x.abs() < 1e-8 { 1.0 } else { x.sin() / x }
 }
 
@@ -95,7 +100,8 @@ fn series(h: &Harmonics, phase: f64, box_width: f64) -> f64 {
     }
     let q_abs2 = h.q.norm_sqr();
     if q_abs2 < 1e-20 {
-        // Only the first harmonic is left: D e^{iφ} sinc(Δ/2).
+        // Only the first harmonic is left: D e^{iφ} sinc(Δ/2). (|q| < 1e-10: the harmonics
+        // m ≥ 2 are at most 1e-10 of it, and the log form below would divide by q.)
         return (h.c0 + 2.0 * (h.d * z).re * sinc(0.5 * box_width)).clamp(0.0, 1.0);
     }
     // Exact box average of D z / (1 − q z) over φ ± Δ/2, since

@@ -72,7 +72,7 @@ pub fn film_on_gpu(
         })
         .collect();
     gpu.checked(&format!("evaluating the film at {} points", samples.len()), || {
-        Ok(dispatch(gpu, ("film_samples", Model::Thesis), (stack, lut, method), &samples, 1)?.0)
+        Ok(dispatch(gpu, ("film_samples", None), (stack, lut, method), &samples, 1)?.0)
     })
 }
 
@@ -91,7 +91,7 @@ pub fn eval_timed(
     repeats: u32,
 ) -> Result<(Vec<[f32; 3]>, std::time::Duration), GpuError> {
     gpu.checked(&format!("evaluating {} samples", samples.len()), || {
-        dispatch(gpu, ("eval_samples", model), (stack, lut, method), samples, repeats)
+        dispatch(gpu, ("eval_samples", Some(model)), (stack, lut, method), samples, repeats)
     })
 }
 
@@ -100,7 +100,7 @@ pub fn eval_timed(
 /// as one argument (the material's stack, its LUT and the colour method).
 fn dispatch(
     gpu: &Gpu,
-    (entry_point, model): (&str, Model),
+    (entry_point, model): (&str, Option<Model>),
     (stack, lut, method): (Stack, &Lut, GpuFilmMethod),
     samples: &[GpuSample],
     repeats: u32,
@@ -124,7 +124,11 @@ fn dispatch(
         bind_group_layouts: &[Some(&film_layout), Some(&io_layout)],
         immediate_size: 0,
     });
-    let constants = [("FILM_METHOD", method.code() as f64), ("BRDF_MODEL", model.code() as f64)];
+    // The film's entry point reads no BRDF model: then the override keeps its default.
+    let mut constants = vec![("FILM_METHOD", method.code() as f64)];
+    if let Some(model) = model {
+        constants.push(("BRDF_MODEL", model.code() as f64));
+    }
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("brdf_eval"),
         layout: Some(&layout),
