@@ -69,47 +69,21 @@ fn distance(a: &[f32], b: [f32; 3]) -> f32 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f32>().sqrt()
 }
 
-/// Runs of rows (in `rows`) where more than half the pixels within ±2 % of the
-/// circumference of the spine are nearer `mark` than any of `others`; gaps of two rows or
-/// less join runs.
+/// Marks of `mark`'s colour crossing the spine (±2 % of the circumference) in `rows`
+/// (`mark_runs`, `whole_marks`).
 fn marks_along_spine(colour: &Image, rows: std::ops::Range<usize>, mark: [f32; 3], others: &[[f32; 3]]) -> usize {
-    let w = colour.width;
-    let (x0, x1) = ((0.48 * w as f32) as usize, (0.52 * w as f32) as usize);
-    let is_mark: Vec<bool> = rows
-        .clone()
-        .map(|y| {
-            let near = (x0..x1)
-                .filter(|x| {
-                    let px = &colour.data[(y * w + x) * 3..(y * w + x) * 3 + 3];
-                    let own = distance(px, mark);
-                    others.iter().all(|o| own < distance(px, *o))
-                })
-                .count();
-            2 * near > x1 - x0
-        })
-        .collect();
-    let mut runs: Vec<(usize, usize)> = Vec::new();
-    let mut y = 0;
-    while y < is_mark.len() {
-        if is_mark[y] {
-            let start = y;
-            while y < is_mark.len() && is_mark[y] {
-                y += 1;
-            }
-            match runs.last_mut() {
-                Some(last) if start - last.1 <= 2 => last.1 = y,
-                _ => runs.push((start, y)),
-            }
-        } else {
-            y += 1;
-        }
-    }
-    // Slivers where a narrow tip of a mark crosses the band are not marks: a run counts
-    // when it is at least a quarter of the median run's length (and three rows).
+    let w = colour.width as f32;
+    let spine = (0.48 * w) as usize..(0.52 * w) as usize;
+    whole_marks(mark_runs(colour, (rows, spine), mark, others)).len()
+}
+
+/// `runs` less the slivers where a narrow tip of a mark crosses the columns: a run counts
+/// when it is at least a quarter of the median run's length (and three rows).
+fn whole_marks(runs: Vec<(usize, usize)>) -> Vec<(usize, usize)> {
     let mut lengths: Vec<usize> = runs.iter().map(|(a, b)| b - a).collect();
     lengths.sort_unstable();
     let median = lengths.get(lengths.len() / 2).copied().unwrap_or(0);
-    runs.iter().filter(|(a, b)| b - a >= 3 && 4 * (b - a) >= median).count()
+    runs.into_iter().filter(|(a, b)| b - a >= 3 && 4 * (b - a) >= median).collect()
 }
 
 /// Every colour the preset's pattern layers and ground use, except `mark`.
@@ -565,4 +539,129 @@ fn irregular_patches_close_behind_the_head() {
         assert!(later_mean > 0.03 * (WIDTH / 2) as f32, "{what}: the control, {later_mean} px a row further on");
         assert!(first.iter().all(|n| *n == 0), "{what}: {first:?} px in the first rows behind the head");
     }
+}
+
+/// Rows (within `rows`) whose pixels at `columns` are mostly nearer `mark` than any of
+/// `others`, as runs (start, end) of the image's rows; gaps of two rows or less join runs.
+fn mark_runs(
+    colour: &Image,
+    (rows, columns): (std::ops::Range<usize>, std::ops::Range<usize>),
+    mark: [f32; 3],
+    others: &[[f32; 3]],
+) -> Vec<(usize, usize)> {
+    let span = columns.len();
+    let per_row = mark_pixels_per_row(colour, (rows.clone(), columns), mark, others);
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for (y, near) in rows.zip(per_row) {
+        if 2 * near <= span {
+            continue;
+        }
+        match runs.last_mut() {
+            Some(last) if y - last.1 <= 2 => last.1 = y + 1,
+            _ => runs.push((y, y + 1)),
+        }
+    }
+    runs
+}
+
+#[test]
+fn the_milk_snakes_side_blotches_alternate_with_its_saddles() {
+    // 'large brown saddles ... alternate with 1 or 2 rows of smaller dark blotches running
+    // down each side' (the preset's source): every side blotch lies between two saddles,
+    // not beside one. An uncounted side series (the tile's spacing) drifted against the
+    // counted saddles, half its blotches beside a saddle (the control).
+    let check = |overrides: &[(&str, &str)]| {
+        let p = preset("lampropeltis-triangulum", overrides);
+        let plan = body_plan(&p);
+        let colour = body_map(&p, MapKind::Color);
+        let (saddle, side) = (&p.pattern[0], &p.pattern[1]);
+        let trunk = rows_of(colour.height, plan.neck_end, plan.vent);
+        let w = colour.width as f32;
+        let column = |u: f32| (u * w) as usize - 1..(u * w) as usize + 2;
+        let centres =
+            |runs: Vec<(usize, usize)>| whole_marks(runs).iter().map(|(a, b)| 0.5 * (a + b) as f32).collect::<Vec<_>>();
+        let saddles = centres(mark_runs(
+            &colour,
+            (trunk.clone(), column(0.5)),
+            linear(saddle.color()),
+            &other_colours(&p, saddle.color()),
+        ));
+        let sides = centres(mark_runs(
+            &colour,
+            (trunk, column(0.5 - side.offset as f32)),
+            linear(side.color()),
+            &other_colours(&p, side.color()),
+        ));
+        // Each side blotch's place between the saddles either side of it, 0 and 1 at them.
+        let places: Vec<f32> = sides
+            .iter()
+            .filter_map(|&c| {
+                let next = saddles.iter().position(|&s| s > c)?;
+                let before = *saddles.get(next.checked_sub(1)?)?;
+                Some((c - before) / (saddles[next] - before))
+            })
+            .collect();
+        let beside = places.iter().filter(|t| !(0.25..=0.75).contains(*t)).count();
+        (places.len(), beside)
+    };
+    let (between, beside) = check(&[]);
+    assert!(between >= 30 && beside == 0, "{beside} of {between} side blotches beside a saddle");
+    let (between, beside) = check(&[("pattern.1.count", "33")]);
+    assert!(beside * 4 > between, "the control: {beside} of {between} beside a saddle");
+}
+
+#[test]
+fn the_banded_kraits_first_ring_is_the_broadest_and_starts_at_the_head() {
+    // Günther (in the preset): 'the first is the broadest, and produced into a triangular
+    // process, the point of which rests on the vertical shield': the head's black runs on
+    // into the first ring, with no yellow across the neck. Along the spine: black from the
+    // end of the head through the neck, and that black longer than any ring behind it.
+    let check = |overrides: &[(&str, &str)]| {
+        let p = preset("bungarus-fasciatus", overrides);
+        let plan = body_plan(&p);
+        let colour = body_map(&p, MapKind::Color);
+        let black = p.pattern[0].colors[0];
+        let h = colour.height;
+        let w = colour.width;
+        let runs = mark_runs(
+            &colour,
+            (rows_of(h, plan.head_end, plan.vent), (0.48 * w as f32) as usize..(0.52 * w as f32) as usize),
+            linear(black),
+            &other_colours(&p, black),
+        );
+        let first = runs.first().copied().unwrap_or((0, 0));
+        let from_head =
+            first.0 <= rows_of(h, plan.head_end, 1.0).start + 1 && first.1 > (plan.neck_end * h as f32) as usize;
+        let broadest = runs[1..runs.len() - 1].iter().all(|(a, b)| (first.1 - first.0) as f32 > 1.3 * (b - a) as f32);
+        (from_head, broadest)
+    };
+    assert_eq!(check(&[]), (true, true));
+    // The control, without the black over the neck: yellow there.
+    assert!(!check(&[("body.head_mark.1.size", "0.3")]).0);
+}
+
+#[test]
+fn a_rattlesnakes_tail_rings_go_round_the_tail() {
+    // 'Tail encircled by broad black and white rings' (crotalus-atrox's source): the bands
+    // cross the subcaudals (`body.tail_band_over_belly`), as many on the belly's midline
+    // (off its seam at u = 0, where the pairs of subcaudals meet) as on the spine. Without
+    // the key (the control) none reach the belly.
+    let check = |overrides: &[(&str, &str)]| {
+        let p = preset("crotalus-atrox", overrides);
+        let plan = body_plan(&p);
+        let colour = body_map(&p, MapKind::Color);
+        let band = p.body.tail_band_color;
+        let mut others = other_colours(&p, band);
+        others.extend(p.body.tail_color.map(linear));
+        others.push(linear(p.belly.color));
+        let w = colour.width as f32;
+        let tail = rows_of(colour.height, plan.vent, 1.0);
+        let runs =
+            |u: f32| mark_runs(&colour, (tail.clone(), (u * w) as usize..(u * w) as usize + 3), linear(band), &others);
+        (runs(0.5).len(), runs(0.03).len())
+    };
+    let (spine, belly) = check(&[]);
+    assert!(spine == 5 && belly == 5, "{spine} bands on the spine, {belly} on the belly");
+    let (spine, belly) = check(&[("body.tail_band_over_belly", "false")]);
+    assert!(spine == 5 && belly == 0, "the control: {spine} on the spine, {belly} on the belly");
 }

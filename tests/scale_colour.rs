@@ -122,6 +122,35 @@ fn edge_tone_changes_only_the_rims() {
 }
 
 #[test]
+fn a_black_rim_is_black_at_the_outline_and_leaves_a_skin_colour_alone() {
+    // 'each smooth dorsal scale edged with black' (erythrolamprus-miliaris): edge_tone −1
+    // must reach black where the scale's edge falls into the groove, not fade with the
+    // crevice (weighted by the scale's own surface, the outermost rim kept 0.78 of its
+    // colour here). Near the outline, on a scale (crevice < 1): the colour at most a third.
+    let rows = compare("edge_tone = -1");
+    let mut at_outline = 0;
+    for (s, a, b) in &rows {
+        if s[channel::CREVICE] < 1.0 && s[channel::INSIDE] < 0.25 * RIM_WIDTH && a[1] > 1e-3 {
+            assert!(b[1] < a[1] / 3.0, "inside {}: {a:?} -> {b:?}", s[channel::INSIDE]);
+            at_outline += 1;
+        }
+    }
+    assert!(at_outline > 500, "only {at_outline} pixels at the outline");
+    // With a skin colour the groove shows that skin, which the rim does not darken.
+    let skin = "skin = \"#d0c9b2\"";
+    let (plain, changed, f) =
+        (colour(&with(skin)), colour(&with(&format!("{skin}\nedge_tone = -1"))), field(&with(skin)));
+    let mut in_groove = 0;
+    for (s, (a, b)) in pixels(&f).zip(pixels(&plain).zip(pixels(&changed))) {
+        if (0.9..1.0).contains(&s[channel::CREVICE]) {
+            assert!(b[1] > 0.85 * a[1], "crevice {}: the skin darkened, {a:?} -> {b:?}", s[channel::CREVICE]);
+            in_groove += 1;
+        }
+    }
+    assert!(in_groove > 200, "only {in_groove} groove pixels");
+}
+
+#[test]
 fn tip_tone_changes_only_the_free_tips() {
     let rows = compare("tip_tone = 0.5");
     let mut lighter = 0;

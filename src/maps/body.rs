@@ -61,7 +61,8 @@ pub(super) fn marks(
     let snap = preset.pattern.iter().map(|l| l.scale_aligned).fold(0.0f64, f64::max);
     if b.tail_bands > 0 {
         // `tail_bands` dark bands spread evenly from the vent to the tip, each
-        // `tail_band_width` of its repeat, centred in it.
+        // `tail_band_width` of its repeat, centred in it, off the subcaudals unless
+        // `tail_band_over_belly`.
         let n = b.tail_bands as f32;
         let repeat = (1.0 - plan.vent) / n;
         let half = 0.5 * b.tail_band_width as f32 * repeat;
@@ -81,7 +82,9 @@ pub(super) fn marks(
         if snap > 0.0 {
             mask = s.snap(g, "body.tail_bands_aligned".into(), mask, snap as f32, true);
         }
-        mask = super::masked(g, "body.tail_bands_off_belly".into(), mask, outside_belly);
+        if !b.tail_band_over_belly {
+            mask = super::masked(g, "body.tail_bands_off_belly".into(), mask, outside_belly);
+        }
         color = g.add(
             "body.tail_bands_tint",
             Op::Tint { color: b.tail_band_color.to_linear(), opacity: 1.0 },

@@ -11,10 +11,18 @@
 //! skin     c ← mix(c, skin, crevice)                        where scales part
 //! tone     c ← c (1 + tone (2ρ₁ − 1) w_s)                    ρ₁ the scale's random number
 //! hue      R ← R (1 + hue (2ρ₂ − 1) w_s), B ← B (1 − …)      warmer or cooler, ρ₂ = hash(ρ₁)
-//! rim      c ← c (1 + edge (1 − smoothstep(0, RIM_WIDTH, inside)) w_s)
+//! rim      c ← c (1 + edge (1 − smoothstep(0, RIM_WIDTH, inside)) w_r)   w_r = w_s with a skin, else 1
 //! tip      c ← c (1 + tip smoothstep(TIP_START, 1, along) w_s)
 //! speckle  c ← mix(c, speckle colour, dot coverage · w_s)
 //! ```
+//!
+//! The rim is the scale's own margin, and the crevice lies over its outer part: a scale's
+//! edge falls there to the scale underneath (at the default `edge_softness` the crevice
+//! reaches 0.09 of a cell inward, the rim 0.12). Weighted by w_s like the rest, the rim
+//! darkened little: at `edge_tone` −1 the darkest pixel kept 0.62 of its colour, and a
+//! species whose "scales are edged with black" showed olive edges. So on a scale the rim
+//! counts in full, crevice or not; where a `skin` colour is set the crevice shows that skin
+//! (w_s), and between scales (no scale: w_s = 0) nothing changes.
 //!
 //! Every change is a factor or a mix, so black stays black and a key at 0 leaves the
 //! pixel's bytes as they were. The speckle dots lie on a fixed grid of `SPECKLES_PER_SCALE`
@@ -132,7 +140,8 @@ impl ScaleColour {
                 }
                 if self.edge != 0.0 {
                     let rim = 1.0 - smoothstep(0.0, RIM_WIDTH, insides[x]);
-                    gain = gain.map(|g| g * (1.0 + self.edge * rim * own));
+                    let weight = if self.skin.is_some() { own } else { 1.0 };
+                    gain = gain.map(|g| g * (1.0 + self.edge * rim * weight));
                 }
                 if self.tip != 0.0 {
                     let tip = smoothstep(TIP_START, 1.0, alongs[x]);

@@ -773,6 +773,9 @@ pub struct Body {
     pub tail_band_color: Srgb8,
     /// Each band's share of its repeat.
     pub tail_band_width: f64,
+    /// The bands cross the subcaudals too, round the whole tail (a rattlesnake's "tail
+    /// encircled by broad black and white rings"); by default they stop at the belly.
+    pub tail_band_over_belly: bool,
     /// A solid colour over the tail's tip (none: no tip colour).
     pub tip_color: Option<Srgb8>,
     /// The tip colour's share of the tail's length.
@@ -797,6 +800,7 @@ impl Default for Body {
             tail_bands: 0,
             tail_band_color: Srgb8([0x14, 0x12, 0x10]),
             tail_band_width: 0.5,
+            tail_band_over_belly: false,
             tip_color: None,
             tip_fraction: 0.1,
             head_mark: Vec::new(),

@@ -655,6 +655,13 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
             no_bands,
         ),
         (
+            "body.tail_band_over_belly",
+            b.tail_band_over_belly != body.tail_band_over_belly,
+            "body.tail_bands",
+            b.tail_bands == 0,
+            no_bands,
+        ),
+        (
             "body.tip_fraction",
             b.tip_fraction != body.tip_fraction,
             "body.tip_color",
