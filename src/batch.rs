@@ -956,7 +956,9 @@ impl BatchIndex {
     fn write(&self, out: &Path, shard: Shard) -> Result<(), Error> {
         let mut json = serde_json::to_vec_pretty(self).map_err(|e| Error::Internal(format!("index: {e}")))?;
         json.push(b'\n');
-        crate::export::create_folder(out)?;
+        // Noted, so a run that fails before anything is in it takes the folder away again
+        // (a full disk failed the index's first write and left the new folder empty).
+        crate::export::create_folder_noted(out)?;
         write_file_atomically(&out.join(index_file_name(shard)), json)?;
         Ok(())
     }

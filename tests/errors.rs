@@ -216,6 +216,25 @@ fn a_stripe_placed_twice_is_refused() {
     }
 }
 
+/// Stripes that reach past the belly's midline wrap round onto the other side's: 16 a side
+/// at the default size made the whole body one colour, without a word (a hostile-input
+/// sweep). Refused on `amount`'s line with the most that fit; negative controls: that many
+/// is accepted, and so are stripes placed by rows (which `amount` does not place).
+#[test]
+fn stripes_that_wrap_round_the_body_are_refused() {
+    let layer = |extra: &str| format!("[[pattern]]\nkind = \"stripes\"\ncolor = \"#101010\"\n{extra}\n");
+    // Size 0.05 from the spine: centres 0, ±0.15, ±0.30, ±0.45 (edge 0.475): four fit.
+    let err = refused("wrap.toml", &layer("amount = 5"), &[]);
+    assert!(err.contains("wrap.toml:4: key `pattern.0.amount` is 5 stripes a side"), "{err}");
+    assert!(err.contains("past the belly's midline (0.5)") && err.contains("at most 4 a side"), "{err}");
+    let err = refused("wrap.toml", &layer("amount = 2\nposition = \"lateral\"\nsize = 0.1"), &[]);
+    assert!(err.contains("not one fits") || err.contains("at most 1 a side"), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    for extra in ["amount = 4", "amount = 1\nposition = \"lateral\"\nsize = 0.1", "rows = [1, 2]"] {
+        accepted(&write_preset(dir.path(), "fits.toml", &layer(extra)), &[]);
+    }
+}
+
 /// A ring `size` beside `colors` is refused: the sequence's widths replace it (it gave the
 /// same bytes as without it). Negative controls: either alone is accepted.
 #[test]

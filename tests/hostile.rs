@@ -1612,6 +1612,38 @@ fn preview_output_names_are_checked_before_the_work() {
     assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was written");
 }
 
+/// An image output named without an extension is taken as it is (a PNG named `heat`), but
+/// it replaces only a file of its own format: `gallery -o notes` over a text file named
+/// `notes` replaced it with a PNG, without a word (found by a hostile-input sweep). Refused
+/// before any work, the file untouched; the negative control: an earlier run's PNG (and an
+/// empty file) under such a name is replaced as before.
+#[test]
+fn an_output_without_an_extension_replaces_only_a_file_of_its_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    std::fs::write(at("notes"), "keep me\n").unwrap();
+    std::fs::write(at("plot"), "keep me too\n").unwrap();
+    for args in [
+        vec!["gallery", "-o", &at("notes"), "--tile", "16"],
+        vec!["brdf", "chart", "-o", &at("notes")],
+        vec!["bench", "layered", "--plot", &at("plot")],
+    ] {
+        let out = snakeskin(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        let format = if args[0] == "bench" { "svg" } else { "png" };
+        assert!(stderr(&out).contains(&format!("exists and is not a .{format} file")), "{args:?}: {}", stderr(&out));
+    }
+    assert_eq!(std::fs::read_to_string(at("notes")).unwrap(), "keep me\n");
+    assert_eq!(std::fs::read_to_string(at("plot")).unwrap(), "keep me too\n");
+    // A gallery written under the name, then written again over itself; an empty file.
+    std::fs::write(at("empty"), "").unwrap();
+    for name in ["gallery", "gallery", "empty"] {
+        let out = snakeskin(&["gallery", "-o", &at(name), "--tile", "16"]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        assert!(std::fs::read(at(name)).unwrap().starts_with(b"\x89PNG"), "{name}: not a PNG");
+    }
+}
+
 /// `sheet` checks its options, species and memory before it makes a renderer (parse, then
 /// run), so none of this needs a GPU (exit 2, nothing written, no folder made):
 /// - a sheet that would not fit the available memory: a body sheet with `--tile 1024` asked

@@ -356,7 +356,8 @@ fn refuse_unlistable(path: &Path) -> Result<(), ExportError> {
 /// render, a sheet, a gallery, a chart; `svg` for a plot): a name with another extension
 /// (`.jpg`, `.exr`) is refused (it was written in `format` under that name, without a
 /// word), and so is the extension alone (`.png`, a hidden file); one without an extension is
-/// taken as it is.
+/// taken as it is, but replaces only a file of `format` (an earlier run's output), not a
+/// file of another kind that stands there (a text file named `notes`).
 pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), ExportError> {
     // Its example named with the format asked for (`chart.v2/` said "as in out/snake.v2").
     if ends_as_a_folder(target) {
@@ -376,7 +377,33 @@ pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), Exp
         Some(extension) if !extension.eq_ignore_ascii_case(format) => {
             Err(ExportError::NamedForAnotherFormat { path: target.into(), format, extension: extension.into_owned() })
         }
+        None if fs::metadata(target).is_ok_and(|m| m.is_file()) && !holds_format(target, format) => {
+            Err(ExportError::WouldReplaceAnotherKind { path: target.into(), format })
+        }
         _ => Ok(()),
+    }
+}
+
+/// Whether the file at `path` begins as a file of `format` does (`png`: its 8-byte
+/// signature, PNG spec §5.2; `svg`: `<svg` or `<?xml` after any white space). An empty
+/// file counts as any format's (nothing is lost replacing it).
+fn holds_format(path: &Path, format: &str) -> bool {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(64);
+    let Ok(file) = fs::File::open(path) else { return false };
+    if file.take(64).read_to_end(&mut head).is_err() {
+        return false;
+    }
+    if head.is_empty() {
+        return true;
+    }
+    match format {
+        "png" => head.starts_with(b"\x89PNG\r\n\x1a\n"),
+        "svg" => {
+            let text = head.trim_ascii_start();
+            text.starts_with(b"<svg") || text.starts_with(b"<?xml")
+        }
+        _ => false,
     }
 }
 

@@ -95,6 +95,13 @@ pub enum ExportError {
     /// written in its own format under that name, without a word.
     #[error("{path}: this output is a .{format} file; give it a name ending in .{format} (it ends in .{extension})")]
     NamedForAnotherFormat { path: PathBuf, format: &'static str, extension: String },
+    /// An output named without an extension where a file of another kind stands
+    /// (`gallery -o notes` over a text file named `notes`): it was replaced without a word.
+    #[error(
+        "{path} exists and is not a .{format} file; an output named without an extension replaces only a file of its \
+         own format: give a name ending in .{format}, or move the file away"
+    )]
+    WouldReplaceAnotherKind { path: PathBuf, format: &'static str },
     /// `-o .png`: Rust reads it as a hidden file named `.png` with no extension, and it was
     /// written so, out of sight of `ls`.
     #[error("{path}: the file's name is only an extension; give it a name, e.g. snake.{format}")]
@@ -161,6 +168,7 @@ impl ExportError {
                 | ExportError::FolderName { .. }
                 | ExportError::Stdout
                 | ExportError::NamedForAnotherFormat { .. }
+                | ExportError::WouldReplaceAnotherKind { .. }
                 | ExportError::OnlyAnExtension { .. }
                 | ExportError::OverwritesInput { .. }
                 | ExportError::InputAtLock { .. }

@@ -554,6 +554,38 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                 });
             }
         }
+        // Stripes are three widths apart from `offset` out (`maps::color`, `PatternKind::Stripes`):
+        // one whose edge passes the belly's midline (half the circumference from the spine)
+        // wraps round onto the other side's stripes (16 a side at the default size covered
+        // the whole body, without a word; found by a hostile-input sweep). Checked only where
+        // the keys are in their ranges, and not for stripes placed by `rows`.
+        let per_side = p.amount.round();
+        let offset = p.position.map_or(p.offset, |q| q.offset());
+        let stripes_in_ranges = (STRIPES_PER_SIDE.0..=STRIPES_PER_SIDE.1).contains(&per_side)
+            && (PATTERN_SIZE.0..=PATTERN_SIZE.1).contains(&p.size)
+            && (PATTERN_OFFSET.0..=PATTERN_OFFSET.1).contains(&offset);
+        if p.kind == PatternKind::Stripes && p.rows.is_empty() && stripes_in_ranges {
+            let outer_edge = offset + (per_side - 1.0) * 3.0 * p.size + 0.5 * p.size;
+            if outer_edge > 0.5 + 1e-9 {
+                let most = ((0.5 - 0.5 * p.size - offset) / (3.0 * p.size) + 1e-9).floor() + 1.0;
+                let fix = if most >= 1.0 {
+                    format!("at most {most} a side at this size and offset")
+                } else {
+                    "not one fits at this size and offset: a smaller offset or size".into()
+                };
+                c.problems.push(Problem {
+                    key: key("amount"),
+                    message: format!(
+                        "is {per_side} stripes a side, three widths ({}) apart from {} off the spine: the outermost \
+                         reaches {} of the circumference from the spine, past the belly's midline (0.5), where it \
+                         meets the other side's; {fix} (for a layer that covers the skin, use kind \"solid\")",
+                        shown((3.0 * p.size * 1e4).round() / 1e4),
+                        shown(offset),
+                        shown((outer_edge * 1e3).ceil() / 1e3),
+                    ),
+                });
+            }
+        }
         c.range(key("offset"), p.offset, PATTERN_OFFSET);
         c.range(key("outline_size"), p.outline_size, OUTLINE_SIZE);
         c.range(key("edge_distortion"), p.edge_distortion, UNIT);

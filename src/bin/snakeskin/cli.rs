@@ -355,7 +355,9 @@ pub struct PresetArgs {
 pub struct GenerateArgs {
     #[command(flatten)]
     pub preset: PresetArgs,
-    /// Output folder (created if missing).
+    /// Output folder (created if missing). A set written over an earlier one of the same
+    /// name replaces all of it: the earlier set's maps this run does not write (not in
+    /// --maps) are removed, unless changed since, and each one removed is named.
     #[arg(short, long, default_value = ".", value_name = "DIR")]
     pub out: PathBuf,
     /// Width of every map in pixels (16 to 16384); the tile is square, a body atlas is
