@@ -16,9 +16,14 @@ const RED: [f32; 3] = [0.8, 0.0, 0.0];
 
 /// A coral-snake triad whose yellow rings (5 % of a repeat) are narrower than one scale.
 fn preset(scale_aligned: f64, seed: u64) -> String {
+    repeated(scale_aligned, seed, 1)
+}
+
+/// `preset` with the triad `amount` times per tile.
+fn repeated(scale_aligned: f64, seed: u64, amount: u32) -> String {
     format!(
         "seed = {seed}\n[scales]\nrows = 15\njitter = 0.3\n[color]\nbase = \"#000000\"\nvariation = 0\nbetween_scales = 0\n\
-         scale_tone = 0\nscale_hue = 0\n[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\namount = 1\n\
+         scale_tone = 0\nscale_hue = 0\n[[pattern]]\nkind = \"rings\"\ncolor = \"#000000\"\namount = {amount}\n\
          colors = [\"#000000\", \"#f3e700\", \"#e70000\", \"#f3e700\"]\nwidths = [0.3, 0.05, 0.6, 0.05]\n\
          over_belly = true\nedge_distortion = 0.3\nscale_aligned = {scale_aligned}\n"
     )
@@ -29,8 +34,12 @@ fn preset(scale_aligned: f64, seed: u64) -> String {
 /// yellow, which is neither; a nearest-colour rule would call it red).
 fn classes(text: &str, size: usize) -> Vec<u8> {
     let source = PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
-    let loaded = parse(&source, &[]).unwrap_or_else(|e| panic!("{e}"));
-    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    classes_of(&parse(&source, &[]).unwrap_or_else(|e| panic!("{e}")).preset, size)
+}
+
+/// `classes` of a preset as it is, validated or not.
+fn classes_of(preset: &snakeskin::preset::Preset, size: usize) -> Vec<u8> {
+    let graph = build_graph(preset, BuildOptions::default());
     let colour: Image =
         evaluate(&graph, &[MapKind::Color], size, size, &|_, _| {}).maps.remove(&MapKind::Color).unwrap();
     colour
@@ -146,5 +155,56 @@ fn the_yellow_rings_either_side_of_a_red_band_cover_as_many_plates() {
                 );
             }
         }
+    }
+}
+
+/// Rings in whole scales are sure to keep the rule only with each band a few scale rows long
+/// (`rings_of_whole_scales`); more repeats than the rows allow gave every band an equal
+/// share, and red met black without a word (a hostile-input sweep: `micrurus-diastema` at
+/// `amount = 4`). Now the loader warns on the key, with the most that keep them; at that
+/// most there is no warning and the rule holds (every seed, red never meets black and a
+/// yellow ring goes round); past it the warning, and at 5 repeats here (drawn anyway) the
+/// rule breaks for every seed: the warning is needed. (The most is a worst case: measured
+/// here, 1 keeps them, 2 and 3 held for these seeds, 4 let red touch black.)
+#[test]
+fn more_rings_than_whole_scales_can_keep_apart_are_warned_of_with_the_most_that_keep_them() {
+    let load = |seed: u64, amount: u32| {
+        let source = PresetSource { name: "t".into(), display: "t.toml".into(), text: repeated(1.0, seed, amount) };
+        parse(&source, &[]).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let warning = |amount: u32| {
+        let loaded = load(1, amount);
+        loaded.warnings("t.toml").into_iter().find(|w| w.contains("pattern.0.amount"))
+    };
+    let said = warning(5).expect("no warning at 5 repeats");
+    assert!(said.contains("t.toml:") && said.contains("scale_aligned = 1"), "{said}");
+    let most: u32 = said
+        .split("at most ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no most in: {said}"));
+    assert!((1..5).contains(&most), "{said}");
+    assert!(warning(most).is_none() && warning(most + 1).is_some(), "the warning's bound is not {most}");
+    for seed in [1, 2, 3] {
+        let class = classes_of(&load(seed, most).preset, 512);
+        assert!(a_yellow_ring_goes_round(&class, 512), "seed {seed}, {most} repeats: a yellow ring is broken");
+        assert_eq!(red_touches_black(&class, 512), 0, "seed {seed}, {most} repeats: red touches black");
+        let class = classes_of(&load(seed, 5).preset, 512);
+        assert!(red_touches_black(&class, 512) > 0, "seed {seed}, 5 repeats: the rule held, no need to warn");
+    }
+}
+
+/// Widening the narrow bands of a ring sequence takes from the wide ones only while they stay
+/// above the floor themselves: in one pass, a band of 0.3 beside one of 0.0001 was left at
+/// 0.21 under a floor of 0.3. Every band at least the floor, the sum kept.
+#[test]
+fn widening_narrow_rings_leaves_no_band_below_the_floor() {
+    use snakeskin::maps::rings_of_whole_scales;
+    for widths in [vec![0.0001, 0.3, 0.6999], vec![0.02, 0.33, 0.65]] {
+        let widened = rings_of_whole_scales(&widths, 10.0, 3.0);
+        let sum: f32 = widened.iter().sum();
+        assert!(widened.iter().all(|w| *w >= 0.3 - 1e-6), "{widths:?} -> {widened:?}");
+        assert!(sum <= 1.0 + 1e-5, "{widths:?} -> {widened:?}");
     }
 }

@@ -240,17 +240,9 @@ fn shapes(
             let (repeats, span) = series(s, layer);
             let repeats = repeats as f32;
             let span_len = span.1 - span.0;
-            let (colors, mut widths): (Vec<Srgb8>, Vec<f32>) = if layer.colors.is_empty() {
-                (vec![layer.color()], vec![size.min(1.0)])
-            } else if layer.widths.is_empty() {
-                let n = layer.colors.len();
-                (layer.colors.clone(), vec![1.0 / n as f32; n])
-            } else {
-                (layer.colors.clone(), layer.widths.iter().map(|w| *w as f32).collect())
-            };
-            if fully_snapped(layer) {
-                let floor_cells = s.field.apart_cells(&s.lattice);
-                widths = rings_of_whole_scales(&widths, s.lattice.rows_v as f32 * span_len / repeats, floor_cells);
+            let (colors, mut widths) = ring_sequence(layer);
+            if let Some(rows) = whole_scale_ring_rows(s, layer) {
+                widths = rings_of_whole_scales(&widths, rows.per_repeat, rows.per_band);
             }
             // Start half way into the first colour, so the texture's v seam falls inside a
             // ring rather than on the boundary between two (a counted series starts at the
@@ -462,6 +454,95 @@ fn fully_snapped(layer: &PatternLayer) -> bool {
     layer.scale_aligned >= 1.0
 }
 
+/// A ring layer's colour sequence and each colour's width, fractions of one repeat (one ring
+/// of `size` without `colors`; equal parts without `widths`).
+fn ring_sequence(layer: &PatternLayer) -> (Vec<Srgb8>, Vec<f32>) {
+    if layer.colors.is_empty() {
+        (vec![layer.color()], vec![(layer.size as f32).min(1.0)])
+    } else if layer.widths.is_empty() {
+        let n = layer.colors.len();
+        (layer.colors.clone(), vec![1.0 / n as f32; n])
+    } else {
+        (layer.colors.clone(), layer.widths.iter().map(|w| *w as f32).collect())
+    }
+}
+
+/// A ring sequence drawn in whole scales, in scale rows along the body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WholeScaleRingRows {
+    /// Rows in one repeat of the sequence.
+    pub per_repeat: f32,
+    /// Rows every band needs at least (`rings_of_whole_scales`: `ScaleField::apart_cells`).
+    pub per_band: f32,
+    /// Its bands: the colours, and the gap the sequence leaves in its repeat, if any.
+    pub bands: usize,
+    /// Rows of the stretch its repeats share: the whole texture, or a counted series' trunk.
+    pub stretch: f32,
+}
+
+impl WholeScaleRingRows {
+    /// Whether every band can be as long as it needs (else the bands keep equal shares and
+    /// the rings neither stay closed nor keep apart: `rings_of_whole_scales`).
+    pub fn fits(&self) -> bool {
+        self.bands as f32 * self.per_band <= self.per_repeat * (1.0 + 1e-4)
+    }
+
+    /// The most repeats over `stretch` at which every band fits.
+    pub fn most_repeats(&self) -> u32 {
+        (self.stretch / (self.bands as f32 * self.per_band)).floor() as u32
+    }
+}
+
+/// For a ring layer drawn in whole scales (`scale_aligned` 1), its rows (None for any other
+/// layer): what `rings_of_whole_scales` is given, and what the loader's warning checks
+/// (`ring_layers_that_do_not_fit`).
+fn whole_scale_ring_rows(s: &Shared, layer: &PatternLayer) -> Option<WholeScaleRingRows> {
+    if layer.kind != PatternKind::Rings || !fully_snapped(layer) {
+        return None;
+    }
+    let (repeats, span) = series(s, layer);
+    let rows = s.lattice.rows_v as f32;
+    let widths = ring_sequence(layer).1;
+    let gap = 1.0 - widths.iter().sum::<f32>();
+    // A counted series: its count over the trunk (it runs on down the tail at that spacing).
+    let stretch = match (s.body(), layer.series_count()) {
+        (Some(plan), Some(_)) => rows * (plan.vent - plan.neck_end),
+        _ => rows * (span.1 - span.0),
+    };
+    Some(WholeScaleRingRows {
+        per_repeat: rows * (span.1 - span.0) / repeats as f32,
+        per_band: s.field.apart_cells(&s.lattice),
+        bands: widths.len() + usize::from(gap > 1e-6),
+        stretch,
+    })
+}
+
+/// The ring layers of `preset` drawn in whole scales whose bands do not fit their repeat
+/// (`WholeScaleRingRows::fits`): on the tile, by `amount`; on the body atlas, by `count`
+/// (checked for every preset, as the body's keys are range-checked on the tile too). Each
+/// with its layer's index and the layout.
+pub fn ring_layers_that_do_not_fit(preset: &Preset) -> Vec<(usize, super::Layout, WholeScaleRingRows)> {
+    let mut found = Vec::new();
+    for layout in [super::Layout::Tile, super::Layout::Body] {
+        let counted = |layer: &PatternLayer| layer.series_count().is_some();
+        if layout == super::Layout::Body && !preset.pattern.iter().any(counted) {
+            continue;
+        }
+        let s = Shared::new(&mut GraphBuilder::new(), preset, layout);
+        for (i, layer) in preset.pattern.iter().enumerate() {
+            // On the body, the counted layers only: the others repeat per circumference, as
+            // on the tile.
+            if layout == super::Layout::Body && !counted(layer) {
+                continue;
+            }
+            if let Some(rows) = whole_scale_ring_rows(&s, layer).filter(|rows| !rows.fits()) {
+                found.push((i, layout, rows));
+            }
+        }
+    }
+    found
+}
+
 /// Ring widths (fractions of one repeat) for a ring sequence drawn in whole scales, so that
 /// its topology survives the snapping (each scale takes the colour at its centre). Every
 /// band — and the gap the sequence leaves in its repeat, if any — is made at least
@@ -474,9 +555,12 @@ fn fully_snapped(layer: &PatternLayer) -> bool {
 /// - at least reach + j: the scales either side of the band have centres further apart
 ///   along the body than two outlines reach, so they never touch.
 ///
-/// The wider bands give up the difference in proportion; a sequence too tight for it keeps
-/// equal shares. `cells_per_repeat` = scale rows along the body per repeat. (Measured:
-/// with the outline's length alone, no rotation, red met black at 2048² with jitter 0.3.)
+/// The wider bands give up the difference in proportion, as long as they stay above the
+/// floor themselves (a band the giving takes below it is held there too, and the rest give
+/// again: one pass left a band of 0.3 at 0.21 beside one of 0.0001); a sequence too tight
+/// for it keeps equal shares (and the loader warns of it: `ring_layers_that_do_not_fit`).
+/// `cells_per_repeat` = scale rows along the body per repeat. (Measured: with the
+/// outline's length alone, no rotation, red met black at 2048² with jitter 0.3.)
 pub fn rings_of_whole_scales(widths: &[f32], cells_per_repeat: f32, floor_cells: f32) -> Vec<f32> {
     let floor = floor_cells / cells_per_repeat.max(1e-3);
     let drawn: f32 = widths.iter().sum();
@@ -486,17 +570,30 @@ pub fn rings_of_whole_scales(widths: &[f32], cells_per_repeat: f32, floor_cells:
     if gap > 1e-6 {
         all.push(gap);
     }
-    let narrow: f32 = all.iter().filter(|w| **w < floor).map(|_| floor).sum();
-    let wide: f32 = all.iter().filter(|w| **w >= floor).sum();
-    let widened: Vec<f32> = if narrow == 0.0 {
-        all
-    } else if narrow >= 1.0 || wide <= 0.0 {
-        vec![1.0 / all.len() as f32; all.len()]
-    } else {
+    // The bands held at the floor, first those narrower than it; then any the others'
+    // giving takes below it, until none is (at most once per band).
+    let mut held: Vec<bool> = all.iter().map(|w| *w < floor).collect();
+    if !held.contains(&true) {
+        return widths.to_vec();
+    }
+    loop {
+        // Summed as it always was (one floor per band), so widths that one pass settles
+        // keep their bytes.
+        let narrow: f32 = held.iter().filter(|h| **h).map(|_| floor).sum();
+        let wide: f32 = all.iter().zip(&held).filter(|(_, h)| !**h).map(|(w, _)| w).sum();
+        if narrow >= 1.0 || wide <= 0.0 {
+            return vec![1.0 / all.len() as f32; widths.len()];
+        }
         let scale = (1.0 - narrow) / wide;
-        all.iter().map(|w| if *w < floor { floor } else { w * scale }).collect()
-    };
-    widened[..widths.len()].to_vec()
+        let below: Vec<usize> = (0..all.len()).filter(|&k| !held[k] && all[k] * scale < floor).collect();
+        if below.is_empty() {
+            let widened = all.iter().zip(&held).map(|(w, h)| if *h { floor } else { w * scale });
+            return widened.take(widths.len()).collect();
+        }
+        for k in below {
+            held[k] = true;
+        }
+    }
 }
 
 /// What every pattern layer shares.

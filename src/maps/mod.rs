@@ -18,6 +18,7 @@ use crate::preset::Preset;
 use crate::preset::schema::{self, IridescenceGradient};
 
 pub use crate::material::MapKind;
+pub use color::{WholeScaleRingRows, ring_layers_that_do_not_fit, rings_of_whole_scales};
 
 /// What one texture set covers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -223,33 +224,40 @@ impl Shared {
     }
 }
 
+impl Shared {
+    /// The scale field and what every map reads from it, added to `g` for `layout`.
+    pub fn new(g: &mut GraphBuilder, preset: &Preset, layout: Layout) -> Shared {
+        let field = scale_field(preset, layout);
+        let lattice = field.lattice();
+        let scales = g.add("scales", Op::Scales(field.clone()), &[]);
+        let index = |channel: usize| field.output_index(channel).expect("height and crevice are always output");
+        let crevice = g.add("scales.crevice", Op::Channel { index: index(channel::CREVICE) }, &[scales]);
+        let scale_height = g.add("scales.height", Op::Channel { index: index(channel::HEIGHT) }, &[scales]);
+        // Fine grain, a few features per scale, shared by height and roughness.
+        let grain = g.add(
+            "noise.grain",
+            Op::Noise(FractalNoise {
+                kind: NoiseKind::Perlin,
+                cells_u: lattice.cols as u32 * 3,
+                cells_v: lattice.rows_v as u32 * 3,
+                octaves: 3,
+                gain: 0.5,
+                seed: derive_seed(preset.seed, "grain"),
+            }),
+            &[],
+        );
+        Shared { scales, field, lattice, crevice, scale_height, grain, tail_bands: preset.body.tail_bands }
+    }
+}
+
 /// Builds the whole graph for a preset; evaluation later picks the part it needs.
 pub fn build_graph(preset: &Preset, options: BuildOptions) -> Graph {
     let mut g = GraphBuilder::new();
-    let field = scale_field(preset, options.layout);
     if options.layout == Layout::Body {
         g.set_open_v();
     }
-    let lattice = field.lattice();
-    let along = field.length;
-    let scales = g.add("scales", Op::Scales(field.clone()), &[]);
-    let index = |channel: usize| field.output_index(channel).expect("height and crevice are always output");
-    let crevice = g.add("scales.crevice", Op::Channel { index: index(channel::CREVICE) }, &[scales]);
-    let scale_height = g.add("scales.height", Op::Channel { index: index(channel::HEIGHT) }, &[scales]);
-    // Fine grain, a few features per scale, shared by height and roughness.
-    let grain = g.add(
-        "noise.grain",
-        Op::Noise(FractalNoise {
-            kind: NoiseKind::Perlin,
-            cells_u: lattice.cols as u32 * 3,
-            cells_v: lattice.rows_v as u32 * 3,
-            octaves: 3,
-            gain: 0.5,
-            seed: derive_seed(preset.seed, "grain"),
-        }),
-        &[],
-    );
-    let shared = Shared { scales, field, lattice, crevice, scale_height, grain, tail_bands: preset.body.tail_bands };
+    let shared = Shared::new(&mut g, preset, options.layout);
+    let along = shared.field.length;
 
     let height = build_height(&mut g, preset, &shared);
     g.set_output(MapKind::Height, height);

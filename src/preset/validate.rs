@@ -170,7 +170,52 @@ fn rows_bounding(rows: u32) -> u32 {
 /// model's limits (`pigment_below_ambient`, `film_below_ambient`) and a film centred too
 /// thin for its spread (`film_floor`).
 pub fn warnings(preset: &Preset) -> Vec<Problem> {
-    pigment_below_ambient(preset).into_iter().chain(film_below_ambient(preset)).chain(film_floor(preset)).collect()
+    pigment_below_ambient(preset)
+        .into_iter()
+        .chain(film_below_ambient(preset))
+        .chain(film_floor(preset))
+        .chain(rings_not_kept_apart(preset))
+        .collect()
+}
+
+/// Rings drawn in whole scales are sure to stay closed round the body and apart only when
+/// each band (and the gap) is a few scale rows long (`maps::color::rings_of_whole_scales`);
+/// with more repeats than the rows allow every band takes an equal share, and past about one
+/// more repeat red met black, without a word (a coral snake's `amount = 4`, `count = 60`;
+/// found by a hostile-input sweep). A warning, not a refusal: the rows asked for are a
+/// worst case (the largest jittered scale at its worst angle), and one or two repeats past
+/// them often still hold (measured: `tests/rings.rs`).
+fn rings_not_kept_apart(preset: &Preset) -> Vec<Problem> {
+    crate::maps::ring_layers_that_do_not_fit(preset)
+        .into_iter()
+        .map(|(i, layout, rows)| {
+            let layer = &preset.pattern[i];
+            let (key, on, value) = match layout {
+                crate::maps::Layout::Tile => ("amount", "per tile", shown(layer.amount)),
+                crate::maps::Layout::Body => ("count", "along the trunk", layer.count.unwrap_or(0).to_string()),
+            };
+            let most = rows.most_repeats();
+            let keep = if most >= 1 {
+                format!("at most {most} {on} keep them")
+            } else {
+                "not one repeat keeps them: fewer colours, or larger scales (fewer `scales.rows`)".into()
+            };
+            let gap = if rows.bands > layer.colors.len().max(1) { " and the gap between repeats" } else { "" };
+            Problem {
+                key: format!("pattern.{i}.{key}"),
+                message: format!(
+                    "{value} leaves {} scale rows to each repeat of this ring sequence drawn in whole scales \
+                     (`scale_aligned = 1`), whose {} bands (its colours{gap}) need {} rows each to be sure to stay \
+                     closed round the body and apart ({} in all): they are drawn at equal widths, and rings may \
+                     break or touch; {keep}, or draw it free of the scales (`scale_aligned` below 1)",
+                    shown((rows.per_repeat as f64 * 100.0).floor() / 100.0),
+                    rows.bands,
+                    shown((rows.per_band as f64 * 100.0).ceil() / 100.0),
+                    shown((rows.bands as f64 * rows.per_band as f64 * 100.0).ceil() / 100.0),
+                ),
+            }
+        })
+        .collect()
 }
 
 /// An ambient so much denser than the pigment layer that the layered model lets out more
