@@ -615,7 +615,11 @@ fn the_banded_kraits_first_ring_is_the_broadest_and_starts_at_the_head() {
     // Günther (in the preset): 'the first is the broadest, and produced into a triangular
     // process, the point of which rests on the vertical shield': the head's black runs on
     // into the first ring, with no yellow across the neck. Along the spine: black from the
-    // end of the head through the neck, and that black longer than any ring behind it.
+    // end of the head through the neck, and that black longer than any ring behind it; and
+    // round the back and flanks (u 0.12-0.88, off the belly), no yellow from behind the V's
+    // arms (which reach 1.1 head lengths) to the first ring's middle: where the collar met
+    // the ring end to end, scales astride the join showed yellow crescents (an independent
+    // review; seeds 1, 2, 3, 7, up to 118 pixels a row at 512 wide, none on the spine).
     let check = |overrides: &[(&str, &str)]| {
         let p = preset("bungarus-fasciatus", overrides);
         let plan = body_plan(&p);
@@ -633,11 +637,23 @@ fn the_banded_kraits_first_ring_is_the_broadest_and_starts_at_the_head() {
         let from_head =
             first.0 <= rows_of(h, plan.head_end, 1.0).start + 1 && first.1 > (plan.neck_end * h as f32) as usize;
         let broadest = runs[1..runs.len() - 1].iter().all(|(a, b)| (first.1 - first.0) as f32 > 1.3 * (b - a) as f32);
-        (from_head, broadest)
+        let yellow = linear(p.color.base);
+        let neck_end = (plan.neck_end * h as f32) as usize;
+        let neck = (1.15 * plan.head_end * h as f32) as usize..(neck_end + first.1.max(neck_end)) / 2;
+        let back = (0.12 * w as f32) as usize..(0.88 * w as f32) as usize;
+        let yellow_on_back = mark_pixels_per_row(&colour, (neck, back), yellow, &[linear(black)]).iter().sum::<usize>();
+        (from_head, broadest, yellow_on_back)
     };
-    assert_eq!(check(&[]), (true, true));
-    // The control, without the black over the neck: yellow there.
+    for seed in ["1", "2", "3", "7"] {
+        assert_eq!(check(&[("seed", seed)]), (true, true, 0), "seed {seed}");
+    }
+    // The controls: without the black over the neck, yellow there; the collar ending at the
+    // ring's start (size 1.5, the first version), yellow crescents at the join (54-124
+    // pixels for these seeds; none from 1.6 up).
     assert!(!check(&[("body.head_mark.1.size", "0.3")]).0);
+    for seed in ["1", "3"] {
+        assert!(check(&[("seed", seed), ("body.head_mark.1.size", "1.5")]).2 > 0, "seed {seed}: the control");
+    }
 }
 
 #[test]

@@ -1623,10 +1623,14 @@ fn an_output_without_an_extension_replaces_only_a_file_of_its_format() {
     let at = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
     std::fs::write(at("notes"), "keep me\n").unwrap();
     std::fs::write(at("plot"), "keep me too\n").unwrap();
+    // An XML file that is not an SVG (a review found any `<?xml` taken for one).
+    let settings = "<?xml version=\"1.0\"?>\n<settings><a>1</a></settings>\n";
+    std::fs::write(at("cfg"), settings).unwrap();
     for args in [
         vec!["gallery", "-o", &at("notes"), "--tile", "16"],
         vec!["brdf", "chart", "-o", &at("notes")],
         vec!["bench", "layered", "--plot", &at("plot")],
+        vec!["bench", "layered", "--plot", &at("cfg")],
     ] {
         let out = snakeskin(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
@@ -1635,6 +1639,13 @@ fn an_output_without_an_extension_replaces_only_a_file_of_its_format() {
     }
     assert_eq!(std::fs::read_to_string(at("notes")).unwrap(), "keep me\n");
     assert_eq!(std::fs::read_to_string(at("plot")).unwrap(), "keep me too\n");
+    assert_eq!(std::fs::read_to_string(at("cfg")).unwrap(), settings);
+    // An SVG (with an XML declaration) is a plot's to replace.
+    std::fs::write(at("old-plot"), "<?xml version=\"1.0\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\"/>\n").unwrap();
+    let plot = ["bench", "irid", "--d-step-nm", "200", "--angle-step-deg", "45", "--plot", &at("old-plot")];
+    let out = snakeskin(&plot);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::read(at("old-plot")).unwrap().starts_with(b"<svg"), "the plot was not written");
     // A gallery written under the name, then written again over itself; an empty file.
     std::fs::write(at("empty"), "").unwrap();
     for name in ["gallery", "gallery", "empty"] {

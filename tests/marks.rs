@@ -394,3 +394,33 @@ fn a_solid_tint_snapped_to_scales_keeps_its_shades() {
     assert!((0.25..0.5).contains(&mean), "mean tint {mean}");
     assert!(high - low > 0.05, "tints from {low} to {high}: the shades are gone");
 }
+
+#[test]
+fn the_adders_zigzag_is_a_line_that_swings_not_a_notched_stripe() {
+    // 'the dark zigzag line passing along the back' (vipera-berus' source): a band thick
+    // along the body against its swing (`length` 0.6 of a zigzag) left a straight stripe in
+    // its middle, notched at the sides, every row dark there. On the back (within 0.1 of
+    // the circumference of the spine) no column may be the zigzag's colour in over 90 % of
+    // the rows; the control (0.6) has columns dark in every row.
+    let darkest_column = |length: &str| {
+        let text = snakeskin::preset::library::get("vipera-berus").unwrap();
+        let preset = common::preset_from(text);
+        let mark = preset.pattern[0].color.unwrap().to_linear();
+        let ground = preset.color.base.to_linear();
+        let c = common::colour_map(&text.replace("length = 0.4\n", &format!("length = {length}\n")), SIZE);
+        let near = |p: &[f32], q: [f32; 3]| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f32>();
+        (((0.4 * SIZE as f32) as usize)..((0.6 * SIZE as f32) as usize))
+            .map(|x| {
+                let dark = (0..SIZE).filter(|y| {
+                    let p = &c.data[(y * SIZE + x) * 3..(y * SIZE + x) * 3 + 3];
+                    near(p, mark) < near(p, ground)
+                });
+                dark.count() as f32 / SIZE as f32
+            })
+            .fold(0.0f32, f32::max)
+    };
+    let zigzag = darkest_column("0.4");
+    assert!(zigzag < 0.9, "a column of the back is dark in {:.0} % of the rows", 100.0 * zigzag);
+    let stripe = darkest_column("0.6");
+    assert!(stripe > 0.99, "the control: the darkest column {:.0} %", 100.0 * stripe);
+}

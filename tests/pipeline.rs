@@ -444,8 +444,12 @@ fn a_map_written_alone_computes_only_its_scale_channels_and_the_same_samples() {
         if c.tip_tone != 0.0 {
             wanted.push(channel::ALONG);
         }
-        if c.edge_tone != 0.0 {
+        let belly_edge = loaded.preset.belly.edge_tone;
+        if c.edge_tone != 0.0 || belly_edge != 0.0 {
             wanted.push(channel::INSIDE);
+        }
+        if c.edge_tone != belly_edge {
+            wanted.push(channel::ROW);
         }
         if loaded.preset.pattern.iter().any(|p| p.scale_aligned > 0.0) {
             wanted.extend([channel::CENTRE_U, channel::CENTRE_V]);

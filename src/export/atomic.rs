@@ -385,13 +385,15 @@ pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), Exp
 }
 
 /// Whether the file at `path` begins as a file of `format` does (`png`: its 8-byte
-/// signature, PNG spec §5.2; `svg`: `<svg` or `<?xml` after any white space). An empty
-/// file counts as any format's (nothing is lost replacing it).
+/// signature, PNG spec §5.2; `svg`: `<svg` after any white space, or an XML declaration
+/// with an `<svg` element within its first KiB: any other XML file, a settings file, is not
+/// an SVG, as an independent review found it taken for one). An empty file counts as any
+/// format's (nothing is lost replacing it).
 fn holds_format(path: &Path, format: &str) -> bool {
     use std::io::Read;
-    let mut head = Vec::with_capacity(64);
+    let mut head = Vec::with_capacity(1024);
     let Ok(file) = fs::File::open(path) else { return false };
-    if file.take(64).read_to_end(&mut head).is_err() {
+    if file.take(1024).read_to_end(&mut head).is_err() {
         return false;
     }
     if head.is_empty() {
@@ -401,7 +403,7 @@ fn holds_format(path: &Path, format: &str) -> bool {
         "png" => head.starts_with(b"\x89PNG\r\n\x1a\n"),
         "svg" => {
             let text = head.trim_ascii_start();
-            text.starts_with(b"<svg") || text.starts_with(b"<?xml")
+            text.starts_with(b"<svg") || (text.starts_with(b"<?xml") && text.windows(4).any(|w| w == b"<svg"))
         }
         _ => false,
     }

@@ -107,7 +107,8 @@ impl Op {
             (Op::SnapToScales { centre_u, centre_v, .. }, 1) => Some(vec![centre_u, centre_v]),
             (Op::ScaleColour(op), 1) => {
                 let c = &mut op.channels;
-                let optional = [&mut c.random, &mut c.inside, &mut c.along].into_iter().flat_map(Option::as_mut);
+                let optional =
+                    [&mut c.random, &mut c.inside, &mut c.along, &mut c.row].into_iter().flat_map(Option::as_mut);
                 Some(std::iter::once(&mut c.crevice).chain(optional).collect())
             }
             _ => None,
@@ -499,6 +500,7 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             tone,
             hue,
             edge,
+            belly_edge,
             tip,
             speckle,
             speckle_color,
@@ -506,10 +508,11 @@ pub fn hash_op<H: std::hash::Hasher>(op: &Op, h: &mut H) {
             speckle_cells,
             speckle_cells_v,
             seed,
-            channels: ScaleChannels { crevice, random, inside, along },
+            channels: ScaleChannels { crevice, random, inside, along, row },
         }) => {
-            (speckle_cells, speckle_cells_v, seed, crevice, random, inside, along, skin.is_some()).hash(h);
-            for x in [tone, hue, edge, tip, speckle].into_iter().chain(speckle_color).chain(skin.iter().flatten()) {
+            (speckle_cells, speckle_cells_v, seed, crevice, random, inside, along, row, skin.is_some()).hash(h);
+            let floats = [tone, hue, edge, belly_edge, tip, speckle].into_iter();
+            for x in floats.chain(speckle_color).chain(skin.iter().flatten()) {
                 float(h, *x);
             }
         }

@@ -148,6 +148,7 @@ fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
     let any = c.scale_tone > 0.0
         || c.scale_hue > 0.0
         || c.edge_tone != 0.0
+        || preset.belly.edge_tone != 0.0
         || c.tip_tone != 0.0
         || c.speckle > 0.0
         || c.skin.is_some();
@@ -155,6 +156,7 @@ fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
         tone: c.scale_tone as f32,
         hue: c.scale_hue as f32,
         edge: c.edge_tone as f32,
+        belly_edge: preset.belly.edge_tone as f32,
         tip: c.tip_tone as f32,
         speckle: c.speckle as f32,
         speckle_color: c.speckle_color.to_linear(),
@@ -163,22 +165,26 @@ fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
         speckle_cells_v: s.along_count(s.lattice.cols as u32 * SPECKLES_PER_SCALE),
         seed: derive_seed(preset.seed, "per_scale"),
         channels: {
-            let [random, inside, along] = per_scale_reads(preset).map(|(ch, read)| read.then(|| s.channel_index(ch)));
-            ScaleChannels { crevice: s.channel_index(channel::CREVICE), random, inside, along }
+            let [random, inside, along, row] =
+                per_scale_reads(preset).map(|(ch, read)| read.then(|| s.channel_index(ch)));
+            ScaleChannels { crevice: s.channel_index(channel::CREVICE), random, inside, along, row }
         },
     })
 }
 
 /// The scale-field channels the per-scale colour reads besides the crevice, each with
 /// whether its keys are on: the cell's random number (`scale_tone`, `scale_hue`), the
-/// distance inside the outline (`edge_tone`) and the position along the scale (`tip_tone`),
-/// in `ScaleChannels`' order.
-fn per_scale_reads(preset: &Preset) -> [(usize, bool); 3] {
+/// distance inside the outline (`edge_tone`, `belly.edge_tone`), the position along the
+/// scale (`tip_tone`) and the dorsal row (where the back's and the belly's rims differ), in
+/// `ScaleChannels`' order.
+fn per_scale_reads(preset: &Preset) -> [(usize, bool); 4] {
     let c = &preset.color;
+    let belly_edge = preset.belly.edge_tone;
     [
         (channel::CELL_RANDOM, c.scale_tone > 0.0 || c.scale_hue > 0.0),
-        (channel::INSIDE, c.edge_tone != 0.0),
+        (channel::INSIDE, c.edge_tone != 0.0 || belly_edge != 0.0),
         (channel::ALONG, c.tip_tone != 0.0),
+        (channel::ROW, c.edge_tone != belly_edge),
     ]
 }
 
@@ -224,8 +230,7 @@ fn shapes(
             // three stripe widths apart; the innermost at `offset` (or a named position).
             let offset = layer.position.map_or(layer.offset, |p| p.offset()) as f32;
             let mut centres = Vec::new();
-            for k in 0..layer.amount.round() as usize {
-                let d = offset + k as f32 * size * 3.0;
+            for d in stripe_distances(offset, size, layer.amount.round() as u32) {
                 centres.push(0.5 + d);
                 if d > 0.0 {
                     centres.push(0.5 - d);
@@ -447,6 +452,14 @@ fn series(s: &Shared, layer: &PatternLayer) -> (u32, (f32, f32)) {
         }
         _ => (s.along_count(amount), (0.0, 1.0)),
     }
+}
+
+/// How far each stripe of a stripes layer (not placed by `rows`) lies from the spine, one
+/// side, fractions of the circumference: `per_side` stripes three widths apart from `offset`
+/// out. What the generator draws and validation checks (a stripe past the belly's midline
+/// wraps onto the other side's: `preset::validate`).
+pub fn stripe_distances(offset: f32, size: f32, per_side: u32) -> impl Iterator<Item = f32> {
+    (0..per_side).map(move |k| offset + k as f32 * size * 3.0)
 }
 
 /// A layer snapped fully to whole scales (each scale takes the pattern at its centre).

@@ -11,7 +11,7 @@
 //! skin     c ← mix(c, skin, crevice)                        where scales part
 //! tone     c ← c (1 + tone (2ρ₁ − 1) w_s)                    ρ₁ the scale's random number
 //! hue      R ← R (1 + hue (2ρ₂ − 1) w_s), B ← B (1 − …)      warmer or cooler, ρ₂ = hash(ρ₁)
-//! rim      c ← c (1 + edge (1 − smoothstep(0, RIM_WIDTH, inside)) w_r)   w_r = w_s with a skin, else 1
+//! rim      c ← c (1 + edge (1 − smoothstep(0, RIM_WIDTH, inside)) w_r)   w_r: below
 //! tip      c ← c (1 + tip smoothstep(TIP_START, 1, along) w_s)
 //! speckle  c ← mix(c, speckle colour, dot coverage · w_s)
 //! ```
@@ -20,9 +20,13 @@
 //! edge falls there to the scale underneath (at the default `edge_softness` the crevice
 //! reaches 0.09 of a cell inward, the rim 0.12). Weighted by w_s like the rest, the rim
 //! darkened little: at `edge_tone` −1 the darkest pixel kept 0.62 of its colour, and a
-//! species whose "scales are edged with black" showed olive edges. So on a scale the rim
-//! counts in full, crevice or not; where a `skin` colour is set the crevice shows that skin
-//! (w_s), and between scales (no scale: w_s = 0) nothing changes.
+//! species whose "scales are edged with black" showed olive edges. So a dark rim counts in
+//! full into the crevice, w_r = min(1, w_s / `DARK_RIM_FADE`): only the crevice's last
+//! quarter, where the scale meets the gap between scales (w_s = 0, which nothing changes),
+//! fades it out, so the outline has no step. A light rim keeps w_r = w_s (in full it undid
+//! the groove's shade, `between_scales`), and so does any rim where a `skin` colour is set:
+//! the crevice shows that skin. The ventral band (dorsal row 0: the plates) takes its own
+//! tone, `belly_edge`, so that a back and a belly are edged apart.
 //!
 //! Every change is a factor or a mix, so black stays black and a key at 0 leaves the
 //! pixel's bytes as they were. The speckle dots lie on a fixed grid of `SPECKLES_PER_SCALE`
@@ -37,6 +41,11 @@ use super::image::{Image, floor_i32, smoothstep};
 /// Rim band, in scale-cell widths from the outline inward: about an eighth of a scale's
 /// width, the margin that reads as "edged" in photographs of e.g. Natrix or Philodryas.
 pub const RIM_WIDTH: f32 = 0.12;
+/// A dark rim's weight in the crevice, w_s / this at most 1: in full until the crevice is
+/// three quarters deep, then fading to 0 where scales part. (At 1, w_s alone, the rim was
+/// lost in the crevice; in full to the end it stepped from black to the gap's colour in one
+/// pixel: `a_black_rim_is_black_at_the_outline_and_fades_into_the_gap`.)
+pub const DARK_RIM_FADE: f32 = 0.25;
 /// The free tip starts this far along the scale (0 anterior, 1 posterior edge).
 pub const TIP_START: f32 = 0.7;
 /// Speckle grid cells per scale width: melanophore clusters a fraction of a scale across.
@@ -53,10 +62,12 @@ pub struct ScaleChannels {
     pub crevice: usize,
     /// Read by `tone` and `hue`.
     pub random: Option<usize>,
-    /// Read by `edge`.
+    /// Read by `edge` and `belly_edge`.
     pub inside: Option<usize>,
     /// Read by `tip`.
     pub along: Option<usize>,
+    /// The dorsal row (0 on the ventral band), read where `edge` and `belly_edge` differ.
+    pub row: Option<usize>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -65,8 +76,12 @@ pub struct ScaleColour {
     pub tone: f32,
     /// Per-scale warm/cool jitter, ± this fraction on red against blue.
     pub hue: f32,
-    /// Rim brightening (> 0) or darkening (< 0), −1..1.
+    /// Rim brightening (> 0) or darkening (< 0), −1..1, of the dorsal scales.
     pub edge: f32,
+    /// The same for the ventral band's plates and scales (row 0): a species' back and belly
+    /// are edged apart ("each smooth dorsal scale edged with black", a "uniformly yellow"
+    /// belly; "ventrals red, edged with black").
+    pub belly_edge: f32,
     /// Free-tip brightening (> 0) or darkening (< 0), −1..1.
     pub tip: f32,
     /// Fraction of speckle cells that carry a dot, 0..1.
@@ -106,7 +121,9 @@ impl ScaleColour {
             };
             let crevices = field_row(k.crevice);
             let randoms = read(self.tone != 0.0 || self.hue != 0.0, k.random);
-            let insides = read(self.edge != 0.0, k.inside);
+            let rims = self.edge != 0.0 || self.belly_edge != 0.0;
+            let insides = read(rims, k.inside);
+            let dorsal_rows = read(self.edge != self.belly_edge, k.row);
             let alongs = read(self.tip != 0.0, k.along);
             // The scale's second random number, hashed once per run of pixels of one scale
             // (a scale spans many pixels of a row), not once per pixel.
@@ -138,10 +155,15 @@ impl ScaleColour {
                     gain[0] *= 1.0 + warm;
                     gain[2] *= 1.0 - warm;
                 }
-                if self.edge != 0.0 {
+                let edge = match dorsal_rows.get(x) {
+                    Some(row) if *row == 0.0 => self.belly_edge,
+                    _ => self.edge,
+                };
+                if edge != 0.0 {
                     let rim = 1.0 - smoothstep(0.0, RIM_WIDTH, insides[x]);
-                    let weight = if self.skin.is_some() { own } else { 1.0 };
-                    gain = gain.map(|g| g * (1.0 + self.edge * rim * weight));
+                    let dark = edge < 0.0 && self.skin.is_none();
+                    let weight = if dark { (own / DARK_RIM_FADE).min(1.0) } else { own };
+                    gain = gain.map(|g| g * (1.0 + edge * rim * weight));
                 }
                 if self.tip != 0.0 {
                     let tip = smoothstep(TIP_START, 1.0, alongs[x]);
@@ -209,6 +231,7 @@ mod tests {
             tone: 0.0,
             hue: 0.0,
             edge: 0.0,
+            belly_edge: 0.0,
             tip: 0.0,
             speckle: 1.0,
             speckle_color: [0.0; 3],
@@ -216,7 +239,7 @@ mod tests {
             speckle_cells: 64,
             speckle_cells_v: 64,
             seed: 7,
-            channels: ScaleChannels { crevice: 0, random: Some(1), inside: Some(2), along: Some(3) },
+            channels: ScaleChannels { crevice: 0, random: Some(1), inside: Some(2), along: Some(3), row: None },
         };
         kernel.apply(colour, &scales, frame)
     }

@@ -97,9 +97,21 @@ impl Srgb8 {
 
 impl<'de> Deserialize<'de> for Srgb8 {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let text = String::deserialize(deserializer)?;
-        Srgb8::parse(&text)
-            .ok_or_else(|| de::Error::custom(format!("invalid colour {text:?}: expected \"#rrggbb\" (sRGB hex)")))
+        // Parsed inside the visitor, so that a bad colour's error carries the string's own
+        // place: parsed after `String::deserialize` returned, one in a list spread over lines
+        // was placed at the list's opening bracket, without its index.
+        struct Colour;
+        impl de::Visitor<'_> for Colour {
+            type Value = Srgb8;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a colour \"#rrggbb\" (sRGB hex)")
+            }
+            fn visit_str<E: de::Error>(self, text: &str) -> Result<Srgb8, E> {
+                Srgb8::parse(text)
+                    .ok_or_else(|| E::custom(format!("invalid colour {text:?}: expected \"#rrggbb\" (sRGB hex)")))
+            }
+        }
+        deserializer.deserialize_str(Colour)
     }
 }
 
@@ -559,6 +571,9 @@ pub struct Belly {
     pub pattern_amount: f64,
     /// The belly colour runs up onto this many of the lowest dorsal rows each side.
     pub up_rows: u32,
+    /// The plates' rims (and every scale's of the ventral band) lighter (> 0) or darker
+    /// (< 0), as `color.edge_tone` is for the dorsal scales.
+    pub edge_tone: f64,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
@@ -582,6 +597,7 @@ impl Default for Belly {
             pattern_color: Srgb8([0x18, 0x16, 0x14]),
             pattern_amount: 0.5,
             up_rows: 0,
+            edge_tone: 0.0,
         }
     }
 }

@@ -599,34 +599,35 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                 });
             }
         }
-        // Stripes are three widths apart from `offset` out (`maps::color`, `PatternKind::Stripes`):
-        // one whose edge passes the belly's midline (half the circumference from the spine)
+        // Stripes are three widths apart from `offset` out (`maps::stripe_distances`): one
+        // whose edge passes the belly's midline (half the circumference from the spine)
         // wraps round onto the other side's stripes (16 a side at the default size covered
-        // the whole body, without a word; found by a hostile-input sweep). Checked only where
-        // the keys are in their ranges, and not for stripes placed by `rows`.
+        // the whole body, without a word; found by a hostile-input sweep). A single stripe
+        // there only meets its own mirror image (under the belly, by default): not refused.
+        // Checked only where the keys are in their ranges, and not for stripes placed by
+        // `rows`.
         let per_side = p.amount.round();
         let offset = p.position.map_or(p.offset, |q| q.offset());
         let stripes_in_ranges = (STRIPES_PER_SIDE.0..=STRIPES_PER_SIDE.1).contains(&per_side)
             && (PATTERN_SIZE.0..=PATTERN_SIZE.1).contains(&p.size)
             && (PATTERN_OFFSET.0..=PATTERN_OFFSET.1).contains(&offset);
-        if p.kind == PatternKind::Stripes && p.rows.is_empty() && stripes_in_ranges {
-            let outer_edge = offset + (per_side - 1.0) * 3.0 * p.size + 0.5 * p.size;
-            if outer_edge > 0.5 + 1e-9 {
-                let most = ((0.5 - 0.5 * p.size - offset) / (3.0 * p.size) + 1e-9).floor() + 1.0;
-                let fix = if most >= 1.0 {
-                    format!("at most {most} a side at this size and offset")
-                } else {
-                    "not one fits at this size and offset: a smaller offset or size".into()
-                };
+        if p.kind == PatternKind::Stripes && p.rows.is_empty() && stripes_in_ranges && per_side >= 2.0 {
+            let (offset32, size32) = (offset as f32, p.size as f32);
+            let edges: Vec<f32> =
+                crate::maps::stripe_distances(offset32, size32, per_side as u32).map(|d| d + 0.5 * size32).collect();
+            let outer_edge = edges.last().copied().unwrap_or(0.0);
+            if outer_edge > 0.5 + 1e-6 {
+                let most = edges.iter().filter(|edge| **edge <= 0.5 + 1e-6).count().max(1);
                 c.problems.push(Problem {
                     key: key("amount"),
                     message: format!(
                         "is {per_side} stripes a side, three widths ({}) apart from {} off the spine: the outermost \
                          reaches {} of the circumference from the spine, past the belly's midline (0.5), where it \
-                         meets the other side's; {fix} (for a layer that covers the skin, use kind \"solid\")",
+                         meets the other side's; at most {most} a side fit at this size and offset (for a layer \
+                         that covers the skin, use kind \"solid\")",
                         shown((3.0 * p.size * 1e4).round() / 1e4),
                         shown(offset),
-                        shown((outer_edge * 1e3).ceil() / 1e3),
+                        shown((f64::from(outer_edge) * 1e3).ceil() / 1e3),
                     ),
                 });
             }
@@ -652,6 +653,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
 
     c.range("belly.width", preset.belly.width, BELLY_WIDTH);
     c.range("belly.blend", preset.belly.blend, BELLY_BLEND);
+    c.range("belly.edge_tone", preset.belly.edge_tone, SIGNED_UNIT);
     c.range("belly.pattern_amount", preset.belly.pattern_amount, UNIT);
     c.whole_number("belly.up_rows", preset.belly.up_rows, s.rows);
     c.range("color.variation", preset.color.variation, UNIT);

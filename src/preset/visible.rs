@@ -108,12 +108,13 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
 }
 
 /// The most the per-scale colour brightens a pixel (`ops::scale_colour`): tone and hue
-/// (red by up to (1 + tone)(1 + hue)), rim and tip where they lighten.
+/// (red by up to (1 + tone)(1 + hue)), rim and tip where they lighten (the rim's the
+/// lighter of the back's and the belly's, one bound for every colour).
 pub fn per_scale_gain(preset: &Preset) -> f64 {
     let c = &preset.color;
     (1.0 + c.scale_tone.max(0.0))
         * (1.0 + c.scale_hue.max(0.0))
-        * (1.0 + c.edge_tone.max(0.0))
+        * (1.0 + c.edge_tone.max(preset.belly.edge_tone).max(0.0))
         * (1.0 + c.tip_tone.max(0.0))
 }
 
