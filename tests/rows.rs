@@ -161,9 +161,7 @@ fn the_corn_snakes_sides_are_lighter_than_its_back() {
     // back's own centres are mostly blotch: their median is one); and the back (rows 10–15)
     // keeps that ground: none of its centres nearer the sides' colour than the base.
     let text = snakeskin::preset::library::get("pantherophis-guttatus").unwrap();
-    let preset = parse(&PresetSource { name: "corn".into(), display: "corn".into(), text: text.into() }, &[])
-        .unwrap_or_else(|e| panic!("{e}"))
-        .preset;
+    let preset = common::preset_from(text);
     let c = preset.color.base.to_linear();
     let ground = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
     let centres = centres_by_row(text);
@@ -190,9 +188,7 @@ fn the_garter_snakes_checks_stand_out_from_its_ground() {
     // least 3:1, the contrast WCAG 2.1 asks of graphics that must be seen (SC 1.4.11). The
     // preset's first ground, a near-black olive under black spots, gave 1.3 (seen failing).
     let text = snakeskin::preset::library::get("thamnophis-sirtalis").unwrap();
-    let preset = parse(&PresetSource { name: "garter".into(), display: "garter".into(), text: text.into() }, &[])
-        .unwrap_or_else(|e| panic!("{e}"))
-        .preset;
+    let preset = common::preset_from(text);
     let spots = preset.pattern.iter().find(|l| l.kind == PatternKind::Spots).and_then(|l| l.color).unwrap();
     let (spot, ground) = (spots.to_linear(), preset.color.base.to_linear());
     let luminance = |c: &[f32]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];

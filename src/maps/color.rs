@@ -489,6 +489,8 @@ pub struct WholeScaleRingRows {
     pub per_band: f32,
     /// Its bands: the colours, and the gap the sequence leaves in its repeat, if any.
     pub bands: usize,
+    /// Whether one of `bands` is that gap.
+    pub gap: bool,
     /// Rows of the stretch its repeats share: the whole texture, or a counted series' trunk.
     pub stretch: f32,
 }
@@ -497,7 +499,7 @@ impl WholeScaleRingRows {
     /// Whether every band can be as long as it needs (else the bands keep equal shares and
     /// the rings neither stay closed nor keep apart: `rings_of_whole_scales`).
     pub fn fits(&self) -> bool {
-        self.bands as f32 * self.per_band <= self.per_repeat * (1.0 + 1e-4)
+        bands_fit(self.bands, self.per_repeat, self.per_band)
     }
 
     /// The most repeats over `stretch` at which every band fits.
@@ -516,7 +518,7 @@ fn whole_scale_ring_rows(s: &Shared, layer: &PatternLayer) -> Option<WholeScaleR
     let (repeats, span) = series(s, layer);
     let rows = s.lattice.rows_v as f32;
     let widths = ring_sequence(layer).1;
-    let gap = 1.0 - widths.iter().sum::<f32>();
+    let gap = 1.0 - widths.iter().sum::<f32>() > 1e-6;
     // A counted series: its count over the trunk (it runs on down the tail at that spacing).
     let stretch = match (s.body(), layer.series_count()) {
         (Some(plan), Some(_)) => rows * (plan.vent - plan.neck_end),
@@ -525,7 +527,8 @@ fn whole_scale_ring_rows(s: &Shared, layer: &PatternLayer) -> Option<WholeScaleR
     Some(WholeScaleRingRows {
         per_repeat: rows * (span.1 - span.0) / repeats as f32,
         per_band: s.field.apart_cells(&s.lattice),
-        bands: widths.len() + usize::from(gap > 1e-6),
+        bands: widths.len() + usize::from(gap),
+        gap,
         stretch,
     })
 }
@@ -574,6 +577,14 @@ pub fn ring_layers_that_do_not_fit(preset: &Preset) -> Vec<(usize, super::Layout
 /// for it keeps equal shares (and the loader warns of it: `ring_layers_that_do_not_fit`).
 /// `cells_per_repeat` = scale rows along the body per repeat. (Measured: with the
 /// outline's length alone, no rotation, red met black at 2048² with jitter 0.3.)
+/// Whether `bands` bands of at least `floor_cells` scale rows each fit a repeat of
+/// `cells_per_repeat` rows (a ten-thousandth over is taken as fitting: rounding). The one
+/// test of it: `rings_of_whole_scales` keeps equal shares where it fails, and the loader
+/// warns (`WholeScaleRingRows::fits`).
+fn bands_fit(bands: usize, cells_per_repeat: f32, floor_cells: f32) -> bool {
+    bands as f32 * floor_cells <= cells_per_repeat * (1.0 + 1e-4)
+}
+
 pub fn rings_of_whole_scales(widths: &[f32], cells_per_repeat: f32, floor_cells: f32) -> Vec<f32> {
     let floor = floor_cells / cells_per_repeat.max(1e-3);
     let drawn: f32 = widths.iter().sum();
@@ -588,6 +599,9 @@ pub fn rings_of_whole_scales(widths: &[f32], cells_per_repeat: f32, floor_cells:
     let mut held: Vec<bool> = all.iter().map(|w| *w < floor).collect();
     if !held.contains(&true) {
         return widths.to_vec();
+    }
+    if !bands_fit(all.len(), cells_per_repeat.max(1e-3), floor_cells) {
+        return vec![1.0 / all.len() as f32; widths.len()];
     }
     loop {
         // Summed as it always was (one floor per band), so widths that one pass settles

@@ -200,7 +200,7 @@ fn rings_not_kept_apart(preset: &Preset) -> Vec<Problem> {
             } else {
                 "not one repeat keeps them: fewer colours, or larger scales (fewer `scales.rows`)".into()
             };
-            let gap = if rows.bands > layer.colors.len().max(1) { " and the gap between repeats" } else { "" };
+            let gap = if rows.gap { " and the gap between repeats" } else { "" };
             Problem {
                 key: format!("pattern.{i}.{key}"),
                 message: format!(
