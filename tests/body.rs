@@ -681,3 +681,44 @@ fn a_rattlesnakes_tail_rings_go_round_the_tail() {
     let (spine, belly) = check(&[("body.tail_band_over_belly", "false")]);
     assert!(spine == 5 && belly == 0, "the control: {spine} on the spine, {belly} on the belly");
 }
+
+#[test]
+fn the_grass_snakes_collar_is_two_crescents_bordered_behind_with_black() {
+    // anabis (in the preset): 'a white, yellow, or orange collar on the nape, … bordered
+    // behind by two black blotches'; roadkill.at: 'two yellow to orange crescent-shaped
+    // spots'. Over the head's end to a neck's length behind the neck: no yellow on the spine
+    // (two spots, not a band), and on each side (u 0.3 and 0.7) a yellow run with a black
+    // run straight behind it at least half as long (the blotches, not a pattern spot).
+    let black = preset("natrix-natrix", &[]).body.head_mark[0].border_color.expect("the preset's black border");
+    let check = |overrides: &[(&str, &str)]| {
+        let p = preset("natrix-natrix", overrides);
+        let plan = body_plan(&p);
+        let colour = body_map(&p, MapKind::Color);
+        let (h, w) = (colour.height, colour.width as f32);
+        let collar = p.body.head_mark[0].color;
+        let mut others = other_colours(&p, collar);
+        others.push(linear(black));
+        let nape = rows_of(h, plan.head_end, plan.neck_end + (plan.neck_end - plan.head_end));
+        let on_spine = mark_pixels_per_row(
+            &colour,
+            (nape.clone(), (0.49 * w) as usize..(0.51 * w) as usize),
+            linear(collar),
+            &others,
+        );
+        let bordered = [0.3, 0.7].map(|u| {
+            let columns = (u * w) as usize..(u * w) as usize + 3;
+            let yellow = mark_runs(&colour, (nape.clone(), columns.clone()), linear(collar), &others);
+            let dark =
+                mark_runs(&colour, (nape.clone(), columns), linear(black), &[linear(collar), linear(p.color.base)]);
+            let &[(start, end)] = yellow.as_slice() else { return false };
+            dark.iter().any(|&(a, b)| a.abs_diff(end) <= 2 && 2 * (b - a) >= end - start)
+        });
+        (on_spine.iter().sum::<usize>(), bordered)
+    };
+    assert_eq!(check(&[]), (0, [true, true]));
+    // The controls: a collar round the neck is yellow on the spine; a border of the ground's
+    // colour leaves no black behind the crescents.
+    assert!(check(&[("body.head_mark.0.kind", "\"collar\"")]).0 > 0);
+    let ground = format!("\"{}\"", preset("natrix-natrix", &[]).color.base);
+    assert_eq!(check(&[("body.head_mark.0.border_color", &ground)]).1, [false, false]);
+}

@@ -858,3 +858,34 @@ fn an_empty_map_list_is_refused() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("jobs.toml:3: [[job]] 1 (natrix-natrix): maps: an empty list"), "{}", stderr(&out));
 }
+
+/// A head mark's border is drawn behind a mark round the neck only: on another kind it is
+/// refused with its line, as a pattern layer's key of another kind is, and its size without
+/// its colour as a pattern layer's `border_size` is. Negative controls: both on crescents and
+/// on a collar are accepted, and a kind changed by `--set` passes the file's border over.
+#[test]
+fn a_head_marks_border_is_read_by_marks_round_the_neck_only() {
+    let mark = |kind: &str, extra: &str| format!("[[body.head_mark]]\nkind = \"{kind}\"\ncolor = \"#ffffff\"\n{extra}");
+    for (kind, extra, says) in [
+        (
+            "cap",
+            "border_color = \"#000000\"\n",
+            "b.toml:4: key `body.head_mark.0.border_color` is read by kind \"collar\" and \"crescents\" only, not \"cap\"",
+        ),
+        ("lips", "border_size = 0.5\n", "b.toml:4: key `body.head_mark.0.border_size` is read by kind \"collar\""),
+        ("crescents", "border_size = 0.5\n", "b.toml:4: key `body.head_mark.0.border_size` sizes what `border_color`"),
+        ("collar", "border_size = 2.5\nborder_color = \"#000000\"\n", "must be a finite number in [0.3, 2], got 2.5"),
+    ] {
+        let err = refused("b.toml", &mark(kind, extra), &[]);
+        assert!(err.contains(says), "{kind} {extra}: {err}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for kind in ["crescents", "collar"] {
+        let text = mark(kind, "border_color = \"#000000\"\nborder_size = 0.5\n");
+        accepted(&write_preset(dir.path(), &format!("{kind}.toml"), &text), &["--layout", "body"]);
+    }
+    accepted("natrix-natrix", &["--set", "body.head_mark.0.kind=cap"]);
+    let set = ["--set", "body.head_mark.0.kind=cap", "--set", "body.head_mark.0.border_size=0.5"];
+    let err = refused("b.toml", &mark("crescents", "border_color = \"#000000\"\n"), &set);
+    assert!(err.contains("key `body.head_mark.0.border_size` is read by kind \"collar\""), "{err}");
+}

@@ -106,17 +106,23 @@ pub(super) fn marks(
             HeadMarkKind::PostocularStripe => HeadMarkShape::PostocularStripe,
             HeadMarkKind::PostocularSpot => HeadMarkShape::PostocularSpot,
             HeadMarkKind::Collar => HeadMarkShape::Collar,
+            HeadMarkKind::Crescents => HeadMarkShape::Crescents,
             HeadMarkKind::Lips => HeadMarkShape::Lips,
         };
-        let mark = HeadMark { shape, size: m.size as f32, plan: *plan };
-        let mask = g.add(format!("body.head_mark{i}"), Op::HeadMark(mark), &[]);
-        // Off the belly plates (a collar round the neck stops at them).
-        let mask = super::masked(g, format!("body.head_mark{i}_off_belly"), mask, outside_belly);
-        color = g.add(
-            format!("body.head_mark{i}_tint"),
-            Op::Tint { color: m.color.to_linear(), opacity: 1.0 },
-            &[color, mask],
-        );
+        // The border first, as the mark lengthened backward, and the mark over it: the two
+        // meet without a seam of the ground between them.
+        let border = m.border_color.map(|c| ("_border", c, m.border_size as f32));
+        for (part, tint, behind) in border.into_iter().chain([("", m.color, 0.0)]) {
+            let mark = HeadMark { shape, size: m.size as f32, plan: *plan, behind };
+            let mask = g.add(format!("body.head_mark{i}{part}"), Op::HeadMark(mark), &[]);
+            // Off the belly plates (a collar round the neck stops at them).
+            let mask = super::masked(g, format!("body.head_mark{i}{part}_off_belly"), mask, outside_belly);
+            color = g.add(
+                format!("body.head_mark{i}{part}_tint"),
+                Op::Tint { color: tint.to_linear(), opacity: 1.0 },
+                &[color, mask],
+            );
+        }
     }
     color
 }

@@ -192,6 +192,7 @@ pub enum HeadMarkShape {
     PostocularStripe,
     PostocularSpot,
     Collar,
+    Crescents,
     Lips,
 }
 
@@ -200,6 +201,10 @@ pub struct HeadMark {
     pub shape: HeadMarkShape,
     pub size: f32,
     pub plan: BodyPlan,
+    /// The mark lengthened backward by this many of its own widths: a collar's or the
+    /// crescents' border (`head_mark.N.border_color`), drawn under the mark itself (0).
+    /// Other shapes have no border and ignore it.
+    pub behind: f32,
 }
 
 /// Half-width of the head's sides down to the lips, fraction of the circumference from the
@@ -223,6 +228,16 @@ fn postocular_spot_centre() -> (f32, f32) {
     (ax + POSTOCULAR_SPOT_AT * (bx - ax), a_along + POSTOCULAR_SPOT_AT * (b_along - a_along))
 }
 
+/// Half the gap at the spine between a grass snake's two crescents (and their border), in
+/// circumferences: about one dorsal scale's width at 19 rows (1/19 = 0.053). The sources
+/// say "two crescent-shaped spots" and "two black blotches" (presets/natrix-natrix.toml),
+/// not how far apart; one scale keeps them two at every map size from 64 px across.
+const CRESCENT_HALF_GAP_U: f32 = 0.026;
+
+/// How far down the sides a collar or the crescents reach, from the spine, in
+/// circumferences: to the belly's edge, which the belly mask then keeps them off.
+const COLLAR_HALF_U: f32 = 0.42;
+
 /// Distance from p to the segment a–b.
 fn segment_distance(p: (f32, f32), a: (f32, f32), b: (f32, f32)) -> f32 {
     let (dx, dy) = (b.0 - a.0, b.1 - a.1);
@@ -236,7 +251,9 @@ impl HeadMark {
     /// V's arms). A test holds it to `inside` for every shape and size on the built-ins' plans.
     pub fn reach_v(&self) -> f32 {
         let (p, k) = (&self.plan, self.size);
-        (p.head_end * (1.3 + 0.6 * k).max(k)).max(p.head_end + 0.7 * k * (p.neck_end - p.head_end).max(0.005))
+        // A collar reaches 0.7 and the crescents 0.75 of the neck at size 1 (`inside`).
+        let neck_marks = p.head_end + 0.75 * k * (1.0 + self.behind) * (p.neck_end - p.head_end).max(0.005);
+        (p.head_end * (1.3 + 0.6 * k).max(k)).max(neck_marks)
     }
 
     /// Signed distance inside the mark at (u, v), in circumferences (positive inside).
@@ -284,7 +301,27 @@ impl HeadMark {
             }
             HeadMarkShape::Collar => {
                 let neck = (p.neck_end - p.head_end).max(0.005) * p.length;
-                band(head, head + 0.7 * k * neck, s).min(0.42 - du)
+                band(head, head + 0.7 * k * neck * (1.0 + self.behind), s).min(COLLAR_HALF_U - du)
+            }
+            // Each side a crescent between the spine's gap and the belly: t runs −1 (at the
+            // gap) to 1 (at the belly); its middle lies half its width back from the head
+            // and is its thickest (its width), its horns reach forward to the head and thin to
+            // 0.4 of it. Distances along s are divided by the edge's slope so the edge is
+            // anti-aliased over one pixel where it slants.
+            HeadMarkShape::Crescents => {
+                let neck = (p.neck_end - p.head_end).max(0.005) * p.length;
+                let width = 0.5 * k * neck;
+                let (mid, half) =
+                    (0.5 * (CRESCENT_HALF_GAP_U + COLLAR_HALF_U), 0.5 * (COLLAR_HALF_U - CRESCENT_HALF_GAP_U));
+                let t = ((du - mid) / half).clamp(-1.0, 1.0);
+                let front = head + 0.5 * width * (1.0 - t * t);
+                let back = front + width * (1.0 - 0.6 * t * t) * (1.0 + self.behind);
+                // d(front)/d(du) and d(back)/d(du).
+                let front_slope = -width * t / half;
+                let back_slope = front_slope - width * (1.0 + self.behind) * 1.2 * t / half;
+                let along = ((s - front) / (1.0 + front_slope * front_slope).sqrt())
+                    .min((back - s) / (1.0 + back_slope * back_slope).sqrt());
+                along.min(du - CRESCENT_HALF_GAP_U).min(COLLAR_HALF_U - du)
             }
             HeadMarkShape::Lips => {
                 band(0.05 * head, 0.95 * head, s).min(band(HEAD_SIDE_HALF_U - 0.02, HEAD_SIDE_HALF_U + 0.08 * k, du))
@@ -297,6 +334,7 @@ impl HeadMark {
         self.shape.hash(h);
         self.size.to_bits().hash(h);
         self.plan.hash_into(h);
+        self.behind.to_bits().hash(h);
     }
 }
 
@@ -440,14 +478,19 @@ mod tests {
             HeadMarkShape::PostocularStripe,
             HeadMarkShape::PostocularSpot,
             HeadMarkShape::Collar,
+            HeadMarkShape::Crescents,
             HeadMarkShape::Lips,
         ];
         let reached = |scale: f32| {
             let mut reached = 0;
             for plan in &plans {
                 for shape in shapes {
-                    for size in [HEAD_MARK_SIZE.0 as f32, 1.0, HEAD_MARK_SIZE.1 as f32] {
-                        let mark = HeadMark { shape, size, plan: *plan };
+                    for (size, behind) in [HEAD_MARK_SIZE.0, 1.0, HEAD_MARK_SIZE.1]
+                        .into_iter()
+                        .flat_map(|size| [(size, 0.0), (size, HEAD_MARK_SIZE.1)])
+                    {
+                        let (size, behind) = (size as f32, behind as f32);
+                        let mark = HeadMark { shape, size, plan: *plan, behind };
                         let from = mark.reach_v() * scale;
                         let beyond = (0..400).map(|j| (from + 0.2 * j as f32 / 400.0).min(1.0));
                         reached += beyond
@@ -465,7 +508,7 @@ mod tests {
     /// Pixels of a head mark on `plan()`'s head, 512 across: each side's count, each side's
     /// extent across (u) and along (v · length), in circumferences, and its first v.
     fn mark_sides(shape: HeadMarkShape) -> [(usize, f32, f32, f32); 2] {
-        let mark = HeadMark { shape, size: 1.0, plan: plan() };
+        let mark = HeadMark { shape, size: 1.0, plan: plan(), behind: 0.0 };
         let n = 512;
         let rows = (mark.reach_v() * n as f32 * mark.plan.length).ceil() as usize;
         [false, true].map(|right| {
@@ -492,8 +535,8 @@ mod tests {
         assert!(left > 20 && left == right, "one spot a side, mirrored: {left} and {right} px");
         assert!((across / along - 1.0).abs() < 0.1, "round: {across} across, {along} along");
         // On the stripe's line and much smaller than it.
-        let stripe = HeadMark { shape: HeadMarkShape::PostocularStripe, size: 1.0, plan: plan() };
-        let spot_mark = HeadMark { shape: HeadMarkShape::PostocularSpot, size: 1.0, plan: plan() };
+        let stripe = HeadMark { shape: HeadMarkShape::PostocularStripe, size: 1.0, plan: plan(), behind: 0.0 };
+        let spot_mark = HeadMark { shape: HeadMarkShape::PostocularSpot, size: 1.0, plan: plan(), behind: 0.0 };
         let (ux, head) = plan().head_units();
         let (spot_x, spot_along) = postocular_spot_centre();
         let centre = (0.5 + spot_x * ux, spot_along * head / plan().length);

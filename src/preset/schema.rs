@@ -73,7 +73,7 @@ named_enum!(NoiseChoice { Perlin, Cellular });
 named_enum!(BellyPattern { None, Checkered, Spots, HalfMoons, MedianStripe });
 named_enum!(IridescenceGradient { Vertical, Radial });
 named_enum!(HeadScales { Shields, Small });
-named_enum!(HeadMarkKind { Cap, Snout, V, X, Spearhead, PostocularStripe, PostocularSpot, Collar, Lips });
+named_enum!(HeadMarkKind { Cap, Snout, V, X, Spearhead, PostocularStripe, PostocularSpot, Collar, Crescents, Lips });
 
 /// A colour written as `"#rrggbb"` (sRGB, 8 bits per channel).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -740,6 +740,9 @@ pub enum HeadMarkKind {
     PostocularSpot,
     /// A band round the neck just behind the head.
     Collar,
+    /// Two crescents on the nape, one each side, their horns forward round the back of the
+    /// head, parted at the spine (a grass snake's collar).
+    Crescents,
     /// The lip scales along both jaws.
     Lips,
 }
@@ -752,11 +755,23 @@ pub struct HeadMark {
     /// Relative size of the mark (1 the stylised default).
     #[serde(default = "HeadMark::default_size")]
     pub size: f64,
+    /// A band just behind the mark in this colour (collars and crescents only: a grass
+    /// snake's collar "bordered behind by two black blotches").
+    #[serde(default)]
+    pub border_color: Option<Srgb8>,
+    /// The border's width over the mark's own.
+    #[serde(default = "HeadMark::default_size")]
+    pub border_size: f64,
 }
 
 impl HeadMark {
-    fn default_size() -> f64 {
+    pub(crate) fn default_size() -> f64 {
         1.0
+    }
+
+    /// Whether this kind draws a `border_color` (a band behind a mark round the neck).
+    pub fn takes_border(kind: HeadMarkKind) -> bool {
+        matches!(kind, HeadMarkKind::Collar | HeadMarkKind::Crescents)
     }
 }
 

@@ -767,8 +767,32 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
     } else {
         // Not one by one past the limit: thousands of marks buried the message (and took
         // minutes to locate, one line each).
+        use crate::preset::schema::HeadMark;
         for (i, m) in b.head_mark.iter().enumerate() {
-            c.range(format!("body.head_mark.{i}.size"), m.size, HEAD_MARK_SIZE);
+            let key = |field: &str| format!("body.head_mark.{i}.{field}");
+            c.range(key("size"), m.size, HEAD_MARK_SIZE);
+            c.range(key("border_size"), m.border_size, HEAD_MARK_SIZE);
+            // A border only a mark round the neck draws, as a pattern layer refuses a key its
+            // kind does not read (passed over where `--set` changed the file's kind).
+            let sized = m.border_size != HeadMark::default_size();
+            for (field, set) in [("border_color", m.border_color.is_some()), ("border_size", sized)] {
+                if set && !HeadMark::takes_border(m.kind) && !from_file_for_overridden(&key(field), &key("kind")) {
+                    c.problems.push(Problem {
+                        key: key(field),
+                        message: format!(
+                            "is read by kind \"collar\" and \"crescents\" only, not \"{}\"; leave it out of this mark",
+                            spelled(&m.kind)
+                        ),
+                    });
+                }
+            }
+            if sized && HeadMark::takes_border(m.kind) && m.border_color.is_none() {
+                c.problems.push(Problem {
+                    key: key("border_size"),
+                    message: "sizes what `border_color` draws, which this mark does not set; set it, or leave this out"
+                        .into(),
+                });
+            }
         }
     }
 

@@ -161,6 +161,9 @@ fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
     }
     for (i, mark) in body.head_mark.iter_mut().enumerate() {
         keys.push((format!("body.head_mark.{i}.color"), &mut mark.color));
+        if let Some(border) = mark.border_color.as_mut() {
+            keys.push((format!("body.head_mark.{i}.border_color"), border));
+        }
     }
     keys
 }
