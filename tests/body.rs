@@ -722,3 +722,77 @@ fn the_grass_snakes_collar_is_two_crescents_bordered_behind_with_black() {
     let ground = format!("\"{}\"", preset("natrix-natrix", &[]).color.base);
     assert_eq!(check(&[("body.head_mark.0.border_color", &ground)]).1, [false, false]);
 }
+
+#[test]
+fn the_boas_brick_red_is_the_tails() {
+    // 'a ruddy brown ground color, becoming a rich brick red on the tail' (boa-constrictor's
+    // source): the back and flanks at 0.7 of the length, ahead of the vent (0.89), keep the
+    // trunk's colour, nearer the front's (0.3) than the tail's. The shift from halfway down
+    // the trunk (the default 0.5: the control) reddened the trunk's rear half (an audit).
+    let check = |overrides: &[(&str, &str)]| {
+        let p = preset("boa-constrictor", overrides);
+        let colour = body_map(&p, MapKind::Color);
+        let (h, w) = (colour.height, colour.width);
+        let median_at = |v: f32| {
+            let rows = rows_of(h, v - 0.01, v + 0.01);
+            let mut channels = [Vec::new(), Vec::new(), Vec::new()];
+            for y in rows {
+                for x in (0.15 * w as f32) as usize..(0.85 * w as f32) as usize {
+                    for (k, c) in channels.iter_mut().enumerate() {
+                        c.push(colour.data[(y * w + x) * 3 + k]);
+                    }
+                }
+            }
+            channels.map(|mut c| {
+                c.sort_by(f32::total_cmp);
+                c[c.len() / 2]
+            })
+        };
+        let (front, rear) = (median_at(0.3), median_at(0.7));
+        let tail = linear(p.body.tail_color.unwrap());
+        distance(&rear[..], front) < distance(&rear[..], tail)
+    };
+    assert!(check(&[]));
+    assert!(!check(&[("body.tail_shift_start", "0.5")]), "the control");
+}
+
+#[test]
+fn the_green_pythons_white_spots_are_a_few() {
+    // 'a few scattered white spots on sides' (morelia-viridis' source): along each flank's
+    // series (0.24 of the circumference off the spine, ±0.04) from the neck to the vent, the
+    // layer's count (6, a reading of 'a few'), ±1; and at 30 (the control) more than 20.
+    // Uncounted, the tile's 3 a circumference ran on down the body, 27 and 28 a side (an
+    // audit).
+    let check = |overrides: &[(&str, &str)]| {
+        let p = preset("morelia-viridis", overrides);
+        let plan = body_plan(&p);
+        let colour = body_map(&p, MapKind::Color);
+        let white = p.pattern[0].color.unwrap();
+        let w = colour.width as f32;
+        let trunk = rows_of(colour.height, plan.neck_end, plan.vent);
+        [0.26, 0.74].map(|u| {
+            let columns = ((u - 0.04) * w) as usize..((u + 0.04) * w) as usize;
+            // Against the green ground only: the vertebral stripe's cream (#e8e8c8) is near the
+            // spots' white, and the scales' tone jitter split a spot's rows between the two.
+            let per_row =
+                mark_pixels_per_row(&colour, (trunk.clone(), columns), linear(white), &[linear(p.color.base)]);
+            // Runs of rows with a spot's pixels, gaps of two rows or less joined.
+            let mut runs = 0;
+            let mut last = None;
+            for (y, n) in per_row.iter().enumerate() {
+                if *n > 0 {
+                    if last.is_none_or(|l| y > l + 2) {
+                        runs += 1;
+                    }
+                    last = Some(y);
+                }
+            }
+            runs
+        })
+    };
+    let count = preset("morelia-viridis", &[]).pattern[0].count.unwrap();
+    for (side, found) in check(&[]).into_iter().enumerate() {
+        assert_within_one(&format!("side {side}"), found, count);
+    }
+    assert!(check(&[("pattern.0.count", "30")]).iter().all(|n| *n > 20), "the control: 30 a side");
+}

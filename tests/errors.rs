@@ -669,7 +669,7 @@ fn spots_larger_than_their_spacing_are_refused() {
     let layer = "[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\namount = 64\nsize = 0.3\n";
     let err = refused("big_spots.toml", layer, &[]);
     assert!(err.contains("big_spots.toml:5") && err.contains("pattern.0.size"), "{err}");
-    assert!(err.contains("a radius of 19.2 spacings") && err.contains("size ≤ 0.0312 at this amount"), "{err}");
+    assert!(err.contains("a radius of 19.2 spacings") && err.contains("size ≤ 0.0312 at this spacing"), "{err}");
     let presets = tempfile::tempdir().unwrap();
     let path = write_preset(presets.path(), "big_spots.toml", layer);
     accepted(&path, &["--set", "pattern.0.size=0.0312"]);
@@ -685,6 +685,18 @@ fn spots_larger_than_their_spacing_are_refused() {
     let err = refused("too_big.toml", &layer.replace("amount = 64", "amount = 2").replace("0.3", "0.9"), &[]);
     assert!(err.contains("must be a finite number in [0.001, 0.5], got 0.9"), "{err}");
     assert_eq!(err.matches("pattern.0.size").count(), 1, "{err}");
+    // On a band of `rows` the spots lie the band's width over `amount` apart, along the body
+    // too: 64 over the lowest of 19 rows at 0.03 passed the check round the body (0.0312)
+    // and took 37 s for a body atlas 64 pixels wide (a review). The largest size the message
+    // prints is accepted (the control), and the same size round the body.
+    let banded = layer.replace("size = 0.3", "size = 0.03\nrows = [1, 1]");
+    let err = refused("band.toml", &banded, &[]);
+    assert!(err.contains("is 0.03 with 64 spots across rows [1, 1] (`amount`, `rows`),"), "{err}");
+    let largest = err.split("size ≤ ").nth(1).and_then(|t| t.split(' ').next()).expect("the largest size");
+    assert!(largest.parse::<f64>().unwrap() < 0.003, "{err}");
+    let path = write_preset(presets.path(), "band.toml", &banded);
+    accepted(&path, &["--set", &format!("pattern.0.size={largest}")]);
+    accepted(&write_preset(presets.path(), "round.toml", &banded.replace("rows = [1, 1]\n", "")), &[]);
 }
 
 /// A preset that is not UTF-8 is placed by line and column (std's message gave a byte

@@ -170,6 +170,12 @@ fn set_overrides_change_the_output_like_editing_the_file() {
     ]);
     assert!(run_a.status.success() && run_b.status.success(), "{}{}", stderr(&run_a), stderr(&run_b));
     assert_eq!(std::fs::read(a.join("edited_height.png")).unwrap(), std::fs::read(b.join("base_height.png")).unwrap());
+    // The control (a review: both ignoring the keys would pass the above): the base preset
+    // without the overrides makes another height map.
+    let c = dir.path().join("c");
+    let run_c = snakeskin(&["generate", &base, "-o", c.to_str().unwrap(), "--size", "64", "--maps", "height"]);
+    assert!(run_c.status.success(), "{}", stderr(&run_c));
+    assert_ne!(std::fs::read(c.join("base_height.png")).unwrap(), std::fs::read(b.join("base_height.png")).unwrap());
 }
 
 /// A set says what made it beyond its preset: the manifest lists the `--set` overrides as

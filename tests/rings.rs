@@ -195,6 +195,35 @@ fn more_rings_than_whole_scales_can_keep_apart_are_warned_of_with_the_most_that_
     }
 }
 
+/// A ring layer without a count repeats `amount` times a circumference on the body too, but
+/// the body rounds its repeats and its scale rows over the whole length each on its own: a
+/// layer that fits the tile can be short of rows on the body, which was not checked (a
+/// review). Warned of on `amount`, with the largest whole amount that keeps the rings on the
+/// body; that amount is not warned of (the control), and the tile alone is not.
+#[test]
+fn rings_that_fit_the_tile_but_not_the_body_are_warned_of_on_the_body() {
+    let text = |amount: u32| {
+        format!(
+            "seed = 1\n[scales]\nrows = 17\naspect = 1.2\n[body]\nlength = 5.5\n[[pattern]]\nkind = \"rings\"\n\
+             colors = [\"#101010\", \"#e0d040\", \"#c02020\", \"#e0d040\"]\nscale_aligned = 1\namount = {amount}\n"
+        )
+    };
+    let warnings = |amount: u32| {
+        let source = PresetSource { name: "t".into(), display: "t.toml".into(), text: text(amount) };
+        parse(&source, &[]).unwrap_or_else(|e| panic!("{e}")).warnings("t.toml")
+    };
+    let said = warnings(3);
+    let [said] = said.as_slice() else { panic!("one warning: {said:?}") };
+    assert!(said.contains("pattern.0.amount = 3 on the body atlas leaves"), "{said}");
+    let largest: u32 = said
+        .split("`amount` ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no amount in: {said}"));
+    assert!(largest < 3 && warnings(largest).is_empty(), "{said}");
+}
+
 /// Widening the narrow bands of a ring sequence takes from the wide ones only while they stay
 /// above the floor themselves: in one pass, a band of 0.3 beside one of 0.0001 was left at
 /// 0.21 under a floor of 0.3. Every band at least the floor, the sum kept.

@@ -40,7 +40,7 @@ transfer!(f64, encode, decode);
 
 /// The formula rounded to 8 bits: the reference the table is built from.
 pub fn linear_to_srgb8_formula(linear: f32) -> u8 {
-    (encode_f32(linear) * 255.0 + 0.5) as u8
+    super::unit_to_u8(encode_f32(linear))
 }
 
 /// Buckets of the coarse index over [0, 1]: a power of two, so `c · BUCKETS` is exact and a

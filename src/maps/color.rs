@@ -10,7 +10,7 @@ use crate::ops::filters::BlendMode;
 use crate::ops::hash::derive_seed;
 use crate::ops::noise::{FractalNoise, NoiseKind};
 use crate::ops::scale_colour::{SPECKLES_PER_SCALE, ScaleChannels, ScaleColour};
-use crate::ops::scales::channel;
+use crate::ops::scales::{Lattice, channel};
 use crate::ops::shapes::{Axis, BellyMarkKind, BellyMarks, BlotchShape, Blotches, SpotGrid};
 use crate::preset::Preset;
 use crate::preset::schema::{Arrangement, BellyPattern, NoiseChoice, PatternKind, PatternLayer, PatternShape, Srgb8};
@@ -179,13 +179,10 @@ fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
 /// `ScaleChannels`' order.
 fn per_scale_reads(preset: &Preset) -> [(usize, bool); 4] {
     let c = &preset.color;
-    let belly_edge = preset.belly.edge_tone;
-    [
-        (channel::CELL_RANDOM, c.scale_tone > 0.0 || c.scale_hue > 0.0),
-        (channel::INSIDE, c.edge_tone != 0.0 || belly_edge != 0.0),
-        (channel::ALONG, c.tip_tone != 0.0),
-        (channel::ROW, c.edge_tone != belly_edge),
-    ]
+    let [tone, hue, edge, belly_edge, tip] =
+        [c.scale_tone, c.scale_hue, c.edge_tone, preset.belly.edge_tone, c.tip_tone].map(|k| k as f32);
+    let [random, inside, along, row] = ScaleColour::reads(tone, hue, edge, belly_edge, tip);
+    [(channel::CELL_RANDOM, random), (channel::INSIDE, inside), (channel::ALONG, along), (channel::ROW, row)]
 }
 
 /// The scale-field channels the per-scale colour reads, for `scale_outputs`.
@@ -200,6 +197,12 @@ fn perlin(cells_u: u32, cells_v: u32, octaves: u32, gain: f32, seed: u32) -> Op 
 fn levels(g: &mut GraphBuilder, name: &str, input: NodeId, lo: f32, hi: f32) -> NodeId {
     g.add(name, Op::Levels { in_low: 0.0, in_high: 1.0, out_low: lo, out_high: hi }, &[input])
 }
+
+/// The soft edge of a band (stripes across, rings and a stripe's gaps along), a fraction of
+/// the circumference: 2 pixels of a 1024-wide map, so an edge is anti-aliased at the usual
+/// sizes and stays a line at 4K (`ops::shapes::bands` widens it to half a pixel where a map
+/// is smaller). Along a body atlas, divided by its length (the texture's v is the body's).
+const BAND_SOFTNESS: f32 = 0.002;
 
 /// The raw coverage shapes of a layer, each with its colour.
 fn shapes(
@@ -222,21 +225,20 @@ fn shapes(
             let (u0, u1) = s.lattice.row_span_u(layer.rows[0] as f32, layer.rows[1] as f32);
             let half_width = 0.5 * (u1 - u0);
             let centres = vec![0.5 * (u0 + u1), 1.0 - 0.5 * (u0 + u1)];
-            let op = Op::Bands { axis: Axis::U, centres, half_width, softness: 0.002 };
+            let op = Op::Bands { axis: Axis::U, centres, half_width, softness: BAND_SOFTNESS };
             vec![(g.add(name("shape"), op, &[]), layer.color())]
         }
         PatternKind::Stripes => {
             // `amount` stripes each side of the dorsal midline (u = 0.5), centre to centre
             // three stripe widths apart; the innermost at `offset` (or a named position).
-            let offset = layer.position.map_or(layer.offset, |p| p.offset()) as f32;
             let mut centres = Vec::new();
-            for d in stripe_distances(offset, size, layer.amount.round() as u32) {
+            for d in stripe_distances(layer) {
                 centres.push(0.5 + d);
                 if d > 0.0 {
                     centres.push(0.5 - d);
                 }
             }
-            let op = Op::Bands { axis: Axis::U, centres, half_width: size * 0.5, softness: 0.002 };
+            let op = Op::Bands { axis: Axis::U, centres, half_width: size * 0.5, softness: BAND_SOFTNESS };
             vec![(g.add(name("shape"), op, &[]), layer.color())]
         }
         PatternKind::Rings => {
@@ -271,7 +273,7 @@ fn shapes(
                     .map(|r| span.0 + (r as f32 + start + width * 0.5) / repeats * span_len)
                     .collect();
                 let half_width = width * 0.5 / repeats * span_len;
-                let op = Op::Bands { axis: Axis::V, centres, half_width, softness: 0.002 / s.field.length };
+                let op = Op::Bands { axis: Axis::V, centres, half_width, softness: BAND_SOFTNESS / s.field.length };
                 out.push((g.add(name(&format!("ring{k}")), op, &[]), color));
                 start += width;
             }
@@ -341,7 +343,7 @@ fn broken_stripes(
         .map(|k| (k as f32 + 0.5 + jitter * crate::ops::hash::signed(k, 0, 0, seed)) / count as f32)
         .collect();
     let half_width = 0.5 * layer.broken as f32 / count as f32;
-    let op = Op::Bands { axis: Axis::V, centres, half_width, softness: 0.002 / s.field.length };
+    let op = Op::Bands { axis: Axis::V, centres, half_width, softness: BAND_SOFTNESS / s.field.length };
     let gaps = g.add(name("gaps"), op, &[]);
     let kept = levels(g, &name("between_gaps"), gaps, 1.0, 0.0);
     super::masked(g, name("broken"), stripes, Some(kept))
@@ -377,17 +379,24 @@ fn blotches(s: &Shared, layer: &PatternLayer, seed: u32, scale: f32) -> Blotches
     }
 }
 
-/// The spot grid of a `spots` layer.
-fn spot_grid(s: &Shared, layer: &PatternLayer, seed: u32) -> SpotGrid {
+/// A `spots` layer's columns on each side or round the body (`amount`), the band of scale
+/// rows they lie on (`rows`, `Lattice::row_span_u`, as a stripe's; none: round the body), and
+/// its spots per circumference along the body: rows of spots lie as far apart as the columns
+/// across, `across` over the band's width (at most 4096). The loader bounds the spots'
+/// radius by this spacing (`validate`), so the two cannot disagree.
+pub fn spot_spacing(lattice: &Lattice, layer: &PatternLayer) -> (u32, Option<(f32, f32)>, u32) {
     let across = layer.amount.round().max(1.0) as u32;
-    // On named scale rows of each side (`Lattice::row_span_u`), as a stripe's.
-    let band = (layer.rows.len() == 2).then(|| s.lattice.row_span_u(layer.rows[0] as f32, layer.rows[1] as f32));
-    // Rows along the body as far apart as the columns across: `across` round the body, or
-    // `across` over the band's width.
+    let band = (layer.rows.len() == 2).then(|| lattice.row_span_u(layer.rows[0] as f32, layer.rows[1] as f32));
     let per_circumference = match band {
         Some((u0, u1)) => ((across as f32 / (u1 - u0).max(1e-3)).round() as u32).clamp(1, 4096),
         None => across,
     };
+    (across, band, per_circumference)
+}
+
+/// The spot grid of a `spots` layer.
+fn spot_grid(s: &Shared, layer: &PatternLayer, seed: u32) -> SpotGrid {
+    let (across, band, per_circumference) = spot_spacing(&s.lattice, layer);
     // On a body atlas, rows from the end of the head, where the layer's region starts
     // (`body::layer_region`), so that the first row's spots are whole, as a blotch series'
     // first blotch (`series`; spread over the whole length, the head's edge cut the first
@@ -455,11 +464,14 @@ fn series(s: &Shared, layer: &PatternLayer) -> (u32, (f32, f32)) {
 }
 
 /// How far each stripe of a stripes layer (not placed by `rows`) lies from the spine, one
-/// side, fractions of the circumference: `per_side` stripes three widths apart from `offset`
-/// out. What the generator draws and validation checks (a stripe past the belly's midline
-/// wraps onto the other side's: `preset::validate`).
-pub fn stripe_distances(offset: f32, size: f32, per_side: u32) -> impl Iterator<Item = f32> {
-    (0..per_side).map(move |k| offset + k as f32 * size * 3.0)
+/// side, fractions of the circumference: `amount` (rounded) stripes three widths (`size`)
+/// apart from `offset` (or its named `position`) out. What the generator draws and
+/// validation checks (a stripe past the belly's midline wraps onto the other side's:
+/// `preset::validate`), from the layer's keys, so the two read them alike.
+pub fn stripe_distances(layer: &PatternLayer) -> impl Iterator<Item = f32> {
+    let offset = layer.position.map_or(layer.offset, |p| p.offset()) as f32;
+    let size = layer.size as f32;
+    (0..layer.amount.round() as u32).map(move |k| offset + k as f32 * size * 3.0)
 }
 
 /// A layer snapped fully to whole scales (each scale takes the pattern at its centre).
@@ -502,9 +514,18 @@ impl WholeScaleRingRows {
         bands_fit(self.bands, self.per_repeat, self.per_band)
     }
 
-    /// The most repeats over `stretch` at which every band fits.
+    /// The most repeats over `stretch` at which every band fits (`bands_fit`, so a count
+    /// the warning names is one it does not warn of).
     pub fn most_repeats(&self) -> u32 {
-        (self.stretch / (self.bands as f32 * self.per_band)).floor() as u32
+        let fit = |n: u32| n == 0 || bands_fit(self.bands, self.stretch / n as f32, self.per_band);
+        let mut n = (self.stretch / (self.bands as f32 * self.per_band)).floor().max(0.0) as u32;
+        while !fit(n) {
+            n -= 1;
+        }
+        while fit(n + 1) {
+            n += 1;
+        }
+        n
     }
 }
 
@@ -518,7 +539,7 @@ fn whole_scale_ring_rows(s: &Shared, layer: &PatternLayer) -> Option<WholeScaleR
     let (repeats, span) = series(s, layer);
     let rows = s.lattice.rows_v as f32;
     let widths = ring_sequence(layer).1;
-    let gap = 1.0 - widths.iter().sum::<f32>() > 1e-6;
+    let gap = gap_band(widths.iter().sum()).is_some();
     // A counted series: its count over the trunk (it runs on down the tail at that spacing).
     let stretch = match (s.body(), layer.series_count()) {
         (Some(plan), Some(_)) => rows * (plan.vent - plan.neck_end),
@@ -534,21 +555,24 @@ fn whole_scale_ring_rows(s: &Shared, layer: &PatternLayer) -> Option<WholeScaleR
 }
 
 /// The ring layers of `preset` drawn in whole scales whose bands do not fit their repeat
-/// (`WholeScaleRingRows::fits`): on the tile, by `amount`; on the body atlas, by `count`
-/// (checked for every preset, as the body's keys are range-checked on the tile too). Each
-/// with its layer's index and the layout.
+/// (`WholeScaleRingRows::fits`): on the tile, by `amount`; on the body atlas, by `count`, or
+/// by `amount` where the layer has no count (checked for every preset, as the body's keys
+/// are range-checked on the tile too). An uncounted layer repeats `amount` times a
+/// circumference on both, but the body rounds its repeats and its scale rows over the whole
+/// length each on its own (`Shared::along_count`), so a layer that fits the tile can be a few
+/// rows short on the body (a review); warned of once, on the tile, where both fall short.
+/// Each with its layer's index and the layout.
 pub fn ring_layers_that_do_not_fit(preset: &Preset) -> Vec<(usize, super::Layout, WholeScaleRingRows)> {
-    let mut found = Vec::new();
+    let mut found: Vec<(usize, super::Layout, WholeScaleRingRows)> = Vec::new();
+    let rings_in_whole_scales = preset.pattern.iter().any(|l| l.kind == PatternKind::Rings && fully_snapped(l));
+    if !rings_in_whole_scales {
+        return found;
+    }
     for layout in [super::Layout::Tile, super::Layout::Body] {
-        let counted = |layer: &PatternLayer| layer.series_count().is_some();
-        if layout == super::Layout::Body && !preset.pattern.iter().any(counted) {
-            continue;
-        }
         let s = Shared::new(&mut GraphBuilder::new(), preset, layout);
         for (i, layer) in preset.pattern.iter().enumerate() {
-            // On the body, the counted layers only: the others repeat per circumference, as
-            // on the tile.
-            if layout == super::Layout::Body && !counted(layer) {
+            let uncounted_and_warned = layer.series_count().is_none() && found.iter().any(|(j, ..)| *j == i);
+            if uncounted_and_warned {
                 continue;
             }
             if let Some(rows) = whole_scale_ring_rows(&s, layer).filter(|rows| !rows.fits()) {
@@ -557,6 +581,21 @@ pub fn ring_layers_that_do_not_fit(preset: &Preset) -> Vec<(usize, super::Layout
         }
     }
     found
+}
+
+/// Whether `bands` bands of at least `floor_cells` scale rows each fit a repeat of
+/// `cells_per_repeat` rows (a ten-thousandth over is taken as fitting: rounding). The one
+/// test of it: `rings_of_whole_scales` keeps equal shares where it fails, and the loader
+/// warns (`WholeScaleRingRows::fits`).
+fn bands_fit(bands: usize, cells_per_repeat: f32, floor_cells: f32) -> bool {
+    bands as f32 * floor_cells <= cells_per_repeat.max(1e-3) * (1.0 + 1e-4)
+}
+
+/// The uncoloured rest of a ring sequence's repeat, whose colours take `drawn` of it: a band
+/// too, which separates repeats (none where the colours fill the repeat, to a millionth).
+fn gap_band(drawn: f32) -> Option<f32> {
+    let gap = (1.0 - drawn).max(0.0);
+    (gap > 1e-6).then_some(gap)
 }
 
 /// Ring widths (fractions of one repeat) for a ring sequence drawn in whole scales, so that
@@ -577,30 +616,17 @@ pub fn ring_layers_that_do_not_fit(preset: &Preset) -> Vec<(usize, super::Layout
 /// for it keeps equal shares (and the loader warns of it: `ring_layers_that_do_not_fit`).
 /// `cells_per_repeat` = scale rows along the body per repeat. (Measured: with the
 /// outline's length alone, no rotation, red met black at 2048² with jitter 0.3.)
-/// Whether `bands` bands of at least `floor_cells` scale rows each fit a repeat of
-/// `cells_per_repeat` rows (a ten-thousandth over is taken as fitting: rounding). The one
-/// test of it: `rings_of_whole_scales` keeps equal shares where it fails, and the loader
-/// warns (`WholeScaleRingRows::fits`).
-fn bands_fit(bands: usize, cells_per_repeat: f32, floor_cells: f32) -> bool {
-    bands as f32 * floor_cells <= cells_per_repeat * (1.0 + 1e-4)
-}
-
 pub fn rings_of_whole_scales(widths: &[f32], cells_per_repeat: f32, floor_cells: f32) -> Vec<f32> {
     let floor = floor_cells / cells_per_repeat.max(1e-3);
-    let drawn: f32 = widths.iter().sum();
-    // The uncoloured rest of the repeat is a band too: it separates repeats.
-    let gap = (1.0 - drawn).max(0.0);
     let mut all = widths.to_vec();
-    if gap > 1e-6 {
-        all.push(gap);
-    }
+    all.extend(gap_band(widths.iter().sum()));
     // The bands held at the floor, first those narrower than it; then any the others'
     // giving takes below it, until none is (at most once per band).
     let mut held: Vec<bool> = all.iter().map(|w| *w < floor).collect();
     if !held.contains(&true) {
         return widths.to_vec();
     }
-    if !bands_fit(all.len(), cells_per_repeat.max(1e-3), floor_cells) {
+    if !bands_fit(all.len(), cells_per_repeat, floor_cells) {
         return vec![1.0 / all.len() as f32; widths.len()];
     }
     loop {

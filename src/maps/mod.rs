@@ -18,7 +18,9 @@ use crate::preset::Preset;
 use crate::preset::schema::{self, IridescenceGradient};
 
 pub use crate::material::MapKind;
-pub use color::{WholeScaleRingRows, ring_layers_that_do_not_fit, rings_of_whole_scales, stripe_distances};
+pub use color::{
+    WholeScaleRingRows, ring_layers_that_do_not_fit, rings_of_whole_scales, spot_spacing, stripe_distances,
+};
 
 /// What one texture set covers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

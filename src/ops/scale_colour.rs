@@ -98,6 +98,16 @@ pub struct ScaleColour {
 }
 
 impl ScaleColour {
+    /// Which scale-field planes the per-scale colour reads besides the crevice, in
+    /// `ScaleChannels`' order (random, inside, along, row): the cell's random numbers for
+    /// tone and hue, the distance inside the outline for either rim, the position along the
+    /// scale for tips, the dorsal row where the back's and the belly's rims differ. The graph
+    /// asks here which planes to make (`maps::color`), and `apply` which to read, so a plane
+    /// left out is never read (the two once wrote the conditions apart, `> 0` and `!= 0`).
+    pub fn reads(tone: f32, hue: f32, edge: f32, belly_edge: f32, tip: f32) -> [bool; 4] {
+        [tone != 0.0 || hue != 0.0, edge != 0.0 || belly_edge != 0.0, tip != 0.0, edge != belly_edge]
+    }
+
     /// Applies the per-scale colour to `colour` (linear RGB) with the scale field `scales`.
     /// `frame`: the rows of the texture the images hold.
     pub fn apply(&self, colour: Image, scales: &Image, frame: super::image::Frame) -> Image {
@@ -120,11 +130,11 @@ impl ScaleColour {
                 false => &[][..],
             };
             let crevices = field_row(k.crevice);
-            let randoms = read(self.tone != 0.0 || self.hue != 0.0, k.random);
-            let rims = self.edge != 0.0 || self.belly_edge != 0.0;
+            let [random, rims, along, dorsal] = Self::reads(self.tone, self.hue, self.edge, self.belly_edge, self.tip);
+            let randoms = read(random, k.random);
             let insides = read(rims, k.inside);
-            let dorsal_rows = read(self.edge != self.belly_edge, k.row);
-            let alongs = read(self.tip != 0.0, k.along);
+            let dorsal_rows = read(dorsal, k.row);
+            let alongs = read(along, k.along);
             // The scale's second random number, hashed once per run of pixels of one scale
             // (a scale spans many pixels of a row), not once per pixel.
             let mut second_of: (u32, f32) = (u32::MAX, 0.0);

@@ -204,16 +204,30 @@ impl Lattice {
     }
 }
 
+/// Guards of a field built without the loader (tests, the gallery), each wider than its
+/// preset key's range (`preset::validate::ranges`, which asserts it, so a range widened past a
+/// guard fails to compile rather than being cut silently): the narrowest row a vertebral or
+/// lowest row can be (`ROW_WIDTH`), the widest belly (`BELLY_WIDTH`; 1 leaves no dorsal
+/// rows), the softest-edge floor (`EDGE_SOFTNESS`; 0 divides by zero), and `JITTER_MAX`.
+pub(crate) const ROW_WIDTH_FLOOR: f32 = 0.1;
+pub(crate) const BELLY_WIDTH_CEILING: f32 = 0.9;
+pub(crate) const EDGE_SOFTNESS_FLOOR: f32 = 1e-4;
+
 impl ScaleField {
+    /// `edge_softness`, kept off zero (`EDGE_SOFTNESS_FLOOR`).
+    fn softness(&self) -> f32 {
+        self.edge_softness.max(EDGE_SOFTNESS_FLOOR)
+    }
+
     pub fn lattice(&self) -> Lattice {
         let rows = self.rows.max(1) as i32;
         // Relative width of each dorsal row, 1 the lowest.
         let vertebral = (rows % 2 == 1).then_some((rows + 1) / 2);
         let width_of_row = |k: i32| {
             if Some(k) == vertebral {
-                self.vertebral_width.max(0.1)
+                self.vertebral_width.max(ROW_WIDTH_FLOOR)
             } else if k == 1 {
-                self.lowest_row_width.max(0.1)
+                self.lowest_row_width.max(ROW_WIDTH_FLOOR)
             } else {
                 1.0
             }
@@ -221,7 +235,7 @@ impl ScaleField {
         let dorsal: f32 = (1..=rows).map(|k| width_of_row(k.min(rows + 1 - k))).sum();
         let belly_cols = if self.belly_width > 0.0 {
             // Even, at least 2: an equal number of plate columns each side of u = 0.
-            let bw = self.belly_width.min(0.9);
+            let bw = self.belly_width.min(BELLY_WIDTH_CEILING);
             2 * ((dorsal * bw / (2.0 * (1.0 - bw))).round() as i32).max(1)
         } else {
             0
@@ -273,7 +287,7 @@ struct CellTable {
 /// What `jitter` (at most `JITTER_MAX`) moves per unit: a cell's centre up to ±`JITTER_OFFSET`
 /// cells each way, its outline's angle up to ±`JITTER_ANGLE_RAD`, its size up to
 /// ±`JITTER_SIZE` of itself (`CellTable`; `longest_reach_cells` bounds what they reach).
-const JITTER_MAX: f32 = 0.5;
+pub(crate) const JITTER_MAX: f32 = 0.5;
 const JITTER_OFFSET: f32 = 0.5;
 const JITTER_ANGLE_RAD: f32 = 0.6;
 const JITTER_SIZE: f32 = 0.4;
@@ -714,7 +728,7 @@ impl ScaleField {
         // lies on top, its free posterior edge over the scale behind. Its rim falls towards
         // the scale underneath, which leaves a groove along every free edge: the visible
         // crevice between scales.
-        let soft = self.edge_softness.max(1e-4);
+        let soft = self.softness();
         let profile = |inside: f32, y: f32| {
             let along = (y / geo.b * 0.5 + 0.5).clamp(0.0, 1.0);
             SCALE_PROFILE.at(smoothstep(0.0, 0.35, inside), self.imbrication, along)
@@ -838,7 +852,7 @@ impl ScaleField {
             centre_v: c1.centre_v,
             row: c1.row,
         };
-        let soft = self.edge_softness.max(1e-4);
+        let soft = self.softness();
         let along = (cand.y / half_len * 0.5 + 0.5).clamp(0.0, 1.0);
         let rim = smoothstep(0.0, soft, inside);
         let dome = smoothstep(0.0, 0.35, inside);
@@ -848,7 +862,7 @@ impl ScaleField {
     }
 
     fn write_scale(&self, best: Option<Candidate>, height: f32, keel_height: f32, out: &mut [f32]) {
-        let soft = self.edge_softness.max(1e-4);
+        let soft = self.softness();
         match best {
             None => {
                 out[channel::HEIGHT] = 0.0;
@@ -947,7 +961,7 @@ impl ScaleField {
     /// like the dorsal scales (the thesis stretches normal scales "from the middle",
     /// §4.2.2); `side` the pixel's side of the midline (0 for u < 1/2), for divided plates.
     fn plate_pixel(&self, lattice: &Lattice, plates: &PlateRow, dist_belly: f32, side: usize, out: &mut [f32]) {
-        let soft = self.edge_softness.max(1e-4);
+        let soft = self.softness();
         let half_band = lattice.belly_width() * 0.5;
         // Distances in dorsal scale widths, the unit of `edge_softness` (a plate column is
         // one ordinary column wide).
@@ -1008,7 +1022,7 @@ impl ScaleField {
         // In ordinary column widths, the unit of `edge_softness`.
         let cell = lattice.bounds[1];
         let inside = inside_circ / cell;
-        let soft = self.edge_softness.max(1e-4);
+        let soft = self.softness();
         let half_len = 0.5 * (plate.v_range.1 - plate.v_range.0) * body.length / cell;
         let cand = Candidate {
             inside,

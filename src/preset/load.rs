@@ -316,7 +316,7 @@ pub fn parse_with_seed(
     Ok(LoadedPreset {
         name: source.name.clone(),
         preset,
-        content_hash: format!("{:016x}", fnv1a64(canonical.as_bytes())),
+        content_hash: format!("{:016x}", crate::ops::hash::fnv1a64(canonical.as_bytes())),
         clamped_colours,
         warned,
         sets_no_key,
@@ -808,10 +808,6 @@ fn override_value(value: &str) -> Result<toml::Value, String> {
             }
         }
     }
-}
-
-fn fnv1a64(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ *b as u64).wrapping_mul(0x0000_0100_0000_01b3))
 }
 
 #[cfg(test)]

@@ -95,7 +95,15 @@ pub mod ranges {
     /// Ventral counts in snakes run from about 100 to over 400.
     pub const VENTRALS: (u32, u32) = (60, 500);
     pub const SUBCAUDALS: (u32, u32) = (5, 250);
+    // The scale field's own guards lie outside these ranges (`ops::scales`).
+    const _: () = assert!(JITTER.1 as f32 <= crate::ops::scales::JITTER_MAX);
+    const _: () = assert!(ROW_WIDTH.0 as f32 >= crate::ops::scales::ROW_WIDTH_FLOOR);
+    const _: () = assert!(BELLY_WIDTH.1 as f32 <= crate::ops::scales::BELLY_WIDTH_CEILING);
+    const _: () = assert!(EDGE_SOFTNESS.0 as f32 >= crate::ops::scales::EDGE_SOFTNESS_FLOOR);
     pub const TAIL_BANDS: (u32, u32) = (0, 60);
+    /// A tail band's share of its repeat: below 1, so bands and the gaps between them both
+    /// have a length (`maps::body::marks` keeps its knots in order by it).
+    pub const TAIL_BAND_WIDTH: (f64, f64) = (0.05, 0.95);
     /// Marks counted along the trunk.
     pub const MARK_COUNT: (u32, u32) = (1, 200);
     pub const HEAD_MARK_SIZE: (f64, f64) = (0.3, 2.0);
@@ -190,16 +198,37 @@ fn rings_not_kept_apart(preset: &Preset) -> Vec<Problem> {
         .into_iter()
         .map(|(i, layout, rows)| {
             let layer = &preset.pattern[i];
-            let (key, on, value) = match layout {
-                crate::maps::Layout::Tile => ("amount", "per tile", shown(layer.amount)),
-                crate::maps::Layout::Body => ("count", "along the trunk", layer.count.unwrap_or(0).to_string()),
-            };
             let most = rows.most_repeats();
-            let keep = if most >= 1 {
-                format!("at most {most} {on} keep them")
-            } else {
-                "not one repeat keeps them: fewer colours, or larger scales (fewer `scales.rows`)".into()
+            let (key, value, keep) = match (layout, layer.count) {
+                (crate::maps::Layout::Tile, _) => {
+                    ("amount", shown(layer.amount), (most >= 1).then(|| format!("at most {most} per tile keep them")))
+                }
+                (crate::maps::Layout::Body, Some(count)) => (
+                    "count",
+                    count.to_string(),
+                    (most >= 1).then(|| format!("at most {most} along the trunk keep them")),
+                ),
+                // The body repeats an uncounted layer round(amount) × length times, rounded
+                // (`Shared::along_count`): the largest whole amount whose repeats are at most
+                // `most`.
+                (crate::maps::Layout::Body, None) => {
+                    let length = preset.body.length;
+                    let repeats = |a: u32| (f64::from(a) * length).round();
+                    let largest =
+                        (1..=ranges::RINGS_PER_TILE.1 as u32).take_while(|a| repeats(*a) <= f64::from(most)).last();
+                    let keep = largest.map(|a| {
+                        format!(
+                            "`amount` {a} or less keeps them ({} repeats along the body atlas at `body.length` {})",
+                            repeats(a),
+                            shown(length)
+                        )
+                    });
+                    ("amount", format!("{} on the body atlas", shown(layer.amount)), keep)
+                }
             };
+            let keep = keep.unwrap_or_else(|| {
+                "not one repeat keeps them: fewer colours, or larger scales (fewer `scales.rows`)".into()
+            });
             let gap = if rows.gap { " and the gap between repeats" } else { "" };
             Problem {
                 key: format!("pattern.{i}.{key}"),
@@ -553,15 +582,19 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         c.range(key("phase"), p.phase, UNIT);
         c.range(key("center_size"), p.center_size, CENTER_SIZE);
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
-        if !p.rows.is_empty() && matches!(p.kind, PatternKind::Stripes | PatternKind::Spots) {
+        let rows_ok = {
             let rows = rows_bounding(preset.scales.rows);
             let top = (rows as f64 + 1.0) / 2.0;
-            let ok = p.rows.len() == 2
+            p.rows.len() == 2
                 && p.rows.iter().all(|r| r.is_finite())
                 && 0.5 <= p.rows[0]
                 && p.rows[0] <= p.rows[1]
-                && p.rows[1] <= top;
-            if !ok {
+                && p.rows[1] <= top
+        };
+        if !p.rows.is_empty() && matches!(p.kind, PatternKind::Stripes | PatternKind::Spots) {
+            let rows = rows_bounding(preset.scales.rows);
+            let top = (rows as f64 + 1.0) / 2.0;
+            if !rows_ok {
                 c.problems.push(Problem {
                     key: key("rows"),
                     message: format!(
@@ -578,21 +611,38 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         c.range(key("size"), p.size, PATTERN_SIZE);
         // Spots' radius against their spacing: what the two ranges above allow together
         // (0.5 with 64 around) covers each point thousands of times. Checked only where both
-        // are in their ranges (a size already refused is not refused twice).
+        // are in their ranges (a size already refused is not refused twice). On a band of
+        // `rows` the spots lie as far apart as the band's width over `amount`, along the body
+        // too (`maps::spot_spacing`): 64 over the lowest row of 19 (0.04 of the
+        // circumference) at size 0.03 put 48 spacings in a radius, and a body atlas 64 pixels
+        // wide took 37 s (a review found the check counting `amount` round the body).
         let around = p.amount.round();
         let in_ranges = (1.0..=SPOTS_AROUND.1).contains(&around) && (PATTERN_SIZE.0..=PATTERN_SIZE.1).contains(&p.size);
-        if p.kind == PatternKind::Spots && in_ranges {
-            let most = SPOT_RADIUS_SPACINGS / around;
+        let scale_rows_in_range = (ROWS.0..=ROWS.1).contains(&preset.scales.rows);
+        if p.kind == PatternKind::Spots && in_ranges && (p.rows.is_empty() || (rows_ok && scale_rows_in_range)) {
+            let lattice = crate::maps::scale_field(preset, crate::maps::Layout::Tile).lattice();
+            let (_, band, per_circumference) = crate::maps::spot_spacing(&lattice, p);
+            let per_circumference = f64::from(per_circumference);
+            let most = SPOT_RADIUS_SPACINGS / per_circumference;
             if p.size > most {
+                let spacing = match band {
+                    Some(_) => format!(
+                        "{around} spots across rows [{}, {}] (`amount`, `rows`), {per_circumference} per circumference",
+                        shown(p.rows[0]),
+                        shown(p.rows[1])
+                    ),
+                    None => format!("{around} spots around (`amount`)"),
+                };
                 c.problems.push(Problem {
                     key: key("size"),
                     message: format!(
-                        "is {} with {around} spots around (`amount`), a radius of {} spacings between spots; at most \
-                         {SPOT_RADIUS_SPACINGS} spacings are accepted (size ≤ {} at this amount): larger spots overlap \
-                         each point more than a dozen deep (for a layer that covers the skin, use kind \"solid\")",
+                        "is {} with {spacing}, a radius of {} spacings between spots; at most \
+                         {SPOT_RADIUS_SPACINGS} spacings are accepted (size ≤ {} at this spacing): larger spots \
+                         overlap each point more than a dozen deep (for a layer that covers the skin, use kind \
+                         \"solid\")",
                         shown(p.size),
                         // Rounded up, so a radius just past the limit does not print as the limit.
-                        shown((p.size * around * 1e3).ceil() / 1e3),
+                        shown((p.size * per_circumference * 1e3).ceil() / 1e3),
                         // Rounded down, so the number printed is itself accepted.
                         shown((most * 1e4).floor() / 1e4)
                     ),
@@ -612,9 +662,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
             && (PATTERN_SIZE.0..=PATTERN_SIZE.1).contains(&p.size)
             && (PATTERN_OFFSET.0..=PATTERN_OFFSET.1).contains(&offset);
         if p.kind == PatternKind::Stripes && p.rows.is_empty() && stripes_in_ranges && per_side >= 2.0 {
-            let (offset32, size32) = (offset as f32, p.size as f32);
-            let edges: Vec<f32> =
-                crate::maps::stripe_distances(offset32, size32, per_side as u32).map(|d| d + 0.5 * size32).collect();
+            let edges: Vec<f32> = crate::maps::stripe_distances(p).map(|d| d + 0.5 * p.size as f32).collect();
             let outer_edge = edges.last().copied().unwrap_or(0.0);
             if outer_edge > 0.5 + 1e-6 {
                 let most = edges.iter().filter(|edge| **edge <= 0.5 + 1e-6).count().max(1);
@@ -686,7 +734,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
     c.whole_number("body.subcaudals", b.subcaudals, s.rows);
     c.range("body.tail_shift_start", b.tail_shift_start, UNIT);
     c.whole_number("body.tail_bands", b.tail_bands, s.rows);
-    c.range("body.tail_band_width", b.tail_band_width, (0.05, 0.95));
+    c.range("body.tail_band_width", b.tail_band_width, TAIL_BAND_WIDTH);
     c.range("body.tip_fraction", b.tip_fraction, UNIT);
     // A key that shapes what another draws, without that other (the review found
     // `tail_band_width` without `tail_bands`, `tip_fraction` without `tip_color` and

@@ -78,8 +78,8 @@ pub fn plan_sheet(options: SheetOptions, layout: Layout, species: &[String]) -> 
         Layout::Body => {
             // `tile` is the strip's height, one circumference; the longest body sets the
             // strips' length, all at one scale.
-            let longest = species.iter().map(|(_, l)| l.preset.body.length).fold(1.0f64, f64::max);
-            let strip_w = (longest * tile as f64).round() as u32;
+            let strip_w = species.iter().map(|(_, l)| Layout::Body.height(&l.preset, tile as usize)).max().unwrap_or(0);
+            let strip_w = strip_w.max(tile as usize) as u32;
             let (render_w, render_h) = (4 * tile, 2 * tile);
             let label_h = LABEL_HEIGHT + 8 * LABEL_SCALE + 6;
             let closeups_w = if options.closeups { 2 * (render_h + 6) } else { 0 };
@@ -271,7 +271,7 @@ fn render_body_sheet(
         drop(evaluation);
         let strip = imageops::rotate270(&atlas);
         drop(atlas);
-        let length_px = (preset.body.length * circumference as f64).round() as u32;
+        let length_px = Layout::Body.height(preset, circumference as usize) as u32;
         let strip = imageops::resize(&strip, length_px, circumference, imageops::FilterType::Triangle);
         let material = renderer.material(&maps, optics, lut_for(&mut luts, optics), 1)?;
         drop(maps);
@@ -341,7 +341,7 @@ fn check_sheet_memory(plan: &SheetPlan) -> Result<(), Error> {
             let tile = plan.options.tile as u64;
             let (strip, source_width) = match layout {
                 Layout::Tile => (tile * tile, width as u64),
-                Layout::Body => ((l.preset.body.length * tile as f64).round() as u64 * tile, height as u64),
+                Layout::Body => (Layout::Body.height(&l.preset, tile as usize) as u64 * tile, height as u64),
             };
             let colour_bytes = (width * height) as u64 * 3 * 2 + source_width * tile * 16 + strip * 3;
             let memory = DrawMemory {
