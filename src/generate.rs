@@ -441,7 +441,7 @@ impl Plan {
         let mut manifest =
             export::manifest(&loaded, (size, height), entries, request.options, request.format.name(), None);
         manifest.job = request.job.clone();
-        let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
+        let json = export::manifest_json(&manifest)?;
         let manifest_name = export::manifest_file_name(&loaded.name);
         let encode_time = encode_time + encode_start.elapsed();
 
@@ -512,7 +512,7 @@ impl Plan {
         let mut manifest =
             export::manifest(&self.loaded, (self.size, self.height), entries, options, "png", Some(pack));
         manifest.job = self.request.job.clone();
-        let json = serde_json::to_vec_pretty(&manifest).map_err(|e| Error::Internal(format!("manifest: {e}")))?;
+        let json = export::manifest_json(&manifest)?;
         let written = lock.write(&files, (&export::manifest_file_name(name), &json))?;
         let strips = strips_of(&self.graph, &self.maps, self.size, self.height);
         Ok(GenerateReport {

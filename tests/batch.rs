@@ -974,7 +974,9 @@ fn a_batch_writes_over_no_job_preset() {
     assert_eq!(std::fs::read_to_string(&under_index).unwrap(), text, "the preset stays");
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "refused before any job");
 
-    // Job 2's preset saved where job 1's colour map goes.
+    // Job 2's preset saved where job 1's colour map goes (the first case's preset moved
+    // away: a file of another kind where the index goes is refused of itself).
+    std::fs::remove_file(&under_index).unwrap();
     let set = out.join("natrix-natrix/tile-16-seed1-png");
     std::fs::create_dir_all(&set).unwrap();
     let in_set = set.join("natrix-natrix_color.png");

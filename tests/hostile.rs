@@ -2244,3 +2244,137 @@ fn a_gltf_file_name_that_is_not_utf8_is_refused() {
     assert!(ended.status.success(), "{}", stderr(&ended));
     assert!(out.is_file() && dir.path().join("bad\u{ff}.bin").is_file());
 }
+
+/// From a hostile-input sweep: a run never writes a manifest its own readers refuse. A
+/// species of 600,000 quotes (a preset under its 1 MiB limit) doubles in JSON; the manifest
+/// limit was 1 MiB and `verify` refused the set just written, the next run could not read
+/// it (and left a mixed set behind), a batch redid its job for ever. Now `verify` takes it.
+#[test]
+fn the_longest_preset_writes_a_manifest_its_readers_take() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!("species = '{}'\n", "\"".repeat(600_000));
+    let preset = write_preset(dir.path(), "q.toml", &text);
+    let out = dir.path().join("out");
+    let run = snakeskin(&["generate", &preset, "-o", out.to_str().unwrap(), "--size", "16"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let manifest = std::fs::metadata(out.join("q.material.json")).unwrap().len();
+    assert!(manifest > 1 << 20, "the case: a manifest over the old limit, {manifest} bytes");
+    let verified = snakeskin(&["verify", out.to_str().unwrap()]);
+    assert!(verified.status.success(), "{}{}", stdout(&verified), stderr(&verified));
+}
+
+/// From a hostile-input sweep: a run killed while renaming, after it moved the old set aside
+/// and before it moved the new one in, leaves the set only in hidden temporaries; `verify`
+/// passed them over and said `ok` for the folder's other set. Now such a set is FAILED (exit
+/// 1), named; the control: the temporaries gone (nothing of the set left), `ok` again.
+#[test]
+fn verify_fails_a_set_left_only_in_temporaries() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for species in ["natrix-natrix", "vipera-berus"] {
+        let run = snakeskin(&["generate", species, "-o", d.to_str().unwrap(), "--size", "16"]);
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
+    // The state the kill leaves: every file of the set moved aside, as a commit names them.
+    let set_files: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("natrix-natrix"))
+        .collect();
+    assert!(set_files.len() > 2);
+    for (k, name) in set_files.iter().enumerate() {
+        std::fs::rename(d.join(name), d.join(format!(".{name}.AbC{k:03}.snakeskin-tmp"))).unwrap();
+    }
+    let out = snakeskin(&["verify", d.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stdout(&out));
+    let said = stdout(&out);
+    assert!(said.contains("ok ") && said.contains("vipera-berus.material.json"), "{said}");
+    let failed = format!(
+        "FAILED set {}: no manifest and none of its files, only {} hidden temporaries",
+        d.join("natrix-natrix").display(),
+        set_files.len()
+    );
+    assert!(said.contains(&failed), "{said}");
+    for (k, name) in set_files.iter().enumerate() {
+        std::fs::remove_file(d.join(format!(".{name}.AbC{k:03}.snakeskin-tmp"))).unwrap();
+    }
+    let out = snakeskin(&["verify", d.to_str().unwrap()]);
+    assert!(out.status.success(), "the control: {}", stdout(&out));
+}
+
+/// From a hostile-input sweep: `verify DIR` looks for sets two folders down (a batch's
+/// depth) and said `ok` for a folder holding batch outputs one level deeper, their sets
+/// unchecked, without a word. Now it names the folders it did not search (on stderr); the
+/// control: a folder with nothing deeper gets no such note.
+#[test]
+fn verify_says_which_folders_it_did_not_search() {
+    let dir = tempfile::tempdir().unwrap();
+    let deep = dir.path().join("a/b/c");
+    let run = snakeskin(&["generate", "natrix-natrix", "-o", deep.to_str().unwrap(), "--size", "16"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let shallow = dir.path().join("a/loose");
+    let run = snakeskin(&["generate", "natrix-natrix", "-o", shallow.to_str().unwrap(), "--size", "16"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let out = snakeskin(&["verify", dir.path().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let note = format!("1 folder deeper not searched, the first {}", dir.path().join("a/b/c").display());
+    assert!(stderr(&out).contains(&note), "{}", stderr(&out));
+    let out = snakeskin(&["verify", dir.path().join("a").to_str().unwrap()]);
+    assert!(out.status.success() && !stderr(&out).contains("not searched"), "the control: {}", stderr(&out));
+}
+
+/// From a hostile-input sweep: `-o x/.` for a missing `x` failed ("cannot create folder
+/// x/.: No such file or directory") where `mkdir -p x/.` makes it.
+#[test]
+fn an_output_folder_named_with_a_trailing_dot_is_made() {
+    let dir = tempfile::tempdir().unwrap();
+    for path in ["x/.", "y/./z/."] {
+        let out = dir.path().join(path);
+        let run =
+            snakeskin(&["generate", "natrix-natrix", "-o", out.to_str().unwrap(), "--size", "16", "--maps", "color"]);
+        assert!(run.status.success(), "{path}: {}", stderr(&run));
+        assert!(out.join("natrix-natrix_color.png").is_file(), "{path}");
+    }
+}
+
+/// From a hostile-input sweep: files the tool names itself in a folder the user gave
+/// replaced a file of another kind standing there without a word (a web page named
+/// `index.json` in a batch's folder, a text file named `rows.png` among the close-ups). Now
+/// refused (exit 2) before any work, the file untouched; the control: an earlier run's file
+/// of that name is replaced as before.
+#[test]
+fn files_the_tool_names_itself_replace_only_their_own_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    let out = dir.path().join("o");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("index.json"), "<html>site</html>\n").unwrap();
+    let before = snapshot(&out);
+    let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
+    assert!(stderr(&run).contains("index.json exists and is not a batch index this tool wrote"), "{}", stderr(&run));
+    assert_eq!(snapshot(&out), before);
+    // The control: the batch's own index is replaced by the next run.
+    std::fs::remove_file(out.join("index.json")).unwrap();
+    for _ in 0..2 {
+        let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
+    let closeups = dir.path().join("cu");
+    std::fs::create_dir(&closeups).unwrap();
+    std::fs::write(closeups.join("rows.png"), "precious\n").unwrap();
+    let gallery = dir.path().join("g.png");
+    let run = snakeskin(&[
+        "gallery",
+        "-o",
+        gallery.to_str().unwrap(),
+        "--tile",
+        "16",
+        "--closeups",
+        closeups.to_str().unwrap(),
+    ]);
+    assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
+    assert_eq!(std::fs::read(closeups.join("rows.png")).unwrap(), b"precious\n");
+    assert!(!gallery.exists());
+}

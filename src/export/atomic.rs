@@ -286,6 +286,15 @@ fn listed_temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::
     Ok(tmp)
 }
 
+/// The file name a temporary in a folder listing stands for (`.NAME.RANDOM.snakeskin-tmp`:
+/// `NAME`), None for any other name; a name cut to fit (`temporary_stem`) comes back cut.
+/// `verify` finds by it the sets a run left only in temporaries (killed while renaming).
+pub fn temporary_target(file_name: &str) -> Option<&str> {
+    let inner = file_name.strip_prefix('.')?.strip_suffix(TMP_SUFFIX)?;
+    let (target, random) = inner.rsplit_once('.')?;
+    (random.len() == RANDOM_CHARS && !target.is_empty()).then_some(target)
+}
+
 /// A new, empty temporary for `target_name` in `dir` (`.NAME.RANDOM.snakeskin-tmp`, created
 /// exclusively): a map being staged, or the place an old file is moved aside to.
 fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTempFile> {
@@ -387,7 +396,8 @@ pub fn check_target_named(target: &Path, format: &'static str) -> Result<(), Exp
 /// Whether the file at `path` begins as a file of `format` does (`png`: its 8-byte
 /// signature, PNG spec §5.2; `svg`: `<svg` after any white space, or an XML declaration
 /// with an `<svg` element within its first KiB: any other XML file, a settings file, is not
-/// an SVG, as an independent review found it taken for one). An empty file counts as any
+/// an SVG, as an independent review found it taken for one; `batch index`: a JSON object
+/// with snakeskin's `generator` first). An empty file counts as any
 /// format's (nothing is lost replacing it).
 fn holds_format(path: &Path, format: &str) -> bool {
     use std::io::Read;
@@ -401,12 +411,32 @@ fn holds_format(path: &Path, format: &str) -> bool {
     }
     match format {
         "png" => head.starts_with(b"\x89PNG\r\n\x1a\n"),
+        // A batch's index: a JSON object whose first key is `generator`, snakeskin's
+        // (`batch::BatchIndex`).
+        "batch index" => {
+            let text = head.trim_ascii_start();
+            let generator = b"\"generator\": \"snakeskin\"";
+            text.starts_with(b"{") && text.windows(generator.len()).take(64).any(|w| w == generator)
+        }
         "svg" => {
             let text = head.trim_ascii_start();
             text.starts_with(b"<svg") || (text.starts_with(b"<?xml") && text.windows(4).any(|w| w == b"<svg"))
         }
         _ => false,
     }
+}
+
+/// For a file the tool names itself in a folder the user gave (a batch's index, a gallery's
+/// close-ups, the figures), after `check_target` and the check against the command's inputs
+/// (whose messages say more): `format` what it holds; a file of that name is replaced only
+/// where it holds `format` (or is empty), as an output named without an extension is. A web
+/// page named `index.json` in a batch's folder, a text file named `rows.png` among the
+/// close-ups were replaced without a word (a hostile-input sweep).
+pub fn check_replaces_its_own(target: &Path, format: &'static str) -> Result<(), ExportError> {
+    if fs::metadata(target).is_ok_and(|m| m.is_file()) && !holds_format(target, format) {
+        return Err(ExportError::NotOurs { path: target.into(), format });
+    }
+    Ok(())
 }
 
 /// `check_target_named` for a PNG image.
@@ -551,6 +581,10 @@ pub fn create_folder(dir: &Path) -> Result<bool, ExportError> {
     if dir.is_dir() {
         return Ok(false);
     }
+    // Without its `.` components: std's `create_dir_all("x/.")` failed with "No such file or
+    // directory" for a missing `x`, where `mkdir -p x/.` succeeds (a hostile-input sweep).
+    let without_dots: PathBuf = dir.components().filter(|c| *c != std::path::Component::CurDir).collect();
+    let dir = if without_dots.as_os_str().is_empty() { Path::new(".") } else { without_dots.as_path() };
     fs::create_dir_all(dir)
         .map(|_| true)
         .map_err(|source| ExportError::CreateFolder { path: first_missing_folder(dir).into(), source })

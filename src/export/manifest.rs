@@ -267,8 +267,25 @@ pub fn manifest(
 }
 
 /// The most bytes a manifest of an earlier set is read to (a built-in species' body manifest
-/// is under 10 KB): a link to /dev/zero or a huge file in its place is refused unread.
-pub const MANIFEST_MAX_BYTES: u64 = 1 << 20;
+/// is under 10 KB): a link to /dev/zero or a huge file in its place is refused unread. Above
+/// what any run can write: the strings it records from the user are the species (at most a
+/// preset's 1 MiB), the `--set` overrides (Linux passes at most 2 MiB of arguments) or a jobs
+/// file's `set` and the job's key (at most its 1 MiB each), and JSON at most doubles a string
+/// (a `"` or `\\` becomes two bytes; TOML's own escapes are no shorter than JSON's): about 8.5
+/// MiB with the rest. At 1 MiB, a preset whose species was 600,000 quotes wrote a manifest of
+/// 1.2 MB that `verify` refused (a hostile-input sweep). `manifest_json` refuses to write one
+/// over it all the same.
+pub const MANIFEST_MAX_BYTES: u64 = 16 << 20;
+
+/// A set's manifest as written (pretty JSON), refused where it is longer than its readers
+/// take (`MANIFEST_MAX_BYTES`), so that no run leaves a set that cannot be read back.
+pub fn manifest_json(manifest: &Manifest) -> Result<Vec<u8>, super::ExportError> {
+    let json = serde_json::to_vec_pretty(manifest).expect("a manifest serialises: strings, numbers and lists");
+    if json.len() as u64 > MANIFEST_MAX_BYTES {
+        return Err(super::ExportError::ManifestTooLarge { bytes: json.len(), limit: MANIFEST_MAX_BYTES });
+    }
+    Ok(json)
+}
 
 /// An earlier set's manifest, read back and parsed (`verify_set`, `batch`, a commit's
 /// clean-up): a regular file of at most `MANIFEST_MAX_BYTES`. `links`: whether a link is

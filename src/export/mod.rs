@@ -12,14 +12,15 @@ pub mod srgb;
 
 pub use atomic::{
     Earlier, FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, check_folder, check_folder_writable,
-    check_lock_not_an_input, check_lock_place, check_not_an_input, check_png_target, check_target, check_target_named,
-    check_writable, clean_up_before_exit, create_folder, create_folder_noted, ends_as_a_folder, lock_file_name,
-    remove_empty_made_folders, same_path, sha256_hex, wait_for_commit, write_file_atomically,
+    check_lock_not_an_input, check_lock_place, check_not_an_input, check_png_target, check_replaces_its_own,
+    check_target, check_target_named, check_writable, clean_up_before_exit, create_folder, create_folder_noted,
+    ends_as_a_folder, lock_file_name, remove_empty_made_folders, same_path, sha256_hex, temporary_target,
+    wait_for_commit, write_file_atomically,
 };
 pub(crate) use manifest::verify_set_json;
 pub use manifest::{
     Counts, MANIFEST_SUFFIX, Manifest, ManifestReadError, MapEntry, Source, VerifiedSet, body_counts, manifest,
-    manifest_file_name, read_set_manifest, set_file_sha256, verify_set,
+    manifest_file_name, manifest_json, read_set_manifest, set_file_sha256, verify_set,
 };
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
 
@@ -46,6 +47,13 @@ pub enum ExportError {
     CreateFolder { path: PathBuf, source: std::io::Error },
     #[error("cannot encode the {map} map: {message}")]
     Encode { map: MapKind, message: String },
+    /// A manifest longer than its readers take (`manifest::MANIFEST_MAX_BYTES`): the set
+    /// would be one that `verify`, a batch and the next run could not read back.
+    #[error(
+        "the set's manifest would be {bytes} bytes, more than its readers take ({limit} bytes): shorten the preset's \
+         species or common name, or the --set overrides, which it records"
+    )]
+    ManifestTooLarge { bytes: usize, limit: u64 },
     #[error(
         "another snakeskin run is writing the set {name} in {dir} (it holds {dir}/.{name}.lock); run again when it has \
          finished, or write to another folder"
@@ -102,6 +110,13 @@ pub enum ExportError {
          own format: give a name ending in .{format}, or move the file away"
     )]
     WouldReplaceAnotherKind { path: PathBuf, format: &'static str },
+    /// A file the tool names itself (a batch's index, a close-up) where a file of another
+    /// kind stands (`check_replaces_its_own`).
+    #[error(
+        "{path} exists and is not a {format} this tool wrote, which it would replace: move the file away, or give \
+         another folder"
+    )]
+    NotOurs { path: PathBuf, format: &'static str },
     /// `-o .png`: Rust reads it as a hidden file named `.png` with no extension, and it was
     /// written so, out of sight of `ls`.
     #[error("{path}: the file's name is only an extension; give it a name, e.g. snake.{format}")]
@@ -169,12 +184,14 @@ impl ExportError {
                 | ExportError::Stdout
                 | ExportError::NamedForAnotherFormat { .. }
                 | ExportError::WouldReplaceAnotherKind { .. }
+                | ExportError::NotOurs { .. }
                 | ExportError::OnlyAnExtension { .. }
                 | ExportError::OverwritesInput { .. }
                 | ExportError::InputAtLock { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
                 | ExportError::NotListable { .. }
+                | ExportError::ManifestTooLarge { .. }
         )
     }
 }

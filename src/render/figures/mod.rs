@@ -12,7 +12,7 @@ use super::engine::prepare::upload_material;
 use super::engine::renderer::{FrameSettings, Renderer};
 use super::engine::scene::{Camera, Stage, View};
 use crate::Error;
-use crate::export::{FileGroup, check_target, write_file_atomically};
+use crate::export::{FileGroup, write_file_atomically};
 
 /// A rendered image as PNG bytes, as RGB converted without a copy of the RGBA image
 /// (`renderer::frame_bytes` counts the RGB image and the PNG bytes).
@@ -94,7 +94,7 @@ pub fn figure_list() -> Vec<Figure> {
     figures
 }
 
-/// Checks every figure's file in `out_dir` (`check_target`), and that none is the file
+/// Checks every figure's file in `out_dir` (`check_target`, `export::check_replaces_its_own`), and that none is the file
 /// `preset` reads (a preset saved as `stage_a_diffuse.png` in the figures' folder was
 /// replaced by that figure), before any is rendered.
 pub fn check_figure_files(out_dir: &Path, preset: &str) -> Result<(), Error> {
@@ -102,8 +102,9 @@ pub fn check_figure_files(out_dir: &Path, preset: &str) -> Result<(), Error> {
     let mut probed = std::collections::HashSet::new();
     for figure in figure_list() {
         let target = out_dir.join(figure.file);
-        check_target(&target)?;
+        crate::export::check_target(&target)?;
         input.check(&target)?;
+        crate::export::check_replaces_its_own(&target, "png")?;
         // The folder takes files (or can be made): a read-only one was found after the
         // figures' maps and first frame, seconds in (an independent review's find).
         crate::export::check_folder_writable(out_dir, figure.file, &mut probed)?;

@@ -27,6 +27,7 @@ pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> 
         for name in snakeskin::render::figures::gallery::closeup_file_names() {
             let closeup = dir.join(name);
             snakeskin::export::check_target(&closeup)?;
+            snakeskin::export::check_replaces_its_own(&closeup, "png")?;
             // `-o sp/rows.png --closeups sp`: the close-up replaced the gallery (the review).
             if snakeskin::export::same_path(&closeup, out) {
                 return Err(snakeskin::Error::Unsupported(format!(

@@ -29,6 +29,11 @@ enum Check {
     Manifest(PathBuf),
     /// Files of a set named `name` in `folder` with no manifest beside them.
     Orphans { folder: PathBuf, name: String, files: usize },
+    /// A set named `name` in `folder` with neither its manifest nor any of its files, only
+    /// temporaries of them (`.FILE.RANDOM.snakeskin-tmp`): a run killed while renaming,
+    /// after it moved the old set aside and before it moved the new one in (or one still
+    /// writing it). Hidden, they were passed over, and the folder's other sets said `ok`.
+    Interrupted { folder: PathBuf, name: String, temporaries: usize },
     /// A subfolder that could not be listed: the sets in it are not checked.
     Unlistable { folder: PathBuf, error: String },
 }
@@ -61,6 +66,13 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
                  run failed or was killed while writing it)",
                 path_line(&folder.join(name))
             ),
+            Check::Interrupted { folder, name, temporaries } => format!(
+                "set {}: no manifest and none of its files, only {temporaries} hidden temporar{} a run left while \
+                 writing it (.FILE.RANDOM.snakeskin-tmp): the run was killed while renaming (or is still writing); run \
+                 it again",
+                path_line(&folder.join(name)),
+                if *temporaries == 1 { "y" } else { "ies" },
+            ),
             Check::Unlistable { folder, error } => {
                 format!("cannot list {}: {error}: the sets in it are not checked", path_line(folder))
             }
@@ -76,7 +88,8 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
 
 /// What `path` names: a manifest, where it is one (or names one in a folder that holds the
 /// set's files: an incomplete set); in a folder, the sets in it and in its subfolders down
-/// to `SUBFOLDER_LEVELS` (a batch's output), links followed, hidden entries passed over. A
+/// to `SUBFOLDER_LEVELS` (a batch's output), links followed, hidden entries passed over but
+/// for a run's temporaries of a set that is missing (`Check::Interrupted`). A
 /// path that is missing, one that is no manifest, or a folder without a set, is the user's
 /// mistake.
 fn checks_at(path: &Path) -> Result<Vec<Check>> {
@@ -110,6 +123,9 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
     let suffixes: Vec<String> =
         snakeskin::export::every_set_file_name("").into_iter().filter(|n| n != MANIFEST_SUFFIX).collect();
     let mut checks = Vec::new();
+    // Folders deeper than `SUBFOLDER_LEVELS`: said on stderr, so that an `ok` for a folder
+    // holding several batch outputs does not read as every set in it checked (it did).
+    let mut not_searched = Vec::new();
     // Depth first, in name order, so the lines come out in the order `ls -R` lists them.
     let mut folders = vec![(path.to_path_buf(), 0)];
     while let Some((folder, depth)) = folders.pop() {
@@ -125,9 +141,21 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
         // Set name → its files here; which of them have a manifest.
         let mut sets: BTreeMap<String, usize> = BTreeMap::new();
         let mut manifests = Vec::new();
+        // Set name → the temporaries of its files here (hidden, so otherwise passed over).
+        let mut temporaries: BTreeMap<String, usize> = BTreeMap::new();
         for entry in entries {
             let name = entry.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
             if name.starts_with('.') {
+                let target = snakeskin::export::temporary_target(&name);
+                let set = target.and_then(|t| {
+                    t.strip_suffix(MANIFEST_SUFFIX)
+                        .filter(|s| !s.is_empty())
+                        .map(str::to_string)
+                        .or_else(|| set_of(t, &suffixes))
+                });
+                if let Some(set) = set {
+                    *temporaries.entry(set).or_default() += 1;
+                }
                 continue;
             }
             if let Some(set) = name.strip_suffix(MANIFEST_SUFFIX).filter(|s| !s.is_empty()) {
@@ -137,6 +165,8 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
             } else if entry.is_dir() {
                 if depth < SUBFOLDER_LEVELS {
                     below.push((entry, depth + 1));
+                } else {
+                    not_searched.push(entry);
                 }
             } else if let Some(set) = set_of(&name, &suffixes) {
                 *sets.entry(set).or_default() += 1;
@@ -146,12 +176,27 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
                 return Err(invalid(reason).into());
             }
         }
+        for (name, count) in temporaries {
+            if !manifests.contains(&name) && !sets.contains_key(&name) {
+                checks.push(Check::Interrupted { folder: folder.clone(), name, temporaries: count });
+            }
+        }
         for (name, files) in sets {
             if !manifests.contains(&name) {
                 checks.push(Check::Orphans { folder: folder.clone(), name, files });
             }
         }
         folders.extend(below.into_iter().rev());
+    }
+    if let Some(first) = not_searched.first() {
+        eprintln!(
+            "note: sets are looked for {SUBFOLDER_LEVELS} folders below {} (a batch's depth); {} folder{} deeper not \
+             searched, the first {}: name such a folder to verify the sets in it",
+            path_line(path),
+            not_searched.len(),
+            if not_searched.len() == 1 { "" } else { "s" },
+            path_line(first)
+        );
     }
     if checks.is_empty() {
         let reason = format!(
