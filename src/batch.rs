@@ -990,7 +990,10 @@ fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard, for_run
         jobs.iter().filter(|j| seen.insert(j.preset.as_str())).filter_map(|j| crate::preset::input_file(&j.preset));
     let inputs = crate::export::Inputs::new(std::iter::once(jobs_file).chain(preset_files));
     inputs.check(&out.join(index_file_name(shard)))?;
-    crate::export::check_replaces_its_own(&out.join(index_file_name(shard)), "batch index")?;
+    // A run replaces the index; `--list` writes nothing, and lists beside any file.
+    if for_run {
+        crate::export::check_replaces_its_own(&out.join(index_file_name(shard)), "batch index")?;
+    }
     let (mine, resolved): (Vec<&'a Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
     let mut estimates = Vec::new();

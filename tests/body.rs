@@ -760,9 +760,11 @@ fn the_boas_brick_red_is_the_tails() {
 fn the_green_pythons_white_spots_are_a_few() {
     // 'a few scattered white spots on sides' (morelia-viridis' source): along each flank's
     // series (0.24 of the circumference off the spine, ±0.04) from the neck to the vent, the
-    // layer's count (6, a reading of 'a few'), ±1; and at 30 (the control) more than 20.
-    // Uncounted, the tile's 3 a circumference ran on down the body, 27 and 28 a side (an
-    // audit).
+    // layer's count (10, a reading of 'a few'), ±1, each spot at most two scales long ('one
+    // scale each', the preset: one, or two neighbours where its centre falls between them);
+    // at 30 (the control) more than 20; at the tile's length share, streaks. Uncounted, the
+    // tile's 3 a circumference ran on down the body, 27 and 28 a side (an audit); counted at
+    // the tile's length share, the spots were streaks of 3-5 scales (a review).
     let check = |overrides: &[(&str, &str)]| {
         let p = preset("morelia-viridis", overrides);
         let plan = body_plan(&p);
@@ -770,6 +772,7 @@ fn the_green_pythons_white_spots_are_a_few() {
         let white = p.pattern[0].color.unwrap();
         let w = colour.width as f32;
         let trunk = rows_of(colour.height, plan.neck_end, plan.vent);
+        let scale_rows = colour.height as f32 / snakeskin::maps::scale_field(&p, Layout::Body).lattice().rows_v as f32;
         [0.26, 0.74].map(|u| {
             let columns = ((u - 0.04) * w) as usize..((u + 0.04) * w) as usize;
             // Against the green ground only: the vertebral stripe's cream (#e8e8c8) is near the
@@ -777,22 +780,44 @@ fn the_green_pythons_white_spots_are_a_few() {
             let per_row =
                 mark_pixels_per_row(&colour, (trunk.clone(), columns), linear(white), &[linear(p.color.base)]);
             // Runs of rows with a spot's pixels, gaps of two rows or less joined.
-            let mut runs = 0;
-            let mut last = None;
+            let mut runs: Vec<(usize, usize)> = Vec::new();
             for (y, n) in per_row.iter().enumerate() {
                 if *n > 0 {
-                    if last.is_none_or(|l| y > l + 2) {
-                        runs += 1;
+                    match runs.last_mut() {
+                        Some(last) if y <= last.1 + 2 => last.1 = y,
+                        _ => runs.push((y, y)),
                     }
-                    last = Some(y);
                 }
             }
-            runs
+            let longest = runs.iter().map(|(a, b)| (b - a + 1) as f32).fold(0.0, f32::max);
+            (runs.len(), longest <= 2.0 * scale_rows)
         })
     };
     let count = preset("morelia-viridis", &[]).pattern[0].count.unwrap();
-    for (side, found) in check(&[]).into_iter().enumerate() {
+    for (side, (found, one_scale)) in check(&[]).into_iter().enumerate() {
         assert_within_one(&format!("side {side}"), found, count);
+        assert!(one_scale, "side {side}: a spot longer than two scales");
     }
-    assert!(check(&[("pattern.0.count", "30")]).iter().all(|n| *n > 20), "the control: 30 a side");
+    // At 30 a side, a spot's length share three times ours is again one scale long.
+    let thirty = [("pattern.0.count", "30"), ("pattern.0.length", "0.16")];
+    assert!(check(&thirty).iter().all(|(n, _)| *n > 20), "the control: 30 a side");
+    assert!(check(&[("pattern.0.length", "0.16")]).iter().all(|(_, one)| !one), "the control: streaks");
+}
+
+#[test]
+fn a_border_the_new_kind_does_not_read_draws_nothing() {
+    // `--set body.head_mark.0.kind=lips` on the grass snake passes the file's border over (a
+    // kind the border does not belong to), and it was still drawn, in black under the lip
+    // stripe's anti-aliased edge (a review: 1,666 pixels changed). The map equals the
+    // preset's without the border line; the control: crescents, which draw it, differ.
+    let text = snakeskin::preset::library::get("natrix-natrix").unwrap();
+    let border_line = text.lines().find(|l| l.starts_with("border_color")).expect("natrix's border");
+    let without = text.replace(&format!("{border_line}\n"), "");
+    let map = |text: &str, kind: &str| {
+        let source = snakeskin::preset::PresetSource { name: "t".into(), display: "t.toml".into(), text: text.into() };
+        let set = [("body.head_mark.0.kind".to_string(), format!("\"{kind}\""))];
+        body_map(&snakeskin::preset::parse(&source, &set).unwrap().preset, MapKind::Color).data.clone()
+    };
+    assert!(map(text, "lips") == map(&without, "lips"), "a border drawn under the lips");
+    assert!(map(text, "crescents") != map(&without, "crescents"), "the control");
 }

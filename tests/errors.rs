@@ -687,15 +687,29 @@ fn spots_larger_than_their_spacing_are_refused() {
     assert_eq!(err.matches("pattern.0.size").count(), 1, "{err}");
     // On a band of `rows` the spots lie the band's width over `amount` apart, along the body
     // too: 64 over the lowest of 19 rows at 0.03 passed the check round the body (0.0312)
-    // and took 37 s for a body atlas 64 pixels wide (a review). The largest size the message
-    // prints is accepted (the control), and the same size round the body.
+    // and took 37 s for a body atlas 64 pixels wide (a review); and at the largest radius
+    // their spacing allows, 204,800 spots a circumference took seconds (the next review).
+    // Refused on `amount` with the most that keep 64 round the body's count, and on `size`
+    // with the largest radius: each printed value accepted (the controls), and the size
+    // round the body.
     let banded = layer.replace("size = 0.3", "size = 0.03\nrows = [1, 1]");
     let err = refused("band.toml", &banded, &[]);
-    assert!(err.contains("is 0.03 with 64 spots across rows [1, 1] (`amount`, `rows`),"), "{err}");
-    let largest = err.split("size ≤ ").nth(1).and_then(|t| t.split(' ').next()).expect("the largest size");
-    assert!(largest.parse::<f64>().unwrap() < 0.003, "{err}");
+    assert!(err.contains("band.toml:4: key `pattern.0.amount` is 64 spots across rows [1, 1] each side"), "{err}");
+    let most: u32 = err.split("at most ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+    assert!((2..64).contains(&most), "{err}");
     let path = write_preset(presets.path(), "band.toml", &banded);
-    accepted(&path, &["--set", &format!("pattern.0.size={largest}")]);
+    let err = refused("band.toml", &banded, &["--set", &format!("pattern.0.amount={most}")]);
+    assert!(err.contains(&format!("is 0.03 with {most} spots across rows [1, 1] (`amount`, `rows`),")), "{err}");
+    assert!(!err.contains("pattern.0.amount"), "{most} across is accepted: {err}");
+    let largest = err.split("size ≤ ").nth(1).and_then(|t| t.split(' ').next()).expect("the largest size");
+    assert!(largest.parse::<f64>().unwrap() < 0.03, "{err}");
+    accepted(&path, &["--set", &format!("pattern.0.amount={most}"), "--set", &format!("pattern.0.size={largest}")]);
+    let err = refused(
+        "band.toml",
+        &banded,
+        &["--set", &format!("pattern.0.amount={}", most + 1), "--set", "pattern.0.size=0.001"],
+    );
+    assert!(err.contains("pattern.0.amount"), "the control: {} across: {err}", most + 1);
     accepted(&write_preset(presets.path(), "round.toml", &banded.replace("rows = [1, 1]\n", "")), &[]);
 }
 

@@ -2295,6 +2295,15 @@ fn verify_fails_a_set_left_only_in_temporaries() {
         set_files.len()
     );
     assert!(said.contains(&failed), "{said}");
+    // While a run holds the set's lock it is being written: said so, not failed (a review:
+    // a verify during a long run said FAILED); released, FAILED again.
+    let lock = std::fs::File::create(d.join(".natrix-natrix.lock")).unwrap();
+    lock.lock().unwrap();
+    let out = snakeskin(&["verify", d.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stdout(&out));
+    assert!(stdout(&out).contains(&format!("writing {}: a run holds its lock", d.join("natrix-natrix").display())));
+    lock.unlock().unwrap();
+    assert_eq!(snakeskin(&["verify", d.to_str().unwrap()]).status.code(), Some(1));
     for (k, name) in set_files.iter().enumerate() {
         std::fs::remove_file(d.join(format!(".{name}.AbC{k:03}.snakeskin-tmp"))).unwrap();
     }
@@ -2355,7 +2364,15 @@ fn files_the_tool_names_itself_replace_only_their_own_kind() {
     assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
     assert!(stderr(&run).contains("index.json exists and is not a batch index this tool wrote"), "{}", stderr(&run));
     assert_eq!(snapshot(&out), before);
-    // The control: the batch's own index is replaced by the next run.
+    // `--list` writes nothing: it lists beside the file (it was refused, a review).
+    let listed = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--list"]);
+    assert!(listed.status.success(), "{}", stderr(&listed));
+    assert_eq!(snapshot(&out), before);
+    // The controls: an index re-saved compact after a byte-order mark is still one, and the
+    // batch's own index is replaced by the next run.
+    std::fs::write(out.join("index.json"), "\u{feff}{\"generator\":\"snakeskin\",\"jobs\":[]}").unwrap();
+    let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", stderr(&run));
     std::fs::remove_file(out.join("index.json")).unwrap();
     for _ in 0..2 {
         let run = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);

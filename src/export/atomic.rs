@@ -286,6 +286,14 @@ fn listed_temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::
     Ok(tmp)
 }
 
+/// Whether a run holds the lock of set (or export) `name` in `dir` now (`SetLock`): what
+/// `verify` asks before it calls a set found only in temporaries interrupted (a set being
+/// written was FAILED, a review found). No lock file, or one nobody holds: false.
+pub fn lock_is_held(dir: &Path, name: &str) -> bool {
+    let Ok(file) = fs::File::open(dir.join(lock_file_name(name))) else { return false };
+    matches!(file.try_lock_shared(), Err(fs::TryLockError::WouldBlock))
+}
+
 /// The file name a temporary in a folder listing stands for (`.NAME.RANDOM.snakeskin-tmp`:
 /// `NAME`), None for any other name; a name cut to fit (`temporary_stem`) comes back cut.
 /// `verify` finds by it the sets a run left only in temporaries (killed while renaming).
@@ -414,9 +422,15 @@ fn holds_format(path: &Path, format: &str) -> bool {
         // A batch's index: a JSON object whose first key is `generator`, snakeskin's
         // (`batch::BatchIndex`).
         "batch index" => {
-            let text = head.trim_ascii_start();
-            let generator = b"\"generator\": \"snakeskin\"";
-            text.starts_with(b"{") && text.windows(generator.len()).take(64).any(|w| w == generator)
+            // Token by token, white space and a UTF-8 byte-order mark passed over: a re-saved
+            // index (`"generator":"snakeskin"`, compact) is one still (a review).
+            let mut rest = head.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&head);
+            ["{", "\"generator\"", ":", "\"snakeskin\""].iter().all(|token| {
+                rest = rest.trim_ascii_start();
+                let found = rest.starts_with(token.as_bytes());
+                rest = &rest[token.len().min(rest.len())..];
+                found
+            })
         }
         "svg" => {
             let text = head.trim_ascii_start();

@@ -7,7 +7,7 @@ use super::Shared;
 use crate::graph::{GraphBuilder, NodeId, Op};
 use crate::ops::body::{AlongProfile, BodyPlan, HeadMark, HeadMarkShape};
 use crate::preset::Preset;
-use crate::preset::schema::HeadMarkKind;
+use crate::preset::schema::{HeadMark as HeadMarkSchema, HeadMarkKind};
 
 /// About two pixels of a 1024-wide atlas twelve widths long, in v: the soft edge of region
 /// boundaries (an edge that is not anti-aliased reads as a seam).
@@ -111,7 +111,10 @@ pub(super) fn marks(
         };
         // The border first, as the mark lengthened backward, and the mark over it: the two
         // meet without a seam of the ground between them.
-        let border = m.border_color.map(|c| ("_border", c, m.border_size as f32));
+        // Only a mark round the neck draws one (a file's border passed over where `--set`
+        // changed the kind was drawn under a lip stripe: a review).
+        let border = m.border_color.filter(|_| HeadMarkSchema::takes_border(m.kind));
+        let border = border.map(|c| ("_border", c, m.border_size as f32));
         for (part, tint, behind) in border.into_iter().chain([("", m.color, 0.0)]) {
             let mark = HeadMark { shape, size: m.size as f32, plan: *plan, behind };
             let mask = g.add(format!("body.head_mark{i}{part}"), Op::HeadMark(mark), &[]);

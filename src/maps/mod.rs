@@ -156,6 +156,13 @@ pub(crate) fn masked(g: &mut GraphBuilder, name: String, mask: NodeId, by: Optio
     }
 }
 
+/// A count per circumference over a body `length` circumferences long, rounded (at least
+/// one): what `Shared::along_count` draws, and what the loader's ring warning counts with
+/// (in f64 there, it named an amount the body drew one more repeat of: a review).
+pub fn along_repeats(per_circumference: u32, length: f32) -> u32 {
+    ((per_circumference as f32 * length).round() as u32).max(1)
+}
+
 /// Nodes that several maps read.
 pub(crate) struct Shared {
     pub scales: NodeId,
@@ -213,7 +220,7 @@ impl Shared {
         if self.field.body.is_none() {
             return per_circumference;
         }
-        ((per_circumference as f32 * self.field.length).round() as u32).max(1)
+        along_repeats(per_circumference, self.field.length)
     }
 
     /// On a body atlas, marks at `per_circumference` from the end of the head (where an

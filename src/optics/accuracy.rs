@@ -45,10 +45,15 @@ pub struct Sample {
 /// (the default 10 nm × 1° grid has 72,360; 400,000 take a few minutes on two cores).
 pub const MAX_GRID_POINTS: usize = 400_000;
 
+/// The error grid's largest angle of incidence: 89°, short of grazing, where the film's
+/// colour is degenerate (cos θ = 0, every stack reflects everything). Its thicknesses run
+/// over the presets' range, the LUT's fine columns (`lut::FINE_MAX_NM`).
+pub const GRID_ANGLE_MAX_DEG: f64 = 89.0;
+
 /// How many points `grid` makes for these steps, computed without building it.
 pub fn grid_points(d_step_nm: f64, angle_step_deg: f64) -> usize {
     let count = |span: f64, step: f64| (span / step + 1e-9).floor() as usize + 1;
-    GRID_MATERIALS.len() * count(89.0, angle_step_deg) * count(2000.0, d_step_nm)
+    GRID_MATERIALS.len() * count(GRID_ANGLE_MAX_DEG, angle_step_deg) * count(super::lut::FINE_MAX_NM, d_step_nm)
 }
 
 /// The grid with `d_step_nm` and `angle_step_deg` spacing.
@@ -56,9 +61,9 @@ pub fn grid(d_step_nm: f64, angle_step_deg: f64) -> Vec<Sample> {
     let mut samples = Vec::new();
     for material in 0..GRID_MATERIALS.len() {
         let mut angle = 0.0;
-        while angle <= 89.0 + 1e-9 {
+        while angle <= GRID_ANGLE_MAX_DEG + 1e-9 {
             let mut d = 0.0;
-            while d <= 2000.0 + 1e-9 {
+            while d <= super::lut::FINE_MAX_NM + 1e-9 {
                 samples.push(Sample { material, thickness_nm: d, cos0: f64::to_radians(angle).cos() });
                 d += d_step_nm;
             }

@@ -124,8 +124,8 @@ pub fn chart(stack: Stack, method: Method, width: usize, height: usize) -> (Imag
     let rows: Vec<Vec<[f64; 3]>> = (0..height)
         .into_par_iter()
         .map(|y| {
-            let cos0 = (89.0 * y as f64 / (height - 1) as f64).to_radians().cos();
-            (0..width).map(|x| colour(2000.0 * x as f64 / (width - 1) as f64, cos0)).collect()
+            let cos0 = (super::accuracy::GRID_ANGLE_MAX_DEG * y as f64 / (height - 1) as f64).to_radians().cos();
+            (0..width).map(|x| colour(super::lut::FINE_MAX_NM * x as f64 / (width - 1) as f64, cos0)).collect()
         })
         .collect();
     let brightest = rows.iter().flatten().flat_map(|p| p.iter().copied()).fold(1e-6, f64::max);

@@ -213,9 +213,8 @@ fn rings_not_kept_apart(preset: &Preset) -> Vec<Problem> {
                 // `most`.
                 (crate::maps::Layout::Body, None) => {
                     let length = preset.body.length;
-                    let repeats = |a: u32| (f64::from(a) * length).round();
-                    let largest =
-                        (1..=ranges::RINGS_PER_TILE.1 as u32).take_while(|a| repeats(*a) <= f64::from(most)).last();
+                    let repeats = |a: u32| crate::maps::along_repeats(a, length as f32);
+                    let largest = (1..=ranges::RINGS_PER_TILE.1 as u32).take_while(|a| repeats(*a) <= most).last();
                     let keep = largest.map(|a| {
                         format!(
                             "`amount` {a} or less keeps them ({} repeats along the body atlas at `body.length` {})",
@@ -621,7 +620,35 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         let scale_rows_in_range = (ROWS.0..=ROWS.1).contains(&preset.scales.rows);
         if p.kind == PatternKind::Spots && in_ranges && (p.rows.is_empty() || (rows_ok && scale_rows_in_range)) {
             let lattice = crate::maps::scale_field(preset, crate::maps::Layout::Tile).lattice();
-            let (_, band, per_circumference) = crate::maps::spot_spacing(&lattice, p);
+            let (across, band, per_circumference) = crate::maps::spot_spacing(&lattice, p);
+            // On a band the spots are as dense along the body as across it: 64 over the
+            // lowest of 19 rows made 1,600 rows of them a circumference, 204,800 spots (both
+            // sides) in a stretch one circumference long where 64 round the body make 4,096,
+            // and a body atlas 16 px wide took 5.7 s at the largest radius the check below
+            // allows (a review). At most that many.
+            let most_spots = SPOTS_AROUND.1 * SPOTS_AROUND.1;
+            let density = |across: u32, per_circumference: u32| 2.0 * f64::from(across) * f64::from(per_circumference);
+            if band.is_some() && density(across, per_circumference) > most_spots {
+                let fewer = (1..across).rev().find(|&n| {
+                    let fewer = PatternLayer { amount: f64::from(n), ..p.clone() };
+                    let (n, _, along) = crate::maps::spot_spacing(&lattice, &fewer);
+                    density(n, along) <= most_spots
+                });
+                c.problems.push(Problem {
+                    key: key("amount"),
+                    message: format!(
+                        "is {around} spots across rows [{}, {}] each side, {per_circumference} rows of them a \
+                         circumference along the body (spots lie as far apart along it as across the band): {} spots in \
+                         a stretch one circumference long, more than the {most_spots} that {} round the body make; at \
+                         most {} across these rows",
+                        shown(p.rows[0]),
+                        shown(p.rows[1]),
+                        density(across, per_circumference),
+                        SPOTS_AROUND.1,
+                        fewer.unwrap_or(1),
+                    ),
+                });
+            }
             let per_circumference = f64::from(per_circumference);
             let most = SPOT_RADIUS_SPACINGS / per_circumference;
             if p.size > most {

@@ -1077,11 +1077,11 @@ fn parse_exposure(text: &str) -> Result<f32, String> {
 fn parse_d_step_nm(text: &str) -> Result<f64, String> {
     // Finer than 0.1 nm only repeats the 1 nm spectral reference's own resolution; the grid's
     // size is bounded with both steps together (`accuracy::MAX_GRID_POINTS`).
-    bounded(text, (0.1, 2000.0))
+    bounded(text, (0.1, snakeskin::optics::lut::FINE_MAX_NM))
 }
 
 fn parse_angle_step_deg(text: &str) -> Result<f64, String> {
-    bounded(text, (0.1, 89.0))
+    bounded(text, (0.1, snakeskin::optics::accuracy::GRID_ANGLE_MAX_DEG))
 }
 
 /// One value for all three channels, or r,g,b; each inside `range`.

@@ -251,7 +251,7 @@ pub fn ns_per_eval(model: Model, coherent: bool) -> f64 {
                 let sin = (1.0 - a * a).sqrt();
                 [sin * phi.cos(), sin * phi.sin(), a]
             };
-            let mut l = layers.to_f32(2000.0 * u(0) as f64);
+            let mut l = layers.to_f32(crate::optics::lut::FINE_MAX_NM * u(0) as f64);
             l.roughness = 0.05 + 0.9 * u(1);
             (l, dir(u(2), u(3)), dir(u(4), u(5)))
         })

@@ -256,7 +256,7 @@ pub fn bench_per_million(gpu: &Gpu, model: Model, count: usize) -> Result<GpuBen
                 k,
                 e,
             };
-            let layers = layers.to_f32(2000.0 * unit(i, 1) as f64);
+            let layers = layers.to_f32(crate::optics::lut::FINE_MAX_NM * unit(i, 1) as f64);
             let dir = |a: f32, b: f32| {
                 let phi = b * std::f32::consts::TAU;
                 let sin = (1.0 - a * a).sqrt();

@@ -31,8 +31,9 @@ enum Check {
     Orphans { folder: PathBuf, name: String, files: usize },
     /// A set named `name` in `folder` with neither its manifest nor any of its files, only
     /// temporaries of them (`.FILE.RANDOM.snakeskin-tmp`): a run killed while renaming,
-    /// after it moved the old set aside and before it moved the new one in (or one still
-    /// writing it). Hidden, they were passed over, and the folder's other sets said `ok`.
+    /// after it moved the old set aside and before it moved the new one in. Hidden, they were
+    /// passed over, and the folder's other sets said `ok`. Where a run holds the set's lock
+    /// it is being written: said so, not failed (`export::lock_is_held`).
     Interrupted { folder: PathBuf, name: String, temporaries: usize },
     /// A subfolder that could not be listed: the sets in it are not checked.
     Unlistable { folder: PathBuf, error: String },
@@ -66,10 +67,14 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
                  run failed or was killed while writing it)",
                 path_line(&folder.join(name))
             ),
+            Check::Interrupted { folder, name, .. } if snakeskin::export::lock_is_held(folder, name) => {
+                // Being written now (its lock held): not a broken set, and not one to check.
+                println!("writing {}: a run holds its lock now; not checked", path_line(&folder.join(name)));
+                continue;
+            }
             Check::Interrupted { folder, name, temporaries } => format!(
                 "set {}: no manifest and none of its files, only {temporaries} hidden temporar{} a run left while \
-                 writing it (.FILE.RANDOM.snakeskin-tmp): the run was killed while renaming (or is still writing); run \
-                 it again",
+                 writing it (.FILE.RANDOM.snakeskin-tmp): the run was killed while renaming; run it again",
                 path_line(&folder.join(name)),
                 if *temporaries == 1 { "y" } else { "ies" },
             ),
