@@ -551,9 +551,15 @@ fn mark_runs(
 ) -> Vec<(usize, usize)> {
     let span = columns.len();
     let per_row = mark_pixels_per_row(colour, (rows.clone(), columns), mark, others);
+    runs_of(rows, &per_row, |near| 2 * near > span)
+}
+
+/// Runs (start, end) of the rows of `rows` whose count in `per_row` is `kept`; gaps of two
+/// rows or less join runs.
+fn runs_of(rows: std::ops::Range<usize>, per_row: &[usize], kept: impl Fn(usize) -> bool) -> Vec<(usize, usize)> {
     let mut runs: Vec<(usize, usize)> = Vec::new();
     for (y, near) in rows.zip(per_row) {
-        if 2 * near <= span {
+        if !kept(*near) {
             continue;
         }
         match runs.last_mut() {
@@ -779,17 +785,9 @@ fn the_green_pythons_white_spots_are_a_few() {
             // spots' white, and the scales' tone jitter split a spot's rows between the two.
             let per_row =
                 mark_pixels_per_row(&colour, (trunk.clone(), columns), linear(white), &[linear(p.color.base)]);
-            // Runs of rows with a spot's pixels, gaps of two rows or less joined.
-            let mut runs: Vec<(usize, usize)> = Vec::new();
-            for (y, n) in per_row.iter().enumerate() {
-                if *n > 0 {
-                    match runs.last_mut() {
-                        Some(last) if y <= last.1 + 2 => last.1 = y,
-                        _ => runs.push((y, y)),
-                    }
-                }
-            }
-            let longest = runs.iter().map(|(a, b)| (b - a + 1) as f32).fold(0.0, f32::max);
+            // Runs of rows with any of a spot's pixels.
+            let runs = runs_of(trunk.clone(), &per_row, |n| n > 0);
+            let longest = runs.iter().map(|(a, b)| (b - a) as f32).fold(0.0, f32::max);
             (runs.len(), longest <= 2.0 * scale_rows)
         })
     };

@@ -178,12 +178,7 @@ fn more_rings_than_whole_scales_can_keep_apart_are_warned_of_with_the_most_that_
     };
     let said = warning(5).expect("no warning at 5 repeats");
     assert!(said.contains("t.toml:") && said.contains("scale_aligned = 1"), "{said}");
-    let most: u32 = said
-        .split("at most ")
-        .nth(1)
-        .and_then(|rest| rest.split(' ').next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("no most in: {said}"));
+    let most = number_after(&said, "at most ");
     assert!((1..5).contains(&most), "{said}");
     assert!(warning(most).is_none() && warning(most + 1).is_some(), "the warning's bound is not {most}");
     for seed in [1, 2, 3] {
@@ -193,6 +188,16 @@ fn more_rings_than_whole_scales_can_keep_apart_are_warned_of_with_the_most_that_
         let class = classes_of(&load(seed, 5).preset, 512);
         assert!(red_touches_black(&class, 512) > 0, "seed {seed}, 5 repeats: the rule held, no need to warn");
     }
+}
+
+/// The whole number a message gives right after `marker` (a warning's suggested count).
+fn number_after(message: &str, marker: &str) -> u32 {
+    message
+        .split(marker)
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no number after {marker:?} in: {message}"))
 }
 
 /// A ring layer without a count repeats `amount` times a circumference on the body too, but
@@ -215,12 +220,7 @@ fn rings_that_fit_the_tile_but_not_the_body_are_warned_of_on_the_body() {
     let said = warnings(3);
     let [said] = said.as_slice() else { panic!("one warning: {said:?}") };
     assert!(said.contains("pattern.0.amount = 3 on the body atlas leaves"), "{said}");
-    let largest: u32 = said
-        .split("`amount` ")
-        .nth(1)
-        .and_then(|rest| rest.split(' ').next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("no amount in: {said}"));
+    let largest = number_after(said, "`amount` ");
     assert!(largest < 3 && warnings(largest).is_empty(), "{said}");
 }
 

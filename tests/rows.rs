@@ -180,6 +180,14 @@ fn the_corn_snakes_sides_are_lighter_than_its_back() {
     assert!(back.len() > 1000 && lighter == 0, "{lighter} of the back's {} centres have the sides' colour", back.len());
 }
 
+/// The garter snake's preset text, its spots' colour and its ground's (linear).
+fn garter_snake() -> (&'static str, [f32; 3], [f32; 3]) {
+    let text = snakeskin::preset::library::get("thamnophis-sirtalis").unwrap();
+    let preset = common::preset_from(text);
+    let spots = preset.pattern.iter().find(|l| l.kind == PatternKind::Spots).and_then(|l| l.color).unwrap();
+    (text, spots.to_linear(), preset.color.base.to_linear())
+}
+
 #[test]
 fn the_garter_snakes_checks_stand_out_from_its_ground() {
     // 'dark spots between the stripes give a checkered look' (thamnophis-sirtalis' source):
@@ -187,10 +195,7 @@ fn the_garter_snakes_checks_stand_out_from_its_ground() {
     // against the ground's, luminance contrast (L1 + 0.05) / (L2 + 0.05) of their medians at
     // least 3:1, the contrast WCAG 2.1 asks of graphics that must be seen (SC 1.4.11). The
     // preset's first ground, a near-black olive under black spots, gave 1.3 (seen failing).
-    let text = snakeskin::preset::library::get("thamnophis-sirtalis").unwrap();
-    let preset = common::preset_from(text);
-    let spots = preset.pattern.iter().find(|l| l.kind == PatternKind::Spots).and_then(|l| l.color).unwrap();
-    let (spot, ground) = (spots.to_linear(), preset.color.base.to_linear());
+    let (text, spot, ground) = garter_snake();
     let luminance = |c: &[f32]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
     let distance = |a: &[f32], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
     let (f, c) = (field(text), colour(text));
@@ -244,10 +249,7 @@ fn the_garter_snakes_spots_lie_between_its_stripes() {
     // than of the lowest row, below the lateral stripe. Round the body (the preset's first
     // layer, 10 around: the control) the lowest row was the darkest (an audit: 15-20 % against
     // 8 %).
-    let text = snakeskin::preset::library::get("thamnophis-sirtalis").unwrap();
-    let preset = common::preset_from(text);
-    let spots = preset.pattern.iter().find(|l| l.kind == PatternKind::Spots).and_then(|l| l.color).unwrap();
-    let (spot, ground) = (spots.to_linear(), preset.color.base.to_linear());
+    let (text, spot, ground) = garter_snake();
     let shares =
         |text: &str| (rows_nearer(text, (4.0, 8.0), spot, ground).0, rows_nearer(text, (1.0, 1.0), spot, ground).0);
     let (between, lowest) = shares(text);

@@ -581,30 +581,24 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         c.range(key("phase"), p.phase, UNIT);
         c.range(key("center_size"), p.center_size, CENTER_SIZE);
         c.range(key("border_size"), p.border_size, OUTLINE_SIZE);
-        let rows_ok = {
-            let rows = rows_bounding(preset.scales.rows);
-            let top = (rows as f64 + 1.0) / 2.0;
-            p.rows.len() == 2
-                && p.rows.iter().all(|r| r.is_finite())
-                && 0.5 <= p.rows[0]
-                && p.rows[0] <= p.rows[1]
-                && p.rows[1] <= top
-        };
-        if !p.rows.is_empty() && matches!(p.kind, PatternKind::Stripes | PatternKind::Spots) {
-            let rows = rows_bounding(preset.scales.rows);
-            let top = (rows as f64 + 1.0) / 2.0;
-            if !rows_ok {
-                c.problems.push(Problem {
-                    key: key("rows"),
-                    message: format!(
-                        "must be [first, last] dorsal rows with 0.5 ≤ first ≤ last ≤ {top} (the vertebral row of \
-                         {} rows); got {}",
-                        rows,
-                        // A long list is counted, not echoed back whole.
-                        if p.rows.len() <= 4 { format!("{:?}", p.rows) } else { format!("{} entries", p.rows.len()) }
-                    ),
-                });
-            }
+        let rows = rows_bounding(preset.scales.rows);
+        let top = (rows as f64 + 1.0) / 2.0;
+        let rows_ok = p.rows.len() == 2
+            && p.rows.iter().all(|r| r.is_finite())
+            && 0.5 <= p.rows[0]
+            && p.rows[0] <= p.rows[1]
+            && p.rows[1] <= top;
+        if !p.rows.is_empty() && matches!(p.kind, PatternKind::Stripes | PatternKind::Spots) && !rows_ok {
+            c.problems.push(Problem {
+                key: key("rows"),
+                message: format!(
+                    "must be [first, last] dorsal rows with 0.5 ≤ first ≤ last ≤ {top} (the vertebral row of {} \
+                     rows); got {}",
+                    rows,
+                    // A long list is counted, not echoed back whole.
+                    if p.rows.len() <= 4 { format!("{:?}", p.rows) } else { format!("{} entries", p.rows.len()) }
+                ),
+            });
         }
         c.range(key("length"), p.length, BLOTCH_LENGTH);
         c.range(key("size"), p.size, PATTERN_SIZE);
