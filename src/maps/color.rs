@@ -145,13 +145,8 @@ fn belly_colour_half_width(preset: &Preset, s: &Shared) -> f32 {
 /// keys is off (the node is then not in the graph).
 fn per_scale(preset: &Preset, s: &Shared) -> Option<ScaleColour> {
     let c = &preset.color;
-    let any = c.scale_tone > 0.0
-        || c.scale_hue > 0.0
-        || c.edge_tone != 0.0
-        || preset.belly.edge_tone != 0.0
-        || c.tip_tone != 0.0
-        || c.speckle > 0.0
-        || c.skin.is_some();
+    // A plane it reads (`per_scale_reads`), or speckle or skin, which read only the crevice.
+    let any = per_scale_reads(preset).iter().any(|(_, read)| *read) || c.speckle > 0.0 || c.skin.is_some();
     any.then(|| ScaleColour {
         tone: c.scale_tone as f32,
         hue: c.scale_hue as f32,

@@ -231,9 +231,7 @@ impl Shared {
         let marks = ((self.along_count(per_circumference) as f32 * (1.0 - plan.head_end)).round() as u32).max(1);
         Some((marks, (plan.head_end, 1.0)))
     }
-}
 
-impl Shared {
     /// The scale field and what every map reads from it, added to `g` for `layout`.
     pub fn new(g: &mut GraphBuilder, preset: &Preset, layout: Layout) -> Shared {
         let field = scale_field(preset, layout);

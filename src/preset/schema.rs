@@ -773,7 +773,7 @@ impl HeadMark {
         1.0
     }
 
-    fn is_default_size(size: &f64) -> bool {
+    pub(crate) fn is_default_size(size: &f64) -> bool {
         *size == Self::default_size()
     }
 

@@ -843,7 +843,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
             c.range(key("border_size"), m.border_size, HEAD_MARK_SIZE);
             // A border only a mark round the neck draws, as a pattern layer refuses a key its
             // kind does not read (passed over where `--set` changed the file's kind).
-            let sized = m.border_size != HeadMark::default_size();
+            let sized = !HeadMark::is_default_size(&m.border_size);
             for (field, set) in [("border_color", m.border_color.is_some()), ("border_size", sized)] {
                 if set && !HeadMark::takes_border(m.kind) && !from_file_for_overridden(&key(field), &key("kind")) {
                     c.problems.push(Problem {
