@@ -103,6 +103,8 @@ pub(super) fn marks(
             HeadMarkKind::V => HeadMarkShape::V,
             HeadMarkKind::X => HeadMarkShape::X,
             HeadMarkKind::Spearhead => HeadMarkShape::Spearhead,
+            HeadMarkKind::EyeBand => HeadMarkShape::EyeBand,
+            HeadMarkKind::PreocularStripe => HeadMarkShape::PreocularStripe,
             HeadMarkKind::PostocularStripe => HeadMarkShape::PostocularStripe,
             HeadMarkKind::PostocularSpot => HeadMarkShape::PostocularSpot,
             HeadMarkKind::Collar => HeadMarkShape::Collar,

@@ -189,6 +189,8 @@ pub enum HeadMarkShape {
     V,
     X,
     Spearhead,
+    EyeBand,
+    PreocularStripe,
     PostocularStripe,
     PostocularSpot,
     Collar,
@@ -215,6 +217,19 @@ const HEAD_SIDE_HALF_U: f32 = 0.32;
 /// to the angle of the jaw, in head-local units (x in shield half-widths across,
 /// s in head lengths along); a postocular spot lies on it near the eye.
 const POSTOCULAR: ((f32, f32), (f32, f32)) = ((0.62, 0.45), (1.45, 1.0));
+
+/// The half-width of the head's stripes (postocular, preocular, the eye band) at size 1, in
+/// shield half-widths: 0.2 across, about a third of the supraocular's width (`SHIELDS`).
+const STRIPE_HALF_WIDTH: f32 = 0.10;
+
+/// Where the eye band's two halves meet at the spine: on the prefrontals (s 0.24 to 0.40,
+/// `SHIELDS`), in front of the supraoculars that lie over the eyes; each half runs from here
+/// to the eye, where the postocular stripe starts (`POSTOCULAR.0`).
+const EYE_BAND_APEX: (f32, f32) = (0.0, 0.34);
+
+/// Where the preocular stripe starts: the snout, at the rostral's outer corner (`SHIELDS`);
+/// it runs to the eye, where the postocular stripe starts (`POSTOCULAR.0`).
+const PREOCULAR_START: (f32, f32) = (0.36, 0.07);
 
 /// How far down the postocular stripe a postocular spot is centred: behind the eye, clear of
 /// the supraocular shield, which ends 0.60 head lengths back (`SHIELDS`): at size 1 the spot
@@ -293,7 +308,9 @@ impl HeadMark {
                 let t = ((s - apex) / (base - apex)).clamp(0.0, 1.0);
                 (half * t - du).min(s - apex).min(base - s)
             }
-            HeadMarkShape::PostocularStripe => arm(POSTOCULAR.0, POSTOCULAR.1, 0.10 * k),
+            HeadMarkShape::EyeBand => arm(EYE_BAND_APEX, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
+            HeadMarkShape::PreocularStripe => arm(PREOCULAR_START, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
+            HeadMarkShape::PostocularStripe => arm(POSTOCULAR.0, POSTOCULAR.1, STRIPE_HALF_WIDTH * k),
             // A disc 0.3 shield half-widths across at size 1 (the stripe is 0.2 wide).
             HeadMarkShape::PostocularSpot => {
                 let centre = postocular_spot_centre();
@@ -475,6 +492,8 @@ mod tests {
             HeadMarkShape::V,
             HeadMarkShape::X,
             HeadMarkShape::Spearhead,
+            HeadMarkShape::EyeBand,
+            HeadMarkShape::PreocularStripe,
             HeadMarkShape::PostocularStripe,
             HeadMarkShape::PostocularSpot,
             HeadMarkShape::Collar,
@@ -553,6 +572,70 @@ mod tests {
         assert!(left * 3 < stripe_px, "a spot, not a stripe: {left} px against the stripe's {stripe_px}");
         // The control: the stripe itself is not round.
         assert!((stripe_across / stripe_along - 1.0).abs() > 0.1, "{stripe_across} across, {stripe_along} along");
+    }
+
+    /// The pixels of a head mark on `plan()`'s head, 512 across, as head-local points (x in
+    /// shield half-widths, signed; s in head lengths).
+    fn mark_points(shape: HeadMarkShape) -> Vec<(f32, f32)> {
+        let mark = HeadMark { shape, size: 1.0, plan: plan(), behind: 0.0 };
+        let (ux, head) = mark.plan.head_units();
+        let n = 512;
+        let rows = (mark.reach_v() * n as f32 * mark.plan.length).ceil() as usize;
+        let mut points = Vec::new();
+        for y in 0..rows {
+            let v = (y as f32 + 0.5) / (n as f32 * mark.plan.length);
+            for x in 0..n {
+                let u = (x as f32 + 0.5) / n as f32;
+                if mark.inside(u, v) > 0.0 {
+                    points.push(((u - 0.5) / ux, v * mark.plan.length / head));
+                }
+            }
+        }
+        points
+    }
+
+    /// The eye band crosses the spine on the prefrontals, in front of the supraoculars over
+    /// the eyes (a corn snake's eye stripes "meet on top of the head in front of the eyes"),
+    /// and the preocular stripe starts on the snout, within the rostral's length; each shares
+    /// pixels with the postocular stripe on both sides, so that drawn together they are one
+    /// line through the eye. Negative controls: the postocular stripe alone has no pixel on
+    /// the spine and none on the snout; the spot behind the eye, a mark of the same line, does
+    /// not meet the preocular stripe.
+    #[test]
+    fn the_eye_band_and_the_preocular_stripe_meet_the_postocular_stripe_at_the_eye() {
+        let extent = |name: &str| {
+            let (_, _, points) = SHIELDS.iter().find(|(n, ..)| *n == name).unwrap();
+            points.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)))
+        };
+        let (prefrontal, rostral) = (extent("prefrontal"), extent("rostral"));
+        // The two columns beside the spine (512 across; x in shield half-widths).
+        let on_spine = |points: &[(f32, f32)]| -> Vec<f32> {
+            points.iter().filter(|p| p.0.abs() < 1.0 / 512.0 / HEAD_TOP_HALF_U).map(|p| p.1).collect()
+        };
+        let band = mark_points(HeadMarkShape::EyeBand);
+        let spine = on_spine(&band);
+        assert!(!spine.is_empty(), "the band crosses the spine");
+        assert!(
+            spine.iter().all(|&s| s > prefrontal.0 && s < prefrontal.1),
+            "on the prefrontals ({prefrontal:?}): {:?}",
+            (spine.iter().cloned().fold(f32::MAX, f32::min), spine.iter().cloned().fold(f32::MIN, f32::max))
+        );
+        let pre = mark_points(HeadMarkShape::PreocularStripe);
+        let front = pre.iter().map(|p| p.1).fold(f32::MAX, f32::min);
+        assert!(front < rostral.1, "the preocular stripe starts {front} head lengths back");
+        let post = mark_points(HeadMarkShape::PostocularStripe);
+        let shared = |a: &[(f32, f32)], b: &[(f32, f32)], right: bool| {
+            a.iter().filter(|p| (p.0 > 0.0) == right && b.contains(p)).count()
+        };
+        for right in [false, true] {
+            assert!(shared(&band, &post, right) > 0, "the band meets the stripe (right side: {right})");
+            assert!(shared(&pre, &post, right) > 0, "the preocular meets the stripe (right side: {right})");
+        }
+        // The controls.
+        assert!(on_spine(&post).is_empty());
+        assert!(post.iter().all(|p| p.1 > rostral.1));
+        let spot = mark_points(HeadMarkShape::PostocularSpot);
+        assert_eq!(shared(&spot, &pre, true) + shared(&spot, &pre, false), 0);
     }
 
     #[test]

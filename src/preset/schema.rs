@@ -73,7 +73,20 @@ named_enum!(NoiseChoice { Perlin, Cellular });
 named_enum!(BellyPattern { None, Checkered, Spots, HalfMoons, MedianStripe });
 named_enum!(IridescenceGradient { Vertical, Radial });
 named_enum!(HeadScales { Shields, Small });
-named_enum!(HeadMarkKind { Cap, Snout, V, X, Spearhead, PostocularStripe, PostocularSpot, Collar, Crescents, Lips });
+named_enum!(HeadMarkKind {
+    Cap,
+    Snout,
+    V,
+    X,
+    Spearhead,
+    EyeBand,
+    PreocularStripe,
+    PostocularStripe,
+    PostocularSpot,
+    Collar,
+    Crescents,
+    Lips
+});
 
 /// A colour written as `"#rrggbb"` (sRGB, 8 bits per channel).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -734,6 +747,13 @@ pub enum HeadMarkKind {
     X,
     /// A forward-pointing arrowhead between the eyes running onto the neck (corn snakes).
     Spearhead,
+    /// A band across the top of the head from eye to eye, meeting at the spine a little in
+    /// front of them, its ends where the postocular stripes start (a corn snake's eye
+    /// stripes "meet on top of the head in front of the eyes"; a band between the eyes).
+    EyeBand,
+    /// A stripe from the snout to the eye, each side, ending where the postocular stripe
+    /// starts (with it, a line from the snout through the eye to the neck: boas).
+    PreocularStripe,
     /// A stripe from behind the eye to the angle of the jaw, each side.
     PostocularStripe,
     /// A round spot just behind the eye, each side, on the postocular stripe's line.
