@@ -82,7 +82,7 @@ fn thesis_diffuse(layers: Layers, cos_i: f32, cos_o: f32, f_i: vec3<f32>, f_o: v
 // The sky along the normal enters through the film (1 - F at the view cosine) and is
 // attenuated along the view path plus one layer thickness.
 fn thesis_ambient_diffuse(layers: Layers, cos_o: f32, f_o: vec3<f32>) -> vec3<f32> {
-    var base = (vec3<f32>(1.0) - f_o) * layers.albedo;
+    var base = (vec3<f32>(1.0) - f_o) * max(layers.albedo, vec3<f32>(0.0));
     if (HAS_ABSORPTION) {
         let k = snell_cos_sq(layers.n0, layers.n2, cos_o);
         let path = 1.0 / max(sqrt(max(k, 0.0)), COS_MIN) + 1.0;

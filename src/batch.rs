@@ -148,6 +148,13 @@ impl JobPlace {
     /// The place with `detail` after the preset, inside its parentheses.
     fn fmt_with(&self, f: &mut std::fmt::Formatter<'_>, detail: std::fmt::Arguments<'_>) -> std::fmt::Result {
         let JobPlace { path, line, table, preset } = self;
+        // On one line: a newline in a jobs file's preset string printed a line of its own,
+        // which could pass for the tool's (`"x\nok: all 40 jobs done"`, a hostile-input
+        // sweep); the message's printer escapes the other control characters, not newlines.
+        let preset: String = preset
+            .chars()
+            .map(|c| if c.is_control() { c.escape_unicode().to_string() } else { c.to_string() })
+            .collect();
         write!(f, "{}{}: [[job]] {table} ({preset}{detail})", path.display(), at_line(*line))
     }
 }
@@ -579,7 +586,8 @@ pub struct JobOutcome {
 pub struct BatchIndex {
     pub generator: String,
     pub generator_version: String,
-    pub jobs_file: PathBuf,
+    /// `recorded_jobs_file`.
+    pub jobs_file: String,
     /// `K/N`.
     pub shard: String,
     pub jobs: Vec<JobOutcome>,
@@ -848,11 +856,12 @@ pub fn run(
     // an index left from another jobs file (a run stopped by a signal writes none at its
     // end) described sets this run is not about.
     let planned = work.iter().map(|(_, r)| r.outcome.clone()).collect();
+    // A set of theirs that a job here would replace was refused in `plan`.
     if let Some(earlier) = index_of_other_jobs(out, shard, jobs_file) {
         warn(&format!(
             "note: {} listed the jobs of {}; it lists this run's now (their sets stay where they are)",
             out.join(index_file_name(shard)).display(),
-            earlier.display()
+            earlier.jobs_file
         ));
     }
     BatchIndex::new(jobs_file, shard, planned, concurrency).write(out, shard)?;
@@ -927,15 +936,74 @@ pub fn run(
 /// The jobs file of the index already in `out` where it is another than `jobs_file` (the
 /// run replaces that index; a second jobs file into one folder replaced the first's without
 /// a word). None where there is none, it cannot be read, or it is this file's.
-fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<PathBuf> {
+fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<OtherIndex> {
     #[derive(serde::Deserialize)]
-    struct JobsFileOf {
-        jobs_file: PathBuf,
+    struct Listed {
+        jobs_file: String,
+        #[serde(default)]
+        jobs: Vec<ListedJob>,
+    }
+    #[derive(serde::Deserialize)]
+    struct ListedJob {
+        manifest: PathBuf,
+        key: String,
     }
     let text = std::fs::read(out.join(index_file_name(shard))).ok()?;
-    let earlier = serde_json::from_slice::<JobsFileOf>(&text).ok()?.jobs_file;
-    let same = earlier == jobs_file || crate::export::same_path(&earlier, jobs_file);
-    (!same).then_some(earlier)
+    let Listed { jobs_file: earlier, jobs } = serde_json::from_slice::<Listed>(&text).ok()?;
+    let same = earlier == recorded_jobs_file(jobs_file) || crate::export::same_path(Path::new(&earlier), jobs_file);
+    let sets = jobs.into_iter().map(|job| (job.manifest, job.key)).collect();
+    (!same).then_some(OtherIndex { jobs_file: earlier, sets })
+}
+
+/// The index another jobs file's run left where this run writes its own
+/// (`index_of_other_jobs`).
+struct OtherIndex {
+    jobs_file: String,
+    /// Each of its jobs' manifest (relative to the output folder) and job key.
+    sets: std::collections::HashMap<PathBuf, String>,
+}
+
+impl OtherIndex {
+    /// Refuses a job that would replace a set the other jobs file's run made: its index lists
+    /// the job's manifest with another key, and the set there is still the one it made (its
+    /// manifest's `job`). A second jobs file naming another preset `vipera-berus` wrote over
+    /// the first's set in the same folder, and the note said their sets stayed (a
+    /// hostile-input sweep); within one jobs file such a clash is refused (`resolve_all`).
+    fn check(&self, out: &Path, r: &Resolved, place: JobPlace) -> Result<(), Error> {
+        let manifest = &r.outcome.manifest;
+        let Some(their_key) = self.sets.get(manifest) else { return Ok(()) };
+        if r.done || r.outcome.duplicate_of.is_some() || *their_key == r.outcome.key {
+            return Ok(());
+        }
+        let standing = crate::export::read_set_manifest(&out.join(manifest), crate::text_file::Links::Refuse);
+        if standing.ok().and_then(|json| json["job"].as_str().map(String::from)).as_ref() != Some(their_key) {
+            return Ok(());
+        }
+        let message = format!(
+            "would replace the set in {}, which a run of {} made with different output (the folder's index lists \
+             that run's jobs); write this batch into another folder, or remove that set's folder first",
+            out.join(&r.outcome.folder).display(),
+            self.jobs_file,
+        );
+        Err(BatchError::Invalid { place, message }.into())
+    }
+}
+
+/// The jobs file as an index records it: its canonical path (as given where that fails), so
+/// that a later run started from another folder finds it the same file. JSON holds text: a
+/// path that is not UTF-8 has each byte outside UTF-8 written `\xNN` (a batch run in such a
+/// folder failed with "internal error: index: path contains invalid UTF-8 characters", a
+/// hostile-input sweep), and `index_of_other_jobs` compares the same text.
+fn recorded_jobs_file(jobs_file: &Path) -> String {
+    let path = std::fs::canonicalize(jobs_file).unwrap_or_else(|_| jobs_file.into());
+    let mut text = String::new();
+    for chunk in path.as_os_str().as_encoded_bytes().utf8_chunks() {
+        text.push_str(chunk.valid());
+        for byte in chunk.invalid() {
+            text.push_str(&format!("\\x{byte:02x}"));
+        }
+    }
+    text
 }
 
 impl BatchIndex {
@@ -945,7 +1013,7 @@ impl BatchIndex {
             generator_version: env!("CARGO_PKG_VERSION").into(),
             // The file itself, wherever a later run is started from (as given, it was relative
             // to this run's working folder, and a later run's note mistook it for another).
-            jobs_file: std::fs::canonicalize(jobs_file).unwrap_or_else(|_| jobs_file.into()),
+            jobs_file: recorded_jobs_file(jobs_file),
             shard: shard.to_string(),
             jobs,
             concurrency,
@@ -996,6 +1064,11 @@ fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard, for_run
     }
     let (mine, resolved): (Vec<&'a Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
+    if for_run && let Some(other) = index_of_other_jobs(out, shard, jobs_file) {
+        for (job, r) in mine.iter().zip(&resolved) {
+            other.check(out, r, job.place(jobs_file, job.lines.preset))?;
+        }
+    }
     let mut estimates = Vec::new();
     // A plan (the preset's graph, its memory estimate) is the same for every seed: jobs that
     // differ only in their seed share one (`Job::key` at seed 0 names the rest). Planned one

@@ -731,6 +731,95 @@ fn a_batch_says_when_it_replaces_another_jobs_files_index() {
     }
 }
 
+/// A second jobs file whose preset shares the first's name but not its content would write
+/// the first's set with other output: refused before anything runs, naming the set's folder
+/// and the first jobs file, every file as it was (it was replaced, and the note said the
+/// first's sets stayed: a hostile-input sweep). Controls: the same preset's content under
+/// that name shares the set (skipped); the first jobs file again, its preset edited, replaces
+/// its own set.
+#[test]
+fn a_second_jobs_file_does_not_replace_the_firsts_set_with_other_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = jobs_file(dir.path(), &["vipera-berus"], "[1]", 16);
+    let built_in = stdout(&snakeskin(&["presets", "show", "vipera-berus"]));
+    let other_folder = dir.path().join("x");
+    std::fs::create_dir(&other_folder).unwrap();
+    let second = dir.path().join("second.toml");
+    std::fs::write(&second, "[[job]]\npreset = \"x/vipera-berus.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    let out = dir.path().join("out");
+    let run = |jobs: &Path| snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(run(&first).status.success());
+    // The same content under the name: the set is shared.
+    std::fs::write(other_folder.join("vipera-berus.toml"), &built_in).unwrap();
+    let before = tree(&out);
+    let shared = run(&second);
+    assert!(shared.status.success(), "{}", stderr(&shared));
+    assert_eq!(statuses(&read_index(&out)), ["skipped"], "the control: the same output");
+    // Other content under the name.
+    assert!(built_in.contains("\nrows = 21"));
+    std::fs::write(other_folder.join("vipera-berus.toml"), built_in.replace("\nrows = 21", "\nrows = 23")).unwrap();
+    run(&first);
+    let before_second = tree(&out);
+    let refused = run(&second);
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    let message = stderr(&refused);
+    let folder = out.join("vipera-berus").join("tile-16-seed1-png");
+    assert!(
+        message.contains(&format!("would replace the set in {}, which a run of {}", folder.display(), first.display())),
+        "{message}"
+    );
+    assert_eq!(tree(&out), before_second, "a file changed");
+    // The first jobs file's own set, its preset edited: replaced (the built-in cannot be
+    // edited, so the first jobs file is pointed at the edited file).
+    std::fs::write(&first, "[[job]]\npreset = \"x/vipera-berus.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    let replaced = run(&first);
+    assert!(replaced.status.success(), "{}", stderr(&replaced));
+    let colour = Path::new("vipera-berus/tile-16-seed1-png/vipera-berus_color.png");
+    assert_ne!(tree(&out)[colour], before[colour], "the control: its own set is replaced");
+}
+
+/// A newline in a jobs file's preset string is escaped where a message names the job: it
+/// printed a line of its own, which could pass for the tool's. Control: the job's place is
+/// in the message.
+#[test]
+fn a_newline_in_a_jobs_preset_stays_on_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(&jobs, "[[job]]\npreset = \"vipera-berus\\nok: all 40 jobs done\"\nsizes = [16]\n").unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("o").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("[[job]] 1 (vipera-berus\\u{a}ok: all 40 jobs done)"), "{}", stderr(&out));
+    assert!(!stderr(&out).lines().any(|l| l.starts_with("ok:")), "{}", stderr(&out));
+}
+
+/// A batch run in a folder whose path is not UTF-8 writes its index (the jobs file's path
+/// recorded with the bytes outside UTF-8 as `\xNN`) and knows it again: the job is skipped
+/// the second time, without a note of another jobs file. It failed with "internal error:
+/// index: path contains invalid UTF-8 characters" (a hostile-input sweep).
+#[test]
+fn a_batch_runs_in_a_folder_whose_path_is_not_utf8() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join(std::ffi::OsStr::from_bytes(b"n\xfdu"));
+    std::fs::create_dir(&folder).unwrap();
+    jobs_file(&folder, &["vipera-berus"], "[1]", 16);
+    let run = || {
+        Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["batch", "jobs.toml", "-o", "o"])
+            .current_dir(&folder)
+            .output()
+            .unwrap()
+    };
+    for expected in ["done", "skipped"] {
+        let ran = run();
+        assert!(ran.status.success(), "{}", stderr(&ran));
+        assert!(!stderr(&ran).contains("listed the jobs of"), "{}", stderr(&ran));
+        let index = read_index(&folder.join("o"));
+        assert_eq!(statuses(&index), [expected]);
+        assert!(index["jobs_file"].as_str().unwrap().ends_with("/n\\xfdu/jobs.toml"), "{}", index["jobs_file"]);
+    }
+}
+
 #[test]
 fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     let dir = tempfile::tempdir().unwrap();

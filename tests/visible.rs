@@ -165,6 +165,35 @@ fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limi
 /// map at up to 1.14 (linear) unreported: its EXR held that and its PNG clipped it. The
 /// colour map is checked as the graph evaluates it (f32, before any file's quantisation).
 /// Negative control: a grey belly that the brightening keeps below 1 is shown as written.
+/// A clamped colour the preset does not write is called its default: a two-line preset
+/// warned of `belly.color = "#e6dcc0"`, a colour its writer never wrote, with no line and no
+/// word of where it came from (a walkthrough). Controls: the same colour written in the
+/// file (its line, no word of a default), and given by `--set`.
+#[test]
+fn a_clamped_default_colour_is_called_the_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, text: &str, set: &[&str]| {
+        let preset = write_preset(dir.path(), name, text);
+        let out_dir = dir.path().join(name.replace(".toml", ""));
+        let mut args = vec!["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "16", "--maps", "color"];
+        args.extend(set);
+        let out = snakeskin(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out).lines().find(|l| l.contains("belly.color")).unwrap_or_default().to_string()
+    };
+    let default = snakeskin::preset::schema::Belly::default().color.to_string();
+    let warning = run("tone.toml", "[color]\ntip_tone = 0.2\n", &[]);
+    assert!(
+        warning.contains(&format!("tone.toml: belly.color = \"{default}\" (its default: the file does not set it)")),
+        "{warning}"
+    );
+    let written = run("written.toml", &format!("[color]\ntip_tone = 0.2\n[belly]\ncolor = \"{default}\"\n"), &[]);
+    assert!(written.contains(&format!("written.toml:4: belly.color = \"{default}\" would")), "{written}");
+    let set = format!("belly.color={default}");
+    let given = run("given.toml", "[color]\ntip_tone = 0.2\n", &["--set", &set]);
+    assert!(given.contains("belly.color") && !given.contains("default"), "{given}");
+}
+
 #[test]
 fn over_a_lossless_stack_no_key_is_brightened_past_a_reflectance_of_one() {
     let text = "[color]\nbase = \"#ffffff\"\nscale_tone = 0.1\n\n[belly]\ncolor = \"#c0c0c0\"\n";

@@ -1010,14 +1010,21 @@ fn folder_of(path: &Path) -> &Path {
 }
 
 /// Files that appear together or not at all, without a manifest: the documentation figures,
-/// a gallery and its close-ups. Each is staged when its bytes exist (`stage`: the folder is
-/// made and the target checked), so nothing is visible while the work goes on and an
-/// interrupt leaves the earlier files as they were; `commit` puts them all in place at once
-/// (`swap_in`: the old ones aside first, all back if a rename fails). Unlike a set there is
-/// no lock: two runs on one folder each write a whole group, the last one's stays.
+/// a gallery and its close-ups, a preview and its heat map. Each is staged when its bytes
+/// exist (`stage`: the folder is made, the target checked, the bytes kept), so nothing is
+/// visible while the work goes on and an interrupt leaves the earlier files as they were;
+/// `commit` writes them to temporaries and puts them all in place at once (`swap_in`: the
+/// old ones aside first, all back if a rename fails). Unlike a set there is no lock: two
+/// runs on one folder each write a whole group, the last one's stays.
+///
+/// The bytes wait in memory, not in temporaries: without a lock, another run takes a
+/// temporary older than ten minutes for a killed run's (`remove_stale_temporaries`), and a
+/// `preview --reference` staged its frame, then spent longer than that on the reference:
+/// another preview to the same name removed the temporary, and the first failed at its end
+/// with its work lost (a hostile-input sweep). A group's files are a few images.
 #[derive(Debug, Default)]
 pub struct FileGroup {
-    staged: Vec<(tempfile::NamedTempFile, PathBuf)>,
+    staged: Vec<(Vec<u8>, PathBuf)>,
 }
 
 impl FileGroup {
@@ -1025,7 +1032,7 @@ impl FileGroup {
         FileGroup::default()
     }
 
-    /// Writes `bytes` to a temporary beside `target` (creating its folder if needed).
+    /// Keeps `bytes` for `target` (creating its folder if needed, and checking the target).
     pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> Result<(), ExportError> {
         let (dir, name) = (folder_of(target), file_name(target));
         if name.is_empty() || ends_as_a_folder(target) {
@@ -1033,21 +1040,25 @@ impl FileGroup {
         }
         create_folder(dir)?;
         check_target(target)?;
-        // Without a lock, a temporary is only taken as stale once it is older than any write.
-        remove_stale_temporaries(dir, &[&name], std::time::Duration::from_secs(600));
-        let tmp = stage(dir, &name, bytes)?;
-        self.staged.push((tmp, target.into()));
+        self.staged.push((bytes.to_vec(), target.into()));
         Ok(())
     }
 
-    /// Puts every staged file in place, or none (see `swap_in`); returns their paths.
+    /// Writes every staged file to a temporary beside its target and puts them all in place,
+    /// or none (see `swap_in`); returns their paths.
     pub fn commit(self) -> Result<Vec<PathBuf>, ExportError> {
-        for (_, target) in &self.staged {
-            check_target(target)?;
+        let mut staged = Vec::with_capacity(self.staged.len());
+        for (bytes, target) in self.staged {
+            check_target(&target)?;
+            let (dir, name) = (folder_of(&target), file_name(&target));
+            // Without a lock, a temporary is only taken as stale once it is older than any
+            // write; these live for the commit only.
+            remove_stale_temporaries(dir, &[&name], std::time::Duration::from_secs(600));
+            staged.push((stage(dir, &name, &bytes)?, target));
         }
         pause_hook(|| "commit".into());
-        let old: Vec<PathBuf> = self.staged.iter().map(|(_, t)| t.clone()).collect();
-        Ok(swap_in(self.staged, &old, &[], None)?.written)
+        let old: Vec<PathBuf> = staged.iter().map(|(_, t)| t.clone()).collect();
+        Ok(swap_in(staged, &old, &[], None)?.written)
     }
 }
 
@@ -1329,6 +1340,29 @@ pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, Exp
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A group's staged files leave no temporary while the work goes on, so another run's
+    /// sweep of stale temporaries (here everything of the name, at any age) takes nothing
+    /// from it and its commit writes every file. A `preview --reference` staged its frame,
+    /// then spent longer than the sweep's ten minutes on the reference; another preview to
+    /// the same name removed the temporary, and the first failed at its end. Negative
+    /// control: the commit's own temporaries, swept before the renames, fail it.
+    #[test]
+    fn a_groups_staged_files_survive_another_runs_sweep() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+        let mut group = FileGroup::new();
+        group.stage(&a, b"first").unwrap();
+        group.stage(&b, b"second").unwrap();
+        remove_stale_temporaries(dir.path(), &["a.png", "b.png"], std::time::Duration::ZERO);
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0, "a temporary while the work goes on");
+        group.commit().unwrap();
+        assert_eq!((fs::read(&a).unwrap(), fs::read(&b).unwrap()), (b"first".to_vec(), b"second".to_vec()));
+        // The control: a temporary swept before its rename.
+        let swept = stage(dir.path(), "a.png", b"third").unwrap();
+        remove_stale_temporaries(dir.path(), &["a.png"], std::time::Duration::ZERO);
+        assert!(swept.persist(&a).is_err(), "the sweep took nothing");
+    }
 
     /// A lock released a moment after the run starts (a killed run's, while the kernel
     /// tears it down) is taken, not called busy; one held on is busy. Held here by a second

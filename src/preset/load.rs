@@ -66,7 +66,23 @@ impl LoadedPreset {
             let line = p.line.map(|l| format!(":{l}")).unwrap_or_default();
             format!("warning: {preset}{line}: {} = {}", p.key, p.message)
         });
-        empty.into_iter().chain(clamped).chain(warned).chain(self.repeated_overrides()).collect()
+        empty
+            .into_iter()
+            .chain(clamped)
+            .chain(warned)
+            .chain(self.repeated_overrides())
+            .chain(self.seed_not_used())
+            .collect()
+    }
+
+    /// A `--set seed=` that `--seed` overrode (`parse_with_seed`), said as a repeated key is:
+    /// `--seed 5 --set seed=6` ran silently with seed 5, its manifest listing the override
+    /// beside it (a hostile-input sweep).
+    fn seed_not_used(&self) -> Option<String> {
+        let (_, value) = self.overrides.iter().rev().find(|(key, _)| key == "seed")?;
+        let seed = self.preset.seed;
+        (seed_override(value).ok()? != seed)
+            .then(|| format!("warning: --set seed={value} is not used: --seed {seed} overrides it"))
     }
 
     /// One warning per key given more than once among the overrides (`--set a=1 --set a=2`):
@@ -303,6 +319,7 @@ pub fn parse_with_seed(
     let mut clamped_colours = super::visible::clamp_to_visible(&mut preset);
     for c in &mut clamped_colours {
         c.line = line_of(&c.key);
+        c.default = c.line.is_none() && !overridden(&c.key);
     }
     let warned = super::validate::warnings(&preset).into_iter().map(locate).collect();
     let canonical = canonical_text(&preset);

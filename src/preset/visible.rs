@@ -38,6 +38,11 @@ pub struct ClampedColour {
     /// the warning's words only: the manifest records the limit, which says the same.
     #[serde(skip)]
     pub absorbing: bool,
+    /// Whether the key is at its default: neither the file nor an override writes it. The
+    /// warning says so (a two-line preset warned of `belly.color = "#e6dcc0"`, a colour its
+    /// writer never wrote, without a line: a walkthrough).
+    #[serde(skip)]
+    pub default: bool,
 }
 
 impl ClampedColour {
@@ -46,9 +51,14 @@ impl ClampedColour {
         let line = self.line.map(|l| format!(":{l}")).unwrap_or_default();
         let [r, g, b] = self.limit_linear;
         let (key, requested, shown) = (&self.key, &self.requested, &self.clamped_to);
+        let requested = if self.default {
+            format!("\"{requested}\" (its default: the file does not set it)")
+        } else {
+            format!("\"{requested}\"")
+        };
         if self.absorbing {
             return format!(
-                "warning: {preset}{line}: {key} = \"{requested}\" is brighter than this layer stack can show (colours \
+                "warning: {preset}{line}: {key} = {requested} is brighter than this layer stack can show (colours \
                  mean the visible colour; with its absorption, and any headroom this key keeps for the map's per-scale \
                  tone and colour variation, it may be at most linear [{r:.3}, {g:.3}, {b:.3}]); clamped to \"{shown}\". \
                  Lower optics.absorption or the colour to keep it."
@@ -56,7 +66,7 @@ impl ClampedColour {
         }
         let variation = if key == "color.base" { ", color.variation" } else { "" };
         format!(
-            "warning: {preset}{line}: {key} = \"{requested}\" would be brightened past a reflectance of 1 by the map's \
+            "warning: {preset}{line}: {key} = {requested} would be brightened past a reflectance of 1 by the map's \
              per-scale tone and colour variation (colours mean the visible colour; with that headroom it may be at \
              most linear [{r:.3}, {g:.3}, {b:.3}]); clamped to \"{shown}\". Lower color.scale_tone, scale_hue, \
              edge_tone, tip_tone{variation} or the colour to keep it."
@@ -207,6 +217,7 @@ pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
             clamped_to: shown.to_string(),
             limit_linear: allowed,
             absorbing: stack_limit[channel] < 1.0,
+            default: false,
         });
         *colour = shown;
     }

@@ -50,5 +50,26 @@ pub fn diffuse_f32(layers: &Layers32, cos_i: f32, cos_o: f32, f_i: [f32; 3], f_o
 pub fn ambient_diffuse(layers: &Layers, cos_o: f64, f_o: [f64; 3]) -> [f64; 3] {
     let k = snell_cos_sq(layers.n0, layers.n2, cos_o);
     let path = 1.0 / k.max(0.0).sqrt().max(COS_MIN) + 1.0;
-    [0, 1, 2].map(|c| (1.0 - f_o[c]) * layers.albedo[c] * (-layers.optical_depth[c].max(0.0) * path).exp())
+    // k_d clamped at 0 as the direct lobe's (`diffuse`): a negative albedo (the library's
+    // callers can pass one) gave a negative ambient term beside a zero direct one (a review).
+    [0, 1, 2].map(|c| (1.0 - f_o[c]) * layers.albedo[c].max(0.0) * (-layers.optical_depth[c].max(0.0) * path).exp())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A negative albedo (possible through the library's API, not from a colour map) is read
+    /// as 0 by the ambient term as by the direct lobe: the ambient term went negative beside
+    /// a zero direct one (a review). Control: a positive albedo lights both.
+    #[test]
+    fn the_ambient_term_reads_the_albedo_as_the_direct_lobe_does() {
+        let stack = crate::optics::film::Stack { n0: 1.0, n1: 1.55, n2: 2.0 };
+        let layers = |albedo| Layers::of_stack(stack, 300.0, 0.3, [0.2; 3], albedo);
+        let negative = layers([-0.5, 0.2, 0.0]);
+        let (direct, ambient) =
+            (diffuse(&negative, 0.8, 0.7, [0.05; 3], [0.05; 3]), ambient_diffuse(&negative, 0.7, [0.05; 3]));
+        assert_eq!((direct[0], ambient[0]), (0.0, 0.0), "{direct:?} {ambient:?}");
+        assert!(direct[1] > 0.0 && ambient[1] > 0.0, "the control: {direct:?} {ambient:?}");
+    }
 }

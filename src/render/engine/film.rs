@@ -65,12 +65,14 @@ impl GpuFilmMethod {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub(crate) struct FilmInfo {
-    n_cos: u32,
-    n_fine: u32,
-    n_coarse: u32,
-    n_bands: u32,
-    iors_band: [f32; 4],
-    xyz_to_rgb: [[f32; 4]; 3],
+    // Visible to the crate for the layout test (`shaders::tests`), which reads each field's
+    // offset.
+    pub(crate) n_cos: u32,
+    pub(crate) n_fine: u32,
+    pub(crate) n_coarse: u32,
+    pub(crate) n_bands: u32,
+    pub(crate) iors_band: [f32; 4],
+    pub(crate) xyz_to_rgb: [[f32; 4]; 3],
 }
 
 /// Slots per entry of the lobe table (`lobe_table`), in order: the path delta

@@ -249,6 +249,74 @@ mod tests {
         assert_ne!(wgsl_struct_size("brdf_eval", "Sample") as usize, std::mem::size_of::<FilmInfo>());
     }
 
+    /// Each member of WGSL struct `name` of `program`, by name, at the offset naga lays it
+    /// out at.
+    fn wgsl_struct_members(program_name: &str, name: &str) -> Vec<(String, u32)> {
+        let module = naga::front::wgsl::parse_str(&program(program_name)).expect("the program parses");
+        let (_, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{program_name} has no struct {name}"));
+        match &ty.inner {
+            naga::TypeInner::Struct { members, .. } => {
+                members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect()
+            }
+            other => panic!("{name} is not a struct: {other:?}"),
+        }
+    }
+
+    /// A Rust struct's fields, as named, at their offsets.
+    macro_rules! rust_members {
+        ($ty:ty { $($field:ident),* $(,)? }) => {
+            vec![$((stringify!($field).to_string(), std::mem::offset_of!($ty, $field) as u32)),*]
+        };
+    }
+
+    /// The structs' members lie where their WGSL twins read them, field by field: sizes
+    /// alone (`buffers_have_the_sizes_their_shaders_read`) let two fields of one size trade
+    /// places on one side (`sky_top` and `sky_bottom`, `n_fine` and `n_coarse`) unseen, a
+    /// review found. Each field is named once here, so a field added to a Rust struct and
+    /// not listed fails the size test, and one listed in another order than WGSL's fails
+    /// this. Negative control: the same list with two names traded is told apart.
+    #[test]
+    fn buffers_have_their_members_where_their_shaders_read_them() {
+        use crate::render::engine::film::FilmInfo;
+        use crate::render::engine::scene::SceneUniform;
+        use crate::render::reference::brdf_eval::GpuSample;
+        let sample = rust_members!(GpuSample { normal_roughness, wi_thickness, wo_n0, tau_n2, albedo, k, e });
+        for (program_name, name, rust) in [
+            ("brdf_eval", "Sample", sample.clone()),
+            (
+                "brdf_eval",
+                "FilmInfo",
+                rust_members!(FilmInfo { n_cos, n_fine, n_coarse, n_bands, iors_band, xyz_to_rgb }),
+            ),
+            (
+                "skin",
+                "Scene",
+                rust_members!(SceneUniform {
+                    view_proj,
+                    camera,
+                    light_dir,
+                    light_rgb,
+                    sky_top,
+                    sky_bottom,
+                    film,
+                    optical_depth,
+                    bounce_k,
+                    bounce_e,
+                }),
+            ),
+        ] {
+            assert_eq!(wgsl_struct_members(program_name, name), rust, "{program_name}'s {name}");
+        }
+        let mut traded = sample;
+        let (first, second) = (traded[0].0.clone(), traded[1].0.clone());
+        (traded[0].0, traded[1].0) = (second, first);
+        assert_ne!(wgsl_struct_members("brdf_eval", "Sample"), traded);
+    }
+
     /// Every numeric literal outside comments, with its line (a token starting with a digit,
     /// or a '.' followed by one, not inside an identifier), parsed as f64 (suffix dropped).
     fn literals(source: &str) -> Vec<(f64, String)> {

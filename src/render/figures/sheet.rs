@@ -234,6 +234,28 @@ fn render_tile_sheet(
     Ok(sheet)
 }
 
+/// The body sheet's line of counts for the built-in `name`: its plates, a count its preset
+/// does not give called the default (the sheet labelled `crotalus-atrox`, whose sources give
+/// no count, "200 ventrals, 60 subcaudals", as if they were the species': a walkthrough),
+/// its counted marks and its tail bands.
+fn counts_line(name: &str, counts: &crate::export::Counts) -> String {
+    let lines = library::get(name).map(crate::toml_text::KeyLines::new);
+    let default = |key: &str| lines.as_ref().is_some_and(|l| l.line(key).is_none());
+    let plates = match (counts.ventrals, counts.subcaudals) {
+        (Some(ventrals), Some(subcaudals)) => match (default("body.ventrals"), default("body.subcaudals")) {
+            (true, true) => format!("{ventrals} ventrals, {subcaudals} subcaudals (defaults)"),
+            (v, s) => {
+                let said = |d: bool| if d { " (default)" } else { "" };
+                format!("{ventrals} ventrals{}, {subcaudals} subcaudals{}", said(v), said(s))
+            }
+        },
+        _ => "no ventral plates".into(),
+    };
+    let marks = counts.dorsal_marks.map(|n| format!(", {n} dorsal marks")).unwrap_or_default();
+    let bands = counts.tail_bands.map(|n| format!(", {n} tail bands")).unwrap_or_default();
+    format!("{plates}{marks}{bands}")
+}
+
 /// The body sheet (`sheet --layout body`): per species its whole body atlas laid on its
 /// side — snout at the left, tail tip at the right, the spine along the middle of the strip
 /// and the belly at its edges — beside a render of the whole snake, under the label and a
@@ -289,14 +311,7 @@ fn render_body_sheet(
         let clip = |text: String| clipped(&text, cell_w);
         let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
         let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
-        let counts = crate::export::body_counts(preset, &body);
-        let plates = match (counts.ventrals, counts.subcaudals) {
-            (Some(ventrals), Some(subcaudals)) => format!("{ventrals} ventrals, {subcaudals} subcaudals"),
-            _ => "no ventral plates".into(),
-        };
-        let marks = counts.dorsal_marks.map(|n| format!(", {n} dorsal marks")).unwrap_or_default();
-        let bands = counts.tail_bands.map(|n| format!(", {n} tail bands")).unwrap_or_default();
-        let third = clip(format!("{plates}{marks}{bands}"));
+        let third = clip(counts_line(name, &crate::export::body_counts(preset, &body)));
         draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
         draw_text(&mut sheet, x0 + 6, y0 + 8 + 8 * LABEL_SCALE, &second, MUTED);
         draw_text(&mut sheet, x0 + 6, y0 + 12 + 16 * LABEL_SCALE, &third, MUTED);
@@ -418,6 +433,21 @@ pub fn write_sheet(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A preset that gives its plate counts is labelled with them; one whose sources give
+    /// none (`crotalus-atrox`: "ventrals, subcaudals, … not found: defaults used") is
+    /// labelled with the defaults, called so.
+    #[test]
+    fn the_body_sheet_calls_default_counts_defaults() {
+        let counts = |ventrals, subcaudals| crate::export::Counts {
+            ventrals: Some(ventrals),
+            subcaudals: Some(subcaudals),
+            dorsal_marks: None,
+            tail_bands: None,
+        };
+        assert_eq!(counts_line("crotalus-atrox", &counts(200, 60)), "200 ventrals, 60 subcaudals (defaults)");
+        assert_eq!(counts_line("boa-constrictor", &counts(232, 48)), "232 ventrals, 48 subcaudals");
+    }
 
     /// A label that does not fit its cell ends in "..", within the cell; one that fits is
     /// whole. A tile of 64 (a cell 192 wide) holds 11 characters of 16 pixels.
