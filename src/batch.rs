@@ -193,6 +193,8 @@ struct JobTable {
     /// With `pack`: the ambient occlusion map in the pack's occlusion channel (`--ao`).
     ao: Option<bool>,
     layout: Option<String>,
+    /// The normal map's convention (`generate --normal-convention`): `opengl` or `directx`.
+    normal_convention: Option<String>,
     /// `--set` overrides: dotted key to TOML value.
     #[serde(default)]
     set: std::collections::BTreeMap<String, toml::Value>,
@@ -226,9 +228,12 @@ pub struct Job {
     /// With a pack: its occlusion channel holds the ambient occlusion map (`generate --ao`).
     pub ao: bool,
     pub layout: Layout,
+    /// The normal map's convention (OpenGL with a pack, which writes its engine's own).
+    pub normal_convention: NormalConvention,
 }
 
 pub use crate::DEFAULT_SIZE;
+use crate::material::NormalConvention;
 
 impl Job {
     /// Where the job's table is written, at `line` (a key's), for a message about it.
@@ -237,7 +242,7 @@ impl Job {
     }
 
     /// The job's folder under the output folder:
-    /// `<preset>/<layout>-<size>-seed<seed>-<format or pack>[-<maps>][-set<hash>]`, where
+    /// `<preset>/<layout>-<size>-seed<seed>-<format or pack>[-directx][-<maps>][-set<hash>]`, where
     /// `<hash>` is the first 8 hex digits of the overrides' SHA-256 (jobs that differ only in
     /// their overrides must not share a folder).
     pub fn folder(&self, preset_name: &str, seed: u64) -> PathBuf {
@@ -246,6 +251,7 @@ impl Job {
             Some(p) => format!("pack-{}", p.name()),
             None => self.format.name().to_string(),
         };
+        let convention = if self.normal_convention == NormalConvention::DirectX { "-directx" } else { "" };
         let maps = if self.pack.is_none() && self.maps != MapKind::ALL {
             format!("-{}", self.maps.iter().map(|m| m.name()).collect::<Vec<_>>().join("+"))
         } else {
@@ -256,7 +262,11 @@ impl Job {
         } else {
             format!("-set{}", &sha256_hex(serde_json::json!(self.overrides).to_string().as_bytes())[..8])
         };
-        Path::new(preset_name).join(format!("{}-{}-seed{seed}-{what}{maps}{overrides}", self.layout.name(), self.size))
+        Path::new(preset_name).join(format!(
+            "{}-{}-seed{seed}-{what}{convention}{maps}{overrides}",
+            self.layout.name(),
+            self.size
+        ))
     }
 
     /// The job's key: what its output bytes depend on (the preset's content and seed, the
@@ -273,9 +283,13 @@ impl Job {
             "pack": self.pack.map(|p| p.name()),
             "layout": self.layout.name(),
         });
-        // Only when asked for: the keys of jobs written before `ao` existed stay theirs.
+        // Only when asked for: the keys of jobs written before `ao` and `normal_convention`
+        // existed stay theirs.
         if self.ao {
             description["ao"] = true.into();
+        }
+        if self.normal_convention == NormalConvention::DirectX {
+            description["normal_convention"] = "directx".into();
         }
         sha256_hex(description.to_string().as_bytes())
     }
@@ -425,6 +439,30 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                     .into(),
             ));
         }
+        // A pack writes its engine's own (`Pack::normal_convention`: DirectX for Unreal) from
+        // the maps' OpenGL normals, as `generate --pack`, which refuses the flag.
+        let normal_convention = match (table.normal_convention.as_deref(), pack) {
+            (None, Some(_)) => NormalConvention::OpenGl,
+            (Some(_), Some(pack)) => {
+                return Err(invalid(
+                    "normal_convention",
+                    format!(
+                        "normal_convention: pack {:?} writes its normal map in its engine's convention ({}); leave out \
+                         normal_convention, or pack",
+                        pack.name(),
+                        pack.normal_convention().name()
+                    ),
+                ));
+            }
+            (None | Some("opengl"), None) => NormalConvention::OpenGl,
+            (Some("directx"), None) => NormalConvention::DirectX,
+            (Some(other), None) => {
+                return Err(invalid(
+                    "normal_convention",
+                    format!("normal_convention {other:?}: accepted: opengl, directx"),
+                ));
+            }
+        };
         let layout = match table.layout.as_deref() {
             None | Some("tile") => Layout::Tile,
             Some("body") => Layout::Body,
@@ -474,6 +512,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                     pack,
                     ao,
                     layout,
+                    normal_convention,
                 });
             }
         }
@@ -775,7 +814,7 @@ fn request(job: &Job, out: &Path, outcome: &JobOutcome) -> GenerateRequest {
         size: job.size,
         maps: job.maps.clone(),
         out_dir: out.join(&outcome.folder),
-        options: BuildOptions { layout: job.layout, ..BuildOptions::default() },
+        options: BuildOptions { layout: job.layout, normal_convention: job.normal_convention },
         format: job.format,
         pack: job.pack,
         ao: job.ao,

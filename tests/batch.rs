@@ -1279,3 +1279,45 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         assert!(stderr(&refused).contains(says), "{path:?}: {}", stderr(&refused));
     }
 }
+
+/// A job can ask for DirectX normals (`normal_convention`, as `generate --normal-convention`):
+/// its set goes to a folder of its own (`-directx`), its manifest says so, and its normal
+/// map's green channel is the OpenGL one's mirror; left out, OpenGL (the control). With a
+/// pack (which writes its engine's own) and an unknown value, refused with the key's line.
+/// A batch could not make DirectX normals but through `pack = "unreal"` (a walkthrough).
+#[test]
+fn a_job_can_ask_for_directx_normals() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    let job = |extra: &str| format!("[[job]]\npreset = \"vipera-berus\"\nseeds = [1]\nsizes = [16]\n{extra}\n");
+    std::fs::write(&jobs, job("normal_convention = \"directx\"") + &job("")).unwrap();
+    let out = dir.path().join("out");
+    let ran = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(ran.status.success(), "{}", stderr(&ran));
+    let set = |folder: &str| {
+        let folder = out.join("vipera-berus").join(folder);
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(folder.join("vipera-berus.material.json")).unwrap()).unwrap();
+        let normal = image::open(folder.join("vipera-berus_normal.png")).unwrap().into_rgb8();
+        (manifest["normal_convention"].as_str().unwrap().to_string(), normal)
+    };
+    let (directx, dx) = set("tile-16-seed1-png-directx");
+    let (opengl, gl) = set("tile-16-seed1-png");
+    assert_eq!((directx.as_str(), opengl.as_str()), ("directx", "opengl"));
+    for (a, b) in dx.pixels().zip(gl.pixels()) {
+        assert_eq!((a[0], a[2]), (b[0], b[2]));
+        assert!((a[1] as i32 + b[1] as i32 - 255).abs() <= 1, "green {} against {}", a[1], b[1]);
+    }
+    for (extra, said) in [
+        (
+            "pack = \"unreal\"\nnormal_convention = \"directx\"",
+            "normal_convention: pack \"unreal\" writes its normal map",
+        ),
+        ("normal_convention = \"dx\"", "normal_convention \"dx\": accepted: opengl, directx"),
+    ] {
+        std::fs::write(&jobs, job(extra)).unwrap();
+        let refused = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("o").to_str().unwrap()]);
+        assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+        assert!(stderr(&refused).contains(said) && stderr(&refused).contains("jobs.toml:"), "{}", stderr(&refused));
+    }
+}

@@ -434,12 +434,12 @@ pub struct BatchArgs {
     /// The jobs file: [[job]] tables with `preset` (a built-in name or a .toml path relative
     /// to the jobs file) and optional `seeds = [..]`, `sizes = [..]`, `maps = "color,normal"`,
     /// `format = "png"|"exr"`, `pack = "gltf"|"unreal"|"unity-hdrp"` (with `ao = true`: the
-    /// pack's occlusion channel computed, as --ao), `layout = "tile"|"body"` and
-    /// `set = { "scales.rows" = 23 }`. Every combination of seeds and sizes is one job.
+    /// pack's occlusion channel computed, as --ao), `layout = "tile"|"body"`,
+    /// `normal_convention = "opengl"|"directx"` (without a pack) and `set = { "scales.rows" = 23 }`. Every combination of seeds and sizes is one job.
     #[arg(value_name = "JOBS.toml")]
     pub jobs: PathBuf,
     /// Output folder: each job writes
-    /// DIR/<preset>/<layout>-<size>-seed<seed>-<format or pack-ENGINE[-ao]>[-<maps>][-set<hash>]/
+    /// DIR/<preset>/<layout>-<size>-seed<seed>-<format or pack-ENGINE[-ao]>[-directx][-<maps>][-set<hash>]/
     /// (the maps joined by + when not all five, the overrides' hash when the job has `set`),
     /// and the run an index of its jobs (DIR/index.json, or index.shard-K-of-N.json).
     #[arg(short, long, value_name = "DIR")]
