@@ -251,7 +251,10 @@ impl Job {
             Some(p) => format!("pack-{}", p.name()),
             None => self.format.name().to_string(),
         };
-        let convention = if self.normal_convention == NormalConvention::DirectX { "-directx" } else { "" };
+        let convention = match self.normal_convention {
+            NormalConvention::OpenGl => String::new(),
+            other => format!("-{}", other.name()),
+        };
         let maps = if self.pack.is_none() && self.maps != MapKind::ALL {
             format!("-{}", self.maps.iter().map(|m| m.name()).collect::<Vec<_>>().join("+"))
         } else {
@@ -288,8 +291,8 @@ impl Job {
         if self.ao {
             description["ao"] = true.into();
         }
-        if self.normal_convention == NormalConvention::DirectX {
-            description["normal_convention"] = "directx".into();
+        if self.normal_convention != NormalConvention::OpenGl {
+            description["normal_convention"] = self.normal_convention.name().into();
         }
         sha256_hex(description.to_string().as_bytes())
     }
@@ -404,7 +407,20 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
             .then(|| base.join(&table.preset).components().collect::<std::path::PathBuf>());
         let preset = match relative {
             Some(path) if crate::preset::names_a_file(&table.preset, &path) || table.preset.contains('/') => {
-                path.to_string_lossy().into_owned()
+                // Presets are named by their paths as text: joined to a folder whose path is
+                // not UTF-8, the path read lossily named no file ("cannot read preset n�/…",
+                // a review).
+                path.to_str().map(String::from).ok_or_else(|| {
+                    invalid(
+                        "preset",
+                        format!(
+                            "preset: its path {} is not UTF-8 text (the jobs file's folder's is not), and presets \
+                             are named by their paths as text: run the batch from inside that folder, or move the \
+                             jobs file and its presets to a folder whose path is UTF-8",
+                            path.to_string_lossy()
+                        ),
+                    )
+                })?
             }
             _ => table.preset.clone(),
         };
@@ -454,15 +470,17 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                     ),
                 ));
             }
-            (None | Some("opengl"), None) => NormalConvention::OpenGl,
-            (Some("directx"), None) => NormalConvention::DirectX,
-            (Some(other), None) => {
-                return Err(invalid(
-                    "normal_convention",
-                    format!("normal_convention {other:?}: accepted: opengl, directx"),
-                ));
-            }
+            (None, None) => NormalConvention::OpenGl,
+            (Some(name), None) => NormalConvention::from_name(name).ok_or_else(|| {
+                let accepted: Vec<&str> = NormalConvention::ALL.iter().map(|c| c.name()).collect();
+                invalid("normal_convention", format!("normal_convention {name:?}: accepted: {}", accepted.join(", ")))
+            })?,
         };
+        // Without a normal map the convention changes no file: not a set of its own (a
+        // `maps = "color"` job asking for DirectX ran again, in a folder of its own, for the
+        // same bytes: a review).
+        let normal_convention =
+            if maps.contains(&MapKind::Normal) { normal_convention } else { NormalConvention::OpenGl };
         let layout = match table.layout.as_deref() {
             None | Some("tile") => Layout::Tile,
             Some("body") => Layout::Body,
@@ -689,6 +707,8 @@ struct Resolved {
     warnings: Vec<String>,
     /// The files its set writes (`generate::set_file_names`).
     files: Vec<String>,
+    /// The preset's `content_hash`, as its set's manifest records it (`preset_hash`).
+    preset_hash: String,
 }
 
 /// `check`: whether to look for its finished set (reading and hashing its files).
@@ -736,7 +756,7 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
     if done {
         outcome.status = JobStatus::Skipped;
     }
-    Ok(Resolved { outcome, done, warnings, files })
+    Ok(Resolved { outcome, done, warnings, files, preset_hash: loaded.content_hash.clone() })
 }
 
 /// Resolves every job of the file (not only the shard's, so that every shard finds the same
@@ -900,7 +920,7 @@ pub fn run(
         warn(&format!(
             "note: {} listed the jobs of {}; it lists this run's now (their sets stay where they are)",
             out.join(index_file_name(shard)).display(),
-            earlier.jobs_file
+            earlier
         ));
     }
     BatchIndex::new(jobs_file, shard, planned, concurrency).write(out, shard)?;
@@ -975,7 +995,15 @@ pub fn run(
 /// The jobs file of the index already in `out` where it is another than `jobs_file` (the
 /// run replaces that index; a second jobs file into one folder replaced the first's without
 /// a word). None where there is none, it cannot be read, or it is this file's.
-fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<OtherIndex> {
+fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<String> {
+    read_index_file(&out.join(index_file_name(shard)))
+        .map(|(earlier, _)| earlier)
+        .filter(|earlier| !is_this_jobs_file(earlier, jobs_file))
+}
+
+/// An index file's jobs file (as recorded) and each of its jobs' manifest (relative to the
+/// output folder) and key; None where it cannot be read as one.
+fn read_index_file(path: &Path) -> Option<(String, Vec<(PathBuf, String)>)> {
     #[derive(serde::Deserialize)]
     struct Listed {
         jobs_file: String,
@@ -987,42 +1015,67 @@ fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<Oth
         manifest: PathBuf,
         key: String,
     }
-    let text = std::fs::read(out.join(index_file_name(shard))).ok()?;
-    let Listed { jobs_file: earlier, jobs } = serde_json::from_slice::<Listed>(&text).ok()?;
-    let same = earlier == recorded_jobs_file(jobs_file) || crate::export::same_path(Path::new(&earlier), jobs_file);
-    let sets = jobs.into_iter().map(|job| (job.manifest, job.key)).collect();
-    (!same).then_some(OtherIndex { jobs_file: earlier, sets })
+    let text = std::fs::read(path).ok()?;
+    let Listed { jobs_file, jobs } = serde_json::from_slice::<Listed>(&text).ok()?;
+    Some((jobs_file, jobs.into_iter().map(|job| (job.manifest, job.key)).collect()))
 }
 
-/// The index another jobs file's run left where this run writes its own
-/// (`index_of_other_jobs`).
-struct OtherIndex {
-    jobs_file: String,
-    /// Each of its jobs' manifest (relative to the output folder) and job key.
-    sets: std::collections::HashMap<PathBuf, String>,
+/// Whether an index's recorded jobs file is `jobs_file` (`recorded_jobs_file`'s text, or
+/// the same file).
+fn is_this_jobs_file(recorded: &str, jobs_file: &Path) -> bool {
+    recorded == recorded_jobs_file(jobs_file) || crate::export::same_path(Path::new(recorded), jobs_file)
 }
 
-impl OtherIndex {
-    /// Refuses a job that would replace a set the other jobs file's run made: its index lists
-    /// the job's manifest with another key, and the set there is still the one it made (its
-    /// manifest's `job`). A second jobs file naming another preset `vipera-berus` wrote over
-    /// the first's set in the same folder, and the note said their sets stayed (a
-    /// hostile-input sweep); within one jobs file such a clash is refused (`resolve_all`).
+/// The sets other jobs files' runs made in the output folder, as their indexes list them:
+/// every index there (`index.json` and each shard's: a sharded run of a second jobs file
+/// wrote over the first's set unseen, a review found), each set's manifest with the jobs
+/// file and the key it was made with.
+struct OtherSets(std::collections::HashMap<PathBuf, (String, String)>);
+
+impl OtherSets {
+    fn in_folder(out: &Path, jobs_file: &Path) -> OtherSets {
+        let mut sets = std::collections::HashMap::new();
+        let names = std::fs::read_dir(out).into_iter().flatten().flatten().map(|e| e.file_name());
+        for name in names.filter(|n| n.to_str().is_some_and(is_index_file_name)) {
+            let Some((recorded, jobs)) = read_index_file(&out.join(name)) else { continue };
+            if is_this_jobs_file(&recorded, jobs_file) {
+                continue;
+            }
+            for (manifest, key) in jobs {
+                sets.entry(manifest).or_insert_with(|| (recorded.clone(), key));
+            }
+        }
+        OtherSets(sets)
+    }
+
+    /// Refuses a job that would replace a set another jobs file's run made from another
+    /// preset of the same name: an index lists the job's manifest, the set there is still
+    /// the one that run made (its manifest's `job`), and its `preset_hash` is not this job's.
+    /// A second jobs file naming another preset `vipera-berus` wrote over the first's set in
+    /// the same folder, and the note said their sets stayed (a hostile-input sweep); within
+    /// one jobs file such a clash is refused (`resolve_all`). The same preset made by another
+    /// version of the tool (whose job keys differ) is replaced, as its own jobs file's run
+    /// would.
     fn check(&self, out: &Path, r: &Resolved, place: JobPlace) -> Result<(), Error> {
         let manifest = &r.outcome.manifest;
-        let Some(their_key) = self.sets.get(manifest) else { return Ok(()) };
-        if r.done || r.outcome.duplicate_of.is_some() || *their_key == r.outcome.key {
+        let Some((jobs_file, their_key)) = self.0.get(manifest) else { return Ok(()) };
+        if r.done || r.outcome.duplicate_of.is_some() {
             return Ok(());
         }
-        let standing = crate::export::read_set_manifest(&out.join(manifest), crate::text_file::Links::Refuse);
-        if standing.ok().and_then(|json| json["job"].as_str().map(String::from)).as_ref() != Some(their_key) {
+        let Ok(standing) = crate::export::read_set_manifest(&out.join(manifest), crate::text_file::Links::Refuse)
+        else {
+            return Ok(());
+        };
+        let their_hash = standing["preset_hash"].as_str().unwrap_or_default();
+        if standing["job"].as_str() != Some(their_key) || their_hash == r.preset_hash {
             return Ok(());
         }
         let message = format!(
-            "would replace the set in {}, which a run of {} made with different output (the folder's index lists \
-             that run's jobs); write this batch into another folder, or remove that set's folder first",
+            "would replace the set in {}, which a run of {jobs_file} made from another preset of that name \
+             (its preset_hash {their_hash}, this job's {}; the folder's index lists that run's jobs): write this \
+             batch into another folder, or remove that set's folder first",
             out.join(&r.outcome.folder).display(),
-            self.jobs_file,
+            r.preset_hash,
         );
         Err(BatchError::Invalid { place, message }.into())
     }
@@ -1103,10 +1156,10 @@ fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard, for_run
     }
     let (mine, resolved): (Vec<&'a Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
-    if for_run && let Some(other) = index_of_other_jobs(out, shard, jobs_file) {
-        for (job, r) in mine.iter().zip(&resolved) {
-            other.check(out, r, job.place(jobs_file, job.lines.preset))?;
-        }
+    // `--list` too: it shows what a run would do.
+    let others = OtherSets::in_folder(out, jobs_file);
+    for (job, r) in mine.iter().zip(&resolved) {
+        others.check(out, r, job.place(jobs_file, job.lines.preset))?;
     }
     let mut estimates = Vec::new();
     // A plan (the preset's graph, its memory estimate) is the same for every seed: jobs that

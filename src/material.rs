@@ -282,6 +282,13 @@ impl NormalConvention {
             NormalConvention::DirectX => "directx",
         }
     }
+
+    pub const ALL: [NormalConvention; 2] = [NormalConvention::OpenGl, NormalConvention::DirectX];
+
+    /// The convention of that `name` (a jobs file's `normal_convention`).
+    pub fn from_name(name: &str) -> Option<NormalConvention> {
+        Self::ALL.into_iter().find(|c| c.name() == name)
+    }
 }
 
 /// The layer stack's optics (thesis Table 5.2 names in comments; defaults in `thesis`).

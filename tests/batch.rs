@@ -732,11 +732,12 @@ fn a_batch_says_when_it_replaces_another_jobs_files_index() {
 }
 
 /// A second jobs file whose preset shares the first's name but not its content would write
-/// the first's set with other output: refused before anything runs, naming the set's folder
-/// and the first jobs file, every file as it was (it was replaced, and the note said the
-/// first's sets stayed: a hostile-input sweep). Controls: the same preset's content under
-/// that name shares the set (skipped); the first jobs file again, its preset edited, replaces
-/// its own set.
+/// the first's set with other output: refused before anything runs, sharded or not, and by
+/// `--list`, naming the set's folder and the first jobs file, every file as it was (it was
+/// replaced, and the note said the first's sets stayed: a hostile-input sweep; a sharded
+/// run still replaced it: a review). Controls: the same preset's content under that name
+/// shares the set (skipped); the first jobs file again, its preset edited, replaces its own
+/// set.
 #[test]
 fn a_second_jobs_file_does_not_replace_the_firsts_set_with_other_output() {
     let dir = tempfile::tempdir().unwrap();
@@ -760,15 +761,25 @@ fn a_second_jobs_file_does_not_replace_the_firsts_set_with_other_output() {
     std::fs::write(other_folder.join("vipera-berus.toml"), built_in.replace("\nrows = 21", "\nrows = 23")).unwrap();
     run(&first);
     let before_second = tree(&out);
-    let refused = run(&second);
-    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
-    let message = stderr(&refused);
     let folder = out.join("vipera-berus").join("tile-16-seed1-png");
-    assert!(
-        message.contains(&format!("would replace the set in {}, which a run of {}", folder.display(), first.display())),
-        "{message}"
+    let said = format!(
+        "would replace the set in {}, which a run of {} made from another preset of that name",
+        folder.display(),
+        first.display()
     );
-    assert_eq!(tree(&out), before_second, "a file changed");
+    for extra in [&[][..], &["--shard", "0/2"], &["--shard", "1/2"], &["--list"]] {
+        let mut args = vec!["batch", second.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend(extra);
+        let refused = snakeskin(&args);
+        // Shard 1/2 holds no job of this one-job file: nothing of the first's is replaced.
+        if extra == ["--shard", "1/2"] {
+            assert!(refused.status.success(), "{}", stderr(&refused));
+            continue;
+        }
+        assert_eq!(refused.status.code(), Some(2), "{extra:?}: {}", stderr(&refused));
+        assert!(stderr(&refused).contains(&said), "{extra:?}: {}", stderr(&refused));
+        assert_eq!(tree(&out), before_second, "{extra:?}: a file changed");
+    }
     // The first jobs file's own set, its preset edited: replaced (the built-in cannot be
     // edited, so the first jobs file is pointed at the edited file).
     std::fs::write(&first, "[[job]]\npreset = \"x/vipera-berus.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
@@ -795,7 +806,8 @@ fn a_newline_in_a_jobs_preset_stays_on_its_line() {
 /// A batch run in a folder whose path is not UTF-8 writes its index (the jobs file's path
 /// recorded with the bytes outside UTF-8 as `\xNN`) and knows it again: the job is skipped
 /// the second time, without a note of another jobs file. It failed with "internal error:
-/// index: path contains invalid UTF-8 characters" (a hostile-input sweep).
+/// index: path contains invalid UTF-8 characters" (a hostile-input sweep). A preset file
+/// named through that folder from outside it is refused, saying why (a review).
 #[test]
 fn a_batch_runs_in_a_folder_whose_path_is_not_utf8() {
     use std::os::unix::ffi::OsStrExt;
@@ -818,6 +830,22 @@ fn a_batch_runs_in_a_folder_whose_path_is_not_utf8() {
         assert_eq!(statuses(&index), [expected]);
         assert!(index["jobs_file"].as_str().unwrap().ends_with("/n\\xfdu/jobs.toml"), "{}", index["jobs_file"]);
     }
+    // A preset file beside the jobs file, named through that folder from outside it: refused
+    // with the key's line and what to do (it was read lossily, "cannot read preset n�/…").
+    std::fs::write(folder.join("snake.toml"), "[scales]\nrows = 21\n").unwrap();
+    std::fs::write(folder.join("jobs.toml"), "[[job]]\npreset = \"snake.toml\"\nsizes = [16]\n").unwrap();
+    let outside = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .arg("batch")
+        .arg(folder.join("jobs.toml"))
+        .arg("-o")
+        .arg(dir.path().join("o"))
+        .output()
+        .unwrap();
+    assert_eq!(outside.status.code(), Some(2), "{}", stderr(&outside));
+    assert!(stderr(&outside).contains("jobs.toml:2: [[job]] 1 (snake.toml): preset: its path"), "{}", stderr(&outside));
+    assert!(stderr(&outside).contains("is not UTF-8 text"), "{}", stderr(&outside));
+    // The control: run from inside the folder, the same jobs file reads its preset.
+    assert!(run().status.success());
 }
 
 #[test]
@@ -1282,7 +1310,8 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
 
 /// A job can ask for DirectX normals (`normal_convention`, as `generate --normal-convention`):
 /// its set goes to a folder of its own (`-directx`), its manifest says so, and its normal
-/// map's green channel is the OpenGL one's mirror; left out, OpenGL (the control). With a
+/// map's green channel is the OpenGL one's mirror; left out, OpenGL (the control); without
+/// a normal map in the job's maps, no folder of its own (the same bytes). With a
 /// pack (which writes its engine's own) and an unknown value, refused with the key's line.
 /// A batch could not make DirectX normals but through `pack = "unreal"` (a walkthrough).
 #[test]
@@ -1290,7 +1319,8 @@ fn a_job_can_ask_for_directx_normals() {
     let dir = tempfile::tempdir().unwrap();
     let jobs = dir.path().join("jobs.toml");
     let job = |extra: &str| format!("[[job]]\npreset = \"vipera-berus\"\nseeds = [1]\nsizes = [16]\n{extra}\n");
-    std::fs::write(&jobs, job("normal_convention = \"directx\"") + &job("")).unwrap();
+    let colour_only = job("normal_convention = \"directx\"\nmaps = \"color\"");
+    std::fs::write(&jobs, job("normal_convention = \"directx\"") + &job("") + &colour_only).unwrap();
     let out = dir.path().join("out");
     let ran = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(ran.status.success(), "{}", stderr(&ran));
@@ -1301,6 +1331,9 @@ fn a_job_can_ask_for_directx_normals() {
         let normal = image::open(folder.join("vipera-berus_normal.png")).unwrap().into_rgb8();
         (manifest["normal_convention"].as_str().unwrap().to_string(), normal)
     };
+    // Without a normal map the convention changes no file, and makes no set of its own.
+    assert!(out.join("vipera-berus/tile-16-seed1-png-color/vipera-berus_color.png").exists());
+    assert!(!out.join("vipera-berus/tile-16-seed1-png-directx-color").exists());
     let (directx, dx) = set("tile-16-seed1-png-directx");
     let (opengl, gl) = set("tile-16-seed1-png");
     assert_eq!((directx.as_str(), opengl.as_str()), ("directx", "opengl"));

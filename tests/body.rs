@@ -820,61 +820,67 @@ fn a_border_the_new_kind_does_not_read_draws_nothing() {
     assert!(map(text, "crescents") != map(&without, "crescents"), "the control");
 }
 
-/// The head-local point (x in shield half-widths across, s in head lengths from the snout)
-/// as a pixel of a body atlas `colour` of `plan`'s head (`ops::body::BodyPlan::head_units`).
-fn head_pixel(colour: &Image, plan: &snakeskin::ops::body::BodyPlan, (x, s): (f32, f32)) -> (usize, usize) {
-    let u = 0.5 + x * snakeskin::ops::body::HEAD_TOP_HALF_U;
-    let v = s * plan.head_end;
-    ((u * colour.width as f32) as usize, (v * colour.height as f32) as usize)
+/// A species' body atlas colour map seen as its head: one head mark's colour against every
+/// other colour its head can show (the ground, the pattern's and the other marks' colours).
+struct HeadView {
+    colour: Image,
+    plan: snakeskin::ops::body::BodyPlan,
+    mark: [f32; 3],
+    others: Vec<[f32; 3]>,
 }
 
-/// Whether the pixel at (x, y) is nearer `mark` than any of `others`.
-fn is_mark(colour: &Image, (x, y): (usize, usize), mark: [f32; 3], others: &[[f32; 3]]) -> bool {
-    let k = (y * colour.width + x) * 3;
-    let own = distance(&colour.data[k..k + 3], mark);
-    others.iter().all(|o| own < distance(&colour.data[k..k + 3], *o))
+impl HeadView {
+    /// `name` with `overrides`, looking for the colour of its head mark `index`.
+    fn of(name: &str, overrides: &[(&str, &str)], index: usize) -> HeadView {
+        let p = preset(name, overrides);
+        let mark = p.body.head_mark[index].color;
+        let mut others = other_colours(&p, mark);
+        others.extend(p.body.head_mark.iter().map(|m| m.color).filter(|c| *c != mark).map(linear));
+        HeadView { colour: body_map(&p, MapKind::Color), plan: body_plan(&p), mark: linear(mark), others }
+    }
+
+    /// The pixel of the head-local point (x in shield half-widths across, s in head lengths
+    /// from the snout; `ops::body::BodyPlan::head_units`).
+    fn pixel(&self, (x, s): (f32, f32)) -> (usize, usize) {
+        let u = 0.5 + x * snakeskin::ops::body::HEAD_TOP_HALF_U;
+        let v = s * self.plan.head_end;
+        ((u * self.colour.width as f32) as usize, (v * self.colour.height as f32) as usize)
+    }
+
+    /// Whether the pixel at (x, y) is nearer the mark's colour than any other.
+    fn is_mark(&self, (x, y): (usize, usize)) -> bool {
+        let k = (y * self.colour.width + x) * 3;
+        let own = distance(&self.colour.data[k..k + 3], self.mark);
+        self.others.iter().all(|o| own < distance(&self.colour.data[k..k + 3], *o))
+    }
 }
 
-/// Every colour a preset's head can show but `mark`: the ground, the pattern's and the other
-/// head marks' colours.
-fn head_colours_but(p: &Preset, mark: Srgb8) -> Vec<[f32; 3]> {
-    let mut others = other_colours(p, mark);
-    others.extend(p.body.head_mark.iter().map(|m| m.color).filter(|c| *c != mark).map(linear));
-    others
+/// The index of `name`'s first head mark of `kind`.
+fn head_mark_index(name: &str, kind: snakeskin::preset::schema::HeadMarkKind) -> usize {
+    let marks = preset(name, &[]).body.head_mark;
+    marks.iter().position(|m| m.kind == kind).unwrap_or_else(|| panic!("{name} draws no {kind:?}"))
 }
 
 #[test]
-fn a_band_between_the_eyes_crosses_the_head_in_front_of_them() {
+fn a_band_between_the_eyes_crosses_the_head() {
     // pantherophis-guttatus: 'Additional stripes run along the sides of the head, through the
     // eyes and meet on top of the head in front of the eyes'; lampropeltis-triangulum: 'dark
     // transverse band between the eyes'; bitis-arietans: 'two well-marked dark bands: one on
     // the crown and the other between the eyes' (each preset's sources). Every column from
     // the spine to the eyes (0.6 shield half-widths out, each side) holds the band's colour
-    // somewhere between the internasals' back and the eyes (0.24 to 0.5 head lengths from the
-    // snout): a band across, unbroken. The control: the band's mark turned into a spot behind
+    // somewhere between the front and the back of the eyes (0.3 to 0.6 head lengths from the
+    // snout, the supraoculars over the eyes spanning 0.4 to 0.6): a band across, unbroken. The control: the band's mark turned into a spot behind
     // each eye, and the top of the head in front of the eyes is open (the corn snake's
     // spearhead of the same colour, the milk snake's white V, there only near the spine).
     for name in ["pantherophis-guttatus", "lampropeltis-triangulum", "bitis-arietans"] {
-        let index = preset(name, &[])
-            .body
-            .head_mark
-            .iter()
-            .position(|m| m.kind == snakeskin::preset::schema::HeadMarkKind::EyeBand)
-            .unwrap_or_else(|| panic!("{name} draws an eye band"));
-        let key = format!("body.head_mark.{index}.kind");
+        let index = head_mark_index(name, snakeskin::preset::schema::HeadMarkKind::EyeBand);
         let across = |overrides: &[(&str, &str)]| {
-            let p = preset(name, overrides);
-            let plan = body_plan(&p);
-            let colour = body_map(&p, MapKind::Color);
-            let band = p.body.head_mark[index].color;
-            let others = head_colours_but(&p, band);
-            let (_, first) = head_pixel(&colour, &plan, (0.0, 0.24));
-            let (_, last) = head_pixel(&colour, &plan, (0.0, 0.5));
-            let (left, _) = head_pixel(&colour, &plan, (-0.6, 0.0));
-            let (right, _) = head_pixel(&colour, &plan, (0.6, 0.0));
-            (left..=right).filter(|&x| !(first..=last).any(|y| is_mark(&colour, (x, y), linear(band), &others))).count()
+            let head = HeadView::of(name, overrides, index);
+            let ((left, first), (right, last)) = (head.pixel((-0.6, 0.3)), head.pixel((0.6, 0.6)));
+            (left..=right).filter(|&x| !(first..=last).any(|y| head.is_mark((x, y)))).count()
         };
         assert_eq!(across(&[]), 0, "{name}: columns without the band");
+        let key = format!("body.head_mark.{index}.kind");
         assert!(across(&[(&key, "\"postocular_spot\"")]) > 10, "{name}: the control");
     }
 }
@@ -888,30 +894,12 @@ fn the_boas_line_runs_from_the_snout_through_the_eye_to_the_neck() {
     // clear of the thin spearhead of the same colour on the midline). The control: the
     // preocular stripe turned into a spot behind the eye, and the rows in front of the eye
     // lack it (the line began behind the eye, an audit found).
-    let index = preset("boa-constrictor", &[])
-        .body
-        .head_mark
-        .iter()
-        .position(|m| m.kind == snakeskin::preset::schema::HeadMarkKind::PreocularStripe)
-        .expect("the boa draws a preocular stripe");
+    let index = head_mark_index("boa-constrictor", snakeskin::preset::schema::HeadMarkKind::PreocularStripe);
     let rows_without = |overrides: &[(&str, &str)]| {
-        let p = preset("boa-constrictor", overrides);
-        let plan = body_plan(&p);
-        let colour = body_map(&p, MapKind::Color);
-        let line = p.body.head_mark[index].color;
-        let others = head_colours_but(&p, line);
-        let (_, first) = head_pixel(&colour, &plan, (0.0, 0.1));
-        let (_, last) = head_pixel(&colour, &plan, (0.0, 0.95));
-        let sides = [(-1.6, -0.25), (0.25, 1.6)].map(|(a, b)| {
-            let (from, _) = head_pixel(&colour, &plan, (a, 0.0));
-            let (to, _) = head_pixel(&colour, &plan, (b, 0.0));
-            from..=to
-        });
-        (first..=last)
-            .filter(|&y| {
-                !sides.iter().all(|side| side.clone().any(|x| is_mark(&colour, (x, y), linear(line), &others)))
-            })
-            .count()
+        let head = HeadView::of("boa-constrictor", overrides, index);
+        let ((_, first), (_, last)) = (head.pixel((0.0, 0.1)), head.pixel((0.0, 0.95)));
+        let sides = [(-1.6, -0.25), (0.25, 1.6)].map(|(a, b)| head.pixel((a, 0.0)).0..=head.pixel((b, 0.0)).0);
+        (first..=last).filter(|&y| !sides.iter().all(|side| side.clone().any(|x| head.is_mark((x, y))))).count()
     };
     assert_eq!(rows_without(&[]), 0, "rows without the line");
     let key = format!("body.head_mark.{index}.kind");

@@ -182,20 +182,24 @@ fn set_overrides_change_the_output_like_editing_the_file() {
 /// given (a set without any has no such key), and a key given twice is warned of, the last
 /// value used. Before, neither: two sets with different overrides had manifests differing
 /// only in `preset_hash`, and `--set a=1 --set a=2` said nothing.
+/// `natrix-natrix`'s colour map generated into `dir/out` with `args` after the command's
+/// own: its manifest and what it printed on stderr.
+fn natrix_colour_set(dir: &std::path::Path, out: &str, args: &[&str]) -> (serde_json::Value, String) {
+    let folder = dir.join(out);
+    let mut all = vec!["generate", "natrix-natrix", "-o", folder.to_str().unwrap(), "--size", "32", "--maps", "color"];
+    all.extend(args);
+    let run = snakeskin(&all);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let manifest = std::fs::read_to_string(folder.join("natrix-natrix.material.json")).unwrap();
+    (serde_json::from_str::<serde_json::Value>(&manifest).unwrap(), stderr(&run))
+}
+
 #[test]
 fn the_manifest_records_the_overrides_and_a_repeated_key_is_warned_of() {
     let dir = tempfile::tempdir().unwrap();
     let generate = |out: &str, sets: &[&str]| {
-        let folder = dir.path().join(out);
-        let mut args =
-            vec!["generate", "natrix-natrix", "-o", folder.to_str().unwrap(), "--size", "32", "--maps", "color"];
-        for s in sets {
-            args.extend(["--set", s]);
-        }
-        let run = snakeskin(&args);
-        assert!(run.status.success(), "{}", stderr(&run));
-        let manifest = std::fs::read_to_string(folder.join("natrix-natrix.material.json")).unwrap();
-        (serde_json::from_str::<serde_json::Value>(&manifest).unwrap(), stderr(&run))
+        let args: Vec<&str> = sets.iter().flat_map(|s| ["--set", s]).collect();
+        natrix_colour_set(dir.path(), out, &args)
     };
     let (twice, err) = generate("twice", &["scales.rows=10", "scales.rows=20"]);
     let (once, quiet) = generate("once", &["scales.rows=20"]);
@@ -215,14 +219,8 @@ fn the_manifest_records_the_overrides_and_a_repeated_key_is_warned_of() {
 fn a_seed_override_that_seed_overrides_is_warned_of() {
     let dir = tempfile::tempdir().unwrap();
     let generate = |name: &str, args: &[&str]| {
-        let folder = dir.path().join(name);
-        let mut all =
-            vec!["generate", "natrix-natrix", "-o", folder.to_str().unwrap(), "--size", "16", "--maps", "color"];
-        all.extend(args);
-        let run = snakeskin(&all);
-        assert!(run.status.success(), "{}", stderr(&run));
-        let manifest = std::fs::read_to_string(folder.join("natrix-natrix.material.json")).unwrap();
-        (serde_json::from_str::<serde_json::Value>(&manifest).unwrap()["seed"].clone(), stderr(&run))
+        let (manifest, err) = natrix_colour_set(dir.path(), name, args);
+        (manifest["seed"].clone(), err)
     };
     let (seed, err) = generate("both", &["--seed", "5", "--set", "seed=6"]);
     assert_eq!(seed, 5);

@@ -159,12 +159,6 @@ fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limi
     assert_eq!(clamped[0]["key"], "belly.color");
 }
 
-/// A lossless stack shows every colour up to a reflectance of 1, and no further: a key that
-/// the map's per-scale tone and colour variation would brighten past 1 is clamped and
-/// reported like one an absorbing stack cannot show. Before, a white back came out of the
-/// map at up to 1.14 (linear) unreported: its EXR held that and its PNG clipped it. The
-/// colour map is checked as the graph evaluates it (f32, before any file's quantisation).
-/// Negative control: a grey belly that the brightening keeps below 1 is shown as written.
 /// A clamped colour the preset does not write is called its default: a two-line preset
 /// warned of `belly.color = "#e6dcc0"`, a colour its writer never wrote, with no line and no
 /// word of where it came from (a walkthrough). Controls: the same colour written in the
@@ -194,6 +188,12 @@ fn a_clamped_default_colour_is_called_the_default() {
     assert!(given.contains("belly.color") && !given.contains("default"), "{given}");
 }
 
+/// A lossless stack shows every colour up to a reflectance of 1, and no further: a key that
+/// the map's per-scale tone and colour variation would brighten past 1 is clamped and
+/// reported like one an absorbing stack cannot show. Before, a white back came out of the
+/// map at up to 1.14 (linear) unreported: its EXR held that and its PNG clipped it. The
+/// colour map is checked as the graph evaluates it (f32, before any file's quantisation).
+/// Negative control: a grey belly that the brightening keeps below 1 is shown as written.
 #[test]
 fn over_a_lossless_stack_no_key_is_brightened_past_a_reflectance_of_one() {
     let text = "[color]\nbase = \"#ffffff\"\nscale_tone = 0.1\n\n[belly]\ncolor = \"#c0c0c0\"\n";

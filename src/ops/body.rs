@@ -222,10 +222,13 @@ const POSTOCULAR: ((f32, f32), (f32, f32)) = ((0.62, 0.45), (1.45, 1.0));
 /// shield half-widths: 0.2 across, about a third of the supraocular's width (`SHIELDS`).
 const STRIPE_HALF_WIDTH: f32 = 0.10;
 
-/// Where the eye band's two halves meet at the spine: on the prefrontals (s 0.24 to 0.40,
-/// `SHIELDS`), in front of the supraoculars that lie over the eyes; each half runs from here
-/// to the eye, where the postocular stripe starts (`POSTOCULAR.0`).
-const EYE_BAND_APEX: (f32, f32) = (0.0, 0.34);
+/// Where the eye band crosses the spine: between the eyes, level with them (`POSTOCULAR.0`,
+/// where the postocular stripe starts at each eye), so the band runs straight across the
+/// frontal between the supraoculars that lie over the eyes (`SHIELDS`). Its halves first met
+/// on the prefrontals, in front of the eyes, as the corn snake's source says, but the milk
+/// snake's and the puff adder's say "between the eyes", and the chevron joined to the
+/// postocular stripes read as a V (a review).
+const EYE_BAND_APEX: (f32, f32) = (0.0, POSTOCULAR.0.1);
 
 /// Where the preocular stripe starts: the snout, at the rostral's outer corner (`SHIELDS`);
 /// it runs to the eye, where the postocular stripe starts (`POSTOCULAR.0`).
@@ -574,10 +577,10 @@ mod tests {
         assert!((stripe_across / stripe_along - 1.0).abs() > 0.1, "{stripe_across} across, {stripe_along} along");
     }
 
-    /// The pixels of a head mark on `plan()`'s head, 512 across, as head-local points (x in
-    /// shield half-widths, signed; s in head lengths).
-    fn mark_points(shape: HeadMarkShape) -> Vec<(f32, f32)> {
-        let mark = HeadMark { shape, size: 1.0, plan: plan(), behind: 0.0 };
+    /// The pixels of a head mark on `plan`'s head at `size`, 512 across, as head-local points
+    /// (x in shield half-widths, signed; s in head lengths).
+    fn mark_points(shape: HeadMarkShape, plan: BodyPlan, size: f32) -> Vec<(f32, f32)> {
+        let mark = HeadMark { shape, size, plan, behind: 0.0 };
         let (ux, head) = mark.plan.head_units();
         let n = 512;
         let rows = (mark.reach_v() * n as f32 * mark.plan.length).ceil() as usize;
@@ -594,48 +597,57 @@ mod tests {
         points
     }
 
-    /// The eye band crosses the spine on the prefrontals, in front of the supraoculars over
-    /// the eyes (a corn snake's eye stripes "meet on top of the head in front of the eyes"),
-    /// and the preocular stripe starts on the snout, within the rostral's length; each shares
-    /// pixels with the postocular stripe on both sides, so that drawn together they are one
-    /// line through the eye. Negative controls: the postocular stripe alone has no pixel on
-    /// the spine and none on the snout; the spot behind the eye, a mark of the same line, does
-    /// not meet the preocular stripe.
+    /// The eye band crosses the spine between the eyes (its crossing centred within the
+    /// supraoculars' length, the shields over the eyes) and the preocular stripe starts on
+    /// the snout (within the rostral's length); each shares pixels with the postocular
+    /// stripe on both sides, so that drawn together they are one line through the eye. On
+    /// every built-in species' plan, at the smallest, default and largest sizes. Negative
+    /// controls: the postocular stripe alone has no pixel on the spine and none on the snout;
+    /// the spot behind the eye, a mark of the same line, does not meet the preocular stripe.
     #[test]
     fn the_eye_band_and_the_preocular_stripe_meet_the_postocular_stripe_at_the_eye() {
+        use crate::preset::validate::ranges::HEAD_MARK_SIZE;
         let extent = |name: &str| {
             let (_, _, points) = SHIELDS.iter().find(|(n, ..)| *n == name).unwrap();
             points.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)))
         };
-        let (prefrontal, rostral) = (extent("prefrontal"), extent("rostral"));
+        let (supraocular, rostral) = (extent("supraocular"), extent("rostral"));
         // The two columns beside the spine (512 across; x in shield half-widths).
         let on_spine = |points: &[(f32, f32)]| -> Vec<f32> {
             points.iter().filter(|p| p.0.abs() < 1.0 / 512.0 / HEAD_TOP_HALF_U).map(|p| p.1).collect()
         };
-        let band = mark_points(HeadMarkShape::EyeBand);
-        let spine = on_spine(&band);
-        assert!(!spine.is_empty(), "the band crosses the spine");
-        assert!(
-            spine.iter().all(|&s| s > prefrontal.0 && s < prefrontal.1),
-            "on the prefrontals ({prefrontal:?}): {:?}",
-            (spine.iter().cloned().fold(f32::MAX, f32::min), spine.iter().cloned().fold(f32::MIN, f32::max))
-        );
-        let pre = mark_points(HeadMarkShape::PreocularStripe);
-        let front = pre.iter().map(|p| p.1).fold(f32::MAX, f32::min);
-        assert!(front < rostral.1, "the preocular stripe starts {front} head lengths back");
-        let post = mark_points(HeadMarkShape::PostocularStripe);
         let shared = |a: &[(f32, f32)], b: &[(f32, f32)], right: bool| {
             a.iter().filter(|p| (p.0 > 0.0) == right && b.contains(p)).count()
         };
-        for right in [false, true] {
-            assert!(shared(&band, &post, right) > 0, "the band meets the stripe (right side: {right})");
-            assert!(shared(&pre, &post, right) > 0, "the preocular meets the stripe (right side: {right})");
+        let plans = crate::preset::library::all()
+            .iter()
+            .map(|(name, _)| crate::maps::body_plan(&crate::preset::load(name, &[], None).unwrap().preset));
+        for plan in plans {
+            for size in [HEAD_MARK_SIZE.0 as f32, 1.0, HEAD_MARK_SIZE.1 as f32] {
+                let band = mark_points(HeadMarkShape::EyeBand, plan, size);
+                let spine = on_spine(&band);
+                let (lo, hi) = spine.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &s| (lo.min(s), hi.max(s)));
+                let centre = 0.5 * (lo + hi);
+                assert!(
+                    !spine.is_empty() && centre > supraocular.0 && centre < supraocular.1,
+                    "size {size}, head {}: the band crosses the spine at {lo}..{hi}, the supraoculars span {supraocular:?}",
+                    plan.head_end * plan.length
+                );
+                let pre = mark_points(HeadMarkShape::PreocularStripe, plan, size);
+                let front = pre.iter().map(|p| p.1).fold(f32::MAX, f32::min);
+                assert!(front < rostral.1, "size {size}: the preocular stripe starts {front} head lengths back");
+                let post = mark_points(HeadMarkShape::PostocularStripe, plan, size);
+                for right in [false, true] {
+                    assert!(shared(&band, &post, right) > 0, "size {size}: the band meets the stripe ({right})");
+                    assert!(shared(&pre, &post, right) > 0, "size {size}: the preocular meets the stripe ({right})");
+                }
+                // The controls.
+                assert!(on_spine(&post).is_empty());
+                assert!(post.iter().all(|p| p.1 > rostral.1));
+                let spot = mark_points(HeadMarkShape::PostocularSpot, plan, size);
+                assert_eq!(shared(&spot, &pre, true) + shared(&spot, &pre, false), 0);
+            }
         }
-        // The controls.
-        assert!(on_spine(&post).is_empty());
-        assert!(post.iter().all(|p| p.1 > rostral.1));
-        let spot = mark_points(HeadMarkShape::PostocularSpot);
-        assert_eq!(shared(&spot, &pre, true) + shared(&spot, &pre, false), 0);
     }
 
     #[test]

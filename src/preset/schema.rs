@@ -747,9 +747,9 @@ pub enum HeadMarkKind {
     X,
     /// A forward-pointing arrowhead between the eyes running onto the neck (corn snakes).
     Spearhead,
-    /// A band across the top of the head from eye to eye, meeting at the spine a little in
-    /// front of them, its ends where the postocular stripes start (a corn snake's eye
-    /// stripes "meet on top of the head in front of the eyes"; a band between the eyes).
+    /// A band straight across the top of the head between the eyes, its ends at the eyes
+    /// where the postocular stripes start (a milk snake's "transverse band between the
+    /// eyes"; with the stripes, a corn snake's stripes through the eyes meeting on top).
     EyeBand,
     /// A stripe from the snout to the eye, each side, ending where the postocular stripe
     /// starts (with it, a line from the snout through the eye to the neck: boas).
