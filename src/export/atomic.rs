@@ -1033,14 +1033,14 @@ impl FileGroup {
     }
 
     /// Keeps `bytes` for `target` (creating its folder if needed, and checking the target).
-    pub fn stage(&mut self, target: &Path, bytes: &[u8]) -> Result<(), ExportError> {
+    pub fn stage(&mut self, target: &Path, bytes: Vec<u8>) -> Result<(), ExportError> {
         let (dir, name) = (folder_of(target), file_name(target));
         if name.is_empty() || ends_as_a_folder(target) {
             return Err(ExportError::folder_name(target, &super::OUTPUT_EXTENSIONS));
         }
         create_folder(dir)?;
         check_target(target)?;
-        self.staged.push((bytes.to_vec(), target.into()));
+        self.staged.push((bytes, target.into()));
         Ok(())
     }
 
@@ -1352,8 +1352,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
         let mut group = FileGroup::new();
-        group.stage(&a, b"first").unwrap();
-        group.stage(&b, b"second").unwrap();
+        group.stage(&a, b"first".to_vec()).unwrap();
+        group.stage(&b, b"second".to_vec()).unwrap();
         remove_stale_temporaries(dir.path(), &["a.png", "b.png"], std::time::Duration::ZERO);
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0, "a temporary while the work goes on");
         group.commit().unwrap();

@@ -219,7 +219,7 @@ const HEAD_SIDE_HALF_U: f32 = 0.32;
 const POSTOCULAR: ((f32, f32), (f32, f32)) = ((0.62, 0.45), (1.45, 1.0));
 
 /// The half-width of the head's stripes (postocular, preocular, the eye band) at size 1, in
-/// shield half-widths: 0.2 across, about a third of the supraocular's width (`SHIELDS`).
+/// shield half-widths: 0.2 across, half the supraocular's width (0.24 to 0.64, `SHIELDS`).
 const STRIPE_HALF_WIDTH: f32 = 0.10;
 
 /// Where the eye band crosses the spine: between the eyes, level with them (`POSTOCULAR.0`,
@@ -228,7 +228,7 @@ const STRIPE_HALF_WIDTH: f32 = 0.10;
 /// on the prefrontals, in front of the eyes, as the corn snake's source says, but the milk
 /// snake's and the puff adder's say "between the eyes", and the chevron joined to the
 /// postocular stripes read as a V (a review).
-const EYE_BAND_APEX: (f32, f32) = (0.0, POSTOCULAR.0.1);
+const EYE_BAND_AT_SPINE: (f32, f32) = (0.0, POSTOCULAR.0.1);
 
 /// Where the preocular stripe starts: the snout, at the rostral's outer corner (`SHIELDS`);
 /// it runs to the eye, where the postocular stripe starts (`POSTOCULAR.0`).
@@ -311,7 +311,7 @@ impl HeadMark {
                 let t = ((s - apex) / (base - apex)).clamp(0.0, 1.0);
                 (half * t - du).min(s - apex).min(base - s)
             }
-            HeadMarkShape::EyeBand => arm(EYE_BAND_APEX, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
+            HeadMarkShape::EyeBand => arm(EYE_BAND_AT_SPINE, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
             HeadMarkShape::PreocularStripe => arm(PREOCULAR_START, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
             HeadMarkShape::PostocularStripe => arm(POSTOCULAR.0, POSTOCULAR.1, STRIPE_HALF_WIDTH * k),
             // A disc 0.3 shield half-widths across at size 1 (the stripe is 0.2 wide).

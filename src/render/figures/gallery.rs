@@ -370,10 +370,10 @@ pub fn write(
     closeups: Option<&std::path::Path>,
 ) -> Result<Vec<std::path::PathBuf>, Error> {
     let mut group = FileGroup::new();
-    group.stage(path, &encode_png(MapKind::Color, &render(tile, columns)?)?)?;
+    group.stage(path, encode_png(MapKind::Color, &render(tile, columns)?)?)?;
     if let Some(dir) = closeups {
         for (name, png) in closeup_pngs()? {
-            group.stage(&dir.join(name), &png)?;
+            group.stage(&dir.join(name), png)?;
         }
     }
     Ok(group.commit()?)

@@ -145,7 +145,7 @@ pub fn write_figures(
         let settings = FrameSettings { view: figure.view, camera: Camera::close_up(), ..FrameSettings::default() };
         let image = renderer.render_image(&settings, &material, size.0, size.1)?;
         let rgb = image::DynamicImage::ImageRgba8(image).into_rgb8();
-        group.stage(&out_dir.join(figure.file), &png_bytes(&rgb)?)?;
+        group.stage(&out_dir.join(figure.file), png_bytes(&rgb)?)?;
     }
     let written = group.commit()?;
     progress(figures.len(), figures.len());

@@ -87,7 +87,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     // The render and its heat map appear together or not at all: a reference check that
     // failed (or was interrupted) had already replaced the earlier render.
     let mut files = FileGroup::new();
-    files.stage(out, &rendered_png_bytes(&image)?)?;
+    files.stage(out, rendered_png_bytes(&image)?)?;
     drop(image);
     bar.finish();
     if let Some(heat_path) = &args.reference {
@@ -95,7 +95,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         let (report, _) =
             reference_check(&renderer, &material, &settings, width, height, &|done, total| bar.update(done, total))?;
         bar.finish();
-        files.stage(heat_path, &png_bytes(&report.heat_map(5.0))?)?;
+        files.stage(heat_path, png_bytes(&report.heat_map(5.0))?)?;
         eprintln!(
             "reference: {} pixels, CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3} (heat map: black 0 .. yellow >= 5)",
             report.pixels, report.mean_de, report.p99_de, report.max_de
