@@ -220,15 +220,22 @@ mod tests {
 
     /// The size in bytes WGSL gives struct `name` of `program` (naga's layout rules).
     fn wgsl_struct_size(program_name: &str, name: &str) -> u32 {
-        let module = naga::front::wgsl::parse_str(&program(program_name)).expect("the program parses");
+        let (module, handle) = wgsl_struct(program_name, name);
         let mut layouter = naga::proc::Layouter::default();
         layouter.update(module.to_ctx()).expect("the program's types lay out");
-        let (handle, _) = module
+        layouter[handle].size
+    }
+
+    /// `program`'s module, parsed, and its type `name`.
+    fn wgsl_struct(program_name: &str, name: &str) -> (naga::Module, naga::Handle<naga::Type>) {
+        let module = naga::front::wgsl::parse_str(&program(program_name)).expect("the program parses");
+        let handle = module
             .types
             .iter()
             .find(|(_, t)| t.name.as_deref() == Some(name))
+            .map(|(handle, _)| handle)
             .unwrap_or_else(|| panic!("{program_name} has no struct {name}"));
-        layouter[handle].size
+        (module, handle)
     }
 
     /// The structs Rust writes into GPU buffers have the sizes their WGSL twins read, which
@@ -252,13 +259,8 @@ mod tests {
     /// Each member of WGSL struct `name` of `program`, by name, at the offset naga lays it
     /// out at.
     fn wgsl_struct_members(program_name: &str, name: &str) -> Vec<(String, u32)> {
-        let module = naga::front::wgsl::parse_str(&program(program_name)).expect("the program parses");
-        let (_, ty) = module
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("{program_name} has no struct {name}"));
-        match &ty.inner {
+        let (module, handle) = wgsl_struct(program_name, name);
+        match &module.types[handle].inner {
             naga::TypeInner::Struct { members, .. } => {
                 members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect()
             }
