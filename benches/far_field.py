@@ -1,6 +1,7 @@
 # The comparison of benches/far_field.sh: a frame against one K times as wide and tall,
 # averaged over K x K blocks in linear light, on the pixels the snake covers whole (every
-# sub-pixel of the block off the background): CIEDE2000 and mean chroma (CIELAB, D65).
+# sub-pixel of the block off the background): CIEDE2000 and mean chroma (CIELAB, D65), per
+# pixel and over 4 x 4 blocks of pixels.
 import sys, numpy as np
 from PIL import Image
 def lin(a):
@@ -34,5 +35,10 @@ hir=lin(np.asarray(Image.open(sys.argv[2]).convert('RGB'),dtype=float))
 h,w,_=lo.shape; k=hir.shape[0]//h
 covered=(np.abs(hir-hir[0,0]).sum(-1)>0.01).reshape(h,k,w,k).all(axis=(1,3))
 hi=hir.reshape(h,k,w,k,3).mean(axis=(1,3))
-dl=lab(lo)[covered]; dh=lab(hi)[covered]; de=de2000(dh,dl)
-print('pixels %d  dE00 mean %.2f p95 %.2f  chroma far %.2f supersampled %.2f' % (covered.sum(), de.mean(), np.percentile(de,95), np.hypot(dl[:,1],dl[:,2]).mean(), np.hypot(dh[:,1],dh[:,2]).mean()))
+# Per pixel, then over b x b blocks of whole pixels (every pixel of the block covered).
+for b in (1,4):
+    H,W=h//b,w//b
+    c=covered[:H*b,:W*b].reshape(H,b,W,b).all(axis=(1,3))
+    block=lambda a:a[:H*b,:W*b].reshape(H,b,W,b,3).mean(axis=(1,3))[c]
+    dl=lab(block(lo)); dh=lab(block(hi)); de=de2000(dh,dl)
+    print('  %dx%d: %5d  dE00 mean %.2f p95 %.2f  chroma far %.2f supersampled %.2f' % (b,b,c.sum(),de.mean(),np.percentile(de,95),np.hypot(dl[:,1],dl[:,2]).mean(),np.hypot(dh[:,1],dh[:,2]).mean()))

@@ -17,6 +17,10 @@ struct Layers {
     n2: f32,
     roughness: f32,
     thickness_nm: f32,
+    // Where the pixel's footprint spreads over several thicknesses, the film is read this
+    // far either side of thickness_nm and averaged (skin.wgsl's film_offset_nm); 0: read
+    // at thickness_nm.
+    thickness_offset_nm: f32,
     optical_depth: vec3<f32>,
     albedo: vec3<f32>,
     // The stack's bounce terms (layered model): K sent back to the base, E escaping.
@@ -40,8 +44,16 @@ fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
     return fallback;
 }
 
+// The film colour the layers read (the mean of two thicknesses where the footprint spreads).
 fn film_clamped(layers: Layers, c: f32) -> vec3<f32> {
-    return clamp(film_rgb(layers.thickness_nm, clamp(c, 0.0, 1.0)), vec3<f32>(0.0), vec3<f32>(1.0));
+    let cos0 = clamp(c, 0.0, 1.0);
+    var film = film_rgb(layers.thickness_nm, cos0);
+    if (layers.thickness_offset_nm > 0.0) {
+        let thin = max(layers.thickness_nm - layers.thickness_offset_nm, 0.0);
+        let thick = layers.thickness_nm + layers.thickness_offset_nm;
+        film = 0.5 * (film_rgb(thin, cos0) + film_rgb(thick, cos0));
+    }
+    return clamp(film, vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
 // D G2 / (4 cos_i cos_o) for GGX with Smith height-correlated G2 (optics::brdf::ggx).
@@ -375,14 +387,24 @@ fn top_on_row(layers: Layers, k: u32, fx: f32, norm: vec3<f32>) -> Top {
 // The layered coupling from the film table's coupling texture (optics::lut::Lut::
 // coupling_f32): the rule on the lobe's roughness rows at the table's cos texels and
 // thickness columns, two filtered fetches at the texel coordinates (cos, roughness,
-// thickness).
+// thickness); where the footprint spreads (Layers::thickness_offset_nm), the mean of the
+// table at the two thicknesses, as film_clamped.
 fn coupling_table(layers: Layers, cos: f32) -> Top {
+    if (layers.thickness_offset_nm > 0.0) {
+        let thin = coupling_table_at(layers, cos, max(layers.thickness_nm - layers.thickness_offset_nm, 0.0));
+        let thick = coupling_table_at(layers, cos, layers.thickness_nm + layers.thickness_offset_nm);
+        return Top(0.5 * (thin.reflected + thick.reflected), 0.5 * (thin.ms + thick.ms), 0.5 * (thin.path_delta + thick.path_delta));
+    }
+    return coupling_table_at(layers, cos, layers.thickness_nm);
+}
+
+fn coupling_table_at(layers: Layers, cos: f32, thickness_nm: f32) -> Top {
     let n_cos = f32(film_info.n_cos);
     // sqrt: the table's cos texels are uniform in sqrt(cos) (optics::lut::coupling_texel_cos).
     let x = sqrt(clamp(cos, 0.0, 1.0)) * (n_cos - 1.0);
     let rows = f32(E1_ROUGHNESS);
     let v = (clamp(layers.roughness, 0.0, 1.0) * (rows - 1.0) + 0.5) / rows;
-    let w = (lut_column(layers.thickness_nm) + 0.5) / f32(film_info.n_fine + film_info.n_coarse);
+    let w = (lut_column(thickness_nm) + 0.5) / f32(film_info.n_fine + film_info.n_coarse);
     let s = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5) / (2.0 * n_cos), v, w), 0.0);
     let ms = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5 + n_cos) / (2.0 * n_cos), v, w), 0.0);
     return Top(s.rgb, ms.rgb, s.a);

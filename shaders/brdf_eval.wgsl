@@ -27,6 +27,7 @@ fn eval_samples(@builtin(global_invocation_id) id: vec3<u32>) {
         s.tau_n2.w,
         s.normal_roughness.w,
         s.wi_thickness.w,
+        0.0,
         s.tau_n2.xyz,
         s.albedo.xyz,
         s.k.xyz,

@@ -28,7 +28,8 @@ struct Scene {
 @group(2) @binding(0) var albedo_roughness: texture_2d<f32>;
 // rgb: tangent-space normal (OpenGL, +Y up the image), a: height.
 @group(2) @binding(1) var normal_height: texture_2d<f32>;
-// r: iridescence map value in [0, 1].
+// r: iridescence map value t in [0, 1]; g: (t - THICKNESS_MOMENT_CENTRE)^2, so that the
+// filtered pair gives the footprint's variance (render::engine::material).
 @group(2) @binding(2) var thickness_map: texture_2d<f32>;
 @group(2) @binding(3) var map_sampler: sampler;
 
@@ -75,6 +76,9 @@ struct Material {
     normal: vec3<f32>,
     geometric: vec3<f32>,
     thickness_nm: f32,
+    // The standard deviation of the film thickness over the pixel's footprint (nm; 0 where
+    // it is under THICKNESS_SPREAD_MIN of the map's range, half-float rounding).
+    thickness_spread_nm: f32,
     height: f32,
     map_normal: vec3<f32>,
     map_value: f32,
@@ -84,7 +88,8 @@ fn sample_material(in: VertexOut) -> Material {
     var m: Material;
     let ar = textureSample(albedo_roughness, map_sampler, in.uv);
     let nh = textureSample(normal_height, map_sampler, in.uv);
-    let t = textureSample(thickness_map, map_sampler, in.uv).r;
+    let moments = textureSample(thickness_map, map_sampler, in.uv).rg;
+    let t = moments.r;
     m.albedo = ar.rgb;
     m.roughness = ar.a;
     m.height = nh.a;
@@ -99,6 +104,8 @@ fn sample_material(in: VertexOut) -> Material {
     m.normal = normalize(t_axis * tn.x + b_axis * tn.y + n * tn.z);
     m.geometric = n;
     m.thickness_nm = mix(scene.film.x, scene.film.y, clamp(t, 0.0, 1.0));
+    let spread = sqrt(max(moments.g - (t - THICKNESS_MOMENT_CENTRE) * (t - THICKNESS_MOMENT_CENTRE), 0.0));
+    m.thickness_spread_nm = select(0.0, spread * abs(scene.film.y - scene.film.x), spread > THICKNESS_SPREAD_MIN);
     return m;
 }
 

@@ -9,12 +9,16 @@ override STAGE: u32 = STAGE_ALL;
 override VIEW_MAP: u32 = VIEW_SHADED;
 // Which half of the G-buffer fs_gbuffer writes (two passes keep each under 32 bytes/pixel).
 override GBUFFER_PART: u32 = GBUFFER_POSITION_NORMAL;
+// Whether `shade` averages the film over the footprint's thickness spread (FilmFootprint::
+// Spread) or shades the mean thickness alone (FilmFootprint::Mean: the G-buffer then holds
+// no spread either, so the CPU reference shades as the frame did).
+override FOOTPRINT_SPREAD: bool = true;
 
 // The pixel's layers; K and E interpolated between the roughness rows (exact: they are
 // linear in r between rows) and then between the film thicknesses (BounceGrid::at), the
 // base albedo recovered from the colour map as the model reads it (base_albedo;
 // LayerOptics::layers is the CPU twin).
-fn layers_of(m: Material) -> Layers {
+fn layers_of(m: Material, thickness_offset_nm: f32) -> Layers {
     let j = lobe_row(m.roughness);
     let f = clamp(m.roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u) - f32(j);
     var x = 0.0;
@@ -39,7 +43,7 @@ fn layers_of(m: Material) -> Layers {
     let tau = scene.optical_depth.rgb;
     let kd = base_albedo(m.albedo, tau, m.roughness, k, e);
     return with_ms_norms(
-        Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, tau, kd, k, e, vec3<f32>(0.0), vec3<f32>(0.0)),
+        Layers(scene.film.z, scene.film.w, m.roughness, m.thickness_nm, thickness_offset_nm, tau, kd, k, e, vec3<f32>(0.0), vec3<f32>(0.0)),
     );
 }
 
@@ -56,6 +60,38 @@ fn ambient(layers: Layers, n: vec3<f32>, wo: vec3<f32>, top_o: Top, with_diffuse
     return result;
 }
 
+// How far from the mean thickness the film is read either side (nm) where the pixel's
+// footprint covers a spread of thicknesses: the twin of render::engine::material::
+// footprint_offset_nm, which says why (two thicknesses whose average damps the film's first
+// harmonic at FOOTPRINT_WAVELENGTH_NM as the spread does).
+fn footprint_offset_nm(spread_nm: f32, cos_o: f32) -> f32 {
+    let n = film_info.iors_band;
+    let sin1_sq = (n.x / n.y) * (n.x / n.y) * (1.0 - cos_o * cos_o);
+    let cos1 = sqrt(max(1.0 - sin1_sq, 0.0));
+    let phase_per_nm = 4.0 * PI * n.y * cos1 / FOOTPRINT_WAVELENGTH_NM;
+    if (phase_per_nm <= 0.0) {
+        return spread_nm;
+    }
+    let damping = exp(-0.5 * (phase_per_nm * spread_nm) * (phase_per_nm * spread_nm));
+    return acos(damping) / phase_per_nm;
+}
+
+// Where the pixel's footprint covers a spread of film thicknesses (a distant snake, whose
+// mip texels average many scales; a scale's edge up close), the film is read at two
+// thicknesses either side of the mean and averaged (brdf.wgsl's film_clamped and
+// coupling_table read Layers::thickness_offset_nm), instead of at the mean thickness, whose
+// film colour is far more saturated than the footprint's mean colour (BENCHMARKS.md,
+// "Iridescence seen from afar"). 0 where the film does not show: the diffuse stages read
+// none, and a material without one (FILM_NONE) is the same at every thickness.
+fn film_offset_nm(m: Material, world: vec3<f32>) -> f32 {
+    let film_shows = (STAGE == STAGE_ALL || STAGE == STAGE_FILM) && FILM_METHOD != FILM_NONE;
+    if (!FOOTPRINT_SPREAD || !film_shows || m.thickness_spread_nm <= 0.0) {
+        return 0.0;
+    }
+    let wo = normalize(scene.camera.xyz - world);
+    return footprint_offset_nm(m.thickness_spread_nm, max(dot(m.normal, wo), COS_MIN));
+}
+
 fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
     let wo = normalize(scene.camera.xyz - world);
     var radiance = vec3<f32>(0.0);
@@ -70,7 +106,7 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
         }
         return radiance + sky(n) * m.albedo;
     }
-    let layers = layers_of(m);
+    let layers = layers_of(m, film_offset_nm(m, world));
     // What the top does towards the viewer, shared by both lights and the ambient term.
     let top_o = coupling(layers, max(dot(m.normal, wo), COS_MIN));
     for (var i = 0u; i < SCENE_LIGHTS; i++) {
@@ -119,7 +155,8 @@ struct GBuffer {
 }
 
 // Part 0: (world position, thickness nm), (shading normal, roughness).
-// Part 1: (albedo, 1 = covered), (geometric normal, height map value).
+// Part 1: (albedo, thickness spread nm), (geometric normal, height map value); a covered
+// pixel has a unit geometric normal, an uncovered one the cleared zero vector.
 @fragment
 fn fs_gbuffer(in: VertexOut) -> GBuffer {
     let m = sample_material(in);
@@ -128,7 +165,7 @@ fn fs_gbuffer(in: VertexOut) -> GBuffer {
         out.first = vec4<f32>(in.world, m.thickness_nm);
         out.second = vec4<f32>(m.normal, m.roughness);
     } else {
-        out.first = vec4<f32>(m.albedo, 1.0);
+        out.first = vec4<f32>(m.albedo, select(0.0, m.thickness_spread_nm, FOOTPRINT_SPREAD));
         out.second = vec4<f32>(m.geometric, m.height);
     }
     return out;

@@ -556,6 +556,14 @@ pub struct PreviewArgs {
     /// Hide the ground plane.
     #[arg(long)]
     pub no_ground: bool,
+    /// How a pixel that covers scales of several film thicknesses (a distant snake) shades
+    /// the film: spread (the default) averages the shading at the footprint's mean thickness
+    /// plus and minus its standard deviation, read from the thickness map's mips, so the far
+    /// film is as colourful as its scales' average; mean shades the mean thickness once
+    /// (one evaluation instead of two where the thickness varies, but the far film too
+    /// saturated: BENCHMARKS.md, "Iridescence seen from afar").
+    #[arg(long, value_enum, default_value_t = FootprintArg::Spread, value_name = "HOW")]
+    pub film_footprint: FootprintArg,
     /// Frame the mid-body closely instead of the whole snake (of one snake: not with --snakes).
     #[arg(long, conflicts_with = "snakes")]
     pub close_up: bool,
@@ -577,6 +585,22 @@ pub struct GraphArgs {
     /// Print Graphviz DOT (render with `dot -Tsvg`); otherwise a plain list of nodes.
     #[arg(long)]
     pub dot: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FootprintArg {
+    Spread,
+    Mean,
+}
+
+impl FootprintArg {
+    pub fn footprint(self) -> snakeskin::render::engine::renderer::FilmFootprint {
+        use snakeskin::render::engine::renderer::FilmFootprint;
+        match self {
+            FootprintArg::Spread => FilmFootprint::Spread,
+            FootprintArg::Mean => FilmFootprint::Mean,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

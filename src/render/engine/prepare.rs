@@ -266,8 +266,8 @@ pub fn bands_for(method: GpuFilmMethod) -> usize {
 mod tests {
     use super::*;
 
-    /// 64² maps: 5461 texels in their mip chains (4096 + 1024 + … + 1), packed as 36 bytes
-    /// (two RGBA f32 and one f32) and uploaded as 18 (two RGBA f16 and one f16).
+    /// 64² maps: 5461 texels in their mip chains (4096 + 1024 + … + 1), packed as 40 bytes
+    /// (two RGBA f32 and one RG f32) and uploaded as 20 (two RGBA f16 and one RG f16).
     const CHAIN: u64 = 5461;
 
     fn drawing() -> DrawMemory {
@@ -285,7 +285,7 @@ mod tests {
     /// before and the overheads add to it.
     #[test]
     fn the_estimate_is_the_largest_phase_and_what_is_held() {
-        let (packed, textures) = (CHAIN * 36, CHAIN * 18);
+        let (packed, textures) = (CHAIN * 40, CHAIN * 20);
         let frame = 1 << 30;
         let drawing_phase = packed + 2 * textures + frame;
         assert_eq!(DrawMemory { frame_bytes: frame, ..drawing() }.estimate_added_bytes(), drawing_phase);
@@ -298,7 +298,7 @@ mod tests {
         // A material of 128² maps drawn before: its chains, textures and staging.
         let after = DrawMemory { frame_bytes: frame, drawn_after: Some((128, 128)), ..drawing() };
         let before_chain = 21845;
-        assert_eq!(after.estimate_added_bytes(), drawing_phase + before_chain * (36 + 2 * 18));
+        assert_eq!(after.estimate_added_bytes(), drawing_phase + before_chain * (40 + 2 * 20));
         assert_eq!(after.estimate_bytes() - after.estimate_added_bytes(), (256 + 64) << 20);
         // Without a frame, the upload phase (chains, textures, staging, one level in half
         // floats) is the largest.

@@ -132,6 +132,22 @@ pub struct FrameSettings {
     /// The plain PBR shader instead of the skin (the benchmark's baseline).
     pub plain: bool,
     pub background: [f64; 3],
+    /// How a pixel whose footprint covers several film thicknesses is shaded (`skin.wgsl`'s
+    /// `FOOTPRINT_SPREAD`).
+    pub footprint: FilmFootprint,
+}
+
+/// How the skin shader reads the film where a pixel's footprint covers scales of several
+/// thicknesses (a distant snake, whose mip texels average many scales).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum FilmFootprint {
+    /// The mean of the shading at the footprint's mean thickness ± its standard deviation
+    /// (the thickness texture's two moments): the film colour averaged over the footprint.
+    #[default]
+    Spread,
+    /// The shading at the mean thickness alone: one evaluation, but a distant film far more
+    /// saturated than the scales it averages (BENCHMARKS.md, "Iridescence seen from afar").
+    Mean,
 }
 
 impl Default for FrameSettings {
@@ -148,6 +164,7 @@ impl Default for FrameSettings {
             samples: MSAA_SAMPLES,
             plain: false,
             background: [0.05, 0.055, 0.06],
+            footprint: FilmFootprint::default(),
         }
     }
 }
@@ -168,6 +185,7 @@ struct PipelineKey {
     method: u32,
     model: u32,
     absorption: bool,
+    footprint: FilmFootprint,
     samples: u32,
 }
 
@@ -473,6 +491,7 @@ impl Renderer {
                 ("FILM_METHOD", key.method as f64),
                 ("BRDF_MODEL", key.model as f64),
                 ("HAS_ABSORPTION", if key.absorption { 1.0 } else { 0.0 }),
+                ("FOOTPRINT_SPREAD", if key.footprint == FilmFootprint::Spread { 1.0 } else { 0.0 }),
             ]);
             if let Program::GBuffer(part) = key.program {
                 constants.push(("GBUFFER_PART", part as f64));
@@ -573,7 +592,8 @@ impl Renderer {
         // exponential.
         let method = material.optics.specialised_method(settings.method).code();
         let model = settings.model.code();
-        PipelineKey { program, stage, view_map, method, model, absorption: material.optics.has_absorption(), samples }
+        let absorption = material.optics.has_absorption();
+        PipelineKey { program, stage, view_map, method, model, absorption, footprint: settings.footprint, samples }
     }
 
     fn write_scene(&self, settings: &FrameSettings, material: &Material, aspect: f32) {
@@ -814,8 +834,8 @@ impl Renderer {
             ));
         }
         let (position_thickness, normal_roughness) = parts.remove(0);
-        let (albedo_coverage, geometric) = parts.remove(0);
-        Ok(GBuffer { width, height, position_thickness, normal_roughness, albedo_coverage, geometric })
+        let (albedo_spread, geometric) = parts.remove(0);
+        Ok(GBuffer { width, height, position_thickness, normal_roughness, albedo_spread, geometric })
     }
 
     /// Submits `encoder` with a copy of `texture` and returns its rows, tightly packed.
@@ -885,15 +905,18 @@ pub struct GBuffer {
     pub height: u32,
     pub position_thickness: Vec<[f32; 4]>,
     pub normal_roughness: Vec<[f32; 4]>,
-    /// Albedo and, in `w`, 1 where the snake covers the pixel.
-    pub albedo_coverage: Vec<[f32; 4]>,
-    /// Interpolated geometric normal and, in `w`, the height map value.
+    /// Albedo and, in `w`, the film thickness' standard deviation over the pixel's footprint
+    /// in nm (0 where the shader reads one thickness: `skin.wgsl`'s `shade`).
+    pub albedo_spread: Vec<[f32; 4]>,
+    /// Interpolated geometric normal (unit length where the snake covers the pixel, the
+    /// cleared zero vector elsewhere) and, in `w`, the height map value.
     pub geometric: Vec<[f32; 4]>,
 }
 
 impl GBuffer {
     pub fn covered(&self, i: usize) -> bool {
-        self.albedo_coverage[i][3] > 0.5
+        let [x, y, z, _] = self.geometric[i];
+        x * x + y * y + z * z > 0.25
     }
 }
 

@@ -1,6 +1,6 @@
 //! The CPU reference for a rendered frame: shade every pixel the snake covers from the GPU's
 //! own G-buffer (the sampled material: position, shading normal, albedo, roughness, film
-//! thickness) with the f64 BRDF and the 1 nm spectral film colour, under the same lights,
+//! thickness and its spread over the pixel) with the f64 BRDF and the 1 nm spectral film colour, under the same lights,
 //! ambient term, exposure and tone mapping, and compare with the GPU image in CIEDE2000.
 //!
 //! Because both sides start from the same material samples, the difference isolates shading:
@@ -14,6 +14,7 @@ use crate::export::srgb;
 use crate::optics::brdf::COS_MIN;
 use crate::optics::film_rgb_reference;
 use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
+use crate::render::engine::material::footprint_offset_nm;
 use crate::render::engine::renderer::{FrameSettings, GBuffer, Material, Renderer};
 use crate::render::engine::scene::BounceGrid;
 use crate::render::engine::scene::{LayerOptics, Lighting, Stage, View};
@@ -86,7 +87,11 @@ pub fn pbr_neutral(color: [f64; 3]) -> [f64; 3] {
     c.map(|v| v + (new_peak - v) * g)
 }
 
-/// Linear radiance of one covered pixel (stage "all"), the twin of `skin.wgsl`'s `shade`.
+/// Linear radiance of one covered pixel (stage "all"), the twin of `skin.wgsl`'s `shade`:
+/// where the G-buffer holds a thickness spread over the pixel's footprint, the film colour is
+/// the mean of the colours at two thicknesses either side of the mean (`footprint_offset_nm`,
+/// as `brdf.wgsl`'s `film_clamped` and `coupling_table` read it; for a material without a
+/// film, whose shader reads one thickness, the two are the same).
 pub fn shade_pixel(
     gbuffer: &GBuffer,
     i: usize,
@@ -96,11 +101,19 @@ pub fn shade_pixel(
 ) -> [f64; 3] {
     let pt = gbuffer.position_thickness[i].map(|v| v as f64);
     let nr = gbuffer.normal_roughness[i].map(|v| v as f64);
-    let albedo = gbuffer.albedo_coverage[i].map(|v| v as f64);
+    let albedo = gbuffer.albedo_spread[i].map(|v| v as f64);
     let camera = settings.camera.position().to_array().map(|v| v as f64);
     let n = normalize([nr[0], nr[1], nr[2]]);
     let wo = normalize([camera[0] - pt[0], camera[1] - pt[1], camera[2] - pt[2]]);
     let thickness = pt[3];
+    let spread = albedo[3];
+    let stack = optics.stack;
+    let thicknesses = if spread > 0.0 {
+        let offset = footprint_offset_nm(spread, stack.n0, stack.n1, dot(n, wo).max(COS_MIN));
+        vec![(thickness - offset).max(0.0), thickness + offset]
+    } else {
+        vec![thickness]
+    };
     // Each light asks for the film at the same view cosine (421 Airy evaluations each): keep
     // every colour computed for this pixel, keyed by the exact cosine.
     let computed: std::cell::RefCell<Vec<(u64, [f64; 3])>> = Default::default();
@@ -108,7 +121,8 @@ pub fn shade_pixel(
         if let Some((_, rgb)) = computed.borrow().iter().find(|(bits, _)| *bits == cos.to_bits()) {
             return *rgb;
         }
-        let rgb = film_rgb_reference(optics.stack, thickness, cos);
+        let colours = thicknesses.iter().map(|&d| film_rgb_reference(stack, d, cos));
+        let rgb = colours.fold([0.0; 3], |sum, c| [0, 1, 2].map(|k| sum[k] + c[k] / thicknesses.len() as f64));
         computed.borrow_mut().push((cos.to_bits(), rgb));
         rgb
     };

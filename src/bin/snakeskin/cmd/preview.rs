@@ -34,6 +34,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         model: args.model,
         exposure: args.exposure,
         ground: !args.no_ground,
+        footprint: args.film_footprint.footprint(),
         snakes: args.snakes,
         camera: if args.close_up { Camera::close_up() } else { Camera::framing(args.snakes) },
         ..FrameSettings::default()
