@@ -44,16 +44,41 @@ fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
     return fallback;
 }
 
+// How many thicknesses a film read averages: two where the pixel's footprint spreads
+// (Layers::thickness_offset_nm), else one; and the k-th of them.
+fn footprint_reads(layers: Layers) -> u32 {
+    return select(1u, 2u, layers.thickness_offset_nm > 0.0);
+}
+
+fn footprint_thickness(layers: Layers, k: u32) -> f32 {
+    if (layers.thickness_offset_nm <= 0.0) {
+        return layers.thickness_nm;
+    }
+    return max(layers.thickness_nm + select(-1.0, 1.0, k == 1u) * layers.thickness_offset_nm, 0.0);
+}
+
 // The film colour the layers read (the mean of two thicknesses where the footprint spreads).
+// The table's two fetches are written out; the other methods loop over the thicknesses
+// through one call of film_rgb: a second call written out was inlined with every film
+// method's code, and lavapipe's compiler held 136 MiB more for the same pipelines (a
+// preview's peak 209 -> 345 MiB, 0.4 s more to start). Written out, the second fetch only
+// where there are two: the LUT pipeline's whole-snake frame on lavapipe took 106 ms, against
+// 114 averaging two fetches always and 133 through the loop.
 fn film_clamped(layers: Layers, c: f32) -> vec3<f32> {
     let cos0 = clamp(c, 0.0, 1.0);
-    var film = film_rgb(layers.thickness_nm, cos0);
-    if (layers.thickness_offset_nm > 0.0) {
-        let thin = max(layers.thickness_nm - layers.thickness_offset_nm, 0.0);
-        let thick = layers.thickness_nm + layers.thickness_offset_nm;
-        film = 0.5 * (film_rgb(thin, cos0) + film_rgb(thick, cos0));
+    let reads = footprint_reads(layers);
+    var film = vec3<f32>(0.0);
+    if (FILM_METHOD == FILM_LUT) {
+        film = film_lut(footprint_thickness(layers, 0u), cos0);
+        if (reads == 2u) {
+            film += film_lut(footprint_thickness(layers, 1u), cos0);
+        }
+    } else {
+        for (var k = 0u; k < reads; k++) {
+            film += film_rgb(footprint_thickness(layers, k), cos0);
+        }
     }
-    return clamp(film, vec3<f32>(0.0), vec3<f32>(1.0));
+    return clamp(film / f32(reads), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
 // D G2 / (4 cos_i cos_o) for GGX with Smith height-correlated G2 (optics::brdf::ggx).
@@ -390,24 +415,23 @@ fn top_on_row(layers: Layers, k: u32, fx: f32, norm: vec3<f32>) -> Top {
 // thickness); where the footprint spreads (Layers::thickness_offset_nm), the mean of the
 // table at the two thicknesses, as film_clamped.
 fn coupling_table(layers: Layers, cos: f32) -> Top {
-    if (layers.thickness_offset_nm > 0.0) {
-        let thin = coupling_table_at(layers, cos, max(layers.thickness_nm - layers.thickness_offset_nm, 0.0));
-        let thick = coupling_table_at(layers, cos, layers.thickness_nm + layers.thickness_offset_nm);
-        return Top(0.5 * (thin.reflected + thick.reflected), 0.5 * (thin.ms + thick.ms), 0.5 * (thin.path_delta + thick.path_delta));
-    }
-    return coupling_table_at(layers, cos, layers.thickness_nm);
-}
-
-fn coupling_table_at(layers: Layers, cos: f32, thickness_nm: f32) -> Top {
     let n_cos = f32(film_info.n_cos);
     // sqrt: the table's cos texels are uniform in sqrt(cos) (optics::lut::coupling_texel_cos).
     let x = sqrt(clamp(cos, 0.0, 1.0)) * (n_cos - 1.0);
     let rows = f32(E1_ROUGHNESS);
     let v = (clamp(layers.roughness, 0.0, 1.0) * (rows - 1.0) + 0.5) / rows;
-    let w = (lut_column(thickness_nm) + 0.5) / f32(film_info.n_fine + film_info.n_coarse);
-    let s = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5) / (2.0 * n_cos), v, w), 0.0);
-    let ms = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5 + n_cos) / (2.0 * n_cos), v, w), 0.0);
-    return Top(s.rgb, ms.rgb, s.a);
+    let reads = footprint_reads(layers);
+    let width = f32(film_info.n_fine + film_info.n_coarse);
+    var w = (lut_column(footprint_thickness(layers, 0u)) + 0.5) / width;
+    var s = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5) / (2.0 * n_cos), v, w), 0.0);
+    var ms = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5 + n_cos) / (2.0 * n_cos), v, w), 0.0);
+    if (reads == 2u) {
+        w = (lut_column(footprint_thickness(layers, 1u)) + 0.5) / width;
+        s += textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5) / (2.0 * n_cos), v, w), 0.0);
+        ms += textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5 + n_cos) / (2.0 * n_cos), v, w), 0.0);
+    }
+    let mean = 1.0 / f32(reads);
+    return Top(s.rgb * mean, ms.rgb * mean, s.a * mean);
 }
 
 // Whether the coupling comes from the coupling texture: for the LUT film method, and for a

@@ -72,8 +72,11 @@ fn footprint_offset_nm(spread_nm: f32, cos_o: f32) -> f32 {
     if (phase_per_nm <= 0.0) {
         return spread_nm;
     }
-    let damping = exp(-0.5 * (phase_per_nm * spread_nm) * (phase_per_nm * spread_nm));
-    return acos(damping) / phase_per_nm;
+    let exponent = 0.5 * (phase_per_nm * spread_nm) * (phase_per_nm * spread_nm);
+    if (exponent < FOOTPRINT_SMALL_EXPONENT) {
+        return spread_nm;
+    }
+    return acos(exp(-exponent)) / phase_per_nm;
 }
 
 // Where the pixel's footprint covers a spread of film thicknesses (a distant snake, whose
@@ -82,10 +85,10 @@ fn footprint_offset_nm(spread_nm: f32, cos_o: f32) -> f32 {
 // coupling_table read Layers::thickness_offset_nm), instead of at the mean thickness, whose
 // film colour is far more saturated than the footprint's mean colour (BENCHMARKS.md,
 // "Iridescence seen from afar"). 0 where the film does not show: the diffuse stages read
-// none, and a material without one (FILM_NONE) is the same at every thickness.
+// none (shade returns before it asks), and a material without one (FILM_NONE) is the same
+// at every thickness.
 fn film_offset_nm(m: Material, world: vec3<f32>) -> f32 {
-    let film_shows = (STAGE == STAGE_ALL || STAGE == STAGE_FILM) && FILM_METHOD != FILM_NONE;
-    if (!FOOTPRINT_SPREAD || !film_shows || m.thickness_spread_nm <= 0.0) {
+    if (!FOOTPRINT_SPREAD || FILM_METHOD == FILM_NONE || m.thickness_spread_nm <= 0.0) {
         return 0.0;
     }
     let wo = normalize(scene.camera.xyz - world);

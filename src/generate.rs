@@ -749,12 +749,15 @@ fn strips(
     let mut encode_time = Duration::ZERO;
     // Each map's rows are quantised the moment the map is finished in a strip (its f32
     // buffer then freed) and compressed by the map's own thread, in order, while the graph
-    // goes on.
+    // goes on. The hand-over waits for the encoder to take the rows (a rendezvous channel):
+    // one strip's samples being compressed and the next one's waiting is what the estimate
+    // counts (`memory::estimate_strips_bytes`). Through an unbounded channel, an encoder that
+    // fell behind (other work holding the cores) let strips of samples pile up beyond it.
     let (stats, encoders) = std::thread::scope(|scope| {
         let mut senders = Vec::new();
         let mut threads = Vec::new();
         for mut encoder in encoders {
-            let (send, receive) = std::sync::mpsc::channel::<Vec<u8>>();
+            let (send, receive) = std::sync::mpsc::sync_channel::<Vec<u8>>(0);
             senders.push((encoder.map, send));
             threads.push(scope.spawn(move || {
                 let mut time = Duration::ZERO;

@@ -146,7 +146,10 @@ fn linear(image: &image::RgbaImage, i: usize) -> [f64; 3] {
 }
 
 /// A distant snake's film is shaded over the thicknesses its pixels cover: the G-buffer holds
-/// a spread where the scales' thicknesses differ and none where they are one, and the frame
+/// a spread where the scales' thicknesses differ and none where the map holds one value
+/// (over the preset's 260 nm range, so the half floats' rounding must stay under the
+/// threshold: the map values whose rounding reads most among them; seen failing with
+/// `THICKNESS_SPREAD_MIN` at 0), and the frame
 /// is nearer in colour to the same frame rendered K times as wide and tall and averaged
 /// (the footprint's true mean colour) than the frame shaded at each pixel's mean thickness
 /// (`FilmFootprint::Mean`, the negative control), per pixel and over 4 × 4 blocks of
@@ -177,8 +180,21 @@ fn a_distant_film_is_shaded_over_its_footprints_thicknesses() {
     let (spread, covered) = spread_pixels(&skin, &far);
     eprintln!("{spread} of {covered} covered pixels hold a spread");
     assert!(covered > 3000 && spread * 2 > covered, "{spread} of {covered}");
-    let one_thickness = make(&[("iridescence.spread_nm", "0")]);
-    assert_eq!(spread_pixels(&one_thickness, &far).0, 0, "one thickness read as a spread");
+    use snakeskin::render::engine::material::{mip_chain, rounded_texel_spread, thickness_moments};
+    let worst = (0..=100_000).map(|k| k as f32 / 100_000.0).max_by(|a, b| {
+        rounded_texel_spread(thickness_moments(*a)).total_cmp(&rounded_texel_spread(thickness_moments(*b)))
+    });
+    let loaded = load(PRESET, &[]);
+    let optics = LayerOptics::from_preset(&loaded.preset);
+    let lut = snakeskin::optics::lut::Lut::bake(optics.stack, 32, 128, 32);
+    let generated = material_maps(&loaded, 256).unwrap();
+    for value in [worst.unwrap(), 0.0, 0.3, 0.5, 0.77, 1.0] {
+        let mut maps = generated.clone();
+        maps.thickness_moments = mip_chain(vec![thickness_moments(value); 256 * 256], 256, 256);
+        let one_value = renderer.material(&maps, optics, &lut, 1).unwrap();
+        let (spread, covered) = spread_pixels(&one_value, &far);
+        assert_eq!(spread, 0, "a map of one value, {value}, read as a spread at {spread} of {covered} pixels");
+    }
     let mean = FrameSettings { footprint: FilmFootprint::Mean, ..far };
     assert_eq!(spread_pixels(&skin, &mean).0, 0, "the mean footprint's G-buffer holds no spread");
 
@@ -630,6 +646,7 @@ fn bench_render_lut_only_times_the_table_variants() {
     let expected = [
         ("plain-pbr", 1),
         ("skin-lut", 1),
+        ("skin-mean-thickness", 1),
         ("skin-thesis", 1),
         ("skin-no-film", 1),
         ("skin-absorption", 1),
@@ -641,7 +658,7 @@ fn bench_render_lut_only_times_the_table_variants() {
         let ms = variant["median_ms"].as_f64().unwrap();
         assert!(ms.is_finite() && ms > 0.0, "{variant}");
     }
-    for key in ["ratio", "thesis_ratio", "reference_mean_de"] {
+    for key in ["ratio", "thesis_ratio", "mean_thickness_ratio", "reference_mean_de"] {
         assert!(v[key].as_f64().is_some_and(f64::is_finite), "{key} = {}", v[key]);
     }
 }

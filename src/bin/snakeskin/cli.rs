@@ -557,11 +557,11 @@ pub struct PreviewArgs {
     #[arg(long)]
     pub no_ground: bool,
     /// How a pixel that covers scales of several film thicknesses (a distant snake) shades
-    /// the film: spread (the default) averages the shading at the footprint's mean thickness
-    /// plus and minus its standard deviation, read from the thickness map's mips, so the far
-    /// film is as colourful as its scales' average; mean shades the mean thickness once
-    /// (one evaluation instead of two where the thickness varies, but the far film too
-    /// saturated: BENCHMARKS.md, "Iridescence seen from afar").
+    /// the film: spread (the default) reads the film at two thicknesses either side of the
+    /// footprint's mean, placed from its spread (read from the thickness map's mips), and
+    /// averages the reads, so the far film is about as colourful as its scales' average;
+    /// mean reads the mean thickness once (half the film reads where the thickness varies,
+    /// but the far film too saturated: BENCHMARKS.md, "Iridescence seen from afar").
     #[arg(long, value_enum, default_value_t = FootprintArg::Spread, value_name = "HOW")]
     pub film_footprint: FootprintArg,
     /// Frame the mid-body closely instead of the whole snake (of one snake: not with --snakes).
@@ -893,8 +893,9 @@ fn parse_angle_deg(text: &str) -> Result<f64, String> {
 #[derive(Debug, Subcommand)]
 pub enum BenchCommand {
     /// Frame time of the skin shader against a plain PBR shader on the same scene (GPU
-    /// timestamps where available), the specialised variants, 20 snakes, and the CPU
-    /// reference comparison (mean and p99 CIEDE2000).
+    /// timestamps where available), the specialised variants (no film, the other side of the
+    /// absorption switch, the film read at each pixel's mean thickness), 20 snakes, and the
+    /// CPU reference comparison (mean and p99 CIEDE2000).
     Render {
         /// Preset to render.
         #[arg(default_value = "xenopeltis-unicolor")]

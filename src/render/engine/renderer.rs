@@ -141,8 +141,10 @@ pub struct FrameSettings {
 /// thicknesses (a distant snake, whose mip texels average many scales).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum FilmFootprint {
-    /// The mean of the shading at the footprint's mean thickness ± its standard deviation
-    /// (the thickness texture's two moments): the film colour averaged over the footprint.
+    /// Every film read (the film colour, the top's coupling) the mean of two reads at
+    /// thicknesses either side of the footprint's mean, placed from its spread (the
+    /// thickness texture's two moments; `material::footprint_offset_nm`): the film colour
+    /// averaged over the footprint.
     #[default]
     Spread,
     /// The shading at the mean thickness alone: one evaluation, but a distant film far more
@@ -909,7 +911,8 @@ pub struct GBuffer {
     /// in nm (0 where the shader reads one thickness: `skin.wgsl`'s `shade`).
     pub albedo_spread: Vec<[f32; 4]>,
     /// Interpolated geometric normal (unit length where the snake covers the pixel, the
-    /// cleared zero vector elsewhere) and, in `w`, the height map value.
+    /// cleared zero vector elsewhere; a degenerate triangle's NaN reads as uncovered) and, in
+    /// `w`, the height map value.
     pub geometric: Vec<[f32; 4]>,
 }
 

@@ -24,7 +24,9 @@ use crate::optics::methods::{
 use crate::render::engine::scene::{BOUNCE_THICKNESSES, SCENE_LIGHTS};
 
 use super::film::GpuFilmMethod;
-use super::material::{FOOTPRINT_WAVELENGTH_NM, THICKNESS_MOMENT_CENTRE, THICKNESS_SPREAD_MIN};
+use super::material::{
+    FOOTPRINT_SMALL_EXPONENT, FOOTPRINT_WAVELENGTH_NM, THICKNESS_MOMENT_CENTRE, THICKNESS_SPREAD_MIN,
+};
 use super::renderer::{GBUFFER_ALBEDO_GEOMETRY, GBUFFER_POSITION_NORMAL, TONE_MAP_CURVE, TONE_MAP_NONE};
 use super::scene::{Stage, View};
 use crate::render::reference::frame::{PBR_NEUTRAL_DESATURATION, PBR_NEUTRAL_OFFSET, PBR_NEUTRAL_START_COMPRESSION};
@@ -129,6 +131,7 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("THICKNESS_MOMENT_CENTRE", "f32", f32_literal(THICKNESS_MOMENT_CENTRE as f64)),
         ("THICKNESS_SPREAD_MIN", "f32", f32_literal(THICKNESS_SPREAD_MIN as f64)),
         ("FOOTPRINT_WAVELENGTH_NM", "f32", f32_literal(FOOTPRINT_WAVELENGTH_NM)),
+        ("FOOTPRINT_SMALL_EXPONENT", "f32", f32_literal(FOOTPRINT_SMALL_EXPONENT)),
     ];
     // The multiple-scatter lobe's normalisation rule (optics::brdf::energy::ms_rule), one
     // constant per node: (μ, 2 w μ).

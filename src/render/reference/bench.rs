@@ -1,6 +1,7 @@
 //! `snakeskin bench render`: GPU time of the skin shader against a plain metal-roughness PBR
 //! shader on the same mesh, maps and view, in one run, plus the specialised variants (no
-//! film, no absorption), the other film methods, twenty snakes, and the CPU reference check.
+//! film, no absorption, the film read at each pixel's mean thickness), the other film
+//! methods, twenty snakes, and the CPU reference check.
 //!
 //! Timing: GPU timestamps around the scene pass where the adapter offers them (lavapipe does),
 //! otherwise wall time around submit + wait. Variants are interleaved frame by frame and each
@@ -19,7 +20,7 @@ use crate::optics::lut::Lut;
 use crate::preset::LoadedPreset;
 use crate::render::engine::film::GpuFilmMethod;
 use crate::render::engine::prepare::{bands_for, material_maps};
-use crate::render::engine::renderer::{FrameOutput, FrameSettings, Material, OUTPUT_FORMAT, Renderer};
+use crate::render::engine::renderer::{FilmFootprint, FrameOutput, FrameSettings, Material, OUTPUT_FORMAT, Renderer};
 use crate::render::engine::scene::LayerOptics;
 
 #[derive(Debug, Clone, Serialize)]
@@ -43,6 +44,9 @@ pub struct RenderBench {
     pub ratio: f64,
     /// skin-thesis / plain-pbr, one snake (the thesis model, LUT film).
     pub thesis_ratio: f64,
+    /// skin-mean-thickness / plain-pbr, one snake (the film read once a pixel, at its mean
+    /// thickness: `FilmFootprint::Mean`, `preview --film-footprint mean`).
+    pub mean_thickness_ratio: f64,
     pub skin_20_ms: f64,
     pub plain_20_ms: f64,
     pub variants: Vec<VariantTiming>,
@@ -143,9 +147,9 @@ impl<'a> FrameTimer<'a> {
     }
 }
 
-/// Materials the benchmark keeps at once: its eight variants with one snake, and two of them
+/// Materials the benchmark keeps at once: its nine variants with one snake, and two of them
 /// with twenty (`bench_render`'s runs).
-const TIMED_RUNS: usize = 10;
+const TIMED_RUNS: usize = 11;
 
 /// The variants that evaluate the layered rule with their own film at every pixel instead
 /// of reading the coupling texture (README, "The preview renderer"): on an NVIDIA H200 at
@@ -153,13 +157,16 @@ const TIMED_RUNS: usize = 10;
 /// LUT's skin), and seconds a frame on lavapipe. `--lut-only` leaves them out.
 const DIRECT_FILM_VARIANTS: [&str; 3] = ["skin-rgb3", "skin-spectral-8", "skin-gaussian-fit"];
 
+/// How every variant but `skin-mean-thickness` reads a pixel's spread of film thicknesses.
+const SPREAD: FilmFootprint = FilmFootprint::Spread;
+
 /// The runs `bench_render` times under `options`.
 fn timed_runs(options: &BenchOptions) -> usize {
     TIMED_RUNS - if options.lut_only { DIRECT_FILM_VARIANTS.len() } else { 0 }
 }
 
 /// What the benchmark's renderer holds beyond one preview's (`RENDERER_OVERHEAD_BYTES`): the
-/// pipelines of its eight variants, twenty snakes' draws and the timing queries. Measured on
+/// pipelines of its variants (eight when this was measured), twenty snakes' draws and the timing queries. Measured on
 /// lavapipe (Mesa 22.3.6, two cores), peak resident with 64² maps and a 16² reference:
 /// 505 MiB at a 64² frame, 628 MiB at 640×360, 684 MiB at 1280×720 (a preview with such maps
 /// and frame: under 260 MiB), and up to 90 MiB more on a busy machine as for a preview.
@@ -206,24 +213,27 @@ pub fn bench_render(
     let switched = if optics.has_absorption() { [0.0; 3] } else { [0.3; 3] };
     let absorption_switched = LayerOptics { optical_depth: switched, ..optics };
     let switched_name = if optics.has_absorption() { "skin-no-absorption" } else { "skin-absorption" };
-    // Every skin variant shades with the default model but `skin-thesis`.
+    // Every skin variant shades with the default model but `skin-thesis`, and reads the film
+    // over each pixel's spread of thicknesses but `skin-mean-thickness` (`FilmFootprint`:
+    // what the spread costs, in the same rounds).
     let (default, thesis) = (Model::default(), Model::Thesis);
-    let variants: Vec<(String, LayerOptics, GpuFilmMethod, bool, Model)> = vec![
-        ("plain-pbr".into(), optics, GpuFilmMethod::Lut, true, default),
-        ("skin-lut".into(), optics, GpuFilmMethod::Lut, false, default),
-        ("skin-thesis".into(), optics, GpuFilmMethod::Lut, false, thesis),
-        ("skin-no-film".into(), no_film, GpuFilmMethod::Lut, false, default),
-        (switched_name.into(), absorption_switched, GpuFilmMethod::Lut, false, default),
-        ("skin-rgb3".into(), optics, GpuFilmMethod::Rgb3, false, default),
-        ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false, default),
-        ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false, default),
+    let variants: Vec<(String, LayerOptics, GpuFilmMethod, bool, Model, FilmFootprint)> = vec![
+        ("plain-pbr".into(), optics, GpuFilmMethod::Lut, true, default, SPREAD),
+        ("skin-lut".into(), optics, GpuFilmMethod::Lut, false, default, SPREAD),
+        ("skin-mean-thickness".into(), optics, GpuFilmMethod::Lut, false, default, FilmFootprint::Mean),
+        ("skin-thesis".into(), optics, GpuFilmMethod::Lut, false, thesis, SPREAD),
+        ("skin-no-film".into(), no_film, GpuFilmMethod::Lut, false, default, SPREAD),
+        (switched_name.into(), absorption_switched, GpuFilmMethod::Lut, false, default, SPREAD),
+        ("skin-rgb3".into(), optics, GpuFilmMethod::Rgb3, false, default, SPREAD),
+        ("skin-spectral-8".into(), optics, GpuFilmMethod::SpectralN(8), false, default, SPREAD),
+        ("skin-gaussian-fit".into(), optics, GpuFilmMethod::GaussianFit, false, default, SPREAD),
     ];
     // All variants are timed round-robin, one frame each per round, so that a shared
     // machine's drift (other jobs, clock changes) affects every variant alike; the first
     // three rounds are warm-up (pipeline compilation, caches).
     let mut runs = Vec::new();
     for snakes in [1u32, 20] {
-        for (name, variant_optics, method, plain, model) in &variants {
+        for (name, variant_optics, method, plain, model, footprint) in &variants {
             if snakes == 20 && !matches!(name.as_str(), "plain-pbr" | "skin-lut") {
                 continue;
             }
@@ -232,7 +242,8 @@ pub fn bench_render(
             }
             let material = renderer.material(&maps, *variant_optics, &lut, bands_for(*method))?;
             let camera = crate::render::engine::scene::Camera::framing(snakes);
-            let settings = FrameSettings { method: *method, plain: *plain, model: *model, snakes, camera, ..base };
+            let (method, plain, model, footprint) = (*method, *plain, *model, *footprint);
+            let settings = FrameSettings { method, plain, model, snakes, camera, footprint, ..base };
             runs.push((name.clone(), snakes, material, settings, Vec::with_capacity(options.frames)));
         }
     }
@@ -278,6 +289,7 @@ pub fn bench_render(
         plain_ms: find("plain-pbr", 1),
         ratio: find("skin-lut", 1) / find("plain-pbr", 1),
         thesis_ratio: find("skin-thesis", 1) / find("plain-pbr", 1),
+        mean_thickness_ratio: find("skin-mean-thickness", 1) / find("plain-pbr", 1),
         skin_20_ms: find("skin-lut", 20),
         plain_20_ms: find("plain-pbr", 20),
         variants: timings,

@@ -1,10 +1,12 @@
 //! The CPU reference for a rendered frame: shade every pixel the snake covers from the GPU's
 //! own G-buffer (the sampled material: position, shading normal, albedo, roughness, film
-//! thickness and its spread over the pixel) with the f64 BRDF and the 1 nm spectral film colour, under the same lights,
-//! ambient term, exposure and tone mapping, and compare with the GPU image in CIEDE2000.
+//! thickness and its spread over the pixel) with the f64 BRDF and the 1 nm spectral film
+//! colour, under the same lights, ambient term, exposure and tone mapping, and compare with
+//! the GPU image in CIEDE2000.
 //!
 //! Because both sides start from the same material samples, the difference isolates shading:
-//! the film method (LUT or another), f32 arithmetic, and the 8-bit output. This file is the
+//! the film method (LUT or another), f32 arithmetic, how a spread of thicknesses is read
+//! (`shade_pixel`), and the 8-bit output. This file is the
 //! CPU twin of `shaders/skin.wgsl`'s `shade` (stage "all") and `shaders/tonemap.wgsl`.
 
 use rayon::prelude::*;
@@ -87,14 +89,43 @@ pub fn pbr_neutral(color: [f64; 3]) -> [f64; 3] {
     c.map(|v| v + (new_peak - v) * g)
 }
 
-/// Linear radiance of one covered pixel (stage "all"), the twin of `skin.wgsl`'s `shade`:
-/// where the G-buffer holds a thickness spread over the pixel's footprint, the film colour is
-/// the mean of the colours at two thicknesses either side of the mean (`footprint_offset_nm`,
-/// as `brdf.wgsl`'s `film_clamped` and `coupling_table` read it; for a material without a
-/// film, whose shader reads one thickness, the two are the same).
+/// Linear radiance of one covered pixel (stage "all"), the twin of `skin.wgsl`'s `shade`.
+/// Where the G-buffer holds a thickness spread over the pixel's footprint, the mean of the
+/// radiance shaded at two thicknesses either side of the mean (`footprint_offset_nm`): the
+/// two-point rule applied to what the pixel shows. The shader applies it to each film read
+/// instead (the film colour, the top's coupling: `brdf.wgsl`'s `film_clamped` and
+/// `coupling_table`) and reads K, E and the base albedo at the mean, so the comparison
+/// measures that too (for a material without a film, whose shader reads one thickness,
+/// the two shadings are the same).
 pub fn shade_pixel(
     gbuffer: &GBuffer,
     i: usize,
+    settings: &FrameSettings,
+    optics: &LayerOptics,
+    bounce: &BounceGrid,
+) -> [f64; 3] {
+    let thickness = gbuffer.position_thickness[i][3] as f64;
+    let spread = gbuffer.albedo_spread[i][3] as f64;
+    if spread <= 0.0 {
+        return shade_at(gbuffer, i, thickness, settings, optics, bounce);
+    }
+    let pt = gbuffer.position_thickness[i].map(|v| v as f64);
+    let nr = gbuffer.normal_roughness[i].map(|v| v as f64);
+    let camera = settings.camera.position().to_array().map(|v| v as f64);
+    let n = normalize([nr[0], nr[1], nr[2]]);
+    let wo = normalize([camera[0] - pt[0], camera[1] - pt[1], camera[2] - pt[2]]);
+    let stack = optics.stack;
+    let offset = footprint_offset_nm(spread, stack.n0, stack.n1, dot(n, wo).max(COS_MIN));
+    let thin = shade_at(gbuffer, i, (thickness - offset).max(0.0), settings, optics, bounce);
+    let thick = shade_at(gbuffer, i, thickness + offset, settings, optics, bounce);
+    [0, 1, 2].map(|c| 0.5 * (thin[c] + thick[c]))
+}
+
+/// Linear radiance of one covered pixel with the film at `thickness` (nm).
+fn shade_at(
+    gbuffer: &GBuffer,
+    i: usize,
+    thickness: f64,
     settings: &FrameSettings,
     optics: &LayerOptics,
     bounce: &BounceGrid,
@@ -105,15 +136,6 @@ pub fn shade_pixel(
     let camera = settings.camera.position().to_array().map(|v| v as f64);
     let n = normalize([nr[0], nr[1], nr[2]]);
     let wo = normalize([camera[0] - pt[0], camera[1] - pt[1], camera[2] - pt[2]]);
-    let thickness = pt[3];
-    let spread = albedo[3];
-    let stack = optics.stack;
-    let thicknesses = if spread > 0.0 {
-        let offset = footprint_offset_nm(spread, stack.n0, stack.n1, dot(n, wo).max(COS_MIN));
-        vec![(thickness - offset).max(0.0), thickness + offset]
-    } else {
-        vec![thickness]
-    };
     // Each light asks for the film at the same view cosine (421 Airy evaluations each): keep
     // every colour computed for this pixel, keyed by the exact cosine.
     let computed: std::cell::RefCell<Vec<(u64, [f64; 3])>> = Default::default();
@@ -121,8 +143,7 @@ pub fn shade_pixel(
         if let Some((_, rgb)) = computed.borrow().iter().find(|(bits, _)| *bits == cos.to_bits()) {
             return *rgb;
         }
-        let colours = thicknesses.iter().map(|&d| film_rgb_reference(stack, d, cos));
-        let rgb = colours.fold([0.0; 3], |sum, c| [0, 1, 2].map(|k| sum[k] + c[k] / thicknesses.len() as f64));
+        let rgb = film_rgb_reference(optics.stack, thickness, cos);
         computed.borrow_mut().push((cos.to_bits(), rgb));
         rgb
     };

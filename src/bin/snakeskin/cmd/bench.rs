@@ -212,8 +212,9 @@ fn render(preset: &str, options: &BenchOptions, json: bool) -> Result<()> {
         println!("{:<22} {:>7} {:>10.3} {:>10.3} {:>10.3}", v.name, v.snakes, v.median_ms, v.p10_ms, v.p90_ms);
     }
     println!(
-        "skin / plain: {:.3} (layered model, the default), {:.3} (thesis model)",
-        result.ratio, result.thesis_ratio
+        "skin / plain: {:.3} (layered model, the default), {:.3} (thesis model), {:.3} (the film at each pixel's \
+         mean thickness: preview --film-footprint mean)",
+        result.ratio, result.thesis_ratio, result.mean_thickness_ratio
     );
     println!(
         "reference ({}x{}, {} px): CIEDE2000 mean {:.3}, p99 {:.3}, max {:.3}",
