@@ -58,7 +58,7 @@ pub const FOOTPRINT_WAVELENGTH_NM: f64 = crate::optics::methods::RGB3_NM[1] as f
 /// twin).
 ///
 /// Why not ± the spread (the two-point Gauss–Hermite rule): the film's reflectance is a
-/// Fourier series in the phase 2k·d, k = 2π n1 cos θ1 / λ (the Airy sum), and a spread of
+/// Fourier series in the phase p·d, p = 2k = 4π n1 cos θ1 / λ (the Airy sum), and a spread of
 /// thicknesses damps its first harmonic by exp(−½ (2kσ)²) for a normal distribution — to
 /// nothing once σ is a good part of a period (about 180 nm in green for n1 = 1.55). Two
 /// points at ± s damp it by cos(2k s), which at s = σ turns negative beyond 2kσ = π/2: a
@@ -72,7 +72,7 @@ pub const FOOTPRINT_WAVELENGTH_NM: f64 = crate::optics::methods::RGB3_NM[1] as f
 /// higher harmonics (the second turned over in full: cos 2ps → −1; weak for a film that
 /// reflects little), and the directions other than the view's (the shader computes s once a
 /// pixel, at the view's cosine, and reads the light's side and the half vector's with it).
-/// For ½(pσ)² under 1e-4 it is σ (to 1e-4 relative): there acos(exp(−x)) loses its digits in
+/// For ½(pσ)² under 1e-4 it is σ (within 2e-5 relative): there acos(exp(−x)) loses its digits in
 /// f32, and the shader's twin returned 0 for a spread of 5 nm just past a film's critical
 /// angle (n1 < n0), where p is small.
 pub fn footprint_offset_nm(spread_nm: f64, n0: f64, n1: f64, cos_o: f64) -> f64 {
