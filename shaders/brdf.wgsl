@@ -45,15 +45,13 @@ fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
 }
 
 // How many thicknesses a film read averages: two where the pixel's footprint spreads
-// (Layers::thickness_offset_nm), else one; and the k-th of them.
+// (Layers::thickness_offset_nm), else one; and the k-th of them (the mean itself, which is
+// never below 0, where there is no offset).
 fn footprint_reads(layers: Layers) -> u32 {
     return select(1u, 2u, layers.thickness_offset_nm > 0.0);
 }
 
 fn footprint_thickness(layers: Layers, k: u32) -> f32 {
-    if (layers.thickness_offset_nm <= 0.0) {
-        return layers.thickness_nm;
-    }
     return max(layers.thickness_nm + select(-1.0, 1.0, k == 1u) * layers.thickness_offset_nm, 0.0);
 }
 
@@ -421,17 +419,23 @@ fn coupling_table(layers: Layers, cos: f32) -> Top {
     let rows = f32(E1_ROUGHNESS);
     let v = (clamp(layers.roughness, 0.0, 1.0) * (rows - 1.0) + 0.5) / rows;
     let reads = footprint_reads(layers);
-    let width = f32(film_info.n_fine + film_info.n_coarse);
-    var w = (lut_column(footprint_thickness(layers, 0u)) + 0.5) / width;
-    var s = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5) / (2.0 * n_cos), v, w), 0.0);
-    var ms = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5 + n_cos) / (2.0 * n_cos), v, w), 0.0);
+    var t = coupling_texels(x, v, footprint_thickness(layers, 0u));
     if (reads == 2u) {
-        w = (lut_column(footprint_thickness(layers, 1u)) + 0.5) / width;
-        s += textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5) / (2.0 * n_cos), v, w), 0.0);
-        ms += textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5 + n_cos) / (2.0 * n_cos), v, w), 0.0);
+        let second = coupling_texels(x, v, footprint_thickness(layers, 1u));
+        t = Top(t.reflected + second.reflected, t.ms + second.ms, t.path_delta + second.path_delta);
     }
     let mean = 1.0 / f32(reads);
-    return Top(s.rgb * mean, ms.rgb * mean, s.a * mean);
+    return Top(t.reflected * mean, t.ms * mean, t.path_delta * mean);
+}
+
+// The coupling texture's two fetches at the table's cos texel x, roughness coordinate v and
+// a thickness: the reflected share and the path delta, and the multiple-scatter amplitude.
+fn coupling_texels(x: f32, v: f32, thickness_nm: f32) -> Top {
+    let n_cos = f32(film_info.n_cos);
+    let w = (lut_column(thickness_nm) + 0.5) / f32(film_info.n_fine + film_info.n_coarse);
+    let s = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5) / (2.0 * n_cos), v, w), 0.0);
+    let ms = textureSampleLevel(coupling_texture, lut_sampler, vec3<f32>((x + 0.5 + n_cos) / (2.0 * n_cos), v, w), 0.0);
+    return Top(s.rgb, ms.rgb, s.a);
 }
 
 // Whether the coupling comes from the coupling texture: for the LUT film method, and for a

@@ -87,12 +87,11 @@ fn footprint_offset_nm(spread_nm: f32, cos_o: f32) -> f32 {
 // "Iridescence seen from afar"). 0 where the film does not show: the diffuse stages read
 // none (shade returns before it asks), and a material without one (FILM_NONE) is the same
 // at every thickness.
-fn film_offset_nm(m: Material, world: vec3<f32>) -> f32 {
+fn film_offset_nm(m: Material, cos_o: f32) -> f32 {
     if (!FOOTPRINT_SPREAD || FILM_METHOD == FILM_NONE || m.thickness_spread_nm <= 0.0) {
         return 0.0;
     }
-    let wo = normalize(scene.camera.xyz - world);
-    return footprint_offset_nm(m.thickness_spread_nm, max(dot(m.normal, wo), COS_MIN));
+    return footprint_offset_nm(m.thickness_spread_nm, cos_o);
 }
 
 fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
@@ -109,9 +108,10 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
         }
         return radiance + sky(n) * m.albedo;
     }
-    let layers = layers_of(m, film_offset_nm(m, world));
+    let cos_o = max(dot(m.normal, wo), COS_MIN);
+    let layers = layers_of(m, film_offset_nm(m, cos_o));
     // What the top does towards the viewer, shared by both lights and the ambient term.
-    let top_o = coupling(layers, max(dot(m.normal, wo), COS_MIN));
+    let top_o = coupling(layers, cos_o);
     for (var i = 0u; i < SCENE_LIGHTS; i++) {
         let wi = scene.light_dir[i].xyz;
         let cos_i = max(dot(m.normal, wi), 0.0);

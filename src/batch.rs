@@ -458,7 +458,7 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         // A pack writes its engine's own (`Pack::normal_convention`: DirectX for Unreal) from
         // the maps' OpenGL normals, as `generate --pack`, which refuses the flag.
         let normal_convention = match (table.normal_convention.as_deref(), pack) {
-            (None, Some(_)) => NormalConvention::OpenGl,
+            (None, _) => NormalConvention::OpenGl,
             (Some(_), Some(pack)) => {
                 return Err(invalid(
                     "normal_convention",
@@ -470,7 +470,6 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
                     ),
                 ));
             }
-            (None, None) => NormalConvention::OpenGl,
             (Some(name), None) => NormalConvention::from_name(name).ok_or_else(|| {
                 let accepted: Vec<&str> = NormalConvention::ALL.iter().map(|c| c.name()).collect();
                 invalid("normal_convention", format!("normal_convention {name:?}: accepted: {}", accepted.join(", ")))

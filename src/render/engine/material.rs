@@ -180,7 +180,7 @@ pub fn texture_bytes(width: usize, height: usize) -> u64 {
 }
 
 /// Anything a 2×2 box filter can average.
-pub trait Texel: Copy + Default {
+pub trait Texel: Copy {
     fn average(a: Self, b: Self, c: Self, d: Self) -> Self;
 }
 
@@ -190,15 +190,9 @@ impl Texel for f32 {
     }
 }
 
-impl Texel for [f32; 2] {
+impl<const N: usize> Texel for [f32; N] {
     fn average(a: Self, b: Self, c: Self, d: Self) -> Self {
-        [0, 1].map(|k| 0.25 * (a[k] + b[k] + c[k] + d[k]))
-    }
-}
-
-impl Texel for [f32; 4] {
-    fn average(a: Self, b: Self, c: Self, d: Self) -> Self {
-        [0, 1, 2, 3].map(|k| 0.25 * (a[k] + b[k] + c[k] + d[k]))
+        std::array::from_fn(|k| 0.25 * (a[k] + b[k] + c[k] + d[k]))
     }
 }
 

@@ -104,38 +104,35 @@ pub fn shade_pixel(
     optics: &LayerOptics,
     bounce: &BounceGrid,
 ) -> [f64; 3] {
-    let thickness = gbuffer.position_thickness[i][3] as f64;
-    let spread = gbuffer.albedo_spread[i][3] as f64;
-    if spread <= 0.0 {
-        return shade_at(gbuffer, i, thickness, settings, optics, bounce);
-    }
     let pt = gbuffer.position_thickness[i].map(|v| v as f64);
     let nr = gbuffer.normal_roughness[i].map(|v| v as f64);
     let camera = settings.camera.position().to_array().map(|v| v as f64);
     let n = normalize([nr[0], nr[1], nr[2]]);
     let wo = normalize([camera[0] - pt[0], camera[1] - pt[1], camera[2] - pt[2]]);
+    let (thickness, spread) = (pt[3], gbuffer.albedo_spread[i][3] as f64);
+    let shade = |thickness| shade_at(gbuffer, i, thickness, (n, wo), settings, optics, bounce);
+    if spread <= 0.0 {
+        return shade(thickness);
+    }
     let stack = optics.stack;
     let offset = footprint_offset_nm(spread, stack.n0, stack.n1, dot(n, wo).max(COS_MIN));
-    let thin = shade_at(gbuffer, i, (thickness - offset).max(0.0), settings, optics, bounce);
-    let thick = shade_at(gbuffer, i, thickness + offset, settings, optics, bounce);
+    let (thin, thick) = (shade((thickness - offset).max(0.0)), shade(thickness + offset));
     [0, 1, 2].map(|c| 0.5 * (thin[c] + thick[c]))
 }
 
-/// Linear radiance of one covered pixel with the film at `thickness` (nm).
+/// Linear radiance of one covered pixel with the film at `thickness` (nm), its shading
+/// normal `n` seen along `wo` (`shade_pixel` computes them once for both thicknesses).
 fn shade_at(
     gbuffer: &GBuffer,
     i: usize,
     thickness: f64,
+    (n, wo): ([f64; 3], [f64; 3]),
     settings: &FrameSettings,
     optics: &LayerOptics,
     bounce: &BounceGrid,
 ) -> [f64; 3] {
-    let pt = gbuffer.position_thickness[i].map(|v| v as f64);
-    let nr = gbuffer.normal_roughness[i].map(|v| v as f64);
+    let roughness = gbuffer.normal_roughness[i][3] as f64;
     let albedo = gbuffer.albedo_spread[i].map(|v| v as f64);
-    let camera = settings.camera.position().to_array().map(|v| v as f64);
-    let n = normalize([nr[0], nr[1], nr[2]]);
-    let wo = normalize([camera[0] - pt[0], camera[1] - pt[1], camera[2] - pt[2]]);
     // Each light asks for the film at the same view cosine (421 Airy evaluations each): keep
     // every colour computed for this pixel, keyed by the exact cosine.
     let computed: std::cell::RefCell<Vec<(u64, [f64; 3])>> = Default::default();
@@ -147,7 +144,7 @@ fn shade_at(
         computed.borrow_mut().push((cos.to_bits(), rgb));
         rgb
     };
-    let layers = optics.layers(settings.model, bounce, thickness, nr[3], [albedo[0], albedo[1], albedo[2]]);
+    let layers = optics.layers(settings.model, bounce, thickness, roughness, [albedo[0], albedo[1], albedo[2]]);
     let lighting = &settings.lighting;
     let mut radiance = [0.0; 3];
     for light in lighting.lights() {
