@@ -905,3 +905,64 @@ fn the_boas_line_runs_from_the_snout_through_the_eye_to_the_neck() {
     let key = format!("body.head_mark.{index}.kind");
     assert!(rows_without(&[(&key, "\"postocular_spot\"")]) > 5, "the control");
 }
+
+/// The median linear colour of the belly's midline (u within 0.03 of 0, where the plates
+/// lie) over the rows within 0.01 of v.
+fn belly_median_at(colour: &Image, v: f32) -> [f32; 3] {
+    let (h, w) = (colour.height, colour.width);
+    let reach = (0.03 * w as f32) as usize;
+    let mut channels = [Vec::new(), Vec::new(), Vec::new()];
+    for y in rows_of(h, v - 0.01, v + 0.01) {
+        for x in (0..reach).chain(w - reach..w) {
+            for (k, c) in channels.iter_mut().enumerate() {
+                c.push(colour.data[(y * w + x) * 3 + k]);
+            }
+        }
+    }
+    channels.map(|mut c| {
+        c.sort_by(f32::total_cmp);
+        c[c.len() / 2]
+    })
+}
+
+#[test]
+fn the_belly_changes_colour_along_the_body_where_the_sources_say() {
+    // 'Anterior third of the venter is yellow, the rest of the venter is greyish white'
+    // (liasis-mackloti's source): a sixth of the way along the ventral plates the belly is
+    // nearer the yellow than the greyish white, at three fifths the other way round. With the
+    // yellow's end moved to the head (the control), the sixth is greyish white.
+    let front = |overrides: &[(&str, &str)]| {
+        let p = preset("liasis-mackloti", overrides);
+        let plan = body_plan(&p);
+        let colour = body_map(&p, MapKind::Color);
+        let (yellow, grey) = (linear(p.body.belly_front_color.unwrap()), linear(p.belly.color));
+        let at = |share: f32| belly_median_at(&colour, plan.head_end + share * (plan.vent - plan.head_end));
+        let nearer_yellow = |c: [f32; 3]| distance(&c, yellow) < distance(&c, grey);
+        (nearer_yellow(at(1.0 / 6.0)), nearer_yellow(at(0.6)))
+    };
+    assert_eq!(front(&[]), (true, false));
+    assert_eq!(front(&[("body.belly_front_end", "0")]), (false, false), "the control");
+
+    // 'the scales under the tail, past the cloaca ... are black' (pseudechis-porphyriacus'
+    // source): halfway down the tail the belly is black, just ahead of the vent red. Over the
+    // whole tail no pixel is red, the band's soft edges included: tinting the black over the
+    // band after the red left a thin red line along each edge (a fifth of the red at most).
+    // The control: a red under the tail.
+    let tail = |overrides: &[(&str, &str)]| {
+        let p = preset("pseudechis-porphyriacus", overrides);
+        let plan = body_plan(&p);
+        let colour = body_map(&p, MapKind::Color);
+        let (black, red) = (linear(p.body.subcaudal_color.unwrap()), linear(p.belly.color));
+        let nearer_black = |c: [f32; 3]| distance(&c, black) < distance(&c, red);
+        let under = nearer_black(belly_median_at(&colour, plan.vent + 0.5 * (1.0 - plan.vent)));
+        let ahead = nearer_black(belly_median_at(&colour, plan.vent - 0.02));
+        let redness = rows_of(colour.height, plan.vent + 0.01, 1.0)
+            .flat_map(|y| (0..colour.width).map(move |x| y * colour.width + x))
+            .map(|i| colour.data[i * 3] - colour.data[i * 3 + 1])
+            .fold(0.0f32, f32::max);
+        (under, ahead, redness < 0.02)
+    };
+    assert_eq!(tail(&[]), (true, false, true));
+    let red = format!("\"{}\"", preset("pseudechis-porphyriacus", &[]).belly.color);
+    assert_eq!(tail(&[("body.subcaudal_color", &red)]), (false, false, false), "the control");
+}

@@ -58,6 +58,16 @@ fn a_key_without_the_key_it_shapes_is_refused() {
             "b.toml:2: key `body.tail_shift_start` starts",
             "tail_color = \"#aa2200\"\n",
         ),
+        (
+            "[body]\nbelly_front_end = 0.3\n",
+            "b.toml:2: key `body.belly_front_end` ends what",
+            "belly_front_color = \"#d8c068\"\n",
+        ),
+        (
+            "[body]\nsubcaudal_color = \"#101010\"\n[belly]\nwidth = 0\n",
+            "b.toml:2: key `body.subcaudal_color` colours the underside",
+            "",
+        ),
         ("[belly]\nup_rows = 2\nplates = false\n", "b.toml:2: key `belly.up_rows` runs the belly", ""),
         ("[scales]\nkeel_height = 0.7\n", "b.toml:2: key `scales.keel_height` shapes the keels", "keeled = true\n"),
         ("[scales]\nkeel_width = 0.2\n", "b.toml:2: key `scales.keel_width` shapes the keels", "keeled = true\n"),
@@ -67,8 +77,12 @@ fn a_key_without_the_key_it_shapes_is_refused() {
         let err = refused("b.toml", text, &[]);
         assert!(err.contains(says), "{text}: {err}");
         let dir = tempfile::tempdir().unwrap();
-        let partnered =
-            if with.is_empty() { text.replace("plates = false", "plates = true") } else { format!("{text}{with}") };
+        // Without a partner to add, the text's own partner is turned on.
+        let partnered = if with.is_empty() {
+            text.replace("plates = false", "plates = true").replace("width = 0\n", "width = 0.2\n")
+        } else {
+            format!("{text}{with}")
+        };
         accepted(&write_preset(dir.path(), "b.toml", &partnered), &[]);
     }
     // An override that turns a built-in's partner off passes over the keys its file wrote

@@ -1,5 +1,6 @@
 //! The body layout's own colour nodes (`generate --layout body`): the ground shifting to
-//! the tail's colour, bands round the tail, a coloured tail tip and the head's marks.
+//! the tail's colour, the belly's colours along it, bands round the tail, a coloured tail tip
+//! and the head's marks.
 //! Everything else — scales, counted plates, the pattern layers — comes from the same
 //! builders as the tile, with counts along the body (`Shared::along_count`, `series`).
 
@@ -46,6 +47,44 @@ pub(super) fn tail_shift(g: &mut GraphBuilder, preset: &Preset, plan: &BodyPlan,
     };
     let ramp = g.add("body.tail_shift", Op::Along(AlongProfile { knots }), &[]);
     g.add("body.tail_color", Op::Tint { color: tail.to_linear(), opacity: 1.0 }, &[color, ramp])
+}
+
+/// The share of the ventral plates' span over which the belly's front colour fades into
+/// `belly.color`, centred on `belly_front_end`: the sources that give a front colour
+/// (liasis-mackloti: "Anterior third of the venter is yellow, the rest of the venter is
+/// greyish white") do not say how sharp the change is, so it is soft: about one
+/// circumference long at the defaults (12 circumferences, 0.22 of them head and tail).
+const BELLY_FRONT_FADE: f32 = 0.1;
+
+/// The belly's colour along the body where `[body]` changes it (none where it does not): the
+/// belly colour, the front colour (`body.belly_front_color`) from the snout to
+/// `belly_front_end` of the ventral plates' span, fading into it over `BELLY_FRONT_FADE` of
+/// that span, and the subcaudals' colour (`body.subcaudal_color`) from the vent to the tip.
+/// The belly band mixes this in where a constant would be tinted: each colour tinted over
+/// the band in turn left a thin line of the colour below along the band's soft edges.
+pub(super) fn belly_colour(g: &mut GraphBuilder, preset: &Preset, plan: &BodyPlan) -> Option<NodeId> {
+    let b = &preset.body;
+    if b.belly_front_color.is_none() && b.subcaudal_color.is_none() {
+        return None;
+    }
+    let zero = g.add("body.belly_colour_ground", Op::Constant { value: 0.0 }, &[]);
+    let belly = preset.belly.color.to_linear();
+    let mut colour = g.add("body.belly_colour", Op::Colorize { low: belly, high: belly }, &[zero]);
+    let mut tint = |g: &mut GraphBuilder, name: &str, tint: crate::preset::schema::Srgb8, knots| {
+        let along = g.add(format!("body.{name}"), Op::Along(AlongProfile { knots }), &[]);
+        colour =
+            g.add(format!("body.{name}_tint"), Op::Tint { color: tint.to_linear(), opacity: 1.0 }, &[colour, along]);
+    };
+    if let Some(front) = b.belly_front_color {
+        let span = plan.vent - plan.head_end;
+        let end = plan.head_end + span * b.belly_front_end as f32;
+        let half = 0.5 * BELLY_FRONT_FADE * span;
+        tint(g, "belly_front", front, vec![(end - half, 1.0), (end + half, 0.0)]);
+    }
+    if let Some(under_tail) = b.subcaudal_color {
+        tint(g, "subcaudals", under_tail, vec![(plan.vent, 0.0), (plan.vent + EDGE_V, 1.0)]);
+    }
+    Some(colour)
 }
 
 /// Tail bands, the tail tip and head marks over the pattern layers.

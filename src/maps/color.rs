@@ -47,7 +47,10 @@ pub(super) fn build(g: &mut GraphBuilder, preset: &Preset, s: &Shared) -> NodeId
             },
             &[],
         );
-        color = g.add("belly.tint", Op::Tint { color: b.color.to_linear(), opacity: 1.0 }, &[color, mask]);
+        color = match s.body().and_then(|plan| super::body::belly_colour(g, preset, &plan)) {
+            Some(along) => g.add("belly.tint", Op::Blend { mode: BlendMode::Mix, opacity: 1.0 }, &[color, along, mask]),
+            None => g.add("belly.tint", Op::Tint { color: b.color.to_linear(), opacity: 1.0 }, &[color, mask]),
+        };
         let kind = match b.pattern {
             BellyPattern::None => None,
             BellyPattern::Checkered => Some(BellyMarkKind::Checkered),

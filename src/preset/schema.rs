@@ -835,6 +835,15 @@ pub struct Body {
     /// The bands cross the subcaudals too, round the whole tail (a rattlesnake's "tail
     /// encircled by broad black and white rings"); by default they stop at the belly.
     pub tail_band_over_belly: bool,
+    /// The belly's colour over the front of the body, from the snout to `belly_front_end`
+    /// (none: the belly is `belly.color` from chin to tail).
+    pub belly_front_color: Option<Srgb8>,
+    /// Where the front colour gives way to `belly.color`, along the ventral plates (0 the
+    /// end of the head, 1 the vent).
+    pub belly_front_end: f64,
+    /// The colour under the tail, the subcaudals from the vent to the tip (none: the
+    /// belly's colour).
+    pub subcaudal_color: Option<Srgb8>,
     /// A solid colour over the tail's tip (none: no tip colour).
     pub tip_color: Option<Srgb8>,
     /// The tip colour's share of the tail's length.
@@ -860,6 +869,9 @@ impl Default for Body {
             tail_band_color: Srgb8([0x14, 0x12, 0x10]),
             tail_band_width: 0.5,
             tail_band_over_belly: false,
+            belly_front_color: None,
+            belly_front_end: 0.5,
+            subcaudal_color: None,
             tip_color: None,
             tip_fraction: 0.1,
             head_mark: Vec::new(),

@@ -757,6 +757,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
     c.whole_number("body.tail_bands", b.tail_bands, s.rows);
     c.range("body.tail_band_width", b.tail_band_width, TAIL_BAND_WIDTH);
     c.range("body.tip_fraction", b.tip_fraction, UNIT);
+    c.range("body.belly_front_end", b.belly_front_end, UNIT);
     // A key that shapes what another draws, without that other (the review found
     // `tail_band_width` without `tail_bands`, `tip_fraction` without `tip_color` and
     // `up_rows` without `plates` passing silently, where a pattern layer refuses a key its
@@ -815,6 +816,27 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
             "body.tip_color",
             b.tip_color.is_none(),
             "sizes what `body.tip_color` draws, which this preset does not set; set it, or leave this out",
+        ),
+        (
+            "body.belly_front_end",
+            b.belly_front_end != body.belly_front_end,
+            "body.belly_front_color",
+            b.belly_front_color.is_none(),
+            "ends what `body.belly_front_color` draws, which this preset does not set; set it, or leave this out",
+        ),
+        (
+            "body.belly_front_color",
+            b.belly_front_color.is_some(),
+            "belly.width",
+            preset.belly.width == 0.0,
+            "colours the front of the belly, which `belly.width = 0` leaves out; leave this out",
+        ),
+        (
+            "body.subcaudal_color",
+            b.subcaudal_color.is_some(),
+            "belly.width",
+            preset.belly.width == 0.0,
+            "colours the underside of the tail, which `belly.width = 0` leaves out; leave this out",
         ),
         (
             "belly.up_rows",

@@ -166,6 +166,12 @@ fn colour_keys(preset: &mut Preset) -> Vec<(String, &mut Srgb8)> {
     if let Some(tail) = body.tail_color.as_mut() {
         keys.push(("body.tail_color".into(), tail));
     }
+    if let Some(front) = body.belly_front_color.as_mut() {
+        keys.push(("body.belly_front_color".into(), front));
+    }
+    if let Some(under_tail) = body.subcaudal_color.as_mut() {
+        keys.push(("body.subcaudal_color".into(), under_tail));
+    }
     if let Some(tip) = body.tip_color.as_mut() {
         keys.push(("body.tip_color".into(), tip));
     }
