@@ -33,40 +33,12 @@ use crate::{Error, SIZE_RANGE};
 /// `scales = { rows = 25 }`, or `scales = 5` beside `"scales.rows" = 3`), and which: the
 /// entries are applied in the table's key order, so one of the two values was silently lost.
 fn set_twice(set: &std::collections::BTreeMap<String, toml::Value>) -> Option<String> {
-    // Every key an entry writes: a table's own keys (an override merges a table key by key),
-    // a list's entries as `key.N` (`pattern = [{ color = .. }]` beside `"pattern.0.kind"`
-    // loses nothing), anything else its key. An empty table or list writes no key of its own.
-    fn leaves(key: String, value: &toml::Value, into: &mut Vec<String>) {
-        match value {
-            toml::Value::Table(t) => {
-                for (k, v) in t {
-                    leaves(format!("{key}.{k}"), v, into);
-                }
-            }
-            toml::Value::Array(items) => {
-                for (i, v) in items.iter().enumerate() {
-                    leaves(format!("{key}.{i}"), v, into);
-                }
-            }
-            _ => into.push(key),
-        }
-    }
-    let written: Vec<(&String, Vec<String>)> = set
-        .iter()
-        .map(|(key, value)| {
-            let mut into = Vec::new();
-            leaves(key.clone(), value, &mut into);
-            (key, into)
-        })
-        .collect();
-    for (i, (a, a_leaves)) in written.iter().enumerate() {
-        for (b, b_leaves) in &written[i + 1..] {
-            for x in a_leaves {
-                let within = crate::toml_text::key_within;
-                if let Some(y) = b_leaves.iter().find(|y| within(x, y) || within(y, x)) {
-                    let key = if x.len() >= y.len() { x } else { y };
-                    return Some(format!("`{key}` is set by two entries, `{a}` and `{b}`; give it once"));
-                }
+    let written: Vec<(&String, Vec<String>)> =
+        set.iter().map(|(key, value)| (key, crate::toml_text::written_keys(key, value))).collect();
+    for (i, (a, a_keys)) in written.iter().enumerate() {
+        for (b, b_keys) in &written[i + 1..] {
+            if let Some(key) = crate::toml_text::key_written_by_both(a_keys, b_keys) {
+                return Some(format!("`{key}` is set by two entries, `{a}` and `{b}`; give it once"));
             }
         }
     }
@@ -647,6 +619,12 @@ pub struct BatchIndex {
     /// `K/N`.
     pub shard: String,
     pub jobs: Vec<JobOutcome>,
+    /// The sets other jobs files' runs made in the folder, as the index this one replaced
+    /// listed them (its jobs, and the sets it carried so): whose each set is outlives the
+    /// index that said so (`OtherSets`). A set this run's jobs write, or one no longer
+    /// standing with its key, is dropped. Not written where there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub other_sets: Vec<OtherSet>,
     /// How many jobs ran at once (`fitting_concurrency`); not written to the index, whose
     /// bytes do not depend on it.
     #[serde(skip)]
@@ -922,7 +900,8 @@ pub fn run(
             earlier
         ));
     }
-    BatchIndex::new(jobs_file, shard, planned, concurrency).write(out, shard)?;
+    let other_sets = other_sets_to_carry(out, shard, jobs_file, &work);
+    BatchIndex::new(jobs_file, shard, planned, other_sets.clone(), concurrency).write(out, shard)?;
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut failures: Vec<(usize, Error)> = Vec::new();
     std::thread::scope(|scope| {
@@ -980,7 +959,7 @@ pub fn run(
             })
         })
         .collect();
-    let index = BatchIndex::new(jobs_file, shard, outcomes, concurrency);
+    let index = BatchIndex::new(jobs_file, shard, outcomes, other_sets, concurrency);
     let written = index.write(out, shard);
     // The earliest job's error, whichever failed first; the index's own failure with it.
     if let Some((_, e)) = failures.into_iter().min_by_key(|(k, _)| *k) {
@@ -1000,14 +979,26 @@ fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<Str
         .filter(|earlier| !is_this_jobs_file(earlier, jobs_file))
 }
 
-/// An index file's jobs file (as recorded) and each of its jobs' manifest (relative to the
-/// output folder) and key; None where it cannot be read as one.
-fn read_index_file(path: &Path) -> Option<(String, Vec<(PathBuf, String)>)> {
+/// A set another jobs file's run made in the output folder: that jobs file (as recorded),
+/// the set's manifest (relative to the folder) and the key it was made with.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct OtherSet {
+    pub jobs_file: String,
+    pub manifest: PathBuf,
+    pub key: String,
+}
+
+/// An index file's jobs file (as recorded) and the sets it records another jobs file made:
+/// its own jobs where that file is not `jobs_file`, and the sets it carried from the index
+/// it replaced (`BatchIndex::other_sets`); None where it cannot be read as an index.
+fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
     #[derive(serde::Deserialize)]
     struct Listed {
         jobs_file: String,
         #[serde(default)]
         jobs: Vec<ListedJob>,
+        #[serde(default)]
+        other_sets: Vec<OtherSet>,
     }
     #[derive(serde::Deserialize)]
     struct ListedJob {
@@ -1015,8 +1006,37 @@ fn read_index_file(path: &Path) -> Option<(String, Vec<(PathBuf, String)>)> {
         key: String,
     }
     let text = std::fs::read(path).ok()?;
-    let Listed { jobs_file, jobs } = serde_json::from_slice::<Listed>(&text).ok()?;
-    Some((jobs_file, jobs.into_iter().map(|job| (job.manifest, job.key)).collect()))
+    let Listed { jobs_file, jobs, other_sets } = serde_json::from_slice::<Listed>(&text).ok()?;
+    let own =
+        jobs.into_iter().map(|job| OtherSet { jobs_file: jobs_file.clone(), manifest: job.manifest, key: job.key });
+    let sets = own.chain(other_sets).collect();
+    Some((jobs_file, sets))
+}
+
+/// The sets the index this run replaces records other jobs files made (`read_index_file`),
+/// for this run's index to carry: without them, a third jobs file's run into the folder
+/// replaced the index, and a later run of a fourth replaced the first's set from another
+/// preset of its name without the refusal (a hostile-input sweep). Kept: another jobs
+/// file's set that is still standing with its key (`job` in its manifest) and that none of
+/// this run's jobs writes (a job of this run that would replace one from another preset was
+/// refused in `plan`; one from the same preset makes it this run's set).
+fn other_sets_to_carry(out: &Path, shard: Shard, jobs_file: &Path, work: &[(&Job, Resolved)]) -> Vec<OtherSet> {
+    let Some((_, sets)) = read_index_file(&out.join(index_file_name(shard))) else { return Vec::new() };
+    let mine: std::collections::HashSet<&PathBuf> = work.iter().map(|(_, r)| &r.outcome.manifest).collect();
+    let mut carried: Vec<OtherSet> = Vec::new();
+    for set in sets {
+        if is_this_jobs_file(&set.jobs_file, jobs_file)
+            || mine.contains(&set.manifest)
+            || carried.iter().any(|c| c.manifest == set.manifest)
+        {
+            continue;
+        }
+        let standing = crate::export::read_set_manifest(&out.join(&set.manifest), crate::text_file::Links::Refuse);
+        if standing.is_ok_and(|json| json["job"].as_str() == Some(set.key.as_str())) {
+            carried.push(set);
+        }
+    }
+    carried
 }
 
 /// Whether an index's recorded jobs file is `jobs_file` (`recorded_jobs_file`'s text, or
@@ -1036,12 +1056,9 @@ impl OtherSets {
         let mut sets = std::collections::HashMap::new();
         let names = std::fs::read_dir(out).into_iter().flatten().flatten().map(|e| e.file_name());
         for name in names.filter(|n| n.to_str().is_some_and(is_index_file_name)) {
-            let Some((recorded, jobs)) = read_index_file(&out.join(name)) else { continue };
-            if is_this_jobs_file(&recorded, jobs_file) {
-                continue;
-            }
-            for (manifest, key) in jobs {
-                sets.entry(manifest).or_insert_with(|| (recorded.clone(), key));
+            let Some((_, listed)) = read_index_file(&out.join(name)) else { continue };
+            for set in listed.into_iter().filter(|set| !is_this_jobs_file(&set.jobs_file, jobs_file)) {
+                sets.entry(set.manifest).or_insert((set.jobs_file, set.key));
             }
         }
         OtherSets(sets)
@@ -1071,7 +1088,7 @@ impl OtherSets {
         }
         let message = format!(
             "would replace the set in {}, which a run of {jobs_file} made from another preset of that name \
-             (its preset_hash {their_hash}, this job's {}; the folder's index lists that run's jobs): write this \
+             (its preset_hash {their_hash}, this job's {}; the folder's index records that run's sets): write this \
              batch into another folder, or remove that set's folder first",
             out.join(&r.outcome.folder).display(),
             r.preset_hash,
@@ -1098,7 +1115,13 @@ fn recorded_jobs_file(jobs_file: &Path) -> String {
 }
 
 impl BatchIndex {
-    fn new(jobs_file: &Path, shard: Shard, jobs: Vec<JobOutcome>, concurrency: usize) -> BatchIndex {
+    fn new(
+        jobs_file: &Path,
+        shard: Shard,
+        jobs: Vec<JobOutcome>,
+        other_sets: Vec<OtherSet>,
+        concurrency: usize,
+    ) -> BatchIndex {
         BatchIndex {
             generator: "snakeskin".into(),
             generator_version: env!("CARGO_PKG_VERSION").into(),
@@ -1107,6 +1130,7 @@ impl BatchIndex {
             jobs_file: recorded_jobs_file(jobs_file),
             shard: shard.to_string(),
             jobs,
+            other_sets,
             concurrency,
         }
     }

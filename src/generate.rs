@@ -681,15 +681,17 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
         return Some(Strips { count: height.div_ceil(rows), rows, margin });
     }
     // A malformed value is refused at the command line's start.
-    let set_budget = crate::memory::tile_budget_from_env().ok().flatten();
+    // In bytes, saturating: shifted, 2^44 MiB and more wrapped to a small budget (or 0),
+    // and a budget meant as unlimited cut the tile into the most strips (a hostile-input sweep).
+    let set_budget = crate::memory::tile_budget_from_env().ok().flatten().map(|mib| mib.saturating_mul(1 << 20));
     let buffers = |rows: usize| crate::graph::estimate_peak_bytes(graph, maps, width, rows);
     // With the normal node, though a tile evaluated whole goes without it (`whole_tile_maps`):
     // the budget was measured with it, and without it the two species in strips at 4096²
     // would still not fit (their buffers without it: over 1000 and 920–960 MiB).
-    if buffers(height) <= set_budget.map_or(TILE_BUFFER_BUDGET_BYTES, |mib| mib << 20) {
+    if buffers(height) <= set_budget.unwrap_or(TILE_BUFFER_BUDGET_BYTES) {
         return None;
     }
-    let fits = |rows: usize| buffers(rows) <= set_budget.map_or(STRIP_BUFFER_BUDGET_BYTES, |mib| mib << 20);
+    let fits = |rows: usize| buffers(rows) <= set_budget.unwrap_or(STRIP_BUFFER_BUDGET_BYTES);
     let mut best = None;
     for count in 2..=16 {
         let rows = height.div_ceil(count);

@@ -101,10 +101,17 @@ fn is_binary(path: &Path) -> Result<bool, Error> {
         // The one message every output file gets (`export::check_target`).
         return Err(crate::export::ExportError::folder_name(path, &["glb", "gltf"]).into());
     }
-    // `.glb` alone: a name that is all extension (`Path::extension` sees none).
+    // `.glb` alone: a name that is all extension (`Path::extension` sees none); `..gltf`, a
+    // name of dots, wrote the hidden `..bin` and `._basecolor.png` beside it (a hostile-input
+    // sweep).
     let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-    if name == ".glb" || name == ".gltf" {
-        return Err(Error::Unsupported(format!("--gltf {text}: give a name before {name}, as in snake{name}")));
+    if let Some((stem, extension)) = name.rsplit_once('.')
+        && (extension == "glb" || extension == "gltf")
+        && stem.chars().all(|c| c == '.')
+    {
+        return Err(Error::Unsupported(format!(
+            "--gltf {text}: give a name before .{extension}, as in snake.{extension}"
+        )));
     }
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("glb") => Ok(true),

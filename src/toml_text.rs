@@ -163,6 +163,42 @@ fn with_suggestion(message: &str) -> String {
     format!("unknown key `{unknown}`{hint} (accepted keys here: {})", accepted.join(", "))
 }
 
+/// Every dotted key an override of `key` with `value` writes: a table's own keys (an
+/// override merges a table key by key), a list's entries as `key.N` (`pattern = [{ color =
+/// .. }]` beside `"pattern.0.kind"` loses nothing), anything else `key` itself. An empty
+/// table or list writes no key of its own.
+pub fn written_keys(key: &str, value: &toml::Value) -> Vec<String> {
+    fn leaves(key: String, value: &toml::Value, into: &mut Vec<String>) {
+        match value {
+            toml::Value::Table(t) => {
+                for (k, v) in t {
+                    leaves(format!("{key}.{k}"), v, into);
+                }
+            }
+            toml::Value::Array(items) => {
+                for (i, v) in items.iter().enumerate() {
+                    leaves(format!("{key}.{i}"), v, into);
+                }
+            }
+            _ => into.push(key),
+        }
+    }
+    let mut into = Vec::new();
+    leaves(key.to_string(), value, &mut into);
+    into
+}
+
+/// A key that two overrides' written keys (`written_keys`) both reach, the longer of the
+/// first pair where one lies within the other (`scales.rows` for `scales = { rows = 25 }` and
+/// `"scales.rows" = 23`; `scales.rows` for `scales = 5` beside it): one of the two values is
+/// lost. None where they write apart.
+pub fn key_written_by_both<'a>(a: &'a [String], b: &'a [String]) -> Option<&'a String> {
+    a.iter().find_map(|x| {
+        let y = b.iter().find(|y| key_within(x, y) || key_within(y, x))?;
+        Some(if x.len() >= y.len() { x } else { y })
+    })
+}
+
 /// Whether the dotted key `key` is `table` or lies inside it (`scales.rows` in `scales`, not
 /// `scales_x`).
 pub fn key_within(key: &str, table: &str) -> bool {

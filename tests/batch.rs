@@ -780,6 +780,19 @@ fn a_second_jobs_file_does_not_replace_the_firsts_set_with_other_output() {
         assert!(stderr(&refused).contains(&said), "{extra:?}: {}", stderr(&refused));
         assert_eq!(tree(&out), before_second, "{extra:?}: a file changed");
     }
+    // A third jobs file's run into the folder replaces the index, which carries the first's
+    // set: the second is still refused (it replaced the first's set once a third had run: a
+    // hostile-input sweep).
+    let third = dir.path().join("third.toml");
+    std::fs::write(&third, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    let ran = run(&third);
+    assert!(ran.status.success(), "{}", stderr(&ran));
+    assert!(stderr(&ran).contains("listed the jobs of"), "{}", stderr(&ran));
+    let after_third = tree(&out);
+    let refused = run(&second);
+    assert_eq!(refused.status.code(), Some(2), "after a third jobs file: {}", stderr(&refused));
+    assert!(stderr(&refused).contains(&said), "{}", stderr(&refused));
+    assert_eq!(tree(&out), after_third, "after a third jobs file: a file changed");
     // The first jobs file's own set, its preset edited: replaced (the built-in cannot be
     // edited, so the first jobs file is pointed at the edited file).
     std::fs::write(&first, "[[job]]\npreset = \"x/vipera-berus.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
@@ -1241,6 +1254,20 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
     assert_eq!(stdout(&whole).lines().filter(|l| l.starts_with("ok ")).count(), 2, "{}", stdout(&whole));
     let alone = verify(&[&manifests[0]]);
     assert_eq!(alone.status.code(), Some(0), "{}", stderr(&alone));
+
+    // A map entry whose file is empty is no plain file name (it was "a folder, not a
+    // regular file": a hostile-input sweep); the control, `../x`, said so already.
+    let text = std::fs::read(&manifests[0]).unwrap();
+    for file in ["", "../x"] {
+        let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
+        json["maps"][0]["file"] = serde_json::json!(file);
+        std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
+        let listed = verify(&[&manifests[0]]);
+        assert_eq!(listed.status.code(), Some(1), "{file:?}: {}", stderr(&listed));
+        let said = format!("map file {file:?} is not a plain file name");
+        assert!(stdout(&listed).contains(&said), "{file:?}: {}", stdout(&listed));
+    }
+    std::fs::write(&manifests[0], &text).unwrap();
 
     // One byte appended to one map of the first set.
     let set_folder = manifests[0].parent().unwrap();

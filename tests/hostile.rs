@@ -186,6 +186,15 @@ fn a_malformed_memory_cap_is_refused() {
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
         assert!(stderr(&out).contains("at most 18446744073709551615"), "{}", stderr(&out));
     }
+    // The strip budget at its largest means no strips: shifted into bytes, 2^44 MiB and more
+    // wrapped to a tiny budget, the most strips (a hostile-input sweep). The control: 1 MiB.
+    for (value, strips) in [("17592186044416", false), ("18446744073709551615", false), ("1", true)] {
+        let args = ["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "256", "--stats"];
+        let out = snakeskin_env(&args, &[("SNAKESKIN_TILE_BUDGET_MIB", value)]);
+        assert!(out.status.success(), "{value}: {}", stderr(&out));
+        assert_eq!(stderr(&out).contains("evaluated in "), strips, "{value}: {}", stderr(&out));
+    }
+    std::fs::remove_dir_all(&o).unwrap();
     let out = snakeskin_env(
         &["generate", PRESET, "-o", o.to_str().unwrap(), "--size", "8192"],
         &[("SNAKESKIN_MEMORY_LIMIT_MIB", " 1024 ")],
@@ -1461,14 +1470,24 @@ fn outputs_that_are_not_regular_files_are_refused() {
     }
     assert!(!dir.path().join("nowhere").exists());
 
-    // glTF file names: all extension, or a folder's (a trailing slash: "Not a directory",
-    // exit 1, after the work).
-    for (name, says) in [(".glb", "give a name before .glb"), ("x.glb/", "names a folder")] {
+    // glTF file names: all extension, dots before it (`..gltf` wrote the hidden `..bin`
+    // beside it), or a folder's (a trailing slash: "Not a directory", exit 1, after the work).
+    for (name, says) in [
+        (".glb", "give a name before .glb"),
+        ("..gltf", "give a name before .gltf"),
+        ("...GLB", "give a name before .glb"),
+        ("x.glb/", "names a folder"),
+    ] {
         let path = format!("{}/{name}", dir.path().display());
         let out = snakeskin(&["export", PRESET, "--size", "16", "--gltf", &path]);
         assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
         assert!(stderr(&out).contains(says), "{name}: {}", stderr(&out));
     }
+    // The control: a name with a dot in it is a name.
+    let named = dir.path().join(".x.gltf");
+    let out = snakeskin(&["export", PRESET, "--size", "16", "--gltf", named.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!dir.path().join("..bin").exists() && dir.path().join(".x.bin").exists());
 }
 
 /// A preset whose noise lattice outgrows its image does not allocate the lattice: within

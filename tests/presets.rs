@@ -210,6 +210,22 @@ fn the_manifest_records_the_overrides_and_a_repeated_key_is_warned_of() {
     assert_eq!(twice["preset_hash"], once["preset_hash"]);
     assert!(err.contains("warning: --set scales.rows is given 2 times: the last, scales.rows=20, is used"), "{err}");
     assert!(!quiet.contains("given"), "{quiet}");
+    // Another key that writes the same one (an inline table; silent before: a hostile-input
+    // sweep), either way round; the control: a table that writes another key of `scales`.
+    for (sets, later) in [
+        (["scales.rows=20", "scales={rows=30}"], "scales={rows=30}"),
+        (["scales={rows=30}", "scales.rows=20"], "scales.rows=20"),
+    ] {
+        let (_, err) = generate("table", &sets);
+        let said = format!(
+            "warning: --set {} and --set {} both set `scales.rows`: the later, {later}, is used",
+            sets[0].split('=').next().unwrap(),
+            later.split('=').next().unwrap()
+        );
+        assert!(err.contains(&said), "{sets:?}: {err}");
+    }
+    let (_, err) = generate("apart", &["scales.rows=20", "scales={keeled=true}"]);
+    assert!(!err.contains("both set"), "{err}");
 }
 
 /// `--seed` wins over `--set seed=`, and says so where they differ (`--seed 5 --set seed=6`

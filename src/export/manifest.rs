@@ -378,7 +378,9 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
         else {
             return Err(problem("a map entry lacks map, file or sha256".into()));
         };
-        if file.contains(['/', '\\']) || file.starts_with('.') {
+        // An empty name too: it joined to the set's folder, "it is a folder, not a regular
+        // file" (a hostile-input sweep).
+        if file.is_empty() || file.contains(['/', '\\']) || file.starts_with('.') {
             return Err(problem(format!("map file {file:?} is not a plain file name")));
         }
         if files.iter().any(|(m, p): &(String, PathBuf)| m == map || p.ends_with(file)) {

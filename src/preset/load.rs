@@ -86,17 +86,42 @@ impl LoadedPreset {
     }
 
     /// One warning per key given more than once among the overrides (`--set a=1 --set a=2`):
-    /// the last wins, silently before.
+    /// the last wins, silently before. And one per pair of other keys that write one key
+    /// (`--set scales.rows=20 --set 'scales={rows=30}'`): the later wins, silently before
+    /// (a hostile-input sweep; a batch job's `set` refuses such a pair, `batch::set_twice`).
     fn repeated_overrides(&self) -> Vec<String> {
         let given = &self.overrides;
         // Each key at its last override, in the order those come.
         let lasts = given.iter().enumerate().filter(|(i, (k, _))| !given[i + 1..].iter().any(|(later, _)| later == k));
-        lasts
+        let mut warnings: Vec<String> = lasts
             .filter_map(|(_, (k, v))| {
                 let times = given.iter().filter(|(other, _)| other == k).count();
                 (times > 1).then(|| format!("warning: --set {k} is given {times} times: the last, {k}={v}, is used"))
             })
-            .collect()
+            .collect();
+        // A value that does not parse was refused before any warning is asked for; as its
+        // key, it writes that key.
+        let written: Vec<Vec<String>> = given
+            .iter()
+            .map(|(k, v)| {
+                override_value(v)
+                    .map(|value| crate::toml_text::written_keys(k, &value))
+                    .unwrap_or_else(|_| vec![k.clone()])
+            })
+            .collect();
+        for (j, (b, value)) in given.iter().enumerate() {
+            for (i, (a, _)) in given[..j].iter().enumerate() {
+                if a == b {
+                    continue;
+                }
+                if let Some(key) = crate::toml_text::key_written_by_both(&written[i], &written[j]) {
+                    warnings.push(format!(
+                        "warning: --set {a} and --set {b} both set `{key}`: the later, {b}={value}, is used"
+                    ));
+                }
+            }
+        }
+        warnings
     }
 }
 
