@@ -886,6 +886,30 @@ fn a_band_between_the_eyes_crosses_the_head() {
 }
 
 #[test]
+fn the_puff_adders_second_band_crosses_the_crown() {
+    // 'The head has two well-marked dark bands: one on the crown and the other between the
+    // eyes' (bitis-arietans' source). Every column from the spine to the eyes' line (0.6
+    // shield half-widths out, each side) holds the crown band's colour somewhere behind the
+    // eyes (0.7 to 0.9 head lengths from the snout), and on the spine the two bands are two:
+    // ground between them (0.62 to 0.72). The control: the crown band turned into a spot
+    // behind each eye, and the crown is open (the puff adder's crown carried no band before, an
+    // audit found).
+    let name = "bitis-arietans";
+    let index = head_mark_index(name, snakeskin::preset::schema::HeadMarkKind::CrownBand);
+    let check = |overrides: &[(&str, &str)]| {
+        let head = HeadView::of(name, overrides, index);
+        let ((left, first), (right, last)) = (head.pixel((-0.6, 0.7)), head.pixel((0.6, 0.9)));
+        let open = (left..=right).filter(|&x| !(first..=last).any(|y| head.is_mark((x, y)))).count();
+        let ((spine, gap_first), (_, gap_last)) = (head.pixel((0.0, 0.62)), head.pixel((0.0, 0.72)));
+        let parted = (gap_first..=gap_last).any(|y| !head.is_mark((spine, y)));
+        (open, parted)
+    };
+    assert_eq!(check(&[]), (0, true), "columns without the band; ground between the bands");
+    let key = format!("body.head_mark.{index}.kind");
+    assert!(check(&[(&key, "\"postocular_spot\"")]).0 > 10, "the control");
+}
+
+#[test]
 fn the_boas_line_runs_from_the_snout_through_the_eye_to_the_neck() {
     // 'ses yeux ... sont eux aussi parcourus d'une ligne latérale présente du museau à
     // l'embase du cou' (boa-constrictor's source: a line through the eyes from the snout to

@@ -143,6 +143,7 @@ pub(super) fn marks(
             HeadMarkKind::X => HeadMarkShape::X,
             HeadMarkKind::Spearhead => HeadMarkShape::Spearhead,
             HeadMarkKind::EyeBand => HeadMarkShape::EyeBand,
+            HeadMarkKind::CrownBand => HeadMarkShape::CrownBand,
             HeadMarkKind::PreocularStripe => HeadMarkShape::PreocularStripe,
             HeadMarkKind::PostocularStripe => HeadMarkShape::PostocularStripe,
             HeadMarkKind::PostocularSpot => HeadMarkShape::PostocularSpot,

@@ -190,6 +190,7 @@ pub enum HeadMarkShape {
     X,
     Spearhead,
     EyeBand,
+    CrownBand,
     PreocularStripe,
     PostocularStripe,
     PostocularSpot,
@@ -229,6 +230,12 @@ const STRIPE_HALF_WIDTH: f32 = 0.10;
 /// snake's and the puff adder's say "between the eyes", and the chevron joined to the
 /// postocular stripes read as a V (a review).
 const EYE_BAND_AT_SPINE: (f32, f32) = (0.0, POSTOCULAR.0.1);
+
+/// Where the crown band crosses the head, in head-local units (as `POSTOCULAR`): across the
+/// middle of the parietals (0.60 to 1.0 head lengths back, `SHIELDS`), from the spine to
+/// their outer edge there (0.66 across at 0.80), behind the eyes and the eye band. The source
+/// names the crown, not where on it; the middle of the top of the head behind the eyes.
+const CROWN_BAND: ((f32, f32), (f32, f32)) = ((0.0, 0.80), (0.66, 0.80));
 
 /// Where the preocular stripe starts: the snout, at the rostral's outer corner (`SHIELDS`);
 /// it runs to the eye, where the postocular stripe starts (`POSTOCULAR.0`).
@@ -312,6 +319,7 @@ impl HeadMark {
                 (half * t - du).min(s - apex).min(base - s)
             }
             HeadMarkShape::EyeBand => arm(EYE_BAND_AT_SPINE, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
+            HeadMarkShape::CrownBand => arm(CROWN_BAND.0, CROWN_BAND.1, STRIPE_HALF_WIDTH * k),
             HeadMarkShape::PreocularStripe => arm(PREOCULAR_START, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
             HeadMarkShape::PostocularStripe => arm(POSTOCULAR.0, POSTOCULAR.1, STRIPE_HALF_WIDTH * k),
             // A disc 0.3 shield half-widths across at size 1 (the stripe is 0.2 wide).
@@ -496,6 +504,7 @@ mod tests {
             HeadMarkShape::X,
             HeadMarkShape::Spearhead,
             HeadMarkShape::EyeBand,
+            HeadMarkShape::CrownBand,
             HeadMarkShape::PreocularStripe,
             HeadMarkShape::PostocularStripe,
             HeadMarkShape::PostocularSpot,

@@ -80,6 +80,7 @@ named_enum!(HeadMarkKind {
     X,
     Spearhead,
     EyeBand,
+    CrownBand,
     PreocularStripe,
     PostocularStripe,
     PostocularSpot,
@@ -751,6 +752,10 @@ pub enum HeadMarkKind {
     /// where the postocular stripes start (a milk snake's "transverse band between the
     /// eyes"; with the stripes, a corn snake's stripes through the eyes meeting on top).
     EyeBand,
+    /// A band straight across the crown behind the eyes, over the parietals, as wide as the
+    /// eye band (a puff adder's "two well-marked dark bands: one on the crown and the other
+    /// between the eyes").
+    CrownBand,
     /// A stripe from the snout to the eye, each side, ending where the postocular stripe
     /// starts (with it, a line from the snout through the eye to the neck: boas).
     PreocularStripe,
