@@ -619,10 +619,11 @@ pub struct BatchIndex {
     /// `K/N`.
     pub shard: String,
     pub jobs: Vec<JobOutcome>,
-    /// The sets other jobs files' runs made in the folder, as the index this one replaced
-    /// listed them (its jobs, and the sets it carried so): whose each set is outlives the
-    /// index that said so (`OtherSets`). A set this run's jobs write, or one no longer
-    /// standing with its key, is dropped. Not written where there are none.
+    /// The sets earlier runs made in the folder that this run's jobs do not write (other
+    /// jobs files', and this file's dropped jobs), as the index this one replaced listed them
+    /// (its jobs, and the sets it carried so): whose each set is outlives the index that said
+    /// so (`OtherSets`, `other_sets_to_carry`). One no longer standing with its key is
+    /// dropped. Not written where there are none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub other_sets: Vec<OtherSet>,
     /// How many jobs ran at once (`fitting_concurrency`); not written to the index, whose
@@ -900,7 +901,7 @@ pub fn run(
             earlier
         ));
     }
-    let other_sets = other_sets_to_carry(out, shard, jobs_file, &work);
+    let other_sets = other_sets_to_carry(out, shard, &work);
     BatchIndex::new(jobs_file, shard, planned, other_sets.clone(), concurrency).write(out, shard)?;
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut failures: Vec<(usize, Error)> = Vec::new();
@@ -979,8 +980,8 @@ fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<Str
         .filter(|earlier| !is_this_jobs_file(earlier, jobs_file))
 }
 
-/// A set another jobs file's run made in the output folder: that jobs file (as recorded),
-/// the set's manifest (relative to the folder) and the key it was made with.
+/// A set a batch run made in the output folder: its jobs file (as recorded), the set's
+/// manifest (relative to the folder) and the key it was made with.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct OtherSet {
     pub jobs_file: String,
@@ -988,9 +989,9 @@ pub struct OtherSet {
     pub key: String,
 }
 
-/// An index file's jobs file (as recorded) and the sets it records another jobs file made:
-/// its own jobs where that file is not `jobs_file`, and the sets it carried from the index
-/// it replaced (`BatchIndex::other_sets`); None where it cannot be read as an index.
+/// An index file's jobs file (as recorded) and every set it records: its jobs, under that
+/// file, and the sets it carried from the index it replaced (`BatchIndex::other_sets`), under
+/// theirs; None where it cannot be read as an index.
 fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
     #[derive(serde::Deserialize)]
     struct Listed {
@@ -1016,19 +1017,18 @@ fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
 /// The sets the index this run replaces records other jobs files made (`read_index_file`),
 /// for this run's index to carry: without them, a third jobs file's run into the folder
 /// replaced the index, and a later run of a fourth replaced the first's set from another
-/// preset of its name without the refusal (a hostile-input sweep). Kept: another jobs
-/// file's set that is still standing with its key (`job` in its manifest) and that none of
-/// this run's jobs writes (a job of this run that would replace one from another preset was
-/// refused in `plan`; one from the same preset makes it this run's set).
-fn other_sets_to_carry(out: &Path, shard: Shard, jobs_file: &Path, work: &[(&Job, Resolved)]) -> Vec<OtherSet> {
+/// preset of its name without the refusal (a hostile-input sweep). Kept: a set still
+/// standing with its key (`job` in its manifest) that none of this run's jobs writes (a job
+/// of this run that would replace another file's set from another preset was refused in
+/// `plan`; one from the same preset makes it this run's set) — this jobs file's own earlier
+/// sets too, where its jobs no longer name them (dropped, they were no one's, and another
+/// preset of the name replaced them: a review).
+fn other_sets_to_carry(out: &Path, shard: Shard, work: &[(&Job, Resolved)]) -> Vec<OtherSet> {
     let Some((_, sets)) = read_index_file(&out.join(index_file_name(shard))) else { return Vec::new() };
     let mine: std::collections::HashSet<&PathBuf> = work.iter().map(|(_, r)| &r.outcome.manifest).collect();
     let mut carried: Vec<OtherSet> = Vec::new();
     for set in sets {
-        if is_this_jobs_file(&set.jobs_file, jobs_file)
-            || mine.contains(&set.manifest)
-            || carried.iter().any(|c| c.manifest == set.manifest)
-        {
+        if mine.contains(&set.manifest) || carried.iter().any(|c| c.manifest == set.manifest) {
             continue;
         }
         let standing = crate::export::read_set_manifest(&out.join(&set.manifest), crate::text_file::Links::Refuse);
@@ -1047,9 +1047,10 @@ fn is_this_jobs_file(recorded: &str, jobs_file: &Path) -> bool {
 
 /// The sets other jobs files' runs made in the output folder, as their indexes list them:
 /// every index there (`index.json` and each shard's: a sharded run of a second jobs file
-/// wrote over the first's set unseen, a review found), each set's manifest with the jobs
-/// file and the key it was made with.
-struct OtherSets(std::collections::HashMap<PathBuf, (String, String)>);
+/// wrote over the first's set unseen, a review found), each set's manifest with every jobs
+/// file and key an index lists it under (an older shard's index beside a newer run's: the
+/// first read hid the entry of the set standing, and the set was replaced, a review).
+struct OtherSets(std::collections::HashMap<PathBuf, Vec<(String, String)>>);
 
 impl OtherSets {
     fn in_folder(out: &Path, jobs_file: &Path) -> OtherSets {
@@ -1058,7 +1059,7 @@ impl OtherSets {
         for name in names.filter(|n| n.to_str().is_some_and(is_index_file_name)) {
             let Some((_, listed)) = read_index_file(&out.join(name)) else { continue };
             for set in listed.into_iter().filter(|set| !is_this_jobs_file(&set.jobs_file, jobs_file)) {
-                sets.entry(set.manifest).or_insert((set.jobs_file, set.key));
+                sets.entry(set.manifest).or_insert_with(Vec::new).push((set.jobs_file, set.key));
             }
         }
         OtherSets(sets)
@@ -1069,12 +1070,13 @@ impl OtherSets {
     /// the one that run made (its manifest's `job`), and its `preset_hash` is not this job's.
     /// A second jobs file naming another preset `vipera-berus` wrote over the first's set in
     /// the same folder, and the note said their sets stayed (a hostile-input sweep); within
-    /// one jobs file such a clash is refused (`resolve_all`). The same preset made by another
-    /// version of the tool (whose job keys differ) is replaced, as its own jobs file's run
-    /// would.
+    /// one jobs file such a clash is refused (`resolve_all`). The hash is all the check has:
+    /// the same preset made by another version of the tool is replaced where its
+    /// `preset_hash` is the same, and refused as another preset where the version's resolved
+    /// presets hash differently.
     fn check(&self, out: &Path, r: &Resolved, place: JobPlace) -> Result<(), Error> {
         let manifest = &r.outcome.manifest;
-        let Some((jobs_file, their_key)) = self.0.get(manifest) else { return Ok(()) };
+        let Some(listed) = self.0.get(manifest) else { return Ok(()) };
         if r.done || r.outcome.duplicate_of.is_some() {
             return Ok(());
         }
@@ -1082,8 +1084,11 @@ impl OtherSets {
         else {
             return Ok(());
         };
+        // The run that made the set standing: the entry with its key.
+        let made_by = listed.iter().find(|(_, key)| standing["job"].as_str() == Some(key.as_str()));
+        let Some((jobs_file, _)) = made_by else { return Ok(()) };
         let their_hash = standing["preset_hash"].as_str().unwrap_or_default();
-        if standing["job"].as_str() != Some(their_key) || their_hash == r.preset_hash {
+        if their_hash == r.preset_hash {
             return Ok(());
         }
         let message = format!(

@@ -43,20 +43,22 @@ pub fn estimate_generate_bytes(graph: &Graph, maps: &[MapKind], width: usize, he
 
 /// Estimated peak bytes of a set evaluated in strips (a body atlas, `generate::STRIP_ROWS`):
 /// one strip's live buffers at their worst (`strip_rows` rows, margins included) and what the
-/// allocator keeps of the strip before, half as much, at most 64 MiB (its buffers, freed on the
-/// pool's threads, stay in their threads' arenas, and the next strip may ask on another
+/// allocator keeps of the strip before, as much again, at most 128 MiB (its buffers, freed on
+/// the pool's threads, stay in their threads' arenas, and the next strip may ask on another
 /// thread: the body atlas of python-regius at 1024 packed for glTF peaked at 274–312 MiB, ten
 /// runs, where one strip's 101 MiB and the files counted 280; at 2048, strips of about 400 MiB,
 /// the peaks of three species stayed 170–280 MiB under the estimate without it; BENCHMARKS.md,
-/// "Export's memory"), plus the PNG files growing as rows are encoded (at most the quantised
-/// size of the whole set with the fast filter), plus the fixed overhead.
+/// "Export's memory". Half a strip, at most 64 MiB, was counted until a full test run beside
+/// it took that `.glb` to 344 MiB against 328 estimated), plus the PNG files growing as rows
+/// are encoded (at most the quantised size of the whole set with the fast filter), plus the
+/// fixed overhead.
 pub fn estimate_strips_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize, strip_rows: usize) -> u64 {
     let pixels = (width * height) as u64;
     let files: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * pixels).sum();
     let strip_pixels = (width * strip_rows) as u64;
     let strip_quantized: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * strip_pixels).sum();
     let strip = estimate_peak_bytes(graph, maps, width, strip_rows);
-    strip + (strip / 2).min(64 * MIB) + 2 * strip_quantized + files + FIXED_OVERHEAD_BYTES
+    strip + strip.min(128 * MIB) + 2 * strip_quantized + files + FIXED_OVERHEAD_BYTES
 }
 
 /// Hands the memory the allocator keeps from freed blocks back to the system (glibc's

@@ -802,6 +802,51 @@ fn a_second_jobs_file_does_not_replace_the_firsts_set_with_other_output() {
     assert_ne!(tree(&out)[colour], before[colour], "the control: its own set is replaced");
 }
 
+/// Whose a set is survives a sharded run's older index beside a newer one, and a jobs file
+/// that drops the set's job: another jobs file naming another preset `vipera-berus` is still
+/// refused. Both let it through (a review): the older shard index's entry, read first, hid
+/// the newer one; the dropped job's set was recorded as no one's. The control: the first
+/// jobs file itself replaces its set.
+#[test]
+fn a_set_stays_its_jobs_files_across_shards_and_dropped_jobs() {
+    let dir = tempfile::tempdir().unwrap();
+    let built_in = stdout(&snakeskin(&["presets", "show", "vipera-berus"]));
+    std::fs::create_dir(dir.path().join("x")).unwrap();
+    let own = dir.path().join("x").join("vipera-berus.toml");
+    let rows = |n: u32| built_in.replace("\nrows = 21", &format!("\nrows = {n}"));
+    let first = dir.path().join("first.toml");
+    let job = "[[job]]\npreset = \"x/vipera-berus.toml\"\nseeds = [1]\nsizes = [16]\n";
+    let other_job = "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n";
+    let second = jobs_file(dir.path(), &["vipera-berus"], "[1]", 16);
+    let out = dir.path().join("out");
+    let run = |jobs: &Path, extra: &[&str]| {
+        let mut args = vec!["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend(extra);
+        snakeskin(&args)
+    };
+    let refused = |why: &str| {
+        let before = tree(&out);
+        let ran = run(&second, &[]);
+        assert_eq!(ran.status.code(), Some(2), "{why}: {}", stderr(&ran));
+        assert!(stderr(&ran).contains("would replace the set in"), "{why}: {}", stderr(&ran));
+        assert_eq!(tree(&out), before, "{why}: a file changed");
+    };
+    // A sharded run, then its preset edited and an unsharded run: two indexes list the set.
+    std::fs::write(&own, rows(23)).unwrap();
+    std::fs::write(&first, format!("{job}\n{other_job}")).unwrap();
+    assert!(run(&first, &["--shard", "0/2"]).status.success());
+    std::fs::write(&own, rows(25)).unwrap();
+    let replaced = run(&first, &[]);
+    assert!(replaced.status.success(), "the control: its own set: {}", stderr(&replaced));
+    assert!(out.join("index.shard-0-of-2.json").exists() && out.join("index.json").exists());
+    refused("after a sharded run");
+    // The job dropped from the first jobs file, which runs again.
+    std::fs::remove_file(out.join("index.shard-0-of-2.json")).unwrap();
+    std::fs::write(&first, other_job).unwrap();
+    assert!(run(&first, &[]).status.success());
+    refused("after its job was dropped");
+}
+
 /// A newline in a jobs file's preset string is escaped where a message names the job: it
 /// printed a line of its own, which could pass for the tool's. Control: the job's place is
 /// in the message.

@@ -910,6 +910,35 @@ fn the_puff_adders_second_band_crosses_the_crown() {
 }
 
 #[test]
+fn the_corn_snakes_spearpoint_is_two_stripes_from_the_first_blotch() {
+    // 'The first blotch on the back of the neck splits to form two stripes that run on top of
+    // the head and meet to form the characteristic spearpoint' (pantherophis-guttatus'
+    // source). Every row from just behind the point (0.35 head lengths) to the neck's end,
+    // where the first blotch begins, holds the mark's colour on each side of the spine (0.05
+    // to 0.8 shield half-widths out): the stripes run unbroken into the blotch, which has the
+    // same colour. On the spine 1.2 head lengths from the snout, between the stripes, the
+    // ground shows: two stripes, not a wedge. The control: the solid spearhead
+    // the preset drew before, which ended 0.02 of the length short of the first blotch (an
+    // audit) and is solid on the spine.
+    let name = "pantherophis-guttatus";
+    let index = head_mark_index(name, snakeskin::preset::schema::HeadMarkKind::SpearStripes);
+    let check = |overrides: &[(&str, &str)]| {
+        let head = HeadView::of(name, overrides, index);
+        let neck_end = head.plan.neck_end / head.plan.head_end;
+        let ((_, first), (_, last)) = (head.pixel((0.0, 0.35)), head.pixel((0.0, neck_end)));
+        let sides = [(-0.8, -0.05), (0.05, 0.8)].map(|(a, b)| head.pixel((a, 0.0)).0..=head.pixel((b, 0.0)).0);
+        let broken =
+            (first..=last).filter(|&y| !sides.iter().all(|side| side.clone().any(|x| head.is_mark((x, y))))).count();
+        let between = head.pixel((0.0, 1.2));
+        (broken, !head.is_mark(between))
+    };
+    assert_eq!(check(&[]), (0, true), "rows where a stripe breaks; the ground between the stripes");
+    let key = format!("body.head_mark.{index}.kind");
+    let (broken, open) = check(&[(&key, "\"spearhead\""), (&format!("body.head_mark.{index}.size"), "1")]);
+    assert!(broken > 5 && !open, "the control: {broken} rows, open {open}");
+}
+
+#[test]
 fn the_boas_line_runs_from_the_snout_through_the_eye_to_the_neck() {
     // 'ses yeux ... sont eux aussi parcourus d'une ligne latérale présente du museau à
     // l'embase du cou' (boa-constrictor's source: a line through the eyes from the snout to
@@ -966,6 +995,27 @@ fn the_belly_changes_colour_along_the_body_where_the_sources_say() {
     };
     assert_eq!(front(&[]), (true, false));
     assert_eq!(front(&[("body.belly_front_end", "0")]), (false, false), "the control");
+    // The fade stays on the ventral plates: with the end at the vent the tail's underside
+    // just behind it is the rest of the belly's colour (as far down the tail), and with the end
+    // at the head the chin is the whole front colour (as a sixth of the way along at the
+    // default). Centred on the end, the fade ran half onto the tail and left the chin half
+    // yellow (a review; under the tail 0.46 of the way between the two colours, seen).
+    let p = preset("liasis-mackloti", &[]);
+    let (plan, colour) = (body_plan(&p), body_map(&p, MapKind::Color));
+    let (yellow, grey) = (linear(p.body.belly_front_color.unwrap()), linear(p.belly.color));
+    let apart = distance(&yellow, grey);
+    let front_yellow = belly_median_at(&colour, plan.head_end + (plan.vent - plan.head_end) / 6.0);
+    let at_end = |end: &str, v: f32| {
+        belly_median_at(&body_map(&preset("liasis-mackloti", &[("body.belly_front_end", end)]), MapKind::Color), v)
+    };
+    let tail = |end: &str| {
+        let p = preset("liasis-mackloti", &[("body.belly_front_end", end)]);
+        let colour = body_map(&p, MapKind::Color);
+        distance(&belly_median_at(&colour, plan.vent + 0.005), belly_median_at(&colour, plan.vent + 0.1)) / apart
+    };
+    assert!(tail("1") < 0.15, "under the tail at end 1: {} of the way", tail("1"));
+    let chin = distance(&at_end("0", plan.head_end - 0.01), front_yellow) / apart;
+    assert!(chin < 0.15, "the chin at end 0: {chin} of the way");
 
     // 'the scales under the tail, past the cloaca ... are black' (pseudechis-porphyriacus'
     // source): halfway down the tail the belly is black, just ahead of the vent red. Over the

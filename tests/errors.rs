@@ -64,6 +64,11 @@ fn a_key_without_the_key_it_shapes_is_refused() {
             "belly_front_color = \"#d8c068\"\n",
         ),
         (
+            "[body]\nbelly_front_color = \"#d8c068\"\n[belly]\nwidth = 0\n",
+            "b.toml:2: key `body.belly_front_color` colours the front of the belly",
+            "",
+        ),
+        (
             "[body]\nsubcaudal_color = \"#101010\"\n[belly]\nwidth = 0\n",
             "b.toml:2: key `body.subcaudal_color` colours the underside",
             "",

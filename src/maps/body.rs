@@ -50,10 +50,11 @@ pub(super) fn tail_shift(g: &mut GraphBuilder, preset: &Preset, plan: &BodyPlan,
 }
 
 /// The share of the ventral plates' span over which the belly's front colour fades into
-/// `belly.color`, centred on `belly_front_end`: the sources that give a front colour
-/// (liasis-mackloti: "Anterior third of the venter is yellow, the rest of the venter is
-/// greyish white") do not say how sharp the change is, so it is soft: about one
-/// circumference long at the defaults (12 circumferences, 0.22 of them head and tail).
+/// `belly.color`, centred on `belly_front_end` and kept within the span (half of it at the
+/// span's ends). The sources that give a front colour (liasis-mackloti: "Anterior third of
+/// the venter is yellow, the rest of the venter is greyish white") do not say how sharp the
+/// change is, so it is soft: a tenth of the span (about one circumference long on a snake of
+/// the default proportions).
 const BELLY_FRONT_FADE: f32 = 0.1;
 
 /// The belly's colour along the body where `[body]` changes it (none where it does not): the
@@ -79,7 +80,10 @@ pub(super) fn belly_colour(g: &mut GraphBuilder, preset: &Preset, plan: &BodyPla
         let span = plan.vent - plan.head_end;
         let end = plan.head_end + span * b.belly_front_end as f32;
         let half = 0.5 * BELLY_FRONT_FADE * span;
-        tint(g, "belly_front", front, vec![(end - half, 1.0), (end + half, 0.0)]);
+        // The fade kept to the ventral plates: centred on an end at the head or the vent, it
+        // left the chin half the front colour or ran onto the tail's underside (a review).
+        let (from, to) = ((end - half).max(plan.head_end), (end + half).min(plan.vent));
+        tint(g, "belly_front", front, vec![(from, 1.0), (to, 0.0)]);
     }
     if let Some(under_tail) = b.subcaudal_color {
         tint(g, "subcaudals", under_tail, vec![(plan.vent, 0.0), (plan.vent + EDGE_V, 1.0)]);
@@ -142,6 +146,7 @@ pub(super) fn marks(
             HeadMarkKind::V => HeadMarkShape::V,
             HeadMarkKind::X => HeadMarkShape::X,
             HeadMarkKind::Spearhead => HeadMarkShape::Spearhead,
+            HeadMarkKind::SpearStripes => HeadMarkShape::SpearStripes,
             HeadMarkKind::EyeBand => HeadMarkShape::EyeBand,
             HeadMarkKind::CrownBand => HeadMarkShape::CrownBand,
             HeadMarkKind::PreocularStripe => HeadMarkShape::PreocularStripe,

@@ -189,6 +189,7 @@ pub enum HeadMarkShape {
     V,
     X,
     Spearhead,
+    SpearStripes,
     EyeBand,
     CrownBand,
     PreocularStripe,
@@ -230,6 +231,11 @@ const STRIPE_HALF_WIDTH: f32 = 0.10;
 /// snake's and the puff adder's say "between the eyes", and the chevron joined to the
 /// postocular stripes read as a V (a review).
 const EYE_BAND_AT_SPINE: (f32, f32) = (0.0, POSTOCULAR.0.1);
+
+/// The spear stripes' ends across, in shield half-widths: half a dorsal blotch of a corn
+/// snake's preset wide (`size` 0.12 of the circumference) is 0.6, so ends at 0.5 lie inside
+/// the first blotch's front where the stripes reach it.
+const SPEAR_STRIPES_END_X: f32 = 0.5;
 
 /// Where the crown band crosses the head, in head-local units (as `POSTOCULAR`): across the
 /// middle of the parietals (0.60 to 1.0 head lengths back, `SHIELDS`), from the spine to
@@ -277,8 +283,26 @@ impl HeadMark {
     pub fn reach_v(&self) -> f32 {
         let (p, k) = (&self.plan, self.size);
         // A collar reaches 0.7 and the crescents 0.75 of the neck at size 1 (`inside`).
-        let neck_marks = p.head_end + 0.75 * k * (1.0 + self.behind) * (p.neck_end - p.head_end).max(0.005);
-        (p.head_end * (1.3 + 0.6 * k).max(k)).max(neck_marks)
+        let neck_marks = p.head_end + 0.75 * k * (1.0 + self.behind) * self.neck_v();
+        let head_marks = (p.head_end * (1.3 + 0.6 * k).max(k)).max(neck_marks);
+        match self.shape {
+            // The stripes' ends and their round caps (twice the cap's radius: at one, f32
+            // rounding left the cap's edge a hair inside).
+            HeadMarkShape::SpearStripes => {
+                head_marks.max(self.spear_stripes_end_v() + 2.0 * STRIPE_HALF_WIDTH * HEAD_TOP_HALF_U / p.length)
+            }
+            _ => head_marks,
+        }
+    }
+
+    /// The neck's length in v (at least 0.005: a preset may have none).
+    fn neck_v(&self) -> f32 {
+        (self.plan.neck_end - self.plan.head_end).max(0.005)
+    }
+
+    /// Where the spear stripes end along the body, in v: `size` necks behind the head.
+    fn spear_stripes_end_v(&self) -> f32 {
+        self.plan.head_end + self.size * self.neck_v()
     }
 
     /// Signed distance inside the mark at (u, v), in circumferences (positive inside).
@@ -318,6 +342,11 @@ impl HeadMark {
                 let t = ((s - apex) / (base - apex)).clamp(0.0, 1.0);
                 (half * t - du).min(s - apex).min(base - s)
             }
+            // From the spearhead's apex back to the stripes' ends, mirrored: a point forward.
+            HeadMarkShape::SpearStripes => {
+                let end = (SPEAR_STRIPES_END_X, self.spear_stripes_end_v() / p.head_end);
+                arm((0.0, 0.3), end, STRIPE_HALF_WIDTH)
+            }
             HeadMarkShape::EyeBand => arm(EYE_BAND_AT_SPINE, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
             HeadMarkShape::CrownBand => arm(CROWN_BAND.0, CROWN_BAND.1, STRIPE_HALF_WIDTH * k),
             HeadMarkShape::PreocularStripe => arm(PREOCULAR_START, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
@@ -328,7 +357,7 @@ impl HeadMark {
                 arm(centre, centre, 0.15 * k)
             }
             HeadMarkShape::Collar => {
-                let neck = (p.neck_end - p.head_end).max(0.005) * p.length;
+                let neck = self.neck_v() * p.length;
                 band(head, head + 0.7 * k * neck * (1.0 + self.behind), s).min(COLLAR_HALF_U - du)
             }
             // Each side a crescent between the spine's gap and the belly: t runs −1 (at the
@@ -337,7 +366,7 @@ impl HeadMark {
             // 0.4 of it. Distances along s are divided by the edge's slope so the edge is
             // anti-aliased over one pixel where it slants.
             HeadMarkShape::Crescents => {
-                let neck = (p.neck_end - p.head_end).max(0.005) * p.length;
+                let neck = self.neck_v() * p.length;
                 let width = 0.5 * k * neck;
                 let (mid, half) =
                     (0.5 * (CRESCENT_HALF_GAP_U + COLLAR_HALF_U), 0.5 * (COLLAR_HALF_U - CRESCENT_HALF_GAP_U));
@@ -503,6 +532,7 @@ mod tests {
             HeadMarkShape::V,
             HeadMarkShape::X,
             HeadMarkShape::Spearhead,
+            HeadMarkShape::SpearStripes,
             HeadMarkShape::EyeBand,
             HeadMarkShape::CrownBand,
             HeadMarkShape::PreocularStripe,

@@ -79,6 +79,7 @@ named_enum!(HeadMarkKind {
     V,
     X,
     Spearhead,
+    SpearStripes,
     EyeBand,
     CrownBand,
     PreocularStripe,
@@ -746,8 +747,14 @@ pub enum HeadMarkKind {
     V,
     /// A V with a second, backward V: an X on the crown (Vipera berus).
     X,
-    /// A forward-pointing arrowhead between the eyes running onto the neck (corn snakes).
+    /// A forward-pointing arrowhead between the eyes running onto the neck, solid (a boa's
+    /// "thin, dark wedge on the head").
     Spearhead,
+    /// Two stripes that meet in a point between the eyes and run back over the neck, `size`
+    /// neck lengths behind the head (1: to the neck's end, where counted series begin): a corn
+    /// snake's "first blotch on the back of the neck splits to form two stripes that run on top
+    /// of the head and meet to form the characteristic spearpoint".
+    SpearStripes,
     /// A band straight across the top of the head between the eyes, its ends at the eyes
     /// where the postocular stripes start (a milk snake's "transverse band between the
     /// eyes"; with the stripes, a corn snake's stripes through the eyes meeting on top).
@@ -842,12 +849,20 @@ pub struct Body {
     pub tail_band_over_belly: bool,
     /// The belly's colour over the front of the body, from the snout to `belly_front_end`
     /// (none: the belly is `belly.color` from chin to tail).
+    /// This key, `belly_front_end` at its default and `subcaudal_color` are left out of the
+    /// canonical text (`preset_hash`) where unset, as a head mark's `border_color` is: a
+    /// preset without them keeps the hash, and a batch's job keys, it had before they existed
+    /// (every built-in's hash changed, and an identical second jobs file into a folder of
+    /// the earlier version's sets was refused: a review).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub belly_front_color: Option<Srgb8>,
     /// Where the front colour gives way to `belly.color`, along the ventral plates (0 the
     /// end of the head, 1 the vent).
+    #[serde(skip_serializing_if = "Body::is_default_belly_front_end")]
     pub belly_front_end: f64,
     /// The colour under the tail, the subcaudals from the vent to the tip (none: the
     /// belly's colour).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub subcaudal_color: Option<Srgb8>,
     /// A solid colour over the tail's tip (none: no tip colour).
     pub tip_color: Option<Srgb8>,
@@ -855,6 +870,15 @@ pub struct Body {
     pub tip_fraction: f64,
     #[serde(deserialize_with = "tables")]
     pub head_mark: Vec<HeadMark>,
+}
+
+impl Body {
+    /// `belly_front_end`'s default.
+    const BELLY_FRONT_END: f64 = 0.5;
+
+    fn is_default_belly_front_end(end: &f64) -> bool {
+        *end == Self::BELLY_FRONT_END
+    }
 }
 
 impl Default for Body {
@@ -875,7 +899,7 @@ impl Default for Body {
             tail_band_width: 0.5,
             tail_band_over_belly: false,
             belly_front_color: None,
-            belly_front_end: 0.5,
+            belly_front_end: Self::BELLY_FRONT_END,
             subcaudal_color: None,
             tip_color: None,
             tip_fraction: 0.1,
