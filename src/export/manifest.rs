@@ -107,7 +107,9 @@ pub struct Counts {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subcaudals: Option<u32>,
     /// Marks of the first counted pattern layer (`pattern.N.count`) on the trunk, neck to
-    /// vent, if any (without tail bands the series runs on down the tail at its spacing).
+    /// vent, if any (without tail bands the series runs on down the tail at its spacing),
+    /// whatever the layer draws: dorsal blotches, a series each side (per side), repeats of a
+    /// ring sequence. The name is the format's; the body sheet says which.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dorsal_marks: Option<u32>,
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -238,7 +238,7 @@ fn render_tile_sheet(
 /// does not give called the default (the sheet labelled `crotalus-atrox`, whose sources give
 /// no count, "200 ventrals, 60 subcaudals", as if they were the species': a walkthrough),
 /// its counted marks and its tail bands.
-fn counts_line(name: &str, counts: &crate::export::Counts) -> String {
+fn counts_line(name: &str, preset: &crate::preset::Preset, counts: &crate::export::Counts) -> String {
     let lines = library::get(name).map(crate::toml_text::KeyLines::new);
     let default = |key: &str| lines.as_ref().is_some_and(|l| l.line(key).is_none());
     let plates = match (counts.ventrals, counts.subcaudals) {
@@ -251,9 +251,24 @@ fn counts_line(name: &str, counts: &crate::export::Counts) -> String {
         },
         _ => "no ventral plates".into(),
     };
-    let marks = counts.dorsal_marks.map(|n| format!(", {n} dorsal marks")).unwrap_or_default();
+    let series = preset.pattern.iter().find(|l| l.series_count().is_some()).map_or("dorsal marks", series_words);
+    let marks = counts.dorsal_marks.map(|n| format!(", {n} {series}")).unwrap_or_default();
     let bands = counts.tail_bands.map(|n| format!(", {n} tail bands")).unwrap_or_default();
     format!("{plates}{marks}{bands}")
+}
+
+/// What a counted series' marks are, for the sheet's counts: the manifest's `dorsal_marks`
+/// counts the first counted layer whatever it draws, and the sheet called a green tree
+/// python's white spots along each flank and a coral snake's rings "dorsal marks".
+fn series_words(layer: &crate::preset::schema::PatternLayer) -> &'static str {
+    use crate::preset::schema::PatternKind;
+    match layer.kind {
+        PatternKind::Rings if layer.colors.is_empty() => "rings",
+        PatternKind::Rings => "repeats of its rings",
+        // Above 0, two mirrored series, each counted (docs/presets.md, `offset`).
+        _ if layer.offset > 0.0 => "marks a side",
+        _ => "dorsal marks",
+    }
 }
 
 /// The body sheet (`sheet --layout body`): per species its whole body atlas laid on its
@@ -311,7 +326,7 @@ fn render_body_sheet(
         let clip = |text: String| clipped(&text, cell_w);
         let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
         let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
-        let third = clip(counts_line(name, &crate::export::body_counts(preset, &body)));
+        let third = clip(counts_line(name, preset, &crate::export::body_counts(preset, &body)));
         draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
         draw_text(&mut sheet, x0 + 6, y0 + 8 + 8 * LABEL_SCALE, &second, MUTED);
         draw_text(&mut sheet, x0 + 6, y0 + 12 + 16 * LABEL_SCALE, &third, MUTED);
@@ -445,8 +460,27 @@ mod tests {
             dorsal_marks: None,
             tail_bands: None,
         };
-        assert_eq!(counts_line("crotalus-atrox", &counts(200, 60)), "200 ventrals, 60 subcaudals (defaults)");
-        assert_eq!(counts_line("boa-constrictor", &counts(232, 48)), "232 ventrals, 48 subcaudals");
+        let preset = |name: &str| crate::preset::load(name, &[], None).unwrap().preset;
+        let line = |name: &str, counts| counts_line(name, &preset(name), &counts);
+        assert_eq!(line("crotalus-atrox", counts(200, 60)), "200 ventrals, 60 subcaudals (defaults)");
+        assert_eq!(line("boa-constrictor", counts(232, 48)), "232 ventrals, 48 subcaudals");
+    }
+
+    /// The counted series is named for what it draws: dorsal blotches, a series a side, rings
+    /// (the sheet called a green tree python's flank spots and a coral snake's rings dorsal
+    /// marks). The control: a dorsal series is still dorsal marks.
+    #[test]
+    fn the_body_sheet_names_a_series_for_what_it_draws() {
+        for (name, words) in [
+            ("crotalus-atrox", "dorsal marks"),
+            ("morelia-viridis", "marks a side"),
+            ("bungarus-fasciatus", "repeats of its rings"),
+        ] {
+            let preset = crate::preset::load(name, &[], None).unwrap().preset;
+            let plan = crate::maps::body_plan(&preset);
+            let line = counts_line(name, &preset, &crate::export::body_counts(&preset, &plan));
+            assert!(line.contains(&format!(" {words}")), "{name}: {line}");
+        }
     }
 
     /// A label that does not fit its cell ends in "..", within the cell; one that fits is
