@@ -1005,27 +1005,43 @@ fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
     struct ListedJob {
         manifest: PathBuf,
         key: String,
+        #[serde(default)]
+        status: String,
     }
     let text = std::fs::read(path).ok()?;
     let Listed { jobs_file, jobs, other_sets } = serde_json::from_slice::<Listed>(&text).ok()?;
-    let own =
-        jobs.into_iter().map(|job| OtherSet { jobs_file: jobs_file.clone(), manifest: job.manifest, key: job.key });
+    // A job the run skipped (its set was there, made by whichever run made it) or left to
+    // another job (a duplicate) does not make the set its file's: a run that skipped another
+    // file's identical set took it over, and that file's own run was then refused (a
+    // review). The run carries the maker's entry instead (`other_sets_to_carry`).
+    let made =
+        |job: &ListedJob| ![JobStatus::Skipped.word(), JobStatus::Duplicate.word()].contains(&job.status.as_str());
+    let own = jobs.into_iter().filter(made).map(|job| OtherSet {
+        jobs_file: jobs_file.clone(),
+        manifest: job.manifest,
+        key: job.key,
+    });
     let sets = own.chain(other_sets).collect();
     Some((jobs_file, sets))
 }
 
-/// The sets the index this run replaces records other jobs files made (`read_index_file`),
-/// for this run's index to carry: without them, a third jobs file's run into the folder
-/// replaced the index, and a later run of a fourth replaced the first's set from another
-/// preset of its name without the refusal (a hostile-input sweep). Kept: a set still
-/// standing with its key (`job` in its manifest) that none of this run's jobs writes (a job
-/// of this run that would replace another file's set from another preset was refused in
-/// `plan`; one from the same preset makes it this run's set) — this jobs file's own earlier
+/// The sets the index this run replaces records (`read_index_file`), for this run's index to
+/// carry: without them, a third jobs file's run into the folder replaced the index, and a
+/// later run of a fourth replaced the first's set from another preset of its name without
+/// the refusal (a hostile-input sweep). Kept: a set still standing with its key (`job` in its
+/// manifest) that none of this run's jobs makes (a job of this run that would replace another
+/// file's set from another preset was refused in `plan`; one from the same preset makes it
+/// this run's set; one that skips it leaves it its maker's), this jobs file's own earlier
 /// sets too, where its jobs no longer name them (dropped, they were no one's, and another
 /// preset of the name replaced them: a review).
 fn other_sets_to_carry(out: &Path, shard: Shard, work: &[(&Job, Resolved)]) -> Vec<OtherSet> {
     let Some((_, sets)) = read_index_file(&out.join(index_file_name(shard))) else { return Vec::new() };
-    let mine: std::collections::HashSet<&PathBuf> = work.iter().map(|(_, r)| &r.outcome.manifest).collect();
+    // The sets this run makes: a job skipped (its set there already) or a duplicate makes none.
+    let mine: std::collections::HashSet<&PathBuf> = work
+        .iter()
+        .filter(|(_, r)| !r.done && r.outcome.duplicate_of.is_none())
+        .map(|(_, r)| &r.outcome.manifest)
+        .collect();
     let mut carried: Vec<OtherSet> = Vec::new();
     for set in sets {
         if mine.contains(&set.manifest) || carried.iter().any(|c| c.manifest == set.manifest) {

@@ -188,17 +188,6 @@ pub fn written_keys(key: &str, value: &toml::Value) -> Vec<String> {
     into
 }
 
-/// Every dotted key an override of `key` with `value` replaces whole: a table's own keys (it
-/// merges key by key), anything else — a list included, which takes the place of the list
-/// there — `key` itself. What a later `--set` replaces of an earlier one's `written_keys` is
-/// lost (`--set pattern.0.opacity=0.3 --set 'pattern=[..]'` lost the opacity silently).
-pub fn replaced_keys(key: &str, value: &toml::Value) -> Vec<String> {
-    match value {
-        toml::Value::Table(t) => t.iter().flat_map(|(k, v)| replaced_keys(&format!("{key}.{k}"), v)).collect(),
-        _ => vec![key.to_string()],
-    }
-}
-
 /// A key that two overrides' written keys (`written_keys`) both reach, the longer of the
 /// first pair where one lies within the other (`scales.rows` for `scales = { rows = 25 }` and
 /// `"scales.rows" = 23`; `scales.rows` for `scales = 5` beside it): one of the two values is

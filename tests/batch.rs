@@ -847,6 +847,51 @@ fn a_set_stays_its_jobs_files_across_shards_and_dropped_jobs() {
     refused("after its job was dropped");
 }
 
+/// A run that only skips another jobs file's set (the same preset content) does not make it
+/// its own: the maker's run, its preset edited, replaces it, and the skipping file's run,
+/// its own copy edited, is refused. Before, the skipping run took the set over: the maker
+/// was refused and the other replaced it (a review). The control: the skipping run skips.
+#[test]
+fn a_run_that_skips_another_files_set_does_not_take_it_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let built_in = stdout(&snakeskin(&["presets", "show", "vipera-berus"]));
+    for folder in ["x", "y"] {
+        std::fs::create_dir(dir.path().join(folder)).unwrap();
+        std::fs::write(dir.path().join(folder).join("vipera-berus.toml"), &built_in).unwrap();
+    }
+    let jobs = |name: &str, folder: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, format!("[[job]]\npreset = \"{folder}/vipera-berus.toml\"\nseeds = [1]\nsizes = [16]\n"))
+            .unwrap();
+        path
+    };
+    let (maker, same_file, copy) = (jobs("a.toml", "x"), jobs("b.toml", "x"), jobs("c.toml", "y"));
+    let out = dir.path().join("out");
+    let run = |jobs: &Path| snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let edit = |folder: &str, rows: &str| {
+        let text = built_in.replace("\nrows = 21", &format!("\nrows = {rows}"));
+        std::fs::write(dir.path().join(folder).join("vipera-berus.toml"), text).unwrap();
+    };
+    assert!(run(&maker).status.success());
+    for skipping in [&same_file, &copy] {
+        let skipped = run(skipping);
+        assert!(skipped.status.success(), "{}", stderr(&skipped));
+        assert_eq!(statuses(&read_index(&out)), ["skipped"], "the control");
+    }
+    // The maker's preset edited (the same file the second jobs file names): its run replaces
+    // its own set.
+    edit("x", "23");
+    let replaced = run(&maker);
+    assert!(replaced.status.success(), "the maker's run: {}", stderr(&replaced));
+    // The copy edited: the third jobs file's run would replace the maker's set, refused.
+    edit("y", "25");
+    let before = tree(&out);
+    let refused = run(&copy);
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    assert!(stderr(&refused).contains(&format!("which a run of {} made", maker.display())), "{}", stderr(&refused));
+    assert_eq!(tree(&out), before);
+}
+
 /// A newline in a jobs file's preset string is escaped where a message names the job: it
 /// printed a line of its own, which could pass for the tool's. Control: the job's place is
 /// in the message.

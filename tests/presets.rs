@@ -216,6 +216,8 @@ fn the_manifest_records_the_overrides_and_a_repeated_key_is_warned_of() {
         (&["scales.rows=20", "scales={rows=30}"][..], "scales.rows"),
         (&["scales={rows=30}", "scales.rows=20"], "scales.rows"),
         (&["pattern.0.opacity=0.3", "pattern=[{kind=\"spots\",color=\"#000000\"}]"], "pattern.0.opacity"),
+        // A table over the list replaces it whole too (a second review).
+        (&["pattern.0.opacity=0.3", "pattern={kind=\"spots\",color=\"#000000\"}"], "pattern.0.opacity"),
     ] {
         let (_, err) = generate("table", sets);
         let said =
@@ -223,11 +225,33 @@ fn the_manifest_records_the_overrides_and_a_repeated_key_is_warned_of() {
         assert!(err.contains(&said), "{sets:?}: {err}");
         assert_eq!(err.matches("warning: --set").count(), 1, "{sets:?}: {err}");
     }
-    // Three of one key: one warning, naming the last. The controls, nothing said: tables of
-    // one key merge; a key inside a list after the list changes it.
-    let (_, err) = generate("three", &["scales.rows=20", "scales.rows=25", "scales.rows=30"]);
-    assert!(err.contains("warning: --set scales.rows is given 3 times: the last, scales.rows=30, is used"), "{err}");
+    // Three of one key: one warning, naming the last; an empty list replaced by a list; a
+    // repeated key then a table: one line; the seed, where --seed does not override it (it
+    // was said to be used and not used: a second review).
+    for (sets, said) in [
+        (
+            &["scales.rows=20", "scales.rows=25", "scales.rows=30"][..],
+            "--set scales.rows is given 3 times: the last, scales.rows=30, is used",
+        ),
+        (
+            &["pattern=[]", "pattern=[{kind=\"spots\",color=\"#000000\"}]"],
+            "--set pattern is given 2 times: the last, pattern=[{kind=\"spots\",color=\"#000000\"}], is used",
+        ),
+        (
+            &["scales.rows=20", "scales.rows=20", "scales={rows=30}"],
+            "--set scales.rows=20 is not used for `scales.rows`: the later --set scales={rows=30} sets it again",
+        ),
+        (&["seed=1", "seed=2"], "--set seed is given 2 times: the last, seed=2, is used"),
+    ] {
+        let (_, err) = generate("three", sets);
+        assert!(err.contains(&format!("warning: {said}")), "{sets:?}: {err}");
+        assert_eq!(err.matches("warning: --set").count(), 1, "{sets:?}: {err}");
+    }
+    let (_, err) = natrix_colour_set(dir.path(), "seeded", &["--seed", "5", "--set", "seed=1", "--set", "seed=2"]);
+    assert!(err.contains("warning: --set seed=2 is not used: --seed 5 overrides it"), "{err}");
     assert_eq!(err.matches("warning: --set").count(), 1, "{err}");
+    // The controls, nothing said: tables of one key merge; a key inside a list after the list
+    // changes it.
     for sets in [
         &["scales.rows=20", "scales={keeled=true}"][..],
         &["scales={rows=30}", "scales={keeled=true}"],

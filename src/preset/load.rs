@@ -48,6 +48,8 @@ pub struct LoadedPreset {
     /// The overrides as given (`--set`, a jobs file's `set`; `(KEY, VALUE)`, in order): the
     /// manifest records them, so a set says what made it beyond its preset.
     pub overrides: Vec<(String, String)>,
+    /// The warnings of overrides whose values later ones replaced (`lost_overrides`).
+    lost_overrides: Vec<String>,
 }
 
 impl LoadedPreset {
@@ -70,7 +72,7 @@ impl LoadedPreset {
             .into_iter()
             .chain(clamped)
             .chain(warned)
-            .chain(self.repeated_overrides())
+            .chain(self.lost_overrides.iter().cloned())
             .chain(self.seed_not_used())
             .collect()
     }
@@ -84,54 +86,77 @@ impl LoadedPreset {
         (seed_override(value).ok()? != seed)
             .then(|| format!("warning: --set seed={value} is not used: --seed {seed} overrides it"))
     }
+}
 
-    /// A warning for each override whose value a later one replaces, named with the later one
-    /// that is used (the last to replace it): one per key given more than once as a plain
-    /// value (`--set a=1 --set a=2`, silently the last before), and one for each other
-    /// override that loses a key to a later one (`--set scales.rows=20 --set
-    /// 'scales={rows=30}'`, or a list after a key inside it: silent before, a hostile-input
-    /// sweep and a review; a batch job's `set` refuses such a pair, `batch::set_twice`).
-    /// Tables merge key by key: `scales={rows=30}` and a later `scales={keeled=true}` both
-    /// apply, and nothing is said.
-    fn repeated_overrides(&self) -> Vec<String> {
-        let given = &self.overrides;
-        // A value that does not parse was refused before any warning is asked for; as its
-        // key, it writes and replaces that key.
-        let parsed: Vec<Option<toml::Value>> = given.iter().map(|(_, v)| override_value(v).ok()).collect();
-        let keys = |of: fn(&str, &toml::Value) -> Vec<String>| -> Vec<Vec<String>> {
-            given
+/// One warning for each override (`--set`) whose value, somewhere, a later one replaced:
+/// `replaced[i]` is where override i put values whole (`merge`, in the order applied), so a
+/// key i wrote (`toml_text::written_keys` of what it put there; the place itself where that
+/// is an empty table or list) at or inside a place a later one put a value whole is lost.
+/// Counted on the merge's own places, a table over a list replacing it whole and a list a
+/// key inside it was set in (both silent before: a hostile-input sweep, two reviews). The
+/// later override named is the last to replace that key, the one used. One key given more
+/// than once as a plain value says so once (`--set a=1 --set a=2`); the seed, which does not
+/// go into the table, is counted apart, where `--seed` does not override it
+/// (`seed_not_used`). A batch job's `set` refuses such pairs (`batch::set_twice`).
+fn lost_overrides(
+    given: &[(String, String)],
+    applied: &[(String, String)],
+    replaced: &[Vec<String>],
+    seed_flag_wins: bool,
+) -> Vec<String> {
+    let mut warnings: Vec<String> = Vec::new();
+    let seeds: Vec<&String> = given.iter().filter(|(k, _)| k == "seed").map(|(_, v)| v).collect();
+    if let (false, [_, .., last]) = (seed_flag_wins, seeds.as_slice()) {
+        warnings.push(format!("warning: --set seed is given {} times: the last, seed={last}, is used", seeds.len()));
+    }
+    // What each override wrote: the keys of the values it put at each of its places.
+    let wrote: Vec<Vec<String>> = applied
+        .iter()
+        .zip(replaced)
+        .map(|((key, value), places)| {
+            let value = override_value(value).ok();
+            places
                 .iter()
-                .zip(&parsed)
-                .map(|((k, _), v)| v.as_ref().map_or_else(|| vec![k.clone()], |v| of(k, v)))
+                .flat_map(|place| {
+                    let inside = place.strip_prefix(key.as_str()).unwrap_or("").split('.').filter(|s| !s.is_empty());
+                    let put = inside.fold(value.as_ref(), |v, k| v.and_then(|v| v.get(k)));
+                    let keys = put.map(|v| toml_text::written_keys(place, v)).unwrap_or_default();
+                    if keys.is_empty() { vec![place.clone()] } else { keys }
+                })
                 .collect()
-        };
-        let (written, replaced) = (keys(crate::toml_text::written_keys), keys(crate::toml_text::replaced_keys));
-        let plain = |i: usize| !matches!(parsed[i], Some(toml::Value::Table(_)));
-        let mut warnings = Vec::new();
-        let mut said: Vec<&str> = Vec::new();
-        for (i, (a, value)) in given.iter().enumerate() {
-            // The last later override that replaces a key this one writes: the one used there
-            // (one after it that replaced that key would replace this one's too).
-            let lost = (i + 1..given.len()).rev().find_map(|j| {
-                let key = written[i].iter().find(|x| replaced[j].iter().any(|r| crate::toml_text::key_within(x, r)))?;
-                Some((j, key))
-            });
-            let Some((j, key)) = lost else { continue };
-            let (b, used) = &given[j];
-            if a == b && plain(i) && plain(j) {
-                if !said.contains(&a.as_str()) {
-                    said.push(a);
-                    let times = given.iter().enumerate().filter(|(k, (other, _))| other == a && plain(*k)).count();
-                    warnings.push(format!("warning: --set {a} is given {times} times: the last, {b}={used}, is used"));
-                }
-            } else {
-                warnings.push(format!(
-                    "warning: --set {a}={value} is not used for `{key}`: the later --set {b}={used} sets it again"
-                ));
+        })
+        .collect();
+    let plain = |value: &str| !matches!(override_value(value), Ok(toml::Value::Table(_)));
+    for (i, (a, value)) in applied.iter().enumerate() {
+        // Each key of it a later override replaced, under the last to replace it, in order.
+        let mut lost: Vec<(usize, Vec<&String>)> = Vec::new();
+        for x in &wrote[i] {
+            let last = (i + 1..applied.len()).rev().find(|&j| replaced[j].iter().any(|r| toml_text::key_within(x, r)));
+            match (last, lost.iter_mut().find(|(j, _)| Some(*j) == last)) {
+                (Some(_), Some((_, keys))) => keys.push(x),
+                (Some(j), None) => lost.push((j, vec![x])),
+                (None, _) => {}
             }
         }
-        warnings
+        for (j, keys) in lost {
+            let (b, used) = &applied[j];
+            let warning = if a == b && plain(value) && plain(used) {
+                let times = applied.iter().filter(|(other, v)| other == a && plain(v)).count();
+                format!("warning: --set {a} is given {times} times: the last, {b}={used}, is used")
+            } else {
+                let (names, it) = (keys.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>(), ["it", "them"]);
+                let it = it[(names.len() > 1) as usize];
+                format!(
+                    "warning: --set {a}={value} is not used for {}: the later --set {b}={used} sets {it} again",
+                    names.join(", ")
+                )
+            };
+            if !warnings.contains(&warning) {
+                warnings.push(warning);
+            }
+        }
     }
+    warnings
 }
 
 /// The largest preset file accepted, in bytes. Built-in presets are 1–8 KiB; a megabyte is
@@ -280,15 +305,20 @@ pub fn parse_with_seed(
     };
     let seed = seed.or(overridden_seed);
     let overrides = overrides.as_slice();
-    // The keys the overrides wrote, each where it put a value whole (`merge`).
+    // The keys the overrides wrote, each where it put a value whole (`merge`), and each
+    // override's own (`lost_overrides`).
     let mut written = Vec::new();
+    let mut replaced = Vec::new();
     let preset = if overrides.is_empty() {
         file_preset
     } else {
         let file_table = toml::from_str::<WithoutSeed>(&source.text).map_err(|e| parse_error(source, &e))?.rest;
         let mut table = file_table.clone();
         for (key, value) in overrides {
-            apply_override(&mut table, key, value, &mut written)?;
+            let mut places = Vec::new();
+            apply_override(&mut table, key, value, &mut places)?;
+            written.extend(places.iter().cloned());
+            replaced.push(places);
         }
         Preset::deserialize(toml::Value::Table(table)).map_err(|e| {
             // Name the one override that makes this error on its own, where one does (a
@@ -372,6 +402,13 @@ pub fn parse_with_seed(
         warned,
         sets_no_key,
         overrides: overrides_given.to_vec(),
+        lost_overrides: lost_overrides(
+            overrides_given,
+            overrides,
+            &replaced,
+            // `--seed` given, other than the overrides' last (`seed_not_used` says so).
+            seed.is_some() && overridden_seed != seed,
+        ),
     })
 }
 

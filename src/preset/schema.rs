@@ -750,7 +750,7 @@ pub enum HeadMarkKind {
     /// A forward-pointing arrowhead between the eyes running onto the neck, solid (a boa's
     /// "thin, dark wedge on the head").
     Spearhead,
-    /// Two stripes that meet in a point between the eyes and run back over the neck, `size`
+    /// Two stripes that meet in a point in front of the eyes and run back over the neck, `size`
     /// neck lengths behind the head (1: to the neck's end, where counted series begin): a corn
     /// snake's "first blotch on the back of the neck splits to form two stripes that run on top
     /// of the head and meet to form the characteristic spearpoint".
