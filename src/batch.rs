@@ -893,15 +893,19 @@ pub fn run(
     // an index left from another jobs file (a run stopped by a signal writes none at its
     // end) described sets this run is not about.
     let planned = work.iter().map(|(_, r)| r.outcome.clone()).collect();
-    // A set of theirs that a job here would replace was refused in `plan`.
-    if let Some(earlier) = index_of_other_jobs(out, shard, jobs_file) {
+    // The index this run replaces, read once: whose jobs it listed, for the note (a second
+    // jobs file into one folder replaced the first's index without a word), and the sets it
+    // records, for this one to carry. A set of theirs that a job here would replace was
+    // refused in `plan`.
+    let (earlier_jobs_file, earlier_sets) = read_index_file(&out.join(index_file_name(shard))).unzip();
+    if let Some(earlier) = earlier_jobs_file.filter(|earlier| !is_this_jobs_file(earlier, jobs_file)) {
         warn(&format!(
             "note: {} listed the jobs of {}; it lists this run's now (their sets stay where they are)",
             out.join(index_file_name(shard)).display(),
             earlier
         ));
     }
-    let other_sets = other_sets_to_carry(out, shard, &work);
+    let other_sets = other_sets_to_carry(out, earlier_sets.unwrap_or_default(), &work);
     BatchIndex::new(jobs_file, shard, planned, other_sets.clone(), concurrency).write(out, shard)?;
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut failures: Vec<(usize, Error)> = Vec::new();
@@ -971,15 +975,6 @@ pub fn run(
     Ok(index)
 }
 
-/// The jobs file of the index already in `out` where it is another than `jobs_file` (the
-/// run replaces that index; a second jobs file into one folder replaced the first's without
-/// a word). None where there is none, it cannot be read, or it is this file's.
-fn index_of_other_jobs(out: &Path, shard: Shard, jobs_file: &Path) -> Option<String> {
-    read_index_file(&out.join(index_file_name(shard)))
-        .map(|(earlier, _)| earlier)
-        .filter(|earlier| !is_this_jobs_file(earlier, jobs_file))
-}
-
 /// A set a batch run made in the output folder: its jobs file (as recorded), the set's
 /// manifest (relative to the folder) and the key it was made with.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
@@ -1025,8 +1020,8 @@ fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
     Some((jobs_file, sets))
 }
 
-/// The sets the index this run replaces records (`read_index_file`), for this run's index to
-/// carry: without them, a third jobs file's run into the folder replaced the index, and a
+/// Of the sets the index this run replaces records (`sets`, `read_index_file`), those for
+/// this run's index to carry: without them, a third jobs file's run into the folder replaced the index, and a
 /// later run of a fourth replaced the first's set from another preset of its name without
 /// the refusal (a hostile-input sweep). Kept: a set still standing with its key (`job` in its
 /// manifest) that none of this run's jobs makes (a job of this run that would replace another
@@ -1034,8 +1029,7 @@ fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
 /// this run's set; one that skips it leaves it its maker's), this jobs file's own earlier
 /// sets too, where its jobs no longer name them (dropped, they were no one's, and another
 /// preset of the name replaced them: a review).
-fn other_sets_to_carry(out: &Path, shard: Shard, work: &[(&Job, Resolved)]) -> Vec<OtherSet> {
-    let Some((_, sets)) = read_index_file(&out.join(index_file_name(shard))) else { return Vec::new() };
+fn other_sets_to_carry(out: &Path, sets: Vec<OtherSet>, work: &[(&Job, Resolved)]) -> Vec<OtherSet> {
     // The sets this run makes: a job skipped (its set there already) or a duplicate makes none.
     let mine: std::collections::HashSet<&PathBuf> = work
         .iter()
@@ -1122,7 +1116,7 @@ impl OtherSets {
 /// that a later run started from another folder finds it the same file. JSON holds text: a
 /// path that is not UTF-8 has each byte outside UTF-8 written `\xNN` (a batch run in such a
 /// folder failed with "internal error: index: path contains invalid UTF-8 characters", a
-/// hostile-input sweep), and `index_of_other_jobs` compares the same text.
+/// hostile-input sweep), and `run`'s note compares the same text.
 fn recorded_jobs_file(jobs_file: &Path) -> String {
     let path = std::fs::canonicalize(jobs_file).unwrap_or_else(|_| jobs_file.into());
     let mut text = String::new();

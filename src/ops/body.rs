@@ -232,6 +232,10 @@ const STRIPE_HALF_WIDTH: f32 = 0.10;
 /// postocular stripes read as a V (a review).
 const EYE_BAND_AT_SPINE: (f32, f32) = (0.0, POSTOCULAR.0.1);
 
+/// Where a spearhead's point lies, and the spear stripes meet, in head lengths from the
+/// snout: on the prefrontals, in front of the eyes (`SHIELDS`).
+const SPEAR_POINT_S: f32 = 0.3;
+
 /// The spear stripes' ends across, in shield half-widths: half a dorsal blotch of a corn
 /// snake's preset wide (`size` 0.12 of the circumference) is 0.6, so ends at 0.5 lie inside
 /// the first blotch's front where the stripes reach it.
@@ -336,7 +340,7 @@ impl HeadMark {
             }
             HeadMarkShape::Spearhead => {
                 // A triangle, apex forward between the eyes, base on the neck.
-                let apex = 0.3 * head;
+                let apex = SPEAR_POINT_S * head;
                 let base = (1.0 + 0.6 * k) * head;
                 let half = 0.55 * k * ux;
                 let t = ((s - apex) / (base - apex)).clamp(0.0, 1.0);
@@ -345,7 +349,7 @@ impl HeadMark {
             // From the spearhead's apex back to the stripes' ends, mirrored: a point forward.
             HeadMarkShape::SpearStripes => {
                 let end = (SPEAR_STRIPES_END_X, self.spear_stripes_end_v() / p.head_end);
-                arm((0.0, 0.3), end, STRIPE_HALF_WIDTH)
+                arm((0.0, SPEAR_POINT_S), end, STRIPE_HALF_WIDTH)
             }
             HeadMarkShape::EyeBand => arm(EYE_BAND_AT_SPINE, POSTOCULAR.0, STRIPE_HALF_WIDTH * k),
             HeadMarkShape::CrownBand => arm(CROWN_BAND.0, CROWN_BAND.1, STRIPE_HALF_WIDTH * k),

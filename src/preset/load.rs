@@ -109,12 +109,14 @@ fn lost_overrides(
     if let (false, [_, .., last]) = (seed_flag_wins, seeds.as_slice()) {
         warnings.push(format!("warning: --set seed is given {} times: the last, seed={last}, is used", seeds.len()));
     }
+    // Each value parsed once (it was, to be applied: a value that does not parse was refused).
+    let parsed: Vec<Option<toml::Value>> = applied.iter().map(|(_, value)| override_value(value).ok()).collect();
     // What each override wrote: the keys of the values it put at each of its places.
     let wrote: Vec<Vec<String>> = applied
         .iter()
         .zip(replaced)
-        .map(|((key, value), places)| {
-            let value = override_value(value).ok();
+        .zip(&parsed)
+        .map(|(((key, _), places), value)| {
             places
                 .iter()
                 .flat_map(|place| {
@@ -126,7 +128,7 @@ fn lost_overrides(
                 .collect()
         })
         .collect();
-    let plain = |value: &str| !matches!(override_value(value), Ok(toml::Value::Table(_)));
+    let plain = |i: usize| !matches!(parsed[i], Some(toml::Value::Table(_)));
     for (i, (a, value)) in applied.iter().enumerate() {
         // Each key of it a later override replaced, under the last to replace it, in order.
         let mut lost: Vec<(usize, Vec<&String>)> = Vec::new();
@@ -140,8 +142,8 @@ fn lost_overrides(
         }
         for (j, keys) in lost {
             let (b, used) = &applied[j];
-            let warning = if a == b && plain(value) && plain(used) {
-                let times = applied.iter().filter(|(other, v)| other == a && plain(v)).count();
+            let warning = if a == b && plain(i) && plain(j) {
+                let times = applied.iter().enumerate().filter(|(k, (other, _))| other == a && plain(*k)).count();
                 format!("warning: --set {a} is given {times} times: the last, {b}={used}, is used")
             } else {
                 let (names, it) = (keys.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>(), ["it", "them"]);
