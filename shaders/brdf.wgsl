@@ -265,7 +265,8 @@ fn base_albedo(colour: vec3<f32>, optical_depth: vec3<f32>, roughness: f32, k: v
 // and what the top reflects beyond it, x: the
 // multiple scattering (1 - E1) g, g = s sum_ij M_ij F(a_i) F(b_j) + (1 - s) <F>_a <F>_b^2
 // (energy::Multiple), plus the light that comes straight back through the top,
-// q = (1 - <F>) W <F>_back (its three-point rule).
+// q = (1 - E1 <F> - (1 - E1) g) W <F>_back (its three-point rule): a share W of all the
+// light the top lets in, as energy::parts_on_row computes it.
 struct RowParts {
     single: vec3<f32>,
     beyond: vec3<f32>,

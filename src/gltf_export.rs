@@ -141,6 +141,19 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
 }
 
 /// An export checked before any pixel is computed: the preset loaded and validated, the
+/// glTF has no ambient index: a viewer lights the material as in air, whatever the preset's
+/// `optics.ambient_ior` (README, "What glTF cannot carry"). Said before the work, so that an
+/// export of a snake under water is not taken for one (an onboarding review: it was silent).
+fn ambient_warning(ambient_ior: f64) -> Option<String> {
+    (ambient_ior != 1.0).then(|| {
+        format!(
+            "warning: optics.ambient_ior is {ambient_ior}, but glTF has no ambient index: viewers light this \
+             material as in air (its colour map is still the visible colour under {ambient_ior}; the film's and the \
+             base's reflections are not)"
+        )
+    })
+}
+
 /// files it will write checked, its warnings and memory known, so that a caller can say them
 /// before the work (the pack's size warning came after the textures were made).
 pub struct ExportPlan {
@@ -250,7 +263,13 @@ impl ExportPlan {
             crate::export::check_target(&target)?;
             crate::export::check_not_an_input(&target, input)?;
         }
-        let warnings = plan.loaded().warnings(&request.preset).into_iter().chain(plan.size_warning()).collect();
+        let warnings = plan
+            .loaded()
+            .warnings(&request.preset)
+            .into_iter()
+            .chain(plan.size_warning())
+            .chain(ambient_warning(plan.loaded().preset.optics.ambient_ior))
+            .collect();
         Ok(ExportPlan {
             start,
             out: request.out.clone(),

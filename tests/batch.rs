@@ -563,6 +563,9 @@ fn a_non_lock_at_a_later_jobs_lock_is_refused_before_anything_runs() {
 /// quick run meanwhile.
 #[test]
 fn a_set_finished_by_another_run_meanwhile_is_not_generated_again() {
+    if !test_hooks_exist() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let both = dir.path().join("both.toml");
@@ -1379,6 +1382,23 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
     );
     assert_eq!(lines.lines().filter(|l| l.starts_with("ok ")).count(), 1, "{lines}");
     assert!(stderr(&altered).contains("1 of 2 checks failed"), "{}", stderr(&altered));
+    // A second map of that set missing as well: one line names both (it named the first
+    // problem only, an onboarding review).
+    let other = std::fs::read_dir(set_folder)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| p.extension().is_some_and(|x| x == "png") && *p != map)
+        .unwrap();
+    let other_bytes = std::fs::read(&other).unwrap();
+    std::fs::remove_file(&other).unwrap();
+    let both = stdout(&verify(&[&manifests[0]]));
+    let other_name = other.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        both.lines().any(|l| l.starts_with("FAILED ") && l.contains(&map_name) && l.contains(&other_name)),
+        "{both}"
+    );
+    std::fs::write(&other, &other_bytes).unwrap();
     std::fs::write(&map, &bytes).unwrap();
     assert_eq!(verify(&[&out]).status.code(), Some(0));
 

@@ -171,6 +171,22 @@ fn a_film_of_one_thickness_is_written_without_a_thickness_texture() {
     }
 }
 
+/// An export of a snake under water (`optics.ambient_ior` other than 1) says before the work
+/// that glTF viewers light it as in air; control: the default ambient says nothing of it.
+#[test]
+fn an_export_under_water_says_viewers_light_it_as_in_air() {
+    let dir = tempfile::tempdir().unwrap();
+    for (ambient, warned) in [("1.33", true), ("1.0", false)] {
+        let out = dir.path().join(format!("a{ambient}.glb"));
+        let args =
+            ["export", "xenopeltis-unicolor", "--gltf", out.to_str().unwrap(), "--size", "16", "--mesh", "plane"];
+        let run = snakeskin(&[&args[..], &["--set", &format!("optics.ambient_ior={ambient}")]].concat());
+        assert!(run.status.success(), "{}", stderr(&run));
+        let said = stderr(&run).contains("warning: optics.ambient_ior is 1.33, but glTF has no ambient index");
+        assert_eq!(said, warned, "{ambient}: {}", stderr(&run));
+    }
+}
+
 /// A `.gltf` exported into a texture set's folder under the set's own name writes its
 /// images beside the set's maps without overwriting one (the set still verifies), and a
 /// later export without a film leaves no thickness image of the earlier one.

@@ -1956,6 +1956,9 @@ fn a_gallery_and_its_closeups_appear_together_or_not_at_all() {
     };
     let before = files();
     assert_eq!(before.len(), 1 + 6, "{:?}", before.keys());
+    if !test_hooks_exist() {
+        return;
+    }
     // Seven files moved aside (those that exist), then seven renamed in: 14 renames.
     for rename in [0, 6, 7, 10, 13] {
         let at = rename.to_string();

@@ -77,6 +77,8 @@ fn check_packs(preset: &str, layout: &str) {
             let mask = read(&out, &format!("{name}_mask.png"));
             assert!(channel(&mask, 0).iter().all(|&v| v == 0), "metallic");
             assert!(channel(&mask, 1).iter().all(|&v| v == 255), "occlusion");
+            // HDRP's detail mask at 1, as without a mask map (at 0 it hid any detail map).
+            assert!(channel(&mask, 2).iter().all(|&v| v == 255), "detail mask");
             let smooth = channel(&mask, 3);
             assert!(worst(smooth.into_iter(), rough.clone().into_iter(), |r| 255 - r) <= 1, "smoothness");
         } else {

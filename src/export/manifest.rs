@@ -374,6 +374,9 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
         .filter(|m| !m.is_empty())
         .ok_or_else(|| problem("the manifest lists no maps".into()))?;
     let mut files = Vec::new();
+    // Every map's problem, not the first only: a set with a missing map and an altered one
+    // took two runs of `verify` to learn both (an onboarding review).
+    let mut problems = Vec::new();
     for entry in maps {
         let (Some(map), Some(file), Some(expected)) =
             (entry["map"].as_str(), entry["file"].as_str(), entry["sha256"].as_str())
@@ -389,15 +392,18 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
             return Err(problem(format!("the {map} map or its file {file:?} is listed twice")));
         }
         let path = dir.join(file);
-        let actual = set_file_sha256(&path, file_limit, Links::Follow)
-            .map_err(|e| problem(format!("{map} map {}: {e}", path.display())))?;
-        if actual != expected {
-            return Err(problem(format!(
+        match set_file_sha256(&path, file_limit, Links::Follow) {
+            Err(e) => problems.push(format!("{map} map {}: {e}", path.display())),
+            Ok(actual) if actual != expected => problems.push(format!(
                 "{map} map {} has SHA-256 {actual}, the manifest records {expected}: the set is mixed or altered",
                 path.display()
-            )));
+            )),
+            Ok(_) => {}
         }
         files.push((map.to_string(), path));
+    }
+    if !problems.is_empty() {
+        return Err(problem(problems.join("; ")));
     }
     Ok(VerifiedSet { manifest: manifest_path.into(), files })
 }

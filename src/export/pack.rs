@@ -91,6 +91,11 @@ const NORMAL_DIRECTX: [Channel; 3] = [
 const NO_OCCLUSION: Channel = Channel::Constant(255);
 const OCCLUSION: Channel = Channel::map(MapKind::Ao, 0, Transfer::Unit);
 const NOT_METALLIC: Channel = Channel::Constant(0);
+/// HDRP's detail mask (the mask map's B) at 1: a detail map the artist adds applies
+/// everywhere, as it does without a mask map (HDRP's `LitDataIndividualLayer.hlsl` sets
+/// `detailMask = 1.0` and reads the mask map's `.b` only where one is given; `Lit.shader`'s
+/// `_MaskMap` defaults to "white"). At 0 it masked any detail map out.
+const DETAIL_EVERYWHERE: Channel = Channel::Constant(255);
 const ROUGHNESS: Channel = Channel::map(MapKind::Roughness, 0, Transfer::Unit);
 const THICKNESS: Channel = Channel::map(MapKind::Iridescence, 0, Transfer::Unit);
 const HEIGHT: Channel = Channel::map(MapKind::Height, 0, Transfer::Unit);
@@ -242,13 +247,13 @@ impl Pack {
                     channels: vec![
                         NOT_METALLIC,
                         occlusion,
-                        Channel::Constant(0),
+                        DETAIL_EVERYWHERE,
                         Channel::map(MapKind::Roughness, 0, Transfer::Complement),
                     ],
                     bit_depth: 8,
                     srgb: false,
                     meaning: format!(
-                        "R: metallic (0), G: {occlusion_words}, B: detail mask (0), A: smoothness = 1 - roughness"
+                        "R: metallic (0), G: {occlusion_words}, B: detail mask (1: a detail map applies everywhere), A: smoothness = 1 - roughness"
                     ),
                 },
                 height,

@@ -119,9 +119,10 @@ impl Lut {
         }
     }
 
-    /// The cosine of texel row `i`.
+    /// The cosine of texel row `i`; row 0 holds the limit just above grazing light
+    /// (`GRAZING_ROW_COS`), not the film at cos 0.
     fn row_cos(&self, i: usize) -> f64 {
-        i as f64 / (self.n_cos - 1) as f64
+        (i as f64 / (self.n_cos - 1) as f64).max(GRAZING_ROW_COS)
     }
 
     /// The colour of texel column `j` on the row whose film is `film` (at `row_cos`): the
@@ -403,6 +404,14 @@ impl Lut {
     }
 }
 
+/// The cosine row 0 is baked at. Exactly grazing light reflects everything
+/// (`film::FilmAtAngle`), the limit of a stack with an interface but not of one without
+/// (n0 = n1 = n2, or n0 = n2 under a film of no thickness), which reflects nothing at every
+/// angle above grazing: baked at cos 0, its lookups blended toward 1 from the next row's
+/// 89.1° on (a physics review: a lossless white stack of index 1 reflected 1.056 at 89.5°,
+/// the spectral film 1.000). Just above 0 every stack's row holds its own limit.
+const GRAZING_ROW_COS: f64 = 1e-9;
+
 /// The default table (`Lut::bake_default`) with each texel computed on first read, for
 /// queries: one film colour reads 4 of its 20,480 texels, where baking the whole table for
 /// it took 2.6 s of CPU here (`brdf color --method lut`); the queries of a batch share
@@ -464,6 +473,26 @@ pub fn box_colour(stack: Stack, film: &FilmSeries, d: f64, w: f64, cos0: f64) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A stack without an interface reflects nothing near grazing light in the table, as the
+    /// spectral film says; the row at grazing held the film at cos 0, which reflects
+    /// everything, and lookups at 89.5° read 0.45 (seen failing). Control: a stack with an
+    /// interface still reflects nearly all of grazing light there.
+    #[test]
+    fn a_stack_without_an_interface_reflects_nothing_near_grazing_light() {
+        use crate::optics::film::Stack;
+        let matched = [(Stack { n0: 1.0, n1: 1.0, n2: 1.0 }, 400.0), (Stack { n0: 1.5, n1: 2.0, n2: 1.5 }, 0.0)];
+        for (stack, d) in matched {
+            let lut = LazyLut::new(stack);
+            for cos in [0.0, 0.001, 0.0087, 0.02] {
+                let r = lut.lookup_f64(d, cos);
+                assert!(r.iter().all(|c| c.abs() < 1e-6), "{stack:?} d {d} cos {cos}: {r:?}");
+            }
+        }
+        let lut = LazyLut::new(Stack::THESIS);
+        let r = lut.lookup_f64(400.0, 0.0087);
+        assert!(r.iter().all(|c| *c > 0.9), "{r:?}");
+    }
 
     /// The lazy table reads the baked table's values, bit for bit, and computes only the
     /// texels its lookups read (four for one lookup inside the table; one at a corner).

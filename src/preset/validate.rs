@@ -448,13 +448,31 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         if p.kind == Stripes {
             // (key, set away from its default, the key that replaces it)
             let by_rows = !p.rows.is_empty();
+            // The default, where the key has one, counts as unset: `--set` cannot take a
+            // file's key away, but can give it its default (an onboarding review found no way
+            // from the command line).
             let replaced = [
-                ("offset", p.offset != 0.0, if by_rows { Some("rows") } else { p.position.map(|_| "position") }),
-                ("position", p.position.is_some(), by_rows.then_some("rows")),
-                ("size", p.size != PatternLayer::default_size(), by_rows.then_some("rows")),
-                ("amount", p.amount != PatternLayer::default_amount(), by_rows.then_some("rows")),
+                (
+                    "offset",
+                    p.offset != 0.0,
+                    if by_rows { Some("rows") } else { p.position.map(|_| "position") },
+                    Some(0.0),
+                ),
+                ("position", p.position.is_some(), by_rows.then_some("rows"), None),
+                (
+                    "size",
+                    p.size != PatternLayer::default_size(),
+                    by_rows.then_some("rows"),
+                    Some(PatternLayer::default_size()),
+                ),
+                (
+                    "amount",
+                    p.amount != PatternLayer::default_amount(),
+                    by_rows.then_some("rows"),
+                    Some(PatternLayer::default_amount()),
+                ),
             ];
-            for (field, set, by) in replaced {
+            for (field, set, by, default) in replaced {
                 // No pass for a file's key under a kind `--set` changed (as `kinds_only` gives):
                 // stripes read every one of these keys, so it would be dropped silently (the
                 // blotches' `arrangement` is refused the same way, above).
@@ -464,9 +482,12 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                     } else {
                         "places the stripe at a named offset"
                     };
+                    let unset = default.map_or(String::new(), |d| format!(" (its default, {d}, counts as none)"));
                     c.problems.push(Problem {
                         key: key(field),
-                        message: format!("is replaced by this layer's `{by}`, which {what}; give one of the two"),
+                        message: format!(
+                            "is replaced by this layer's `{by}`, which {what}; give one of the two{unset}"
+                        ),
                     });
                 }
             }

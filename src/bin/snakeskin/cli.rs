@@ -347,6 +347,8 @@ pub struct PresetArgs {
     pub source: PresetSource,
     /// Maps to produce, comma-separated: color, height, normal, roughness, iridescence, and ao
     /// (ambient occlusion, only when named); "all" is the first five ("all,ao" adds it).
+    /// `generate` writes them as a whole set: in a folder that holds a set of the same name,
+    /// that set's other maps are removed (see -o); give each partial set its own folder.
     #[arg(long, default_value = "all", value_name = "LIST", value_parser = parse_maps)]
     pub maps: MapList,
 }
@@ -370,7 +372,9 @@ pub struct GenerateArgs {
     /// What the set covers: tile (a square that repeats both ways) or body (the whole
     /// snake, snout at the top, tail tip at the bottom, with the preset's [body] counts,
     /// head shields and marks, and tail; u still wraps round the body, v does not).
-    /// A body atlas is generated a strip at a time: memory does not grow with its length.
+    /// A body atlas is evaluated a strip at a time, so its evaluation's memory does not grow
+    /// with its length; its compressed PNGs are held until written (at most the maps' raw
+    /// size, a few bytes a pixel), an EXR's float maps whole (see --format).
     #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
     pub layout: LayoutArg,
     /// File format: png (8/16-bit, the default) or exr (OpenEXR floats in physical units:
@@ -856,7 +860,7 @@ pub struct AlbedoArgs {
     /// grazing a mirror-smooth top's lobe is narrower than the stratification, and at
     /// roughness 0 the layered model reads 0.903 against the closed form's 0.906 at 89°, 0.878
     /// against 0.990 at 89.9°). reference: the
-    /// smooth-top stack in closed form (roughness ignored; Gauss–Legendre, ~1e-9).
+    /// smooth-top stack in closed form (roughness ignored; Gauss–Legendre, within 5e-5).
     /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
     /// standard error per channel. The references read the exact 1 nm film (--method is
     /// for the models).
