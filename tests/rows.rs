@@ -261,22 +261,40 @@ fn the_garter_snakes_spots_lie_between_its_stripes() {
 }
 
 #[test]
-fn the_rat_snakes_stripes_are_dark_not_the_grounds_olive() {
-    // 'two to four black stripes' (Japan Times), 'dark brown' (orbis-pictus.jp), in the
-    // preset: the stripes' pixels (rows 8-9) not green above red as the olive ground is, and
-    // darker than a third of its luminance. At opacity 0.75 (the control, the preset's first
-    // version) the ground showed through: an audit measured (66, 71, 48).
+fn the_rat_snakes_stripes_are_faint_the_ground_showing_through() {
+    // 'four indistinct blackish-brown stripes' (musimusi, after Japanese Wikipedia), 'not very
+    // distinct' (yakushima.org), 'vague' (the Ministry of the Environment), in the preset: the
+    // stripes' rows (8-9) darker than the olive ground, yet with the ground showing through,
+    // their median luminance more than a third of the way from the stripe colour's to the
+    // ground's. The control: opaque stripes (the preset before the Japanese sources were read,
+    // after an audit had read only 'black' and 'dark brown').
     let text = snakeskin::preset::library::get("elaphe-climacophora").unwrap();
     let preset = common::preset_from(text);
     let stripe = preset.pattern[0].color.unwrap().to_linear();
     let ground = preset.color.base.to_linear();
     let luminance = |c: &[f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let (dark, light) = (luminance(&stripe), luminance(&ground));
     let check = |text: &str| {
-        let (share, median) = rows_nearer(text, (8.0, 9.0), stripe, ground);
-        (share > 0.5, median[1] <= median[0], luminance(&median) < luminance(&ground) / 3.0)
+        let median = luminance(&rows_median(text, (8.0, 9.0)));
+        (median < 0.85 * light, median > dark + (light - dark) / 3.0)
     };
-    assert_eq!(check(text), (true, true, true));
-    let see_through = text.replace("rows = [8, 9]\n", "rows = [8, 9]\nopacity = 0.75\n");
-    assert_ne!(see_through, text);
-    assert!(!check(&see_through).1, "the control");
+    assert_eq!(check(text), (true, true));
+    let opaque = text.replace("opacity = 0.5\n", "");
+    assert_ne!(opaque, text);
+    assert_eq!(check(&opaque), (true, false), "the control");
+}
+
+/// The median colour of the scales (not the crevices) on dorsal rows `rows`.
+fn rows_median(text: &str, rows: (f32, f32)) -> [f32; 3] {
+    let (f, c) = (field(text), colour(text));
+    let on_rows: Vec<&[f32]> = pixels(&f)
+        .zip(pixels(&c))
+        .filter(|(p, _)| (rows.0..=rows.1).contains(&p[channel::ROW]) && p[channel::CREVICE] == 0.0)
+        .map(|(_, c)| c)
+        .collect();
+    [0, 1, 2].map(|k| {
+        let mut v: Vec<f32> = on_rows.iter().map(|c| c[k]).collect();
+        v.sort_by(f32::total_cmp);
+        v[v.len() / 2]
+    })
 }
