@@ -140,7 +140,6 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
     ExportPlan::new(request)?.run(progress)
 }
 
-/// An export checked before any pixel is computed: the preset loaded and validated, the
 /// glTF has no ambient index: a viewer lights the material as in air, whatever the preset's
 /// `optics.ambient_ior` (README, "What glTF cannot carry"). Said before the work, so that an
 /// export of a snake under water is not taken for one (an onboarding review: it was silent).
@@ -154,6 +153,7 @@ fn ambient_warning(ambient_ior: f64) -> Option<String> {
     })
 }
 
+/// An export checked before any pixel is computed: the preset loaded and validated, the
 /// files it will write checked, its warnings and memory known, so that a caller can say them
 /// before the work (the pack's size warning came after the textures were made).
 pub struct ExportPlan {

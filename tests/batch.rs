@@ -1398,6 +1398,23 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         both.lines().any(|l| l.starts_with("FAILED ") && l.contains(&map_name) && l.contains(&other_name)),
         "{both}"
     );
+    // An entry that names no plain file besides them: all three on the line (it stopped at
+    // such an entry, an independent review).
+    let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
+    let third = json["maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|m| m["file"] != map_name.as_str() && m["file"] != other_name.as_str())
+        .unwrap();
+    json["maps"][third]["file"] = serde_json::json!("../evil.png");
+    std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
+    let three = stdout(&verify(&[&manifests[0]]));
+    assert!(
+        three.lines().any(|l| l.contains(&map_name) && l.contains(&other_name) && l.contains("\"../evil.png\"")),
+        "{three}"
+    );
+    std::fs::write(&manifests[0], &text).unwrap();
     std::fs::write(&other, &other_bytes).unwrap();
     std::fs::write(&map, &bytes).unwrap();
     assert_eq!(verify(&[&out]).status.code(), Some(0));

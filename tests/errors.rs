@@ -250,9 +250,12 @@ fn a_stripe_placed_twice_is_refused() {
     // The refusal says the way out from the command line, and it works: `--set` gives the
     // file's key its default, which counts as none.
     let err = refused("twice.toml", &layer("rows = [9.5, 10]\nsize = 0.02"), &[]);
-    assert!(err.contains("give one of the two (its default, 0.05, counts as none)"), "{err}");
+    assert!(err.contains("give one of the two (its default, 0.05, counts as none; `rows = []`"), "{err}");
     let twice = write_preset(dir.path(), "twice.toml", &layer("rows = [9.5, 10]\nsize = 0.02"));
     accepted(&twice, &["--set", "pattern.0.size=0.05"]);
+    accepted(&twice, &["--set", "pattern.0.rows=[]"]);
+    let err = refused("placed.toml", &layer("rows = [9.5, 10]\nposition = \"vertebral\""), &[]);
+    assert!(err.contains("give one of the two (`rows = []` counts as no rows)"), "{err}");
 }
 
 /// Stripes that reach past the belly's midline wrap round onto the other side's: 16 a side

@@ -152,6 +152,28 @@ fn dot_nodes(dot: &str) -> BTreeSet<String> {
         .collect()
 }
 
+/// `graph --layout body` lists the body atlas's graph, exactly the nodes its evaluation
+/// runs, and they include the body's own (`body.`: plates, head, tail) that the tile's graph
+/// has none of (control: without `--layout` no body node is listed).
+#[test]
+fn graph_lists_the_body_atlas_with_layout_body() {
+    let loaded = parse(&read_source(PATTERNED).unwrap(), &[]).unwrap();
+    let options = BuildOptions { layout: snakeskin::maps::Layout::Body, ..BuildOptions::default() };
+    let graph = build_graph(&loaded.preset, options);
+    let maps = snakeskin::parse_map_list("all").unwrap();
+    let evaluated: BTreeSet<String> =
+        evaluate(&graph, &maps, 32, 384, &|_, _| {}).stats.nodes.into_iter().map(|n| n.name).collect();
+    let listed = |extra: &[&str]| {
+        let run = snakeskin(&[&["graph", PATTERNED, "--dot"][..], extra].concat());
+        assert!(run.status.success(), "{}", stderr(&run));
+        dot_nodes(&stdout(&run))
+    };
+    let body = listed(&["--layout", "body"]);
+    assert_eq!(body, evaluated);
+    assert!(body.iter().any(|n| n.starts_with("body.")), "{body:?}");
+    assert!(!listed(&[]).iter().any(|n| n.starts_with("body.")));
+}
+
 #[test]
 fn graph_dot_lists_exactly_the_evaluated_nodes() {
     let graph = patterned_graph();

@@ -381,15 +381,18 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
         let (Some(map), Some(file), Some(expected)) =
             (entry["map"].as_str(), entry["file"].as_str(), entry["sha256"].as_str())
         else {
-            return Err(problem("a map entry lacks map, file or sha256".into()));
+            problems.push("a map entry lacks map, file or sha256".into());
+            continue;
         };
         // An empty name too: it joined to the set's folder, "it is a folder, not a regular
         // file" (a hostile-input sweep).
         if file.is_empty() || file.contains(['/', '\\']) || file.starts_with('.') {
-            return Err(problem(format!("map file {file:?} is not a plain file name")));
+            problems.push(format!("map file {file:?} is not a plain file name"));
+            continue;
         }
         if files.iter().any(|(m, p): &(String, PathBuf)| m == map || p.ends_with(file)) {
-            return Err(problem(format!("the {map} map or its file {file:?} is listed twice")));
+            problems.push(format!("the {map} map or its file {file:?} is listed twice"));
+            continue;
         }
         let path = dir.join(file);
         match set_file_sha256(&path, file_limit, Links::Follow) {

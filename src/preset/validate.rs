@@ -448,9 +448,9 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         if p.kind == Stripes {
             // (key, set away from its default, the key that replaces it)
             let by_rows = !p.rows.is_empty();
-            // The default, where the key has one, counts as unset: `--set` cannot take a
-            // file's key away, but can give it its default (an onboarding review found no way
-            // from the command line).
+            // The default, where the key has one, counts as unset, and `rows = []` as no rows:
+            // `--set` cannot take a file's key away, but can give it these (an onboarding
+            // review found no way from the command line; a later one, `rows = []`).
             let replaced = [
                 (
                     "offset",
@@ -482,7 +482,12 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                     } else {
                         "places the stripe at a named offset"
                     };
-                    let unset = default.map_or(String::new(), |d| format!(" (its default, {d}, counts as none)"));
+                    let mut ways: Vec<String> =
+                        default.map(|d| format!("its default, {d}, counts as none")).into_iter().collect();
+                    if by == "rows" {
+                        ways.push("`rows = []` counts as no rows".into());
+                    }
+                    let unset = if ways.is_empty() { String::new() } else { format!(" ({})", ways.join("; ")) };
                     c.problems.push(Problem {
                         key: key(field),
                         message: format!(

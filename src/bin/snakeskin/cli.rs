@@ -589,6 +589,10 @@ pub struct GraphArgs {
     /// Print Graphviz DOT (render with `dot -Tsvg`); otherwise a plain list of nodes.
     #[arg(long)]
     pub dot: bool,
+    /// tile (the default) or body: the graph `generate --layout body` evaluates for a body
+    /// atlas (head marks, plates along the body, tail), strip by strip.
+    #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
+    pub layout: LayoutArg,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -860,7 +864,8 @@ pub struct AlbedoArgs {
     /// grazing a mirror-smooth top's lobe is narrower than the stratification, and at
     /// roughness 0 the layered model reads 0.903 against the closed form's 0.906 at 89°, 0.878
     /// against 0.990 at 89.9°). reference: the
-    /// smooth-top stack in closed form (roughness ignored; Gauss–Legendre, within 5e-5).
+    /// smooth-top stack in closed form (roughness ignored; Gauss–Legendre, within 5e-5 on
+    /// the stacks measured).
     /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
     /// standard error per channel. The references read the exact 1 nm film (--method is
     /// for the models).

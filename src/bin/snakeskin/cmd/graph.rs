@@ -11,7 +11,9 @@ pub fn run(args: GraphArgs) -> Result<()> {
     let source = &args.preset.source;
     let loaded = snakeskin::preset::load(&source.preset, &source.overrides, source.seed)?;
     crate::output::report_warnings(&source.preset, &loaded);
-    let graph = build_graph(&loaded.preset, BuildOptions::default());
+    // The body atlas's graph too (an onboarding review found no way to see it but
+    // `generate --stats`).
+    let graph = build_graph(&loaded.preset, BuildOptions { layout: args.layout.layout(), ..BuildOptions::default() });
     if args.dot {
         print!("{}", to_dot(&graph, maps));
     } else {
