@@ -1414,6 +1414,20 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         three.lines().any(|l| l.contains(&map_name) && l.contains(&other_name) && l.contains("\"../evil.png\"")),
         "{three}"
     );
+    // An entry without its hash and one listed twice, beside the missing map: all named.
+    let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
+    let twice = json["maps"][third].clone();
+    json["maps"][third].as_object_mut().unwrap().remove("sha256");
+    json["maps"].as_array_mut().unwrap().push(twice.clone());
+    json["maps"].as_array_mut().unwrap().push(twice);
+    std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
+    let more = stdout(&verify(&[&manifests[0]]));
+    assert!(
+        more.lines().any(|l| l.contains(&other_name)
+            && l.contains("lacks map, file or sha256")
+            && l.contains("is listed twice")),
+        "{more}"
+    );
     std::fs::write(&manifests[0], &text).unwrap();
     std::fs::write(&other, &other_bytes).unwrap();
     std::fs::write(&map, &bytes).unwrap();
