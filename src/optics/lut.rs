@@ -7,7 +7,8 @@
 //! over its thickness cell (exact, through the Fourier series in `series.rs`), so texels of
 //! thick films already hold the washed-out colour and a lookup can never alias: no moiré at
 //! 2.4 mm (the thesis' Fig. 5.9) or any other thickness. Cos θ axis: `n_cos` texels uniform
-//! over [0, 1].
+//! over [0, 1], row 0 fitted over the first interval rather than sampled at cos 0 ("Row 0,
+//! fitted", below).
 //!
 //! **The rough top's coupling, tabulated.** The layered model reads, per direction, what the
 //! rough top reflects (`brdf::energy::top`): the rule on the two roughness rows of the lobe
