@@ -254,7 +254,10 @@ fn the_garter_snakes_spots_lie_between_its_stripes() {
         |text: &str| (rows_nearer(text, (4.0, 8.0), spot, ground).0, rows_nearer(text, (1.0, 1.0), spot, ground).0);
     let (between, lowest) = shares(text);
     assert!(between > 0.05 && lowest < 0.5 * between, "{between} between the stripes, {lowest} on row 1");
-    let round_the_body = text.replace("rows = [4, 9]\namount = 3\n", "amount = 10\n");
+    // (Ditmars' pale tinge on row 1, drawn after the spots, left out of the control.)
+    let round_the_body = text
+        .replace("rows = [4, 9]\namount = 3\n", "amount = 10\n")
+        .replace("rows = [0.5, 1]\n", "rows = [0.5, 1]\nopacity = 0\n");
     assert_ne!(round_the_body, text);
     let (between, lowest) = shares(&round_the_body);
     assert!(lowest > between, "the control: {between} between the stripes, {lowest} on row 1");
