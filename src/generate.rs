@@ -137,6 +137,30 @@ pub fn check_set_outputs(
     export::check_lock_place(&lock)
 }
 
+/// What is lost where `ambient_ior` is not air's and the file goes to `reader` (glTF, an
+/// engine's pack): none of them has an ambient index, so a viewer or engine lights the
+/// material as in air (README, "What glTF cannot carry"). Said before the work, so that a
+/// snake under water is not taken for one (an onboarding review: `export` was silent; a
+/// later review: packs too). None in air.
+pub fn ambient_warning(ambient_ior: f64, reader: &str) -> Option<String> {
+    (ambient_ior != 1.0).then(|| {
+        format!(
+            "optics.ambient_ior is {ambient_ior}, but {reader} has no ambient index: it lights this material as \
+             in air (the colour map is still the visible colour under {ambient_ior}; the film's and the base's \
+             reflections are not)"
+        )
+    })
+}
+
+/// The reader `ambient_warning` names for a pack.
+pub fn pack_reader(pack: Pack) -> &'static str {
+    match pack {
+        Pack::Gltf => "glTF",
+        Pack::Unreal => "Unreal's material",
+        Pack::UnityHdrp => "HDRP's Lit material",
+    }
+}
+
 /// `Pack::size_problem` for a set `size` wide in `layout`, with the largest size whose
 /// textures the engine loads (a body atlas's height is rounded, so it is searched for):
 /// "give {give} N or less". None when the textures fit, or without a pack.
@@ -263,6 +287,12 @@ impl Plan {
         let (layout, preset) = (self.request.options.layout, &self.loaded.preset);
         let give = size_option(&self.request);
         pack_size_warning(self.request.pack?, layout, preset, self.size, give).map(|w| format!("warning: {w}"))
+    }
+
+    /// `ambient_warning` for a pack, "warning: " first; None in air, or without a pack.
+    pub fn ambient_warning(&self) -> Option<String> {
+        let reader = pack_reader(self.request.pack?);
+        ambient_warning(self.loaded.preset.optics.ambient_ior, reader).map(|w| format!("warning: {w}"))
     }
 
     /// The layout the maps are drawn in.

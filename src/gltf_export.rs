@@ -140,19 +140,6 @@ pub fn export(request: &ExportRequest, progress: &(dyn Fn(usize, usize) + Sync))
     ExportPlan::new(request)?.run(progress)
 }
 
-/// glTF has no ambient index: a viewer lights the material as in air, whatever the preset's
-/// `optics.ambient_ior` (README, "What glTF cannot carry"). Said before the work, so that an
-/// export of a snake under water is not taken for one (an onboarding review: it was silent).
-fn ambient_warning(ambient_ior: f64) -> Option<String> {
-    (ambient_ior != 1.0).then(|| {
-        format!(
-            "warning: optics.ambient_ior is {ambient_ior}, but glTF has no ambient index: viewers light this \
-             material as in air (its colour map is still the visible colour under {ambient_ior}; the film's and the \
-             base's reflections are not)"
-        )
-    })
-}
-
 /// An export checked before any pixel is computed: the preset loaded and validated, the
 /// files it will write checked, its warnings and memory known, so that a caller can say them
 /// before the work (the pack's size warning came after the textures were made).
@@ -268,7 +255,10 @@ impl ExportPlan {
             .warnings(&request.preset)
             .into_iter()
             .chain(plan.size_warning())
-            .chain(ambient_warning(plan.loaded().preset.optics.ambient_ior))
+            .chain(
+                crate::generate::ambient_warning(plan.loaded().preset.optics.ambient_ior, "glTF")
+                    .map(|w| format!("warning: {w}")),
+            )
             .collect();
         Ok(ExportPlan {
             start,

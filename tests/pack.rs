@@ -228,3 +228,32 @@ fn a_pack_longer_than_its_engine_loads_is_warned_of_with_a_size_that_fits() {
     let warned = |size| ExportPlan::new(&request(size)).unwrap().warnings().iter().any(|w| w.contains("16384 texels"));
     assert!(warned(410) && !warned(409));
 }
+
+/// A pack of a snake under water (`optics.ambient_ior` other than 1) says before the work
+/// that its engine lights it as in air, naming the engine, as `export` does for glTF (a
+/// review: packs were silent); control: in air nothing is said of it.
+#[test]
+fn a_pack_under_water_says_its_engine_lights_it_as_in_air() {
+    let dir = tempfile::tempdir().unwrap();
+    for (pack, ambient, said) in [
+        ("unreal", "1.33", Some("Unreal's material has no ambient index")),
+        ("unity-hdrp", "1.33", Some("HDRP's Lit material has no ambient index")),
+        ("gltf", "1.33", Some("glTF has no ambient index")),
+        ("unreal", "1.0", None),
+    ] {
+        let out = dir.path().join(format!("{pack}-{ambient}"));
+        let set = format!("optics.ambient_ior={ambient}");
+        let args =
+            ["generate", "natrix-natrix", "-o", out.to_str().unwrap(), "--size", "16", "--pack", pack, "--set", &set];
+        let run = snakeskin(&args);
+        assert!(run.status.success(), "{}", stderr(&run));
+        match said {
+            Some(words) => assert!(
+                stderr(&run).contains(&format!("warning: optics.ambient_ior is 1.33, but {words}")),
+                "{pack}: {}",
+                stderr(&run)
+            ),
+            None => assert!(!stderr(&run).contains("has no ambient index"), "{pack}: {}", stderr(&run)),
+        }
+    }
+}

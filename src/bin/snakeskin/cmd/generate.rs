@@ -34,7 +34,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     };
     let plan = Plan::new(&request)?;
     crate::output::report_warnings(&source.preset, plan.loaded());
-    if let Some(warning) = plan.size_warning() {
+    for warning in plan.size_warning().into_iter().chain(plan.ambient_warning()) {
         eprintln!("{warning}");
     }
     let memory = plan.memory();
