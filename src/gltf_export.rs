@@ -254,11 +254,9 @@ impl ExportPlan {
             .loaded()
             .warnings(&request.preset)
             .into_iter()
+            // The plan's pack is glTF's: its warnings are the export's.
             .chain(plan.size_warning())
-            .chain(
-                crate::generate::ambient_warning(plan.loaded().preset.optics.ambient_ior, "glTF")
-                    .map(|w| format!("warning: {w}")),
-            )
+            .chain(plan.ambient_warning())
             .collect();
         Ok(ExportPlan {
             start,

@@ -307,10 +307,8 @@ pub fn parse_with_seed(
     };
     let seed = seed.or(overridden_seed);
     let overrides = overrides.as_slice();
-    // The keys the overrides wrote, each where it put a value whole (`merge`), and each
-    // override's own (`lost_overrides`).
-    let mut written = Vec::new();
-    let mut replaced = Vec::new();
+    // Each override's places, where it put a value whole (`merge`; `lost_overrides`).
+    let mut replaced: Vec<Vec<String>> = Vec::new();
     let preset = if overrides.is_empty() {
         file_preset
     } else {
@@ -319,7 +317,6 @@ pub fn parse_with_seed(
         for (key, value) in overrides {
             let mut places = Vec::new();
             apply_override(&mut table, key, value, &mut places)?;
-            written.extend(places.iter().cloned());
             replaced.push(places);
         }
         Preset::deserialize(toml::Value::Table(table)).map_err(|e| {
@@ -353,7 +350,7 @@ pub fn parse_with_seed(
     // A key an override wrote, or one inside a value it put whole (an inline table in place
     // of the file's layers), has no line in the file; the file is parsed for lines once, not
     // once per problem (thousands of them took minutes).
-    let under_written = |key: &str| written.iter().any(|k: &String| toml_text::key_within(key, k));
+    let under_written = |key: &str| replaced.iter().flatten().any(|k| toml_text::key_within(key, k));
     // The seed's overrides are not among `overrides` (above): a seed given by `--seed` or
     // `--set seed=` has no line either.
     let seed_given = seed.is_some();
