@@ -145,11 +145,8 @@ fn row_keys_are_checked() {
 /// The median of the linear luminance of the scale centres of `rows` (median: the spots and
 /// blotches on them, a minority of the centres, do not move it).
 fn median_luminance(centres: &[(u32, [f32; 3])], rows: std::ops::RangeInclusive<u32>) -> f32 {
-    let mut luminance: Vec<f32> = centres
-        .iter()
-        .filter(|(row, _)| rows.contains(row))
-        .map(|(_, c)| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2])
-        .collect();
+    let mut luminance: Vec<f32> =
+        centres.iter().filter(|(row, _)| rows.contains(row)).map(|(_, c)| common::luminance(c)).collect();
     luminance.sort_by(f32::total_cmp);
     luminance[luminance.len() / 2]
 }
@@ -163,7 +160,7 @@ fn the_corn_snakes_sides_are_lighter_than_its_back() {
     let text = snakeskin::preset::library::get("pantherophis-guttatus").unwrap();
     let preset = common::preset_from(text);
     let c = preset.color.base.to_linear();
-    let ground = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let ground = common::luminance(&c);
     let centres = centres_by_row(text);
     let sides = median_luminance(&centres, 1..=8);
     assert!(sides > 1.2 * ground, "sides {sides}, the back's ground {ground}");
@@ -196,7 +193,7 @@ fn the_garter_snakes_checks_stand_out_from_its_ground() {
     // least 3:1, the contrast WCAG 2.1 asks of graphics that must be seen (SC 1.4.11). The
     // preset's first ground, a near-black olive under black spots, gave 1.3 (seen failing).
     let (text, spot, ground) = garter_snake();
-    let luminance = |c: &[f32]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let luminance = common::luminance;
     let distance = |a: &[f32], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
     let (f, c) = (field(text), colour(text));
     let (mut on_spots, mut on_ground) = (Vec::new(), Vec::new());
@@ -275,7 +272,7 @@ fn the_rat_snakes_stripes_are_faint_the_ground_showing_through() {
     let preset = common::preset_from(text);
     let stripe = preset.pattern[0].color.unwrap().to_linear();
     let ground = preset.color.base.to_linear();
-    let luminance = |c: &[f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let luminance = |c: &[f32; 3]| common::luminance(c);
     let (dark, light) = (luminance(&stripe), luminance(&ground));
     let check = |text: &str| {
         let median = luminance(&rows_median(text, (8.0, 9.0)));
@@ -285,6 +282,29 @@ fn the_rat_snakes_stripes_are_faint_the_ground_showing_through() {
     let opaque = text.replace("opacity = 0.5\n", "");
     assert_ne!(opaque, text);
     assert_eq!(check(&opaque), (true, false), "the control");
+}
+
+#[test]
+fn black_bellied_species_have_bellies_as_dark_as_their_black_marks() {
+    // Phalotris lemniscatus: 'Tout le dessous du corps d'une couleur noire' (the species'
+    // original description, Duméril 1854); a male adder: 'buik meestal zwart' (Naturalis).
+    // The ventral plates' median (row 0 off the crevices) within twice the luminance of the
+    // species' own black mark. The controls: each preset's belly before these sources were
+    // read (a cream; the dark grey of 'grey, greyish-brown or bluish').
+    for (species, now, before) in
+        [("phalotris-lemniscatus", "#141010", "#e8d8b0"), ("vipera-berus", "#24211f", "#3a3634")]
+    {
+        let text = snakeskin::preset::library::get(species).unwrap();
+        let preset = common::preset_from(text);
+        let black = common::luminance(&preset.pattern[0].color.unwrap().to_linear());
+        let belly = |text: &str| common::luminance(&rows_median(text, (0.0, 0.0)));
+        assert!(belly(text) < 2.0 * black, "{species}: belly {}, its black {black}", belly(text));
+        let (head, tail) = text.split_at(text.find("[belly]").unwrap());
+        let old =
+            format!("{head}{}", tail.replacen(&format!("color = \"{now}\""), &format!("color = \"{before}\""), 1));
+        assert_ne!(old, text, "{species}: the control changes the belly");
+        assert!(belly(&old) > 2.0 * black, "{species}: the control, belly {}, its black {black}", belly(&old));
+    }
 }
 
 /// The median colour of the scales (not the crevices) on dorsal rows `rows`.

@@ -110,6 +110,12 @@ pub fn gpu_required() -> bool {
     std::env::var("SNAKESKIN_REQUIRE_GPU").is_ok_and(|v| v == "1")
 }
 
+/// Relative luminance Y of a linear sRGB colour, from the library's own sRGB matrix
+/// (`optics::spectrum`), so that no test writes the weights again.
+pub fn luminance(rgb: &[f32]) -> f32 {
+    snakeskin::optics::spectrum::linear_srgb_to_xyz([rgb[0], rgb[1], rgb[2]].map(f64::from))[1] as f32
+}
+
 /// A preset parsed from TOML text (panics with the error and the text).
 pub fn preset_from(text: &str) -> snakeskin::preset::Preset {
     let source = snakeskin::preset::PresetSource { name: "t".into(), display: "test preset".into(), text: text.into() };
