@@ -77,6 +77,20 @@ pub enum BatchError {
     TooMany { path: PathBuf, count: usize, max: usize },
     #[error("invalid --shard {0:?}: expected K/N with 0 <= K < N, e.g. 0/4 (K is the array index)")]
     Shard(String),
+    /// An index file in the output folder (this run's, or another run's or shard's, which
+    /// tell what sets other jobs files made there) that cannot be read as one: a FIFO, a
+    /// device, a link, a file larger than an index can be, or not an index.
+    #[error(
+        "{path} cannot be read as a batch index: {reason}. The indexes in an output folder record which jobs file \
+         made each set there; remove it (or write to another folder) and run again"
+    )]
+    Index { path: PathBuf, reason: String },
+    /// Another batch run writes this index in the output folder now.
+    #[error(
+        "another snakeskin batch is running into {out} (it holds {lock}); run again when it has finished, or write to \
+         another folder"
+    )]
+    Busy { out: PathBuf, lock: PathBuf },
     /// The job refused when the run was planned, before any job ran: its size (a body atlas
     /// too tall, more memory than the machine has) or its output (a folder, file or link
     /// in the way); the place's line: the job's `sizes` key, else its `preset` key; with the
@@ -873,6 +887,18 @@ pub fn run(
     warn: &mut dyn FnMut(&str),
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
+    // One run at a time writes an index, from the plan to its last record: two runs into one
+    // folder each read the index as they began and wrote it whole at their end, and the later
+    // dropped the other's record (a review: the set so forgotten was then replaced by a third
+    // jobs file's preset of the same name). Shards keep their own indexes and run side by side.
+    let index_name = index_file_name(shard);
+    let _index_lock = crate::export::SetLock::acquire(out, &index_name).map_err(|e| match e {
+        crate::export::ExportError::Busy { .. } => Error::from(BatchError::Busy {
+            out: out.into(),
+            lock: out.join(crate::export::lock_file_name(&index_name)),
+        }),
+        e => e.into(),
+    })?;
     let Planned { mine, resolved, estimates } = plan(jobs_file, jobs, out, shard, true)?;
     let requested = concurrency.clamp(1, MAX_CONCURRENCY);
     // With nothing to run, the summary says what was asked (one, from an empty list, read as
@@ -903,7 +929,7 @@ pub fn run(
     // jobs file into one folder replaced the first's index without a word), and the sets it
     // records, for this one to carry. A set of theirs that a job here would replace was
     // refused in `plan`.
-    let (earlier_jobs_file, earlier_sets) = read_index_file(&out.join(index_file_name(shard))).unzip();
+    let (earlier_jobs_file, earlier_sets) = read_index_file(&out.join(index_file_name(shard)))?.unzip();
     if let Some(earlier) = earlier_jobs_file.filter(|earlier| !is_this_jobs_file(earlier, jobs_file)) {
         warn(&format!(
             "note: {} listed the jobs of {}; it lists this run's now (their sets stay where they are)",
@@ -990,12 +1016,28 @@ pub struct OtherSet {
     pub key: String,
 }
 
+/// The largest index file a run reads back. An index lists at most `MAX_JOBS` jobs of a few
+/// hundred bytes each (two relative paths, a 64-digit key: about 400 bytes for a built-in
+/// preset's, so 40 MB for the most a run can hold) and the sets it carried from earlier
+/// runs'; 256 MiB leaves room for long paths while a device, a FIFO or a planted huge file
+/// is refused before anything is read (`text_file`): the read was unbounded, a FIFO hung the
+/// run and /dev/zero took memory until the read failed and the index was skipped unseen.
+const INDEX_MAX_BYTES: u64 = 256 << 20;
+
 /// An index file's jobs file (as recorded) and every set it records: its jobs, under that
 /// file, and the sets it carried from the index it replaced (`BatchIndex::other_sets`), under
-/// theirs; None where it cannot be read as an index.
-fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
+/// theirs; None where there is none, or where the file is of another kind (a web page named
+/// `index.json`: not a record; a run refuses to replace its own, `check_replaces_its_own`).
+/// A FIFO, a device, a link, a file over `INDEX_MAX_BYTES`, or an index of ours that does
+/// not parse (cut short, altered) is an error: each was skipped without a word, and with it
+/// the record that keeps another jobs file's sets from being replaced.
+fn read_index_file(path: &Path) -> Result<Option<(String, Vec<OtherSet>)>, BatchError> {
+    use crate::text_file::{BoundedReadError, Links, read_bounded_bytes};
     #[derive(serde::Deserialize)]
     struct Listed {
+        // A re-saved index may have lost it (`check_replaces_its_own` takes such a file for
+        // an index still): its jobs are then no jobs file's.
+        #[serde(default)]
         jobs_file: String,
         #[serde(default)]
         jobs: Vec<ListedJob>,
@@ -1009,8 +1051,18 @@ fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
         #[serde(default)]
         status: String,
     }
-    let text = std::fs::read(path).ok()?;
-    let Listed { jobs_file, jobs, other_sets } = serde_json::from_slice::<Listed>(&text).ok()?;
+    let refused = |reason: String| BatchError::Index { path: path.into(), reason };
+    let text = match read_bounded_bytes(path, INDEX_MAX_BYTES, Links::Refuse) {
+        Ok(text) => text,
+        Err(BoundedReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(refused(e.to_string())),
+    };
+    if text.trim_ascii().is_empty() || !crate::export::begins_as(&text, "batch index") {
+        return Ok(None);
+    }
+    let json = text.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&text);
+    let Listed { jobs_file, jobs, other_sets } = serde_json::from_slice::<Listed>(json)
+        .map_err(|e| refused(format!("it begins as one but does not parse: cut short or altered? ({e})")))?;
     // A job the run skipped (its set was there, made by whichever run made it) or left to
     // another job (a duplicate) does not make the set its file's: a run that skipped another
     // file's identical set took it over, and that file's own run was then refused (a
@@ -1023,7 +1075,7 @@ fn read_index_file(path: &Path) -> Option<(String, Vec<OtherSet>)> {
         key: job.key,
     });
     let sets = own.chain(other_sets).collect();
-    Some((jobs_file, sets))
+    Ok(Some((jobs_file, sets)))
 }
 
 /// Of the sets the index this run replaces records (`sets`, `read_index_file`), those for
@@ -1069,16 +1121,16 @@ fn is_this_jobs_file(recorded: &str, jobs_file: &Path) -> bool {
 struct OtherSets(std::collections::HashMap<PathBuf, Vec<(String, String)>>);
 
 impl OtherSets {
-    fn in_folder(out: &Path, jobs_file: &Path) -> OtherSets {
+    fn in_folder(out: &Path, jobs_file: &Path) -> Result<OtherSets, BatchError> {
         let mut sets = std::collections::HashMap::new();
         let names = std::fs::read_dir(out).into_iter().flatten().flatten().map(|e| e.file_name());
         for name in names.filter(|n| n.to_str().is_some_and(is_index_file_name)) {
-            let Some((_, listed)) = read_index_file(&out.join(name)) else { continue };
+            let Some((_, listed)) = read_index_file(&out.join(name))? else { continue };
             for set in listed.into_iter().filter(|set| !is_this_jobs_file(&set.jobs_file, jobs_file)) {
                 sets.entry(set.manifest).or_insert_with(Vec::new).push((set.jobs_file, set.key));
             }
         }
-        OtherSets(sets)
+        Ok(OtherSets(sets))
     }
 
     /// Refuses a job that would replace a set another jobs file's run made from another
@@ -1201,7 +1253,7 @@ fn plan<'a>(jobs_file: &Path, jobs: &'a [Job], out: &Path, shard: Shard, for_run
     let (mine, resolved): (Vec<&'a Job>, Vec<Resolved>) =
         jobs.iter().zip(resolve_all(jobs_file, jobs, out, shard)?).filter(|(j, _)| shard.contains(j)).unzip();
     // `--list` too: it shows what a run would do.
-    let others = OtherSets::in_folder(out, jobs_file);
+    let others = OtherSets::in_folder(out, jobs_file)?;
     for (job, r) in mine.iter().zip(&resolved) {
         others.check(out, r, job.place(jobs_file, job.lines.preset))?;
     }

@@ -1360,7 +1360,31 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         let said = format!("map file {file:?} is not a plain file name");
         assert!(stdout(&listed).contains(&said), "{file:?}: {}", stdout(&listed));
     }
+    // A manifest whose size is missing or forged names its key (every map was said to be
+    // "more than such a file can be": a hostile-input review); the control, the size as
+    // written, verifies.
+    for (key, value, said) in [
+        ("width", serde_json::json!(1_000_000_000_000u64), "the manifest's width 1000000000000 is wider than any set"),
+        (
+            "height",
+            serde_json::json!(1_000_000_000_000u64),
+            "the manifest's height 1000000000000 is taller than any set",
+        ),
+        ("width", serde_json::Value::Null, "the manifest's width and height are not both whole numbers of pixels"),
+    ] {
+        let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
+        json[key] = value;
+        std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
+        let listed = verify(&[&manifests[0]]);
+        assert_eq!(listed.status.code(), Some(1), "{said}: {}", stderr(&listed));
+        assert!(
+            stdout(&listed).contains(said) && !stdout(&listed).contains("more than such a file"),
+            "{}",
+            stdout(&listed)
+        );
+    }
     std::fs::write(&manifests[0], &text).unwrap();
+    assert_eq!(verify(&[&manifests[0]]).status.code(), Some(0), "the control");
 
     // One byte appended to one map of the first set.
     let set_folder = manifests[0].parent().unwrap();
@@ -1521,4 +1545,97 @@ fn a_job_can_ask_for_directx_normals() {
         assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
         assert!(stderr(&refused).contains(said) && stderr(&refused).contains("jobs.toml:"), "{}", stderr(&refused));
     }
+}
+
+/// An index file in the output folder that cannot be read as one (a FIFO, a link to
+/// /dev/zero, a sparse 64 GiB file, an index cut short), this run's or another shard's, is
+/// refused with its name, before any job runs and without reading it whole: the read was
+/// unbounded (a FIFO hung `batch` and `--list`, /dev/zero took memory until the read
+/// failed) and an unreadable index was skipped unseen, and with it the record of another
+/// jobs file's sets (a hostile-input review). Controls: a file of another kind under
+/// another shard's index name (a web page) is no record and is passed over; with the
+/// planted file gone the run goes on.
+#[test]
+fn an_index_file_that_is_no_index_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[3]", 16);
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir(&out_dir).unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        snakeskin(&args)
+    };
+    let fifo = |path: &Path| {
+        let c = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+    };
+    type Plant<'a> = (&'a str, &'a str, &'a dyn Fn(&Path));
+    let plants: [Plant; 4] = [
+        ("a FIFO", "not a regular file", &|p| fifo(p)),
+        ("a link to /dev/zero", "symbolic link", &|p| std::os::unix::fs::symlink("/dev/zero", p).unwrap()),
+        ("a sparse 64 GiB file", "more than such a file can be", &|p| {
+            std::fs::File::create(p).unwrap().set_len(64 << 30).unwrap()
+        }),
+        ("an index cut short", "does not parse", &|p| {
+            std::fs::write(p, "{\"generator\": \"snakeskin\", \"jobs_file\": \"j.toml\", \"jobs\": [").unwrap()
+        }),
+    ];
+    for name in ["index.json", "index.shard-1-of-2.json"] {
+        let index = out_dir.join(name);
+        for (what, said, plant) in plants {
+            plant(&index);
+            for extra in [&[][..], &["--list"][..]] {
+                let start = Instant::now();
+                let refused = run(extra);
+                let text = stderr(&refused);
+                assert_eq!(refused.status.code(), Some(2), "{name} {what} {extra:?}: {text}");
+                assert!(text.contains(index.to_str().unwrap()), "{what}: {text}");
+                // This run's own index may be refused as a target the run would replace (it
+                // was already, where `plan` checks it first); another shard's, which the run
+                // only reads, as an index.
+                let as_index = text.contains("cannot be read as a batch index");
+                if name == "index.json" {
+                    assert!(as_index || text.contains("would replace"), "{what}: {text}");
+                } else {
+                    assert!(as_index && text.contains(said), "{what}: {text}");
+                }
+                assert!(start.elapsed() < Duration::from_secs(20), "{what}: took {:?}", start.elapsed());
+                assert!(!out_dir.join("natrix-natrix").exists(), "{what}: a job ran");
+            }
+            std::fs::remove_file(&index).unwrap();
+        }
+    }
+    std::fs::write(out_dir.join("index.shard-1-of-2.json"), "<html>site</html>\n").unwrap();
+    let control = run(&[]);
+    assert_eq!(summary_counts(&control), (1, 0), "{}", stderr(&control));
+}
+
+/// Two batch runs into one folder do not run at once: each wrote the whole index at its end
+/// from what it read as it began, and the later dropped the other's record (a review).
+/// A second run while the index's lock is held is refused at once (exit 1, the lock named)
+/// and writes nothing. Control: once the lock is let go, the same run goes on.
+#[test]
+fn a_second_batch_into_the_same_folder_waits_for_none_and_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[4]", 16);
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir(&out_dir).unwrap();
+    // The lock a running batch holds (`SetLock` on the index's name), taken here.
+    let lock_path = out_dir.join(".index.json.lock");
+    let lock = std::fs::File::create(&lock_path).unwrap();
+    lock.try_lock().unwrap();
+    let run = || snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
+    let refused = run();
+    assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+    assert!(stderr(&refused).contains("another snakeskin batch is running into"), "{}", stderr(&refused));
+    assert!(stderr(&refused).contains(".index.json.lock"), "{}", stderr(&refused));
+    assert!(!out_dir.join("index.json").exists() && !out_dir.join("natrix-natrix").exists());
+    // Another shard keeps its own index and lock: it runs beside the held one.
+    let shard = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--shard", "0/2"]);
+    assert!(shard.status.success(), "{}", stderr(&shard));
+    drop(lock);
+    let control = run();
+    assert!(control.status.success(), "the control: {}", stderr(&control));
+    assert!(out_dir.join("index.json").is_file());
 }

@@ -414,6 +414,12 @@ fn holds_format(path: &Path, format: &str) -> bool {
     if file.take(1024).read_to_end(&mut head).is_err() {
         return false;
     }
+    begins_as(&head, format)
+}
+
+/// `holds_format` for a file's first bytes (its first KiB is enough; `batch` reads an index
+/// whole and asks of it as of a file).
+pub fn begins_as(head: &[u8], format: &str) -> bool {
     if head.is_empty() {
         return true;
     }
@@ -424,7 +430,7 @@ fn holds_format(path: &Path, format: &str) -> bool {
         "batch index" => {
             // Token by token, white space and a UTF-8 byte-order mark passed over: a re-saved
             // index (`"generator":"snakeskin"`, compact) is one still (a review).
-            let mut rest = head.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&head);
+            let mut rest = head.strip_prefix(b"\xef\xbb\xbf").unwrap_or(head);
             ["{", "\"generator\"", ":", "\"snakeskin\""].iter().all(|token| {
                 rest = rest.trim_ascii_start();
                 let found = rest.starts_with(token.as_bytes());

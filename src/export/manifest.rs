@@ -314,12 +314,26 @@ pub enum ManifestReadError {
 /// run writes (wider than `SIZE_RANGE`, taller than `generate::MAX_HEIGHT`: a forged
 /// manifest's 2³² × 2³² made the bound wrap to nothing), nothing is.
 pub fn set_file_max_bytes(json: &serde_json::Value) -> u64 {
-    let (Some(width), Some(height)) = (json["width"].as_u64(), json["height"].as_u64()) else { return 0 };
-    if width > u64::from(*crate::SIZE_RANGE.end()) || height > crate::generate::MAX_HEIGHT as u64 {
-        return 0;
-    }
+    let Ok((width, height)) = set_size(json) else { return 0 };
     let maps = MapKind::ALL.len() as u64;
     width * height * 16 * maps * 2 + (1 << 20)
+}
+
+/// The set's `width` and `height` as a run writes them, or why they are not (the key and
+/// what is accepted: `verify` blamed every map for being "more than such a file can be"
+/// where the manifest's size was missing or forged, a hostile-input review).
+fn set_size(json: &serde_json::Value) -> Result<(u64, u64), String> {
+    let (max_width, max_height) = (u64::from(*crate::SIZE_RANGE.end()), crate::generate::MAX_HEIGHT as u64);
+    match (json["width"].as_u64(), json["height"].as_u64()) {
+        (Some(width), _) if width > max_width => {
+            Err(format!("the manifest's width {width} is wider than any set ({max_width} pixels at most)"))
+        }
+        (_, Some(height)) if height > max_height => {
+            Err(format!("the manifest's height {height} is taller than any set ({max_height} pixels at most)"))
+        }
+        (Some(width), Some(height)) => Ok((width, height)),
+        _ => Err("the manifest's width and height are not both whole numbers of pixels".into()),
+    }
 }
 
 /// The SHA-256 of an earlier set's file (or an earlier export's image), streamed (the file is
@@ -368,6 +382,7 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
 pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) -> Result<VerifiedSet, ExportError> {
     let problem = |problem: String| ExportError::Verify { manifest: manifest_path.into(), problem };
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
+    set_size(json).map_err(problem)?;
     let file_limit = set_file_max_bytes(json);
     let maps = json["maps"]
         .as_array()
