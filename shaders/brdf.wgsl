@@ -89,12 +89,15 @@ fn specular_scale(cos_h: f32, sin2_h: f32, cos_i: f32, cos_o: f32, a2: f32) -> f
     return d * g2 / (4.0 * cos_i * cos_o);
 }
 
-// Snell's cos^2 in n2 of light at cosine cos in n0, below 0 beyond the critical angle of
-// n0 > n2; (1 - eta^2) + eta^2 cos^2, exact at grazing light where eta = 1
-// (optics::brdf::snell_cos_sq).
-fn snell_cos_sq(n0: f32, n2: f32, cos: f32) -> f32 {
-    let eta2 = (n0 / n2) * (n0 / n2);
-    return (1.0 - eta2) + eta2 * cos * cos;
+// GGX alpha of a roughness: roughness^2 within [ALPHA_MIN, 1] (optics::brdf::ggx_alpha).
+fn ggx_alpha(roughness: f32) -> f32 {
+    return clamp(roughness * roughness, ALPHA_MIN, 1.0);
+}
+
+// (n0/n2)^2, the radiance factor of light leaving the pigment layer into the ambient
+// (optics::brdf::radiance_factor).
+fn radiance_factor(n0: f32, n2: f32) -> f32 {
+    return (n0 / n2) * (n0 / n2);
 }
 
 // ---- The thesis model (optics::brdf::thesis). ----
@@ -158,15 +161,21 @@ struct LobeCell {
     fy: f32,
 }
 
+// The continuous row coordinate of `roughness` in every table with a roughness axis, rows
+// uniform in r (optics::brdf::energy::GridCell::row_coordinate).
+fn roughness_coordinate(roughness: f32) -> f32 {
+    return clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
+}
+
 // The lobe table's roughness row below `roughness` (GridCell::at's j).
 fn lobe_row(roughness: f32) -> u32 {
-    return min(u32(clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u)), E1_ROUGHNESS - 2u);
+    return min(u32(roughness_coordinate(roughness)), E1_ROUGHNESS - 2u);
 }
 
 fn lobe_cell(cos: f32, roughness: f32) -> LobeCell {
     // sqrt: the nodes are uniform in sqrt(mu) (optics::brdf::energy::node_mu).
     let x = sqrt(clamp(cos, 0.0, 1.0)) * f32(E1_MU - 1u);
-    let y = clamp(roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u);
+    let y = roughness_coordinate(roughness);
     let i = min(u32(x), E1_MU - 2u);
     let j = lobe_row(roughness);
     return LobeCell(LOBE_VEC4S * (j * E1_MU + i), LOBE_VEC4S * ((j + 1u) * E1_MU + i), x - f32(i), y - f32(j));
@@ -212,7 +221,7 @@ fn normal_transmittance(optical_depth: vec3<f32>, roughness: f32) -> vec3<f32> {
 // (n0/n2)^2 k_d a(mu_i) a(mu_o) / (pi (1 - k_d K)), the two paths through the pigment layer
 // in one exponential (layered::diffuse_f32), with the tops at mu_i and mu_o (coupling).
 fn layered_diffuse(layers: Layers, cos_i: f32, cos_o: f32, top_i: Top, top_o: Top) -> vec3<f32> {
-    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    let eta2 = radiance_factor(layers.n0, layers.n2);
     let k_i = snell_cos_sq(layers.n0, layers.n2, cos_i);
     let k_o = snell_cos_sq(layers.n0, layers.n2, cos_o);
     let kd = clamp(layers.albedo, vec3<f32>(0.0), vec3<f32>(1.0));
@@ -418,7 +427,7 @@ fn coupling_table(layers: Layers, cos: f32) -> Top {
     // sqrt: the table's cos texels are uniform in sqrt(cos) (optics::lut::coupling_texel_cos).
     let x = sqrt(clamp(cos, 0.0, 1.0)) * (n_cos - 1.0);
     let rows = f32(E1_ROUGHNESS);
-    let v = (clamp(layers.roughness, 0.0, 1.0) * (rows - 1.0) + 0.5) / rows;
+    let v = (roughness_coordinate(layers.roughness) + 0.5) / rows;
     let reads = footprint_reads(layers);
     var t = coupling_texels(x, v, footprint_thickness(layers, 0u));
     if (reads == 2u) {
@@ -538,7 +547,7 @@ fn skin_brdf_seen(
     if (dot(h, h) == 0.0) {
         return vec3<f32>(0.0);
     }
-    let alpha = clamp(layers.roughness * layers.roughness, ALPHA_MIN, 1.0);
+    let alpha = ggx_alpha(layers.roughness);
     let cos_h = clamp(dot(n, h), 0.0, 1.0);
     // sin^2 from the cross product: cos^2 (a^2 - 1) + 1 cancels near the peak in f32.
     let nxh = cross(n, h);

@@ -116,8 +116,16 @@ fn harmonics(a: vec2<f32>, b: vec2<f32>) -> Harmonics {
     return Harmonics(dot(a, a) + k2 * inv, cmul(k, vec2<f32>(a.x, -a.y)) + q * (k2 * inv), q);
 }
 
-fn cos_in(eta: f32, cos0: f32) -> vec2<f32> {
-    return csqrt_real((1.0 - eta * eta) + eta * eta * cos0 * cos0);
+// Snell's cos^2 in n of light at cosine cos in n0, below 0 beyond the critical angle of
+// n0 > n; (1 - eta^2) + eta^2 cos^2, exact at grazing light where eta = 1
+// (optics::film::snell_cos_sq). Every later file of a program reads it.
+fn snell_cos_sq(n0: f32, n: f32, cos: f32) -> f32 {
+    let eta2 = (n0 / n) * (n0 / n);
+    return (1.0 - eta2) + eta2 * cos * cos;
+}
+
+fn cos_in(n0: f32, n: f32, cos0: f32) -> vec2<f32> {
+    return csqrt_real(snell_cos_sq(n0, n, cos0));
 }
 
 fn r_s(ni: f32, ci: vec2<f32>, nj: f32, cj: vec2<f32>) -> vec2<f32> {
@@ -139,12 +147,12 @@ fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
     let c0 = vec2<f32>(cos0, 0.0);
     // Off exactly 0 at the film's critical angle (optics::fast::film_f32).
     let eta1 = n0 / n1;
-    var x1 = (1.0 - eta1 * eta1) + eta1 * eta1 * cos0 * cos0;
+    var x1 = snell_cos_sq(n0, n1, cos0);
     if (x1 == 0.0) {
         x1 = F32_EPSILON * abs(1.0 - eta1 * eta1);
     }
     let c1 = csqrt_real(x1);
-    let c2 = cos_in(n0 / n2, cos0);
+    let c2 = cos_in(n0, n2, cos0);
     let a_s = r_s(n0, c0, n1, c1);
     let b_s = r_s(n1, c1, n2, c2);
     let a_p = r_p(n0, c0, n1, c1);
@@ -281,7 +289,7 @@ fn film_gaussian_fit(thickness_nm: f32, cos0: f32) -> vec3<f32> {
 fn film_none(cos0: f32) -> vec3<f32> {
     let n = film_info.iors_band;
     let c0 = vec2<f32>(clamp(cos0, 0.0, 1.0), 0.0);
-    let c2 = cos_in(n.x / n.z, c0.x);
+    let c2 = cos_in(n.x, n.z, c0.x);
     let rs = r_s(n.x, c0, n.z, c2);
     let rp = r_p(n.x, c0, n.z, c2);
     return vec3<f32>(0.5 * (dot(rs, rs) + dot(rp, rp)));

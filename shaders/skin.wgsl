@@ -20,7 +20,7 @@ override FOOTPRINT_SPREAD: bool = true;
 // LayerOptics::layers is the CPU twin).
 fn layers_of(m: Material, thickness_offset_nm: f32) -> Layers {
     let j = lobe_row(m.roughness);
-    let f = clamp(m.roughness, 0.0, 1.0) * f32(E1_ROUGHNESS - 1u) - f32(j);
+    let f = roughness_coordinate(m.roughness) - f32(j);
     var x = 0.0;
     if (scene.film.y > scene.film.x) {
         x = clamp((m.thickness_nm - scene.film.x) / (scene.film.y - scene.film.x), 0.0, 1.0);
@@ -66,8 +66,7 @@ fn ambient(layers: Layers, n: vec3<f32>, wo: vec3<f32>, top_o: Top, with_diffuse
 // harmonic at FOOTPRINT_WAVELENGTH_NM as the spread does).
 fn footprint_offset_nm(spread_nm: f32, cos_o: f32) -> f32 {
     let n = film_info.iors_band;
-    let sin1_sq = (n.x / n.y) * (n.x / n.y) * (1.0 - cos_o * cos_o);
-    let cos1 = sqrt(max(1.0 - sin1_sq, 0.0));
+    let cos1 = sqrt(max(snell_cos_sq(n.x, n.y, cos_o), 0.0));
     let phase_per_nm = 4.0 * PI * n.y * cos1 / FOOTPRINT_WAVELENGTH_NM;
     if (phase_per_nm <= 0.0) {
         return spread_nm;

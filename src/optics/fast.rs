@@ -5,6 +5,7 @@
 //! `harmonics_f32` computes the same Fourier coefficients as `series::FilmSeries` and
 //! `reflectance_f32` sums the prefiltered series (see `series.rs` for the derivation).
 
+use super::film::snell_cos_sq_f32;
 use super::series::MAX_Q;
 
 pub type C32 = [f32; 2];
@@ -121,14 +122,12 @@ pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
         };
     }
     let c0: C32 = [cos0, 0.0];
-    // (1 − η²) + η² cos²θ0: exact for η = 1 at grazing (see film::cos_in).
-    let cos_sq = |eta: f32| (1.0 - eta * eta) + eta * eta * cos0 * cos0;
     // Where the film's cancels to exactly 0 (light at its critical angle), the size of the
     // sum's rounding, as `film::film_cos_in` (never 0 where n1 = n0: cos0² is normal here).
+    let x1 = snell_cos_sq_f32(n0, n1, cos0);
     let eta1 = n0 / n1;
-    let x1 = cos_sq(eta1);
     let c1 = sqrt_real(if x1 == 0.0 { f32::EPSILON * (1.0 - eta1 * eta1).abs() } else { x1 });
-    let c2 = sqrt_real(cos_sq(n0 / n2));
+    let c2 = sqrt_real(snell_cos_sq_f32(n0, n2, cos0));
     let r = |ni: f32, ci: C32, nj: f32, cj: C32| {
         let (a, b) = (scale(ci, ni), scale(cj, nj));
         let rs = div(sub(a, b), add(a, b));

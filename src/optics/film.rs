@@ -46,13 +46,29 @@ impl FilmRT {
     }
 }
 
-/// Complex cosine of the angle in a medium of index `n` for incidence `cos0` in `n0`:
-/// sqrt(1 − (n0/n)² sin²θ0), imaginary (evanescent) beyond total internal reflection.
-pub fn cos_in(n0: f64, n: f64, cos0: f64) -> C64 {
-    // Written as (1 − η²) + η² cos²θ0 rather than 1 − η² sin²θ0: at grazing incidence with
-    // η = 1 the latter cancels to 0 and the film equations divide 0 by 0.
+/// Snell's cos² of the direction refracted into a medium of index `n` from a direction at
+/// cosine `cos` in `n0`, below 0 beyond the critical angle of n0 > n. Written as
+/// (1 − η²) + η² cos² rather than 1 − η² sin²: at grazing light with η = 1 the latter
+/// cancels to 0 and the film equations divide 0 by 0. Every refraction of the models reads
+/// it (the film's cosines here and in `fast`, `brdf::cos_transmitted`, the renderer's
+/// `footprint_offset_nm`); `film.wgsl`'s `snell_cos_sq` is the same expression. (The random
+/// walk's `refract` keeps its own: the reference is written apart from what it checks.)
+pub fn snell_cos_sq(n0: f64, n: f64, cos: f64) -> f64 {
     let eta2 = (n0 / n) * (n0 / n);
-    C64::real((1.0 - eta2) + eta2 * cos0 * cos0).sqrt_upper()
+    (1.0 - eta2) + eta2 * cos * cos
+}
+
+/// `snell_cos_sq` in f32.
+pub fn snell_cos_sq_f32(n0: f32, n: f32, cos: f32) -> f32 {
+    let eta2 = (n0 / n) * (n0 / n);
+    (1.0 - eta2) + eta2 * cos * cos
+}
+
+/// Complex cosine of the angle in a medium of index `n` for incidence `cos0` in `n0`:
+/// sqrt(1 − (n0/n)² sin²θ0) (`snell_cos_sq`), imaginary (evanescent) beyond total internal
+/// reflection.
+pub fn cos_in(n0: f64, n: f64, cos0: f64) -> C64 {
+    C64::real(snell_cos_sq(n0, n, cos0)).sqrt_upper()
 }
 
 /// cos θ1 in a film of index `n1` under an ambient of index `n0` (`cos_in`), except where

@@ -26,7 +26,7 @@ use rayon::prelude::*;
 
 use std::sync::OnceLock;
 
-use crate::optics::brdf::energy::{self, E1_ROUGHNESS};
+use crate::optics::brdf::energy::{self, E1_ROUGHNESS, GridCell};
 use crate::optics::brdf::path;
 
 use super::film::{FilmAtAngle, Stack};
@@ -223,7 +223,7 @@ impl Lut {
                         let cos = coupling_texel_cos(i_cos, n_cos);
                         let top = energy::top_on_row_with_f32(cos, i_r, &film, &path.through_f32, rule, norm);
                         let (s, m) = (top.reflected, top.ms_amplitude);
-                        let r = i_r as f32 / (E1_ROUGHNESS - 1) as f32;
+                        let r = GridCell::<f32>::row_roughness(i_r);
                         let delta = energy::GridCell::<f32>::at(cos, r).bilinear(&path.delta_f32);
                         column.push([s[0], s[1], s[2], delta, m[0], m[1], m[2], 0.0]);
                     }
@@ -358,9 +358,7 @@ impl Lut {
         let x = self.column_f32(thickness_nm);
         let x0 = x as usize;
         let (x1, fx) = ((x0 + 1).min(self.width() - 1), x - x0 as f32);
-        let z = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as f32;
-        let z0 = (z as usize).min(E1_ROUGHNESS - 2);
-        let fz = z - z0 as f32;
+        let (z0, fz) = GridCell::<f32>::row_below(roughness);
         let corner = |i_d: usize, wx: f32, i_r: usize, wz: f32| ((i_d * E1_ROUGHNESS + i_r) * self.n_cos, wx * wz);
         [
             corner(x0, 1.0 - fx, z0, 1.0 - fz),

@@ -16,7 +16,7 @@
 //! the map then agree.
 
 use super::schema::{Preset, Srgb8};
-use crate::optics::brdf::energy::E1_ROUGHNESS;
+use crate::optics::brdf::energy::{E1_ROUGHNESS, GridCell};
 use crate::optics::brdf::{exact, layered};
 use crate::render::engine::scene::LayerOptics;
 use rayon::prelude::*;
@@ -89,11 +89,11 @@ pub fn visible_limit(preset: &Preset) -> Option<[f64; 3]> {
     // top shows less: its light crosses the pigment layer more obliquely, so the rows of
     // roughness the map never reaches would clamp too hard).
     let (lo, hi) = crate::maps::roughness_range(preset);
-    let steps = (E1_ROUGHNESS - 1) as f64;
-    let rows = (lo * steps).floor() as usize..=((hi * steps).ceil() as usize).min(E1_ROUGHNESS - 1);
+    let row = GridCell::<f64>::row_coordinate;
+    let rows = row(lo).floor() as usize..=(row(hi).ceil() as usize).min(E1_ROUGHNESS - 1);
     let t1: Vec<(usize, [f64; 3])> = rows
         .map(|j| {
-            let roughness = j as f64 / steps;
+            let roughness = GridCell::<f64>::row_roughness(j);
             (j, layered::normal_transmittance(optics.stack.n0, optics.stack.n2, roughness, optics.optical_depth))
         })
         .collect();

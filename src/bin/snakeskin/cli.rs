@@ -1474,6 +1474,34 @@ mod tests {
         assert!(!names(2e-3), "{help}");
     }
 
+    /// The largest N that a help text gives `spectral-N` (and `Method::ACCEPTED`, which
+    /// errors quote) is the number of 1 nm samples of the reference, `spectrum::SAMPLES`: a
+    /// help text cannot take the constant. Negative control: a text naming 420.
+    #[test]
+    fn the_spectral_band_limit_named_in_help_is_the_sample_count() {
+        use snakeskin::optics::spectrum::SAMPLES;
+        fn limits(text: &str) -> Vec<usize> {
+            ["N = 1 to ", "N = 1.."]
+                .iter()
+                .flat_map(|p| text.match_indices(p).map(move |(i, _)| &text[i + p.len()..]))
+                .filter_map(|rest| rest.split(|c: char| !c.is_ascii_digit()).next()?.parse().ok())
+                .collect()
+        }
+        fn helps(command: &clap::Command, out: &mut Vec<String>) {
+            for arg in command.get_arguments() {
+                out.extend([arg.get_help(), arg.get_long_help()].into_iter().flatten().map(|h| h.to_string()));
+            }
+            for sub in command.get_subcommands() {
+                helps(sub, out);
+            }
+        }
+        let mut texts = vec![snakeskin::optics::methods::Method::ACCEPTED.to_string()];
+        helps(&<Cli as clap::CommandFactory>::command(), &mut texts);
+        let named: Vec<usize> = texts.iter().flat_map(|t| limits(t)).collect();
+        assert!(named.len() >= 4 && named.iter().all(|n| *n == SAMPLES), "{named:?}");
+        assert_eq!(limits("spectral-N (N = 1 to 420, e.g. spectral-16)"), [420]);
+    }
+
     #[test]
     fn a_normal_is_a_direction_or_zero() {
         assert_eq!(parse_normal("0,0,0"), Ok([0.0; 3]));

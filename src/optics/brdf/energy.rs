@@ -67,7 +67,7 @@ use std::sync::OnceLock;
 
 use super::ggx::{ggx_d_sin, smith_g2, stratified_half_vectors};
 use super::path::{THROUGH_LEN, THROUGH_NODES};
-use super::{ALPHA_MIN, COS_MIN};
+use super::{COS_MIN, ggx_alpha};
 
 /// Table entries over μ ∈ [0, 1] (at `node_mu`, dense towards grazing light) and over
 /// r ∈ [0, 1] (uniform).
@@ -193,7 +193,7 @@ pub fn lobe(cos_o: f64, roughness: f64) -> Lobe {
 fn lobe_samples(cos_o: f64, roughness: f64) -> impl Iterator<Item = (f64, f64)> {
     let cos_o = cos_o.clamp(COS_MIN, 1.0);
     let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
-    let alpha = (roughness * roughness).clamp(ALPHA_MIN, 1.0);
+    let alpha = ggx_alpha(roughness);
     stratified_half_vectors(wo, alpha, STRATA).map(move |hv| {
         let cos_i = hv.wi[2];
         let f = ggx_d_sin(hv.cos_h, hv.sin_h * hv.sin_h, alpha) * smith_g2(cos_i.max(COS_MIN), cos_o, alpha)
@@ -283,7 +283,7 @@ pub fn quantile_table() -> &'static [[f64; QUANTILES]] {
         split_over_threads(E1_MU * E1_ROUGHNESS, |k| {
             let (i_mu, i_r) = (k % E1_MU, k / E1_MU);
             let mu = node_mu(i_mu);
-            if i_r == 0 { [mu; QUANTILES] } else { quantile_nodes(mu, i_r as f64 / (E1_ROUGHNESS - 1) as f64) }
+            if i_r == 0 { [mu; QUANTILES] } else { quantile_nodes(mu, GridCell::<f64>::row_roughness(i_r)) }
         })
     })
 }
@@ -554,10 +554,10 @@ fn multiple_scattering(i_mu: usize, i_r: usize, lobe: &Lobe) -> Multiple {
     if i_r == 0 {
         return fallback;
     }
-    // As the path table's walks: light exactly along the surface never meets it.
-    let mu = node_mu(i_mu).max(1e-3);
-    let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
-    let alpha = (r * r).max(ALPHA_MIN);
+    // As the path table's walks (`path::MU_MIN`): light exactly along the surface never meets it.
+    let mu = node_mu(i_mu).max(super::path::MU_MIN);
+    let r = GridCell::<f64>::row_roughness(i_r);
+    let alpha = ggx_alpha(r);
     let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
     // Not a multiple of SplitMix64's own increment (0x9e37…), which would make one node's
     // stream another's shifted by a few draws.
@@ -606,7 +606,7 @@ pub fn tables() -> &'static Tables {
 pub(super) fn build_lobe_nodes() -> Vec<[f32; NODE_LEN]> {
     let mut lobes = Vec::with_capacity(E1_MU * E1_ROUGHNESS);
     for i_r in 0..E1_ROUGHNESS {
-        let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
+        let r = GridCell::<f64>::row_roughness(i_r);
         // r = 0 is a mirror: everything the film reflects leaves by the lobe, at μ.
         let row: Vec<Lobe> = (0..E1_MU)
             .map(|i_mu| {
@@ -699,12 +699,35 @@ macro_rules! grid_cell_impl {
                 cos.clamp(0.0, 1.0).sqrt() * (n - 1) as $t
             }
 
+            /// The roughness of row `j` of every table with a roughness axis (the lobe and
+            /// energy tables, the path table, the film table's coupling, the bounce rows):
+            /// j / (E1_ROUGHNESS − 1), rows uniform in r.
+            pub fn row_roughness(j: usize) -> $t {
+                j as $t / (E1_ROUGHNESS - 1) as $t
+            }
+
+            /// The continuous row coordinate of `roughness`, clamped to [0, 1]: the inverse of
+            /// `row_roughness` (`brdf.wgsl`'s `roughness_coordinate`).
+            #[inline(always)]
+            pub fn row_coordinate(roughness: $t) -> $t {
+                roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as $t
+            }
+
+            /// The row below `roughness` (at most the last but one) and the weight of the
+            /// row above.
+            #[inline(always)]
+            pub fn row_below(roughness: $t) -> (usize, $t) {
+                let y = Self::row_coordinate(roughness);
+                let j = (y as usize).min(E1_ROUGHNESS - 2);
+                (j, y - j as $t)
+            }
+
             pub fn at(cos: $t, roughness: $t) -> GridCell<$t> {
                 // The nodes lie at `node_mu`.
                 let x = Self::axis_coordinate(cos, E1_MU);
-                let y = roughness.clamp(0.0, 1.0) * (E1_ROUGHNESS - 1) as $t;
-                let (i, j) = ((x as usize).min(E1_MU - 2), (y as usize).min(E1_ROUGHNESS - 2));
-                GridCell { i, j, fx: x - i as $t, fy: y - j as $t }
+                let i = (x as usize).min(E1_MU - 2);
+                let (j, fy) = Self::row_below(roughness);
+                GridCell { i, j, fx: x - i as $t, fy }
             }
 
             /// Bilinear interpolation of a table of the grid.
@@ -992,7 +1015,7 @@ mod tests {
         for k in [4 * E1_MU + 5, 7 * E1_MU + 20, E1_ROUGHNESS * E1_MU - 1] {
             let (i_mu, i_r) = (k % E1_MU, k / E1_MU);
             let mu = node_mu(i_mu);
-            let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
+            let r = GridCell::<f64>::row_roughness(i_r);
             let alone = multiple_scattering(i_mu, i_r, &lobe(mu, r));
             assert_ne!(alone, Multiple::of_lobe(&lobe(mu, r).rule), "node ({i_mu}, {i_r}) is walked");
             let held = &node(i_mu, i_r)[PAIR_SLOT..];
@@ -1042,7 +1065,7 @@ mod tests {
         use crate::optics::film::Stack;
         use crate::optics::lab::{ciede2000, linear_srgb_to_lab};
         let i_r = E1_ROUGHNESS - 2;
-        let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
+        let r = GridCell::<f64>::row_roughness(i_r);
         let water = Stack { n0: 1.33, n1: 1.55, n2: 2.0 };
         let air = Stack { n0: 1.0, n1: 1.55, n2: 2.0 };
         for (stack, thickness_nm, i_mu, bound, uncorrelated_above) in
@@ -1145,7 +1168,7 @@ mod tests {
         let film = |c: f64| [0.04 + 0.5 * (1.0 - c).powi(3), 0.2 + 0.1 * (7.0 * c).sin(), 0.3 * c * c];
         for (i_mu, i_r) in [(20, 12), (3, 15), (31, 9)] {
             let mu = node_mu(i_mu);
-            let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
+            let r = GridCell::<f64>::row_roughness(i_r);
             let rule = multiple_scattering(i_mu, i_r, &lobe(mu, r));
             let e1 = node(i_mu, i_r)[0] as f64;
             let (_, x) = parts_on_row(mu, i_r, &film, &[], LobeRule::Gauss);

@@ -23,7 +23,8 @@ use std::f64::consts::PI;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use super::energy;
-use super::{BrdfValue, Layers, cos_transmitted};
+use super::layered::{closed_form_diffuse, closed_form_reflectance};
+use super::{BrdfValue, Layers, cos_transmitted, radiance_factor};
 use crate::optics::film::Stack;
 use crate::optics::film_rgb_reference;
 use crate::optics::spectrum::{Observer, xyz_to_linear_srgb};
@@ -246,7 +247,7 @@ impl SmoothTop {
         let sent_back = |node: usize, _| inside[node];
         let absorbing = tau.iter().any(|t| *t > 0.0);
         let path = (row > 0 && absorbing).then(|| super::path::cached(self.stack.n0, self.stack.n2));
-        let r = row as f64 / (energy::E1_ROUGHNESS - 1) as f64;
+        let r = energy::GridCell::<f64>::row_roughness(row);
         let (mut k, mut e) = match &path {
             None => self.integrate(tau, sent_back, |_, mu| mu),
             Some(path) => self.integrate(tau, sent_back, |node, mu| match self.outside[node] {
@@ -258,7 +259,7 @@ impl SmoothTop {
         if row == 0 {
             return (k, e);
         }
-        let eta2 = (self.stack.n0 / self.stack.n2).powi(2);
+        let eta2 = radiance_factor(self.stack.n0, self.stack.n2);
         for (&(mu_out, weight), s) in self.beyond_critical.iter().zip(beyond) {
             let cos_eff = path.as_ref().map_or(1.0, |p| p.cos_eff(0.0, mu_out, r));
             for c in 0..3 {
@@ -309,11 +310,8 @@ impl SmoothTop {
     pub fn diffuse(&self, layers: &Layers, cos_i: f64, cos_o: f64) -> [f64; 3] {
         let (k, _) = self.k_e(layers.optical_depth);
         let (a_i, a_o) = (self.entering(layers, cos_i), self.entering(layers, cos_o));
-        let eta2 = (self.stack.n0 / self.stack.n2).powi(2);
-        [0, 1, 2].map(|c| {
-            let kd = layers.albedo[c].max(0.0);
-            a_i[c] * a_o[c] * eta2 * kd / (PI * (1.0 - kd * k[c]))
-        })
+        let eta2 = radiance_factor(self.stack.n0, self.stack.n2);
+        [0, 1, 2].map(|c| closed_form_diffuse(eta2, layers.albedo[c], a_i[c], a_o[c], k[c]))
     }
 
     /// The directional albedo for light from a direction at cosine `cos_i`: the mirror
@@ -322,10 +320,7 @@ impl SmoothTop {
     pub fn albedo(&self, layers: &Layers, cos_i: f64) -> BrdfValue {
         let (k, e) = self.k_e(layers.optical_depth);
         let a_i = self.entering(layers, cos_i);
-        let diffuse = [0, 1, 2].map(|c| {
-            let kd = layers.albedo[c].max(0.0);
-            a_i[c] * kd * e[c] / (1.0 - kd * k[c])
-        });
+        let diffuse = [0, 1, 2].map(|c| closed_form_reflectance(layers.albedo[c], a_i[c], k[c], e[c]));
         BrdfValue { specular: reflectance(self.stack, self.thickness_nm, cos_i), diffuse }
     }
 }
@@ -351,9 +346,7 @@ impl BounceTable {
 
 /// The roughness row below `roughness` and the weight of the one above (rows uniform in r).
 fn row_of(roughness: f64) -> (usize, f64) {
-    let x = roughness.clamp(0.0, 1.0) * (energy::E1_ROUGHNESS - 1) as f64;
-    let i = (x as usize).min(energy::E1_ROUGHNESS - 2);
-    (i, x - i as f64)
+    energy::GridCell::<f64>::row_below(roughness)
 }
 
 type KE = ([f64; 3], [f64; 3]);

@@ -84,17 +84,20 @@ impl PigmentBelowAmbient {
             let critical_angle_deg = (stack.n2 / stack.n0).asin().to_degrees();
             return Some(PigmentBelowAmbient::LowContrast { critical_angle_deg });
         }
-        let last = (super::energy::E1_ROUGHNESS - 1) as f64;
+        let row = super::energy::GridCell::<f64>::row_coordinate;
         let (smoothest, roughest) = (roughness.0.min(roughness.1), roughness.0.max(roughness.1));
-        let rows =
-            (smoothest.clamp(0.0, 1.0) * last).floor() as usize..=(roughest.clamp(0.0, 1.0) * last).ceil() as usize;
+        let rows = row(smoothest).floor() as usize..=row(roughest).ceil() as usize;
         let mut found: Option<(f64, f64)> = None;
         for row in rows {
             for film_nm in [thickness_nm.0, thickness_nm.1] {
                 let (k, e) = super::exact::cached(stack, film_nm).k_e_row([0.0; 3], row);
                 let excess = (0..3).map(|c| k[c] + e[c] - 1.0).fold(0.0, f64::max);
                 if excess > PIGMENT_BELOW_AMBIENT_EXCESS {
-                    found = Some(found.map_or((row as f64 / last, excess), |(from, worst)| (from, worst.max(excess))));
+                    found = Some(
+                        found.map_or((super::energy::GridCell::<f64>::row_roughness(row), excess), |(from, worst)| {
+                            (from, worst.max(excess))
+                        }),
+                    );
                 }
             }
         }
@@ -202,21 +205,45 @@ pub fn normal_transmittance(n0: f64, n2: f64, roughness: f64, optical_depth: [f6
     path_transmittance(n0, n2, roughness, optical_depth, 1.0, 1.0)
 }
 
+/// The closed form of PHYSICS.md ("Layered transport, exactly") for one channel, written
+/// once for every lobe that reads it: the model's (`diffuse`, `ambient_diffuse`,
+/// `diffuse_f32`, `visible_colour`) and the smooth-top reference's (`exact::SmoothTop`);
+/// `brdf.wgsl`'s `layered_diffuse` and `layered_ambient_diffuse` are the shader's forms.
+///
+/// - `closed_form_diffuse`: the diffuse lobe (n0/n2)² k_d a_i a_o / (π (1 − k_d K)), a_i and
+///   a_o the light let in along each direction and carried through the pigment layer, the
+///   base's bounces 1 / (1 − k_d K) with K what the top sends back down;
+/// - `closed_form_reflectance`: the directional diffuse reflectance a k_d E / (1 − k_d K),
+///   E the share of the base's light that escapes.
+///
+/// k_d is read within [0, 1] (`albedo.clamp`): above 1 the base would give back more than
+/// reaches it and the bounce series can diverge. (The smooth-top reference read max(0)
+/// alone until the two were one function; the random walk clamps as here.)
+macro_rules! closed_form_diffuse {
+    ($name:ident, $float:ty, $pi:expr) => {
+        pub fn $name(radiance_factor: $float, albedo: $float, a_i: $float, a_o: $float, k: $float) -> $float {
+            let kd = albedo.clamp(0.0, 1.0);
+            radiance_factor * kd * a_i * a_o / ($pi * (1.0 - kd * k))
+        }
+    };
+}
+closed_form_diffuse!(closed_form_diffuse, f64, PI);
+closed_form_diffuse!(closed_form_diffuse_f32, f32, std::f32::consts::PI);
+
+pub fn closed_form_reflectance(albedo: f64, a: f64, k: f64, e: f64) -> f64 {
+    let kd = albedo.clamp(0.0, 1.0);
+    a * kd * e / (1.0 - kd * k)
+}
+
 pub fn diffuse(layers: &Layers, cos_i: f64, cos_o: f64, f_i: [f64; 3], f_o: [f64; 3]) -> [f64; 3] {
     let (a_i, a_o) = (entering(layers, cos_i, f_i), entering(layers, cos_o, f_o));
-    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
-    [0, 1, 2].map(|c| {
-        let kd = layers.albedo[c].clamp(0.0, 1.0);
-        eta2 * kd * a_i[c] * a_o[c] / (PI * (1.0 - kd * layers.k[c]))
-    })
+    let eta2 = super::radiance_factor(layers.n0, layers.n2);
+    [0, 1, 2].map(|c| closed_form_diffuse(eta2, layers.albedo[c], a_i[c], a_o[c], layers.k[c]))
 }
 
 pub fn ambient_diffuse(layers: &Layers, cos_o: f64, f_o: [f64; 3]) -> [f64; 3] {
     let a_o = entering(layers, cos_o, f_o);
-    [0, 1, 2].map(|c| {
-        let kd = layers.albedo[c].clamp(0.0, 1.0);
-        a_o[c] * kd * layers.e[c] / (1.0 - kd * layers.k[c])
-    })
+    [0, 1, 2].map(|c| closed_form_reflectance(layers.albedo[c], a_o[c], layers.k[c], layers.e[c]))
 }
 
 /// The f32 diffuse lobe, as `brdf.wgsl`'s `layered_diffuse`: the two directions' paths
@@ -226,7 +253,7 @@ pub fn ambient_diffuse(layers: &Layers, cos_o: f64, f_o: [f64; 3]) -> [f64; 3] {
 /// (`lut::Lut::coupling_f32`).
 pub fn diffuse_f32(layers: &Layers32, cos: [f32; 2], reflected: [[f32; 3]; 2], path_delta: [f32; 2]) -> [f32; 3] {
     let ([cos_i, cos_o], [f_i, f_o]) = (cos, reflected);
-    let eta2 = (layers.n0 / layers.n2) * (layers.n0 / layers.n2);
+    let eta2 = super::radiance_factor_f32(layers.n0, layers.n2);
     // Snell's cos_t², below 0 beyond the critical angle of n0 > n2, where cos_t is taken as 0
     // (`path::snell_cos`).
     let (k_i, k_o) =
@@ -240,9 +267,9 @@ pub fn diffuse_f32(layers: &Layers32, cos: [f32; 2], reflected: [[f32; 3]; 2], p
         0.0
     };
     [0, 1, 2].map(|c| {
-        let kd = layers.albedo[c].clamp(0.0, 1.0);
         let attenuation = if absorbing { (-layers.optical_depth[c].max(0.0) * inverse_path).exp() } else { 1.0 };
-        eta2 * kd * (1.0 - f_i[c]) * (1.0 - f_o[c]) * attenuation / (std::f32::consts::PI * (1.0 - kd * layers.k[c]))
+        let (a_i, a_o) = ((1.0 - f_i[c]) * attenuation, 1.0 - f_o[c]);
+        closed_form_diffuse_f32(eta2, layers.albedo[c], a_i, a_o, layers.k[c])
     })
 }
 
@@ -260,8 +287,7 @@ pub fn diffuse_f32(layers: &Layers32, cos: [f32; 2], reflected: [[f32; 3]; 2], p
 /// top transmits), so a colour map is a base colour other tools read right. `base_albedo`
 /// inverts it per pixel.
 pub fn visible_colour(albedo: f64, normal_transmittance: f64, k: f64, e: f64) -> f64 {
-    let kd = albedo.clamp(0.0, 1.0);
-    normal_transmittance * kd * e / (1.0 - kd * k)
+    closed_form_reflectance(albedo, normal_transmittance, k, e)
 }
 
 /// The brightest visible colour the stack can show (k_d = 1): t₁ E / (1 − K). For a

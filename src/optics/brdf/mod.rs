@@ -39,6 +39,18 @@ use super::lut::Lut;
 /// Smallest GGX α: roughness 0 would make D a Dirac delta. 1e-3 keeps D's peak
 /// 1 / (π α²) ≈ 3.2e5, finite in f32, and is a mirror to the eye.
 pub const ALPHA_MIN: f64 = 1e-3;
+
+/// GGX α of a roughness: roughness² (the perceptual mapping of Burley 2012, as glTF reads
+/// its roughness), within [ALPHA_MIN, 1]. Every lobe, table and walk reads it; `brdf.wgsl`'s
+/// `ggx_alpha` is the same expression.
+pub fn ggx_alpha(roughness: f64) -> f64 {
+    (roughness * roughness).clamp(ALPHA_MIN, 1.0)
+}
+
+/// `ggx_alpha` in f32.
+pub fn ggx_alpha_f32(roughness: f32) -> f32 {
+    (roughness * roughness).clamp(ALPHA_MIN as f32, 1.0)
+}
 /// Floor on cosines after the hemisphere test.
 pub const COS_MIN: f64 = 1e-6;
 /// A direction shorter than this is treated as no direction (zero normal, zero wi or wo).
@@ -317,19 +329,19 @@ pub fn cos_transmitted(n0: f64, n2: f64, cos: f64) -> Option<f64> {
     (k > 0.0).then(|| k.sqrt())
 }
 
-/// Snell's cos² of the direction refracted into n2 from a direction at cosine `cos` in n0,
-/// below 0 beyond the critical angle of n0 > n2. Written as (1 − η²) + η² cos² rather than
-/// 1 − η² sin²: at grazing light with η = 1 the latter cancels to 0 (`film::cos_in`). The
-/// f32 twin `snell_cos_sq_f32` and `brdf.wgsl`'s `snell_cos_sq` are the same expression.
-pub fn snell_cos_sq(n0: f64, n2: f64, cos: f64) -> f64 {
-    let eta2 = (n0 / n2) * (n0 / n2);
-    (1.0 - eta2) + eta2 * cos * cos
+pub use crate::optics::film::{snell_cos_sq, snell_cos_sq_f32};
+
+/// (n0/n2)²: the radiance factor of light leaving the pigment layer (index n2) into the
+/// ambient (n0), radiance going as n² across an interface (PHYSICS.md, "Layered transport,
+/// exactly"). Every diffuse lobe and escape term multiplies by it; `brdf.wgsl`'s
+/// `radiance_factor` is the same expression.
+pub fn radiance_factor(n0: f64, n2: f64) -> f64 {
+    (n0 / n2) * (n0 / n2)
 }
 
-/// `snell_cos_sq` in f32.
-pub fn snell_cos_sq_f32(n0: f32, n2: f32, cos: f32) -> f32 {
-    let eta2 = (n0 / n2) * (n0 / n2);
-    (1.0 - eta2) + eta2 * cos * cos
+/// `radiance_factor` in f32.
+pub fn radiance_factor_f32(n0: f32, n2: f32) -> f32 {
+    (n0 / n2) * (n0 / n2)
 }
 
 /// The film as the f64 coupling reads it: at the cosine clamped to [0, 1], its colour
@@ -415,7 +427,7 @@ impl Model {
         let Some(h) = normalize32([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]) else {
             return [0.0; 3];
         };
-        let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN as f32, 1.0);
+        let alpha = ggx_alpha_f32(layers.roughness);
         let film = |c: f32| lut.lookup_f32(layers.thickness_nm, c.clamp(0.0, 1.0)).map(|v| v.clamp(0.0, 1.0));
 
         let cos_h = dot32(n, h).clamp(0.0, 1.0);
@@ -435,7 +447,7 @@ impl Model {
     pub fn furnace_albedo(self, layers: &Layers, cos_o: f64, film: &dyn Fn(f64) -> [f64; 3], n: usize) -> [f64; 3] {
         let cos_o = cos_o.clamp(COS_MIN, 1.0);
         let wo = [(1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o];
-        let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
+        let alpha = ggx_alpha(layers.roughness);
         let mut spec = [0.0; 3];
         for hv in ggx::stratified_half_vectors(wo, alpha, n) {
             // f cos θi / pdf(wi).
@@ -495,7 +507,7 @@ fn single_lobe(
     let (wi, wo) = (normalize(wi)?, normalize(wo)?);
     let (cos_i, cos_o) = (floored_cos(n, wi)?, floored_cos(n, wo)?);
     let h = normalize([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]])?;
-    let alpha = (layers.roughness * layers.roughness).clamp(ALPHA_MIN, 1.0);
+    let alpha = ggx_alpha(layers.roughness);
     let nxh = cross(n, h);
     let d = ggx_d_sin(dot(n, h).clamp(0.0, 1.0), dot(nxh, nxh), alpha);
     let g2 = smith_g2(cos_i, cos_o, alpha);
@@ -569,7 +581,7 @@ mod tests {
                 };
                 let c = cos_o.max(COS_MIN);
                 let wo = [(1.0 - c * c).sqrt(), 0.0, c];
-                let alpha = (roughness * roughness).clamp(ALPHA_MIN, 1.0);
+                let alpha = ggx_alpha(roughness);
                 let mut sum = [0.0; 3];
                 for hv in ggx::stratified_half_vectors(wo, alpha, n) {
                     let (single, _, _) = single_lobe(&layers, NORMAL, hv.wi, wo, &film).unwrap_or_default();

@@ -55,7 +55,7 @@
 use std::sync::{Arc, Mutex};
 
 use super::energy::{E1_MU, E1_ROUGHNESS, GridCell, node_mu};
-use super::{ALPHA_MIN, COS_MIN, cos_transmitted};
+use super::{COS_MIN, cos_transmitted, ggx_alpha};
 
 /// The optical depth the effective cosine is matched at (see the module's measurements).
 const TAU_REF: f64 = 0.5;
@@ -76,7 +76,7 @@ const THROUGH_ENTRY_MIN: usize = 64;
 /// weight is 1 minus the others).
 pub const THROUGH_LEN: usize = 2 * THROUGH_NODES;
 /// The most grazing light walked (μ = 0 itself never meets the top).
-const MU_MIN: f64 = 1e-3;
+pub(super) const MU_MIN: f64 = 1e-3;
 
 /// cos_eff − cos_t over (μ, r) on the lobe grid (row-major by roughness): the rough path's
 /// departure from Snell's, which is 0 in row r = 0, so a smooth top is Snell's law exactly
@@ -167,8 +167,8 @@ fn entry(n0: f64, n2: f64, k: usize) -> f64 {
     // microfacets; Snell's cosine is taken as 0 there (`snell_cos`), so the delta is the
     // effective cosine itself, and meets the one inside the critical angle at it.
     let cos_t = snell_cos(n0, n2, mu);
-    let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
-    let alpha = (r * r).max(ALPHA_MIN);
+    let r = GridCell::<f64>::row_roughness(i_r);
+    let alpha = ggx_alpha(r);
     let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
     let cosines = super::walk::transmitted_cosines(wi, alpha, n0, n2, PHOTONS, seed_of(k));
     if cosines.is_empty() {
@@ -193,8 +193,8 @@ fn through_walk(n0: f64, n2: f64, k: usize) -> ThroughWalk {
         return (0, 0, Vec::new());
     }
     let mu = node_mu(i_mu).max(MU_MIN);
-    let r = i_r as f64 / (E1_ROUGHNESS - 1) as f64;
-    let alpha = (r * r).max(ALPHA_MIN);
+    let r = GridCell::<f64>::row_roughness(i_r);
+    let alpha = ggx_alpha(r);
     let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
     let seed = seed_of(k) ^ 0x7468_726f_7567_6821;
     super::walk::through_cosines(wi, alpha, n0, n2, THROUGH_PHOTONS, seed)
@@ -398,7 +398,7 @@ mod tests {
         let walked = |n2: f64, k: usize| {
             let (i_mu, i_r) = (k % E1_MU, k / E1_MU);
             let mu = node_mu(i_mu).max(MU_MIN);
-            let alpha = ((i_r as f64 / (E1_ROUGHNESS - 1) as f64).powi(2)).max(ALPHA_MIN);
+            let alpha = ggx_alpha(GridCell::<f64>::row_roughness(i_r));
             let wi = [(1.0 - mu * mu).sqrt(), 0.0, mu];
             let down = super::super::walk::transmitted_cosines(wi, alpha, 1.4, n2, 256, seed_of(k));
             let (entered, back, _) = super::super::walk::through_cosines(wi, alpha, 1.4, n2, 256, seed_of(k));
@@ -456,7 +456,7 @@ mod tests {
             }
             let cos_eff = |i: usize, row: usize| {
                 let mu = node_mu(i);
-                let r = row as f64 / (E1_ROUGHNESS - 1) as f64;
+                let r = GridCell::<f64>::row_roughness(row);
                 table.cos_eff(cos_transmitted(n0, n2, mu).unwrap(), mu, r)
             };
             // Rough rows at light within 60° of the normal: the walked mean against the
@@ -464,13 +464,13 @@ mod tests {
             // multiple scattering there), and at τ = 1.5 through the one cos_eff (to 3 %: the
             // price of one τ_ref for every τ).
             for row in [2, 5] {
-                let r = row as f64 / (E1_ROUGHNESS - 1) as f64;
+                let r = GridCell::<f64>::row_roughness(row);
                 for i in [22, 27, 31] {
                     let mu = node_mu(i);
                     let cos_eff = cos_eff(i, row);
                     for (tau, tolerance) in [(TAU_REF, 0.01), (1.5, 0.03)] {
                         let walked = (-tau / cos_eff).exp();
-                        let quadrature = single_scatter_mean(n0, n2, mu, (r * r).max(ALPHA_MIN), tau);
+                        let quadrature = single_scatter_mean(n0, n2, mu, ggx_alpha(r), tau);
                         assert!(
                             (walked - quadrature).abs() < tolerance * quadrature,
                             "n0 {n0} n2 {n2} r {r:.2} μ {mu:.2} τ {tau}: walked {walked:.4}, quadrature {quadrature:.4}"

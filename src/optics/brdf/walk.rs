@@ -451,10 +451,10 @@ pub fn multiple_reflections(wi: V3, alpha: f64, twice: usize, photons: u64, seed
     paths
 }
 
-/// GGX α of the walk's top: 0 (a mirror, m = n) for roughness 0, else roughness² floored
-/// at ALPHA_MIN as in the models.
+/// GGX α of the walk's top: 0 (a mirror, m = n) for roughness 0, else the models'
+/// `ggx_alpha`.
 fn walk_alpha(layers: &Layers) -> f64 {
-    if layers.roughness <= 0.0 { 0.0 } else { (layers.roughness * layers.roughness).max(super::ALPHA_MIN) }
+    if layers.roughness <= 0.0 { 0.0 } else { super::ggx_alpha(layers.roughness) }
 }
 
 /// Each channel's own stream, fixed by the seed.

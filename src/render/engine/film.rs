@@ -53,10 +53,11 @@ impl GpuFilmMethod {
 
     pub fn name(self) -> String {
         match self {
-            GpuFilmMethod::Lut => "lut".into(),
-            GpuFilmMethod::Rgb3 => "rgb3".into(),
-            GpuFilmMethod::SpectralN(n) => format!("spectral-{n}"),
-            GpuFilmMethod::GaussianFit => "gaussian-fit".into(),
+            // The optics method's own name (`Method::name`); only "no film" is the GPU's.
+            GpuFilmMethod::Lut => Method::Lut.name(),
+            GpuFilmMethod::Rgb3 => Method::Rgb3.name(),
+            GpuFilmMethod::SpectralN(n) => Method::SpectralN(n).name(),
+            GpuFilmMethod::GaussianFit => Method::GaussianFit.name(),
             GpuFilmMethod::None => "none".into(),
         }
     }

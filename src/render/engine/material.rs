@@ -76,8 +76,7 @@ pub const FOOTPRINT_WAVELENGTH_NM: f64 = crate::optics::methods::RGB3_NM[1] as f
 /// f32, and the shader's twin returned 0 for a spread of 5 nm just past a film's critical
 /// angle (n1 < n0), where p is small.
 pub fn footprint_offset_nm(spread_nm: f64, n0: f64, n1: f64, cos_o: f64) -> f64 {
-    let sin1_sq = (n0 / n1).powi(2) * (1.0 - cos_o * cos_o);
-    let cos1 = (1.0 - sin1_sq).max(0.0).sqrt();
+    let cos1 = crate::optics::film::snell_cos_sq(n0, n1, cos_o).max(0.0).sqrt();
     // 2k: the phase per nm of thickness (the round trip through the film).
     let phase_per_nm = 4.0 * std::f64::consts::PI * n1 * cos1 / FOOTPRINT_WAVELENGTH_NM;
     if phase_per_nm <= 0.0 {

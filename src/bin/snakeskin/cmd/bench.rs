@@ -132,7 +132,8 @@ fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_d
         // An option pair, not a query: it said "invalid query".
         let reason = format!(
             "{d_step_nm} with --angle-step-deg {angle_step_deg} makes {points} grid points; at most \
-             {MAX_GRID_POINTS} are accepted (each needs a 421-wavelength reference sum): use larger steps"
+             {MAX_GRID_POINTS} are accepted (each needs a {SAMPLES}-wavelength reference sum): use larger steps",
+            SAMPLES = snakeskin::optics::spectrum::SAMPLES
         );
         return Err(Error::InvalidOption { option: "--d-step-nm", reason }.into());
     }
