@@ -85,10 +85,12 @@ pub enum BatchError {
          made each set there; remove it (or write to another folder) and run again"
     )]
     Index { path: PathBuf, reason: String },
-    /// Another batch run writes this index in the output folder now.
+    /// Another batch run held this index's lock through a second of tries (it holds it only
+    /// while it reads and writes the index: a run stopped there, or a file system that does
+    /// not release it).
     #[error(
-        "another snakeskin batch is running into {out} (it holds {lock}); run again when it has finished, or write to \
-         another folder"
+        "another snakeskin batch is writing the index in {out} (it holds {lock}); run again when it has finished, or \
+         write to another folder"
     )]
     Busy { out: PathBuf, lock: PathBuf },
     /// The job refused when the run was planned, before any job ran: its size (a body atlas
@@ -887,18 +889,6 @@ pub fn run(
     warn: &mut dyn FnMut(&str),
     progress: &mut dyn FnMut(usize, usize, &JobOutcome),
 ) -> Result<BatchIndex, Error> {
-    // One run at a time writes an index, from the plan to its last record: two runs into one
-    // folder each read the index as they began and wrote it whole at their end, and the later
-    // dropped the other's record (a review: the set so forgotten was then replaced by a third
-    // jobs file's preset of the same name). Shards keep their own indexes and run side by side.
-    let index_name = index_file_name(shard);
-    let _index_lock = crate::export::SetLock::acquire(out, &index_name).map_err(|e| match e {
-        crate::export::ExportError::Busy { .. } => Error::from(BatchError::Busy {
-            out: out.into(),
-            lock: out.join(crate::export::lock_file_name(&index_name)),
-        }),
-        e => e.into(),
-    })?;
     let Planned { mine, resolved, estimates } = plan(jobs_file, jobs, out, shard, true)?;
     let requested = concurrency.clamp(1, MAX_CONCURRENCY);
     // With nothing to run, the summary says what was asked (one, from an empty list, read as
@@ -930,15 +920,25 @@ pub fn run(
     // records, for this one to carry. A set of theirs that a job here would replace was
     // refused in `plan`.
     let (earlier_jobs_file, earlier_sets) = read_index_file(&out.join(index_file_name(shard)))?.unzip();
-    if let Some(earlier) = earlier_jobs_file.filter(|earlier| !is_this_jobs_file(earlier, jobs_file)) {
+    // (An index re-saved without its jobs file names none: no note.)
+    let named = |earlier: &String| !earlier.is_empty() && !is_this_jobs_file(earlier, jobs_file);
+    if let Some(earlier) = earlier_jobs_file.filter(named) {
         warn(&format!(
             "note: {} listed the jobs of {}; it lists this run's now (their sets stay where they are)",
             out.join(index_file_name(shard)).display(),
             earlier
         ));
     }
-    let other_sets = other_sets_to_carry(out, earlier_sets.unwrap_or_default(), &work);
-    BatchIndex::new(jobs_file, shard, planned, other_sets.clone(), concurrency).write(out, shard)?;
+    // The sets this run makes: a job skipped (its set there already) or a duplicate makes none.
+    let planned_sets: std::collections::HashSet<&PathBuf> = work
+        .iter()
+        .filter(|(_, r)| !r.done && r.outcome.duplicate_of.is_none())
+        .map(|(_, r)| &r.outcome.manifest)
+        .collect();
+    let other_sets = other_sets_to_carry(out, earlier_sets.unwrap_or_default(), &planned_sets);
+    let mut started = BatchIndex::new(jobs_file, shard, planned, other_sets, concurrency);
+    started.write_merged(out, shard, &planned_sets)?;
+    let other_sets = started.other_sets;
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut failures: Vec<(usize, Error)> = Vec::new();
     std::thread::scope(|scope| {
@@ -996,8 +996,12 @@ pub fn run(
             })
         })
         .collect();
-    let index = BatchIndex::new(jobs_file, shard, outcomes, other_sets, concurrency);
-    let written = index.write(out, shard);
+    let mut index = BatchIndex::new(jobs_file, shard, outcomes, other_sets, concurrency);
+    // The sets it made, at its end: a set another run finished meanwhile (this run's job
+    // skipped it) stays its maker's, whose entry an index written meanwhile may hold.
+    let made =
+        index.jobs.iter().filter(|j| j.status == JobStatus::Done).map(|j| j.manifest.clone()).collect::<Vec<_>>();
+    let written = index.write_merged(out, shard, &made.iter().collect());
     // The earliest job's error, whichever failed first; the index's own failure with it.
     if let Some((_, e)) = failures.into_iter().min_by_key(|(k, _)| *k) {
         let index_error = written.err().map(Box::new);
@@ -1087,13 +1091,8 @@ fn read_index_file(path: &Path) -> Result<Option<(String, Vec<OtherSet>)>, Batch
 /// this run's set; one that skips it leaves it its maker's), this jobs file's own earlier
 /// sets too, where its jobs no longer name them (dropped, they were no one's, and another
 /// preset of the name replaced them: a review).
-fn other_sets_to_carry(out: &Path, sets: Vec<OtherSet>, work: &[(&Job, Resolved)]) -> Vec<OtherSet> {
-    // The sets this run makes: a job skipped (its set there already) or a duplicate makes none.
-    let mine: std::collections::HashSet<&PathBuf> = work
-        .iter()
-        .filter(|(_, r)| !r.done && r.outcome.duplicate_of.is_none())
-        .map(|(_, r)| &r.outcome.manifest)
-        .collect();
+/// `mine`: the sets this run makes (`planned_sets`), or made (`made_sets`).
+fn other_sets_to_carry(out: &Path, sets: Vec<OtherSet>, mine: &std::collections::HashSet<&PathBuf>) -> Vec<OtherSet> {
     let mut carried: Vec<OtherSet> = Vec::new();
     for set in sets {
         if mine.contains(&set.manifest) || carried.iter().any(|c| c.manifest == set.manifest) {
@@ -1206,6 +1205,37 @@ impl BatchIndex {
             other_sets,
             concurrency,
         }
+    }
+
+    /// Writes the index as `write` does, under the lock of its name (`SetLock`), after
+    /// carrying the sets that the index there now records and this one does not
+    /// (`other_sets_to_carry`): two runs into one folder at once (which stays possible: the
+    /// later skips the sets the earlier finishes) each wrote the whole index from what they
+    /// read as they began, and the later dropped the other's record; the set so forgotten was
+    /// then replaced by a third jobs file's preset of the same name (a hostile-input review).
+    /// The lock is held for the read and the write alone; a run still writing after a second
+    /// of tries is `BatchError::Busy`. Where no other run wrote meanwhile, nothing is added:
+    /// the bytes are a lone run's.
+    fn write_merged(
+        &mut self,
+        out: &Path,
+        shard: Shard,
+        mine: &std::collections::HashSet<&PathBuf>,
+    ) -> Result<(), Error> {
+        let name = index_file_name(shard);
+        let _lock = crate::export::SetLock::acquire(out, &name).map_err(|e| match e {
+            crate::export::ExportError::Busy { .. } => {
+                Error::from(BatchError::Busy { out: out.into(), lock: out.join(crate::export::lock_file_name(&name)) })
+            }
+            e => e.into(),
+        })?;
+        if let Some((_, sets)) = read_index_file(&out.join(&name))? {
+            let listed: std::collections::HashSet<PathBuf> =
+                self.other_sets.iter().map(|s| s.manifest.clone()).collect();
+            let new = sets.into_iter().filter(|s| !listed.contains(&s.manifest)).collect();
+            self.other_sets.extend(other_sets_to_carry(out, new, mine));
+        }
+        self.write(out, shard)
     }
 
     /// Writes the index to `out` (created if missing), replacing the one there.

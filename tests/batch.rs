@@ -1364,13 +1364,16 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
     // "more than such a file can be": a hostile-input review); the control, the size as
     // written, verifies.
     for (key, value, said) in [
-        ("width", serde_json::json!(1_000_000_000_000u64), "the manifest's width 1000000000000 is wider than any set"),
+        ("width", serde_json::json!(1_000_000_000_000u64), "the manifest's width 1000000000000 is outside what a set"),
         (
             "height",
             serde_json::json!(1_000_000_000_000u64),
-            "the manifest's height 1000000000000 is taller than any set",
+            "the manifest's height 1000000000000 is outside what a set",
         ),
-        ("width", serde_json::Value::Null, "the manifest's width and height are not both whole numbers of pixels"),
+        ("width", serde_json::json!(0), "the manifest's width 0 is outside what a set can be (16 to"),
+        ("height", serde_json::json!(1), "the manifest's height 1 is outside what a set can be (16 to"),
+        ("width", serde_json::Value::Null, "the manifest's width and height are not both integers"),
+        ("width", serde_json::json!(16.0), "the manifest's width and height are not both integers"),
     ] {
         let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
         json[key] = value;
@@ -1611,27 +1614,73 @@ fn an_index_file_that_is_no_index_is_refused_by_name() {
     assert_eq!(summary_counts(&control), (1, 0), "{}", stderr(&control));
 }
 
-/// Two batch runs into one folder do not run at once: each wrote the whole index at its end
-/// from what it read as it began, and the later dropped the other's record (a review).
-/// A second run while the index's lock is held is refused at once (exit 1, the lock named)
-/// and writes nothing. Control: once the lock is let go, the same run goes on.
+/// Two batch runs into one folder at once keep each other's records: each wrote the whole
+/// index at its end from what it read as it began, and the later dropped the other's record
+/// of the set it made; a third jobs file's preset of that set's name then replaced it
+/// without the refusal the record exists for (a hostile-input review). Here the slow run
+/// (each commit paused three seconds, a debug-build hook) ends after the quick one; its index
+/// carries the quick run's set, and the third run is refused. Runs into one folder at once
+/// stay possible (`a_set_finished_by_another_run_meanwhile_is_not_generated_again`).
 #[test]
-fn a_second_batch_into_the_same_folder_waits_for_none_and_is_refused() {
+fn runs_into_one_folder_at_once_keep_each_others_records() {
+    if !test_hooks_exist() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let job = |preset: &str| format!("[[job]]\npreset = \"{preset}\"\nseeds = [1]\nsizes = [16]\n");
+    let (slow_jobs, quick_jobs, third_jobs) =
+        (dir.path().join("a.toml"), dir.path().join("b.toml"), dir.path().join("c.toml"));
+    std::fs::write(&slow_jobs, job("natrix-natrix")).unwrap();
+    std::fs::write(&quick_jobs, job("boa-constrictor")).unwrap();
+    std::fs::create_dir(dir.path().join("c")).unwrap();
+    let natrix = stdout(&snakeskin(&["presets", "show", "natrix-natrix"]));
+    std::fs::write(dir.path().join("c/boa-constrictor.toml"), natrix).unwrap();
+    std::fs::write(&third_jobs, job("c/boa-constrictor.toml")).unwrap();
+    let slow = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["batch", slow_jobs.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // While the slow run's job waits at its commit.
+    std::thread::sleep(Duration::from_millis(1000));
+    let quick = snakeskin(&["batch", quick_jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(summary_counts(&quick), (1, 0), "{}", stderr(&quick));
+    let slow = slow.wait_with_output().unwrap();
+    assert_eq!(summary_counts(&slow), (1, 0), "{}", stderr(&slow));
+    let index = read_index(&out);
+    assert!(index["jobs_file"].as_str().unwrap().ends_with("a.toml"), "the slow run's index: {index}");
+    let carried: Vec<&str> =
+        index["other_sets"].as_array().into_iter().flatten().filter_map(|s| s["manifest"].as_str()).collect();
+    assert_eq!(carried, ["boa-constrictor/tile-16-seed1-png/boa-constrictor.material.json"], "{index}");
+    let boa = out.join("boa-constrictor/tile-16-seed1-png");
+    let before = std::fs::read(boa.join("boa-constrictor_color.png")).unwrap();
+    let third = snakeskin(&["batch", third_jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(third.status.code(), Some(2), "{}", stderr(&third));
+    assert!(stderr(&third).contains("from another preset of that name"), "{}", stderr(&third));
+    assert_eq!(std::fs::read(boa.join("boa-constrictor_color.png")).unwrap(), before);
+}
+
+/// A run whose index another holds the lock of (a run stopped while writing it) is refused
+/// after a second of tries (exit 1, the lock named) and writes nothing. Shards keep their own
+/// indexes and locks. Control: once the lock is let go, the same run goes on.
+#[test]
+fn an_index_whose_lock_is_held_is_not_written() {
     let dir = tempfile::tempdir().unwrap();
     let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[4]", 16);
     let out_dir = dir.path().join("out");
     std::fs::create_dir(&out_dir).unwrap();
-    // The lock a running batch holds (`SetLock` on the index's name), taken here.
-    let lock_path = out_dir.join(".index.json.lock");
-    let lock = std::fs::File::create(&lock_path).unwrap();
+    // The lock a run holds while it writes the index (`SetLock` on the index's name).
+    let lock = std::fs::File::create(out_dir.join(".index.json.lock")).unwrap();
     lock.try_lock().unwrap();
     let run = || snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
     let refused = run();
     assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
-    assert!(stderr(&refused).contains("another snakeskin batch is running into"), "{}", stderr(&refused));
+    assert!(stderr(&refused).contains("another snakeskin batch is writing the index"), "{}", stderr(&refused));
     assert!(stderr(&refused).contains(".index.json.lock"), "{}", stderr(&refused));
     assert!(!out_dir.join("index.json").exists() && !out_dir.join("natrix-natrix").exists());
-    // Another shard keeps its own index and lock: it runs beside the held one.
     let shard = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--shard", "0/2"]);
     assert!(shard.status.success(), "{}", stderr(&shard));
     drop(lock);

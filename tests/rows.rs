@@ -288,22 +288,27 @@ fn the_rat_snakes_stripes_are_faint_the_ground_showing_through() {
 fn black_bellied_species_have_bellies_as_dark_as_their_black_marks() {
     // Phalotris lemniscatus: 'Tout le dessous du corps d'une couleur noire' (the species'
     // original description, Duméril 1854); a male adder: 'buik meestal zwart' (Naturalis).
-    // The ventral plates' median (row 0 off the crevices) within twice the luminance of the
-    // species' own black mark. The controls: each preset's belly before these sources were
-    // read (a cream; the dark grey of 'grey, greyish-brown or bluish').
+    // The ventral plates' median colour (row 0 off the crevices) within CIEDE2000 8 of the
+    // species' own black mark (a colour, not only a luminance: a dark red belly fails too).
+    // The controls: each preset's belly before these sources were read (a cream; the dark
+    // grey of 'grey, greyish-brown or bluish').
+    use snakeskin::optics::lab::{ciede2000, linear_srgb_to_lab};
+    let lab = |c: [f32; 3]| linear_srgb_to_lab(c.map(f64::from));
     for (species, now, before) in
         [("phalotris-lemniscatus", "#141010", "#e8d8b0"), ("vipera-berus", "#24211f", "#3a3634")]
     {
         let text = snakeskin::preset::library::get(species).unwrap();
         let preset = common::preset_from(text);
-        let black = common::luminance(&preset.pattern[0].color.unwrap().to_linear());
-        let belly = |text: &str| common::luminance(&rows_median(text, (0.0, 0.0)));
-        assert!(belly(text) < 2.0 * black, "{species}: belly {}, its black {black}", belly(text));
-        let (head, tail) = text.split_at(text.find("[belly]").unwrap());
+        let black = lab(preset.pattern[0].color.unwrap().to_linear());
+        let distance = |text: &str| ciede2000(lab(rows_median(text, (0.0, 0.0))), black);
+        assert!(distance(text) < 8.0, "{species}: the belly is ΔE00 {} from its black", distance(text));
+        let (head, tail) = text.split_at(text.find("\n[belly]\n").unwrap());
         let old =
             format!("{head}{}", tail.replacen(&format!("color = \"{now}\""), &format!("color = \"{before}\""), 1));
         assert_ne!(old, text, "{species}: the control changes the belly");
-        assert!(belly(&old) > 2.0 * black, "{species}: the control, belly {}, its black {black}", belly(&old));
+        assert!(distance(&old) > 8.0, "{species}: the control, ΔE00 {} from its black", distance(&old));
+        let red = format!("{head}{}", tail.replacen(&format!("color = \"{now}\""), "color = \"#400000\"", 1));
+        assert!(distance(&red) > 8.0, "{species}: a dark red belly, ΔE00 {} from its black", distance(&red));
     }
 }
 

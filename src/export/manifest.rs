@@ -323,16 +323,19 @@ pub fn set_file_max_bytes(json: &serde_json::Value) -> u64 {
 /// what is accepted: `verify` blamed every map for being "more than such a file can be"
 /// where the manifest's size was missing or forged, a hostile-input review).
 fn set_size(json: &serde_json::Value) -> Result<(u64, u64), String> {
+    // A set is at least the smallest `--size` each way (a body atlas is taller, never
+    // narrower), at most `SIZE_RANGE`'s end wide and `MAX_HEIGHT` tall.
+    let least = u64::from(*crate::SIZE_RANGE.start());
     let (max_width, max_height) = (u64::from(*crate::SIZE_RANGE.end()), crate::generate::MAX_HEIGHT as u64);
-    match (json["width"].as_u64(), json["height"].as_u64()) {
-        (Some(width), _) if width > max_width => {
-            Err(format!("the manifest's width {width} is wider than any set ({max_width} pixels at most)"))
-        }
-        (_, Some(height)) if height > max_height => {
-            Err(format!("the manifest's height {height} is taller than any set ({max_height} pixels at most)"))
-        }
+    let (width, height) = (json["width"].as_u64(), json["height"].as_u64());
+    let outside = |key: &str, value: u64, most: u64| {
+        format!("the manifest's {key} {value} is outside what a set can be ({least} to {most} pixels)")
+    };
+    match (width, height) {
+        (Some(width), _) if !(least..=max_width).contains(&width) => Err(outside("width", width, max_width)),
+        (_, Some(height)) if !(least..=max_height).contains(&height) => Err(outside("height", height, max_height)),
         (Some(width), Some(height)) => Ok((width, height)),
-        _ => Err("the manifest's width and height are not both whole numbers of pixels".into()),
+        _ => Err("the manifest's width and height are not both integers (pixels, as a run writes them: 1024)".into()),
     }
 }
 

@@ -221,6 +221,8 @@ pub fn normal_transmittance(n0: f64, n2: f64, roughness: f64, optical_depth: [f6
 /// alone until the two were one function; the random walk clamps as here.)
 macro_rules! closed_form_diffuse {
     ($name:ident, $float:ty, $pi:expr) => {
+        /// The closed form's diffuse lobe for one channel, (n0/n2)² k_d a_i a_o / (π (1 − k_d K))
+        /// (the comment above `closed_form_diffuse!`).
         pub fn $name(radiance_factor: $float, albedo: $float, a_i: $float, a_o: $float, k: $float) -> $float {
             let kd = albedo.clamp(0.0, 1.0);
             radiance_factor * kd * a_i * a_o / ($pi * (1.0 - kd * k))
@@ -230,6 +232,8 @@ macro_rules! closed_form_diffuse {
 closed_form_diffuse!(closed_form_diffuse, f64, PI);
 closed_form_diffuse!(closed_form_diffuse_f32, f32, std::f32::consts::PI);
 
+/// The closed form's directional diffuse reflectance for one channel, a k_d E / (1 − k_d K)
+/// (the comment above `closed_form_diffuse!`).
 pub fn closed_form_reflectance(albedo: f64, a: f64, k: f64, e: f64) -> f64 {
     let kd = albedo.clamp(0.0, 1.0);
     a * kd * e / (1.0 - kd * k)

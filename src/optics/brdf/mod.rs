@@ -16,8 +16,8 @@
 //! clamped to [0, 1] per channel (a saturated film colour can fall outside the sRGB gamut,
 //! and 1 − F must stay a valid transmittance).
 //!
-//! Stability rules (PHYSICS.md): GGX α = max(roughness², ALPHA_MIN) so roughness 0 stays
-//! finite; a zero-length or non-finite normal falls back to the tangent-space up vector;
+//! Stability rules (PHYSICS.md): GGX α = roughness² within [ALPHA_MIN, 1] (`ggx_alpha`) so
+//! roughness 0 stays finite; a zero-length or non-finite normal falls back to the tangent-space up vector;
 //! directions below the shading horizon give 0; cosines are floored at COS_MIN after that
 //! test so grazing angles give finite values. These numbers reach the WGSL from here
 //! (`render::engine::shaders::generated_constants`), never by copy.
@@ -42,7 +42,9 @@ pub const ALPHA_MIN: f64 = 1e-3;
 
 /// GGX α of a roughness: roughness² (the perceptual mapping of Burley 2012, as glTF reads
 /// its roughness), within [ALPHA_MIN, 1]. Every lobe, table and walk reads it; `brdf.wgsl`'s
-/// `ggx_alpha` is the same expression.
+/// `ggx_alpha` is the same expression. (`plain.wgsl`, the baseline shader `bench gpu` times
+/// the skin against, is a program of its own without brdf.wgsl and keeps its own. A NaN
+/// roughness stays NaN, as `clamp` passes it: presets and the command line refuse one.)
 pub fn ggx_alpha(roughness: f64) -> f64 {
     (roughness * roughness).clamp(ALPHA_MIN, 1.0)
 }
