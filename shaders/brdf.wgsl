@@ -79,13 +79,16 @@ fn film_clamped(layers: Layers, c: f32) -> vec3<f32> {
     return clamp(film / f32(reads), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
+// Smith Lambda for GGX at cosine c, a2 = alpha^2 (Heitz 2014, eq. 72; optics::brdf::ggx).
+fn smith_lambda(c: f32, a2: f32) -> f32 {
+    return 0.5 * (sqrt(1.0 + a2 * max(1.0 - c * c, 0.0) / (c * c)) - 1.0);
+}
+
 // D G2 / (4 cos_i cos_o) for GGX with Smith height-correlated G2 (optics::brdf::ggx).
 fn specular_scale(cos_h: f32, sin2_h: f32, cos_i: f32, cos_o: f32, a2: f32) -> f32 {
     let t = sin2_h + cos_h * cos_h * a2;
     let d = a2 / (PI * t * t);
-    let lambda_i = 0.5 * (sqrt(1.0 + a2 * max(1.0 - cos_i * cos_i, 0.0) / (cos_i * cos_i)) - 1.0);
-    let lambda_o = 0.5 * (sqrt(1.0 + a2 * max(1.0 - cos_o * cos_o, 0.0) / (cos_o * cos_o)) - 1.0);
-    let g2 = 1.0 / (1.0 + lambda_i + lambda_o);
+    let g2 = 1.0 / (1.0 + smith_lambda(cos_i, a2) + smith_lambda(cos_o, a2));
     return d * g2 / (4.0 * cos_i * cos_o);
 }
 

@@ -93,6 +93,17 @@ fn film_offset_nm(m: Material, cos_o: f32) -> f32 {
     return footprint_offset_nm(m.thickness_spread_nm, cos_o);
 }
 
+// A Lambertian surface of `albedo` at normal n under the scene's lights and sky: the diffuse
+// stages and the ground.
+fn lambertian(albedo: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    var radiance = vec3<f32>(0.0);
+    for (var i = 0u; i < SCENE_LIGHTS; i++) {
+        let wi = scene.light_dir[i].xyz;
+        radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * albedo / PI * max(dot(n, wi), 0.0);
+    }
+    return radiance + sky(n) * albedo;
+}
+
 fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
     let wo = normalize(scene.camera.xyz - world);
     var radiance = vec3<f32>(0.0);
@@ -101,11 +112,7 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
         if (STAGE == STAGE_DIFFUSE) {
             n = m.geometric;
         }
-        for (var i = 0u; i < SCENE_LIGHTS; i++) {
-            let wi = scene.light_dir[i].xyz;
-            radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * m.albedo / PI * max(dot(n, wi), 0.0);
-        }
-        return radiance + sky(n) * m.albedo;
+        return lambertian(m.albedo, n);
     }
     let cos_o = max(dot(m.normal, wo), COS_MIN);
     let layers = layers_of(m, film_offset_nm(m, cos_o));
@@ -183,10 +190,5 @@ fn fs_ground(in: VertexOut) -> @location(0) vec4<f32> {
     let w = fwidth(p) + vec2<f32>(1e-4); // not a shared constant: keeps w > 0 on flat ground
     let i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
     let checker = mix(0.07, 0.09, 0.5 - 0.5 * i.x * i.y);
-    var radiance = sky(n) * checker;
-    for (var i = 0u; i < SCENE_LIGHTS; i++) {
-        let wi = scene.light_dir[i].xyz;
-        radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * checker / PI * max(dot(n, wi), 0.0);
-    }
-    return vec4<f32>(radiance, 1.0);
+    return vec4<f32>(lambertian(vec3<f32>(checker), n), 1.0);
 }
