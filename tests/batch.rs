@@ -1637,15 +1637,9 @@ fn runs_into_one_folder_at_once_keep_each_others_records() {
     let natrix = stdout(&snakeskin(&["presets", "show", "natrix-natrix"]));
     std::fs::write(dir.path().join("c/boa-constrictor.toml"), natrix).unwrap();
     std::fs::write(&third_jobs, job("c/boa-constrictor.toml")).unwrap();
-    let slow = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(["batch", slow_jobs.to_str().unwrap(), "-o", out.to_str().unwrap()])
-        .env("SNAKESKIN_TEST_PAUSE_AT", "commit")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
     // While the slow run's job waits at its commit.
-    std::thread::sleep(Duration::from_millis(1000));
+    let args = ["batch", slow_jobs.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    let slow = spawn_paused_at_commit(&args, &out.join("natrix-natrix/tile-16-seed1-png"));
     let quick = snakeskin(&["batch", quick_jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert_eq!(summary_counts(&quick), (1, 0), "{}", stderr(&quick));
     let slow = slow.wait_with_output().unwrap();
