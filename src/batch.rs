@@ -1091,7 +1091,8 @@ fn read_index_file(path: &Path) -> Result<Option<(String, Vec<OtherSet>)>, Batch
 /// this run's set; one that skips it leaves it its maker's), this jobs file's own earlier
 /// sets too, where its jobs no longer name them (dropped, they were no one's, and another
 /// preset of the name replaced them: a review).
-/// `mine`: the sets this run makes (`planned_sets`), or made (`made_sets`).
+/// `mine`: the sets this run makes (`run`'s `planned_sets`, as it starts) or made (its jobs
+/// `done`, at its end).
 fn other_sets_to_carry(out: &Path, sets: Vec<OtherSet>, mine: &std::collections::HashSet<&PathBuf>) -> Vec<OtherSet> {
     let mut carried: Vec<OtherSet> = Vec::new();
     for set in sets {
