@@ -915,11 +915,18 @@ pub fn run(
     // an index left from another jobs file (a run stopped by a signal writes none at its
     // end) described sets this run is not about.
     let planned = work.iter().map(|(_, r)| r.outcome.clone()).collect();
-    // The index this run replaces, read once: whose jobs it listed, for the note (a second
-    // jobs file into one folder replaced the first's index without a word), and the sets it
-    // records, for this one to carry. A set of theirs that a job here would replace was
-    // refused in `plan`.
-    let (earlier_jobs_file, earlier_sets) = read_index_file(&out.join(index_file_name(shard)))?.unzip();
+    // The sets this run makes: a job skipped (its set there already) or a duplicate makes none.
+    let planned_sets: std::collections::HashSet<&PathBuf> = work
+        .iter()
+        .filter(|(_, r)| !r.done && r.outcome.duplicate_of.is_none())
+        .map(|(_, r)| &r.outcome.manifest)
+        .collect();
+    // Written over the index this run replaces, carrying the sets it records (`write_merged`;
+    // a set of theirs that a job here would replace was refused in `plan`), and saying whose
+    // jobs it listed (a second jobs file into one folder replaced the first's index without
+    // a word).
+    let mut started = BatchIndex::new(jobs_file, shard, planned, Vec::new(), concurrency);
+    let earlier_jobs_file = started.write_merged(out, shard, &planned_sets)?;
     // (An index re-saved without its jobs file names none: no note.)
     let named = |earlier: &String| !earlier.is_empty() && !is_this_jobs_file(earlier, jobs_file);
     if let Some(earlier) = earlier_jobs_file.filter(named) {
@@ -929,15 +936,6 @@ pub fn run(
             earlier
         ));
     }
-    // The sets this run makes: a job skipped (its set there already) or a duplicate makes none.
-    let planned_sets: std::collections::HashSet<&PathBuf> = work
-        .iter()
-        .filter(|(_, r)| !r.done && r.outcome.duplicate_of.is_none())
-        .map(|(_, r)| &r.outcome.manifest)
-        .collect();
-    let other_sets = other_sets_to_carry(out, earlier_sets.unwrap_or_default(), &planned_sets);
-    let mut started = BatchIndex::new(jobs_file, shard, planned, other_sets, concurrency);
-    started.write_merged(out, shard, &planned_sets)?;
     let other_sets = started.other_sets;
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut failures: Vec<(usize, Error)> = Vec::new();
@@ -1216,13 +1214,13 @@ impl BatchIndex {
     /// then replaced by a third jobs file's preset of the same name (a hostile-input review).
     /// The lock is held for the read and the write alone; a run still writing after a second
     /// of tries is `BatchError::Busy`. Where no other run wrote meanwhile, nothing is added:
-    /// the bytes are a lone run's.
+    /// the bytes are a lone run's. Returns the jobs file the replaced index recorded.
     fn write_merged(
         &mut self,
         out: &Path,
         shard: Shard,
         mine: &std::collections::HashSet<&PathBuf>,
-    ) -> Result<(), Error> {
+    ) -> Result<Option<String>, Error> {
         let name = index_file_name(shard);
         let _lock = crate::export::SetLock::acquire(out, &name).map_err(|e| match e {
             crate::export::ExportError::Busy { .. } => {
@@ -1230,13 +1228,15 @@ impl BatchIndex {
             }
             e => e.into(),
         })?;
-        if let Some((_, sets)) = read_index_file(&out.join(&name))? {
+        let (earlier_jobs_file, sets) = read_index_file(&out.join(&name))?.unzip();
+        if let Some(sets) = sets {
             let listed: std::collections::HashSet<PathBuf> =
                 self.other_sets.iter().map(|s| s.manifest.clone()).collect();
             let new = sets.into_iter().filter(|s| !listed.contains(&s.manifest)).collect();
             self.other_sets.extend(other_sets_to_carry(out, new, mine));
         }
-        self.write(out, shard)
+        self.write(out, shard)?;
+        Ok(earlier_jobs_file)
     }
 
     /// Writes the index to `out` (created if missing), replacing the one there.

@@ -314,7 +314,11 @@ pub enum ManifestReadError {
 /// run writes (wider than `SIZE_RANGE`, taller than `generate::MAX_HEIGHT`: a forged
 /// manifest's 2³² × 2³² made the bound wrap to nothing), nothing is.
 pub fn set_file_max_bytes(json: &serde_json::Value) -> u64 {
-    let Ok((width, height)) = set_size(json) else { return 0 };
+    set_size(json).map_or(0, file_max_bytes)
+}
+
+/// `set_file_max_bytes` of a size `set_size` accepted.
+fn file_max_bytes((width, height): (u64, u64)) -> u64 {
     let maps = MapKind::ALL.len() as u64;
     width * height * 16 * maps * 2 + (1 << 20)
 }
@@ -385,8 +389,7 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
 pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) -> Result<VerifiedSet, ExportError> {
     let problem = |problem: String| ExportError::Verify { manifest: manifest_path.into(), problem };
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
-    set_size(json).map_err(problem)?;
-    let file_limit = set_file_max_bytes(json);
+    let file_limit = set_size(json).map(file_max_bytes).map_err(problem)?;
     let maps = json["maps"]
         .as_array()
         .filter(|m| !m.is_empty())

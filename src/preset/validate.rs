@@ -446,33 +446,19 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         // `position` sets its offset, so the keys they replace were silently ignored beside
         // them (`position = "lateral"` with `offset = 0.1` drew the lateral stripe).
         if p.kind == Stripes {
-            // (key, set away from its default, the key that replaces it)
+            // (key, set away from its default, the key that replaces it, its default)
             let by_rows = !p.rows.is_empty();
             // The default, where the key has one, counts as unset, and `rows = []` as no rows:
             // `--set` cannot take a file's key away, but can give it these (an onboarding
             // review found no way from the command line; a later one, `rows = []`).
+            let away = |value: f64, default: f64| (value != default, Some(default));
             let replaced = [
-                (
-                    "offset",
-                    p.offset != 0.0,
-                    if by_rows { Some("rows") } else { p.position.map(|_| "position") },
-                    Some(0.0),
-                ),
-                ("position", p.position.is_some(), by_rows.then_some("rows"), None),
-                (
-                    "size",
-                    p.size != PatternLayer::default_size(),
-                    by_rows.then_some("rows"),
-                    Some(PatternLayer::default_size()),
-                ),
-                (
-                    "amount",
-                    p.amount != PatternLayer::default_amount(),
-                    by_rows.then_some("rows"),
-                    Some(PatternLayer::default_amount()),
-                ),
+                ("offset", away(p.offset, 0.0), if by_rows { Some("rows") } else { p.position.map(|_| "position") }),
+                ("position", (p.position.is_some(), None), by_rows.then_some("rows")),
+                ("size", away(p.size, PatternLayer::default_size()), by_rows.then_some("rows")),
+                ("amount", away(p.amount, PatternLayer::default_amount()), by_rows.then_some("rows")),
             ];
-            for (field, set, by, default) in replaced {
+            for (field, (set, default), by) in replaced {
                 // No pass for a file's key under a kind `--set` changed (as `kinds_only` gives):
                 // stripes read every one of these keys, so it would be dropped silently (the
                 // blotches' `arrangement` is refused the same way, above).
