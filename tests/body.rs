@@ -800,7 +800,8 @@ fn the_green_pythons_white_spots_are_a_few() {
         assert_within_one(&format!("side {side}"), found, count);
         assert!(one_scale, "side {side}: a spot longer than two scales");
     }
-    // At 30 a side, a spot's length share three times ours is again one scale long.
+    // At 30 a side (a spot's length share 0.16: three or four scales long), more than 20 a
+    // side are found; and at our 10 a side, that length makes streaks.
     let thirty = [("pattern.0.count", "30"), ("pattern.0.length", "0.16")];
     assert!(check(&thirty).iter().all(|(n, _)| *n > 20), "the control: 30 a side");
     assert!(check(&[("pattern.0.length", "0.16")]).iter().all(|(_, one)| !one), "the control: streaks");

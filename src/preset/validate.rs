@@ -37,7 +37,10 @@ pub mod ranges {
     pub const RINGS_PER_TILE: (f64, f64) = (1.0, 32.0);
     pub const BLOTCHES_PER_TILE: (f64, f64) = (1.0, 32.0);
     pub const RING_WIDTH: (f64, f64) = (0.0, 1.0);
-    pub const BLOTCH_LENGTH: (f64, f64) = (0.05, 1.0);
+    /// Down to 0.01 of the spacing: a sparse series of one-scale spots on a fine-scaled
+    /// snake (morelia-viridis: ten a side along the body, 53 rows: 0.02) needs a length
+    /// share under the 0.05 this once was, which drew them three scales long.
+    pub const BLOTCH_LENGTH: (f64, f64) = (0.01, 1.0);
     /// A stripe's share left out: at most 0.6, so that the pieces kept are 1.2 scale lengths
     /// long on average (a gap every three: `maps::color`), and a stripe snapped to scales
     /// keeps most of them (a piece with no scale centre in it is not drawn; at 0.9 whole

@@ -235,7 +235,7 @@ fn render_tile_sheet(
 }
 
 /// The body sheet's line of counts for the built-in `name`: its plates, a count its preset
-/// does not give called the default (the sheet labelled `crotalus-atrox`, whose sources give
+/// does not give called the default (the sheet labelled `crotalus-atrox`, whose sources then gave
 /// no count, "200 ventrals, 60 subcaudals", as if they were the species': a walkthrough),
 /// its counted marks and its tail bands.
 fn counts_line(name: &str, preset: &crate::preset::Preset, counts: &crate::export::Counts) -> String {
@@ -450,8 +450,8 @@ mod tests {
     use super::*;
 
     /// A preset that gives its plate counts is labelled with them; one whose sources give
-    /// none (`crotalus-atrox`: "ventrals, subcaudals, … not found: defaults used") is
-    /// labelled with the defaults, called so.
+    /// none (`pantherophis-guttatus`: "ventrals, subcaudals: not found") is labelled with the
+    /// defaults, called so.
     #[test]
     fn the_body_sheet_calls_default_counts_defaults() {
         let counts = |ventrals, subcaudals| crate::export::Counts {
@@ -462,7 +462,7 @@ mod tests {
         };
         let preset = |name: &str| crate::preset::load(name, &[], None).unwrap().preset;
         let line = |name: &str, counts| counts_line(name, &preset(name), &counts);
-        assert_eq!(line("crotalus-atrox", counts(200, 60)), "200 ventrals, 60 subcaudals (defaults)");
+        assert_eq!(line("pantherophis-guttatus", counts(200, 60)), "200 ventrals, 60 subcaudals (defaults)");
         assert_eq!(line("boa-constrictor", counts(232, 48)), "232 ventrals, 48 subcaudals");
     }
 
