@@ -5,6 +5,12 @@
 // The baseline's Schlick F0 for a dielectric (n = 1.5), its own number.
 const PLAIN_F0: f32 = 0.04; // not a shared constant
 
+// Schlick's approximation of the Fresnel reflectance at `cos_theta`, for the lights' half
+// vectors and the sky's view direction alike.
+fn plain_schlick(cos_theta: f32) -> f32 {
+    return PLAIN_F0 + (1.0 - PLAIN_F0) * pow(1.0 - max(cos_theta, 0.0), 5.0);
+}
+
 fn plain_brdf(albedo: vec3<f32>, roughness: f32, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     let cos_i = dot(n, wi);
     let cos_o = dot(n, wo);
@@ -18,7 +24,7 @@ fn plain_brdf(albedo: vec3<f32>, roughness: f32, n: vec3<f32>, wi: vec3<f32>, wo
     let t = cos_h * cos_h * (a2 - 1.0) + 1.0;
     let d = a2 / (PI * t * t);
     let vis = 0.5 / (cos_i * sqrt(cos_o * cos_o * (1.0 - a2) + a2) + cos_o * sqrt(cos_i * cos_i * (1.0 - a2) + a2));
-    let f = PLAIN_F0 + (1.0 - PLAIN_F0) * pow(1.0 - max(dot(wo, h), 0.0), 5.0);
+    let f = plain_schlick(dot(wo, h));
     return vec3<f32>(d * vis * f) + (1.0 - f) * albedo / PI;
 }
 
@@ -32,7 +38,7 @@ fn fs_plain(in: VertexOut) -> @location(0) vec4<f32> {
         radiance += scene.light_dir[i].w * scene.light_rgb[i].rgb * plain_brdf(m.albedo, m.roughness, m.normal, wi, wo)
             * max(dot(m.normal, wi), 0.0);
     }
-    let f = PLAIN_F0 + (1.0 - PLAIN_F0) * pow(1.0 - max(dot(m.normal, wo), 0.0), 5.0);
+    let f = plain_schlick(dot(m.normal, wo));
     radiance += sky(m.normal) * m.albedo * (1.0 - f) + sky(reflect(-wo, m.normal)) * f;
     return vec4<f32>(radiance, 1.0);
 }

@@ -730,8 +730,7 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         warnings.push(format!("warning: {}: {problem}", job.place(jobs_file, job.lines.sizes.or(job.lines.preset))));
     }
     if let Some(pack) = job.pack
-        && let Some(lost) =
-            crate::generate::ambient_warning(loaded.preset.optics.ambient_ior, crate::generate::pack_reader(pack))
+        && let Some(lost) = crate::generate::ambient_warning(loaded.preset.optics.ambient_ior, pack.material_reader())
     {
         warnings.push(format!("warning: {}: {lost}", job.place(jobs_file, job.lines.preset)));
     }

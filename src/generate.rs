@@ -152,15 +152,6 @@ pub fn ambient_warning(ambient_ior: f64, reader: &str) -> Option<String> {
     })
 }
 
-/// The reader `ambient_warning` names for a pack.
-pub fn pack_reader(pack: Pack) -> &'static str {
-    match pack {
-        Pack::Gltf => "glTF",
-        Pack::Unreal => "Unreal's material",
-        Pack::UnityHdrp => "HDRP's Lit material",
-    }
-}
-
 /// `Pack::size_problem` for a set `size` wide in `layout`, with the largest size whose
 /// textures the engine loads (a body atlas's height is rounded, so it is searched for):
 /// "give {give} N or less". None when the textures fit, or without a pack.
@@ -291,7 +282,7 @@ impl Plan {
 
     /// `ambient_warning` for a pack, "warning: " first; None in air, or without a pack.
     pub fn ambient_warning(&self) -> Option<String> {
-        let reader = pack_reader(self.request.pack?);
+        let reader = self.request.pack?.material_reader();
         ambient_warning(self.loaded.preset.optics.ambient_ior, reader).map(|w| format!("warning: {w}"))
     }
 
@@ -716,8 +707,8 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
     let set_budget = crate::memory::tile_budget_from_env().ok().flatten().map(|mib| mib.saturating_mul(1 << 20));
     let buffers = |rows: usize| crate::graph::estimate_peak_bytes(graph, maps, width, rows);
     // With the normal node, though a tile evaluated whole goes without it (`whole_tile_maps`):
-    // the budget was measured with it, and without it the two species in strips at 4096²
-    // would still not fit (their buffers without it: over 1000 and 920–960 MiB).
+    // the budget was measured with it, and without it the presets in strips at 4096² would
+    // still not fit (the two measured then, without it: over 1000 and 920–960 MiB).
     if buffers(height) <= set_budget.unwrap_or(TILE_BUFFER_BUDGET_BYTES) {
         return None;
     }

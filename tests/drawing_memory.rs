@@ -17,14 +17,38 @@ const PLAIN_PRESET: &str = "erythrolamprus-miliaris";
 /// Under a `wrapper` (e.g. `xvfb-run`) it is the largest peak among the wrapper and the
 /// children it reaps: `xvfb-run` waits for the binary (not for Xvfb, which it kills).
 #[cfg(target_os = "linux")]
-#[allow(clippy::zombie_processes, reason = "the child is reaped by wait4, which Child::wait cannot give")]
 fn peak_resident_kib(wrapper: &[&str], args: &[&str]) -> u64 {
+    let run = measured(wrapper, args, |c| c);
+    assert!(run.succeeded, "{wrapper:?} {args:?} failed: {}\n{}", run.status, run.stderr);
+    run.peak_kib
+}
+
+/// A measured run: whether it exited 0, its wait status, its stderr and its peak resident
+/// memory (KiB).
+#[cfg(target_os = "linux")]
+struct Measured {
+    succeeded: bool,
+    status: i32,
+    stderr: String,
+    peak_kib: u64,
+}
+
+/// Runs `snakeskin args` (under `wrapper`, as `peak_resident_kib` says), its command set up
+/// further by `setup` (an environment), and measures it, whether it succeeds or not.
+#[cfg(target_os = "linux")]
+#[allow(clippy::zombie_processes, reason = "the child is reaped by wait4, which Child::wait cannot give")]
+fn measured(
+    wrapper: &[&str],
+    args: &[&str],
+    setup: impl FnOnce(&mut std::process::Command) -> &mut std::process::Command,
+) -> Measured {
     use std::io::{Read, Seek};
     use std::process::{Command, Stdio};
     let binary = env!("CARGO_BIN_EXE_snakeskin");
     let (program, first) = wrapper.split_first().map_or((binary, &[][..]), |(p, rest)| (*p, rest));
     let mut errors = tempfile::tempfile().unwrap();
-    let child = on_x11(&mut Command::new(program))
+    let mut command = Command::new(program);
+    let child = setup(on_x11(&mut command))
         .args(first)
         .args((!wrapper.is_empty()).then_some(binary))
         .args(args)
@@ -35,12 +59,32 @@ fn peak_resident_kib(wrapper: &[&str], args: &[&str]) -> u64 {
     let pid = child.id() as libc::pid_t;
     let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
     assert_eq!(unsafe { libc::wait4(pid, &mut status, 0, &mut usage) }, pid, "wait4");
-    if !(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0) {
-        let mut text = String::new();
-        errors.rewind().and_then(|_| errors.read_to_string(&mut text)).unwrap();
-        panic!("{wrapper:?} {args:?} failed: status {status}\n{text}");
+    let mut stderr = String::new();
+    errors.rewind().and_then(|_| errors.read_to_string(&mut stderr)).unwrap();
+    Measured {
+        succeeded: libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
+        status,
+        stderr,
+        peak_kib: usage.ru_maxrss as u64,
     }
-    usage.ru_maxrss as u64
+}
+
+/// A window without a display is refused before its maps are made: `preview --window
+/// --map-size 4096` built its maps (5 GB, seconds) and then said "cannot open a window" (a
+/// hostile-input review). Measured by its peak, which the maps would raise past a
+/// gigabyte; the memory check still comes first (a 1 MiB limit refuses it, as
+/// `the_memory_estimate_of_a_drawing_is_above_its_peak` reads it). No GPU is needed.
+#[cfg(all(target_os = "linux", feature = "window"))]
+#[test]
+fn a_window_without_a_display_is_refused_before_its_maps_are_made() {
+    let _alone = MEASURING.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let args = ["preview", PLAIN_PRESET, "--window", "--map-size", "4096", "--frames", "3"];
+    let run = measured(&[], &args, |c| c.env_remove("DISPLAY"));
+    assert!(!run.succeeded, "it opened a window without a display");
+    assert!(run.stderr.contains("cannot open a window"), "{}", run.stderr);
+    assert!(run.peak_kib < 200 * 1024, "peaked at {} MiB before refusing", run.peak_kib / 1024);
+    let limited = common::snakeskin_env(&args, &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1")]);
+    assert!(common::stderr(&limited).contains("needs about"), "{}", common::stderr(&limited));
 }
 
 /// Held by each test while it measures, so that no test's children run beside another's.

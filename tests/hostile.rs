@@ -1932,6 +1932,13 @@ fn a_gallery_and_its_closeups_appear_together_or_not_at_all() {
     let out = snakeskin(&["gallery", "-o", g, "--tile", "16", "--closeups", blocked.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("rows.png: a folder is in the way"), "{}", stderr(&out));
+    // A folder that takes no file (one root cannot write in either) is found before the
+    // gallery is drawn, naming a close-up: it failed after the drawing, a second and 180 MB
+    // in, as "cannot write /proc/self" (a hostile-input review).
+    let out = snakeskin(&["gallery", "-o", g, "--tile", "16", "--closeups", "/proc/self"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("cannot write /proc/self/per-scale-colour.png"), "{}", stderr(&out));
+    assert!(!gallery.exists(), "the gallery was written");
     assert!(!gallery.exists(), "the gallery was written before the close-ups' names were checked");
     assert_eq!(std::fs::read_dir(&blocked).unwrap().count(), 1, "a close-up was written");
     // The gallery named as one of the close-ups (the review: the close-up replaced it).
@@ -2025,6 +2032,22 @@ fn figures_are_checked_before_any_is_drawn() {
     // a GPU, which this test does not ask for: it stops at the renderer or draws).
     let out = snakeskin_env(&[&args[..], &["16x16"]].concat(), &[("SNAKESKIN_MEMORY_LIMIT_MIB", "400")]);
     assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
+    // Without a GPU adapter: no folder made (it said "created folder" of one it then
+    // removed), and before that the warnings of the preset as the figures draw it, which
+    // were never printed: the absorption figure's 0.7 darkens the stack below this
+    // preset's base colour, which it draws clamped (a hostile-input review). The preset
+    // itself warns of nothing: the control, that the warning is the figure's.
+    let nested = dir.path().join("n1/n2");
+    let no_gpu = [("VK_ICD_FILENAMES", "/nonexistent.json"), ("WGPU_BACKEND", "vulkan")];
+    let out = snakeskin_env(&["figures", PRESET, "-o", nested.to_str().unwrap(), "--size", "16x16"], &no_gpu);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("no GPU adapter found"), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("created folder"), "{}", stderr(&out));
+    assert!(!dir.path().join("n1").exists(), "a folder was made");
+    let clamped = "color.base = \"#8a7a48\" is brighter than this layer stack can show";
+    assert!(stderr(&out).contains(clamped), "{}", stderr(&out));
+    assert!(stderr(&out).contains("(in absorption_0.7.png, with its overrides)"), "{}", stderr(&out));
+    assert!(!stderr(&snakeskin(&["graph", PRESET])).contains("warning"), "the preset warns by itself");
 }
 
 /// A legal file name near the 255-byte limit was refused after the work ("cannot write .:

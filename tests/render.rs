@@ -431,8 +431,20 @@ fn preview_writes_a_png_and_rejects_bad_options() {
         "{}",
         common::stderr(&run)
     );
+    // The flags it concerns named (it spoke of "the preview": a hostile-input review).
+    assert!(common::stderr(&run).contains("(--size 4112x4096 with --reference)"), "{}", common::stderr(&run));
     assert_eq!(std::fs::read(&out).unwrap(), before, "the render was written before the refusal");
     assert!(!dir.path().join("new").exists(), "a folder was made for the refused heat map");
+    // A frame that shows none of the snake compares nothing: it printed "0 pixels, CIEDE2000
+    // mean NaN" and passed, writing both files (the review). Refused, exit 2, nothing
+    // written. (The reference runs that compare pixels, below and in the tests after this
+    // one, are the control.)
+    let args = ["preview", PRESET, "--out", o, "--map-size", "64", "--size", "16x2048", "--snakes", "100"];
+    let run = snakeskin(&[&args[..], &["--reference", h]].concat());
+    assert_eq!(run.status.code(), Some(2), "{}", common::stderr(&run));
+    assert!(common::stderr(&run).contains("shows no pixel of the snake"), "{}", common::stderr(&run));
+    assert_eq!(std::fs::read(&out).unwrap(), before, "the render was written");
+    assert!(!heat.exists(), "a heat map of nothing was written");
 }
 
 /// The render and its heat map appear together or not at all: a heat map that could not be

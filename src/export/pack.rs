@@ -121,6 +121,15 @@ impl Pack {
         }
     }
 
+    /// What reads the pack's material, in words (`generate::ambient_warning` names it).
+    pub fn material_reader(self) -> &'static str {
+        match self {
+            Pack::Gltf => "glTF",
+            Pack::Unreal => "Unreal's material",
+            Pack::UnityHdrp => "HDRP's Lit material",
+        }
+    }
+
     /// The longest texture side the engine is documented to load, and where that is said: past
     /// it an engine scales the texture down on import or refuses it, so a pack (or a glTF
     /// file) with a longer side is warned of (`size_problem`). A body atlas is `body.length`

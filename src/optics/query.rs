@@ -128,7 +128,10 @@ pub fn chart(stack: Stack, method: Method, width: usize, height: usize) -> (Imag
             (0..width).map(|x| colour(super::lut::FINE_MAX_NM * x as f64 / (width - 1) as f64, cos0)).collect()
         })
         .collect();
-    let brightest = rows.iter().flatten().flat_map(|p| p.iter().copied()).fold(1e-6, f64::max);
+    // Floored only against a division by zero: a floor of 1e-6 drew a stack of n2 = n1 +
+    // 1e-7 (reflecting about 1e-15) at a fifth of full scale, where the help promises the
+    // brightest channel at 1 (a hostile-input review).
+    let brightest = rows.iter().flatten().flat_map(|p| p.iter().copied()).fold(f64::MIN_POSITIVE, f64::max);
     let exposure = 1.0 / brightest;
     let image = Image {
         width,
@@ -142,6 +145,19 @@ pub fn chart(stack: Stack, method: Method, width: usize, height: usize) -> (Imag
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The chart's brightest channel is 1, however faintly the stack reflects (a floor of
+    /// 1e-6 drew n2 = n1 + 1e-7 at a billionth of full scale: a hostile-input review); a stack
+    /// that reflects nothing is black, its exposure finite.
+    #[test]
+    fn a_faint_stacks_chart_is_scaled_to_one_and_a_blank_one_is_black() {
+        let brightest = |image: &Image| image.data.iter().copied().fold(0.0f32, f32::max);
+        let faint = Stack { n0: 1.0, n1: 1.0, n2: 1.0000001 };
+        let (image, exposure) = chart(faint, Method::Rgb3, 8, 8);
+        assert!((brightest(&image) - 1.0).abs() < 1e-6, "brightest {} at exposure {exposure}", brightest(&image));
+        let (image, exposure) = chart(Stack { n0: 1.0, n1: 1.0, n2: 1.0 }, Method::Rgb3, 8, 8);
+        assert!(exposure.is_finite() && brightest(&image) == 0.0, "{exposure} {}", brightest(&image));
+    }
 
     /// Queries of materials in the two orders that defeat the simpler rules: cycling
     /// through one more material than the cache holds (every query made again when a full cache

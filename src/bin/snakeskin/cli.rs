@@ -63,7 +63,8 @@ pub enum Command {
         /// Tile size in pixels, 16 to 2048.
         #[arg(long, default_value_t = 256, value_parser = ranged_u64(16, 2048))]
         tile: u64,
-        /// Tiles per row, 1 to 64.
+        /// Tiles per row, 1 to 64 (a row holds at most every tile: more columns than tiles
+        /// give one row).
         #[arg(long, default_value_t = 6, value_parser = ranged_u64(1, 64))]
         columns: u64,
         /// Also write one close-up per capability of the skin vocabulary into this folder: a
@@ -104,7 +105,7 @@ pub enum Command {
         /// render 4·tile × 2·tile), 64 to 1024.
         #[arg(long, default_value_t = 224, value_parser = ranged_u32(64, 1024))]
         tile: u32,
-        /// Cells per row, 1 to 8.
+        /// Cells per row, 1 to 8 (at most one per species drawn: more give one row).
         #[arg(long, default_value_t = 2, value_parser = ranged_u32(1, 8))]
         columns: u32,
         /// Map resolution per species (pixels per side; a body atlas's width, narrowed for a
@@ -767,7 +768,8 @@ pub enum BrdfCommand {
         height: u32,
     },
     /// Random and adversarial inputs: counts NaN and Inf, the range of R and T, the worst
-    /// white-furnace albedo of the thesis model, which must never pass 1 (`max_albedo`),
+    /// white-furnace albedo of the thesis model, which must never pass 1 but by the
+    /// quadrature's rounding in the last bits (`max_albedo`),
     /// every model's furnace range (`furnace_by_model`: the layered model's is about 1, off
     /// at the grazing and n0 > n2 draws) and the f32 path's worst deviation from f64 (JSON
     /// with --json).
@@ -924,8 +926,8 @@ pub enum BenchCommand {
         /// full-HD frame); WIDTHxHEIGHT, each 16 to 8192 pixels.
         #[arg(long, default_value = "480x300", value_parser = parse_image_size)]
         reference_size: ImageSize,
-        /// Time only the variants that read the film table (plain, skin, thesis, no film,
-        /// absorption, twenty snakes): skip skin-rgb3, skin-spectral-8 and skin-gaussian-fit,
+        /// Time only the variants that read the film table (plain, skin, skin at the mean
+        /// thickness, thesis, no film, absorption, twenty snakes): skip skin-rgb3, skin-spectral-8 and skin-gaussian-fit,
         /// which evaluate the film at every pixel and take most of a run (on a hardware GPU
         /// about 1 s a round of the 1.1 s, on lavapipe seconds a frame).
         #[arg(long)]
@@ -959,7 +961,8 @@ pub enum BenchCommand {
         /// Print JSON {"default", "methods": [{"name","mean_de","p95_de","max_de","ns_per_eval"}]}.
         #[arg(long)]
         json: bool,
-        /// Write an SVG plot of error against cost, one point per method.
+        /// Write an SVG plot of the mean error (ΔE00 against the spectral reference) against CPU
+        /// cost, one point per method.
         #[arg(long, value_name = "FILE")]
         plot: Option<PathBuf>,
         /// Thickness step of the grid in nm (the grid spans 0..2000 nm), 0.1 to 2000; the grid
@@ -997,8 +1000,8 @@ pub enum BenchCommand {
         /// minutes on two cores).
         #[arg(long, default_value_t = 40_000, value_parser = ranged_u64(1000, 10_000_000))]
         photons: u64,
-        /// Write an SVG plot of error (mean, p95, max ΔE00) against CPU cost, one point per
-        /// model.
+        /// Write an SVG plot of the mean error (ΔE00 against the photon walk) against CPU
+        /// cost, one point per model (the JSON has p95 and max).
         #[arg(long, value_name = "FILE")]
         plot: Option<PathBuf>,
     },

@@ -41,9 +41,12 @@ use super::{COS_MIN, Layers, Layers32};
 /// up to 0.04 (light straight back that the multiple scattering's pair rule misses across
 /// the critical angle's corner: `tests/brdf.rs`), and past a contrast of about 1.35 the
 /// shortfall summed over the hemisphere lets out more light than arrives: the lossless E
-/// passes 1, K is held at 0, and a white stack without absorption reflects up to about E
-/// (`brdf stress`'s 1.5 over 1: 1.05 at roughness 0.97; E at roughness 1 and 0 / 400 nm
-/// films: 1.0007 at n0 / n2 = 1.35, 1.028 at 1.4, 1.074 at 1.5; up to 1.35, within 0.0056).
+/// passes 1, K is held at 0, and a white stack without absorption reflects more than
+/// arrives (`brdf stress`'s 1.5 over 1: 1.05 at roughness 0.97; E at roughness 1 and 0 / 400
+/// nm films: 1.0007 at n0 / n2 = 1.35, 1.028 at 1.4, 1.074 at 1.5; up to 1.35, within
+/// 0.0056). E bounds the albedo only loosely at high contrast: at n0 / n2 = 3, E 1.424 and the
+/// albedo at most about 1.08 (0°–89°, roughness 1: a hostile-input review), so the warning
+/// names E as E, not as the albedo.
 /// Found from the material's own K and E (`exact::SmoothTop::k_e_row`) on the roughness rows
 /// a preset's roughness spans, at the thinnest and thickest films; warned of where E passes
 /// 1 by more than `PIGMENT_BELOW_AMBIENT_EXCESS`.
@@ -122,8 +125,9 @@ impl std::fmt::Display for PigmentBelowAmbient {
             PigmentBelowAmbient::Escapes { roughness_from, excess } => write!(
                 f,
                 "from roughness {roughness_from:.2} the layered model's rough top lets out more light than arrives \
-                 (it reflects too little of the light a rough top sends straight back at this contrast), so a white \
-                 stack without absorption reflects up to about {:.3} of the light",
+                 (it reflects too little of the light a rough top sends straight back at this contrast): the share \
+                 of the base's light it lets out reaches {:.3}, so a white stack without absorption reflects more \
+                 than all the light (how much at one angle: `snakeskin brdf albedo --albedo 1 --absorption 0`)",
                 1.0 + excess
             ),
         }

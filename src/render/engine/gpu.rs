@@ -12,7 +12,7 @@ pub enum GpuError {
     #[error("the GPU adapter refused a device: {0}")]
     Device(String),
     /// The adapter cannot hold a texture the renderer needs (`check_texture_limits`).
-    #[error("the GPU adapter is too small for the preview: {0}")]
+    #[error("the GPU adapter is too small for this run: {0}")]
     Limits(String),
     #[error("GPU readback failed: {0}")]
     Readback(String),
@@ -57,8 +57,11 @@ impl Gpu {
         }))
         .map_err(|e| {
             // `with_env` lets WGPU_BACKEND choose the backends: a typo there, not a driver,
-            // may be why there is none.
+            // may be why there is none. Where it already names Vulkan the hint would repeat
+            // it (a hostile-input review), and the driver is what is missing.
             let chosen = std::env::var("WGPU_BACKEND")
+                .ok()
+                .filter(|v| !v.trim().eq_ignore_ascii_case("vulkan"))
                 .map(|v| format!("; WGPU_BACKEND={v:?} chose the backends tried (unset it, or set it to vulkan)"))
                 .unwrap_or_default();
             GpuError::NoAdapter(format!("{e}{chosen}"))

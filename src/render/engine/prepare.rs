@@ -168,6 +168,28 @@ pub fn check_preview_memory(
     })
 }
 
+/// `material_maps_cached`'s memory check of a window's first maps, alone: the window runs it
+/// before it asks for a display, which it asks for before it builds the maps.
+pub fn check_window_memory(
+    loaded: &LoadedPreset,
+    map_size: usize,
+    layout: Layout,
+    frame_bytes: u64,
+) -> Result<(), Error> {
+    let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
+    first_maps_memory(&graph, map_dimensions(loaded, map_size, layout), frame_bytes).check(PREVIEW_MAPS)
+}
+
+/// What a window's first maps take, with nothing made before them but its frame: the whole
+/// process. The cache keeps every node, and hands copies of the maps over.
+fn first_maps_memory(graph: &crate::graph::Graph, (width, height): (usize, usize), frame_bytes: u64) -> DrawMemory {
+    DrawMemory {
+        evaluation_bytes: maps_bytes(width, height),
+        held_bytes: estimate_cached_peak_bytes(graph, &MapKind::ALL, width, height),
+        ..DrawMemory::new(graph, (width, height), frame_bytes)
+    }
+}
+
 /// What `snakes` snakes add to a frame's memory over one (`renderer::more_snakes_bytes`),
 /// drawn with the body mesh of `layout` (an atlas' has more rings).
 pub fn more_snakes_bytes(loaded: &LoadedPreset, layout: Layout, snakes: u32) -> u64 {
@@ -209,18 +231,12 @@ pub fn material_maps_cached(
 ) -> Result<(MaterialMaps, crate::graph::CacheStats), Error> {
     let graph = build_graph(&loaded.preset, BuildOptions { layout, ..BuildOptions::default() });
     let (width, height) = map_dimensions(loaded, map_size, layout);
-    // The cache keeps every node, and hands copies of the maps over.
-    let kept = estimate_cached_peak_bytes(&graph, &MapKind::ALL, width, height);
-    let handed_over = maps_bytes(width, height);
     if cache.bytes() == 0 {
-        // The window's first maps, before its renderer: the whole process.
-        let memory = DrawMemory {
-            evaluation_bytes: handed_over,
-            held_bytes: kept,
-            ..DrawMemory::new(&graph, (width, height), frame_bytes)
-        };
-        memory.check(PREVIEW_MAPS)?;
+        // The window's first maps, before its renderer (`check_window_memory`).
+        first_maps_memory(&graph, (width, height), frame_bytes).check(PREVIEW_MAPS)?;
     } else {
+        let kept = estimate_cached_peak_bytes(&graph, &MapKind::ALL, width, height);
+        let handed_over = maps_bytes(width, height);
         // A reload, in a window that holds its renderer, targets, cache and textures: what it
         // adds is the nodes that run (at most every one kept), the maps handed over, their
         // chains, and the new textures beside the old.

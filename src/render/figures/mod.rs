@@ -112,6 +112,21 @@ pub fn check_figure_files(out_dir: &Path, preset: &str) -> Result<(), Error> {
     Ok(())
 }
 
+/// The preset as each figure of `figure_list` draws it (its overrides applied), in the list's
+/// order, parsed from `source`: `write_figures` renders these, and the command prints their
+/// warnings first (the figures' own overrides can clamp a preset's colours: absorption 0.7
+/// darkens the stack below a bright base colour).
+pub fn figure_variants(source: &crate::preset::PresetSource) -> Result<Vec<crate::preset::LoadedPreset>, Error> {
+    figure_list()
+        .iter()
+        .map(|figure| {
+            let overrides: Vec<(String, String)> =
+                figure.overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+            Ok(crate::preset::parse(source, &overrides)?)
+        })
+        .collect()
+}
+
 /// Renders every figure of `figure_list` for `preset` into `out_dir`, and puts them in place
 /// together (`FileGroup`: an interrupted or failed run leaves the earlier figures as they
 /// were, not some new ones among them); returns the files. `source` is the preset's text as
@@ -129,14 +144,7 @@ pub fn write_figures(
 ) -> Result<Vec<PathBuf>, Error> {
     check_figure_files(out_dir, preset)?;
     let figures = figure_list();
-    let presets = figures
-        .iter()
-        .map(|figure| {
-            let overrides: Vec<(String, String)> =
-                figure.overrides.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-            crate::preset::parse(source, &overrides)
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let presets = figure_variants(source)?;
     let mut group = FileGroup::new();
     for (i, (figure, loaded)) in figures.iter().zip(&presets).enumerate() {
         progress(i, figures.len());

@@ -19,6 +19,7 @@ use crate::optics::brdf::Model;
 use crate::optics::lut::Lut;
 use crate::preset::LoadedPreset;
 use crate::render::engine::film::GpuFilmMethod;
+use crate::render::engine::gpu::GpuError;
 use crate::render::engine::prepare::{bands_for, material_maps};
 use crate::render::engine::renderer::{FilmFootprint, FrameOutput, FrameSettings, Material, OUTPUT_FORMAT, Renderer};
 use crate::render::engine::scene::LayerOptics;
@@ -202,7 +203,12 @@ pub fn bench_render(
 ) -> Result<RenderBench, Error> {
     // The reference check at the end reads its G-buffer back in one buffer: refused now,
     // not after every timing run.
-    renderer.check_readback(options.reference_size.0, options.reference_size.1, 16)?;
+    // The size named: the refusal spoke of "the preview" (a hostile-input review).
+    let (w, h) = options.reference_size;
+    renderer.check_readback(w, h, 16).map_err(|e| match e {
+        GpuError::Limits(why) => GpuError::Limits(format!("{why} (--reference-size {w}x{h})")),
+        e => e,
+    })?;
     let maps = material_maps(loaded, options.map_size)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);

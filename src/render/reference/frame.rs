@@ -33,7 +33,16 @@ pub fn reference_check(
     let settings = FrameSettings { samples: 1, ground: false, view: View::Shaded(Stage::All), ..*settings };
     let image = renderer.render_image(&settings, material, width, height)?;
     let gbuffer = renderer.render_gbuffer(&settings, material, width, height)?;
-    Ok((compare(&image, &gbuffer, &settings, &material.optics, progress), image))
+    let report = compare(&image, &gbuffer, &settings, &material.optics, progress);
+    // No pixel compared is no check: it printed "0 pixels, CIEDE2000 mean NaN" and passed (a
+    // hostile-input review: a frame 16 wide with 400 snakes).
+    if report.pixels == 0 {
+        return Err(Error::Unsupported(format!(
+            "the {width}×{height} frame shows no pixel of the snake, so nothing was compared with the CPU \
+             reference: give a larger size or fewer snakes"
+        )));
+    }
+    Ok((report, image))
 }
 
 /// Mean, 99th percentile and max CIEDE2000 over covered pixels, and the heat map.

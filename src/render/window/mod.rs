@@ -94,6 +94,16 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let snakes = options.settings.snakes.max(panel::SNAKES_SLIDER_MAX);
     let frame_bytes = super::engine::renderer::window_frame_bytes(options.size.0, options.size.1)
         + super::engine::prepare::more_snakes_bytes(&loaded, options.layout, snakes);
+    // The memory, then the window system, then the work: without a display the maps
+    // (seconds, and 5 GB at --map-size 4096) were built and thrown away (a hostile-input
+    // review).
+    super::engine::prepare::check_window_memory(&loaded, options.map_size, options.layout, frame_bytes)?;
+    let event_loop = EventLoop::new().map_err(|e| {
+        Error::Gpu(GpuError::Window(format!(
+            "cannot open a window: {} (no display? run under `xvfb-run -a`, or use --out)",
+            without_source_location(&e.to_string())
+        )))
+    })?;
     let (maps, _) = material_maps_cached(&loaded, options.map_size, options.layout, &mut cache, frame_bytes)?;
     let optics = LayerOptics::from_preset(&loaded.preset);
     let lut = Lut::bake_default(optics.stack);
@@ -101,12 +111,6 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let (lut_jobs, lut_results) = reload::spawn_lut_worker();
     let map_worker = reload::spawn_map_worker(&options, cache);
 
-    let event_loop = EventLoop::new().map_err(|e| {
-        Error::Gpu(GpuError::Window(format!(
-            "cannot open a window: {} (no display? run under `xvfb-run -a`, or use --out)",
-            without_source_location(&e.to_string())
-        )))
-    })?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         settings: options.settings,

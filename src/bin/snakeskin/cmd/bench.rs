@@ -71,7 +71,11 @@ fn layered(json: bool, photons: u64, plot: Option<&std::path::Path>) -> Result<(
                 ns_per_eval: m.ns_per_eval,
             })
             .collect();
-        let svg = snakeskin::optics::plot::error_vs_cost_svg(&points, snakeskin::optics::brdf::Model::default().name());
+        let svg = snakeskin::optics::plot::error_vs_cost_svg(
+            &points,
+            snakeskin::optics::brdf::Model::default().name(),
+            "the photon walk",
+        );
         snakeskin::export::write_file_atomically(path, svg.into_bytes())?;
         // On stderr, as `brdf chart` says its file: stdout may be the JSON.
         eprintln!("wrote {}", path_line(path));
@@ -170,7 +174,7 @@ fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_d
         }
     }
     if let Some(path) = plot {
-        let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default);
+        let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default, "the spectral reference");
         snakeskin::export::write_file_atomically(path, svg.into_bytes())?;
         eprintln!("wrote {}", path_line(path));
     }
@@ -203,7 +207,7 @@ fn render(preset: &str, options: &BenchOptions, json: bool) -> Result<()> {
     let result = bench_render(&renderer, &loaded, options, &|what| bar.message(what))?;
     bar.finish();
     if json {
-        println!("{}", serde_json::to_string_pretty(&result)?);
+        println!("{}", serde_json::to_string(&result)?);
         return Ok(());
     }
     println!("adapter: {} (timing: {})", result.adapter, result.timing);

@@ -24,10 +24,14 @@ pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> 
     }
     if let Some(dir) = closeups {
         snakeskin::export::check_folder(dir)?;
+        let mut probed = std::collections::HashSet::new();
         for name in snakeskin::render::figures::gallery::closeup_file_names() {
-            let closeup = dir.join(name);
+            let closeup = dir.join(&name);
             snakeskin::export::check_target(&closeup)?;
             snakeskin::export::check_replaces_its_own(&closeup, "png")?;
+            // A read-only folder was found after the gallery was drawn, seconds and a
+            // gigabyte in, as "cannot write DIR" (a hostile-input review).
+            snakeskin::export::check_folder_writable(dir, &name, &mut probed)?;
             // `-o sp/rows.png --closeups sp`: the close-up replaced the gallery (the review).
             if snakeskin::export::same_path(&closeup, out) {
                 return Err(snakeskin::Error::Unsupported(format!(

@@ -8,6 +8,7 @@ use crate::progress::Progress;
 use snakeskin::Error;
 use snakeskin::export::FileGroup;
 use snakeskin::render::Renderer;
+use snakeskin::render::engine::gpu::GpuError;
 use snakeskin::render::engine::prepare::upload_material_in;
 use snakeskin::render::engine::renderer::{FrameSettings, frame_bytes, gbuffer_bytes};
 use snakeskin::render::engine::scene::Camera;
@@ -76,7 +77,10 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     let renderer = Renderer::headless()?;
     if args.reference.is_some() {
         // Before the render is written: the check's G-buffer is read back in one buffer.
-        renderer.check_readback(width, height, 16)?;
+        renderer.check_readback(width, height, 16).map_err(|e| match e {
+            GpuError::Limits(why) => GpuError::Limits(format!("{why} (--size {width}x{height} with --reference)")),
+            e => e,
+        })?;
     }
     // Before the work: a folder that takes no new file is said at once, naming the file.
     for file in std::iter::once(out).chain(args.reference.as_deref()) {
