@@ -141,6 +141,12 @@ pub struct FilmAtAngle {
     /// 1e-308: the transmittance would be inf · 0, a non-finite value, which is taken as the
     /// grazing limit).
     reflects_all: bool,
+    /// True where there is no interface at all: equal ambient and substrate with a film of
+    /// their index or of no thickness. Everything passes at every angle, grazing included,
+    /// where the Airy sum is 0 / 0 (r01 = −1, r12 = 1 in f64 at cos0 ≈ 1e-16: `brdf film
+    /// --n0 1 --n1 1.55 --n2 1 --thickness-nm 0 --angle-deg 90` read R = 1, and with n0 =
+    /// n2 = 1.33, T = 0.52 with R = 0: an independent review).
+    passes_all: bool,
 }
 
 impl FilmAtAngle {
@@ -149,6 +155,7 @@ impl FilmAtAngle {
     pub fn new(stack: Stack, thickness_nm: f64, cos0: f64) -> FilmAtAngle {
         let cos0 = cos0.clamp(0.0, 1.0);
         let Stack { n0, n1, n2 } = stack;
+        let passes_all = n0 == n2 && (n1 == n0 || thickness_nm == 0.0);
         let c0 = C64::real(cos0);
         let c1 = film_cos_in(n0, n1, cos0);
         let c2 = cos_in(n0, n2, cos0);
@@ -163,7 +170,8 @@ impl FilmAtAngle {
             t01: [t01s, t01p],
             t12: [t12s, t12p],
             flux,
-            reflects_all: !(cos0 > 0.0 && flux.iter().all(|f| f.is_finite())),
+            reflects_all: !(passes_all || (cos0 > 0.0 && flux.iter().all(|f| f.is_finite()))),
+            passes_all,
         }
     }
 
@@ -183,6 +191,9 @@ impl FilmAtAngle {
     pub fn at(&self, wavelength_nm: f64) -> FilmRT {
         if self.reflects_all {
             return FilmRT::from_sp(1.0, 1.0, 0.0, 0.0);
+        }
+        if self.passes_all {
+            return FilmRT::from_sp(0.0, 0.0, 1.0, 1.0);
         }
         let beta = self.beta(wavelength_nm);
         let (e1, e2) = (C64::exp_i(beta), C64::exp_i(beta * 2.0));
@@ -206,6 +217,9 @@ impl FilmAtAngle {
     pub fn reflectance(&self, wavelength_nm: f64) -> f64 {
         if self.reflects_all {
             return 1.0;
+        }
+        if self.passes_all {
+            return 0.0;
         }
         let e2 = C64::exp_i(self.beta(wavelength_nm) * 2.0);
         let (rs, rp) = (self.airy_r(0, e2).norm_sqr(), self.airy_r(1, e2).norm_sqr());
@@ -240,6 +254,30 @@ pub fn incoherent(stack: Stack, cos0: f64) -> FilmRT {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// No interface at all (equal ambient and substrate, the film of their index or of no
+    /// thickness) passes everything at every angle, grazing included: `--angle-deg 90` is
+    /// cos 6.1e-17, where the Airy sum of a 0 nm film is 0 / 0 and read R = 1, or R = 0 with
+    /// T = 0.52 (an independent review). Controls: a film 400 nm thick between equal media,
+    /// and a 0 nm film over another substrate, reflect all of grazing light, as interfaces do.
+    #[test]
+    fn no_interface_passes_everything_at_every_angle() {
+        let grazing = std::f64::consts::FRAC_PI_2.cos();
+        for (stack, d) in [
+            (Stack { n0: 1.0, n1: 1.55, n2: 1.0 }, 0.0),
+            (Stack { n0: 1.33, n1: 1.56, n2: 1.33 }, 0.0),
+            (Stack { n0: 1.5, n1: 1.5, n2: 1.5 }, 400.0),
+        ] {
+            for cos0 in [0.0, grazing, 1e-12, 1e-9, 0.5, 1.0] {
+                let rt = airy(stack, d, 550.0, cos0);
+                assert!(rt.r == 0.0 && rt.t == 1.0, "{stack:?} {d} nm at cos {cos0}: {rt:?}");
+                assert_eq!(FilmAtAngle::new(stack, d, cos0).reflectance(550.0), 0.0);
+            }
+        }
+        let interface = |stack: Stack, d: f64| airy(stack, d, 550.0, grazing).r;
+        assert!(interface(Stack { n0: 1.0, n1: 1.55, n2: 1.0 }, 400.0) > 0.999);
+        assert!(interface(Stack { n0: 1.0, n1: 1.55, n2: 2.0 }, 0.0) > 0.999);
+    }
 
     /// `FilmAtAngle::reflectance` (what the spectral sums call) is `at(λ).r` bit for bit:
     /// over films that vanish (n1 = n0), stacks with total internal reflection in the film

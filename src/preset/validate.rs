@@ -178,11 +178,12 @@ fn rows_bounding(rows: u32) -> u32 {
 }
 
 /// What a preset that loads does not do as its keys seem to say, one warning each: the
-/// model's limits (`pigment_below_ambient`, `film_below_ambient`) and a film centred too
+/// model's limits (`pigment_below_ambient`, `pigment_near_ambient`, `film_below_ambient`) and a film centred too
 /// thin for its spread (`film_floor`).
 pub fn warnings(preset: &Preset) -> Vec<Problem> {
     pigment_below_ambient(preset)
         .into_iter()
+        .chain(pigment_near_ambient(preset))
         .chain(film_below_ambient(preset))
         .chain(film_floor(preset))
         .chain(rings_not_kept_apart(preset))
@@ -264,6 +265,31 @@ fn pigment_below_ambient(preset: &Preset) -> Option<Problem> {
             "{} is above optics.pigment_ior = {}: {limit}. Keep ambient_ior at most pigment_ior, or from about \
              1.03 to 1.35 times it, for an energy-conserving render.",
             o.ambient_ior, o.pigment_ior
+        ),
+    })
+}
+
+/// A pigment layer as dense as the ambient or just denser, under a film and a rough top:
+/// the layered model misreads the light the top sends straight back (`PigmentNearAmbient`),
+/// for the thickness map's thickest film and the roughness map's roughest top. A warning:
+/// the physics is fine (a snake's skin under water of about its index).
+fn pigment_near_ambient(preset: &Preset) -> Option<Problem> {
+    let o = &preset.optics;
+    if !crate::maps::has_film(preset) {
+        return None;
+    }
+    let stack = crate::optics::film::Stack { n0: o.ambient_ior, n1: o.film_ior, n2: o.pigment_ior };
+    let thickest_nm = crate::maps::map_thickness_range_nm(preset).1;
+    let roughest = crate::maps::roughness_range(preset).1;
+    let limit = crate::optics::brdf::layered::PigmentNearAmbient::of(stack, thickest_nm, roughest)?;
+    Some(Problem {
+        key: "optics.pigment_ior".into(),
+        message: format!(
+            "{} is near optics.ambient_ior = {}: {limit}. Keep pigment_ior at least {} times ambient_ior for an \
+             accurate render of a rough film.",
+            o.pigment_ior,
+            o.ambient_ior,
+            crate::optics::brdf::layered::PIGMENT_NEAR_AMBIENT
         ),
     })
 }

@@ -867,7 +867,7 @@ pub struct AlbedoArgs {
     /// roughness 0 the layered model reads 0.903 against the closed form's 0.906 at 89°, 0.878
     /// against 0.990 at 89.9°). reference: the
     /// smooth-top stack in closed form (roughness ignored; Gauss–Legendre, within 5e-5 on
-    /// the stacks measured).
+    /// the stacks measured, but up to 5e-4 with a thick film less dense than --n0).
     /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
     /// standard error per channel. The references read the exact 1 nm film (--method is
     /// for the models).

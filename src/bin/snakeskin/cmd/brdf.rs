@@ -10,7 +10,7 @@ use crate::cli::{AlbedoArgs, AlbedoModel, BrdfCommand, EvalArgs, LayerArgs, Stac
 use crate::output::{ensure_parent_folder, path_line, printable};
 use snakeskin::Error;
 use snakeskin::optics::brdf::exact::SmoothTop;
-use snakeskin::optics::brdf::layered::{FilmBelowAmbient, PigmentBelowAmbient};
+use snakeskin::optics::brdf::layered::{FilmBelowAmbient, PigmentBelowAmbient, PigmentNearAmbient};
 use snakeskin::optics::brdf::walk::{FilmTables, walk};
 use snakeskin::optics::brdf::{BrdfValue, Layers, Model};
 use snakeskin::optics::film::{Stack, airy};
@@ -85,7 +85,7 @@ fn color_json_with(stack: Stack, thickness_nm: f64, angle_deg: f64, method: Meth
     Ok(serde_json::json!({ "rgb": rgb }).to_string())
 }
 
-/// The layered model's known limits (`PigmentBelowAmbient`, `FilmBelowAmbient`, which a
+/// The layered model's known limits (`PigmentBelowAmbient`, `PigmentNearAmbient`, `FilmBelowAmbient`, which a
 /// preset's check warns of too) for a film `thickness_nm` thick under a top `roughness`
 /// rough, each said once, on stderr.
 fn warn_of_model_limit(model: Model, stack: Stack, thickness_nm: f64, roughness: f64) {
@@ -95,6 +95,9 @@ fn warn_of_model_limit(model: Model, stack: Stack, thickness_nm: f64, roughness:
     let walk = "`brdf albedo --model stochastic` walks the stack itself";
     if let Some(limit) = PigmentBelowAmbient::of(stack, (thickness_nm, thickness_nm), (roughness, roughness)) {
         eprintln!("warning: --n0 {} is above --n2 {}: {limit} ({walk})", stack.n0, stack.n2);
+    }
+    if let Some(limit) = PigmentNearAmbient::of(stack, thickness_nm, roughness) {
+        eprintln!("warning: --n2 {} is near --n0 {}: {limit} ({walk})", stack.n2, stack.n0);
     }
     if let Some(limit) = FilmBelowAmbient::of(stack.n0, stack.n1, thickness_nm, (roughness, roughness)) {
         eprintln!("warning: --n1 {} is below --n0 {}: {limit} ({walk})", stack.n1, stack.n0);
