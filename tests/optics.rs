@@ -468,18 +468,20 @@ mod commands {
             let says = "warning: --n1 1.3 is below --n0 1.5: within a few degrees of the film's critical angle (60°";
             assert_eq!(err.contains(says), warned, "{layer:?} {model}: {err}");
         }
-        // An ambient denser than the pigment layer: warned of only where the model's E passes
-        // 1 (`PigmentBelowAmbient`: 1.5 over 1 at roughness 1), not at a lower contrast or
-        // roughness.
+        // An ambient denser than the pigment layer: warned of energy only where the model's E
+        // passes 1 (`PigmentBelowAmbient`: 1.5 over 1 at roughness 1), not at a lower
+        // contrast or roughness; below a contrast of 1.35 under a film, of the top's light
+        // straight back instead (`PigmentNearAmbient`).
         let says = "warning: --n0 1.5 is above --n2 1: from roughness 1.00 the layered model's rough top lets out more";
-        for (indices, roughness, warned) in
-            [(["1.5", "1"], "1", true), (["1.5", "1"], "0.5", false), (["1.5", "1.33"], "1", false)]
+        for (indices, roughness, warned, near) in
+            [(["1.5", "1"], "1", true, false), (["1.5", "1"], "0.5", false, false), (["1.5", "1.33"], "1", false, true)]
         {
             let denser = ["--n0", indices[0], "--n1", "1.55", "--n2", indices[1], "--roughness", roughness];
             let (code, _, err) = run(&[&eval[..6], &denser[..]].concat());
             assert_eq!(code, 0, "{err}");
             assert_eq!(err.contains(says), warned, "{indices:?} roughness {roughness}: {err}");
-            assert!(warned || err.is_empty(), "{err}");
+            assert_eq!(err.contains("is near --n0"), near, "{indices:?} roughness {roughness}: {err}");
+            assert!(warned || near || err.is_empty(), "{err}");
         }
         // Within about 3 % of the pigment's index, the critical angle near grazing: warned of
         // at any roughness (`PigmentBelowAmbient::LowContrast`: 1.21 at 85° here, roughness 1).

@@ -442,7 +442,7 @@ fn preview_writes_a_png_and_rejects_bad_options() {
     let args = ["preview", PRESET, "--out", o, "--map-size", "64", "--size", "16x2048", "--snakes", "100"];
     let run = snakeskin(&[&args[..], &["--reference", h]].concat());
     assert_eq!(run.status.code(), Some(2), "{}", common::stderr(&run));
-    assert!(common::stderr(&run).contains("shows no pixel of the snake"), "{}", common::stderr(&run));
+    assert!(common::stderr(&run).contains("shows no pixel of a snake"), "{}", common::stderr(&run));
     assert_eq!(std::fs::read(&out).unwrap(), before, "the render was written");
     assert!(!heat.exists(), "a heat map of nothing was written");
 }
@@ -822,8 +822,9 @@ fn figures_read_their_preset_once() {
         }
     };
     let source = snakeskin::preset::read_source(preset).unwrap();
+    let variants = snakeskin::render::figures::figure_variants(&source).unwrap();
     let written =
-        snakeskin::render::figures::write_figures(&renderer, preset, &source, dir.path(), (16, 16), 64, &progress)
+        snakeskin::render::figures::write_figures(&renderer, preset, &variants, dir.path(), (16, 16), 64, &progress)
             .unwrap_or_else(|e| panic!("the file saved during the run was read: {e}"));
     assert_eq!(written.len(), snakeskin::render::figures::figure_list().len());
     assert!(written.iter().all(|f| f.is_file()), "{written:?}");

@@ -328,10 +328,11 @@ fn export_and_batch_report_clamped_colours() {
 
 /// An ambient denser than the pigment layer: a rough top lets light in and out beyond the
 /// critical angle, and the layered model follows it, so the white furnace holds there and a
-/// preset with such indices loads without a word. Until a later session the model lost the
-/// light there (0.50 at 75° on 1.4 | 1.33, roughness 0.5: this test's first assertion then
+/// preset with such indices draws no warning of energy. Until a later session the model lost
+/// the light there (0.50 at 75° on 1.4 | 1.33, roughness 0.5: this test's first assertion then
 /// failed, as it was written to, once the model was mended) and such presets were warned
-/// of. Control: equal indices.
+/// of. What is left near matching indices, the light the film sends straight back, is
+/// warned of (`layered::PigmentNearAmbient`). Control: equal indices.
 #[test]
 fn an_ambient_denser_than_the_pigment_keeps_the_furnace_without_a_warning() {
     let albedo = |n0: &str, n2: &str| {
@@ -342,7 +343,7 @@ fn an_ambient_denser_than_the_pigment_keeps_the_furnace_without_a_warning() {
         (json["albedo"][1].as_f64().unwrap(), stderr(&out))
     };
     let ((denser, said), (equal, said_of_equal)) = (albedo("1.4", "1.33"), albedo("1.33", "1.33"));
-    assert!(said.is_empty(), "{said}");
+    assert!(!said.contains("is above") && said.contains("--n2 1.33 is near --n0 1.4"), "{said}");
     // Equal indices under a rough film are warned of (`layered::PigmentNearAmbient`: the
     // light the film sends straight back is misread), though the furnace holds.
     assert!(said_of_equal.contains("--n2 1.33 is near --n0 1.33"), "{said_of_equal}");
@@ -356,7 +357,8 @@ fn an_ambient_denser_than_the_pigment_keeps_the_furnace_without_a_warning() {
     let preset = write_preset(dir.path(), "oily.toml", text);
     let out_dir = dir.path().join("out");
     let out = snakeskin(&["generate", &preset, "-o", out_dir.to_str().unwrap(), "--size", "32", "--maps", "color"]);
-    assert!(out.status.success() && !stderr(&out).contains("ambient_ior"), "{}", stderr(&out));
+    assert!(out.status.success() && !stderr(&out).contains("ambient_ior = 1.4 is above"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("optics.pigment_ior = 1.33 is near optics.ambient_ior = 1.4"), "{}", stderr(&out));
     // Past a contrast of about 1.35 under rough tops the model lets out more light than
     // arrives (`layered::PigmentBelowAmbient`): warned of with the key and line.
     let text = "species = \"oily\"\n\n[optics]\nambient_ior = 1.5\npigment_ior = 1.0\n\n[roughness]\nbase = 1.0\n";
@@ -398,6 +400,13 @@ fn a_pigment_as_dense_as_the_ambient_under_a_rough_film_is_warned_of() {
     let (far, said) = off("1.2");
     assert!(far < 0.01, "{far} off at 1.2 times, outside the warned range");
     assert!(!said.contains("is near"), "{said}");
+    // Below the ambient's index too, to a contrast of 1.35 (0.135 off at 1.1 | 1, 85°).
+    let below = |n0: &str| {
+        let args = ["brdf", "albedo", "--n0", n0, "--n2", "1", "--roughness", "1", "--angle-deg", "85"];
+        stderr(&snakeskin(&args))
+    };
+    assert!(below("1.1").contains("warning: --n2 1 is near --n0 1.1"), "{}", below("1.1"));
+    assert!(!below("1.5").contains("is near"), "{}", below("1.5"));
 
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("out");

@@ -285,11 +285,12 @@ fn pigment_near_ambient(preset: &Preset) -> Option<Problem> {
     Some(Problem {
         key: "optics.pigment_ior".into(),
         message: format!(
-            "{} is near optics.ambient_ior = {}: {limit}. Keep pigment_ior at least {} times ambient_ior for an \
-             accurate render of a rough film.",
+            "{} is near optics.ambient_ior = {}: {limit}. Keep pigment_ior at least {} times ambient_ior (or \
+             ambient_ior over {} times pigment_ior) for an accurate render of a rough film.",
             o.pigment_ior,
             o.ambient_ior,
-            crate::optics::brdf::layered::PIGMENT_NEAR_AMBIENT
+            crate::optics::brdf::layered::PIGMENT_NEAR_AMBIENT,
+            crate::optics::brdf::layered::PIGMENT_NEAR_AMBIENT_BELOW
         ),
     })
 }

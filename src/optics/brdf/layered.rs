@@ -134,19 +134,21 @@ impl std::fmt::Display for PigmentBelowAmbient {
     }
 }
 
-/// A known limit of the layered model, where the pigment layer's index is at or just above
-/// the medium's above it (n0 ≤ n2 < `PIGMENT_NEAR_AMBIENT` n0) and a film lies between them,
-/// under a rough top. The light a rough top lets in and sends straight back out (`path`'s
-/// q) is walked through the bare interface n0 | n2 and reweighted by the film's reflectance
-/// over the bare one at the last reflection; near index matching the bare interface reflects
-/// almost nothing, so few walked photons carry the rule (and at n0 = n2 none: W = 0), while
-/// the film's own reflections from below send much light straight back. What the top
-/// reflects is then off the photon walk (`brdf albedo --model stochastic`, 100,000 photons;
-/// n0 1, film 1.55 of 400 nm, black base; an independent review's find): at roughness 1 and
-/// 85°, by 0.32 at n2 = 1, 0.13 at 1.01, 0.04 at 1.05, 0.019 at 1.1, 0.010 at 1.15 and 0.006
-/// at 1.2; at 60°, by 0.067 at most; under a top of roughness 0.2, 0.018 at n2 = 1 and 0.002
-/// at 1.03; at 0.1, within 0.004. Films of 1.33 and 2.0 at n2 = 1.05: 0.011 and 0.017 (80°,
-/// roughness 0.8).
+/// A known limit of the layered model, where the pigment layer's index is near the medium's
+/// above it (n0 / `PIGMENT_NEAR_AMBIENT_BELOW` < n2 < `PIGMENT_NEAR_AMBIENT` n0) and a film
+/// lies between them, under a rough top. The light a rough top lets in and sends straight
+/// back out (`path`'s q) is walked through the bare interface n0 | n2 and reweighted by the
+/// film's reflectance over the bare one at the last reflection; near index matching the
+/// bare interface reflects little, so few walked photons carry the rule (and at n0 = n2
+/// none: W = 0), while the film's own reflections from below send much light straight
+/// back. What the top reflects is then off the photon walk (`brdf albedo --model
+/// stochastic`, 100,000 photons; film 1.55 of 400 nm, black base; an independent review's
+/// find, and a second review's for n2 below n0). At roughness 1 and 85°, n0 1: by 0.32 at n2
+/// = 1, 0.13 at 1.01, 0.04 at 1.05, 0.019 at 1.1, 0.010 at 1.15, 0.006 at 1.2; n2 1: by 0.32
+/// at n0 = 1.03, 0.135 at 1.1, 0.061 at 1.2, 0.035 at 1.35, 0.009 at 1.5 (at 60°: 0.106 at
+/// 1.1, 0.017–0.019 at 1.5 and 2). Under a top of roughness 0.2, at most 0.018 (n2 = n0 and
+/// n0 = 1.03 n2); at 0.1, within 0.005. Films of 1.33 and 2.0 at n2 = 1.05: 0.011 and 0.017
+/// (80°, roughness 0.8). Beyond a contrast of 1.35 `PigmentBelowAmbient::Escapes` warns.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PigmentNearAmbient {
     /// n2 / n0.
@@ -156,6 +158,9 @@ pub struct PigmentNearAmbient {
 /// Contrasts n2 / n0 from 1 to below this are warned of (`PigmentNearAmbient`): 1.15 read
 /// within 0.010 of the walk at 85° and roughness 1, 1.1 by 0.019.
 pub const PIGMENT_NEAR_AMBIENT: f64 = 1.15;
+/// Contrasts n0 / n2 above 1 and below this are warned of too (`PigmentNearAmbient`): 1.35
+/// read 0.035 off at 85°, 1.5 0.009; past 1.35 `PigmentBelowAmbient::Escapes` takes over.
+pub const PIGMENT_NEAR_AMBIENT_BELOW: f64 = 1.35;
 /// From this roughness up (`PigmentNearAmbient`): 0.2 read 0.018 off at n2 = n0.
 pub const PIGMENT_NEAR_AMBIENT_ROUGH: f64 = 0.2;
 
@@ -165,9 +170,9 @@ impl PigmentNearAmbient {
     /// contrast that is not near 1).
     pub fn of(stack: crate::optics::film::Stack, thickest_nm: f64, roughest: f64) -> Option<Self> {
         let ratio = stack.n2 / stack.n0;
+        let near = ratio < PIGMENT_NEAR_AMBIENT && ratio * PIGMENT_NEAR_AMBIENT_BELOW > 1.0;
         let film = thickest_nm > 0.0 && stack.n1 != stack.n0;
-        ((1.0..PIGMENT_NEAR_AMBIENT).contains(&ratio) && film && roughest >= PIGMENT_NEAR_AMBIENT_ROUGH)
-            .then_some(PigmentNearAmbient { ratio })
+        (near && film && roughest >= PIGMENT_NEAR_AMBIENT_ROUGH).then_some(PigmentNearAmbient { ratio })
     }
 }
 
@@ -175,10 +180,10 @@ impl std::fmt::Display for PigmentNearAmbient {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "at {:.3} times the ambient index the bare interface reflects almost nothing, and the layered model \
-             misreads the light a rough top's film sends straight back: what the top reflects is off the photon \
-             walk by up to 0.3 of the light at equal indices, 0.04 at 1.05 times and 0.01 at 1.15 (85°, roughness \
-             1; within 0.02 under tops of roughness 0.2 or less)",
+            "at {:.3} times the ambient index the bare interface reflects little, and the layered model misreads \
+             the light a rough top's film sends straight back: what the top reflects is off the photon walk by up \
+             to 0.3 of the light near equal indices, 0.04 at 1.05 times, 0.01 at 1.15, and 0.035 at 1 / 1.35 (85°, \
+             roughness 1; within 0.02 under tops smoother than 0.2)",
             self.ratio
         )
     }

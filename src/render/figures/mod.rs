@@ -129,14 +129,15 @@ pub fn figure_variants(source: &crate::preset::PresetSource) -> Result<Vec<crate
 
 /// Renders every figure of `figure_list` for `preset` into `out_dir`, and puts them in place
 /// together (`FileGroup`: an interrupted or failed run leaves the earlier figures as they
-/// were, not some new ones among them); returns the files. `source` is the preset's text as
-/// the command read it once (`preset::read_source`), every figure's variant parsed from it
-/// before any is rendered (each figure read the file again: one saved during a run made a
-/// set of two presets' figures, and an error in it came after the others' rendering).
+/// were, not some new ones among them); returns the files. `variants` are the figures'
+/// presets (`figure_variants`), parsed from the preset's text as the command read it once
+/// (`preset::read_source`) before any is rendered (each figure read the file again: one
+/// saved during a run made a set of two presets' figures, and an error in it came after the
+/// others' rendering).
 pub fn write_figures(
     renderer: &Renderer,
     preset: &str,
-    source: &crate::preset::PresetSource,
+    variants: &[crate::preset::LoadedPreset],
     out_dir: &Path,
     size: (u32, u32),
     map_size: usize,
@@ -144,9 +145,11 @@ pub fn write_figures(
 ) -> Result<Vec<PathBuf>, Error> {
     check_figure_files(out_dir, preset)?;
     let figures = figure_list();
-    let presets = figure_variants(source)?;
+    if variants.len() != figures.len() {
+        return Err(Error::Internal(format!("{} variants for {} figures", variants.len(), figures.len())));
+    }
     let mut group = FileGroup::new();
-    for (i, (figure, loaded)) in figures.iter().zip(&presets).enumerate() {
+    for (i, (figure, loaded)) in figures.iter().zip(variants).enumerate() {
         progress(i, figures.len());
         crate::memory::release_freed();
         let material = upload_material(renderer, loaded, map_size, GpuFilmMethod::Lut)?;

@@ -450,8 +450,8 @@ mod tests {
     use super::*;
 
     /// A preset that gives its plate counts is labelled with them; one whose sources give
-    /// none (`pantherophis-guttatus`: "ventrals, subcaudals: not found") is labelled with the
-    /// defaults, called so.
+    /// none (`pantherophis-guttatus`: one text's counts, doubtful for the species and not
+    /// used) is labelled with the defaults, called so.
     #[test]
     fn the_body_sheet_calls_default_counts_defaults() {
         let counts = |ventrals, subcaudals| crate::export::Counts {

@@ -38,7 +38,7 @@ pub fn reference_check(
     // hostile-input review: a frame 16 wide with 400 snakes).
     if report.pixels == 0 {
         return Err(Error::Unsupported(format!(
-            "the {width}×{height} frame shows no pixel of the snake, so nothing was compared with the CPU \
+            "the {width}×{height} frame shows no pixel of a snake, so nothing was compared with the CPU \
              reference: give a larger size or fewer snakes"
         )));
     }
