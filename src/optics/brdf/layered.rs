@@ -182,8 +182,9 @@ impl std::fmt::Display for PigmentNearAmbient {
             f,
             "at {:.3} times the ambient index the bare interface reflects little, and the layered model misreads \
              the light a rough top's film sends straight back: what the top reflects is off the photon walk by up \
-             to 0.3 of the light near equal indices, 0.04 at 1.05 times, 0.01 at 1.15, and 0.035 at 1 / 1.35 (85°, \
-             roughness 1; within 0.02 under tops smoother than 0.2)",
+             to 0.3 of the light near equal indices, 0.04 at 1.05 times, 0.01 at {PIGMENT_NEAR_AMBIENT}, and 0.035 \
+             at 1 / {PIGMENT_NEAR_AMBIENT_BELOW} (85°, roughness 1; within 0.02 under tops smoother than \
+             {PIGMENT_NEAR_AMBIENT_ROUGH})",
             self.ratio
         )
     }
