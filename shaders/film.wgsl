@@ -97,7 +97,8 @@ struct Harmonics {
 // As optics::fast::Film32: kappa1 = Im cos theta1 (> 0 beyond the critical angle of a film
 // less dense than the ambient, where the wave in the film is evanescent), exact (the series is
 // not used and band_reflectance reads the exact film: evanescent, or |q|^2 >= MAX_Q2), and
-// the Fresnel amplitudes (r01 in xy, r12 in zw) of s and of p.
+// the Fresnel amplitudes (r01 in xy, r12 in zw) of s and of p, and whether the substrate's
+// and the film's indices are the ambient's (film_passes_all).
 struct Film {
     s: Harmonics,
     p: Harmonics,
@@ -106,6 +107,13 @@ struct Film {
     exact: bool,
     amplitudes_s: vec4<f32>,
     amplitudes_p: vec4<f32>,
+    substrate_is_ambient: bool,
+    film_is_ambient: bool,
+}
+
+// No interface at all at this thickness: everything passes (optics::fast::Film32::passes_all).
+fn film_passes_all(f: Film, thickness_nm: f32) -> bool {
+    return f.substrate_is_ambient && (f.film_is_ambient || thickness_nm == 0.0);
 }
 
 fn harmonics(a: vec2<f32>, b: vec2<f32>) -> Harmonics {
@@ -138,11 +146,13 @@ fn r_p(ni: f32, ci: vec2<f32>, nj: f32, cj: vec2<f32>) -> vec2<f32> {
 
 fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
     let cos0 = clamp(cos0_in, 0.0, 1.0);
+    let substrate_is_ambient = n2 == n0;
+    let film_is_ambient = n1 == n0;
     if (cos0 * cos0 < F32_MIN_POSITIVE) {
-        // Grazing light is all reflected (optics::fast::film_f32).
+        // Grazing light is all reflected, unless there is no interface (optics::fast::film_f32).
         let none = Harmonics(1.0, vec2<f32>(0.0), vec2<f32>(0.0));
         let reflects_all = vec4<f32>(1.0, 0.0, 0.0, 0.0);
-        return Film(none, none, 0.0, 0.0, true, reflects_all, reflects_all);
+        return Film(none, none, 0.0, 0.0, true, reflects_all, reflects_all, substrate_is_ambient, film_is_ambient);
     }
     let c0 = vec2<f32>(cos0, 0.0);
     // Off exactly 0 at the film's critical angle (optics::fast::film_f32).
@@ -164,7 +174,7 @@ fn film_coefficients(n0: f32, n1: f32, n2: f32, cos0_in: f32) -> Film {
         cos1 = c1.x;
     }
     let exact = !(c1.y == 0.0 && dot(s.q, s.q) < MAX_Q2 && dot(p.q, p.q) < MAX_Q2);
-    return Film(s, p, cos1, c1.y, exact, vec4<f32>(a_s, b_s), vec4<f32>(a_p, b_p));
+    return Film(s, p, cos1, c1.y, exact, vec4<f32>(a_s, b_s), vec4<f32>(a_p, b_p), substrate_is_ambient, film_is_ambient);
 }
 
 // One polarisation's exact reflectance |a + b e|^2 / |1 + a b e|^2 (optics::fast::
@@ -177,6 +187,9 @@ fn airy_one(ab: vec4<f32>, e: vec2<f32>) -> f32 {
 
 // The exact coherent film at one wavelength (optics::fast::airy_reflectance_f32).
 fn airy_reflectance(f: Film, n1: f32, thickness_nm: f32, wavelength_nm: f32) -> f32 {
+    if (film_passes_all(f, thickness_nm)) {
+        return 0.0;
+    }
     let k = 4.0 * PI * n1 * thickness_nm / wavelength_nm;
     let e = vec2<f32>(cos(k * f.cos1), sin(k * f.cos1)) * exp(-k * f.kappa1);
     return clamp(0.5 * (airy_one(f.amplitudes_s, e) + airy_one(f.amplitudes_p, e)), 0.0, 1.0);
@@ -285,9 +298,13 @@ fn film_gaussian_fit(thickness_nm: f32, cos0: f32) -> vec3<f32> {
     return vec3<f32>(dot(m[0].xyz, xyz), dot(m[1].xyz, xyz), dot(m[2].xyz, xyz));
 }
 
-// Unpolarised Fresnel reflectance of the n0|n2 interface (no film), grey.
+// Unpolarised Fresnel reflectance of the n0|n2 interface (no film), grey; none where the
+// indices are equal (no interface: grazing light read 0 / 0 there, as in film_passes_all).
 fn film_none(cos0: f32) -> vec3<f32> {
     let n = film_info.iors_band;
+    if (n.x == n.z) {
+        return vec3<f32>(0.0);
+    }
     let c0 = vec2<f32>(clamp(cos0, 0.0, 1.0), 0.0);
     let c2 = cos_in(n.x, n.z, c0.x);
     let rs = r_s(n.x, c0, n.z, c2);

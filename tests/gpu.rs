@@ -150,17 +150,26 @@ fn wgsl_brdf_matches_the_rust_twin_on_10000_inputs() {
 fn every_film_method_on_the_gpu_matches_its_rust_twin() {
     use snakeskin::optics::methods::{gaussian_fit_f32, rgb3_f32, spectral_n_f32};
     let Some(gpu) = gpu_or_skip("every_film_method_on_the_gpu_matches_its_rust_twin") else { return };
-    // The thesis' stack, one under water and one over a pigment less dense than the film.
-    let stacks = [Stack::THESIS, Stack { n0: 1.33, n1: 1.55, n2: 2.0 }, Stack { n0: 1.0, n1: 1.56, n2: 1.33 }];
+    // The thesis' stack, one under water, one over a pigment less dense than the film, and
+    // one whose pigment has the ambient's index (a film of 0 nm there is no interface at all:
+    // every method read NaN near grazing, `optics::fast::Film32::passes_all`).
+    let stacks = [
+        Stack::THESIS,
+        Stack { n0: 1.33, n1: 1.55, n2: 2.0 },
+        Stack { n0: 1.0, n1: 1.56, n2: 1.33 },
+        Stack { n0: 1.33, n1: 1.55, n2: 1.33 },
+    ];
     let mut rng = Rng(7);
     // Thicknesses over the presets' range and beyond, cosines over the hemisphere with the
-    // ends (grazing light, normal light) and the bare film (0 nm) among them.
+    // ends (grazing light, almost grazing, normal light) and the bare film (0 nm) among them.
     let points: Vec<(f32, f32)> = (0..2000)
         .map(|i| {
             let thickness_nm = if i % 13 == 0 { 0.0 } else { rng.next() * 3000.0 };
             let cos = match i % 17 {
                 0 => 0.0,
                 1 => 1.0,
+                2 => 1e-9,
+                3 => 1e-12,
                 _ => rng.next(),
             };
             (thickness_nm, cos)
@@ -213,6 +222,7 @@ fn every_film_method_on_the_gpu_matches_its_rust_twin() {
                 let cpu = twin(stack, d, c);
                 for k in 0..3 {
                     assert!(g[k].is_finite(), "{method:?} on {stack:?}: not finite at {d} nm, cos {c}");
+                    assert!(cpu[k].is_finite(), "{method:?}'s twin on {stack:?}: not finite at {d} nm, cos {c}");
                     let e = (g[k] - cpu[k]).abs();
                     if e > worst {
                         (worst, worst_at) = (e, format!("{d} nm, cos {c}: cpu {cpu:?}, gpu {g:?}"));

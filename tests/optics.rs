@@ -501,6 +501,13 @@ mod commands {
         assert_eq!(v["nan"], 0);
         assert_eq!(v["inf"], 0);
         assert!(v["min_r"].as_f64().unwrap() >= 0.0 && v["max_r"].as_f64().unwrap() <= 1.0);
+        // The lossless film keeps R + T = 1 (2.2e-13 here); the f32 films stay in [0, 1] and
+        // within 3.2e-4 of f64 here (2.2e-3 over 100,000 samples, near grazing). Before
+        // `fast::Film32::passes_all` these samples read 396 NaN (n2 = n0, a film of 0 nm,
+        // light at cos 1e-9) and the f32 exact film 1.0 off f64 (grazing light there).
+        assert!(v["film_energy_err"].as_f64().unwrap() < 1e-9, "{v}");
+        assert!(v["film_f32_min_r"].as_f64().unwrap() >= 0.0 && v["film_f32_max_r"].as_f64().unwrap() <= 1.0);
+        assert!(v["max_film_f32_dev"].as_f64().unwrap() < 1e-2, "{v}");
         assert!(v["max_albedo"].as_f64().unwrap() <= 1.0 + 2e-3);
         // The layered model's furnace on the stress films, each integration with its own
         // film's K and E: 0.998 to 1.001 in these samples' two integrations (0.293 to 1.008
@@ -511,7 +518,10 @@ mod commands {
         let layered = v["furnace_by_model"].as_array().unwrap().iter().find(|m| m["model"] == "layered").unwrap();
         let (min, max) = (layered["min_albedo"].as_f64().unwrap(), layered["max_albedo"].as_f64().unwrap());
         assert!((0.98..=1.02).contains(&min) && (0.98..=1.02).contains(&max), "{layered}");
-        assert!(v["max_f32_dev"].as_f64().unwrap() < 1e-2);
+        // 0.018 here: the ambient denser than the pigment under a mirror-smooth top, whose
+        // step at the critical angle the f32 coupling table interpolates across (BENCHMARKS,
+        // "Stress": up to 6.1 % over a million samples on the stress' first seven materials).
+        assert!(v["max_f32_dev"].as_f64().unwrap() < 0.07, "{v}");
     }
 
     #[test]

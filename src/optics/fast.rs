@@ -73,6 +73,23 @@ pub struct Film32 {
     /// The Fresnel amplitudes [r01, r12] of s and of p (the exact film's, `airy_reflectance_f32`).
     pub amplitudes_s: [C32; 2],
     pub amplitudes_p: [C32; 2],
+    /// The substrate's index is the ambient's (n2 = n0), and `film_is_ambient`: the film's is
+    /// too (n1 = n0). Where both hold, or the first with a film of no thickness, there is no
+    /// interface at all and everything passes at every angle (`passes_all`, as
+    /// `film::FilmAtAngle`'s). The Airy sum cannot say so in f32 near grazing: below cos0 ≈
+    /// 3e-8, r01 and r12 round to ∓1 and a film of 0 nm read 0 / 0 (NaN) in every method
+    /// (found by `brdf stress` once it drew n2 = n0 and the f32 films), and grazing light
+    /// read 1.
+    pub substrate_is_ambient: bool,
+    pub film_is_ambient: bool,
+}
+
+impl Film32 {
+    /// True where there is no interface at all at this thickness (see `substrate_is_ambient`).
+    #[inline]
+    pub fn passes_all(&self, thickness_nm: f32) -> bool {
+        self.substrate_is_ambient && (self.film_is_ambient || thickness_nm == 0.0)
+    }
 }
 
 /// Floor on 1 − |q|² in the harmonics' normalisation: |q| < 1 for any physical interface
@@ -102,12 +119,14 @@ fn harmonics(a: C32, b: C32) -> Harmonics32 {
 #[inline]
 pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
     let cos0 = cos0.clamp(0.0, 1.0);
+    let (substrate_is_ambient, film_is_ambient) = (n2 == n0, n1 == n0);
     if cos0 * cos0 < f32::MIN_POSITIVE {
         // Grazing light carries no flux and is all reflected, as `film::FilmAtAngle` takes it
-        // (r01 was 0 / 0 where n1 = n0): the exact film with r01 = 1 and no second face. So is
-        // light whose cosine squares to less than a normal f32 (below 1.1e-19, where the exact
-        // film reflects 1 to f32's precision): the cosines' squares and the amplitudes'
-        // denominators underflowed there (NaN where n1 = n0).
+        // (r01 was 0 / 0 where n1 = n0): the exact film with r01 = 1 and no second face,
+        // unless there is no interface at all (`Film32::passes_all`). So is light whose cosine
+        // squares to less than a normal f32 (below 1.1e-19, where the exact film reflects 1
+        // to f32's precision): the cosines' squares and the amplitudes' denominators
+        // underflowed there (NaN where n1 = n0).
         let none = Harmonics32 { c0: 1.0, d: [0.0; 2], q: [0.0; 2] };
         let reflects_all = [[1.0, 0.0], [0.0; 2]];
         let amplitudes_s = reflects_all;
@@ -119,6 +138,8 @@ pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
             exact: true,
             amplitudes_s,
             amplitudes_p: amplitudes_s,
+            substrate_is_ambient,
+            film_is_ambient,
         };
     }
     let c0: C32 = [cos0, 0.0];
@@ -146,6 +167,8 @@ pub fn film_f32(n0: f32, n1: f32, n2: f32, cos0: f32) -> Film32 {
         exact: !(c1[1] == 0.0 && norm_sqr(s.q) < MAX_Q2_F32 && norm_sqr(p.q) < MAX_Q2_F32),
         amplitudes_s: [a_s, b_s],
         amplitudes_p: [a_p, b_p],
+        substrate_is_ambient,
+        film_is_ambient,
     }
 }
 
@@ -196,9 +219,13 @@ pub fn phase_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32) 
 /// which for an evanescent film (cos θ1 = i κ) is the real decay exp(−4π n1 d κ / λ).
 /// 1 + r01 r12 e ≠ 0: it would need |r01| = |r12| = |e| = 1, a travelling wave with both faces
 /// reflecting totally, which only cos θ1 = 0 gives, and `film_f32` keeps cos θ1 off 0 (or,
-/// for grazing light, holds no second face).
+/// for grazing light, holds no second face); in f32 it also vanishes where r01 and r12 round
+/// to ∓1, which `Film32::passes_all` takes first.
 #[inline]
 pub fn airy_reflectance_f32(film: &Film32, n1: f32, thickness_nm: f32, wavelength_nm: f32) -> f32 {
+    if film.passes_all(thickness_nm) {
+        return 0.0;
+    }
     let k = 4.0 * std::f32::consts::PI * n1 * thickness_nm / wavelength_nm;
     let e = scale([(k * film.cos1).cos(), (k * film.cos1).sin()], (-k * film.kappa1).exp());
     let r = |[a, b]: [C32; 2]| norm_sqr(add(a, mul(b, e))) / norm_sqr(add([1.0, 0.0], mul(mul(a, b), e)));

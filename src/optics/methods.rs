@@ -300,4 +300,58 @@ mod tests {
             assert_eq!(Method::parse(refused), None, "{refused}");
         }
     }
+
+    /// Where there is no interface at all (the substrate's index the ambient's, with a film
+    /// of no thickness or of their index), every f32 film method reads 0 at every cosine,
+    /// grazing included, as the f64 film does (`film::FilmAtAngle`'s passes_all). Before
+    /// `fast::Film32::passes_all` they read NaN from cos 1e-12 to 3e-8 (r01 and r12 round
+    /// to ∓1: 0 / 0) and 1 at grazing. Controls: a film 1 nm thick, and a substrate a
+    /// millionth denser than the ambient, reflect nearly everything near grazing in f32 as
+    /// the f64 film does; their colours stay finite too.
+    #[test]
+    fn no_interface_passes_everything_in_every_f32_method_at_every_angle() {
+        use super::super::film::{Stack, airy};
+        type F32Method = fn(f32, f32, f32, f32, f32) -> [f32; 3];
+        let methods: [(&str, F32Method, f32); 3] = [
+            ("rgb3", rgb3_f32, 1e-5),
+            ("spectral-8", |a, b, c, d, e| spectral_n_f32(a, b, c, d, e, 8), 1e-5),
+            // The fit's own error on a bare interface at ordinary angles (1.1e-3 at cos 0.5).
+            ("gaussian-fit", gaussian_fit_f32, 2e-3),
+        ];
+        let cosines = [0.0f32, 1e-30, 1e-20, 1e-12, 1e-9, 3e-8, 1e-7, 1e-5, 0.5, 1.0];
+        let f32s = |s: Stack| (s.n0 as f32, s.n1 as f32, s.n2 as f32);
+        let passes = [
+            (Stack { n0: 1.33, n1: 1.55, n2: 1.33 }, 0.0),
+            (Stack { n0: 1.0, n1: 1.55, n2: 1.0 }, 0.0),
+            (Stack { n0: 1.33, n1: 1.33, n2: 1.33 }, 300.0),
+            (Stack { n0: 1.0, n1: 1.0, n2: 1.0 }, 0.0),
+        ];
+        for (stack, d) in passes {
+            let (n0, n1, n2) = f32s(stack);
+            for c in cosines {
+                assert_eq!(airy(stack, d, 550.0, f64::from(c)).r, 0.0, "the f64 film, {stack:?} {d} nm, cos {c}");
+                for (name, method, tolerance) in methods {
+                    let rgb = method(n0, n1, n2, d as f32, c);
+                    assert!(rgb.iter().all(|v| v.abs() <= tolerance), "{name} on {stack:?}, {d} nm, cos {c}: {rgb:?}");
+                }
+            }
+        }
+        let reflect = [(Stack { n0: 1.33, n1: 1.55, n2: 1.33 }, 1.0), (Stack { n0: 1.0, n1: 1.55, n2: 1.000001 }, 0.0)];
+        for (stack, d) in reflect {
+            let (n0, n1, n2) = f32s(stack);
+            for c in cosines {
+                for (name, method, _) in methods {
+                    let rgb = method(n0, n1, n2, d as f32, c);
+                    assert!(rgb.iter().all(|v| v.is_finite()), "{name} on {stack:?}, {d} nm, cos {c}: {rgb:?}");
+                }
+            }
+            for c in [0.0f32, 1e-20, 1e-9] {
+                assert!(airy(stack, d, 550.0, f64::from(c)).r > 0.999, "the f64 film, {stack:?} {d} nm, cos {c}");
+                for (name, method, _) in methods {
+                    let rgb = method(n0, n1, n2, d as f32, c);
+                    assert!(rgb.iter().all(|v| *v > 0.99), "{name} on {stack:?}, {d} nm, cos {c}: {rgb:?}");
+                }
+            }
+        }
+    }
 }

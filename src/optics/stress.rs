@@ -2,15 +2,20 @@
 //! f64 and f32, counting anything non-finite and the worst of every bound PHYSICS.md sets.
 //!
 //! Adversarial on purpose: grazing (cos = 0 and 1e-9) and back-facing directions, d = 0 and
-//! 10 mm, n1 = n0, n2 < n1, n0 > n2 (total internal reflection), roughness 0 and 1, τ = 0 and
-//! 50, zero-length and back-facing normals. Samples are generated from (seed, index) alone,
-//! so a report is reproducible at any thread count.
+//! 10 mm, n1 = n0, n2 < n1, n0 > n2 (total internal reflection), n2 = n0 (no interface without
+//! the film) and n2 a millionth above n0, roughness 0 and 1, τ = 0 and 50, zero-length and
+//! back-facing normals. The film goes through f64 (R, T and R + T = 1: every index is real, so
+//! nothing is absorbed) and through the f32 kernels the real-time film methods and the shader
+//! share (`fast`, `methods`). Samples are generated from (seed, index) alone, so a report is
+//! reproducible at any thread count.
 
 use rayon::prelude::*;
 
 use super::brdf::{Layers, Model};
+use super::fast;
 use super::film::{Stack, airy, incoherent};
 use super::lut::Lut;
+use super::methods;
 use super::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
 use crate::ops::hash;
 
@@ -22,6 +27,19 @@ pub struct StressReport {
     /// Smallest and largest of R_s, R_p, R, T_s, T_p, T seen (must stay in [0, 1]).
     pub min_r: f64,
     pub max_r: f64,
+    /// Largest |R + T − 1| of the f64 film, per polarisation, exact and incoherent: the
+    /// stress' indices are real, so the film absorbs nothing.
+    pub film_energy_err: f64,
+    /// Smallest and largest f32 film reflectance seen: the exact film and the prefiltered
+    /// series band (`fast::airy_reflectance_f32`, `fast::band_reflectance_f32`), which must
+    /// stay in [0, 1]; the f32 film colours (rgb3, spectral-8, gaussian-fit) are counted for
+    /// NaN and Inf only (a saturated film colour lies outside sRGB's [0, 1]).
+    pub film_f32_min_r: f64,
+    pub film_f32_max_r: f64,
+    /// Largest |R_f32 − R_f64| of the exact film at one wavelength, for films up to
+    /// `F32_FILM_DEV_MAX_NM` (beyond, f32 cannot hold the phase: 4π n1 d / λ is 10⁶ rad at
+    /// 10 mm, where f32's spacing is 0.06 rad).
+    pub max_film_f32_dev: f64,
     /// Largest white-furnace albedo (k_d = 1, τ = 0) over the furnace subset, for the
     /// models that must never reflect more than arrives (the thesis model).
     pub max_albedo: f64,
@@ -30,7 +48,9 @@ pub struct StressReport {
     /// stress also views at 89.94° (cos 0.001), where a mirror-smooth top reads 0.79–0.86, and
     /// draws n0 = 1.5 over n2 = 1, where tops of roughness 0.87 and more reflect up to 1.05
     /// (`layered::PigmentBelowAmbient`; before the model followed the light beyond the
-    /// critical angle, 0.44 there).
+    /// critical angle, 0.44 there), and a pigment a millionth denser than the ambient, where
+    /// near-mirror tops at 89.94° read up to 2.1 through the film table (0.99 through the
+    /// exact film: BENCHMARKS, "Stress").
     pub furnace_by_model: Vec<ModelFurnace>,
     /// Largest |f32 − f64| / (1 + |f64|) of the BRDF.
     pub max_f32_dev: f64,
@@ -47,7 +67,7 @@ pub struct ModelFurnace {
 }
 
 /// The materials the stress draws from: the thesis default and its edge cases.
-pub const STRESS_MATERIALS: [Stack; 7] = [
+pub const STRESS_MATERIALS: [Stack; 9] = [
     Stack::THESIS,
     Stack { n0: 1.0, n1: 1.0, n2: 2.0 },
     Stack { n0: 1.0, n1: 1.56, n2: 1.33 },
@@ -55,7 +75,16 @@ pub const STRESS_MATERIALS: [Stack; 7] = [
     Stack { n0: 1.33, n1: 1.55, n2: 2.0 },
     Stack { n0: 1.0, n1: 3.0, n2: 1.0 },
     Stack { n0: 1.0, n1: 2.0, n2: 2.0 },
+    // No interface without the film, and a pigment a millionth denser than the ambient: a film
+    // of 0 nm passes everything here, and the f32 films read NaN near grazing until
+    // `fast::Film32::passes_all`.
+    Stack { n0: 1.33, n1: 1.55, n2: 1.33 },
+    Stack { n0: 1.0, n1: 1.55, n2: 1.000001 },
 ];
+
+/// The thickest film whose f32 reflectance the stress compares with f64 (see
+/// `StressReport::max_film_f32_dev`): twice the presets' thickest films.
+pub const F32_FILM_DEV_MAX_NM: f64 = 2000.0;
 
 /// One furnace integration per this many samples (it costs ~2000 BRDF evaluations).
 const FURNACE_EVERY: u64 = 2000;
@@ -106,6 +135,10 @@ pub fn run(samples: u64, seed: u32) -> StressReport {
         total.inf += p.inf;
         total.min_r = total.min_r.min(p.min_r);
         total.max_r = total.max_r.max(p.max_r);
+        total.film_energy_err = total.film_energy_err.max(p.film_energy_err);
+        total.film_f32_min_r = total.film_f32_min_r.min(p.film_f32_min_r);
+        total.film_f32_max_r = total.film_f32_max_r.max(p.film_f32_max_r);
+        total.max_film_f32_dev = total.max_film_f32_dev.max(p.max_film_f32_dev);
         total.max_albedo = total.max_albedo.max(p.max_albedo);
         for (t, q) in total.furnace_by_model.iter_mut().zip(&p.furnace_by_model) {
             t.min_albedo = t.min_albedo.min(q.min_albedo);
@@ -124,6 +157,10 @@ fn empty() -> StressReport {
         inf: 0,
         min_r: f64::INFINITY,
         max_r: f64::NEG_INFINITY,
+        film_energy_err: 0.0,
+        film_f32_min_r: f64::INFINITY,
+        film_f32_max_r: f64::NEG_INFINITY,
+        max_film_f32_dev: 0.0,
         max_albedo: 0.0,
         max_f32_dev: 0.0,
         furnace_evaluations: 0,
@@ -147,7 +184,7 @@ fn count(acc: &mut StressReport, values: &[f64]) {
 
 fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
     acc.samples += 1;
-    let material = draw.pick(&[0, 1, 2, 3, 4, 5, 6]);
+    let material = draw.pick(&[0, 1, 2, 3, 4, 5, 6, 7, 8]);
     let stack = STRESS_MATERIALS[material];
     let thickness = match draw.pick(&[0, 1, 2, 3]) {
         0 => 0.0,
@@ -169,8 +206,8 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
     // Film R and T at a random wavelength and angle.
     let cos0 = draw.pick(&[0.0, 1e-9, 1.0, -1.0]);
     let cos0 = if cos0 < 0.0 { draw.unit() } else { cos0 };
-    let film =
-        airy(stack, thickness, f64::from(LAMBDA_MIN_NM) + draw.unit() * f64::from(LAMBDA_MAX_NM - LAMBDA_MIN_NM), cos0);
+    let wavelength_nm = f64::from(LAMBDA_MIN_NM) + draw.unit() * f64::from(LAMBDA_MAX_NM - LAMBDA_MIN_NM);
+    let film = airy(stack, thickness, wavelength_nm, cos0);
     let inc = incoherent(stack, cos0);
     let rt = [film.rs, film.rp, film.r, film.ts, film.tp, film.t, inc.r, inc.t];
     count(acc, &rt);
@@ -178,6 +215,12 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
         acc.min_r = acc.min_r.min(v);
         acc.max_r = acc.max_r.max(v);
     }
+    for f in [&film, &inc] {
+        for (r, t) in [(f.rs, f.ts), (f.rp, f.tp)] {
+            acc.film_energy_err = acc.film_energy_err.max((r + t - 1.0).abs());
+        }
+    }
+    film_f32(acc, stack, thickness, wavelength_nm, cos0, film.r);
 
     let lut = &luts[material];
     // K and E of a 400 nm film for every sample: these look for non-finite and
@@ -221,5 +264,32 @@ fn sample(acc: &mut StressReport, luts: &[Lut], mut draw: Draw) {
             f.min_albedo = albedo.iter().cloned().fold(f.min_albedo, f64::min);
             f.max_albedo = albedo.iter().cloned().fold(f.max_albedo, f64::max);
         }
+    }
+}
+
+/// The f32 film kernels at the sample's film: the exact film and a series band (range, and
+/// the exact film against f64's `r64`), and the three f32 film colours (NaN and Inf).
+fn film_f32(acc: &mut StressReport, stack: Stack, thickness_nm: f64, wavelength_nm: f64, cos0: f64, r64: f64) {
+    let (n0, n1, n2) = (stack.n0 as f32, stack.n1 as f32, stack.n2 as f32);
+    let (d, lambda, cos) = (thickness_nm as f32, wavelength_nm as f32, cos0 as f32);
+    let film = fast::film_f32(n0, n1, n2, cos);
+    let exact = fast::airy_reflectance_f32(&film, n1, d, lambda);
+    let band = fast::band_reflectance_f32(&film, n1, d, lambda, methods::RGB3_BAND_NM);
+    count(acc, &[exact as f64, band as f64]);
+    for r in [exact, band] {
+        acc.film_f32_min_r = acc.film_f32_min_r.min(r as f64);
+        acc.film_f32_max_r = acc.film_f32_max_r.max(r as f64);
+    }
+    if thickness_nm <= F32_FILM_DEV_MAX_NM {
+        // A NaN is counted above (`f64::max` passes it over here).
+        acc.max_film_f32_dev = acc.max_film_f32_dev.max((exact as f64 - r64).abs());
+    }
+    let colours = [
+        methods::rgb3_f32(n0, n1, n2, d, cos),
+        methods::spectral_n_f32(n0, n1, n2, d, cos, 8),
+        methods::gaussian_fit_f32(n0, n1, n2, d, cos),
+    ];
+    for rgb in colours {
+        count(acc, &rgb.map(f64::from));
     }
 }

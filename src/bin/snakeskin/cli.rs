@@ -767,15 +767,16 @@ pub enum BrdfCommand {
         #[arg(long, default_value_t = 300, value_parser = ranged_u32(2, 4096))]
         height: u32,
     },
-    /// Random and adversarial inputs: counts NaN and Inf, the range of R and T, the worst
-    /// white-furnace albedo of the thesis model, which must never pass 1 but by the
-    /// quadrature's rounding in the last bits (`max_albedo`),
-    /// every model's furnace range (`furnace_by_model`: the layered model's is about 1, off
-    /// at the grazing and n0 > n2 draws) and the f32 path's worst deviation from f64 (JSON
-    /// with --json).
+    /// Random and adversarial inputs: counts NaN and Inf, the range of R and T and how far
+    /// R + T strays from 1 (the stress' films absorb nothing), the f32 film kernels' range and
+    /// worst deviation from f64 (films up to 2000 nm), the worst white-furnace albedo of the
+    /// thesis model, which must never pass 1 but by the quadrature's rounding in the last
+    /// bits (`max_albedo`), every model's furnace range (`furnace_by_model`: the layered
+    /// model's is about 1, off at the grazing, n0 > n2 and near-matched draws) and the f32
+    /// BRDF's worst deviation from f64 (JSON with --json).
     Stress {
-        /// Number of random samples, 1 to 10,000,000 (the default takes about 13 seconds on
-        /// two cores, 11 of them baking the stacks' film tables, whatever the count).
+        /// Number of random samples, 1 to 10,000,000 (the default takes about 35 seconds on
+        /// two cores, 10 of them baking the nine stacks' film tables, whatever the count).
         #[arg(long, default_value_t = 100_000, value_parser = ranged_u64(1, 10_000_000))]
         samples: u64,
         /// Seed of the sample generator, 0 to 4294967295 (its hash takes 32 bits: a larger

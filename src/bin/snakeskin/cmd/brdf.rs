@@ -344,6 +344,14 @@ fn stress_table(r: &snakeskin::optics::stress::StressReport) -> String {
     let mut text = format!("samples: {} (layer models: {})\n", r.samples, r.models.join(", "));
     text += &format!("NaN: {}, Inf: {}\n", r.nan, r.inf);
     text += &format!("R and T of the film: {:.6} to {:.6} (must lie in [0, 1])\n", r.min_r, r.max_r);
+    text += &format!("|R + T - 1| of the film (nothing absorbed): at most {:.3e}\n", r.film_energy_err);
+    text += &format!(
+        "f32 film reflectance: {:.6} to {:.6} (must lie in [0, 1]); against f64 up to {} nm: at most {:.3e}\n",
+        r.film_f32_min_r,
+        r.film_f32_max_r,
+        snakeskin::optics::stress::F32_FILM_DEV_MAX_NM,
+        r.max_film_f32_dev
+    );
     text += &format!("white furnace (k_d = 1, tau = 0), {} evaluations:\n", r.furnace_evaluations);
     for m in &r.furnace_by_model {
         if r.furnace_evaluations == 0 {
