@@ -1913,6 +1913,14 @@ fn a_backend_variable_that_finds_no_adapter_is_named() {
     assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
     assert!(stderr(&run).contains("WGPU_BACKEND=\"bogus\" chose the backends tried"), "{}", stderr(&run));
     assert!(!out.exists());
+    // Where it takes Vulkan as wgpu reads it ("vk" too, in any case, in a list) the hint
+    // would only repeat it: the driver is what is missing.
+    for vulkan in ["vk", " Vulkan , VK"] {
+        let run = snakeskin_env(&args, &[("WGPU_BACKEND", vulkan), ("VK_ICD_FILENAMES", "/nonexistent.json")]);
+        assert_eq!(run.status.code(), Some(1), "{vulkan}: {}", stderr(&run));
+        assert!(stderr(&run).contains("no GPU adapter found"), "{vulkan}: {}", stderr(&run));
+        assert!(!stderr(&run).contains("chose the backends tried"), "{vulkan}: {}", stderr(&run));
+    }
 }
 
 /// A gallery and its close-ups appear together or not at all (`FileGroup`): a folder in the

@@ -767,13 +767,15 @@ pub enum BrdfCommand {
         #[arg(long, default_value_t = 300, value_parser = ranged_u32(2, 4096))]
         height: u32,
     },
-    /// Random and adversarial inputs: counts NaN and Inf, the range of R and T and how far
-    /// R + T strays from 1 (the stress' films absorb nothing), the f32 film kernels' range and
-    /// worst deviation from f64 (films up to 2000 nm), the worst white-furnace albedo of the
-    /// thesis model, which must never pass 1 but by the quadrature's rounding in the last
-    /// bits (`max_albedo`), every model's furnace range (`furnace_by_model`: the layered
-    /// model's is about 1, off at the grazing, n0 > n2 and near-matched draws) and the f32
-    /// BRDF's worst deviation from f64 (JSON with --json).
+    /// Random and adversarial inputs: counts NaN and Inf (`nan`, `inf`), the range of R and T
+    /// (`min_r`, `max_r`) and how far R + T strays from 1 (`film_energy_err`: the stress'
+    /// films absorb nothing), the f32 film kernels' range (`film_f32_min_r`,
+    /// `film_f32_max_r`) and worst deviation from f64 (`max_film_f32_dev`, films up to 2000
+    /// nm), the worst white-furnace albedo of the thesis model, which must never pass 1 but by
+    /// the quadrature's rounding in the last bits (`max_albedo`), every model's furnace range
+    /// (`furnace_by_model`: the layered model's is about 1, off at the grazing, n0 > n2 and
+    /// near-matched draws) and the f32 BRDF's worst deviation from f64 (`max_f32_dev`; JSON
+    /// with --json).
     Stress {
         /// Number of random samples, 1 to 10,000,000 (the default takes about 35 seconds on
         /// two cores, 10 of them baking the nine stacks' film tables, whatever the count).

@@ -57,11 +57,12 @@ impl Gpu {
         }))
         .map_err(|e| {
             // `with_env` lets WGPU_BACKEND choose the backends: a typo there, not a driver,
-            // may be why there is none. Where it already names Vulkan the hint would repeat
-            // it (a hostile-input review), and the driver is what is missing.
+            // may be why there is none. Where it already takes Vulkan (as wgpu reads it:
+            // "vulkan" or "vk", alone or in a list) the hint would repeat it (a hostile-input
+            // review), and the driver is what is missing.
             let chosen = std::env::var("WGPU_BACKEND")
                 .ok()
-                .filter(|v| !v.trim().eq_ignore_ascii_case("vulkan"))
+                .filter(|v| !wgpu::Backends::from_comma_list(v).contains(wgpu::Backends::VULKAN))
                 .map(|v| format!("; WGPU_BACKEND={v:?} chose the backends tried (unset it, or set it to vulkan)"))
                 .unwrap_or_default();
             GpuError::NoAdapter(format!("{e}{chosen}"))
