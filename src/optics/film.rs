@@ -101,8 +101,14 @@ pub(crate) fn fresnel_amplitudes(ni: f64, ci: C64, nj: f64, cj: C64) -> (C64, C6
     (rs, rp, ts, tp)
 }
 
-/// Fresnel intensity reflectance (R_s, R_p) of a single interface n0 | n.
+/// Fresnel intensity reflectance (R_s, R_p) of a single interface n0 | n; none where the
+/// indices are equal (no interface: at cos 0 the amplitudes were 0 / 0, NaN, which the
+/// walk's bare interface could read, an independent review's find; below cos 1e-154, whose
+/// square underflows, they read 1).
 pub fn fresnel(n0: f64, n: f64, cos0: f64) -> (f64, f64) {
+    if n0 == n {
+        return (0.0, 0.0);
+    }
     let c0 = C64::real(cos0);
     let c1 = cos_in(n0, n, cos0);
     let (rs, rp, _, _) = fresnel_amplitudes(n0, c0, n, c1);
@@ -234,10 +240,14 @@ impl FilmAtAngle {
 /// R = R01 + T01² R12 / (1 − R01 R12), per polarisation (PHYSICS.md, mistake 6).
 pub fn incoherent(stack: Stack, cos0: f64) -> FilmRT {
     let cos0 = cos0.clamp(0.0, 1.0);
+    let Stack { n0, n1, n2 } = stack;
+    if n0 == n1 && n1 == n2 {
+        // No interface at all: everything passes, grazing light too (as `airy`).
+        return FilmRT::from_sp(0.0, 0.0, 1.0, 1.0);
+    }
     if cos0 <= 0.0 {
         return FilmRT::from_sp(1.0, 1.0, 0.0, 0.0);
     }
-    let Stack { n0, n1, n2 } = stack;
     let (r01s, r01p) = fresnel(n0, n1, cos0);
     let c1 = cos_in(n0, n1, cos0);
     // Internal incidence on the 1|2 interface: cos θ1 real unless TIR at 0|1 (then R01 = 1).
@@ -277,6 +287,17 @@ mod tests {
         let interface = |stack: Stack, d: f64| airy(stack, d, 550.0, grazing).r;
         assert!(interface(Stack { n0: 1.0, n1: 1.55, n2: 1.0 }, 400.0) > 0.999);
         assert!(interface(Stack { n0: 1.0, n1: 1.55, n2: 2.0 }, 0.0) > 0.999);
+        // The bare interface and the incoherent film, likewise: equal indices reflected NaN
+        // at cos 0 (0 / 0) and 1 below cos 1e-154, and the incoherent film of one index
+        // read 1 at both. Controls: an interface, and a thick film between equal media,
+        // reflect all of grazing light.
+        for cos0 in [0.0, 1e-320, 1e-200, grazing, 0.5, 1.0] {
+            assert_eq!(fresnel(1.33, 1.33, cos0), (0.0, 0.0), "cos {cos0}");
+            let rt = incoherent(Stack { n0: 1.5, n1: 1.5, n2: 1.5 }, cos0);
+            assert!(rt.r == 0.0 && rt.t == 1.0, "cos {cos0}: {rt:?}");
+        }
+        assert_eq!(fresnel(1.0, 1.33, 0.0), (1.0, 1.0));
+        assert_eq!(incoherent(Stack { n0: 1.0, n1: 1.55, n2: 1.0 }, 0.0).r, 1.0);
     }
 
     /// `FilmAtAngle::reflectance` (what the spectral sums call) is `at(λ).r` bit for bit:
