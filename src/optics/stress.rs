@@ -83,7 +83,8 @@ pub const STRESS_MATERIALS: [Stack; 9] = [
 ];
 
 /// The thickest film whose f32 reflectance the stress compares with f64 (see
-/// `StressReport::max_film_f32_dev`): twice the presets' thickest films.
+/// `StressReport::max_film_f32_dev`): the thin-film chart's range, about three times the
+/// built-in species' thickest films (xenopeltis: 420 nm, spread 260).
 pub const F32_FILM_DEV_MAX_NM: f64 = 2000.0;
 
 /// One furnace integration per this many samples (it costs ~2000 BRDF evaluations).
