@@ -111,7 +111,8 @@ struct Film {
     film_is_ambient: bool,
 }
 
-// No interface at all at this thickness: everything passes (optics::fast::Film32::passes_all).
+// No interface at all at this thickness: everything passes (optics::film::Stack::passes_all,
+// on f32 indices as optics::fast::Film32::passes_all).
 fn film_passes_all(f: Film, thickness_nm: f32) -> bool {
     return f.substrate_is_ambient && (f.film_is_ambient || thickness_nm == 0.0);
 }

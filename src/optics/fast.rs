@@ -75,8 +75,8 @@ pub struct Film32 {
     pub amplitudes_p: [C32; 2],
     /// The substrate's index is the ambient's (n2 = n0), and `film_is_ambient`: the film's is
     /// too (n1 = n0). Where both hold, or the first with a film of no thickness, there is no
-    /// interface at all and everything passes at every angle (`passes_all`, as
-    /// `film::FilmAtAngle`'s). The Airy sum cannot say so in f32 near grazing: below cos0 ≈
+    /// interface at all and everything passes at every angle (`passes_all`:
+    /// `film::Stack::passes_all` on f32 indices). The Airy sum cannot say so in f32 near grazing: below cos0 ≈
     /// 3e-8, r01 and r12 round to ∓1 and a film of 0 nm read 0 / 0 (NaN) in every method
     /// (found by `brdf stress` once it drew n2 = n0 and the f32 films), and grazing light
     /// read 1.

@@ -27,6 +27,17 @@ impl Stack {
         n1: crate::material::thesis::FILM_IOR,
         n2: crate::material::thesis::PIGMENT_IOR,
     };
+
+    /// True where there is no interface at all: the substrate has the ambient's index and
+    /// the film either has it too or no thickness. Everything passes then, at every angle,
+    /// grazing included, where the Airy sum is 0 / 0. The one rule of the f64 films
+    /// (`FilmAtAngle::new`; `incoherent`, a film of some thickness). Its f32 and WGSL twins
+    /// (`fast::Film32::passes_all`, `film.wgsl`'s `film_passes_all`) apply it to their own
+    /// f32 indices, which they must: indices that differ in f64 can round equal in f32
+    /// (1 + 1e-9), and an f32 Airy sum of equal indices reads NaN near grazing.
+    pub fn passes_all(&self, thickness_nm: f64) -> bool {
+        self.n0 == self.n2 && (self.n1 == self.n0 || thickness_nm == 0.0)
+    }
 }
 
 /// Reflectance and transmittance per polarisation and unpolarised (the mean of s and p).
@@ -161,7 +172,7 @@ impl FilmAtAngle {
     pub fn new(stack: Stack, thickness_nm: f64, cos0: f64) -> FilmAtAngle {
         let cos0 = cos0.clamp(0.0, 1.0);
         let Stack { n0, n1, n2 } = stack;
-        let passes_all = n0 == n2 && (n1 == n0 || thickness_nm == 0.0);
+        let passes_all = stack.passes_all(thickness_nm);
         let c0 = C64::real(cos0);
         let c1 = film_cos_in(n0, n1, cos0);
         let c2 = cos_in(n0, n2, cos0);
@@ -241,8 +252,9 @@ impl FilmAtAngle {
 pub fn incoherent(stack: Stack, cos0: f64) -> FilmRT {
     let cos0 = cos0.clamp(0.0, 1.0);
     let Stack { n0, n1, n2 } = stack;
-    if n0 == n1 && n1 == n2 {
-        // No interface at all: everything passes, grazing light too (as `airy`).
+    // The incoherent limit is a thick film: no interface only where all three indices agree.
+    if stack.passes_all(f64::INFINITY) {
+        // Everything passes, grazing light too (as `airy`).
         return FilmRT::from_sp(0.0, 0.0, 1.0, 1.0);
     }
     if cos0 <= 0.0 {

@@ -301,9 +301,39 @@ mod tests {
         }
     }
 
+    /// The f32 "no interface" rule (`fast::Film32::passes_all`) is the f64 one
+    /// (`film::Stack::passes_all`) on indices that f32 holds exactly, at every cosine
+    /// (the grazing branch of `film_f32` carries it too). Control: 1 + 1e-9 rounds to 1 in
+    /// f32, so there the f32 rule passes everything where f64 sees an interface, as it must
+    /// (an f32 Airy sum of equal indices reads NaN near grazing).
+    #[test]
+    fn the_f32_no_interface_rule_is_the_f64_one() {
+        let indices = [1.0, 1.25, 1.5, 2.0];
+        let mut passing = 0;
+        for n0 in indices {
+            for n1 in indices {
+                for n2 in indices {
+                    for d in [0.0, 1e-3, 400.0] {
+                        let stack = Stack { n0, n1, n2 };
+                        for cos0 in [0.0f32, 1e-30, 0.5, 1.0] {
+                            let f32_rule = film_f32(n0 as f32, n1 as f32, n2 as f32, cos0).passes_all(d as f32);
+                            assert_eq!(f32_rule, stack.passes_all(d), "{stack:?} {d} nm at cos {cos0}");
+                        }
+                        passing += stack.passes_all(d) as usize;
+                    }
+                }
+            }
+        }
+        // n2 = n0 (16 stacks) at 0 nm, and n1 = n0 too (4 stacks) at the other two thicknesses.
+        assert_eq!(passing, 16 + 2 * 4);
+        let near = Stack { n0: 1.0, n1: 1.0, n2: 1.0 + 1e-9 };
+        assert!(!near.passes_all(400.0));
+        assert!(film_f32(1.0, 1.0, near.n2 as f32, 0.5).passes_all(400.0));
+    }
+
     /// Where there is no interface at all (the substrate's index the ambient's, with a film
     /// of no thickness or of their index), every f32 film method reads 0 at every cosine,
-    /// grazing included, as the f64 film does (`film::FilmAtAngle`'s passes_all). Before
+    /// grazing included, as the f64 film does (`film::Stack::passes_all`). Before
     /// `fast::Film32::passes_all` they read NaN from cos 1e-12 to 3e-8 (r01 and r12 round
     /// to ∓1: 0 / 0) and 1 at grazing. Controls: a film 1 nm thick, and a substrate a
     /// millionth denser than the ambient, reflect nearly everything near grazing in f32 as
