@@ -705,8 +705,9 @@ fn spots_larger_than_their_spacing_are_refused() {
     let err = refused("default_size.toml", &layer.replace("size = 0.3\n", ""), &[]);
     assert!(err.contains("is 0.05 with 64 spots around"), "{err}");
     // A key at its default is named as one, not as an override's (it said "(with --set)"
-    // with nothing set); one an override wrote still is.
-    assert!(err.contains("default_size.toml: key `pattern.0.size` (not written: its default)"), "{err}");
+    // with nothing set), at the line of the key it is checked against (it had none); one an
+    // override wrote still is.
+    assert!(err.contains("default_size.toml:4: key `pattern.0.size` (not written: its default)"), "{err}");
     let err = refused("default_size.toml", &layer.replace("size = 0.3\n", ""), &["--set", "pattern.0.size=0.2"]);
     assert!(err.contains("default_size.toml (with --set): key `pattern.0.size`"), "{err}");
     accepted("acanthophis-antarcticus", &["--set", "pattern.0.kind=spots"]);

@@ -419,6 +419,20 @@ fn a_pigment_as_dense_as_the_ambient_under_a_rough_film_is_warned_of() {
     let water = "species = \"wet\"\n\n[optics]\nambient_ior = 1.33\npigment_ior = 1.4\n\n[roughness]\nbase = 0.6\n";
     let err = generate("wet.toml", water);
     assert!(err.contains("wet.toml:5: optics.pigment_ior = 1.4 is near optics.ambient_ior = 1.33"), "{err}");
+    // A preset that sets only the ambient's index meets the default pigment (2) and film
+    // (1.55) under a nearly smooth top (where the film's warning shows): each warning names
+    // its key as a default, at the line of the ambient's index, the key it is checked against
+    // (there was no line). The pigment's warning above, whose key is written, is not called a
+    // default.
+    assert!(!err.contains("(not written"), "{err}");
+    let err =
+        generate("ambient.toml", "species = \"wet\"\n\n[optics]\nambient_ior = 1.8\n\n[roughness]\nbase = 0.06\n");
+    for said in [
+        "ambient.toml:4: optics.pigment_ior (not written: its default) = 2 is near optics.ambient_ior = 1.8",
+        "ambient.toml:4: optics.film_ior (not written: its default) = 1.55 is below optics.ambient_ior = 1.8",
+    ] {
+        assert!(err.contains(said), "{said}: {err}");
+    }
     for (name, text) in [
         ("dense.toml", water.replace("1.4", "2")),
         (

@@ -61,20 +61,31 @@ pub struct LocatedProblem {
     pub line: Option<usize>,
     /// Whether `--set` (or a jobs file's `set`) wrote the key.
     pub overridden: bool,
+    /// Whether the key is at its default (neither written nor overridden); `line` is then
+    /// the line of the check's other key (`validate::Problem::second_key`), if any.
+    pub default: bool,
     pub message: String,
 }
 
+impl LocatedProblem {
+    /// " (not written: its default)" for a key at its default, else nothing.
+    pub fn default_note(&self) -> &'static str {
+        if self.default { " (not written: its default)" } else { "" }
+    }
+}
+
 /// One line per problem: the file and line of a key written in the file, the file `(with
-/// OVERRIDES)` for one an override wrote (`--set`, or a jobs file's `set`), and the file
-/// alone for a key at its default (a check across keys can name one: `pattern.0.size`
-/// against the `amount` written; that said "(with --set)" when nothing was set).
+/// OVERRIDES)` for one an override wrote (`--set`, or a jobs file's `set`), and a key at its
+/// default named as one (a check across keys can name one: `pattern.0.size` against the
+/// `amount` written; that said "(with --set)" when nothing was set), at the line of the
+/// check's other key where the file writes it.
 pub fn describe_problems(file: &str, problems: &[LocatedProblem], overrides: &str) -> String {
     problems
         .iter()
         .map(|p| match (p.line, p.overridden) {
-            (Some(line), _) => format!("{file}:{line}: key `{}` {}", p.key, p.message),
+            (Some(line), _) => format!("{file}:{line}: key `{}`{} {}", p.key, p.default_note(), p.message),
             (None, true) => format!("{file} (with {overrides}): key `{}` {}", p.key, p.message),
-            (None, false) => format!("{file}: key `{}` (not written: its default) {}", p.key, p.message),
+            (None, false) => format!("{file}: key `{}`{} {}", p.key, p.default_note(), p.message),
         })
         .collect::<Vec<_>>()
         .join("\n")

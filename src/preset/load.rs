@@ -66,7 +66,7 @@ impl LoadedPreset {
         let clamped = self.clamped_colours.iter().map(|c| c.message(preset));
         let warned = self.warned.iter().map(|p| {
             let line = p.line.map(|l| format!(":{l}")).unwrap_or_default();
-            format!("warning: {preset}{line}: {} = {}", p.key, p.message)
+            format!("warning: {preset}{line}: {}{} = {}", p.key, p.default_note(), p.message)
         });
         empty
             .into_iter()
@@ -371,9 +371,13 @@ pub fn parse_with_seed(
             // made the table (`--set pattern.0.kind=spots` on a preset without layers).
             let table = p.key.rsplit_once('.').map_or("", |(table, _)| table);
             let line = line_of(table);
-            return LocatedProblem { line, overridden: line.is_none(), key: p.key, message: p.message };
+            return LocatedProblem { line, overridden: line.is_none(), default: false, key: p.key, message: p.message };
         }
-        LocatedProblem { line: line_of(&p.key), overridden: overridden(&p.key), key: p.key, message: p.message }
+        let (line, overridden) = (line_of(&p.key), overridden(&p.key));
+        let default = line.is_none() && !overridden;
+        // A key at its default has no line; a check across two keys is placed at the other's.
+        let line = if default { p.second_key.as_deref().and_then(line_of) } else { line };
+        LocatedProblem { line, overridden, default, key: p.key, message: p.message }
     };
     if !problems.is_empty() {
         let located = problems.into_iter().map(locate).collect();

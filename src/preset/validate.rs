@@ -9,6 +9,11 @@ pub struct Problem {
     /// Dotted key path, e.g. `optics.film_ior` or `pattern.1.size`.
     pub key: String,
     pub message: String,
+    /// The other key of a check across two keys (`pattern.0.amount` for spots too large
+    /// for their spacing; `optics.ambient_ior` for a pigment near the ambient): where `key`
+    /// is not written in the file (its default), the problem is placed at this key's line.
+    /// A preset that set only `ambient_ior` was warned of `optics.pigment_ior` with no line.
+    pub second_key: Option<String>,
 }
 
 /// How a problem with a required key that is absent begins: such a key has no line of its
@@ -137,6 +142,7 @@ impl Checker {
             self.problems.push(Problem {
                 key,
                 message: format!("must be one of {} for kind \"{}\"{note}", names.join(", "), spelled(&kind)),
+                second_key: None,
             });
         }
     }
@@ -146,6 +152,7 @@ impl Checker {
             self.problems.push(Problem {
                 key: key.into(),
                 message: format!("must be a finite number in [{lo}, {hi}], got {}", shown(value)),
+                second_key: None,
             });
         }
     }
@@ -164,8 +171,11 @@ impl Checker {
 
     fn int_range(&mut self, key: &str, value: u32, (lo, hi): (u32, u32)) {
         if !(lo..=hi).contains(&value) {
-            self.problems
-                .push(Problem { key: key.into(), message: format!("must be an integer in [{lo}, {hi}], got {value}") });
+            self.problems.push(Problem {
+                key: key.into(),
+                message: format!("must be an integer in [{lo}, {hi}], got {value}"),
+                second_key: None,
+            });
         }
     }
 }
@@ -245,6 +255,7 @@ fn rings_not_kept_apart(preset: &Preset) -> Vec<Problem> {
                     shown((rows.per_band as f64 * 100.0).ceil() / 100.0),
                     shown((rows.bands as f64 * rows.per_band as f64 * 100.0).ceil() / 100.0),
                 ),
+                second_key: None,
             }
         })
         .collect()
@@ -266,6 +277,7 @@ fn pigment_below_ambient(preset: &Preset) -> Option<Problem> {
              1.03 to 1.35 times it, for an energy-conserving render.",
             o.ambient_ior, o.pigment_ior
         ),
+        second_key: Some("optics.pigment_ior".into()),
     })
 }
 
@@ -292,6 +304,7 @@ fn pigment_near_ambient(preset: &Preset) -> Option<Problem> {
             crate::optics::brdf::layered::PIGMENT_NEAR_AMBIENT,
             crate::optics::brdf::layered::PIGMENT_NEAR_AMBIENT_BELOW
         ),
+        second_key: Some("optics.ambient_ior".into()),
     })
 }
 
@@ -314,6 +327,7 @@ fn film_below_ambient(preset: &Preset) -> Option<Problem> {
              energy-conserving render.",
             o.film_ior, o.ambient_ior
         ),
+        second_key: Some("optics.ambient_ior".into()),
     })
 }
 
@@ -331,6 +345,7 @@ fn film_floor(preset: &Preset) -> Option<Problem> {
             spread * 0.5,
             spread * 0.5
         ),
+        second_key: Some("iridescence.spread_nm".into()),
     })
 }
 
@@ -404,6 +419,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                 seed_range_words(),
                 preset.seed
             ),
+            second_key: None,
         });
     }
     let s = &preset.scales;
@@ -424,6 +440,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         c.problems.push(Problem {
             key: "pattern".into(),
             message: format!("has {} layers; at most {MAX_PATTERN_LAYERS} are accepted", preset.pattern.len()),
+            second_key: None,
         });
         // Checking ten thousand layers one by one only buries this message.
         return c.problems;
@@ -435,6 +452,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                 c.problems.push(Problem {
                     key: key(field),
                     message: format!("has {count} entries; at most {MAX_LAYER_COLORS} are accepted"),
+                    second_key: None,
                 });
             }
         }
@@ -509,6 +527,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                         message: format!(
                             "is replaced by this layer's `{by}`, which {what}; give one of the two{unset}"
                         ),
+                        second_key: None,
                     });
                 }
             }
@@ -520,6 +539,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
             c.problems.push(Problem {
                 key: key("color"),
                 message: format!("{MISSING}: give the layer's colour as \"#rrggbb\"{or_rings}"),
+                second_key: None,
             });
         }
         // A ring sequence's widths are its colours' (`widths`, or equal parts), so a ring
@@ -532,6 +552,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                      parts); give one of the two (a size of {}, the default, counts as none)",
                     PatternLayer::default_size()
                 ),
+                second_key: None,
             });
         }
         // Keys some kinds read, set away from their defaults on a kind that ignores them
@@ -570,6 +591,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                         "is read by kind {names} only, not \"{}\"; leave it out of this layer",
                         spelled(&k)
                     ),
+                    second_key: None,
                 });
             }
         }
@@ -597,6 +619,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                     message: format!(
                         "sizes what `{colour}` draws, which this layer does not set; set it, or leave this out"
                     ),
+                    second_key: None,
                 });
             }
         }
@@ -611,12 +634,17 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                     p.colors.len(),
                     p.widths.len()
                 ),
+                second_key: None,
             });
         }
         // The sum of widths each in range (one out of it is its own problem, not the sum's).
         let widths_in_range = p.widths.iter().all(|w| (RING_WIDTH.0..=RING_WIDTH.1).contains(w));
         if widths_in_range && p.widths.iter().sum::<f64>() > 1.0 + 1e-9 {
-            c.problems.push(Problem { key: key("widths"), message: "must sum to at most 1 (one repeat)".into() });
+            c.problems.push(Problem {
+                key: key("widths"),
+                message: "must sum to at most 1 (one repeat)".into(),
+                second_key: None,
+            });
         }
         c.range(key("scale_aligned"), p.scale_aligned, UNIT);
         c.range(key("broken"), p.broken, STRIPE_BROKEN);
@@ -640,6 +668,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                     // A long list is counted, not echoed back whole.
                     if p.rows.len() <= 4 { format!("{:?}", p.rows) } else { format!("{} entries", p.rows.len()) }
                 ),
+                second_key: None,
             });
         }
         c.range(key("length"), p.length, BLOTCH_LENGTH);
@@ -683,6 +712,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                         SPOTS_AROUND.1,
                         fewer.unwrap_or(1),
                     ),
+                    second_key: None,
                 });
             }
             let per_circumference = f64::from(per_circumference);
@@ -709,6 +739,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                         // Rounded down, so the number printed is itself accepted.
                         shown((most * 1e4).floor() / 1e4)
                     ),
+                    second_key: Some(key("amount")),
                 });
             }
         }
@@ -740,6 +771,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                         shown(offset),
                         shown((f64::from(outer_edge) * 1e3).ceil() / 1e3),
                     ),
+                    second_key: Some(key("size")),
                 });
             }
         }
@@ -757,6 +789,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                         "counts marks of kind \"blotches\" or \"rings\" only, not \"{}\"",
                         spelled(&p.kind)
                     ),
+                    second_key: None,
                 });
             }
         }
@@ -889,13 +922,14 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         ),
     ] {
         if set && unread && !from_file_for_overridden(key, partner) {
-            c.problems.push(Problem { key: key.into(), message: message.into() });
+            c.problems.push(Problem { key: key.into(), message: message.into(), second_key: None });
         }
     }
     if b.head_mark.len() > MAX_HEAD_MARKS {
         c.problems.push(Problem {
             key: "body.head_mark".into(),
             message: format!("may list at most {MAX_HEAD_MARKS} head marks, got {}", b.head_mark.len()),
+            second_key: None,
         });
     } else {
         // Not one by one past the limit: thousands of marks buried the message (and took
@@ -916,6 +950,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                             "is read by kind \"collar\" and \"crescents\" only, not \"{}\"; leave it out of this mark",
                             spelled(&m.kind)
                         ),
+                        second_key: None,
                     });
                 }
             }
@@ -924,6 +959,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                     key: key("border_size"),
                     message: "sizes what `border_color` draws, which this mark does not set; set it, or leave this out"
                         .into(),
+                    second_key: None,
                 });
             }
         }
