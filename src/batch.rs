@@ -139,10 +139,7 @@ impl JobPlace {
         // On one line: a newline in a jobs file's preset string printed a line of its own,
         // which could pass for the tool's (`"x\nok: all 40 jobs done"`, a hostile-input
         // sweep); the message's printer escapes the other control characters, not newlines.
-        let preset: String = preset
-            .chars()
-            .map(|c| if c.is_control() { c.escape_unicode().to_string() } else { c.to_string() })
-            .collect();
+        let preset = crate::toml_text::one_line(preset);
         write!(f, "{}{}: [[job]] {table} ({preset}{detail})", path.display(), at_line(*line))
     }
 }
@@ -390,9 +387,13 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         // is a built-in preset. An entry with a `/` is a path even where it names a folder
         // there (refused as one): left as written, it was looked for in the working folder.
         // Joined without `.` inside (`J/./sub` named in messages read as a path to write).
-        let relative = Path::new(&table.preset)
-            .is_relative()
-            .then(|| base.join(&table.preset).components().collect::<std::path::PathBuf>());
+        // And kept a path where the join drops the `/` (`NAME/` beside a jobs file named
+        // without a folder read as `NAME`, the built-in, where `./jobs.toml` refused it).
+        let relative = Path::new(&table.preset).is_relative().then(|| {
+            let joined = base.join(&table.preset).components().collect::<std::path::PathBuf>();
+            let lost_its_slash = table.preset.contains('/') && !joined.to_string_lossy().contains('/');
+            if lost_its_slash { Path::new(".").join(joined) } else { joined }
+        });
         let preset = match relative {
             Some(path) if crate::preset::names_a_file(&table.preset, &path) || table.preset.contains('/') => {
                 // Presets are named by their paths as text: joined to a folder whose path is
@@ -712,9 +713,14 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         crate::preset::load_beside(&job.preset, folder, &job.overrides, job.seed).map_err(|source| match source {
             // The preset's message says `--set`, which a jobs file's reader did not write.
             crate::preset::PresetError::Override { argument, message } => {
-                BatchError::Set { place: job.place(jobs_file, job.lines.set), entries: argument, message }
+                // Its entries on one line: a key with a newline printed a made-up `1/1 done` line.
+                let entries = crate::toml_text::one_line(&argument);
+                BatchError::Set { place: job.place(jobs_file, job.lines.set), entries, message }
             }
-            crate::preset::PresetError::Invalid { file, problems } if !job.overrides.is_empty() => {
+            // At the `set` line where the table wrote a refused key; problems all in the file
+            // are the file's, at the `preset` line (they were placed at `set` whenever the job
+            // had one).
+            crate::preset::PresetError::Invalid { file, problems } if problems.iter().any(|p| p.overridden) => {
                 BatchError::Invalid {
                     place: job.place(jobs_file, job.lines.set),
                     message: crate::preset::describe_problems(&file, &problems, "its `set` table"),

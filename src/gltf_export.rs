@@ -95,6 +95,39 @@ fn stale_image_stays(path: &Path, regular: bool, recorded: Option<&str>) -> Opti
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
+/// Another `.gltf` in `dir` named `name` with the extension in other case (`x.GLTF` beside
+/// `x.gltf`, `out`), which names its side files as `out` does (`gltf_side_file_names` reads
+/// the stem): a file that is not `out` itself (where the file system ignores case, the other
+/// spellings name `out`).
+fn gltf_sharing_side_files(out: &Path, dir: &Path, name: &str) -> Option<std::path::PathBuf> {
+    let spelled = out.extension()?.to_str()?;
+    let identity = |path: &Path| std::fs::metadata(path).ok().map(|m| file_identity(&m));
+    let ours = identity(out);
+    (0..16u8)
+        .map(|case| {
+            let letters = "gltf".chars().enumerate();
+            letters.map(|(i, c)| if case & (1 << i) != 0 { c.to_ascii_uppercase() } else { c }).collect::<String>()
+        })
+        .filter(|extension| extension != spelled)
+        .map(|extension| dir.join(format!("{name}.{extension}")))
+        .find(|other| identity(other).is_some_and(|theirs| ours != Some(theirs)))
+}
+
+/// What tells two files apart: device and inode (on Unix), or nothing (elsewhere, where file
+/// systems ignore case: every spelling is then taken as the same file).
+fn file_identity(metadata: &std::fs::Metadata) -> (u64, u64) {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        (metadata.dev(), metadata.ino())
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = metadata;
+        (0, 0)
+    }
+}
+
 fn is_binary(path: &Path) -> Result<bool, Error> {
     let text = path.to_string_lossy();
     if crate::export::ends_as_a_folder(path) {
@@ -245,6 +278,11 @@ impl ExportPlan {
         // an empty one (a valid preset) not refused as a lock with content, was removed.
         let lock = dir.join(crate::export::lock_file_name(&name));
         crate::export::check_lock_not_an_input(&lock, &crate::export::Inputs::new(input))?;
+        if !binary && let Some(other) = gltf_sharing_side_files(&request.out, &dir, &name) {
+            return Err(
+                crate::export::ExportError::SharesSideFiles { path: request.out.clone(), other, stem: name }.into()
+            );
+        }
         for file in side_files {
             let target = dir.join(file);
             crate::export::check_target(&target)?;

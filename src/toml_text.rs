@@ -149,8 +149,16 @@ pub fn line_column(text: &str, offset: usize) -> (usize, usize) {
     (line, column)
 }
 
+/// Text from a file for a message of one line: every control character, newline included,
+/// written as `\u{..}`. A key or a name from a file printed raw could start a line of its
+/// own that passes for the tool's (`"a\nFAKE" = 1` printed `FAKE` alone on a line, and a
+/// jobs file's `set` a made-up `1/1 done` line: a hostile-input sweep).
+pub fn one_line(text: &str) -> String {
+    text.chars().map(|c| if c.is_control() { c.escape_unicode().to_string() } else { c.to_string() }).collect()
+}
+
 /// Rewrites serde's "unknown field `x`, expected one of `a`, `b`" into a message that names
-/// the key, suggests the nearest accepted one, and lists them all.
+/// the key (on one line: `one_line`), suggests the nearest accepted one, and lists them all.
 fn with_suggestion(message: &str) -> String {
     let Some(rest) = message.strip_prefix("unknown field `") else {
         return message.to_string();
@@ -160,7 +168,7 @@ fn with_suggestion(message: &str) -> String {
     };
     let accepted: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
     let hint = nearest(unknown, accepted.iter().copied()).map(|a| format!("; did you mean `{a}`?")).unwrap_or_default();
-    format!("unknown key `{unknown}`{hint} (accepted keys here: {})", accepted.join(", "))
+    format!("unknown key `{}`{hint} (accepted keys here: {})", one_line(unknown), accepted.join(", "))
 }
 
 /// Every dotted key an override of `key` with `value` writes: a table's own keys (an

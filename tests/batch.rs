@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 
-use common::{snakeskin, spawn_paused_at_commit, stderr, stdout, test_hooks_exist};
+use common::{snakeskin, spawn_paused_at_commit, stderr, stdout, test_hooks_exist, write_preset};
 
 /// Every file under `dir` (relative path → bytes), index files left out (they record what
 /// each run did, which differs between the runs compared).
@@ -907,6 +907,66 @@ fn a_newline_in_a_jobs_preset_stays_on_its_line() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("[[job]] 1 (vipera-berus\\u{a}ok: all 40 jobs done)"), "{}", stderr(&out));
     assert!(!stderr(&out).lines().any(|l| l.starts_with("ok:")), "{}", stderr(&out));
+    // So is one in a key the file writes, unknown to a job or to its preset (a preset file
+    // too), and in a `set` table's key: they printed `FAKE` and a made-up `1/1 done` line on
+    // lines of their own (a hostile-input sweep).
+    let preset = write_preset(dir.path(), "p.toml", "\"a\\nFAKE\" = 1\n");
+    for (jobs_text, said) in [
+        ("[[job]]\npreset = \"natrix-natrix\"\n\"a\\nFAKE\" = 1\n", "unknown key `a\\u{a}FAKE`"),
+        (&format!("[[job]]\npreset = \"{preset}\"\n") as &str, "unknown key `a\\u{a}FAKE`"),
+        ("[[job]]\npreset = \"natrix-natrix\"\nsizes = [16]\nset = { \"x\\nFAKE\" = 5 }\n", "set `x\\u{a}FAKE=5`"),
+    ] {
+        std::fs::write(&jobs, jobs_text).unwrap();
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("o").to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains(said), "{said}: {}", stderr(&out));
+        assert!(!stderr(&out).lines().any(|l| l.starts_with("FAKE")), "{}", stderr(&out));
+    }
+}
+
+/// A jobs file's preset written with a `/` is a path wherever the jobs file is named from:
+/// `natrix-natrix/` beside a jobs file named without a folder (`jobs.toml`) read as the
+/// built-in, silently, where `./jobs.toml` refused it (the join to an empty folder dropped the
+/// slash; a hostile-input sweep). Control: the name without the slash is the built-in.
+#[test]
+fn a_jobs_preset_with_a_slash_is_a_path_however_the_jobs_file_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("jobs.toml"), "[[job]]\npreset = \"natrix-natrix/\"\nsizes = [16]\n").unwrap();
+    let run = |jobs: &str| {
+        Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["batch", jobs, "-o", "o", "--list"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    for jobs in ["jobs.toml", "./jobs.toml"] {
+        let out = run(jobs);
+        assert_eq!(out.status.code(), Some(2), "{jobs}: {}", stderr(&out));
+        assert!(stderr(&out).contains("cannot read preset ./natrix-natrix"), "{jobs}: {}", stderr(&out));
+    }
+    std::fs::write(dir.path().join("jobs.toml"), "[[job]]\npreset = \"natrix-natrix\"\nsizes = [16]\n").unwrap();
+    assert!(run("jobs.toml").status.success(), "{}", stderr(&run("jobs.toml")));
+}
+
+/// A preset file's own problem is placed at the job's `preset` line, not at its `set` line
+/// because the job has a `set` table (`set` named a key it had not written); one the table
+/// wrote still is at `set`.
+#[test]
+fn a_preset_files_problem_is_placed_at_the_jobs_preset_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let preset = write_preset(dir.path(), "bad.toml", "[optics]\nfilm_ior = 7\n");
+    let jobs = dir.path().join("jobs.toml");
+    let refused = |set: &str| {
+        let text = format!("[[job]]\npreset = \"{preset}\"\nsizes = [16]\nset = {{ {set} }}\n");
+        std::fs::write(&jobs, text).unwrap();
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("o").to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let err = refused("\"scales.rows\" = 20");
+    assert!(err.contains("jobs.toml:2: [[job]] 1") && err.contains("bad.toml:2: key `optics.film_ior`"), "{err}");
+    let err = refused("\"optics.pigment_ior\" = 9");
+    assert!(err.contains("jobs.toml:4: [[job]] 1") && err.contains("key `optics.pigment_ior`"), "{err}");
 }
 
 /// A batch run in a folder whose path is not UTF-8 writes its index (the jobs file's path

@@ -244,6 +244,17 @@ fn an_upper_case_extension_names_the_file_written() {
         assert!(!dir.path().join(lower).exists(), "{name}");
     }
     assert!(dir.path().join("UP.bin").is_file());
+    // A `.gltf` whose name differs from one beside it only in the extension's case shares
+    // its side files (`UP.bin`, `UP.basecolor.png`): refused, the earlier export left whole
+    // (it was written over, and the first `.gltf` read a buffer of another length). Controls:
+    // the same name again, and another name, are exported.
+    let before = common::snapshot(dir.path());
+    let out = snakeskin(&["export", "xenopeltis-unicolor", "--gltf", dir.path().join("UP.gltf").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("UP.GLTF beside it is another .gltf export"), "{}", stderr(&out));
+    assert_eq!(common::snapshot(dir.path()), before);
+    export(dir.path(), "xenopeltis-unicolor", "UP.GLTF", &["--mesh", "plane"]);
+    export(dir.path(), "xenopeltis-unicolor", "Up.gltf", &["--mesh", "plane"]);
     // A name that ends as a folder's is refused with an example of its own kind (it said
     // "as in out/snake.png", a name `--gltf` refuses).
     for (given, example) in [

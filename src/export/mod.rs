@@ -121,6 +121,16 @@ pub enum ExportError {
     /// written so, out of sight of `ls`.
     #[error("{path}: the file's name is only an extension; give it a name, e.g. snake.{format}")]
     OnlyAnExtension { path: PathBuf, format: &'static str },
+    /// A `.gltf` beside another whose name differs only in the extension's case (`x.GLTF`
+    /// and `x.gltf`): both name their side files after the stem (`x.bin`, `x_basecolor.png`),
+    /// and the second export wrote over the first's, which then read a buffer of another
+    /// length and images of another export, without a word (a hostile-input sweep).
+    #[error(
+        "{path}: {other} beside it is another .gltf export, whose side files ({stem}.bin and its images) this one \
+         would write over: their names differ only in the extension's case; give this export another name, or move \
+         {other} and its side files away"
+    )]
+    SharesSideFiles { path: PathBuf, other: PathBuf, stem: String },
     #[error(
         "{path} is {kind}, not a regular file: snakeskin writes an output whole and renames it over the old one, \
          which would replace it; give the path of a regular file (or of none)"
@@ -187,6 +197,7 @@ impl ExportError {
                 | ExportError::NotOurs { .. }
                 | ExportError::OnlyAnExtension { .. }
                 | ExportError::OverwritesInput { .. }
+                | ExportError::SharesSideFiles { .. }
                 | ExportError::InputAtLock { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
