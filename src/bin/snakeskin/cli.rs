@@ -777,8 +777,10 @@ pub enum BrdfCommand {
     /// near-matched draws) and the f32 BRDF's worst deviation from f64 (`max_f32_dev`; JSON
     /// with --json).
     Stress {
-        /// Number of random samples, 1 to 10,000,000 (the default takes about 35 seconds on
-        /// two cores, 10 of them baking the nine stacks' film tables, whatever the count).
+        /// Number of random samples, 1 to 10,000,000 (the default takes about 40 seconds on
+        /// two cores, nearly all of them baking tables whatever the count: 12 the nine stacks'
+        /// film tables, about 30 more the layered model's coupling tables, which a thousand
+        /// samples already reach; 1,000,000 take about 95).
         #[arg(long, default_value_t = 100_000, value_parser = ranged_u64(1, 10_000_000))]
         samples: u64,
         /// Seed of the sample generator, 0 to 4294967295 (its hash takes 32 bits: a larger
