@@ -1368,7 +1368,7 @@ fn a_stopped_batch_writes_its_index_with_what_failed_and_what_never_ran() {
     let summary = stdout(&out);
     assert!(
         summary.contains(
-            "4 jobs of 4 in shard 0/1, up to 1 at once: 0 run, 1 already done, 1 duplicates of another job, 1 failed, \
+            "4 jobs of 4 in shard 0/1, up to 1 at once: 0 run, 1 already done, 1 duplicate of another job, 1 failed, \
              1 not run; index: "
         ),
         "{summary}"

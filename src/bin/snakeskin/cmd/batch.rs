@@ -59,12 +59,12 @@ pub fn run(args: BatchArgs) -> Result<()> {
     }
     let count = |status: JobStatus| index.jobs.iter().filter(|j| j.status == status).count();
     let mut counts = format!("{} run, {} already done", count(JobStatus::Done), count(JobStatus::Skipped));
-    let others = [
-        (JobStatus::Duplicate, "duplicates of another job"),
-        (JobStatus::Failed, "failed"),
-        (JobStatus::NotRun, "not run"),
-    ];
-    for (status, words) in others {
+    let duplicates = count(JobStatus::Duplicate);
+    if duplicates > 0 {
+        // "1 duplicate of another job", not "1 duplicates" (a hostile-input sweep's nit).
+        counts.push_str(&format!(", {} of another job", counted(duplicates, "duplicate")));
+    }
+    for (status, words) in [(JobStatus::Failed, "failed"), (JobStatus::NotRun, "not run")] {
         if count(status) > 0 {
             counts.push_str(&format!(", {} {words}", count(status)));
         }
