@@ -391,8 +391,11 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
         // without a folder read as `NAME`, the built-in, where `./jobs.toml` refused it).
         let relative = Path::new(&table.preset).is_relative().then(|| {
             let joined = base.join(&table.preset).components().collect::<std::path::PathBuf>();
-            let lost_its_slash = table.preset.contains('/') && !joined.to_string_lossy().contains('/');
-            if lost_its_slash { Path::new(".").join(joined) } else { joined }
+            // A file name alone, no folder: `NAME/` joined to an empty folder (not `./`, which
+            // is the folder `.`, and read `./.`).
+            let name_alone = matches!(joined.components().next_back(), Some(std::path::Component::Normal(_)))
+                && joined.parent().is_some_and(|p| p.as_os_str().is_empty());
+            if table.preset.contains('/') && name_alone { Path::new(".").join(joined) } else { joined }
         });
         let preset = match relative {
             Some(path) if crate::preset::names_a_file(&table.preset, &path) || table.preset.contains('/') => {

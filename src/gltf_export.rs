@@ -94,15 +94,27 @@ fn stale_image_stays(path: &Path, regular: bool, recorded: Option<&str>) -> Opti
     std::fs::remove_file(path).err().map(|e| KeptBecause::WouldNotMove(e.to_string()))
 }
 
-/// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
-/// Another `.gltf` in `dir` named `name` with the extension in other case (`x.GLTF` beside
-/// `x.gltf`, `out`), which names its side files as `out` does (`gltf_side_file_names` reads
-/// the stem): a file that is not `out` itself (where the file system ignores case, the other
-/// spellings name `out`).
+/// Another `.gltf` file in `dir` named `name` with the extension in other case (`x.GLTF`
+/// beside `x.gltf`, `out`), which names its side files as `out` does
+/// (`gltf_side_file_names` reads the stem). Not one that is `out` itself: where the file
+/// system ignores case the other spellings name `out`, and a symbolic link to `out` reads
+/// the new file. A hard link to `out` is another: the export's rename leaves it reading the
+/// old document beside the new side files (an independent review).
 fn gltf_sharing_side_files(out: &Path, dir: &Path, name: &str) -> Option<std::path::PathBuf> {
     let spelled = out.extension()?.to_str()?;
-    let identity = |path: &Path| std::fs::metadata(path).ok().map(|m| file_identity(&m));
-    let ours = identity(out);
+    let ours = std::fs::metadata(out).ok();
+    let shares = |other: &Path| {
+        let (Ok(link), Ok(theirs)) = (std::fs::symlink_metadata(other), std::fs::metadata(other)) else {
+            return false;
+        };
+        match &ours {
+            _ if !theirs.is_file() => false,
+            None => true,
+            Some(ours) if !crate::export::same_identity(ours, &theirs) => true,
+            // One file: another name for it only where the folder lists both names.
+            Some(_) => !link.is_symlink() && listed_apart(dir, out, other),
+        }
+    };
     (0..16u8)
         .map(|case| {
             let letters = "gltf".chars().enumerate();
@@ -110,24 +122,19 @@ fn gltf_sharing_side_files(out: &Path, dir: &Path, name: &str) -> Option<std::pa
         })
         .filter(|extension| extension != spelled)
         .map(|extension| dir.join(format!("{name}.{extension}")))
-        .find(|other| identity(other).is_some_and(|theirs| ours != Some(theirs)))
+        .find(|other| shares(other))
 }
 
-/// What tells two files apart: device and inode (on Unix), or nothing (elsewhere, where file
-/// systems ignore case: every spelling is then taken as the same file).
-fn file_identity(metadata: &std::fs::Metadata) -> (u64, u64) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        (metadata.dev(), metadata.ino())
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = metadata;
-        (0, 0)
-    }
+/// Whether `dir` lists both `a`'s and `b`'s file names (two entries, not one read under
+/// either spelling).
+fn listed_apart(dir: &Path, a: &Path, b: &Path) -> bool {
+    let (Some(a), Some(b)) = (a.file_name(), b.file_name()) else { return false };
+    let Ok(entries) = std::fs::read_dir(dir) else { return false };
+    let names: Vec<std::ffi::OsString> = entries.filter_map(|e| e.ok().map(|e| e.file_name())).collect();
+    names.iter().any(|n| n == a) && names.iter().any(|n| n == b)
 }
 
+/// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.
 fn is_binary(path: &Path) -> Result<bool, Error> {
     let text = path.to_string_lossy();
     if crate::export::ends_as_a_folder(path) {

@@ -221,7 +221,21 @@ pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
         if item.is_empty() {
             return Err(format!("an empty name in {list:?}; name the maps, one comma between two"));
         }
-        let maps = if item == "all" { MapKind::ALL.to_vec() } else { vec![item.parse()?] };
+        let maps = if item == "all" {
+            MapKind::ALL.to_vec()
+        } else {
+            // `all` is a word of the list, not a map's name: named and suggested here (`ALL` and
+            // `al` got no suggestion, and the accepted names left it out: a hostile-input sweep).
+            let near_all = crate::toml_text::edit_distance(&item.to_ascii_lowercase(), "all") <= 1;
+            vec![item.parse().map_err(|e: String| {
+                let e = if near_all && !e.contains("did you mean") {
+                    format!("unknown map {item:?}; did you mean all? {}", after_accepted(&e))
+                } else {
+                    e
+                };
+                format!("{e}, or all (the five of every set)")
+            })?]
+        };
         for map in maps {
             if !out.contains(&map) {
                 out.push(map);
@@ -230,6 +244,11 @@ pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
     }
     out.sort();
     Ok(out)
+}
+
+/// "accepted: ..." of a map name's error (`MapKind::from_str`).
+fn after_accepted(error: &str) -> &str {
+    error.find("accepted:").map_or(error, |at| &error[at..])
 }
 
 /// How a map's linear f32 samples become file samples.

@@ -922,6 +922,22 @@ fn a_newline_in_a_jobs_preset_stays_on_its_line() {
         assert!(stderr(&out).contains(said), "{said}: {}", stderr(&out));
         assert!(!stderr(&out).lines().any(|l| l.starts_with("FAKE")), "{}", stderr(&out));
     }
+    // And one in the name of the folder a preset lies in, where the preset's own messages
+    // name its path: a problem, a warning, a file missing (an independent review).
+    let folder = dir.path().join("d\nFAKE");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::write(folder.join("bad.toml"), "[optics]\nfilm_ior = 7\n").unwrap();
+    std::fs::write(folder.join("warned.toml"), "[optics]\nambient_ior = 1.8\n").unwrap();
+    for (name, said) in [
+        ("bad.toml", "d\\u{a}FAKE/bad.toml:2: key `optics.film_ior`"),
+        ("warned.toml", "d\\u{a}FAKE/warned.toml:2: optics.pigment_ior"),
+        ("missing.toml", "d\\u{a}FAKE/missing.toml: No such file"),
+    ] {
+        std::fs::write(&jobs, format!("[[job]]\npreset = \"d\\nFAKE/{name}\"\nsizes = [16]\n")).unwrap();
+        let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("o").to_str().unwrap()]);
+        assert!(stderr(&out).contains(said), "{said}: {}", stderr(&out));
+        assert!(!stderr(&out).lines().any(|l| l.starts_with("FAKE")), "{}", stderr(&out));
+    }
 }
 
 /// A jobs file's preset written with a `/` is a path wherever the jobs file is named from:
@@ -967,6 +983,17 @@ fn a_preset_files_problem_is_placed_at_the_jobs_preset_line() {
     assert!(err.contains("jobs.toml:2: [[job]] 1") && err.contains("bad.toml:2: key `optics.film_ior`"), "{err}");
     let err = refused("\"optics.pigment_ior\" = 9");
     assert!(err.contains("jobs.toml:4: [[job]] 1") && err.contains("key `optics.pigment_ior`"), "{err}");
+    // A key at its default refused for the other key of its check, which the table wrote
+    // (spots at their default size, `amount` set): at `set` too, said to be the table's (it
+    // went to the `preset` line and the file, once problems were placed by their own keys:
+    // an independent review).
+    let spots = write_preset(dir.path(), "sp.toml", "[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\n");
+    let text = format!("[[job]]\npreset = \"{spots}\"\nsizes = [16]\nset = {{ \"pattern.0.amount\" = 64 }}\n");
+    std::fs::write(&jobs, text).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("o").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let said = "(with its `set` table): key `pattern.0.size` (not written: its default) is 0.05 with 64 spots";
+    assert!(stderr(&out).contains("jobs.toml:4: [[job]] 1") && stderr(&out).contains(said), "{}", stderr(&out));
 }
 
 /// A batch run in a folder whose path is not UTF-8 writes its index (the jobs file's path
@@ -1039,7 +1066,7 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     assert!(!out_dir.exists(), "--list wrote its output folder");
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stdout(&out).contains("3 run, 0 already done, 1 duplicates"), "{}", stdout(&out));
+    assert!(stdout(&out).contains("3 run, 0 already done, 1 duplicate of another job"), "{}", stdout(&out));
     assert_eq!(list(&jobs, &out_dir), ["done", "done", "done", "duplicate"]);
     let sets = manifests(&out_dir);
     assert_eq!(sets.len(), 3, "{sets:?}");
@@ -1057,7 +1084,7 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     // The same run again has nothing to do: every set is settled (its files match the
     // hashes its manifest records).
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
-    assert!(stdout(&out).contains("0 run, 3 already done, 1 duplicates"), "{}", stdout(&out));
+    assert!(stdout(&out).contains("0 run, 3 already done, 1 duplicate of another job"), "{}", stdout(&out));
     assert_eq!(manifests(&out_dir), sets, "a settled set was written again");
 
     // Two different preset files with one name would share a folder: refused, in every

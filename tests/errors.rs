@@ -692,6 +692,28 @@ fn out_of_range_value_names_key_and_range() {
 /// prints is accepted, so is a lower amount, and so is the built-in layer that comes closest
 /// when turned to spots (acanthophis-antarcticus' rings, 1.75 spacings). A size out of its
 /// own range is refused once, by its range.
+/// A pattern's `amount` that counts marks (stripes, rings, spots, blotches) must be whole:
+/// a fraction was rounded where they are drawn, silently (2.4 stripes drew 2, 7.5 spots 8: a
+/// hostile-input sweep). Controls: a whole count, and an irregular layer's fractional
+/// coverage, are accepted.
+#[test]
+fn a_count_of_marks_must_be_whole() {
+    let presets = tempfile::tempdir().unwrap();
+    for (kind, amount, said) in [
+        ("stripes", "2.4", "must be a whole number of stripes a side in [1, 16], got 2.4"),
+        ("spots", "7.5", "must be a whole number of spots in [1, 64], got 7.5"),
+        ("rings", "1.5", "must be a whole number of repeats per tile in [1, 32], got 1.5"),
+        ("blotches", "1.49", "must be a whole number of blotches per tile in [1, 32], got 1.49"),
+    ] {
+        let layer = format!("[[pattern]]\nkind = \"{kind}\"\ncolor = \"#101010\"\namount = {amount}\nsize = 0.02\n");
+        let err = refused("count.toml", &layer, &[]);
+        assert!(err.contains("count.toml:4: key `pattern.0.amount`") && err.contains(said), "{kind}: {err}");
+        accepted(&write_preset(presets.path(), "c.toml", &layer.replace(amount, "2")), &[]);
+    }
+    let irregular = "[[pattern]]\nkind = \"irregular\"\ncolor = \"#101010\"\namount = 0.25\n";
+    accepted(&write_preset(presets.path(), "i.toml", irregular), &[]);
+}
+
 #[test]
 fn spots_larger_than_their_spacing_are_refused() {
     let layer = "[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\namount = 64\nsize = 0.3\n";
@@ -862,6 +884,12 @@ fn a_mistyped_map_name_gets_a_suggestion() {
         ("aoo", "unknown map \"aoo\"; did you mean ao?"),
         // The same name in capitals, at any length (`AO` had none).
         ("AO", "unknown map \"AO\"; did you mean ao?"),
+        // `all`, a word of the list, is suggested and accepted by name too (`ALL` and `al`
+        // had neither: a hostile-input sweep); a map's suggestion comes first (`aol`).
+        ("ALL", "unknown map \"ALL\"; did you mean all? accepted: color, height"),
+        ("color,al", "unknown map \"al\"; did you mean all?"),
+        ("sheen", "iridescence, ao, or all (the five of every set)"),
+        ("aol", "unknown map \"aol\"; did you mean ao?"),
         ("color,", "an empty name in \"color,\"; name the maps, one comma between two"),
     ] {
         let out = snakeskin(&["graph", "natrix-natrix", "--maps", maps]);

@@ -251,9 +251,19 @@ fn an_upper_case_extension_names_the_file_written() {
     let before = common::snapshot(dir.path());
     let out = snakeskin(&["export", "xenopeltis-unicolor", "--gltf", dir.path().join("UP.gltf").to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("UP.GLTF beside it is another .gltf export"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("UP.GLTF beside it is a .gltf file whose name differs only"), "{}", stderr(&out));
     assert_eq!(common::snapshot(dir.path()), before);
     export(dir.path(), "xenopeltis-unicolor", "UP.GLTF", &["--mesh", "plane"]);
+    export(dir.path(), "xenopeltis-unicolor", "Up.gltf", &["--mesh", "plane"]);
+    // A hard link is another name that the export's rename would leave reading the old
+    // document beside the new side files: refused too (an independent review). Controls: a
+    // symbolic link reads the new file, and a folder of that name is no document.
+    std::fs::hard_link(dir.path().join("Up.gltf"), dir.path().join("Up.GLTF")).unwrap();
+    let out = snakeskin(&["export", "xenopeltis-unicolor", "--gltf", dir.path().join("Up.gltf").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    std::fs::remove_file(dir.path().join("Up.GLTF")).unwrap();
+    std::os::unix::fs::symlink("Up.gltf", dir.path().join("Up.GLTF")).unwrap();
+    std::fs::create_dir(dir.path().join("Up.glTF")).unwrap();
     export(dir.path(), "xenopeltis-unicolor", "Up.gltf", &["--mesh", "plane"]);
     // A name that ends as a folder's is refused with an example of its own kind (it said
     // "as in out/snake.png", a name `--gltf` refuses).

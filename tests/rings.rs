@@ -181,6 +181,17 @@ fn more_rings_than_whole_scales_can_keep_apart_are_warned_of_with_the_most_that_
     let most = number_after(&said, "at most ");
     assert!((1..5).contains(&most), "{said}");
     assert!(warning(most).is_none() && warning(most + 1).is_some(), "the warning's bound is not {most}");
+    // With `amount` at its default and too many colours for the rows, the warning is placed at
+    // the `colors` line, the other key of its check (it had no line: an independent review).
+    let colours: Vec<String> = (0..32).map(|i| format!("\"#{:02x}0000\"", i * 7)).collect();
+    let text = format!(
+        "[scales]\nrows = 15\n\n[[pattern]]\nkind = \"rings\"\nscale_aligned = 1\ncolors = [{}]\n",
+        colours.join(", ")
+    );
+    let warned =
+        parse(&PresetSource { name: "c".into(), display: "c.toml".into(), text }, &[]).unwrap().warnings("c.toml");
+    let at_colours = "warning: c.toml:7: pattern.0.amount (not written: its default) = 1 leaves";
+    assert!(warned.iter().any(|w| w.starts_with(at_colours)), "{warned:?}");
     for seed in [1, 2, 3] {
         let class = classes_of(&load(seed, most).preset, 512);
         assert!(a_yellow_ring_goes_round(&class, 512), "seed {seed}, {most} repeats: a yellow ring is broken");

@@ -1263,17 +1263,23 @@ impl Drop for SetLock {
 
 /// True when `path` still names the open `file` (same device and inode).
 fn same_file(file: &File, path: &Path) -> bool {
+    match (file.metadata(), fs::symlink_metadata(path)) {
+        (Ok(a), Ok(b)) => same_identity(&a, &b),
+        _ => false,
+    }
+}
+
+/// Whether two files' metadata are of one file: device and inode on Unix; elsewhere taken
+/// as one.
+pub fn same_identity(a: &fs::Metadata, b: &fs::Metadata) -> bool {
     #[cfg(unix)]
     {
         use std::os::unix::fs::MetadataExt;
-        match (file.metadata(), fs::symlink_metadata(path)) {
-            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
-            _ => false,
-        }
+        a.dev() == b.dev() && a.ino() == b.ino()
     }
     #[cfg(not(unix))]
     {
-        let _ = (file, path);
+        let _ = (a, b);
         true
     }
 }

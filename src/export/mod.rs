@@ -14,8 +14,8 @@ pub use atomic::{
     Earlier, FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, begins_as, check_folder, check_folder_writable,
     check_lock_not_an_input, check_lock_place, check_not_an_input, check_png_target, check_replaces_its_own,
     check_target, check_target_named, check_writable, clean_up_before_exit, create_folder, create_folder_noted,
-    ends_as_a_folder, lock_file_name, lock_is_held, remove_empty_made_folders, same_path, sha256_hex, temporary_target,
-    wait_for_commit, write_file_atomically,
+    ends_as_a_folder, lock_file_name, lock_is_held, remove_empty_made_folders, same_identity, same_path, sha256_hex,
+    temporary_target, wait_for_commit, write_file_atomically,
 };
 pub(crate) use manifest::verify_set_json;
 pub use manifest::{
@@ -122,13 +122,13 @@ pub enum ExportError {
     #[error("{path}: the file's name is only an extension; give it a name, e.g. snake.{format}")]
     OnlyAnExtension { path: PathBuf, format: &'static str },
     /// A `.gltf` beside another whose name differs only in the extension's case (`x.GLTF`
-    /// and `x.gltf`): both name their side files after the stem (`x.bin`, `x_basecolor.png`),
+    /// and `x.gltf`): both name their side files after the stem (`x.bin`, `x.basecolor.png`),
     /// and the second export wrote over the first's, which then read a buffer of another
     /// length and images of another export, without a word (a hostile-input sweep).
     #[error(
-        "{path}: {other} beside it is another .gltf export, whose side files ({stem}.bin and its images) this one \
-         would write over: their names differ only in the extension's case; give this export another name, or move \
-         {other} and its side files away"
+        "{path}: {other} beside it is a .gltf file whose name differs only in the extension's case, and a .gltf's \
+         side files are named after the stem: this export would write over the ones {other} reads ({stem}.bin and \
+         its images); give this export another name, or move {other} and its side files away"
     )]
     SharesSideFiles { path: PathBuf, other: PathBuf, stem: String },
     #[error(

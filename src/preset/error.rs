@@ -2,18 +2,24 @@
 //! column or the `--set` argument), what (the key) and what would be accepted.
 
 use std::fmt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// A preset's path for a message of one line (`toml_text::one_line`): a jobs file names its
+/// presets, and a folder name with a newline printed a line of its own (an independent review).
+fn one_line(path: &Path) -> String {
+    crate::toml_text::one_line(&path.display().to_string())
+}
 
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
     /// `hint`: empty, or "; ..." naming the built-in preset a missing file is named after.
-    #[error("cannot read preset {path}: {source}{hint}")]
+    #[error("cannot read preset {}: {source}{hint}", one_line(.path))]
     Read { path: PathBuf, source: std::io::Error, hint: String },
 
-    #[error("cannot read preset {path}: it is {kind}; a preset must be a regular file")]
+    #[error("cannot read preset {}: it is {kind}; a preset must be a regular file", one_line(.path))]
     NotAFile { path: PathBuf, kind: &'static str },
 
-    #[error("cannot read preset {path}: it is {size}; presets are limited to {limit} bytes")]
+    #[error("cannot read preset {}: it is {size}; presets are limited to {limit} bytes", one_line(.path))]
     TooLarge { path: PathBuf, size: crate::text_file::FileSize, limit: u64 },
 
     /// A preset file whose name the set's files cannot carry.
@@ -46,10 +52,11 @@ pub struct Location {
 
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        let file = crate::toml_text::one_line(&self.file);
         match (self.line, self.column) {
-            (Some(l), Some(c)) => write!(f, "{}:{l}:{c}", self.file),
-            (Some(l), None) => write!(f, "{}:{l}", self.file),
-            _ => write!(f, "{}", self.file),
+            (Some(l), Some(c)) => write!(f, "{file}:{l}:{c}"),
+            (Some(l), None) => write!(f, "{file}:{l}"),
+            _ => write!(f, "{file}"),
         }
     }
 }
@@ -59,7 +66,8 @@ pub struct LocatedProblem {
     pub key: String,
     /// Line in the file, or None when the value came from `--set` or is the key's default.
     pub line: Option<usize>,
-    /// Whether `--set` (or a jobs file's `set`) wrote the key.
+    /// Whether `--set` (or a jobs file's `set`) wrote the key, or for a key at its default
+    /// the check's other key (`validate::Problem::second_key`).
     pub overridden: bool,
     /// Whether the key is at its default (neither written nor overridden); `line` is then
     /// the line of the check's other key (`validate::Problem::second_key`), if any.
@@ -80,11 +88,12 @@ impl LocatedProblem {
 /// `amount` written; that said "(with --set)" when nothing was set), at the line of the
 /// check's other key where the file writes it.
 pub fn describe_problems(file: &str, problems: &[LocatedProblem], overrides: &str) -> String {
+    let file = crate::toml_text::one_line(file);
     problems
         .iter()
         .map(|p| match (p.line, p.overridden) {
             (Some(line), _) => format!("{file}:{line}: key `{}`{} {}", p.key, p.default_note(), p.message),
-            (None, true) => format!("{file} (with {overrides}): key `{}` {}", p.key, p.message),
+            (None, true) => format!("{file} (with {overrides}): key `{}`{} {}", p.key, p.default_note(), p.message),
             (None, false) => format!("{file}: key `{}`{} {}", p.key, p.default_note(), p.message),
         })
         .collect::<Vec<_>>()

@@ -57,6 +57,8 @@ impl LoadedPreset {
     /// given), one line each: colours clamped to what the stack can show, and the keys
     /// `warned` of.
     pub fn warnings(&self, preset: &str) -> Vec<String> {
+        // On one line: a jobs file names its presets (a folder name with a newline).
+        let preset = &crate::toml_text::one_line(preset);
         let empty = self.sets_no_key.then(|| {
             format!(
                 "warning: {preset}: the file sets no key: every key takes its default (`snakeskin presets show NAME` \
@@ -373,10 +375,15 @@ pub fn parse_with_seed(
             let line = line_of(table);
             return LocatedProblem { line, overridden: line.is_none(), default: false, key: p.key, message: p.message };
         }
-        let (line, overridden) = (line_of(&p.key), overridden(&p.key));
-        let default = line.is_none() && !overridden;
-        // A key at its default has no line; a check across two keys is placed at the other's.
-        let line = if default { p.second_key.as_deref().and_then(line_of) } else { line };
+        let (line, written_by_override) = (line_of(&p.key), overridden(&p.key));
+        let default = line.is_none() && !written_by_override;
+        // A key at its default has no line; a check across two keys is placed at the other's,
+        // or is the override's where an override wrote the other (a jobs file's `set`
+        // naming `amount` for spots at their default size: an independent review).
+        let (line, overridden) = match p.second_key.as_deref() {
+            Some(second) if default => (line_of(second), overridden(second)),
+            _ => (line, written_by_override),
+        };
         LocatedProblem { line, overridden, default, key: p.key, message: p.message }
     };
     if !problems.is_empty() {

@@ -10,8 +10,9 @@ pub struct Problem {
     pub key: String,
     pub message: String,
     /// The other key of a check across two keys (`pattern.0.amount` for spots too large
-    /// for their spacing; `optics.ambient_ior` for a pigment near the ambient): where `key`
-    /// is not written in the file (its default), the problem is placed at this key's line.
+    /// for their spacing; `optics.ambient_ior` for a pigment near the ambient; a ring
+    /// sequence's `colors`): where `key` is not written in the file (its default), the problem
+    /// is placed at this key's line, or said to come from the override that wrote this key.
     /// A preset that set only `ambient_ior` was warned of `optics.pigment_ior` with no line.
     pub second_key: Option<String>,
 }
@@ -157,6 +158,27 @@ impl Checker {
         }
     }
 
+    /// A count written as a number (a pattern layer's `amount` for the kinds that count
+    /// marks): in its range and whole. A fraction was rounded where the marks are drawn,
+    /// without a word (`amount = 2.4` stripes drew 2, 7.5 spots 8: a hostile-input sweep),
+    /// as `rows = 19.5` is refused.
+    fn whole_count(&mut self, key: impl Into<String>, value: f64, range: (f64, f64), counted: &str) {
+        let key = key.into();
+        self.range(key.clone(), value, range);
+        if value.is_finite() && (range.0..=range.1).contains(&value) && value.fract() != 0.0 {
+            self.problems.push(Problem {
+                key,
+                message: format!(
+                    "must be a whole number of {counted} in [{}, {}], got {}",
+                    range.0,
+                    range.1,
+                    shown(value)
+                ),
+                second_key: None,
+            });
+        }
+    }
+
     /// A whole-number key against its range (`whole_number_range`; `rows`: the preset's
     /// `scales.rows`, which bounds the keys counted in half its rows).
     fn whole_number(&mut self, key: &str, value: u32, rows: u32) {
@@ -255,7 +277,9 @@ fn rings_not_kept_apart(preset: &Preset) -> Vec<Problem> {
                     shown((rows.per_band as f64 * 100.0).ceil() / 100.0),
                     shown((rows.bands as f64 * rows.per_band as f64 * 100.0).ceil() / 100.0),
                 ),
-                second_key: None,
+                // The ring sequence's colours, which the bands are (an `amount` at its default
+                // had no line: an independent review).
+                second_key: Some(format!("pattern.{i}.colors")),
             }
         })
         .collect()
@@ -277,7 +301,9 @@ fn pigment_below_ambient(preset: &Preset) -> Option<Problem> {
              1.03 to 1.35 times it, for an energy-conserving render.",
             o.ambient_ior, o.pigment_ior
         ),
-        second_key: Some("optics.pigment_ior".into()),
+        // The ambient's index is always written here: above the pigment's, whose least (1)
+        // is the ambient's default.
+        second_key: None,
     })
 }
 
@@ -340,10 +366,15 @@ fn film_floor(preset: &Preset) -> Option<Problem> {
     (thickness < spread * 0.5).then(|| Problem {
         key: "optics.film_thickness_nm".into(),
         message: format!(
-            "{thickness} is below half of iridescence.spread_nm ({spread} / 2 = {}): a film cannot be thinner than \
-             0 nm, so its range is {min_nm}-{max_nm} nm, the same for any film_thickness_nm up to {}",
-            spread * 0.5,
-            spread * 0.5
+            "{} is below half of iridescence.spread_nm ({} / 2 = {}): a film cannot be thinner than 0 nm, so its \
+             range is {}-{} nm, the same for any film_thickness_nm up to {}",
+            // `shown`: 1e-320 printed as 330 digits (a hostile-input sweep).
+            shown(thickness),
+            shown(spread),
+            shown(spread * 0.5),
+            shown(min_nm),
+            shown(max_nm),
+            shown(spread * 0.5)
         ),
         second_key: Some("iridescence.spread_nm".into()),
     })
@@ -460,10 +491,10 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
             continue;
         }
         match p.kind {
-            PatternKind::Stripes => c.range(key("amount"), p.amount, STRIPES_PER_SIDE),
-            PatternKind::Spots => c.range(key("amount"), p.amount, SPOTS_AROUND),
-            PatternKind::Rings => c.range(key("amount"), p.amount, RINGS_PER_TILE),
-            PatternKind::Blotches => c.range(key("amount"), p.amount, BLOTCHES_PER_TILE),
+            PatternKind::Stripes => c.whole_count(key("amount"), p.amount, STRIPES_PER_SIDE, "stripes a side"),
+            PatternKind::Spots => c.whole_count(key("amount"), p.amount, SPOTS_AROUND, "spots"),
+            PatternKind::Rings => c.whole_count(key("amount"), p.amount, RINGS_PER_TILE, "repeats per tile"),
+            PatternKind::Blotches => c.whole_count(key("amount"), p.amount, BLOTCHES_PER_TILE, "blotches per tile"),
             PatternKind::Irregular | PatternKind::Solid => c.range(key("amount"), p.amount, UNIT),
         }
         let shapes: &[PatternShape] = match p.kind {
@@ -771,7 +802,8 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
                         shown(offset),
                         shown((f64::from(outer_edge) * 1e3).ceil() / 1e3),
                     ),
-                    second_key: Some(key("size")),
+                    // `amount` is always written here (two stripes or more; its default is 1).
+                    second_key: None,
                 });
             }
         }
