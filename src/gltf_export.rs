@@ -96,23 +96,28 @@ fn stale_image_stays(path: &Path, regular: bool, recorded: Option<&str>) -> Opti
 
 /// Another `.gltf` file in `dir` named `name` with the extension in other case (`x.GLTF`
 /// beside `x.gltf`, `out`), which names its side files as `out` does
-/// (`gltf_side_file_names` reads the stem). Not one that is `out` itself: where the file
-/// system ignores case the other spellings name `out`, and a symbolic link to `out` reads
-/// the new file. A hard link to `out` is another: the export's rename leaves it reading the
-/// old document beside the new side files (an independent review).
+/// (`gltf_side_file_names` reads the stem), and which the export would leave reading the
+/// old document beside new side files. Not `out` under another spelling where the file
+/// system ignores case, nor a symbolic link to `out` (it reads the new document). A hard
+/// link to `out` is another (the export's rename leaves it the old document), and so is a
+/// symbolic link to anything else, or a name the folder cannot be listed to tell apart
+/// (independent reviews).
 fn gltf_sharing_side_files(out: &Path, dir: &Path, name: &str) -> Option<std::path::PathBuf> {
     let spelled = out.extension()?.to_str()?;
-    let ours = std::fs::metadata(out).ok();
     let shares = |other: &Path| {
         let (Ok(link), Ok(theirs)) = (std::fs::symlink_metadata(other), std::fs::metadata(other)) else {
             return false;
         };
-        match &ours {
-            _ if !theirs.is_file() => false,
-            None => true,
-            Some(ours) if !crate::export::same_identity(ours, &theirs) => true,
-            // One file: another name for it only where the folder lists both names.
-            Some(_) => !link.is_symlink() && listed_apart(dir, out, other),
+        if !theirs.is_file() {
+            return false;
+        }
+        if link.is_symlink() {
+            let canonical = |path: &Path| std::fs::canonicalize(path).ok();
+            return canonical(other).is_none() || canonical(other) != canonical(out);
+        }
+        match std::fs::metadata(out) {
+            Ok(ours) if crate::export::same_identity(&ours, &theirs) => !listed_as_one(dir, out, other),
+            _ => true,
         }
     };
     (0..16u8)
@@ -125,13 +130,13 @@ fn gltf_sharing_side_files(out: &Path, dir: &Path, name: &str) -> Option<std::pa
         .find(|other| shares(other))
 }
 
-/// Whether `dir` lists both `a`'s and `b`'s file names (two entries, not one read under
-/// either spelling).
-fn listed_apart(dir: &Path, a: &Path, b: &Path) -> bool {
+/// Whether `dir` lists one entry for `a`'s and `b`'s file names (one file read under either
+/// spelling), not both; false where it cannot be listed.
+fn listed_as_one(dir: &Path, a: &Path, b: &Path) -> bool {
     let (Some(a), Some(b)) = (a.file_name(), b.file_name()) else { return false };
     let Ok(entries) = std::fs::read_dir(dir) else { return false };
     let names: Vec<std::ffi::OsString> = entries.filter_map(|e| e.ok().map(|e| e.file_name())).collect();
-    names.iter().any(|n| n == a) && names.iter().any(|n| n == b)
+    !(names.iter().any(|n| n == a) && names.iter().any(|n| n == b))
 }
 
 /// Whether the file is binary glTF (`.glb`) or JSON (`.gltf`), from its extension.

@@ -686,12 +686,6 @@ fn out_of_range_value_names_key_and_range() {
     assert!(err.contains("[1, 3]"), "{err}");
 }
 
-/// Spots larger than their spacing: each range alone allowed `size = 0.3` with 64 around, a
-/// radius of 19 spacings that drew each point hundreds of times over (59.9 s for 16 layers
-/// of them on a body atlas 16 pixels wide). Negative controls: the largest size the message
-/// prints is accepted, so is a lower amount, and so is the built-in layer that comes closest
-/// when turned to spots (acanthophis-antarcticus' rings, 1.75 spacings). A size out of its
-/// own range is refused once, by its range.
 /// A pattern's `amount` that counts marks (stripes, rings, spots, blotches) must be whole:
 /// a fraction was rounded where they are drawn, silently (2.4 stripes drew 2, 7.5 spots 8: a
 /// hostile-input sweep). Controls: a whole count, and an irregular layer's fractional
@@ -701,19 +695,38 @@ fn a_count_of_marks_must_be_whole() {
     let presets = tempfile::tempdir().unwrap();
     for (kind, amount, said) in [
         ("stripes", "2.4", "must be a whole number of stripes a side in [1, 16], got 2.4"),
-        ("spots", "7.5", "must be a whole number of spots in [1, 64], got 7.5"),
+        ("spots", "7.5", "must be a whole number of spots around the body in [1, 64], got 7.5"),
+        // Out of its range and not whole: one problem in the same words (it said only
+        // "a finite number in [1, 16]", and 15.5 was refused next).
+        ("stripes", "16.5", "must be a whole number of stripes a side in [1, 16], got 16.5"),
         ("rings", "1.5", "must be a whole number of repeats per tile in [1, 32], got 1.5"),
         ("blotches", "1.49", "must be a whole number of blotches per tile in [1, 32], got 1.49"),
     ] {
         let layer = format!("[[pattern]]\nkind = \"{kind}\"\ncolor = \"#101010\"\namount = {amount}\nsize = 0.02\n");
         let err = refused("count.toml", &layer, &[]);
         assert!(err.contains("count.toml:4: key `pattern.0.amount`") && err.contains(said), "{kind}: {err}");
+        // Refused once: the checks that read the count (spots' spacing, stripes past the
+        // belly) do not refuse it again as the count it rounds to.
+        assert_eq!(err.matches("key `").count(), 1, "{kind}: {err}");
         accepted(&write_preset(presets.path(), "c.toml", &layer.replace(amount, "2")), &[]);
+    }
+    // Counts that the spacing and wrap checks read as they round: refused once, not again
+    // as 41 spots too large at the default size or 3 stripes past the belly (an
+    // independent review).
+    for extra in ["kind = \"spots\"\namount = 40.5", "kind = \"stripes\"\namount = 2.5\nsize = 0.1\noffset = 0.3"] {
+        let err = refused("count.toml", &format!("[[pattern]]\ncolor = \"#101010\"\n{extra}\n"), &[]);
+        assert_eq!(err.matches("key `").count(), 1, "{extra}: {err}");
     }
     let irregular = "[[pattern]]\nkind = \"irregular\"\ncolor = \"#101010\"\namount = 0.25\n";
     accepted(&write_preset(presets.path(), "i.toml", irregular), &[]);
 }
 
+/// Spots larger than their spacing: each range alone allowed `size = 0.3` with 64 around, a
+/// radius of 19 spacings that drew each point hundreds of times over (59.9 s for 16 layers
+/// of them on a body atlas 16 pixels wide). Negative controls: the largest size the message
+/// prints is accepted, so is a lower amount, and so is the built-in layer that comes closest
+/// when turned to spots (acanthophis-antarcticus' rings, 1.75 spacings). A size out of its
+/// own range is refused once, by its range.
 #[test]
 fn spots_larger_than_their_spacing_are_refused() {
     let layer = "[[pattern]]\nkind = \"spots\"\ncolor = \"#101010\"\namount = 64\nsize = 0.3\n";

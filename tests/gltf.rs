@@ -265,6 +265,14 @@ fn an_upper_case_extension_names_the_file_written() {
     std::os::unix::fs::symlink("Up.gltf", dir.path().join("Up.GLTF")).unwrap();
     std::fs::create_dir(dir.path().join("Up.glTF")).unwrap();
     export(dir.path(), "xenopeltis-unicolor", "Up.gltf", &["--mesh", "plane"]);
+    // A symbolic link to a hard link of the export is the old document after it: refused
+    // (it was let through as the same file: a second review).
+    std::fs::create_dir(dir.path().join("keep")).unwrap();
+    std::fs::hard_link(dir.path().join("Up.gltf"), dir.path().join("keep/Up.gltf")).unwrap();
+    std::fs::remove_file(dir.path().join("Up.GLTF")).unwrap();
+    std::os::unix::fs::symlink("keep/Up.gltf", dir.path().join("Up.GLTF")).unwrap();
+    let out = snakeskin(&["export", "xenopeltis-unicolor", "--gltf", dir.path().join("Up.gltf").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     // A name that ends as a folder's is refused with an example of its own kind (it said
     // "as in out/snake.png", a name `--gltf` refuses).
     for (given, example) in [

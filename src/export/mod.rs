@@ -127,8 +127,8 @@ pub enum ExportError {
     /// length and images of another export, without a word (a hostile-input sweep).
     #[error(
         "{path}: {other} beside it is a .gltf file whose name differs only in the extension's case, and a .gltf's \
-         side files are named after the stem: this export would write over the ones {other} reads ({stem}.bin and \
-         its images); give this export another name, or move {other} and its side files away"
+         side files are named after its stem ({stem}.bin and its images): this export would replace the side files \
+         that a document of that name reads; give this export another name, or move {other} and its side files away"
     )]
     SharesSideFiles { path: PathBuf, other: PathBuf, stem: String },
     #[error(

@@ -162,12 +162,12 @@ impl Checker {
     /// marks): in its range and whole. A fraction was rounded where the marks are drawn,
     /// without a word (`amount = 2.4` stripes drew 2, 7.5 spots 8: a hostile-input sweep),
     /// as `rows = 19.5` is refused.
+    /// One problem for a count out of its range or not whole, in the same words (16.5
+    /// stripes had only the range's, and 15.5 was refused next).
     fn whole_count(&mut self, key: impl Into<String>, value: f64, range: (f64, f64), counted: &str) {
-        let key = key.into();
-        self.range(key.clone(), value, range);
-        if value.is_finite() && (range.0..=range.1).contains(&value) && value.fract() != 0.0 {
+        if !(is_whole_in(value, range)) {
             self.problems.push(Problem {
-                key,
+                key: key.into(),
                 message: format!(
                     "must be a whole number of {counted} in [{}, {}], got {}",
                     range.0,
@@ -200,6 +200,13 @@ impl Checker {
             });
         }
     }
+}
+
+/// Whether a count written as a number is whole and within `(lo, hi)` (`Checker::whole_count`;
+/// the checks that read the count run only then, so that a refused count is not refused
+/// again as the count it rounds to).
+fn is_whole_in(value: f64, (lo, hi): (f64, f64)) -> bool {
+    value.is_finite() && (lo..=hi).contains(&value) && value.fract() == 0.0
 }
 
 /// The row count the keys `scales.rows` bounds (`WholeRange::HalfTheRows`, a stripe's
@@ -492,9 +499,15 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         }
         match p.kind {
             PatternKind::Stripes => c.whole_count(key("amount"), p.amount, STRIPES_PER_SIDE, "stripes a side"),
-            PatternKind::Spots => c.whole_count(key("amount"), p.amount, SPOTS_AROUND, "spots"),
+            PatternKind::Spots => {
+                let counted = if p.rows.is_empty() { "spots around the body" } else { "columns of spots a side" };
+                c.whole_count(key("amount"), p.amount, SPOTS_AROUND, counted)
+            }
             PatternKind::Rings => c.whole_count(key("amount"), p.amount, RINGS_PER_TILE, "repeats per tile"),
-            PatternKind::Blotches => c.whole_count(key("amount"), p.amount, BLOTCHES_PER_TILE, "blotches per tile"),
+            PatternKind::Blotches => {
+                let counted = if p.shape == PatternShape::Zigzag { "zigzags per tile" } else { "blotches per tile" };
+                c.whole_count(key("amount"), p.amount, BLOTCHES_PER_TILE, counted)
+            }
             PatternKind::Irregular | PatternKind::Solid => c.range(key("amount"), p.amount, UNIT),
         }
         let shapes: &[PatternShape] = match p.kind {
@@ -711,8 +724,8 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         // too (`maps::spot_spacing`): 64 over the lowest row of 19 (0.04 of the
         // circumference) at size 0.03 put 48 spacings in a radius, and a body atlas 64 pixels
         // wide took 37 s (a review found the check counting `amount` round the body).
-        let around = p.amount.round();
-        let in_ranges = (1.0..=SPOTS_AROUND.1).contains(&around) && (PATTERN_SIZE.0..=PATTERN_SIZE.1).contains(&p.size);
+        let around = p.amount;
+        let in_ranges = is_whole_in(around, SPOTS_AROUND) && (PATTERN_SIZE.0..=PATTERN_SIZE.1).contains(&p.size);
         let scale_rows_in_range = (ROWS.0..=ROWS.1).contains(&preset.scales.rows);
         if p.kind == PatternKind::Spots && in_ranges && (p.rows.is_empty() || (rows_ok && scale_rows_in_range)) {
             let lattice = crate::maps::scale_field(preset, crate::maps::Layout::Tile).lattice();
@@ -783,7 +796,7 @@ pub fn validate(preset: &Preset, overridden: &dyn Fn(&str) -> bool) -> Vec<Probl
         // `rows`.
         let per_side = p.amount.round();
         let offset = p.position.map_or(p.offset, |q| q.offset());
-        let stripes_in_ranges = (STRIPES_PER_SIDE.0..=STRIPES_PER_SIDE.1).contains(&per_side)
+        let stripes_in_ranges = is_whole_in(p.amount, STRIPES_PER_SIDE)
             && (PATTERN_SIZE.0..=PATTERN_SIZE.1).contains(&p.size)
             && (PATTERN_OFFSET.0..=PATTERN_OFFSET.1).contains(&offset);
         if p.kind == PatternKind::Stripes && p.rows.is_empty() && stripes_in_ranges && per_side >= 2.0 {
