@@ -112,8 +112,9 @@ fn gltf_sharing_side_files(out: &Path, dir: &Path, name: &str) -> Option<std::pa
             return false;
         }
         if link.is_symlink() {
-            let canonical = |path: &Path| std::fs::canonicalize(path).ok();
-            return canonical(other).is_none() || canonical(other) != canonical(out);
+            // Resolved once each (it was three resolutions of two paths).
+            let target = std::fs::canonicalize(other).ok();
+            return target.is_none() || target != std::fs::canonicalize(out).ok();
         }
         match std::fs::metadata(out) {
             Ok(ours) if crate::export::same_identity(&ours, &theirs) => !listed_as_one(dir, out, other),

@@ -161,9 +161,8 @@ impl Checker {
     /// A count written as a number (a pattern layer's `amount` for the kinds that count
     /// marks): in its range and whole. A fraction was rounded where the marks are drawn,
     /// without a word (`amount = 2.4` stripes drew 2, 7.5 spots 8: a hostile-input sweep),
-    /// as `rows = 19.5` is refused.
-    /// One problem for a count out of its range or not whole, in the same words (16.5
-    /// stripes had only the range's, and 15.5 was refused next).
+    /// as `rows = 19.5` is refused. Out of its range or not whole is one problem, in the same
+    /// words (16.5 stripes had only the range's, and 15.5 was refused next).
     fn whole_count(&mut self, key: impl Into<String>, value: f64, range: (f64, f64), counted: &str) {
         if !(is_whole_in(value, range)) {
             self.problems.push(Problem {
