@@ -48,6 +48,9 @@ fn set_twice(set: &std::collections::BTreeMap<String, toml::Value>) -> Option<St
 /// At most this many jobs per file (after expansion): a typo such as `sizes = [..]` with a
 /// thousand entries is refused before anything runs.
 pub const MAX_JOBS: usize = 100_000;
+
+/// A job's overrides, as its problems and warnings name them (`preset::place`).
+const SET_TABLE: &str = "its `set` table";
 /// Jobs files are small; anything larger is refused unread.
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
 
@@ -726,12 +729,12 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
             crate::preset::PresetError::Invalid { file, problems } if problems.iter().any(|p| p.overridden) => {
                 BatchError::Invalid {
                     place: job.place(jobs_file, job.lines.set),
-                    message: crate::preset::describe_problems(&file, &problems, "its `set` table"),
+                    message: crate::preset::describe_problems(&file, &problems, SET_TABLE),
                 }
             }
             source => BatchError::Preset { place: job.place(jobs_file, job.lines.preset), source: Box::new(source) },
         })?;
-    let mut warnings = loaded.warnings(&job.preset);
+    let mut warnings = loaded.warnings(&job.preset, SET_TABLE);
     // A pack longer than its engine loads, at the job's `sizes` line (`Pack::size_problem`).
     if let Some(pack) = job.pack
         && let Some(problem) = pack_size_warning(pack, job.layout, &loaded.preset, job.size as usize, "a size of")

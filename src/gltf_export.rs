@@ -303,7 +303,7 @@ impl ExportPlan {
         }
         let warnings = plan
             .loaded()
-            .warnings(&request.preset)
+            .warnings(&request.preset, crate::preset::SET_FLAG)
             .into_iter()
             // The plan's pack is glTF's: its warnings are the export's.
             .chain(plan.size_warning())

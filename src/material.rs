@@ -190,17 +190,27 @@ impl fmt::Display for MapKind {
 impl FromStr for MapKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        MapKind::EVERY.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-            // `colour`, as the documentation's prose spells it, is one letter from the name.
-            // (Not for a name of one or two letters: any is within two edits of `ao`.)
-            // The same name in another case is suggested at any length (`AO`).
-            let names = MapKind::EVERY.map(MapKind::name);
-            let same = names.into_iter().find(|n| n.eq_ignore_ascii_case(s));
-            let near = same.or_else(|| (s.len() > 2).then(|| crate::toml_text::nearest(s, names)).flatten());
-            let suggestion = near.map(|n| format!("did you mean {n}? ")).unwrap_or_default();
-            format!("unknown map {s:?}; {suggestion}accepted: color, height, normal, roughness, iridescence, ao")
-        })
+        MapKind::EVERY.into_iter().find(|m| m.name() == s).ok_or_else(|| unknown_map(s, false))
     }
+}
+
+/// The error for a name that is no map, with the nearest name as "did you mean" and the
+/// accepted names; in a map list (`in_list`) `all` is one of them.
+fn unknown_map(s: &str, in_list: bool) -> String {
+    let names = MapKind::EVERY.map(MapKind::name);
+    // `colour`, as the documentation's prose spells it, is one letter from the name.
+    // (Not for a name of one or two letters: any is within two edits of `ao`.)
+    // The same name in another case is suggested at any length (`AO`).
+    let same = names.into_iter().find(|n| n.eq_ignore_ascii_case(s));
+    let near = same.or_else(|| (s.len() > 2).then(|| crate::toml_text::nearest(s, names)).flatten());
+    // `all` is a word of the list, not a map's name, and a map's name is the likelier meaning
+    // (`aol` is one edit from both `ao` and `all`). `ALL` and `al` got no suggestion, and the
+    // accepted names left `all` out: a hostile-input sweep.
+    let near_all = in_list && crate::toml_text::edit_distance(&s.to_ascii_lowercase(), "all") <= 1;
+    let near = near.or(near_all.then_some("all"));
+    let suggestion = near.map(|n| format!("did you mean {n}? ")).unwrap_or_default();
+    let or_all = if in_list { ", or all (the five of every set)" } else { "" };
+    format!("unknown map {s:?}; {suggestion}accepted: {}{or_all}", names.join(", "))
 }
 
 /// Parses a comma-separated map list ("color,height"); "all" means the five of every set
@@ -209,12 +219,10 @@ impl FromStr for MapKind {
 /// with the variable unset wrote every map without a word.
 pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
     if list.trim().is_empty() {
-        return Err("an empty list; name the maps (color, height, normal, roughness, iridescence, ao), or all \
-                    (leave the list out for all five)"
-            .into());
-    }
-    if list.trim() == "all" {
-        return Ok(MapKind::ALL.to_vec());
+        return Err(format!(
+            "an empty list; name the maps ({}), or all (leave the list out for all five)",
+            MapKind::EVERY.map(MapKind::name).join(", ")
+        ));
     }
     let mut out = Vec::new();
     for item in list.split(',').map(str::trim) {
@@ -224,17 +232,8 @@ pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
         let maps = if item == "all" {
             MapKind::ALL.to_vec()
         } else {
-            // `all` is a word of the list, not a map's name: named and suggested here (`ALL` and
-            // `al` got no suggestion, and the accepted names left it out: a hostile-input sweep).
-            let near_all = crate::toml_text::edit_distance(&item.to_ascii_lowercase(), "all") <= 1;
-            vec![item.parse().map_err(|e: String| {
-                let e = if near_all && !e.contains("did you mean") {
-                    format!("unknown map {item:?}; did you mean all? {}", after_accepted(&e))
-                } else {
-                    e
-                };
-                format!("{e}, or all (the five of every set)")
-            })?]
+            let map = MapKind::EVERY.into_iter().find(|m| m.name() == item);
+            vec![map.ok_or_else(|| unknown_map(item, true))?]
         };
         for map in maps {
             if !out.contains(&map) {
@@ -244,11 +243,6 @@ pub fn parse_map_list(list: &str) -> Result<Vec<MapKind>, String> {
     }
     out.sort();
     Ok(out)
-}
-
-/// "accepted: ..." of a map name's error (`MapKind::from_str`).
-fn after_accepted(error: &str) -> &str {
-    error.find("accepted:").map_or(error, |at| &error[at..])
 }
 
 /// How a map's linear f32 samples become file samples.

@@ -8,7 +8,7 @@ use std::collections::VecDeque;
 use snakeskin::graph::evaluate;
 use snakeskin::maps::{BuildOptions, MapKind, build_graph};
 use snakeskin::ops::Image;
-use snakeskin::preset::{PresetSource, parse};
+use snakeskin::preset::{PresetSource, SET_FLAG, parse};
 
 const BLACK: [f32; 3] = [0.0, 0.0, 0.0];
 const YELLOW: [f32; 3] = [0.9, 0.8, 0.0];
@@ -174,7 +174,7 @@ fn more_rings_than_whole_scales_can_keep_apart_are_warned_of_with_the_most_that_
     };
     let warning = |amount: u32| {
         let loaded = load(1, amount);
-        loaded.warnings("t.toml").into_iter().find(|w| w.contains("pattern.0.amount"))
+        loaded.warnings("t.toml", SET_FLAG).into_iter().find(|w| w.contains("pattern.0.amount"))
     };
     let said = warning(5).expect("no warning at 5 repeats");
     assert!(said.contains("t.toml:") && said.contains("scale_aligned = 1"), "{said}");
@@ -188,8 +188,9 @@ fn more_rings_than_whole_scales_can_keep_apart_are_warned_of_with_the_most_that_
         "[scales]\nrows = 15\n\n[[pattern]]\nkind = \"rings\"\nscale_aligned = 1\ncolors = [{}]\n",
         colours.join(", ")
     );
-    let warned =
-        parse(&PresetSource { name: "c".into(), display: "c.toml".into(), text }, &[]).unwrap().warnings("c.toml");
+    let warned = parse(&PresetSource { name: "c".into(), display: "c.toml".into(), text }, &[])
+        .unwrap()
+        .warnings("c.toml", SET_FLAG);
     let at_colours = "warning: c.toml:7: pattern.0.amount (not written: its default) = 1 leaves";
     assert!(warned.iter().any(|w| w.starts_with(at_colours)), "{warned:?}");
     for seed in [1, 2, 3] {
@@ -226,7 +227,7 @@ fn rings_that_fit_the_tile_but_not_the_body_are_warned_of_on_the_body() {
     };
     let warnings = |amount: u32| {
         let source = PresetSource { name: "t".into(), display: "t.toml".into(), text: text(amount) };
-        parse(&source, &[]).unwrap_or_else(|e| panic!("{e}")).warnings("t.toml")
+        parse(&source, &[]).unwrap_or_else(|e| panic!("{e}")).warnings("t.toml", SET_FLAG)
     };
     let said = warnings(3);
     let [said] = said.as_slice() else { panic!("one warning: {said:?}") };

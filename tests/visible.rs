@@ -127,8 +127,9 @@ fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limi
     let map = image::open(out_dir.join("ink_color.png")).unwrap().to_rgb8();
     assert!(map.pixels().all(|p| (0..3).all(|c| p.0[c] <= bound[c])), "map brighter than {bound:?}");
 
-    // A colour an override wrote has no line in the file (it named line 3, `#e0c0a0`),
-    // whether the override names the key or the table around it; an inline table writes its
+    // A colour an override wrote has no line in the file (it named line 3, `#e0c0a0`), and is
+    // placed at the override as its problems are (the warning named the file alone), whether
+    // the override names the key or the table around it; an inline table writes its
     // own keys only, so the file's `color.base` keeps its line when the override sets
     // another key of `color` (the whole table lost its lines).
     let colour_with = |set: &str| {
@@ -139,7 +140,7 @@ fn a_colour_the_stack_cannot_show_is_clamped_and_reported_with_key_line_and_limi
     };
     for set in ["color.base=\"#f0f0f0\"", "color={base=\"#f0f0f0\"}", "color={base=\"#f0f0f0\", scale_tone=0.1}"] {
         let err = colour_with(set);
-        assert!(err.contains("ink.toml: color.base = \"#f0f0f0\" is brighter"), "{set}: {err}");
+        assert!(err.contains("ink.toml (with --set): color.base = \"#f0f0f0\" is brighter"), "{set}: {err}");
         assert!(err.contains("ink.toml:8: belly.color"), "{set}: {err}");
     }
     let err = colour_with("color={scale_tone=0.05}");
@@ -433,6 +434,25 @@ fn a_pigment_as_dense_as_the_ambient_under_a_rough_film_is_warned_of() {
     ] {
         assert!(err.contains(said), "{said}: {err}");
     }
+    // The ambient's index given by `--set` (or a jobs file's `set`): the warnings are placed
+    // at the override, as a problem is (they named the file alone).
+    let smooth = write_preset(dir.path(), "smooth.toml", "species = \"wet\"\n\n[roughness]\nbase = 0.06\n");
+    let dir_arg = out_dir.to_str().unwrap();
+    let args =
+        ["generate", &smooth, "-o", dir_arg, "--size", "32", "--maps", "color", "--set", "optics.ambient_ior=1.8"];
+    let err = stderr(&snakeskin(&args));
+    assert!(
+        err.contains("smooth.toml (with --set): optics.pigment_ior (not written: its default) = 2 is near"),
+        "{err}"
+    );
+    let jobs = dir.path().join("jobs.toml");
+    let job =
+        "[[job]]\npreset = \"smooth.toml\"\nsizes = [32]\nmaps = \"color\"\nset = { \"optics.ambient_ior\" = 1.8 }\n";
+    std::fs::write(&jobs, job).unwrap();
+    let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("sets").to_str().unwrap()]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("smooth.toml (with its `set` table): optics.film_ior (not written: its default)"), "{err}");
     for (name, text) in [
         ("dense.toml", water.replace("1.4", "2")),
         (

@@ -35,7 +35,7 @@ pub enum PresetError {
     Parse { location: Location, message: String },
 
     /// Values out of range, one line each.
-    #[error("{}", describe_problems(.file, .problems, "--set"))]
+    #[error("{}", describe_problems(.file, .problems, SET_FLAG))]
     Invalid { file: String, problems: Vec<LocatedProblem> },
 
     #[error("invalid --set {argument:?}: {message}")]
@@ -88,14 +88,33 @@ impl LocatedProblem {
 /// `amount` written; that said "(with --set)" when nothing was set), at the line of the
 /// check's other key where the file writes it.
 pub fn describe_problems(file: &str, problems: &[LocatedProblem], overrides: &str) -> String {
-    let file = crate::toml_text::one_line(file);
     problems
         .iter()
-        .map(|p| match (p.line, p.overridden) {
-            (Some(line), _) => format!("{file}:{line}: key `{}`{} {}", p.key, p.default_note(), p.message),
-            (None, true) => format!("{file} (with {overrides}): key `{}`{} {}", p.key, p.default_note(), p.message),
-            (None, false) => format!("{file}: key `{}`{} {}", p.key, p.default_note(), p.message),
+        .map(|p| {
+            format!(
+                "{}: key `{}`{} {}",
+                place(file, p.line, p.overridden, overrides),
+                p.key,
+                p.default_note(),
+                p.message
+            )
         })
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+/// The command line's overrides, as problems and warnings name them (a jobs file's are "its
+/// `set` table").
+pub const SET_FLAG: &str = "--set";
+
+/// Where a preset's key is, as its problems and warnings say it, on one line: `FILE:LINE`
+/// for a key written in the file, `FILE (with OVERRIDES)` for one an override wrote, else
+/// `FILE` (a key at its default, or a built-in preset's name).
+pub fn place(file: &str, line: Option<usize>, overridden: bool, overrides: &str) -> String {
+    let file = crate::toml_text::one_line(file);
+    match (line, overridden) {
+        (Some(line), _) => format!("{file}:{line}"),
+        (None, true) => format!("{file} (with {overrides})"),
+        (None, false) => file,
+    }
 }

@@ -55,8 +55,14 @@ pub struct LoadedPreset {
 impl LoadedPreset {
     /// The warnings every command prints for the preset (`preset`: its file or name, as
     /// given), one line each: colours clamped to what the stack can show, and the keys
-    /// `warned` of.
-    pub fn warnings(&self, preset: &str) -> Vec<String> {
+    /// `warned` of, each placed as a problem is (`preset::place`; `overrides` names the
+    /// overrides: `preset::SET_FLAG`, or a jobs file's `set`).
+    pub fn warnings(&self, preset: &str, overrides: &str) -> Vec<String> {
+        let clamped = self.clamped_colours.iter().map(|c| c.message(preset, overrides));
+        let warned = self.warned.iter().map(|p| {
+            let place = super::place(preset, p.line, p.overridden, overrides);
+            format!("warning: {place}: {}{} = {}", p.key, p.default_note(), p.message)
+        });
         // On one line: a jobs file names its presets (a folder name with a newline).
         let preset = &crate::toml_text::one_line(preset);
         let empty = self.sets_no_key.then(|| {
@@ -64,11 +70,6 @@ impl LoadedPreset {
                 "warning: {preset}: the file sets no key: every key takes its default (`snakeskin presets show NAME` \
                  prints a whole preset to start from)"
             )
-        });
-        let clamped = self.clamped_colours.iter().map(|c| c.message(preset));
-        let warned = self.warned.iter().map(|p| {
-            let line = p.line.map(|l| format!(":{l}")).unwrap_or_default();
-            format!("warning: {preset}{line}: {}{} = {}", p.key, p.default_note(), p.message)
         });
         empty
             .into_iter()
@@ -393,7 +394,8 @@ pub fn parse_with_seed(
     let mut clamped_colours = super::visible::clamp_to_visible(&mut preset);
     for c in &mut clamped_colours {
         c.line = line_of(&c.key);
-        c.default = c.line.is_none() && !overridden(&c.key);
+        c.overridden = overridden(&c.key);
+        c.default = c.line.is_none() && !c.overridden;
     }
     let warned = super::validate::warnings(&preset).into_iter().map(locate).collect();
     let canonical = canonical_text(&preset);
@@ -943,10 +945,12 @@ mod tests {
     /// seed given or not. Negative controls: one key, a `--set`, and a built-in preset.
     #[test]
     fn a_file_that_sets_no_key_is_warned_of() {
-        let says = |loaded: &LoadedPreset| loaded.warnings("t.toml").iter().any(|w| w.contains("sets no key"));
+        let says = |loaded: &LoadedPreset| {
+            loaded.warnings("t.toml", crate::preset::SET_FLAG).iter().any(|w| w.contains("sets no key"))
+        };
         for text in ["", "\n  \n", "# a comment only\n", "[scales]\n[body]\n", "scales = {}"] {
             let loaded = parse(&source(text), &[]).unwrap();
-            assert!(says(&loaded), "{text:?}: {:?}", loaded.warnings("t.toml"));
+            assert!(says(&loaded), "{text:?}: {:?}", loaded.warnings("t.toml", crate::preset::SET_FLAG));
         }
         assert!(!says(&parse(&source("seed = 1"), &[]).unwrap()));
         assert!(!says(&parse(&source(""), &[("scales.rows".into(), "21".into())]).unwrap()));

@@ -43,12 +43,17 @@ pub struct ClampedColour {
     /// writer never wrote, without a line: a walkthrough).
     #[serde(skip)]
     pub default: bool,
+    /// Whether an override (`--set`, a jobs file's `set`) wrote the key: the warning is then
+    /// placed at the override, as a problem is (`preset::place`).
+    #[serde(skip)]
+    pub overridden: bool,
 }
 
 impl ClampedColour {
-    /// The warning for `preset` (its file or name), as every command prints it.
-    pub fn message(&self, preset: &str) -> String {
-        let line = self.line.map(|l| format!(":{l}")).unwrap_or_default();
+    /// The warning for `preset` (its file or name), as every command prints it; `overrides`
+    /// names the overrides where one wrote the key (`preset::place`).
+    pub fn message(&self, preset: &str, overrides: &str) -> String {
+        let place = super::place(preset, self.line, self.overridden, overrides);
         let [r, g, b] = self.limit_linear;
         let (key, requested, shown) = (&self.key, &self.requested, &self.clamped_to);
         let requested = if self.default {
@@ -58,7 +63,7 @@ impl ClampedColour {
         };
         if self.absorbing {
             return format!(
-                "warning: {preset}{line}: {key} = {requested} is brighter than this layer stack can show (colours \
+                "warning: {place}: {key} = {requested} is brighter than this layer stack can show (colours \
                  mean the visible colour; with its absorption, and any headroom this key keeps for the map's per-scale \
                  tone and colour variation, it may be at most linear [{r:.3}, {g:.3}, {b:.3}]); clamped to \"{shown}\". \
                  Lower optics.absorption or the colour to keep it."
@@ -66,7 +71,7 @@ impl ClampedColour {
         }
         let variation = if key == "color.base" { ", color.variation" } else { "" };
         format!(
-            "warning: {preset}{line}: {key} = {requested} would be brightened past a reflectance of 1 by the map's \
+            "warning: {place}: {key} = {requested} would be brightened past a reflectance of 1 by the map's \
              per-scale tone and colour variation (colours mean the visible colour; with that headroom it may be at \
              most linear [{r:.3}, {g:.3}, {b:.3}]); clamped to \"{shown}\". Lower color.scale_tone, scale_hue, \
              edge_tone, tip_tone{variation} or the colour to keep it."
@@ -224,6 +229,7 @@ pub fn clamp_to_visible(preset: &mut Preset) -> Vec<ClampedColour> {
             limit_linear: allowed,
             absorbing: stack_limit[channel] < 1.0,
             default: false,
+            overridden: false,
         });
         *colour = shown;
     }

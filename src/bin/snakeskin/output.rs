@@ -260,7 +260,7 @@ pub fn ensure_folder(folder: &Path) -> anyhow::Result<()> {
 /// show and what they were clamped to, once per key, and where the model is darker than
 /// the physics.
 pub fn report_warnings(preset: &str, loaded: &snakeskin::preset::LoadedPreset) {
-    for warning in loaded.warnings(preset) {
+    for warning in loaded.warnings(preset, snakeskin::preset::SET_FLAG) {
         eprintln!("{warning}");
     }
 }

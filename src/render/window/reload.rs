@@ -128,7 +128,7 @@ pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache) -> MapWor
                 continue;
             }
             let result = crate::preset::load(&spec, &overrides, seed).map_err(Error::from).and_then(|loaded| {
-                for warning in loaded.warnings(&spec) {
+                for warning in loaded.warnings(&spec, crate::preset::SET_FLAG) {
                     eprintln!("{warning}");
                 }
                 let (maps, stats) = material_maps_cached(&loaded, map_size, layout, &mut cache, 0)?;
