@@ -50,8 +50,9 @@ pub fn estimate_generate_bytes(graph: &Graph, maps: &[MapKind], width: usize, he
 /// the peaks of three species stayed 170–280 MiB under the estimate without it; BENCHMARKS.md,
 /// "Export's memory". Half a strip, at most 64 MiB, was counted until a full test run beside
 /// it took that `.glb` to 344 MiB against 328 estimated), plus the PNG files growing as rows
-/// are encoded (at most the quantised size of the whole set with the fast filter), plus the
-/// fixed overhead.
+/// are encoded (counted at the set's quantised size: a streamed 16-bit map can come out a
+/// sixth over its own, `export::png_file_encoder`, but the set's 8-bit maps compress to
+/// half of theirs or less), plus the fixed overhead.
 pub fn estimate_strips_bytes(graph: &Graph, maps: &[MapKind], width: usize, height: usize, strip_rows: usize) -> u64 {
     let pixels = (width * height) as u64;
     let files: u64 = maps.iter().map(|m| m.format().bytes_per_pixel() as u64 * pixels).sum();

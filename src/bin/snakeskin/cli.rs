@@ -164,20 +164,27 @@ impl Cli {
     /// `0,0,1` an unexpected argument: one of the command's flags right after such a flag is
     /// refused as its missing value. And every flag that takes a value takes a negative
     /// number as one, to refuse it with its range: `--size -16` said "unexpected argument
-    /// '-1'" with the tip `-- -1`, which did not help either.
+    /// '-1'" with the tip `-- -1`, which did not help either (and clap knows `-1e-3`,
+    /// `-.5` and `-inf` as no numbers: `negative_values_attached`).
     pub fn try_parse_checked_from(args: Vec<std::ffi::OsString>) -> Result<Cli, clap::Error> {
         use clap::{CommandFactory, FromArgMatches};
-        let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
         let mut command = negative_numbers_as_values(Cli::command());
         command.build();
         // The subcommands the words name (`brdf`, `eval`): their flags are the ones that
         // count, and the error shows the last one's usage.
-        let mut path = vec![&command];
-        for word in words.iter().skip(1) {
-            if let Some(sub) = path.last().and_then(|c| c.find_subcommand(word)) {
-                path.push(sub);
+        let path_of = |words: &[&str]| {
+            let mut path = vec![&command];
+            for word in words.iter().skip(1) {
+                if let Some(sub) = path.last().and_then(|c| c.find_subcommand(word)) {
+                    path.push(sub);
+                }
             }
-        }
+            path
+        };
+        let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
+        let args = negative_values_attached(&args, &path_of(&words));
+        let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
+        let path = path_of(&words);
         let long_flags = |c: &clap::Command| {
             c.get_arguments()
                 .filter_map(|a| a.get_long().map(|l| (format!("--{l}"), a.is_allow_hyphen_values_set())))
@@ -297,6 +304,47 @@ fn ranged_u32(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, String> + Clone 
     move |text| parse(text).map(|n| n as u32)
 }
 
+/// The command line with a value that starts with `-` and then a digit, a point or `inf` /
+/// `nan` written onto the long flag before it that takes a value (`--angle-deg=-1e-3`):
+/// clap's negative numbers (`negative_numbers_as_values`) are digits and one point only,
+/// so `--angle-deg -1e-3` said "unexpected argument '-1'", and `-.5`, `-inf` and `-nan`
+/// the same (a hostile-input sweep), where `--angle-deg -1` gives the flag's range. `path`
+/// is the commands the words name, whose flags count. Nothing after `--` is touched.
+fn negative_values_attached(args: &[std::ffi::OsString], path: &[&clap::Command]) -> Vec<std::ffi::OsString> {
+    let takes_value = |word: &str| {
+        path.iter()
+            .flat_map(|c| c.get_arguments())
+            .any(|a| a.get_action().takes_values() && a.get_long().is_some_and(|l| word.strip_prefix("--") == Some(l)))
+    };
+    let looks_negative = |word: &str| {
+        word.strip_prefix('-').is_some_and(|rest| {
+            rest.starts_with(|c: char| c.is_ascii_digit() || c == '.')
+                || ["inf", "infinity", "nan"].contains(&rest.to_ascii_lowercase().as_str())
+        })
+    };
+    let mut out = Vec::with_capacity(args.len());
+    let mut i = 0;
+    while i < args.len() {
+        let (word, next) = (args[i].to_str(), args.get(i + 1).and_then(|a| a.to_str()));
+        if word == Some("--") {
+            out.extend_from_slice(&args[i..]);
+            break;
+        }
+        if let (Some(flag), Some(value)) = (word, next)
+            && i > 0
+            && takes_value(flag)
+            && looks_negative(value)
+        {
+            out.push(format!("{flag}={value}").into());
+            i += 2;
+            continue;
+        }
+        out.push(args[i].clone());
+        i += 1;
+    }
+    out
+}
+
 /// `command` and its subcommands with every flag that takes a value taking a negative
 /// number as one (`Cli::try_parse_checked_from`).
 fn negative_numbers_as_values(command: clap::Command) -> clap::Command {
@@ -374,8 +422,8 @@ pub struct GenerateArgs {
     /// snake, snout at the top, tail tip at the bottom, with the preset's [body] counts,
     /// head shields and marks, and tail; u still wraps round the body, v does not).
     /// A body atlas is evaluated a strip at a time, so its evaluation's memory does not grow
-    /// with its length; its compressed PNGs are held until written (at most the maps' raw
-    /// size, a few bytes a pixel), an EXR's float maps whole (see --format).
+    /// with its length; its compressed PNGs are held until written (about the maps' raw
+    /// size at most, a few bytes a pixel), an EXR's float maps whole (see --format).
     #[arg(long, value_enum, default_value_t = LayoutArg::Tile)]
     pub layout: LayoutArg,
     /// File format: png (8/16-bit, the default) or exr (OpenEXR floats in physical units:
@@ -813,7 +861,9 @@ pub struct EvalArgs {
     /// thesis (the thesis' eq. 4.21 diffuse lobe; README, "Which layer model"). The
     /// layered model's tables ship built for the default indices (--n0 1, --n2 2): a query
     /// takes well under a second; other indices walk their path table first, once per run
-    /// (about 1 s on two cores; the evaluation itself well under a microsecond).
+    /// (1.5 s on two cores for --n2 1.5; longer as --n2 nears --n0, where light crosses a
+    /// rough top back and forth before it leaves: 9 s of processor time for --n2 1.001, 48 s
+    /// for 1.000001; the evaluation itself well under a microsecond).
     #[arg(long, default_value = "layered", value_parser = parse_model)]
     pub model: Model,
     /// Film colour method (as for `brdf color`; spectral = the exact 1 nm sum).
@@ -875,11 +925,11 @@ pub struct AlbedoArgs {
     /// the stacks measured, but up to 5e-4 with a thick film less dense than --n0).
     /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
     /// standard error per channel. The references read the exact 1 nm film (--method is
-    /// for the models).
+    /// for the models). layered walks its path table first where `brdf eval --model` does.
     #[arg(long, default_value = "layered", value_parser = parse_albedo_model)]
     pub model: AlbedoModel,
     /// Photons per channel for --model stochastic (only), 1000 to 100,000,000 (σ ∝ 1/√N);
-    /// default 200,000.
+    /// default 200,000. On one thread: about 10 s of processor time per 10,000,000.
     #[arg(long, value_parser = ranged_u64(1000, 100_000_000))]
     pub photons: Option<u64>,
 }
@@ -1128,6 +1178,11 @@ fn parse_angle_step_deg(text: &str) -> Result<f64, String> {
 
 /// One value for all three channels, or r,g,b; each inside `range`.
 fn vec3_or_scalar(text: &str, range: (f64, f64)) -> Result<[f64; 3], String> {
+    // A number nearer 0 than a float holds is told so, as for one number (`bounded`): the
+    // list's words alone said only "a finite number in [0, 100]" of `1e-400`.
+    if let Some(tiny) = text.split(',').find(|p| snakeskin::toml_text::underflows(p)) {
+        return Err(snakeskin::toml_text::underflow_message(tiny, &format!("a number in [{}, {}]", range.0, range.1)));
+    }
     let parts: Vec<&str> = text.split(',').collect();
     let values: Vec<f64> = parts
         .iter()
@@ -1273,6 +1328,11 @@ mod tests {
             let eval = ["brdf", "eval", "--wi", "0,0,1", "--wo"];
             let error = parse(&[&eval[..], &[&format!("1,0,-{tiny}")]].concat()).expect_err(tiny);
             assert!(error.contains("is nearer 0 than a 64-bit float holds"), "{error}");
+            // A flag of one number or r,g,b (it said only "a finite number in [0, 100]").
+            for list in [tiny.to_string(), format!("0.5,{tiny},0.5")] {
+                let error = parse(&["brdf", "albedo", "--angle-deg", "0", "--absorption", &list]).expect_err(tiny);
+                assert!(error.contains("is nearer 0 than a 64-bit float holds"), "{error}");
+            }
         }
         for fine in ["0", "0.0", "-0", "0e-400", "5e-324"] {
             parse(&[&film[..], &[fine]].concat()).unwrap_or_else(|e| panic!("{fine}: {e}"));
@@ -1280,8 +1340,10 @@ mod tests {
     }
 
     /// A negative number is a flag's value, refused with the flag's range: `--size -16` said
-    /// "unexpected argument '-1'" with clap's tip `-- -1`, which made it another error.
-    /// Negative controls: a value in range, and a flag after a flag is still a missing value.
+    /// "unexpected argument '-1'" with clap's tip `-- -1`, which made it another error, and
+    /// so did the ones clap does not read as numbers (`-1e-3`, `-.5`, `-inf`: a sweep).
+    /// Negative controls: a value in range, a flag after a flag is still a missing value,
+    /// and a word after `--` is no flag's.
     #[test]
     fn a_negative_number_is_refused_with_the_flags_range() {
         for (args, says) in [
@@ -1296,6 +1358,13 @@ mod tests {
             (&["preview", "natrix-natrix", "--out", "a.png", "--snakes", "-3"], "-3 is not in 1..=400"),
             (&["bench", "render", "--frames", "-5"], "-5 is not in 3..=10000"),
             (&["generate", "natrix-natrix", "--size", "--maps", "color"], "a value is required for '--size"),
+            (&["brdf", "albedo", "--angle-deg", "-1e-3"], "'-1e-3' for '--angle-deg <ANGLE_DEG>': must be a finite"),
+            (&["brdf", "albedo", "--thickness-nm", "-.5"], "'-.5' for '--thickness-nm <THICKNESS_NM>': must be"),
+            (&["brdf", "albedo", "--n0", "-inf"], "'-inf' for '--n0 <N0>': must be a finite number in [1, 3]"),
+            (&["brdf", "albedo", "--angle-deg", "-NaN"], "'-NaN' for '--angle-deg <ANGLE_DEG>': must be"),
+            (&["bench", "render", "--size", "-1x-1"], "'-1x-1' for '--size <SIZE>': expected WIDTHxHEIGHT"),
+            (&["generate", "natrix-natrix", "--size", "-1e3"], "'-1e3' for '--size <SIZE>': not a whole number"),
+            (&["brdf", "albedo", "--angle-deg", "30", "--", "-1e-3"], "unexpected argument '-1e-3'"),
         ] {
             let error = parse(args).expect_err(&format!("{args:?} was accepted"));
             assert!(error.contains(says), "{args:?}: {error}");

@@ -178,7 +178,7 @@ pub const VARIANTS: &[(&str, MapKind, &str)] = &[
 /// tiles took 4.8 GB and was not checked at all.
 pub fn render(tile: usize, columns: usize) -> Result<Image, Error> {
     let columns = fitted_columns(columns);
-    check_memory(tile, columns)?;
+    check_memory(tile, columns, false)?;
     let tiles: Vec<Image> = VARIANTS
         .par_iter()
         .map(|(label, map, overrides)| {
@@ -238,8 +238,12 @@ fn canvas_size(tile: usize, columns: usize) -> (usize, usize) {
 
 /// The gallery's peak against the available memory: every variant's finished tile (three
 /// f32 channels), the canvas (f32, then its 8-bit copy and PNG), and the heaviest variant's
-/// graph once per thread evaluating at a time.
-pub fn check_memory(tile: usize, columns: usize) -> Result<(), Error> {
+/// graph once per thread evaluating at a time; with `closeups`, the larger of that and the
+/// close-ups' (`closeup_pngs`, made after the gallery: its PNG, at most the canvas' 8-bit
+/// size, and the heaviest close-up's graph at `CLOSEUP_MAP`² once per thread, each with its
+/// crop). The close-ups were left out: `gallery --tile 16 --closeups` peaked at 151 MiB
+/// against the 129 estimated (an independent sweep).
+pub fn check_memory(tile: usize, columns: usize, closeups: bool) -> Result<(), Error> {
     let (w, h) = canvas_size(tile, columns);
     let tiles = (VARIANTS.len() * tile * tile * 12) as u64;
     let canvas = (w * h * (12 + 3 + 3)) as u64;
@@ -249,8 +253,21 @@ pub fn check_memory(tile: usize, columns: usize) -> Result<(), Error> {
         heaviest = heaviest.max(crate::memory::estimate_generate_bytes(&graph, &[*map], tile, tile));
     }
     let graphs = heaviest.saturating_mul(rayon::current_num_threads().min(VARIANTS.len()) as u64);
-    let check = crate::memory::MemoryCheck::against_available(tiles + canvas + graphs);
-    check.refuse_if_over(&format!("a gallery of {w}×{h} pixels ({} tiles of {tile}²)", VARIANTS.len()))
+    let mut peak = tiles + canvas + graphs;
+    let mut what = format!("a gallery of {w}×{h} pixels ({} tiles of {tile}²)", VARIANTS.len());
+    if closeups {
+        let maps = [MapKind::Color, MapKind::Normal];
+        let mut heaviest = 0;
+        for (stem, _, text) in CLOSEUPS {
+            let graph = build_graph(&parse(&closeup_source(stem, text), &[])?.preset, BuildOptions::default());
+            heaviest = heaviest.max(crate::memory::estimate_generate_bytes(&graph, &maps, CLOSEUP_MAP, CLOSEUP_MAP));
+        }
+        let crop = (2 * CLOSEUP_CROP * CLOSEUP_CROP * 12) as u64;
+        let threads = rayon::current_num_threads().min(CLOSEUPS.len()) as u64;
+        peak = peak.max((w * h * 3) as u64 + (heaviest + crop).saturating_mul(threads));
+        what = format!("{what} and {} close-ups of {CLOSEUP_MAP}² maps", CLOSEUPS.len());
+    }
+    crate::memory::MemoryCheck::against_available(peak).refuse_if_over(&what)
 }
 
 /// A one-channel map shown as gray: the linear value whose sRGB encoding is the value, so
@@ -369,6 +386,9 @@ pub fn write(
     columns: usize,
     closeups: Option<&std::path::Path>,
 ) -> Result<Vec<std::path::PathBuf>, Error> {
+    if closeups.is_some() {
+        check_memory(tile, columns, true)?;
+    }
     let mut group = FileGroup::new();
     group.stage(path, encode_png(MapKind::Color, &render(tile, columns)?)?)?;
     if let Some(dir) = closeups {

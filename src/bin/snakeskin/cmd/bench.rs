@@ -161,6 +161,14 @@ fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_d
         }
     }
     let default = Method::Lut.name();
+    // The plot is written before the results are printed, as `layered`'s: a plot that could
+    // not be written printed the whole JSON and then exited 1 (a hostile-input sweep, on a
+    // full disk), so a script had complete results and a failure.
+    if let Some(path) = plot {
+        let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default, "the spectral reference");
+        snakeskin::export::write_file_atomically(path, svg.into_bytes())?;
+        eprintln!("wrote {}", path_line(path));
+    }
     if json {
         println!("{}", serde_json::json!({ "default": default, "methods": reports }));
     } else {
@@ -172,11 +180,6 @@ fn irid(json: bool, plot: Option<&std::path::Path>, d_step_nm: f64, angle_step_d
                 r.name, r.mean_de, r.p95_de, r.max_de, r.ns_per_eval
             );
         }
-    }
-    if let Some(path) = plot {
-        let svg = snakeskin::optics::plot::error_vs_cost_svg(&reports, &default, "the spectral reference");
-        snakeskin::export::write_file_atomically(path, svg.into_bytes())?;
-        eprintln!("wrote {}", path_line(path));
     }
     Ok(())
 }

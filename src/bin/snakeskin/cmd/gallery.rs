@@ -11,7 +11,7 @@ use crate::output::{ensure_folder, ensure_parent_folder, path_line};
 /// in the way of one close-up after the gallery and some close-ups were. Memory and the
 /// names are checked before any folder is made; the files appear together (`gallery::write`).
 pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> Result<()> {
-    snakeskin::render::figures::gallery::check_memory(tile, columns)?;
+    snakeskin::render::figures::gallery::check_memory(tile, columns, closeups.is_some())?;
     snakeskin::export::check_png_target(out)?;
     if let Some(dir) = closeups
         && snakeskin::export::same_path(dir, out)
