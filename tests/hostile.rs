@@ -853,6 +853,11 @@ fn a_map_past_the_file_size_limit_is_an_error_that_keeps_the_earlier_set() {
     assert_eq!(out.status.code(), Some(1), "{:?}: {}", out.status, stderr(&out));
     assert!(stderr(&out).contains("File too large"), "{}", stderr(&out));
     assert_eq!(snapshot(dir.path()), before, "hidden files left: {:?}", hidden_files(dir.path()));
+    // A file named without a folder is named as given (it said "cannot write ./chart.png").
+    let script = "ulimit -f 16; exec \"$0\" brdf chart -o chart.png";
+    let out = Command::new("sh").args(["-c", script, BIN]).current_dir(dir.path()).output().unwrap();
+    assert_eq!(out.status.code(), Some(1), "{:?}: {}", out.status, stderr(&out));
+    assert!(stderr(&out).contains("error: cannot write chart.png: File too large"), "{}", stderr(&out));
 }
 
 /// The folder's files a user sees (`snapshot` without the hidden temporaries and lock).

@@ -270,9 +270,12 @@ fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedT
     // Named as the file it will become (the temporary is hidden from the user), a full disk
     // said "cannot write /out/.x.png.JWK6WF.snakeskin-tmp: No space left on device (os
     // error 28) at path "/out/.x.png.JWK6WF.snakeskin-tmp"".
+    // A file named without a folder is named so (`folder_of` reads it as in `.`: a full
+    // disk said "cannot write ./s.png" of `-o s.png`: a sweep).
+    let shown = if dir == Path::new(".") { PathBuf::from(target_name) } else { dir.join(target_name) };
     tmp.write_all(bytes)
         .and_then(|_| tmp.as_file().sync_all())
-        .map_err(|e| io_error(&dir.join(target_name))(without_temporary_path(e)))?;
+        .map_err(|e| io_error(&shown)(without_temporary_path(e)))?;
     Ok(tmp)
 }
 
