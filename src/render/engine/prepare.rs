@@ -39,7 +39,7 @@ pub fn material_maps_in(loaded: &LoadedPreset, map_size: usize, layout: Layout) 
     let (width, height) = map_dimensions(loaded, map_size, layout);
     // Its callers hold a renderer already, and the commands checked the whole drawing before
     // they made it (`check_preview_memory`): what the maps add is checked here.
-    DrawMemory::new(&graph, (width, height), 0).check_added(PREVIEW_MAPS)?;
+    DrawMemory::new(&graph, (width, height), 0).check_added(DRAWN_MAPS)?;
     let evaluation = evaluate(&graph, &MapKind::ALL, width, height, &|_, _| {});
     packed(&evaluation.maps, loaded, layout)
 }
@@ -142,8 +142,13 @@ fn maps_bytes(width: usize, height: usize) -> u64 {
     channels * std::mem::size_of::<f32>() as u64 * (width * height) as u64
 }
 
-/// What the memory check calls the preview's maps.
+/// What the memory check calls a window's maps.
 const PREVIEW_MAPS: &str = "the preview's set of maps";
+
+/// What the memory check calls the maps of a drawing after its renderer is made (a
+/// preview's, a figure's, a sheet's species': `material_maps_in`). `figures` refused under
+/// `ulimit -v` with "the preview's set of maps" (a sweep).
+const DRAWN_MAPS: &str = "the set of maps to draw";
 
 /// `material_maps_in`'s memory check alone, for a command to run before it makes its
 /// renderer (so that a machine without a GPU hears about the memory first).
