@@ -23,7 +23,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     if args.out.is_none() && !args.window {
         // `--frames` alone said "nothing to do", as if it were not there.
         let what = if args.frames.is_some() {
-            "--frames times frames in a window: add --window"
+            "--frames N renders N frames in a window and prints their mean time: add --window"
         } else {
             "nothing to do: give --out FILE.png (headless) or --window"
         };
