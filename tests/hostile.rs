@@ -860,6 +860,33 @@ fn a_map_past_the_file_size_limit_is_an_error_that_keeps_the_earlier_set() {
     assert!(stderr(&out).contains("error: cannot write chart.png: File too large"), "{}", stderr(&out));
 }
 
+/// A file a run replaces keeps its permissions, as one written in place does: a `chmod 600`
+/// map (and manifest) came back 0644 after the next run (a sweep). Control: the new bytes
+/// are there, and a map left at the mode the run made keeps that mode.
+#[cfg(unix)]
+#[test]
+fn a_replaced_file_keeps_its_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    assert!(generate_into(dir.path(), "1", &[]).status.success());
+    let mode = |name: &str| std::fs::metadata(dir.path().join(name)).unwrap().permissions().mode() & 0o777;
+    let map = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap());
+    let names: Vec<String> = map.filter(|n| !n.starts_with('.')).collect();
+    let (colour, manifest) = (
+        names.iter().find(|n| n.ends_with("_color.png")).unwrap().clone(),
+        names.iter().find(|n| n.ends_with(".material.json")).unwrap().clone(),
+    );
+    let height = names.iter().find(|n| n.ends_with("_height.png")).unwrap().clone();
+    let made = mode(&height);
+    for (name, wanted) in [(&colour, 0o600), (&manifest, 0o640)] {
+        std::fs::set_permissions(dir.path().join(name), std::fs::Permissions::from_mode(wanted)).unwrap();
+    }
+    let before = std::fs::read(dir.path().join(&colour)).unwrap();
+    assert!(generate_into(dir.path(), "2", &[]).status.success());
+    assert_ne!(std::fs::read(dir.path().join(&colour)).unwrap(), before, "the map was not replaced");
+    assert_eq!((mode(&colour), mode(&manifest), mode(&height)), (0o600, 0o640, made));
+}
+
 /// The folder's files a user sees (`snapshot` without the hidden temporaries and lock).
 fn visible_files(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
     snapshot(dir).into_iter().filter(|(p, _)| !p.file_name().unwrap().to_string_lossy().starts_with('.')).collect()

@@ -267,6 +267,7 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
 /// drop unless persisted).
 fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedTempFile, ExportError> {
     let mut tmp = listed_temporary(dir, target_name).map_err(io_error(dir))?;
+    keep_permissions_of(&dir.join(target_name), tmp.as_file());
     // Named as the file it will become (the temporary is hidden from the user), a full disk
     // said "cannot write /out/.x.png.JWK6WF.snakeskin-tmp: No space left on device (os
     // error 28) at path "/out/.x.png.JWK6WF.snakeskin-tmp"".
@@ -317,6 +318,23 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
     builder.tempfile_in(dir).map_err(without_temporary_path)
+}
+
+/// The file that replaces `target` keeps its permission bits, as a file written in place
+/// (`File::create`) does: a `chmod 600` map came back 0644 after the next run (a sweep).
+/// Nothing for a target that is not there or not a plain file (refused elsewhere), and the
+/// temporary's own (`temporary`) where they cannot be set.
+fn keep_permissions_of(target: &Path, replacement: &fs::File) {
+    #[cfg(unix)]
+    if let Ok(meta) = fs::symlink_metadata(target)
+        && meta.is_file()
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = meta.permissions().mode() & 0o777;
+        let _ = replacement.set_permissions(fs::Permissions::from_mode(mode));
+    }
+    #[cfg(not(unix))]
+    let _ = (target, replacement);
 }
 
 /// tempfile's errors name the hidden temporary (`... at path "/out/.t.png.RZ4prK.
