@@ -734,7 +734,16 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
             }
             source => BatchError::Preset { place: job.place(jobs_file, job.lines.preset), source: Box::new(source) },
         })?;
-    let mut warnings = loaded.warnings(&job.preset, SET_TABLE);
+    // A warning of a key the job's `set` wrote names that job: "its `set` table", as its
+    // errors say after the job's place, named no job here, and jobs of one preset with
+    // different tables could not be told apart (a review).
+    let set_table = format!(
+        "the `set` of [[job]] {} at {}{}",
+        job.table,
+        crate::toml_text::one_line(&jobs_file.display().to_string()),
+        at_line(job.lines.set)
+    );
+    let mut warnings = loaded.warnings(&job.preset, &set_table);
     // A pack longer than its engine loads, at the job's `sizes` line (`Pack::size_problem`).
     if let Some(pack) = job.pack
         && let Some(problem) = pack_size_warning(pack, job.layout, &loaded.preset, job.size as usize, "a size of")

@@ -1365,7 +1365,11 @@ fn ao_without_a_pack_is_refused_whatever_comes_with_it() {
 fn preview_flags_that_would_do_nothing_are_named() {
     let out = snakeskin(&["preview", PRESET, "--frames", "3"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("--frames N renders N frames in a window and prints their mean time: add --window"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--frames N renders N frames in a window and prints their mean time: add --window"),
+        "{}",
+        stderr(&out)
+    );
     let out = snakeskin(&["preview", PRESET, "--close-up", "--snakes", "4", "--out", "x.png"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("'--close-up' cannot be used with '--snakes <SNAKES>'"), "{}", stderr(&out));

@@ -446,13 +446,24 @@ fn a_pigment_as_dense_as_the_ambient_under_a_rough_film_is_warned_of() {
         "{err}"
     );
     let jobs = dir.path().join("jobs.toml");
-    let job =
-        "[[job]]\npreset = \"smooth.toml\"\nsizes = [32]\nmaps = \"color\"\nset = { \"optics.ambient_ior\" = 1.8 }\n";
-    std::fs::write(&jobs, job).unwrap();
+    // Each job's own `set` is named: two jobs of one preset with different tables.
+    let job = |ior: &str| {
+        format!(
+            "[[job]]\npreset = \"smooth.toml\"\nsizes = [32]\nmaps = \"color\"\nset = {{ \"optics.ambient_ior\" = {ior} }}\n"
+        )
+    };
+    std::fs::write(&jobs, format!("{}\n{}", job("1.8"), job("1.7"))).unwrap();
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", dir.path().join("sets").to_str().unwrap()]);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
-    assert!(err.contains("smooth.toml (with its `set` table): optics.film_ior (not written: its default)"), "{err}");
+    for (table, line, ior) in [(1, 5, "1.8"), (2, 11, "1.7")] {
+        let said = format!(
+            "smooth.toml (with the `set` of [[job]] {table} at {}:{line}): optics.film_ior (not written: its default) \
+             = 1.55 is below optics.ambient_ior = {ior}",
+            jobs.display()
+        );
+        assert!(err.contains(&said), "{said}: {err}");
+    }
     for (name, text) in [
         ("dense.toml", water.replace("1.4", "2")),
         (

@@ -181,10 +181,12 @@ impl Cli {
             }
             path
         };
-        let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
-        let args = negative_values_attached(&args, &path_of(&words));
+        // The checks below read the words as given (a flag's value attached by
+        // `negative_values_attached` would show in their messages as `--wo=-1,0,1`); clap
+        // reads them attached.
         let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
         let path = path_of(&words);
+        let attached = negative_values_attached(&args, &path);
         let long_flags = |c: &clap::Command| {
             c.get_arguments()
                 .filter_map(|a| a.get_long().map(|l| (format!("--{l}"), a.is_allow_hyphen_values_set())))
@@ -236,7 +238,7 @@ impl Cli {
                 return Err(refusal(&mut command, &names, clap::error::ErrorKind::UnknownArgument, message));
             }
         }
-        let mut matches = command.try_get_matches_from_mut(args)?;
+        let mut matches = command.try_get_matches_from_mut(attached)?;
         let cli = Cli::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut command))?;
         // `--ao` without `--pack`: clap's `requires` said only that `--pack <ENGINE>` was
         // missing, and its conflict with `--maps` only that the two cannot be used together,
@@ -309,12 +311,18 @@ fn ranged_u32(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, String> + Clone 
 /// clap's negative numbers (`negative_numbers_as_values`) are digits and one point only,
 /// so `--angle-deg -1e-3` said "unexpected argument '-1'", and `-.5`, `-inf` and `-nan`
 /// the same (a hostile-input sweep), where `--angle-deg -1` gives the flag's range. `path`
-/// is the commands the words name, whose flags count. Nothing after `--` is touched.
+/// is the commands the words name, whose flags count. Nothing after `--` is touched, nor a
+/// flag that takes a path or text: `--out -1dir` stays refused, as `-o -1dir` and
+/// `--out -weird` are (a review).
 fn negative_values_attached(args: &[std::ffi::OsString], path: &[&clap::Command]) -> Vec<std::ffi::OsString> {
+    use clap::builder::ValueParser;
+    let words = [ValueParser::path_buf(), ValueParser::os_string(), ValueParser::string()].map(|p| p.type_id());
     let takes_value = |word: &str| {
-        path.iter()
-            .flat_map(|c| c.get_arguments())
-            .any(|a| a.get_action().takes_values() && a.get_long().is_some_and(|l| word.strip_prefix("--") == Some(l)))
+        path.iter().flat_map(|c| c.get_arguments()).any(|a| {
+            a.get_action().takes_values()
+                && !words.contains(&a.get_value_parser().type_id())
+                && a.get_long().is_some_and(|l| word.strip_prefix("--") == Some(l))
+        })
     };
     let looks_negative = |word: &str| {
         word.strip_prefix('-').is_some_and(|rest| {
@@ -1365,6 +1373,10 @@ mod tests {
             (&["bench", "render", "--size", "-1x-1"], "'-1x-1' for '--size <SIZE>': expected WIDTHxHEIGHT"),
             (&["generate", "natrix-natrix", "--size", "-1e3"], "'-1e3' for '--size <SIZE>': not a whole number"),
             (&["brdf", "albedo", "--angle-deg", "30", "--", "-1e-3"], "unexpected argument '-1e-3'"),
+            // A path is no number: refused as `-o -1dir` is (it wrote `-1dir/`).
+            (&["generate", "natrix-natrix", "--out", "-1dir"], "unexpected argument '-1'"),
+            // A missing value is named as the words were given (it said `--wo=-1,0,1`).
+            (&["brdf", "eval", "--wi", "--wo", "-1,0,1"], "the next word is the flag `--wo`"),
         ] {
             let error = parse(args).expect_err(&format!("{args:?} was accepted"));
             assert!(error.contains(says), "{args:?}: {error}");
