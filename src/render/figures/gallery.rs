@@ -240,9 +240,11 @@ fn canvas_size(tile: usize, columns: usize) -> (usize, usize) {
 /// f32 channels), the canvas (f32, then its 8-bit copy and PNG), and the heaviest variant's
 /// graph once per thread evaluating at a time; with `closeups`, the larger of that and the
 /// close-ups' (`closeup_pngs`, made after the gallery: its PNG, at most the canvas' 8-bit
-/// size, and the heaviest close-up's graph at `CLOSEUP_MAP`² once per thread, each with its
-/// crop). The close-ups were left out: `gallery --tile 16 --closeups` peaked at 151 MiB
-/// against the 129 estimated (an independent sweep).
+/// size, the heaviest close-up's graph at `CLOSEUP_MAP`² once per thread, each with its
+/// crop, and the process' fixed overhead once). The close-ups were left out: `gallery
+/// --tile 16 --closeups` peaked at 151 MiB against the 129 estimated (an independent
+/// sweep). Counted as sets (`estimate_generate_bytes`: quantised maps and the overhead per
+/// thread), they came to 2–3 times the peak at 4–16 threads (a review).
 pub fn check_memory(tile: usize, columns: usize, closeups: bool) -> Result<(), Error> {
     let (w, h) = canvas_size(tile, columns);
     let tiles = (VARIANTS.len() * tile * tile * 12) as u64;
@@ -260,11 +262,12 @@ pub fn check_memory(tile: usize, columns: usize, closeups: bool) -> Result<(), E
         let mut heaviest = 0;
         for (stem, _, text) in CLOSEUPS {
             let graph = build_graph(&parse(&closeup_source(stem, text), &[])?.preset, BuildOptions::default());
-            heaviest = heaviest.max(crate::memory::estimate_generate_bytes(&graph, &maps, CLOSEUP_MAP, CLOSEUP_MAP));
+            heaviest = heaviest.max(crate::graph::estimate_peak_bytes(&graph, &maps, CLOSEUP_MAP, CLOSEUP_MAP));
         }
         let crop = (2 * CLOSEUP_CROP * CLOSEUP_CROP * 12) as u64;
         let threads = rayon::current_num_threads().min(CLOSEUPS.len()) as u64;
-        peak = peak.max((w * h * 3) as u64 + (heaviest + crop).saturating_mul(threads));
+        let closeups = (heaviest + crop).saturating_mul(threads) + crate::memory::FIXED_OVERHEAD_BYTES;
+        peak = peak.max((w * h * 3) as u64 + closeups);
         what = format!("{what} and {} close-ups of {CLOSEUP_MAP}² maps", CLOSEUPS.len());
     }
     crate::memory::MemoryCheck::against_available(peak).refuse_if_over(&what)
