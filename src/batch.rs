@@ -143,7 +143,8 @@ impl JobPlace {
         // which could pass for the tool's (`"x\nok: all 40 jobs done"`, a hostile-input
         // sweep); the message's printer escapes the other control characters, not newlines.
         let preset = crate::toml_text::one_line(preset);
-        write!(f, "{}{}: [[job]] {table} ({preset}{detail})", path.display(), at_line(*line))
+        let path = crate::toml_text::one_line(&path.display().to_string());
+        write!(f, "{path}{}: [[job]] {table} ({preset}{detail})", at_line(*line))
     }
 }
 

@@ -314,27 +314,38 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(TMP_SUFFIX).rand_bytes(RANDOM_CHARS);
     // tempfile creates 0600 files; outputs are ordinary files (0666 less the umask, as
-    // `File::create` makes them), readable by whoever reads the user's other files.
+    // `File::create` makes them), readable by whoever reads the user's other files. One that
+    // replaces a file is made no more open than it (then given its bits exactly:
+    // `keep_permissions_of`): made 0666 less the umask, a `chmod 600` map's replacement
+    // could be opened by others before its bits were set (a review).
     #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(
+        permission_bits(&dir.join(target_name)).unwrap_or(0o666),
+    ));
     builder.tempfile_in(dir).map_err(without_temporary_path)
 }
 
-/// The file that replaces `target` keeps its permission bits, as a file written in place
-/// (`File::create`) does: a `chmod 600` map came back 0644 after the next run (a sweep).
+/// The file that replaces `target` keeps its permission bits, as `sed -i` and editors keep
+/// them (a read-only file too, which the run replaces by renaming, as they do): a
+/// `chmod 600` map came back 0644 after the next run (a sweep). The owner is the run's.
 /// Nothing for a target that is not there or not a plain file (refused elsewhere), and the
-/// temporary's own (`temporary`) where they cannot be set.
+/// temporary's own (`temporary`, made no more open than this) where they cannot be set.
 fn keep_permissions_of(target: &Path, replacement: &fs::File) {
     #[cfg(unix)]
-    if let Ok(meta) = fs::symlink_metadata(target)
-        && meta.is_file()
-    {
+    if let Some(mode) = permission_bits(target) {
         use std::os::unix::fs::PermissionsExt;
-        let mode = meta.permissions().mode() & 0o777;
         let _ = replacement.set_permissions(fs::Permissions::from_mode(mode));
     }
     #[cfg(not(unix))]
     let _ = (target, replacement);
+}
+
+/// The permission bits of a plain file at `path` (not through a link), if there is one.
+#[cfg(unix)]
+fn permission_bits(path: &Path) -> Option<u32> {
+    use std::os::unix::fs::PermissionsExt;
+    let meta = fs::symlink_metadata(path).ok().filter(|m| m.is_file())?;
+    Some(meta.permissions().mode() & 0o777)
 }
 
 /// tempfile's errors name the hidden temporary (`... at path "/out/.t.png.RZ4prK.

@@ -243,8 +243,10 @@ fn canvas_size(tile: usize, columns: usize) -> (usize, usize) {
 /// size, the heaviest close-up's graph at `CLOSEUP_MAP`² once per thread, each with its
 /// crop, and the process' fixed overhead once). The close-ups were left out: `gallery
 /// --tile 16 --closeups` peaked at 151 MiB against the 129 estimated (an independent
-/// sweep). Counted as sets (`estimate_generate_bytes`: quantised maps and the overhead per
-/// thread), they came to 2–3 times the peak at 4–16 threads (a review).
+/// sweep). The variants and close-ups were counted as sets (`estimate_generate_bytes`:
+/// quantised maps and the process' overhead per thread): the close-ups came to 2–3 times
+/// the peak at 4–16 threads, and `--tile 16` alone, 14 MiB at its peak, was estimated at
+/// 1985 MiB on 32 threads (two reviews).
 pub fn check_memory(tile: usize, columns: usize, closeups: bool) -> Result<(), Error> {
     let (w, h) = canvas_size(tile, columns);
     let tiles = (VARIANTS.len() * tile * tile * 12) as u64;
@@ -252,10 +254,10 @@ pub fn check_memory(tile: usize, columns: usize, closeups: bool) -> Result<(), E
     let mut heaviest = 0;
     for (label, map, overrides) in VARIANTS {
         let graph = variant_graph(label, overrides)?;
-        heaviest = heaviest.max(crate::memory::estimate_generate_bytes(&graph, &[*map], tile, tile));
+        heaviest = heaviest.max(crate::graph::estimate_peak_bytes(&graph, &[*map], tile, tile));
     }
     let graphs = heaviest.saturating_mul(rayon::current_num_threads().min(VARIANTS.len()) as u64);
-    let mut peak = tiles + canvas + graphs;
+    let mut peak = tiles + canvas + graphs + crate::memory::FIXED_OVERHEAD_BYTES;
     let mut what = format!("a gallery of {w}×{h} pixels ({} tiles of {tile}²)", VARIANTS.len());
     if closeups {
         let maps = [MapKind::Color, MapKind::Normal];
