@@ -267,7 +267,6 @@ fn remove_stale_temporaries(dir: &Path, file_names: &[&str], min_age: std::time:
 /// drop unless persisted).
 fn stage(dir: &Path, target_name: &str, bytes: &[u8]) -> Result<tempfile::NamedTempFile, ExportError> {
     let mut tmp = listed_temporary(dir, target_name).map_err(io_error(dir))?;
-    keep_permissions_of(&dir.join(target_name), tmp.as_file());
     // Named as the file it will become (the temporary is hidden from the user), a full disk
     // said "cannot write /out/.x.png.JWK6WF.snakeskin-tmp: No space left on device (os
     // error 28) at path "/out/.x.png.JWK6WF.snakeskin-tmp"".
@@ -315,29 +314,26 @@ fn temporary(dir: &Path, target_name: &str) -> std::io::Result<tempfile::NamedTe
     builder.prefix(&prefix).suffix(TMP_SUFFIX).rand_bytes(RANDOM_CHARS);
     // tempfile creates 0600 files; outputs are ordinary files (0666 less the umask, as
     // `File::create` makes them), readable by whoever reads the user's other files. One that
-    // replaces a file is made no more open than it (then given its bits exactly:
-    // `keep_permissions_of`): made 0666 less the umask, a `chmod 600` map's replacement
-    // could be opened by others before its bits were set (a review).
+    // replaces a file keeps that file's bits, as `sed -i` and editors keep them (a read-only
+    // file too, which the run replaces by renaming, as they do; the owner is the run's): a
+    // `chmod 600` map came back 0644 after the next run (a sweep). It is created with them,
+    // so never more open than they are (set only after, a `chmod 600` map's replacement
+    // could be opened by others first: a review), and then given them exactly (creation
+    // takes the umask off).
     #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(
-        permission_bits(&dir.join(target_name)).unwrap_or(0o666),
-    ));
-    builder.tempfile_in(dir).map_err(without_temporary_path)
-}
-
-/// The file that replaces `target` keeps its permission bits, as `sed -i` and editors keep
-/// them (a read-only file too, which the run replaces by renaming, as they do): a
-/// `chmod 600` map came back 0644 after the next run (a sweep). The owner is the run's.
-/// Nothing for a target that is not there or not a plain file (refused elsewhere), and the
-/// temporary's own (`temporary`, made no more open than this) where they cannot be set.
-fn keep_permissions_of(target: &Path, replacement: &fs::File) {
-    #[cfg(unix)]
-    if let Some(mode) = permission_bits(target) {
+    {
         use std::os::unix::fs::PermissionsExt;
-        let _ = replacement.set_permissions(fs::Permissions::from_mode(mode));
+        let kept = permission_bits(&dir.join(target_name));
+        builder.permissions(fs::Permissions::from_mode(kept.unwrap_or(0o666)));
+        let tmp = builder.tempfile_in(dir).map_err(without_temporary_path)?;
+        if let Some(bits) = kept {
+            // Where they cannot be set, the temporary keeps the ones it was made with.
+            let _ = tmp.as_file().set_permissions(fs::Permissions::from_mode(bits));
+        }
+        Ok(tmp)
     }
     #[cfg(not(unix))]
-    let _ = (target, replacement);
+    builder.tempfile_in(dir).map_err(without_temporary_path)
 }
 
 /// The permission bits of a plain file at `path` (not through a link), if there is one.

@@ -164,7 +164,7 @@ impl Checker {
     /// as `rows = 19.5` is refused. Out of its range or not whole is one problem, in the same
     /// words (16.5 stripes had only the range's, and 15.5 was refused next).
     fn whole_count(&mut self, key: impl Into<String>, value: f64, range: (f64, f64), counted: &str) {
-        if !(is_whole_in(value, range)) {
+        if !is_whole_in(value, range) {
             self.problems.push(Problem {
                 key: key.into(),
                 message: format!(

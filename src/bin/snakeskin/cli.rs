@@ -170,22 +170,18 @@ impl Cli {
         use clap::{CommandFactory, FromArgMatches};
         let mut command = negative_numbers_as_values(Cli::command());
         command.build();
-        // The subcommands the words name (`brdf`, `eval`): their flags are the ones that
-        // count, and the error shows the last one's usage.
-        let path_of = |words: &[&str]| {
-            let mut path = vec![&command];
-            for word in words.iter().skip(1) {
-                if let Some(sub) = path.last().and_then(|c| c.find_subcommand(word)) {
-                    path.push(sub);
-                }
-            }
-            path
-        };
         // The checks below read the words as given (a flag's value attached by
         // `negative_values_attached` would show in their messages as `--wo=-1,0,1`); clap
         // reads them attached.
         let words: Vec<&str> = args.iter().map(|a| a.to_str().unwrap_or("")).collect();
-        let path = path_of(&words);
+        // The subcommands the words name (`brdf`, `eval`): their flags are the ones that
+        // count, and the error shows the last one's usage.
+        let mut path = vec![&command];
+        for word in words.iter().skip(1) {
+            if let Some(sub) = path.last().and_then(|c| c.find_subcommand(word)) {
+                path.push(sub);
+            }
+        }
         let attached = negative_values_attached(&args, &path);
         let long_flags = |c: &clap::Command| {
             c.get_arguments()
