@@ -9,10 +9,12 @@ use snakeskin::maps::{BuildOptions, Layout, MapKind, build_graph, thickness_rang
 use snakeskin::preset::load;
 
 /// A file's first layer: its channels as (name, OpenEXR sample type, f32 samples in
-/// row-major order), and its `wrapmodes` attribute.
+/// row-major order), its `wrapmodes` attribute, and the file's `chromaticities` (red, green,
+/// blue, white as xy).
 struct ExrFile {
     channels: Vec<(String, &'static str, Vec<f32>)>,
     wrap_modes: Option<String>,
+    chromaticities: Option<[[f32; 2]; 4]>,
 }
 
 fn read_exr(path: &std::path::Path) -> ExrFile {
@@ -32,7 +34,8 @@ fn read_exr(path: &std::path::Path) -> ExrFile {
             (c.name.to_string(), sample_type, samples)
         })
         .collect();
-    ExrFile { channels, wrap_modes: layer.attributes.wrap_mode_name.as_ref().map(|t| t.to_string()) }
+    let chromaticities = image.attributes.chromaticities.map(|c| [c.red, c.green, c.blue, c.white].map(|v| [v.0, v.1]));
+    ExrFile { channels, wrap_modes: layer.attributes.wrap_mode_name.as_ref().map(|t| t.to_string()), chromaticities }
 }
 
 #[test]
@@ -80,6 +83,10 @@ fn check_exr(name: &str, layout: Layout) {
         let file = dir.path().join(format!("{name}_{}.exr", map.name()));
         let exr = read_exr(&file);
         assert_eq!(exr.wrap_modes.as_deref(), Some(wrap_modes), "{map}");
+        // The colour map names its primaries: sRGB's, IEC 61966-2-1 (OpenEXR's own default
+        // `Chromaticities()`, ImfChromaticities.h); the data maps have no colour to name.
+        let srgb = [[0.64, 0.33], [0.30, 0.60], [0.15, 0.06], [0.3127, 0.3290]];
+        assert_eq!(exr.chromaticities, (*map == MapKind::Color).then_some(srgb), "{map}");
         let entry = manifest["maps"].as_array().unwrap().iter().find(|m| m["map"] == map.name()).unwrap();
         for (channel, sample_type, _) in &exr.channels {
             assert_eq!(entry["sample_type"], *sample_type, "{map} {channel}: the manifest says the file's type");

@@ -262,7 +262,8 @@ pub fn exr_wrap_modes(wraps_v: bool) -> &'static str {
 /// Encodes one map as OpenEXR (`MapKind::exr_channels`): linear floats in physical units —
 /// the colour map's linear values, the normal's xyz in [-1, 1], the film thickness in nm
 /// (`thickness_nm` = the manifest's range the map's [0, 1] spans) — with the set's wrap
-/// modes (`exr_wrap_modes`).
+/// modes (`exr_wrap_modes`) and, on the colour map, the sRGB primaries and white as its
+/// `chromaticities`.
 pub fn encode_exr(
     map: MapKind,
     image: &Image,
@@ -290,6 +291,14 @@ pub fn encode_exr(
         .collect();
     let mut exr_image = exr::image::Image::from_channels((w, h), AnyChannels::sort(channels));
     exr_image.layer_data.attributes.wrap_mode_name = Some(Text::from(exr_wrap_modes(wraps_v)));
+    if map == MapKind::Color {
+        // Readers that convert colour (OCIO, Nuke, Resolve) read the primaries from here;
+        // without them they assume Rec. 709, which is what the values are, but a file
+        // should say so. Data maps carry none: their channels are not colours.
+        let [r, g, b, white] = crate::optics::spectrum::SRGB_PRIMARIES_XY.map(|[x, y]| Vec2(x as f32, y as f32));
+        exr_image.attributes.chromaticities =
+            Some(exr::meta::attribute::Chromaticities { red: r, green: g, blue: b, white });
+    }
     let mut bytes = Cursor::new(Vec::new());
     exr_image.write().to_buffered(&mut bytes).map_err(|e| ExportError::Encode { map, message: e.to_string() })?;
     Ok(bytes.into_inner())

@@ -19,6 +19,12 @@ pub const SAMPLES: usize = (LAMBDA_MAX_NM - LAMBDA_MIN_NM + 1) as usize;
 pub const XYZ_TO_SRGB: [[f64; 3]; 3] =
     [[3.2404542, -1.5371385, -0.4985314], [-0.9692660, 1.8760108, 0.0415560], [0.0556434, -0.2040259, 1.0572252]];
 
+/// The sRGB primaries and white as CIE 1931 xy chromaticities: red, green, blue, then the
+/// D65 white (IEC 61966-2-1; the ITU-R BT.709 primaries). `XYZ_TO_SRGB` is the matrix they
+/// define (the test `srgb_matrix_is_the_primaries_matrix` derives it from them), and an
+/// OpenEXR colour map records them as its `chromaticities`.
+pub const SRGB_PRIMARIES_XY: [[f64; 2]; 4] = [[0.64, 0.33], [0.30, 0.60], [0.15, 0.06], [0.3127, 0.3290]];
+
 /// Per-wavelength weights k S(λ) (x̄, ȳ, z̄)(λ) for λ = 360..=780 nm.
 pub struct Observer {
     pub weights: Vec<[f64; 3]>,
@@ -124,6 +130,27 @@ mod tests {
         // The D65 chromaticity (CIE 015: x = 0.31272, y = 0.32903 for the 2° observer).
         let sum = white.iter().sum::<f64>();
         assert!((white[0] / sum - 0.31272).abs() < 2e-4 && (white[1] / sum - 0.32903).abs() < 2e-4, "{white:?}");
+    }
+
+    #[test]
+    fn srgb_matrix_is_the_primaries_matrix() {
+        // RGB → XYZ from the chromaticities alone: the columns are the primaries' xyz
+        // scaled so that RGB = (1, 1, 1) is the white with Y = 1 (the standard derivation,
+        // e.g. SMPTE RP 177). The matrix above was derived from the white's XYZ to five
+        // digits (0.95047, 1, 1.08883), whose xy round to the standard's (0.3127, 0.3290):
+        // the two agree to 6e-4, not closer.
+        let xyz_of = |[x, y]: [f64; 2]| [x / y, 1.0, (1.0 - x - y) / y];
+        let [r, g, b, white] = SRGB_PRIMARIES_XY.map(xyz_of);
+        let primaries = [0, 1, 2].map(|row| [r[row], g[row], b[row]]);
+        let scale = mat3_mul(&mat3_inverse(&primaries), white);
+        let rgb_to_xyz = [0, 1, 2].map(|row| [0, 1, 2].map(|col| primaries[row][col] * scale[col]));
+        let derived = mat3_inverse(&rgb_to_xyz);
+        for row in 0..3 {
+            for col in 0..3 {
+                let error = (derived[row][col] - XYZ_TO_SRGB[row][col]).abs();
+                assert!(error < 6e-4, "{row},{col}: {derived:?} against {XYZ_TO_SRGB:?}");
+            }
+        }
     }
 
     #[test]
