@@ -1461,6 +1461,8 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         ("height", serde_json::json!(1), "the manifest's height 1 is outside what a set can be (16 to"),
         ("width", serde_json::Value::Null, "the manifest's width and height are not both integers"),
         ("width", serde_json::json!(16.0), "the manifest's width and height are not both integers"),
+        // An integer, but below any set (it was "not both integers", a review).
+        ("width", serde_json::json!(-1), "the manifest's width -1 is outside what a set can be (16 to"),
     ] {
         let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
         json[key] = value;
@@ -1473,6 +1475,26 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
             stdout(&listed)
         );
     }
+    // A hash no run writes is the manifest's fault, not the map's (an empty or upper-case
+    // one was "the set is mixed or altered", a review); the control, the hash as written,
+    // verifies below.
+    for forged in [String::new(), json_hash(&text, 0).to_uppercase()] {
+        let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
+        json["maps"][0]["sha256"] = serde_json::json!(forged);
+        std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
+        let listed = stdout(&verify(&[&manifests[0]]));
+        assert!(listed.contains(&format!("sha256 {forged:?} is not a SHA-256")), "{listed}");
+        assert!(!listed.contains("mixed or altered"), "{listed}");
+    }
+    // More entries than a set has files: refused before any is checked (80,000 of them took
+    // five minutes, the duplicate check's square; a hostile-input sweep).
+    let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
+    let entries: Vec<serde_json::Value> =
+        (0..5000).map(|i| serde_json::json!({"map": format!("m{i}"), "file": format!("f{i}"), "sha256": ""})).collect();
+    json["maps"] = serde_json::Value::Array(entries);
+    std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
+    let listed = stdout(&verify(&[&manifests[0]]));
+    assert!(listed.contains("the manifest lists 5000 maps; a set has at most"), "{listed}");
     std::fs::write(&manifests[0], &text).unwrap();
     assert_eq!(verify(&[&manifests[0]]).status.code(), Some(0), "the control");
 
@@ -1538,7 +1560,7 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
     let more = stdout(&verify(&[&manifests[0]]));
     assert!(
         more.lines().any(|l| l.contains(&other_name)
-            && l.contains("lacks map, file or sha256")
+            && l.contains(&format!("map entry {} lacks sha256 (a string each)", third + 1))
             && l.contains("is listed twice")),
         "{more}"
     );
@@ -1588,6 +1610,12 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         assert_eq!(refused.status.code(), Some(2), "{path:?}: {}", stderr(&refused));
         assert!(stderr(&refused).contains(says), "{path:?}: {}", stderr(&refused));
     }
+}
+
+/// The SHA-256 the manifest `text` records for its map entry `index`.
+fn json_hash(text: &[u8], index: usize) -> String {
+    let json: serde_json::Value = serde_json::from_slice(text).unwrap();
+    json["maps"][index]["sha256"].as_str().unwrap().to_string()
 }
 
 /// A job can ask for DirectX normals (`normal_convention`, as `generate --normal-convention`):

@@ -2420,6 +2420,72 @@ fn verify_fails_a_set_left_only_in_temporaries() {
     assert!(out.status.success(), "the control: {}", stdout(&out));
 }
 
+/// From a sweep of `verify`: sets were told apart by where their manifests' links led, so a
+/// folder whose manifest links to another set's (identical sets stored once, as git-annex
+/// keeps them) was passed over, and its altered map said `ok`; an incomplete set named
+/// three times, or reached again through a link to its own folder, was listed each time; a
+/// folder named as a manifest was "no set" when named and "not a regular file" when its
+/// folder was; a manifest linking to nothing was "the set is incomplete". The controls:
+/// the linked copy unaltered is `ok`, and a set named twice is one line.
+#[test]
+fn verify_tells_sets_apart_by_where_they_lie() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = snakeskin(&["generate", "natrix-natrix", "-o", d.join("a").to_str().unwrap(), "--size", "16"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    std::fs::create_dir(d.join("b")).unwrap();
+    for entry in std::fs::read_dir(d.join("a")).unwrap() {
+        let name = entry.unwrap().file_name();
+        if name.to_string_lossy().ends_with(".png") {
+            std::fs::copy(d.join("a").join(&name), d.join("b").join(&name)).unwrap();
+        }
+    }
+    std::os::unix::fs::symlink("../a/natrix-natrix.material.json", d.join("b/natrix-natrix.material.json")).unwrap();
+    let verify = |paths: &[&Path]| {
+        let args: Vec<&str> = ["verify"].into_iter().chain(paths.iter().map(|p| p.to_str().unwrap())).collect();
+        snakeskin(&args)
+    };
+    let out = verify(&[d]);
+    assert!(out.status.success(), "the control: {}", stdout(&out));
+    assert_eq!(stdout(&out).lines().filter(|l| l.starts_with("ok ")).count(), 2, "{}", stdout(&out));
+    let color = d.join("b/natrix-natrix_color.png");
+    let mut bytes = std::fs::read(&color).unwrap();
+    bytes.push(0);
+    std::fs::write(&color, bytes).unwrap();
+    let out = verify(&[d]);
+    assert_eq!(out.status.code(), Some(1), "{}", stdout(&out));
+    assert!(stdout(&out).contains(&format!("FAILED set {}", d.join("b/natrix-natrix.material.json").display())));
+
+    // An incomplete set named three ways and reached through a link to its own folder: one
+    // line.
+    let c = d.join("c");
+    std::fs::create_dir(&c).unwrap();
+    std::fs::write(c.join("other_color.png"), b"x").unwrap();
+    std::os::unix::fs::symlink(".", c.join("self")).unwrap();
+    let dot_c = d.join("./c");
+    let out = verify(&[&c, &c, &dot_c]);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(stdout(&out).lines().count(), 1, "{}", stdout(&out));
+    assert!(stderr(&out).contains("1 of 1 checks failed"), "{}", stderr(&out));
+
+    // A folder named as a manifest: a failed set, named or found.
+    let e = d.join("e");
+    std::fs::create_dir_all(e.join("x.material.json")).unwrap();
+    std::fs::write(e.join("x_color.png"), b"x").unwrap();
+    for path in [e.join("x.material.json"), e.clone()] {
+        let out = verify(&[&path]);
+        assert_eq!(out.status.code(), Some(1), "{path:?}: {}{}", stdout(&out), stderr(&out));
+        assert!(stdout(&out).contains("not a regular file"), "{path:?}: {}", stdout(&out));
+    }
+    // A manifest that links to nothing says so.
+    let f = d.join("f");
+    std::fs::create_dir(&f).unwrap();
+    std::os::unix::fs::symlink("gone.json", f.join("y.material.json")).unwrap();
+    let out = verify(&[&f]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stdout(&out).contains("the manifest is a link to gone.json, which does not exist"), "{}", stdout(&out));
+}
+
 /// From a hostile-input sweep: `verify DIR` looks for sets two folders down (a batch's
 /// depth) and said `ok` for a folder holding batch outputs one level deeper, their sets
 /// unchecked, without a word. Now it names the folders it did not search (on stderr); the

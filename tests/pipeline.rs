@@ -660,6 +660,61 @@ fn the_graph_list_keeps_its_columns() {
     }
 }
 
+/// `graph` shows the operations `generate` runs: every node `generate --stats` lists that
+/// it did not fuse has the same label in `graph`'s list (a scale field trimmed to the maps
+/// numbers its channels anew: `graph --maps roughness` showed `channel 2` and `channel 1`
+/// where the run read channels 1 and 0, a review).
+#[test]
+fn the_graph_shows_the_operations_generate_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let columns = |line: &str| -> Vec<String> {
+        line.split("  ").map(str::trim).filter(|s| !s.is_empty()).map(str::to_string).collect()
+    };
+    for maps in ["roughness", "color", "height,normal", "all"] {
+        let species = "erythrolamprus-miliaris";
+        let run = snakeskin(&[
+            "generate",
+            species,
+            "--maps",
+            maps,
+            "--stats",
+            "--size",
+            "32",
+            "-o",
+            dir.path().to_str().unwrap(),
+        ]);
+        assert!(run.status.success(), "{}", stderr(&run));
+        let err = stderr(&run);
+        let ran: Vec<(String, String)> = err
+            .lines()
+            .skip_while(|line| !line.starts_with("node "))
+            .skip(1)
+            .take_while(|line| !line.contains("nodes evaluated"))
+            .map(|line| {
+                let c = columns(line);
+                (c[0].clone(), c[1].clone())
+            })
+            .filter(|(_, label)| !label.starts_with("fused"))
+            // A map streamed to its file is said so in the run's statistics only.
+            .map(|(name, label)| (name, label.trim_end_matches(" rows → file").to_string()))
+            .collect();
+        assert!(ran.iter().any(|(_, label)| label.starts_with("channel")), "{maps}: a scale channel is run\n{err}");
+        let listed = snakeskin(&["graph", species, "--maps", maps]);
+        assert!(listed.status.success(), "{}", stderr(&listed));
+        let listed: Vec<(String, String)> = stdout(&listed)
+            .lines()
+            .map(|line| {
+                let c = columns(line.split(" <- ").next().unwrap());
+                (c[0].clone(), c[1].clone())
+            })
+            .collect();
+        for (name, label) in &ran {
+            let shown = listed.iter().find(|(n, _)| n == name).map(|(_, l)| l);
+            assert_eq!(shown, Some(label), "{maps}: node {name}");
+        }
+    }
+}
+
 #[test]
 fn the_manifest_gives_the_height_maps_rise_and_the_normal_maps_convention_as_the_maps_are() {
     // `displacement.rise_texture_widths` and `normal_convention`, read back from the written maps

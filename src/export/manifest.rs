@@ -331,14 +331,17 @@ fn set_size(json: &serde_json::Value) -> Result<(u64, u64), String> {
     // narrower), at most `SIZE_RANGE`'s end wide and `MAX_HEIGHT` tall.
     let least = u64::from(*crate::SIZE_RANGE.start());
     let (max_width, max_height) = (u64::from(*crate::SIZE_RANGE.end()), crate::generate::MAX_HEIGHT as u64);
-    let (width, height) = (json["width"].as_u64(), json["height"].as_u64());
-    let outside = |key: &str, value: u64, most: u64| {
+    // Any integer JSON holds, so that `-1` is said to be outside, not "not an integer".
+    let integer = |value: &serde_json::Value| value.as_u64().map(i128::from).or(value.as_i64().map(i128::from));
+    let (width, height) = (integer(&json["width"]), integer(&json["height"]));
+    let outside = |key: &str, value: i128, most: u64| {
         format!("the manifest's {key} {value} is outside what a set can be ({least} to {most} pixels)")
     };
+    let within = |value: i128, most: u64| (i128::from(least)..=i128::from(most)).contains(&value);
     match (width, height) {
-        (Some(width), _) if !(least..=max_width).contains(&width) => Err(outside("width", width, max_width)),
-        (_, Some(height)) if !(least..=max_height).contains(&height) => Err(outside("height", height, max_height)),
-        (Some(width), Some(height)) => Ok((width, height)),
+        (Some(width), _) if !within(width, max_width) => Err(outside("width", width, max_width)),
+        (_, Some(height)) if !within(height, max_height) => Err(outside("height", height, max_height)),
+        (Some(width), Some(height)) => Ok((width as u64, height as u64)),
         _ => Err("the manifest's width and height are not both integers (pixels, as a run writes them: 1024)".into()),
     }
 }
@@ -373,6 +376,12 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
     let json = read_set_manifest(manifest_path, Links::Follow).map_err(|e| {
         problem(match e {
             ManifestReadError::Read(crate::text_file::BoundedReadError::Io(e))
+                if e.kind() == std::io::ErrorKind::NotFound && manifest_path.is_symlink() =>
+            {
+                let target = std::fs::read_link(manifest_path).unwrap_or_default();
+                format!("the manifest is a link to {}, which does not exist", target.display())
+            }
+            ManifestReadError::Read(crate::text_file::BoundedReadError::Io(e))
                 if e.kind() == std::io::ErrorKind::NotFound =>
             {
                 "no manifest: the set is incomplete (a run failed or was killed while writing it)".into()
@@ -394,17 +403,34 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
         .as_array()
         .filter(|m| !m.is_empty())
         .ok_or_else(|| problem("the manifest lists no maps".into()))?;
+    // No set has more files than a set can be named (`every_set_file_name`, its manifest
+    // aside): a forged manifest of 330,000 entries within the read limit took the duplicate
+    // check below an hour (80,000 entries: 309 s; a hostile-input sweep).
+    let most = super::every_set_file_name("").len() - 1;
+    if maps.len() > most {
+        return Err(problem(format!("the manifest lists {} maps; a set has at most {most} files", maps.len())));
+    }
     let mut files = Vec::new();
     // Every map's problem, not the first only: a set with a missing map and an altered one
     // took two runs of `verify` to learn both (an onboarding review).
     let mut problems = Vec::new();
-    for entry in maps {
-        let (Some(map), Some(file), Some(expected)) =
-            (entry["map"].as_str(), entry["file"].as_str(), entry["sha256"].as_str())
-        else {
-            problems.push("a map entry lacks map, file or sha256".into());
-            continue;
+    for (index, entry) in maps.iter().enumerate() {
+        let text = |key: &'static str| entry[key].as_str().ok_or(key);
+        let (map, file, expected) = match (text("map"), text("file"), text("sha256")) {
+            (Ok(map), Ok(file), Ok(expected)) => (map, file, expected),
+            (map, file, expected) => {
+                let keys: Vec<&str> = [map, file, expected].into_iter().filter_map(Result::err).collect();
+                let keys = keys.join(", ");
+                problems.push(format!("map entry {} lacks {keys} (a string each)", index + 1));
+                continue;
+            }
         };
+        // What a run records (`atomic::hex`): an empty or upper-case hash is a forged or
+        // edited manifest, not an altered file (it was reported as "the set is mixed").
+        if expected.len() != 64 || !expected.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)) {
+            problems.push(format!("the {map} map's sha256 {expected:?} is not a SHA-256 (64 lower-case hex digits)"));
+            continue;
+        }
         // An empty name too: it joined to the set's folder, "it is a folder, not a regular
         // file" (a hostile-input sweep).
         if file.is_empty() || file.contains(['/', '\\']) || file.starts_with('.') {

@@ -12,8 +12,11 @@ pub fn run(args: GraphArgs) -> Result<()> {
     let loaded = snakeskin::preset::load(&source.preset, &source.overrides, source.seed)?;
     crate::output::report_warnings(&source.preset, &loaded);
     // The body atlas's graph too (an onboarding review found no way to see it but
-    // `generate --stats`).
-    let graph = build_graph(&loaded.preset, BuildOptions { layout: args.layout.layout(), ..BuildOptions::default() });
+    // `generate --stats`); trimmed to the maps as `generate` trims it, so that a scale
+    // field's channels are numbered as the run numbers them (`--maps roughness` showed
+    // channels 2 and 1 where the run reads 1 and 0).
+    let options = BuildOptions { layout: args.layout.layout(), ..BuildOptions::default() };
+    let graph = build_graph(&loaded.preset, options).for_maps(maps);
     if args.dot {
         print!("{}", to_dot(&graph, maps));
     } else {

@@ -44,12 +44,10 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
     for path in paths {
         checks.extend(checks_at(path)?);
     }
-    // Each set once, however often it is named (a manifest and its folder, `./x` and `x`).
+    // Each set once, however often it is named (a manifest and its folder, `./x` and `x`, a
+    // folder reached again through a link to it).
     let mut seen = std::collections::HashSet::new();
-    checks.retain(|check| match check {
-        Check::Manifest(path) => seen.insert(std::fs::canonicalize(path).unwrap_or_else(|_| path.clone())),
-        _ => true,
-    });
+    checks.retain(|check| seen.insert(identity(check)));
     let mut failed = 0;
     for check in &checks {
         let failure = match check {
@@ -64,7 +62,7 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
             },
             Check::Orphans { folder, name, files } => format!(
                 "set {}: {files} of its files but no manifest ({name}{MANIFEST_SUFFIX}): the set is incomplete (a \
-                 run failed or was killed while writing it)",
+                 run failed or was killed while writing it), or the files are not a set's",
                 path_line(&folder.join(name))
             ),
             Check::Interrupted { folder, name, .. } if snakeskin::export::lock_is_held(folder, name) => {
@@ -91,6 +89,24 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
     Ok(())
 }
 
+/// Which set a check is of, the same however it was reached: the kind of check, and the
+/// set's folder with links resolved joined with its name. A manifest is known by the folder
+/// it lies in, not by the file a link to it points to: its maps are looked for beside the
+/// link, so two folders whose manifests link to one file are two sets (one was passed over,
+/// and an altered copy said `ok`; a review).
+fn identity(check: &Check) -> (u8, PathBuf) {
+    let real = |folder: &Path| std::fs::canonicalize(folder).unwrap_or_else(|_| folder.to_path_buf());
+    match check {
+        Check::Manifest(path) => {
+            let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            (0, real(folder).join(path.file_name().unwrap_or_default()))
+        }
+        Check::Orphans { folder, name, .. } => (1, real(folder).join(name)),
+        Check::Interrupted { folder, name, .. } => (2, real(folder).join(name)),
+        Check::Unlistable { folder, .. } => (3, real(folder)),
+    }
+}
+
 /// What `path` names: a manifest, where it is one (or names one in a folder that holds the
 /// set's files: an incomplete set); in a folder, the sets in it and in its subfolders down
 /// to `SUBFOLDER_LEVELS` (a batch's output), links followed, hidden entries passed over but
@@ -102,11 +118,10 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let set_name = name.strip_suffix(MANIFEST_SUFFIX).filter(|s| !s.is_empty());
     let metadata = std::fs::metadata(path);
-    if let Some(set_name) = set_name
-        && !metadata.as_ref().is_ok_and(|m| m.is_dir())
-    {
-        // A manifest that is there is checked; a missing one is an incomplete set where the
-        // set's files lie beside it, and a wrong path otherwise (a typo).
+    if let Some(set_name) = set_name {
+        // A manifest that is there is checked (a folder of that name too: `verify_set` says
+        // it is no file, as when its folder is named); a missing one is an incomplete set
+        // where the set's files lie beside it, and a wrong path otherwise (a typo).
         let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
         let present = metadata.is_ok() || path.is_symlink();
         if present || set_files_in(folder, set_name) > 0 {
