@@ -782,6 +782,125 @@ fn the_window_reloads_the_preset_file_on_save() {
     assert!(edited_after.is_some(), "no reload of an edit in the folder made again");
 }
 
+/// From a sweep of the window: a save while the first maps were being made (seconds at
+/// larger map sizes) was never reloaded (the file was watched only once they were made);
+/// a window resized past the GPU's largest texture panicked in wgpu's `Surface::configure`
+/// (16400×64 on lavapipe, whose limit is 16384). Now the file is watched before it is read,
+/// and the window stops drawing, says so, and draws again when made smaller (resized with
+/// `xdotool`, in the window's own X display).
+#[cfg(feature = "window")]
+#[test]
+fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
+    use std::io::{BufRead, BufReader};
+    use std::os::unix::process::CommandExt;
+    use std::process::{Command, Stdio};
+    use std::sync::mpsc;
+    use std::time::{Duration, Instant};
+    let name = "the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize";
+    if gpu_or_skip(name).is_none() {
+        return;
+    }
+    for tool in ["xvfb-run", "xdotool"] {
+        if Command::new(tool).arg("--help").output().is_err() {
+            assert!(!gpu_required(), "SNAKESKIN_REQUIRE_GPU=1 but {tool} is missing (apt-get install xvfb xdotool)");
+            eprintln!("{name}: SKIPPED: {tool} not installed");
+            return;
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let preset = dir.path().join("starting.toml");
+    let original = snakeskin::preset::library::get(PLAIN_PRESET).unwrap();
+    std::fs::write(&preset, original).unwrap();
+    // 1024² maps: seconds between reading the file and the first frame.
+    let mut child = on_x11(&mut Command::new("xvfb-run"))
+        .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
+        .args(["preview", preset.to_str().unwrap(), "--window", "--frames", "1000000", "--size", "320x200"])
+        .args(["--map-size", "1024"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .process_group(0)
+        .spawn()
+        .unwrap();
+    let (lines_tx, lines) = mpsc::channel();
+    let stderr = child.stderr.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = lines_tx.send(line);
+        }
+    });
+    // Every line read, so that one that came before the line waited for is still found (the
+    // reload may end before the first frame).
+    let seen = std::cell::RefCell::new(Vec::<String>::new());
+    let wait_for = |needle: &str| -> Option<String> {
+        if let Some(line) = seen.borrow().iter().find(|line| line.contains(needle)) {
+            return Some(line.clone());
+        }
+        let deadline = Instant::now() + Duration::from_secs(120);
+        while Instant::now() < deadline {
+            if let Ok(line) = lines.recv_timeout(Duration::from_millis(200)) {
+                seen.borrow_mut().push(line.clone());
+                if line.contains(needle) {
+                    return Some(line);
+                }
+            }
+        }
+        None
+    };
+    // The preview's own process (under xvfb-run's shell): its command line names the file.
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let pid = loop {
+        let found = std::fs::read_dir("/proc").unwrap().flatten().find_map(|entry| {
+            let cmdline = std::fs::read(entry.path().join("cmdline")).ok()?;
+            let args: Vec<&[u8]> = cmdline.split(|b| *b == 0).collect();
+            let ours = args.first().is_some_and(|a| a.ends_with(b"/snakeskin"))
+                && args.iter().any(|a| *a == preset.to_str().unwrap().as_bytes());
+            ours.then(|| entry.file_name().to_string_lossy().into_owned())
+        });
+        if let Some(pid) = found {
+            break pid;
+        }
+        assert!(Instant::now() < deadline, "the preview never started");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    // Half a second in, the file has been read and the maps are being made.
+    std::thread::sleep(Duration::from_millis(500));
+    std::fs::write(&preset, original.replace("color = \"#d8c248\"", "color = \"#304080\"")).unwrap();
+    let first = wait_for("first frame presented");
+    let reloaded = wait_for("reloaded in");
+    // The window in the preview's display, made wider than any texture, then smaller.
+    // Its X display and the display's key (xvfb-run makes one: "Authorization required").
+    let environ = std::fs::read(format!("/proc/{pid}/environ")).unwrap();
+    let variable = |name: &str| {
+        let prefix = format!("{name}=");
+        environ
+            .split(|b| *b == 0)
+            .find_map(|v| v.strip_prefix(prefix.as_bytes()))
+            .map(|v| String::from_utf8_lossy(v).into_owned())
+            .unwrap_or_default()
+    };
+    let (display, authority) = (variable("DISPLAY"), variable("XAUTHORITY"));
+    let xdotool = |args: &[&str]| {
+        Command::new("xdotool").args(args).env("DISPLAY", &display).env("XAUTHORITY", &authority).output().unwrap()
+    };
+    let search = xdotool(&["search", "--name", "snakeskin"]);
+    let window = String::from_utf8_lossy(&search.stdout).lines().next().unwrap_or_default().to_string();
+    xdotool(&["windowsize", &window, "16400", "64"]);
+    let stopped = wait_for("not drawn until the window is made smaller");
+    xdotool(&["windowsize", &window, "320", "200"]);
+    let again = wait_for("drawn again at 320×200");
+    let still_running = child.try_wait().unwrap().is_none();
+    let group = format!("-{}", child.id());
+    let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
+    let _ = child.wait();
+    let seen = seen.borrow().join("\n");
+    assert!(first.is_some(), "the window never presented a frame:\n{seen}");
+    assert!(reloaded.is_some(), "the save made while the window started was not reloaded:\n{seen}");
+    assert!(!window.is_empty(), "xdotool found no window: {}", String::from_utf8_lossy(&search.stderr));
+    let stopped = stopped.unwrap_or_else(|| panic!("the huge window was not refused:\n{seen}"));
+    assert!(stopped.contains("the window is 16400×64; the GPU draws at most"), "{stopped}");
+    assert!(again.is_some() && still_running, "the window did not draw again:\n{seen}");
+}
+
 #[test]
 fn twenty_instanced_snakes_are_all_in_view() {
     use snakeskin::render::engine::renderer::snake_grid;

@@ -61,6 +61,17 @@ struct Gfx {
     material: Material,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
+    /// Why the window is not drawn at its size now (`App::resize`), or None while it is.
+    not_drawn: Option<NotDrawn>,
+}
+
+/// Why a window's frames are not drawn (`App::resize`).
+#[derive(Debug)]
+enum NotDrawn {
+    /// Minimised (no pixels): nothing to say.
+    Minimised,
+    /// Larger than the GPU or the memory can draw: said once, until it is smaller again.
+    TooLarge(String),
 }
 
 struct App {
@@ -87,6 +98,9 @@ struct App {
 
 /// Opens the window and runs until it is closed (or `frames` frames were drawn).
 pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
+    // Watched before it is read: a save while the first maps were made (seconds) was never
+    // reloaded (a window sweep: saved 0.7 s after the start, shown stale for good).
+    let watch = reload::watch_preset(&options.preset);
     let loaded = crate::preset::load(&options.preset, &options.overrides, options.seed)?;
     let sliders = Sliders::from_preset(&loaded.preset);
     let mut cache = NodeCache::new();
@@ -109,7 +123,11 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     let lut = Lut::bake_default(optics.stack);
 
     let (lut_jobs, lut_results) = reload::spawn_lut_worker();
-    let map_worker = reload::spawn_map_worker(&options, cache);
+    let status = match &watch {
+        Ok(_) => "watching the preset file".to_string(),
+        Err(why) => format!("not reloaded: {why}"),
+    };
+    let map_worker = reload::spawn_map_worker(&options, cache, watch);
 
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
@@ -129,7 +147,7 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
         frames_done: 0,
         lut_jobs,
         lut_results,
-        status: if map_worker.watching { "watching the preset file".to_string() } else { String::new() },
+        status,
         map_worker,
         options,
     };
@@ -209,8 +227,61 @@ impl App {
         let lut = self.lut.take().expect("initial LUT");
         let material = renderer.material(&maps, optics, &lut, self.baked_bands)?;
         let targets = renderer.targets(config.width, config.height, self.settings.samples);
-        self.gfx = Some(Gfx { window, surface, config, renderer, targets, material, egui_state, egui_renderer });
+        self.gfx = Some(Gfx {
+            window,
+            surface,
+            config,
+            renderer,
+            targets,
+            material,
+            egui_state,
+            egui_renderer,
+            not_drawn: None,
+        });
         Ok(())
+    }
+
+    /// Remakes the surface and the frame's targets for the window's new size, or stops
+    /// drawing while it cannot be drawn: minimised (wgpu asks that a surface of no pixels
+    /// not be configured; 1×1 frames were drawn as fast as the loop ran), wider or taller
+    /// than the GPU's largest texture (wgpu panicked in `Surface::configure`: 16400×64 on
+    /// lavapipe, a window sweep), or with frames larger than the memory available (an
+    /// 8192×4096 window took 2.2 GB, unchecked: only `--size` was). Said once, on stderr
+    /// and in the panel; drawn again when the window is made smaller.
+    fn resize(&mut self, width: u32, height: u32) {
+        let Some(gfx) = self.gfx.as_mut() else { return };
+        let limit = gfx.renderer.gpu.device.limits().max_texture_dimension_2d;
+        let not_drawn = if width == 0 || height == 0 {
+            Some(NotDrawn::Minimised)
+        } else if width > limit || height > limit {
+            Some(NotDrawn::TooLarge(format!(
+                "the window is {width}×{height}; the GPU draws at most {limit} pixels a side"
+            )))
+        } else {
+            // Its frames beside the old ones: a remake holds both for a moment.
+            let bytes = super::engine::renderer::window_frame_bytes(width, height);
+            let check = crate::memory::MemoryCheck::against_available(bytes);
+            check.refuse_if_over(&format!("a {width}×{height} window")).err().map(|e| NotDrawn::TooLarge(e.to_string()))
+        };
+        // Once as it stops (not at every step of a drag), and the panel says the latest.
+        if let Some(NotDrawn::TooLarge(why)) = &not_drawn {
+            self.status = format!("not drawn until the window is made smaller: {why}");
+            if !matches!(gfx.not_drawn, Some(NotDrawn::TooLarge(_))) {
+                (self.options.report)(&self.status);
+            }
+        }
+        if not_drawn.is_none() && matches!(gfx.not_drawn, Some(NotDrawn::TooLarge(_))) {
+            self.status = format!("drawn again at {width}×{height}");
+            (self.options.report)(&self.status);
+        }
+        gfx.not_drawn = not_drawn;
+        // X11 reports the first size even when it is the one configured: nothing to remake
+        // then (a remake holds the old targets beside the new for a moment).
+        if gfx.not_drawn.is_none() && (width, height) != (gfx.config.width, gfx.config.height) {
+            (gfx.config.width, gfx.config.height) = (width, height);
+            gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
+            gfx.targets = gfx.renderer.targets(width, height, self.settings.samples);
+        }
     }
 
     /// Swaps in finished background work and pushes slider changes to the GPU.
@@ -223,8 +294,16 @@ impl App {
             });
             match uploaded {
                 Ok(reloaded) => {
+                    for warning in &reloaded.warnings {
+                        (self.options.report)(warning);
+                    }
+                    let warned = match reloaded.warnings.len() {
+                        0 => String::new(),
+                        1 => format!("; {}", reloaded.warnings[0]),
+                        n => format!("; {n} warnings (on the terminal)"),
+                    };
                     self.status = format!(
-                        "reloaded in {:.0} ms: {} nodes re-evaluated, {} reused",
+                        "reloaded in {:.0} ms: {} nodes re-evaluated, {} reused{warned}",
                         reloaded.took.as_secs_f64() * 1e3,
                         reloaded.stats.evaluated,
                         reloaded.stats.reused
@@ -260,6 +339,9 @@ impl App {
     }
 
     fn draw(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.as_ref().is_some_and(|gfx| gfx.not_drawn.is_some()) {
+            return;
+        }
         self.apply_updates();
         let now = Instant::now();
         if let Some(last) = self.last_frame {
@@ -364,16 +446,7 @@ impl ApplicationHandler for App {
         let consumed = gfx.egui_state.on_window_event(&gfx.window, &event).consumed;
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
-            WindowEvent::Resized(size) => {
-                // X11 reports the first size even when it is the one configured: nothing to
-                // remake then (a remake holds the old targets beside the new for a moment).
-                let (width, height) = (size.width.max(1), size.height.max(1));
-                if (width, height) != (gfx.config.width, gfx.config.height) {
-                    (gfx.config.width, gfx.config.height) = (width, height);
-                    gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
-                    gfx.targets = gfx.renderer.targets(width, height, self.settings.samples);
-                }
-            }
+            WindowEvent::Resized(size) => self.resize(size.width, size.height),
             WindowEvent::RedrawRequested => self.draw(event_loop),
             WindowEvent::MouseInput { state, button: MouseButton::Left, .. } => {
                 self.drag = (state == ElementState::Pressed && !consumed).then_some(self.cursor);
@@ -399,9 +472,15 @@ impl ApplicationHandler for App {
         }
     }
 
-    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         if let Some(gfx) = &self.gfx {
-            gfx.window.request_redraw();
+            // A window not drawn waits for its next event (a resize) instead of spinning.
+            if gfx.not_drawn.is_some() {
+                event_loop.set_control_flow(ControlFlow::Wait);
+            } else {
+                event_loop.set_control_flow(ControlFlow::Poll);
+                gfx.window.request_redraw();
+            }
         }
     }
 }

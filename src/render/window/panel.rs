@@ -11,7 +11,8 @@ use crate::render::engine::scene::{LayerOptics, Light, Stage, View};
 /// The most snakes the panel's slider draws (the window's memory check counts as many).
 pub const SNAKES_SLIDER_MAX: u32 = 20;
 
-/// Optics as the sliders edit them (σ0 as one number; an RGB σ0 shows its mean).
+/// Optics as the sliders edit them (σ0 as one number: an RGB σ0 shows its mean, and the
+/// slider scales the three channels together).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sliders {
     pub n0: f64,
@@ -21,11 +22,15 @@ pub struct Sliders {
     spread_nm: f64,
     pigment_thickness: f64,
     absorption: f64,
+    /// σ0's channels over their mean (1, 1, 1 for a grey σ0): the window drew a tinted σ0
+    /// as its mean, unlike the headless preview (a window sweep).
+    absorption_tint: [f64; 3],
 }
 
 impl Sliders {
     pub fn from_preset(preset: &crate::preset::Preset) -> Sliders {
         let o = &preset.optics;
+        let mean_absorption = o.absorption.0.iter().sum::<f64>() / 3.0;
         Sliders {
             n0: o.ambient_ior,
             n1: o.film_ior,
@@ -33,7 +38,8 @@ impl Sliders {
             thickness_nm: o.film_thickness_nm,
             spread_nm: preset.iridescence.spread_nm,
             pigment_thickness: o.pigment_thickness,
-            absorption: o.absorption.0.iter().sum::<f64>() / 3.0,
+            absorption: mean_absorption,
+            absorption_tint: o.absorption.0.map(|a| if mean_absorption > 0.0 { a / mean_absorption } else { 1.0 }),
         }
     }
 
@@ -41,7 +47,7 @@ impl Sliders {
         LayerOptics {
             stack: Stack { n0: self.n0, n1: self.n1, n2: self.n2 },
             thickness_range_nm: crate::material::thickness_range_nm(self.thickness_nm, self.spread_nm),
-            optical_depth: [self.absorption * self.pigment_thickness; 3],
+            optical_depth: self.absorption_tint.map(|tint| tint * self.absorption * self.pigment_thickness),
         }
     }
 }
@@ -90,7 +96,11 @@ pub fn controls(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Sliders
         ui.add(slider(&mut s.absorption, ranges::ABSORPTION, true, "σ0 absorption"));
         ui.separator();
         ui.label("Scene");
-        ui.add(egui::Slider::new(&mut settings.exposure, 0.1..=4.0).logarithmic(true).text("exposure"));
+        // Dragged over the usual range; a value given on the command line outside it (the
+        // CLI takes 1e-6 to 1000 and up to 400 snakes) stays until the slider is moved: it
+        // was clamped to the slider's ends at the first frame (a window sweep).
+        let exposure = egui::Slider::new(&mut settings.exposure, 0.1..=4.0).logarithmic(true);
+        ui.add(exposure.clamping(egui::SliderClamping::Edits).text("exposure"));
         let mut azimuth = settings.lighting.key.direction.x.atan2(settings.lighting.key.direction.z).to_degrees();
         let mut elevation = settings.lighting.key.direction.y.clamp(-1.0, 1.0).asin().to_degrees();
         let a = ui.add(egui::Slider::new(&mut azimuth, -180.0..=180.0).text("light azimuth"));
@@ -101,7 +111,8 @@ pub fn controls(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Sliders
         }
         ui.checkbox(&mut settings.lighting.fill.enabled, "fill light");
         ui.checkbox(&mut settings.ground, "ground");
-        ui.add(egui::Slider::new(&mut settings.snakes, 1..=SNAKES_SLIDER_MAX).text("snakes"));
+        let snakes = egui::Slider::new(&mut settings.snakes, 1..=SNAKES_SLIDER_MAX);
+        ui.add(snakes.clamping(egui::SliderClamping::Edits).text("snakes"));
         ui.separator();
         ui.label("drag: orbit · wheel: zoom");
         if !status.is_empty() {
@@ -123,4 +134,44 @@ fn view_name(view: View) -> String {
 /// A slider over one of the preset's ranges.
 fn slider<'a>(value: &'a mut f64, (lo, hi): (f64, f64), logarithmic: bool, text: &str) -> egui::Slider<'a> {
     egui::Slider::new(value, lo..=hi).logarithmic(logarithmic).text(text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sliders give back the optics the preset has: a tinted σ0 keeps its channels (the
+    /// window drew their mean, the headless preview the three).
+    #[test]
+    fn the_sliders_keep_the_presets_optics() {
+        for (name, overrides) in [
+            ("erythrolamprus-miliaris", vec![("optics.absorption".to_string(), "[0.1, 0.4, 0.9]".to_string())]),
+            ("erythrolamprus-miliaris", vec![("optics.absorption".to_string(), "0".to_string())]),
+            ("xenopeltis-unicolor", vec![]),
+        ] {
+            let loaded = crate::preset::load(name, &overrides, None).unwrap();
+            let want = LayerOptics::from_preset(&loaded.preset);
+            let got = Sliders::from_preset(&loaded.preset).optics();
+            for c in 0..3 {
+                let (g, w) = (got.optical_depth[c], want.optical_depth[c]);
+                assert!((g - w).abs() <= 1e-12 * w.abs().max(1.0), "{name} {overrides:?}: {got:?} against {want:?}");
+            }
+            assert_eq!(got.stack, want.stack);
+            assert_eq!(got.thickness_range_nm, want.thickness_range_nm);
+        }
+    }
+
+    /// A value the command line gave outside a slider's range survives the panel's frames
+    /// (it was clamped to the slider's end at the first frame).
+    #[test]
+    fn the_panel_keeps_command_line_values_outside_its_sliders() {
+        let loaded = crate::preset::load("natrix-natrix", &[], None).unwrap();
+        let mut sliders = Sliders::from_preset(&loaded.preset);
+        let mut settings = FrameSettings { exposure: 10.0, snakes: 100, ..FrameSettings::default() };
+        let context = egui::Context::default();
+        for _ in 0..2 {
+            let _ = context.run_ui(egui::RawInput::default(), |ui| controls(ui, &mut settings, &mut sliders, "", 0.0));
+        }
+        assert_eq!((settings.exposure, settings.snakes), (10.0, 100));
+    }
 }
