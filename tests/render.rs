@@ -787,7 +787,8 @@ fn the_window_reloads_the_preset_file_on_save() {
 /// a window resized past the GPU's largest texture panicked in wgpu's `Surface::configure`
 /// (16400×64 on lavapipe, whose limit is 16384). Now the file is watched before it is read,
 /// and the window stops drawing, says so, and draws again when made smaller (resized with
-/// `xdotool`, in the window's own X display).
+/// `xdotool`, in the window's own X display). A reload names the keys `--set` holds over
+/// the file.
 #[cfg(feature = "window")]
 #[test]
 fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
@@ -815,7 +816,7 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     let mut child = on_x11(&mut Command::new("xvfb-run"))
         .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
         .args(["preview", preset.to_str().unwrap(), "--window", "--frames", "1000000", "--size", "320x200"])
-        .args(["--map-size", "1024"])
+        .args(["--map-size", "1024", "--set", "color.between_scales=0.3"])
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .process_group(0)
@@ -894,7 +895,10 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     let _ = child.wait();
     let seen = seen.borrow().join("\n");
     assert!(first.is_some(), "the window never presented a frame:\n{seen}");
-    assert!(reloaded.is_some(), "the save made while the window started was not reloaded:\n{seen}");
+    let reloaded =
+        reloaded.unwrap_or_else(|| panic!("the save made while the window started was not reloaded:\n{seen}"));
+    // The key `--set` holds over the file is named (an edit of it changed nothing, unsaid).
+    assert!(reloaded.contains("; --set holds color.between_scales over the file"), "{reloaded}");
     assert!(!window.is_empty(), "xdotool found no window: {}", String::from_utf8_lossy(&search.stderr));
     let stopped = stopped.unwrap_or_else(|| panic!("the huge window was not refused:\n{seen}"));
     assert!(stopped.contains("the window is 16400×64; the GPU draws at most"), "{stopped}");

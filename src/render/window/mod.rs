@@ -302,8 +302,18 @@ impl App {
                         1 => format!("; {}", reloaded.warnings[0]),
                         n => format!("; {n} warnings (on the terminal)"),
                     };
+                    // An edit of a key `--set` gives changed nothing, without a word (a window
+                    // sweep): the keys it holds are named at every reload.
+                    let mut held: Vec<&str> = self.options.overrides.iter().map(|(key, _)| key.as_str()).collect();
+                    held.sort();
+                    held.dedup();
+                    let held = if held.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; --set holds {} over the file", held.join(", "))
+                    };
                     self.status = format!(
-                        "reloaded in {:.0} ms: {} nodes re-evaluated, {} reused{warned}",
+                        "reloaded in {:.0} ms: {} nodes re-evaluated, {} reused{warned}{held}",
                         reloaded.took.as_secs_f64() * 1e3,
                         reloaded.stats.evaluated,
                         reloaded.stats.reused
