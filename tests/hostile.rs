@@ -2425,7 +2425,8 @@ fn verify_fails_a_set_left_only_in_temporaries() {
 /// keeps them) was passed over, and its altered map said `ok`; an incomplete set named
 /// three times, or reached again through a link to its own folder, was listed each time; a
 /// folder named as a manifest was "no set" when named and "not a regular file" when its
-/// folder was; a manifest linking to nothing was "the set is incomplete". The controls:
+/// folder was; a manifest linking to nothing was "the set is incomplete"; names that differ
+/// only in bytes that are not UTF-8 were one set. The controls:
 /// the linked copy unaltered is `ok`, and a set named twice is one line.
 #[test]
 fn verify_tells_sets_apart_by_where_they_lie() {
@@ -2477,6 +2478,19 @@ fn verify_tells_sets_apart_by_where_they_lie() {
         assert_eq!(out.status.code(), Some(1), "{path:?}: {}{}", stdout(&out), stderr(&out));
         assert!(stdout(&out).contains("not a regular file"), "{path:?}: {}", stdout(&out));
     }
+    // Two sets whose names differ only in bytes that are not UTF-8: two lines, each name
+    // written with its bytes (read lossily, both were one set `a�`).
+    let g = d.join("g");
+    std::fs::create_dir(&g).unwrap();
+    for name in [&b"a\xff_color.png"[..], &b"a\xfe_color.png"[..]] {
+        use std::os::unix::ffi::OsStrExt;
+        std::fs::write(g.join(std::ffi::OsStr::from_bytes(name)), b"x").unwrap();
+    }
+    let out = verify(&[&g]);
+    assert_eq!(out.status.code(), Some(1));
+    let lines = stdout(&out);
+    assert_eq!(lines.lines().count(), 2, "{lines}");
+    assert!(lines.contains("a\\xff:") && lines.contains("a\\xfe:"), "{lines}");
     // A manifest that links to nothing says so.
     let f = d.join("f");
     std::fs::create_dir(&f).unwrap();

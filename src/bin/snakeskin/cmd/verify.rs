@@ -164,7 +164,7 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
         // Set name → the temporaries of its files here (hidden, so otherwise passed over).
         let mut temporaries: BTreeMap<String, usize> = BTreeMap::new();
         for entry in entries {
-            let name = entry.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            let name = entry.file_name().map(name_text).unwrap_or_default();
             if name.starts_with('.') {
                 let target = snakeskin::export::temporary_target(&name);
                 let set = target.and_then(|t| {
@@ -226,6 +226,29 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
         return Err(invalid(reason).into());
     }
     Ok(checks)
+}
+
+/// A file name as text that keeps every name apart: its bytes that are not UTF-8 written as
+/// `\xNN`. Read lossily, `a\xff_color.png` and `a\xfe_color.png` were one set `a�` (a sweep
+/// of `verify`: two incomplete sets reported as one, or one hidden beside a whole set
+/// `a\xff`).
+fn name_text(name: &std::ffi::OsStr) -> String {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let mut text = String::new();
+        for chunk in name.as_bytes().utf8_chunks() {
+            text.push_str(chunk.valid());
+            for byte in chunk.invalid() {
+                text.push_str(&format!("\\x{byte:02x}"));
+            }
+        }
+        text
+    }
+    #[cfg(not(unix))]
+    {
+        name.to_string_lossy().into_owned()
+    }
 }
 
 /// The set whose file `file_name` is (`NAME_color.png`, `NAME_orm.png`, …), if it ends in one
