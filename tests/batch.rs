@@ -1560,7 +1560,7 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
     let more = stdout(&verify(&[&manifests[0]]));
     assert!(
         more.lines().any(|l| l.contains(&other_name)
-            && l.contains(&format!("map entry {} lacks sha256 (a string each)", third + 1))
+            && l.contains(&format!("map entry {}: sha256 is missing or not text", third + 1))
             && l.contains("is listed twice")),
         "{more}"
     );

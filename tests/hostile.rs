@@ -2457,14 +2457,14 @@ fn verify_tells_sets_apart_by_where_they_lie() {
     assert_eq!(out.status.code(), Some(1), "{}", stdout(&out));
     assert!(stdout(&out).contains(&format!("FAILED set {}", d.join("b/natrix-natrix.material.json").display())));
 
-    // An incomplete set named three ways and reached through a link to its own folder: one
-    // line.
+    // An incomplete set named four ways (its missing manifest too) and reached through a
+    // link to its own folder: one line.
     let c = d.join("c");
     std::fs::create_dir(&c).unwrap();
     std::fs::write(c.join("other_color.png"), b"x").unwrap();
     std::os::unix::fs::symlink(".", c.join("self")).unwrap();
     let dot_c = d.join("./c");
-    let out = verify(&[&c, &c, &dot_c]);
+    let out = verify(&[&c, &c, &dot_c, &c.join("other.material.json")]);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(stdout(&out).lines().count(), 1, "{}", stdout(&out));
     assert!(stderr(&out).contains("1 of 1 checks failed"), "{}", stderr(&out));
@@ -2482,15 +2482,16 @@ fn verify_tells_sets_apart_by_where_they_lie() {
     // written with its bytes (read lossily, both were one set `a�`).
     let g = d.join("g");
     std::fs::create_dir(&g).unwrap();
-    for name in [&b"a\xff_color.png"[..], &b"a\xfe_color.png"[..]] {
+    // And a name spelt with a backslash, `a\xff`, which is neither.
+    for name in [&b"a\xff_color.png"[..], &b"a\xfe_color.png"[..], &b"a\\xff_color.png"[..]] {
         use std::os::unix::ffi::OsStrExt;
         std::fs::write(g.join(std::ffi::OsStr::from_bytes(name)), b"x").unwrap();
     }
     let out = verify(&[&g]);
     assert_eq!(out.status.code(), Some(1));
     let lines = stdout(&out);
-    assert_eq!(lines.lines().count(), 2, "{lines}");
-    assert!(lines.contains("a\\xff:") && lines.contains("a\\xfe:"), "{lines}");
+    assert_eq!(lines.lines().count(), 3, "{lines}");
+    assert!(lines.contains("a\\xff:") && lines.contains("a\\xfe:") && lines.contains("a\\\\xff:"), "{lines}");
     // A manifest that links to nothing says so.
     let f = d.join("f");
     std::fs::create_dir(&f).unwrap();

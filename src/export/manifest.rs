@@ -420,8 +420,8 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
             (Ok(map), Ok(file), Ok(expected)) => (map, file, expected),
             (map, file, expected) => {
                 let keys: Vec<&str> = [map, file, expected].into_iter().filter_map(Result::err).collect();
-                let keys = keys.join(", ");
-                problems.push(format!("map entry {} lacks {keys} (a string each)", index + 1));
+                let (keys, are) = (keys.join(", "), if keys.len() == 1 { "is" } else { "are" });
+                problems.push(format!("map entry {}: {keys} {are} missing or not text", index + 1));
                 continue;
             }
         };

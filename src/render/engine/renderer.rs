@@ -72,7 +72,7 @@ const SWAP_CHAIN_IMAGES_AT_MOST: u64 = 5;
 /// `SWAP_CHAIN_IMAGES_AT_MOST` of 4 bytes); a window has no readback or PNG. 76 bytes a
 /// pixel: a 4096×2048 window (lavapipe under Xvfb, whose swap chain has 3 images; 64² maps,
 /// five frames) peaked 60.7 bytes a pixel above a 16×16 one's. For the window's size when it
-/// opens (`--size`); a window resized later is not checked again.
+/// opens (`--size`), and again at each resize (`window::App::resize`).
 pub fn window_frame_bytes(width: u32, height: u32) -> u64 {
     let per_pixel = TARGET_BYTES_PER_PIXEL + SWAP_CHAIN_IMAGES_AT_MOST * 4;
     width as u64 * height as u64 * per_pixel

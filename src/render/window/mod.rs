@@ -245,13 +245,16 @@ impl App {
     /// drawing while it cannot be drawn: minimised (wgpu asks that a surface of no pixels
     /// not be configured; 1×1 frames were drawn as fast as the loop ran), wider or taller
     /// than the GPU's largest texture (wgpu panicked in `Surface::configure`: 16400×64 on
-    /// lavapipe, a window sweep), or with frames larger than the memory available (an
-    /// 8192×4096 window took 2.2 GB, unchecked: only `--size` was). Said once, on stderr
-    /// and in the panel; drawn again when the window is made smaller.
+    /// lavapipe, a window sweep), with frames larger than the memory available (an
+    /// 8192×4096 window took 2.2 GB, unchecked: only `--size` was), or with frames the
+    /// driver will not make (at 9000×9000 the 4× multisampled target alone is one 2.6 GB
+    /// allocation, over lavapipe's largest: wgpu panicked "Out of Memory", a review). Said
+    /// once on stderr; drawn again, and said so, when the window is made smaller.
     fn resize(&mut self, width: u32, height: u32) {
+        let samples = self.settings.samples;
         let Some(gfx) = self.gfx.as_mut() else { return };
         let limit = gfx.renderer.gpu.device.limits().max_texture_dimension_2d;
-        let not_drawn = if width == 0 || height == 0 {
+        let mut not_drawn = if width == 0 || height == 0 {
             Some(NotDrawn::Minimised)
         } else if width > limit || height > limit {
             Some(NotDrawn::TooLarge(format!(
@@ -263,25 +266,39 @@ impl App {
             let check = crate::memory::MemoryCheck::against_available(bytes);
             check.refuse_if_over(&format!("a {width}×{height} window")).err().map(|e| NotDrawn::TooLarge(e.to_string()))
         };
-        // Once as it stops (not at every step of a drag), and the panel says the latest.
-        if let Some(NotDrawn::TooLarge(why)) = &not_drawn {
-            self.status = format!("not drawn until the window is made smaller: {why}");
-            if !matches!(gfx.not_drawn, Some(NotDrawn::TooLarge(_))) {
-                (self.options.report)(&self.status);
-            }
-        }
-        if not_drawn.is_none() && matches!(gfx.not_drawn, Some(NotDrawn::TooLarge(_))) {
-            self.status = format!("drawn again at {width}×{height}");
-            (self.options.report)(&self.status);
-        }
-        gfx.not_drawn = not_drawn;
         // X11 reports the first size even when it is the one configured: nothing to remake
         // then (a remake holds the old targets beside the new for a moment).
-        if gfx.not_drawn.is_none() && (width, height) != (gfx.config.width, gfx.config.height) {
-            (gfx.config.width, gfx.config.height) = (width, height);
-            gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
-            gfx.targets = gfx.renderer.targets(width, height, self.settings.samples);
+        if not_drawn.is_none() && (width, height) != (gfx.config.width, gfx.config.height) {
+            let config = wgpu::SurfaceConfiguration { width, height, ..gfx.config.clone() };
+            let made = gfx.renderer.gpu.checked(&format!("making a {width}×{height} window's frames"), || {
+                gfx.surface.configure(&gfx.renderer.gpu.device, &config);
+                Ok(gfx.renderer.targets(width, height, samples))
+            });
+            match made {
+                Ok(targets) => (gfx.config, gfx.targets) = (config, targets),
+                Err(error) => {
+                    // The surface may be left at the refused size: no size a frame can use
+                    // is recorded, so the next one that fits configures it again.
+                    gfx.config.width = 0;
+                    not_drawn = Some(NotDrawn::TooLarge(error.to_string()));
+                }
+            }
         }
+        // Once as it stops (not at every step of a drag). On stderr only: the panel is
+        // not drawn meanwhile, and keeps its own line (what the file watch is doing).
+        let was_too_large = matches!(gfx.not_drawn, Some(NotDrawn::TooLarge(_)));
+        match &not_drawn {
+            Some(NotDrawn::TooLarge(why)) if !was_too_large => {
+                (self.options.report)(&format!("not drawn until the window is made smaller: {why}"))
+            }
+            None if was_too_large => (self.options.report)(&format!("drawn again at {width}×{height}")),
+            _ => {}
+        }
+        if not_drawn.is_some() {
+            // The time not drawn is no frame's.
+            self.last_frame = None;
+        }
+        gfx.not_drawn = not_drawn;
     }
 
     /// Swaps in finished background work and pushes slider changes to the GPU.

@@ -47,7 +47,12 @@ impl Sliders {
         LayerOptics {
             stack: Stack { n0: self.n0, n1: self.n1, n2: self.n2 },
             thickness_range_nm: crate::material::thickness_range_nm(self.thickness_nm, self.spread_nm),
-            optical_depth: self.absorption_tint.map(|tint| tint * self.absorption * self.pigment_thickness),
+            // Each channel within the key's range: a tinted σ0's largest channel would pass
+            // it as the slider nears its end ([0, 0, 100] is a mean of 33 and a tint of 3).
+            optical_depth: self.absorption_tint.map(|tint| {
+                let (lo, hi) = crate::preset::validate::ranges::ABSORPTION;
+                (tint * self.absorption).clamp(lo, hi) * self.pigment_thickness
+            }),
         }
     }
 }
@@ -170,7 +175,10 @@ mod tests {
         let mut settings = FrameSettings { exposure: 10.0, snakes: 100, ..FrameSettings::default() };
         let context = egui::Context::default();
         for _ in 0..2 {
-            let _ = context.run_ui(egui::RawInput::default(), |ui| controls(ui, &mut settings, &mut sliders, "", 0.0));
+            let mut output =
+                context.run_ui(egui::RawInput::default(), |ui| controls(ui, &mut settings, &mut sliders, "", 0.0));
+            // No renderer takes the font texture here (epaint's debug build asserts on it).
+            output.textures_delta.clear();
         }
         assert_eq!((settings.exposure, settings.snakes), (10.0, 100));
     }
