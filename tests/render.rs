@@ -824,6 +824,12 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
         .process_group(0)
         .spawn()
         .unwrap();
+    // Stops the preview, Xvfb and xvfb-run (its own process group), also before a failed
+    // assertion: a failure left the preview running.
+    let group = format!("-{}", child.id());
+    let stop = || {
+        let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
+    };
     let (lines_tx, lines) = mpsc::channel();
     let stderr = child.stderr.take().unwrap();
     std::thread::spawn(move || {
@@ -862,7 +868,10 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
         if let Some(pid) = found {
             break pid;
         }
-        assert!(Instant::now() < deadline, "the preview never started");
+        if Instant::now() > deadline {
+            stop();
+            panic!("the preview never started");
+        }
         std::thread::sleep(Duration::from_millis(20));
     };
     // The file watched within two seconds of the start, while the maps are made (it was
@@ -878,7 +887,10 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     while !watching() && started.elapsed() < Duration::from_secs(2) {
         std::thread::sleep(Duration::from_millis(10));
     }
-    assert!(watching(), "the preset file was not watched within 2 s of the preview's start");
+    if !watching() {
+        stop();
+        panic!("the preset file was not watched within 2 s of the preview's start");
+    }
     std::fs::write(&preset, original.replace("color = \"#d8c248\"", "color = \"#304080\"")).unwrap();
     let first = wait_for("first frame presented");
     let reloaded = wait_for("reloaded in");
@@ -900,7 +912,7 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     let search = xdotool(&["search", "--name", "snakeskin"]);
     let window = String::from_utf8_lossy(&search.stdout).lines().next().unwrap_or_default().to_string();
     if window.is_empty() {
-        let _ = Command::new("kill").args(["-TERM", "--", &format!("-{}", child.id())]).status();
+        stop();
         panic!("xdotool found no window: {}", String::from_utf8_lossy(&search.stderr));
     }
     xdotool(&["windowsize", &window, &too_wide.to_string(), "64"]);
@@ -908,8 +920,7 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     xdotool(&["windowsize", &window, "320", "200"]);
     let again = wait_for("drawn again at 320×200");
     let still_running = child.try_wait().unwrap().is_none();
-    let group = format!("-{}", child.id());
-    let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
+    stop();
     let _ = child.wait();
     let seen = seen.borrow().join("\n");
     assert!(first.is_some(), "the window never presented a frame:\n{seen}");
