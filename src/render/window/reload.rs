@@ -88,10 +88,9 @@ pub struct Watch {
 pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache, watch: Result<Watch, String>) -> MapWorker {
     let (reload_out, reloads) = channel();
     let (stop, stopped) = channel::<()>();
-    let Ok(Watch { watch, news: watched_rx }) = watch else {
+    let Ok(Watch { mut watch, news: watched_rx }) = watch else {
         return MapWorker { reloads, _stop: stop };
     };
-    let mut watch = Some(watch);
     let (spec, overrides, seed, map_size, layout) =
         (options.preset.clone(), options.overrides.clone(), options.seed, options.map_size, options.layout);
     std::thread::spawn(move || {
@@ -102,9 +101,7 @@ pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache, watch: Re
             let mut reload = match watched_rx.recv_timeout(WAKE_INTERVAL) {
                 Ok(Watched::Changed) => true,
                 Ok(Watched::Lost(dir)) => {
-                    if let Some(w) = watch.as_mut() {
-                        w.lose(dir);
-                    }
+                    watch.lose(dir);
                     false
                 }
                 Err(RecvTimeoutError::Timeout) => false,
@@ -113,15 +110,15 @@ pub fn spawn_map_worker(options: &WindowOptions, mut cache: NodeCache, watch: Re
             };
             // On every wake (a steady stream of edits must not keep it from running): a folder
             // watched again may hold a file changed while it was not watched.
-            reload |= watch.as_mut().is_some_and(PresetWatch::refresh);
+            reload |= watch.refresh();
             if !reload {
                 continue;
             }
             // Editors save in bursts (truncate, write, rename): let the file settle.
             std::thread::sleep(Duration::from_millis(150));
             while let Ok(news) = watched_rx.try_recv() {
-                if let (Watched::Lost(dir), Some(w)) = (news, watch.as_mut()) {
-                    w.lose(dir);
+                if let Watched::Lost(dir) = news {
+                    watch.lose(dir);
                 }
             }
             let start = Instant::now();

@@ -236,9 +236,9 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
 }
 
 /// A file name as text that keeps every name apart: its bytes that are not UTF-8 written as
-/// `\xNN`, and a backslash as two (so that a name spelt `a\xff` is not the byte's). Read lossily, `a\xff_color.png` and `a\xfe_color.png` were one set `a�` (a sweep
-/// of `verify`: two incomplete sets reported as one, or one hidden beside a whole set
-/// `a\xff`).
+/// `\xNN`, and a backslash as two (so that a name spelt `a\xff` is not the byte's). Read
+/// lossily, `a\xff_color.png` and `a\xfe_color.png` were one set `a�` (a sweep of `verify`:
+/// two incomplete sets reported as one, or one hidden beside a whole set `a\xff`).
 fn name_text(name: &std::ffi::OsStr) -> String {
     #[cfg(unix)]
     {
