@@ -183,6 +183,76 @@ fn a_body_atlas_still_wraps_round_the_body() {
     }
 }
 
+/// A preset of one blotch series of `shape` on a body without plates, `count` marks widened
+/// `widen` times toward the vent (the tail's light bands of its own end the series there),
+/// written to `dir`.
+fn widened_series(dir: &std::path::Path, shape: &str, size: f32, count: u32, widen: f32, offset: f32) -> Preset {
+    let file = dir.join(format!("{shape}-{widen}.toml"));
+    let text = format!(
+        "seed = 3\n[belly]\nwidth = 0\n[color]\nvariation = 0\n\
+         [body]\ntail_bands = 3\ntail_band_color = \"#e0e0e0\"\n[[pattern]]\nkind = \"blotches\"\n\
+         shape = \"{shape}\"\ncolor = \"#101010\"\nsize = {size}\ncount = {count}\nwiden_to_tail = {widen}\n\
+         offset = {offset}\nedge_distortion = 0\n"
+    );
+    std::fs::write(&file, text).unwrap();
+    preset(file.to_str().unwrap(), &[])
+}
+
+#[test]
+fn marks_widened_past_the_circumference_still_wrap_round_the_body() {
+    // Chevrons and hourglasses half the circumference wide, widened six times toward the
+    // tail: the last marks span about three circumferences, and every copy of them that
+    // reaches the texture must be drawn (one copy either side left a straight seam at u = 0).
+    let dir = tempfile::tempdir().unwrap();
+    for shape in ["chevron", "hourglass"] {
+        let p = widened_series(dir.path(), shape, 0.5, 8, 6.0, 0.2);
+        let colour = body_map(&p, MapKind::Color);
+        assert_rows_seamless(&transpose(&colour), &format!("{shape} widened 6 times, columns"));
+    }
+}
+
+/// The most dark pixels (the marks' colour, #101010, 0.005 linear) across each mark of a
+/// series, in rows order: a mark is a run of rows with a dark pixel on the spine. (The
+/// ground's grooves are darker than 0.1 but not than 0.02.)
+fn mark_widths(colour: &Image) -> Vec<usize> {
+    let w = colour.width;
+    let dark = |y: usize, x: usize| colour.data[(y * w + x) * 3..(y * w + x) * 3 + 3].iter().all(|c| *c < 0.02);
+    let mut widths = Vec::new();
+    let mut current: Option<usize> = None;
+    for y in 0..colour.height {
+        let across = (0..w).filter(|&x| dark(y, x)).count();
+        match (dark(y, w / 2), current) {
+            (true, Some(widest)) => current = Some(widest.max(across)),
+            (true, None) => current = Some(across),
+            (false, Some(widest)) => {
+                widths.push(widest);
+                current = None;
+            }
+            (false, None) => {}
+        }
+    }
+    widths.extend(current);
+    widths
+}
+
+#[test]
+fn widen_to_tail_is_the_last_marks_width_over_the_firsts() {
+    // docs/presets.md: "the half-width of its last mark ... over the first's". Five saddles
+    // of 0.05 a side (0.1 of the circumference across); the pattern layers' own jitter
+    // changes a mark's size by up to 9 %, so the ratio is within 20 %. (Widened at the
+    // marks' midpoints, the ratio was 3.7 for 6.)
+    let dir = tempfile::tempdir().unwrap();
+    for widen in [1.0, 6.0] {
+        let p = widened_series(dir.path(), "saddle", 0.05, 5, widen, 0.0);
+        let widths = mark_widths(&body_map(&p, MapKind::Color));
+        assert_eq!(widths.len(), 5, "widen {widen}: marks {widths:?}");
+        let first = widths[0] as f32 / WIDTH as f32;
+        let ratio = widths[4] as f32 / widths[0] as f32;
+        assert!((first - 0.1).abs() < 0.02, "widen {widen}: the first mark is {first} of the circumference, not 0.1");
+        assert!((ratio / widen - 1.0).abs() < 0.2, "widen {widen}: last over first {ratio} ({widths:?})");
+    }
+}
+
 #[test]
 fn the_head_differs_from_the_trunk() {
     // Head shields: the head's height map has far fewer plate edges per row than the

@@ -757,10 +757,18 @@ pub fn height_to_normal(height: &Image, spec: NormalSpec) -> Image {
 /// back and freed). `height_to_normal` is these rows.
 pub fn height_to_normal_rows(height: &Image, spec: NormalSpec) -> impl Fn(usize, &mut [f32]) + Sync + '_ {
     let kernel = NormalKernel::new(height, spec);
-    let at = move |c, l, r, up: &[f32], here: &[f32], down: &[f32], out: &mut [f32]| {
-        kernel.at(here[r] - here[l], down[c] - up[c], out)
-    };
-    move |y, row| neighbourhood_row(height, y, spec.wraps_v, 3, &at, row)
+    move |y, row| {
+        // At the first and last rows of a texture that does not wrap (the body's snout and
+        // tail tip) the row beyond is the row itself (`edge_row`): the difference spans one
+        // row, not two, and halved it gave half the slope there. (A strip's edge rows inside
+        // the texture are its margin, cropped.)
+        let ends = !spec.wraps_v && (y == 0 || y + 1 == height.height);
+        let rows_spanned = if ends { 1.0 } else { 2.0 };
+        let at = |c, l, r, up: &[f32], here: &[f32], down: &[f32], out: &mut [f32]| {
+            kernel.at(here[r] - here[l], (down[c] - up[c]) * (2.0 / rows_spanned), out)
+        };
+        neighbourhood_row(height, y, spec.wraps_v, 3, &at, row)
+    }
 }
 
 /// The per-pixel normal of `height_to_normal`: central differences of the height, scaled
@@ -981,6 +989,20 @@ mod tests {
         for p in n.data.chunks(3) {
             assert!(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 1.0).abs() < 1e-5);
         }
+    }
+
+    #[test]
+    fn a_body_atlas_ends_keep_the_slope_of_a_ramp_along_it() {
+        // A linear ramp along v has one slope everywhere; at the ends of a texture that does
+        // not wrap (snout and tail tip) the difference is one-sided, and must give it too.
+        let ramp = Image::gray_from_fn(8, 16, |_, v| 0.5 * v);
+        let along = NormalSpec { wraps_v: false, ..spec(1.0, NormalConvention::OpenGl, ramp.height) };
+        let n = height_to_normal(&ramp, along);
+        let green = |y: usize| n.data[(y * 8 + 3) * 3 + 1];
+        for y in [0, 1, 8, 15] {
+            assert!((green(y) - green(7)).abs() < 1e-5, "row {y}: {} against {}", green(y), green(7));
+        }
+        assert!(green(7) > 0.4, "the ramp is steep: {}", green(7));
     }
 
     #[test]

@@ -493,8 +493,11 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
         let jx = hash::signed(i, 0, 0, b.seed) * b.jitter * 0.05;
         let js = blotch_size(b, i) * b.scale;
         let mut hw = b.half_width * js * w;
-        if b.widen != 1.0 {
-            let t = ((i as f32 + 0.5) / count as f32).clamp(0.0, 1.0);
+        if b.widen != 1.0 && count > 1 {
+            // From 1 at the first mark to `widen` at the last, as the key says (the marks'
+            // midpoints in the span, (i + 0.5) / count, made the first wider than `size` and
+            // the ratio short of `widen`: 3.85 for 6 over five marks).
+            let t = i as f32 / (count - 1) as f32;
             hw *= 1.0 + (b.widen - 1.0) * t;
         }
         let limit = half_length_limit(b, i, count as i32, frame.wraps_v);
@@ -505,8 +508,12 @@ pub fn blotches(frame: Frame, b: &Blotches) -> Image {
             let cx = (0.5 + side * b.offset + if side < 0.0 { -jx } else { jx }) * w;
             for &copy_v in copies_v(frame) {
                 let cy = origin + (i as f32 + 0.5 + jy + b.phase + shift) * spacing + copy_v * h;
-                for copy_u in [-1.0f32, 0.0, 1.0] {
-                    let cx = cx + copy_u * w;
+                // Copies round the body as far as the mark reaches: a mark widened toward the
+                // tail may span more than the circumference (a chevron of `size` 0.5 widened
+                // 6 times: 3.3), and one copy either side left a straight seam at u = 0.
+                let copies = (hw / w).ceil() as i32 + 1;
+                for copy_u in -copies..=copies {
+                    let cx = cx + copy_u as f32 * w;
                     if !canvas.keeps((cx - hw, cx + hw), (cy - hl, cy + hl)) {
                         continue;
                     }
