@@ -1367,8 +1367,13 @@ impl Drop for StopOnPanic<'_> {
     }
 }
 
+/// How often a job whose set another run is writing looks whether that run has finished
+/// (each look also tries the set's lock, a second of tries: `export::SetLock::acquire`).
+const BUSY_SET_POLL: std::time::Duration = std::time::Duration::from_millis(250);
+
 /// One job: a duplicate's set is the earlier job's, a done job is left as it is, any other
-/// is generated.
+/// is generated (after waiting for another run that is making it, and skipped if that run
+/// did).
 fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Result<JobOutcome, Error> {
     let mut outcome = resolved.outcome.clone();
     // Another run into the same folder may have finished the set since this one was planned:
@@ -1383,18 +1388,40 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
     } else if !done {
         let running = RunningJob { place: job.place(jobs_file, job.lines.preset), seed: outcome.seed, size: job.size };
         let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
-        // Checked against the available memory with the other jobs when the run was planned
-        // (`fitting_concurrency`); the jobs running beside this one hold part of it now.
-        let plan = Plan::within_checked_budget(&request(job, out, &outcome)).map_err(failed)?;
-        // The preset is read again here: an edit since the plan would write a set of the
-        // edited preset under the planned key, which a later run, the edit undone, took as
-        // done.
-        let loaded = plan.loaded();
-        if job.key(&loaded.content_hash, loaded.preset.seed) != outcome.key {
-            return Err(BatchError::Changed { job: running.clone() }.into());
-        }
-        outcome.kept = plan.run(&|_, _| {}).map_err(failed)?.kept;
-        outcome.status = JobStatus::Done;
+        let manifest = out.join(&outcome.manifest);
+        outcome.status = loop {
+            // Checked against the available memory with the other jobs when the run was
+            // planned (`fitting_concurrency`); the jobs running beside this one hold part of
+            // it now.
+            let plan = Plan::within_checked_budget(&request(job, out, &outcome)).map_err(failed)?;
+            // The preset is read again here: an edit since the plan would write a set of the
+            // edited preset under the planned key, which a later run, the edit undone, took
+            // as done.
+            let loaded = plan.loaded();
+            if job.key(&loaded.content_hash, loaded.preset.seed) != outcome.key {
+                return Err(BatchError::Changed { job: running.clone() }.into());
+            }
+            match plan.run(&|_, _| {}) {
+                Ok(report) => {
+                    outcome.kept = report.kept;
+                    break JobStatus::Done;
+                }
+                // Another run into the folder (a shard beside a whole run, a second jobs file
+                // sharing sets) holds the set's lock, past the lock's second of tries: it is
+                // making the set. Waited for and looked at again: skipped if it made it,
+                // made here if it failed. (Failed, the job stopped the whole queue: of two
+                // batches over the same 3K sets started together, the second made none.)
+                Err(Error::Export(crate::export::ExportError::Busy { .. })) => {
+                    std::thread::sleep(BUSY_SET_POLL);
+                    if is_done(&manifest, &outcome.key, &resolved.files) {
+                        // Its lock left as a skipped set's is (below).
+                        let _ = crate::export::SetLock::acquire(&out.join(&outcome.folder), &outcome.preset);
+                        break JobStatus::Skipped;
+                    }
+                }
+                Err(e) => return Err(failed(e).into()),
+            }
+        };
     } else {
         outcome.status = JobStatus::Skipped;
         // A run killed after committing this set but before removing its lock file left an

@@ -334,6 +334,14 @@ impl ExportPlan {
         // left (a `.glb`'s whole file) are stale whatever their age. Its drop takes away the
         // folder it made if the export fails.
         let lock = SetLock::acquire(&dir, &name)?;
+        // Looked for again under the lock: an export to the other spelling (`a.GLTF` beside
+        // `a.gltf`) started at the same moment passed the plan's look before either had
+        // written, then waited for the lock and wrote its images over the first's; both said
+        // they succeeded, one document reading the other's skin (5 tries of 5, a sweep).
+        // Under the lock the other has finished or waits.
+        if !binary && let Some(other) = gltf_sharing_side_files(&out, &dir, &name) {
+            return Err(crate::export::ExportError::SharesSideFiles { path: out, other, stem: name }.into());
+        }
         let (mut textures, stats, encode_time) = plan.pack_textures(Pack::Gltf, progress)?;
         // The evaluation's buffers, freed on the pool's threads, go back before the file is
         // made (python-regius's body atlas at 1024 kept 225 MB resident for 47 MB of textures).

@@ -1797,3 +1797,57 @@ fn an_index_whose_lock_is_held_is_not_written() {
     assert!(control.status.success(), "the control: {}", stderr(&control));
     assert!(out_dir.join("index.json").is_file());
 }
+
+/// A job whose set another run is writing (its lock held, past the lock's second of tries)
+/// waits for that run instead of failing, and with it the whole queue (of two batches over
+/// the same 3K sets started together, the second stopped at its first job, exit 1, having
+/// made nothing: a sweep). Where the other run made the set meanwhile, the job is skipped;
+/// where it let go without making it, the job makes it.
+#[test]
+fn a_set_another_run_is_writing_is_waited_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[1, 2]", 16);
+    // The first job's set, made apart to be put in place as if another run had made it.
+    let elsewhere = dir.path().join("elsewhere");
+    let one = dir.path().join("one.toml");
+    std::fs::write(&one, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    let made = snakeskin(&["batch", one.to_str().unwrap(), "-o", elsewhere.to_str().unwrap()]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    let set = Path::new("natrix-natrix/tile-16-seed1-png");
+    for makes_it in [true, false] {
+        let out = dir.path().join(format!("out-{makes_it}"));
+        let folder = out.join(set);
+        std::fs::create_dir_all(&folder).unwrap();
+        // The lock another run holds while it makes the set (`SetLock`, `.NAME.lock`).
+        let lock = std::fs::File::create(folder.join(".natrix-natrix.lock")).unwrap();
+        lock.try_lock().unwrap();
+        let run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "1"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Past the lock's second of tries.
+        std::thread::sleep(Duration::from_millis(2500));
+        if makes_it {
+            for file in std::fs::read_dir(elsewhere.join(set)).unwrap() {
+                let file = file.unwrap().path();
+                std::fs::copy(&file, folder.join(file.file_name().unwrap())).unwrap();
+            }
+        }
+        let manifest = folder.join("natrix-natrix.material.json");
+        let placed = std::fs::metadata(&manifest).ok().map(|m| m.modified().unwrap());
+        drop(lock);
+        let run = run.wait_with_output().unwrap();
+        assert!(run.status.success(), "the other run makes it: {makes_it}: {}", stderr(&run));
+        let expected = if makes_it { (1, 1) } else { (2, 0) };
+        assert_eq!(summary_counts(&run), expected, "the other run makes it: {makes_it}: {}", stdout(&run));
+        assert_eq!(statuses(&read_index(&out))[0], if makes_it { "skipped" } else { "done" });
+        if makes_it {
+            assert_eq!(std::fs::metadata(&manifest).unwrap().modified().ok(), placed, "the set was made again");
+        }
+        let (theirs, made_apart) = (tree(&out.join(set)), tree(&elsewhere.join(set)));
+        assert_eq!(theirs.keys().collect::<Vec<_>>(), made_apart.keys().collect::<Vec<_>>(), "{makes_it}");
+        assert!(theirs == made_apart, "the other run makes it: {makes_it}: the set differs");
+    }
+}

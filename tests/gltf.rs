@@ -233,6 +233,36 @@ fn a_gltf_beside_a_set_of_the_same_name_leaves_the_set_whole() {
     }
 }
 
+/// A `.gltf` of the other spelling made while an export waits for the name's lock (two
+/// exports, `a.gltf` and `a.GLTF`, started together) is refused under the lock: both passed
+/// the look made before it, and the second wrote its images over the first's, both saying
+/// they had succeeded (a sweep: 5 tries of 5). Here the other export is the test, holding
+/// the lock while it writes `RACE.GLTF`.
+#[test]
+fn a_gltf_of_the_other_spelling_made_while_waiting_for_the_lock_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let lock = std::fs::File::create(dir.path().join(".RACE.lock")).unwrap();
+    lock.try_lock().unwrap();
+    let target = dir.path().join("RACE.gltf");
+    let run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["export", "xenopeltis-unicolor", "--mesh", "plane", "--size", "16", "--gltf", target.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Within the lock's second of tries.
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    std::fs::write(dir.path().join("RACE.GLTF"), "{}").unwrap();
+    drop(lock);
+    let out = run.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("RACE.GLTF beside it is a .gltf file whose name differs only"), "{}", stderr(&out));
+    let mut left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    left.sort();
+    // (The lock file, let go, the export removes as it does its own.)
+    assert_eq!(left, ["RACE.GLTF"].map(std::ffi::OsString::from), "nothing written");
+}
+
 /// `--gltf NAME.GLTF` writes the file named, its extension's case kept, as `.GLB` did (it
 /// wrote NAME.gltf, a file other than the one named and checked).
 #[test]
