@@ -23,10 +23,8 @@ pub enum PresetError {
     TooLarge { path: PathBuf, size: crate::text_file::FileSize, limit: u64 },
 
     /// A preset file whose name the set's files cannot carry.
-    #[error(
-        "preset {path:?}: its file name has control characters, and a set's files are named after it; rename the file"
-    )]
-    FileName { path: PathBuf },
+    #[error("preset {path:?}: its file name has {what}, and a set's files are named after it; rename the file")]
+    FileName { path: PathBuf, what: &'static str },
     #[error("unknown preset {name:?}: not a .toml file and not a built-in preset{suggestion} (built-in: {available})")]
     UnknownPreset { name: String, suggestion: String, available: String },
 
