@@ -371,7 +371,8 @@ pub fn load_jobs(path: &Path) -> Result<Vec<Job>, BatchError> {
     if file.job.is_empty() {
         return Err(BatchError::Empty { path: path.into() });
     }
-    let base = path.parent().unwrap_or(Path::new("."));
+    let base = jobs_folder(path);
+    let base = base.as_path();
     let listed = |list: &Option<Vec<u64>>| list.as_ref().map_or(1, Vec::len);
     let count: usize = file.job.iter().map(|t| listed(&t.seeds).saturating_mul(listed(&t.sizes))).sum();
     if count > MAX_JOBS {
@@ -715,9 +716,9 @@ struct Resolved {
 
 /// `check`: whether to look for its finished set (reading and hashing its files).
 fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resolved, Error> {
-    let folder = jobs_file.parent().unwrap_or(Path::new(""));
+    let folder = jobs_folder(jobs_file);
     let loaded =
-        crate::preset::load_beside(&job.preset, folder, &job.overrides, job.seed).map_err(|source| match source {
+        crate::preset::load_beside(&job.preset, &folder, &job.overrides, job.seed).map_err(|source| match source {
             // The preset's message says `--set`, which a jobs file's reader did not write.
             crate::preset::PresetError::Override { argument, message } => {
                 // Its entries on one line: a key with a newline printed a made-up `1/1 done` line.
@@ -1365,6 +1366,22 @@ impl Drop for StopOnPanic<'_> {
             self.0.store(true, std::sync::atomic::Ordering::SeqCst);
         }
     }
+}
+
+/// The folder a jobs file's preset paths are relative to: the file's own, through any
+/// symbolic links to it (a link `link.toml -> sub/jobs.toml` looked for `my.toml` beside the
+/// link, not in `sub/`, while the run's index took both names for one jobs file: a sweep).
+/// The path as given where it is no link, so messages keep the paths as the user wrote them.
+fn jobs_folder(path: &Path) -> PathBuf {
+    let mut file = path.to_path_buf();
+    // As many links as the kernel follows (ELOOP past 40).
+    for _ in 0..40 {
+        match std::fs::read_link(&file) {
+            Ok(target) => file = file.parent().unwrap_or(Path::new("")).join(target),
+            Err(_) => break,
+        }
+    }
+    file.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
 }
 
 /// How often a job whose set another run is writing looks whether that run has finished

@@ -641,6 +641,32 @@ fn a_jobs_entry_with_a_slash_is_in_the_jobs_folder() {
     assert!(dir.path().join("out/name/tile-16-seed2-png").is_dir(), "{}", stdout(&out));
 }
 
+/// A jobs file reached through a symbolic link reads its presets beside the file itself, as
+/// the run's index takes the link and the file for one jobs file: it looked beside the link
+/// ("cannot read preset my.toml", a sweep). Control: a `my.toml` beside the link is not read.
+#[cfg(unix)]
+#[test]
+fn a_jobs_file_through_a_link_reads_its_presets_beside_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    std::fs::write(dir.path().join("sub/my.toml"), "seed = 5\n").unwrap();
+    std::fs::write(dir.path().join("sub/jobs.toml"), "[[job]]\npreset = \"my.toml\"\nsizes = [16]\n").unwrap();
+    std::os::unix::fs::symlink("sub/jobs.toml", dir.path().join("link.toml")).unwrap();
+    // A link to the link, from another folder.
+    std::fs::create_dir(dir.path().join("other")).unwrap();
+    std::os::unix::fs::symlink("../link.toml", dir.path().join("other/jobs.toml")).unwrap();
+    std::fs::write(dir.path().join("other/my.toml"), "seed = 6\n").unwrap();
+    for (jobs, out) in [("link.toml", "out1"), ("other/jobs.toml", "out2")] {
+        let run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["batch", jobs, "-o", out])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{jobs}: {}", stderr(&run));
+        assert!(dir.path().join(out).join("my/tile-16-seed5-png").is_dir(), "{jobs}: {}", stdout(&run));
+    }
+}
+
 /// `ao = true` with a pack puts the ambient occlusion map in the pack's occlusion channel,
 /// in a folder of its own, with the same bytes as `generate --pack gltf --ao` (a batch had
 /// no way to ask for it); without a pack it is refused with the way to name the map.
