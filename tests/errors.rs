@@ -822,7 +822,11 @@ fn sizes_outside_the_range_are_refused_before_anything_runs() {
     for size in ["0", "15", "1000000", "16385"] {
         let err = refused("fine.toml", "seed = 1\n", &["--size", size]);
         assert!(err.contains("16..=16384") || err.contains("16 to 16384"), "{size}: {err}");
+        assert!(!err.contains("one width"), "{size}: {err}");
     }
+    // A frame's size, as `preview --size` takes it, is told what a set's size is.
+    let err = refused("fine.toml", "seed = 1\n", &["--size", "1024x1024"]);
+    assert!(err.contains("a set's --size is one width (the tile is square"), "{err}");
 }
 
 #[test]

@@ -1372,7 +1372,12 @@ fn preview_flags_that_would_do_nothing_are_named() {
     );
     let out = snakeskin(&["preview", PRESET, "--close-up", "--snakes", "4", "--out", "x.png"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("'--close-up' cannot be used with '--snakes <SNAKES>'"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--close-up frames one snake, not --snakes 4"), "{}", stderr(&out));
+    // Control: one snake, the default, named (clap's conflict refused it too); stopped by the
+    // memory check before any GPU work.
+    let one = ["preview", PRESET, "--close-up", "--snakes", "1", "--out", "x.png"];
+    let out = snakeskin_env(&one, &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1")]);
+    assert!(stderr(&out).contains("needs about") && !stderr(&out).contains("--close-up"), "{}", stderr(&out));
     // A body atlas narrowed to stay within the tallest texture is named (only the memory
     // refusal named the maps' size); the refusal ends the run before any GPU work.
     let args = ["preview", "crotalus-atrox", "--layout", "body", "--map-size", "1024", "--out", "x.png"];
@@ -1559,7 +1564,13 @@ fn a_preview_memory_cannot_hold_is_refused() {
     let args = ["preview", PRESET, "--out", image.to_str().unwrap(), "--size", "64x64", "--layout", "body"];
     let out = snakeskin_env(&[&args[..], &["--map-size", "4096"]].concat(), &limit);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("the preview's frame with its maps (682×8184 maps) needs about"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains(
+            "the preview's frame with its maps (682×8184 maps), 320 MiB of it the renderer's at any size, needs about"
+        ),
+        "{}",
+        stderr(&out)
+    );
     assert!(!image.exists());
     let out = snakeskin_env(&[&args[..], &["--map-size", "64"]].concat(), &limit);
     assert!(!stderr(&out).contains("needs about"), "{}", stderr(&out));
@@ -1571,7 +1582,13 @@ fn a_preview_memory_cannot_hold_is_refused() {
         &limit,
     );
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("the preview's frame with its maps (64×64 maps) needs about"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains(
+            "the preview's frame with its maps (64×64 maps), 320 MiB of it the renderer's at any size, needs about"
+        ),
+        "{}",
+        stderr(&out)
+    );
     assert!(!dir.path().join("new").exists(), "a folder was made for a refused preview");
 }
 
@@ -2077,7 +2094,7 @@ fn figures_are_checked_before_any_is_drawn() {
     let out = snakeskin_env(&[&args[..], &["8192x8192"]].concat(), &limit);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(
-        stderr(&out).contains("drawing the figures' frames with their maps (64×64 maps) needs about"),
+        stderr(&out).contains("drawing the figures' frames with their maps (64×64 maps), 320 MiB of it the renderer's at any size, needs about"),
         "{}",
         stderr(&out)
     );

@@ -285,7 +285,21 @@ fn ranged_u64(lo: u64, hi: u64) -> impl Fn(&str) -> Result<u64, String> + Clone 
 
 /// A set's `--size`: `snakeskin::SIZE_RANGE`.
 fn set_size() -> impl Fn(&str) -> Result<u64, String> + Clone + Send + Sync + 'static {
-    ranged_u64((*snakeskin::SIZE_RANGE.start()).into(), (*snakeskin::SIZE_RANGE.end()).into())
+    let parse = ranged_u64((*snakeskin::SIZE_RANGE.start()).into(), (*snakeskin::SIZE_RANGE.end()).into());
+    move |text| {
+        parse(text).map_err(|e| {
+            // `preview --size` takes WIDTHxHEIGHT, a frame's; a set's maps have one width.
+            let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+            let frame = text.split_once(['x', 'X']).is_some_and(|(w, h)| digits(w) && w != "0" && digits(h));
+            if frame {
+                format!(
+                    "{e}; a set's --size is one width (the tile is square; a body atlas is body.length widths tall)"
+                )
+            } else {
+                e
+            }
+        })
+    }
 }
 
 /// A drawing command's `--map-size`: `render::engine::prepare::MAP_SIZE_RANGE`.
@@ -401,7 +415,8 @@ pub struct PresetArgs {
     /// Maps to produce, comma-separated: color, height, normal, roughness, iridescence, and ao
     /// (ambient occlusion, only when named); "all" is the first five ("all,ao" adds it).
     /// `generate` writes them as a whole set: in a folder that holds a set of the same name,
-    /// that set's other maps are removed (see -o); give each partial set its own folder.
+    /// that set's other maps are removed (see `generate --help`, -o); give each partial set
+    /// its own folder.
     #[arg(long, default_value = "all", value_name = "LIST", value_parser = parse_maps)]
     pub maps: MapList,
 }
@@ -621,8 +636,9 @@ pub struct PreviewArgs {
     /// but the far film too saturated: BENCHMARKS.md, "Iridescence seen from afar").
     #[arg(long, value_enum, default_value_t = FootprintArg::Spread, value_name = "HOW")]
     pub film_footprint: FootprintArg,
-    /// Frame the mid-body closely instead of the whole snake (of one snake: not with --snakes).
-    #[arg(long, conflicts_with = "snakes")]
+    /// Frame the mid-body closely instead of the whole snake (of one snake: not with --snakes
+    /// above 1).
+    #[arg(long)]
     pub close_up: bool,
     /// Also shade the frame on the CPU with the f64 spectral reference, print mean and p99
     /// CIEDE2000 against the GPU image, and write the error heat map to this PNG. The check

@@ -119,7 +119,10 @@ impl DrawMemory {
     /// `Error::Memory` when the estimate exceeds the available memory, before a renderer is
     /// made; `what` names the work.
     pub fn check(&self, what: &str) -> Result<(), Error> {
-        self.refuse_over(self.estimate_bytes(), what)
+        // The renderer's part named: no smaller size brings the estimate under it (a limit of
+        // 300 MiB refused 16×16 frames of 64² maps, "use a smaller size").
+        let fixed_mib = (RENDERER_OVERHEAD_BYTES + FIXED_OVERHEAD_BYTES).div_ceil(1 << 20);
+        self.refuse_over(self.estimate_bytes(), what, &format!(", {fixed_mib} MiB of it the renderer's at any size,"))
     }
 
     /// The same for a process that holds its renderer (and whatever it drew) already: the
@@ -127,12 +130,12 @@ impl DrawMemory {
     /// Counted again, a 2048² window's reloads (1312 MiB estimated, 891 resident) would be
     /// refused unless about 2.2 GiB were free.
     pub fn check_added(&self, what: &str) -> Result<(), Error> {
-        self.refuse_over(self.estimate_added_bytes(), what)
+        self.refuse_over(self.estimate_added_bytes(), what, "")
     }
 
-    fn refuse_over(&self, bytes: u64, what: &str) -> Result<(), Error> {
+    fn refuse_over(&self, bytes: u64, what: &str, fixed: &str) -> Result<(), Error> {
         let (width, height) = self.maps;
-        MemoryCheck::against_available(bytes).refuse_if_over(&format!("{what} ({width}×{height} maps)"))
+        MemoryCheck::against_available(bytes).refuse_if_over(&format!("{what} ({width}×{height} maps){fixed}"))
     }
 }
 

@@ -29,6 +29,11 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         };
         return Err(Error::Preview(what.into()).into());
     }
+    // Here, not as clap's conflict: that refused `--snakes 1`, the default, too.
+    if args.close_up && args.snakes > 1 {
+        let what = format!("--close-up frames one snake, not --snakes {}: leave one of them out", args.snakes);
+        return Err(Error::Preview(what).into());
+    }
     let settings = FrameSettings {
         view: args.layers,
         method: args.method,
