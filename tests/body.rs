@@ -399,6 +399,23 @@ fn the_manifest_records_the_layout_counts_and_regions() {
     }
     let vent = range("vent");
     assert!(vent[0] < trunk[1] && trunk[1] < vent[1]);
+    // Where the maps lie: the snout at the first row, the belly at the edges, v not wrapping.
+    let space = m["texture_space"].as_str().unwrap();
+    for says in ["the belly's midline at u = 0 and 1", "from the snout (v = 0, the first row)", "wraps in u, not in v"]
+    {
+        assert!(space.contains(says), "{space}");
+    }
+    // A tail shorter than a ventral plate: the vent's range ends at the tail tip.
+    let short = ["--set", "body.tail_fraction=0.02", "--set", "body.ventrals=60"];
+    let out = common::snakeskin(
+        &[&["generate", "crotalus-atrox", "-o", d, "--size", "16", "--layout", "body"][..], &short].concat(),
+    );
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("crotalus-atrox.material.json")).unwrap())
+            .unwrap();
+    let vent = m["regions"]["vent"][1].as_f64().unwrap();
+    assert!(vent <= 1.0, "the vent's range ends at {vent}");
 
     // The tile's manifest says so and has neither.
     let out = common::snakeskin(&["generate", "crotalus-atrox", "-o", d, "--size", "64"]);
@@ -407,6 +424,7 @@ fn the_manifest_records_the_layout_counts_and_regions() {
     let m: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(m["layout"], "tile");
     assert!(m.get("counts").is_none() && m.get("regions").is_none());
+    assert!(m["texture_space"].as_str().unwrap().contains("the tile repeats in u and in v"), "{m}");
 }
 
 #[test]

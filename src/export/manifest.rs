@@ -32,6 +32,10 @@ pub struct Manifest {
     /// Body layout: the v range (0 snout .. 1 tail tip) of each region.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regions: Option<Regions>,
+    /// How the maps lie on the snake (`TILE_TEXTURE_SPACE`, `BODY_TEXTURE_SPACE`): what an
+    /// artist needs to map them onto a mesh, which the keys alone did not say (where the
+    /// belly is, which image row is the snout, which edges wrap: a sweep).
+    pub texture_space: String,
     pub maps: Vec<MapEntry>,
     pub iridescence: IridescenceRange,
     /// The height map's physical scale (not `height`, the image's rows, beside `width`).
@@ -223,6 +227,17 @@ pub fn manifest_file_name(set_name: &str) -> String {
     format!("{set_name}{MANIFEST_SUFFIX}")
 }
 
+/// `texture_space` of the tile layout (DESIGN.md's texture space).
+pub const TILE_TEXTURE_SPACE: &str = "u (image x, left to right) runs round the body, the belly's midline at u = 0 and \
+     1, the spine at u = 0.5; v (image rows, top to bottom) runs along it, head to tail; the tile repeats in u and in v";
+
+/// `texture_space` of the body layout (`--layout body`).
+pub const BODY_TEXTURE_SPACE: &str = "u (image x, left to right) runs round the body, the belly's midline at u = 0 \
+     and 1, the spine at u = 0.5; v (image rows, top to bottom) runs along it from the snout (v = 0, the first row) \
+     to the tail tip (v = 1, the last row), as glTF's v does (a mesh whose v points up reads 1 - v); the atlas \
+     wraps in u, not in v, and is height / width circumferences long (the preset's body.length); `regions` are \
+     ranges of v";
+
 /// What a set's name is followed by in its manifest's file name.
 pub const MANIFEST_SUFFIX: &str = ".material.json";
 
@@ -246,7 +261,8 @@ pub fn manifest(
             head: [0.0, b.head_end],
             neck: [b.head_end, b.neck_end],
             trunk: [b.neck_end, b.vent],
-            vent: [b.vent - plate, b.vent + plate],
+            // Within the trunk and the tail (a tail of 0.02 under 60 ventrals ran past 1).
+            vent: [(b.vent - plate).max(b.neck_end), (b.vent + plate).min(1.0)],
             tail: [b.vent, 1.0],
         }
     });
@@ -257,6 +273,7 @@ pub fn manifest(
         pack: pack.map(|pack| pack.name().into()),
         counts,
         regions,
+        texture_space: if options.layout == Layout::Body { BODY_TEXTURE_SPACE } else { TILE_TEXTURE_SPACE }.into(),
         maps: entries,
         iridescence: IridescenceRange { film: crate::maps::has_film(p), min_nm, max_nm },
         displacement: HeightScale { rise_texture_widths: crate::maps::height_rise_texture_widths(p) as f64 },
