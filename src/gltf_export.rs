@@ -34,6 +34,17 @@ pub enum MeshKind {
     Plane,
 }
 
+impl MeshKind {
+    /// As `export --mesh` names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            MeshKind::Snake => "snake",
+            MeshKind::Sphere => "sphere",
+            MeshKind::Plane => "plane",
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct ExportRequest {
     pub preset: String,
@@ -198,6 +209,7 @@ pub struct ExportPlan {
     plan: Plan,
     material: GltfMaterial,
     mesh: Mesh,
+    mesh_kind: MeshKind,
     thickness_varies: bool,
     ao: bool,
     memory: MemoryCheck,
@@ -318,6 +330,7 @@ impl ExportPlan {
             plan,
             material,
             mesh,
+            mesh_kind: request.mesh,
             thickness_varies,
             ao: request.ao,
             memory,
@@ -327,7 +340,8 @@ impl ExportPlan {
 
     /// Evaluates the textures and writes the file (and, for `.gltf`, its side files).
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<ExportReport, Error> {
-        let ExportPlan { start, out, binary, name, dir, plan, material, mesh, thickness_varies, ao, .. } = self;
+        let ExportPlan { start, out, binary, name, dir, plan, material, mesh, mesh_kind, thickness_varies, ao, .. } =
+            self;
         // Before the work, as `generate` does: a second export of this name into this folder
         // stops at once (it did all its work, then a `.gltf` was refused at its commit and a
         // `.glb` replaced the other's), and under the lock the temporaries a killed export
@@ -360,8 +374,14 @@ impl ExportPlan {
             thickness: texture("thickness").filter(|_| thickness_varies),
             occlusion: ao,
         };
-        // The asset's `extras`: the manifest's keys for what made it (`gltf::document`).
-        let source = crate::export::Source::of(plan.loaded(), dimensions, plan.layout());
+        // The asset's `extras`: the manifest's keys for what made it (`gltf::document`), and
+        // the export's own options, so that it can be made again (the mesh and `--ao` were
+        // left out: a sweep).
+        let source = crate::export::Source {
+            mesh: Some(mesh_kind.name()),
+            ambient_occlusion: Some(ao),
+            ..crate::export::Source::of(plan.loaded(), dimensions, plan.layout())
+        };
         let created_folder = lock.created_folder;
         let mut removed = Vec::new();
         let mut kept = Vec::new();

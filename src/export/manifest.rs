@@ -72,6 +72,12 @@ pub struct Source {
     pub height: usize,
     /// `tile` (a square that tiles both ways) or `body` (the whole snake, snout at v = 0).
     pub layout: String,
+    /// A glTF export's `--mesh` (`gltf_export::MeshKind::name`); absent from a manifest.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<&'static str>,
+    /// A glTF export's `--ao`; absent from a manifest (whose `maps` list an `ao` map).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ambient_occlusion: Option<bool>,
 }
 
 impl Source {
@@ -87,6 +93,8 @@ impl Source {
             width,
             height,
             layout: layout.name().into(),
+            mesh: None,
+            ambient_occlusion: None,
         }
     }
 }
