@@ -114,6 +114,14 @@ pub enum BatchError {
          their jobs asked). Run the batch again"
     )]
     Changed { job: RunningJob },
+    /// Another run made the job's set while the job waited for it (`run_one`), from other
+    /// input: this job's set would replace it.
+    #[error(
+        "{job}: another snakeskin run made {} while this one waited for it, from other input (another jobs file's \
+         preset of the same name, or other options); this job's set would replace it: give the jobs folders of their own",
+        .manifest.display()
+    )]
+    MadeMeanwhile { job: RunningJob, manifest: PathBuf },
     /// A job failed (`Failed`, `Changed`) and the run stopped: `source` is the earliest
     /// failed job's error (its words are this error's), `index` the run's index, every job
     /// `done`, `skipped`, `duplicate`, `failed` or `not run`, for the caller's summary, and
@@ -962,7 +970,12 @@ pub fn run(
     let mut finished: Vec<Option<JobOutcome>> = vec![None; total];
     let mut failures: Vec<(usize, Error)> = Vec::new();
     std::thread::scope(|scope| {
-        let (sender, receiver) = std::sync::mpsc::channel::<(usize, Result<JobOutcome, Error>)>();
+        // A job's end, or a note while it runs (said by the caller's `warn`, on this thread).
+        enum Event {
+            Ended(usize, Result<JobOutcome, Error>),
+            Note(String),
+        }
+        let (sender, receiver) = std::sync::mpsc::channel::<Event>();
         for _ in 0..concurrency.min(total) {
             let sender = sender.clone();
             let (work, next, stop) = (&work, &next, &stop);
@@ -970,14 +983,16 @@ pub fn run(
                 // A job that panics stops the queue too (the panic reaches the caller when
                 // the scope ends).
                 let _stop_on_panic = StopOnPanic(stop);
+                let notes = sender.clone();
+                let note = move |text: &str| drop(notes.send(Event::Note(text.into())));
                 while !stop.load(std::sync::atomic::Ordering::SeqCst) {
                     let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
                     let Some((job, resolved)) = work.get(k) else { break };
-                    let result = run_one(jobs_file, job, resolved, out);
+                    let result = run_one(jobs_file, job, resolved, out, &note);
                     if result.is_err() {
                         stop.store(true, std::sync::atomic::Ordering::SeqCst);
                     }
-                    if sender.send((k, result)).is_err() {
+                    if sender.send(Event::Ended(k, result)).is_err() {
                         break;
                     }
                 }
@@ -985,14 +1000,15 @@ pub fn run(
         }
         drop(sender);
         let mut done = 0;
-        for (k, result) in receiver {
-            match result {
-                Ok(outcome) => {
+        for event in receiver {
+            match event {
+                Event::Ended(k, Ok(outcome)) => {
                     done += 1;
                     progress(done, total, &outcome);
                     finished[k] = Some(outcome);
                 }
-                Err(e) => failures.push((k, e)),
+                Event::Ended(k, Err(e)) => failures.push((k, e)),
+                Event::Note(text) => warn(&text),
             }
         }
     });
@@ -1391,7 +1407,13 @@ const BUSY_SET_POLL: std::time::Duration = std::time::Duration::from_millis(250)
 /// One job: a duplicate's set is the earlier job's, a done job is left as it is, any other
 /// is generated (after waiting for another run that is making it, and skipped if that run
 /// did).
-fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Result<JobOutcome, Error> {
+fn run_one(
+    jobs_file: &Path,
+    job: &Job,
+    resolved: &Resolved,
+    out: &Path,
+    waiting: &dyn Fn(&str),
+) -> Result<JobOutcome, Error> {
     let mut outcome = resolved.outcome.clone();
     // Another run into the same folder may have finished the set since this one was planned:
     // looked for again (of two batches over the same jobs, the second generated again every
@@ -1406,6 +1428,8 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
         let running = RunningJob { place: job.place(jobs_file, job.lines.preset), seed: outcome.seed, size: job.size };
         let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
         let manifest = out.join(&outcome.manifest);
+        let folder = out.join(&outcome.folder);
+        let mut said = false;
         outcome.status = loop {
             // Checked against the available memory with the other jobs when the run was
             // planned (`fitting_concurrency`); the jobs running beside this one hold part of
@@ -1425,15 +1449,33 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
                 }
                 // Another run into the folder (a shard beside a whole run, a second jobs file
                 // sharing sets) holds the set's lock, past the lock's second of tries: it is
-                // making the set. Waited for and looked at again: skipped if it made it,
-                // made here if it failed. (Failed, the job stopped the whole queue: of two
-                // batches over the same 3K sets started together, the second made none.)
+                // making the set. Waited for (said once) and looked at again: skipped if it
+                // made it, made here if it let go without making it. (Failed, the job stopped
+                // the whole queue: of two batches over the same 3K sets started together, the
+                // second made none.) The wait only looks at the lock, a try each
+                // `BUSY_SET_POLL`: taken again with its second of tries, the set another run
+                // had just made was made again most times, and the jobs beside it waited on
+                // the process's table of held locks (the review).
                 Err(Error::Export(crate::export::ExportError::Busy { .. })) => {
-                    std::thread::sleep(BUSY_SET_POLL);
+                    let before = modified(&manifest);
+                    if !said {
+                        let lock = folder.join(crate::export::lock_file_name(&outcome.preset));
+                        waiting(&format!(
+                            "note: {running}: another snakeskin run is writing {} (it holds {}); waiting for it",
+                            folder.display(),
+                            lock.display()
+                        ));
+                        said = true;
+                    }
+                    while lock_held_elsewhere(&folder, &outcome.preset) {
+                        std::thread::sleep(BUSY_SET_POLL);
+                    }
                     if is_done(&manifest, &outcome.key, &resolved.files) {
-                        // Its lock left as a skipped set's is (below).
-                        let _ = crate::export::SetLock::acquire(&out.join(&outcome.folder), &outcome.preset);
+                        let_go_of_a_left_lock(&folder, &outcome.preset);
                         break JobStatus::Skipped;
+                    }
+                    if modified(&manifest) != before {
+                        return Err(BatchError::MadeMeanwhile { job: running.clone(), manifest }.into());
                     }
                 }
                 Err(e) => return Err(failed(e).into()),
@@ -1441,12 +1483,34 @@ fn run_one(jobs_file: &Path, job: &Job, resolved: &Resolved, out: &Path) -> Resu
         };
     } else {
         outcome.status = JobStatus::Skipped;
-        // A run killed after committing this set but before removing its lock file left an
-        // empty `.NAME.lock` behind: taking the lock and letting it go removes it (and leaves
-        // the set alone; a set some other run holds is left as it is).
-        let _ = crate::export::SetLock::acquire(&out.join(&outcome.folder), &outcome.preset);
+        let_go_of_a_left_lock(&out.join(&outcome.folder), &outcome.preset);
     }
     Ok(outcome)
+}
+
+/// A run killed after committing a set but before removing its lock file left an empty
+/// `.NAME.lock` behind: taking the lock and letting it go removes it (and leaves the set
+/// alone; a set some other run holds is left as it is).
+fn let_go_of_a_left_lock(folder: &Path, name: &str) {
+    let _ = crate::export::SetLock::acquire(folder, name);
+}
+
+/// Whether another process holds the lock of set `name` in `folder` now: one try, without
+/// `SetLock`'s second of tries and its table of held locks. A lock file that is gone, or
+/// cannot be opened, is no one's.
+fn lock_held_elsewhere(folder: &Path, name: &str) -> bool {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    // Not through a link, and without waiting on a FIFO (as `SetLock::acquire` opens it).
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW | libc::O_NONBLOCK);
+    let Ok(file) = options.open(folder.join(crate::export::lock_file_name(name))) else { return false };
+    matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock))
+}
+
+/// When `path` was last modified, if it can be read.
+fn modified(path: &Path) -> Option<std::time::SystemTime> {
+    std::fs::metadata(path).and_then(|m| m.modified()).ok()
 }
 
 #[cfg(test)]

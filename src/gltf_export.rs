@@ -265,6 +265,16 @@ impl ExportPlan {
                 request.out.display()
             ))
         })?;
+        // A `.gltf`'s side files are named after it, and a backslash is a folder's separator
+        // on Windows, where the document may be read (as a preset file's name: `PresetError::
+        // FileName`); a `.glb` carries its name inside only.
+        if !binary && name.contains('\\') {
+            return Err(Error::Unsupported(format!(
+                "--gltf {}: the file name has a backslash (a folder's separator on Windows), and the .gltf's side files \
+                 are named after it; rename it",
+                request.out.display()
+            )));
+        }
         let plan = Plan::within_checked_budget(&GenerateRequest {
             preset: request.preset.clone(),
             overrides: request.overrides.clone(),

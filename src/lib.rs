@@ -83,7 +83,11 @@ impl Error {
                 | batch::BatchError::Failed { source, .. }
                 | batch::BatchError::Stopped { source, .. },
             ) => source.is_invalid_input(),
-            Error::Batch(batch::BatchError::Changed { .. } | batch::BatchError::Busy { .. }) => false,
+            Error::Batch(
+                batch::BatchError::Changed { .. }
+                | batch::BatchError::Busy { .. }
+                | batch::BatchError::MadeMeanwhile { .. },
+            ) => false,
             Error::Gpu(_) | Error::Internal(_) => false,
             _ => true,
         }

@@ -1825,55 +1825,90 @@ fn an_index_whose_lock_is_held_is_not_written() {
 }
 
 /// A job whose set another run is writing (its lock held, past the lock's second of tries)
-/// waits for that run instead of failing, and with it the whole queue (of two batches over
-/// the same 3K sets started together, the second stopped at its first job, exit 1, having
-/// made nothing: a sweep). Where the other run made the set meanwhile, the job is skipped;
-/// where it let go without making it, the job makes it.
+/// waits for that run, and says so once, instead of failing, and with it the whole queue (of
+/// two batches over the same 3K sets started together, the second stopped at its first job,
+/// exit 1, having made nothing: a sweep). Where the other run made the set meanwhile, the
+/// job is skipped (the set not made again: taking the lock again with its second of tries,
+/// it was made again most times, the review); where it let go without making it, the job
+/// makes it; where it made another set there (another preset of the name), the job fails
+/// rather than replace it.
 #[test]
 fn a_set_another_run_is_writing_is_waited_for() {
+    use std::io::BufRead;
     let dir = tempfile::tempdir().unwrap();
     let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[1, 2]", 16);
-    // The first job's set, made apart to be put in place as if another run had made it.
+    // The first job's set, made apart to be put in place as if another run had made it, and
+    // another preset's set of that name.
     let elsewhere = dir.path().join("elsewhere");
     let one = dir.path().join("one.toml");
     std::fs::write(&one, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n").unwrap();
     let made = snakeskin(&["batch", one.to_str().unwrap(), "-o", elsewhere.to_str().unwrap()]);
     assert!(made.status.success(), "{}", stderr(&made));
+    let other = dir.path().join("other");
+    std::fs::create_dir(&other).unwrap();
+    std::fs::write(other.join("natrix-natrix.toml"), "seed = 9\n").unwrap();
+    let other_jobs = other.join("jobs.toml");
+    std::fs::write(&other_jobs, "[[job]]\npreset = \"natrix-natrix.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    let made_other = snakeskin(&["batch", other_jobs.to_str().unwrap(), "-o", other.join("out").to_str().unwrap()]);
+    assert!(made_other.status.success(), "{}", stderr(&made_other));
     let set = Path::new("natrix-natrix/tile-16-seed1-png");
-    for makes_it in [true, false] {
-        let out = dir.path().join(format!("out-{makes_it}"));
+    for meanwhile in ["makes it", "lets go", "makes another"] {
+        let out = dir.path().join(format!("out-{}", meanwhile.replace(' ', "-")));
         let folder = out.join(set);
         std::fs::create_dir_all(&folder).unwrap();
         // The lock another run holds while it makes the set (`SetLock`, `.NAME.lock`).
         let lock = std::fs::File::create(folder.join(".natrix-natrix.lock")).unwrap();
         lock.try_lock().unwrap();
-        let run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        let mut run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
             .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "1"])
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        // Past the lock's second of tries.
-        std::thread::sleep(Duration::from_millis(2500));
-        if makes_it {
-            for file in std::fs::read_dir(elsewhere.join(set)).unwrap() {
-                let file = file.unwrap().path();
-                std::fs::copy(&file, folder.join(file.file_name().unwrap())).unwrap();
-            }
+        // Until the run says it waits (past the lock's second of tries).
+        let mut said = String::new();
+        let mut log = std::io::BufReader::new(run.stderr.take().unwrap());
+        while !said.contains("waiting for it") {
+            let mut line = String::new();
+            assert!(log.read_line(&mut line).unwrap() > 0, "{meanwhile}: the run ended without waiting: {said}");
+            said += &line;
+        }
+        assert!(said.contains("another snakeskin run is writing") && said.contains(".natrix-natrix.lock"), "{said}");
+        let source = match meanwhile {
+            "makes it" => Some(elsewhere.join(set)),
+            "makes another" => Some(other.join("out").join(set)),
+            _ => None,
+        };
+        for file in source.iter().flat_map(|source| std::fs::read_dir(source).unwrap()) {
+            let file = file.unwrap().path();
+            std::fs::copy(&file, folder.join(file.file_name().unwrap())).unwrap();
         }
         let manifest = folder.join("natrix-natrix.material.json");
         let placed = std::fs::metadata(&manifest).ok().map(|m| m.modified().unwrap());
         drop(lock);
-        let run = run.wait_with_output().unwrap();
-        assert!(run.status.success(), "the other run makes it: {makes_it}: {}", stderr(&run));
-        let expected = if makes_it { (1, 1) } else { (2, 0) };
-        assert_eq!(summary_counts(&run), expected, "the other run makes it: {makes_it}: {}", stdout(&run));
-        assert_eq!(statuses(&read_index(&out))[0], if makes_it { "skipped" } else { "done" });
-        if makes_it {
+        let status = run.wait().unwrap();
+        let mut rest = String::new();
+        std::io::Read::read_to_string(&mut log, &mut rest).unwrap();
+        let stdout = std::io::read_to_string(run.stdout.take().unwrap()).unwrap();
+        if meanwhile == "makes another" {
+            assert_eq!(status.code(), Some(1), "{rest}");
+            assert!(rest.contains("another snakeskin run made") && rest.contains("from other input"), "{rest}");
+            // (The lock file left is the test's: the run never took it.)
+            std::fs::remove_file(folder.join(".natrix-natrix.lock")).unwrap();
+            assert!(tree(&folder) == tree(&other.join("out").join(set)), "the other preset's set was replaced");
+            continue;
+        }
+        assert!(status.success(), "{meanwhile}: {rest}");
+        assert_eq!(said.matches("waiting for it").count() + rest.matches("waiting for it").count(), 1, "{rest}");
+        let counts = stdout.lines().last().and_then(|l| l.split(": ").nth(1)).unwrap_or_default().to_string();
+        let expected = if meanwhile == "makes it" { "1 run, 1 already done" } else { "2 run, 0 already done" };
+        assert!(counts.starts_with(expected), "{meanwhile}: {stdout}");
+        assert_eq!(statuses(&read_index(&out))[0], if meanwhile == "makes it" { "skipped" } else { "done" });
+        if meanwhile == "makes it" {
             assert_eq!(std::fs::metadata(&manifest).unwrap().modified().ok(), placed, "the set was made again");
         }
         let (theirs, made_apart) = (tree(&out.join(set)), tree(&elsewhere.join(set)));
-        assert_eq!(theirs.keys().collect::<Vec<_>>(), made_apart.keys().collect::<Vec<_>>(), "{makes_it}");
-        assert!(theirs == made_apart, "the other run makes it: {makes_it}: the set differs");
+        assert_eq!(theirs.keys().collect::<Vec<_>>(), made_apart.keys().collect::<Vec<_>>(), "{meanwhile}");
+        assert!(theirs == made_apart, "{meanwhile}: the set differs");
     }
 }

@@ -250,8 +250,18 @@ fn a_gltf_of_the_other_spelling_made_while_waiting_for_the_lock_is_refused() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    // Within the lock's second of tries.
-    std::thread::sleep(std::time::Duration::from_millis(400));
+    // Within the lock's second of tries: the export holds the lock file open while it tries
+    // (past its plan's look), which its descriptors in /proc show.
+    let lock_path = dir.path().join(".RACE.lock");
+    let holds_it = || {
+        let fds = std::fs::read_dir(format!("/proc/{}/fd", run.id())).into_iter().flatten().flatten();
+        fds.filter_map(|fd| std::fs::read_link(fd.path()).ok()).any(|target| target == lock_path)
+    };
+    let start = std::time::Instant::now();
+    while !holds_it() {
+        assert!(start.elapsed().as_secs() < 60, "the export never opened its lock");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
     std::fs::write(dir.path().join("RACE.GLTF"), "{}").unwrap();
     drop(lock);
     let out = run.wait_with_output().unwrap();
@@ -261,6 +271,26 @@ fn a_gltf_of_the_other_spelling_made_while_waiting_for_the_lock_is_refused() {
     left.sort();
     // (The lock file, let go, the export removes as it does its own.)
     assert_eq!(left, ["RACE.GLTF"].map(std::ffi::OsString::from), "nothing written");
+}
+
+/// A `.gltf` whose name holds a backslash is refused before any work: its side files are
+/// named after it (`x\\y.bin`), which Windows reads as a folder (a sweep). Control: a `.glb`,
+/// whose name is only inside it, is written.
+#[test]
+fn a_gltf_named_with_a_backslash_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = snakeskin(&[
+        "export",
+        "xenopeltis-unicolor",
+        "--size",
+        "16",
+        "--gltf",
+        dir.path().join("x\\y.gltf").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the file name has a backslash"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "nothing written");
+    export(dir.path(), "xenopeltis-unicolor", "x\\y.glb", &["--mesh", "plane"]);
 }
 
 /// `--gltf NAME.GLTF` writes the file named, its extension's case kept, as `.GLB` did (it

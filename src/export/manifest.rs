@@ -269,8 +269,7 @@ pub fn manifest(
             head: [0.0, b.head_end],
             neck: [b.head_end, b.neck_end],
             trunk: [b.neck_end, b.vent],
-            // Within the trunk and the tail (a tail of 0.02 under 60 ventrals ran past 1).
-            vent: [(b.vent - plate).max(b.neck_end), (b.vent + plate).min(1.0)],
+            vent: [b.vent - plate, b.vent + plate],
             tail: [b.vent, 1.0],
         }
     });
