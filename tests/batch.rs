@@ -1865,13 +1865,25 @@ fn a_set_another_run_is_writing_is_waited_for() {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        // Until the run says it waits (past the lock's second of tries).
+        // Until the run says it waits (past the lock's second of tries); its lines read on a
+        // thread of their own, so that a run that never says it (it waits silently, the lock
+        // held here) is stopped after a minute instead of hanging the test.
+        let (lines, log) = std::sync::mpsc::channel::<String>();
+        let stderr_pipe = std::io::BufReader::new(run.stderr.take().unwrap());
+        let reader = std::thread::spawn(move || {
+            for line in stderr_pipe.lines().map_while(Result::ok) {
+                let _ = lines.send(line + "\n");
+            }
+        });
         let mut said = String::new();
-        let mut log = std::io::BufReader::new(run.stderr.take().unwrap());
         while !said.contains("waiting for it") {
-            let mut line = String::new();
-            assert!(log.read_line(&mut line).unwrap() > 0, "{meanwhile}: the run ended without waiting: {said}");
-            said += &line;
+            match log.recv_timeout(Duration::from_secs(60)) {
+                Ok(line) => said += &line,
+                Err(e) => {
+                    let _ = run.kill();
+                    panic!("{meanwhile}: the run did not say it waits ({e:?}): {said}");
+                }
+            }
         }
         assert!(said.contains("another snakeskin run is writing") && said.contains(".natrix-natrix.lock"), "{said}");
         let source = match meanwhile {
@@ -1887,8 +1899,8 @@ fn a_set_another_run_is_writing_is_waited_for() {
         let placed = std::fs::metadata(&manifest).ok().map(|m| m.modified().unwrap());
         drop(lock);
         let status = run.wait().unwrap();
-        let mut rest = String::new();
-        std::io::Read::read_to_string(&mut log, &mut rest).unwrap();
+        reader.join().unwrap();
+        let rest: String = log.try_iter().collect();
         let stdout = std::io::read_to_string(run.stdout.take().unwrap()).unwrap();
         if meanwhile == "makes another" {
             assert_eq!(status.code(), Some(1), "{rest}");
