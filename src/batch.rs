@@ -118,7 +118,7 @@ pub enum BatchError {
     /// input: this job's set would replace it.
     #[error(
         "{job}: another snakeskin run made {} while this one waited for it, from other input (another jobs file's \
-         preset of the same name, or other options); this job's set would replace it: give the jobs folders of their own",
+         preset of the same name, or other options); this job's set would replace it: write each jobs file into a -o folder of its own",
         .manifest.display()
     )]
     MadeMeanwhile { job: RunningJob, manifest: PathBuf },
@@ -1400,8 +1400,8 @@ fn jobs_folder(path: &Path) -> PathBuf {
     file.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
 }
 
-/// How often a job whose set another run is writing looks whether that run has finished
-/// (each look also tries the set's lock, a second of tries: `export::SetLock::acquire`).
+/// How often a job whose set another run is writing looks whether that run has let go of
+/// the set's lock (`lock_held_elsewhere`, one try each).
 const BUSY_SET_POLL: std::time::Duration = std::time::Duration::from_millis(250);
 
 /// One job: a duplicate's set is the earlier job's, a done job is left as it is, any other
@@ -1430,6 +1430,10 @@ fn run_one(
         let manifest = out.join(&outcome.manifest);
         let folder = out.join(&outcome.folder);
         let mut said = false;
+        // The manifest there as the job starts: another run's commit puts a new file in its
+        // place (taken before the first try at the lock, whose second of tries another run
+        // may commit in).
+        let found = manifest_identity(&manifest);
         outcome.status = loop {
             // Checked against the available memory with the other jobs when the run was
             // planned (`fitting_concurrency`); the jobs running beside this one hold part of
@@ -1457,7 +1461,6 @@ fn run_one(
                 // had just made was made again most times, and the jobs beside it waited on
                 // the process's table of held locks (the review).
                 Err(Error::Export(crate::export::ExportError::Busy { .. })) => {
-                    let before = modified(&manifest);
                     if !said {
                         let lock = folder.join(crate::export::lock_file_name(&outcome.preset));
                         waiting(&format!(
@@ -1474,7 +1477,8 @@ fn run_one(
                         let_go_of_a_left_lock(&folder, &outcome.preset);
                         break JobStatus::Skipped;
                     }
-                    if modified(&manifest) != before {
+                    let now = manifest_identity(&manifest);
+                    if now.is_some() && now != found {
                         return Err(BatchError::MadeMeanwhile { job: running.clone(), manifest }.into());
                     }
                 }
@@ -1500,17 +1504,27 @@ fn let_go_of_a_left_lock(folder: &Path, name: &str) {
 /// cannot be opened, is no one's.
 fn lock_held_elsewhere(folder: &Path, name: &str) -> bool {
     let mut options = std::fs::OpenOptions::new();
-    options.read(true);
-    // Not through a link, and without waiting on a FIFO (as `SetLock::acquire` opens it).
+    // For writing, as `SetLock::acquire` opens it: on NFS an exclusive `flock` is a byte-range
+    // lock, which a descriptor opened for reading cannot take (EBADF, read as free: the
+    // review). Not through a link, and without waiting on a FIFO (ENXIO: refused by the
+    // acquire that follows).
+    options.write(true);
     #[cfg(unix)]
     std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW | libc::O_NONBLOCK);
     let Ok(file) = options.open(folder.join(crate::export::lock_file_name(name))) else { return false };
     matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock))
 }
 
-/// When `path` was last modified, if it can be read.
-fn modified(path: &Path) -> Option<std::time::SystemTime> {
-    std::fs::metadata(path).and_then(|m| m.modified()).ok()
+/// Which file `path` is (device, inode) and its length and time, if it is there: a commit
+/// renames a new file into place, so a set made meanwhile is another file even within one
+/// tick of a coarse clock.
+fn manifest_identity(path: &Path) -> Option<(u64, u64, u64, Option<std::time::SystemTime>)> {
+    let m = std::fs::symlink_metadata(path).ok()?;
+    #[cfg(unix)]
+    let (device, inode) = { (std::os::unix::fs::MetadataExt::dev(&m), std::os::unix::fs::MetadataExt::ino(&m)) };
+    #[cfg(not(unix))]
+    let (device, inode) = (0, 0);
+    Some((device, inode, m.len(), m.modified().ok()))
 }
 
 #[cfg(test)]

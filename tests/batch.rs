@@ -1898,7 +1898,18 @@ fn a_set_another_run_is_writing_is_waited_for() {
         let manifest = folder.join("natrix-natrix.material.json");
         let placed = std::fs::metadata(&manifest).ok().map(|m| m.modified().unwrap());
         drop(lock);
-        let status = run.wait().unwrap();
+        // Within a minute, or stopped (a wait that never saw the lock free hung the test).
+        let start = Instant::now();
+        let status = loop {
+            if let Some(status) = run.try_wait().unwrap() {
+                break status;
+            }
+            if start.elapsed() > Duration::from_secs(60) {
+                let _ = run.kill();
+                panic!("{meanwhile}: the run went on waiting after the lock was let go");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
         reader.join().unwrap();
         let rest: String = log.try_iter().collect();
         let stdout = std::io::read_to_string(run.stdout.take().unwrap()).unwrap();
