@@ -763,9 +763,9 @@ pub fn height_to_normal_rows(height: &Image, spec: NormalSpec) -> impl Fn(usize,
         // row, not two, and halved it gave half the slope there. (A strip's edge rows inside
         // the texture are its margin, cropped.)
         let ends = !spec.wraps_v && (y == 0 || y + 1 == height.height);
-        let rows_spanned = if ends { 1.0 } else { 2.0 };
+        let along_scale = if ends { 2.0 } else { 1.0 };
         let at = |c, l, r, up: &[f32], here: &[f32], down: &[f32], out: &mut [f32]| {
-            kernel.at(here[r] - here[l], (down[c] - up[c]) * (2.0 / rows_spanned), out)
+            kernel.at(here[r] - here[l], (down[c] - up[c]) * along_scale, out)
         };
         neighbourhood_row(height, y, spec.wraps_v, 3, &at, row)
     }

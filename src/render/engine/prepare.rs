@@ -73,6 +73,9 @@ pub struct DrawMemory {
     pub drawn_after: Option<(usize, usize)>,
 }
 
+/// What a drawing process holds at any size: the renderer's and the process's own overheads.
+const DRAWING_OVERHEAD_BYTES: u64 = RENDERER_OVERHEAD_BYTES + FIXED_OVERHEAD_BYTES;
+
 impl DrawMemory {
     /// One material from `graph`'s maps at `maps` (width, height), drawn into a frame of
     /// `frame_bytes`.
@@ -84,7 +87,7 @@ impl DrawMemory {
     /// Estimated peak bytes of a process that makes its renderer for this drawing:
     /// `estimate_added_bytes` and the renderer's and the process's own overheads.
     pub fn estimate_bytes(&self) -> u64 {
-        self.estimate_added_bytes() + RENDERER_OVERHEAD_BYTES + FIXED_OVERHEAD_BYTES
+        self.estimate_added_bytes() + DRAWING_OVERHEAD_BYTES
     }
 
     /// Estimated bytes the drawing adds to what the process holds. The phases follow one
@@ -121,7 +124,7 @@ impl DrawMemory {
     pub fn check(&self, what: &str) -> Result<(), Error> {
         // The renderer's part named: no smaller size brings the estimate under it (a limit of
         // 300 MiB refused 16×16 frames of 64² maps, "use a smaller size").
-        let fixed_mib = (RENDERER_OVERHEAD_BYTES + FIXED_OVERHEAD_BYTES).div_ceil(1 << 20);
+        let fixed_mib = DRAWING_OVERHEAD_BYTES.div_ceil(1 << 20);
         self.refuse_over(self.estimate_bytes(), what, &format!(", {fixed_mib} MiB of it the renderer's at any size,"))
     }
 
