@@ -988,7 +988,13 @@ pub fn run(
                 while !stop.load(std::sync::atomic::Ordering::SeqCst) {
                     let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
                     let Some((job, resolved)) = work.get(k) else { break };
-                    let result = run_one(jobs_file, job, resolved, out, &note);
+                    let stopped = || stop.load(std::sync::atomic::Ordering::SeqCst);
+                    let result = match run_one(jobs_file, job, resolved, out, &note, &stopped) {
+                        Ok(Some(outcome)) => Ok(outcome),
+                        // The queue stopped while it waited: not run.
+                        Ok(None) => break,
+                        Err(e) => Err(e),
+                    };
                     if result.is_err() {
                         stop.store(true, std::sync::atomic::Ordering::SeqCst);
                     }
@@ -1400,96 +1406,83 @@ fn jobs_folder(path: &Path) -> PathBuf {
     file.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
 }
 
-/// How often a job whose set another run is writing looks whether that run has let go of
-/// the set's lock (`lock_held_elsewhere`, one try each).
-const BUSY_SET_POLL: std::time::Duration = std::time::Duration::from_millis(250);
-
 /// One job: a duplicate's set is the earlier job's, a done job is left as it is, any other
 /// is generated (after waiting for another run that is making it, and skipped if that run
-/// did).
+/// did). None where the queue stopped (`stopped`) while it waited.
 fn run_one(
     jobs_file: &Path,
     job: &Job,
     resolved: &Resolved,
     out: &Path,
     waiting: &dyn Fn(&str),
-) -> Result<JobOutcome, Error> {
+    stopped: &dyn Fn() -> bool,
+) -> Result<Option<JobOutcome>, Error> {
     let mut outcome = resolved.outcome.clone();
     // Another run into the same folder may have finished the set since this one was planned:
     // looked for again (of two batches over the same jobs, the second generated again every
-    // set the first finished after the second was planned; the QA review). Not under the
-    // set's lock: a run that commits the set between this look and the lock is a set
-    // generated twice, the same bytes.
+    // set the first finished after the second was planned; the QA review), and under the
+    // set's lock below where the manifest changes meanwhile.
     let done = resolved.done
         || (outcome.duplicate_of.is_none() && is_done(&out.join(&outcome.manifest), &outcome.key, &resolved.files));
     if outcome.duplicate_of.is_some() {
         // Its set is the earlier job's (in this shard or another).
-    } else if !done {
-        let running = RunningJob { place: job.place(jobs_file, job.lines.preset), seed: outcome.seed, size: job.size };
-        let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
-        let manifest = out.join(&outcome.manifest);
-        let folder = out.join(&outcome.folder);
-        let mut said = false;
-        // The manifest there as the job starts: another run's commit puts a new file in its
-        // place (taken before the first try at the lock, whose second of tries another run
-        // may commit in).
-        let found = manifest_identity(&manifest);
-        outcome.status = loop {
-            // Checked against the available memory with the other jobs when the run was
-            // planned (`fitting_concurrency`); the jobs running beside this one hold part of
-            // it now.
-            let plan = Plan::within_checked_budget(&request(job, out, &outcome)).map_err(failed)?;
-            // The preset is read again here: an edit since the plan would write a set of the
-            // edited preset under the planned key, which a later run, the edit undone, took
-            // as done.
-            let loaded = plan.loaded();
-            if job.key(&loaded.content_hash, loaded.preset.seed) != outcome.key {
-                return Err(BatchError::Changed { job: running.clone() }.into());
-            }
-            match plan.run(&|_, _| {}) {
-                Ok(report) => {
-                    outcome.kept = report.kept;
-                    break JobStatus::Done;
-                }
-                // Another run into the folder (a shard beside a whole run, a second jobs file
-                // sharing sets) holds the set's lock, past the lock's second of tries: it is
-                // making the set. Waited for (said once) and looked at again: skipped if it
-                // made it, made here if it let go without making it. (Failed, the job stopped
-                // the whole queue: of two batches over the same 3K sets started together, the
-                // second made none.) The wait only looks at the lock, a try each
-                // `BUSY_SET_POLL`: taken again with its second of tries, the set another run
-                // had just made was made again most times, and the jobs beside it waited on
-                // the process's table of held locks (the review).
-                Err(Error::Export(crate::export::ExportError::Busy { .. })) => {
-                    if !said {
-                        let lock = folder.join(crate::export::lock_file_name(&outcome.preset));
-                        waiting(&format!(
-                            "note: {running}: another snakeskin run is writing {} (it holds {}); waiting for it",
-                            folder.display(),
-                            lock.display()
-                        ));
-                        said = true;
-                    }
-                    while lock_held_elsewhere(&folder, &outcome.preset) {
-                        std::thread::sleep(BUSY_SET_POLL);
-                    }
-                    if is_done(&manifest, &outcome.key, &resolved.files) {
-                        let_go_of_a_left_lock(&folder, &outcome.preset);
-                        break JobStatus::Skipped;
-                    }
-                    let now = manifest_identity(&manifest);
-                    if now.is_some() && now != found {
-                        return Err(BatchError::MadeMeanwhile { job: running.clone(), manifest }.into());
-                    }
-                }
-                Err(e) => return Err(failed(e).into()),
-            }
-        };
-    } else {
+        return Ok(Some(outcome));
+    }
+    if done {
         outcome.status = JobStatus::Skipped;
         let_go_of_a_left_lock(&out.join(&outcome.folder), &outcome.preset);
+        return Ok(Some(outcome));
     }
-    Ok(outcome)
+    let running = RunningJob { place: job.place(jobs_file, job.lines.preset), seed: outcome.seed, size: job.size };
+    let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
+    let manifest = out.join(&outcome.manifest);
+    // The manifest there as the job starts, known by its file: another run's commit puts a
+    // new file in its place, even within one tick of a coarse clock.
+    let found = manifest_identity(&manifest);
+    // Checked against the available memory with the other jobs when the run was planned
+    // (`fitting_concurrency`); the jobs running beside this one hold part of it now.
+    let plan = Plan::within_checked_budget(&request(job, out, &outcome)).map_err(failed)?;
+    // The preset is read again here: an edit since the plan would write a set of the edited
+    // preset under the planned key, which a later run, the edit undone, took as done.
+    let loaded = plan.loaded();
+    if job.key(&loaded.content_hash, loaded.preset.seed) != outcome.key {
+        return Err(BatchError::Changed { job: running.clone() }.into());
+    }
+    // Another run into the folder (a shard beside a whole run, a second jobs file sharing
+    // sets) that holds the set's lock is making it: waited for, said once. (Failed, the job
+    // stopped the whole queue: of two batches over the same 3K sets started together, the
+    // second made none.)
+    let folder = out.join(&outcome.folder);
+    let mut say = || {
+        let lock = folder.join(crate::export::lock_file_name(&outcome.preset));
+        waiting(&format!(
+            "note: {running}: another snakeskin run is writing {} (it holds {}); waiting for it",
+            folder.display(),
+            lock.display()
+        ))
+    };
+    let lock = match plan.lock_set_waiting(&mut say, stopped) {
+        Ok(lock) => lock,
+        Err(Error::Export(crate::export::ExportError::Busy { .. })) if stopped() => return Ok(None),
+        Err(e) => return Err(failed(e).into()),
+    };
+    // Under the lock, what another run did meanwhile, whether this job waited for it or took
+    // the lock the moment it let go (within the acquire's second of tries): a set it made
+    // for this job is skipped; another preset's set there is refused, not written over.
+    let now = manifest_identity(&manifest);
+    if now != found {
+        if is_done(&manifest, &outcome.key, &resolved.files) {
+            outcome.status = JobStatus::Skipped;
+            return Ok(Some(outcome));
+        }
+        if now.is_some() {
+            return Err(BatchError::MadeMeanwhile { job: running.clone(), manifest }.into());
+        }
+    }
+    let report = plan.run_locked(lock, &|_, _| {}).map_err(failed)?;
+    outcome.kept = report.kept;
+    outcome.status = JobStatus::Done;
+    Ok(Some(outcome))
 }
 
 /// A run killed after committing a set but before removing its lock file left an empty
@@ -1497,22 +1490,6 @@ fn run_one(
 /// alone; a set some other run holds is left as it is).
 fn let_go_of_a_left_lock(folder: &Path, name: &str) {
     let _ = crate::export::SetLock::acquire(folder, name);
-}
-
-/// Whether another process holds the lock of set `name` in `folder` now: one try, without
-/// `SetLock`'s second of tries and its table of held locks. A lock file that is gone, or
-/// cannot be opened, is no one's.
-fn lock_held_elsewhere(folder: &Path, name: &str) -> bool {
-    let mut options = std::fs::OpenOptions::new();
-    // For writing, as `SetLock::acquire` opens it: on NFS an exclusive `flock` is a byte-range
-    // lock, which a descriptor opened for reading cannot take (EBADF, read as free: the
-    // review). Not through a link, and without waiting on a FIFO (ENXIO: refused by the
-    // acquire that follows).
-    options.write(true);
-    #[cfg(unix)]
-    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW | libc::O_NONBLOCK);
-    let Ok(file) = options.open(folder.join(crate::export::lock_file_name(name))) else { return false };
-    matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock))
 }
 
 /// Which file `path` is (device, inode) and its length and time, if it is there: a commit

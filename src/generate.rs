@@ -305,14 +305,35 @@ impl Plan {
         check_set_outputs(&self.request.out_dir, &self.loaded.name, &self.file_names(), &export::Inputs::new(preset))
     }
 
-    /// Runs the plan. `progress(done, total)` reports node evaluations.
+    /// Runs the plan: `lock_set`, then `run_locked`. `progress(done, total)` reports node
+    /// evaluations.
     pub fn run(self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
+        let lock = self.lock_set()?;
+        self.run_locked(lock, progress)
+    }
+
+    /// The set's folder and files checked (`check_outputs`), then its lock taken
+    /// (`SetLock::acquire`: a set another run is writing is `ExportError::Busy`).
+    pub fn lock_set(&self) -> Result<SetLock, Error> {
         self.check_outputs()?;
+        Ok(SetLock::acquire(&self.request.out_dir, &self.loaded.name)?)
+    }
+
+    /// `lock_set`, waiting for a set another run is writing (`SetLock::acquire_waiting`):
+    /// a batch's job, which then looks under the lock whether that run made the set.
+    pub fn lock_set_waiting(&self, waiting: &mut dyn FnMut(), give_up: &dyn Fn() -> bool) -> Result<SetLock, Error> {
+        self.check_outputs()?;
+        Ok(SetLock::acquire_waiting(&self.request.out_dir, &self.loaded.name, waiting, give_up)?)
+    }
+
+    /// Runs the plan under `lock`, the set's (`lock_set`, `lock_set_waiting`): evaluates,
+    /// encodes and commits the set. Panics if `lock` is another set's.
+    pub fn run_locked(self, lock: SetLock, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
+        assert!(lock.is_for(&self.request.out_dir, &self.loaded.name), "run_locked under another set's lock");
         if let Some(pack) = self.request.pack {
-            return self.run_pack(pack, progress);
+            return self.run_pack(pack, lock, progress);
         }
         let Plan { request, size, height, loaded, graph, start, .. } = self;
-        let lock = SetLock::acquire(&request.out_dir, &loaded.name)?;
         let strip_layout = strips_of(&graph, &request.maps, size, height);
         let mut constant_maps = Vec::new();
         let (kinds, files, stats, encode_time) = if request.format == FileFormat::Exr {
@@ -516,8 +537,12 @@ impl Plan {
     }
 
     /// `run` for a pack: the packed textures and a manifest naming them.
-    fn run_pack(self, pack: Pack, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<GenerateReport, Error> {
-        let lock = SetLock::acquire(&self.request.out_dir, &self.loaded.name)?;
+    fn run_pack(
+        self,
+        pack: Pack,
+        lock: SetLock,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<GenerateReport, Error> {
         let (textures, stats, encode_time) = self.pack_textures(pack, progress)?;
         let name = &self.loaded.name;
         let names: Vec<String> = textures.iter().map(|(spec, _)| texture_file_name(name, spec)).collect();

@@ -1916,8 +1916,8 @@ fn a_set_another_run_is_writing_is_waited_for() {
         if meanwhile == "makes another" {
             assert_eq!(status.code(), Some(1), "{rest}");
             assert!(rest.contains("another snakeskin run made") && rest.contains("from other input"), "{rest}");
-            // (The lock file left is the test's: the run never took it.)
-            std::fs::remove_file(folder.join(".natrix-natrix.lock")).unwrap();
+            // (Refused under the lock, which the run took and let go of, as it removes its own.)
+            assert!(!folder.join(".natrix-natrix.lock").exists(), "{rest}");
             assert!(tree(&folder) == tree(&other.join("out").join(set)), "the other preset's set was replaced");
             continue;
         }
@@ -1934,4 +1934,114 @@ fn a_set_another_run_is_writing_is_waited_for() {
         assert_eq!(theirs.keys().collect::<Vec<_>>(), made_apart.keys().collect::<Vec<_>>(), "{meanwhile}");
         assert!(theirs == made_apart, "{meanwhile}: the set differs");
     }
+}
+
+/// Another preset's set committed in the moment a job's lock was taken: the other run let go
+/// within the job's second of tries at the lock, before the job called the set busy and
+/// waited. The job looks under the lock whether the manifest changed since it started, and
+/// refuses; it wrote over the set, taken for the old one, where only a job that waited
+/// looked.
+#[cfg(target_os = "linux")]
+#[test]
+fn another_presets_set_made_while_the_lock_is_tried_is_not_written_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[1]", 16);
+    let other = dir.path().join("other");
+    std::fs::create_dir(&other).unwrap();
+    std::fs::write(other.join("natrix-natrix.toml"), "seed = 9\n").unwrap();
+    let other_jobs = other.join("jobs.toml");
+    std::fs::write(&other_jobs, "[[job]]\npreset = \"natrix-natrix.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    let made_other = snakeskin(&["batch", other_jobs.to_str().unwrap(), "-o", other.join("out").to_str().unwrap()]);
+    assert!(made_other.status.success(), "{}", stderr(&made_other));
+    let set = Path::new("natrix-natrix/tile-16-seed1-png");
+    let out = dir.path().join("out");
+    let folder = out.join(set);
+    std::fs::create_dir_all(&folder).unwrap();
+    let lock_path = folder.join(".natrix-natrix.lock");
+    let lock = std::fs::File::create(&lock_path).unwrap();
+    lock.try_lock().unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The job tries the lock (it holds the lock file open): the other preset's set is put in
+    // place and the lock let go, well within the second of tries.
+    common::wait_until_open(run.id(), &lock_path.canonicalize().unwrap());
+    for file in std::fs::read_dir(other.join("out").join(set)).unwrap() {
+        let file = file.unwrap().path();
+        std::fs::copy(&file, folder.join(file.file_name().unwrap())).unwrap();
+    }
+    drop(lock);
+    let done = run.wait_with_output().unwrap();
+    assert_eq!(done.status.code(), Some(1), "{}", stderr(&done));
+    assert!(stderr(&done).contains("another snakeskin run made"), "{}", stderr(&done));
+    assert!(!stderr(&done).contains("waiting for it"), "the lock was let go within its tries: {}", stderr(&done));
+    assert!(tree(&folder) == tree(&other.join("out").join(set)), "the other preset's set was replaced");
+}
+
+/// A job waiting for another run's set stops waiting when the queue stops (another job
+/// failed): the run ends, the waiting job `not run`. It waited on, and the run with it, until
+/// the other run let go.
+#[test]
+fn a_waiting_job_stops_with_the_queue() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = jobs_file(dir.path(), &["natrix-natrix", "python-regius"], "[1]", 16);
+    let out = dir.path().join("out");
+    // Both sets' locks held, as another run making them would; then one lock is let go with
+    // bytes in its file (not a lock snakeskin made), so that its job fails when it takes it.
+    let mut locks = Vec::new();
+    for preset in ["natrix-natrix", "python-regius"] {
+        let folder = out.join(preset).join("tile-16-seed1-png");
+        std::fs::create_dir_all(&folder).unwrap();
+        let lock = std::fs::File::create(folder.join(format!(".{preset}.lock"))).unwrap();
+        lock.try_lock().unwrap();
+        locks.push(lock);
+    }
+    let mut run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "2"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (lines, log) = std::sync::mpsc::channel::<String>();
+    let stderr_pipe = std::io::BufReader::new(run.stderr.take().unwrap());
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        for line in stderr_pipe.lines().map_while(Result::ok) {
+            let _ = lines.send(line + "\n");
+        }
+    });
+    let mut said = String::new();
+    while said.matches("waiting for it").count() < 2 {
+        match log.recv_timeout(Duration::from_secs(60)) {
+            Ok(line) => said += &line,
+            Err(e) => {
+                let _ = run.kill();
+                panic!("the jobs did not both say they wait ({e:?}): {said}");
+            }
+        }
+    }
+    let failing = locks.pop().unwrap();
+    std::io::Write::write_all(&mut &failing, b"not a lock").unwrap();
+    drop(failing);
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = run.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = run.kill();
+            panic!("the waiting job went on waiting after the queue stopped");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    reader.join().unwrap();
+    let rest: String = log.try_iter().collect();
+    // (The failed job's error is of what is in a set's place: exit 2, as `generate` says it.)
+    assert_eq!(status.code(), Some(2), "{rest}");
+    assert!(rest.contains("python-regius") && rest.contains("not a lock"), "{rest}");
+    assert_eq!(statuses(&read_index(&out)), ["not run", "failed"], "{rest}");
+    drop(locks);
 }

@@ -253,17 +253,7 @@ fn a_gltf_of_the_other_spelling_made_while_waiting_for_the_lock_is_refused() {
         .unwrap();
     // Within the lock's second of tries: the export holds the lock file open while it tries
     // (past its plan's look), which its descriptors in /proc show.
-    // As /proc names it: through any link in the temporary folder's path.
-    let lock_path = dir.path().canonicalize().unwrap().join(".RACE.lock");
-    let holds_it = || {
-        let fds = std::fs::read_dir(format!("/proc/{}/fd", run.id())).into_iter().flatten().flatten();
-        fds.filter_map(|fd| std::fs::read_link(fd.path()).ok()).any(|target| target == lock_path)
-    };
-    let start = std::time::Instant::now();
-    while !holds_it() {
-        assert!(start.elapsed().as_secs() < 60, "the export never opened its lock");
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    common::wait_until_open(run.id(), &dir.path().canonicalize().unwrap().join(".RACE.lock"));
     std::fs::write(dir.path().join("RACE.GLTF"), "{}").unwrap();
     drop(lock);
     let out = run.wait_with_output().unwrap();

@@ -2433,6 +2433,34 @@ fn verify_fails_a_set_left_only_in_temporaries() {
     assert!(stdout(&out).contains(&format!("writing {}: a run holds its lock", d.join("natrix-natrix").display())));
     lock.unlock().unwrap();
     assert_eq!(snakeskin(&["verify", d.to_str().unwrap()]).status.code(), Some(1));
+    // A FIFO where the lock goes is no run's lock: FAILED, at once (the look opened it
+    // plainly and waited for a writer for ever).
+    #[cfg(unix)]
+    {
+        drop(lock);
+        std::fs::remove_file(d.join(".natrix-natrix.lock")).unwrap();
+        let c = std::ffi::CString::new(d.join(".natrix-natrix.lock").as_os_str().as_encoded_bytes()).unwrap();
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+        let mut run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["verify", d.to_str().unwrap()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        let status = loop {
+            if let Some(status) = run.try_wait().unwrap() {
+                break status;
+            }
+            if start.elapsed().as_secs() > 60 {
+                let _ = run.kill();
+                panic!("verify waited on the FIFO at the set's lock");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        };
+        assert_eq!(status.code(), Some(1));
+        std::fs::remove_file(d.join(".natrix-natrix.lock")).unwrap();
+    }
     for (k, name) in set_files.iter().enumerate() {
         std::fs::remove_file(d.join(format!(".{name}.AbC{k:03}.snakeskin-tmp"))).unwrap();
     }

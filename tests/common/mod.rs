@@ -31,6 +31,22 @@ pub fn test_hooks_exist() -> bool {
     cfg!(debug_assertions)
 }
 
+/// Returns once process `pid` holds `path` open, as its descriptors in /proc show (a run
+/// trying a lock another holds keeps the lock file open while it tries); panics after a
+/// minute. `path` as /proc names it: canonical, through any link in the temporary folder's.
+#[cfg(target_os = "linux")]
+pub fn wait_until_open(pid: u32, path: &Path) {
+    let holds_it = || {
+        let fds = std::fs::read_dir(format!("/proc/{pid}/fd")).into_iter().flatten().flatten();
+        fds.filter_map(|fd| std::fs::read_link(fd.path()).ok()).any(|target| target == path)
+    };
+    let start = std::time::Instant::now();
+    while !holds_it() {
+        assert!(start.elapsed().as_secs() < 60, "process {pid} never opened {path:?}");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
 /// Starts `snakeskin args` paused at its commit (`SNAKESKIN_TEST_PAUSE_AT=commit`, three
 /// seconds: debug builds) and returns once it has staged a file in `folder` (a temporary
 /// there with bytes: `check_writable`'s probe is an empty one, made before the work), so
