@@ -265,13 +265,11 @@ impl ExportPlan {
                 request.out.display()
             ))
         })?;
-        // A `.gltf`'s side files are named after it, and a backslash is a folder's separator
-        // on Windows, where the document may be read (as a preset file's name: `PresetError::
-        // FileName`); a `.glb` carries its name inside only.
-        if !binary && name.contains('\\') {
+        // A `.gltf`'s side files are named after it (as a set's after its preset file); a
+        // `.glb` carries its name inside only.
+        if let Some(what) = crate::export::unfit_for_file_names(&name).filter(|_| !binary) {
             return Err(Error::Unsupported(format!(
-                "--gltf {}: the file name has a backslash (a folder's separator on Windows), and the .gltf's side files \
-                 are named after it; rename it",
+                "--gltf {}: the file name has {what}, and the .gltf's side files are named after it; rename it",
                 request.out.display()
             )));
         }

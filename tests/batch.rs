@@ -1473,6 +1473,22 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         let said = format!("map file {file:?} is not a plain file name");
         assert!(stdout(&listed).contains(&said), "{file:?}: {}", stdout(&listed));
     }
+    // Names no run writes, as preset file names and `.gltf`s are refused alike
+    // (`export::unfit_for_file_names`): a file of that name beside the manifest, with the
+    // recorded bytes, verified `ok`.
+    for (file, what) in [("a\\b.png", "a backslash"), ("a\u{1b}b.png", "control characters")] {
+        let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
+        let recorded = json["maps"][0]["file"].as_str().unwrap().to_string();
+        let folder = manifests[0].parent().unwrap();
+        std::fs::copy(folder.join(&recorded), folder.join(file)).unwrap();
+        json["maps"][0]["file"] = serde_json::json!(file);
+        std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
+        let listed = verify(&[&manifests[0]]);
+        assert_eq!(listed.status.code(), Some(1), "{file:?}: {}", stdout(&listed));
+        let said = format!("map file {file:?} has {what}");
+        assert!(stdout(&listed).contains(&said), "{file:?}: {}", stdout(&listed));
+        std::fs::remove_file(folder.join(file)).unwrap();
+    }
     // A manifest whose size is missing or forged names its key (every map was said to be
     // "more than such a file can be": a hostile-input review); the control, the size as
     // written, verifies.

@@ -457,8 +457,13 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
         }
         // An empty name too: it joined to the set's folder, "it is a folder, not a regular
         // file" (a hostile-input sweep).
-        if file.is_empty() || file.contains(['/', '\\']) || file.starts_with('.') {
+        if file.is_empty() || file.contains('/') || file.starts_with('.') {
             problems.push(format!("map file {file:?} is not a plain file name"));
+            continue;
+        }
+        // A name no run writes (`super::unfit_for_file_names`).
+        if let Some(what) = super::unfit_for_file_names(file) {
+            problems.push(format!("map file {file:?} has {what}, which no set's file name carries"));
             continue;
         }
         if files.iter().any(|(m, p): &(String, PathBuf)| m == map || p.ends_with(file)) {

@@ -207,6 +207,23 @@ impl ExportError {
     }
 }
 
+/// What makes `name` unfit to be carried by a set's file names (its maps and manifest are
+/// named after the preset file's stem, a `.gltf`'s side files after the `.gltf`'s), None
+/// where it is fit: control characters (a newline in a name broke every listing and script
+/// that reads the files), or a backslash (a folder's separator on Windows, where the set may
+/// be read: a preset `a\b.toml` made a manifest naming `a\b_color.png`, which `verify`
+/// refused, so `batch` never took the set as done and made it at every run). Asked of a
+/// preset file's stem, of a `.gltf`'s, and of the map files a manifest names (`verify`).
+pub fn unfit_for_file_names(name: &str) -> Option<&'static str> {
+    if name.chars().any(char::is_control) {
+        return Some("control characters");
+    }
+    if name.contains('\\') {
+        return Some("a backslash (a folder's separator on Windows)");
+    }
+    None
+}
+
 /// File name of a map for a preset name (PNG).
 pub fn map_file_name(preset_name: &str, map: MapKind) -> String {
     map_file_name_in(preset_name, map, FileFormat::Png)

@@ -202,20 +202,10 @@ pub fn read_source(spec: &str) -> Result<PresetSource, PresetError> {
 pub fn read_source_beside(spec: &str, folder: &Path) -> Result<PresetSource, PresetError> {
     let path = Path::new(spec);
     if names_a_file(spec, path) {
-        // A newline or an escape in the name would go into the set's file names and break
-        // every listing and script that reads them (`--set` refuses the same). A backslash
-        // is a folder's separator on Windows, where the set may be read: a manifest naming
-        // `a\b_color.png` is refused by `verify` (and so was never done for `batch`, which
-        // made its set again at every run: a sweep).
+        // The set's files are named after it (`--set` refuses control characters too).
         let stem = path.file_stem().map(|s| s.to_string_lossy()).unwrap_or_default();
-        if stem.chars().any(char::is_control) {
-            return Err(PresetError::FileName { path: path.into(), what: "control characters" });
-        }
-        if stem.contains('\\') {
-            return Err(PresetError::FileName {
-                path: path.into(),
-                what: "a backslash (a folder's separator on Windows)",
-            });
+        if let Some(what) = crate::export::unfit_for_file_names(&stem) {
+            return Err(PresetError::FileName { path: path.into(), what });
         }
         let text = read_bounded(path)?;
         // The set's files are named after it: a hidden name (`.toml`) would hide them.
