@@ -729,7 +729,8 @@ fn strips_of(graph: &Graph, maps: &[MapKind], width: usize, height: usize) -> Op
     // A malformed value is refused at the command line's start.
     // In bytes, saturating: shifted, 2^44 MiB and more wrapped to a small budget (or 0),
     // and a budget meant as unlimited cut the tile into the most strips (a hostile-input sweep).
-    let set_budget = crate::memory::tile_budget_from_env().ok().flatten().map(|mib| mib.saturating_mul(1 << 20));
+    let set_budget =
+        crate::memory::tile_budget_from_env().ok().flatten().map(|mib| mib.saturating_mul(crate::memory::MIB));
     let buffers = |rows: usize| crate::graph::estimate_peak_bytes(graph, maps, width, rows);
     // With the normal node, though a tile evaluated whole goes without it (`whole_tile_maps`):
     // the budget was measured with it, and without it the presets in strips at 4096² would

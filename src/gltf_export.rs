@@ -385,10 +385,10 @@ impl ExportPlan {
         // The asset's `extras`: the manifest's keys for what made it (`gltf::document`), and
         // the export's own options, so that it can be made again (the mesh and `--ao` were
         // left out: a sweep).
-        let source = crate::export::Source {
-            mesh: Some(mesh_kind.name()),
-            ambient_occlusion: Some(ao),
-            ..crate::export::Source::of(plan.loaded(), dimensions, plan.layout())
+        let source = crate::export::gltf::ExportSource {
+            set: crate::export::Source::of(plan.loaded(), dimensions, plan.layout()),
+            mesh: mesh_kind.name(),
+            ambient_occlusion: ao,
         };
         let created_folder = lock.created_folder;
         let mut removed = Vec::new();

@@ -24,7 +24,8 @@ use crate::Error;
 use crate::graph::{Graph, estimate_peak_bytes};
 use crate::material::MapKind;
 
-const MIB: u64 = 1 << 20;
+/// Bytes in a mebibyte: every MiB the tool reads (`SNAKESKIN_MEMORY_LIMIT_MIB`) or prints.
+pub const MIB: u64 = 1 << 20;
 
 /// Allocator slack, thread stacks, the binary and its tables: measured resident size of a
 /// 16² run is about 20 MiB; 64 MiB leaves room.

@@ -182,16 +182,28 @@ enum Images<'a> {
     Files(&'a [String]),
 }
 
-/// `source`: what made the file, written as the asset's `extras` (the texture set
-/// manifest's first keys), so that an exported file can be traced to its preset and made
-/// again; None: no `extras`.
+/// What made an exported file, written as its asset's `extras`: the set manifest's keys for
+/// what made it (`Source`), and the export's own options, so that the file can be made
+/// again (the mesh and `--ao` were left out: a sweep).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ExportSource {
+    #[serde(flatten)]
+    pub set: Source,
+    /// `--mesh` (`gltf_export::MeshKind::name`).
+    pub mesh: &'static str,
+    /// `--ao`.
+    pub ambient_occlusion: bool,
+}
+
+/// `source`: what made the file (`ExportSource`), written as the asset's `extras`; None: no
+/// `extras`.
 fn document(
     name: &str,
     mesh: &Mesh,
     material: GltfMaterial,
     textures: &GltfTextures,
     images: Images,
-    source: Option<&Source>,
+    source: Option<&ExportSource>,
 ) -> Document {
     let mut buffer = Buffer::default();
     let v = &mesh.vertices;
@@ -297,7 +309,7 @@ fn document(
         "buffers": [buffer],
     });
     if let Some(source) = source {
-        json["asset"]["extras"] = serde_json::to_value(source).expect("a Source is plain data");
+        json["asset"]["extras"] = serde_json::to_value(source).expect("an ExportSource is plain data");
     }
     Document { json, mesh_bin: bin, image_offsets, length }
 }
@@ -314,7 +326,7 @@ pub fn glb(
     mesh: &Mesh,
     material: GltfMaterial,
     textures: &GltfTextures,
-    source: Option<&Source>,
+    source: Option<&ExportSource>,
 ) -> Result<Vec<u8>, ExportError> {
     let Document { json, mesh_bin, image_offsets, length } =
         document(name, mesh, material, textures, Images::Embedded, source);
@@ -353,7 +365,7 @@ pub fn gltf_files(
     mesh: &Mesh,
     material: GltfMaterial,
     textures: GltfTextures,
-    source: Option<&Source>,
+    source: Option<&ExportSource>,
 ) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
     let names: Vec<String> = textures.images().iter().map(|(role, _)| gltf_image_file_name(name, role)).collect();
     let Document { json, mesh_bin, .. } = document(name, mesh, material, &textures, Images::Files(&names), source);

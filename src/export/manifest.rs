@@ -72,12 +72,6 @@ pub struct Source {
     pub height: usize,
     /// `tile` (a square that tiles both ways) or `body` (the whole snake, snout at v = 0).
     pub layout: String,
-    /// A glTF export's `--mesh` (`gltf_export::MeshKind::name`); absent from a manifest.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub mesh: Option<&'static str>,
-    /// A glTF export's `--ao`; absent from a manifest (whose `maps` list an `ao` map).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ambient_occlusion: Option<bool>,
 }
 
 impl Source {
@@ -93,8 +87,6 @@ impl Source {
             width,
             height,
             layout: layout.name().into(),
-            mesh: None,
-            ambient_occlusion: None,
         }
     }
 }
@@ -235,16 +227,26 @@ pub fn manifest_file_name(set_name: &str) -> String {
     format!("{set_name}{MANIFEST_SUFFIX}")
 }
 
+/// How u lies in every layout (DESIGN.md's texture space): the start of each `texture_space`.
+macro_rules! u_round_the_body {
+    () => {
+        "u (image x, left to right) runs round the body, the belly's midline at u = 0 and 1, the spine at u = 0.5; "
+    };
+}
+
 /// `texture_space` of the tile layout (DESIGN.md's texture space).
-pub const TILE_TEXTURE_SPACE: &str = "u (image x, left to right) runs round the body, the belly's midline at u = 0 and \
-     1, the spine at u = 0.5; v (image rows, top to bottom) runs along it, head to tail; the tile repeats in u and in v";
+pub const TILE_TEXTURE_SPACE: &str = concat!(
+    u_round_the_body!(),
+    "v (image rows, top to bottom) runs along it, head to tail; the tile repeats in u and in v"
+);
 
 /// `texture_space` of the body layout (`--layout body`).
-pub const BODY_TEXTURE_SPACE: &str = "u (image x, left to right) runs round the body, the belly's midline at u = 0 \
-     and 1, the spine at u = 0.5; v (image rows, top to bottom) runs along it from the snout (v = 0, the first row) \
-     to the tail tip (v = 1, the last row), as glTF's v does (a mesh whose v points up reads 1 - v); the atlas \
-     wraps in u, not in v, and is height / width circumferences long (the preset's body.length); `regions` are \
-     ranges of v";
+pub const BODY_TEXTURE_SPACE: &str = concat!(
+    u_round_the_body!(),
+    "v (image rows, top to bottom) runs along it from the snout (v = 0, the first row) to the tail tip (v = 1, the \
+     last row), as glTF's v does (a mesh whose v points up reads 1 - v); the atlas wraps in u, not in v, and is \
+     height / width circumferences long (the preset's body.length); `regions` are ranges of v"
+);
 
 /// What a set's name is followed by in its manifest's file name.
 pub const MANIFEST_SUFFIX: &str = ".material.json";

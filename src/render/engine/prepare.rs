@@ -124,7 +124,7 @@ impl DrawMemory {
     pub fn check(&self, what: &str) -> Result<(), Error> {
         // The renderer's part named: no smaller size brings the estimate under it (a limit of
         // 300 MiB refused 16×16 frames of 64² maps, "use a smaller size").
-        let fixed_mib = DRAWING_OVERHEAD_BYTES.div_ceil(1 << 20);
+        let fixed_mib = DRAWING_OVERHEAD_BYTES.div_ceil(crate::memory::MIB);
         self.refuse_over(self.estimate_bytes(), what, &format!(", {fixed_mib} MiB of it the renderer's at any size,"))
     }
 

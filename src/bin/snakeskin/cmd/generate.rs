@@ -11,7 +11,7 @@ use snakeskin::graph::EvalStats;
 use snakeskin::maps::BuildOptions;
 use snakeskin::ops::filters::NormalConvention;
 
-const MIB: f64 = (1u64 << 20) as f64;
+const MIB: f64 = snakeskin::memory::MIB as f64;
 
 pub fn run(args: GenerateArgs) -> Result<()> {
     let convention = match args.normal_convention {
