@@ -159,6 +159,22 @@ fn a_closed_log_pipe_does_not_stop_the_batch() {
     assert!(status.success(), "{status:?}");
     assert_eq!(manifests(&out).len(), 6);
     assert!(entries(&out).iter().all(|p| !p.file_name().unwrap().to_string_lossy().starts_with('.')));
+    // Its notes and its lines in one pipe (`2>&1 | head -1`): a whole batch, every set made
+    // and its index written, exited 1 without a word at its last note ("created folder").
+    std::fs::remove_dir_all(&out).unwrap();
+    let (reader, writer) = std::io::pipe().unwrap();
+    let mut child = {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_snakeskin"));
+        command.args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        command.stdout(writer.try_clone().unwrap()).stderr(writer);
+        command.spawn().unwrap()
+    };
+    let mut first = String::new();
+    std::io::BufReader::new(reader).read_line(&mut first).unwrap();
+    assert!(first.starts_with("1/6 done "), "{first}");
+    let status = child.wait().unwrap();
+    assert!(status.success(), "2>&1: {status:?}");
+    assert_eq!(manifests(&out).len(), 6);
 }
 
 /// Ctrl-C or SIGTERM: the batch ends with 128 + the signal and leaves its finished sets and

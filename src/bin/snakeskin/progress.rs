@@ -7,6 +7,20 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 pub struct Progress(Option<ProgressBar>);
 
+/// `eprintln!`, but a reader that went away (`2>&1 | head`) loses the line and the run goes
+/// on, as the batch's lines on stdout do (`cmd::batch`'s `JobLog`): under an ignored SIGPIPE
+/// (a batch, which must not die mid-commit) a whole batch that had made every set and
+/// written its index exited 1 without a word at its last note. Where SIGPIPE is the default
+/// the process ends at the write as every command's does. Any other failure (`2> /dev/full`)
+/// panics as `eprintln!` does (`output::stdout_failure_is_an_error` ends the run).
+pub fn eprintln_unless_closed(line: &str) {
+    use std::io::Write;
+    match writeln!(std::io::stderr(), "{line}") {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => panic!("failed printing to stderr: {e}"),
+        _ => {}
+    }
+}
+
 impl Progress {
     /// A bar counting `{pos}/{len}` units; `template` is an indicatif template.
     pub fn counting(template: &str) -> Progress {
@@ -49,7 +63,7 @@ impl Progress {
     pub fn println(&self, line: &str) {
         match &self.0 {
             Some(bar) => bar.println(line),
-            None => eprintln!("{line}"),
+            None => eprintln_unless_closed(line),
         }
     }
 

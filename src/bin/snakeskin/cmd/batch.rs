@@ -55,7 +55,7 @@ pub fn run(args: BatchArgs) -> Result<()> {
     };
     bar.finish();
     if !had_folder && args.out.is_dir() {
-        eprintln!("note: created folder {}", path_line(&args.out));
+        crate::progress::eprintln_unless_closed(&format!("note: created folder {}", path_line(&args.out)));
     }
     let count = |status: JobStatus| index.jobs.iter().filter(|j| j.status == status).count();
     let mut counts = format!("{} run, {} already done", count(JobStatus::Done), count(JobStatus::Skipped));
