@@ -2134,6 +2134,40 @@ fn figures_are_checked_before_any_is_drawn() {
     assert!(!stderr(&snakeskin(&["graph", PRESET])).contains("warning"), "the preset warns by itself");
 }
 
+/// `figures` warns of what its figures draw, each figure's own value, on one line (a sweep):
+/// a preset's film thickness, which every figure sets for itself, was warned of though no
+/// figure drew it; warnings were merged by key, so a line quoted the first figure's 900 nm
+/// for the 200, 400 and 600 nm figures; and a figure's warning printed the preset's path
+/// raw, an escape sequence in a folder's name sent to the terminal. (Before any GPU is
+/// asked for: here there is none.)
+#[cfg(unix)]
+#[test]
+fn figures_warn_of_what_each_figure_draws_on_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("d\u{1b}[31mRED");
+    std::fs::create_dir(&folder).unwrap();
+    let no_gpu = [("VK_ICD_FILENAMES", "/nonexistent.json"), ("WGPU_BACKEND", "vulkan")];
+    let figures = |text: &str| {
+        let preset = folder.join("p.toml");
+        std::fs::write(&preset, text).unwrap();
+        let out = dir.path().join("out");
+        let out = snakeskin_env(&["figures", preset.to_str().unwrap(), "-o", out.to_str().unwrap()], &no_gpu);
+        assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+        stderr(&out)
+    };
+    // Every figure sets its own film thickness: the preset's 100 nm is drawn in none.
+    let err = figures("seed = 1\n[optics]\nfilm_thickness_nm = 100\n[iridescence]\nspread_nm = 300\n");
+    assert!(!err.contains("film_thickness_nm = 100"), "{err}");
+    assert!(!err.contains('\u{1b}') && err.contains("d\\u{1b}[31mRED"), "{err}");
+    // Each figure's own thickness, with the figures that draw it (the control: the warning
+    // of the thickness figures' values is given).
+    let err = figures("seed = 1\n[optics]\nfilm_thickness_nm = 2000\n[iridescence]\nspread_nm = 2000\n");
+    let of = |nm: &str| err.lines().find(|l| l.contains(&format!("film_thickness_nm = {nm} is below"))).unwrap_or("");
+    assert!(of("200").contains(" in thickness_200nm.png (the figures'"), "{err}");
+    assert!(of("600").contains(" in thickness_600nm.png (the figures'"), "{err}");
+    assert!(!of("900").contains("thickness_200nm.png") && of("900").contains("stage_a_diffuse.png"), "{err}");
+}
+
 /// A legal file name near the 255-byte limit was refused after the work ("cannot write .:
 /// File name too long": its temporary's name is 22 bytes longer); one past the limit is
 /// refused before the work, with the name's length, exit 2. A set whose name is long has
