@@ -2210,6 +2210,34 @@ fn a_long_file_name_is_written_and_one_past_the_limit_refused_first() {
     let out = snakeskin(&["export", "erythrolamprus-miliaris", "--gltf", glb.to_str().unwrap(), "--size", "16"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(glb.is_file());
+
+    // A folder's name past the limit, and a path past the system's, are refused with the
+    // folder or the length, exit 2, nothing made (each failed as the folder was made, exit
+    // 1, "File name too long", the second naming the first folder it made: a sweep). Every
+    // kind of output: a set's folder, a file's, a gallery's close-ups. Control: 255 bytes.
+    let long = "f".repeat(256);
+    let deep = "dd/".repeat(1400);
+    let cases: [(Vec<String>, &str); 4] = [
+        (vec!["generate".into(), "natrix-natrix".into(), "-o".into(), format!("x/{long}/y")], "x/ff"),
+        (vec!["brdf".into(), "chart".into(), "-o".into(), format!("{long}/c.png")], "ff"),
+        (vec!["gallery".into(), "-o".into(), "g.png".into(), "--closeups".into(), long.clone()], "ff"),
+        (vec!["brdf".into(), "chart".into(), "-o".into(), format!("{deep}c.png")], "dd/dd"),
+    ];
+    for (args, named) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = Command::new(env!("CARGO_BIN_EXE_snakeskin")).args(&args).current_dir(dir.path()).output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{:.100}: {err:.300}", args.join(" "));
+        let said = if named == "dd/dd" { "bytes long, and paths may be at most 4095" } else { "its name is 256 bytes" };
+        assert!(err.contains(said) && err.contains(named), "{err:.300}");
+        assert!(!dir.path().join("x").exists() && !dir.path().join("dd").exists(), "a folder was made");
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["brdf", "chart", "--width", "4", "--height", "4", "-o", &format!("{}/c.png", "f".repeat(255))])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "the control: {}", stderr(&out));
 }
 
 /// An output path with a control character is refused before any work, exit 2, nothing

@@ -387,6 +387,9 @@ pub fn check_target(target: &Path) -> Result<(), ExportError> {
     if ends_as_a_folder(target) {
         return Err(ExportError::folder_name(target, &super::OUTPUT_EXTENSIONS));
     }
+    if let Some(folder) = target.parent() {
+        check_name_lengths(folder)?;
+    }
     let name_bytes = target.file_name().map_or(0, |n| n.len());
     if name_bytes > NAME_MAX_BYTES {
         return Err(ExportError::NameTooLong { path: target.into(), bytes: name_bytes, limit: NAME_MAX_BYTES });
@@ -670,6 +673,7 @@ fn first_missing_folder(dir: &Path) -> &Path {
 /// one under folders is fine.
 pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
     refuse_unlistable(dir)?;
+    check_name_lengths(dir)?;
     for path in dir.ancestors().filter(|p| !p.as_os_str().is_empty()) {
         match fs::metadata(path) {
             Ok(meta) if meta.is_dir() => return Ok(()),
@@ -686,6 +690,30 @@ pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
                 Ok(_) => return Err(ExportError::NotAFolder { path: path.into() }),
                 Err(_) => continue,
             },
+        }
+    }
+    Ok(())
+}
+
+/// The longest path Linux takes in one call (`PATH_MAX`, 4096 with its closing NUL).
+const PATH_MAX_BYTES: usize = 4095;
+
+/// Refuses a folder path no file system takes: a folder's name over `NAME_MAX_BYTES`, or the
+/// whole path over `PATH_MAX_BYTES` (both failed as the folder was made, exit 1, the second
+/// naming the first folder made: a sweep).
+fn check_name_lengths(dir: &Path) -> Result<(), ExportError> {
+    let bytes = dir.as_os_str().len();
+    if bytes > PATH_MAX_BYTES {
+        let path = dir.to_string_lossy().into_owned();
+        return Err(ExportError::PathTooLong { path, bytes, limit: PATH_MAX_BYTES });
+    }
+    let mut folder = PathBuf::new();
+    for component in dir.components() {
+        folder.push(component);
+        if let std::path::Component::Normal(name) = component
+            && name.len() > NAME_MAX_BYTES
+        {
+            return Err(ExportError::FolderNameTooLong { folder, bytes: name.len(), limit: NAME_MAX_BYTES });
         }
     }
     Ok(())

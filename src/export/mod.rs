@@ -149,6 +149,17 @@ pub enum ExportError {
         "cannot write {path}: its file name is {bytes} bytes long, and file systems take at most {limit}; give a shorter name"
     )]
     NameTooLong { path: PathBuf, bytes: usize, limit: usize },
+    /// A folder of an output's path whose name no file system takes (`check_folder`): it
+    /// failed as the folder was made, "File name too long (os error 36)", exit 1.
+    #[error(
+        "cannot make folder {folder}: its name is {bytes} bytes long, and file systems take at most {limit}; give a \
+         shorter name"
+    )]
+    FolderNameTooLong { folder: PathBuf, bytes: usize, limit: usize },
+    /// An output's path longer than the system takes in one call: it failed naming the first
+    /// folder it made ("cannot create folder dd: File name too long").
+    #[error("{path:.80}… is {bytes} bytes long, and paths may be at most {limit}; give a shorter path")]
+    PathTooLong { path: String, bytes: usize, limit: usize },
     #[error(
         "cannot write {path:?}: the path has a control character (a newline, a tab, an escape) or bytes that are \
          not UTF-8, which the lists of files written cannot show as they are (a script reading them would get \
@@ -201,6 +212,8 @@ impl ExportError {
                 | ExportError::InputAtLock { .. }
                 | ExportError::BrokenLink { .. }
                 | ExportError::NameTooLong { .. }
+                | ExportError::FolderNameTooLong { .. }
+                | ExportError::PathTooLong { .. }
                 | ExportError::NotListable { .. }
                 | ExportError::ManifestTooLarge { .. }
         )
