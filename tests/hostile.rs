@@ -1281,9 +1281,11 @@ fn a_chart_of_a_stack_that_reflects_nothing_says_it_is_black() {
     let args = ["brdf", "chart", "-o", chart.to_str().unwrap(), "--width", "8", "--height", "4"];
     let out = snakeskin(&[&args[..], &["--n0", "2", "--n1", "2", "--n2", "2"]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stderr(&out).contains("(black: this stack reflects nothing"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the chart is black: this stack reflects nothing"), "{}", stderr(&out));
     let out = snakeskin(&args);
-    assert!(stderr(&out).contains("(linear reflectance scaled by "), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the chart's linear reflectance is scaled by "), "{}", stderr(&out));
+    // The file written on stdout, as every image command prints it (it was on stderr).
+    assert_eq!(stdout(&out), format!("{}\n", chart.display()));
 }
 
 #[test]

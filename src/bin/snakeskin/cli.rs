@@ -90,7 +90,7 @@ pub enum Command {
         /// Image size WIDTHxHEIGHT (or one number for a square), each 16 to 8192 pixels.
         #[arg(long, default_value = "640x400", value_parser = parse_image_size)]
         size: ImageSize,
-        /// Map resolution for the preview (pixels per side), 64 to 4096.
+        /// Resolution of the maps each figure is drawn with (pixels per side), 64 to 4096.
         #[arg(long, default_value_t = 1024, value_parser = map_size())]
         map_size: u64,
     },

@@ -308,15 +308,16 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             let (image, exposure) = chart(stack, method, width as usize, height as usize);
             let png = snakeskin::export::encode_png(snakeskin::material::MapKind::Color, &image)?;
             snakeskin::export::write_file_atomically(&out, png)?;
+            // The path on stdout, as `gallery`, `sheet` and `figures` print what they wrote
+            // (it was on stderr: `$(snakeskin brdf chart …)` caught nothing, a sweep); how the
+            // chart was scaled is a note.
             if image.data.iter().all(|v| *v == 0.0) {
                 // Matched indices: nothing to scale, so no scale to report.
-                eprintln!("wrote {} (black: this stack reflects nothing at any thickness and angle)", path_line(&out));
+                eprintln!("note: the chart is black: this stack reflects nothing at any thickness and angle");
             } else {
-                eprintln!(
-                    "wrote {} (linear reflectance scaled by {exposure:.3} before sRGB encoding)",
-                    path_line(&out)
-                );
+                eprintln!("note: the chart's linear reflectance is scaled by {exposure:.3} before sRGB encoding");
             }
+            println!("{}", path_line(&out));
             Ok(())
         }
         BrdfCommand::Eval(args) => {
