@@ -720,6 +720,10 @@ struct Resolved {
     files: Vec<String>,
     /// The preset's `content_hash`, as its set's manifest records it (`preset_hash`).
     preset_hash: String,
+    /// The manifest there as the run was planned (`manifest_identity`; None where there was
+    /// none, or the job is another shard's): a job compares it under the set's lock, so that
+    /// a set another run made since is never taken for the one it planned to replace.
+    found: Option<ManifestIdentity>,
 }
 
 /// `check`: whether to look for its finished set (reading and hashing its files).
@@ -782,11 +786,13 @@ fn resolve(jobs_file: &Path, job: &Job, out: &Path, check: bool) -> Result<Resol
         kept: Vec::new(),
     };
     let files = set_file_names(&loaded, &request(job, out, &outcome));
+    // Taken before the look at the set: a set committed between the two is another file.
+    let found = if check { manifest_identity(&out.join(&outcome.manifest)) } else { None };
     let done = check && is_done(&out.join(&outcome.manifest), &outcome.key, &files);
     if done {
         outcome.status = JobStatus::Skipped;
     }
-    Ok(Resolved { outcome, done, warnings, files, preset_hash: loaded.content_hash.clone() })
+    Ok(Resolved { outcome, done, warnings, files, preset_hash: loaded.content_hash.clone(), found })
 }
 
 /// Resolves every job of the file (not only the shard's, so that every shard finds the same
@@ -1436,9 +1442,6 @@ fn run_one(
     let running = RunningJob { place: job.place(jobs_file, job.lines.preset), seed: outcome.seed, size: job.size };
     let failed = |source: Error| BatchError::Failed { job: running.clone(), source: Box::new(source) };
     let manifest = out.join(&outcome.manifest);
-    // The manifest there as the job starts, known by its file: another run's commit puts a
-    // new file in its place, even within one tick of a coarse clock.
-    let found = manifest_identity(&manifest);
     // Checked against the available memory with the other jobs when the run was planned
     // (`fitting_concurrency`); the jobs running beside this one hold part of it now.
     let plan = Plan::within_checked_budget(&request(job, out, &outcome)).map_err(failed)?;
@@ -1466,11 +1469,13 @@ fn run_one(
         Err(Error::Export(crate::export::ExportError::Busy { .. })) if stopped() => return Ok(None),
         Err(e) => return Err(failed(e).into()),
     };
-    // Under the lock, what another run did meanwhile, whether this job waited for it or took
-    // the lock the moment it let go (within the acquire's second of tries): a set it made
-    // for this job is skipped; another preset's set there is refused, not written over.
+    // Under the lock, what another run did since the plan (`Resolved::found`), whether this
+    // job waited for it, took the lock the moment it let go, or started after it had gone:
+    // a set it made for this job is skipped; another preset's set there is refused, not
+    // written over. (Compared with the manifest as the job started, a set made while the
+    // jobs before it ran was taken for the old one: the review.)
     let now = manifest_identity(&manifest);
-    if now != found {
+    if now != resolved.found {
         if is_done(&manifest, &outcome.key, &resolved.files) {
             outcome.status = JobStatus::Skipped;
             return Ok(Some(outcome));
@@ -1492,10 +1497,13 @@ fn let_go_of_a_left_lock(folder: &Path, name: &str) {
     let _ = crate::export::SetLock::acquire(folder, name);
 }
 
+/// A manifest's device, inode, length and modification time (`manifest_identity`).
+type ManifestIdentity = (u64, u64, u64, Option<std::time::SystemTime>);
+
 /// Which file `path` is (device, inode) and its length and time, if it is there: a commit
 /// renames a new file into place, so a set made meanwhile is another file even within one
 /// tick of a coarse clock.
-fn manifest_identity(path: &Path) -> Option<(u64, u64, u64, Option<std::time::SystemTime>)> {
+fn manifest_identity(path: &Path) -> Option<ManifestIdentity> {
     let m = std::fs::symlink_metadata(path).ok()?;
     #[cfg(unix)]
     let (device, inode) = { (std::os::unix::fs::MetadataExt::dev(&m), std::os::unix::fs::MetadataExt::ino(&m)) };

@@ -159,19 +159,19 @@ fn a_closed_log_pipe_does_not_stop_the_batch() {
     assert!(status.success(), "{status:?}");
     assert_eq!(manifests(&out).len(), 6);
     assert!(entries(&out).iter().all(|p| !p.file_name().unwrap().to_string_lossy().starts_with('.')));
-    // Its notes and its lines in one pipe (`2>&1 | head -1`): a whole batch, every set made
-    // and its index written, exited 1 without a word at its last note ("created folder").
+    // Its notes and its lines in one pipe whose reader went away (`2>&1 | head`): a whole
+    // batch, every set made and its index written, exited 1 without a word at its last note
+    // ("created folder"). The reader is gone before the run starts, so that every line and
+    // note meets the closed pipe however fast the run is.
     std::fs::remove_dir_all(&out).unwrap();
     let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
     let mut child = {
         let mut command = Command::new(env!("CARGO_BIN_EXE_snakeskin"));
         command.args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
         command.stdout(writer.try_clone().unwrap()).stderr(writer);
         command.spawn().unwrap()
     };
-    let mut first = String::new();
-    std::io::BufReader::new(reader).read_line(&mut first).unwrap();
-    assert!(first.starts_with("1/6 done "), "{first}");
     let status = child.wait().unwrap();
     assert!(status.success(), "2>&1: {status:?}");
     assert_eq!(manifests(&out).len(), 6);
@@ -2009,7 +2009,6 @@ fn another_presets_set_made_while_the_lock_is_tried_is_not_written_over() {
     let done = run.wait_with_output().unwrap();
     assert_eq!(done.status.code(), Some(1), "{}", stderr(&done));
     assert!(stderr(&done).contains("another snakeskin run made"), "{}", stderr(&done));
-    assert!(!stderr(&done).contains("waiting for it"), "the lock was let go within its tries: {}", stderr(&done));
     assert!(tree(&folder) == tree(&other.join("out").join(set)), "the other preset's set was replaced");
 }
 
@@ -2065,6 +2064,7 @@ fn a_waiting_job_stops_with_the_queue() {
         }
         if start.elapsed() > Duration::from_secs(60) {
             let _ = run.kill();
+            let _ = run.wait();
             panic!("the waiting job went on waiting after the queue stopped");
         }
         std::thread::sleep(Duration::from_millis(20));
@@ -2076,4 +2076,78 @@ fn a_waiting_job_stops_with_the_queue() {
     assert!(rest.contains("python-regius") && rest.contains("not a lock"), "{rest}");
     assert_eq!(statuses(&read_index(&out)), ["not run", "failed"], "{rest}");
     drop(locks);
+}
+
+/// Another preset's set made after the run was planned, while the jobs before it ran: the job
+/// compares the manifest under the lock with the one there as the run was planned, and
+/// refuses. Compared with the one there as the job started, it took the other run's fresh
+/// set for the old one and wrote over it, exit 0 (the review: a long queue made the window
+/// the whole run).
+#[test]
+fn another_presets_set_made_after_the_plan_is_not_written_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let preset = "[scales]\nrows = 20\n";
+    std::fs::write(dir.path().join("foo.toml"), preset).unwrap();
+    let jobs = dir.path().join("jobs.toml");
+    std::fs::write(
+        &jobs,
+        "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n\n\
+         [[job]]\npreset = \"foo.toml\"\nseeds = [1]\nsizes = [16]\n",
+    )
+    .unwrap();
+    // The other preset of that name, and its set, made apart.
+    let other = dir.path().join("other");
+    std::fs::create_dir(&other).unwrap();
+    std::fs::write(other.join("foo.toml"), "[scales]\nrows = 24\n").unwrap();
+    let other_jobs = other.join("jobs.toml");
+    std::fs::write(&other_jobs, "[[job]]\npreset = \"foo.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
+    let made_other = snakeskin(&["batch", other_jobs.to_str().unwrap(), "-o", other.join("out").to_str().unwrap()]);
+    assert!(made_other.status.success(), "{}", stderr(&made_other));
+    let set = Path::new("foo/tile-16-seed1-png");
+    let out = dir.path().join("out");
+    // The first job waits for a lock the test holds, so that the second starts after the
+    // other preset's set is in place.
+    let first = out.join("natrix-natrix/tile-16-seed1-png");
+    std::fs::create_dir_all(&first).unwrap();
+    let lock = std::fs::File::create(first.join(".natrix-natrix.lock")).unwrap();
+    lock.try_lock().unwrap();
+    let mut run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "1"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (lines, log) = std::sync::mpsc::channel::<String>();
+    let stderr_pipe = std::io::BufReader::new(run.stderr.take().unwrap());
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        for line in stderr_pipe.lines().map_while(Result::ok) {
+            let _ = lines.send(line + "\n");
+        }
+    });
+    let mut said = String::new();
+    while !said.contains("waiting for it") {
+        match log.recv_timeout(Duration::from_secs(60)) {
+            Ok(line) => said += &line,
+            Err(e) => {
+                let _ = run.kill();
+                let _ = run.wait();
+                panic!("the first job did not say it waits ({e:?}): {said}");
+            }
+        }
+    }
+    std::fs::create_dir_all(out.join(set)).unwrap();
+    for file in std::fs::read_dir(other.join("out").join(set)).unwrap() {
+        let file = file.unwrap().path();
+        std::fs::copy(&file, out.join(set).join(file.file_name().unwrap())).unwrap();
+    }
+    drop(lock);
+    let status = run.wait().unwrap();
+    reader.join().unwrap();
+    let rest: String = log.try_iter().collect();
+    assert_eq!(status.code(), Some(1), "{rest}");
+    assert!(rest.contains("another snakeskin run made") && rest.contains("from other input"), "{rest}");
+    assert!(tree(&out.join(set)) == tree(&other.join("out").join(set)), "the other preset's set was replaced");
+    // The control: the first job, which waited and found nothing made meanwhile, made its set.
+    assert_eq!(statuses(&read_index(&out)), ["done", "failed"], "{rest}");
 }

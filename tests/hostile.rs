@@ -2230,16 +2230,26 @@ fn a_long_file_name_is_written_and_one_past_the_limit_refused_first() {
         let out = Command::new(env!("CARGO_BIN_EXE_snakeskin")).args(&args).current_dir(dir.path()).output().unwrap();
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{:.100}: {err:.300}", args.join(" "));
-        let said = if named == "dd/dd" { "bytes long, and paths may be at most 4095" } else { "its name is 256 bytes" };
+        let said = if named == "dd/dd" {
+            "bytes long, and an output's folder may be at most 3839"
+        } else {
+            "its name is 256 bytes"
+        };
         assert!(err.contains(said) && err.contains(named), "{err:.300}");
         assert!(!dir.path().join("x").exists() && !dir.path().join("dd").exists(), "a folder was made");
     }
-    let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(["brdf", "chart", "--width", "4", "--height", "4", "-o", &format!("{}/c.png", "f".repeat(255))])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "the control: {}", stderr(&out));
+    // The controls: a folder named with 255 bytes, and a folder path of 3839 bytes, the most
+    // that leaves room for a file name of 255 (a byte more is refused).
+    let at_most = format!("{}{}", format!("{}/", "d".repeat(99)).repeat(38), "d".repeat(39));
+    assert_eq!(at_most.len(), 3839);
+    for (folder, written) in [("f".repeat(255), true), (at_most.clone(), true), (format!("{at_most}d"), false)] {
+        let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(["brdf", "chart", "--width", "4", "--height", "4", "-o", &format!("{folder}/c.png")])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.success(), written, "{} bytes: {:.300}", folder.len(), stderr(&out));
+    }
 }
 
 /// An output path with a control character is refused before any work, exit 2, nothing

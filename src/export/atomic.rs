@@ -302,8 +302,9 @@ pub fn lock_is_held(dir: &Path, name: &str) -> bool {
 }
 
 /// How a set's lock file is opened, by the acquire (`write`, creating it) and by a look at
-/// whether it is held: not through a link, and without waiting (a FIFO there fails to open,
-/// ENXIO, where a plain open waited for the other end for ever: `verify` opened it plainly).
+/// whether it is held: not through a link, and without waiting (a plain open of a FIFO there
+/// waited for the other end for ever: `verify` opened it plainly). Opened so, a FIFO fails
+/// to open for writing (ENXIO), and opens for reading at once and reads as not held.
 fn lock_open_options(write: bool) -> fs::OpenOptions {
     let mut options = fs::OpenOptions::new();
     match write {
@@ -698,14 +699,20 @@ pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
 /// The longest path Linux takes in one call (`PATH_MAX`, 4096 with its closing NUL).
 const PATH_MAX_BYTES: usize = 4095;
 
+/// The longest folder path an output goes in: `PATH_MAX_BYTES` less a separator and a file
+/// name of up to `NAME_MAX_BYTES`, which the lock and the temporaries can reach (they are cut
+/// to it). A folder within 4095 bytes, but not with its files' names, was made and then
+/// failed at its lock, "File name too long", exit 1 (the review).
+const FOLDER_PATH_MAX_BYTES: usize = PATH_MAX_BYTES - 1 - NAME_MAX_BYTES;
+
 /// Refuses a folder path no file system takes: a folder's name over `NAME_MAX_BYTES`, or the
-/// whole path over `PATH_MAX_BYTES` (both failed as the folder was made, exit 1, the second
-/// naming the first folder made: a sweep).
+/// whole path over `FOLDER_PATH_MAX_BYTES` (both failed as the folder was made, exit 1, the
+/// second naming the first folder made: a sweep).
 fn check_name_lengths(dir: &Path) -> Result<(), ExportError> {
     let bytes = dir.as_os_str().len();
-    if bytes > PATH_MAX_BYTES {
+    if bytes > FOLDER_PATH_MAX_BYTES {
         let path = dir.to_string_lossy().into_owned();
-        return Err(ExportError::PathTooLong { path, bytes, limit: PATH_MAX_BYTES });
+        return Err(ExportError::PathTooLong { path, bytes, limit: FOLDER_PATH_MAX_BYTES });
     }
     let mut folder = PathBuf::new();
     for component in dir.components() {
@@ -888,12 +895,19 @@ impl SetLock {
             // A run killed a moment ago holds its lock until the kernel has torn it down
             // (0.3 s after a 4K run's SIGKILL, an independent review measured: a run started
             // at once was told another run was writing); a lock held a second on is a run's.
+            // The table is let go of while it waits: another process holds this lock file, so
+            // it is not this run's to remove, and the other sets' acquires, their drops and
+            // the exit's clean-up go on (held through the second, every busy set stopped the
+            // batch's other jobs for it: the review). A clean-up that takes the table meanwhile
+            // keeps it until the process exits.
             let mut attempt = file.try_lock();
             for _ in 0..BUSY_RETRIES {
                 if !matches!(attempt, Err(fs::TryLockError::WouldBlock)) {
                     break;
                 }
+                drop(held);
                 std::thread::sleep(BUSY_RETRY_WAIT);
+                held = locked(&HELD_LOCKS);
                 attempt = file.try_lock();
             }
             match attempt {
@@ -940,7 +954,9 @@ impl SetLock {
     /// lock and not the process's table of held locks: it looks whether the lock is held
     /// (`lock_is_held`) every `LOCK_WAIT_POLL`, and takes it with `acquire` once free (taken
     /// again with the second of tries each time, the jobs beside it waited on the table: a
-    /// review measured 3.8–6.3 s for 1.3 s).
+    /// review measured 3.8–6.3 s for 1.3 s). It sleeps before each look: a lock held shared
+    /// (a `verify`'s look) reads as free, and the acquire that then found it busy was tried
+    /// again at once, its twenty tries a second for as long as the lock was held (a review).
     pub fn acquire_waiting(
         dir: &Path,
         name: &str,
@@ -960,11 +976,14 @@ impl SetLock {
                 waiting();
                 said = true;
             }
-            while lock_is_held(dir, name) {
+            loop {
+                std::thread::sleep(LOCK_WAIT_POLL);
                 if give_up() {
                     return Err(busy);
                 }
-                std::thread::sleep(LOCK_WAIT_POLL);
+                if !lock_is_held(dir, name) {
+                    break;
+                }
             }
         }
     }

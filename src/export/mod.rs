@@ -156,9 +156,13 @@ pub enum ExportError {
          shorter name"
     )]
     FolderNameTooLong { folder: PathBuf, bytes: usize, limit: usize },
-    /// An output's path longer than the system takes in one call: it failed naming the first
-    /// folder it made ("cannot create folder dd: File name too long").
-    #[error("{path:.80}… is {bytes} bytes long, and paths may be at most {limit}; give a shorter path")]
+    /// An output's folder path too long for the system to take with a file's name in it
+    /// (`check_folder`): it failed naming the first folder it made ("cannot create folder dd:
+    /// File name too long").
+    #[error(
+        "the folder {path:.80}… is {bytes} bytes long, and an output's folder may be at most {limit} (a path is at \
+         most 4095 bytes, and a file name in it up to 255 more); give a shorter path"
+    )]
     PathTooLong { path: String, bytes: usize, limit: usize },
     #[error(
         "cannot write {path:?}: the path has a control character (a newline, a tab, an escape) or bytes that are \
