@@ -113,19 +113,31 @@ pub fn chart_bytes(width: usize, height: usize) -> u64 {
 
 /// The film colour chart: thickness 0..2000 nm across, angle 0..89° down, scaled so the
 /// brightest channel is 1. Returns the linear image and the exposure applied (film
-/// reflectances are a few percent to a few tens of percent).
-pub fn chart(stack: Stack, method: Method, width: usize, height: usize) -> (Image, f64) {
+/// reflectances are a few percent to a few tens of percent). `progress(done, total)` counts
+/// rows (the spectral reference takes about half a minute at 1024² on two cores, minutes at
+/// the largest: it ran without a word, a sweep).
+pub fn chart(
+    stack: Stack,
+    method: Method,
+    width: usize,
+    height: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> (Image, f64) {
     // The table taken once, not through the cache's lock per pixel (16 million at 4096²).
     let lut = matches!(method, Method::Lut).then(|| lut_for(stack));
     let colour = |thickness_nm: f64, cos0: f64| match &lut {
         Some(lut) => lut.lookup_f64(thickness_nm, cos0),
         None => film_colour(method, stack, thickness_nm, cos0),
     };
+    let done = std::sync::atomic::AtomicUsize::new(0);
     let rows: Vec<Vec<[f64; 3]>> = (0..height)
         .into_par_iter()
         .map(|y| {
             let cos0 = (super::accuracy::GRID_ANGLE_MAX_DEG * y as f64 / (height - 1) as f64).to_radians().cos();
-            (0..width).map(|x| colour(super::lut::FINE_MAX_NM * x as f64 / (width - 1) as f64, cos0)).collect()
+            let row =
+                (0..width).map(|x| colour(super::lut::FINE_MAX_NM * x as f64 / (width - 1) as f64, cos0)).collect();
+            progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, height);
+            row
         })
         .collect();
     // Floored only against a division by zero: a floor of 1e-6 drew a stack of n2 = n1 +
@@ -153,9 +165,9 @@ mod tests {
     fn a_faint_stacks_chart_is_scaled_to_one_and_a_blank_one_is_black() {
         let brightest = |image: &Image| image.data.iter().copied().fold(0.0f32, f32::max);
         let faint = Stack { n0: 1.0, n1: 1.0, n2: 1.0000001 };
-        let (image, exposure) = chart(faint, Method::Rgb3, 8, 8);
+        let (image, exposure) = chart(faint, Method::Rgb3, 8, 8, &|_, _| {});
         assert!((brightest(&image) - 1.0).abs() < 1e-6, "brightest {} at exposure {exposure}", brightest(&image));
-        let (image, exposure) = chart(Stack { n0: 1.0, n1: 1.0, n2: 1.0 }, Method::Rgb3, 8, 8);
+        let (image, exposure) = chart(Stack { n0: 1.0, n1: 1.0, n2: 1.0 }, Method::Rgb3, 8, 8, &|_, _| {});
         assert!(exposure.is_finite() && brightest(&image) == 0.0, "{exposure} {}", brightest(&image));
     }
 

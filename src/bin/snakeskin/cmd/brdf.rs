@@ -305,7 +305,10 @@ pub fn run(command: BrdfCommand) -> Result<()> {
             snakeskin::memory::MemoryCheck::against_available(bytes)
                 .refuse_if_over(&format!("a film colour chart of {width}×{height} pixels"))?;
             ensure_parent_folder(&out)?;
-            let (image, exposure) = chart(stack, method, width as usize, height as usize);
+            let bar = crate::progress::Progress::counting("{spinner} chart [{bar:30}] {pos}/{len} rows {elapsed}");
+            let (image, exposure) =
+                chart(stack, method, width as usize, height as usize, &|done, total| bar.update(done, total));
+            bar.finish();
             let png = snakeskin::export::encode_png(snakeskin::material::MapKind::Color, &image)?;
             snakeskin::export::write_file_atomically(&out, png)?;
             // The path on stdout, as `gallery`, `sheet` and `figures` print what they wrote
