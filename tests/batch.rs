@@ -70,6 +70,86 @@ fn statuses(index: &serde_json::Value) -> Vec<&str> {
     index["jobs"].as_array().unwrap().iter().map(|j| j["status"].as_str().unwrap()).collect()
 }
 
+/// Another preset's set of the name `preset_file` gives (seed 1, size 16), made apart, as
+/// another run would make it: `preset_file` in `dir/other` holding `text`, its set under the
+/// folder returned (`dir/other/out`), to be put where a test's run makes its own.
+fn set_made_apart(dir: &Path, preset_file: &str, text: &str) -> PathBuf {
+    let other = dir.join("other");
+    std::fs::create_dir(&other).unwrap();
+    std::fs::write(other.join(preset_file), text).unwrap();
+    let jobs = other.join("jobs.toml");
+    std::fs::write(&jobs, format!("[[job]]\npreset = \"{preset_file}\"\nseeds = [1]\nsizes = [16]\n")).unwrap();
+    let out = other.join("out");
+    let made = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    out
+}
+
+/// A `batch` run whose stderr is read on a thread of its own, so that a test can wait for
+/// what it says while it runs (a job that waits for a lock the test holds), and a run that
+/// never says it, or never ends, is stopped after a minute instead of hanging the test.
+struct WatchedRun {
+    run: std::process::Child,
+    log: std::sync::mpsc::Receiver<String>,
+    reader: std::thread::JoinHandle<()>,
+    /// Its stderr so far.
+    said: String,
+}
+
+impl WatchedRun {
+    fn start(args: &[&str]) -> WatchedRun {
+        let mut run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let (lines, log) = std::sync::mpsc::channel::<String>();
+        let stderr_pipe = std::io::BufReader::new(run.stderr.take().unwrap());
+        let reader = std::thread::spawn(move || {
+            use std::io::BufRead;
+            for line in stderr_pipe.lines().map_while(Result::ok) {
+                let _ = lines.send(line + "\n");
+            }
+        });
+        WatchedRun { run, log, reader, said: String::new() }
+    }
+
+    /// Returns once the run has said `text` `times` times on stderr.
+    fn until_said(&mut self, text: &str, times: usize) {
+        while self.said.matches(text).count() < times {
+            match self.log.recv_timeout(Duration::from_secs(60)) {
+                Ok(line) => self.said += &line,
+                Err(e) => {
+                    let _ = self.run.kill();
+                    let _ = self.run.wait();
+                    panic!("the run did not say {text:?} {times} times ({e:?}): {}", self.said);
+                }
+            }
+        }
+    }
+
+    /// Waits for the run to end: its status, all it said on stderr and its stdout.
+    fn end(mut self) -> (std::process::ExitStatus, String, String) {
+        let start = Instant::now();
+        let status = loop {
+            if let Some(status) = self.run.try_wait().unwrap() {
+                break status;
+            }
+            if start.elapsed() > Duration::from_secs(60) {
+                let _ = self.run.kill();
+                let _ = self.run.wait();
+                panic!("the run went on after a minute: {}", self.said);
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        self.reader.join().unwrap();
+        let said = self.said + &self.log.try_iter().collect::<String>();
+        let stdout = std::io::read_to_string(self.run.stdout.take().unwrap()).unwrap();
+        (status, said, stdout)
+    }
+}
+
 fn summary_counts(out: &std::process::Output) -> (usize, usize) {
     // "40 jobs of 40 in shard 0/1, up to 2 at once: 33 run, 7 already done; index: …"
     let text = stdout(out);
@@ -1478,32 +1558,33 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
     assert_eq!(alone.status.code(), Some(0), "{}", stderr(&alone));
 
     // A map entry whose file is empty is no plain file name (it was "a folder, not a
-    // regular file": a hostile-input sweep); the control, `../x`, said so already.
+    // regular file": a hostile-input sweep); the control, `../x`, said so already. Names no
+    // run writes, as preset file names and `.gltf`s are refused alike
+    // (`export::unfit_for_file_names`), with a file of that name and the recorded bytes
+    // beside the manifest: such a map verified `ok`.
     let text = std::fs::read(&manifests[0]).unwrap();
-    for file in ["", "../x"] {
+    let not_plain = "is not a plain file name";
+    let cases = [
+        ("", not_plain),
+        ("../x", not_plain),
+        ("a\\b.png", "has a backslash"),
+        ("a\u{1b}b.png", "has control characters"),
+    ];
+    for (file, what) in cases {
         let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
-        json["maps"][0]["file"] = serde_json::json!(file);
-        std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
-        let listed = verify(&[&manifests[0]]);
-        assert_eq!(listed.status.code(), Some(1), "{file:?}: {}", stderr(&listed));
-        let said = format!("map file {file:?} is not a plain file name");
-        assert!(stdout(&listed).contains(&said), "{file:?}: {}", stdout(&listed));
-    }
-    // Names no run writes, as preset file names and `.gltf`s are refused alike
-    // (`export::unfit_for_file_names`): a file of that name beside the manifest, with the
-    // recorded bytes, verified `ok`.
-    for (file, what) in [("a\\b.png", "a backslash"), ("a\u{1b}b.png", "control characters")] {
-        let mut json: serde_json::Value = serde_json::from_slice(&text).unwrap();
-        let recorded = json["maps"][0]["file"].as_str().unwrap().to_string();
         let folder = manifests[0].parent().unwrap();
-        std::fs::copy(folder.join(&recorded), folder.join(file)).unwrap();
+        if what != not_plain {
+            std::fs::copy(folder.join(json["maps"][0]["file"].as_str().unwrap()), folder.join(file)).unwrap();
+        }
         json["maps"][0]["file"] = serde_json::json!(file);
         std::fs::write(&manifests[0], serde_json::to_vec(&json).unwrap()).unwrap();
         let listed = verify(&[&manifests[0]]);
         assert_eq!(listed.status.code(), Some(1), "{file:?}: {}", stdout(&listed));
-        let said = format!("map file {file:?} has {what}");
+        let said = format!("map file {file:?} {what}");
         assert!(stdout(&listed).contains(&said), "{file:?}: {}", stdout(&listed));
-        std::fs::remove_file(folder.join(file)).unwrap();
+        if what != not_plain {
+            std::fs::remove_file(folder.join(file)).unwrap();
+        }
     }
     // A manifest whose size is missing or forged names its key (every map was said to be
     // "more than such a file can be": a hostile-input review); the control, the size as
@@ -1866,7 +1947,6 @@ fn an_index_whose_lock_is_held_is_not_written() {
 /// rather than replace it.
 #[test]
 fn a_set_another_run_is_writing_is_waited_for() {
-    use std::io::BufRead;
     let dir = tempfile::tempdir().unwrap();
     let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[1, 2]", 16);
     // The first job's set, made apart to be put in place as if another run had made it, and
@@ -1876,13 +1956,7 @@ fn a_set_another_run_is_writing_is_waited_for() {
     std::fs::write(&one, "[[job]]\npreset = \"natrix-natrix\"\nseeds = [1]\nsizes = [16]\n").unwrap();
     let made = snakeskin(&["batch", one.to_str().unwrap(), "-o", elsewhere.to_str().unwrap()]);
     assert!(made.status.success(), "{}", stderr(&made));
-    let other = dir.path().join("other");
-    std::fs::create_dir(&other).unwrap();
-    std::fs::write(other.join("natrix-natrix.toml"), "seed = 9\n").unwrap();
-    let other_jobs = other.join("jobs.toml");
-    std::fs::write(&other_jobs, "[[job]]\npreset = \"natrix-natrix.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
-    let made_other = snakeskin(&["batch", other_jobs.to_str().unwrap(), "-o", other.join("out").to_str().unwrap()]);
-    assert!(made_other.status.success(), "{}", stderr(&made_other));
+    let other_out = set_made_apart(dir.path(), "natrix-natrix.toml", "seed = 9\n");
     let set = Path::new("natrix-natrix/tile-16-seed1-png");
     for meanwhile in ["makes it", "lets go", "makes another"] {
         let out = dir.path().join(format!("out-{}", meanwhile.replace(' ', "-")));
@@ -1891,36 +1965,16 @@ fn a_set_another_run_is_writing_is_waited_for() {
         // The lock another run holds while it makes the set (`SetLock`, `.NAME.lock`).
         let lock = std::fs::File::create(folder.join(".natrix-natrix.lock")).unwrap();
         lock.try_lock().unwrap();
-        let mut run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-            .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "1"])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        // Until the run says it waits (past the lock's second of tries); its lines read on a
-        // thread of their own, so that a run that never says it (it waits silently, the lock
-        // held here) is stopped after a minute instead of hanging the test.
-        let (lines, log) = std::sync::mpsc::channel::<String>();
-        let stderr_pipe = std::io::BufReader::new(run.stderr.take().unwrap());
-        let reader = std::thread::spawn(move || {
-            for line in stderr_pipe.lines().map_while(Result::ok) {
-                let _ = lines.send(line + "\n");
-            }
-        });
-        let mut said = String::new();
-        while !said.contains("waiting for it") {
-            match log.recv_timeout(Duration::from_secs(60)) {
-                Ok(line) => said += &line,
-                Err(e) => {
-                    let _ = run.kill();
-                    panic!("{meanwhile}: the run did not say it waits ({e:?}): {said}");
-                }
-            }
-        }
+        let mut run =
+            WatchedRun::start(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "1"]);
+        // Until the run says it waits (past the lock's second of tries; a run that waits
+        // silently, the lock held here, is stopped after a minute).
+        run.until_said("waiting for it", 1);
+        let said = &run.said;
         assert!(said.contains("another snakeskin run is writing") && said.contains(".natrix-natrix.lock"), "{said}");
         let source = match meanwhile {
             "makes it" => Some(elsewhere.join(set)),
-            "makes another" => Some(other.join("out").join(set)),
+            "makes another" => Some(other_out.join(set)),
             _ => None,
         };
         for file in source.iter().flat_map(|source| std::fs::read_dir(source).unwrap()) {
@@ -1931,30 +1985,17 @@ fn a_set_another_run_is_writing_is_waited_for() {
         let placed = std::fs::metadata(&manifest).ok().map(|m| m.modified().unwrap());
         drop(lock);
         // Within a minute, or stopped (a wait that never saw the lock free hung the test).
-        let start = Instant::now();
-        let status = loop {
-            if let Some(status) = run.try_wait().unwrap() {
-                break status;
-            }
-            if start.elapsed() > Duration::from_secs(60) {
-                let _ = run.kill();
-                panic!("{meanwhile}: the run went on waiting after the lock was let go");
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        };
-        reader.join().unwrap();
-        let rest: String = log.try_iter().collect();
-        let stdout = std::io::read_to_string(run.stdout.take().unwrap()).unwrap();
+        let (status, rest, stdout) = run.end();
         if meanwhile == "makes another" {
             assert_eq!(status.code(), Some(1), "{rest}");
             assert!(rest.contains("another snakeskin run made") && rest.contains("from other input"), "{rest}");
             // (Refused under the lock, which the run took and let go of, as it removes its own.)
             assert!(!folder.join(".natrix-natrix.lock").exists(), "{rest}");
-            assert!(tree(&folder) == tree(&other.join("out").join(set)), "the other preset's set was replaced");
+            assert!(tree(&folder) == tree(&other_out.join(set)), "the other preset's set was replaced");
             continue;
         }
         assert!(status.success(), "{meanwhile}: {rest}");
-        assert_eq!(said.matches("waiting for it").count() + rest.matches("waiting for it").count(), 1, "{rest}");
+        assert_eq!(rest.matches("waiting for it").count(), 1, "{rest}");
         let counts = stdout.lines().last().and_then(|l| l.split(": ").nth(1)).unwrap_or_default().to_string();
         let expected = if meanwhile == "makes it" { "1 run, 1 already done" } else { "2 run, 0 already done" };
         assert!(counts.starts_with(expected), "{meanwhile}: {stdout}");
@@ -1978,13 +2019,7 @@ fn a_set_another_run_is_writing_is_waited_for() {
 fn another_presets_set_made_while_the_lock_is_tried_is_not_written_over() {
     let dir = tempfile::tempdir().unwrap();
     let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[1]", 16);
-    let other = dir.path().join("other");
-    std::fs::create_dir(&other).unwrap();
-    std::fs::write(other.join("natrix-natrix.toml"), "seed = 9\n").unwrap();
-    let other_jobs = other.join("jobs.toml");
-    std::fs::write(&other_jobs, "[[job]]\npreset = \"natrix-natrix.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
-    let made_other = snakeskin(&["batch", other_jobs.to_str().unwrap(), "-o", other.join("out").to_str().unwrap()]);
-    assert!(made_other.status.success(), "{}", stderr(&made_other));
+    let other_out = set_made_apart(dir.path(), "natrix-natrix.toml", "seed = 9\n");
     let set = Path::new("natrix-natrix/tile-16-seed1-png");
     let out = dir.path().join("out");
     let folder = out.join(set);
@@ -2001,7 +2036,7 @@ fn another_presets_set_made_while_the_lock_is_tried_is_not_written_over() {
     // The job tries the lock (it holds the lock file open): the other preset's set is put in
     // place and the lock let go, well within the second of tries.
     common::wait_until_open(run.id(), &lock_path.canonicalize().unwrap());
-    for file in std::fs::read_dir(other.join("out").join(set)).unwrap() {
+    for file in std::fs::read_dir(other_out.join(set)).unwrap() {
         let file = file.unwrap().path();
         std::fs::copy(&file, folder.join(file.file_name().unwrap())).unwrap();
     }
@@ -2009,7 +2044,7 @@ fn another_presets_set_made_while_the_lock_is_tried_is_not_written_over() {
     let done = run.wait_with_output().unwrap();
     assert_eq!(done.status.code(), Some(1), "{}", stderr(&done));
     assert!(stderr(&done).contains("another snakeskin run made"), "{}", stderr(&done));
-    assert!(tree(&folder) == tree(&other.join("out").join(set)), "the other preset's set was replaced");
+    assert!(tree(&folder) == tree(&other_out.join(set)), "the other preset's set was replaced");
 }
 
 /// A job waiting for another run's set stops waiting when the queue stops (another job
@@ -2030,47 +2065,14 @@ fn a_waiting_job_stops_with_the_queue() {
         lock.try_lock().unwrap();
         locks.push(lock);
     }
-    let mut run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "2"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let (lines, log) = std::sync::mpsc::channel::<String>();
-    let stderr_pipe = std::io::BufReader::new(run.stderr.take().unwrap());
-    let reader = std::thread::spawn(move || {
-        use std::io::BufRead;
-        for line in stderr_pipe.lines().map_while(Result::ok) {
-            let _ = lines.send(line + "\n");
-        }
-    });
-    let mut said = String::new();
-    while said.matches("waiting for it").count() < 2 {
-        match log.recv_timeout(Duration::from_secs(60)) {
-            Ok(line) => said += &line,
-            Err(e) => {
-                let _ = run.kill();
-                panic!("the jobs did not both say they wait ({e:?}): {said}");
-            }
-        }
-    }
+    let mut run =
+        WatchedRun::start(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "2"]);
+    run.until_said("waiting for it", 2);
     let failing = locks.pop().unwrap();
     std::io::Write::write_all(&mut &failing, b"not a lock").unwrap();
     drop(failing);
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = run.try_wait().unwrap() {
-            break status;
-        }
-        if start.elapsed() > Duration::from_secs(60) {
-            let _ = run.kill();
-            let _ = run.wait();
-            panic!("the waiting job went on waiting after the queue stopped");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    reader.join().unwrap();
-    let rest: String = log.try_iter().collect();
+    // (A waiting job that went on waiting after the queue stopped is stopped after a minute.)
+    let (status, rest, _) = run.end();
     // (The failed job's error is of what is in a set's place: exit 2, as `generate` says it.)
     assert_eq!(status.code(), Some(2), "{rest}");
     assert!(rest.contains("python-regius") && rest.contains("not a lock"), "{rest}");
@@ -2096,13 +2098,7 @@ fn another_presets_set_made_after_the_plan_is_not_written_over() {
     )
     .unwrap();
     // The other preset of that name, and its set, made apart.
-    let other = dir.path().join("other");
-    std::fs::create_dir(&other).unwrap();
-    std::fs::write(other.join("foo.toml"), "[scales]\nrows = 24\n").unwrap();
-    let other_jobs = other.join("jobs.toml");
-    std::fs::write(&other_jobs, "[[job]]\npreset = \"foo.toml\"\nseeds = [1]\nsizes = [16]\n").unwrap();
-    let made_other = snakeskin(&["batch", other_jobs.to_str().unwrap(), "-o", other.join("out").to_str().unwrap()]);
-    assert!(made_other.status.success(), "{}", stderr(&made_other));
+    let other_out = set_made_apart(dir.path(), "foo.toml", "[scales]\nrows = 24\n");
     let set = Path::new("foo/tile-16-seed1-png");
     let out = dir.path().join("out");
     // The first job waits for a lock the test holds, so that the second starts after the
@@ -2111,43 +2107,19 @@ fn another_presets_set_made_after_the_plan_is_not_written_over() {
     std::fs::create_dir_all(&first).unwrap();
     let lock = std::fs::File::create(first.join(".natrix-natrix.lock")).unwrap();
     lock.try_lock().unwrap();
-    let mut run = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
-        .args(["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "1"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let (lines, log) = std::sync::mpsc::channel::<String>();
-    let stderr_pipe = std::io::BufReader::new(run.stderr.take().unwrap());
-    let reader = std::thread::spawn(move || {
-        use std::io::BufRead;
-        for line in stderr_pipe.lines().map_while(Result::ok) {
-            let _ = lines.send(line + "\n");
-        }
-    });
-    let mut said = String::new();
-    while !said.contains("waiting for it") {
-        match log.recv_timeout(Duration::from_secs(60)) {
-            Ok(line) => said += &line,
-            Err(e) => {
-                let _ = run.kill();
-                let _ = run.wait();
-                panic!("the first job did not say it waits ({e:?}): {said}");
-            }
-        }
-    }
+    let mut run =
+        WatchedRun::start(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap(), "--concurrent", "1"]);
+    run.until_said("waiting for it", 1);
     std::fs::create_dir_all(out.join(set)).unwrap();
-    for file in std::fs::read_dir(other.join("out").join(set)).unwrap() {
+    for file in std::fs::read_dir(other_out.join(set)).unwrap() {
         let file = file.unwrap().path();
         std::fs::copy(&file, out.join(set).join(file.file_name().unwrap())).unwrap();
     }
     drop(lock);
-    let status = run.wait().unwrap();
-    reader.join().unwrap();
-    let rest: String = log.try_iter().collect();
+    let (status, rest, _) = run.end();
     assert_eq!(status.code(), Some(1), "{rest}");
     assert!(rest.contains("another snakeskin run made") && rest.contains("from other input"), "{rest}");
-    assert!(tree(&out.join(set)) == tree(&other.join("out").join(set)), "the other preset's set was replaced");
+    assert!(tree(&out.join(set)) == tree(&other_out.join(set)), "the other preset's set was replaced");
     // The control: the first job, which waited and found nothing made meanwhile, made its set.
     assert_eq!(statuses(&read_index(&out)), ["done", "failed"], "{rest}");
 }
