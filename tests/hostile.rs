@@ -1650,11 +1650,15 @@ fn preview_output_names_are_checked_before_the_work() {
         let args = ["preview", PRESET, "--size", "64x40", "--map-size", "64", "--close-up"];
         snakeskin_env(&[&args[..], extra].concat(), &[("SNAKESKIN_MEMORY_LIMIT_MIB", "1")])
     };
+    // `DIR/../DIR-NAME/FILE`: through `..` out of a folder that exists (out of one that does
+    // not, the path is refused first: `a_way_up_out_of_a_missing_folder_is_refused`).
+    let up_and_back =
+        |name: &str| format!("{}/../{}/{name}", dir.path().display(), dir.path().file_name().unwrap().display());
     let same = at("same.png");
     for (extra, says) in [
         (vec!["--out", &same, "--reference", &same], "--out and --reference name one file".to_string()),
         // ... however it is written (the review: `sub/../same.png` replaced the render).
-        (vec!["--out", &at("sub/../same.png"), "--reference", &same], "--out and --reference name one file".into()),
+        (vec!["--out", &up_and_back("same.png"), "--reference", &same], "--out and --reference name one file".into()),
         (vec!["--out", &format!("{}/", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
         (vec!["--out", &format!("{}/.", at("new"))], "names a folder (it ends in a slash or a dot)".into()),
         // Its example a PNG's name whatever the folder's (`shots.d/` said "as in out/snake.d").
@@ -2250,6 +2254,47 @@ fn a_long_file_name_is_written_and_one_past_the_limit_refused_first() {
             .unwrap();
         assert_eq!(out.status.success(), written, "{} bytes: {:.300}", folder.len(), stderr(&out));
     }
+}
+
+/// An output path that goes up (`..`) out of a folder that does not exist is refused before
+/// any work, exit 2, naming that folder, nothing made: `preview --out ghost/../x.png` made
+/// `ghost` to go through, and left it empty, its note naming `ghost/..`; with a file where
+/// the path went on (`ghost/../afile/x.png`) it failed, exit 1, `ghost` left (a sweep).
+/// Every kind of output. Negative control: through a folder that exists, written.
+#[test]
+fn a_way_up_out_of_a_missing_folder_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("afile"), "").unwrap();
+    std::fs::create_dir(dir.path().join("real")).unwrap();
+    let cases: [&[&str]; 5] = [
+        &["generate", "natrix-natrix", "--size", "16", "-o", "ghost/../set"],
+        &["preview", "natrix-natrix", "--size", "64x40", "--map-size", "64", "--out", "ghost/../x.png"],
+        &["preview", "natrix-natrix", "--size", "64x40", "--map-size", "64", "--out", "ghost/../afile/x.png"],
+        &["export", "natrix-natrix", "--size", "16", "--gltf", "real/ghost/../x.glb"],
+        &["brdf", "chart", "--width", "4", "--height", "4", "-o", "ghost/../c.png"],
+    ];
+    let listing = || {
+        let mut names: Vec<String> =
+            std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into()).collect();
+        names.sort();
+        names
+    };
+    for args in cases {
+        let out = Command::new(env!("CARGO_BIN_EXE_snakeskin")).args(args).current_dir(dir.path()).output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        let missing = if args.contains(&"real/ghost/../x.glb") { "out of real/ghost," } else { "out of ghost," };
+        assert!(err.contains("the path goes up (..)") && err.contains(missing), "{args:?}: {err}");
+        assert_eq!(listing(), ["afile", "real"], "{args:?}: something was made");
+        assert_eq!(std::fs::read_dir(dir.path().join("real")).unwrap().count(), 0, "{args:?}");
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["brdf", "chart", "--width", "4", "--height", "4", "-o", "real/../c.png"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(listing(), ["afile", "c.png", "real"]);
 }
 
 /// An output path with a control character is refused before any work, exit 2, nothing

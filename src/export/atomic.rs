@@ -606,8 +606,8 @@ static MADE_FOLDERS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// `create_folder`, noting each folder it made so that a run that fails can take them away
 /// again (`remove_empty_made_folders`): the parts of the path below its deepest existing
-/// folder, up to the first `..` or `.` (`c/../there/d` with `c` missing notes `c` alone:
-/// `c/../there` is a folder that was there, and `d` under it is left as made).
+/// folder, up to the first `..` or `.` (a `..` out of a missing folder is refused before,
+/// by `check_folder`).
 pub fn create_folder_noted(dir: &Path) -> Result<bool, ExportError> {
     // Held while the folder is made: once `clean_up_before_exit` holds it, none is.
     let mut made = locked(&MADE_FOLDERS);
@@ -670,11 +670,13 @@ fn first_missing_folder(dir: &Path) -> &Path {
 /// An output folder's path, checked without creating anything: a path that exists and is
 /// not a folder is `ExportError::NotAFolder`, and so is a missing folder under a file
 /// (`-o a-file/sub` names `a-file`); a link to nothing on the way is
-/// `ExportError::BrokenLink` (creating the folder would fail with "File exists"); a missing
-/// one under folders is fine.
+/// `ExportError::BrokenLink` (creating the folder would fail with "File exists"); a `..` out
+/// of a missing folder is `ExportError::ThroughMissingFolder`; a missing one under folders
+/// is fine.
 pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
     refuse_unlistable(dir)?;
     check_name_lengths(dir)?;
+    check_no_way_up_from_missing(dir)?;
     for path in dir.ancestors().filter(|p| !p.as_os_str().is_empty()) {
         match fs::metadata(path) {
             Ok(meta) if meta.is_dir() => return Ok(()),
@@ -692,6 +694,24 @@ pub fn check_folder(dir: &Path) -> Result<(), ExportError> {
                 Err(_) => continue,
             },
         }
+    }
+    Ok(())
+}
+
+/// Refuses a `..` that follows a folder that does not exist (`ExportError::ThroughMissingFolder`),
+/// naming that folder. Before a `..`, the path up to it must be there: the system resolves
+/// `a/..` only where `a` is.
+fn check_no_way_up_from_missing(dir: &Path) -> Result<(), ExportError> {
+    let mut before = PathBuf::new();
+    for component in dir.components() {
+        if component == std::path::Component::ParentDir
+            && !before.as_os_str().is_empty()
+            && fs::symlink_metadata(&before).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+        {
+            let missing = first_missing_folder(&before).to_path_buf();
+            return Err(ExportError::ThroughMissingFolder { path: dir.into(), missing });
+        }
+        before.push(component);
     }
     Ok(())
 }
@@ -1638,16 +1658,20 @@ mod tests {
     }
 
     /// Folders a failed run made go when its lock goes: a parent another lock made too (a
-    /// batch's jobs share `out/PRESET/`) once the last of them goes, and through a `..` only
-    /// what lies before it (`c/../there`: `there` was there before). A folder that holds a
-    /// file stays. Negative controls: the folders that were there stay.
+    /// batch's jobs share `out/PRESET/`) once the last of them goes, and through a `..` what
+    /// lies after it (`there/../c/d`: `there` was there before). A `..` out of a missing folder
+    /// makes nothing (`check_folder`). A folder that holds a file stays. Negative controls:
+    /// the folders that were there stay.
     #[test]
     fn empty_folders_a_run_made_go_with_its_lock() {
         let dir = tempfile::tempdir().unwrap();
         let at = |p: &str| dir.path().join(p);
         fs::create_dir(at("there")).unwrap();
-        let through = SetLock::acquire(&at("c/../there/d"), "boa").unwrap();
-        assert!(at("c").is_dir() && at("there/d").is_dir());
+        let refused = SetLock::acquire(&at("c/../there/d"), "boa");
+        assert!(matches!(refused, Err(ExportError::ThroughMissingFolder { .. })), "{refused:?}");
+        assert!(!at("c").exists() && !at("there/d").exists());
+        let through = SetLock::acquire(&at("there/../c/d"), "boa").unwrap();
+        assert!(at("c/d").is_dir());
         drop(through);
         assert!(!at("c").exists() && at("there").is_dir(), "c goes, the folder that was there stays");
         let first = SetLock::acquire(&at("out/boa/seed1"), "boa").unwrap();

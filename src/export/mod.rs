@@ -164,6 +164,15 @@ pub enum ExportError {
          most 4095 bytes, and a file name in it up to 255 more); give a shorter path"
     )]
     PathTooLong { path: String, bytes: usize, limit: usize },
+    /// An output's path that goes up (`..`) out of a folder that does not exist
+    /// (`ghost/../x.png`): no system resolves it (`ls ghost/..` fails), and making it resolve
+    /// made `ghost`, left empty after the run, and a run that failed there left it too (a
+    /// hostile-input sweep).
+    #[error(
+        "{path}: the path goes up (..) out of {missing}, which does not exist; give the path without it, or make the \
+         folder first"
+    )]
+    ThroughMissingFolder { path: PathBuf, missing: PathBuf },
     #[error(
         "cannot write {path:?}: the path has a control character (a newline, a tab, an escape) or bytes that are \
          not UTF-8, which the lists of files written cannot show as they are (a script reading them would get \
@@ -218,6 +227,7 @@ impl ExportError {
                 | ExportError::NameTooLong { .. }
                 | ExportError::FolderNameTooLong { .. }
                 | ExportError::PathTooLong { .. }
+                | ExportError::ThroughMissingFolder { .. }
                 | ExportError::NotListable { .. }
                 | ExportError::ManifestTooLarge { .. }
         )
