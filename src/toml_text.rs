@@ -122,14 +122,16 @@ fn too_deep_line(text: &str) -> Option<usize> {
 
 /// The first control character TOML forbids (U+0000–U+001F but tab, line feed and carriage
 /// return, and U+007F: TOML 1.0 and 1.1, "Comment" and "String") from `offset`, where the
-/// reader's error starts, or the character just before it (a line that starts with one:
-/// the reader points past it, "key with no value"), to the end of its line, with its offset.
+/// reader's error starts, or the run of them just before it (a line that starts with some:
+/// the reader points past the first, "key with no value", at the last: `\u{1}\u{1}` was
+/// reported at column 2), to the end of its line, with its offset.
 /// One further before the error, or on another line, is not what the reader refused there.
 /// A carriage return out of place is left to the reader's own message.
 fn control_on_line(text: &str, offset: usize) -> Option<(usize, char)> {
     let end = text.get(offset..)?.find('\n').map_or(text.len(), |i| offset + i);
     let forbidden = |c: char| (c <= '\u{1f}' && !matches!(c, '\t' | '\n' | '\r')) || c == '\u{7f}';
-    let start = text[..offset].chars().next_back().filter(|c| forbidden(*c)).map_or(offset, |c| offset - c.len_utf8());
+    let run_before: usize = text[..offset].chars().rev().take_while(|c| forbidden(*c)).map(char::len_utf8).sum();
+    let start = offset - run_before;
     text[start..end].char_indices().find(|&(_, c)| forbidden(c)).map(|(i, c)| (start + i, c))
 }
 
@@ -494,6 +496,8 @@ mod tests {
             ("seed = 1 # a\u{1}\n", (1, 13), "U+0001"),
             // At a line's start the reader points past it ("key with no value" at 2:2).
             ("seed = 7\n\u{1}\n", (2, 1), "U+0001"),
+            ("seed = 7\n\u{1}\u{2}\u{1}\n", (2, 1), "U+0001"),
+            ("seed = 7\n  \u{2}\u{1}\n", (2, 3), "U+0002"),
             ("\0", (1, 1), "U+0000"),
         ] {
             let error = toml::from_str::<Named>(text).unwrap_err();

@@ -1243,9 +1243,10 @@ fn parse_direction(text: &str) -> Result<[f64; 3], String> {
     direction(parse_vec3(text)?)
 }
 
-/// `v` where it is at least 1e-6 long.
+/// `v` where it is at least 1e-6 long. The length by `hypot`, which does not underflow: the
+/// sum of squares said "got length 0e0" of 1e-300,0,0 (a sweep).
 fn direction(v: [f64; 3]) -> Result<[f64; 3], String> {
-    let length = v.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let length = v[0].hypot(v[1]).hypot(v[2]);
     if length < 1e-6 {
         return Err(format!("a direction must be at least 1e-6 long (it is normalised), got length {length:e}"));
     }
@@ -1608,9 +1609,13 @@ mod tests {
         assert_eq!(parse_normal("0,0,0"), Ok([0.0; 3]));
         assert_eq!(parse_normal("-0,0,0"), Ok([0.0; 3]));
         assert_eq!(parse_normal("0,2,0"), Ok([0.0, 2.0, 0.0]));
-        for tiny in ["1e-9,0,0", "1e-300,0,0"] {
+        // Each with its own length (1e-300's squared length underflows: it said 0e0).
+        for (tiny, length) in
+            [("1e-9,0,0", "got length 1e-9;"), ("0,1e-300,1e-300", "got length 1.414213562373095e-300;")]
+        {
             let said = parse_normal(tiny).unwrap_err();
             assert!(said.contains("at least 1e-6 long") && said.contains("or 0,0,0"), "{tiny}: {said}");
+            assert!(said.contains(length), "{tiny}: {said}");
         }
     }
 
