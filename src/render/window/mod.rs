@@ -11,7 +11,7 @@ mod reload;
 
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -74,6 +74,17 @@ enum NotDrawn {
     TooLarge(String),
 }
 
+/// How long the window goes on drawing after something changed (input, a slider, a reload,
+/// a resize): long enough for the panel's frame time to be measured over several frames
+/// even on a software GPU (lavapipe draws a 960×540 frame in about 0.2 s), short enough that
+/// an idle window is idle. It drew without end before: an untouched 320×200 window took
+/// 1.1 to 1.8 cores of two on lavapipe (a window sweep).
+const DRAWN_ON_AFTER_A_CHANGE: Duration = Duration::from_millis(500);
+
+/// How often an idle window looks whether the background workers finished (a reload, film
+/// tables): a look is a channel's `try_recv`, so the idle window costs nothing measurable.
+const IDLE_LOOK_INTERVAL: Duration = Duration::from_millis(100);
+
 struct App {
     options: WindowOptions,
     settings: FrameSettings,
@@ -94,6 +105,15 @@ struct App {
     lut_results: Receiver<(Stack, usize, Lut)>,
     map_worker: reload::MapWorker,
     status: String,
+    /// Frames are drawn one after another until then (`DRAWN_ON_AFTER_A_CHANGE`).
+    drawing_until: Option<Instant>,
+    /// When egui asked for its next frame (an animation, a tooltip's delay).
+    egui_repaint_at: Option<Instant>,
+    /// The window is wholly covered or iconified, as the window system says: not drawn.
+    occluded: bool,
+    /// The window was destroyed from outside (not closed through the window manager):
+    /// nothing may ask it anything (winit's size query panicked, "BadDrawable": a sweep).
+    destroyed: bool,
 }
 
 /// Opens the window and runs until it is closed (or `frames` frames were drawn).
@@ -150,6 +170,10 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
         status,
         map_worker,
         options,
+        drawing_until: None,
+        egui_repaint_at: None,
+        occluded: false,
+        destroyed: false,
     };
     event_loop.run_app(&mut app).map_err(|e| Error::Gpu(GpuError::Window(format!("window event loop failed: {e}"))))?;
     if let Some(error) = app.error {
@@ -301,10 +325,13 @@ impl App {
         gfx.not_drawn = not_drawn;
     }
 
-    /// Swaps in finished background work and pushes slider changes to the GPU.
-    fn apply_updates(&mut self) {
-        let Some(gfx) = self.gfx.as_mut() else { return };
+    /// Swaps in finished background work and pushes slider changes to the GPU; true where
+    /// some work had finished (the window has something new to show).
+    fn apply_updates(&mut self) -> bool {
+        let Some(gfx) = self.gfx.as_mut() else { return false };
+        let mut arrived = false;
         while let Ok(result) = self.map_worker.reloads.try_recv() {
+            arrived = true;
             // A reload fails in the generator or in the upload alike: the last good maps stay.
             let uploaded = result.map_err(|e| e.to_string()).and_then(|reloaded| {
                 gfx.renderer.retexture(&mut gfx.material, &reloaded.maps).map(|()| reloaded).map_err(|e| e.to_string())
@@ -344,6 +371,7 @@ impl App {
             (self.options.report)(&self.status);
         }
         while let Ok((stack, bands, lut)) = self.lut_results.try_recv() {
+            arrived = true;
             let optics = LayerOptics { stack, ..gfx.material.optics };
             if let Err(error) = gfx.renderer.refilm(&mut gfx.material, optics, &lut, bands) {
                 self.status = format!("the film tables were not uploaded, keeping the last: {error}");
@@ -363,10 +391,16 @@ impl App {
         }
         // Uniform-only parameters apply immediately; indices wait for their LUT.
         gfx.material.optics = LayerOptics { stack: gfx.material.optics.stack, ..wanted };
+        arrived
+    }
+
+    /// Something changed: frames are drawn until `DRAWN_ON_AFTER_A_CHANGE` from now.
+    fn wake(&mut self) {
+        self.drawing_until = Some(Instant::now() + DRAWN_ON_AFTER_A_CHANGE);
     }
 
     fn draw(&mut self, event_loop: &ActiveEventLoop) {
-        if self.gfx.as_ref().is_some_and(|gfx| gfx.not_drawn.is_some()) {
+        if self.destroyed || self.occluded || self.gfx.as_ref().is_some_and(|gfx| gfx.not_drawn.is_some()) {
             return;
         }
         self.apply_updates();
@@ -383,6 +417,9 @@ impl App {
         let raw = gfx.egui_state.take_egui_input(&gfx.window);
         let (settings, sliders, status) = (&mut self.settings, &mut self.sliders, &self.status);
         let full = self.egui.run_ui(raw, |ui| controls(ui, settings, sliders, status, mean_ms));
+        // egui's next frame, if it asked for one (zero: at once; never: `Duration::MAX`).
+        let egui_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
+        self.egui_repaint_at = egui_delay.and_then(|delay| now.checked_add(delay));
         gfx.egui_state.handle_platform_output(&gfx.window, full.platform_output);
         let jobs = self.egui.tessellate(full.shapes, full.pixels_per_point);
         let device = &gfx.renderer.gpu.device;
@@ -460,20 +497,53 @@ impl App {
 
 impl ApplicationHandler for App {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.gfx.is_none()
-            && let Err(error) = self.init(event_loop)
-        {
-            self.error = Some(error);
-            event_loop.exit();
+        if self.gfx.is_none() {
+            match self.init(event_loop) {
+                Ok(()) => self.wake(),
+                Err(error) => {
+                    self.error = Some(error);
+                    event_loop.exit();
+                }
+            }
         }
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        if self.destroyed {
+            return;
+        }
+        if matches!(event, WindowEvent::Destroyed) {
+            self.destroyed = true;
+            event_loop.exit();
+            return;
+        }
         let Some(gfx) = self.gfx.as_mut() else { return };
-        let consumed = gfx.egui_state.on_window_event(&gfx.window, &event).consumed;
+        let response = gfx.egui_state.on_window_event(&gfx.window, &event);
+        let consumed = response.consumed;
+        // Input, a resize, the window shown again: drawn until a while after (the drag and
+        // the wheel below change the camera; egui says what changes its panel, and asks a
+        // repaint of every redraw too, which would draw without end).
+        let changes = (response.repaint && !matches!(event, WindowEvent::RedrawRequested))
+            || matches!(
+                event,
+                WindowEvent::Resized(_)
+                    | WindowEvent::MouseInput { .. }
+                    | WindowEvent::CursorMoved { .. }
+                    | WindowEvent::MouseWheel { .. }
+                    | WindowEvent::Occluded(false)
+                    | WindowEvent::ScaleFactorChanged { .. }
+            );
+        if changes {
+            self.wake();
+        }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => self.resize(size.width, size.height),
+            WindowEvent::Occluded(occluded) => {
+                self.occluded = occluded;
+                // The time covered is no frame's.
+                self.last_frame = None;
+            }
             WindowEvent::RedrawRequested => self.draw(event_loop),
             WindowEvent::MouseInput { state, button: MouseButton::Left, .. } => {
                 self.drag = (state == ElementState::Pressed && !consumed).then_some(self.cursor);
@@ -499,15 +569,35 @@ impl ApplicationHandler for App {
         }
     }
 
+    /// Draws frame after frame while something changes (`wake`), for `--frames`, and where
+    /// egui asks; otherwise waits for the next event, looking at the background workers every
+    /// `IDLE_LOOK_INTERVAL`. A window not drawn (minimised, too large, covered) waits for its
+    /// next event (a resize, shown again) instead of spinning.
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        if let Some(gfx) = &self.gfx {
-            // A window not drawn waits for its next event (a resize) instead of spinning.
-            if gfx.not_drawn.is_some() {
-                event_loop.set_control_flow(ControlFlow::Wait);
-            } else {
-                event_loop.set_control_flow(ControlFlow::Poll);
-                gfx.window.request_redraw();
-            }
+        let Some(not_drawn) = self.gfx.as_ref().map(|gfx| gfx.not_drawn.is_some()) else { return };
+        if self.destroyed {
+            return;
+        }
+        if not_drawn || self.occluded {
+            event_loop.set_control_flow(ControlFlow::Wait);
+            return;
+        }
+        if self.apply_updates() {
+            self.wake();
+        }
+        let now = Instant::now();
+        let egui_due = self.egui_repaint_at.is_some_and(|at| at <= now);
+        let drawing = self.options.frames.is_some() || self.drawing_until.is_some_and(|until| now < until);
+        let Some(gfx) = &self.gfx else { return };
+        if drawing || egui_due {
+            event_loop.set_control_flow(ControlFlow::Poll);
+            gfx.window.request_redraw();
+        } else {
+            // The time idle is no frame's.
+            self.last_frame = None;
+            let look = now + IDLE_LOOK_INTERVAL;
+            let until = self.egui_repaint_at.map_or(look, |at| at.min(look));
+            event_loop.set_control_flow(ControlFlow::WaitUntil(until));
         }
     }
 }
