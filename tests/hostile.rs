@@ -2689,6 +2689,60 @@ fn verify_says_which_folders_it_did_not_search() {
     assert!(out.status.success() && !stderr(&out).contains("not searched"), "the control: {}", stderr(&out));
 }
 
+/// From a sweep of `verify`: a manifest copied over another set's name (`b.material.json`
+/// listing `a_*` files) said `ok`, and the set's own maps, garbage, were never looked at; a
+/// set being written (its lock held) whose manifest and maps disagreed was FAILED; a folder
+/// with links to itself was listed again through each (200 links: 29 s, 573 MB, "8000000
+/// folders deeper not searched"). Controls: the set that owns the files is `ok`; released,
+/// the altered set FAILS; without the links the note is the same (none).
+#[cfg(unix)]
+#[test]
+fn verify_knows_a_set_by_its_own_files_and_a_folder_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for species in ["natrix-natrix", "vipera-berus"] {
+        let run = snakeskin(&["generate", species, "-o", d.to_str().unwrap(), "--size", "16"]);
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
+    std::fs::copy(d.join("vipera-berus.material.json"), d.join("natrix-natrix.material.json")).unwrap();
+    std::fs::write(d.join("natrix-natrix_color.png"), b"garbage").unwrap();
+    let out = snakeskin(&["verify", d.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stdout(&out));
+    let said = stdout(&out);
+    let manifest = d.join("natrix-natrix.material.json");
+    let failed = format!(
+        "FAILED set {}: it lists 5 files not of set \"natrix-natrix\" (the first \"vipera-berus_color.png\"",
+        manifest.display()
+    );
+    assert!(said.contains(&failed), "{said}");
+    assert!(said.contains(&format!("ok {}", d.join("vipera-berus.material.json").display())), "{said}");
+
+    // Being written: said so, exit 0; released, FAILED again.
+    let lock = std::fs::File::create(d.join(".natrix-natrix.lock")).unwrap();
+    lock.lock().unwrap();
+    let out = snakeskin(&["verify", d.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stdout(&out));
+    assert!(stdout(&out).contains(&format!("writing {}: a run holds its lock", d.join("natrix-natrix").display())));
+    let out = snakeskin(&["verify", manifest.to_str().unwrap()]);
+    assert!(out.status.success() && stdout(&out).starts_with("writing "), "{}", stdout(&out));
+    lock.unlock().unwrap();
+    assert_eq!(snakeskin(&["verify", d.to_str().unwrap()]).status.code(), Some(1));
+
+    // Twenty links to the folder itself: listed once, nothing deeper.
+    let e = d.join("e");
+    let run = snakeskin(&["generate", "natrix-natrix", "-o", e.to_str().unwrap(), "--size", "16"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let out = snakeskin(&["verify", e.to_str().unwrap()]);
+    assert!(out.status.success() && !stderr(&out).contains("not searched"), "the control: {}", stderr(&out));
+    for k in 0..20 {
+        std::os::unix::fs::symlink(".", e.join(format!("self{k}"))).unwrap();
+    }
+    let out = snakeskin(&["verify", e.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out).lines().count(), 1, "{}", stdout(&out));
+    assert!(!stderr(&out).contains("not searched"), "{}", stderr(&out));
+}
+
 /// From a hostile-input sweep: `-o x/.` for a missing `x` failed ("cannot create folder
 /// x/.: No such file or directory") where `mkdir -p x/.` makes it.
 #[test]

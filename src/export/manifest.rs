@@ -436,6 +436,12 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
     if maps.len() > most {
         return Err(problem(format!("the manifest lists {} maps; a set has at most {most} files", maps.len())));
     }
+    // The set's own file names, where the manifest is named as a set's (`NAME.material.json`):
+    // another set's manifest copied or renamed over this one listed that set's files, and
+    // `verify` said `ok` of a set whose own maps it never looked at (a sweep).
+    let set_name = manifest_path.file_name().and_then(|n| n.to_str()).and_then(|n| n.strip_suffix(MANIFEST_SUFFIX));
+    let own_files = set_name.map(super::every_set_file_name);
+    let mut foreign = Vec::new();
     let mut files = Vec::new();
     // Every map's problem, not the first only: a set with a missing map and an altered one
     // took two runs of `verify` to learn both (an onboarding review).
@@ -468,6 +474,10 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
             problems.push(format!("map file {file:?} has {what}, which no set's file name carries"));
             continue;
         }
+        if own_files.as_ref().is_some_and(|own| !own.iter().any(|name| name == file)) {
+            foreign.push(file);
+            continue;
+        }
         if files.iter().any(|(m, p): &(String, PathBuf)| m == map || p.ends_with(file)) {
             problems.push(format!("the {map} map or its file {file:?} is listed twice"));
             continue;
@@ -482,6 +492,16 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
             Ok(_) => {}
         }
         files.push((map.to_string(), path));
+    }
+    if let (Some(first), Some(set_name)) = (foreign.first(), set_name) {
+        let count = if foreign.len() == 1 { "a file".to_string() } else { format!("{} files", foreign.len()) };
+        problems.insert(
+            0,
+            format!(
+                "it lists {count} not of set {set_name:?} (the first {first:?}; a set's files are named after it, \
+                 as {set_name}_color.png): the manifest is another set's, copied or renamed"
+            ),
+        );
     }
     if !problems.is_empty() {
         return Err(problem(problems.join("; ")));
