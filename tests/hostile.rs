@@ -2741,6 +2741,12 @@ fn verify_knows_a_set_by_its_own_files_and_a_folder_once() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(stdout(&out).lines().count(), 1, "{}", stdout(&out));
     assert!(!stderr(&out).contains("not searched"), "{}", stderr(&out));
+
+    // A manifest's alias, a link named otherwise, is the set its target names (the review:
+    // "not of set latest").
+    std::os::unix::fs::symlink("natrix-natrix.material.json", d.join("e/latest.material.json")).unwrap();
+    let out = snakeskin(&["verify", d.join("e/latest.material.json").to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stdout(&out));
 }
 
 /// From a hostile-input sweep: `-o x/.` for a missing `x` failed ("cannot create folder

@@ -438,8 +438,11 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
     }
     // The set's own file names, where the manifest is named as a set's (`NAME.material.json`):
     // another set's manifest copied or renamed over this one listed that set's files, and
-    // `verify` said `ok` of a set whose own maps it never looked at (a sweep).
-    let set_name = manifest_path.file_name().and_then(|n| n.to_str()).and_then(|n| n.strip_suffix(MANIFEST_SUFFIX));
+    // `verify` said `ok` of a set whose own maps it never looked at (a sweep). A link's name
+    // is its target's: `latest.material.json` linking to `boa.material.json` is boa's set
+    // (the review).
+    let named = std::fs::canonicalize(manifest_path).unwrap_or_else(|_| manifest_path.to_path_buf());
+    let set_name = named.file_name().and_then(|n| n.to_str()).and_then(|n| n.strip_suffix(MANIFEST_SUFFIX));
     let own_files = set_name.map(super::every_set_file_name);
     let mut foreign = Vec::new();
     let mut files = Vec::new();

@@ -399,8 +399,17 @@ impl App {
         self.drawing_until = Some(Instant::now() + DRAWN_ON_AFTER_A_CHANGE);
     }
 
+    /// Whether frames are left undrawn now: the window destroyed, too large or minimised
+    /// (`resize`), or covered (not for `--frames`, which draws its frames whatever: a covered
+    /// window's count stalled, a review).
+    fn undrawn(&self) -> bool {
+        self.destroyed
+            || (self.occluded && self.options.frames.is_none())
+            || self.gfx.as_ref().is_some_and(|gfx| gfx.not_drawn.is_some())
+    }
+
     fn draw(&mut self, event_loop: &ActiveEventLoop) {
-        if self.destroyed || self.occluded || self.gfx.as_ref().is_some_and(|gfx| gfx.not_drawn.is_some()) {
+        if self.undrawn() {
             return;
         }
         self.apply_updates();
@@ -571,21 +580,22 @@ impl ApplicationHandler for App {
 
     /// Draws frame after frame while something changes (`wake`), for `--frames`, and where
     /// egui asks; otherwise waits for the next event, looking at the background workers every
-    /// `IDLE_LOOK_INTERVAL`. A window not drawn (minimised, too large, covered) waits for its
-    /// next event (a resize, shown again) instead of spinning.
+    /// `IDLE_LOOK_INTERVAL`. A window not drawn (minimised, too large, covered) only looks at
+    /// the workers, whose reloads it still applies and reports (the window may be behind
+    /// others: a covered window said nothing of a save until it was shown, a review).
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        let Some(not_drawn) = self.gfx.as_ref().map(|gfx| gfx.not_drawn.is_some()) else { return };
-        if self.destroyed {
-            return;
-        }
-        if not_drawn || self.occluded {
-            event_loop.set_control_flow(ControlFlow::Wait);
+        if self.gfx.is_none() || self.destroyed {
             return;
         }
         if self.apply_updates() {
             self.wake();
         }
         let now = Instant::now();
+        if self.undrawn() {
+            self.last_frame = None;
+            event_loop.set_control_flow(ControlFlow::WaitUntil(now + IDLE_LOOK_INTERVAL));
+            return;
+        }
         let egui_due = self.egui_repaint_at.is_some_and(|at| at <= now);
         let drawing = self.options.frames.is_some() || self.drawing_until.is_some_and(|until| now < until);
         let Some(gfx) = &self.gfx else { return };

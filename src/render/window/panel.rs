@@ -57,11 +57,22 @@ impl Sliders {
     }
 }
 
-/// The side panel.
+/// The side panel. The status line (a reload's result, why the file is not watched) comes
+/// first, and the rest scrolls: last, below the sliders, it was cut off at the README's own
+/// 960×540 and out of sight at 320×200 (a window sweep).
 pub fn controls(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Sliders, status: &str, frame_ms: f64) {
     egui::Panel::left("controls").default_size(260.0).show(ui, |ui| {
+        egui::ScrollArea::vertical().show(ui, |ui| panel_contents(ui, settings, s, status, frame_ms));
+    });
+}
+
+fn panel_contents(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Sliders, status: &str, frame_ms: f64) {
+    {
         ui.heading("snakeskin");
         ui.label(format!("frame {frame_ms:.2} ms ({:.0} fps)", if frame_ms > 0.0 { 1000.0 / frame_ms } else { 0.0 }));
+        if !status.is_empty() {
+            ui.label(status);
+        }
         ui.separator();
         ui.label("View");
         let mut view = settings.view;
@@ -120,10 +131,7 @@ pub fn controls(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Sliders
         ui.add(snakes.clamping(egui::SliderClamping::Edits).text("snakes"));
         ui.separator();
         ui.label("drag: orbit · wheel: zoom");
-        if !status.is_empty() {
-            ui.label(status);
-        }
-    });
+    }
 }
 
 fn view_name(view: View) -> String {
@@ -164,6 +172,32 @@ mod tests {
             assert_eq!(got.stack, want.stack);
             assert_eq!(got.thickness_range_nm, want.thickness_range_nm);
         }
+    }
+
+    /// The status line is in sight in a small window (320×200, the tests' size): it came last,
+    /// below the panel's end (a window sweep).
+    #[test]
+    fn the_status_line_is_in_sight_in_a_small_window() {
+        let loaded = crate::preset::load("natrix-natrix", &[], None).unwrap();
+        let mut sliders = Sliders::from_preset(&loaded.preset);
+        let mut settings = FrameSettings::default();
+        let context = egui::Context::default();
+        let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(320.0, 200.0));
+        let input = || egui::RawInput { screen_rect: Some(screen), ..Default::default() };
+        let status = "reload failed, keeping the last good maps";
+        let mut bottom = None;
+        for _ in 0..2 {
+            let mut output = context.run_ui(input(), |ui| controls(ui, &mut settings, &mut sliders, status, 0.0));
+            output.textures_delta.clear();
+            bottom = output.shapes.iter().find_map(|clipped| match &clipped.shape {
+                egui::Shape::Text(text) if text.galley.text().starts_with("reload failed") => {
+                    Some(text.pos.y + text.galley.size().y)
+                }
+                _ => None,
+            });
+        }
+        let bottom = bottom.expect("the status line is drawn");
+        assert!(bottom <= screen.max.y, "the status line ends at {bottom}, below the window's {}", screen.max.y);
     }
 
     /// A value the command line gave outside a slider's range survives the panel's frames

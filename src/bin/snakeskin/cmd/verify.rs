@@ -220,7 +220,8 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
             } else if entry.is_dir() {
                 if depth < SUBFOLDER_LEVELS {
                     below.push((entry, depth + 1));
-                } else {
+                } else if !folder_identity(&entry).is_some_and(|identity| listed.contains_key(&identity)) {
+                    // Not a folder searched already (a link back up: the review).
                     not_searched.0 += 1;
                     not_searched.1.get_or_insert(entry);
                 }
