@@ -793,8 +793,7 @@ fn the_window_reloads_the_preset_file_on_save() {
 #[test]
 fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     use std::io::{BufRead, BufReader};
-    use std::os::unix::process::CommandExt;
-    use std::process::{Command, Stdio};
+    use std::process::Command;
     use std::sync::mpsc;
     use std::time::{Duration, Instant};
     let name = "the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize";
@@ -803,25 +802,16 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     let too_wide = gpu.device.limits().max_texture_dimension_2d + 16;
     assert!(too_wide <= 32767, "an adapter whose textures are wider than an X11 window can be");
     drop(gpu);
-    for tool in ["xvfb-run", "xdotool"] {
-        if Command::new(tool).arg("--help").output().is_err() {
-            assert!(!gpu_required(), "SNAKESKIN_REQUIRE_GPU=1 but {tool} is missing (apt-get install xvfb xdotool)");
-            eprintln!("{name}: SKIPPED: {tool} not installed");
-            return;
-        }
+    if !x11_tools_or_skip(name) {
+        return;
     }
     let dir = tempfile::tempdir().unwrap();
     let preset = dir.path().join("starting.toml");
     let original = snakeskin::preset::library::get(PLAIN_PRESET).unwrap();
     std::fs::write(&preset, original).unwrap();
     // 1024² maps: seconds between reading the file and the first frame.
-    let mut child = on_x11(&mut Command::new("xvfb-run"))
-        .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
-        .args(["preview", preset.to_str().unwrap(), "--window", "--frames", "1000000", "--size", "320x200"])
-        .args(["--map-size", "1024", "--set", "color.between_scales=0.3"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .process_group(0)
+    let mut child = window_under_xvfb(&preset, &["--frames", "1000000", "--size", "320x200", "--map-size", "1024"])
+        .args(["--set", "color.between_scales=0.3"])
         .spawn()
         .unwrap();
     // Stops the preview, Xvfb and xvfb-run (its own process group), also before a failed
@@ -903,6 +893,36 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     assert!(again.is_some() && still_running, "the window did not draw again:\n{seen}");
 }
 
+/// Whether `xvfb-run` and `xdotool` are there; where they are not, the test `name` is
+/// skipped, or fails under `SNAKESKIN_REQUIRE_GPU=1`.
+#[cfg(feature = "window")]
+fn x11_tools_or_skip(name: &str) -> bool {
+    for tool in ["xvfb-run", "xdotool"] {
+        if std::process::Command::new(tool).arg("--help").output().is_err() {
+            assert!(!gpu_required(), "SNAKESKIN_REQUIRE_GPU=1 but {tool} is missing (apt-get install xvfb xdotool)");
+            eprintln!("{name}: SKIPPED: {tool} not installed");
+            return false;
+        }
+    }
+    true
+}
+
+/// `preview PRESET --window ARGS` under xvfb-run, stderr piped, in a process group of its
+/// own (so that stopping the group also stops Xvfb and the preview).
+#[cfg(feature = "window")]
+fn window_under_xvfb(preset: &std::path::Path, args: &[&str]) -> std::process::Command {
+    use std::os::unix::process::CommandExt;
+    let mut command = std::process::Command::new("xvfb-run");
+    on_x11(&mut command)
+        .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
+        .args(["preview", preset.to_str().unwrap(), "--window"])
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .process_group(0);
+    command
+}
+
 /// The process of a preview started under xvfb-run (under its shell): the one whose
 /// command line names `preset`; None if none started within a minute.
 #[cfg(feature = "window")]
@@ -964,31 +984,19 @@ fn preview_window(xdotool: &impl Fn(&[&str]) -> std::process::Output) -> Option<
 #[cfg(feature = "window")]
 #[test]
 fn an_idle_window_draws_nothing_and_a_destroyed_one_ends_cleanly() {
-    use std::os::unix::process::CommandExt;
-    use std::process::{Command, Stdio};
+    use std::process::Command;
     use std::time::{Duration, Instant};
     let name = "an_idle_window_draws_nothing_and_a_destroyed_one_ends_cleanly";
     if gpu_or_skip(name).is_none() {
         return;
     }
-    for tool in ["xvfb-run", "xdotool"] {
-        if Command::new(tool).arg("--help").output().is_err() {
-            assert!(!gpu_required(), "SNAKESKIN_REQUIRE_GPU=1 but {tool} is missing (apt-get install xvfb xdotool)");
-            eprintln!("{name}: SKIPPED: {tool} not installed");
-            return;
-        }
+    if !x11_tools_or_skip(name) {
+        return;
     }
     let dir = tempfile::tempdir().unwrap();
     let preset = dir.path().join("idle.toml");
     std::fs::write(&preset, snakeskin::preset::library::get(PLAIN_PRESET).unwrap()).unwrap();
-    let mut child = on_x11(&mut Command::new("xvfb-run"))
-        .args(["-a", "-s", "-screen 0 1280x720x24", env!("CARGO_BIN_EXE_snakeskin")])
-        .args(["preview", preset.to_str().unwrap(), "--window", "--size", "480x300", "--map-size", "64"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .process_group(0)
-        .spawn()
-        .unwrap();
+    let mut child = window_under_xvfb(&preset, &["--size", "480x300", "--map-size", "64"]).spawn().unwrap();
     let group = format!("-{}", child.id());
     let stop = || {
         let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
