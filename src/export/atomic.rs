@@ -1164,8 +1164,8 @@ struct Swapped {
     stayed: Vec<KeptFile>,
 }
 
-/// The folder a target file is in (`.` for a bare file name).
-fn folder_of(path: &Path) -> &Path {
+/// The folder a file is in (`.` for a bare file name).
+pub fn folder_of(path: &Path) -> &Path {
     path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."))
 }
 

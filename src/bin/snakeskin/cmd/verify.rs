@@ -101,7 +101,7 @@ fn said_being_written(folder: &Path, name: &str) -> bool {
 
 /// `said_being_written` of the set whose manifest is `manifest`.
 fn being_written(manifest: &Path) -> bool {
-    let folder = manifest.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let folder = snakeskin::export::folder_of(manifest);
     let name = manifest.file_name().and_then(|n| n.to_str()).and_then(|n| n.strip_suffix(MANIFEST_SUFFIX));
     name.is_some_and(|name| said_being_written(folder, name))
 }
@@ -115,7 +115,7 @@ fn identity(check: &Check) -> (u8, PathBuf) {
     let real = |folder: &Path| std::fs::canonicalize(folder).unwrap_or_else(|_| folder.to_path_buf());
     match check {
         Check::Manifest(path) => {
-            let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            let folder = snakeskin::export::folder_of(path);
             let name = path.file_name().unwrap_or_default();
             // A manifest named but missing is the set its folder's files make: the same
             // line as its folder's (`verify c/x.material.json c` said it twice, a review).
@@ -146,7 +146,7 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
         // A manifest that is there is checked (a folder of that name too: `verify_set` says
         // it is no file, as when its folder is named); a missing one is an incomplete set
         // where the set's files lie beside it, and a wrong path otherwise (a typo).
-        let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let folder = snakeskin::export::folder_of(path);
         let present = metadata.is_ok() || path.is_symlink();
         if present || set_files_in(folder, set_name) > 0 {
             return Ok(vec![Check::Manifest(path.to_path_buf())]);
