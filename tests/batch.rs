@@ -1748,6 +1748,17 @@ fn verify_passes_whole_sets_and_fails_altered_or_incomplete_ones() {
         let refused = verify(&[path]);
         assert_eq!(refused.status.code(), Some(2), "{path:?}: {}", stderr(&refused));
         assert!(stderr(&refused).contains(says), "{path:?}: {}", stderr(&refused));
+        // Named between two sets, it does not keep them from being checked (`verify a typo
+        // c` checked nothing, a sweep's note): both are reported, the run is still the
+        // user's mistake, and says what the others' checks found.
+        let among = verify(&[&manifests[0], path, &manifests[1]]);
+        assert_eq!(among.status.code(), Some(2), "{path:?}: {}", stderr(&among));
+        assert_eq!(stdout(&among).lines().filter(|l| l.starts_with("ok ")).count(), 2, "{}", stdout(&among));
+        assert!(
+            stderr(&among).contains(says) && stderr(&among).contains("(the other paths' 2 checks: none failed)"),
+            "{path:?}: {}",
+            stderr(&among)
+        );
     }
 }
 

@@ -136,7 +136,8 @@ pub enum Command {
     /// path that is no manifest or folder of sets. glTF exports carry no manifest.
     Verify {
         /// A set's manifest (NAME.material.json), or a folder: every manifest in it and in its
-        /// subfolders two levels down (a batch's output folder).
+        /// subfolders two levels down (a batch's output folder). A path that holds no set is
+        /// the user's mistake (exit 2), said after the other paths are checked.
         #[arg(required = true, value_name = "PATH")]
         paths: Vec<PathBuf>,
     },

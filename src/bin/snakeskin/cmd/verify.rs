@@ -41,8 +41,15 @@ enum Check {
 
 pub fn run(paths: &[PathBuf]) -> Result<()> {
     let mut checks = Vec::new();
+    // The paths that hold no set to check (the user's mistake, exit 2), each with why. They
+    // do not keep the others from being checked: `verify a typo c` checked nothing, and a
+    // pipeline learnt of a and c only from a second run (a sweep's note).
+    let mut unusable = Vec::new();
     for path in paths {
-        checks.extend(checks_at(path)?);
+        match checks_at(path) {
+            Ok(found) => checks.extend(found),
+            Err(reason) => unusable.push(reason),
+        }
     }
     // Each set once, however often it is named (a manifest and its folder, `./x` and `x`, a
     // folder reached again through a link to it).
@@ -80,6 +87,16 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
         };
         failed += 1;
         println!("FAILED {}", crate::output::printable(&failure).replace('\n', "\\n"));
+    }
+    if !unusable.is_empty() {
+        // The paths' own reasons first, as a single bad path's error has always read; what
+        // the others' checks found after them, where there were any.
+        let mut reason = unusable.join("; ");
+        if !checks.is_empty() {
+            let outcome = if failed > 0 { format!("{failed} failed (listed above)") } else { "none failed".into() };
+            reason += &format!(" (the other paths' {} checks: {outcome})", checks.len());
+        }
+        return Err(snakeskin::Error::InvalidOption { option: "verify PATH", reason }.into());
     }
     if failed > 0 {
         anyhow::bail!("{failed} of {} checks failed: sets incomplete, altered or unread (listed above)", checks.len());
@@ -136,9 +153,8 @@ fn identity(check: &Check) -> (u8, PathBuf) {
 /// to `SUBFOLDER_LEVELS` (a batch's output), links followed, hidden entries passed over but
 /// for a run's temporaries of a set that is missing (`Check::Interrupted`). A
 /// path that is missing, one that is no manifest, or a folder without a set, is the user's
-/// mistake.
-fn checks_at(path: &Path) -> Result<Vec<Check>> {
-    let invalid = |reason: String| snakeskin::Error::InvalidOption { option: "verify PATH", reason };
+/// mistake: the error is why.
+fn checks_at(path: &Path) -> Result<Vec<Check>, String> {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let set_name = name.strip_suffix(MANIFEST_SUFFIX).filter(|s| !s.is_empty());
     let metadata = std::fs::metadata(path);
@@ -152,9 +168,9 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
             return Ok(vec![Check::Manifest(path.to_path_buf())]);
         }
         let reason = format!("{}: no such manifest, and no file of set {set_name:?} beside it", path_line(path));
-        return Err(invalid(reason).into());
+        return Err(reason);
     }
-    let metadata = metadata.map_err(|e| invalid(format!("{}: {e}", path_line(path))))?;
+    let metadata = metadata.map_err(|e| format!("{}: {e}", path_line(path)))?;
     if !metadata.is_dir() {
         let gltf = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
         let reason = format!(
@@ -162,7 +178,7 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
             path_line(path),
             if gltf { " (a glTF export carries no manifest)" } else { "" }
         );
-        return Err(invalid(reason).into());
+        return Err(reason);
     }
     let suffixes: Vec<String> =
         snakeskin::export::every_set_file_name("").into_iter().filter(|n| n != MANIFEST_SUFFIX).collect();
@@ -186,7 +202,7 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
         }
         let entries = match read_sorted(&folder) {
             Ok(entries) => entries,
-            Err(e) if depth == 0 => return Err(invalid(format!("cannot list {}: {e}", path_line(&folder))).into()),
+            Err(e) if depth == 0 => return Err(format!("cannot list {}: {e}", path_line(&folder))),
             Err(e) => {
                 checks.push(Check::Unlistable { folder, error: e.to_string() });
                 continue;
@@ -230,7 +246,7 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
             }
             if checks.len() > MAX_SETS {
                 let reason = format!("{} holds more than {MAX_SETS} sets: name a set's folder", path_line(path));
-                return Err(invalid(reason).into());
+                return Err(reason);
             }
         }
         for (name, count) in temporaries {
@@ -259,7 +275,7 @@ fn checks_at(path: &Path) -> Result<Vec<Check>> {
             "{} holds no set (NAME{MANIFEST_SUFFIX} or a set's files), nor do its subfolders: nothing to verify",
             path_line(path)
         );
-        return Err(invalid(reason).into());
+        return Err(reason);
     }
     Ok(checks)
 }
