@@ -672,8 +672,8 @@ fn keys_of_another_kind_are_refused_not_ignored() {
 
 /// A set's files are named after its preset file: a newline there made `new\nline_color.png`;
 /// a backslash `a\b_color.png`, which `verify` refuses in a manifest (a folder's separator on
-/// Windows), so `batch` never took the set as done and made it again at every run (a sweep).
-/// Control: a name with a space and a `#` is taken.
+/// Windows), so `batch` never took the set as done and made it again at every run (a sweep);
+/// a bidirectional control. Control: a name with a space and a `#` is taken.
 #[cfg(unix)]
 #[test]
 fn a_preset_file_name_with_control_characters_or_a_backslash_is_refused() {
@@ -681,8 +681,15 @@ fn a_preset_file_name_with_control_characters_or_a_backslash_is_refused() {
     assert!(err.contains("its file name has control characters") && err.contains("rename the file"), "{err}");
     let err = refused("back\\slash.toml", "seed = 1\n", &[]);
     assert!(err.contains("its file name has a backslash") && err.contains("rename the file"), "{err}");
+    // A bidirectional control: `gnp.exe` after U+202E shows as `exe.png` (it was taken, and
+    // the name printed raw: "Trojan Source"); the message shows it escaped.
+    let err = refused("x\u{202e}gnp.exe.toml", "seed = 1\n", &[]);
+    assert!(err.contains("its file name has bidirectional controls") && err.contains("x\\u{202e}gnp"), "{err}");
+    assert!(!err.contains('\u{202e}'), "{err}");
     let dir = tempfile::tempdir().unwrap();
     accepted(&write_preset(dir.path(), "a b#c.toml", "seed = 1\n"), &[]);
+    // Right-to-left letters are no controls: a name in Hebrew is taken.
+    accepted(&write_preset(dir.path(), "\u{05e6}\u{05e4}\u{05e2}.toml", "seed = 1\n"), &[]);
 }
 
 #[test]

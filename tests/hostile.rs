@@ -2689,6 +2689,23 @@ fn verify_says_which_folders_it_did_not_search() {
     assert!(out.status.success() && !stderr(&out).contains("not searched"), "the control: {}", stderr(&out));
 }
 
+/// A bidirectional control in a file's name (U+202E: what follows shows reversed) is printed
+/// escaped, as a control character is: `verify` wrote the names it found raw ("Trojan
+/// Source", CVE-2021-42574). Control: a Hebrew name, right to left but no control, as is.
+#[cfg(unix)]
+#[test]
+fn verify_prints_a_name_that_reorders_text_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["x\u{202e}gnp.exe", "\u{05e6}\u{05e4}\u{05e2}"] {
+        std::fs::write(dir.path().join(format!("{name}_color.png")), b"png").unwrap();
+    }
+    let out = snakeskin(&["verify", dir.path().to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let report = stdout(&out);
+    assert!(report.contains("x\\u{202e}gnp.exe") && !report.contains('\u{202e}'), "{report}");
+    assert!(report.contains("\u{05e6}\u{05e4}\u{05e2}"), "the control: {report}");
+}
+
 /// From a sweep of `verify`: a manifest copied over another set's name (`b.material.json`
 /// listing `a_*` files) said `ok`, and the set's own maps, garbage, were never looked at; a
 /// set being written (its lock held) whose manifest and maps disagreed was FAILED; a folder

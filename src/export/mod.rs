@@ -234,16 +234,31 @@ impl ExportError {
     }
 }
 
+/// Whether `c` changes the order in which a terminal or an editor shows the text around it:
+/// Unicode's bidirectional controls (UAX #9, section 2: the embeddings and overrides U+202A
+/// to U+202E, the isolates U+2066 to U+2069, the marks U+200E, U+200F and U+061C). In a file
+/// name they make one that ends `.exe` show as ending `.png` ("Trojan Source",
+/// CVE-2021-42574); being no control characters (`char::is_control`), they were written
+/// raw. Refused in the names a run writes (`unfit_for_file_names`), escaped in the paths the
+/// binary prints.
+pub fn reorders_text(c: char) -> bool {
+    matches!(c, '\u{061C}' | '\u{200E}' | '\u{200F}' | '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
+}
+
 /// What makes `name` unfit to be carried by a set's file names (its maps and manifest are
 /// named after the preset file's stem, a `.gltf`'s side files after the `.gltf`'s), None
 /// where it is fit: control characters (a newline in a name broke every listing and script
 /// that reads the files), or a backslash (a folder's separator on Windows, where the set may
 /// be read: a preset `a\b.toml` made a manifest naming `a\b_color.png`, which `verify`
-/// refused, so `batch` never took the set as done and made it at every run). Asked of a
-/// preset file's stem, of a `.gltf`'s, and of the map files a manifest names (`verify`).
+/// refused, so `batch` never took the set as done and made it at every run), a
+/// bidirectional control (`reorders_text`). Asked of a preset file's stem, of a `.gltf`'s,
+/// and of the map files a manifest names (`verify`).
 pub fn unfit_for_file_names(name: &str) -> Option<&'static str> {
     if name.chars().any(char::is_control) {
         return Some("control characters");
+    }
+    if name.chars().any(reorders_text) {
+        return Some("bidirectional controls (they show a name's text in another order than it has)");
     }
     if name.contains('\\') {
         return Some("a backslash (a folder's separator on Windows)");

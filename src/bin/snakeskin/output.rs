@@ -206,11 +206,11 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
     1
 }
 
-/// `text` with every control character but newline and tab written as `\u{..}`.
+/// `text` with every control character but newline and tab, and every bidirectional
+/// control (`export::reorders_text`), written as `\u{..}`.
 pub fn printable(text: &str) -> String {
-    text.chars()
-        .map(|c| if c.is_control() && c != '\n' && c != '\t' { c.escape_unicode().to_string() } else { c.to_string() })
-        .collect()
+    let hidden = |c: char| (c.is_control() && c != '\n' && c != '\t') || snakeskin::export::reorders_text(c);
+    text.chars().map(|c| if hidden(c) { c.escape_unicode().to_string() } else { c.to_string() }).collect()
 }
 
 /// A path for a line of its own (stdout lists one file per line): newlines escaped too.
