@@ -906,9 +906,21 @@ pub fn fitting_concurrency(requested: usize, mut estimates: Vec<u64>, available_
     fit.max(1)
 }
 
+/// What `run` tells its caller while it works, on the caller's thread: a batch said nothing
+/// on a terminal until its first job ended (an 8K set: 85 s of a blank screen; a sweep).
+#[derive(Debug)]
+pub enum BatchProgress<'a> {
+    /// Every job of the shard planned: `total` of them, the first event.
+    Planned { total: usize },
+    /// A job began to make its set (not a job whose set is there already, or a duplicate).
+    Started { outcome: &'a JobOutcome },
+    /// A job ended, `done` of `total` so far, in the order they end.
+    Ended { done: usize, total: usize, outcome: &'a JobOutcome },
+}
+
 /// Runs the shard's jobs, up to `concurrency` at once (each job's graph still uses every
-/// core; bounded by memory: `fitting_concurrency`); `progress(done, total, outcome)` as each
-/// job finishes, in the order they finish. Every job of the shard is planned first (preset
+/// core; bounded by memory: `fitting_concurrency`); `progress` as the jobs are planned, as
+/// each starts and as each ends (`BatchProgress`). Every job of the shard is planned first (preset
 /// loaded and validated, memory checked), so a bad job stops the run before any set is
 /// written, not in the middle of it. A job that fails at run time stops the run: no new job
 /// starts, the running ones finish (each set is written atomically), the index is written
@@ -923,9 +935,10 @@ pub fn run(
     shard: Shard,
     concurrency: usize,
     warn: &mut dyn FnMut(&str),
-    progress: &mut dyn FnMut(usize, usize, &JobOutcome),
+    progress: &mut dyn FnMut(BatchProgress),
 ) -> Result<BatchIndex, Error> {
     let Planned { mine, resolved, estimates } = plan(jobs_file, jobs, out, shard, true)?;
+    progress(BatchProgress::Planned { total: mine.len() });
     let requested = concurrency.clamp(1, MAX_CONCURRENCY);
     // With nothing to run, the summary says what was asked (one, from an empty list, read as
     // if memory had limited it).
@@ -978,6 +991,7 @@ pub fn run(
     std::thread::scope(|scope| {
         // A job's end, or a note while it runs (said by the caller's `warn`, on this thread).
         enum Event {
+            Started(usize),
             Ended(usize, Result<JobOutcome, Error>),
             Note(String),
         }
@@ -994,6 +1008,9 @@ pub fn run(
                 while !stop.load(std::sync::atomic::Ordering::SeqCst) {
                     let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
                     let Some((job, resolved)) = work.get(k) else { break };
+                    if !resolved.done && resolved.outcome.duplicate_of.is_none() {
+                        let _ = sender.send(Event::Started(k));
+                    }
                     let stopped = || stop.load(std::sync::atomic::Ordering::SeqCst);
                     let result = match run_one(jobs_file, job, resolved, out, &note, &stopped) {
                         Ok(Some(outcome)) => Ok(outcome),
@@ -1014,9 +1031,10 @@ pub fn run(
         let mut done = 0;
         for event in receiver {
             match event {
+                Event::Started(k) => progress(BatchProgress::Started { outcome: &work[k].1.outcome }),
                 Event::Ended(k, Ok(outcome)) => {
                     done += 1;
-                    progress(done, total, &outcome);
+                    progress(BatchProgress::Ended { done, total, outcome: &outcome });
                     finished[k] = Some(outcome);
                 }
                 Event::Ended(k, Err(e)) => failures.push((k, e)),

@@ -2134,3 +2134,31 @@ fn another_presets_set_made_after_the_plan_is_not_written_over() {
     // The control: the first job, which waited and found nothing made meanwhile, made its set.
     assert_eq!(statuses(&read_index(&out)), ["done", "failed"], "{rest}");
 }
+
+/// On a terminal a batch's bar is drawn at once, says it is planning, and while a job runs
+/// which set it is making, ticking meanwhile: it showed nothing until the first job ended
+/// and stood still between jobs (an 8K set: 85 s of a blank screen; a sweep). `script`
+/// (util-linux, in every Debian) gives the run a terminal. Control: redirected, stderr holds
+/// no bar.
+#[cfg(unix)]
+#[test]
+fn a_batch_on_a_terminal_says_what_it_is_making_before_the_job_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    // Big enough that the job lasts several of the bar's ticks (about 1.5 s on two cores).
+    let jobs = jobs_file(dir.path(), &["natrix-natrix"], "[1]", 2048);
+    let out = dir.path().join("out");
+    let line = format!("'{}' batch '{}' -o '{}'", env!("CARGO_BIN_EXE_snakeskin"), jobs.display(), out.display());
+    let run = Command::new("script")
+        .args(["-qfec", &line, "/dev/null"])
+        .stdin(Stdio::null())
+        .output()
+        .expect("`script` (util-linux) runs the batch on a terminal");
+    assert!(run.status.success(), "{}{}", stdout(&run), stderr(&run));
+    let screen = stdout(&run);
+    let at = |text: &str| screen.find(text).unwrap_or_else(|| panic!("{text:?} not on the screen: {screen:?}"));
+    let making = at("making natrix-natrix/tile-2048-seed1-png");
+    assert!(at("planning 1 job") < making, "{screen:?}");
+    assert!(making < at("1/1 done"), "{screen:?}");
+    let redirected = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(redirected.status.success() && !stderr(&redirected).contains("making"), "{}", stderr(&redirected));
+}

@@ -7,6 +7,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 pub struct Progress(Option<ProgressBar>);
 
+/// How often a bar or spinner is redrawn between updates.
+const TICK: std::time::Duration = std::time::Duration::from_millis(120);
+
 /// `eprintln!`, but a reader that went away (`2>&1 | head`) loses the line and the run goes
 /// on, as the batch's lines on stdout do (`cmd::batch`'s `JobLog`): under an ignored SIGPIPE
 /// (a batch, which must not die mid-commit) a whole batch that had made every set and
@@ -22,13 +25,16 @@ pub fn eprintln_unless_closed(line: &str) {
 }
 
 impl Progress {
-    /// A bar counting `{pos}/{len}` units; `template` is an indicatif template.
+    /// A bar counting `{pos}/{len}` units; `template` is an indicatif template. It is drawn
+    /// at once and ticks (its spinner, its `{elapsed}`) between updates: drawn only at an
+    /// update, a batch's bar first showed when its first job ended, minutes in (a sweep).
     pub fn counting(template: &str) -> Progress {
         Progress(std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::new(1);
             if let Ok(style) = ProgressStyle::with_template(template) {
                 bar.set_style(style);
             }
+            bar.enable_steady_tick(TICK);
             bar
         }))
     }
@@ -41,7 +47,7 @@ impl Progress {
                 bar.set_style(style);
             }
             bar.set_message(message.to_string());
-            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+            bar.enable_steady_tick(TICK);
             bar
         }))
     }
