@@ -1515,19 +1515,12 @@ fn let_go_of_a_left_lock(folder: &Path, name: &str) {
     let _ = crate::export::SetLock::acquire(folder, name);
 }
 
-/// A manifest's device, inode, length and modification time (`manifest_identity`).
-type ManifestIdentity = (u64, u64, u64, Option<std::time::SystemTime>);
+/// A manifest's identity (`export::file_identity`).
+type ManifestIdentity = crate::export::FileIdentity;
 
-/// Which file `path` is (device, inode) and its length and time, if it is there: a commit
-/// renames a new file into place, so a set made meanwhile is another file even within one
-/// tick of a coarse clock.
+/// `export::file_identity` of the manifest itself (a run never writes a link).
 fn manifest_identity(path: &Path) -> Option<ManifestIdentity> {
-    let m = std::fs::symlink_metadata(path).ok()?;
-    #[cfg(unix)]
-    let (device, inode) = { (std::os::unix::fs::MetadataExt::dev(&m), std::os::unix::fs::MetadataExt::ino(&m)) };
-    #[cfg(not(unix))]
-    let (device, inode) = (0, 0);
-    Some((device, inode, m.len(), m.modified().ok()))
+    crate::export::file_identity(path, crate::text_file::Links::Refuse)
 }
 
 #[cfg(test)]

@@ -766,6 +766,16 @@ fn a_kill_at_any_rename_or_during_the_undo_never_leaves_a_manifest_over_other_ma
     let earlier = visible_files(dir.path());
     let out = generate_into(dir.path(), "7", &[("SNAKESKIN_TEST_FAIL_AT_RENAME", "8,11")]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    // The error says where the earlier files wait, and that the next run removes them: it
+    // said only why the commit failed (a sweep). Two of them here: the map whose rename back
+    // failed, and the manifest, kept aside with it.
+    let said = stderr(&out);
+    assert!(
+        said.contains("undoing the commit failed too: 2 of the earlier set's files could not be put back")
+            && said.contains(&format!("was {PRESET}.material.json"))
+            && said.contains("rename them back before another run in this folder, which removes them"),
+        "{said}"
+    );
     let err = snakeskin::export::verify_set(&manifest_of(dir.path())).unwrap_err();
     assert!(err.to_string().contains("incomplete"), "{err}");
     let kept: Vec<Vec<u8>> = snapshot(dir.path())
@@ -2687,6 +2697,46 @@ fn verify_says_which_folders_it_did_not_search() {
     assert!(stderr(&out).contains(&note), "{}", stderr(&out));
     let out = snakeskin(&["verify", dir.path().join("a").to_str().unwrap()]);
     assert!(out.status.success() && !stderr(&out).contains("not searched"), "the control: {}", stderr(&out));
+}
+
+/// A set replaced while `verify` checks it (its manifest read, its maps not yet: a run
+/// committed a new set meanwhile) is checked again: the new maps read against the old
+/// manifest were FAILED, "mixed or altered", 1 check in 835 beside a run making the set again
+/// and again (a sweep). The run is paused at its commit (three seconds), `verify` after its
+/// manifest's reading (three seconds, from a second later): the commit lands between. Control:
+/// a map altered for good still fails after the tries.
+#[cfg(unix)]
+#[test]
+fn verify_checks_again_a_set_replaced_while_it_checked() {
+    if !test_hooks_exist() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("set");
+    let first = snakeskin(&["generate", "natrix-natrix", "-o", out.to_str().unwrap(), "--size", "16", "--seed", "1"]);
+    assert!(first.status.success(), "{}", stderr(&first));
+    let args = ["generate", "natrix-natrix", "-o", out.to_str().unwrap(), "--size", "16", "--seed", "2"];
+    let mut second = spawn_paused_at_commit(&args, &out);
+    std::thread::sleep(std::time::Duration::from_secs(1));
+    let verify = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
+        .args(["verify", out.to_str().unwrap()])
+        .env("SNAKESKIN_TEST_PAUSE_AT", "verify-1")
+        .output()
+        .unwrap();
+    assert!(second.wait().unwrap().success());
+    assert_eq!(verify.status.code(), Some(0), "{}{}", stdout(&verify), stderr(&verify));
+    assert!(stdout(&verify).starts_with("ok "), "{}", stdout(&verify));
+    let seed: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("natrix-natrix.material.json")).unwrap()).unwrap();
+    assert_eq!(seed["seed"], 2, "the second run's set, checked after it landed");
+    // The control: a map altered for good fails, whatever the tries.
+    let map = out.join("natrix-natrix_color.png");
+    let mut bytes = std::fs::read(&map).unwrap();
+    bytes.push(0);
+    std::fs::write(&map, bytes).unwrap();
+    let altered = snakeskin(&["verify", out.to_str().unwrap()]);
+    assert_eq!(altered.status.code(), Some(1), "{}", stdout(&altered));
+    assert!(stdout(&altered).contains("mixed or altered"), "{}", stdout(&altered));
 }
 
 /// A bidirectional control in a file's name (U+202E: what follows shows reversed) is printed

@@ -1128,18 +1128,15 @@ fn swap_in(
                 };
                 stayed.push(KeptFile { path: target.clone(), why: KeptBecause::WouldNotMove(error), by: Earlier::Set });
             }
-            Err(e) => {
-                put_back(aside, &[], manifest, &mut renames);
-                return Err(e);
-            }
+            Err(e) => return Err(not_put_back(e, put_back(aside, &[], manifest, &mut renames))),
         }
     }
     let mut written = Vec::new();
     for (tmp, target) in staged {
         let temporary = tmp.path().to_path_buf();
         if let Err(e) = before_rename(&mut renames).and_then(|()| tmp.persist(&target).map(drop).map_err(|e| e.error)) {
-            put_back(aside, &written, manifest, &mut renames);
-            return Err(ExportError::Io { path: target, source: e });
+            let kept = put_back(aside, &written, manifest, &mut renames);
+            return Err(not_put_back(ExportError::Io { path: target, source: e }, kept));
         }
         forget_temporary(&temporary);
         written.push(target);
@@ -1316,31 +1313,43 @@ fn recorded_left_overs(
 /// ones back, the maps before the manifest (`aside` holds the manifest first), so that the
 /// old manifest returns only over its own maps. An old file that cannot go back stays in
 /// its temporary (never deleted), and then the old manifest stays aside too: the set is
-/// incomplete, not mixed. `renames` counts on from the commit's (`before_rename`).
+/// incomplete, not mixed. `renames` counts on from the commit's (`before_rename`). Returns
+/// the old files kept so: each temporary and the file it was.
 fn put_back(
     aside: Vec<(tempfile::TempPath, PathBuf)>,
     written: &[PathBuf],
     manifest: Option<&Path>,
     renames: &mut usize,
-) {
+) -> Vec<(PathBuf, PathBuf)> {
     let mut whole = true;
     for target in written {
         whole &= fs::remove_file(target).is_ok();
     }
+    let mut kept = Vec::new();
     for (backup, target) in aside.into_iter().rev() {
-        if Some(target.as_path()) == manifest && !whole {
-            let _ = backup.keep();
-            continue;
-        }
-        let back = match before_rename(renames) {
-            Ok(()) => backup.persist(&target).map_err(|e| e.path),
-            Err(_) => Err(backup),
+        let back = if Some(target.as_path()) == manifest && !whole {
+            Err(backup)
+        } else {
+            match before_rename(renames) {
+                Ok(()) => backup.persist(&target).map_err(|e| e.path),
+                Err(_) => Err(backup),
+            }
         };
         if let Err(backup) = back {
             whole = false;
-            let _ = backup.keep();
+            if let Ok(temporary) = backup.keep() {
+                kept.push((temporary, target));
+            }
         }
     }
+    // In the set's order, the manifest first, as they were moved aside.
+    kept.reverse();
+    kept
+}
+
+/// A commit's `error`, with the earlier files its undo could not put back (`put_back`).
+fn not_put_back(error: ExportError, kept: Vec<(PathBuf, PathBuf)>) -> ExportError {
+    if kept.is_empty() { error } else { ExportError::NotPutBack { source: Box::new(error), kept } }
 }
 
 /// The file name of a path in the set's folder.
@@ -1380,9 +1389,10 @@ fn before_rename(renames: &mut usize) -> std::io::Result<()> {
 
 /// Test hook (debug builds only): `SNAKESKIN_TEST_PAUSE_AT=POINT` stops the run for three
 /// seconds at POINT, `commit` (every file staged, before the commit lock and the first
-/// rename) or `rename-N` (before rename N, see `before_rename`, the lock held), so that a
-/// test can interrupt the run there.
-fn pause_hook(point: impl Fn() -> String) {
+/// rename), `rename-N` (before rename N, see `before_rename`, the lock held) or `verify-N`
+/// (`verify_set`'s try N, its manifest read, its maps not), so that a test can interrupt the
+/// run there or change its files.
+pub(crate) fn pause_hook(point: impl Fn() -> String) {
     #[cfg(debug_assertions)]
     if std::env::var("SNAKESKIN_TEST_PAUSE_AT").is_ok_and(|at| at == point()) {
         std::thread::sleep(std::time::Duration::from_secs(3));

@@ -394,10 +394,49 @@ pub struct VerifiedSet {
     pub files: Vec<(String, PathBuf)>,
 }
 
+/// Which file `path` is (device, inode) and its length and modification time, if it is
+/// there; `links` followed or not: a commit renames a new file into place, so a set made
+/// meanwhile is another file even within one tick of a coarse clock.
+pub type FileIdentity = (u64, u64, u64, Option<std::time::SystemTime>);
+
+/// `FileIdentity` of `path`, None where it is not there.
+pub fn file_identity(path: &Path, links: Links) -> Option<FileIdentity> {
+    let m = match links {
+        Links::Follow => std::fs::metadata(path),
+        Links::Refuse => std::fs::symlink_metadata(path),
+    }
+    .ok()?;
+    #[cfg(unix)]
+    let (device, inode) = { (std::os::unix::fs::MetadataExt::dev(&m), std::os::unix::fs::MetadataExt::ino(&m)) };
+    #[cfg(not(unix))]
+    let (device, inode) = (0, 0);
+    Some((device, inode, m.len(), m.modified().ok()))
+}
+
+/// How often `verify_set` checks a set again whose manifest was replaced while it checked.
+const VERIFY_TRIES: usize = 3;
+
 /// Checks a set through its manifest: every map it lists exists beside it with the SHA-256
 /// it records. A set whose manifest is missing is incomplete (a run failed or was killed
-/// while renaming); one whose hashes differ is mixed or altered.
+/// while writing it); one whose hashes differ is mixed or altered. A set replaced while it
+/// was checked (its manifest another file after its maps were read: a run committed a new
+/// set meanwhile) is checked again, up to `VERIFY_TRIES` times: the new maps read against
+/// the old manifest failed as "mixed or altered", 1 check in 835 beside a run making the
+/// set again and again (a sweep).
 pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
+    let mut tries = 1;
+    loop {
+        let before = file_identity(manifest_path, Links::Follow);
+        let result = verify_set_once(manifest_path, tries);
+        if result.is_ok() || tries == VERIFY_TRIES || file_identity(manifest_path, Links::Follow) == before {
+            return result;
+        }
+        tries += 1;
+    }
+}
+
+/// `verify_set`, once (its try `try_number`).
+fn verify_set_once(manifest_path: &Path, try_number: usize) -> Result<VerifiedSet, ExportError> {
     let problem = |problem: String| ExportError::Verify { manifest: manifest_path.into(), problem };
     let json = read_set_manifest(manifest_path, Links::Follow).map_err(|e| {
         problem(match e {
@@ -416,6 +455,7 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
             ManifestReadError::NotJson(e) => format!("the manifest is not valid JSON: {e}"),
         })
     })?;
+    super::atomic::pause_hook(|| format!("verify-{try_number}"));
     verify_set_json(manifest_path, &json)
 }
 

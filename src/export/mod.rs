@@ -19,8 +19,8 @@ pub use atomic::{
 };
 pub(crate) use manifest::verify_set_json;
 pub use manifest::{
-    Counts, MANIFEST_SUFFIX, Manifest, ManifestReadError, MapEntry, Source, VerifiedSet, body_counts, manifest,
-    manifest_file_name, manifest_json, read_set_manifest, set_file_sha256, verify_set,
+    Counts, FileIdentity, MANIFEST_SUFFIX, Manifest, ManifestReadError, MapEntry, Source, VerifiedSet, body_counts,
+    file_identity, manifest, manifest_file_name, manifest_json, read_set_manifest, set_file_sha256, verify_set,
 };
 pub use srgb::{linear_to_srgb8, linear_to_srgb8_formula};
 
@@ -37,6 +37,18 @@ use crate::ops::Image;
 pub enum ExportError {
     #[error("cannot write {path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
+    /// A commit that failed, and whose undo failed too: the earlier set's files that could
+    /// not go back (`kept`: each temporary and the file it was) wait in hidden temporaries,
+    /// which the next run in the folder removes. It said only why the commit failed, and
+    /// `verify` then advised the run that removed them (a sweep).
+    #[error(
+        "{source}; undoing the commit failed too: {} of the earlier set's files could not be put back and are kept \
+         in hidden temporaries beside it ({}): rename them back before another run in this folder, which removes \
+         them",
+        kept.len(),
+        kept_words(kept)
+    )]
+    NotPutBack { source: Box<ExportError>, kept: Vec<(PathBuf, PathBuf)> },
     /// A file that could not be made in a folder that exists because the folder refused it:
     /// the folder is what the user has to change (it said "cannot write ro/.NAME.lock").
     #[error("cannot write in folder {folder} (making {name} there): {source}")]
@@ -232,6 +244,15 @@ impl ExportError {
                 | ExportError::ManifestTooLarge { .. }
         )
     }
+}
+
+/// `NotPutBack`'s files in words: each temporary and the name it had.
+fn kept_words(kept: &[(PathBuf, PathBuf)]) -> String {
+    let name = |path: &PathBuf| path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    kept.iter()
+        .map(|(temporary, was)| format!("{} was {}", temporary.display(), name(was)))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Whether `c` changes the order in which a terminal or an editor shows the text around it:

@@ -131,8 +131,8 @@ pub enum Command {
     },
     /// Check sets against their manifests: every file a NAME.material.json lists must lie
     /// beside it with the SHA-256 it records. One line per set on stdout, `ok` or `FAILED`
-    /// with why (a missing manifest: a run was killed while renaming; a file that differs: the
-    /// set was altered or mixed); exit 0 when every set is whole, 1 when one is not, 2 for a
+    /// with why (a missing manifest: a run was killed or failed while writing the set; a file
+    /// that differs: the set was altered or mixed); exit 0 when every set is whole, 1 when one is not, 2 for a
     /// path that is no manifest or folder of sets. glTF exports carry no manifest.
     Verify {
         /// A set's manifest (NAME.material.json), or a folder: every manifest in it and in its

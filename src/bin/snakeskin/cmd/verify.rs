@@ -77,7 +77,9 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
             Check::Interrupted { folder, name, .. } if said_being_written(folder, name) => continue,
             Check::Interrupted { folder, name, temporaries } => format!(
                 "set {}: no manifest and none of its files, only {temporaries} hidden temporar{} a run left while \
-                 writing it (.FILE.RANDOM.snakeskin-tmp): the run was killed while renaming; run it again",
+                 writing it (.FILE.RANDOM.snakeskin-tmp): the run was killed or failed before the set was whole. They \
+                 may hold the earlier set's files (a commit that failed and could not be undone keeps them so, and \
+                 says so): look before running again, which removes them",
                 path_line(&folder.join(name)),
                 if *temporaries == 1 { "y" } else { "ies" },
             ),
