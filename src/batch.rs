@@ -260,7 +260,7 @@ impl Job {
         let overrides = if self.overrides.is_empty() {
             String::new()
         } else {
-            format!("-set{}", &sha256_hex(serde_json::json!(self.overrides).to_string().as_bytes())[..8])
+            format!("-set{}", &sha256_hex(serde_json::json!(self.keyed_overrides()).to_string().as_bytes())[..8])
         };
         Path::new(preset_name).join(format!(
             "{}-{}-seed{seed}-{what}{convention}{maps}{overrides}",
@@ -269,13 +269,42 @@ impl Job {
         ))
     }
 
+    /// The overrides as the job's folder and key know them: a table's keys as dotted keys, in
+    /// key order, so that the spellings of one override are one job. `set = { scales = {
+    /// rows = 19 } }` and `set = { "scales.rows" = 19 }`, which the README says are the same
+    /// (an override merges a table key by key), were two jobs making the same bytes in two
+    /// folders (a sweep). Overrides of single values, the common case, keep their folders
+    /// and keys (the same list, in the same order). A list is a value, kept whole.
+    fn keyed_overrides(&self) -> Vec<(String, String)> {
+        fn leaves(key: String, value: toml::Value, into: &mut Vec<(String, String)>) {
+            match value {
+                toml::Value::Table(table) if !table.is_empty() => {
+                    for (k, v) in table {
+                        leaves(format!("{key}.{k}"), v, into);
+                    }
+                }
+                other => into.push((key, other.to_string())),
+            }
+        }
+        let mut keyed = Vec::new();
+        for (key, text) in &self.overrides {
+            // The value as `load_jobs` wrote it (`toml::Value`'s text), read back.
+            match format!("v = {text}").parse::<toml::Table>().ok().and_then(|mut t| t.remove("v")) {
+                Some(value) => leaves(key.clone(), value, &mut keyed),
+                None => keyed.push((key.clone(), text.clone())),
+            }
+        }
+        keyed.sort();
+        keyed
+    }
+
     /// The job's key: what its output bytes depend on (the preset's content and seed, the
     /// overrides, the options and the generator's version).
     pub fn key(&self, preset_hash: &str, seed: u64) -> String {
         let mut description = serde_json::json!({
             "generator_version": env!("CARGO_PKG_VERSION"),
             "preset_hash": preset_hash,
-            "overrides": self.overrides,
+            "overrides": self.keyed_overrides(),
             "seed": seed,
             "size": self.size,
             "maps": self.maps.iter().map(|m| m.name()).collect::<Vec<_>>(),

@@ -1167,14 +1167,17 @@ fn a_batch_runs_in_a_folder_whose_path_is_not_utf8() {
 fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     let dir = tempfile::tempdir().unwrap();
     let jobs = dir.path().join("jobs.toml");
-    // Three different jobs of one preset (two differ only in their overrides) and a fourth
-    // that repeats the first.
+    // Three different jobs of one preset (two differ only in their overrides), a fourth
+    // that repeats the first, and a fifth that repeats the second in other words (a table
+    // for the dotted key, which the README says is the same: it made a folder of its own with
+    // the same bytes, a sweep).
     std::fs::write(
         &jobs,
         "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n\
          [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { \"scales.rows\" = 17 }\n\n\
          [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { \"scales.rows\" = 23 }\n\n\
-         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n",
+         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n\
+         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { scales = { rows = 17 } }\n",
     )
     .unwrap();
     let out_dir = dir.path().join("out");
@@ -1184,12 +1187,12 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
         assert!(out.status.success(), "{}", stderr(&out));
         stdout(&out).lines().map(|l| l.split_whitespace().nth(1).unwrap_or("").to_string()).collect::<Vec<_>>()
     };
-    assert_eq!(list(&jobs, &out_dir), ["to", "to", "to", "duplicate"]);
+    assert_eq!(list(&jobs, &out_dir), ["to", "to", "to", "duplicate", "duplicate"]);
     assert!(!out_dir.exists(), "--list wrote its output folder");
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stdout(&out).contains("3 run, 0 already done, 1 duplicate of another job"), "{}", stdout(&out));
-    assert_eq!(list(&jobs, &out_dir), ["done", "done", "done", "duplicate"]);
+    assert!(stdout(&out).contains("3 run, 0 already done, 2 duplicates of another job"), "{}", stdout(&out));
+    assert_eq!(list(&jobs, &out_dir), ["done", "done", "done", "duplicate", "duplicate"]);
     let sets = manifests(&out_dir);
     assert_eq!(sets.len(), 3, "{sets:?}");
     // Each set is complete and is its own job's (a set overwritten by another job's maps
@@ -1198,6 +1201,13 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     let index = index["jobs"].as_array().unwrap();
     assert_eq!(index[3]["status"], "duplicate");
     assert_eq!(index[3]["duplicate_of"], 0);
+    assert_eq!(index[4]["duplicate_of"], 1);
+    // A dotted key's folder is named as it was before tables were read as dotted keys: the
+    // first 8 hex digits of the SHA-256 of the overrides' JSON (sets made then stay done).
+    use sha2::Digest;
+    let digest = sha2::Sha256::digest(br#"[["scales.rows","17"]]"#);
+    let hash: String = digest.iter().take(4).map(|b| format!("{b:02x}")).collect();
+    assert_eq!(index[1]["folder"], format!("natrix-natrix/tile-32-seed31-png-set{hash}"), "{index:?}");
     for job in &index[..3] {
         let manifest: serde_json::Value =
             serde_json::from_slice(&std::fs::read(out_dir.join(job["manifest"].as_str().unwrap())).unwrap()).unwrap();
@@ -1206,7 +1216,7 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     // The same run again has nothing to do: every set is settled (its files match the
     // hashes its manifest records).
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
-    assert!(stdout(&out).contains("0 run, 3 already done, 1 duplicate of another job"), "{}", stdout(&out));
+    assert!(stdout(&out).contains("0 run, 3 already done, 2 duplicates of another job"), "{}", stdout(&out));
     assert_eq!(manifests(&out_dir), sets, "a settled set was written again");
 
     // Two different preset files with one name would share a folder: refused, in every
