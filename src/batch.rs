@@ -257,10 +257,11 @@ impl Job {
         } else {
             String::new()
         };
-        let overrides = if self.overrides.is_empty() {
+        let keyed = self.keyed_overrides();
+        let overrides = if keyed.is_empty() {
             String::new()
         } else {
-            format!("-set{}", &sha256_hex(serde_json::json!(self.keyed_overrides()).to_string().as_bytes())[..8])
+            format!("-set{}", &sha256_hex(serde_json::json!(keyed).to_string().as_bytes())[..8])
         };
         Path::new(preset_name).join(format!(
             "{}-{}-seed{seed}-{what}{convention}{maps}{overrides}",
@@ -273,12 +274,14 @@ impl Job {
     /// key order, so that the spellings of one override are one job. `set = { scales = {
     /// rows = 19 } }` and `set = { "scales.rows" = 19 }`, which the README says are the same
     /// (an override merges a table key by key), were two jobs making the same bytes in two
-    /// folders (a sweep). Overrides of single values, the common case, keep their folders
-    /// and keys (the same list, in the same order). A list is a value, kept whole.
+    /// folders (a sweep); an empty table writes nothing, the job of no override. Overrides of
+    /// single values, the common case, keep their folders and keys (the same list, in the
+    /// same order). A list is a value, kept whole.
     fn keyed_overrides(&self) -> Vec<(String, String)> {
         fn leaves(key: String, value: toml::Value, into: &mut Vec<(String, String)>) {
             match value {
-                toml::Value::Table(table) if !table.is_empty() => {
+                // An empty table writes no key (`scales = {}` is no override).
+                toml::Value::Table(table) => {
                     for (k, v) in table {
                         leaves(format!("{key}.{k}"), v, into);
                     }
@@ -945,6 +948,9 @@ pub enum BatchProgress<'a> {
     Started { outcome: &'a JobOutcome },
     /// A job ended, `done` of `total` so far, in the order they end.
     Ended { done: usize, total: usize, outcome: &'a JobOutcome },
+    /// A job that started ended without its set: it failed (the run stops), or the run
+    /// stopped while it waited for another run's lock on the set.
+    Left { outcome: &'a JobOutcome },
 }
 
 /// Runs the shard's jobs, up to `concurrency` at once (each job's graph still uses every
@@ -1022,6 +1028,7 @@ pub fn run(
         enum Event {
             Started(usize),
             Ended(usize, Result<JobOutcome, Error>),
+            Left(usize),
             Note(String),
         }
         let (sender, receiver) = std::sync::mpsc::channel::<Event>();
@@ -1044,7 +1051,10 @@ pub fn run(
                     let result = match run_one(jobs_file, job, resolved, out, &note, &stopped) {
                         Ok(Some(outcome)) => Ok(outcome),
                         // The queue stopped while it waited: not run.
-                        Ok(None) => break,
+                        Ok(None) => {
+                            let _ = sender.send(Event::Left(k));
+                            break;
+                        }
                         Err(e) => Err(e),
                     };
                     if result.is_err() {
@@ -1066,7 +1076,11 @@ pub fn run(
                     progress(BatchProgress::Ended { done, total, outcome: &outcome });
                     finished[k] = Some(outcome);
                 }
-                Event::Ended(k, Err(e)) => failures.push((k, e)),
+                Event::Ended(k, Err(e)) => {
+                    progress(BatchProgress::Left { outcome: &work[k].1.outcome });
+                    failures.push((k, e));
+                }
+                Event::Left(k) => progress(BatchProgress::Left { outcome: &work[k].1.outcome }),
                 Event::Note(text) => warn(&text),
             }
         }

@@ -154,9 +154,11 @@ pub fn line_column(text: &str, offset: usize) -> (usize, usize) {
 /// Text from a file for a message of one line: every control character, newline included,
 /// written as `\u{..}`. A key or a name from a file printed raw could start a line of its
 /// own that passes for the tool's (`"a\nFAKE" = 1` printed `FAKE` alone on a line, and a
-/// jobs file's `set` a made-up `1/1 done` line: a hostile-input sweep).
+/// jobs file's `set` a made-up `1/1 done` line: a hostile-input sweep), and every character
+/// that reorders text or breaks its lines (`export::reshapes_text`: they were printed raw).
 pub fn one_line(text: &str) -> String {
-    text.chars().map(|c| if c.is_control() { c.escape_unicode().to_string() } else { c.to_string() }).collect()
+    let hidden = |c: char| c.is_control() || crate::export::reshapes_text(c);
+    text.chars().map(|c| if hidden(c) { c.escape_unicode().to_string() } else { c.to_string() }).collect()
 }
 
 /// Rewrites serde's "unknown field `x`, expected one of `a`, `b`" into a message that names

@@ -1170,14 +1170,15 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     // Three different jobs of one preset (two differ only in their overrides), a fourth
     // that repeats the first, and a fifth that repeats the second in other words (a table
     // for the dotted key, which the README says is the same: it made a folder of its own with
-    // the same bytes, a sweep).
+    // the same bytes, a sweep), and a sixth whose empty table overrides nothing (the first's).
     std::fs::write(
         &jobs,
         "[[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n\
          [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { \"scales.rows\" = 17 }\n\n\
          [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { \"scales.rows\" = 23 }\n\n\
          [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\n\n\
-         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { scales = { rows = 17 } }\n",
+         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { scales = { rows = 17 } }\n\n\
+         [[job]]\npreset = \"natrix-natrix\"\nsizes = [32]\nset = { scales = {} }\n",
     )
     .unwrap();
     let out_dir = dir.path().join("out");
@@ -1187,12 +1188,12 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
         assert!(out.status.success(), "{}", stderr(&out));
         stdout(&out).lines().map(|l| l.split_whitespace().nth(1).unwrap_or("").to_string()).collect::<Vec<_>>()
     };
-    assert_eq!(list(&jobs, &out_dir), ["to", "to", "to", "duplicate", "duplicate"]);
+    assert_eq!(list(&jobs, &out_dir), ["to", "to", "to", "duplicate", "duplicate", "duplicate"]);
     assert!(!out_dir.exists(), "--list wrote its output folder");
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stdout(&out).contains("3 run, 0 already done, 2 duplicates of another job"), "{}", stdout(&out));
-    assert_eq!(list(&jobs, &out_dir), ["done", "done", "done", "duplicate", "duplicate"]);
+    assert!(stdout(&out).contains("3 run, 0 already done, 3 duplicates of another job"), "{}", stdout(&out));
+    assert_eq!(list(&jobs, &out_dir), ["done", "done", "done", "duplicate", "duplicate", "duplicate"]);
     let sets = manifests(&out_dir);
     assert_eq!(sets.len(), 3, "{sets:?}");
     // Each set is complete and is its own job's (a set overwritten by another job's maps
@@ -1202,6 +1203,7 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     assert_eq!(index[3]["status"], "duplicate");
     assert_eq!(index[3]["duplicate_of"], 0);
     assert_eq!(index[4]["duplicate_of"], 1);
+    assert_eq!(index[5]["duplicate_of"], 0);
     // A dotted key's folder is named as it was before tables were read as dotted keys: the
     // first 8 hex digits of the SHA-256 of the overrides' JSON (sets made then stay done).
     use sha2::Digest;
@@ -1216,7 +1218,7 @@ fn every_different_job_gets_its_own_folder_and_a_repeated_job_runs_once() {
     // The same run again has nothing to do: every set is settled (its files match the
     // hashes its manifest records).
     let out = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out_dir.to_str().unwrap()]);
-    assert!(stdout(&out).contains("0 run, 3 already done, 2 duplicates of another job"), "{}", stdout(&out));
+    assert!(stdout(&out).contains("0 run, 3 already done, 3 duplicates of another job"), "{}", stdout(&out));
     assert_eq!(manifests(&out_dir), sets, "a settled set was written again");
 
     // Two different preset files with one name would share a folder: refused, in every
@@ -2148,9 +2150,9 @@ fn another_presets_set_made_after_the_plan_is_not_written_over() {
 /// On a terminal a batch's bar is drawn at once, says it is planning, and while a job runs
 /// which set it is making, ticking meanwhile: it showed nothing until the first job ended
 /// and stood still between jobs (an 8K set: 85 s of a blank screen; a sweep). `script`
-/// (util-linux, in every Debian) gives the run a terminal. Control: redirected, stderr holds
-/// no bar.
-#[cfg(unix)]
+/// (util-linux, in every Debian; its `-c` and `-e` are Linux's) gives the run a terminal.
+/// Control: redirected, into a folder of its own (a job to make), stderr holds no bar.
+#[cfg(target_os = "linux")]
 #[test]
 fn a_batch_on_a_terminal_says_what_it_is_making_before_the_job_ends() {
     let dir = tempfile::tempdir().unwrap();
@@ -2169,6 +2171,10 @@ fn a_batch_on_a_terminal_says_what_it_is_making_before_the_job_ends() {
     let making = at("making natrix-natrix/tile-2048-seed1-png");
     assert!(at("planning 1 job") < making, "{screen:?}");
     assert!(making < at("1/1 done"), "{screen:?}");
-    let redirected = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", out.to_str().unwrap()]);
-    assert!(redirected.status.success() && !stderr(&redirected).contains("making"), "{}", stderr(&redirected));
+    let elsewhere = dir.path().join("elsewhere");
+    let redirected = snakeskin(&["batch", jobs.to_str().unwrap(), "-o", elsewhere.to_str().unwrap()]);
+    assert!(redirected.status.success(), "{}", stderr(&redirected));
+    assert!(stdout(&redirected).contains("1/1 done"), "the job ran: {}", stdout(&redirected));
+    let said = stderr(&redirected);
+    assert!(!said.contains("planning") && !said.contains("making"), "{said}");
 }

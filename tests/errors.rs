@@ -686,6 +686,9 @@ fn a_preset_file_name_with_control_characters_or_a_backslash_is_refused() {
     let err = refused("x\u{202e}gnp.exe.toml", "seed = 1\n", &[]);
     assert!(err.contains("its file name has bidirectional controls") && err.contains("x\\u{202e}gnp"), "{err}");
     assert!(!err.contains('\u{202e}'), "{err}");
+    // A line separator, a line break to an editor and to Python's `splitlines`.
+    let err = refused("line\u{2028}break.toml", "seed = 1\n", &[]);
+    assert!(err.contains("or line separators") && err.contains("line\\u{2028}break"), "{err}");
     let dir = tempfile::tempdir().unwrap();
     accepted(&write_preset(dir.path(), "a b#c.toml", "seed = 1\n"), &[]);
     // Right-to-left letters are no controls: a name in Hebrew is taken.

@@ -771,7 +771,7 @@ fn a_kill_at_any_rename_or_during_the_undo_never_leaves_a_manifest_over_other_ma
     // failed, and the manifest, kept aside with it.
     let said = stderr(&out);
     assert!(
-        said.contains("undoing the commit failed too: 2 of the earlier set's files could not be put back")
+        said.contains("undoing the commit failed too: 2 of the earlier set's files are kept in hidden temporaries")
             && said.contains(&format!("was {PRESET}.material.json"))
             && said.contains("rename them back before another run in this folder, which removes them"),
         "{said}"
@@ -2700,11 +2700,12 @@ fn verify_says_which_folders_it_did_not_search() {
 }
 
 /// A set replaced while `verify` checks it (its manifest read, its maps not yet: a run
-/// committed a new set meanwhile) is checked again: the new maps read against the old
-/// manifest were FAILED, "mixed or altered", 1 check in 835 beside a run making the set again
-/// and again (a sweep). The run is paused at its commit (three seconds), `verify` after its
-/// manifest's reading (three seconds, from a second later): the commit lands between. Control:
-/// a map altered for good still fails after the tries.
+/// committed a new set meanwhile) is checked again, and says so: the new maps read against
+/// the old manifest were FAILED, "mixed or altered", 1 check in 835 beside a run making the
+/// set again and again (a sweep). `verify` pauses after reading the manifest (three seconds,
+/// debug builds); two seconds in, the test renames another seed's set over it as a commit
+/// does, maps first, manifest last. Control: a map altered for good still fails after the
+/// tries.
 #[cfg(unix)]
 #[test]
 fn verify_checks_again_a_set_replaced_while_it_checked() {
@@ -2712,23 +2713,34 @@ fn verify_checks_again_a_set_replaced_while_it_checked() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("set");
-    let first = snakeskin(&["generate", "natrix-natrix", "-o", out.to_str().unwrap(), "--size", "16", "--seed", "1"]);
-    assert!(first.status.success(), "{}", stderr(&first));
-    let args = ["generate", "natrix-natrix", "-o", out.to_str().unwrap(), "--size", "16", "--seed", "2"];
-    let mut second = spawn_paused_at_commit(&args, &out);
-    std::thread::sleep(std::time::Duration::from_secs(1));
+    let (out, new) = (dir.path().join("set"), dir.path().join("new"));
+    for (folder, seed) in [(&out, "1"), (&new, "2")] {
+        let run =
+            snakeskin(&["generate", "natrix-natrix", "-o", folder.to_str().unwrap(), "--size", "16", "--seed", seed]);
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
     let verify = std::process::Command::new(env!("CARGO_BIN_EXE_snakeskin"))
         .args(["verify", out.to_str().unwrap()])
         .env("SNAKESKIN_TEST_PAUSE_AT", "verify-1")
-        .output()
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
         .unwrap();
-    assert!(second.wait().unwrap().success());
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    let manifest = "natrix-natrix.material.json";
+    let mut files: Vec<String> =
+        std::fs::read_dir(&new).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    files.sort_by_key(|name| name == manifest);
+    for name in &files {
+        std::fs::rename(new.join(name), out.join(name)).unwrap();
+    }
+    let verify = verify.wait_with_output().unwrap();
     assert_eq!(verify.status.code(), Some(0), "{}{}", stdout(&verify), stderr(&verify));
-    assert!(stdout(&verify).starts_with("ok "), "{}", stdout(&verify));
-    let seed: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("natrix-natrix.material.json")).unwrap()).unwrap();
-    assert_eq!(seed["seed"], 2, "the second run's set, checked after it landed");
+    assert!(
+        stdout(&verify).starts_with("ok ") && stdout(&verify).contains("replaced while checked, checked again"),
+        "{}",
+        stdout(&verify)
+    );
     // The control: a map altered for good fails, whatever the tries.
     let map = out.join("natrix-natrix_color.png");
     let mut bytes = std::fs::read(&map).unwrap();
@@ -2754,6 +2766,24 @@ fn verify_prints_a_name_that_reorders_text_escaped() {
     let report = stdout(&out);
     assert!(report.contains("x\\u{202e}gnp.exe") && !report.contains('\u{202e}'), "{report}");
     assert!(report.contains("\u{05e6}\u{05e4}\u{05e2}"), "the control: {report}");
+    // A warning that names a preset's path through such a folder escapes it too (it was
+    // printed raw: a review).
+    let folder = dir.path().join("p\u{202e}gnp.exe");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::write(folder.join("empty.toml"), "").unwrap();
+    let out_dir = dir.path().join("out");
+    let run = snakeskin(&[
+        "generate",
+        folder.join("empty.toml").to_str().unwrap(),
+        "--size",
+        "16",
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let warned = stderr(&run);
+    assert!(warned.contains("warning: ") && warned.contains("p\\u{202e}gnp.exe"), "{warned}");
+    assert!(!warned.contains('\u{202e}'), "{warned}");
 }
 
 /// From a sweep of `verify`: a manifest copied over another set's name (`b.material.json`

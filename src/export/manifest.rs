@@ -390,6 +390,8 @@ pub fn set_file_sha256(path: &Path, limit: u64, links: Links) -> Result<String, 
 #[derive(Debug, Clone)]
 pub struct VerifiedSet {
     pub manifest: PathBuf,
+    /// How many times it was checked: more than once where it was replaced while checked.
+    pub tries: usize,
     /// (map name, file path) in manifest order.
     pub files: Vec<(String, PathBuf)>,
 }
@@ -427,7 +429,7 @@ pub fn verify_set(manifest_path: &Path) -> Result<VerifiedSet, ExportError> {
     let mut tries = 1;
     loop {
         let before = file_identity(manifest_path, Links::Follow);
-        let result = verify_set_once(manifest_path, tries);
+        let result = verify_set_once(manifest_path, tries).map(|set| VerifiedSet { tries, ..set });
         if result.is_ok() || tries == VERIFY_TRIES || file_identity(manifest_path, Links::Follow) == before {
             return result;
         }
@@ -549,5 +551,5 @@ pub(crate) fn verify_set_json(manifest_path: &Path, json: &serde_json::Value) ->
     if !problems.is_empty() {
         return Err(problem(problems.join("; ")));
     }
-    Ok(VerifiedSet { manifest: manifest_path.into(), files })
+    Ok(VerifiedSet { manifest: manifest_path.into(), tries: 1, files })
 }

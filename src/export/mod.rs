@@ -42,9 +42,9 @@ pub enum ExportError {
     /// which the next run in the folder removes. It said only why the commit failed, and
     /// `verify` then advised the run that removed them (a sweep).
     #[error(
-        "{source}; undoing the commit failed too: {} of the earlier set's files could not be put back and are kept \
-         in hidden temporaries beside it ({}): rename them back before another run in this folder, which removes \
-         them",
+        "{source}; undoing the commit failed too: {} of the earlier set's files are kept in hidden temporaries \
+         beside it, those that could not go back and the manifest, kept aside with them ({}): rename them back \
+         before another run in this folder, which removes them",
         kept.len(),
         kept_words(kept)
     )]
@@ -255,15 +255,20 @@ fn kept_words(kept: &[(PathBuf, PathBuf)]) -> String {
         .join(", ")
 }
 
-/// Whether `c` changes the order in which a terminal or an editor shows the text around it:
-/// Unicode's bidirectional controls (UAX #9, section 2: the embeddings and overrides U+202A
-/// to U+202E, the isolates U+2066 to U+2069, the marks U+200E, U+200F and U+061C). In a file
-/// name they make one that ends `.exe` show as ending `.png` ("Trojan Source",
-/// CVE-2021-42574); being no control characters (`char::is_control`), they were written
-/// raw. Refused in the names a run writes (`unfit_for_file_names`), escaped in the paths the
-/// binary prints.
-pub fn reorders_text(c: char) -> bool {
-    matches!(c, '\u{061C}' | '\u{200E}' | '\u{200F}' | '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
+/// Whether `c` changes the order or the lines in which a terminal or an editor shows the text
+/// around it: Unicode's bidirectional controls (UAX #9, section 2: the embeddings and
+/// overrides U+202A to U+202E, the isolates U+2066 to U+2069, the marks U+200E, U+200F and
+/// U+061C), and the line and paragraph separators U+2028 and U+2029 (a line break to an
+/// editor, to Python's `splitlines`). In a file name the first make one that ends `.exe`
+/// show as ending `.png` ("Trojan Source", CVE-2021-42574), the second split a listing's
+/// line; being no control characters (`char::is_control`), they were written raw. Refused in
+/// the names a run writes (`unfit_for_file_names`), escaped wherever text from a file or a
+/// path is printed (`toml_text::one_line`, the binary's `printable`).
+pub fn reshapes_text(c: char) -> bool {
+    matches!(
+        c,
+        '\u{061C}' | '\u{200E}' | '\u{200F}' | '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}' | '\u{2028}' | '\u{2029}'
+    )
 }
 
 /// What makes `name` unfit to be carried by a set's file names (its maps and manifest are
@@ -272,14 +277,17 @@ pub fn reorders_text(c: char) -> bool {
 /// that reads the files), or a backslash (a folder's separator on Windows, where the set may
 /// be read: a preset `a\b.toml` made a manifest naming `a\b_color.png`, which `verify`
 /// refused, so `batch` never took the set as done and made it at every run), a
-/// bidirectional control (`reorders_text`). Asked of a preset file's stem, of a `.gltf`'s,
+/// bidirectional control or a line separator (`reshapes_text`). Asked of a preset file's stem, of a `.gltf`'s,
 /// and of the map files a manifest names (`verify`).
 pub fn unfit_for_file_names(name: &str) -> Option<&'static str> {
     if name.chars().any(char::is_control) {
         return Some("control characters");
     }
-    if name.chars().any(reorders_text) {
-        return Some("bidirectional controls (they show a name's text in another order than it has)");
+    if name.chars().any(reshapes_text) {
+        return Some(
+            "bidirectional controls or line separators (they show a name's text in another order or on lines of its \
+             own)",
+        );
     }
     if name.contains('\\') {
         return Some("a backslash (a folder's separator on Windows)");

@@ -206,10 +206,10 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
     1
 }
 
-/// `text` with every control character but newline and tab, and every bidirectional
-/// control (`export::reorders_text`), written as `\u{..}`.
+/// `text` with every control character but newline and tab, and every character that
+/// reorders text or breaks its lines (`export::reshapes_text`), written as `\u{..}`.
 pub fn printable(text: &str) -> String {
-    let hidden = |c: char| (c.is_control() && c != '\n' && c != '\t') || snakeskin::export::reorders_text(c);
+    let hidden = |c: char| (c.is_control() && c != '\n' && c != '\t') || snakeskin::export::reshapes_text(c);
     text.chars().map(|c| if hidden(c) { c.escape_unicode().to_string() } else { c.to_string() }).collect()
 }
 
@@ -261,7 +261,7 @@ pub fn ensure_folder(folder: &Path) -> anyhow::Result<()> {
 /// the physics.
 pub fn report_warnings(preset: &str, loaded: &snakeskin::preset::LoadedPreset) {
     for warning in loaded.warnings(preset, snakeskin::preset::SET_FLAG) {
-        eprintln!("{warning}");
+        eprintln!("{}", printable(&warning));
     }
 }
 

@@ -65,8 +65,11 @@ impl Progress {
         }
     }
 
-    /// A line on stderr above the bar (a warning while it runs).
+    /// A line on stderr above the bar (a warning while it runs), escaped as every printed
+    /// line is (`output::printable`: a batch's warnings naming a preset's path wrote its
+    /// bidirectional controls raw, and its note of an earlier index's jobs file everything).
     pub fn println(&self, line: &str) {
+        let line = &crate::output::printable(line);
         match &self.0 {
             Some(bar) => bar.println(line),
             None => eprintln_unless_closed(line),

@@ -45,6 +45,12 @@ pub fn run(args: BatchArgs) -> Result<()> {
             making.push(path_line(&outcome.folder));
             bar.message(&making_words(&making));
         }
+        // (A failed job's error ends the run; the bar stops saying it makes the set.)
+        BatchProgress::Left { outcome } => {
+            let folder = path_line(&outcome.folder);
+            making.retain(|f| *f != folder);
+            bar.message(&making_words(&making));
+        }
         BatchProgress::Ended { done, total, outcome } => {
             bar.update(done, total);
             let folder = path_line(&outcome.folder);

@@ -1,7 +1,7 @@
 //! `snakeskin verify PATH...`: checks sets against their manifests, for pipelines that take
 //! a set from a shared folder, a cache or an archive and need to know it is whole. A run
-//! killed while renaming leaves an incomplete set (maps without their manifest), and a file
-//! replaced by hand a mixed one; both fail here. The check of a manifest is the library's
+//! killed or failed while writing a set leaves an incomplete one (maps without their
+//! manifest), and a file replaced by hand a mixed one; both fail here. The check of a manifest is the library's
 //! (`export::verify_set`: every map it lists exists beside it with the SHA-256 it records),
 //! so `batch`, which skips finished jobs by it, and this command agree on what a finished
 //! set is; a set's files are known by `export::every_set_file_name`, as a commit knows them.
@@ -30,8 +30,9 @@ enum Check {
     /// Files of a set named `name` in `folder` with no manifest beside them.
     Orphans { folder: PathBuf, name: String, files: usize },
     /// A set named `name` in `folder` with neither its manifest nor any of its files, only
-    /// temporaries of them (`.FILE.RANDOM.snakeskin-tmp`): a run killed while renaming,
-    /// after it moved the old set aside and before it moved the new one in. Hidden, they were
+    /// temporaries of them (`.FILE.RANDOM.snakeskin-tmp`): a run killed or failed while
+    /// writing, after it moved the old set aside and before it moved the new one in (or
+    /// before any rename, where there was no old set). Hidden, they were
     /// passed over, and the folder's other sets said `ok`. Where a run holds the set's lock
     /// it is being written: said so, not failed (`export::lock_is_held`).
     Interrupted { folder: PathBuf, name: String, temporaries: usize },
@@ -61,7 +62,9 @@ pub fn run(paths: &[PathBuf]) -> Result<()> {
             Check::Manifest(manifest) => match snakeskin::export::verify_set(manifest) {
                 Ok(set) => {
                     let count = set.files.len();
-                    println!("ok {} ({count} file{})", path_line(manifest), if count == 1 { "" } else { "s" });
+                    // A set a run replaced while it was checked was checked again, whole.
+                    let again = if set.tries > 1 { "; replaced while checked, checked again" } else { "" };
+                    println!("ok {} ({count} file{}{again})", path_line(manifest), if count == 1 { "" } else { "s" });
                     continue;
                 }
                 Err(_) if being_written(manifest) => continue,
