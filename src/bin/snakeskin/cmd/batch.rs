@@ -34,6 +34,12 @@ pub fn run(args: BatchArgs) -> Result<()> {
     bar.update(0, jobs.len());
     bar.message(&format!("planning {} (loading presets, checking the sets there)", counted(jobs.len(), "job")));
     let mut making: Vec<String> = Vec::new();
+    // The set `folder` is no longer being made (it ended, failed or never began).
+    let made = |making: &mut Vec<String>, folder: &std::path::Path| {
+        let folder = path_line(folder);
+        making.retain(|f| *f != folder);
+        bar.message(&making_words(making));
+    };
     let concurrency = args.concurrent.map_or_else(batch::default_concurrency, |n| n as usize);
     let mut warn = |warning: &str| bar.println(warning);
     let result = batch::run(&args.jobs, &jobs, &args.out, shard, concurrency, &mut warn, &mut |event| match event {
@@ -46,16 +52,10 @@ pub fn run(args: BatchArgs) -> Result<()> {
             bar.message(&making_words(&making));
         }
         // (A failed job's error ends the run; the bar stops saying it makes the set.)
-        BatchProgress::Left { outcome } => {
-            let folder = path_line(&outcome.folder);
-            making.retain(|f| *f != folder);
-            bar.message(&making_words(&making));
-        }
+        BatchProgress::Left { outcome } => made(&mut making, &outcome.folder),
         BatchProgress::Ended { done, total, outcome } => {
             bar.update(done, total);
-            let folder = path_line(&outcome.folder);
-            making.retain(|f| *f != folder);
-            bar.message(&making_words(&making));
+            made(&mut making, &outcome.folder);
             // One line a job on stdout as well, as `generate` prints the paths it wrote: a
             // redirected run (an array job's log) said nothing until its summary, and nothing
             // of what it had finished when a signal ended it.

@@ -332,16 +332,11 @@ fn set_files_in(folder: &Path, set_name: &str) -> usize {
 /// A folder's file identity (device, inode), links followed; None where it cannot be read
 /// (listing it then says why) or off Unix.
 fn folder_identity(folder: &Path) -> Option<(u64, u64)> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        std::fs::metadata(folder).ok().map(|m| (m.dev(), m.ino()))
+    if cfg!(not(unix)) {
+        return None;
     }
-    #[cfg(not(unix))]
-    {
-        let _ = folder;
-        None
-    }
+    let (device, inode, ..) = snakeskin::export::file_identity(folder, snakeskin::text_file::Links::Follow)?;
+    Some((device, inode))
 }
 
 /// The entries of `folder`, sorted by path (the listing's order is the file system's).
