@@ -893,6 +893,101 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     assert!(again.is_some() && still_running, "the window did not draw again:\n{seen}");
 }
 
+/// The S key saves the view: the frame without the panel, at the window's size, the bytes
+/// `--out` renders at that size, as NAME_view_1.png in `--shots` (made), then _2, _3 (none
+/// replaced); R puts the view back where it opened. Negative control: orbited (dragged),
+/// the saved view is not the headless frame; after R it is again.
+#[cfg(feature = "window")]
+#[test]
+fn the_window_saves_its_view_and_puts_it_back() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Command;
+    use std::time::{Duration, Instant};
+    let name = "the_window_saves_its_view_and_puts_it_back";
+    if gpu_or_skip(name).is_none() || !x11_tools_or_skip(name) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let preset = dir.path().join("saved.toml");
+    std::fs::write(&preset, snakeskin::preset::library::get(PLAIN_PRESET).unwrap()).unwrap();
+    let shots = dir.path().join("shots");
+    let size = ["--size", "480x300", "--map-size", "128"];
+    let mut child =
+        window_under_xvfb(&preset, &[&size[..], &["--shots", shots.to_str().unwrap()]].concat()).spawn().unwrap();
+    let group = format!("-{}", child.id());
+    let stop = || {
+        let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
+    };
+    let (lines_tx, lines) = std::sync::mpsc::channel();
+    let stderr = child.stderr.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = lines_tx.send(line);
+        }
+    });
+    let seen = std::cell::RefCell::new(Vec::<String>::new());
+    let wait_for = |needle: &str| -> Option<String> {
+        let deadline = Instant::now() + Duration::from_secs(120);
+        while Instant::now() < deadline {
+            if let Ok(line) = lines.recv_timeout(Duration::from_millis(200)) {
+                seen.borrow_mut().push(line.clone());
+                if line.contains(needle) {
+                    return Some(line);
+                }
+            }
+        }
+        None
+    };
+    let Some(pid) = preview_process(&preset) else {
+        stop();
+        panic!("the preview never started");
+    };
+    let first = wait_for("first frame presented");
+    let xdotool = xdotool_in_display_of(&pid);
+    let Some(window) = preview_window(&xdotool).filter(|_| first.is_some()) else {
+        stop();
+        panic!("no window drawn:\n{}", seen.borrow().join("\n"));
+    };
+    xdotool(&["windowfocus", "--sync", &window]);
+    let mut saved = Vec::new();
+    xdotool(&["key", "s"]);
+    saved.push(wait_for("saved the view as"));
+    // Orbited in its view (right of the panel).
+    xdotool(&["mousemove", "--window", &window, "400", "150", "mousedown", "1"]);
+    for x in ["410", "420", "430", "440"] {
+        xdotool(&["mousemove", "--window", &window, x, "160"]);
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    xdotool(&["mouseup", "1"]);
+    xdotool(&["key", "s"]);
+    saved.push(wait_for("saved the view as"));
+    xdotool(&["key", "r"]);
+    xdotool(&["key", "s"]);
+    saved.push(wait_for("saved the view as"));
+    stop();
+    let _ = child.wait();
+    let seen = seen.borrow().join("\n");
+    for (n, line) in saved.iter().enumerate() {
+        let line = line.as_ref().unwrap_or_else(|| panic!("save {} was not said:\n{seen}", n + 1));
+        let file = shots.join(format!("saved_view_{}.png", n + 1));
+        assert!(line.contains(&format!("saved the view as {} (480×300)", file.display())), "{line}");
+    }
+    let headless = dir.path().join("headless.png");
+    let out =
+        snakeskin(&[&["preview", preset.to_str().unwrap(), "--out", headless.to_str().unwrap()], &size[..]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let pixels = |path: &std::path::Path| image::open(path).unwrap().to_rgb8();
+    let want = pixels(&headless);
+    let [opened, orbited, put_back] = [1, 2, 3].map(|n| pixels(&shots.join(format!("saved_view_{n}.png"))));
+    assert_eq!(opened.dimensions(), (480, 300));
+    assert!(opened == want, "the saved view is not the frame --out renders");
+    assert!(
+        orbited != want,
+        "the orbited view is the frame as it opened: the drag was not seen (the negative control)"
+    );
+    assert!(put_back == want, "R did not put the view back where it opened");
+}
+
 /// Whether `xvfb-run` and `xdotool` are there; where they are not, the test `name` is
 /// skipped, or fails under `SNAKESKIN_REQUIRE_GPU=1`.
 #[cfg(feature = "window")]

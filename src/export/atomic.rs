@@ -1513,9 +1513,70 @@ pub fn write_file_atomically(path: &Path, bytes: Vec<u8>) -> Result<PathBuf, Exp
     Ok(path.into())
 }
 
+/// The most numbered names `write_new_numbered_file` tries in one folder.
+pub const NUMBERED_NAMES_MAX: u32 = 9999;
+
+/// Writes `bytes` as `dir/STEM_N.EXTENSION` for the first N from 1 whose file is not there,
+/// atomically (exclusive temporary, then a link that refuses to replace), so that a
+/// picture saved twice, or by two windows into one folder at once, keeps every earlier one.
+/// The folder is made if missing.
+pub fn write_new_numbered_file(dir: &Path, stem: &str, extension: &str, bytes: &[u8]) -> Result<PathBuf, ExportError> {
+    let name = |n: u32| format!("{stem}_{n}.{extension}");
+    create_folder(dir)?;
+    let mut tmp = stage(dir, &name(1), bytes)?;
+    let temporary = tmp.path().to_path_buf();
+    let written = (|| {
+        for n in 1..=NUMBERED_NAMES_MAX {
+            let target = dir.join(name(n));
+            match tmp.persist_noclobber(&target) {
+                Ok(_) => return Ok(target),
+                Err(e) if e.error.kind() == std::io::ErrorKind::AlreadyExists => tmp = e.file,
+                Err(e) => return Err(io_error(&target)(e.error)),
+            }
+        }
+        Err(ExportError::Io {
+            path: dir.join(name(NUMBERED_NAMES_MAX)),
+            source: std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                format!("{} files named {stem}_N.{extension} are there already; move some away", NUMBERED_NAMES_MAX),
+            ),
+        })
+    })();
+    forget_temporary(&temporary);
+    written
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Numbered files never replace one another: the third save beside 1 and 3 (2 removed)
+    /// is 2, and 1 and 3 keep their bytes; no temporary is left. Negative control: a folder
+    /// that is a file is refused, and nothing is written.
+    #[test]
+    fn numbered_files_take_the_first_free_number_and_replace_none() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let first = write_new_numbered_file(d, "boa", "png", b"one").unwrap();
+        let second = write_new_numbered_file(d, "boa", "png", b"two").unwrap();
+        let third = write_new_numbered_file(d, "boa", "png", b"three").unwrap();
+        assert_eq!(
+            [&first, &second, &third].map(|p| p.file_name().unwrap().to_owned()),
+            ["boa_1.png", "boa_2.png", "boa_3.png"].map(std::ffi::OsString::from)
+        );
+        fs::remove_file(&second).unwrap();
+        let again = write_new_numbered_file(d, "boa", "png", b"again").unwrap();
+        assert_eq!(again, second);
+        for (path, bytes) in [(&first, &b"one"[..]), (&second, b"again"), (&third, b"three")] {
+            assert_eq!(fs::read(path).unwrap(), bytes);
+        }
+        let names: Vec<String> =
+            fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names.len(), 3, "{names:?}");
+        let file = d.join("boa_1.png");
+        assert!(write_new_numbered_file(&file, "boa", "png", b"x").is_err());
+        assert_eq!(fs::read_dir(d).unwrap().count(), 3);
+    }
 
     /// A group's staged files leave no temporary while the work goes on, so another run's
     /// sweep of stale temporaries (here everything of the name, at any age) takes nothing

@@ -579,8 +579,9 @@ pub struct PreviewArgs {
     /// Write the rendered image to this PNG file (headless; no window needed).
     #[arg(short, long, value_name = "FILE.png")]
     pub out: Option<PathBuf>,
-    /// Open a window: drag to orbit, wheel to zoom, sliders for the optics; the preset file
-    /// is watched and reloaded on save.
+    /// Open a window: drag to orbit, wheel to zoom, sliders for the optics, S to save the
+    /// view as a PNG (see --shots), R to reset the view; the preset file is watched and
+    /// reloaded on save.
     // Not with --out or --reference: the window wrote neither, silently.
     #[arg(long, conflicts_with_all = ["out", "reference"])]
     pub window: bool,
@@ -620,6 +621,12 @@ pub struct PreviewArgs {
         value_parser = ranged_u32(1, 1_000_000)
     )]
     pub frames: Option<u32>,
+    /// With --window: the folder the S key saves the view into (made if missing), as
+    /// NAME_view_N.png for the first N free: the frame without the panel, at the window's
+    /// size, as --out would render it with the same camera. The line that names the file
+    /// gives the sliders' changes as --set arguments for generate or export.
+    #[arg(long, value_name = "DIR", default_value = ".", conflicts_with_all = ["out", "reference"])]
+    pub shots: PathBuf,
     /// Exposure multiplier before tone mapping (Khronos PBR Neutral), 1e-6 to 1000.
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     pub exposure: f32,

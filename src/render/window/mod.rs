@@ -16,13 +16,14 @@ use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::Key;
 use winit::window::{Window, WindowId};
 
 use self::panel::{Sliders, controls};
 use super::engine::material::MaterialMaps;
 use super::engine::prepare::{bands_for, material_maps_cached};
 use super::engine::renderer::{FrameOutput, FrameSettings, Material, Renderer, Targets, WINDOW_FRAME_LATENCY};
-use super::engine::scene::LayerOptics;
+use super::engine::scene::{Camera, LayerOptics};
 use super::{Gpu, GpuError};
 use crate::Error;
 use crate::graph::NodeCache;
@@ -40,6 +41,9 @@ pub struct WindowOptions {
     /// Render this many frames, then exit (tests, benchmarks).
     pub frames: Option<u32>,
     pub settings: FrameSettings,
+    /// The folder the S key saves the view into (`export::write_new_numbered_file`: made if
+    /// missing, never replacing a file).
+    pub shots: std::path::PathBuf,
     /// Receives status lines (first frame, each reload or failed reload) for the user: the
     /// window may be behind others, and tests read them. The library itself prints nothing.
     pub report: Box<dyn Fn(&str)>,
@@ -89,6 +93,13 @@ struct App {
     options: WindowOptions,
     settings: FrameSettings,
     sliders: Sliders,
+    /// The sliders as the preset file gives them (its `--set` included), at the start and
+    /// at each reload: what the saved view's `--set` arguments differ from.
+    file_sliders: Sliders,
+    /// The view the window opened with (the R key goes back to it).
+    start_camera: Camera,
+    /// The preset's output name (a saved view is `NAME_view_N.png`).
+    name: String,
     baked_stack: Stack,
     baked_bands: usize,
     initial_maps: Option<(MaterialMaps, LayerOptics)>,
@@ -152,6 +163,9 @@ pub fn run(options: WindowOptions) -> Result<WindowReport, Error> {
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         settings: options.settings,
+        file_sliders: sliders,
+        start_camera: options.settings.camera,
+        name: loaded.name.clone(),
         baked_stack: optics.stack,
         baked_bands: bands_for(options.settings.method),
         sliders,
@@ -364,6 +378,7 @@ impl App {
                     );
                     // The file is the source of truth for the optics too.
                     self.sliders = reloaded.sliders;
+                    self.file_sliders = reloaded.sliders;
                 }
                 Err(error) => self.status = format!("reload failed, keeping the last good maps: {error}"),
             }
@@ -392,6 +407,43 @@ impl App {
         // Uniform-only parameters apply immediately; indices wait for their LUT.
         gfx.material.optics = LayerOptics { stack: gfx.material.optics.stack, ..wanted };
         arrived
+    }
+
+    /// Saves the view (the frame without the panel, at the window's size, as the headless
+    /// preview renders it) as `NAME_view_N.png` in `--shots`, and says where, with the
+    /// `--set` arguments that carry the sliders' optics where they differ from the file.
+    fn save_view(&mut self) {
+        let Some(gfx) = &self.gfx else { return };
+        let (width, height) = (gfx.config.width, gfx.config.height);
+        let saved = match &gfx.not_drawn {
+            Some(_) => Err("the window is not drawn at its size".to_string()),
+            None => {
+                // Its own frame's targets and read-back beside the window's.
+                let bytes = super::engine::renderer::frame_bytes(width, height);
+                crate::memory::MemoryCheck::against_available(bytes)
+                    .refuse_if_over(&format!("a {width}×{height} view"))
+                    .and_then(|()| Ok(gfx.renderer.render_image(&self.settings, &gfx.material, width, height)?))
+                    .and_then(|image| super::figures::rendered_png_bytes(&image))
+                    .and_then(|png| {
+                        let stem = format!("{}_view", self.name);
+                        Ok(crate::export::write_new_numbered_file(&self.options.shots, &stem, "png", &png)?)
+                    })
+                    .map_err(|e| e.to_string())
+            }
+        };
+        self.status = match saved {
+            Ok(path) => {
+                let set = self.sliders.set_arguments(&self.file_sliders);
+                let set = if set.is_empty() {
+                    String::new()
+                } else {
+                    format!("; the sliders differ from the preset: {}", set.join(" "))
+                };
+                format!("saved the view as {} ({width}×{height}){set}", path.display())
+            }
+            Err(why) => format!("the view was not saved: {why}"),
+        };
+        (self.options.report)(&self.status);
     }
 
     /// Something changed: frames are drawn until `DRAWN_ON_AFTER_A_CHANGE` from now.
@@ -539,6 +591,7 @@ impl ApplicationHandler for App {
                     | WindowEvent::MouseInput { .. }
                     | WindowEvent::CursorMoved { .. }
                     | WindowEvent::MouseWheel { .. }
+                    | WindowEvent::KeyboardInput { .. }
                     | WindowEvent::Occluded(false)
                     | WindowEvent::ScaleFactorChanged { .. }
             );
@@ -564,6 +617,16 @@ impl ApplicationHandler for App {
                     camera.yaw_deg -= (position.x - x) as f32 * 0.3;
                     camera.pitch_deg = (camera.pitch_deg + (position.y - y) as f32 * 0.3).clamp(-5.0, 89.0);
                     self.drag = Some(self.cursor);
+                }
+            }
+            // Keys the panel does not take (a slider's value being typed takes them).
+            WindowEvent::KeyboardInput { event, .. }
+                if !consumed && event.state == ElementState::Pressed && !event.repeat =>
+            {
+                match event.logical_key.as_ref() {
+                    Key::Character(c) if c.eq_ignore_ascii_case("s") => self.save_view(),
+                    Key::Character(c) if c.eq_ignore_ascii_case("r") => self.settings.camera = self.start_camera,
+                    _ => {}
                 }
             }
             WindowEvent::MouseWheel { delta, .. } if !consumed => {

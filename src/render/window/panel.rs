@@ -43,16 +43,53 @@ impl Sliders {
         }
     }
 
+    /// The preset keys where these sliders differ from `file` (the sliders of the preset as
+    /// loaded, its `--set` included), as `--set KEY=VALUE` arguments that carry the tuned
+    /// optics to `generate`, `export` or a headless preview; empty where none differs. Values
+    /// to six significant digits (a drag gives fifteen), and a key differs where its six
+    /// digits do; σ0 as the three channels the shader reads.
+    pub fn set_arguments(&self, file: &Sliders) -> Vec<String> {
+        let absorption = |s: &Sliders| {
+            let channels = s.channels().map(significant);
+            if channels.iter().all(|c| *c == channels[0]) {
+                channels[0].clone()
+            } else {
+                format!("[{}]", channels.join(","))
+            }
+        };
+        let keys: [(&str, fn(&Sliders) -> String); 7] = [
+            ("optics.ambient_ior", |s| significant(s.n0)),
+            ("optics.film_ior", |s| significant(s.n1)),
+            ("optics.pigment_ior", |s| significant(s.n2)),
+            ("optics.film_thickness_nm", |s| significant(s.thickness_nm)),
+            ("iridescence.spread_nm", |s| significant(s.spread_nm)),
+            ("optics.pigment_thickness", |s| significant(s.pigment_thickness)),
+            ("optics.absorption", absorption),
+        ];
+        keys.iter()
+            .filter(|(_, value)| value(self) != value(file))
+            .map(|(key, value)| {
+                let argument = format!("{key}={}", value(self));
+                // Quoted where a shell would read a character: σ0's brackets are a glob.
+                if argument.contains('[') { format!("--set '{argument}'") } else { format!("--set {argument}") }
+            })
+            .collect()
+    }
+
+    /// σ0 per channel, as the shader reads it: the tint times the slider, within the key's
+    /// range.
+    fn channels(&self) -> [f64; 3] {
+        let (lo, hi) = crate::preset::validate::ranges::ABSORPTION;
+        self.absorption_tint.map(|tint| (tint * self.absorption).clamp(lo, hi))
+    }
+
     pub fn optics(&self) -> LayerOptics {
         LayerOptics {
             stack: Stack { n0: self.n0, n1: self.n1, n2: self.n2 },
             thickness_range_nm: crate::material::thickness_range_nm(self.thickness_nm, self.spread_nm),
             // Each channel within the key's range: a tinted σ0's largest channel would pass
             // it as the slider nears its end ([0, 0, 100] is a mean of 33 and a tint of 3).
-            optical_depth: self.absorption_tint.map(|tint| {
-                let (lo, hi) = crate::preset::validate::ranges::ABSORPTION;
-                (tint * self.absorption).clamp(lo, hi) * self.pigment_thickness
-            }),
+            optical_depth: self.channels().map(|absorption| absorption * self.pigment_thickness),
         }
     }
 }
@@ -130,8 +167,18 @@ fn panel_contents(ui: &mut egui::Ui, settings: &mut FrameSettings, s: &mut Slide
         let snakes = egui::Slider::new(&mut settings.snakes, 1..=SNAKES_SLIDER_MAX);
         ui.add(snakes.clamping(egui::SliderClamping::Edits).text("snakes"));
         ui.separator();
-        ui.label("drag: orbit · wheel: zoom");
+        ui.label("drag: orbit · wheel: zoom\nS: save the view as a PNG\nR: reset the view");
     }
+}
+
+/// `value` to six significant digits, without trailing zeros (TOML reads it back).
+fn significant(value: f64) -> String {
+    if value == 0.0 || !value.is_finite() {
+        return format!("{value}");
+    }
+    let decimals = (5 - value.abs().log10().floor() as i32).max(0) as usize;
+    let text = format!("{value:.decimals$}");
+    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
 }
 
 fn view_name(view: View) -> String {
@@ -171,6 +218,54 @@ mod tests {
             }
             assert_eq!(got.stack, want.stack);
             assert_eq!(got.thickness_range_nm, want.thickness_range_nm);
+        }
+    }
+
+    /// The sliders' `--set` arguments carry them: loaded with them, the preset's sliders give
+    /// none back (to six digits). Untouched sliders give none; each one moved gives its key.
+    #[test]
+    fn the_sliders_set_arguments_give_their_optics_back() {
+        let loaded = crate::preset::load("erythrolamprus-miliaris", &[], None).unwrap();
+        let file = Sliders::from_preset(&loaded.preset);
+        assert_eq!(file.set_arguments(&file), Vec::<String>::new());
+        let moved = Sliders {
+            n1: 1.712345678,
+            thickness_nm: 512.3456789,
+            spread_nm: 33.3,
+            absorption: file.absorption * 2.5 + 0.01,
+            absorption_tint: [0.5, 1.0, 1.5],
+            ..file
+        };
+        let arguments = moved.set_arguments(&file);
+        assert_eq!(arguments.len(), 4, "{arguments:?}");
+        assert!(arguments.contains(&"--set optics.film_ior=1.71235".to_string()), "{arguments:?}");
+        assert!(arguments.contains(&"--set optics.film_thickness_nm=512.346".to_string()), "{arguments:?}");
+        let overrides: Vec<(String, String)> = arguments
+            .iter()
+            .map(|a| {
+                let a = a.trim_start_matches("--set ").trim_matches('\'');
+                let (key, value) = a.split_once('=').unwrap();
+                (key.to_string(), value.to_string())
+            })
+            .collect();
+        let reloaded = crate::preset::load("erythrolamprus-miliaris", &overrides, None).unwrap();
+        let back = Sliders::from_preset(&reloaded.preset);
+        assert_eq!(moved.set_arguments(&back), Vec::<String>::new(), "{overrides:?}");
+        assert_eq!(back.set_arguments(&file).len(), 4);
+    }
+
+    /// Six significant digits, as TOML reads them back.
+    #[test]
+    fn values_are_written_to_six_significant_digits() {
+        for (value, text) in [
+            (512.3456789, "512.346"),
+            (1.5, "1.5"),
+            (2_412_345.6, "2412346"),
+            (0.000012345678, "0.0000123457"),
+            (0.0, "0"),
+            (100.0, "100"),
+        ] {
+            assert_eq!(significant(value), text);
         }
     }
 

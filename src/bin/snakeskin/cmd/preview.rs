@@ -120,6 +120,8 @@ pub fn run(args: PreviewArgs) -> Result<()> {
 
 #[cfg(feature = "window")]
 fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
+    // A file where the views would go is said now, not at the first S.
+    snakeskin::export::check_folder(&args.shots)?;
     let options = snakeskin::render::window::WindowOptions {
         preset: args.source.preset.clone(),
         overrides: args.source.overrides.clone(),
@@ -129,6 +131,7 @@ fn window(args: &PreviewArgs, settings: FrameSettings) -> Result<()> {
         size: (args.size.width, args.size.height),
         frames: args.frames,
         settings,
+        shots: args.shots.clone(),
         report: Box::new(|status| eprintln!("preview: {}", crate::output::printable(status))),
     };
     let report = snakeskin::render::window::run(options)?;
