@@ -129,22 +129,33 @@ fn shade(m: Material, world: vec3<f32>) -> vec3<f32> {
     return radiance + ambient(layers, m.normal, wo, top_o, STAGE == STAGE_ALL);
 }
 
+// An sRGB encoding to linear light (export::srgb's `decode`, its twin).
+fn srgb_decode(encoded: vec3<f32>) -> vec3<f32> {
+    let e = clamp(encoded, vec3<f32>(0.0), vec3<f32>(1.0));
+    let curve = pow((e + vec3<f32>(SRGB_OFFSET)) / SRGB_SCALE, vec3<f32>(SRGB_GAMMA));
+    return select(curve, e / SRGB_SLOPE, e <= vec3<f32>(SRGB_ENCODED_KNEE));
+}
+
+// One map as its file stores it. The frame's sRGB target encodes what is written: the
+// colour map is linear colour (its file sRGB), the others are values whose files hold them
+// linearly, so they are decoded first and the target gives back their codes (the map
+// viewer showed a flat normal as (187, 189, 255) for the file's (128, 131, 255), a sweep).
 fn map_view(m: Material) -> vec3<f32> {
     switch VIEW_MAP {
         case VIEW_COLOR: {
             return m.albedo;
         }
         case VIEW_HEIGHT: {
-            return vec3<f32>(m.height);
+            return srgb_decode(vec3<f32>(m.height));
         }
         case VIEW_NORMAL: {
-            return m.map_normal * 0.5 + vec3<f32>(0.5);
+            return srgb_decode(m.map_normal * 0.5 + vec3<f32>(0.5));
         }
         case VIEW_ROUGHNESS: {
-            return vec3<f32>(m.roughness);
+            return srgb_decode(vec3<f32>(m.roughness));
         }
         default: {
-            return vec3<f32>(m.map_value);
+            return srgb_decode(vec3<f32>(m.map_value));
         }
     }
 }

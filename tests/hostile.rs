@@ -1623,6 +1623,13 @@ fn gallery_sizes_and_names_are_checked_before_the_work() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("-o and --closeups name one path"), "{}", stderr(&out));
     assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was made");
+    // The close-ups' folder inside the gallery's file: made, the work done, then refused as
+    // a folder in the gallery's way (a sweep).
+    let inside = format!("{f}/sub");
+    let out = snakeskin(&["gallery", "-o", f, "--closeups", &inside, "--tile", "16"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains(&format!("--closeups {inside} lies inside -o {f}")), "{}", stderr(&out));
+    assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was made");
     let out = snakeskin_env(&["gallery", "-o", f, "--tile", "16"], &[("SNAKESKIN_MEMORY_LIMIT_MIB", "0")]);
     assert!(
         stderr(&out).contains("a gallery of 124×124 pixels") && stderr(&out).contains("needs about"),
@@ -1683,6 +1690,13 @@ fn preview_output_names_are_checked_before_the_work() {
         (vec!["--out", &at(".jpg")], "the file's name is only an extension".into()),
         // `-` is standard output to most tools: it was written as a file named `-`.
         (vec!["--out", "-"], "-: writing to standard output is not supported".into()),
+        // One inside the other: `same.png` was made a folder, the work done, then refused
+        // as "a folder is in the way of this output file" (a sweep).
+        (vec!["--out", &same, "--reference", &at("same.png/heat.png")], "heat.png lies inside --out".to_string()),
+        (
+            vec!["--out", &at("heat.png/same.png"), "--reference", &at("heat.png")],
+            "same.png lies inside --reference".to_string(),
+        ),
     ] {
         let out = preview(&extra);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));

@@ -531,6 +531,14 @@ pub fn same_path(a: &Path, b: &Path) -> bool {
     matches!((resolved(a), resolved(b)), (Some(a), Some(b)) if a == b)
 }
 
+/// Whether `path` lies inside `outer` (below it, not `outer` itself), by `same_path`'s rule:
+/// one output inside another that is a file (`gallery -o g.png --closeups g.png/sub`) made
+/// the file's path a folder, ran the whole work, and failed with "a folder is in the way of
+/// this output file" (a sweep).
+pub fn lies_under(path: &Path, outer: &Path) -> bool {
+    matches!((resolved(path), resolved(outer)), (Some(p), Some(o)) if p != o && p.starts_with(&o))
+}
+
 /// Refuses a lock path (`lock_file_name` in its folder) that names one of `inputs`
 /// (`ExportError::InputAtLock`): `generate ./.preset.lock` took its own (empty) preset as its
 /// lock and removed it.

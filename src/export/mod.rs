@@ -14,8 +14,8 @@ pub use atomic::{
     Earlier, FileGroup, Inputs, KeptBecause, KeptFile, SetLock, Staged, begins_as, check_folder, check_folder_writable,
     check_lock_not_an_input, check_lock_place, check_not_an_input, check_png_target, check_replaces_its_own,
     check_target, check_target_named, check_writable, clean_up_before_exit, create_folder, create_folder_noted,
-    ends_as_a_folder, folder_of, lock_file_name, lock_is_held, remove_empty_made_folders, same_identity, same_path,
-    sha256_hex, temporary_target, wait_for_commit, write_file_atomically, write_new_numbered_file,
+    ends_as_a_folder, folder_of, lies_under, lock_file_name, lock_is_held, remove_empty_made_folders, same_identity,
+    same_path, sha256_hex, temporary_target, wait_for_commit, write_file_atomically, write_new_numbered_file,
 };
 pub(crate) use manifest::verify_set_json;
 pub use manifest::{

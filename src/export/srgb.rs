@@ -15,23 +15,41 @@
 
 use std::sync::OnceLock;
 
-/// The sRGB transfer function and its inverse (IEC 61966-2-1: encoded 12.92 c up to linear
-/// 0.0031308, 1.055 c^(1/2.4) − 0.055 above; decoded e / 12.92 up to 0.04045, ((e + 0.055) /
-/// 1.055)^2.4 above), both clamping to [0, 1], written once for each float width: each
-/// caller keeps the precision its bytes were made with (the f64 formula rounds 219 f32
-/// inputs to another 8-bit code and decodes 214 of the 256 codes to another f32).
+/// The sRGB transfer's constants (IEC 61966-2-1), here for the shaders' prelude too
+/// (`render::engine::shaders`; the map viewer's decode in `skin.wgsl`): encoded 12.92 c up
+/// to linear 0.0031308, 1.055 c^(1/2.4) − 0.055 above; decoded e / 12.92 up to 0.04045,
+/// ((e + 0.055) / 1.055)^2.4 above.
+pub const SRGB_LINEAR_KNEE: f64 = 0.003_130_8;
+pub const SRGB_ENCODED_KNEE: f64 = 0.040_45;
+pub const SRGB_SLOPE: f64 = 12.92;
+pub const SRGB_SCALE: f64 = 1.055;
+pub const SRGB_OFFSET: f64 = 0.055;
+pub const SRGB_GAMMA: f64 = 2.4;
+
+/// The sRGB transfer function and its inverse (the constants above), both clamping to
+/// [0, 1], written once for each float width: each caller keeps the precision its bytes were
+/// made with (the f64 formula rounds 219 f32 inputs to another 8-bit code and decodes 214 of
+/// the 256 codes to another f32).
 macro_rules! transfer {
     ($float:ty, $encode:ident, $decode:ident) => {
         /// Linear light to its sRGB encoding, both in [0, 1].
         pub fn $encode(linear: $float) -> $float {
             let c = linear.clamp(0.0, 1.0);
-            if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+            if c <= SRGB_LINEAR_KNEE as $float {
+                c * SRGB_SLOPE as $float
+            } else {
+                SRGB_SCALE as $float * c.powf(1.0 / SRGB_GAMMA as $float) - SRGB_OFFSET as $float
+            }
         }
 
         /// An sRGB encoding to linear light, both in [0, 1].
         pub fn $decode(encoded: $float) -> $float {
             let e = encoded.clamp(0.0, 1.0);
-            if e <= 0.040_45 { e / 12.92 } else { ((e + 0.055) / 1.055).powf(2.4) }
+            if e <= SRGB_ENCODED_KNEE as $float {
+                e / SRGB_SLOPE as $float
+            } else {
+                ((e + SRGB_OFFSET as $float) / SRGB_SCALE as $float).powf(SRGB_GAMMA as $float)
+            }
         }
     };
 }

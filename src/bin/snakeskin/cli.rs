@@ -627,7 +627,8 @@ pub struct PreviewArgs {
     /// gives the sliders' changes as --set arguments for generate or export.
     #[arg(long, value_name = "DIR", default_value = ".", conflicts_with_all = ["out", "reference"])]
     pub shots: PathBuf,
-    /// Exposure multiplier before tone mapping (Khronos PBR Neutral), 1e-6 to 1000.
+    /// Exposure multiplier before tone mapping (Khronos PBR Neutral), 1e-6 to 1000 (not for
+    /// the map: views, which show each map as its file stores it).
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     pub exposure: f32,
     /// Number of snakes (instanced in a grid), 1 to 400.

@@ -99,6 +99,13 @@ pub fn shared_constants() -> Vec<(&'static str, &'static str, String)> {
         ("PBR_NEUTRAL_DESATURATION", "f32", f32_literal(PBR_NEUTRAL_DESATURATION)),
         ("TONE_MAP_CURVE", "u32", format!("{TONE_MAP_CURVE}u")),
         ("TONE_MAP_NONE", "u32", format!("{TONE_MAP_NONE}u")),
+        // The sRGB transfer (export::srgb), which the map viewer undoes (skin.wgsl's
+        // `srgb_decode`) so that the sRGB target shows each map as its file stores it.
+        ("SRGB_ENCODED_KNEE", "f32", f32_literal(crate::export::srgb::SRGB_ENCODED_KNEE)),
+        ("SRGB_SLOPE", "f32", f32_literal(crate::export::srgb::SRGB_SLOPE)),
+        ("SRGB_SCALE", "f32", f32_literal(crate::export::srgb::SRGB_SCALE)),
+        ("SRGB_OFFSET", "f32", f32_literal(crate::export::srgb::SRGB_OFFSET)),
+        ("SRGB_GAMMA", "f32", f32_literal(crate::export::srgb::SRGB_GAMMA)),
         ("GBUFFER_POSITION_NORMAL", "u32", format!("{GBUFFER_POSITION_NORMAL}u")),
         ("GBUFFER_ALBEDO_GEOMETRY", "u32", format!("{GBUFFER_ALBEDO_GEOMETRY}u")),
         // The axes of the rough lobe's table (optics::brdf::energy; the table itself is a

@@ -20,8 +20,8 @@ use crate::render::engine::renderer::{FrameSettings, Renderer, frame_bytes};
 use crate::render::engine::scene::{Camera, LayerOptics};
 
 const LABEL_SCALE: u32 = 2;
-/// Two lines of text: the scientific name, then common name and category.
-const LABEL_HEIGHT: u32 = 2 * 8 * LABEL_SCALE + 14;
+/// From one label line's top to the next's (its 16 pixels of glyphs and 4 between).
+const LINE_PITCH: u32 = 8 * LABEL_SCALE + 4;
 const BACKGROUND: Rgb<u8> = Rgb([24, 24, 26]);
 const INK: Rgb<u8> = Rgb([235, 235, 230]);
 const MUTED: Rgb<u8> = Rgb([170, 170, 160]);
@@ -49,7 +49,8 @@ pub struct SheetPlan {
     /// One species' cell, and the whole canvas.
     cell: (u32, u32),
     canvas: (u32, u32),
-    /// The label's height; the body layout's longest strip and its renders' size.
+    /// The label's height (the most lines a species' label wraps to); the body layout's
+    /// longest strip and its renders' size.
     label_h: u32,
     strip_w: u32,
     render: (u32, u32),
@@ -73,17 +74,30 @@ pub fn plan_sheet(options: SheetOptions, layout: Layout, species: &[String]) -> 
     let columns = options.columns.clamp(1, (species.len() as u32).max(1));
     let rows = (species.len() as u32).div_ceil(columns);
     let tile = options.tile;
+    let cell_w = |strip_w: u32, render_w: u32, closeups_w: u32| match layout {
+        Layout::Tile => 3 * tile,
+        Layout::Body => strip_w + render_w + closeups_w + 12,
+    };
+    // Every label as many lines high as the longest wraps to in its cell (they were cut
+    // to one line each: "Philodrya.." for both Philodryas, no category, at --tile 64).
+    let lines = |cell_w: u32| {
+        species.iter().map(|(name, loaded)| label_lines(name, loaded, layout, cell_w).len() as u32).max().unwrap_or(0)
+    };
     let (cell, label_h, strip_w, render) = match layout {
-        Layout::Tile => ((3 * tile, tile + LABEL_HEIGHT), LABEL_HEIGHT, 0, (2 * tile, tile)),
+        Layout::Tile => {
+            let label_h = LINE_PITCH * lines(cell_w(0, 0, 0)) + 6;
+            ((3 * tile, tile + label_h), label_h, 0, (2 * tile, tile))
+        }
         Layout::Body => {
             // `tile` is the strip's height, one circumference; the longest body sets the
             // strips' length, all at one scale.
             let strip_w = species.iter().map(|(_, l)| Layout::Body.height(&l.preset, tile as usize)).max().unwrap_or(0);
             let strip_w = strip_w.max(tile as usize) as u32;
             let (render_w, render_h) = (4 * tile, 2 * tile);
-            let label_h = LABEL_HEIGHT + 8 * LABEL_SCALE + 6;
             let closeups_w = if options.closeups { 2 * (render_h + 6) } else { 0 };
-            ((strip_w + render_w + closeups_w + 12, label_h + render_h + 8), label_h, strip_w, (render_w, render_h))
+            let width = cell_w(strip_w, render_w, closeups_w);
+            let label_h = LINE_PITCH * lines(width) + 8;
+            ((width, label_h + render_h + 8), label_h, strip_w, (render_w, render_h))
         }
     };
     let canvas = (cell.0 * columns, cell.1 * rows);
@@ -121,15 +135,67 @@ pub fn sheet_camera() -> Camera {
     Camera { target: glam::Vec3::new(-0.3, 0.08, 0.15), yaw_deg: 5.0, pitch_deg: 38.0, distance: 1.25, fov_y_deg: 35.0 }
 }
 
+/// A species' label as the lines a cell `cell_w` wide draws: the scientific name (in ink),
+/// the common name and category, and for a body the counts its atlas was drawn with, each
+/// wrapped at its spaces (`wrapped`).
+fn label_lines(name: &str, loaded: &LoadedPreset, layout: Layout, cell_w: u32) -> Vec<(String, Rgb<u8>)> {
+    let preset = &loaded.preset;
+    let category = preset.category.map(|c| format!(" ({})", c.name())).unwrap_or_default();
+    let mut texts = vec![
+        (preset.species.clone().unwrap_or_else(|| name.to_string()), INK),
+        (format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category), MUTED),
+    ];
+    if layout == Layout::Body {
+        let counts = counts_line(name, preset, &crate::export::body_counts(preset, &body_plan(preset)));
+        texts.push((counts, MUTED));
+    }
+    texts
+        .into_iter()
+        .flat_map(|(text, colour)| wrapped(&text, cell_w).into_iter().map(move |line| (line, colour)))
+        .collect()
+}
+
+/// `text` in lines a cell `cell_w` wide holds, broken at spaces; a word longer than a line
+/// is `clipped`. An empty text is one empty line (the label keeps its place).
+fn wrapped(text: &str, cell_w: u32) -> Vec<String> {
+    let fits = line_chars(cell_w);
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let word = clipped(word, cell_w);
+        if !line.is_empty() && line.chars().count() + 1 + word.chars().count() > fits {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(&word);
+    }
+    lines.push(line);
+    lines
+}
+
+/// How many characters a label line of a cell `cell_w` wide holds (6 pixels each side).
+fn line_chars(cell_w: u32) -> usize {
+    (cell_w as usize).saturating_sub(12) / (8 * LABEL_SCALE as usize)
+}
+
 /// `text` as a label line of a cell `cell_w` wide holds it: whole, or cut with ".." where
 /// it was cut mid-word without a sign ("Crotalus at", "Western dia" at `--tile 64`).
 fn clipped(text: &str, cell_w: u32) -> String {
-    let fits = (cell_w as usize).saturating_sub(12) / (8 * LABEL_SCALE as usize);
+    let fits = line_chars(cell_w);
     if text.chars().count() <= fits || fits < 3 {
         return text.chars().take(fits).collect();
     }
     let kept: String = text.chars().take(fits.saturating_sub(2)).collect();
     format!("{}..", kept.trim_end())
+}
+
+/// Draws a label's lines from the cell's top-left corner `(x0, y0)`, one `LINE_PITCH` apart.
+fn draw_label(sheet: &mut RgbImage, (x0, y0): (u32, u32), lines: &[(String, Rgb<u8>)]) {
+    for (k, (line, colour)) in lines.iter().enumerate() {
+        draw_text(sheet, x0 + 6, y0 + 4 + k as u32 * LINE_PITCH, line, *colour);
+    }
 }
 
 /// Draws `text` with its top-left corner at (x, y); characters outside the font are skipped.
@@ -220,15 +286,9 @@ fn render_tile_sheet(
         let render = image::DynamicImage::ImageRgba8(render).into_rgb8();
 
         let (x0, y0) = ((i as u32 % columns) * cell_w, (i as u32 / columns) * cell_h);
-        let preset = &loaded.preset;
-        let category = preset.category.map(|c| format!(" ({})", c.name())).unwrap_or_default();
-        let clip = |text: String| clipped(&text, cell_w);
-        let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
-        let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
-        draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
-        draw_text(&mut sheet, x0 + 6, y0 + 8 + 8 * LABEL_SCALE, &second, MUTED);
-        imageops::replace(&mut sheet, &colour, (x0) as i64, (y0 + LABEL_HEIGHT) as i64);
-        imageops::replace(&mut sheet, &render, (x0 + tile) as i64, (y0 + LABEL_HEIGHT) as i64);
+        draw_label(&mut sheet, (x0, y0), &label_lines(name, loaded, Layout::Tile, cell_w));
+        imageops::replace(&mut sheet, &colour, (x0) as i64, (y0 + plan.label_h) as i64);
+        imageops::replace(&mut sheet, &render, (x0 + tile) as i64, (y0 + plan.label_h) as i64);
     }
     progress(presets.len(), presets.len());
     Ok(sheet)
@@ -322,14 +382,7 @@ fn render_body_sheet(
         let render = image::DynamicImage::ImageRgba8(render).into_rgb8();
 
         let (x0, y0) = ((i as u32 % columns) * cell_w, (i as u32 / columns) * cell_h);
-        let category = preset.category.map(|c| format!(" ({})", c.name())).unwrap_or_default();
-        let clip = |text: String| clipped(&text, cell_w);
-        let first = clip(preset.species.clone().unwrap_or_else(|| name.to_string()));
-        let second = clip(format!("{}{}", preset.common_name.as_deref().unwrap_or(""), category));
-        let third = clip(counts_line(name, preset, &crate::export::body_counts(preset, &body)));
-        draw_text(&mut sheet, x0 + 6, y0 + 4, &first, INK);
-        draw_text(&mut sheet, x0 + 6, y0 + 8 + 8 * LABEL_SCALE, &second, MUTED);
-        draw_text(&mut sheet, x0 + 6, y0 + 12 + 16 * LABEL_SCALE, &third, MUTED);
+        draw_label(&mut sheet, (x0, y0), &label_lines(name, loaded, Layout::Body, cell_w));
         let strip_y = y0 + label_h + (render_h - circumference) / 2;
         imageops::replace(&mut sheet, &strip, (x0 + 6) as i64, strip_y as i64);
         imageops::replace(&mut sheet, &render, (x0 + strip_w + 12) as i64, (y0 + label_h) as i64);
@@ -480,6 +533,44 @@ mod tests {
             let plan = crate::maps::body_plan(&preset);
             let line = counts_line(name, &preset, &crate::export::body_counts(&preset, &plan));
             assert!(line.contains(&format!(" {words}")), "{name}: {line}");
+        }
+    }
+
+    /// At `--tile 64` (a cell 192 pixels wide, 11 characters a line) every label is whole,
+    /// wrapped at its spaces within the cell (a word longer than a line cut, with ".."), and
+    /// the cells as tall as the longest label:
+    /// the two Philodryas were both "Philodrya..", with no category, a sweep. Negative
+    /// control: at `--tile 256` every label is its two lines, as high as before.
+    #[test]
+    fn labels_wrap_whole_in_small_cells() {
+        let species = ["philodryas-aestiva", "philodryas-olfersii", "crotalus-atrox"].map(String::from);
+        let options = |tile| SheetOptions { tile, columns: 3, map_size: 64, closeups: false };
+        let plan = plan_sheet(options(64), Layout::Tile, &species).unwrap();
+        let mut most = 0;
+        for (name, loaded) in &plan.species {
+            let lines = label_lines(name, loaded, Layout::Tile, plan.cell.0);
+            let text: Vec<&str> = lines.iter().map(|(line, _)| line.as_str()).collect();
+            assert!(text.iter().all(|l| l.chars().count() <= 11), "{name}: {text:?}");
+            let p = &loaded.preset;
+            let whole = format!(
+                "{} {} ({})",
+                p.species.as_deref().unwrap(),
+                p.common_name.as_deref().unwrap(),
+                p.category.unwrap().name()
+            );
+            // Every word whole but one longer than a line ("Lichtenstein's"), cut with "..".
+            let words: Vec<String> = whole.split_whitespace().map(|w| clipped(w, 192)).collect();
+            assert_eq!(text.join(" "), words.join(" "));
+            assert!(words.iter().filter(|w| w.ends_with("..")).all(|w| w.starts_with("Lichtenst")), "{words:?}");
+            most = most.max(lines.len() as u32);
+        }
+        assert!(most > 2);
+        assert_eq!(plan.label_h, LINE_PITCH * most + 6);
+        assert_eq!(plan.cell.1, 64 + plan.label_h);
+        let wide = plan_sheet(options(256), Layout::Tile, &species).unwrap();
+        assert_eq!(wide.label_h, 2 * 8 * LABEL_SCALE + 14, "two lines, as high as before");
+        for (name, loaded) in &wide.species {
+            assert_eq!(label_lines(name, loaded, Layout::Tile, wide.cell.0).len(), 2);
         }
     }
 

@@ -22,6 +22,16 @@ pub fn run(out: &Path, tile: usize, columns: usize, closeups: Option<&Path>) -> 
         ))
         .into());
     }
+    if let Some(dir) = closeups
+        && snakeskin::export::lies_under(dir, out)
+    {
+        return Err(snakeskin::Error::Unsupported(format!(
+            "--closeups {} lies inside -o {}, the gallery's file; give the close-ups a folder of their own",
+            path_line(dir),
+            path_line(out)
+        ))
+        .into());
+    }
     if let Some(dir) = closeups {
         snakeskin::export::check_folder(dir)?;
         let mut probed = std::collections::HashSet::new();

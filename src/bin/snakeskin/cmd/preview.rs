@@ -11,7 +11,7 @@ use snakeskin::render::Renderer;
 use snakeskin::render::engine::gpu::GpuError;
 use snakeskin::render::engine::prepare::upload_material_in;
 use snakeskin::render::engine::renderer::{FrameSettings, frame_bytes, gbuffer_bytes};
-use snakeskin::render::engine::scene::Camera;
+use snakeskin::render::engine::scene::{Camera, View};
 use snakeskin::render::figures::{png_bytes, rendered_png_bytes};
 use snakeskin::render::reference::frame::reference_check;
 
@@ -46,6 +46,14 @@ pub fn run(args: PreviewArgs) -> Result<()> {
         ..FrameSettings::default()
     };
     narrowed_note(&loaded, args.map_size as usize, args.layout.layout());
+    if matches!(args.layers, View::Map(_)) && args.exposure != 1.0 {
+        // It was dropped without a word (a sweep): a map view shows values, not light.
+        eprintln!(
+            "note: --exposure {} does nothing here: a map view shows each map as its file stores it, unlit and \
+             unexposed",
+            args.exposure
+        );
+    }
     if args.window {
         return window(&args, settings);
     }
@@ -60,6 +68,20 @@ pub fn run(args: PreviewArgs) -> Result<()> {
             path_line(out)
         ))
         .into());
+    }
+    if let Some(heat_path) = &args.reference {
+        for (inner, flag, outer, outer_flag) in
+            [(heat_path.as_path(), "--reference", out, "--out"), (out, "--out", heat_path.as_path(), "--reference")]
+        {
+            if snakeskin::export::lies_under(inner, outer) {
+                return Err(Error::Preview(format!(
+                    "{flag} {} lies inside {outer_flag} {}, a file this run writes; give each its own place",
+                    path_line(inner),
+                    path_line(outer)
+                ))
+                .into());
+            }
+        }
     }
     // Names, then memory, then the GPU's limits, then folders: a refused run makes none
     // (`ensure_parent_folder` checks the names again, where other commands rely on it).
