@@ -362,7 +362,8 @@ fn the_map_viewer_shows_data_maps_as_their_files_store_them() {
     let material = material(&renderer, &[], GpuFilmMethod::Lut);
     let (w, h) = (200, 125);
     let gbuffer = renderer.render_gbuffer(&FrameSettings { samples: 1, ..close_up() }, &material, w, h).unwrap();
-    let sampled: [(MapKind, fn(&GBuffer, usize) -> f32); 2] =
+    type Sampled = fn(&GBuffer, usize) -> f32;
+    let sampled: [(MapKind, Sampled); 2] =
         [(MapKind::Height, |g, i| g.geometric[i][3]), (MapKind::Roughness, |g, i| g.normal_roughness[i][3])];
     for (map, value) in sampled {
         let settings = FrameSettings { samples: 1, view: View::Map(map), ..close_up() };

@@ -57,7 +57,8 @@ impl Sliders {
                 format!("[{}]", channels.join(","))
             }
         };
-        let keys: [(&str, fn(&Sliders) -> String); 7] = [
+        type Value = fn(&Sliders) -> String;
+        let keys: [(&str, Value); 7] = [
             ("optics.ambient_ior", |s| significant(s.n0)),
             ("optics.film_ior", |s| significant(s.n1)),
             ("optics.pigment_ior", |s| significant(s.n2)),
