@@ -824,9 +824,7 @@ fn the_window_reloads_the_preset_file_on_save() {
 #[cfg(feature = "window")]
 #[test]
 fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
-    use std::io::{BufRead, BufReader};
     use std::process::Command;
-    use std::sync::mpsc;
     use std::time::{Duration, Instant};
     let name = "the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize";
     let Some(gpu) = gpu_or_skip(name) else { return };
@@ -852,31 +850,10 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     let stop = || {
         let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
     };
-    let (lines_tx, lines) = mpsc::channel();
-    let stderr = child.stderr.take().unwrap();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            let _ = lines_tx.send(line);
-        }
-    });
-    // Every line read, so that one that came before the line waited for is still found (the
-    // reload may end before the first frame).
-    let seen = std::cell::RefCell::new(Vec::<String>::new());
-    let wait_for = |needle: &str| -> Option<String> {
-        if let Some(line) = seen.borrow().iter().find(|line| line.contains(needle)) {
-            return Some(line.clone());
-        }
-        let deadline = Instant::now() + Duration::from_secs(120);
-        while Instant::now() < deadline {
-            if let Ok(line) = lines.recv_timeout(Duration::from_millis(200)) {
-                seen.borrow_mut().push(line.clone());
-                if line.contains(needle) {
-                    return Some(line);
-                }
-            }
-        }
-        None
-    };
+    // A line that came before the one waited for is still found (the reload may end
+    // before the first frame).
+    let said = StderrLines::of(&mut child);
+    let wait_for = |needle: &str| said.seen(needle).or_else(|| said.next(needle));
     let Some(pid) = preview_process(&preset) else {
         stop();
         panic!("the preview never started");
@@ -914,7 +891,7 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
     let still_running = child.try_wait().unwrap().is_none();
     stop();
     let _ = child.wait();
-    let seen = seen.borrow().join("\n");
+    let seen = said.all();
     assert!(first.is_some(), "the window never presented a frame:\n{seen}");
     let reloaded =
         reloaded.unwrap_or_else(|| panic!("the save made while the window started was not reloaded:\n{seen}"));
@@ -932,9 +909,8 @@ fn the_window_reloads_a_save_made_while_it_starts_and_survives_a_huge_resize() {
 #[cfg(feature = "window")]
 #[test]
 fn the_window_saves_its_view_and_puts_it_back() {
-    use std::io::{BufRead, BufReader};
     use std::process::Command;
-    use std::time::{Duration, Instant};
+    use std::time::Duration;
     let name = "the_window_saves_its_view_and_puts_it_back";
     if gpu_or_skip(name).is_none() || !x11_tools_or_skip(name) {
         return;
@@ -950,26 +926,9 @@ fn the_window_saves_its_view_and_puts_it_back() {
     let stop = || {
         let _ = Command::new("kill").args(["-TERM", "--", &group]).status();
     };
-    let (lines_tx, lines) = std::sync::mpsc::channel();
-    let stderr = child.stderr.take().unwrap();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            let _ = lines_tx.send(line);
-        }
-    });
-    let seen = std::cell::RefCell::new(Vec::<String>::new());
-    let wait_for = |needle: &str| -> Option<String> {
-        let deadline = Instant::now() + Duration::from_secs(120);
-        while Instant::now() < deadline {
-            if let Ok(line) = lines.recv_timeout(Duration::from_millis(200)) {
-                seen.borrow_mut().push(line.clone());
-                if line.contains(needle) {
-                    return Some(line);
-                }
-            }
-        }
-        None
-    };
+    // Each save's own line: the next one said, not the first.
+    let said = StderrLines::of(&mut child);
+    let wait_for = |needle: &str| said.next(needle);
     let Some(pid) = preview_process(&preset) else {
         stop();
         panic!("the preview never started");
@@ -978,7 +937,7 @@ fn the_window_saves_its_view_and_puts_it_back() {
     let xdotool = xdotool_in_display_of(&pid);
     let Some(window) = preview_window(&xdotool).filter(|_| first.is_some()) else {
         stop();
-        panic!("no window drawn:\n{}", seen.borrow().join("\n"));
+        panic!("no window drawn:\n{}", said.all());
     };
     xdotool(&["windowfocus", "--sync", &window]);
     let mut saved = Vec::new();
@@ -998,7 +957,7 @@ fn the_window_saves_its_view_and_puts_it_back() {
     saved.push(wait_for("saved the view as"));
     stop();
     let _ = child.wait();
-    let seen = seen.borrow().join("\n");
+    let seen = said.all();
     for (n, line) in saved.iter().enumerate() {
         let line = line.as_ref().unwrap_or_else(|| panic!("save {} was not said:\n{seen}", n + 1));
         let file = shots.join(format!("saved_view_{}.png", n + 1));
@@ -1018,6 +977,52 @@ fn the_window_saves_its_view_and_puts_it_back() {
         "the orbited view is the frame as it opened: the drag was not seen (the negative control)"
     );
     assert!(put_back == want, "R did not put the view back where it opened");
+}
+
+/// A child's stderr, read line by line on a thread of its own and every line kept.
+#[cfg(feature = "window")]
+struct StderrLines {
+    lines: std::sync::mpsc::Receiver<String>,
+    seen: std::cell::RefCell<Vec<String>>,
+}
+
+#[cfg(feature = "window")]
+impl StderrLines {
+    fn of(child: &mut std::process::Child) -> StderrLines {
+        use std::io::BufRead;
+        let (lines_tx, lines) = std::sync::mpsc::channel();
+        let stderr = child.stderr.take().expect("stderr piped");
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(stderr).lines().map_while(Result::ok) {
+                let _ = lines_tx.send(line);
+            }
+        });
+        StderrLines { lines, seen: Default::default() }
+    }
+
+    /// The first line read so far that contains `needle`.
+    fn seen(&self, needle: &str) -> Option<String> {
+        self.seen.borrow().iter().find(|line| line.contains(needle)).cloned()
+    }
+
+    /// The next line not yet read that contains `needle`, within two minutes.
+    fn next(&self, needle: &str) -> Option<String> {
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+        while std::time::Instant::now() < deadline {
+            if let Ok(line) = self.lines.recv_timeout(std::time::Duration::from_millis(200)) {
+                self.seen.borrow_mut().push(line.clone());
+                if line.contains(needle) {
+                    return Some(line);
+                }
+            }
+        }
+        None
+    }
+
+    /// Every line read so far.
+    fn all(&self) -> String {
+        self.seen.borrow().join("\n")
+    }
 }
 
 /// Whether `xvfb-run` and `xdotool` are there; where they are not, the test `name` is
