@@ -954,7 +954,9 @@ pub struct AlbedoArgs {
     /// the stacks measured, but up to 5e-4 with a thick film less dense than --n0).
     /// stochastic: photons through the stack with a rough GGX top; adds "sigma", the
     /// standard error per channel. The references read the exact 1 nm film (--method is
-    /// for the models). layered walks its path table first where `brdf eval --model` does.
+    /// for the models), as RGB colours clamped to [0, 1] per channel as the models read
+    /// them: where the film's colour lies outside sRGB that moves them from the spectral
+    /// physics by up to ΔE00 4 (README, "two references"). layered walks its path table first where `brdf eval --model` does.
     #[arg(long, default_value = "layered", value_parser = parse_albedo_model)]
     pub model: AlbedoModel,
     /// Photons per channel for --model stochastic (only), 1000 to 100,000,000 (σ ∝ 1/√N);
