@@ -68,12 +68,16 @@ impl Sliders {
             ("optics.absorption", absorption),
         ];
         keys.iter()
-            .filter(|(_, value)| value(self) != value(file))
-            .map(|(key, value)| {
-                let argument = format!("{key}={}", value(self));
-                // Quoted where a shell would read a character: σ0's brackets are a glob.
-                if argument.contains('[') { format!("--set '{argument}'") } else { format!("--set {argument}") }
+            .filter_map(|(key, value)| {
+                let now = value(self);
+                (now != value(file)).then(|| format!("{key}={now}"))
             })
+            // Quoted where a shell would read a character: σ0's brackets are a glob.
+            .map(
+                |argument| {
+                    if argument.contains('[') { format!("--set '{argument}'") } else { format!("--set {argument}") }
+                },
+            )
             .collect()
     }
 
